@@ -1,0 +1,172 @@
+/*
+ * frontdt: exact 3D Delaunay tetrahedralization by Tanemura's advancing
+ * front, parallelised after M. L. Merriam (NASA TM-103951, 1992).
+ *
+ * This is the whole public API. Every name starts with fdt_ / FDT_.
+ * Functions return 0 (FDT_OK) or a negative FDT_E* code; the library never
+ * exits, never longjmps and never prints.
+ *
+ * Ownership: pointers passed in are borrowed for the duration of the call
+ * unless a comment says otherwise; pointers returned by fdt_result_* getters
+ * are owned by the result and live until fdt_result_free().
+ */
+#ifndef FRONTDT_H
+#define FRONTDT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(FDT_BUILDING_LIBRARY) && defined(__GNUC__)
+#define FDT_API __attribute__((visibility("default")))
+#else
+#define FDT_API
+#endif
+
+#define FDT_VERSION_MAJOR 0
+#define FDT_VERSION_MINOR 1
+#define FDT_VERSION_PATCH 0
+#define FDT_VERSION_STRING "0.1.0"
+
+/* A vertex id: an index into the caller's point array. */
+typedef int32_t fdt_vid;
+#define FDT_VID_MAX INT32_MAX
+/* A tetrahedron id: an index into fdt_result_tets() (in units of tets). */
+typedef int64_t fdt_tid;
+#define FDT_TID_MAX INT64_MAX
+
+enum {
+    FDT_OK = 0,
+    FDT_EINVAL = -1,      /* invalid argument or setting */
+    FDT_ENOMEM = -2,      /* out of memory */
+    FDT_EDEGENERATE = -3, /* fewer than 4 distinct points, or all coplanar */
+    FDT_ERANGE = -4,      /* a coordinate is NaN or infinite */
+    FDT_ETOOBIG = -5,     /* more points or tets than the index types hold */
+    FDT_ECHECK = -6,      /* fdt_check found the mesh is not the Delaunay mesh */
+    FDT_ECANCELED = -7,   /* the progress callback asked to stop */
+    FDT_EINTERNAL = -8,   /* an internal invariant failed (a bug: please report) */
+    FDT_ETHREAD = -9      /* a thread could not be created */
+};
+
+/* A static English description of an FDT_E* code (never NULL). */
+FDT_API const char *fdt_strerror(int err);
+FDT_API const char *fdt_version(void);
+
+typedef enum fdt_mode {
+    FDT_MODE_AUTO = 0,    /* serial for one thread, shared otherwise */
+    FDT_MODE_SERIAL = 1,  /* one thread, no mailbox: the reference */
+    FDT_MODE_SHARED = 2,  /* threads read each other's points (Cray-2 style) */
+    FDT_MODE_MESSAGE = 3  /* remote range queries travel as NODESEND/NODERECV */
+} fdt_mode;
+
+/*
+ * Progress callback: called now and then from the calling thread with the
+ * fraction of tetrahedra believed built (an estimate in [0, 1]). Return
+ * nonzero to cancel: fdt_triangulate() then returns FDT_ECANCELED.
+ */
+typedef int (*fdt_progress_fn)(void *user, double fraction);
+
+typedef struct fdt_settings {
+    fdt_mode mode;
+    int n_threads;           /* 0: one per physical core (hwloc) */
+    int pin;                 /* nonzero: bind thread i to core i */
+    int leaf_size;           /* kd-tree points per leaf, default 18 (§4) */
+    int neighbors;           /* nonzero: compute tet neighbours */
+    fdt_progress_fn progress;/* may be NULL */
+    void *progress_user;     /* borrowed, passed back to progress */
+} fdt_settings;
+
+FDT_API void fdt_default_settings(fdt_settings *s);
+
+typedef struct fdt_context fdt_context;
+typedef struct fdt_result fdt_result;
+
+/* Creates a context from settings (copied). *ctx is NULL on failure. */
+FDT_API int fdt_open(fdt_context **ctx, const fdt_settings *s);
+/* Frees the context and sets *ctx to NULL; NULL is fine. */
+FDT_API void fdt_close(fdt_context **ctx);
+
+/*
+ * Triangulates n points. xyz holds 3n doubles (x0 y0 z0 x1 ...), borrowed:
+ * it is read during the call only. Duplicate points (bit-identical
+ * coordinates, with -0 equal to +0) are merged into their first index.
+ * On success *out is a new result owned by the caller (fdt_result_free).
+ * On FDT_EDEGENERATE / FDT_ERANGE, fdt_context_diagnostic() says why and
+ * which point.
+ */
+FDT_API int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
+                            fdt_result **out);
+/* The diagnostic of the last failed call on ctx ("" if none). Owned by ctx. */
+FDT_API const char *fdt_context_diagnostic(const fdt_context *ctx);
+
+FDT_API void fdt_result_free(fdt_result **r);
+
+/* Number of tetrahedra; tets() holds 4 vertex ids per tet, in the caller's
+ * input numbering, positively oriented: (b-a, c-a, d-a) has a positive
+ * determinant. */
+FDT_API size_t fdt_result_num_tets(const fdt_result *r);
+FDT_API const fdt_vid *fdt_result_tets(const fdt_result *r);
+/* 4 per tet: neighbour across the face opposite vertex i, -1 on the hull.
+ * NULL unless settings.neighbors was set. */
+FDT_API const fdt_tid *fdt_result_neighbors(const fdt_result *r);
+/* Hull faces: 3 vertex ids each, ordered so the hull's interior is on the
+ * negative side (outward normals by the right-hand rule). */
+FDT_API size_t fdt_result_num_hull_faces(const fdt_result *r);
+FDT_API const fdt_vid *fdt_result_hull_faces(const fdt_result *r);
+/* n entries: the vertex each input point was merged into (itself when it
+ * is the first of its coordinates). */
+FDT_API const fdt_vid *fdt_result_duplicate_map(const fdt_result *r);
+FDT_API size_t fdt_result_num_duplicates(const fdt_result *r);
+
+/* Puts the tets in canonical order: by their 4 ids sorted ascending,
+ * compared as integer tuples. Each tet keeps its positive orientation;
+ * neighbours are renumbered to match. Idempotent. */
+FDT_API int fdt_result_sort(fdt_result *r);
+
+/* A checksum of the tet set, independent of tet order, vertex order within
+ * a tet, thread count and mode: FNV-1a 64 (offset basis 14695981039346656037,
+ * prime 1099511628211) over the bytes of the canonical text: each tet's ids
+ * ascending in decimal, "a b c d\n", lines in ascending order (the exact
+ * content of a .tets file). Sorts r first (fdt_result_sort). */
+FDT_API int fdt_result_hash(fdt_result *r, uint64_t *hash);
+
+typedef struct fdt_stats {
+    size_t points;            /* input points */
+    size_t vertices;          /* distinct points */
+    size_t tets;
+    size_t hull_faces;
+    size_t faces_advanced;    /* apex searches performed */
+    size_t kd_nodes_visited;
+    size_t points_tested;     /* points examined by range queries */
+    size_t exact_orient;      /* orient3d calls that needed exact arithmetic */
+    size_t exact_insphere;    /* insphere calls that needed exact arithmetic */
+    size_t max_front;         /* largest front size */
+    int threads;
+    fdt_mode mode;
+    double t_prepare;         /* seconds: validate, merge, scale, kd-tree */
+    double t_front;           /* seconds: advancing the front */
+    double t_finish;          /* seconds: renumbering, neighbours */
+} fdt_stats;
+
+FDT_API int fdt_result_stats(const fdt_result *r, fdt_stats *st);
+
+/*
+ * Independent exact verification of a mesh on n points (xyz as above, tets
+ * in input numbering, duplicates allowed in xyz but tets must use each
+ * coordinate's first index): every tet positively oriented, every interior
+ * face shared by exactly two tets (and linked both ways if nbrs is not
+ * NULL), hull closed and convex, every point used, and the perturbed
+ * empty-sphere condition across every interior face. Returns 0 or
+ * FDT_ECHECK with a description in msg (NUL-terminated, truncated to len).
+ */
+FDT_API int fdt_check(const double *xyz, size_t n, const fdt_vid *tets,
+                      size_t ntets, const fdt_tid *nbrs, char *msg,
+                      size_t len);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* FRONTDT_H */

@@ -1,0 +1,194 @@
+/* The public entry points: settings, context, the triangulation pipeline
+ * (DESIGN.md, Data flow). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "frontdt.h"
+#include "front.h"
+#include "kdtree.h"
+#include "prepare.h"
+#include "result.h"
+#include "seed.h"
+
+struct fdt_context {
+    fdt_settings s;
+    char diag[512];
+};
+
+const char *fdt_strerror(int err)
+{
+    switch (err) {
+    case FDT_OK: return "success";
+    case FDT_EINVAL: return "invalid argument";
+    case FDT_ENOMEM: return "out of memory";
+    case FDT_EDEGENERATE: return "degenerate input (fewer than 4 distinct points, or all coplanar)";
+    case FDT_ERANGE: return "a coordinate is NaN or infinite";
+    case FDT_ETOOBIG: return "too many points or tetrahedra for the index types";
+    case FDT_ECHECK: return "the mesh failed verification";
+    case FDT_ECANCELED: return "canceled";
+    case FDT_EINTERNAL: return "internal error (a bug: please report it)";
+    case FDT_ETHREAD: return "could not create a thread";
+    default: return "unknown error";
+    }
+}
+
+const char *fdt_version(void) { return FDT_VERSION_STRING; }
+
+void fdt_default_settings(fdt_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    s->mode = FDT_MODE_AUTO;
+    s->n_threads = 0;
+    s->leaf_size = 18;
+}
+
+int fdt_open(fdt_context **ctx, const fdt_settings *s)
+{
+    if (!ctx)
+        return FDT_EINVAL;
+    *ctx = NULL;
+    if (!s || s->n_threads < 0 || s->n_threads > 1024 || s->leaf_size < 0 ||
+        s->mode < FDT_MODE_AUTO || s->mode > FDT_MODE_MESSAGE)
+        return FDT_EINVAL;
+    fdt_context *c = calloc(1, sizeof *c);
+    if (!c)
+        return FDT_ENOMEM;
+    c->s = *s;
+    if (c->s.leaf_size == 0)
+        c->s.leaf_size = 18;
+    *ctx = c;
+    return FDT_OK;
+}
+
+void fdt_close(fdt_context **ctx)
+{
+    if (!ctx)
+        return;
+    free(*ctx);
+    *ctx = NULL;
+}
+
+const char *fdt_context_diagnostic(const fdt_context *ctx)
+{
+    return ctx ? ctx->diag : "";
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* The point whose coordinates are nearest the centre of the root box
+ * (§2.1: "a node near the center of the cloud"). */
+static uint32_t central_point(const fdt_kdtree *t)
+{
+    const fdt_kdnode *r = &t->nodes[0];
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = r->lo[k] * 0.5 + r->hi[k] * 0.5;
+    return fdt_kd_nearest(t, c, FDT_NONE, NULL);
+}
+
+int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
+                    fdt_result **out)
+{
+    if (!ctx || !out || (!xyz && n))
+        return FDT_EINVAL;
+    *out = NULL;
+    ctx->diag[0] = '\0';
+    fdt_mode mode = ctx->s.mode;
+    if (mode == FDT_MODE_AUTO)
+        mode = FDT_MODE_SERIAL;
+    if (mode != FDT_MODE_SERIAL) {
+        snprintf(ctx->diag, sizeof ctx->diag,
+                 "mode %s is not available in this build: only serial",
+                 mode == FDT_MODE_SHARED ? "shared" : "message");
+        return FDT_EINVAL;
+    }
+    double t0 = now_s();
+    fdt_prepared pr;
+    fdt_kdtree tree = {0};
+    fdt_meshbuf mb = {0};
+    fdt_result *r = NULL;
+    int err = fdt_prepare(xyz, n, &pr, ctx->diag, sizeof ctx->diag);
+    if (err)
+        return err;
+    if ((err = fdt_seed_check_dimension(pr.p, pr.orig, (uint32_t)pr.m, ctx->diag,
+                                        sizeof ctx->diag)) != FDT_OK)
+        goto fail;
+    err = FDT_ENOMEM;
+    if (fdt_kd_build(&tree, pr.p, pr.orig, 0, (uint32_t)pr.m, ctx->s.leaf_size) != FDT_OK)
+        goto fail;
+    if (fdt_meshbuf_init(&mb, (size_t)(6.7 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
+        goto fail;
+    double t1 = now_s();
+    fdt_front_stats fst;
+    memset(&fst, 0, sizeof fst);
+    err = fdt_front_serial(&tree, central_point(&tree), &mb, ctx->s.progress,
+                           ctx->s.progress_user, &fst);
+    if (err) {
+        if (err == FDT_ENOMEM)
+            snprintf(ctx->diag, sizeof ctx->diag, "out of memory after %zu tetrahedra", mb.ntets);
+        else if (err == FDT_EINTERNAL)
+            snprintf(ctx->diag, sizeof ctx->diag,
+                     "internal error: the front became inconsistent after %zu tetrahedra", mb.ntets);
+        goto fail;
+    }
+    double t2 = now_s();
+    err = FDT_ENOMEM;
+    r = calloc(1, sizeof *r);
+    if (!r)
+        goto fail;
+    /* Renumber into the caller's numbering in place: tree-order id i is
+     * input point pr.orig[i] (same width, so the buffers are reused). */
+    fdt_vid *tets = (fdt_vid *)mb.tets;
+    for (size_t i = 0; i < 4 * mb.ntets; i++)
+        tets[i] = pr.orig[mb.tets[i]];
+    fdt_vid *hull = (fdt_vid *)mb.hull;
+    for (size_t i = 0; i < 3 * mb.nhull; i++)
+        hull[i] = pr.orig[mb.hull[i]];
+    r->tets = tets;
+    r->ntets = mb.ntets;
+    r->nbrs = mb.nbrs;
+    r->hull = hull;
+    r->nhull = mb.nhull;
+    r->dupmap = pr.dupmap;
+    pr.dupmap = NULL;
+    r->n = n;
+    r->ndup = pr.ndup;
+    memset(&mb, 0, sizeof mb);
+    fdt_stats *st = &r->stats;
+    st->points = n;
+    st->vertices = pr.m;
+    st->tets = r->ntets;
+    st->hull_faces = r->nhull;
+    st->faces_advanced = fst.faces_advanced;
+    st->kd_nodes_visited = fst.kq.nodes;
+    st->points_tested = fst.kq.points;
+    st->exact_orient = fst.kq.pc.orient_exact;
+    st->exact_insphere = fst.kq.pc.insphere_exact;
+    st->max_front = fst.max_front;
+    st->threads = 1;
+    st->mode = FDT_MODE_SERIAL;
+    st->t_prepare = t1 - t0;
+    st->t_front = t2 - t1;
+    st->t_finish = now_s() - t2;
+    fdt_kd_free(&tree);
+    fdt_prepared_free(&pr);
+    if (ctx->s.progress)
+        ctx->s.progress(ctx->s.progress_user, 1.0);
+    *out = r;
+    return FDT_OK;
+fail:
+    if (err == FDT_ENOMEM && !ctx->diag[0])
+        snprintf(ctx->diag, sizeof ctx->diag, "out of memory triangulating %zu points", n);
+    fdt_meshbuf_free(&mb);
+    fdt_kd_free(&tree);
+    fdt_prepared_free(&pr);
+    fdt_result_free(&r);
+    return err;
+}

@@ -1,0 +1,47 @@
+/*
+ * The front's face table (§2.2): a hash table keyed on a face's vertex
+ * triple. A face enters when the first tet holding it is built (it is then
+ * a front face) and leaves when the second tet is built or the face is
+ * found to be on the convex hull. Open addressing with linear probing and
+ * backward-shift deletion (no tombstones, so a long run does not degrade).
+ */
+#ifndef FDT_FACETAB_H
+#define FDT_FACETAB_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct fdt_face {
+    uint32_t v[3];   /* oriented: the open side is orient3d(v0,v1,v2,x) > 0;
+                        rotated so v[0] is the smallest id; v[0] ==
+                        UINT32_MAX marks an empty slot */
+    uint32_t aux;    /* caller's use (e.g. the owner partition) */
+    uint64_t tet;    /* (tet id << 2) | local face index of the tet on the
+                        closed side */
+} fdt_face;
+
+typedef struct fdt_facetab {
+    fdt_face *slots;
+    size_t cap;      /* power of two */
+    size_t count;
+} fdt_facetab;
+
+int fdt_facetab_init(fdt_facetab *t, size_t expected);
+void fdt_facetab_free(fdt_facetab *t);
+
+/* Rotates (a, b, c) so the smallest id is first, keeping the orientation. */
+void fdt_face_canon(uint32_t a, uint32_t b, uint32_t c, uint32_t out[3]);
+
+/* Looks up the face with the same vertex set as the canonical triple v.
+ * Returns the slot or NULL. */
+fdt_face *fdt_facetab_find(const fdt_facetab *t, const uint32_t v[3]);
+
+/* Finds f's vertex set; if absent inserts f and returns NULL with *err 0.
+ * If present returns the existing slot (not modified). *err is FDT_ENOMEM
+ * when growing failed. */
+fdt_face *fdt_facetab_find_or_insert(fdt_facetab *t, const fdt_face *f, int *err);
+
+/* Removes the face in slot s (a pointer returned by find). */
+void fdt_facetab_remove(fdt_facetab *t, fdt_face *s);
+
+#endif

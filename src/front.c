@@ -1,0 +1,211 @@
+/* The serial advancing front; see front.h. */
+#include "front.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include "facetab.h"
+#include "seed.h"
+
+/* For a positively oriented (v0,v1,v2,v3), (v1,v2,v3,v0) is an odd
+ * permutation, so v0 is on the negative side of (v1,v2,v3): that face is
+ * already outward; the others follow the same parity count. */
+const int fdt_tet_face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+int fdt_meshbuf_init(fdt_meshbuf *mb, size_t expected_tets, int want_nbrs)
+{
+    memset(mb, 0, sizeof *mb);
+    mb->tcap = expected_tets < 64 ? 64 : expected_tets;
+    mb->tets = malloc(mb->tcap * 4 * sizeof *mb->tets);
+    if (want_nbrs)
+        mb->nbrs = malloc(mb->tcap * 4 * sizeof *mb->nbrs);
+    mb->hcap = 1024;
+    mb->hull = malloc(mb->hcap * 3 * sizeof *mb->hull);
+    if (!mb->tets || !mb->hull || (want_nbrs && !mb->nbrs)) {
+        fdt_meshbuf_free(mb);
+        return FDT_ENOMEM;
+    }
+    return FDT_OK;
+}
+
+void fdt_meshbuf_free(fdt_meshbuf *mb)
+{
+    free(mb->tets);
+    free(mb->nbrs);
+    free(mb->hull);
+    memset(mb, 0, sizeof *mb);
+}
+
+int64_t fdt_meshbuf_add_tet(fdt_meshbuf *mb, const uint32_t v[4])
+{
+    if (mb->ntets == mb->tcap) {
+        size_t ncap = mb->tcap + mb->tcap / 2;
+        uint32_t *nt = realloc(mb->tets, ncap * 4 * sizeof *nt);
+        if (!nt)
+            return -1;
+        mb->tets = nt;
+        if (mb->nbrs) {
+            int64_t *nn = realloc(mb->nbrs, ncap * 4 * sizeof *nn);
+            if (!nn)
+                return -1;
+            mb->nbrs = nn;
+        }
+        mb->tcap = ncap;
+    }
+    memcpy(mb->tets + 4 * mb->ntets, v, 4 * sizeof *v);
+    if (mb->nbrs)
+        for (int k = 0; k < 4; k++)
+            mb->nbrs[4 * mb->ntets + k] = -1;
+    return (int64_t)mb->ntets++;
+}
+
+int fdt_meshbuf_add_hull(fdt_meshbuf *mb, const uint32_t v[3])
+{
+    if (mb->nhull == mb->hcap) {
+        size_t ncap = mb->hcap * 2;
+        uint32_t *nh = realloc(mb->hull, ncap * 3 * sizeof *nh);
+        if (!nh)
+            return FDT_ENOMEM;
+        mb->hull = nh;
+        mb->hcap = ncap;
+    }
+    memcpy(mb->hull + 3 * mb->nhull, v, 3 * sizeof *v);
+    mb->nhull++;
+    return FDT_OK;
+}
+
+typedef struct facestack {
+    uint32_t *v;
+    size_t n, cap;
+} facestack;
+
+static int push_face(facestack *fs, const uint32_t v[3])
+{
+    if (fs->n == fs->cap) {
+        size_t ncap = fs->cap ? fs->cap * 2 : 4096;
+        uint32_t *nv = realloc(fs->v, ncap * 3 * sizeof *nv);
+        if (!nv)
+            return FDT_ENOMEM;
+        fs->v = nv;
+        fs->cap = ncap;
+    }
+    memcpy(fs->v + 3 * fs->n, v, 3 * sizeof *v);
+    fs->n++;
+    return FDT_OK;
+}
+
+/*
+ * Hands the four faces of new tet `tid` to the front: a face already in
+ * the table is the other side of an existing front face, which the new tet
+ * completes (§2.2: "the new tetrahedron is the missing neighbor and another
+ * triangle is removed from the front"); a face not in the table becomes a
+ * front face with its open side away from the new tet.
+ */
+static int add_tet_faces(fdt_facetab *ft, facestack *fs, fdt_meshbuf *mb,
+                         int64_t tid)
+{
+    const uint32_t *v = mb->tets + 4 * (size_t)tid;
+    for (int i = 0; i < 4; i++) {
+        fdt_face f;
+        fdt_face_canon(v[fdt_tet_face[i][0]], v[fdt_tet_face[i][1]],
+                       v[fdt_tet_face[i][2]], f.v);
+        f.aux = 0;
+        f.tet = ((uint64_t)tid << 2) | (uint64_t)i;
+        int err;
+        fdt_face *s = fdt_facetab_find_or_insert(ft, &f, &err);
+        if (err)
+            return err;
+        if (!s) {
+            if ((err = push_face(fs, f.v)) != FDT_OK)
+                return err;
+            continue;
+        }
+        /* Completed: the stored face is oriented with its open side
+         * towards the new tet, i.e. opposite to f. Equal orientation
+         * would mean two tets on one side of a face: an overlap. */
+        if (s->v[1] == f.v[1])
+            return FDT_EINTERNAL;
+        if (mb->nbrs) {
+            int64_t other = (int64_t)(s->tet >> 2);
+            mb->nbrs[4 * (size_t)other + (s->tet & 3)] = tid;
+            mb->nbrs[4 * (size_t)tid + i] = other;
+        }
+        fdt_facetab_remove(ft, s);
+    }
+    return FDT_OK;
+}
+
+int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
+                     fdt_progress_fn progress, void *puser,
+                     fdt_front_stats *st)
+{
+    fdt_facetab ft;
+    facestack fs = {0};
+    uint32_t seed[4];
+    int err = fdt_seed_tet(t, start, seed, &st->kq);
+    if (err)
+        return err;
+    if ((err = fdt_facetab_init(&ft, 4096)) != FDT_OK)
+        return err;
+    const double *P = t->P;
+    int64_t tid = fdt_meshbuf_add_tet(out, seed);
+    if (tid < 0) {
+        err = FDT_ENOMEM;
+        goto done;
+    }
+    if ((err = add_tet_faces(&ft, &fs, out, tid)) != FDT_OK)
+        goto done;
+    /* A Delaunay tetrahedralization of n random points has about 6.5n
+     * tets; the estimate only drives the progress bar. */
+    double expect = 6.5 * (double)t->n + 1.0;
+    size_t next_report = 1u << 16;
+    while (fs.n > 0) {
+        fs.n--;
+        const uint32_t *fv = fs.v + 3 * fs.n;
+        fdt_face *s = fdt_facetab_find(&ft, fv);
+        /* Faces completed since they were pushed are skipped here rather
+         * than searched for in the stack when they complete. */
+        if (!s || s->v[1] != fv[1])
+            continue;
+        if (ft.count > st->max_front)
+            st->max_front = ft.count;
+        uint32_t f[3] = {s->v[0], s->v[1], s->v[2]};
+        st->faces_advanced++;
+        fdt_apex ap;
+        fdt_apex_init(&ap, P + 3 * (size_t)f[0], P + 3 * (size_t)f[1], P + 3 * (size_t)f[2],
+                      f[0], f[1], f[2]);
+        fdt_apex_search(&ap, t, &st->kq);
+        if (ap.best == FDT_NONE) {
+            /* Nothing on the open side: a convex-hull face (§2.2). Its
+             * open side is the outside, so f is already outward. */
+            if ((err = fdt_meshbuf_add_hull(out, f)) != FDT_OK)
+                goto done;
+            fdt_facetab_remove(&ft, s);
+            continue;
+        }
+        /* (f0, f1, f2, apex) is positively oriented: the apex is on the
+         * open side, orient3d > 0. */
+        uint32_t v[4] = {f[0], f[1], f[2], ap.best};
+        if ((tid = fdt_meshbuf_add_tet(out, v)) < 0) {
+            err = FDT_ENOMEM;
+            goto done;
+        }
+        if ((err = add_tet_faces(&ft, &fs, out, tid)) != FDT_OK)
+            goto done;
+        if (out->ntets >= next_report) {
+            next_report += 1u << 16;
+            if (progress) {
+                double fr = (double)out->ntets / expect;
+                if (progress(puser, fr > 0.99 ? 0.99 : fr)) {
+                    err = FDT_ECANCELED;
+                    goto done;
+                }
+            }
+        }
+    }
+    if (ft.count != 0)
+        err = FDT_EINTERNAL;
+done:
+    fdt_facetab_free(&ft);
+    free(fs.v);
+    return err;
+}

@@ -1,0 +1,457 @@
+/* kd-tree build and range queries; see kdtree.h. */
+#include "kdtree.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void fdt_kd_free(fdt_kdtree *t)
+{
+    free(t->nodes);
+    memset(t, 0, sizeof *t);
+}
+
+static void swap_pt(double *P, fdt_vid *orig, uint32_t i, uint32_t j)
+{
+    double x0 = P[3 * (size_t)i], x1 = P[3 * (size_t)i + 1], x2 = P[3 * (size_t)i + 2];
+    P[3 * (size_t)i] = P[3 * (size_t)j];
+    P[3 * (size_t)i + 1] = P[3 * (size_t)j + 1];
+    P[3 * (size_t)i + 2] = P[3 * (size_t)j + 2];
+    P[3 * (size_t)j] = x0;
+    P[3 * (size_t)j + 1] = x1;
+    P[3 * (size_t)j + 2] = x2;
+    fdt_vid o = orig[i];
+    orig[i] = orig[j];
+    orig[j] = o;
+}
+
+/* Quickselect with a three-way partition (< pivot, == pivot, > pivot):
+ * afterwards the point at k has the k-th smallest coordinate `dim` in
+ * [lo, hi), smaller-or-equal ones before it, greater-or-equal after. The
+ * equal block always holds the pivot, so every round makes progress, even
+ * on the heavily repeated coordinates of lattices and lidar planes. */
+static void select_k(double *P, fdt_vid *orig, uint32_t lo, uint32_t hi,
+                     uint32_t k, int dim)
+{
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        double a = P[3 * (size_t)lo + dim], b = P[3 * (size_t)mid + dim],
+               c = P[3 * (size_t)(hi - 1) + dim];
+        double piv = a < b ? (b < c ? b : (a < c ? c : a))
+                           : (a < c ? a : (b < c ? c : b));
+        /* Invariant: [lo, lt) < piv, [lt, i) == piv, [gt, hi) > piv. */
+        uint32_t lt = lo, i = lo, gt = hi;
+        while (i < gt) {
+            double x = P[3 * (size_t)i + dim];
+            if (x < piv)
+                swap_pt(P, orig, lt++, i++);
+            else if (x > piv)
+                swap_pt(P, orig, i, --gt);
+            else
+                i++;
+        }
+        if (k < lt)
+            hi = lt;
+        else if (k >= gt)
+            lo = gt;
+        else
+            return;
+    }
+}
+
+typedef struct build_ctx {
+    fdt_kdtree *t;
+    double *P;
+    fdt_vid *orig;
+    uint32_t leaf;
+    uint32_t cap;
+} build_ctx;
+
+static void node_box(const double *P, uint32_t begin, uint32_t end,
+                     double *lo, double *hi)
+{
+    for (int k = 0; k < 3; k++) {
+        lo[k] = INFINITY;
+        hi[k] = -INFINITY;
+    }
+    for (uint32_t i = begin; i < end; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = P[3 * (size_t)i + k];
+            if (x < lo[k])
+                lo[k] = x;
+            if (x > hi[k])
+                hi[k] = x;
+        }
+}
+
+/* Fills node `id` over [begin, end) and its subtree. Recursion depth is
+ * log2(n / leaf), at most ~32. */
+static void build_rec(build_ctx *bc, uint32_t id, uint32_t begin, uint32_t end)
+{
+    fdt_kdnode *nd = &bc->t->nodes[id];
+    nd->begin = begin;
+    nd->end = end;
+    nd->left = 0;
+    nd->dim = 0;
+    node_box(bc->P, begin, end, nd->lo, nd->hi);
+    if (end - begin <= bc->leaf)
+        return;
+    int dim = 0;
+    double w = nd->hi[0] - nd->lo[0];
+    for (int k = 1; k < 3; k++)
+        if (nd->hi[k] - nd->lo[k] > w) {
+            w = nd->hi[k] - nd->lo[k];
+            dim = k;
+        }
+    uint32_t mid = begin + (end - begin) / 2;
+    select_k(bc->P, bc->orig, begin, end, mid, dim);
+    uint32_t left = bc->t->nnodes;
+    bc->t->nnodes += 2;
+    nd->left = left;
+    nd->dim = (uint32_t)dim;
+    build_rec(bc, left, begin, mid);
+    build_rec(bc, left + 1, mid, end);
+}
+
+int fdt_kd_build(fdt_kdtree *t, double *P, fdt_vid *orig, uint32_t base,
+                 uint32_t n, int leaf_size)
+{
+    memset(t, 0, sizeof *t);
+    if (leaf_size < 1)
+        leaf_size = 1;
+    /* A node over c > leaf points splits into halves, so leaves hold at
+     * least leaf/2 points: at most 2n/leaf + 1 leaves, twice that nodes. */
+    size_t cap = 4 * ((size_t)n / (size_t)leaf_size + 1) + 4;
+    t->nodes = malloc(cap * sizeof *t->nodes);
+    if (!t->nodes)
+        return FDT_ENOMEM;
+    t->P = P;
+    t->base = base;
+    t->n = n;
+    t->nnodes = 1;
+    build_ctx bc = {t, P, orig, (uint32_t)leaf_size, (uint32_t)cap};
+    build_rec(&bc, 0, base, base + n);
+    return FDT_OK;
+}
+
+/* Squared distance from c to the box; 0 inside. */
+static double box_dist2(const double *lo, const double *hi, const double *c)
+{
+    double d2 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double d = 0.0;
+        if (c[k] < lo[k])
+            d = lo[k] - c[k];
+        else if (c[k] > hi[k])
+            d = c[k] - hi[k];
+        d2 += d * d;
+    }
+    return d2;
+}
+
+static double dist2(const double *a, const double *b)
+{
+    double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+    return dx * dx + dy * dy + dz * dz;
+}
+
+/* Depth of a balanced tree with leaves of >= 1 point is < 64: a stack of
+ * 2 * 64 entries per walk would do, but walks push both children, so we
+ * size it to the node count bound of one root-to-leaf path times 2. */
+#define WALK_STACK 256
+
+uint32_t fdt_kd_nearest(const fdt_kdtree *t, const double *q,
+                        uint32_t exclude, fdt_kdq *kq)
+{
+    uint32_t stack[WALK_STACK];
+    int sp = 0;
+    uint32_t best = FDT_NONE;
+    double bd = INFINITY;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const fdt_kdnode *nd = &t->nodes[stack[--sp]];
+        if (box_dist2(nd->lo, nd->hi, q) > bd)
+            continue;
+        if (kq)
+            kq->nodes++;
+        if (!nd->left) {
+            for (uint32_t i = nd->begin; i < nd->end; i++) {
+                if (i == exclude)
+                    continue;
+                double d = dist2(t->P + 3 * (size_t)i, q);
+                if (d < bd || (d == bd && i < best)) {
+                    bd = d;
+                    best = i;
+                }
+            }
+            continue;
+        }
+        const fdt_kdnode *l = &t->nodes[nd->left], *r = l + 1;
+        double dl = box_dist2(l->lo, l->hi, q), dr = box_dist2(r->lo, r->hi, q);
+        /* Push the farther child first so the nearer one is searched first. */
+        if (dl <= dr) {
+            stack[sp++] = nd->left + 1;
+            stack[sp++] = nd->left;
+        } else {
+            stack[sp++] = nd->left;
+            stack[sp++] = nd->left + 1;
+        }
+    }
+    return best;
+}
+
+int fdt_kd_ball(const fdt_kdtree *t, const double *c, double r,
+                int (*fn)(void *user, uint32_t id), void *user, fdt_kdq *kq)
+{
+    uint32_t stack[WALK_STACK];
+    int sp = 0;
+    /* Widen by a relative 1e-12 so rounding in the distances never drops a
+     * point the caller would accept exactly. */
+    double rr = r * (1.0 + 1e-12) + 1e-300;
+    double r2 = rr * rr;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const fdt_kdnode *nd = &t->nodes[stack[--sp]];
+        if (box_dist2(nd->lo, nd->hi, c) > r2)
+            continue;
+        if (kq)
+            kq->nodes++;
+        if (!nd->left) {
+            for (uint32_t i = nd->begin; i < nd->end; i++)
+                if (dist2(t->P + 3 * (size_t)i, c) <= r2) {
+                    int rc = fn(user, i);
+                    if (rc)
+                        return rc;
+                }
+            continue;
+        }
+        stack[sp++] = nd->left;
+        stack[sp++] = nd->left + 1;
+    }
+    return 0;
+}
+
+/* ---- the apex search ---------------------------------------------------- */
+
+static double norm3(const double *v)
+{
+    return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
+
+static void cross3(const double *u, const double *v, double *w)
+{
+    w[0] = u[1] * v[2] - u[2] * v[1];
+    w[1] = u[2] * v[0] - u[0] * v[2];
+    w[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+void fdt_apex_init(fdt_apex *s, const double *a, const double *b,
+                   const double *c, uint32_t ia, uint32_t ib, uint32_t ic)
+{
+    double u[3], v[3];
+    s->a = a;
+    s->b = b;
+    s->c = c;
+    s->ia = ia;
+    s->ib = ib;
+    s->ic = ic;
+    for (int k = 0; k < 3; k++) {
+        u[k] = b[k] - a[k];
+        v[k] = c[k] - a[k];
+    }
+    cross3(u, v, s->nrm);
+    s->nabs[0] = fabs(u[1] * v[2]) + fabs(u[2] * v[1]);
+    s->nabs[1] = fabs(u[2] * v[0]) + fabs(u[0] * v[2]);
+    s->nabs[2] = fabs(u[0] * v[1]) + fabs(u[1] * v[0]);
+    /* Look first where the apex of a well-shaped tet would be: above the
+     * centroid by about half an edge. */
+    double nn = norm3(s->nrm);
+    double len = (norm3(u) + norm3(v)) * 0.5;
+    for (int k = 0; k < 3; k++) {
+        double g = (a[k] + b[k] + c[k]) / 3.0;
+        s->target[k] = nn > 0 ? g + s->nrm[k] / nn * len * 0.6 : g;
+    }
+    s->best = FDT_NONE;
+    s->bp = NULL;
+    s->r2 = INFINITY;
+}
+
+/*
+ * Side of d relative to the face: +1 open side, 0 coplanar, -1 closed.
+ * The floating value s = nrm . (d - a) errs by less than 1e-14 times the
+ * permanent nabs . |d - a| (the exact bound is below 16 eps: the rounded
+ * differences, the two products and the difference in each nrm component,
+ * the three products and two sums of the dot product each add at most one
+ * relative eps of their permanent term); outside that band its sign is
+ * the exact orient3d sign, inside it we ask the exact predicate.
+ */
+static int open_side(const fdt_apex *s, const double *d, fdt_kdq *kq)
+{
+    double w0 = d[0] - s->a[0], w1 = d[1] - s->a[1], w2 = d[2] - s->a[2];
+    double v = s->nrm[0] * w0 + s->nrm[1] * w1 + s->nrm[2] * w2;
+    double perm = s->nabs[0] * fabs(w0) + s->nabs[1] * fabs(w1) + s->nabs[2] * fabs(w2);
+    double tol = perm * 1e-14;
+    if (v > tol)
+        return 1;
+    if (v < -tol)
+        return -1;
+    return fdt_orient3d(s->a, s->b, s->c, d, kq ? &kq->pc : NULL);
+}
+
+/*
+ * Recomputes the conservative search ball after `best` changed. The
+ * circumcentre x (relative to a) of the tet (a, b, c, best) is
+ *   x = (|u|^2 (v x w) + |v|^2 (w x u) + |w|^2 (u x v)) / (2 u.(v x w)).
+ * With K = |u||v||w| / det (>= 1 by Hadamard), the floating result errs by
+ * O(eps K^2 L) (L the longest of u, v, w); we widen the radius by
+ * 64 eps K (K + 1) L plus an absolute term for the coordinates' rounding,
+ * and give up on the ball (infinite radius) when K > 1e6: such slivers
+ * have enormous spheres anyway and the open-side test still prunes.
+ */
+static void update_ball(fdt_apex *s)
+{
+    const double *a = s->a;
+    double u[3], v[3], w[3], vw[3], wu[3], uv[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = s->b[k] - a[k];
+        v[k] = s->c[k] - a[k];
+        w[k] = s->bp[k] - a[k];
+    }
+    cross3(v, w, vw);
+    cross3(w, u, wu);
+    cross3(u, v, uv);
+    double det = u[0] * vw[0] + u[1] * vw[1] + u[2] * vw[2];
+    double nu = norm3(u), nv = norm3(v), nw = norm3(w);
+    double prod = nu * nv * nw;
+    if (!(det > 0.0) || !(prod < 1e6 * det) || !isfinite(prod)) {
+        s->r2 = INFINITY;
+        return;
+    }
+    double K = prod / det;
+    double uu = nu * nu, vv = nv * nv, ww = nw * nw;
+    double x[3], xmax = 0.0, amax = 0.0;
+    for (int k = 0; k < 3; k++) {
+        x[k] = (uu * vw[k] + vv * wu[k] + ww * uv[k]) / (2.0 * det);
+        s->center[k] = a[k] + x[k];
+        if (fabs(x[k]) > xmax)
+            xmax = fabs(x[k]);
+        if (fabs(a[k]) > amax)
+            amax = fabs(a[k]);
+    }
+    double L = nu > nv ? nu : nv;
+    if (nw > L)
+        L = nw;
+    double r = norm3(x);
+    double tol = 64.0 * DBL_EPSILON * K * (K + 1.0) * L + 8.0 * DBL_EPSILON * (amax + xmax);
+    double rr = r + tol;
+    s->r2 = rr * rr;
+    if (!isfinite(s->r2))
+        s->r2 = INFINITY;
+}
+
+void fdt_apex_offer(fdt_apex *s, uint32_t id, const double *d, fdt_kdq *kq)
+{
+    if (id == s->ia || id == s->ib || id == s->ic || id == s->best)
+        return;
+    if (s->best != FDT_NONE && dist2(d, s->center) > s->r2)
+        return;
+    if (open_side(s, d, kq) <= 0)
+        return;
+    if (s->best != FDT_NONE &&
+        fdt_insphere_perturbed(s->a, s->b, s->c, s->bp, d, kq ? &kq->pc : NULL) <= 0)
+        return;
+    s->best = id;
+    s->bp = d;
+    update_ball(s);
+}
+
+int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi)
+{
+    if (s->best != FDT_NONE && box_dist2(lo, hi, s->center) > s->r2)
+        return 0;
+    /* Largest value of nrm . (x - a) over the box, against a margin for
+     * rounding in the same spirit as open_side's. */
+    double mx = 0.0, perm = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double c = (lo[k] + hi[k]) * 0.5 - s->a[k];
+        double h = (hi[k] - lo[k]) * 0.5;
+        mx += s->nrm[k] * c + fabs(s->nrm[k]) * h;
+        perm += s->nabs[k] * (fabs(c) + h);
+    }
+    return mx >= -perm * 1e-13;
+}
+
+void fdt_apex_search(fdt_apex *s, const fdt_kdtree *t, fdt_kdq *kq)
+{
+    uint32_t stack[WALK_STACK];
+    int sp = 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const fdt_kdnode *nd = &t->nodes[stack[--sp]];
+        if (!fdt_apex_box_useful(s, nd->lo, nd->hi))
+            continue;
+        kq->nodes++;
+        if (!nd->left) {
+            kq->points += nd->end - nd->begin;
+            for (uint32_t i = nd->begin; i < nd->end; i++)
+                fdt_apex_offer(s, i, t->P + 3 * (size_t)i, kq);
+            continue;
+        }
+        const fdt_kdnode *l = &t->nodes[nd->left], *r = l + 1;
+        const double *q = s->best != FDT_NONE ? s->center : s->target;
+        double dl = box_dist2(l->lo, l->hi, q), dr = box_dist2(r->lo, r->hi, q);
+        if (dl <= dr) {
+            stack[sp++] = nd->left + 1;
+            stack[sp++] = nd->left;
+        } else {
+            stack[sp++] = nd->left;
+            stack[sp++] = nd->left + 1;
+        }
+    }
+}
+
+typedef struct inside_ctx {
+    const fdt_kdtree *t;
+    const uint32_t *v;
+    const double *p[4];
+    fdt_kdq *kq;
+    uint32_t found;
+} inside_ctx;
+
+static int inside_cb(void *user, uint32_t id)
+{
+    inside_ctx *ic = user;
+    for (int k = 0; k < 4; k++)
+        if (id == ic->v[k])
+            return 0;
+    const double *d = ic->t->P + 3 * (size_t)id;
+    if (fdt_insphere_perturbed(ic->p[0], ic->p[1], ic->p[2], ic->p[3], d,
+                               ic->kq ? &ic->kq->pc : NULL) > 0) {
+        ic->found = id;
+        return 1;
+    }
+    return 0;
+}
+
+uint32_t fdt_kd_any_inside(const fdt_kdtree *t, const uint32_t v[4], fdt_kdq *kq)
+{
+    inside_ctx ic = {t, v, {0}, kq, FDT_NONE};
+    for (int k = 0; k < 4; k++)
+        ic.p[k] = t->P + 3 * (size_t)v[k];
+    /* Reuse the apex machinery's conservative ball for (a, b, c, d). */
+    fdt_apex s;
+    fdt_apex_init(&s, ic.p[0], ic.p[1], ic.p[2], v[0], v[1], v[2]);
+    s.best = v[3];
+    s.bp = ic.p[3];
+    update_ball(&s);
+    double r = isfinite(s.r2) ? sqrt(s.r2) : INFINITY;
+    if (!isfinite(r)) {
+        for (uint32_t i = t->base; i < t->base + t->n; i++)
+            if (inside_cb(&ic, i))
+                break;
+        return ic.found;
+    }
+    fdt_kd_ball(t, s.center, r, inside_cb, &ic, kq);
+    return ic.found;
+}

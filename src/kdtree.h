@@ -1,0 +1,96 @@
+/*
+ * Coordinate-bisection kd-tree (Bentley 1975; Merriam §4: "the
+ * partitioning continues until only a few nodes (typically 18) occupy each
+ * partition") over one coordinate array permuted into tree order, so every
+ * node is a contiguous run of ids, and the range queries the advancing
+ * front needs.
+ *
+ * A tree covers the ids [base, base + n) of a global coordinate array; a
+ * partition of the parallel engine is one such tree. Trees are immutable
+ * after fdt_kd_build, so any thread may query any tree without locks.
+ */
+#ifndef FDT_KDTREE_H
+#define FDT_KDTREE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "frontdt.h"
+#include "predicates.h"
+
+#define FDT_NONE UINT32_MAX
+
+typedef struct fdt_kdnode {
+    double lo[3], hi[3];   /* exact bounding box of the node's points */
+    uint32_t begin, end;   /* global ids [begin, end) */
+    uint32_t left;         /* first child (right is left + 1); 0: a leaf */
+    uint32_t dim;          /* split dimension */
+} fdt_kdnode;
+
+typedef struct fdt_kdtree {
+    fdt_kdnode *nodes;     /* owned; nodes[0] is the root */
+    uint32_t nnodes;
+    const double *P;       /* borrowed: global coordinates, 3 per id */
+    uint32_t base, n;
+} fdt_kdtree;
+
+/* Per-thread counters of the queries' work (owned by the querying thread). */
+typedef struct fdt_kdq {
+    size_t nodes, points;
+    fdt_pred_counts pc;
+} fdt_kdq;
+
+/*
+ * Builds the tree over ids [base, base + n) of P (3 doubles per id),
+ * permuting P's points in that range and the parallel array orig (indexed
+ * by global id) into tree order. leaf_size > 0. FDT_OK or FDT_ENOMEM.
+ */
+int fdt_kd_build(fdt_kdtree *t, double *P, fdt_vid *orig, uint32_t base,
+                 uint32_t n, int leaf_size);
+void fdt_kd_free(fdt_kdtree *t);
+
+/* Nearest point to q other than id `exclude` (floating-point distances),
+ * FDT_NONE if the tree holds no other point. */
+uint32_t fdt_kd_nearest(const fdt_kdtree *t, const double *q,
+                        uint32_t exclude, fdt_kdq *kq);
+
+/* Calls fn(user, id) for every point whose distance to c may be <= r
+ * (a superset within rounding: the caller decides exactly). */
+int fdt_kd_ball(const fdt_kdtree *t, const double *c, double r,
+                int (*fn)(void *user, uint32_t id), void *user, fdt_kdq *kq);
+
+/*
+ * The apex search (§2.2). For the oriented face (a, b, c), the "open side"
+ * is fdt_orient3d(a, b, c, x) > 0. Among the points strictly on the open
+ * side, the apex is the one whose sphere through a, b, c holds no other
+ * open-side point under the perturbed insphere; the pencil of spheres
+ * through the circle abc orders the open-side points totally, and the apex
+ * is its first element. A search state may be run over several trees
+ * (partitions) in turn; the result is the apex over their union.
+ */
+typedef struct fdt_apex {
+    const double *a, *b, *c;
+    uint32_t ia, ib, ic;
+    double nrm[3];       /* (b-a) x (c-a): points to the open side */
+    double nabs[3];      /* |components| permanent for the side filter */
+    double target[3];    /* where the search looks first */
+    uint32_t best;       /* FDT_NONE until a candidate is found */
+    const double *bp;    /* coordinates of best */
+    double center[3];    /* conservative search ball of the best sphere */
+    double r2;           /* INFINITY while unknown or ill-conditioned */
+} fdt_apex;
+
+void fdt_apex_init(fdt_apex *s, const double *a, const double *b,
+                   const double *c, uint32_t ia, uint32_t ib, uint32_t ic);
+/* Offers one point (global id, coordinates) to the search: used by the
+ * tree walk and by answers that arrive from other partitions. */
+void fdt_apex_offer(fdt_apex *s, uint32_t id, const double *d, fdt_kdq *kq);
+void fdt_apex_search(fdt_apex *s, const fdt_kdtree *t, fdt_kdq *kq);
+/* Whether the box [lo, hi] could hold a point that improves s. */
+int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi);
+
+/* A point of the tree strictly inside the perturbed circumsphere of the
+ * positively oriented tet (a,b,c,d) other than its vertices, or FDT_NONE. */
+uint32_t fdt_kd_any_inside(const fdt_kdtree *t, const uint32_t v[4],
+                           fdt_kdq *kq);
+
+#endif

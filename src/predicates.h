@@ -1,0 +1,238 @@
+/*
+ * Exact geometric predicates on double coordinates, and the symbolic
+ * perturbation that makes the Delaunay tetrahedralization unique.
+ *
+ * Sign conventions are CGAL's, so that our mesh equals CGAL's
+ * Delaunay_triangulation_3 tet for tet:
+ *   fdt_orient3d(a,b,c,d)  = sign det[b-a; c-a; d-a]
+ *       > 0: (a,b,c,d) positively oriented (d on the positive side of abc)
+ *   fdt_insphere(a,b,c,d,e) for positively oriented (a,b,c,d)
+ *       > 0: e strictly inside the circumsphere, < 0 outside, 0 on it
+ *       (CGAL side_of_oriented_sphere: ON_POSITIVE_SIDE is +1).
+ *
+ * Every function is exact for all finite doubles: a floating-point filter
+ * with a proven error bound decides most calls; the rest are evaluated
+ * exactly (expansion arithmetic when no intermediate can underflow, GMP
+ * integers otherwise). No global mutable state; thread-safe.
+ *
+ * The filters are static inline below (the hot path, called tens of
+ * millions of times); the exact stages are out of line in
+ * src/predicates.c. The filters' error analysis holds whether or not the
+ * compiler contracts a*b+c into a fused multiply-add (contraction only
+ * removes roundings), but not under -ffast-math (reassociation) or with
+ * x87 extended-precision evaluation (src/predicates.c refuses to compile
+ * unless FLT_EVAL_METHOD is 0). IEEE round-to-nearest-even is assumed.
+ */
+#ifndef FDT_PREDICATES_H
+#define FDT_PREDICATES_H
+
+#include <float.h>
+#include <math.h>
+#include <stddef.h>
+
+/* Counters of calls that left the filter; per thread, owned by the caller.
+ * May be NULL everywhere below. */
+typedef struct fdt_pred_counts {
+    size_t orient_exact;
+    size_t insphere_exact;
+} fdt_pred_counts;
+
+int fdt_orient3d(const double *a, const double *b, const double *c,
+                 const double *d, fdt_pred_counts *cnt);
+int fdt_insphere(const double *a, const double *b, const double *c,
+                 const double *d, const double *e, fdt_pred_counts *cnt);
+
+/* Lexicographic (x, then y, then z) comparison: -1, 0, +1. */
+int fdt_lex_compare(const double *p, const double *q);
+
+/*
+ * Perturbed insphere (Devillers & Teillaud 2011, as in CGAL's
+ * Delaunay_triangulation_3::side_of_oriented_sphere with perturb=true).
+ * Precondition: (a,b,c,d) positively oriented, the five points pairwise
+ * distinct. Never returns 0: +1 inside, -1 outside.
+ */
+int fdt_insphere_perturbed(const double *a, const double *b, const double *c,
+                           const double *d, const double *e,
+                           fdt_pred_counts *cnt);
+
+/* ------------------------------------------------------------------ */
+/* Filters and exact stages, for callers that want to inline the filter. */
+
+/* What a filter returns when it cannot decide the sign. */
+#define FDT_PRED_UNSURE 2
+
+/*
+ * The exact stages alone (no filter): same results and sign conventions as
+ * fdt_orient3d / fdt_insphere; they count the call in cnt (may be NULL).
+ */
+int fdt_orient3d_exact(const double *a, const double *b, const double *c,
+                       const double *d, fdt_pred_counts *cnt);
+int fdt_insphere_exact(const double *a, const double *b, const double *c,
+                       const double *d, const double *e, fdt_pred_counts *cnt);
+
+/*
+ * Error-bound constants of the filters (derivations at the filters).
+ * eps = 2^-53 is the unit roundoff.
+ *   FDT_O3D_ERRBOUND = 8 eps (1 + 2^-12)
+ *   FDT_ISP_ERRBOUND = 16 eps (1 + 2^-12)
+ */
+#define FDT_O3D_ERRBOUND 0x1.001p-50
+#define FDT_ISP_ERRBOUND 0x1.001p-49
+
+/*
+ * Floating-point filter for orient3d: +1 or -1 when that is certainly the
+ * sign of det[b-a; c-a; d-a], FDT_PRED_UNSURE otherwise (never 0).
+ *
+ * Error bound. Write eps = 2^-53, eta = 2^-1075 (half the smallest
+ * subnormal). Every operation obeys fl(x op y) = (x op y)(1 + delta) + mu,
+ * |delta| <= eps, |mu| <= eta, and mu = 0 for + and - (a sum that lands in
+ * the subnormal range is exact) -- provided nothing overflows.
+ *
+ * No overflow: perm is computed with the same association as det from the
+ * same products, with |.| everywhere; rounding is monotone and
+ * |fl(x - y)| <= fl(|x| + |y|), so every intermediate of det is at most
+ * the matching intermediate of perm in magnitude. perm <= DBL_MAX therefore
+ * means nothing overflowed (an overflowed difference gives perm = inf or
+ * NaN, and both fail the test).
+ *
+ * Rounding without underflow. det is a sum of six monomials t_k = +-u_i
+ * v_j w_l of the exact differences. Each reaches det_computed multiplied
+ * by at most 8 factors (1 + delta): three differences, the inner product,
+ * the inner difference, the outer product and at most two outer sums. So
+ * |det_computed - det| <= gamma8 P, gamma8 = 8eps/(1 - 8eps), with
+ * P = sum |t_k| the exact permanent; and perm >= (1 - eps)^8 P because
+ * perm's terms go through the same number of roundings, all on
+ * non-negative values.
+ *
+ * Underflow. A product's mu in one of the six inner products (v_j w_l) is
+ * then multiplied by the computed |u_i| and rounded at most 3 more times;
+ * an outer product's mu at most twice. The absolute perturbation of det
+ * (and, likewise, the amount by which perm may fall short) is at most
+ *   U = 2 eta (1+eps)^4 su' + 3 eta (1+eps)^2,  su' = |ux|+|uy|+|uz|
+ * (exact sum of the computed magnitudes; su' <= (1+3eps) su). We require
+ * perm >= 2^-800 and fl(su 2^-980) <= perm. Scaling by 2^-980 is exact
+ * unless su < 2^-42 (and then U < 2^-1070 anyway); otherwise
+ * su <= 2^980 perm and U <= 2^-93 perm + 2^-1071 <= 2^-92 perm.
+ *
+ * Together: |det_computed - det| <= gamma8 P + U and
+ * P <= (perm + U) / (1-eps)^8, so the error is at most
+ * gamma8 (1-eps)^-8 perm + 2U <= (8eps + 200 eps^2 + 2^-91) perm.
+ * The computed bound fl(B perm), B = FDT_O3D_ERRBOUND, is at least
+ * B perm (1 - eps) (no underflow: B perm >= 2^-851) = (8eps + 2^-62 - ...)
+ * perm, which exceeds the error by ~2^-62 perm. Hence det_computed > bound
+ * implies det > 0, and det_computed < -bound implies det < 0.
+ */
+static inline int fdt_orient3d_filter(const double *a, const double *b,
+                                      const double *c, const double *d)
+{
+    const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+    const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
+    const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
+    const double vywz = vy * wz, vzwy = vz * wy;
+    const double vzwx = vz * wx, vxwz = vx * wz;
+    const double vxwy = vx * wy, vywx = vy * wx;
+    const double det = ux * (vywz - vzwy) + uy * (vzwx - vxwz) + uz * (vxwy - vywx);
+    const double aux = fabs(ux), auy = fabs(uy), auz = fabs(uz);
+    const double perm = aux * (fabs(vywz) + fabs(vzwy)) + auy * (fabs(vzwx) + fabs(vxwz)) +
+                        auz * (fabs(vxwy) + fabs(vywx));
+    const double su = aux + auy + auz;
+    if (perm >= 0x1p-800 && perm <= DBL_MAX && su * 0x1p-980 <= perm) {
+        const double bound = FDT_O3D_ERRBOUND * perm;
+        /* Branch-free: the sign itself is a coin flip on typical input,
+         * whether it is certain is nearly always yes. */
+        const int s = (det > bound) - (det < -bound);
+        if (s != 0)
+            return s;
+    }
+    return FDT_PRED_UNSURE;
+}
+
+/*
+ * Floating-point filter for insphere: +1 / -1 when that is certainly the
+ * CGAL insphere sign (see the top of this file), FDT_PRED_UNSURE otherwise.
+ *
+ * With A = a-e, B = b-e, C = c-e, D = d-e (rows) and |A|^2 etc.,
+ *   det4 = det[A |A|^2; B |B|^2; C |C|^2; D |D|^2]
+ *        = (|D|^2 abc - |C|^2 dab) + (|B|^2 cda - |A|^2 bcd),
+ * where abc = det[A; B; C] etc. (expanded along the z column from the xy
+ * minors ab = Ax By - Bx Ay, ...). det4 equals the lifted 5x5 determinant
+ * det[p |p|^2 1] (rows a..e), which is positive exactly when e is outside
+ * the sphere of a CGAL-positively oriented (a,b,c,d); so the CGAL sign is
+ * -sign(det4).
+ *
+ * Error bound, in the model of fdt_orient3d_filter. No overflow: perm
+ * mirrors det4's evaluation with |.| (same argument). Rounding: each of
+ * the monomials (a lift square times a z difference times an xy product:
+ * five differences) meets at most 16 roundings: 5 differences, inner
+ * product and difference (2), z product (1), two sums of the 3x3 minor
+ * (2), the square and two sums of the lift (3), the outer product (1) and
+ * two outer sums (2). So |det4_computed - det4| <= gamma16 P and
+ * perm >= (1-eps)^16 P.
+ * Underflow: with M the largest computed |difference| (so each lift <= 4M^2,
+ * each xy minor <= 3M^2, each 3x3 minor <= 10M^3, all up to negligible mu
+ * terms), a product's mu is amplified by at most: 24 inner-product paths
+ * times M (z) times 4M^2 (lift); 12 z-products times 4M^2; 12 squares times
+ * 10M^3 (their 3x3 minor); 4 outer products times 1; with (1+eps)^8 of
+ * rounding: U <= 1.01 eta (216 M^3 + 48 M^2 + 4) <= 2^-1066 (M^4 + 1).
+ * L = sum of the four computed lifts has M^2 <= 1.01 L + 2^-1070, and we
+ * require perm >= 2^-800 and fl(L fl(L 2^-960)) <= perm: an overflow gives
+ * inf and fails; if L < 2^-31 then M < 1 and U <= 2^-1065; otherwise
+ * L 2^-960 is exact, the product is not subnormal, and
+ * L^2 <= (1+eps) 2^960 perm. So U <= 2^-1066 (1.03 * 2^960 perm + 2)
+ * <= 2^-104 perm.
+ * Total error <= (gamma16 (1-eps)^-16 + 2^-102) perm
+ * <= (16 eps + 600 eps^2 + 2^-102) perm, while fl(B perm) with
+ * B = FDT_ISP_ERRBOUND is >= (16eps + 2^-61 - 17 eps^2) perm.
+ */
+static inline int fdt_insphere_filter(const double *a, const double *b,
+                                      const double *c, const double *d,
+                                      const double *e)
+{
+    const double aex = a[0] - e[0], aey = a[1] - e[1], aez = a[2] - e[2];
+    const double bex = b[0] - e[0], bey = b[1] - e[1], bez = b[2] - e[2];
+    const double cex = c[0] - e[0], cey = c[1] - e[1], cez = c[2] - e[2];
+    const double dex = d[0] - e[0], dey = d[1] - e[1], dez = d[2] - e[2];
+
+    const double aexbey = aex * bey, bexaey = bex * aey;
+    const double bexcey = bex * cey, cexbey = cex * bey;
+    const double cexdey = cex * dey, dexcey = dex * cey;
+    const double dexaey = dex * aey, aexdey = aex * dey;
+    const double aexcey = aex * cey, cexaey = cex * aey;
+    const double bexdey = bex * dey, dexbey = dex * bey;
+    const double ab = aexbey - bexaey, bc = bexcey - cexbey;
+    const double cd = cexdey - dexcey, da = dexaey - aexdey;
+    const double ac = aexcey - cexaey, bd = bexdey - dexbey;
+
+    const double abc = aez * bc - bez * ac + cez * ab;
+    const double bcd = bez * cd - cez * bd + dez * bc;
+    const double cda = cez * da + dez * ac + aez * cd;
+    const double dab = dez * ab + aez * bd + bez * da;
+
+    const double alift = aex * aex + aey * aey + aez * aez;
+    const double blift = bex * bex + bey * bey + bez * bez;
+    const double clift = cex * cex + cey * cey + cez * cez;
+    const double dlift = dex * dex + dey * dey + dez * dez;
+
+    const double det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+
+    const double abP = fabs(aexbey) + fabs(bexaey), bcP = fabs(bexcey) + fabs(cexbey);
+    const double cdP = fabs(cexdey) + fabs(dexcey), daP = fabs(dexaey) + fabs(aexdey);
+    const double acP = fabs(aexcey) + fabs(cexaey), bdP = fabs(bexdey) + fabs(dexbey);
+    const double aezP = fabs(aez), bezP = fabs(bez), cezP = fabs(cez), dezP = fabs(dez);
+    const double abcP = aezP * bcP + bezP * acP + cezP * abP;
+    const double bcdP = bezP * cdP + cezP * bdP + dezP * bcP;
+    const double cdaP = cezP * daP + dezP * acP + aezP * cdP;
+    const double dabP = dezP * abP + aezP * bdP + bezP * daP;
+    const double perm = (dlift * abcP + clift * dabP) + (blift * cdaP + alift * bcdP);
+
+    const double lsum = (alift + blift) + (clift + dlift);
+    if (perm >= 0x1p-800 && perm <= DBL_MAX && lsum * (lsum * 0x1p-960) <= perm) {
+        const double bound = FDT_ISP_ERRBOUND * perm;
+        const int s = (det < -bound) - (det > bound);
+        if (s != 0)
+            return s;
+    }
+    return FDT_PRED_UNSURE;
+}
+
+#endif

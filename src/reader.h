@@ -1,0 +1,36 @@
+/*
+ * Point-cloud readers for the CLI and tests (not part of the library API).
+ * Format by extension (case-insensitive): .xyz .txt (x y z per line,
+ * whitespace or commas, '#' comments, exponents), .node (TetGen), .ply
+ * (ascii, binary_little_endian, binary_big_endian; float or double x y z,
+ * other properties and elements skipped).
+ *
+ * Errors name the file and the line (text) or byte offset (binary), e.g.
+ *   "pts.xyz:17: expected 3 numbers, found 2"
+ *   "cloud.ply: byte 1032: file ends inside vertex 40 of 1000"
+ */
+#ifndef FDT_READER_H
+#define FDT_READER_H
+
+#include <stddef.h>
+
+enum {
+    FDT_IO_OK = 0,
+    FDT_IO_EOPEN = -101,   /* missing file, a directory, no permission */
+    FDT_IO_EFORMAT = -102, /* malformed content, NaN/Inf, count mismatch */
+    FDT_IO_ENOMEM = -103,  /* allocation failed */
+    FDT_IO_EWRITE = -104,  /* writing or renaming output failed */
+    FDT_IO_EEXT = -105     /* unknown file extension */
+};
+
+/*
+ * Reads all points of path. On success *xyz is a malloc'd array of 3 * *n
+ * doubles owned by the caller (free()). On failure *xyz is NULL, *n is 0
+ * and err holds a one-line message (NUL-terminated, truncated to errlen).
+ * A header count that the file size cannot hold is refused before any
+ * allocation.
+ */
+int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
+                    size_t errlen);
+
+#endif
