@@ -73,13 +73,23 @@ int fdt_meshbuf_add_hull(fdt_meshbuf *mb, const uint32_t v[3])
     return FDT_OK;
 }
 
+/* Front faces waiting for their apex search, first in first out: the
+ * front then grows as a compact shell around the seed (a LIFO order lets
+ * it wander and grow to about one face per point). Faces completed while
+ * queued stay in the queue and are skipped when they come up. */
 typedef struct facestack {
     uint32_t *v;
-    size_t n, cap;
+    size_t head, n, cap;   /* live entries are [head, n) */
 } facestack;
 
 static int push_face(facestack *fs, const uint32_t v[3])
 {
+    if (fs->n == fs->cap && fs->head >= fs->cap / 2) {
+        /* Slide the live entries down instead of growing. */
+        memmove(fs->v, fs->v + 3 * fs->head, 3 * (fs->n - fs->head) * sizeof *fs->v);
+        fs->n -= fs->head;
+        fs->head = 0;
+    }
     if (fs->n == fs->cap) {
         size_t ncap = fs->cap ? fs->cap * 2 : 4096;
         uint32_t *nv = realloc(fs->v, ncap * 3 * sizeof *nv);
@@ -158,9 +168,8 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
      * tets; the estimate only drives the progress bar. */
     double expect = 6.5 * (double)t->n + 1.0;
     size_t next_report = 1u << 16;
-    while (fs.n > 0) {
-        fs.n--;
-        const uint32_t *fv = fs.v + 3 * fs.n;
+    while (fs.head < fs.n) {
+        const uint32_t *fv = fs.v + 3 * fs.head++;
         fdt_face *s = fdt_facetab_find(&ft, fv);
         /* Faces completed since they were pushed are skipped here rather
          * than searched for in the stack when they complete. */

@@ -284,7 +284,9 @@ void fdt_apex_init(fdt_apex *s, const double *a, const double *b,
  * differences, the two products and the difference in each nrm component,
  * the three products and two sums of the dot product each add at most one
  * relative eps of their permanent term); outside that band its sign is
- * the exact orient3d sign, inside it we ask the exact predicate.
+ * the exact orient3d sign, inside it we ask the exact predicate. Below a
+ * permanent of 2^-800 products may have underflowed and the band itself
+ * may round to zero, so such tiny configurations always go exact.
  */
 static int open_side(const fdt_apex *s, const double *d, fdt_kdq *kq)
 {
@@ -292,10 +294,12 @@ static int open_side(const fdt_apex *s, const double *d, fdt_kdq *kq)
     double v = s->nrm[0] * w0 + s->nrm[1] * w1 + s->nrm[2] * w2;
     double perm = s->nabs[0] * fabs(w0) + s->nabs[1] * fabs(w1) + s->nabs[2] * fabs(w2);
     double tol = perm * 1e-14;
-    if (v > tol)
-        return 1;
-    if (v < -tol)
-        return -1;
+    if (perm >= 0x1p-800) {
+        if (v > tol)
+            return 1;
+        if (v < -tol)
+            return -1;
+    }
     return fdt_orient3d(s->a, s->b, s->c, d, kq ? &kq->pc : NULL);
 }
 

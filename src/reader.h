@@ -8,6 +8,28 @@
  * Errors name the file and the line (text) or byte offset (binary), e.g.
  *   "pts.xyz:17: expected 3 numbers, found 2"
  *   "cloud.ply: byte 1032: file ends inside vertex 40 of 1000"
+ * Lines and vertices are counted from 1; offending tokens are quoted, cut
+ * to 24 bytes, with non-printable bytes as \xHH.
+ *
+ * Details (src/reader.c):
+ * - Text numbers: [+-]? (digits [. digits?] | . digits) ([eE] [+-]? digits)?
+ *   correctly rounded. Rejected: hex floats, nan/inf/infinity (any case),
+ *   literals beyond DBL_MAX, nonzero literals below DBL_MIN (subnormal or
+ *   zero). The locale's decimal point does not matter.
+ * - .xyz/.txt: fields separated by blanks and/or at most one comma (a
+ *   leading, trailing or doubled comma is an error); '#' to end of line is a
+ *   comment; CRLF and a UTF-8 byte order mark are accepted.
+ * - .node: the header may leave out trailing fields as in TetGen (dim 3, 0
+ *   attributes, 0 markers); every data line must have exactly index, x, y,
+ *   z, the attributes and the marker; indices start at 0 or 1 and are
+ *   consecutive; lines beyond the declared count are an error.
+ * - .ply: one item per line in ASCII. Elements before and after "vertex"
+ *   are walked and checked but not kept; the data must end exactly where
+ *   the header's counts say (extra data is an error). x, y, z may be any
+ *   scalar type; ASCII values are taken as written (a "float" property is
+ *   not rounded to binary32); binary NaN/Inf in x, y, z is refused, in
+ *   other properties ignored.
+ * - Never more than INT32_MAX points (fdt_vid).
  */
 #ifndef FDT_READER_H
 #define FDT_READER_H

@@ -1,0 +1,922 @@
+/*
+ * frontdt: the command-line tool. Reads a point cloud (src/reader.h),
+ * triangulates it with the library (include/frontdt.h), optionally checks
+ * the result and writes it (src/writer.h).
+ *
+ * Exit codes (also listed by --help; scripts and tests rely on them):
+ *   0  success
+ *   1  usage error (bad option or value, missing input, a setting the
+ *      library refuses)
+ *   2  bad input: unreadable or malformed file, unknown input extension,
+ *      NaN/Inf, fewer than 4 distinct points, all points coplanar
+ *   3  --check found the mesh is not the Delaunay tetrahedralization
+ *   4  out of resources: memory, index range, threads
+ *   5  cannot write the output (or unknown output extension)
+ *   6  interrupted by SIGINT or SIGTERM (no output, no temporary file left)
+ *   7  internal error (a bug: please report it)
+ *
+ * Everything the tool says goes to stderr with a "frontdt: " prefix, except
+ * the summary and the --hash line, which go to stdout (to stderr when
+ * "--stats-json -" claims stdout for the JSON object alone).
+ */
+#include "frontdt.h"
+#include "reader.h"
+#include "writer.h"
+
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+enum {
+    CLI_OK = 0,
+    CLI_USAGE = 1,
+    CLI_INPUT = 2,
+    CLI_CHECK = 3,
+    CLI_RESOURCES = 4,
+    CLI_WRITE = 5,
+    CLI_SIGNAL = 6,
+    CLI_INTERNAL = 7
+};
+
+#define DEMO_DEFAULT_N 1000000u
+/* Fixed so that "--demo N" is the same point set on every run and host. */
+#define DEMO_SEED UINT64_C(0x5eed0f0f1992)
+
+typedef struct cli {
+    const char *input;      /* NULL with --demo */
+    const char *output;     /* NULL: triangulate and report only */
+    const char *stats_json; /* NULL, a path, or "-" for stdout */
+    fdt_mode mode;
+    int threads;            /* -1: the library's default */
+    int pin, check, stats, hash, quiet;
+    int demo;
+    size_t demo_n;
+} cli;
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+        "Usage: frontdt [options] INPUT [-o OUTPUT]\n"
+        "       frontdt --demo [N] [options] [-o OUTPUT]\n"
+        "Exact 3D Delaunay tetrahedralization by the advancing front.\n"
+        "\n"
+        "INPUT:  .xyz/.txt (x y z per line), .node (TetGen), .ply\n"
+        "OUTPUT: .tets (canonical sorted text), .ele (TetGen .node/.ele/\n"
+        "        .face/.neigh), .vtu (VTK XML, ParaView), .vtk (VTK legacy)\n"
+        "\n"
+        "Options:\n"
+        "  -o, --output FILE      write the mesh (format by extension)\n"
+        "      --mode MODE        serial, shared, message or auto (default)\n"
+        "  -t, --threads N        worker threads (0: one per core)\n"
+        "      --pin              bind thread i to core i\n"
+        "      --check            verify the result exactly (exit 3 if not Delaunay)\n"
+        "      --stats            print statistics to stderr\n"
+        "      --stats-json FILE  write statistics as JSON ('-': stdout)\n"
+        "      --hash             print the canonical hash of the tet set\n"
+        "  -q, --quiet            no summary, no progress, no notes\n"
+        "      --demo [N]         triangulate N random points in the unit cube\n"
+        "                         (fixed seed; default %u)\n"
+        "  -h, --help             this help\n"
+        "  -V, --version          version\n"
+        "\n"
+        "Exit codes:\n"
+        "  0 success             1 usage error        2 bad input\n"
+        "  3 --check failed      4 out of resources   5 cannot write output\n"
+        "  6 interrupted         7 internal error\n",
+        DEMO_DEFAULT_N);
+}
+
+static void say(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("frontdt: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+static int usage_error(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("frontdt: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+    fputs("Try 'frontdt --help' for more information.\n", stderr);
+    return CLI_USAGE;
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Signals                                                                   */
+/* ------------------------------------------------------------------------ */
+
+/*
+ * SIGINT/SIGTERM: remove the temporary (or just renamed, if its file set
+ * is incomplete) output files and leave with exit code 6. Only
+ * async-signal-safe calls here: unlink() inside fdt_io_cleanup_temps(),
+ * write() and _exit().
+ */
+static void on_signal(int sig)
+{
+    (void)sig;
+    fdt_io_cleanup_temps();
+    static const char msg[] = "\nfrontdt: interrupted\n";
+    ssize_t w = write(STDERR_FILENO, msg, sizeof msg - 1);
+    (void)w;
+    _exit(CLI_SIGNAL);
+}
+
+static int install_signals(void)
+{
+    static const int sigs[2] = { SIGINT, SIGTERM };
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    /* One handler at a time: a SIGTERM during SIGINT's cleanup waits. */
+    sigaddset(&sa.sa_mask, SIGINT);
+    sigaddset(&sa.sa_mask, SIGTERM);
+    for (int i = 0; i < 2; i++) {
+        struct sigaction old;
+        if (sigaction(sigs[i], NULL, &old) != 0)
+            return -1;
+        /* A signal ignored at startup stays ignored (the Unix convention:
+         * the shell ignores SIGINT for background jobs, nohup and friends
+         * mean it). */
+        if (old.sa_handler == SIG_IGN)
+            continue;
+        if (sigaction(sigs[i], &sa, NULL) != 0)
+            return -1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Argument parsing                                                          */
+/* ------------------------------------------------------------------------ */
+
+static int all_digits(const char *s)
+{
+    if (!*s)
+        return 0;
+    for (; *s; s++)
+        if (*s < '0' || *s > '9')
+            return 0;
+    return 1;
+}
+
+/* A decimal count: digits only, no sign, no overflow. */
+static int parse_count(const char *s, unsigned long long max,
+                       unsigned long long *v)
+{
+    if (!all_digits(s))
+        return -1;
+    errno = 0;
+    char *end;
+    unsigned long long x = strtoull(s, &end, 10);
+    if (errno || *end || x > max)
+        return -1;
+    *v = x;
+    return 0;
+}
+
+enum {
+    OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH,
+    OPT_DEMO
+};
+
+static const struct option long_opts[] = {
+    { "output", required_argument, NULL, 'o' },
+    { "mode", required_argument, NULL, OPT_MODE },
+    { "threads", required_argument, NULL, 't' },
+    { "pin", no_argument, NULL, OPT_PIN },
+    { "check", no_argument, NULL, OPT_CHECK },
+    { "stats", no_argument, NULL, OPT_STATS },
+    { "stats-json", required_argument, NULL, OPT_STATS_JSON },
+    { "hash", no_argument, NULL, OPT_HASH },
+    { "quiet", no_argument, NULL, 'q' },
+    { "demo", optional_argument, NULL, OPT_DEMO },
+    { "help", no_argument, NULL, 'h' },
+    { "version", no_argument, NULL, 'V' },
+    { NULL, 0, NULL, 0 },
+};
+
+/*
+ * getopt_long's optional_argument only takes "--demo=N"; "--demo N" with a
+ * separate numeric word is rewritten to "--demo=N" before parsing (an
+ * input file named by digits alone cannot be meant with --demo, which
+ * takes no input). Returns a new argv (strings borrowed or owned by
+ * *owned) or NULL when out of memory.
+ */
+static char **rewrite_demo(int argc, char **argv, int *new_argc,
+                           char ***owned, int *n_owned)
+{
+    char **out = calloc((size_t)argc + 1, sizeof *out);
+    char **own = calloc((size_t)argc + 1, sizeof *own);
+    if (!out || !own) {
+        free(out);
+        free(own);
+        return NULL;
+    }
+    int k = 0, no = 0, options_done = 0;
+    for (int i = 0; i < argc; i++) {
+        if (i > 0 && !options_done && strcmp(argv[i], "--") == 0)
+            options_done = 1;
+        if (i > 0 && !options_done && strcmp(argv[i], "--demo") == 0 &&
+            i + 1 < argc && all_digits(argv[i + 1])) {
+            size_t len = strlen(argv[i + 1]) + sizeof "--demo=";
+            char *s = malloc(len);
+            if (!s) {
+                for (int j = 0; j < no; j++)
+                    free(own[j]);
+                free(own);
+                free(out);
+                return NULL;
+            }
+            snprintf(s, len, "--demo=%s", argv[i + 1]);
+            own[no++] = s;
+            out[k++] = s;
+            i++;
+            continue;
+        }
+        out[k++] = argv[i];
+    }
+    out[k] = NULL;
+    *new_argc = k;
+    *owned = own;
+    *n_owned = no;
+    return out;
+}
+
+/* Was the option getopt_long just refused a short one ("-x")? Then
+ * optopt names it; for long ones we quote the word instead. */
+static int short_opt(char **argv, int ind)
+{
+    return optopt > 0 && optopt < 128 && ind > 0 && argv[ind - 1] &&
+           strncmp(argv[ind - 1], "--", 2) != 0;
+}
+
+/* Returns -1 to go on, or an exit code (0 after --help/--version). */
+static int parse_args(int argc, char **argv, cli *c)
+{
+    memset(c, 0, sizeof *c);
+    c->mode = FDT_MODE_AUTO;
+    c->threads = -1;
+    c->demo_n = DEMO_DEFAULT_N;
+    opterr = 0; /* we print our own messages */
+    optind = 1;
+    int ch;
+    unsigned long long v;
+    while ((ch = getopt_long(argc, argv, ":o:t:qhV", long_opts, NULL)) != -1) {
+        switch (ch) {
+        case 'o':
+            if (c->output)
+                return usage_error("-o given twice");
+            if (!*optarg)
+                return usage_error("empty output file name");
+            c->output = optarg;
+            break;
+        case OPT_MODE:
+            if (!strcmp(optarg, "serial"))
+                c->mode = FDT_MODE_SERIAL;
+            else if (!strcmp(optarg, "shared"))
+                c->mode = FDT_MODE_SHARED;
+            else if (!strcmp(optarg, "message"))
+                c->mode = FDT_MODE_MESSAGE;
+            else if (!strcmp(optarg, "auto"))
+                c->mode = FDT_MODE_AUTO;
+            else
+                return usage_error("unknown mode '%s' (serial, shared, "
+                                   "message or auto)", optarg);
+            break;
+        case 't':
+            if (parse_count(optarg, INT_MAX, &v) != 0)
+                return usage_error("--threads wants a count, not '%s'",
+                                   optarg);
+            c->threads = (int)v;
+            break;
+        case OPT_PIN:
+            c->pin = 1;
+            break;
+        case OPT_CHECK:
+            c->check = 1;
+            break;
+        case OPT_STATS:
+            c->stats = 1;
+            break;
+        case OPT_STATS_JSON:
+            if (!*optarg)
+                return usage_error("empty --stats-json file name");
+            c->stats_json = optarg;
+            break;
+        case OPT_HASH:
+            c->hash = 1;
+            break;
+        case 'q':
+            c->quiet = 1;
+            break;
+        case OPT_DEMO:
+            c->demo = 1;
+            if (optarg) {
+                if (parse_count(optarg, SIZE_MAX, &v) != 0)
+                    return usage_error("--demo wants a point count, not '%s'",
+                                       optarg);
+                c->demo_n = (size_t)v;
+            }
+            break;
+        case 'h':
+            usage(stdout);
+            return fflush(stdout) == 0 ? CLI_OK : CLI_WRITE;
+        case 'V':
+            printf("frontdt %s (library %s)\n", FDT_VERSION_STRING,
+                   fdt_version());
+            return fflush(stdout) == 0 ? CLI_OK : CLI_WRITE;
+        case ':':
+            if (short_opt(argv, optind))
+                return usage_error("option -%c needs a value", optopt);
+            return usage_error("option %s needs a value", argv[optind - 1]);
+        case '?':
+        default:
+            if (short_opt(argv, optind))
+                return usage_error("unknown option -%c", optopt);
+            return usage_error("unknown, ambiguous or misused option %s",
+                               argv[optind - 1]);
+        }
+    }
+    int npos = argc - optind;
+    if (c->demo) {
+        if (npos > 0)
+            return usage_error("--demo takes no input file (got '%s')",
+                               argv[optind]);
+    } else {
+        if (npos == 0)
+            return usage_error("no input file");
+        if (npos > 1)
+            return usage_error("one input file only (got '%s' and '%s')",
+                               argv[optind], argv[optind + 1]);
+        c->input = argv[optind];
+    }
+    return -1;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Output pre-checks (before the long computation)                          */
+/* ------------------------------------------------------------------------ */
+
+static int ends_with_ci(const char *s, const char *ext)
+{
+    size_t ls = strlen(s), le = strlen(ext);
+    if (ls <= le || s[ls - le - 1] == '/')
+        return 0;
+    for (size_t i = 0; i < le; i++) {
+        char ch = s[ls - le + i];
+        if (ch >= 'A' && ch <= 'Z')
+            ch = (char)(ch - 'A' + 'a');
+        if (ch != ext[i])
+            return 0;
+    }
+    return 1;
+}
+
+/* The extensions fdt_write_mesh() knows (src/writer.h lists them). */
+static int known_output(const char *path)
+{
+    return ends_with_ci(path, ".tets") || ends_with_ci(path, ".ele") ||
+           ends_with_ci(path, ".vtu") || ends_with_ci(path, ".vtk");
+}
+
+/*
+ * Can a file be created at path? Its directory must exist, be a directory
+ * and be writable; path itself must not be a directory. A cheap early
+ * answer so a doomed run fails in milliseconds rather than after the
+ * triangulation; the writer still checks every step for real.
+ */
+static int output_dir_ok(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    char dir[4096];
+    if (!slash) {
+        strcpy(dir, ".");
+    } else {
+        size_t len = (size_t)(slash - path);
+        if (len == 0)
+            len = 1; /* "/name": the root directory */
+        if (len >= sizeof dir) {
+            say("%s: %s", path, strerror(ENAMETOOLONG));
+            return 0;
+        }
+        memcpy(dir, path, len);
+        dir[len] = '\0';
+    }
+    struct stat st;
+    if (stat(dir, &st) != 0) {
+        say("%s: %s", path, strerror(errno));
+        return 0;
+    }
+    if (!S_ISDIR(st.st_mode)) {
+        say("%s: %s", path, strerror(ENOTDIR));
+        return 0;
+    }
+    if (access(dir, W_OK | X_OK) != 0) {
+        say("%s: %s", path, strerror(errno));
+        return 0;
+    }
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        say("%s: %s", path, strerror(EISDIR));
+        return 0;
+    }
+    return 1;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Demo points                                                               */
+/* ------------------------------------------------------------------------ */
+
+/* splitmix64 (Steele, Lea, Flood 2014): expands the seed into the
+ * xoshiro256** state (Blackman and Vigna 2018), which draws the points. */
+static uint64_t splitmix64(uint64_t *s)
+{
+    uint64_t z = (*s += UINT64_C(0x9e3779b97f4a7c15));
+    z = (z ^ (z >> 30)) * UINT64_C(0xbf58476d1ce4e5b9);
+    z = (z ^ (z >> 27)) * UINT64_C(0x94d049bb133111eb);
+    return z ^ (z >> 31);
+}
+
+static inline uint64_t rotl64(uint64_t x, int k)
+{
+    return (x << k) | (x >> (64 - k));
+}
+
+static inline uint64_t xoshiro_next(uint64_t s[4])
+{
+    uint64_t r = rotl64(s[1] * 5, 7) * 9;
+    uint64_t t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = rotl64(s[3], 45);
+    return r;
+}
+
+/* n points uniform in [0, 1)^3, 53 random bits per coordinate. */
+static double *demo_points(size_t n)
+{
+    if (n > SIZE_MAX / (3 * sizeof(double)))
+        return NULL;
+    double *xyz = malloc(n > 0 ? 3 * n * sizeof *xyz : 1);
+    if (!xyz)
+        return NULL;
+    uint64_t seed = DEMO_SEED, s[4];
+    for (int i = 0; i < 4; i++)
+        s[i] = splitmix64(&seed);
+    for (size_t i = 0; i < 3 * n; i++)
+        xyz[i] = (double)(xoshiro_next(s) >> 11) * 0x1.0p-53;
+    return xyz;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Progress bar                                                              */
+/* ------------------------------------------------------------------------ */
+
+typedef struct progress {
+    double last;  /* time of the last redraw */
+    int drawn;    /* something is on the line */
+} progress;
+
+static int progress_cb(void *user, double fraction)
+{
+    progress *p = user;
+    double t = now_s();
+    /* At most ~10 redraws a second: a terminal is slow, and the engine may
+     * call far more often than anyone can read. */
+    if (p->drawn && t - p->last < 0.1)
+        return 0;
+    if (!(fraction >= 0))
+        fraction = 0;
+    if (fraction > 1)
+        fraction = 1;
+    enum { WIDTH = 40 };
+    char bar[WIDTH + 1];
+    int full = (int)(fraction * WIDTH + 0.5);
+    for (int i = 0; i < WIDTH; i++)
+        bar[i] = i < full ? '#' : '.';
+    bar[WIDTH] = '\0';
+    fprintf(stderr, "\rfrontdt: [%s] %3d%%", bar, (int)(fraction * 100 + 0.5));
+    fflush(stderr);
+    p->last = t;
+    p->drawn = 1;
+    return 0;
+}
+
+static void progress_clear(progress *p)
+{
+    if (p->drawn) {
+        fprintf(stderr, "\r%*s\r", 60, "");
+        fflush(stderr);
+        p->drawn = 0;
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* Error mapping                                                             */
+/* ------------------------------------------------------------------------ */
+
+static int exit_for_engine(int err)
+{
+    switch (err) {
+    case FDT_OK:
+        return CLI_OK;
+    case FDT_EINVAL:
+        return CLI_USAGE;
+    case FDT_EDEGENERATE:
+    case FDT_ERANGE:
+        return CLI_INPUT;
+    case FDT_ENOMEM:
+    case FDT_ETOOBIG:
+    case FDT_ETHREAD:
+        return CLI_RESOURCES;
+    case FDT_ECHECK:
+        return CLI_CHECK;
+    default: /* FDT_EINTERNAL, and FDT_ECANCELED which we never ask for */
+        return CLI_INTERNAL;
+    }
+}
+
+static int exit_for_reader(int err)
+{
+    return err == FDT_IO_ENOMEM ? CLI_RESOURCES : CLI_INPUT;
+}
+
+static int exit_for_writer(int err)
+{
+    switch (err) {
+    case FDT_IO_EWRITE:
+    case FDT_IO_EEXT:
+        return CLI_WRITE;
+    case FDT_IO_ENOMEM:
+        return CLI_RESOURCES;
+    default: /* FDT_IO_EFORMAT: we handed the writer a broken mesh */
+        return CLI_INTERNAL;
+    }
+}
+
+static const char *mode_name(fdt_mode m)
+{
+    switch (m) {
+    case FDT_MODE_SERIAL:
+        return "serial";
+    case FDT_MODE_SHARED:
+        return "shared";
+    case FDT_MODE_MESSAGE:
+        return "message";
+    default:
+        return "auto";
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* Statistics                                                                */
+/* ------------------------------------------------------------------------ */
+
+typedef struct timings {
+    double read, triangulate, check, write;
+} timings;
+
+static void print_stats(const fdt_stats *st, size_t dups, const timings *tm)
+{
+    fprintf(stderr,
+        "frontdt: statistics\n"
+        "  points            %zu\n"
+        "  vertices          %zu (%zu duplicates merged)\n"
+        "  tets              %zu\n"
+        "  hull faces        %zu\n"
+        "  faces advanced    %zu\n"
+        "  kd nodes visited  %zu\n"
+        "  points tested     %zu\n"
+        "  exact orient3d    %zu\n"
+        "  exact insphere    %zu\n"
+        "  largest front     %zu\n"
+        "  threads           %d\n"
+        "  mode              %s\n"
+        "  time prepare      %.3f s\n"
+        "  time front        %.3f s\n"
+        "  time finish       %.3f s\n"
+        "  time read         %.3f s\n"
+        "  time triangulate  %.3f s\n"
+        "  time check        %.3f s\n"
+        "  time write        %.3f s\n",
+        st->points, st->vertices, dups, st->tets, st->hull_faces,
+        st->faces_advanced, st->kd_nodes_visited, st->points_tested,
+        st->exact_orient, st->exact_insphere, st->max_front, st->threads,
+        mode_name(st->mode), st->t_prepare, st->t_front, st->t_finish,
+        tm->read, tm->triangulate, tm->check, tm->write);
+}
+
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\')
+            fprintf(f, "\\%c", *p);
+        else if (*p < 0x20)
+            fprintf(f, "\\u%04x", *p);
+        else
+            fputc(*p, f);
+    }
+    fputc('"', f);
+}
+
+/* JSON numbers cannot be NaN or infinite; times never are, but be safe. */
+static double finite_or_zero(double x)
+{
+    return (x == x && x - x == 0) ? x : 0;
+}
+
+static void write_stats_json(FILE *f, const cli *c, const fdt_stats *st,
+                             size_t dups, const timings *tm, int have_hash,
+                             uint64_t hash)
+{
+    fputs("{\"input\": ", f);
+    if (c->input)
+        json_string(f, c->input);
+    else
+        fputs("null", f);
+    if (c->demo)
+        fprintf(f, ", \"demo\": %zu", c->demo_n);
+    fprintf(f,
+        ", \"points\": %zu, \"vertices\": %zu, \"duplicates\": %zu"
+        ", \"tets\": %zu, \"hull_faces\": %zu, \"faces_advanced\": %zu"
+        ", \"kd_nodes_visited\": %zu, \"points_tested\": %zu"
+        ", \"exact_orient\": %zu, \"exact_insphere\": %zu"
+        ", \"max_front\": %zu, \"threads\": %d, \"mode\": \"%s\""
+        ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
+        ", \"t_read\": %.9g, \"t_triangulate\": %.9g, \"t_check\": %.9g"
+        ", \"t_write\": %.9g",
+        st->points, st->vertices, dups, st->tets, st->hull_faces,
+        st->faces_advanced, st->kd_nodes_visited, st->points_tested,
+        st->exact_orient, st->exact_insphere, st->max_front, st->threads,
+        mode_name(st->mode), finite_or_zero(st->t_prepare),
+        finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
+        finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
+        finite_or_zero(tm->check), finite_or_zero(tm->write));
+    if (c->check)
+        fputs(", \"check\": \"passed\"", f);
+    if (have_hash)
+        fprintf(f, ", \"hash\": \"%016" PRIx64 "\"", hash);
+    fputs("}\n", f);
+}
+
+/* ------------------------------------------------------------------------ */
+/* The run                                                                   */
+/* ------------------------------------------------------------------------ */
+
+static int run(const cli *c)
+{
+    int code = CLI_OK;
+    double *xyz = NULL;
+    size_t n = 0;
+    fdt_context *ctx = NULL;
+    fdt_result *res = NULL;
+    timings tm = { 0, 0, 0, 0 };
+    const char *name = c->input ? c->input : "demo";
+    int json_stdout = c->stats_json && !strcmp(c->stats_json, "-");
+    /* stdout carries the JSON object alone when asked to. */
+    FILE *info = json_stdout ? stderr : stdout;
+
+    /* Refuse doomed outputs before reading or computing anything. */
+    if (c->output) {
+        if (!known_output(c->output)) {
+            say("%s: unknown output format (use .tets, .ele, .vtu or .vtk)",
+                c->output);
+            return CLI_WRITE;
+        }
+        if (!output_dir_ok(c->output))
+            return CLI_WRITE;
+    }
+    if (c->stats_json && !json_stdout && !output_dir_ok(c->stats_json))
+        return CLI_WRITE;
+
+    /* Points. */
+    double t0 = now_s();
+    if (c->demo) {
+        n = c->demo_n;
+        xyz = demo_points(n);
+        if (!xyz) {
+            say("demo: no memory for %zu points", n);
+            return CLI_RESOURCES;
+        }
+    } else {
+        char err[1024];
+        int r = fdt_read_points(c->input, &xyz, &n, err, sizeof err);
+        if (r != FDT_IO_OK) {
+            say("%s", err);
+            return exit_for_reader(r);
+        }
+    }
+    tm.read = now_s() - t0;
+
+    /* Triangulation. */
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = c->mode;
+    if (c->threads >= 0)
+        s.n_threads = c->threads;
+    s.pin = c->pin;
+    s.neighbors = c->check || (c->output && ends_with_ci(c->output, ".ele"));
+    progress prog = { 0, 0 };
+    if (!c->quiet && isatty(STDERR_FILENO)) {
+        s.progress = progress_cb;
+        s.progress_user = &prog;
+    }
+    int r = fdt_open(&ctx, &s);
+    if (r != FDT_OK) {
+        say("cannot use these settings: %s", fdt_strerror(r));
+        code = exit_for_engine(r);
+        goto done;
+    }
+    t0 = now_s();
+    r = fdt_triangulate(ctx, xyz, n, &res);
+    tm.triangulate = now_s() - t0;
+    progress_clear(&prog);
+    if (r != FDT_OK) {
+        const char *diag = fdt_context_diagnostic(ctx);
+        say("%s: %s", name, diag && *diag ? diag : fdt_strerror(r));
+        code = exit_for_engine(r);
+        goto done;
+    }
+    /* No engine threads may outlive this point: the signal handler then
+     * runs on the thread that is writing, never beside it. */
+    fdt_close(&ctx);
+
+    size_t dups = fdt_result_num_duplicates(res);
+    if (dups > 0 && !c->quiet)
+        say("%s: merged %zu duplicate points", name, dups);
+
+    size_t nt = fdt_result_num_tets(res);
+    if (c->check) {
+        char msg[1024];
+        t0 = now_s();
+        r = fdt_check(xyz, n, fdt_result_tets(res), nt,
+                      fdt_result_neighbors(res), msg, sizeof msg);
+        tm.check = now_s() - t0;
+        if (r != FDT_OK) {
+            if (r == FDT_ECHECK)
+                say("%s: check failed: %s", name, msg);
+            else
+                say("%s: check could not run: %s", name, fdt_strerror(r));
+            code = exit_for_engine(r);
+            goto done;
+        }
+    }
+
+    /* The canonical order makes .tets and the hash independent of thread
+     * count and mode; the other formats do not need it. */
+    if (c->hash || (c->output && ends_with_ci(c->output, ".tets"))) {
+        r = fdt_result_sort(res);
+        if (r != FDT_OK) {
+            say("%s: sorting the tets failed: %s", name, fdt_strerror(r));
+            code = exit_for_engine(r);
+            goto done;
+        }
+    }
+    uint64_t hash = 0;
+    if (c->hash) {
+        r = fdt_result_hash(res, &hash);
+        if (r != FDT_OK) {
+            say("%s: hashing the tets failed: %s", name, fdt_strerror(r));
+            code = exit_for_engine(r);
+            goto done;
+        }
+    }
+
+    if (c->output) {
+        fdt_mesh_view v = {
+            .xyz = xyz, .n_points = n, .tets = fdt_result_tets(res),
+            .n_tets = nt, .nbrs = fdt_result_neighbors(res),
+            .hull = fdt_result_hull_faces(res),
+            .n_hull = fdt_result_num_hull_faces(res),
+        };
+        char err[1024];
+        t0 = now_s();
+        r = fdt_write_mesh(c->output, &v, err, sizeof err);
+        tm.write = now_s() - t0;
+        if (r != FDT_IO_OK) {
+            say("%s", err);
+            code = exit_for_writer(r);
+            goto done;
+        }
+    }
+
+    fdt_stats st;
+    memset(&st, 0, sizeof st);
+    r = fdt_result_stats(res, &st);
+    if (r != FDT_OK && (c->stats || c->stats_json)) {
+        say("%s: no statistics: %s", name, fdt_strerror(r));
+        code = exit_for_engine(r);
+        goto done;
+    }
+    if (c->stats)
+        print_stats(&st, dups, &tm);
+    if (c->stats_json) {
+        FILE *f = json_stdout ? stdout : fopen(c->stats_json, "w");
+        if (!f) {
+            say("%s: %s", c->stats_json, strerror(errno));
+            code = CLI_WRITE;
+            goto done;
+        }
+        errno = 0;
+        write_stats_json(f, c, &st, dups, &tm, c->hash, hash);
+        int e = ferror(f) ? (errno ? errno : EIO) : 0;
+        if (json_stdout) {
+            if (fflush(f) != 0 && !e)
+                e = errno ? errno : EIO;
+        } else {
+            if (fclose(f) != 0 && !e)
+                e = errno ? errno : EIO;
+            if (e)
+                unlink(c->stats_json);
+        }
+        if (e) {
+            say("%s: %s", json_stdout ? "stdout" : c->stats_json,
+                strerror(e));
+            code = CLI_WRITE;
+            goto done;
+        }
+    }
+
+    if (c->hash)
+        fprintf(info, "hash: %016" PRIx64 "\n", hash);
+    if (!c->quiet) {
+        size_t nh = fdt_result_num_hull_faces(res);
+        if (c->demo)
+            fprintf(info, "demo: %zu random points in the unit cube\n", n);
+        else
+            fprintf(info, "input: %s\n", c->input);
+        fprintf(info, "points: %zu", n);
+        if (dups)
+            fprintf(info, " (%zu duplicates merged)", dups);
+        fprintf(info, "\ntets: %zu\nhull faces: %zu\n", nt, nh);
+        fprintf(info, "time: %.3f s\n", tm.triangulate);
+        fprintf(info, "tets/s: %.0f\n",
+                tm.triangulate > 0 ? (double)nt / tm.triangulate : 0.0);
+        if (c->check)
+            fprintf(info, "check: passed\n");
+        if (c->output)
+            fprintf(info, "output: %s\n", c->output);
+    }
+    if (fflush(stdout) != 0) {
+        say("stdout: %s", strerror(errno));
+        code = CLI_WRITE;
+    }
+
+done:
+    fdt_result_free(&res);
+    fdt_close(&ctx);
+    free(xyz);
+    return code;
+}
+
+int main(int argc, char **argv)
+{
+    if (install_signals() != 0) {
+        say("cannot install signal handlers: %s", strerror(errno));
+        return CLI_INTERNAL;
+    }
+    int nargc = 0, n_owned = 0;
+    char **owned = NULL;
+    char **nargv = rewrite_demo(argc, argv, &nargc, &owned, &n_owned);
+    if (!nargv) {
+        say("out of memory");
+        return CLI_RESOURCES;
+    }
+    cli c;
+    int code = parse_args(nargc, nargv, &c);
+    if (code < 0)
+        code = run(&c);
+    for (int i = 0; i < n_owned; i++)
+        free(owned[i]);
+    free(owned);
+    free(nargv);
+    return code;
+}

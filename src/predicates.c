@@ -1,0 +1,628 @@
+/*
+ * Exact orient3d / insphere for all finite doubles, and the symbolic
+ * perturbation of Devillers & Teillaud. Sign conventions and the
+ * floating-point filters (stage A, with their error bounds) are in
+ * src/predicates.h. This file holds the two exact stages:
+ *
+ *   stage B: the coordinate differences are exact doubles and every
+ *            intermediate stays clear of underflow and overflow: the
+ *            determinant of the differences is evaluated exactly with
+ *            floating-point expansions (Shewchuk, "Adaptive precision
+ *            floating-point arithmetic and fast robust geometric
+ *            predicates", DCG 18, 1997: Two-Sum, Two-Product,
+ *            Fast-Expansion-Sum, Scale-Expansion and Compress, with zero
+ *            elimination). Scanner data with big offsets lands here: by
+ *            Sterbenz's lemma nearby coordinates subtract exactly.
+ *   stage C: anything else (mixed magnitudes, subnormals, huge values,
+ *            inexact differences): every double is m 2^k with an integer
+ *            |m| < 2^53, so scaling all coordinates by 2^-kmin makes them
+ *            integers, and the determinant is evaluated in GMP integers.
+ *
+ * Both stages compute the same polynomial as the filters, so the sign
+ * conventions carry over unchanged.
+ */
+#include "predicates.h"
+
+#include <float.h>
+#include <gmp.h>
+#include <math.h>
+#include <stdbool.h>
+
+/* Expansion arithmetic needs each operation rounded once to double. */
+#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
+#error "src/predicates.c needs FLT_EVAL_METHOD == 0 (SSE2 doubles, no x87)"
+#endif
+
+/* ------------------------------------------------------------------ */
+/* Error-free transformations (Shewchuk 1997, section 2).
+ *
+ * They are exact in IEEE double arithmetic with round-to-nearest-even
+ * as long as nothing overflows and every exact intermediate is a multiple
+ * of 2^-1074: then each operation's exact result either is a normal number
+ * (rounded as in the unbounded-exponent model the proofs assume) or is a
+ * multiple of 2^-1074 below 2^-1022 with fewer than 53 significant bits,
+ * which both the model and IEEE represent exactly. The stage-B range check
+ * (coords_in_range) guarantees this for every operation below. Two-Sum and
+ * Two-Diff on their own (no products) are exact for all finite inputs
+ * whose sum does not overflow: a sum in the subnormal range is exact. */
+
+/* x + y == a + b exactly, x = fl(a + b) (Knuth's Two-Sum). */
+static inline void two_sum(double a, double b, double *x, double *y)
+{
+    double s = a + b;
+    double bv = s - a;
+    double av = s - bv;
+    double br = b - bv;
+    double ar = a - av;
+    *x = s;
+    *y = ar + br;
+}
+
+/* x + y == a - b exactly, x = fl(a - b). */
+static inline void two_diff(double a, double b, double *x, double *y)
+{
+    double s = a - b;
+    double bv = a - s;
+    double av = s + bv;
+    double br = bv - b;
+    double ar = a - av;
+    *x = s;
+    *y = ar + br;
+}
+
+/* Dekker's Fast-Two-Sum: needs |a| >= |b| (or a == 0). */
+static inline void fast_two_sum(double a, double b, double *x, double *y)
+{
+    double s = a + b;
+    double bv = s - a;
+    *x = s;
+    *y = b - bv;
+}
+
+/* x + y == a * b exactly, x = fl(a * b). With a hardware FMA the error
+ * is one fused operation; without one, Veltkamp's split and Dekker's
+ * product (the compiler cannot contract anything there, having no FMA).
+ * The split multiplies by 2^27 + 1, so |a|, |b| must stay below 2^995;
+ * the stage-B check keeps every operand below 2^800. */
+#if defined(__FP_FAST_FMA)
+static inline void two_product(double a, double b, double *x, double *y)
+{
+    double p = a * b;
+    *x = p;
+    *y = __builtin_fma(a, b, -p);
+}
+#else
+static inline void split(double a, double *hi, double *lo)
+{
+    double c = 0x1.0000002p+27 * a; /* 2^27 + 1 */
+    double abig = c - a;
+    *hi = c - abig;
+    *lo = a - *hi;
+}
+
+static inline void two_product(double a, double b, double *x, double *y)
+{
+    double p = a * b;
+    double ahi, alo, bhi, blo;
+    split(a, &ahi, &alo);
+    split(b, &bhi, &blo);
+    double err1 = p - ahi * bhi;
+    double err2 = err1 - alo * bhi;
+    double err3 = err2 - ahi * blo;
+    *x = p;
+    *y = alo * blo - err3;
+}
+#endif
+
+/* ------------------------------------------------------------------ */
+/* Expansions: arrays of doubles, increasing magnitude, strongly
+ * nonoverlapping (Shewchuk's sense), no zero components; the value is the
+ * exact sum, length 0 means 0, and the sign is that of the last (largest)
+ * component. Two-Sum and Two-Product outputs under round-to-even are
+ * nonadjacent, hence valid two-component expansions once zeros are
+ * dropped; Fast-Expansion-Sum and Scale-Expansion map strongly
+ * nonoverlapping inputs to strongly nonoverlapping outputs (round-to-even),
+ * and dropping zero components preserves that. */
+
+static inline int expansion_sign(const double *e, int n)
+{
+    if (n == 0)
+        return 0;
+    return e[n - 1] > 0.0 ? 1 : -1;
+}
+
+/* h = e + f (Fast-Expansion-Sum with zero elimination): merge the
+ * components by magnitude, then sweep a running sum Q through them,
+ * emitting each rounding error. h may not alias e or f; it needs
+ * elen + flen slots. Returns the length of h. */
+static int expansion_sum(const double *e, int elen, const double *f, int flen, double *h)
+{
+    int i = 0, j = 0, n = 0;
+    const int total = elen + flen;
+    if (total == 0)
+        return 0;
+/* The next component of the merge, smaller magnitudes first. */
+#define NEXT_COMPONENT() \
+    ((j >= flen || (i < elen && fabs(e[i]) <= fabs(f[j]))) ? e[i++] : f[j++])
+    double q = NEXT_COMPONENT();
+    double hh;
+    if (i + j < total) {
+        double g = NEXT_COMPONENT();
+        fast_two_sum(g, q, &q, &hh); /* |g| >= |q| by the merge order */
+        if (hh != 0.0)
+            h[n++] = hh;
+        while (i + j < total) {
+            g = NEXT_COMPONENT();
+            two_sum(q, g, &q, &hh);
+            if (hh != 0.0)
+                h[n++] = hh;
+        }
+    }
+#undef NEXT_COMPONENT
+    if (q != 0.0)
+        h[n++] = q;
+    return n;
+}
+
+/* h = b * e (Scale-Expansion with zero elimination); h needs 2 elen
+ * slots and may not alias e. */
+static int scale_expansion(const double *e, int elen, double b, double *h)
+{
+    int n = 0;
+    if (elen == 0 || b == 0.0)
+        return 0;
+    double q, hh, p1, p0, sum;
+    two_product(e[0], b, &q, &hh);
+    if (hh != 0.0)
+        h[n++] = hh;
+    for (int i = 1; i < elen; i++) {
+        two_product(e[i], b, &p1, &p0);
+        two_sum(q, p0, &sum, &hh);
+        if (hh != 0.0)
+            h[n++] = hh;
+        fast_two_sum(p1, sum, &q, &hh);
+        if (hh != 0.0)
+            h[n++] = hh;
+    }
+    if (q != 0.0)
+        h[n++] = q;
+    return n;
+}
+
+/* h = a b - c d exactly (at most 4 components). */
+static int product_diff(double a, double b, double c, double d, double *h)
+{
+    double p[2], q[2], x, y;
+    int pn = 0, qn = 0;
+    two_product(a, b, &x, &y);
+    if (y != 0.0)
+        p[pn++] = y;
+    if (x != 0.0)
+        p[pn++] = x;
+    two_product(c, d, &x, &y);
+    if (y != 0.0)
+        q[qn++] = -y;
+    if (x != 0.0)
+        q[qn++] = -x;
+    return expansion_sum(p, pn, q, qn, h);
+}
+
+/* ------------------------------------------------------------------ */
+/* Stage B admission.
+ *
+ * All coordinates of the call must be 0 or have magnitude in
+ * [2^-lo, 2^hi]. A nonzero double x >= 2^-lo is a multiple of
+ * ulp(x) >= 2^(-lo-52), so every difference is a multiple of
+ * 2^(-lo-52) and at most 2^(hi+1) in magnitude. The degree-k polynomial
+ * (k = 3 for orient, 5 for insphere) then only involves multiples of
+ * 2^(-k(lo+52)) >= 2^-1074 and values below (a small constant) 2^(k(hi+1)).
+ *   orient3d:  lo = hi = 300: multiples of 2^-1056, values < 2^910;
+ *   insphere:  lo = hi = 150: multiples of 2^-1010, values < 2^770
+ *              (at most 72 monomials of magnitude 2^755 each).
+ * Every operand of a split is a difference, a minor component or an
+ * expansion component, hence below 2^800 < 2^995. */
+static inline bool coords_in_range(const double *p, double lo, double hi)
+{
+    for (int k = 0; k < 3; k++) {
+        double x = fabs(p[k]);
+        if (x != 0.0 && !(x >= lo && x <= hi))
+            return false;
+    }
+    return true;
+}
+
+/* Differences out[k] = fl(p[k] - q[k]); true if all are exact. Two-Diff's
+ * tail is exact for any finite inputs; an overflowed difference gives a
+ * NaN tail, which also reads as inexact. */
+static inline bool exact_diff3(const double *p, const double *q, double *out)
+{
+    bool ok = true;
+    for (int k = 0; k < 3; k++) {
+        double tail;
+        two_diff(p[k], q[k], &out[k], &tail);
+        ok = ok && tail == 0.0;
+    }
+    return ok;
+}
+
+/* ------------------------------------------------------------------ */
+/* Stage C helpers: doubles as scaled GMP integers. */
+
+/* The exponent k of x = m 2^k with |m| < 2^53 an integer (x != 0). */
+static int int_exponent(double x)
+{
+    int k;
+    (void)frexp(x, &k);
+    return k - 53;
+}
+
+static int min_int_exponent(const double *const *pts, int npts)
+{
+    int kmin = 0;
+    bool any = false;
+    for (int i = 0; i < npts; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = pts[i][k];
+            if (x == 0.0)
+                continue;
+            int e = int_exponent(x);
+            if (!any || e < kmin)
+                kmin = e;
+            any = true;
+        }
+    return kmin;
+}
+
+/* z = x 2^-kmin, an integer because kmin <= int_exponent(x). */
+static void mpz_set_scaled(mpz_t z, double x, int kmin)
+{
+    if (x == 0.0) {
+        mpz_set_ui(z, 0);
+        return;
+    }
+    int k;
+    double f = frexp(x, &k);
+    mpz_set_d(z, ldexp(f, 53)); /* an integer below 2^53: exact */
+    mpz_mul_2exp(z, z, (mp_bitcnt_t)(k - 53 - kmin));
+}
+
+/* r = det[u; v; w] for integer rows; t is scratch. */
+static void mpz_det3(mpz_t r, mpz_t *const u, mpz_t *const v, mpz_t *const w, mpz_t t)
+{
+    mpz_mul(t, v[1], w[2]);
+    mpz_submul(t, v[2], w[1]);
+    mpz_mul(r, u[0], t);
+    mpz_mul(t, v[2], w[0]);
+    mpz_submul(t, v[0], w[2]);
+    mpz_addmul(r, u[1], t);
+    mpz_mul(t, v[0], w[1]);
+    mpz_submul(t, v[1], w[0]);
+    mpz_addmul(r, u[2], t);
+}
+
+/* ------------------------------------------------------------------ */
+/* orient3d, exact stages. */
+
+static int orient_stage_b(const double *u, const double *v, const double *w)
+{
+    double mx[4], my[4], mz[4], t0[8], t1[8], t2[8], s01[16], det[24];
+    int nx = product_diff(v[1], w[2], v[2], w[1], mx);
+    int ny = product_diff(v[2], w[0], v[0], w[2], my);
+    int nz = product_diff(v[0], w[1], v[1], w[0], mz);
+    int n0 = scale_expansion(mx, nx, u[0], t0);
+    int n1 = scale_expansion(my, ny, u[1], t1);
+    int n2 = scale_expansion(mz, nz, u[2], t2);
+    int n01 = expansion_sum(t0, n0, t1, n1, s01);
+    int n = expansion_sum(s01, n01, t2, n2, det);
+    return expansion_sign(det, n);
+}
+
+static int orient_stage_c(const double *a, const double *b, const double *c, const double *d)
+{
+    const double *const pts[4] = {a, b, c, d};
+    int kmin = min_int_exponent(pts, 4);
+    mpz_t q[4][3], r, t;
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++) {
+            mpz_init(q[i][k]);
+            mpz_set_scaled(q[i][k], pts[i][k], kmin);
+        }
+    mpz_init(r);
+    mpz_init(t);
+    for (int i = 1; i < 4; i++)
+        for (int k = 0; k < 3; k++)
+            mpz_sub(q[i][k], q[i][k], q[0][k]);
+    mpz_det3(r, q[1], q[2], q[3], t);
+    int s = mpz_sgn(r);
+    mpz_clear(t);
+    mpz_clear(r);
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++)
+            mpz_clear(q[i][k]);
+    return s;
+}
+
+int fdt_orient3d_exact(const double *a, const double *b, const double *c,
+                       const double *d, fdt_pred_counts *cnt)
+{
+    if (cnt)
+        cnt->orient_exact++;
+    double u[3], v[3], w[3];
+    bool exact = exact_diff3(b, a, u);
+    exact = exact_diff3(c, a, v) && exact;
+    exact = exact_diff3(d, a, w) && exact;
+    const double lo = 0x1p-300, hi = 0x1p+300;
+    if (exact && coords_in_range(a, lo, hi) && coords_in_range(b, lo, hi) &&
+        coords_in_range(c, lo, hi) && coords_in_range(d, lo, hi))
+        return orient_stage_b(u, v, w);
+    return orient_stage_c(a, b, c, d);
+}
+
+int fdt_orient3d(const double *a, const double *b, const double *c,
+                 const double *d, fdt_pred_counts *cnt)
+{
+    int s = fdt_orient3d_filter(a, b, c, d);
+    if (s != FDT_PRED_UNSURE)
+        return s;
+    return fdt_orient3d_exact(a, b, c, d, cnt);
+}
+
+/* ------------------------------------------------------------------ */
+/* insphere, exact stages. */
+
+/* m = x1 e1 + x2 e2 + x3 e3 for 4-component expansions e_i (24 slots). */
+static int combo3(double x1, const double *e1, int n1, double x2, const double *e2, int n2,
+                  double x3, const double *e3, int n3, double *m)
+{
+    double t1[8], t2[8], t3[8], s[16];
+    int m1 = scale_expansion(e1, n1, x1, t1);
+    int m2 = scale_expansion(e2, n2, x2, t2);
+    int m3 = scale_expansion(e3, n3, x3, t3);
+    int ns = expansion_sum(t1, m1, t2, m2, s);
+    return expansion_sum(s, ns, t3, m3, m);
+}
+
+/* |p|^2 as an expansion (6 slots). */
+static int square_norm(const double *p, double *h)
+{
+    double s[3][2], t[4];
+    int n[3];
+    for (int k = 0; k < 3; k++) {
+        double x, y;
+        two_product(p[k], p[k], &x, &y);
+        n[k] = 0;
+        if (y != 0.0)
+            s[k][n[k]++] = y;
+        if (x != 0.0)
+            s[k][n[k]++] = x;
+    }
+    int nt = expansion_sum(s[0], n[0], s[1], n[1], t);
+    return expansion_sum(t, nt, s[2], n[2], h);
+}
+
+/*
+ * Shewchuk's Compress, in place: the same value with few components.
+ * A top-down Fast-Two-Sum sweep gathers the bits into large components;
+ * a bottom-up sweep makes the result nonadjacent again (round-to-even),
+ * hence valid input for expansion_sum. No zero components remain. The
+ * products below would otherwise multiply component counts; after Compress
+ * a degree-k value of 53-bit data has about k components. n <= 24.
+ */
+static int compress(double *e, int n)
+{
+    if (n <= 1)
+        return n;
+    double g[24];
+    int bottom = n - 1;
+    double q = e[n - 1], qq;
+    for (int i = n - 2; i >= 0; i--) {
+        fast_two_sum(q, e[i], &q, &qq);
+        if (qq != 0.0) {
+            g[bottom--] = q;
+            q = qq;
+        }
+    }
+    g[bottom] = q;
+    int top = 0;
+    for (int i = bottom + 1; i < n; i++) {
+        fast_two_sum(g[i], q, &q, &qq);
+        if (qq != 0.0)
+            e[top++] = qq;
+    }
+    if (q != 0.0)
+        e[top++] = q;
+    return top;
+}
+
+/* h = e * f (scale e by each component of f and add up); h needs
+ * 2 elen flen slots, at most 288 here (elen <= 24, flen <= 6). */
+static int expansion_product(const double *e, int elen, const double *f, int flen, double *h)
+{
+    double t[48], acc[2][288];
+    int n = 0, cur = 0;
+    for (int i = 0; i < flen; i++) {
+        int nt = scale_expansion(e, elen, f[i], t);
+        double *dst = i == flen - 1 ? h : acc[cur ^ 1];
+        n = expansion_sum(acc[cur], n, t, nt, dst);
+        cur ^= 1;
+    }
+    return n; /* the last round wrote h (flen == 0: h is empty) */
+}
+
+/* The CGAL insphere sign from exact differences A..D (relative to e):
+ * -sign det4, det4 as in fdt_insphere_filter. */
+static int insphere_stage_b(const double *A, const double *B, const double *C, const double *D)
+{
+    double ab[4], bc[4], cd[4], da[4], ac[4], bd[4];
+    int nab = product_diff(A[0], B[1], B[0], A[1], ab);
+    int nbc = product_diff(B[0], C[1], C[0], B[1], bc);
+    int ncd = product_diff(C[0], D[1], D[0], C[1], cd);
+    int nda = product_diff(D[0], A[1], A[0], D[1], da);
+    int nac = product_diff(A[0], C[1], C[0], A[1], ac);
+    int nbd = product_diff(B[0], D[1], D[0], B[1], bd);
+
+    /* The 3x3 minors, negated where det4 subtracts them:
+     * det4 = |D|^2 abc + |C|^2 (-dab) + |B|^2 cda + |A|^2 (-bcd). */
+    double m3[4][24];
+    int n3[4];
+    n3[0] = combo3(A[2], bc, nbc, -B[2], ac, nac, C[2], ab, nab, m3[0]);      /* abc */
+    n3[1] = combo3(-D[2], ab, nab, -A[2], bd, nbd, -B[2], da, nda, m3[1]);    /* -dab */
+    n3[2] = combo3(C[2], da, nda, D[2], ac, nac, A[2], cd, ncd, m3[2]);       /* cda */
+    n3[3] = combo3(-B[2], cd, ncd, C[2], bd, nbd, -D[2], bc, nbc, m3[3]);     /* -bcd */
+    const double *const lifted[4] = {D, C, B, A};
+
+    double acc[2][1152], lift[6], term[288];
+    int n = 0, cur = 0;
+    for (int i = 0; i < 4; i++) {
+        int nl = compress(lift, square_norm(lifted[i], lift));
+        int nm = compress(m3[i], n3[i]);
+        int nt = expansion_product(m3[i], nm, lift, nl, term);
+        n = expansion_sum(acc[cur], n, term, nt, acc[cur ^ 1]);
+        cur ^= 1;
+    }
+    return -expansion_sign(acc[cur], n);
+}
+
+static int insphere_stage_c(const double *a, const double *b, const double *c,
+                            const double *d, const double *e)
+{
+    const double *const pts[5] = {a, b, c, d, e};
+    int kmin = min_int_exponent(pts, 5);
+    mpz_t q[5][3], m3, lift, det, t;
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++) {
+            mpz_init(q[i][k]);
+            mpz_set_scaled(q[i][k], pts[i][k], kmin);
+        }
+    mpz_inits(m3, lift, det, t, NULL);
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++)
+            mpz_sub(q[i][k], q[i][k], q[4][k]);
+    /* det4 = sum over rows i of (-1)^(i+1) |P_i|^2 det3(other rows), the
+     * expansion along the lift column (rows A, B, C, D = 0..3). */
+    mpz_set_ui(det, 0);
+    for (int i = 0; i < 4; i++) {
+        mpz_t *rows[3];
+        for (int j = 0, r = 0; j < 4; j++)
+            if (j != i)
+                rows[r++] = q[j];
+        mpz_det3(m3, rows[0], rows[1], rows[2], t);
+        mpz_mul(lift, q[i][0], q[i][0]);
+        mpz_addmul(lift, q[i][1], q[i][1]);
+        mpz_addmul(lift, q[i][2], q[i][2]);
+        if (i % 2 == 0)
+            mpz_submul(det, lift, m3);
+        else
+            mpz_addmul(det, lift, m3);
+    }
+    int s = -mpz_sgn(det);
+    mpz_clears(m3, lift, det, t, NULL);
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            mpz_clear(q[i][k]);
+    return s;
+}
+
+int fdt_insphere_exact(const double *a, const double *b, const double *c,
+                       const double *d, const double *e, fdt_pred_counts *cnt)
+{
+    if (cnt)
+        cnt->insphere_exact++;
+    double A[3], B[3], C[3], D[3];
+    bool exact = exact_diff3(a, e, A);
+    exact = exact_diff3(b, e, B) && exact;
+    exact = exact_diff3(c, e, C) && exact;
+    exact = exact_diff3(d, e, D) && exact;
+    const double lo = 0x1p-150, hi = 0x1p+150;
+    if (exact && coords_in_range(a, lo, hi) && coords_in_range(b, lo, hi) &&
+        coords_in_range(c, lo, hi) && coords_in_range(d, lo, hi) &&
+        coords_in_range(e, lo, hi))
+        return insphere_stage_b(A, B, C, D);
+    return insphere_stage_c(a, b, c, d, e);
+}
+
+int fdt_insphere(const double *a, const double *b, const double *c,
+                 const double *d, const double *e, fdt_pred_counts *cnt)
+{
+    int s = fdt_insphere_filter(a, b, c, d, e);
+    if (s != FDT_PRED_UNSURE)
+        return s;
+    return fdt_insphere_exact(a, b, c, d, e, cnt);
+}
+
+/* ------------------------------------------------------------------ */
+
+int fdt_lex_compare(const double *p, const double *q)
+{
+    for (int k = 0; k < 3; k++) {
+        if (p[k] < q[k])
+            return -1;
+        if (p[k] > q[k])
+            return 1;
+    }
+    return 0;
+}
+
+/*
+ * The symbolic tie-break of the perturbed insphere, for five pairwise
+ * distinct points with (a,b,c,d) positively oriented and e exactly on
+ * their sphere.
+ *
+ * Devillers & Teillaud lift each point p to |p|^2 + eps_p, with eps_p
+ * infinitely larger for lexicographically larger p. The lifted 5x5
+ * determinant is linear in each eps_p, so once its constant term (the
+ * unperturbed insphere) vanishes, its sign is that of the coefficient of
+ * the largest eps_p that is nonzero, taken in decreasing lexicographic
+ * order of p. That coefficient is, in CGAL's sign convention:
+ *   p == e:            -1 (it is -orient(a,b,c,d), and (a,b,c,d) is
+ *                      positive): e is outside;
+ *   p one of a,b,c,d:  orient3d of (a,b,c,d) with p replaced by e in its
+ *                      position.
+ * This is CGAL's Delaunay_triangulation_3::side_of_oriented_sphere with
+ * perturb=true.
+ *
+ * Termination: the first two points examined cannot both give 0. If the
+ * largest is e we stop at once. Otherwise, if both of the first two are
+ * among a,b,c,d (say p and p'), two zero orientations put e on both planes
+ * spanned by the other two points with p' and with p; those planes are
+ * distinct (a,b,c,d are not coplanar) and meet in the line through the two
+ * remaining points, which meets the sphere only in those two points; e,
+ * on the sphere, would equal one of them. If the second is e we stop
+ * there. So the final return is unreachable under the precondition.
+ */
+static int insphere_tiebreak(const double *a, const double *b, const double *c,
+                             const double *d, const double *e, fdt_pred_counts *cnt)
+{
+    const double *p[5] = {a, b, c, d, e};
+    int order[5] = {0, 1, 2, 3, 4};
+    /* Insertion sort, lexicographically decreasing. */
+    for (int i = 1; i < 5; i++) {
+        int x = order[i], j = i;
+        while (j > 0 && fdt_lex_compare(p[order[j - 1]], p[x]) < 0) {
+            order[j] = order[j - 1];
+            j--;
+        }
+        order[j] = x;
+    }
+    for (int r = 0; r < 5; r++) {
+        int i = order[r];
+        if (i == 4)
+            return -1;
+        const double *q[4] = {a, b, c, d};
+        q[i] = e;
+        int o = fdt_orient3d(q[0], q[1], q[2], q[3], cnt);
+        if (o != 0)
+            return o;
+    }
+    return -1; /* unreachable under the precondition (see above) */
+}
+
+int fdt_insphere_perturbed(const double *a, const double *b, const double *c,
+                           const double *d, const double *e,
+                           fdt_pred_counts *cnt)
+{
+    int s = fdt_insphere(a, b, c, d, e, cnt);
+    if (s != 0)
+        return s;
+    return insphere_tiebreak(a, b, c, d, e, cnt);
+}

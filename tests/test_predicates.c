@@ -1,0 +1,1018 @@
+/*
+ * Tests for src/predicates.c.
+ *
+ * The reference here shares no code with src/predicates.c and uses a
+ * different method: every input double is taken exactly as a GMP rational,
+ * the lifted determinants
+ *   orient:   det[p 1]           (4x4, rows a..d)
+ *   insphere: det[p |p|^2 1]     (5x5, rows a..e)
+ * are built from the raw coordinates, each column is scaled to integers by
+ * the lcm of its denominators (a positive factor: signs unchanged) and the
+ * determinant is evaluated by Bareiss elimination. Sign conventions (CGAL):
+ *   orient3d = sign det[b-a; c-a; d-a] = -sign det[p 1]
+ *     (subtract row a from the others, expand along the ones column);
+ *   insphere = -sign det[p |p|^2 1]
+ *     (the 5x5 equals det[p-e |p-e|^2] over a..d, which is positive when e
+ *     is outside the sphere of a positively oriented tet; checked below on
+ *     a concrete tetrahedron).
+ * The perturbed reference lifts p to |p|^2 + eps_p with eps_p infinitely
+ * larger for lexicographically larger p; the determinant is linear in each
+ * eps_p, so its sign is that of the first nonzero among the constant term
+ * and the eps_p coefficients (the cofactors of the lift column), largest
+ * p first.
+ *
+ * Families: random; nearly coplanar and nearly cospherical (nudged by a
+ * few ulps with nextafter); integer lattices and cospherical integer
+ * points (exact degeneracies); big offsets (4.9e6 + k 2.5e-4); magnitudes
+ * near 1e-150 and 1e150; mixed magnitudes 1e-300 .. 1e300; subnormals;
+ * differences that overflow. Each case checks fdt_orient3d / fdt_insphere
+ * and the exact stages alone against the reference, and that every zero
+ * answer was counted as leaving the filter.
+ *
+ * Perturbation: the reference on degenerate sets, invariance under the 12
+ * even permutations of (a,b,c,d) and under translations and positive
+ * scalings, the sign convention (lexicographically largest query is
+ * outside), and that the perturbed-empty tets of 5 cospherical points
+ * triangulate their hull.
+ *
+ * Ends with a micro-benchmark (ns per call), printed, not checked.
+ * Usage: test_predicates [seed [scale [verbose]]]; scale multiplies the
+ * case counts (e.g. 0.05 under valgrind, 10 for a long run).
+ */
+#include "predicates.h"
+
+#include <gmp.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* ------------------------------------------------------------------ */
+/* Context: RNG, reference workspace, failure count. */
+
+typedef struct tctx {
+    uint64_t rng;
+    long failures;
+    long checks;
+    mpq_t q[5][5];   /* the rational matrix */
+    mpz_t z[5][5];   /* its integer-scaled copy */
+    mpz_t l, t, prev;
+    fdt_pred_counts cnt;
+} tctx;
+
+static void fail_at(tctx *T, const char *what, int line)
+{
+    T->failures++;
+    if (T->failures <= 30)
+        fprintf(stderr, "test_predicates.c:%d: FAILED: %s\n", line, what);
+}
+
+#define CHECK(T, cond)                        \
+    do {                                      \
+        (T)->checks++;                        \
+        if (!(cond))                          \
+            fail_at((T), #cond, __LINE__);    \
+    } while (0)
+
+static uint64_t next_u64(tctx *T)
+{
+    uint64_t z = (T->rng += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+/* Uniform in [0, 1). */
+static double unif(tctx *T)
+{
+    return (double)(next_u64(T) >> 11) * 0x1p-53;
+}
+
+/* Uniform in [-1, 1). */
+static double sunif(tctx *T)
+{
+    return 2.0 * unif(T) - 1.0;
+}
+
+/* Uniform integer in [lo, hi]. */
+static long irand(tctx *T, long lo, long hi)
+{
+    return lo + (long)(next_u64(T) % (uint64_t)(hi - lo + 1));
+}
+
+/* x moved by k ulps (k < 0: down). */
+static double nudge(double x, int k)
+{
+    for (; k > 0; k--)
+        x = nextafter(x, INFINITY);
+    for (; k < 0; k++)
+        x = nextafter(x, -INFINITY);
+    return x;
+}
+
+static void print_pts(const double (*p)[3], int n)
+{
+    for (int i = 0; i < n; i++)
+        fprintf(stderr, "  (%a, %a, %a)\n", p[i][0], p[i][1], p[i][2]);
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ------------------------------------------------------------------ */
+/* Reference: exact determinants of the lifted matrices. */
+
+/* Sign of det of the n x n rational matrix T->q (n <= 5). */
+static int ref_det_sign(tctx *T, int n)
+{
+    /* Scale each column by the lcm of its denominators. */
+    for (int j = 0; j < n; j++) {
+        mpz_set_ui(T->l, 1);
+        for (int i = 0; i < n; i++)
+            mpz_lcm(T->l, T->l, mpq_denref(T->q[i][j]));
+        for (int i = 0; i < n; i++) {
+            mpz_divexact(T->t, T->l, mpq_denref(T->q[i][j]));
+            mpz_mul(T->z[i][j], mpq_numref(T->q[i][j]), T->t);
+        }
+    }
+    /* Bareiss fraction-free elimination with row pivoting. */
+    int sign = 1;
+    mpz_set_ui(T->prev, 1);
+    for (int k = 0; k < n - 1; k++) {
+        if (mpz_sgn(T->z[k][k]) == 0) {
+            int p = -1;
+            for (int i = k + 1; i < n; i++)
+                if (mpz_sgn(T->z[i][k]) != 0) {
+                    p = i;
+                    break;
+                }
+            if (p < 0)
+                return 0;
+            for (int j = 0; j < n; j++)
+                mpz_swap(T->z[k][j], T->z[p][j]);
+            sign = -sign;
+        }
+        for (int i = k + 1; i < n; i++) {
+            for (int j = k + 1; j < n; j++) {
+                mpz_mul(T->t, T->z[i][j], T->z[k][k]);
+                mpz_submul(T->t, T->z[i][k], T->z[k][j]);
+                mpz_divexact(T->z[i][j], T->t, T->prev);
+            }
+        }
+        mpz_set(T->prev, T->z[k][k]);
+    }
+    return sign * mpz_sgn(T->z[n - 1][n - 1]);
+}
+
+/* Row i of T->q: (x, y, z, [|p|^2,] 1). */
+static void ref_row(tctx *T, int i, const double *p, int lifted)
+{
+    for (int k = 0; k < 3; k++)
+        mpq_set_d(T->q[i][k], p[k]);
+    if (lifted) {
+        mpq_t s;
+        mpq_init(s);
+        mpq_set_ui(T->q[i][3], 0, 1);
+        for (int k = 0; k < 3; k++) {
+            mpq_mul(s, T->q[i][k], T->q[i][k]);
+            mpq_add(T->q[i][3], T->q[i][3], s);
+        }
+        mpq_clear(s);
+        mpq_set_ui(T->q[i][4], 1, 1);
+    } else {
+        mpq_set_ui(T->q[i][3], 1, 1);
+    }
+}
+
+static int ref_orient(tctx *T, const double *a, const double *b, const double *c, const double *d)
+{
+    const double *p[4] = {a, b, c, d};
+    for (int i = 0; i < 4; i++)
+        ref_row(T, i, p[i], 0);
+    return -ref_det_sign(T, 4);
+}
+
+static int ref_insphere(tctx *T, const double *a, const double *b, const double *c,
+                        const double *d, const double *e)
+{
+    const double *p[5] = {a, b, c, d, e};
+    for (int i = 0; i < 5; i++)
+        ref_row(T, i, p[i], 1);
+    return -ref_det_sign(T, 5);
+}
+
+/* The test's own lexicographic order (not fdt_lex_compare). */
+static int lex_greater(const double *p, const double *q)
+{
+    if (p[0] != q[0])
+        return p[0] > q[0];
+    if (p[1] != q[1])
+        return p[1] > q[1];
+    return p[2] > q[2];
+}
+
+/*
+ * Perturbed insphere from the symbolic lifted determinant
+ * det[p  |p|^2 + eps_p  1] = det0 + sum_p eps_p C_p,
+ * C_p = (-1)^(i+3) det[q 1] over the other four points q (row i of p,
+ * lift column 3, both 0-based). Returns 0 if every coefficient vanishes
+ * (impossible for distinct points with (a,b,c,d) not coplanar).
+ */
+static int ref_insphere_perturbed(tctx *T, const double *a, const double *b, const double *c,
+                                  const double *d, const double *e)
+{
+    const double *p[5] = {a, b, c, d, e};
+    int s = ref_insphere(T, a, b, c, d, e);
+    if (s != 0)
+        return s;
+    int used[5] = {0, 0, 0, 0, 0};
+    for (int r = 0; r < 5; r++) {
+        int best = -1;
+        for (int i = 0; i < 5; i++)
+            if (!used[i] && (best < 0 || lex_greater(p[i], p[best])))
+                best = i;
+        used[best] = 1;
+        for (int i = 0, row = 0; i < 5; i++)
+            if (i != best)
+                ref_row(T, row++, p[i], 0);
+        int cof = ref_det_sign(T, 4) * ((best + 3) % 2 == 0 ? 1 : -1);
+        if (cof != 0)
+            return -cof;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------ */
+/* Checks against the reference. */
+
+static void check_orient(tctx *T, const double *a, const double *b, const double *c,
+                         const double *d, const char *family)
+{
+    int ref = ref_orient(T, a, b, c, d);
+    size_t before = T->cnt.orient_exact;
+    int got = fdt_orient3d(a, b, c, d, &T->cnt);
+    int counted = T->cnt.orient_exact != before;
+    int ex = fdt_orient3d_exact(a, b, c, d, NULL);
+    int f = fdt_orient3d_filter(a, b, c, d);
+    T->checks += 3;
+    if (got != ref || ex != ref || (f != FDT_PRED_UNSURE && f != ref) || (got == 0 && !counted)) {
+        T->failures++;
+        if (T->failures <= 30) {
+            fprintf(stderr, "orient3d mismatch [%s]: ref %d got %d exact %d filter %d counted %d\n",
+                    family, ref, got, ex, f, counted);
+            const double pts[4][3] = {{a[0], a[1], a[2]}, {b[0], b[1], b[2]},
+                                      {c[0], c[1], c[2]}, {d[0], d[1], d[2]}};
+            print_pts(pts, 4);
+        }
+    }
+}
+
+static void check_insphere(tctx *T, const double *a, const double *b, const double *c,
+                           const double *d, const double *e, const char *family)
+{
+    int ref = ref_insphere(T, a, b, c, d, e);
+    size_t before = T->cnt.insphere_exact;
+    int got = fdt_insphere(a, b, c, d, e, &T->cnt);
+    int counted = T->cnt.insphere_exact != before;
+    int ex = fdt_insphere_exact(a, b, c, d, e, NULL);
+    int f = fdt_insphere_filter(a, b, c, d, e);
+    T->checks += 3;
+    if (got != ref || ex != ref || (f != FDT_PRED_UNSURE && f != ref) || (got == 0 && !counted)) {
+        T->failures++;
+        if (T->failures <= 30) {
+            fprintf(stderr, "insphere mismatch [%s]: ref %d got %d exact %d filter %d counted %d\n",
+                    family, ref, got, ex, f, counted);
+            const double pts[5][3] = {{a[0], a[1], a[2]}, {b[0], b[1], b[2]},
+                                      {c[0], c[1], c[2]}, {d[0], d[1], d[2]},
+                                      {e[0], e[1], e[2]}};
+            print_pts(pts, 5);
+        }
+    }
+}
+
+/* Checks orient3d on (a,b,c,d) and (b,c,d,e), insphere on all five. */
+static void check_five(tctx *T, double (*p)[3], const char *family)
+{
+    check_orient(T, p[0], p[1], p[2], p[3], family);
+    check_orient(T, p[1], p[2], p[3], p[4], family);
+    check_insphere(T, p[0], p[1], p[2], p[3], p[4], family);
+}
+
+/* ------------------------------------------------------------------ */
+/* Generators. Each fills five points. */
+
+static void gen_random(tctx *T, double (*p)[3])
+{
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            p[i][k] = sunif(T);
+}
+
+/* d and e on the plane of a, b, c (computed in floating point, so only
+ * nearly), then nudged by up to 2 ulps per coordinate. */
+static void gen_near_coplanar(tctx *T, double (*p)[3])
+{
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            p[i][k] = sunif(T);
+    for (int i = 3; i < 5; i++) {
+        double s = 3.0 * unif(T) - 1.0, t = 3.0 * unif(T) - 1.0;
+        for (int k = 0; k < 3; k++)
+            p[i][k] = nudge(p[0][k] + s * (p[1][k] - p[0][k]) + t * (p[2][k] - p[0][k]),
+                            (int)irand(T, -2, 2));
+    }
+}
+
+/* Five points on a sphere (computed in floating point), the last nudged. */
+static void gen_near_cospherical(tctx *T, double (*p)[3], double offset)
+{
+    double ctr[3], r = 0.1 + unif(T);
+    for (int k = 0; k < 3; k++)
+        ctr[k] = offset + sunif(T);
+    for (int i = 0; i < 5; i++) {
+        double v[3], n2;
+        do {
+            for (int k = 0; k < 3; k++)
+                v[k] = sunif(T);
+            n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        } while (n2 < 0.01 || n2 > 1.0);
+        double s = r / sqrt(n2);
+        for (int k = 0; k < 3; k++)
+            p[i][k] = ctr[k] + s * v[k];
+    }
+    for (int k = 0; k < 3; k++)
+        p[4][k] = nudge(p[4][k], (int)irand(T, -3, 3));
+}
+
+static void gen_lattice(tctx *T, double (*p)[3], long n)
+{
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            p[i][k] = (double)irand(T, -n, n);
+}
+
+/* Integer points on spheres x^2 + y^2 + z^2 = r2. */
+typedef struct sphere_set {
+    int n;
+    int pt[200][3];
+} sphere_set;
+
+static void make_sphere(sphere_set *S, int r2)
+{
+    S->n = 0;
+    int r = (int)sqrt((double)r2) + 1;
+    for (int x = -r; x <= r; x++)
+        for (int y = -r; y <= r; y++)
+            for (int z = -r; z <= r; z++)
+                if (x * x + y * y + z * z == r2 && S->n < 200) {
+                    S->pt[S->n][0] = x;
+                    S->pt[S->n][1] = y;
+                    S->pt[S->n][2] = z;
+                    S->n++;
+                }
+}
+
+/* Five distinct points of S, mapped by x -> (x + shift) * 2^e. */
+static void gen_cospherical(tctx *T, const sphere_set *S, double (*p)[3], const double *shift,
+                            int e)
+{
+    int idx[5];
+    for (int i = 0; i < 5; i++) {
+        int again;
+        do {
+            idx[i] = (int)irand(T, 0, S->n - 1);
+            again = 0;
+            for (int j = 0; j < i; j++)
+                again |= idx[j] == idx[i];
+        } while (again);
+        for (int k = 0; k < 3; k++)
+            p[i][k] = ldexp((double)S->pt[idx[i]][k] + shift[k], e);
+    }
+}
+
+/* Big offsets as in scanner data: 4.9e6 + k * 2.5e-4. */
+static void gen_offset(tctx *T, double (*p)[3], long kmax)
+{
+    static const double base[3] = {4.9e6, 5.6e6, 120.0};
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            p[i][k] = base[k] + (double)irand(T, -kmax, kmax) * 2.5e-4;
+}
+
+/* Each coordinate a random value times 10^(one of -300 .. 300). */
+static void gen_mixed(tctx *T, double (*p)[3])
+{
+    static const double mag[] = {1e-300, 1e-200, 1e-150, 1e-20, 1.0, 1e20, 1e150, 1e200, 1e300};
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            p[i][k] = sunif(T) * mag[irand(T, 0, 8)];
+}
+
+/* Subnormal coordinates, sometimes next to 1e-300 or 1. */
+static void gen_subnormal(tctx *T, double (*p)[3])
+{
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++) {
+            long r = irand(T, 0, 9);
+            if (r < 7)
+                p[i][k] = ldexp((double)irand(T, -40, 40), -1074);
+            else if (r < 9)
+                p[i][k] = sunif(T) * 1e-300;
+            else
+                p[i][k] = sunif(T);
+        }
+}
+
+/* Near DBL_MAX: differences overflow. */
+static void gen_huge(tctx *T, double (*p)[3])
+{
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            p[i][k] = (irand(T, 0, 1) ? 1.0 : -1.0) * (0.5 + 0.5 * unif(T)) * DBL_MAX;
+}
+
+static void scale_all(double (*p)[3], double s)
+{
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            p[i][k] *= s;
+}
+
+/* ------------------------------------------------------------------ */
+
+static void test_conventions(tctx *T)
+{
+    const double o[3] = {0, 0, 0}, x[3] = {1, 0, 0}, y[3] = {0, 1, 0}, z[3] = {0, 0, 1};
+    const double in[3] = {0.25, 0.25, 0.25}, out[3] = {5, 5, 5};
+    const double on[3] = {1, 1, 0}; /* on the sphere through o, x, y, z */
+    CHECK(T, fdt_orient3d(o, x, y, z, NULL) == 1);
+    CHECK(T, fdt_orient3d(o, y, x, z, NULL) == -1);
+    CHECK(T, fdt_orient3d(o, x, y, on, NULL) == 0);
+    CHECK(T, ref_orient(T, o, x, y, z) == 1);
+    CHECK(T, fdt_insphere(o, x, y, z, in, NULL) == 1);
+    CHECK(T, fdt_insphere(o, x, y, z, out, NULL) == -1);
+    CHECK(T, fdt_insphere(o, x, y, z, on, NULL) == 0);
+    CHECK(T, ref_insphere(T, o, x, y, z, in) == 1);
+    CHECK(T, ref_insphere(T, o, x, y, z, out) == -1);
+    CHECK(T, fdt_insphere_perturbed(o, x, y, z, in, NULL) == 1);
+    CHECK(T, fdt_insphere_perturbed(o, x, y, z, out, NULL) == -1);
+    /* (1,1,0) is the lexicographic maximum of the five: outside. */
+    CHECK(T, fdt_insphere_perturbed(o, x, y, z, on, NULL) == -1);
+    /* (0,1,1) is on the sphere too; x = (1,0,0) is the largest point, but
+     * replacing it gives (o, on2, y, z), all in the plane x = 0: orientation
+     * 0. The next largest is the query itself: outside. */
+    const double on2[3] = {0, 1, 1};
+    CHECK(T, fdt_insphere(o, x, y, z, on2, NULL) == 0);
+    CHECK(T, fdt_orient3d(o, on2, y, z, NULL) == 0);
+    CHECK(T, fdt_insphere_perturbed(o, x, y, z, on2, NULL) == -1);
+    CHECK(T, ref_insphere_perturbed(T, o, x, y, z, on2) == -1);
+    /* Cube corners on the sphere about (1,1,1): with A = (2,2,2), C, B, D
+     * (positively oriented in that order) and the query E = (2,2,0), A is
+     * the largest point; E lies on A's side of the plane x+y+z = 2 through
+     * B, C, D, so (E, C, B, D) is positive too: inside. With the query
+     * O = (0,0,0) on the other side: outside. */
+    const double A[3] = {2, 2, 2}, B[3] = {2, 0, 0}, C[3] = {0, 2, 0}, D[3] = {0, 0, 2};
+    const double E[3] = {2, 2, 0};
+    CHECK(T, fdt_orient3d(A, C, B, D, NULL) == 1);
+    CHECK(T, fdt_insphere(A, C, B, D, E, NULL) == 0);
+    CHECK(T, fdt_insphere_perturbed(A, C, B, D, E, NULL) == 1);
+    CHECK(T, ref_insphere_perturbed(T, A, C, B, D, E) == 1);
+    CHECK(T, fdt_insphere_perturbed(A, C, B, D, o, NULL) == -1);
+    CHECK(T, ref_insphere_perturbed(T, A, C, B, D, o) == -1);
+
+    /* Underflow traps: an inner product underflows to 0 while a large
+     * factor multiplies it, and another term of the opposite sign keeps
+     * the permanent well above 2^-800. A filter that ignored underflow
+     * would get the sign wrong; the true signs follow by hand:
+     * orient: det = 2^600 (2^-1080) - 2^-481 = 2^-481 > 0. */
+    const double ta[3] = {0, 0, 0}, tb[3] = {0x1p600, 1, 0};
+    const double tc[3] = {0, 0x1p-540, 0x1p-240}, td[3] = {-0x1p-241, 0, 0x1p-540};
+    CHECK(T, fdt_orient3d_filter(ta, tb, tc, td) == FDT_PRED_UNSURE);
+    CHECK(T, fdt_orient3d(ta, tb, tc, td, NULL) == 1);
+    CHECK(T, ref_orient(T, ta, tb, tc, td) == 1);
+    /* insphere, e = 0: det4 = 2^600 * 2^-1080 - 2^-481 - (tiny) > 0, so
+     * the CGAL sign is -1 (a filter ignoring underflow says +1). */
+    const double sa[3] = {1, 0, 0}, sb[3] = {0, 0x1p-480, 0};
+    const double sc[3] = {-0x1p-301, 0, 0x1p-600}, sd[3] = {0, 0, 0x1p300};
+    CHECK(T, fdt_insphere_filter(sa, sb, sc, sd, ta) == FDT_PRED_UNSURE);
+    CHECK(T, fdt_insphere(sa, sb, sc, sd, ta, NULL) == -1);
+    CHECK(T, ref_insphere(T, sa, sb, sc, sd, ta) == -1);
+
+    /* fdt_lex_compare */
+    const double p1[3] = {1, 2, 3}, p2[3] = {1, 2, 4}, p3[3] = {1, 3, -9}, p4[3] = {2, -5, -5};
+    const double zp[3] = {0.0, 0.0, 0.0}, zn[3] = {-0.0, -0.0, -0.0};
+    CHECK(T, fdt_lex_compare(p1, p2) == -1 && fdt_lex_compare(p2, p1) == 1);
+    CHECK(T, fdt_lex_compare(p1, p3) == -1 && fdt_lex_compare(p3, p1) == 1);
+    CHECK(T, fdt_lex_compare(p3, p4) == -1 && fdt_lex_compare(p4, p3) == 1);
+    CHECK(T, fdt_lex_compare(p1, p1) == 0 && fdt_lex_compare(zp, zn) == 0);
+}
+
+/* Family wrappers with one signature, for the table below. */
+static void fam_random(tctx *T, double (*p)[3])
+{
+    gen_random(T, p);
+}
+static void fam_near_coplanar(tctx *T, double (*p)[3])
+{
+    gen_near_coplanar(T, p);
+}
+static void fam_near_cospherical(tctx *T, double (*p)[3])
+{
+    gen_near_cospherical(T, p, 0.0);
+}
+/* Cospherical integer points on a 2^-12 grid offset by (4.9e6, 5.6e6,
+ * 120) (exact), the query nudged by a few ulps: tiny nonzero answers. */
+static void fam_near_cospherical_offset(tctx *T, double (*p)[3])
+{
+    static const int r2[] = {50, 75, 125};
+    sphere_set S;
+    make_sphere(&S, r2[irand(T, 0, 2)]);
+    const double big[3] = {4.9e6 * 4096, 5.6e6 * 4096, 120 * 4096};
+    gen_cospherical(T, &S, p, big, -12);
+    for (int k = 0; k < 3; k++)
+        p[4][k] = nudge(p[4][k], (int)irand(T, -2, 2));
+}
+static void fam_lattice(tctx *T, double (*p)[3])
+{
+    gen_lattice(T, p, 2);
+}
+static void fam_offset_lattice(tctx *T, double (*p)[3])
+{
+    gen_offset(T, p, 3);
+}
+static void fam_offset(tctx *T, double (*p)[3])
+{
+    gen_offset(T, p, 2000);
+}
+static void fam_mixed(tctx *T, double (*p)[3])
+{
+    gen_mixed(T, p);
+}
+static void fam_subnormal(tctx *T, double (*p)[3])
+{
+    gen_subnormal(T, p);
+}
+static void fam_huge(tctx *T, double (*p)[3])
+{
+    gen_huge(T, p);
+}
+/* Cospherical integer points at many scales (down to subnormal, up to
+ * 2^1000) and offsets (4.9e6 with a 2^-12 grid). */
+static void fam_cospherical(tctx *T, double (*p)[3])
+{
+    static const int ex[] = {0, -12, -500, -1000, -1066, 500, 900, 1000};
+    static const int r2[] = {50, 75};
+    sphere_set S;
+    make_sphere(&S, r2[irand(T, 0, 1)]);
+    const double none[3] = {0, 0, 0}, big[3] = {4.9e6 * 4096, 5.6e6 * 4096, 120 * 4096};
+    const double small[3] = {7, -3, 11};
+    int e = ex[irand(T, 0, 7)];
+    const double *shift = e == -12 ? big : (irand(T, 0, 1) ? none : small);
+    gen_cospherical(T, &S, p, shift, e);
+}
+/* Magnitudes near 1e-150 and 1e150, rounded and exact scalings. */
+static void fam_near_coplanar_scaled(tctx *T, double (*p)[3])
+{
+    gen_near_coplanar(T, p);
+    scale_all(p, irand(T, 0, 1) ? 1e-150 : 1e150);
+}
+static void fam_near_cospherical_scaled(tctx *T, double (*p)[3])
+{
+    gen_near_cospherical(T, p, 0.0);
+    scale_all(p, irand(T, 0, 1) ? 0x1p-500 : 0x1p+500);
+}
+static void fam_lattice_scaled(tctx *T, double (*p)[3])
+{
+    gen_lattice(T, p, 3);
+    scale_all(p, irand(T, 0, 1) ? 1e-150 : 1e150);
+}
+/* Mixed magnitudes with a near degeneracy: d nearly on the plane abc. */
+static void fam_mixed_near_coplanar(tctx *T, double (*p)[3])
+{
+    gen_mixed(T, p);
+    for (int k = 0; k < 3; k++)
+        p[3][k] = nudge(p[0][k] + 0.5 * (p[1][k] - p[0][k]) + 0.25 * (p[2][k] - p[0][k]),
+                        (int)irand(T, -1, 1));
+}
+
+typedef struct family {
+    const char *name;
+    void (*gen)(tctx *T, double (*p)[3]);
+    int count; /* cases (each: 2 orient3d, 1 insphere) at scale 1 */
+} family;
+
+static const family families[] = {
+    {"random", fam_random, 6000},
+    {"near-coplanar", fam_near_coplanar, 6000},
+    {"near-cospherical", fam_near_cospherical, 6000},
+    {"near-cospherical-offset", fam_near_cospherical_offset, 4000},
+    {"lattice", fam_lattice, 6000},
+    {"offset-lattice", fam_offset_lattice, 6000},
+    {"offset", fam_offset, 6000},
+    {"cospherical", fam_cospherical, 3000},
+    {"near-coplanar-scaled", fam_near_coplanar_scaled, 2000},
+    {"near-cospherical-scaled", fam_near_cospherical_scaled, 2000},
+    {"lattice-scaled", fam_lattice_scaled, 2000},
+    {"mixed", fam_mixed, 800},
+    {"mixed-near-coplanar", fam_mixed_near_coplanar, 800},
+    {"subnormal", fam_subnormal, 2000},
+    {"huge", fam_huge, 1000},
+};
+
+static void test_families(tctx *T, double scale, int verbose)
+{
+    double p[5][3];
+    for (size_t f = 0; f < sizeof families / sizeof families[0]; f++) {
+        double t0 = now_s();
+        long fails = T->failures;
+        size_t oe = T->cnt.orient_exact, ie = T->cnt.insphere_exact;
+        const long count = (long)(families[f].count * scale);
+        for (long it = 0; it < count; it++) {
+            families[f].gen(T, p);
+            check_five(T, p, families[f].name);
+        }
+        if (verbose)
+            printf("  %-24s %6ld cases, %6zu orient / %6zu insphere left the filter, "
+                   "%ld failures, %.2f s\n",
+                   families[f].name, count, T->cnt.orient_exact - oe,
+                   T->cnt.insphere_exact - ie, T->failures - fails, now_s() - t0);
+    }
+}
+
+/* ------------------------------------------------------------------ */
+/* Perturbation. */
+
+static const int even_perm[12][4] = {
+    {0, 1, 2, 3}, {0, 2, 3, 1}, {0, 3, 1, 2}, {1, 0, 3, 2}, {1, 2, 0, 3}, {1, 3, 2, 0},
+    {2, 0, 1, 3}, {2, 1, 3, 0}, {2, 3, 0, 1}, {3, 0, 2, 1}, {3, 1, 0, 2}, {3, 2, 1, 0},
+};
+
+/* Orders (a,b,c,d) positively by swapping a and b; false if coplanar. */
+static int orient_positive(tctx *T, double (*p)[3])
+{
+    int o = ref_orient(T, p[0], p[1], p[2], p[3]);
+    if (o == 0)
+        return 0;
+    if (o < 0)
+        for (int k = 0; k < 3; k++) {
+            double t = p[0][k];
+            p[0][k] = p[1][k];
+            p[1][k] = t;
+        }
+    return 1;
+}
+
+static void check_perturbed(tctx *T, double (*p)[3], int integer, const char *what)
+{
+    int ref = ref_insphere_perturbed(T, p[0], p[1], p[2], p[3], p[4]);
+    int got = fdt_insphere_perturbed(p[0], p[1], p[2], p[3], p[4], NULL);
+    T->checks++;
+    if (got != ref || ref == 0) {
+        T->failures++;
+        if (T->failures <= 30) {
+            fprintf(stderr, "perturbed insphere mismatch [%s]: ref %d got %d\n", what, ref, got);
+            print_pts((const double (*)[3])p, 5);
+        }
+        return;
+    }
+    /* Even permutations of (a,b,c,d) keep the orientation and the answer. */
+    for (int j = 1; j < 12; j++) {
+        const int *q = even_perm[j];
+        int g = fdt_insphere_perturbed(p[q[0]], p[q[1]], p[q[2]], p[q[3]], p[4], NULL);
+        CHECK(T, g == got);
+    }
+    /* Translations and positive scalings keep the lexicographic order (the
+     * transformed small integers below are exact doubles). */
+    if (!integer)
+        return;
+    double r[5][3];
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            r[i][k] = ldexp(p[i][k] + 4096.0 * (k + 1), -1040);
+    CHECK(T, fdt_insphere_perturbed(r[0], r[1], r[2], r[3], r[4], NULL) == got);
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            r[i][k] = 4.9e6 + ldexp(p[i][k], -12);
+    CHECK(T, fdt_insphere_perturbed(r[0], r[1], r[2], r[3], r[4], NULL) == got);
+}
+
+static void test_perturbed(tctx *T, double scale)
+{
+    double p[5][3];
+    static const int r2s[] = {25, 50, 75, 81, 125};
+    sphere_set S[5];
+    for (int i = 0; i < 5; i++)
+        make_sphere(&S[i], r2s[i]);
+    const double none[3] = {0, 0, 0};
+    long done = 0, need = (long)(3000 * scale), zero_fallbacks = 0;
+    while (done < need) {
+        int which = (int)irand(T, 0, 4);
+        gen_cospherical(T, &S[which], p, none, 0);
+        if (!orient_positive(T, p))
+            continue;
+        /* How often the first tie-break orientation vanishes: the
+         * coplanar-cocircular cases we want to see. */
+        if (fdt_insphere(p[0], p[1], p[2], p[3], p[4], NULL) == 0) {
+            int best = 4;
+            for (int i = 0; i < 4; i++)
+                if (lex_greater(p[i], p[best]))
+                    best = i;
+            if (best != 4) {
+                const double *q[4] = {p[0], p[1], p[2], p[3]};
+                q[best] = p[4];
+                zero_fallbacks += fdt_orient3d(q[0], q[1], q[2], q[3], NULL) == 0;
+            }
+        }
+        check_perturbed(T, p, 1, "cospherical");
+        done++;
+    }
+    CHECK(T, zero_fallbacks > 0);
+    /* Lattices: many cospherical and coplanar subsets. */
+    for (done = 0; done < need;) {
+        gen_lattice(T, p, 1);
+        int distinct = 1;
+        for (int i = 0; i < 5; i++)
+            for (int j = 0; j < i; j++)
+                distinct &= memcmp(p[i], p[j], sizeof p[i]) != 0;
+        if (!distinct || !orient_positive(T, p))
+            continue;
+        check_perturbed(T, p, 1, "lattice");
+        done++;
+    }
+    /* Coplanar-cocircular: a, b, c and e on the circle x^2 + y^2 = 25, z = 0,
+     * d elsewhere on the sphere of radius 5. */
+    int circle[12], nc = 0, rest[200], nr = 0;
+    for (int i = 0; i < S[0].n; i++) {
+        if (S[0].pt[i][2] == 0)
+            circle[nc++] = i;
+        else
+            rest[nr++] = i;
+    }
+    for (done = 0; done < need / 4;) {
+        int id[5] = {circle[irand(T, 0, nc - 1)], circle[irand(T, 0, nc - 1)],
+                     circle[irand(T, 0, nc - 1)], rest[irand(T, 0, nr - 1)],
+                     circle[irand(T, 0, nc - 1)]};
+        if (id[0] == id[1] || id[0] == id[2] || id[1] == id[2] || id[4] == id[0] ||
+            id[4] == id[1] || id[4] == id[2])
+            continue;
+        for (int i = 0; i < 5; i++)
+            for (int k = 0; k < 3; k++)
+                p[i][k] = S[0].pt[id[i]][k];
+        if (!orient_positive(T, p))
+            continue;
+        CHECK(T, fdt_insphere(p[0], p[1], p[2], p[3], p[4], NULL) == 0);
+        CHECK(T, fdt_orient3d(p[0], p[1], p[2], p[4], NULL) == 0);
+        check_perturbed(T, p, 1, "cocircular");
+        done++;
+    }
+    /* The lexicographically largest point as the query is outside. */
+    for (done = 0; done < need / 4;) {
+        gen_cospherical(T, &S[(int)irand(T, 0, 4)], p, none, 0);
+        int best = 0;
+        for (int i = 1; i < 5; i++)
+            if (lex_greater(p[i], p[best]))
+                best = i;
+        for (int k = 0; k < 3; k++) {
+            double t = p[4][k];
+            p[4][k] = p[best][k];
+            p[best][k] = t;
+        }
+        if (!orient_positive(T, p))
+            continue;
+        CHECK(T, fdt_insphere_perturbed(p[0], p[1], p[2], p[3], p[4], NULL) == -1);
+        done++;
+    }
+    /* Non-degenerate inputs: the perturbed answer is the plain one. */
+    for (done = 0; done < need;) {
+        gen_near_cospherical(T, p, 0.0);
+        if (!orient_positive(T, p))
+            continue;
+        int s = fdt_insphere(p[0], p[1], p[2], p[3], p[4], NULL);
+        if (s != 0)
+            CHECK(T, fdt_insphere_perturbed(p[0], p[1], p[2], p[3], p[4], NULL) == s);
+        else
+            check_perturbed(T, p, 0, "near-cospherical");
+        done++;
+    }
+}
+
+/* 6 x signed volume of (a,b,c,d), exactly (integer inputs). */
+static void ref_volume6(tctx *T, mpz_t out, const double *a, const double *b, const double *c,
+                        const double *d)
+{
+    const double *p[4] = {a, b, c, d};
+    for (int i = 0; i < 4; i++)
+        ref_row(T, i, p[i], 0);
+    /* Bareiss leaves the determinant in z[3][3] up to the pivot sign. */
+    int s = ref_det_sign(T, 4);
+    mpz_abs(out, T->z[3][3]);
+    if (s == 0)
+        mpz_set_ui(out, 0);
+}
+
+/*
+ * Five cospherical points in convex position, no four coplanar: the 4-subsets
+ * whose fifth point is perturbed-outside must triangulate the hull: 2 or 3
+ * tets, pairwise on opposite sides of their common face, with total volume
+ * the hull volume. The five 4-subsets are exactly the two triangulations of
+ * the bipyramid, so the hull volume is half their total.
+ */
+static void test_triangulation(tctx *T, double scale)
+{
+    static const int r2s[] = {75, 99, 101, 125, 150, 171};
+    sphere_set S;
+    mpz_t vol[5], total, empty_sum;
+    for (int i = 0; i < 5; i++)
+        mpz_init(vol[i]);
+    mpz_inits(total, empty_sum, NULL);
+    long done = 0, need = (long)(800 * scale), seen2 = 0, seen3 = 0;
+    while (done < need) {
+        make_sphere(&S, r2s[irand(T, 0, 5)]);
+        double p[5][3];
+        const double none[3] = {0, 0, 0};
+        gen_cospherical(T, &S, p, none, (int)irand(T, 0, 3)); /* integers */
+        int coplanar = 0;
+        for (int skip = 0; skip < 5; skip++) {
+            const double *q[4];
+            for (int i = 0, j = 0; i < 5; i++)
+                if (i != skip)
+                    q[j++] = p[i];
+            coplanar |= ref_orient(T, q[0], q[1], q[2], q[3]) == 0;
+        }
+        if (coplanar)
+            continue;
+        int empty[5], nempty = 0;
+        mpz_set_ui(total, 0);
+        mpz_set_ui(empty_sum, 0);
+        for (int skip = 0; skip < 5; skip++) {
+            const double *q[4];
+            for (int i = 0, j = 0; i < 5; i++)
+                if (i != skip)
+                    q[j++] = p[i];
+            if (fdt_orient3d(q[0], q[1], q[2], q[3], NULL) < 0) {
+                const double *t = q[0];
+                q[0] = q[1];
+                q[1] = t;
+            }
+            empty[skip] = fdt_insphere_perturbed(q[0], q[1], q[2], q[3], p[skip], NULL) < 0;
+            ref_volume6(T, vol[skip], q[0], q[1], q[2], q[3]);
+            mpz_add(total, total, vol[skip]);
+            if (empty[skip]) {
+                nempty++;
+                mpz_add(empty_sum, empty_sum, vol[skip]);
+            }
+        }
+        CHECK(T, nempty == 2 || nempty == 3);
+        seen2 += nempty == 2;
+        seen3 += nempty == 3;
+        mpz_mul_2exp(empty_sum, empty_sum, 1);
+        CHECK(T, mpz_cmp(empty_sum, total) == 0);
+        /* Two empty tets (missing points i and j) share the face of the
+         * other three points and must lie on opposite sides of it. */
+        for (int i = 0; i < 5; i++)
+            for (int j = i + 1; j < 5; j++) {
+                if (!empty[i] || !empty[j])
+                    continue;
+                const double *f[3];
+                for (int k = 0, m = 0; k < 5; k++)
+                    if (k != i && k != j)
+                        f[m++] = p[k];
+                int si = fdt_orient3d(f[0], f[1], f[2], p[i], NULL);
+                int sj = fdt_orient3d(f[0], f[1], f[2], p[j], NULL);
+                CHECK(T, si * sj == -1);
+            }
+        done++;
+    }
+    /* Both shapes of triangulation must have occurred. */
+    CHECK(T, seen2 > 0 && seen3 > 0);
+    for (int i = 0; i < 5; i++)
+        mpz_clear(vol[i]);
+    mpz_clears(total, empty_sum, NULL);
+}
+
+/* ------------------------------------------------------------------ */
+/* Micro-benchmark: ns per call on random points (filtered path). */
+
+
+/* CPU time of this process: less disturbed by other load than wall time. */
+static double cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+enum { BENCH_NP = 4096, BENCH_MASK = BENCH_NP - 1 };
+
+/* ns per call of one predicate over n calls on P, best of 3 rounds. */
+static double bench_one(int which, const double (*P)[3], int n, long *acc)
+{
+    double best = INFINITY;
+    fdt_pred_counts cnt = {0, 0};
+    for (int round = 0; round < 3; round++) {
+        double t0 = cpu_s();
+        long s = 0;
+        for (int i = 0; i < n; i++) {
+            const double *a = P[i & BENCH_MASK], *b = P[(i + 1) & BENCH_MASK];
+            const double *c = P[(i + 7) & BENCH_MASK], *d = P[(i + 13) & BENCH_MASK];
+            const double *e = P[(i + 29) & BENCH_MASK];
+            switch (which) {
+            case 0: s += fdt_orient3d(a, b, c, d, &cnt); break;
+            case 1: s += fdt_insphere(a, b, c, d, e, &cnt); break;
+            case 2: s += fdt_orient3d_filter(a, b, c, d); break;
+            case 3: s += fdt_insphere_filter(a, b, c, d, e); break;
+            case 4: s += fdt_insphere_perturbed(a, b, c, d, e, &cnt); break;
+            case 5: s += fdt_orient3d_exact(a, b, c, d, &cnt); break;
+            default: s += fdt_insphere_exact(a, b, c, d, e, &cnt); break;
+            }
+        }
+        double t = (cpu_s() - t0) * 1e9 / n;
+        if (t < best)
+            best = t;
+        *acc += s;
+    }
+    return best;
+}
+
+static void bench(tctx *T)
+{
+    double(*P)[3] = malloc(sizeof(double[3]) * BENCH_NP);
+    double(*L)[3] = malloc(sizeof(double[3]) * BENCH_NP);
+    double(*M)[3] = malloc(sizeof(double[3]) * BENCH_NP);
+    if (!P || !L || !M) {
+        free(P);
+        free(L);
+        free(M);
+        return;
+    }
+    for (int i = 0; i < BENCH_NP; i++)
+        for (int k = 0; k < 3; k++) {
+            P[i][k] = sunif(T);
+            /* A small lattice at a big offset: degenerate, exact differences. */
+            L[i][k] = 4.9e6 + (double)irand(T, 0, 3) * 0.25;
+            /* Mixed magnitudes: inexact differences, GMP. */
+            M[i][k] = sunif(T) * (irand(T, 0, 1) ? 1e-200 : 1e200);
+        }
+    long acc = 0;
+    const double (*cP)[3] = (const double (*)[3])P, (*cL)[3] = (const double (*)[3])L;
+    const double (*cM)[3] = (const double (*)[3])M;
+    double o = bench_one(0, cP, 1 << 20, &acc), i = bench_one(1, cP, 1 << 20, &acc);
+    double of = bench_one(2, cP, 1 << 20, &acc), inf = bench_one(3, cP, 1 << 20, &acc);
+    double ip = bench_one(4, cP, 1 << 20, &acc);
+    double ob = bench_one(5, cL, 1 << 13, &acc), ib = bench_one(6, cL, 1 << 13, &acc);
+    double oc = bench_one(5, cM, 1 << 11, &acc), ic = bench_one(6, cM, 1 << 11, &acc);
+    printf("bench (ns/call, random points in the unit cube, CPU time, best of 3):\n"
+           "  fdt_orient3d %.1f, fdt_insphere %.1f, fdt_insphere_perturbed %.1f\n"
+           "  inline filters alone: orient3d %.1f, insphere %.1f\n"
+           "  exact stage B (offset lattice): orient3d %.0f, insphere %.0f\n"
+           "  exact stage C (mixed 1e-200/1e200): orient3d %.0f, insphere %.0f  [checksum %ld]\n",
+           o, i, ip, of, inf, ob, ib, oc, ic, acc);
+    free(P);
+    free(L);
+    free(M);
+}
+
+/* ------------------------------------------------------------------ */
+
+int main(int argc, char **argv)
+{
+    tctx T;
+    memset(&T, 0, sizeof T);
+    T.rng = argc > 1 ? strtoull(argv[1], NULL, 0) : 20240611u;
+    double scale = argc > 2 ? atof(argv[2]) : 1.0;
+    if (!(scale > 0.0))
+        scale = 1.0;
+    int verbose = argc > 3;
+    for (int i = 0; i < 5; i++)
+        for (int j = 0; j < 5; j++) {
+            mpq_init(T.q[i][j]);
+            mpz_init(T.z[i][j]);
+        }
+    mpz_inits(T.l, T.t, T.prev, NULL);
+
+    double t0 = now_s();
+    test_conventions(&T);
+    test_families(&T, scale, verbose);
+    double t1 = now_s();
+    test_perturbed(&T, scale);
+    test_triangulation(&T, scale);
+    double t2 = now_s();
+    bench(&T);
+
+    printf("test_predicates: %ld checks, %ld failures (families %.2f s, perturbation %.2f s)\n",
+           T.checks, T.failures, t1 - t0, t2 - t1);
+    for (int i = 0; i < 5; i++)
+        for (int j = 0; j < 5; j++) {
+            mpq_clear(T.q[i][j]);
+            mpz_clear(T.z[i][j]);
+        }
+    mpz_clears(T.l, T.t, T.prev, NULL);
+    return T.failures == 0 ? 0 : 1;
+}
