@@ -123,7 +123,7 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     err = FDT_ENOMEM;
     if (fdt_kd_build(&tree, pr.p, pr.orig, 0, (uint32_t)pr.m, ctx->s.leaf_size) != FDT_OK)
         goto fail;
-    if (fdt_meshbuf_init(&mb, (size_t)(6.7 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
+    if (fdt_meshbuf_init(&mb, (size_t)(6.9 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
         goto fail;
     double t1 = now_s();
     fdt_front_stats fst;
