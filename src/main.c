@@ -344,12 +344,17 @@ static int parse_args(int argc, char **argv, cli *c)
             }
             break;
         case 'h':
-            usage(stdout);
-            return fflush(stdout) == 0 ? CLI_OK : CLI_WRITE;
         case 'V':
-            printf("frontdt %s (library %s)\n", FDT_VERSION_STRING,
-                   fdt_version());
-            return fflush(stdout) == 0 ? CLI_OK : CLI_WRITE;
+            if (ch == 'h')
+                usage(stdout);
+            else
+                printf("frontdt %s (library %s)\n", FDT_VERSION_STRING,
+                       fdt_version());
+            if (fflush(stdout) != 0) {
+                say("stdout: %s", strerror(errno));
+                return CLI_WRITE;
+            }
+            return CLI_OK;
         case ':':
             if (short_opt(argv, optind))
                 return usage_error("option -%c needs a value", optopt);

@@ -224,6 +224,8 @@ class Runner:
             msg = self.check_in(case, d)
         except CaseFailure as e:
             return False, str(e), d
+        except Exception as e:  # a harness or environment error: report it, go on
+            return False, "harness error: %s: %s" % (type(e).__name__, e), d
         if not self.a.keep:
             shutil.rmtree(d, ignore_errors=True)
         return True, msg, d

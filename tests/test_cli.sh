@@ -150,6 +150,18 @@ else
     [ "$rows" -gt 0 ] || fail "EXPECTED.txt has no rows"
 fi
 
+# Inputs the reader accepts but the library cannot triangulate: exit 2,
+# the library's diagnostic, nothing written.
+awk 'BEGIN { srand(4); for (i = 0; i < 50; i++) printf "%.17g %.17g 0.5\n", rand(), rand() }' >flat.xyz
+printf '0 0 0\n1 0 0\n0 1 0\n1 0 0\n0 0 0\n' >three.xyz
+printf '0 0 0\n1 1 1\n2 2 2\n3 3 3\n4 4 4\n' >line.xyz
+for f in flat three line; do
+    rm -rf out && mkdir out
+    run "degenerate_$f" "$FRONTDT" "$f.xyz" -o out/mesh.ele --check
+    expect_rc "degenerate_$f" 2 && expect_in "degenerate_$f" err "frontdt: $f.xyz: "
+    expect_empty_dir "degenerate_$f" out
+done
+
 # ---------------------------------------------------------------------------
 # Output refusals before any computation
 # ---------------------------------------------------------------------------
@@ -371,7 +383,7 @@ done
 # The TetGen set (four files) and the slow %.17g of .vtk give the window.
 for target in big.ele big.vtk; do
     rm -rf out && mkdir out
-    "$FRONTDT" --demo 300000 -o "out/$target" --quiet >sig.out 2>sig.err &
+    "$FRONTDT" --demo 200000 -o "out/$target" --quiet >sig.out 2>sig.err &
     pid=$!
     seen=0
     while kill -0 "$pid" 2>/dev/null; do
