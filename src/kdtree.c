@@ -60,6 +60,12 @@ static void select_k(double *P, fdt_vid *orig, uint32_t lo, uint32_t hi,
     }
 }
 
+void fdt_kd_select(double *P, fdt_vid *orig, uint32_t lo, uint32_t hi,
+                   uint32_t k, int dim)
+{
+    select_k(P, orig, lo, hi, k, dim);
+}
+
 typedef struct build_ctx {
     fdt_kdtree *t;
     double *P;
@@ -386,11 +392,13 @@ int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi)
     return mx >= -perm * 1e-13;
 }
 
-void fdt_apex_search(fdt_apex *s, const fdt_kdtree *t, fdt_kdq *kq)
+/* Top-down walk of the subtree at `root`, nearer child first, pruning
+ * every node whose box cannot hold an improvement. */
+static void apex_walk(fdt_apex *s, const fdt_kdtree *t, uint32_t root, fdt_kdq *kq)
 {
     uint32_t stack[WALK_STACK];
     int sp = 0;
-    stack[sp++] = 0;
+    stack[sp++] = root;
     while (sp > 0) {
         const fdt_kdnode *nd = &t->nodes[stack[--sp]];
         if (!fdt_apex_box_useful(s, nd->lo, nd->hi))
@@ -412,6 +420,68 @@ void fdt_apex_search(fdt_apex *s, const fdt_kdtree *t, fdt_kdq *kq)
             stack[sp++] = nd->left;
             stack[sp++] = nd->left + 1;
         }
+    }
+}
+
+void fdt_apex_search(fdt_apex *s, const fdt_kdtree *t, fdt_kdq *kq)
+{
+    apex_walk(s, t, 0, kq);
+}
+
+/*
+ * Bottom-up variant. The apex lies near the face, so we start in the leaf
+ * holding `start` (a face vertex) and climb. Each node's *cell* -- the
+ * region its ancestors' split planes give it, not its points' bounding
+ * box -- holds every point of the tree inside it that is not in a sibling
+ * subtree; left children take coordinates <= the split value, right ones
+ * >= it. Once the search ball lies strictly inside the current node's
+ * cell, no point outside the node can be inside the ball, so the climb
+ * stops. Otherwise the sibling subtree is walked top-down and we go up.
+ * On uniform clouds this skips most of the root-to-leaf descent and its
+ * box tests.
+ */
+void fdt_apex_search_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start,
+                          fdt_kdq *kq)
+{
+    uint32_t path[64];
+    double clo[64][3], chi[64][3];
+    int depth = 0;
+    uint32_t node = 0;
+    for (int k = 0; k < 3; k++) {
+        clo[0][k] = -INFINITY;
+        chi[0][k] = INFINITY;
+    }
+    path[0] = 0;
+    while (t->nodes[node].left && depth < 63) {
+        const fdt_kdnode *nd = &t->nodes[node];
+        uint32_t l = nd->left, dim = nd->dim;
+        uint32_t child = start < t->nodes[l].end ? l : l + 1;
+        memcpy(clo[depth + 1], clo[depth], sizeof clo[0]);
+        memcpy(chi[depth + 1], chi[depth], sizeof chi[0]);
+        /* The split value itself is not stored (the children's later
+         * splits reorder their points), but every left point is <= it <=
+         * every right point, so the right child's smallest coordinate
+         * bounds the left cell from above and the left child's largest
+         * bounds the right cell from below: cells a little larger than
+         * the true ones, still disjoint from the sibling's points. */
+        if (child == l)
+            chi[depth + 1][dim] = t->nodes[l + 1].lo[dim];
+        else
+            clo[depth + 1][dim] = t->nodes[l].hi[dim];
+        path[++depth] = node = child;
+    }
+    apex_walk(s, t, node, kq);
+    for (int d = depth; d > 0; d--) {
+        if (s->best != FDT_NONE && isfinite(s->r2)) {
+            double r = sqrt(s->r2);
+            int inside = 1;
+            for (int k = 0; k < 3 && inside; k++)
+                inside = s->center[k] - r > clo[d][k] && s->center[k] + r < chi[d][k];
+            if (inside)
+                return;
+        }
+        uint32_t parent = path[d - 1], l = t->nodes[parent].left;
+        apex_walk(s, t, path[d] == l ? l + 1 : l, kq);
     }
 }
 

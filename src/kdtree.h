@@ -48,6 +48,13 @@ int fdt_kd_build(fdt_kdtree *t, double *P, fdt_vid *orig, uint32_t base,
                  uint32_t n, int leaf_size);
 void fdt_kd_free(fdt_kdtree *t);
 
+/* Quickselect on coordinate dim (0..2) over ids [lo, hi), lo <= k < hi:
+ * afterwards the point at k has the (k - lo)-th smallest coordinate, the
+ * points before it are <= it and those after are >= it; P and orig are
+ * permuted together. Used by the partitioner (src/partition.c). */
+void fdt_kd_select(double *P, fdt_vid *orig, uint32_t lo, uint32_t hi,
+                   uint32_t k, int dim);
+
 /* Nearest point to q other than id `exclude` (floating-point distances),
  * FDT_NONE if the tree holds no other point. */
 uint32_t fdt_kd_nearest(const fdt_kdtree *t, const double *q,
@@ -85,6 +92,10 @@ void fdt_apex_init(fdt_apex *s, const double *a, const double *b,
  * tree walk and by answers that arrive from other partitions. */
 void fdt_apex_offer(fdt_apex *s, uint32_t id, const double *d, fdt_kdq *kq);
 void fdt_apex_search(fdt_apex *s, const fdt_kdtree *t, fdt_kdq *kq);
+/* The same search over tree t, starting from the leaf that holds point
+ * `start` (in t) and climbing: cheaper when the apex is near `start`. */
+void fdt_apex_search_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start,
+                          fdt_kdq *kq);
 /* Whether the box [lo, hi] could hold a point that improves s. */
 int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi);
 
