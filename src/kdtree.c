@@ -376,6 +376,39 @@ void fdt_apex_offer(fdt_apex *s, uint32_t id, const double *d, fdt_kdq *kq)
     update_ball(s);
 }
 
+/*
+ * The exact half of the open-side box test, for boxes that touch the
+ * face's plane within rounding: planar data (lidar ground, the layers of
+ * an extruded grid, lattice faces) puts whole subtrees exactly in the
+ * plane of hull faces, and without an exact answer every such face would
+ * visit all of them. The plane function is linear, so its maximum over
+ * the box is at the corner that takes hi[k] where the normal's component
+ * k is positive and lo[k] where it is negative; a component whose sign the
+ * rounding (at most 3 eps of its permanent) leaves open tries both. The
+ * corners are coordinates of input points, so orient3d is exact on them.
+ */
+static int box_touches_open_side(const fdt_apex *s, const double *lo, const double *hi)
+{
+    int choice[3]; /* 1: hi, -1: lo, 0: both */
+    for (int k = 0; k < 3; k++) {
+        double tol = s->nabs[k] * 1e-15;
+        choice[k] = s->nrm[k] > tol ? 1 : (s->nrm[k] < -tol ? -1 : 0);
+    }
+    for (int m = 0; m < 8; m++) {
+        double q[3];
+        int skip = 0;
+        for (int k = 0; k < 3 && !skip; k++) {
+            int bit = (m >> k) & 1;
+            if (choice[k] != 0 && bit)
+                skip = 1; /* only the 0 bit is used for a decided axis */
+            q[k] = choice[k] == 1 ? hi[k] : choice[k] == -1 ? lo[k] : (bit ? hi[k] : lo[k]);
+        }
+        if (!skip && fdt_orient3d(s->a, s->b, s->c, q, NULL) > 0)
+            return 1;
+    }
+    return 0;
+}
+
 int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi)
 {
     if (s->best != FDT_NONE && box_dist2(lo, hi, s->center) > s->r2)
@@ -389,7 +422,11 @@ int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi)
         mx += s->nrm[k] * c + fabs(s->nrm[k]) * h;
         perm += s->nabs[k] * (fabs(c) + h);
     }
-    return mx >= -perm * 1e-13;
+    if (mx < -perm * 1e-13)
+        return 0;
+    if (mx > perm * 1e-13)
+        return 1;
+    return box_touches_open_side(s, lo, hi);
 }
 
 /* Top-down walk of the subtree at `root`, nearer child first, pruning
