@@ -133,6 +133,16 @@ FDT_API int fdt_result_sort(fdt_result *r);
  * content of a .tets file). Sorts r first (fdt_result_sort). */
 FDT_API int fdt_result_hash(fdt_result *r, uint64_t *hash);
 
+/* Message counts by kind (Merriam §4; DESIGN.md, Mailboxes). */
+typedef struct fdt_msg_counts {
+    size_t iamdone;           /* "no work left anywhere": ends a run */
+    size_t nodesend;          /* range queries to another partition */
+    size_t noderecv;          /* their answers */
+    size_t facesend;          /* faces, and found apexes, for their owner */
+    size_t facerecv;          /* acknowledgements of FACESEND (the engine
+                                 needs none: 0, see src/parallel.c) */
+} fdt_msg_counts;
+
 typedef struct fdt_stats {
     size_t points;            /* input points */
     size_t vertices;          /* distinct points */
@@ -149,9 +159,43 @@ typedef struct fdt_stats {
     double t_prepare;         /* seconds: validate, merge, scale, kd-tree */
     double t_front;           /* seconds: advancing the front */
     double t_finish;          /* seconds: renumbering, neighbours */
+    /* The parallel modes (shared, message); zero in serial mode. */
+    fdt_msg_counts sent;      /* messages sent, summed over threads */
+    fdt_msg_counts received;  /* messages received (equal to sent: checked) */
+    size_t remote_queries;    /* range queries sent to other partitions */
+    size_t remote_answered;   /* range queries answered for other partitions */
+    size_t remote_improved;   /* answers that improved the asker's apex */
+    size_t tet_requests;      /* apexes found by one partition for a tet
+                                 another owns (FACESEND with an apex) */
+    size_t duplicate_requests;/* requests for a tet already built */
+    double t_idle;            /* seconds threads waited with no work (sum) */
+    double t_query_wait;      /* seconds waiting for remote answers (sum) */
+    double load_imbalance;    /* max / mean tets built per thread (1: even) */
+    int pinned;               /* 1: threads bound to cores; 0: not asked;
+                                 -1: asked but refused or unavailable */
 } fdt_stats;
 
 FDT_API int fdt_result_stats(const fdt_result *r, fdt_stats *st);
+
+/* Statistics of one worker thread of a parallel run. */
+typedef struct fdt_thread_stats {
+    size_t points;            /* points of its partition */
+    size_t tets;              /* tets it built (it owns) */
+    size_t hull_faces;
+    size_t faces_advanced;    /* apex searches it performed */
+    size_t max_front;         /* largest size of its face table */
+    size_t remote_queries, remote_answered, remote_improved;
+    size_t tet_requests, duplicate_requests;
+    fdt_msg_counts sent, received;
+    double t_idle, t_query_wait;
+    double t_cpu;             /* CPU seconds the thread used (0 if unknown) */
+    int core;                 /* core it was bound to, -1 if not pinned */
+} fdt_thread_stats;
+
+/* Fills *ts for worker thread 0 <= thread < stats.threads. A serial run
+ * reports its one thread. FDT_EINVAL if thread is out of range. */
+FDT_API int fdt_result_thread_stats(const fdt_result *r, int thread,
+                                    fdt_thread_stats *ts);
 
 /*
  * Independent exact verification of a mesh on n points (xyz as above, tets

@@ -8,6 +8,7 @@
 #include "frontdt.h"
 #include "front.h"
 #include "kdtree.h"
+#include "parallel.h"
 #include "prepare.h"
 #include "result.h"
 #include "seed.h"
@@ -100,19 +101,21 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
         return FDT_EINVAL;
     *out = NULL;
     ctx->diag[0] = '\0';
+    /* AUTO: serial for one thread, shared otherwise; 0 threads: one per
+     * physical core. Shared and message run src/parallel.c, which fills
+     * the same meshbuf (global tree-order ids) and counters. */
     fdt_mode mode = ctx->s.mode;
+    int nthreads = ctx->s.n_threads;
+    if (mode != FDT_MODE_SERIAL && nthreads == 0)
+        nthreads = fdt_parallel_default_threads();
     if (mode == FDT_MODE_AUTO)
-        mode = FDT_MODE_SERIAL;
-    if (mode != FDT_MODE_SERIAL) {
-        snprintf(ctx->diag, sizeof ctx->diag,
-                 "mode %s is not available in this build: only serial",
-                 mode == FDT_MODE_SHARED ? "shared" : "message");
-        return FDT_EINVAL;
-    }
+        mode = nthreads == 1 ? FDT_MODE_SERIAL : FDT_MODE_SHARED;
     double t0 = now_s();
     fdt_prepared pr;
     fdt_kdtree tree = {0};
     fdt_meshbuf mb = {0};
+    fdt_par_out par;
+    memset(&par, 0, sizeof par);
     fdt_result *r = NULL;
     int err = fdt_prepare(xyz, n, &pr, ctx->diag, sizeof ctx->diag);
     if (err)
@@ -120,16 +123,29 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     if ((err = fdt_seed_check_dimension(pr.p, pr.orig, (uint32_t)pr.m, ctx->diag,
                                         sizeof ctx->diag)) != FDT_OK)
         goto fail;
-    err = FDT_ENOMEM;
-    if (fdt_kd_build(&tree, pr.p, pr.orig, 0, (uint32_t)pr.m, ctx->s.leaf_size) != FDT_OK)
-        goto fail;
-    if (fdt_meshbuf_init(&mb, (size_t)(6.9 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
-        goto fail;
-    double t1 = now_s();
+    double t1;
     fdt_front_stats fst;
     memset(&fst, 0, sizeof fst);
-    err = fdt_front_serial(&tree, central_point(&tree), &mb, ctx->s.progress,
-                           ctx->s.progress_user, &fst);
+    if (mode != FDT_MODE_SERIAL) {
+        double tp = now_s();
+        err = fdt_parallel_triangulate(&pr, &ctx->s, mode, nthreads, &par, ctx->diag,
+                                       sizeof ctx->diag);
+        if (err)
+            goto fail;
+        mb = par.mb;
+        memset(&par.mb, 0, sizeof par.mb);
+        fst = par.fst;
+        t1 = tp + par.t_setup; /* partition, trees and seeds count as preparation */
+    } else {
+        err = FDT_ENOMEM;
+        if (fdt_kd_build(&tree, pr.p, pr.orig, 0, (uint32_t)pr.m, ctx->s.leaf_size) != FDT_OK)
+            goto fail;
+        if (fdt_meshbuf_init(&mb, (size_t)(6.9 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
+            goto fail;
+        t1 = now_s();
+        err = fdt_front_serial(&tree, central_point(&tree), &mb, ctx->s.progress,
+                               ctx->s.progress_user, &fst);
+    }
     if (err) {
         if (err == FDT_ENOMEM)
             snprintf(ctx->diag, sizeof ctx->diag, "out of memory after %zu tetrahedra", mb.ntets);
@@ -177,6 +193,13 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     st->t_prepare = t1 - t0;
     st->t_front = t2 - t1;
     st->t_finish = now_s() - t2;
+    if (mode != FDT_MODE_SERIAL) {
+        fdt_parallel_fill_stats(&par, mode, st);
+        st->t_front = par.t_front;
+        st->t_finish += par.t_gather;
+        r->tstats = par.tstats;
+        par.tstats = NULL;
+    }
     fdt_kd_free(&tree);
     fdt_prepared_free(&pr);
     if (ctx->s.progress)
@@ -187,6 +210,7 @@ fail:
     if (err == FDT_ENOMEM && !ctx->diag[0])
         snprintf(ctx->diag, sizeof ctx->diag, "out of memory triangulating %zu points", n);
     fdt_meshbuf_free(&mb);
+    fdt_par_out_free(&par);
     fdt_kd_free(&tree);
     fdt_prepared_free(&pr);
     fdt_result_free(&r);

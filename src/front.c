@@ -84,7 +84,7 @@ typedef struct facestack {
 
 static int push_face(facestack *fs, const uint32_t v[3])
 {
-    if (fs->n == fs->cap && fs->head >= fs->cap / 2) {
+    if (fs->n == fs->cap && fs->head > 0 && fs->head >= fs->cap / 2) {
         /* Slide the live entries down instead of growing. */
         memmove(fs->v, fs->v + 3 * fs->head, 3 * (fs->n - fs->head) * sizeof *fs->v);
         fs->n -= fs->head;

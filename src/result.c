@@ -12,6 +12,7 @@ void fdt_result_free(fdt_result **r)
     free((*r)->nbrs);
     free((*r)->hull);
     free((*r)->dupmap);
+    free((*r)->tstats);
     free(*r);
     *r = NULL;
 }
@@ -29,6 +30,26 @@ int fdt_result_stats(const fdt_result *r, fdt_stats *st)
     if (!r || !st)
         return FDT_EINVAL;
     *st = r->stats;
+    return FDT_OK;
+}
+
+int fdt_result_thread_stats(const fdt_result *r, int thread,
+                            fdt_thread_stats *ts)
+{
+    if (!r || !ts || thread < 0 || thread >= r->stats.threads)
+        return FDT_EINVAL;
+    if (r->tstats) {
+        *ts = r->tstats[thread];
+        return FDT_OK;
+    }
+    /* Serial: the one thread did everything. */
+    memset(ts, 0, sizeof *ts);
+    ts->points = r->stats.vertices;
+    ts->tets = r->stats.tets;
+    ts->hull_faces = r->stats.hull_faces;
+    ts->faces_advanced = r->stats.faces_advanced;
+    ts->max_front = r->stats.max_front;
+    ts->core = -1;
     return FDT_OK;
 }
 

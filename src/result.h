@@ -14,6 +14,8 @@ struct fdt_result {
     size_t n, ndup;
     int sorted;          /* tets are in canonical order */
     fdt_stats stats;
+    fdt_thread_stats *tstats; /* stats.threads entries, parallel modes only
+                                 (owned; NULL in serial mode) */
 };
 
 #endif

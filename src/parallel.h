@@ -1,0 +1,52 @@
+/*
+ * The parallel engine (§3-§5; DESIGN.md, Ownership, Termination, The two
+ * modes, Mailboxes): one thread per partition, each advancing the front
+ * faces it owns, in shared mode (range queries read every partition) or in
+ * message mode (range queries on another partition travel as
+ * NODESEND/NODERECV). The result equals the serial engine's tet for tet.
+ */
+#ifndef FDT_PARALLEL_H
+#define FDT_PARALLEL_H
+
+#include <stddef.h>
+#include "frontdt.h"
+#include "front.h"
+#include "prepare.h"
+
+typedef struct fdt_par_out {
+    fdt_meshbuf mb;            /* every tet, global tree-order ids; neighbours
+                                  (if asked) in this meshbuf's tet numbering */
+    fdt_front_stats fst;       /* work counters summed over the threads */
+    fdt_stats pst;             /* only the parallel fields (sent .. pinned) */
+    fdt_thread_stats *tstats;  /* nthreads entries (owned until taken) */
+    int nthreads;
+    double t_setup;            /* seconds: partition, kd-trees, seed tets */
+    double t_front;            /* seconds: the threads' run */
+    double t_gather;           /* seconds: gathering the threads' tets */
+} fdt_par_out;
+
+/* The default thread count: physical cores (hwloc), else online CPUs,
+ * clamped to [1, 1024]. */
+int fdt_parallel_default_threads(void);
+
+/*
+ * Triangulates the prepared points (pr->p and pr->orig are permuted into
+ * partition and tree order, as fdt_kd_build does for the serial engine)
+ * with nthreads threads (1..1024) in mode FDT_MODE_SHARED or
+ * FDT_MODE_MESSAGE, using s's leaf_size, neighbors, pin and progress.
+ * Precondition: the points span 3-D space. On success out holds the mesh;
+ * on failure out is empty and diag says why. Returns FDT_OK, FDT_EINVAL,
+ * FDT_ENOMEM, FDT_ETHREAD, FDT_ECANCELED or FDT_EINTERNAL.
+ */
+int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
+                             fdt_mode mode, int nthreads, fdt_par_out *out,
+                             char *diag, size_t dlen);
+
+/* Copies the parallel fields (sent .. pinned, threads, mode) into st. */
+void fdt_parallel_fill_stats(const fdt_par_out *o, fdt_mode mode,
+                             fdt_stats *st);
+
+/* Frees what out still owns (mb, tstats). */
+void fdt_par_out_free(fdt_par_out *out);
+
+#endif

@@ -1,0 +1,198 @@
+/* Recursive coordinate bisection into N parts; see partition.h. */
+#include "partition.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void fdt_partition_free(fdt_partition *pt)
+{
+    if (pt->trees)
+        for (int p = 0; p < pt->nparts; p++)
+            fdt_kd_free(&pt->trees[p]);
+    free(pt->trees);
+    free(pt->nodes);
+    free(pt->start);
+    memset(pt, 0, sizeof *pt);
+}
+
+static void range_box(const double *P, uint32_t begin, uint32_t end,
+                      double *lo, double *hi)
+{
+    for (int k = 0; k < 3; k++) {
+        lo[k] = INFINITY;
+        hi[k] = -INFINITY;
+    }
+    for (uint32_t i = begin; i < end; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = P[3 * (size_t)i + k];
+            if (x < lo[k])
+                lo[k] = x;
+            if (x > hi[k])
+                hi[k] = x;
+        }
+}
+
+typedef struct rcb_ctx {
+    fdt_partition *pt;
+    double *P;
+    fdt_vid *orig;
+} rcb_ctx;
+
+/*
+ * Fills node `id` with ids [begin, end) shared by parts [p0, p0 + k).
+ * The paper splits at the mean and alternates x, y, z (§3.1); we split at
+ * an exact count (quickselect) along the widest extent, which gives equal
+ * parts for any k (not only powers of two) and keeps parts compact on
+ * flat or elongated clouds. With k = a + b, a = k / 2, the first a parts
+ * get round(count * a / k) points. Depth is log2(k) <= 10.
+ */
+static void rcb(rcb_ctx *rc, int id, uint32_t begin, uint32_t end, int p0,
+                int k)
+{
+    fdt_partition *pt = rc->pt;
+    fdt_pnode *nd = &pt->nodes[id];
+    range_box(rc->P, begin, end, nd->lo, nd->hi);
+    nd->begin = begin;
+    nd->end = end;
+    if (k == 1) {
+        nd->left = -1;
+        nd->part = p0;
+        pt->start[p0] = begin;
+        return;
+    }
+    nd->part = -1;
+    int a = k / 2;
+    uint64_t count = end - begin;
+    /* round(count * a / k), in integers: count < 2^32, a < 2^10. */
+    uint32_t nleft = (uint32_t)((2 * count * (uint64_t)a + (uint64_t)k) / (2 * (uint64_t)k));
+    if (nleft > 0 && nleft < count) {
+        int dim = 0;
+        double w = nd->hi[0] - nd->lo[0];
+        for (int d = 1; d < 3; d++)
+            if (nd->hi[d] - nd->lo[d] > w) {
+                w = nd->hi[d] - nd->lo[d];
+                dim = d;
+            }
+        fdt_kd_select(rc->P, rc->orig, begin, end, begin + nleft, dim);
+    }
+    int left = pt->nnodes;
+    pt->nnodes += 2;
+    nd->left = left;
+    rcb(rc, left, begin, begin + nleft, p0, a);
+    rcb(rc, left + 1, begin + nleft, end, p0 + a, k - a);
+}
+
+int fdt_partition_build(fdt_partition *pt, double *P, fdt_vid *orig,
+                        uint32_t m, int nparts, int leaf_size)
+{
+    memset(pt, 0, sizeof *pt);
+    if (nparts < 1 || nparts > FDT_PARTITION_MAX)
+        return FDT_EINVAL;
+    pt->nparts = nparts;
+    pt->m = m;
+    pt->start = malloc(((size_t)nparts + 1) * sizeof *pt->start);
+    pt->nodes = malloc((2 * (size_t)nparts - 1) * sizeof *pt->nodes);
+    pt->trees = calloc((size_t)nparts, sizeof *pt->trees);
+    if (!pt->start || !pt->nodes || !pt->trees) {
+        fdt_partition_free(pt);
+        return FDT_ENOMEM;
+    }
+    pt->nnodes = 1;
+    rcb_ctx rc = {pt, P, orig};
+    rcb(&rc, 0, 0, m, 0, nparts);
+    pt->start[nparts] = m;
+    for (int p = 0; p < nparts; p++) {
+        uint32_t n = pt->start[p + 1] - pt->start[p];
+        if (n == 0)
+            continue;
+        if (fdt_kd_build(&pt->trees[p], P, orig, pt->start[p], n, leaf_size) != FDT_OK) {
+            fdt_partition_free(pt);
+            return FDT_ENOMEM;
+        }
+    }
+    return FDT_OK;
+}
+
+int fdt_partition_owner(const fdt_partition *pt, uint32_t id)
+{
+    /* The last p with start[p] <= id: its range [start[p], start[p + 1])
+     * holds id because start[p + 1] > id. Empty parts (start[p] ==
+     * start[p + 1]) are never the last such p. */
+    int lo = 0, hi = pt->nparts - 1;
+    while (lo < hi) {
+        int mid = lo + (hi - lo + 1) / 2;
+        if (pt->start[mid] <= id)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return lo;
+}
+
+/* Copies node j of src and its subtree into dst->nodes[slot]. */
+static void copy_subtree(const fdt_kdtree *src, uint32_t j, fdt_kdtree *dst,
+                         uint32_t slot)
+{
+    dst->nodes[slot] = src->nodes[j];
+    if (!src->nodes[j].left)
+        return;
+    uint32_t l = dst->nnodes;
+    dst->nnodes += 2;
+    dst->nodes[slot].left = l;
+    copy_subtree(src, src->nodes[j].left, dst, l);
+    copy_subtree(src, src->nodes[j].left + 1, dst, l + 1);
+}
+
+/* Fills dst->nodes[slot] from bisection node id, skipping empty halves
+ * (a kd node must have two children or none). */
+static void compose(const fdt_partition *pt, int id, fdt_kdtree *dst,
+                    uint32_t slot)
+{
+    const fdt_pnode *nd = &pt->nodes[id];
+    if (nd->left < 0) {
+        copy_subtree(&pt->trees[nd->part], 0, dst, slot);
+        return;
+    }
+    const fdt_pnode *l = &pt->nodes[nd->left], *r = l + 1;
+    if (l->begin == l->end) {
+        compose(pt, nd->left + 1, dst, slot);
+        return;
+    }
+    if (r->begin == r->end) {
+        compose(pt, nd->left, dst, slot);
+        return;
+    }
+    fdt_kdnode *k = &dst->nodes[slot];
+    memcpy(k->lo, nd->lo, sizeof k->lo);
+    memcpy(k->hi, nd->hi, sizeof k->hi);
+    k->begin = nd->begin;
+    k->end = nd->end;
+    k->dim = 0;
+    uint32_t c = dst->nnodes;
+    dst->nnodes += 2;
+    k->left = c;
+    compose(pt, nd->left, dst, c);
+    compose(pt, nd->left + 1, dst, c + 1);
+}
+
+int fdt_partition_global_tree(const fdt_partition *pt, fdt_kdtree *out)
+{
+    memset(out, 0, sizeof *out);
+    size_t cap = 2 * (size_t)pt->nparts;
+    const double *P = NULL;
+    for (int p = 0; p < pt->nparts; p++) {
+        cap += pt->trees[p].nnodes;
+        if (pt->trees[p].n)
+            P = pt->trees[p].P;
+    }
+    out->nodes = malloc(cap * sizeof *out->nodes);
+    if (!out->nodes)
+        return FDT_ENOMEM;
+    out->P = P;
+    out->base = 0;
+    out->n = pt->m;
+    out->nnodes = 1;
+    compose(pt, 0, out, 0);
+    return FDT_OK;
+}

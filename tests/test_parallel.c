@@ -1,0 +1,789 @@
+/*
+ * Tests of the parallel engine (src/parallel.c, src/partition.c): shared
+ * and message modes must give the serial tetrahedralization exactly, for
+ * any thread count, on the named hard families (uniform, lattice, integer
+ * points on a sphere, extruded 2-D grid, clusters, big offset with 1 mm
+ * resolution) and on shuffled copies of them:
+ *   - the canonical hash equals serial mode's;
+ *   - after canonical sorting the tets, their neighbours and the hull faces
+ *     equal serial mode's (so the threads' neighbour links are right);
+ *   - every message kind was received as often as it was sent, in total and
+ *     summed over the per-thread statistics; IAMDONE went to every other
+ *     thread once, FACERECV never; NODESEND only in message mode;
+ *   - the partition module: proportional part sizes for any N, contiguous
+ *     ranges, owner lookup, the composite tree.
+ * Then many threads on tiny inputs (where nearly every tet straddles parts:
+ * the §5 "pockets"), repeated, and error paths (bad arguments).
+ *
+ * Usage: test_parallel            the default suite (small inputs)
+ *        test_parallel --quick    fewer thread counts (for sanitizers)
+ *        test_parallel --long     200k uniform points, N in {1, 2, 4, 8}
+ * A hang fails the test through alarm().
+ */
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "frontdt.h"
+#include "partition.h"
+
+#define CHECK(cond)                                                          \
+    do {                                                                     \
+        if (!(cond)) {                                                       \
+            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, \
+                    #cond);                                                  \
+            exit(1);                                                         \
+        }                                                                    \
+    } while (0)
+
+#define CHECK_EQ(a, b)                                                       \
+    do {                                                                     \
+        long long va_ = (long long)(a), vb_ = (long long)(b);                \
+        if (va_ != vb_) {                                                    \
+            fprintf(stderr, "%s:%d: check failed: %s == %s (%lld != %lld)\n", \
+                    __FILE__, __LINE__, #a, #b, va_, vb_);                   \
+            exit(1);                                                         \
+        }                                                                    \
+    } while (0)
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- inputs --------------------------------------------------------------- */
+
+typedef struct rng {
+    uint64_t s;
+} rng;
+
+/* splitmix64: plenty for test inputs, identical everywhere. */
+static uint64_t rnext(rng *r)
+{
+    uint64_t z = (r->s += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+static double runif(rng *r)
+{
+    return (double)(rnext(r) >> 11) * 0x1.0p-53;
+}
+
+static double rgauss(rng *r)
+{
+    double u = runif(r), v = runif(r);
+    if (u < 1e-300)
+        u = 1e-300;
+    return sqrt(-2.0 * log(u)) * cos(6.283185307179586 * v);
+}
+
+typedef struct pts {
+    char name[64];
+    double *xyz;
+    size_t n;
+} pts;
+
+static pts pts_alloc(const char *name, size_t n)
+{
+    pts p;
+    snprintf(p.name, sizeof p.name, "%s", name);
+    p.n = n;
+    p.xyz = malloc((n ? n : 1) * 3 * sizeof *p.xyz);
+    CHECK(p.xyz);
+    return p;
+}
+
+static pts fam_uniform(size_t n, uint64_t seed)
+{
+    pts p = pts_alloc("uniform", n);
+    rng r = {seed};
+    for (size_t i = 0; i < 3 * n; i++)
+        p.xyz[i] = runif(&r);
+    return p;
+}
+
+static pts fam_lattice(int s)
+{
+    pts p = pts_alloc("lattice", (size_t)s * s * s);
+    size_t k = 0;
+    for (int x = 0; x < s; x++)
+        for (int y = 0; y < s; y++)
+            for (int z = 0; z < s; z++) {
+                p.xyz[k++] = x;
+                p.xyz[k++] = y;
+                p.xyz[k++] = z;
+            }
+    return p;
+}
+
+/* Every integer point with x^2 + y^2 + z^2 = r2: all cospherical. */
+static pts fam_intsphere(int r2)
+{
+    int r = (int)sqrt((double)r2) + 1;
+    size_t cnt = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        pts p = pts_alloc("intsphere", cnt);
+        size_t k = 0;
+        for (int x = -r; x <= r; x++)
+            for (int y = -r; y <= r; y++)
+                for (int z = -r; z <= r; z++)
+                    if (x * x + y * y + z * z == r2) {
+                        if (pass) {
+                            p.xyz[3 * k] = x;
+                            p.xyz[3 * k + 1] = y;
+                            p.xyz[3 * k + 2] = z;
+                        }
+                        k++;
+                    }
+        if (pass)
+            return p;
+        cnt = k;
+        free(p.xyz);
+    }
+    return pts_alloc("intsphere", 0);
+}
+
+/* A k x k grid in the plane, each (x, y) at z = 0 and at z = 1. */
+static pts fam_grid2(int k)
+{
+    pts p = pts_alloc("grid2d", (size_t)2 * k * k);
+    size_t j = 0;
+    for (int z = 0; z < 2; z++)
+        for (int x = 0; x < k; x++)
+            for (int y = 0; y < k; y++) {
+                p.xyz[j++] = x;
+                p.xyz[j++] = y;
+                p.xyz[j++] = z;
+            }
+    return p;
+}
+
+/* Gaussian clusters of very different spreads. */
+static pts fam_clusters(size_t n, uint64_t seed)
+{
+    pts p = pts_alloc("clusters", n);
+    rng r = {seed};
+    double c[8][4];
+    for (int i = 0; i < 8; i++) {
+        for (int k = 0; k < 3; k++)
+            c[i][k] = runif(&r) * 10.0;
+        c[i][3] = pow(10.0, -3.0 * runif(&r));
+    }
+    for (size_t i = 0; i < n; i++) {
+        int j = (int)(rnext(&r) % 8);
+        for (int k = 0; k < 3; k++)
+            p.xyz[3 * i + k] = c[j][k] + c[j][3] * rgauss(&r);
+    }
+    return p;
+}
+
+/* UTM-like: 5e6 plus a 100 m box at 1 mm resolution (many ties). */
+static pts fam_offset(size_t n, uint64_t seed)
+{
+    pts p = pts_alloc("offset5e6", n);
+    rng r = {seed};
+    for (size_t i = 0; i < 3 * n; i++)
+        p.xyz[i] = 5e6 + (double)(rnext(&r) % 100000) / 1000.0;
+    return p;
+}
+
+/* A shuffled copy; perm[i] = the original index of point i. */
+static pts shuffled(const pts *src, uint64_t seed, size_t **perm_out)
+{
+    char name[64];
+    snprintf(name, sizeof name, "%.50s-shuf", src->name);
+    pts p = pts_alloc(name, src->n);
+    size_t *perm = malloc((src->n ? src->n : 1) * sizeof *perm);
+    CHECK(perm);
+    for (size_t i = 0; i < src->n; i++)
+        perm[i] = i;
+    rng r = {seed};
+    for (size_t i = src->n; i > 1; i--) {
+        size_t j = (size_t)(rnext(&r) % i);
+        size_t t = perm[i - 1];
+        perm[i - 1] = perm[j];
+        perm[j] = t;
+    }
+    for (size_t i = 0; i < src->n; i++)
+        memcpy(p.xyz + 3 * i, src->xyz + 3 * perm[i], 3 * sizeof *p.xyz);
+    *perm_out = perm;
+    return p;
+}
+
+/* ---- running and comparing ------------------------------------------------ */
+
+static const char *mode_name(fdt_mode m)
+{
+    switch (m) {
+    case FDT_MODE_SERIAL: return "serial";
+    case FDT_MODE_SHARED: return "shared";
+    case FDT_MODE_MESSAGE: return "message";
+    default: return "auto";
+    }
+}
+
+static fdt_result *run(const pts *p, fdt_mode mode, int nthreads, int nbrs,
+                       int expect_err)
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = mode;
+    s.n_threads = nthreads;
+    s.neighbors = nbrs;
+    fdt_context *ctx = NULL;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    fdt_result *r = NULL;
+    int err = fdt_triangulate(ctx, p->xyz, p->n, &r);
+    if (err != expect_err)
+        fprintf(stderr, "%s, %s, %d threads: %s (%s)\n", p->name, mode_name(mode),
+                nthreads, fdt_strerror(err), fdt_context_diagnostic(ctx));
+    CHECK_EQ(err, expect_err);
+    fdt_close(&ctx);
+    return r;
+}
+
+/* Canonical hull: each face rotated so its smallest id leads (keeps the
+ * orientation), faces sorted. */
+static int tri_cmp(const void *x, const void *y)
+{
+    const fdt_vid *a = x, *b = y;
+    for (int i = 0; i < 3; i++)
+        if (a[i] != b[i])
+            return a[i] < b[i] ? -1 : 1;
+    return 0;
+}
+
+static fdt_vid *canon_hull(const fdt_result *r)
+{
+    size_t nh = fdt_result_num_hull_faces(r);
+    const fdt_vid *h = fdt_result_hull_faces(r);
+    fdt_vid *c = malloc((nh ? nh : 1) * 3 * sizeof *c);
+    CHECK(c);
+    for (size_t i = 0; i < nh; i++) {
+        const fdt_vid *f = h + 3 * i;
+        int k = f[0] < f[1] ? (f[0] < f[2] ? 0 : 2) : (f[1] < f[2] ? 1 : 2);
+        for (int j = 0; j < 3; j++)
+            c[3 * i + j] = f[(k + j) % 3];
+    }
+    qsort(c, nh, 3 * sizeof *c, tri_cmp);
+    return c;
+}
+
+typedef struct reference {
+    uint64_t hash;
+    size_t ntets, nhull;
+    fdt_result *r;   /* sorted */
+    fdt_vid *hull;   /* canonical */
+} reference;
+
+static reference make_ref(const pts *p)
+{
+    reference ref;
+    ref.r = run(p, FDT_MODE_SERIAL, 1, 1, FDT_OK);
+    CHECK_EQ(fdt_result_hash(ref.r, &ref.hash), FDT_OK);
+    ref.ntets = fdt_result_num_tets(ref.r);
+    ref.nhull = fdt_result_num_hull_faces(ref.r);
+    ref.hull = canon_hull(ref.r);
+    CHECK(ref.ntets > 0);
+    return ref;
+}
+
+static void free_ref(reference *ref)
+{
+    fdt_result_free(&ref->r);
+    free(ref->hull);
+}
+
+static void check_stats(const fdt_result *r, fdt_mode mode, int nthreads)
+{
+    fdt_stats st;
+    CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
+    CHECK_EQ(st.threads, nthreads);
+    CHECK_EQ(st.mode, mode);
+    CHECK_EQ(st.tets, fdt_result_num_tets(r));
+    CHECK_EQ(st.sent.iamdone, st.received.iamdone);
+    CHECK_EQ(st.sent.nodesend, st.received.nodesend);
+    CHECK_EQ(st.sent.noderecv, st.received.noderecv);
+    CHECK_EQ(st.sent.facesend, st.received.facesend);
+    CHECK_EQ(st.sent.facerecv, st.received.facerecv);
+    CHECK_EQ(st.sent.iamdone, nthreads - 1);
+    CHECK_EQ(st.sent.facerecv, 0);
+    CHECK_EQ(st.sent.nodesend, st.sent.noderecv);
+    CHECK_EQ(st.remote_queries, st.sent.nodesend);
+    CHECK_EQ(st.remote_answered, st.sent.nodesend);
+    CHECK(st.remote_improved <= st.remote_queries);
+    CHECK(st.tet_requests <= st.sent.facesend);
+    CHECK(st.duplicate_requests <= st.tet_requests);
+    if (mode == FDT_MODE_SHARED)
+        CHECK_EQ(st.sent.nodesend, 0);
+    if (nthreads == 1) {
+        CHECK_EQ(st.sent.facesend, 0);
+        CHECK_EQ(st.sent.nodesend, 0);
+    }
+    CHECK(st.load_imbalance >= 1.0 - 1e-12 && st.load_imbalance <= nthreads + 1e-9);
+    CHECK_EQ(st.pinned, 0);
+    /* Per-thread statistics add up to the totals. */
+    fdt_msg_counts s = {0, 0, 0, 0, 0}, rc = {0, 0, 0, 0, 0};
+    size_t tets = 0, pts_ = 0, hull = 0, adv = 0, rq = 0, ra = 0;
+    for (int i = 0; i < nthreads; i++) {
+        fdt_thread_stats ts;
+        CHECK_EQ(fdt_result_thread_stats(r, i, &ts), FDT_OK);
+        tets += ts.tets;
+        pts_ += ts.points;
+        hull += ts.hull_faces;
+        adv += ts.faces_advanced;
+        rq += ts.remote_queries;
+        ra += ts.remote_answered;
+        s.iamdone += ts.sent.iamdone;
+        s.nodesend += ts.sent.nodesend;
+        s.noderecv += ts.sent.noderecv;
+        s.facesend += ts.sent.facesend;
+        s.facerecv += ts.sent.facerecv;
+        rc.iamdone += ts.received.iamdone;
+        rc.nodesend += ts.received.nodesend;
+        rc.noderecv += ts.received.noderecv;
+        rc.facesend += ts.received.facesend;
+        rc.facerecv += ts.received.facerecv;
+        CHECK_EQ(ts.core, -1);
+        CHECK(ts.t_idle >= 0.0 && ts.t_query_wait >= 0.0 && ts.t_cpu >= 0.0);
+        /* Each thread got exactly one IAMDONE, or sent them all. */
+        CHECK(ts.received.iamdone == 1 || (ts.received.iamdone == 0 &&
+                                           ts.sent.iamdone == (size_t)nthreads - 1));
+    }
+    fdt_thread_stats ts;
+    CHECK_EQ(fdt_result_thread_stats(r, nthreads, &ts), FDT_EINVAL);
+    CHECK_EQ(fdt_result_thread_stats(r, -1, &ts), FDT_EINVAL);
+    CHECK_EQ(tets, st.tets);
+    CHECK_EQ(pts_, st.vertices);
+    CHECK_EQ(hull, st.hull_faces);
+    CHECK_EQ(adv, st.faces_advanced);
+    CHECK_EQ(rq, st.remote_queries);
+    CHECK_EQ(ra, st.remote_answered);
+    CHECK(memcmp(&s, &st.sent, sizeof s) == 0);
+    CHECK(memcmp(&rc, &st.received, sizeof rc) == 0);
+    /* Hull faces each close one front face: every face advanced is either
+     * a hull face or yields a tet (built here or asked of its owner). */
+    CHECK(st.faces_advanced >= st.hull_faces);
+}
+
+static int g_verbose = 0;
+
+static void compare_run(const pts *p, const reference *ref, fdt_mode mode,
+                        int nthreads)
+{
+    fdt_result *r = run(p, mode, nthreads, 1, FDT_OK);
+    uint64_t h;
+    CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
+    if (h != ref->hash)
+        fprintf(stderr, "%s: %s with %d threads: hash %016" PRIx64 " != serial %016" PRIx64
+                " (%zu vs %zu tets)\n", p->name, mode_name(mode), nthreads, h, ref->hash,
+                fdt_result_num_tets(r), ref->ntets);
+    CHECK(h == ref->hash);
+    size_t nt = fdt_result_num_tets(r);
+    CHECK_EQ(nt, ref->ntets);
+    CHECK_EQ(fdt_result_num_hull_faces(r), ref->nhull);
+    /* Both sorted canonically: identical arrays, neighbours included. */
+    CHECK(memcmp(fdt_result_tets(r), fdt_result_tets(ref->r), 4 * nt * sizeof(fdt_vid)) == 0);
+    CHECK(fdt_result_neighbors(r));
+    CHECK(memcmp(fdt_result_neighbors(r), fdt_result_neighbors(ref->r),
+                 4 * nt * sizeof(fdt_tid)) == 0);
+    fdt_vid *hull = canon_hull(r);
+    CHECK(memcmp(hull, ref->hull, 3 * ref->nhull * sizeof *hull) == 0);
+    free(hull);
+    check_stats(r, mode, nthreads);
+    if (g_verbose) {
+        fdt_stats st;
+        fdt_result_stats(r, &st);
+        printf("  %-18s %-7s N=%-3d tets %zu facesend %zu nodesend %zu dup %zu imb %.2f\n",
+               p->name, mode_name(mode), nthreads, nt, st.sent.facesend, st.sent.nodesend,
+               st.duplicate_requests, st.load_imbalance);
+    }
+    fdt_result_free(&r);
+}
+
+static int quad_cmp(const void *x, const void *y)
+{
+    const fdt_vid *a = x, *b = y;
+    for (int i = 0; i < 4; i++)
+        if (a[i] != b[i])
+            return a[i] < b[i] ? -1 : 1;
+    return 0;
+}
+
+/* Serial on a shuffled copy, mapped back, is serial on the original. */
+static void check_shuffle_invariance(const reference *orig, const reference *sh,
+                                     const size_t *perm)
+{
+    CHECK_EQ(orig->ntets, sh->ntets);
+    size_t nt = sh->ntets;
+    fdt_vid (*keys)[4] = malloc((nt ? nt : 1) * sizeof *keys);
+    CHECK(keys);
+    const fdt_vid *t = fdt_result_tets(sh->r);
+    for (size_t i = 0; i < nt; i++) {
+        fdt_vid k[4];
+        for (int j = 0; j < 4; j++)
+            k[j] = (fdt_vid)perm[t[4 * i + j]];
+        for (int a = 1; a < 4; a++)
+            for (int b = a; b > 0 && k[b - 1] > k[b]; b--) {
+                fdt_vid x = k[b];
+                k[b] = k[b - 1];
+                k[b - 1] = x;
+            }
+        memcpy(keys[i], k, sizeof k);
+    }
+    qsort(keys, nt, sizeof *keys, quad_cmp);
+    const fdt_vid *o = fdt_result_tets(orig->r);
+    for (size_t i = 0; i < nt; i++) {
+        fdt_vid k[4];
+        memcpy(k, o + 4 * i, sizeof k);
+        if (k[2] > k[3]) {
+            fdt_vid x = k[2];
+            k[2] = k[3];
+            k[3] = x;
+        }
+        CHECK(memcmp(k, keys[i], sizeof k) == 0);
+    }
+    free(keys);
+}
+
+static const int k_threads_full[] = {1, 2, 3, 4, 5, 8, 16, 64};
+static const int k_threads_quick[] = {1, 2, 3, 5, 16};
+
+static void test_family(pts p, int quick)
+{
+    const int *tl = quick ? k_threads_quick : k_threads_full;
+    int nt = quick ? (int)(sizeof k_threads_quick / sizeof *tl)
+                   : (int)(sizeof k_threads_full / sizeof *tl);
+    double t0 = now_s();
+    size_t *perm;
+    pts sp = shuffled(&p, 0x5eed0000ULL + p.n, &perm);
+    reference ref = make_ref(&p), sref = make_ref(&sp);
+    check_shuffle_invariance(&ref, &sref, perm);
+    for (int i = 0; i < nt; i++)
+        for (int m = FDT_MODE_SHARED; m <= FDT_MODE_MESSAGE; m++) {
+            compare_run(&p, &ref, (fdt_mode)m, tl[i]);
+            compare_run(&sp, &sref, (fdt_mode)m, tl[i]);
+        }
+    printf("%-10s %6zu points %6zu tets: shared and message equal serial for %d thread counts"
+           " (%.1f s)\n", p.name, p.n, ref.ntets, nt, now_s() - t0);
+    fflush(stdout);
+    free_ref(&ref);
+    free_ref(&sref);
+    free(perm);
+    free(sp.xyz);
+    free(p.xyz);
+}
+
+/* ---- partition module ------------------------------------------------------ */
+
+static void test_partition(void)
+{
+    pts p = fam_uniform(1000, 7);
+    const int counts[] = {1, 2, 3, 5, 7, 64, 100, 1000, 1024};
+    for (size_t c = 0; c < sizeof counts / sizeof *counts; c++) {
+        int np = counts[c];
+        double *P = malloc(3 * p.n * sizeof *P);
+        fdt_vid *orig = malloc(p.n * sizeof *orig);
+        CHECK(P && orig);
+        memcpy(P, p.xyz, 3 * p.n * sizeof *P);
+        for (size_t i = 0; i < p.n; i++)
+            orig[i] = (fdt_vid)i;
+        fdt_partition pt;
+        CHECK_EQ(fdt_partition_build(&pt, P, orig, (uint32_t)p.n, np, 18), FDT_OK);
+        CHECK_EQ(pt.nparts, np);
+        CHECK_EQ(pt.start[0], 0);
+        CHECK_EQ(pt.start[np], p.n);
+        size_t lo = p.n, hi = 0;
+        for (int i = 0; i < np; i++) {
+            CHECK(pt.start[i] <= pt.start[i + 1]);
+            size_t sz = pt.start[i + 1] - pt.start[i];
+            if (sz < lo)
+                lo = sz;
+            if (sz > hi)
+                hi = sz;
+            /* Every id of the part maps back to it; its tree covers it. */
+            for (uint32_t id = pt.start[i]; id < pt.start[i + 1]; id++)
+                CHECK_EQ(fdt_partition_owner(&pt, id), i);
+            CHECK_EQ(pt.trees[i].n, sz);
+            if (sz)
+                CHECK_EQ(pt.trees[i].base, pt.start[i]);
+        }
+        /* Proportional splits: sizes differ by a few points at most (one
+         * rounding per level), and nobody is empty while m >= N. */
+        CHECK(hi - lo <= 10);
+        if ((size_t)np <= p.n)
+            CHECK(lo >= 1);
+        /* The permutation kept every point (orig is a permutation and P
+         * follows it). */
+        char *seen = calloc(p.n, 1);
+        CHECK(seen);
+        for (size_t i = 0; i < p.n; i++) {
+            CHECK(orig[i] >= 0 && (size_t)orig[i] < p.n && !seen[orig[i]]);
+            seen[orig[i]] = 1;
+            CHECK(memcmp(P + 3 * i, p.xyz + 3 * (size_t)orig[i], 3 * sizeof *P) == 0);
+        }
+        free(seen);
+        /* Bisection boxes contain their points. */
+        for (int j = 0; j < pt.nnodes; j++) {
+            const fdt_pnode *nd = &pt.nodes[j];
+            for (uint32_t id = nd->begin; id < nd->end; id++)
+                for (int k = 0; k < 3; k++)
+                    CHECK(P[3 * id + k] >= nd->lo[k] && P[3 * id + k] <= nd->hi[k]);
+        }
+        /* The composite tree finds the true nearest point. */
+        fdt_kdtree all;
+        CHECK_EQ(fdt_partition_global_tree(&pt, &all), FDT_OK);
+        CHECK_EQ(all.n, p.n);
+        rng r = {99};
+        for (int q = 0; q < 50; q++) {
+            double c3[3] = {runif(&r), runif(&r), runif(&r)};
+            uint32_t b = fdt_kd_nearest(&all, c3, FDT_NONE, NULL);
+            double bd = INFINITY;
+            uint32_t bi = 0;
+            for (uint32_t i = 0; i < p.n; i++) {
+                double dx = P[3 * i] - c3[0], dy = P[3 * i + 1] - c3[1], dz = P[3 * i + 2] - c3[2];
+                double d = dx * dx + dy * dy + dz * dz;
+                if (d < bd) {
+                    bd = d;
+                    bi = i;
+                }
+            }
+            CHECK_EQ(b, bi);
+        }
+        fdt_kd_free(&all);
+        fdt_partition_free(&pt);
+        free(P);
+        free(orig);
+    }
+    /* More parts than points: empty parts, and owner() skips them. */
+    {
+        double P[5 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
+        fdt_vid orig[5] = {0, 1, 2, 3, 4};
+        fdt_partition pt;
+        CHECK_EQ(fdt_partition_build(&pt, P, orig, 5, 16, 18), FDT_OK);
+        int nonempty = 0;
+        for (int i = 0; i < 16; i++)
+            nonempty += pt.start[i + 1] > pt.start[i];
+        CHECK_EQ(nonempty, 5);
+        for (uint32_t id = 0; id < 5; id++) {
+            int o = fdt_partition_owner(&pt, id);
+            CHECK(pt.start[o] <= id && id < pt.start[o + 1]);
+        }
+        fdt_kdtree all;
+        CHECK_EQ(fdt_partition_global_tree(&pt, &all), FDT_OK);
+        double q[3] = {0.9, 0.9, 0.9};
+        uint32_t b = fdt_kd_nearest(&all, q, FDT_NONE, NULL);
+        CHECK(P[3 * b] == 1 && P[3 * b + 1] == 1 && P[3 * b + 2] == 1);
+        fdt_kd_free(&all);
+        fdt_partition_free(&pt);
+    }
+    double P1[3] = {0, 0, 0};
+    fdt_vid o1[1] = {0};
+    fdt_partition pt;
+    CHECK_EQ(fdt_partition_build(&pt, P1, o1, 1, 0, 18), FDT_EINVAL);
+    CHECK_EQ(fdt_partition_build(&pt, P1, o1, 1, FDT_PARTITION_MAX + 1, 18), FDT_EINVAL);
+    free(p.xyz);
+    printf("partition: proportional parts, owners, boxes, composite tree\n");
+}
+
+/* ---- many threads on tiny inputs ------------------------------------------ */
+
+static void test_tiny(int reps)
+{
+    for (int rep = 0; rep < reps; rep++) {
+        pts inputs[4] = {fam_uniform(12 + 9 * (size_t)rep, 100 + (uint64_t)rep),
+                         fam_lattice(3 + rep % 2), fam_intsphere(325),
+                         fam_grid2(3 + rep % 3)};
+        for (int f = 0; f < 4; f++) {
+            reference ref = make_ref(&inputs[f]);
+            for (int m = FDT_MODE_SHARED; m <= FDT_MODE_MESSAGE; m++) {
+                compare_run(&inputs[f], &ref, (fdt_mode)m, 16);
+                compare_run(&inputs[f], &ref, (fdt_mode)m, 64);
+            }
+            free_ref(&ref);
+            free(inputs[f].xyz);
+        }
+    }
+    printf("tiny inputs with 16 and 64 threads (pockets), %d rounds: equal serial\n", reps);
+}
+
+/* AUTO with several threads runs shared mode; errors are refused. */
+static void test_api(void)
+{
+    pts p = fam_uniform(300, 3);
+    reference ref = make_ref(&p);
+    fdt_result *r = run(&p, FDT_MODE_AUTO, 3, 1, FDT_OK);
+    fdt_stats st;
+    CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
+    CHECK_EQ(st.mode, FDT_MODE_SHARED);
+    CHECK_EQ(st.threads, 3);
+    uint64_t h;
+    CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
+    CHECK(h == ref.hash);
+    fdt_result_free(&r);
+    r = run(&p, FDT_MODE_AUTO, 1, 0, FDT_OK);
+    CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
+    CHECK_EQ(st.mode, FDT_MODE_SERIAL);
+    fdt_thread_stats ts;
+    CHECK_EQ(fdt_result_thread_stats(r, 0, &ts), FDT_OK);
+    CHECK_EQ(ts.tets, st.tets);
+    CHECK_EQ(fdt_result_thread_stats(r, 1, &ts), FDT_EINVAL);
+    fdt_result_free(&r);
+    /* n_threads 0: the core count, any mode. */
+    r = run(&p, FDT_MODE_MESSAGE, 0, 0, FDT_OK);
+    CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
+    CHECK(st.threads >= 1 && st.threads <= 1024);
+    CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
+    CHECK(h == ref.hash);
+    fdt_result_free(&r);
+    /* Every point twice: merged before partitioning, same mesh. */
+    {
+        pts d = pts_alloc("uniform-twice", 2 * p.n);
+        memcpy(d.xyz, p.xyz, 3 * p.n * sizeof *d.xyz);
+        memcpy(d.xyz + 3 * p.n, p.xyz, 3 * p.n * sizeof *d.xyz);
+        for (int m = FDT_MODE_SHARED; m <= FDT_MODE_MESSAGE; m++) {
+            r = run(&d, (fdt_mode)m, 3 + m, 0, FDT_OK);
+            CHECK_EQ(fdt_result_num_duplicates(r), p.n);
+            CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
+            CHECK(h == ref.hash);
+            fdt_result_free(&r);
+        }
+        free(d.xyz);
+    }
+    /* Neighbours off: no neighbour array. */
+    r = run(&p, FDT_MODE_SHARED, 4, 0, FDT_OK);
+    CHECK(fdt_result_neighbors(r) == NULL);
+    fdt_result_free(&r);
+    /* Pinning: bound (1, each thread on a core) or refused (-1, unpinned);
+     * either way the same mesh. */
+    {
+        fdt_settings s;
+        fdt_default_settings(&s);
+        s.mode = FDT_MODE_SHARED;
+        s.n_threads = 3;
+        s.pin = 1;
+        fdt_context *ctx = NULL;
+        CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+        CHECK_EQ(fdt_triangulate(ctx, p.xyz, p.n, &r), FDT_OK);
+        CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
+        CHECK(st.pinned == 1 || st.pinned == -1);
+        for (int i = 0; i < 3; i++) {
+            CHECK_EQ(fdt_result_thread_stats(r, i, &ts), FDT_OK);
+            if (st.pinned == 1)
+                CHECK(ts.core >= 0);
+        }
+        CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
+        CHECK(h == ref.hash);
+        printf("pin: %s\n", st.pinned == 1 ? "threads bound to cores" : "binding refused, ran unpinned");
+        fdt_result_free(&r);
+        fdt_close(&ctx);
+    }
+    /* Degenerate input is refused before any thread starts. */
+    pts flat = fam_grid2(5);
+    for (size_t i = 0; i < flat.n; i++)
+        flat.xyz[3 * i + 2] = 0.0; /* duplicates merge: one plane */
+    r = run(&flat, FDT_MODE_SHARED, 4, 0, FDT_EDEGENERATE);
+    CHECK(r == NULL);
+    free(flat.xyz);
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.n_threads = 1025;
+    fdt_context *ctx = NULL;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_EINVAL);
+    free_ref(&ref);
+    free(p.xyz);
+    printf("api: auto mode, thread count 0, no neighbours, refusals\n");
+}
+
+/* A progress callback that cancels: the run stops with FDT_ECANCELED,
+ * without hanging, and leaks nothing (run under a leak checker). */
+static int cancel_cb(void *user, double f)
+{
+    (void)f;
+    int *calls = user;
+    return ++*calls >= 1;
+}
+
+static void test_cancel(void)
+{
+    pts p = fam_uniform(400000, 11);
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = FDT_MODE_MESSAGE;
+    s.n_threads = 3;
+    int calls = 0;
+    s.progress = cancel_cb;
+    s.progress_user = &calls;
+    fdt_context *ctx = NULL;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    fdt_result *r = NULL;
+    int err = fdt_triangulate(ctx, p.xyz, p.n, &r);
+    /* On a very fast machine the run may finish before the first report
+     * (every 50 ms); then the final report cannot cancel any more. */
+    CHECK(err == FDT_ECANCELED || (err == FDT_OK && calls <= 1));
+    if (err == FDT_ECANCELED)
+        CHECK(r == NULL);
+    fdt_result_free(&r);
+    fdt_close(&ctx);
+    free(p.xyz);
+    printf("cancel: progress callback stops a message-mode run (%s)\n", fdt_strerror(err));
+}
+
+static void test_long(void)
+{
+    pts p = fam_uniform(200000, 2024);
+    reference ref = make_ref(&p);
+    const int tl[] = {1, 2, 4, 8};
+    for (int i = 0; i < 4; i++)
+        for (int m = FDT_MODE_SHARED; m <= FDT_MODE_MESSAGE; m++)
+            compare_run(&p, &ref, (fdt_mode)m, tl[i]);
+    printf("uniform %zu points, %zu tets: shared and message equal serial for N = 1, 2, 4, 8\n",
+           p.n, ref.ntets);
+    free_ref(&ref);
+    free(p.xyz);
+}
+
+int main(int argc, char **argv)
+{
+    int quick = 0, lng = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--quick"))
+            quick = 1;
+        else if (!strcmp(argv[i], "--long"))
+            lng = 1;
+        else if (!strcmp(argv[i], "-v"))
+            g_verbose = 1;
+        else {
+            fprintf(stderr, "usage: test_parallel [--quick] [--long] [-v]\n");
+            return 2;
+        }
+    }
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    /* A lost wakeup or a deadlock must fail, not hang. */
+    alarm(lng ? 3000 : 1200);
+    if (lng) {
+        test_long();
+        return 0;
+    }
+    test_partition();
+    test_api();
+    test_family(fam_uniform(quick ? 600 : 2000, 1), quick);
+    test_family(fam_lattice(quick ? 6 : 9), quick);
+    test_family(fam_intsphere(quick ? 325 : 725), quick);
+    test_family(fam_grid2(quick ? 10 : 16), quick);
+    test_family(fam_clusters(quick ? 600 : 1500, 5), quick);
+    test_family(fam_offset(quick ? 600 : 1500, 9), quick);
+    test_tiny(quick ? 2 : 4);
+    if (!quick)
+        test_cancel();
+    printf("all parallel tests passed\n");
+    return 0;
+}
