@@ -148,6 +148,16 @@ static void on_signal(int sig)
 static int install_signals(void)
 {
     static const int sigs[2] = { SIGINT, SIGTERM };
+    /* A write beyond RLIMIT_FSIZE (ulimit -f) raises SIGXFSZ, whose default
+     * action kills the process and leaves the temporary output behind.
+     * Ignored, the write fails with EFBIG instead, which the writer reports
+     * like a full disk (exit 5, temporaries removed). */
+    struct sigaction ign;
+    memset(&ign, 0, sizeof ign);
+    ign.sa_handler = SIG_IGN;
+    sigemptyset(&ign.sa_mask);
+    if (sigaction(SIGXFSZ, &ign, NULL) != 0)
+        return -1;
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
@@ -608,7 +618,53 @@ typedef struct timings {
     double read, triangulate, check, write;
 } timings;
 
-static void print_stats(const fdt_stats *st, size_t dups, const timings *tm)
+/* The five message kinds of Merriam's §4, by name, in one order for the
+ * text and JSON forms. */
+static const char *const msg_names[5] = {"IAMDONE", "NODESEND", "NODERECV", "FACESEND", "FACERECV"};
+static const char *const msg_keys[5] = {"iamdone", "nodesend", "noderecv", "facesend", "facerecv"};
+
+static void msg_array(const fdt_msg_counts *m, size_t out[5])
+{
+    out[0] = m->iamdone;
+    out[1] = m->nodesend;
+    out[2] = m->noderecv;
+    out[3] = m->facesend;
+    out[4] = m->facerecv;
+}
+
+/* Per-thread and per-kind figures of a parallel run (§4-§5): what the
+ * bench harness and the issue notes report. */
+static void print_parallel_stats(const fdt_result *res, const fdt_stats *st)
+{
+    size_t sent[5], recv[5];
+    msg_array(&st->sent, sent);
+    msg_array(&st->received, recv);
+    fprintf(stderr, "  messages          sent / received\n");
+    for (int k = 0; k < 5; k++)
+        fprintf(stderr, "    %-15s %zu / %zu\n", msg_names[k], sent[k], recv[k]);
+    fprintf(stderr,
+        "  remote queries    %zu made, %zu answered, %zu improved the apex\n"
+        "  tet requests      %zu (%zu for tets already built)\n"
+        "  idle time         %.3f s (sum over threads), query wait %.3f s\n"
+        "  load imbalance    %.3f (max / mean tets per thread)\n"
+        "  pinned            %s\n",
+        st->remote_queries, st->remote_answered, st->remote_improved,
+        st->tet_requests, st->duplicate_requests, st->t_idle, st->t_query_wait,
+        st->load_imbalance,
+        st->pinned > 0 ? "yes" : st->pinned < 0 ? "refused (ran unpinned)" : "no");
+    fprintf(stderr, "  thread  points      tets  faces adv  rem.q made/ans  FACESEND s/r  idle s  core\n");
+    for (int i = 0; i < st->threads; i++) {
+        fdt_thread_stats ts;
+        if (fdt_result_thread_stats(res, i, &ts) != FDT_OK)
+            break;
+        fprintf(stderr, "  %6d %7zu %9zu %10zu %8zu/%-6zu %7zu/%-6zu %7.3f %5d\n", i, ts.points,
+                ts.tets, ts.faces_advanced, ts.remote_queries, ts.remote_answered,
+                ts.sent.facesend, ts.received.facesend, ts.t_idle, ts.core);
+    }
+}
+
+static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
+                        const timings *tm)
 {
     fprintf(stderr,
         "frontdt: statistics\n"
@@ -636,6 +692,8 @@ static void print_stats(const fdt_stats *st, size_t dups, const timings *tm)
         st->exact_orient, st->exact_insphere, st->max_front, st->threads,
         mode_name(st->mode), st->t_prepare, st->t_front, st->t_finish,
         tm->read, tm->triangulate, tm->check, tm->write);
+    if (st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE)
+        print_parallel_stats(res, st);
 }
 
 static void json_string(FILE *f, const char *s)
@@ -658,9 +716,19 @@ static double finite_or_zero(double x)
     return (x == x && x - x == 0) ? x : 0;
 }
 
-static void write_stats_json(FILE *f, const cli *c, const fdt_stats *st,
-                             size_t dups, const timings *tm, int have_hash,
-                             uint64_t hash)
+static void json_msgs(FILE *f, const char *key, const fdt_msg_counts *m)
+{
+    size_t v[5];
+    msg_array(m, v);
+    fprintf(f, ", \"%s\": {", key);
+    for (int k = 0; k < 5; k++)
+        fprintf(f, "%s\"%s\": %zu", k ? ", " : "", msg_keys[k], v[k]);
+    fputc('}', f);
+}
+
+static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
+                             const fdt_stats *st, size_t dups, const timings *tm,
+                             int have_hash, uint64_t hash)
 {
     fputs("{\"input\": ", f);
     if (c->input)
@@ -685,6 +753,30 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_stats *st,
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
         finite_or_zero(tm->check), finite_or_zero(tm->write));
+    json_msgs(f, "sent", &st->sent);
+    json_msgs(f, "received", &st->received);
+    fprintf(f,
+        ", \"remote_queries\": %zu, \"remote_answered\": %zu, \"remote_improved\": %zu"
+        ", \"tet_requests\": %zu, \"duplicate_requests\": %zu, \"t_idle\": %.9g"
+        ", \"t_query_wait\": %.9g, \"load_imbalance\": %.9g, \"pinned\": %d",
+        st->remote_queries, st->remote_answered, st->remote_improved, st->tet_requests,
+        st->duplicate_requests, finite_or_zero(st->t_idle), finite_or_zero(st->t_query_wait),
+        finite_or_zero(st->load_imbalance), st->pinned);
+    fputs(", \"per_thread\": [", f);
+    for (int i = 0; i < st->threads; i++) {
+        fdt_thread_stats ts;
+        if (fdt_result_thread_stats(res, i, &ts) != FDT_OK)
+            break;
+        fprintf(f, "%s{\"points\": %zu, \"tets\": %zu, \"faces_advanced\": %zu"
+                   ", \"remote_queries\": %zu, \"remote_answered\": %zu"
+                   ", \"t_idle\": %.9g, \"t_cpu\": %.9g, \"core\": %d",
+                i ? ", " : "", ts.points, ts.tets, ts.faces_advanced, ts.remote_queries,
+                ts.remote_answered, finite_or_zero(ts.t_idle), finite_or_zero(ts.t_cpu), ts.core);
+        json_msgs(f, "sent", &ts.sent);
+        json_msgs(f, "received", &ts.received);
+        fputc('}', f);
+    }
+    fputc(']', f);
     if (c->check)
         fputs(", \"check\": \"passed\"", f);
     if (have_hash)
@@ -842,8 +934,16 @@ static int run(const cli *c)
         goto done;
     }
     if (c->stats)
-        print_stats(&st, dups, &tm);
+        print_stats(res, &st, dups, &tm);
     if (c->stats_json) {
+        /* Only a regular file (or a new one) is ours to remove if the
+         * write fails: "--stats-json /dev/full" must not unlink the
+         * device, nor a symbolic link the file it stands for. */
+        struct stat jst;
+        int removable = !json_stdout &&
+                        (lstat(c->stats_json, &jst) != 0
+                             ? errno == ENOENT
+                             : S_ISREG(jst.st_mode));
         FILE *f = json_stdout ? stdout : fopen(c->stats_json, "w");
         if (!f) {
             say("%s: %s", c->stats_json, strerror(errno));
@@ -851,7 +951,7 @@ static int run(const cli *c)
             goto done;
         }
         errno = 0;
-        write_stats_json(f, c, &st, dups, &tm, c->hash, hash);
+        write_stats_json(f, c, res, &st, dups, &tm, c->hash, hash);
         int e = ferror(f) ? (errno ? errno : EIO) : 0;
         if (json_stdout) {
             if (fflush(f) != 0 && !e)
@@ -859,7 +959,7 @@ static int run(const cli *c)
         } else {
             if (fclose(f) != 0 && !e)
                 e = errno ? errno : EIO;
-            if (e)
+            if (e && removable)
                 unlink(c->stats_json);
         }
         if (e) {
