@@ -216,6 +216,10 @@ int fdt_kd_ball(const fdt_kdtree *t, const double *c, double r,
      * point the caller would accept exactly. */
     double rr = r * (1.0 + 1e-12) + 1e-300;
     double r2 = rr * rr;
+    /* A radius whose square falls below 2^-900 would compare against
+     * underflowed distances: visit everything, the caller decides. */
+    if (!(r2 >= 0x1p-900))
+        r2 = INFINITY;
     stack[sp++] = 0;
     while (sp > 0) {
         const fdt_kdnode *nd = &t->nodes[stack[--sp]];
@@ -323,10 +327,22 @@ static void update_ball(fdt_apex *s)
 {
     const double *a = s->a;
     double u[3], v[3], w[3], vw[3], wu[3], uv[3];
+    double big = 0.0;
     for (int k = 0; k < 3; k++) {
         u[k] = s->b[k] - a[k];
         v[k] = s->c[k] - a[k];
         w[k] = s->bp[k] - a[k];
+        big = fmax(big, fmax(fabs(u[k]), fmax(fabs(v[k]), fabs(w[k]))));
+    }
+    /* Work in units of a power of two near the longest edge (exact), so
+     * the degree-5 products below neither underflow nor overflow when the
+     * input mixes magnitudes (1e-149 next to 1e151 after scaling). */
+    int e;
+    (void)frexp(big, &e);
+    for (int k = 0; k < 3; k++) {
+        u[k] = ldexp(u[k], -e);
+        v[k] = ldexp(v[k], -e);
+        w[k] = ldexp(w[k], -e);
     }
     cross3(v, w, vw);
     cross3(w, u, wu);
@@ -342,21 +358,21 @@ static void update_ball(fdt_apex *s)
     double uu = nu * nu, vv = nv * nv, ww = nw * nw;
     double x[3], xmax = 0.0, amax = 0.0;
     for (int k = 0; k < 3; k++) {
-        x[k] = (uu * vw[k] + vv * wu[k] + ww * uv[k]) / (2.0 * det);
+        x[k] = ldexp((uu * vw[k] + vv * wu[k] + ww * uv[k]) / (2.0 * det), e);
         s->center[k] = a[k] + x[k];
         if (fabs(x[k]) > xmax)
             xmax = fabs(x[k]);
         if (fabs(a[k]) > amax)
             amax = fabs(a[k]);
     }
-    double L = nu > nv ? nu : nv;
-    if (nw > L)
-        L = nw;
+    double L = ldexp(nu > nv ? (nu > nw ? nu : nw) : (nv > nw ? nv : nw), e);
     double r = norm3(x);
     double tol = 64.0 * DBL_EPSILON * K * (K + 1.0) * L + 8.0 * DBL_EPSILON * (amax + xmax);
     double rr = r + tol;
     s->r2 = rr * rr;
-    if (!isfinite(s->r2))
+    /* Squared distances below 2^-900 may have lost their precision to
+     * underflow: at that scale the ball cannot prune safely. */
+    if (!isfinite(s->r2) || s->r2 < 0x1p-900)
         s->r2 = INFINITY;
 }
 
@@ -422,10 +438,13 @@ int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi)
         mx += s->nrm[k] * c + fabs(s->nrm[k]) * h;
         perm += s->nabs[k] * (fabs(c) + h);
     }
-    if (mx < -perm * 1e-13)
-        return 0;
-    if (mx > perm * 1e-13)
-        return 1;
+    if (perm >= 0x1p-800) {
+        if (mx < -perm * 1e-13)
+            return 0;
+        if (mx > perm * 1e-13)
+            return 1;
+    }
+    /* Near the plane, or so small that underflow voids the bound. */
     return box_touches_open_side(s, lo, hi);
 }
 
