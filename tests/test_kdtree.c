@@ -197,9 +197,10 @@ static void test_family(int fam, size_t want, int leaf)
                 const double *x = P + 3 * (size_t)j, *y = P + 3 * (size_t)a;
                 double d = (x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) +
                            (x[2] - y[2]) * (x[2] - y[2]);
-                int k = cnt < 8 ? cnt++ : 7;
-                if (k == 7 && cnt == 8 && d >= nd[7])
+                /* Insertion into the sorted 8 nearest so far. */
+                if (cnt == 8 && d >= nd[7])
                     continue;
+                int k = cnt < 8 ? cnt++ : 7;
                 while (k > 0 && nd[k - 1] > d) {
                     nd[k] = nd[k - 1];
                     near[k] = near[k - 1];
