@@ -162,10 +162,69 @@ static double dist2(const double *a, const double *b)
     return dx * dx + dy * dy + dz * dz;
 }
 
+/*
+ * Ball tests in scaled units. Squared distances of points 1e-300 apart
+ * underflow and of points 1e200 apart overflow, and inputs that mix
+ * magnitudes (1e-150 next to 1e150; prepare can only bring the largest
+ * near 1) have spheres of both sizes. So a ball of radius rr is stored as
+ * sc, a power of two bringing rr near 1, and r2 = (rr sc)^2, and a point
+ * d is inside when |(d - c) sc|^2 <= r2: a difference of doubles that is
+ * subnormal is exact, scaling by a power of two is exact (a scaled-down
+ * value may lose 2^-1075, negligible next to r2 near 1), and the scaled
+ * squares are normal numbers, so the usual relative rounding holds. For
+ * radii within [2^-400, 2^400] sc is 1 and nothing changes.
+ */
+static void ball_scale(double rr, double *sc, double *r2)
+{
+    *sc = 1.0;
+    if (!(rr > 0.0) || !(rr < INFINITY)) {
+        *r2 = INFINITY; /* unknown: visit everything, the caller decides */
+        return;
+    }
+    if (rr < 0x1p-400 || rr > 0x1p400)
+        *sc = ldexp(1.0, -ilogb(rr));
+    double q = rr * *sc;
+    *r2 = q * q;
+}
+
+static inline double dist2_sc(const double *a, const double *b, double sc)
+{
+    double dx = (a[0] - b[0]) * sc, dy = (a[1] - b[1]) * sc, dz = (a[2] - b[2]) * sc;
+    return dx * dx + dy * dy + dz * dz;
+}
+
+/* Squared scaled distance from c to the box; 0 inside. */
+static double box_dist2_sc(const double *lo, const double *hi, const double *c, double sc)
+{
+    double d2 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double d = 0.0;
+        if (c[k] < lo[k])
+            d = (lo[k] - c[k]) * sc;
+        else if (c[k] > hi[k])
+            d = (c[k] - hi[k]) * sc;
+        d2 += d * d;
+    }
+    return d2;
+}
+
 /* Depth of a balanced tree with leaves of >= 1 point is < 64: a stack of
  * 2 * 64 entries per walk would do, but walks push both children, so we
  * size it to the node count bound of one root-to-leaf path times 2. */
 #define WALK_STACK 256
+
+/*
+ * Floating squared distances are only compared where they are far apart:
+ * each carries a relative error below 8 eps (three rounded differences,
+ * three squares, two sums) plus absolute errors below 2^-1000 where
+ * products underflow, so NEAR_REL and NEAR_ABS bound the band in which
+ * the floating order may be wrong. Inside it fdt_compare_dist decides
+ * exactly, so the result is an exact nearest point (lowest id on exact
+ * ties) even when the input mixes magnitudes and every floating distance
+ * rounds to the same value: the seed's first edge relies on it (§2.1).
+ */
+#define NEAR_REL 0x1p-40
+#define NEAR_ABS 0x1p-1000
 
 uint32_t fdt_kd_nearest(const fdt_kdtree *t, const double *q,
                         uint32_t exclude, fdt_kdq *kq)
@@ -177,7 +236,7 @@ uint32_t fdt_kd_nearest(const fdt_kdtree *t, const double *q,
     stack[sp++] = 0;
     while (sp > 0) {
         const fdt_kdnode *nd = &t->nodes[stack[--sp]];
-        if (box_dist2(nd->lo, nd->hi, q) > bd)
+        if (box_dist2(nd->lo, nd->hi, q) > bd * (1.0 + NEAR_REL) + NEAR_ABS)
             continue;
         if (kq)
             kq->nodes++;
@@ -185,8 +244,18 @@ uint32_t fdt_kd_nearest(const fdt_kdtree *t, const double *q,
             for (uint32_t i = nd->begin; i < nd->end; i++) {
                 if (i == exclude)
                     continue;
-                double d = dist2(t->P + 3 * (size_t)i, q);
-                if (d < bd || (d == bd && i < best)) {
+                const double *p = t->P + 3 * (size_t)i;
+                double d = dist2(p, q);
+                int take;
+                if (best == FDT_NONE || d < bd * (1.0 - NEAR_REL) - NEAR_ABS)
+                    take = 1;
+                else if (d > bd * (1.0 + NEAR_REL) + NEAR_ABS)
+                    take = 0;
+                else {
+                    int c = fdt_compare_dist(q, p, t->P + 3 * (size_t)best);
+                    take = c < 0 || (c == 0 && i < best);
+                }
+                if (take) {
                     bd = d;
                     best = i;
                 }
@@ -213,23 +282,20 @@ int fdt_kd_ball(const fdt_kdtree *t, const double *c, double r,
     uint32_t stack[WALK_STACK];
     int sp = 0;
     /* Widen by a relative 1e-12 so rounding in the distances never drops a
-     * point the caller would accept exactly. */
-    double rr = r * (1.0 + 1e-12) + 1e-300;
-    double r2 = rr * rr;
-    /* A radius whose square falls below 2^-900 would compare against
-     * underflowed distances: visit everything, the caller decides. */
-    if (!(r2 >= 0x1p-900))
-        r2 = INFINITY;
+     * point the caller would accept exactly; compare in units where the
+     * radius is near 1 (ball_scale). */
+    double sc, r2;
+    ball_scale(r * (1.0 + 1e-12), &sc, &r2);
     stack[sp++] = 0;
     while (sp > 0) {
         const fdt_kdnode *nd = &t->nodes[stack[--sp]];
-        if (box_dist2(nd->lo, nd->hi, c) > r2)
+        if (box_dist2_sc(nd->lo, nd->hi, c, sc) > r2)
             continue;
         if (kq)
             kq->nodes++;
         if (!nd->left) {
             for (uint32_t i = nd->begin; i < nd->end; i++)
-                if (dist2(t->P + 3 * (size_t)i, c) <= r2) {
+                if (dist2_sc(t->P + 3 * (size_t)i, c, sc) <= r2) {
                     int rc = fn(user, i);
                     if (rc)
                         return rc;
@@ -284,6 +350,7 @@ void fdt_apex_init(fdt_apex *s, const double *a, const double *b,
     }
     s->best = FDT_NONE;
     s->bp = NULL;
+    s->sc = 1.0;
     s->r2 = INFINITY;
 }
 
@@ -323,6 +390,49 @@ static int open_side(const fdt_apex *s, const double *d, fdt_kdq *kq)
  * and give up on the ball (infinite radius) when K > 1e6: such slivers
  * have enormous spheres anyway and the open-side test still prunes.
  */
+/*
+ * The ball of an ill-conditioned tet (K > 1e6: a sliver, or points of
+ * very different magnitudes, where the floating bound above would be
+ * useless): the centre from exact arithmetic (src/predicates.c), each
+ * component of x = centre - a within 2^-51 relative. Then the rounded
+ * centre is off by at most 4 eps (amax + 2 xmax) in norm, the rounded
+ * radius by 4 eps r, and the distances compared against the ball carry a
+ * relative 5 eps: widening by 16 eps (r + amax + 2 xmax) covers all of it.
+ * Before this, such tets got an infinite ball and every apex search that
+ * met one scanned the whole open side: inputs mixing 1e-150, 1 and 1e150
+ * ran in O(n) a face.
+ */
+static void update_ball_exact(fdt_apex *s)
+{
+    double x[3];
+    if (fdt_circumcenter_exact(s->a, s->b, s->c, s->bp, x) != 0) {
+        ball_scale(INFINITY, &s->sc, &s->r2);
+        return;
+    }
+    double xmax = 0.0, amax = 0.0;
+    for (int k = 0; k < 3; k++) {
+        s->center[k] = s->a[k] + x[k];
+        xmax = fmax(xmax, fabs(x[k]));
+        amax = fmax(amax, fabs(s->a[k]));
+    }
+    /* norm3 of x without overflow or underflow of the squares */
+    double r = 0.0;
+    if (xmax > 0.0) {
+        double y0 = x[0] / xmax, y1 = x[1] / xmax, y2 = x[2] / xmax;
+        r = xmax * sqrt(y0 * y0 + y1 * y1 + y2 * y2);
+    }
+    ball_scale(r + 16.0 * DBL_EPSILON * (r + amax + 2.0 * xmax), &s->sc, &s->r2);
+}
+
+/* 2^k for -1022 <= k <= 1023, built from its bits. */
+static inline double pow2i(int k)
+{
+    uint64_t b = (uint64_t)(k + 1023) << 52;
+    double x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
 static void update_ball(fdt_apex *s)
 {
     const double *a = s->a;
@@ -332,17 +442,37 @@ static void update_ball(fdt_apex *s)
         u[k] = s->b[k] - a[k];
         v[k] = s->c[k] - a[k];
         w[k] = s->bp[k] - a[k];
-        big = fmax(big, fmax(fabs(u[k]), fmax(fabs(v[k]), fabs(w[k]))));
+        /* ternaries, not fmax: gcc calls libm's fmax for its NaN rules */
+        double m = fabs(u[k]) > fabs(v[k]) ? fabs(u[k]) : fabs(v[k]);
+        m = m > fabs(w[k]) ? m : fabs(w[k]);
+        big = big > m ? big : m;
     }
     /* Work in units of a power of two near the longest edge (exact), so
      * the degree-5 products below neither underflow nor overflow when the
      * input mixes magnitudes (1e-149 next to 1e151 after scaling). */
     int e;
-    (void)frexp(big, &e);
+    if (big >= DBL_MIN && big <= DBL_MAX) { /* normal: read the exponent */
+        uint64_t bits;
+        memcpy(&bits, &big, sizeof bits);
+        e = (int)((bits >> 52) & 0x7ff) - 1022; /* big in [2^(e-1), 2^e) */
+    } else {
+        (void)frexp(big, &e);
+    }
+    /* Multiplying by 2^-e is the same exact scaling as ldexp and several
+     * times cheaper than the library call (it was 9 % of a run): 2^-e and
+     * 2^e are normal doubles for |e| <= 1000, i.e. whenever the longest
+     * difference is not itself near the ends of the double range. */
+    double down, up;
+    if (e >= -1000 && e <= 1000) {
+        down = pow2i(-e);
+        up = pow2i(e);
+    } else {
+        down = up = 0.0; /* marks the ldexp path */
+    }
     for (int k = 0; k < 3; k++) {
-        u[k] = ldexp(u[k], -e);
-        v[k] = ldexp(v[k], -e);
-        w[k] = ldexp(w[k], -e);
+        u[k] = up != 0.0 ? u[k] * down : ldexp(u[k], -e);
+        v[k] = up != 0.0 ? v[k] * down : ldexp(v[k], -e);
+        w[k] = up != 0.0 ? w[k] * down : ldexp(w[k], -e);
     }
     cross3(v, w, vw);
     cross3(w, u, wu);
@@ -351,36 +481,34 @@ static void update_ball(fdt_apex *s)
     double nu = norm3(u), nv = norm3(v), nw = norm3(w);
     double prod = nu * nv * nw;
     if (!(det > 0.0) || !(prod < 1e6 * det) || !isfinite(prod)) {
-        s->r2 = INFINITY;
+        update_ball_exact(s);
         return;
     }
     double K = prod / det;
     double uu = nu * nu, vv = nv * nv, ww = nw * nw;
-    double x[3], xmax = 0.0, amax = 0.0;
+    double x[3], xs[3], xmax = 0.0, amax = 0.0;
     for (int k = 0; k < 3; k++) {
-        x[k] = ldexp((uu * vw[k] + vv * wu[k] + ww * uv[k]) / (2.0 * det), e);
+        xs[k] = (uu * vw[k] + vv * wu[k] + ww * uv[k]) / (2.0 * det);
+        x[k] = up != 0.0 ? xs[k] * up : ldexp(xs[k], e);
         s->center[k] = a[k] + x[k];
         if (fabs(x[k]) > xmax)
             xmax = fabs(x[k]);
         if (fabs(a[k]) > amax)
             amax = fabs(a[k]);
     }
-    double L = ldexp(nu > nv ? (nu > nw ? nu : nw) : (nv > nw ? nv : nw), e);
-    double r = norm3(x);
+    double L = nu > nv ? (nu > nw ? nu : nw) : (nv > nw ? nv : nw);
+    double r = norm3(xs); /* squares in the scaled units */
+    L = up != 0.0 ? L * up : ldexp(L, e);
+    r = up != 0.0 ? r * up : ldexp(r, e);
     double tol = 64.0 * DBL_EPSILON * K * (K + 1.0) * L + 8.0 * DBL_EPSILON * (amax + xmax);
-    double rr = r + tol;
-    s->r2 = rr * rr;
-    /* Squared distances below 2^-900 may have lost their precision to
-     * underflow: at that scale the ball cannot prune safely. */
-    if (!isfinite(s->r2) || s->r2 < 0x1p-900)
-        s->r2 = INFINITY;
+    ball_scale(r + tol, &s->sc, &s->r2);
 }
 
 void fdt_apex_offer(fdt_apex *s, uint32_t id, const double *d, fdt_kdq *kq)
 {
     if (id == s->ia || id == s->ib || id == s->ic || id == s->best)
         return;
-    if (s->best != FDT_NONE && dist2(d, s->center) > s->r2)
+    if (s->best != FDT_NONE && dist2_sc(d, s->center, s->sc) > s->r2)
         return;
     if (open_side(s, d, kq) <= 0)
         return;
@@ -427,7 +555,7 @@ static int box_touches_open_side(const fdt_apex *s, const double *lo, const doub
 
 int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi)
 {
-    if (s->best != FDT_NONE && box_dist2(lo, hi, s->center) > s->r2)
+    if (s->best != FDT_NONE && box_dist2_sc(lo, hi, s->center, s->sc) > s->r2)
         return 0;
     /* Largest value of nrm . (x - a) over the box, against a margin for
      * rounding in the same spirit as open_side's. */
@@ -441,7 +569,7 @@ int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi)
         double dl = lo[k] - s->a[k], dh = hi[k] - s->a[k];
         double tl = s->nrm[k] * dl, th = s->nrm[k] * dh;
         mx += tl > th ? tl : th;
-        perm += s->nabs[k] * fmax(fabs(dl), fabs(dh));
+        perm += s->nabs[k] * (fabs(dl) > fabs(dh) ? fabs(dl) : fabs(dh));
     }
     if (perm >= 0x1p-800) {
         if (mx < -perm * 1e-13)
@@ -473,7 +601,7 @@ static void apex_walk(fdt_apex *s, const fdt_kdtree *t, uint32_t root, fdt_kdq *
         }
         const fdt_kdnode *l = &t->nodes[nd->left], *r = l + 1;
         const double *q = s->best != FDT_NONE ? s->center : s->target;
-        double dl = box_dist2(l->lo, l->hi, q), dr = box_dist2(r->lo, r->hi, q);
+        double dl = box_dist2_sc(l->lo, l->hi, q, s->sc), dr = box_dist2_sc(r->lo, r->hi, q, s->sc);
         if (dl <= dr) {
             stack[sp++] = nd->left + 1;
             stack[sp++] = nd->left;
@@ -487,6 +615,57 @@ static void apex_walk(fdt_apex *s, const fdt_kdtree *t, uint32_t root, fdt_kdq *
 void fdt_apex_search(fdt_apex *s, const fdt_kdtree *t, fdt_kdq *kq)
 {
     apex_walk(s, t, 0, kq);
+}
+
+/*
+ * Offers first the point of leaf `leaf` that floating point says is the
+ * apex: every sphere through a, b, c has its centre at cc + t N (cc the
+ * triangle's circumcentre, N its normal), and a point x on the open side
+ * lies inside the one with t > tau(x) = (|x - cc|^2 - |a - cc|^2) /
+ * (2 N.(x - a)), so the apex is the point of least tau. Offered in index
+ * order, the leaf's points improved the best candidate about 7 times a
+ * face, each time recomputing the ball (update_ball) and leaving a larger
+ * ball than necessary for the climb. This is only an ordering: the offer
+ * decides exactly, as for every other point.
+ */
+static void offer_likely_apex(fdt_apex *s, const fdt_kdtree *t, uint32_t leaf,
+                              fdt_kdq *kq)
+{
+    const fdt_kdnode *nd = &t->nodes[leaf];
+    const double *a = s->a, *N = s->nrm;
+    double u[3], v[3], m[3], cc[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = s->b[k] - a[k];
+        v[k] = s->c[k] - a[k];
+    }
+    double nn = N[0] * N[0] + N[1] * N[1] + N[2] * N[2];
+    if (!(nn > 0.0) || !(nn < INFINITY))
+        return;
+    double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    double vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    for (int k = 0; k < 3; k++)
+        m[k] = uu * v[k] - vv * u[k];
+    cross3(m, N, cc); /* 2 nn (cc - a) */
+    double best_q = 0.0, best_h = 0.0;
+    uint32_t best = FDT_NONE;
+    for (uint32_t i = nd->begin; i < nd->end; i++) {
+        const double *x = t->P + 3 * (size_t)i;
+        double w0 = x[0] - a[0], w1 = x[1] - a[1], w2 = x[2] - a[2];
+        double h = N[0] * w0 + N[1] * w1 + N[2] * w2;
+        if (!(h > 0.0))
+            continue;
+        /* 2 nn (|x - cc|^2 - |a - cc|^2) = 2 nn |w|^2 - 2 (2 nn (cc - a)).w */
+        double q = 2.0 * nn * (w0 * w0 + w1 * w1 + w2 * w2) -
+                   2.0 * (cc[0] * w0 + cc[1] * w1 + cc[2] * w2);
+        /* tau(x) < tau(best) <=> q h_best < q_best h (both h > 0) */
+        if (best == FDT_NONE || q * best_h < best_q * h) {
+            best = i;
+            best_q = q;
+            best_h = h;
+        }
+    }
+    if (best != FDT_NONE)
+        fdt_apex_offer(s, best, t->P + 3 * (size_t)best, kq);
 }
 
 /*
@@ -531,10 +710,11 @@ void fdt_apex_search_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start,
             clo[depth + 1][dim] = t->nodes[l].hi[dim];
         path[++depth] = node = child;
     }
+    offer_likely_apex(s, t, node, kq);
     apex_walk(s, t, node, kq);
     for (int d = depth; d > 0; d--) {
         if (s->best != FDT_NONE && isfinite(s->r2)) {
-            double r = sqrt(s->r2);
+            double r = sqrt(s->r2) / s->sc;
             int inside = 1;
             for (int k = 0; k < 3 && inside; k++)
                 inside = s->center[k] - r > clo[d][k] && s->center[k] + r < chi[d][k];
@@ -580,7 +760,7 @@ uint32_t fdt_kd_any_inside(const fdt_kdtree *t, const uint32_t v[4], fdt_kdq *kq
     s.best = v[3];
     s.bp = ic.p[3];
     update_ball(&s);
-    double r = isfinite(s.r2) ? sqrt(s.r2) : INFINITY;
+    double r = isfinite(s.r2) ? sqrt(s.r2) / s.sc : INFINITY;
     if (!isfinite(r)) {
         for (uint32_t i = t->base; i < t->base + t->n; i++)
             if (inside_cb(&ic, i))

@@ -55,7 +55,8 @@ void fdt_kd_free(fdt_kdtree *t);
 void fdt_kd_select(double *P, fdt_vid *orig, uint32_t lo, uint32_t hi,
                    uint32_t k, int dim);
 
-/* Nearest point to q other than id `exclude` (floating-point distances),
+/* An exactly nearest point to q other than id `exclude` (the lowest id on
+ * exact ties; floating distances, fdt_compare_dist on near-ties),
  * FDT_NONE if the tree holds no other point. */
 uint32_t fdt_kd_nearest(const fdt_kdtree *t, const double *q,
                         uint32_t exclude, fdt_kdq *kq);
@@ -83,7 +84,9 @@ typedef struct fdt_apex {
     uint32_t best;       /* FDT_NONE until a candidate is found */
     const double *bp;    /* coordinates of best */
     double center[3];    /* conservative search ball of the best sphere */
-    double r2;           /* INFINITY while unknown or ill-conditioned */
+    double sc;           /* a power of two: the ball test compares */
+    double r2;           /* |(d - center) sc|^2 with r2 = (radius sc)^2, */
+                         /* INFINITY while unknown or ill-conditioned */
 } fdt_apex;
 
 void fdt_apex_init(fdt_apex *s, const double *a, const double *b,

@@ -358,10 +358,81 @@ int fdt_orient3d_exact(const double *a, const double *b, const double *c,
     return orient_stage_c(a, b, c, d);
 }
 
+/*
+ * Second chance for the filters, on inputs far from 1 in scale. The
+ * bounds need the permanent above 2^-800 (below it, underflow may eat the
+ * margin), so differences below about 2^-266 (orient3d, degree 3) or
+ * 2^-160 (insphere, degree 5) always failed the filter: a cluster of
+ * points 1e-150 across next to points at 1 (prepare scales the largest
+ * coordinate near 1) sent every predicate among its points to the exact
+ * stages, and those inputs ran thousands of times slower. Both signs are
+ * invariant under scaling the differences by a positive power of two, and
+ * the filters' proofs hold for any rounded differences: scaling them is
+ * exact, except that a value scaled into the subnormal range may lose up
+ * to 2^-1075, one more absolute error of the size the proofs' underflow
+ * term U already allows for (U is below 2^-92 perm with room to spare).
+ * Differences within [2^-100, 2^100] are not rescaled: there the filter
+ * failed because the sign is close, and rescaling cannot help.
+ */
+static int rescale_diffs(double (*rows)[3], int nrows)
+{
+    double m = 0.0;
+    for (int i = 0; i < nrows; i++)
+        for (int k = 0; k < 3; k++)
+            m = fmax(m, fabs(rows[i][k]));
+    if (m == 0.0 || !isfinite(m) || (m >= 0x1p-100 && m <= 0x1p100))
+        return 0;
+    int e = ilogb(m);
+    for (int i = 0; i < nrows; i++)
+        for (int k = 0; k < 3; k++)
+            rows[i][k] = ldexp(rows[i][k], -e);
+    return 1;
+}
+
+/* orient3d's determinant is linear in each row, so each row of
+ * differences may take its own power of two: a face 1e-150 across tested
+ * against a point at distance 1 becomes well scaled too (insphere's lifted
+ * rows are not linear in the differences, so it scales them all alike). */
+static int orient3d_filter_rescaled(const double *a, const double *b,
+                                    const double *c, const double *d)
+{
+    double r[3][3];
+    int any = 0;
+    for (int k = 0; k < 3; k++) {
+        r[0][k] = b[k] - a[k];
+        r[1][k] = c[k] - a[k];
+        r[2][k] = d[k] - a[k];
+    }
+    for (int i = 0; i < 3; i++)
+        any |= rescale_diffs(&r[i], 1);
+    if (!any)
+        return FDT_PRED_UNSURE;
+    return fdt_orient3d_filter_diff(r[0], r[1], r[2]);
+}
+
+static int insphere_filter_rescaled(const double *a, const double *b,
+                                    const double *c, const double *d,
+                                    const double *e)
+{
+    double r[4][3];
+    for (int k = 0; k < 3; k++) {
+        r[0][k] = a[k] - e[k];
+        r[1][k] = b[k] - e[k];
+        r[2][k] = c[k] - e[k];
+        r[3][k] = d[k] - e[k];
+    }
+    if (!rescale_diffs(r, 4))
+        return FDT_PRED_UNSURE;
+    return fdt_insphere_filter_diff(r[0], r[1], r[2], r[3]);
+}
+
 int fdt_orient3d(const double *a, const double *b, const double *c,
                  const double *d, fdt_pred_counts *cnt)
 {
     int s = fdt_orient3d_filter(a, b, c, d);
+    if (s != FDT_PRED_UNSURE)
+        return s;
+    s = orient3d_filter_rescaled(a, b, c, d);
     if (s != FDT_PRED_UNSURE)
         return s;
     return fdt_orient3d_exact(a, b, c, d, cnt);
@@ -547,6 +618,9 @@ int fdt_insphere(const double *a, const double *b, const double *c,
     int s = fdt_insphere_filter(a, b, c, d, e);
     if (s != FDT_PRED_UNSURE)
         return s;
+    s = insphere_filter_rescaled(a, b, c, d, e);
+    if (s != FDT_PRED_UNSURE)
+        return s;
     return fdt_insphere_exact(a, b, c, d, e, cnt);
 }
 
@@ -561,6 +635,133 @@ int fdt_lex_compare(const double *p, const double *q)
             return 1;
     }
     return 0;
+}
+
+int fdt_compare_dist(const double *q, const double *x, const double *y)
+{
+    /* Rarely called (near-ties only), so straight to integers: every
+     * coordinate is m 2^k with k >= kmin, so scaling by 2^-kmin makes the
+     * whole computation exact in mpz. */
+    const double *const pts[3] = {q, x, y};
+    int kmin = min_int_exponent(pts, 3);
+    mpz_t zq, zx, zy, acc, t;
+    mpz_init(zq);
+    mpz_init(zx);
+    mpz_init(zy);
+    mpz_init(acc);
+    mpz_init(t);
+    for (int k = 0; k < 3; k++) {
+        mpz_set_scaled(zq, q[k], kmin);
+        mpz_set_scaled(zx, x[k], kmin);
+        mpz_set_scaled(zy, y[k], kmin);
+        mpz_sub(zx, zx, zq);
+        mpz_sub(zy, zy, zq);
+        mpz_addmul(acc, zx, zx);
+        mpz_mul(t, zy, zy);
+        mpz_sub(acc, acc, t);
+    }
+    int s = mpz_sgn(acc);
+    mpz_clear(t);
+    mpz_clear(acc);
+    mpz_clear(zy);
+    mpz_clear(zx);
+    mpz_clear(zq);
+    return s;
+}
+
+/* ldexp(n / den, k) to 53 bits, truncated: den > 0. The quotient is first
+ * taken to 64-65 significant bits (integer division, so the one
+ * truncation there is below 2^-63 relative), then mpz_get_d truncates to
+ * 53: within 2^-52 of the true value in all. */
+static double mpz_ratio_ldexp(const mpz_t n, const mpz_t den, long k, mpz_t t)
+{
+    if (mpz_sgn(n) == 0)
+        return 0.0;
+    long sh = 64 - ((long)mpz_sizeinbase(n, 2) - (long)mpz_sizeinbase(den, 2));
+    if (sh >= 0) {
+        mpz_mul_2exp(t, n, (mp_bitcnt_t)sh);
+        mpz_tdiv_q(t, t, den);
+    } else {
+        mpz_tdiv_q_2exp(t, n, (mp_bitcnt_t)(-sh));
+        mpz_tdiv_q(t, t, den);
+    }
+    long e = k - sh;
+    if (e > 4000)
+        return mpz_sgn(n) > 0 ? INFINITY : -INFINITY;
+    if (e < -4000)
+        return 0.0;
+    return ldexp(mpz_get_d(t), (int)e);
+}
+
+int fdt_circumcenter_exact(const double *a, const double *b, const double *c,
+                           const double *d, double x[3])
+{
+    const double *const pts[4] = {a, b, c, d};
+    int kmin = min_int_exponent(pts, 4);
+    /* q[0] = a; q[1..3] = u, v, w = b - a, c - a, d - a (scaled, exact) */
+    mpz_t q[4][3], cr[3][3], len[3], num[3], det, t;
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++) {
+            mpz_init(q[i][k]);
+            mpz_set_scaled(q[i][k], pts[i][k], kmin);
+        }
+    for (int i = 1; i < 4; i++)
+        for (int k = 0; k < 3; k++)
+            mpz_sub(q[i][k], q[i][k], q[0][k]);
+    for (int i = 0; i < 3; i++) {
+        mpz_init(len[i]);
+        mpz_init(num[i]);
+        for (int k = 0; k < 3; k++)
+            mpz_init(cr[i][k]);
+    }
+    mpz_init(det);
+    mpz_init(t);
+    /* cr[0] = v x w, cr[1] = w x u, cr[2] = u x v; len[i] = |row i|^2 */
+    for (int i = 0; i < 3; i++) {
+        mpz_t *p = q[1 + (i + 1) % 3], *r = q[1 + (i + 2) % 3];
+        for (int k = 0; k < 3; k++) {
+            int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+            mpz_mul(cr[i][k], p[k1], r[k2]);
+            mpz_submul(cr[i][k], p[k2], r[k1]);
+        }
+        mpz_set_ui(len[i], 0);
+        for (int k = 0; k < 3; k++)
+            mpz_addmul(len[i], q[1 + i][k], q[1 + i][k]);
+    }
+    /* x = (|u|^2 (v x w) + |v|^2 (w x u) + |w|^2 (u x v)) / (2 u.(v x w)) */
+    mpz_set_ui(det, 0);
+    for (int k = 0; k < 3; k++)
+        mpz_addmul(det, q[1][k], cr[0][k]);
+    int rc = 0;
+    if (mpz_sgn(det) == 0)
+        rc = -1;
+    else {
+        int neg = mpz_sgn(det) < 0;
+        mpz_abs(det, det);
+        mpz_mul_2exp(det, det, 1);
+        for (int k = 0; k < 3 && rc == 0; k++) {
+            mpz_mul(num[k], len[0], cr[0][k]);
+            mpz_addmul(num[k], len[1], cr[1][k]);
+            mpz_addmul(num[k], len[2], cr[2][k]);
+            if (neg)
+                mpz_neg(num[k], num[k]);
+            x[k] = mpz_ratio_ldexp(num[k], det, kmin, t);
+            if (!isfinite(x[k]))
+                rc = -1;
+        }
+    }
+    mpz_clear(t);
+    mpz_clear(det);
+    for (int i = 0; i < 3; i++) {
+        mpz_clear(len[i]);
+        mpz_clear(num[i]);
+        for (int k = 0; k < 3; k++)
+            mpz_clear(cr[i][k]);
+    }
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++)
+            mpz_clear(q[i][k]);
+    return rc;
 }
 
 /*

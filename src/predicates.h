@@ -45,6 +45,21 @@ int fdt_insphere(const double *a, const double *b, const double *c,
 /* Lexicographic (x, then y, then z) comparison: -1, 0, +1. */
 int fdt_lex_compare(const double *p, const double *q);
 
+/* Exact sign of |x - q|^2 - |y - q|^2 for any finite doubles: -1 when x
+ * is strictly nearer to q than y, 0 on a tie, +1 otherwise. Floating
+ * squared distances can tie (or invert) when the points mix magnitudes
+ * (1e-149 next to 1), which made the seed's "nearest neighbour" edge
+ * non-Delaunay; callers use this only on floating near-ties. */
+int fdt_compare_dist(const double *q, const double *x, const double *y);
+
+/* The circumcentre of the tetrahedron (a, b, c, d) relative to a, from
+ * exact integer arithmetic: x[k] within a relative 2^-51 of the true
+ * value for any finite input, however flat the tet. 0 on success, -1 when
+ * the four points are coplanar or a component overflows a double. For
+ * the ill-conditioned spheres the floating formula cannot bound. */
+int fdt_circumcenter_exact(const double *a, const double *b, const double *c,
+                           const double *d, double x[3]);
+
 /*
  * Perturbed insphere (Devillers & Teillaud 2011, as in CGAL's
  * Delaunay_triangulation_3::side_of_oriented_sphere with perturb=true).
@@ -122,12 +137,12 @@ int fdt_insphere_exact(const double *a, const double *b, const double *c,
  * perm, which exceeds the error by ~2^-62 perm. Hence det_computed > bound
  * implies det > 0, and det_computed < -bound implies det < 0.
  */
-static inline int fdt_orient3d_filter(const double *a, const double *b,
-                                      const double *c, const double *d)
+static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
+                                           const double w[3])
 {
-    const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
-    const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
-    const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
+    const double ux = u[0], uy = u[1], uz = u[2];
+    const double vx = v[0], vy = v[1], vz = v[2];
+    const double wx = w[0], wy = w[1], wz = w[2];
     const double vywz = vy * wz, vzwy = vz * wy;
     const double vzwx = vz * wx, vxwz = vx * wz;
     const double vxwy = vx * wy, vywx = vy * wx;
@@ -145,6 +160,18 @@ static inline int fdt_orient3d_filter(const double *a, const double *b,
             return s;
     }
     return FDT_PRED_UNSURE;
+}
+
+/* The filter proper works on the rounded differences u = b - a, v = c - a,
+ * w = d - a; fdt_orient3d() also calls it on differences rescaled by a
+ * power of two when they lie outside the range the bound covers. */
+static inline int fdt_orient3d_filter(const double *a, const double *b,
+                                      const double *c, const double *d)
+{
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    return fdt_orient3d_filter_diff(u, v, w);
 }
 
 /*
@@ -184,14 +211,13 @@ static inline int fdt_orient3d_filter(const double *a, const double *b,
  * <= (16 eps + 600 eps^2 + 2^-102) perm, while fl(B perm) with
  * B = FDT_ISP_ERRBOUND is >= (16eps + 2^-61 - 17 eps^2) perm.
  */
-static inline int fdt_insphere_filter(const double *a, const double *b,
-                                      const double *c, const double *d,
-                                      const double *e)
+static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
+                                           const double C[3], const double D[3])
 {
-    const double aex = a[0] - e[0], aey = a[1] - e[1], aez = a[2] - e[2];
-    const double bex = b[0] - e[0], bey = b[1] - e[1], bez = b[2] - e[2];
-    const double cex = c[0] - e[0], cey = c[1] - e[1], cez = c[2] - e[2];
-    const double dex = d[0] - e[0], dey = d[1] - e[1], dez = d[2] - e[2];
+    const double aex = A[0], aey = A[1], aez = A[2];
+    const double bex = B[0], bey = B[1], bez = B[2];
+    const double cex = C[0], cey = C[1], cez = C[2];
+    const double dex = D[0], dey = D[1], dez = D[2];
 
     const double aexbey = aex * bey, bexaey = bex * aey;
     const double bexcey = bex * cey, cexbey = cex * bey;
@@ -233,6 +259,19 @@ static inline int fdt_insphere_filter(const double *a, const double *b,
             return s;
     }
     return FDT_PRED_UNSURE;
+}
+
+/* As for orient3d: the proper filter takes the rounded differences
+ * A = a - e, ..., D = d - e. */
+static inline int fdt_insphere_filter(const double *a, const double *b,
+                                      const double *c, const double *d,
+                                      const double *e)
+{
+    const double A[3] = {a[0] - e[0], a[1] - e[1], a[2] - e[2]};
+    const double B[3] = {b[0] - e[0], b[1] - e[1], b[2] - e[2]};
+    const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
+    const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
+    return fdt_insphere_filter_diff(A, B, C, D);
 }
 
 #endif

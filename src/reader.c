@@ -1520,16 +1520,69 @@ static int rd_slurp(rd_ctx *c, int fd, const struct stat *st, char **out)
     return FDT_IO_OK;
 }
 
-int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
-                    size_t errlen)
+/* Starts a read: clears the outputs and the message. */
+static void rd_begin(rd_ctx *c, double **xyz, size_t *n)
 {
-    rd_ctx c = {path != NULL ? path : "(null)", err, errlen, NULL, 0};
     if (xyz != NULL)
         *xyz = NULL;
     if (n != NULL)
         *n = 0;
-    if (err != NULL && errlen > 0)
-        err[0] = '\0';
+    if (c->err != NULL && c->errlen > 0)
+        c->err[0] = '\0';
+}
+
+/*
+ * Parses c->buf (c->size bytes and a NUL, owned by the caller) as a file of
+ * the given kind. On success *xyz and *n are set; on failure they are left
+ * alone and the message is in c->err.
+ */
+static int rd_parse(rd_ctx *c, int kind, double **xyz, size_t *n)
+{
+    rd_points pb = {NULL, 0, 0};
+    int rc;
+    if (c->size == 0) {
+        rc = rd_fail(c, FDT_IO_EFORMAT, ": no points (empty file)");
+    } else if (kind == EXT_PLY) {
+        rc = rd_read_ply(c, &pb);
+    } else {
+        const char *start = c->buf;
+        /* a UTF-8 byte order mark, as some Windows tools write */
+        if (c->size >= 3 && memcmp(c->buf, "\xef\xbb\xbf", 3) == 0)
+            start += 3;
+        rc = kind == EXT_NODE ? rd_read_node(c, start, &pb)
+                              : rd_read_xyz(c, start, &pb);
+    }
+    if (rc == FDT_IO_OK && pb.n == 0)
+        rc = rd_fail(c, FDT_IO_EFORMAT, ": no points");
+    if (rc != FDT_IO_OK) {
+        free(pb.xyz);
+        return rc;
+    }
+    if (pb.cap > pb.n) {
+        double *x = realloc(pb.xyz, pb.n * 3 * sizeof(double));
+        if (x != NULL) /* shrinking cannot lose data; keep the old block */
+            pb.xyz = x;
+    }
+    *xyz = pb.xyz;
+    *n = pb.n;
+    return FDT_IO_OK;
+}
+
+/* The "unknown extension" refusal shared by both entry points. */
+static int rd_bad_extension(const rd_ctx *c, const char *ext)
+{
+    char q[RD_QUOTE_CAP];
+    return rd_fail(c, FDT_IO_EEXT,
+                   ": unknown extension %s (expected .xyz, .txt, .node or "
+                   ".ply)",
+                   rd_quote(q, ext, strlen(ext)));
+}
+
+int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
+                    size_t errlen)
+{
+    rd_ctx c = {path != NULL ? path : "(null)", err, errlen, NULL, 0};
+    rd_begin(&c, xyz, n);
     if (path == NULL || xyz == NULL || n == NULL)
         return rd_fail(&c, FDT_IO_EOPEN, ": invalid arguments");
 
@@ -1553,44 +1606,44 @@ int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
     int kind = rd_extension(path, &ext);
     if (kind == EXT_NONE) {
         close(fd);
-        char q[RD_QUOTE_CAP];
-        return rd_fail(&c, FDT_IO_EEXT,
-                       ": unknown extension %s (expected .xyz, .txt, .node "
-                       "or .ply)",
-                       rd_quote(q, ext, strlen(ext)));
+        return rd_bad_extension(&c, ext);
     }
     char *buf = NULL;
     int rc = rd_slurp(&c, fd, &st, &buf);
     close(fd);
     if (rc != FDT_IO_OK)
         return rc;
-
-    rd_points pb = {NULL, 0, 0};
-    if (c.size == 0) {
-        rc = rd_fail(&c, FDT_IO_EFORMAT, ": no points (empty file)");
-    } else if (kind == EXT_PLY) {
-        rc = rd_read_ply(&c, &pb);
-    } else {
-        const char *start = buf;
-        /* a UTF-8 byte order mark, as some Windows tools write */
-        if (c.size >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0)
-            start += 3;
-        rc = kind == EXT_NODE ? rd_read_node(&c, start, &pb)
-                              : rd_read_xyz(&c, start, &pb);
-    }
-    if (rc == FDT_IO_OK && pb.n == 0)
-        rc = rd_fail(&c, FDT_IO_EFORMAT, ": no points");
+    rc = rd_parse(&c, kind, xyz, n);
     free(buf);
-    if (rc != FDT_IO_OK) {
-        free(pb.xyz);
-        return rc;
-    }
-    if (pb.cap > pb.n) {
-        double *x = realloc(pb.xyz, pb.n * 3 * sizeof(double));
-        if (x != NULL) /* shrinking cannot lose data; keep the old block */
-            pb.xyz = x;
-    }
-    *xyz = pb.xyz;
-    *n = pb.n;
-    return FDT_IO_OK;
+    return rc;
+}
+
+int fdt_read_points_mem(const char *name, const void *data, size_t len,
+                        double **xyz, size_t *n, char *err, size_t errlen)
+{
+    rd_ctx c = {name != NULL ? name : "(null)", err, errlen, NULL, 0};
+    rd_begin(&c, xyz, n);
+    if (name == NULL || (data == NULL && len > 0) || xyz == NULL || n == NULL)
+        return rd_fail(&c, FDT_IO_EOPEN, ": invalid arguments");
+    const char *ext;
+    int kind = rd_extension(name, &ext);
+    if (kind == EXT_NONE)
+        return rd_bad_extension(&c, ext);
+    /* The parsers expect what rd_slurp gives them: a private copy with a
+     * NUL after the last byte. Copying keeps the two entry points one code
+     * path (and lets the fuzzers find reads past that NUL). */
+    if (len > SIZE_MAX - 1)
+        return rd_fail(&c, FDT_IO_ENOMEM, ": file too large for memory");
+    char *buf = malloc(len + 1);
+    if (buf == NULL)
+        return rd_fail(&c, FDT_IO_ENOMEM, ": out of memory reading %zu bytes",
+                       len);
+    if (len > 0)
+        memcpy(buf, data, len);
+    buf[len] = '\0';
+    c.buf = buf;
+    c.size = len;
+    int rc = rd_parse(&c, kind, xyz, n);
+    free(buf);
+    return rc;
 }

@@ -55,4 +55,14 @@ enum {
 int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
                     size_t errlen);
 
+/*
+ * The same parse of len bytes already in memory (data: borrowed, need not
+ * be NUL-terminated). name stands in for the path: its extension picks the
+ * format and messages start with it. Same results and messages as
+ * fdt_read_points() on a file holding those bytes. For the fuzzers
+ * (tests/fuzz/) and for callers that have the bytes already.
+ */
+int fdt_read_points_mem(const char *name, const void *data, size_t len,
+                        double **xyz, size_t *n, char *err, size_t errlen);
+
 #endif

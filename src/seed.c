@@ -47,6 +47,31 @@ static double norm_robust(const double *v)
     return m * sqrt(x * x + y * y + z * z);
 }
 
+/*
+ * Exactly: are a, b and t collinear? The triangle is degenerate iff its
+ * three projections onto the coordinate planes are, and the projection
+ * dropping axis k is degenerate iff orient3d of the three points with
+ * coordinate k set to 0 and the unit point on axis k is zero (the
+ * determinant is the projected doubled area, up to sign). Every one of
+ * those points is a double, so the exact orient3d decides; floating cross
+ * products do not, since they underflow or cancel when the input mixes
+ * magnitudes.
+ */
+static int collinear_exact(const double *a, const double *b, const double *t)
+{
+    for (int k = 0; k < 3; k++) {
+        double pa[3], pb[3], pt[3], e[3] = {0.0, 0.0, 0.0};
+        memcpy(pa, a, sizeof pa);
+        memcpy(pb, b, sizeof pb);
+        memcpy(pt, t, sizeof pt);
+        pa[k] = pb[k] = pt[k] = 0.0;
+        e[k] = 1.0;
+        if (fdt_orient3d(pa, pb, pt, e, NULL) != 0)
+            return 0;
+    }
+    return 1;
+}
+
 int fdt_seed_check_dimension(const double *P, const fdt_vid *orig, uint32_t m,
                              char *diag, size_t dlen)
 {
@@ -55,8 +80,9 @@ int fdt_seed_check_dimension(const double *P, const fdt_vid *orig, uint32_t m,
                  m, m == 1 ? "" : "s");
         return FDT_EDEGENERATE;
     }
-    /* a = 0, b = the farthest point from a, c = the point farthest from
-     * line ab (floating point proposes, exact orient3d decides below). */
+    /* a = 0, b = the farthest point from a (any b != a will do: points are
+     * distinct after the merge), c = the point farthest from line ab, all
+     * proposed in floating point and decided exactly below. */
     const double *a = P;
     uint32_t ib = 1;
     double best = -1.0;
@@ -85,23 +111,29 @@ int fdt_seed_check_dimension(const double *P, const fdt_vid *orig, uint32_t m,
             ic = i;
         }
     }
-    if (ic != FDT_NONE) {
-        const double *c = P + 3 * (size_t)ic;
-        for (uint32_t i = 1; i < m; i++)
-            if (i != ib && i != ic && fdt_orient3d(a, b, c, P + 3 * (size_t)i, NULL) != 0)
-                return FDT_OK;
+    /* The floating choice may be collinear after all (rounding made its
+     * cross product nonzero), or every floating cross product may have
+     * vanished for points that are not collinear: look for an exactly
+     * non-collinear third point. */
+    if (ic == FDT_NONE || collinear_exact(a, b, P + 3 * (size_t)ic)) {
+        ic = FDT_NONE;
+        for (uint32_t i = 1; i < m && ic == FDT_NONE; i++)
+            if (i != ib && !collinear_exact(a, b, P + 3 * (size_t)i))
+                ic = i;
     }
-    /* No fourth point off the plane abc. If the floating cross products
-     * were all exactly zero the set is collinear (or the exact test would
-     * have found a point off any plane through a non-collinear triple,
-     * since a collinear abc makes every orient3d zero -- both cases are a
-     * degenerate input; name the one the numbers show). */
-    if (ic == FDT_NONE)
+    if (ic == FDT_NONE) {
         snprintf(diag, dlen, "all %u distinct points are collinear (on the line through input points %d and %d)",
                  m, (int)orig[0], (int)orig[ib]);
-    else
-        snprintf(diag, dlen, "all %u distinct points are coplanar (in the plane of input points %d, %d and %d)",
-                 m, (int)orig[0], (int)orig[ib], (int)orig[ic]);
+        return FDT_EDEGENERATE;
+    }
+    /* abc spans a plane exactly, so a point off it exists iff the set is
+     * not coplanar. */
+    const double *c = P + 3 * (size_t)ic;
+    for (uint32_t i = 1; i < m; i++)
+        if (i != ib && i != ic && fdt_orient3d(a, b, c, P + 3 * (size_t)i, NULL) != 0)
+            return FDT_OK;
+    snprintf(diag, dlen, "all %u distinct points are coplanar (in the plane of input points %d, %d and %d)",
+             m, (int)orig[0], (int)orig[ib], (int)orig[ic]);
     return FDT_EDEGENERATE;
 }
 
@@ -117,6 +149,7 @@ typedef struct cand_ctx {
     cand *c;
     size_t n, cap;
     int nomem;
+    int all; /* keep floating-collinear candidates too (the fallback) */
 } cand_ctx;
 
 /* Circumradius of (a, b, t) as |u - v| / (2 sin angle(u, v)), u = b - a,
@@ -146,7 +179,7 @@ static int cand_cb(void *user, uint32_t id)
     if (id == cc->ia || id == cc->ib)
         return 0;
     double r = circumradius(cc, cc->P + 3 * (size_t)id);
-    if (!isfinite(r))
+    if (!isfinite(r) && !cc->all)
         return 0;
     if (cc->n == cc->cap) {
         size_t ncap = cc->cap ? 2 * cc->cap : 64;
@@ -200,7 +233,7 @@ int fdt_seed_tet(const fdt_kdtree *t, uint32_t a, uint32_t out[4], fdt_kdq *kq)
     uint32_t b = fdt_kd_nearest(t, P + 3 * (size_t)a, a, kq);
     if (b == FDT_NONE)
         return FDT_EINTERNAL;
-    cand_ctx cc = {P, a, b, {0}, {0}, NULL, 0, 0, 0};
+    cand_ctx cc = {P, a, b, {0}, {0}, NULL, 0, 0, 0, 0};
     const double *pa = P + 3 * (size_t)a, *pb = P + 3 * (size_t)b;
     for (int k = 0; k < 3; k++)
         cc.u[k] = pb[k] - pa[k];
@@ -233,13 +266,36 @@ int fdt_seed_tet(const fdt_kdtree *t, uint32_t a, uint32_t out[4], fdt_kdq *kq)
             break; /* every point seen: take what there is */
         r = isfinite(rmin) ? 2.0 * rmin * (1.0 + 1e-6) * 1.01 : r * 2.0;
     }
-    qsort(cc.c, cc.n, sizeof *cc.c, cand_cmp);
+    if (cc.n > 1)
+        qsort(cc.c, cc.n, sizeof *cc.c, cand_cmp);
     int rc = FDT_EINTERNAL;
     for (size_t i = 0; i < cc.n; i++)
         if (try_face(t, a, b, cc.c[i].id, out, kq) == FDT_OK) {
             rc = FDT_OK;
             break;
         }
+    if (rc != FDT_OK) {
+        /* The floating radii can all be wrong when the input mixes
+         * magnitudes (a triangle 1e-100 wide next to one 1e-2 wide: the
+         * sine cancels), so the window may miss every exact minimizer.
+         * ab is an edge of the tetrahedralization (step 1), so some
+         * triangle abt is a face of it and try_face accepts it: try every
+         * t, floating-collinear ones last. Reached only on such inputs. */
+        cc.n = 0;
+        cc.all = 1;
+        fdt_kd_ball(t, mid, INFINITY, cand_cb, &cc, kq);
+        if (cc.nomem) {
+            free(cc.c);
+            return FDT_ENOMEM;
+        }
+        if (cc.n > 1)
+            qsort(cc.c, cc.n, sizeof *cc.c, cand_cmp);
+        for (size_t i = 0; i < cc.n; i++)
+            if (try_face(t, a, b, cc.c[i].id, out, kq) == FDT_OK) {
+                rc = FDT_OK;
+                break;
+            }
+    }
     free(cc.c);
     return rc;
 }

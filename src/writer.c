@@ -215,9 +215,12 @@ static int set_err(char *err, size_t errlen, int code, const char *path,
     return code;
 }
 
+/* An errno as FDT_IO_EWRITE, except ENOMEM (our buffer, or stdio's):
+ * running out of memory is not a write failure and the CLI says so. */
 static int set_errno_err(char *err, size_t errlen, const char *path, int e)
 {
-    return set_err(err, errlen, FDT_IO_EWRITE, path, strerror(e ? e : EIO));
+    return set_err(err, errlen, e == ENOMEM ? FDT_IO_ENOMEM : FDT_IO_EWRITE,
+                   path, strerror(e ? e : EIO));
 }
 
 /* ------------------------------------------------------------------------ */

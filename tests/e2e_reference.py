@@ -13,8 +13,9 @@ seed, a real point cloud from DATA_DIR, or a small hand-written file):
   2. `frontdt IN --hash --quiet` must print cgal_ref's hash (FNV-1a 64 of
      the canonical text, which this script also recomputes on small
      outputs);
-  3. `--mode serial` on a shuffled copy of IN, mapped back through the
-     permutation, must give the same tets (input-order independence);
+  3. `--mode serial --check` on a shuffled copy of IN must pass its own
+     exact check and, mapped back through the permutation, give the same
+     tets (input-order independence);
   4. on random non-degenerate inputs (uniform, ball, gaussian) frontdt must
      also equal tetgen_ref (TetGen 1.5), a second independent reference;
   5. `--mode shared --threads 3` and `--mode message --threads 3` must
@@ -38,6 +39,7 @@ import random
 import re
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -72,7 +74,7 @@ class Case:
     """One input: a gen_points family, a data file, or literal text."""
 
     def __init__(self, name, family=None, n=0, seed=0, path=None, text=None,
-                 tetgen=False):
+                 tetgen=False, degenerate=False):
         self.name = name
         self.family = family
         self.n = n
@@ -80,6 +82,7 @@ class Case:
         self.path = path
         self.text = text
         self.tetgen = tetgen
+        self.degenerate = degenerate  # no tetrahedron exists (known a priori)
 
     def describe(self):
         if self.family:
@@ -173,7 +176,14 @@ class Runner:
     def __init__(self, args, workdir):
         self.a = args
         self.workdir = workdir
-        self.timeout = 3000 if args.long else 300
+        # FDT_E2E_TIMEOUT_SCALE stretches the per-command limit for slow
+        # builds (.ci/run's ASan+UBSan run sets 4, like its meson
+        # --timeout-multiplier).
+        # Default cases have at most ~36k points (CGAL: well under a second
+        # each): a command still running after 120 s is a failure, and
+        # failing it early keeps the whole run inside meson's 900 s.
+        scale = float(os.environ.get("FDT_E2E_TIMEOUT_SCALE", "1") or "1")
+        self.timeout = int((3000 if args.long else 120) * max(scale, 1.0))
 
     def frontdt(self, *argv):
         return run([self.a.frontdt] + list(argv), self.timeout)
@@ -203,7 +213,7 @@ class Runner:
         if case.path:
             inp = case.path
             with open(inp, "rb") as f:
-                lines = [l for l in f.read().splitlines()]
+                lines = f.read().splitlines()
         else:
             with open(inp, "wb") as f:
                 f.write(case.text.encode())
@@ -238,15 +248,16 @@ class Runner:
 
         rc, out, err, t_fdt = self.frontdt(inp, "-o", fdt_tets, "--quiet")
         cgal_hash = None
-        degenerate = False
+        degenerate = case.degenerate
+        cerr = "known degenerate input"
         if self.a.cgal_ref != "none":
             crc, cout, cerr, _ = run([self.a.cgal_ref, inp, cgal_tets], self.timeout)
-            if crc == 3:
-                degenerate = True
-            elif crc:
+            if crc not in (0, 3):
                 raise CaseFailure("cgal_ref failed (%d): %s" % (crc, cerr.strip()))
-            else:
-                cgal_hash = summary_field(cout, "hash")
+            if (crc == 3) != case.degenerate:
+                raise CaseFailure("REFERENCE BUG: cgal_ref exits %d on a %sdegenerate input"
+                                  % (crc, "" if case.degenerate else "non-"))
+            cgal_hash = summary_field(cout, "hash") if crc == 0 else None
         else:
             notes.append("no cgal_ref")
 
@@ -296,9 +307,12 @@ class Runner:
         if len(canon) != len(perm):
             raise CaseFailure("shuffled copy has %d points, input %d" % (len(perm), len(canon)))
         shuf_tets = os.path.join(d, "frontdt_shuf.tets")
-        rc, _, err, _ = self.frontdt(shuf, "-o", shuf_tets, "--quiet", "--mode", "serial")
+        # --check too: frontdt's own exact verification, the only proof of
+        # correctness left when cgal_ref is not built.
+        rc, _, err, _ = self.frontdt(shuf, "-o", shuf_tets, "--quiet", "--mode", "serial",
+                                     "--check")
         if rc:
-            raise CaseFailure("frontdt --mode serial on the shuffled copy exit %d: %s"
+            raise CaseFailure("frontdt --mode serial --check on the shuffled copy exit %d: %s"
                               % (rc, err.strip()[-2000:]))
         mapped = canonical_text(map_back(read_tets(shuf_tets), perm, canon))
         if mapped != fdt_bytes:
@@ -398,11 +412,49 @@ def build_cases(args, families):
             rows.append("%.3f %.3f %.3f" % (x, y, z))
     cases.append(Case("syntax", text="# header comment\n\n" + "\n".join(rows) + "\n"))
     cases.append(Case("coplanar", text="".join(
-        "%d %d 0\n" % (i, j) for i in range(6) for j in range(5))))
-    cases.append(Case("three", text="0 0 0\n1 0 0\n0 1 0\n"))
-    cases.append(Case("four_with_dup", text="0 0 0\n1 0 0\n0 1 0\n-0 0 -0\n"))
-    cases.append(Case("collinear", text="".join("%d 0 0\n" % i for i in range(10))))
+        "%d %d 0\n" % (i, j) for i in range(6) for j in range(5)), degenerate=True))
+    cases.append(Case("three", text="0 0 0\n1 0 0\n0 1 0\n", degenerate=True))
+    cases.append(Case("four_with_dup", text="0 0 0\n1 0 0\n0 1 0\n-0 0 -0\n",
+                      degenerate=True))
+    cases.append(Case("collinear", text="".join("%d 0 0\n" % i for i in range(10)),
+                      degenerate=True))
     cases.append(Case("one_tet", text="0 0 0\n1 0 0\n0 1 0\n0 0 1\n"))
+    # Mixed magnitudes (1e-149 .. 1e151) in one file, found by
+    # tests/fuzz/fuzz_mesh.c and minimised: six points whose Delaunay
+    # tetrahedralization frontdt got wrong (a point strictly inside a
+    # tet's circumsphere, confirmed with rational arithmetic), nine on
+    # which the front became inconsistent (FDT_EINTERNAL), four that are
+    # not coplanar (exact orient3d is nonzero) but were called collinear,
+    # and six on which the front failed before its first tet.
+    cases.append(Case("mixed_6", text=(
+        "5.0509496586156005e+51 9.353610478917779e+50 4.5832691346697116e+51\n"
+        "4.6768052394588893e+51 2.9931553532536892e+51 4.863877449037245e+51\n"
+        "5.987675272459225e-149 6.476465090619162e-149 1.2219745453998419e-149\n"
+        "2.9931553532536892e+51 4.5832691346697116e+51 4.489733029880534e+51\n"
+        "2.9931553532536892e+51 4.489733029880534e+51 9.353610478917779e+50\n"
+        "8.183476519740355e+150 3.92806872947537e+151 2.6187124863169135e+151\n")))
+    cases.append(Case("mixed_9", text=(
+        "1.1544172651950977e-98 5.48633947815492e-99 3.65755965210328e-99\n"
+        "49.0 46.0 48.0\n"
+        "3.6825644338831596e+151 3.92806872947537e+151 8.183476519740355e+150\n"
+        "3.764399199080563e+151 3.92806872947537e+151 8.183476519740355e+150\n"
+        "4.302660820302178e+51 4.6768052394588893e+51 4.957413553826423e+51\n"
+        "4.489733029880534e+51 4.302660820302178e+51 5.144485763404778e+51\n"
+        "4.337242555462388e+151 2.6187124863169135e+151 3.6825644338831596e+151\n"
+        "4.302660820302178e+51 4.5832691346697116e+51 4.6768052394588893e+51\n"
+        "2.9931553532536892e+51 4.5832691346697116e+51 4.302660820302178e+51\n")))
+    cases.append(Case("mixed_seed_4", text=(
+        "1073741824.000002 1073741824.0 1073741824.0\n"
+        "1.2272733663244316e-91 1.227273366324484e-91 1.2272733663244316e-91\n"
+        "1.312085177259197e-141 1.312085177259197e-141 1.312085177259197e-141\n"
+        "1.3120851772592017e-141 1.3120851772592087e-141 1.3120851772592133e-141\n")))
+    cases.append(Case("mixed_front_6", text=(
+        "-4.521305817979415e-149 -1.8329618180997628e-149 1.2219745453998419e-149\n"
+        "-5.48633947815492e-99 9.1438991302582e-100 0.0\n"
+        "0.0 0.0 -1.005828904328402e-98\n"
+        "0.0 2.0 0.0\n"
+        "-1.0 27.0 -76.0\n"
+        "1.1086977695438067e-98 0.0 1.3944446173643755e-98\n")))
     return cases
 
 
@@ -437,6 +489,18 @@ def main():
         print("note: cgal_ref not built: CGAL comparisons skipped")
 
     workdir = tempfile.mkdtemp(prefix="fdt-e2e-")
+
+    # meson's timeout sends SIGTERM to the whole process group (the running
+    # frontdt too) and SIGKILL 0.5 s later: remove the scratch files at once
+    # instead of leaving every unfinished case's directory in /tmp.
+    def on_signal(signum, frame):
+        print("stopped by signal %d; %s %s" % (signum, "kept" if args.keep else "removed",
+                                               workdir), flush=True)
+        if not args.keep:
+            shutil.rmtree(workdir, ignore_errors=True)
+        os._exit(128 + signum)
+    signal.signal(signal.SIGTERM, on_signal)
+    signal.signal(signal.SIGINT, on_signal)
     r = Runner(args, workdir)
     failed = 0
     t0 = time.monotonic()

@@ -374,12 +374,11 @@ static int fam_neardup(pts *p, size_t n, rng *r)
     return 0;
 }
 
-/* N points drawn from N/10 distinct ones, in random order, so a point's
+/* N points drawn from nd distinct ones, in random order, so a point's
  * first occurrence is anywhere. A fifth of the distinct points have a zero
  * coordinate, written as +0 or -0 at random: the same point either way. */
-static int fam_dup(pts *p, size_t n, rng *r)
+static int dup_of(pts *p, size_t n, rng *r, size_t nd)
 {
-    size_t nd = n / 10 < 4 ? 4 : n / 10;
     if (nd > n)
         nd = n;
     double *d = malloc(3 * nd * sizeof *d);
@@ -413,6 +412,55 @@ static int fam_dup(pts *p, size_t n, rng *r)
             p->xyz[3 * i + c] = p->xyz[3 * j + c];
             p->xyz[3 * j + c] = t;
         }
+    }
+    return 0;
+}
+
+/* N points from N/10 distinct ones (each about 10 times). */
+static int fam_dup(pts *p, size_t n, rng *r)
+{
+    return dup_of(p, n, r, n / 10 < 4 ? 4 : n / 10);
+}
+
+/* Heavy duplication: N points from about sqrt(N) distinct ones (at
+ * N = 2500, 50 points each repeated about 50 times). */
+static int fam_dupheavy(pts *p, size_t n, rng *r)
+{
+    size_t nd = (size_t)sqrt((double)n);
+    return dup_of(p, n, r, nd < 4 ? 4 : nd);
+}
+
+/* Mixed magnitudes in one file: uniform in the unit cube, each point then
+ * scaled by 1e-150, 1 or 1e150 (a third each). orient3d and insphere mix
+ * terms near 1e-300 with terms near 1e300, beyond what any one power-of-
+ * two scaling of the input brings into range, so only exact arithmetic
+ * that cannot underflow (GMP integers, README.md Limits) gets them right. */
+static int fam_mixed(pts *p, size_t n, rng *r)
+{
+    static const double scale[3] = {1e-150, 1.0, 1e150};
+    for (size_t i = 0; i < n; i++) {
+        double s = scale[rng_below(r, 3)];
+        double x = rng_u01(r) * s, y = rng_u01(r) * s, z = rng_u01(r) * s;
+        if (pts_add(p, x, y, z))
+            return -1;
+    }
+    return 0;
+}
+
+/* A large offset and a tiny extent: 2^40 (about 1.1e12) plus random
+ * multiples of 2^-12 below 2^10, so coordinates differ in their last 22 of
+ * 53 bits only (extent 0.25 at 1.1e12). All values are exact doubles; the
+ * points lie on a lattice of the offset, so cospherical and coplanar
+ * subsets are everywhere, and every difference is tiny next to the
+ * coordinates themselves. */
+static int fam_ulpgrid(pts *p, size_t n, rng *r)
+{
+    for (size_t i = 0; i < n; i++) {
+        double c[3];
+        for (int d = 0; d < 3; d++)
+            c[d] = 0x1p40 + ldexp((double)rng_below(r, 1024), -12);
+        if (pts_add(p, c[0], c[1], c[2]))
+            return -1;
     }
     return 0;
 }
@@ -512,7 +560,8 @@ static const struct family {
     {"offset", fam_offset},       {"tiny", fam_tiny},
     {"huge", fam_huge},           {"neardup", fam_neardup},
     {"dup", fam_dup},             {"cfdgrid", fam_cfdgrid},
-    {"lidar", fam_lidar},
+    {"lidar", fam_lidar},         {"dupheavy", fam_dupheavy},
+    {"mixed", fam_mixed},         {"ulpgrid", fam_ulpgrid},
 };
 #define N_FAMILIES (sizeof families / sizeof families[0])
 

@@ -10,7 +10,8 @@
 # Covers: --help/--version, usage errors (exit 1), every hostile input
 # (its exit code and message, and no output or temporary file left), an
 # unknown output extension refused before any computation, an output
-# directory that does not exist (exit 5, nothing left), SIGTERM and SIGINT
+# directory that does not exist (exit 5, nothing left), write errors part-
+# way (file size limit, /dev/full: exit 5, nothing left), SIGTERM and SIGINT
 # during a long run and during the write (exit 6, nothing left), --demo,
 # repeatability (byte-identical .tets, identical --hash), independence of
 # input order (shuffled copy mapped back), --check, --stats/--stats-json,
@@ -201,6 +202,38 @@ expect_empty_dir isdir out
 run jsondir "$FRONTDT" pts.xyz --stats-json out/no/stats.json
 expect_rc jsondir 5
 expect_empty_dir jsondir out
+
+# ---------------------------------------------------------------------------
+# Write errors during the run: reported (exit 5), never ignored
+# ---------------------------------------------------------------------------
+# A file size limit makes write() fail part-way with EFBIG, as a full disk
+# fails with ENOSPC; frontdt ignores SIGXFSZ so the error reaches the
+# writer, which removes its temporaries. Every format, in a subshell so the
+# limit stays there (16 KiB: the 300-point meshes are larger).
+for fmt in tets ele vtu vtk; do
+    rm -rf out && mkdir out
+    (
+        trap - XFSZ
+        ulimit -f 16
+        exec "$FRONTDT" pts.xyz -o "out/big.$fmt" --quiet
+    ) >"fsize_$fmt.out" 2>"fsize_$fmt.err"
+    RC=$?
+    # (.ele: the first of the four files, big.node, is the one that fails)
+    expect_rc "fsize_$fmt" 5 && expect_in "fsize_$fmt" err "frontdt: out/big."
+    expect_in "fsize_$fmt" err ": File too large"
+    expect_empty_dir "fsize_$fmt (file size limit)" out
+done
+# stdout on a full device: the summary cannot be written.
+run full_stdout bash -c '"$1" "$2" --hash >/dev/full' _ "$FRONTDT" pts.xyz
+expect_rc full_stdout 5 && expect_in full_stdout err "stdout: No space left on device"
+# --stats-json on a full device, through a symbolic link: exit 5, and the
+# link is not removed (only a regular file of ours is).
+rm -rf out && mkdir out
+ln -s /dev/full out/full.json
+run full_json "$FRONTDT" pts.xyz --stats-json out/full.json --quiet
+expect_rc full_json 5 && expect_in full_json err "out/full.json: No space left on device"
+[ -L out/full.json ] || fail "full_json: the symbolic link to /dev/full was removed"
+rm -f out/full.json
 
 # ---------------------------------------------------------------------------
 # A normal run: every format, --check, --stats, --hash

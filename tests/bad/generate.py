@@ -138,6 +138,56 @@ def bad():
         + b''.join(struct.pack('<3f', *p) for p in POINTS[:4]))
 
 
+def degenerate():
+    """Files every reader accepts and the library refuses (exit 2 from the
+    CLI): their EXPECTED.txt messages come from src/seed.c and name
+    'distinct point'."""
+    put(BAD, 'three_points.xyz', '0 0 0\n1 0 0\n0 1 0\n')
+    put(BAD, 'repeated_point.xyz', '1.5 -2 3\n' * 4000)
+    put(BAD, 'repeated_three.ply',
+        ply_header('binary_little_endian',
+                   [('vertex', 3000, ['float x', 'float y', 'float z'])])
+        + b''.join(struct.pack('<3f', *POINTS[i % 3]) for i in range(3000)))
+    put(BAD, 'collinear.xyz',
+        ''.join('%d %d %d\n' % (i, 2 * i, 3 * i) for i in (3, 0, 5, 1, 4, 2, 1)))
+    put(BAD, 'coplanar.node',
+        '9 3 0 0\n' + ''.join('%d %d %d %d\n' % (k, i, j, 1 - i - j)
+                             for k, (i, j) in enumerate(
+                                 (a, b) for a in range(3) for b in range(3))))
+
+
+def more_bad():
+    """Hostile inputs added after the first corpus (kept apart so the
+    random bytes drawn above stay the same)."""
+    rnd = random.Random(20240602)
+    put(BAD, 'random_bytes.node', bytes(rnd.randrange(256) for _ in range(300)))
+    put(BAD, 'node_overflow.node', '4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 -1e400 0\n3 0 0 1\n')
+    put(BAD, 'node_inf.node', '4 3\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 inf\n')
+    put(BAD, 'ply_header_garbage.ply',
+        b'ply\nformat binary_little_endian 1.0\nelement vertex 1\n'
+        b'property float x\n\x00\x13\xfe\xffgarbage\nproperty float y\n'
+        b'property float z\nend_header\n' + struct.pack('<3f', 0, 0, 0))
+    put(BAD, 'ply_header_cut.ply',
+        'ply\nformat binary_big_endian 1.0\nelement vertex 4\nproperty float x\n'
+        'property float y\n')
+    # a bit flipped in the exponent of vertex 2's y: 1.0f becomes Inf
+    hdr = ply_header('binary_little_endian', [('vertex', 4, ['float x', 'float y', 'float z'])])
+    body = bytearray(b''.join(struct.pack('<3f', *p) for p in POINTS[:4]))
+    body[2 * 12 + 4 + 3] |= 0x40
+    put(BAD, 'ply_bitflip_le.ply', hdr + bytes(body))
+    # counts a point index can hold (below 2^31) that the bytes cannot:
+    # refused before allocating (tests/test_faults.c checks no allocation
+    # grows with the count)
+    node = ['%d %s\n' % (i, ' '.join(repr(float(v)) for v in p))
+            for i, p in enumerate(POINTS[:4])]
+    put(BAD, 'node_big_count.node', '2000000000 3 0 0\n' + ''.join(node))
+    hdr = ply_header('binary_little_endian', [('vertex', 2000000000, ['float x', 'float y', 'float z'])])
+    put(BAD, 'ply_big_count.ply', hdr + b''.join(struct.pack('<3f', *p) for p in POINTS[:4]))
+    hdr = ply_header('ascii', [('vertex', 2000000000, ['float x', 'float y', 'float z']),
+                               ('face', 1, ['list uchar int vertex_indices'])])
+    put(BAD, 'ply_ascii_big_count.ply', hdr + b'0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n')
+
+
 def good():
     # plain text, with everything the format allows
     lines = ['# ten points: the unit cube and two more', '']
@@ -189,4 +239,6 @@ def cum(*parts):
 if __name__ == '__main__':
     os.makedirs(GOOD, exist_ok=True)
     bad()
+    degenerate()
+    more_bad()
     good()

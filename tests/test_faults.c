@@ -1,0 +1,871 @@
+/*
+ * Allocation-failure injection over the library and the file formats.
+ *
+ * The test is linked with -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,
+ * --wrap=aligned_alloc,--wrap=free (tests/meson.build), so every call to
+ * these from the static libraries (the files in src/) and from this file goes through
+ * the __wrap_ functions below. Allocations made inside libc (fopen, qsort)
+ * and GMP are not seen: they cannot be made to fail from here. (GMP aborts
+ * on a failed allocation by design; README.md, Limits.)
+ *
+ * For each scenario (a read, a triangulation, a sort, a hash, a check, a
+ * write) and k = 1, 2, ...:
+ *   - "once":  the k-th allocation of the scenario fails, later ones work;
+ *   - "from":  the k-th and every later allocation fail (error paths that
+ *              allocate while cleaning up fail too);
+ * until a run meets no k-th allocation. Every run that hit a failure must
+ * return the scenario's out-of-memory code (FDT_ENOMEM / FDT_IO_ENOMEM),
+ * or succeed with the reference answer where the code can do without the
+ * memory (the readers' final shrinking realloc keeps the larger block), not
+ * crash, and free everything it allocated: the count of live blocks is
+ * back to its value before the run (and ASan's leak check agrees in the
+ * sanitizer build). A run that hit none must succeed and give the
+ * reference answer. Results left by a failed fdt_result_sort() or
+ * fdt_result_hash() must still hash to the reference, and a failed write
+ * must leave its directory empty.
+ *
+ * The wrappers also record the largest request, so the test can show that
+ * no file of the hostile corpus makes a reader allocate in proportion to a
+ * count in its header rather than to its size (check_bad_sizes()).
+ *
+ * usage: test_faults GOOD_DIR BAD_DIR  (tests/good, tests/bad)
+ *        test_faults --parallel        (the engine's parallel modes)
+ */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#endif
+
+#include "frontdt.h"
+#include "reader.h"
+#include "writer.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* ------------------------------------------------------------------ */
+/* The allocation hooks                                               */
+/* ------------------------------------------------------------------ */
+
+/*
+ * The hooks have no context argument, so their state is global: the one
+ * place this test keeps mutable globals. Atomics, because a scenario
+ * could run engine threads (the serial runs here do not).
+ */
+static atomic_long fault_seen;  /* allocation calls since fault_arm() */
+static atomic_long fault_at;    /* 0: off; k: the k-th call fails */
+static atomic_int fault_sticky; /* every call after the k-th fails too */
+static atomic_int fault_hit;    /* a failure was injected */
+static atomic_long fault_live;  /* blocks handed out and not freed */
+static atomic_size_t fault_max; /* largest size asked for since reset */
+
+/* Records the size of a request (for the no-big-allocation check). */
+static void fault_note(size_t size)
+{
+    size_t m = atomic_load(&fault_max);
+    while (size > m && !atomic_compare_exchange_weak(&fault_max, &m, size))
+        ;
+}
+
+void *__real_malloc(size_t size);
+void *__real_calloc(size_t nmemb, size_t size);
+void *__real_realloc(void *p, size_t size);
+void *__real_aligned_alloc(size_t align, size_t size);
+void __real_free(void *p);
+void *__wrap_malloc(size_t size);
+void *__wrap_calloc(size_t nmemb, size_t size);
+void *__wrap_realloc(void *p, size_t size);
+void *__wrap_aligned_alloc(size_t align, size_t size);
+void __wrap_free(void *p);
+
+/* Whether this allocation call is to fail. */
+static int fault_now(void)
+{
+    long at = atomic_load(&fault_at);
+    if (at == 0)
+        return 0;
+    long k = atomic_fetch_add(&fault_seen, 1) + 1;
+    if (k == at || (k > at && atomic_load(&fault_sticky))) {
+        atomic_store(&fault_hit, 1);
+        errno = ENOMEM;
+        return 1;
+    }
+    return 0;
+}
+
+void *__wrap_malloc(size_t size)
+{
+    fault_note(size);
+    if (fault_now())
+        return NULL;
+    void *p = __real_malloc(size);
+    if (p != NULL)
+        atomic_fetch_add(&fault_live, 1);
+    return p;
+}
+
+void *__wrap_calloc(size_t nmemb, size_t size)
+{
+    fault_note(size != 0 && nmemb > SIZE_MAX / size ? SIZE_MAX : nmemb * size);
+    if (fault_now())
+        return NULL;
+    void *p = __real_calloc(nmemb, size);
+    if (p != NULL)
+        atomic_fetch_add(&fault_live, 1);
+    return p;
+}
+
+void *__wrap_aligned_alloc(size_t align, size_t size)
+{
+    fault_note(size);
+    if (fault_now())
+        return NULL;
+    void *p = __real_aligned_alloc(align, size);
+    if (p != NULL)
+        atomic_fetch_add(&fault_live, 1);
+    return p;
+}
+
+void *__wrap_realloc(void *p, size_t size)
+{
+    fault_note(size);
+    if (fault_now())
+        return NULL; /* like a real failure: p is untouched */
+    void *q = __real_realloc(p, size);
+    if (p == NULL && q != NULL)
+        atomic_fetch_add(&fault_live, 1);
+    else if (p != NULL && q == NULL && size == 0)
+        atomic_fetch_sub(&fault_live, 1); /* glibc: realloc(p, 0) frees */
+    return q;
+}
+
+void __wrap_free(void *p)
+{
+    if (p != NULL)
+        atomic_fetch_sub(&fault_live, 1);
+    __real_free(p);
+}
+
+static void fault_arm(long k, int sticky)
+{
+    atomic_store(&fault_seen, 0);
+    atomic_store(&fault_hit, 0);
+    atomic_store(&fault_sticky, sticky);
+    atomic_store(&fault_at, k);
+}
+
+/* Stops injecting; returns whether a failure was injected. */
+static int fault_disarm(void)
+{
+    atomic_store(&fault_at, 0);
+    return atomic_load(&fault_hit);
+}
+
+/* ------------------------------------------------------------------ */
+/* Test bookkeeping                                                   */
+/* ------------------------------------------------------------------ */
+
+static int failures;
+static long total_runs, total_injected, total_absorbed;
+
+#define CHECK(cond, ...)                                                     \
+    do {                                                                     \
+        if (!(cond)) {                                                       \
+            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, \
+                    #cond);                                                  \
+            fprintf(stderr, __VA_ARGS__);                                    \
+            fputc('\n', stderr);                                             \
+            failures++;                                                      \
+        }                                                                    \
+    } while (0)
+
+/*
+ * A scenario: one call (or a short sequence) that cleans up after itself
+ * whatever happens. Returns its status; *bad may name what went
+ * wrong beyond the status (a wrong answer after success, a result left
+ * unusable, a file left behind): NULL when all is well.
+ */
+typedef struct scenario {
+    const char *name;
+    int enomem; /* the out-of-memory code it must return */
+    int (*run)(void *arg, const char **bad);
+    void *arg;
+} scenario;
+
+/* Runs sc for k = 1, 2, ... in both injection modes. */
+static void inject_all(const scenario *sc)
+{
+    for (int sticky = 0; sticky <= 1; sticky++) {
+        long k, absorbed = 0;
+        for (k = 1;; k++) {
+            long live0 = atomic_load(&fault_live);
+            const char *bad = NULL;
+            fault_arm(k, sticky);
+            int rc = sc->run(sc->arg, &bad);
+            int hit = fault_disarm();
+            long leaked = atomic_load(&fault_live) - live0;
+            total_runs++;
+            CHECK(leaked == 0, "%s, %s allocation %ld: %ld blocks leaked",
+                  sc->name, sticky ? "from" : "only", k, leaked);
+            CHECK(bad == NULL, "%s, %s allocation %ld failed: %s", sc->name,
+                  sticky ? "from" : "only", k, bad ? bad : "");
+            if (!hit) {
+                CHECK(rc == 0, "%s: status %d with no failure injected",
+                      sc->name, rc);
+                break;
+            }
+            total_injected++;
+            if (k > 100000) {
+                CHECK(0, "%s: more than 100000 allocations?", sc->name);
+                break;
+            }
+            if (rc == 0) { /* done without the memory: bad says if wrongly */
+                absorbed++;
+                total_absorbed++;
+                continue;
+            }
+            CHECK(rc == sc->enomem,
+                  "%s, %s allocation %ld failed: status %d, want %d",
+                  sc->name, sticky ? "from" : "only", k, rc, sc->enomem);
+        }
+        if (!sticky)
+            printf("%-34s %3ld allocation sites", sc->name, k - 1);
+        if (absorbed)
+            printf(" (%s: %ld failure(s) absorbed)", sticky ? "from" : "once",
+                   absorbed);
+        if (sticky)
+            printf("\n");
+    }
+}
+
+/* ------------------------------------------------------------------ */
+/* Inputs                                                             */
+/* ------------------------------------------------------------------ */
+
+/* xorshift64*: any fixed sequence will do. */
+static double rnd01(uint64_t *st)
+{
+    *st ^= *st >> 12;
+    *st ^= *st << 25;
+    *st ^= *st >> 27;
+    return (double)((*st * 2685821657736338717u) >> 11) * 0x1p-53;
+}
+
+/* A point set for the engine scenarios. */
+typedef struct ptset {
+    const char *name;
+    double *xyz; /* 3 * n (owned) */
+    size_t n;
+} ptset;
+
+static double *alloc_points(size_t n)
+{
+    double *p = malloc(3 * n * sizeof *p);
+    if (p == NULL) {
+        fprintf(stderr, "out of memory\n");
+        exit(1);
+    }
+    return p;
+}
+
+/*
+ * 60 points: 27 on a 3x3x3 lattice (cospherical and coplanar subsets: the
+ * exact predicates and the perturbation run), 30 random, 3 duplicates.
+ */
+static ptset make_lattice(uint64_t *rng)
+{
+    ptset s = {"lattice", alloc_points(60), 60};
+    double *p = s.xyz;
+    size_t i = 0;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            for (int c = 0; c < 3; c++, i++) {
+                p[3 * i] = a;
+                p[3 * i + 1] = b;
+                p[3 * i + 2] = c;
+            }
+    for (; i < 57; i++)
+        for (int k = 0; k < 3; k++)
+            p[3 * i + k] = 2.0 * rnd01(rng);
+    for (int d = 0; d < 3; d++, i++)
+        memcpy(p + 3 * i, p + 3 * (size_t)(d * 17 + 5), 3 * sizeof(double));
+    return s;
+}
+
+/*
+ * 2 x 24 points on two skew lines: about 23^2 tets, far more than the
+ * engine's first guess of 6.9 a point, so the tet (and neighbour) arrays
+ * grow while the front runs.
+ */
+static ptset make_skew_lines(uint64_t *rng)
+{
+    ptset s = {"skew lines", alloc_points(48), 48};
+    for (size_t i = 0; i < 24; i++) {
+        double t = (double)i + 0.5 * rnd01(rng);
+        double u = (double)i + 0.5 * rnd01(rng);
+        double *a = s.xyz + 6 * i;
+        a[0] = t, a[1] = 0, a[2] = 0;
+        a[3] = 0, a[4] = u, a[5] = 8;
+    }
+    return s;
+}
+
+/*
+ * 700 points near a sphere and 20 inside: about 1400 hull faces, more than
+ * the engine's first hull array holds.
+ */
+static ptset make_sphere(uint64_t *rng)
+{
+    ptset s = {"sphere", alloc_points(720), 720};
+    for (size_t i = 0; i < 700; i++) {
+        /* Fibonacci sphere, radius jittered so no 5 are cospherical */
+        double z = 1.0 - (2.0 * (double)i + 1.0) / 700.0;
+        double r = sqrt(1.0 - z * z), ph = 2.399963229728653 * (double)i;
+        double rad = 1.0 + 1e-3 * rnd01(rng);
+        s.xyz[3 * i] = rad * r * cos(ph);
+        s.xyz[3 * i + 1] = rad * r * sin(ph);
+        s.xyz[3 * i + 2] = rad * z;
+    }
+    for (size_t i = 700; i < 720; i++)
+        for (int k = 0; k < 3; k++)
+            s.xyz[3 * i + k] = 0.5 * rnd01(rng) - 0.25;
+    return s;
+}
+
+/* ------------------------------------------------------------------ */
+/* Scenarios: the engine                                              */
+/* ------------------------------------------------------------------ */
+
+/* How the engine runs: serial, or a parallel mode with some threads. */
+typedef struct engine_cfg {
+    fdt_mode mode;
+    int threads;
+} engine_cfg;
+
+static const engine_cfg serial_cfg = {FDT_MODE_SERIAL, 1};
+
+typedef struct tri_arg {
+    const ptset *ps;
+    const engine_cfg *cfg;
+    int neighbors;
+    uint64_t want_hash; /* the reference, from an uninjected run */
+    size_t want_tets;
+} tri_arg;
+
+static int triangulate(const ptset *ps, const engine_cfg *cfg, int neighbors,
+                       fdt_result **res)
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = cfg->mode;
+    s.n_threads = cfg->threads;
+    s.neighbors = neighbors;
+    fdt_context *ctx = NULL;
+    int rc = fdt_open(&ctx, &s);
+    if (rc != FDT_OK)
+        return rc;
+    rc = fdt_triangulate(ctx, ps->xyz, ps->n, res);
+    if (rc == FDT_ENOMEM && fdt_context_diagnostic(ctx)[0] == '\0')
+        rc = FDT_EINTERNAL; /* FDT_ENOMEM must come with a diagnostic */
+    fdt_close(&ctx);
+    return rc;
+}
+
+/* fdt_open + fdt_triangulate; the answer is checked after success (the
+ * hash is taken with injection off). */
+static int sc_triangulate(void *arg, const char **bad)
+{
+    tri_arg *a = arg;
+    fdt_result *r = NULL;
+    int rc = triangulate(a->ps, a->cfg, a->neighbors, &r);
+    if (rc != FDT_OK) {
+        if (r != NULL)
+            *bad = "a failed fdt_triangulate returned a result";
+        fdt_result_free(&r);
+        return rc;
+    }
+    long at = atomic_load(&fault_at);
+    atomic_store(&fault_at, 0);
+    uint64_t h = 0;
+    if (fdt_result_hash(r, &h) != FDT_OK || h != a->want_hash ||
+        fdt_result_num_tets(r) != a->want_tets)
+        *bad = "wrong mesh";
+    if (a->neighbors && fdt_result_neighbors(r) == NULL)
+        *bad = "no neighbours";
+    atomic_store(&fault_at, at);
+    fdt_result_free(&r);
+    return rc;
+}
+
+typedef struct post_arg {
+    const ptset *ps;
+    int neighbors;
+    int what; /* 0: sort, 1: hash, 2: check */
+    uint64_t want_hash;
+} post_arg;
+
+/* A result made without injection, then sort/hash/check under it. */
+static int sc_post(void *arg, const char **bad)
+{
+    post_arg *a = arg;
+    long at = atomic_load(&fault_at);
+    atomic_store(&fault_at, 0);
+    fdt_result *r = NULL;
+    if (triangulate(a->ps, &serial_cfg, a->neighbors, &r) != FDT_OK) {
+        *bad = "cannot make the result";
+        return FDT_OK;
+    }
+    atomic_store(&fault_at, at);
+    int rc;
+    if (a->what == 0) {
+        rc = fdt_result_sort(r);
+    } else if (a->what == 1) {
+        uint64_t h = 0;
+        rc = fdt_result_hash(r, &h);
+        if (rc == FDT_OK && h != a->want_hash)
+            *bad = "wrong hash";
+    } else {
+        char msg[256];
+        rc = fdt_check(a->ps->xyz, a->ps->n, fdt_result_tets(r),
+                       fdt_result_num_tets(r),
+                       fdt_result_neighbors(r), msg, sizeof msg);
+        if (rc == FDT_ENOMEM && msg[0] == '\0')
+            *bad = "FDT_ENOMEM from fdt_check without a message";
+    }
+    /* Whatever happened, the result must still be whole. */
+    atomic_store(&fault_at, 0);
+    uint64_t h = 0;
+    if (fdt_result_hash(r, &h) != FDT_OK || h != a->want_hash)
+        *bad = "the result is damaged after the failure";
+    char msg[256];
+    if (fdt_check(a->ps->xyz, a->ps->n, fdt_result_tets(r),
+                  fdt_result_num_tets(r),
+                  fdt_result_neighbors(r), msg, sizeof msg) != FDT_OK)
+        *bad = "the result fails fdt_check after the failure";
+    atomic_store(&fault_at, at);
+    fdt_result_free(&r);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ */
+/* Scenarios: readers and writers                                     */
+/* ------------------------------------------------------------------ */
+
+typedef struct read_arg {
+    const char *path;
+    const char *data; /* non-NULL: fdt_read_points_mem on these bytes */
+    size_t len;
+    size_t want_n;
+    double *want; /* 3 * want_n coordinates (read without injection) */
+} read_arg;
+
+static int sc_read(void *arg, const char **bad)
+{
+    read_arg *a = arg;
+    double *xyz = NULL;
+    size_t n = 0;
+    char err[512];
+    int rc = a->data != NULL
+                 ? fdt_read_points_mem(a->path, a->data, a->len, &xyz, &n,
+                                       err, sizeof err)
+                 : fdt_read_points(a->path, &xyz, &n, err, sizeof err);
+    if (rc == FDT_OK && (n != a->want_n || a->want == NULL ||
+                         memcmp(xyz, a->want, 3 * n * sizeof *xyz) != 0))
+        *bad = "wrong points";
+    if (rc != FDT_OK && (xyz != NULL || n != 0 || err[0] == '\0'))
+        *bad = "failure with points left or without a message";
+    if (rc == FDT_IO_ENOMEM && strstr(err, "out of memory") == NULL)
+        *bad = "FDT_IO_ENOMEM without 'out of memory' in the message";
+    free(xyz);
+    return rc;
+}
+
+/* The reference points of a read, without injection. */
+static void reference_read(read_arg *a)
+{
+    size_t n = 0;
+    char err[512];
+    int rc = a->data != NULL
+                 ? fdt_read_points_mem(a->path, a->data, a->len, &a->want, &n,
+                                       err, sizeof err)
+                 : fdt_read_points(a->path, &a->want, &n, err, sizeof err);
+    CHECK(rc == FDT_IO_OK && n == a->want_n, "%s: %s (%zu points)", a->path,
+          rc == FDT_IO_OK ? "read" : err, n);
+}
+
+typedef struct write_arg {
+    const ptset *ps;
+    const char *dir;
+    const char *ext;
+    fdt_result *res; /* sorted, with neighbours */
+} write_arg;
+
+/* Entries of dir other than . and .. (-1 if it cannot be read). */
+static int count_entries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d == NULL)
+        return -1;
+    int k = 0;
+    struct dirent *de;
+    while ((de = readdir(d)) != NULL)
+        if (strcmp(de->d_name, ".") != 0 && strcmp(de->d_name, "..") != 0)
+            k++;
+    closedir(d);
+    return k;
+}
+
+static void empty_dir(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d == NULL)
+        return;
+    struct dirent *de;
+    char p[1024];
+    while ((de = readdir(d)) != NULL) {
+        if (strcmp(de->d_name, ".") == 0 || strcmp(de->d_name, "..") == 0)
+            continue;
+        snprintf(p, sizeof p, "%s/%s", dir, de->d_name);
+        unlink(p);
+    }
+    closedir(d);
+}
+
+static int sc_write(void *arg, const char **bad)
+{
+    write_arg *a = arg;
+    char path[1024], err[512];
+    snprintf(path, sizeof path, "%s/mesh%s", a->dir, a->ext);
+    fdt_mesh_view v = {
+        .xyz = a->ps->xyz, .n_points = a->ps->n,
+        .tets = fdt_result_tets(a->res),
+        .n_tets = fdt_result_num_tets(a->res),
+        .nbrs = fdt_result_neighbors(a->res),
+        .hull = fdt_result_hull_faces(a->res),
+        .n_hull = fdt_result_num_hull_faces(a->res),
+    };
+    int rc = fdt_write_mesh(path, &v, err, sizeof err);
+    int left = count_entries(a->dir);
+    int want = rc != FDT_IO_OK ? 0 : strcmp(a->ext, ".ele") == 0 ? 4 : 1;
+    if (left != want)
+        *bad = rc != FDT_IO_OK ? "files left after a failed write"
+                               : "wrong number of files after the write";
+    if (rc != FDT_IO_OK && strncmp(err, a->dir, strlen(a->dir)) != 0)
+        *bad = "failed write without a message naming the file";
+    empty_dir(a->dir);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ */
+/* Inputs on disk                                                     */
+/* ------------------------------------------------------------------ */
+
+static int write_file(const char *path, const char *data, size_t len)
+{
+    FILE *f = fopen(path, "wb");
+    if (f == NULL)
+        return -1;
+    size_t w = fwrite(data, 1, len, f);
+    return (fclose(f) != 0 || w != len) ? -1 : 0;
+}
+
+/* A binary little-endian PLY with a face element (lists) before and after
+ * the vertices: the header tables and list walking allocate and run. */
+static size_t make_ply_le(char *buf, size_t cap)
+{
+    static const char hdr[] =
+        "ply\nformat binary_little_endian 1.0\ncomment fault test\n"
+        "element face 1\nproperty list uchar int vertex_indices\n"
+        "element vertex 5\nproperty float x\nproperty double y\n"
+        "property float z\nproperty uchar red\n"
+        "element edge 2\nproperty int a\nproperty int b\nend_header\n";
+    size_t o = sizeof hdr - 1;
+    if (cap < o + 64 + 5 * 17 + 8)
+        return 0;
+    memcpy(buf, hdr, o);
+    unsigned char three = 3;
+    memcpy(buf + o++, &three, 1);
+    for (int32_t i = 0; i < 3; i++, o += 4)
+        memcpy(buf + o, &i, 4); /* the host is little-endian (checked) */
+    static const float xs[5] = {0, 1, 0, 0, 0.25f};
+    static const double ys[5] = {0, 0, 1, 0, 0.25};
+    static const float zs[5] = {0, 0, 0, 1, 0.25f};
+    for (int i = 0; i < 5; i++) {
+        memcpy(buf + o, &xs[i], 4);
+        o += 4;
+        memcpy(buf + o, &ys[i], 8);
+        o += 8;
+        memcpy(buf + o, &zs[i], 4);
+        o += 4;
+        buf[o++] = 7;
+    }
+    memset(buf + o, 0, 16);
+    return o + 16;
+}
+
+/*
+ * --parallel: fdt_triangulate in the shared and message modes with 2 and 3
+ * threads. The allocation order varies from run to run (threads), so the
+ * k-th allocation is a different site each time; every run must still
+ * either succeed with the serial answer or return FDT_ENOMEM with nothing
+ * leaked and no thread left behind (a worker that fails must stop the
+ * others, not leave them waiting for its messages).
+ */
+static int run_parallel(void)
+{
+    uint64_t rng = 0x9e3779b97f4a7c15u;
+    ptset sets[2] = {make_lattice(&rng), make_sphere(&rng)};
+    static const engine_cfg cfgs[4] = {{FDT_MODE_SHARED, 2},
+                                       {FDT_MODE_SHARED, 3},
+                                       {FDT_MODE_MESSAGE, 2},
+                                       {FDT_MODE_MESSAGE, 3}};
+    static const char *const cfg_name[4] = {"shared -t 2", "shared -t 3",
+                                            "message -t 2", "message -t 3"};
+    for (int si = 0; si < 2; si++) {
+        for (int nb = 0; nb <= 1; nb++) {
+            fdt_result *r = NULL;
+            int rc = triangulate(&sets[si], &serial_cfg, nb, &r);
+            CHECK(rc == FDT_OK, "%s: reference: %s", sets[si].name,
+                  fdt_strerror(rc));
+            uint64_t h = 0;
+            if (rc == FDT_OK)
+                CHECK(fdt_result_hash(r, &h) == FDT_OK, "reference hash");
+            size_t nt = fdt_result_num_tets(r);
+            fdt_result_free(&r);
+            if (rc != FDT_OK)
+                continue;
+            for (int c = 0; c < 4; c++) {
+                char nm[96];
+                snprintf(nm, sizeof nm, "triangulate %s %s%s", sets[si].name,
+                         cfg_name[c], nb ? " (nbrs)" : "");
+                tri_arg ta = {&sets[si], &cfgs[c], nb, h, nt};
+                scenario sc = {nm, FDT_ENOMEM, sc_triangulate, &ta};
+                inject_all(&sc);
+            }
+        }
+    }
+    for (int si = 0; si < 2; si++)
+        free(sets[si].xyz);
+    printf("%ld runs, %ld with an injected failure (%ld absorbed)\n",
+           total_runs, total_injected, total_absorbed);
+    if (failures) {
+        fprintf(stderr, "%d failure(s)\n", failures);
+        return 1;
+    }
+    printf("all parallel fault-injection tests passed\n");
+    return 0;
+}
+
+/*
+ * Every file of the hostile corpus (tests/bad), read without injection:
+ * no request may be larger than 8 bytes per byte of the file plus 64 KiB
+ * (the reader's first buffer for files of unknown size). A header that
+ * declares billions of points in a few bytes must be refused before
+ * anything proportional to its count is allocated.
+ */
+static void check_bad_sizes(const char *bad)
+{
+    DIR *d = opendir(bad);
+    CHECK(d != NULL, "cannot open %s", bad);
+    if (d == NULL)
+        return;
+    int files = 0;
+    size_t worst = 0;
+    struct dirent *de;
+    while ((de = readdir(d)) != NULL) {
+        char p[1100];
+        snprintf(p, sizeof p, "%s/%s", bad, de->d_name);
+        struct stat st;
+        if (de->d_name[0] == '.' || stat(p, &st) != 0 || !S_ISREG(st.st_mode))
+            continue;
+        size_t limit = 8 * (size_t)st.st_size + 65536;
+        atomic_store(&fault_max, 0);
+        double *xyz = NULL;
+        size_t n = 0;
+        char err[512];
+        fdt_read_points(p, &xyz, &n, err, sizeof err);
+        free(xyz);
+        size_t got = atomic_load(&fault_max);
+        CHECK(got <= limit, "%s (%lld bytes): an allocation of %zu bytes", p,
+              (long long)st.st_size, got);
+        if (got > worst)
+            worst = got;
+        files++;
+    }
+    closedir(d);
+    CHECK(files >= 40, "only %d files in %s", files, bad);
+    printf("hostile corpus: %d files read, largest allocation %zu bytes\n",
+           files, worst);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc == 2 && strcmp(argv[1], "--parallel") == 0)
+        return run_parallel();
+    if (argc != 3) {
+        fprintf(stderr, "usage: %s GOOD_DIR BAD_DIR | --parallel\n", argv[0]);
+        return 2;
+    }
+    const char *good = argv[1];
+    check_bad_sizes(argv[2]);
+    uint16_t one = 1;
+    unsigned char lo;
+    memcpy(&lo, &one, 1);
+
+    char dir[] = "/tmp/fdt_test_faults.XXXXXX";
+    if (mkdtemp(dir) == NULL) {
+        perror("mkdtemp");
+        return 1;
+    }
+    char outdir[1100];
+    snprintf(outdir, sizeof outdir, "%s/out", dir);
+    if (mkdir(outdir, 0700) != 0) {
+        perror("mkdir");
+        return 1;
+    }
+
+    /* --- readers --- */
+    char p_xyz[1100], p_node[1100], p_aply[1100], p_bply[1100];
+    snprintf(p_xyz, sizeof p_xyz, "%s/long.xyz", dir);
+    snprintf(p_node, sizeof p_node, "%s/attr.node", dir);
+    snprintf(p_aply, sizeof p_aply, "%s/ascii.ply", dir);
+    snprintf(p_bply, sizeof p_bply, "%s/bin.ply", dir);
+    /* A literal longer than the reader's stack buffer: its heap copy. */
+    char longlit[400];
+    memset(longlit, 0, sizeof longlit);
+    strcpy(longlit, "0.");
+    memset(longlit + 2, '3', 300);
+    char xyz_text[1024];
+    int xl = snprintf(xyz_text, sizeof xyz_text,
+                      "# x y z\n0 0 0\n1,0,0\n0 1 0\n0 0 %s\n1e-3 2E+1 -0.5\n",
+                      longlit);
+    static const char node_text[] = "5 3 1 1\n1 0 0 0 0.5 1\n2 1 0 0 0.5 0\n"
+                                    "3 0 1 0 nan 1\n4 0 0 1 0.5 0\n"
+                                    "5 .5 .5 .5 1 1\n";
+    static const char aply_text[] =
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\n"
+        "property double y\nproperty double z\nproperty float nx\n"
+        "element face 1\nproperty list uchar int vertex_indices\n"
+        "end_header\n0 0 0 nan\n1 0 0 1\n0 1 0 1\n0 0 1 1\n3 0 1 2\n";
+    char bply[512];
+    size_t bl = make_ply_le(bply, sizeof bply);
+    CHECK(write_file(p_xyz, xyz_text, (size_t)xl) == 0, "write %s", p_xyz);
+    CHECK(write_file(p_node, node_text, sizeof node_text - 1) == 0, "node");
+    CHECK(write_file(p_aply, aply_text, sizeof aply_text - 1) == 0, "aply");
+    CHECK(lo == 1 && bl > 0 && write_file(p_bply, bply, bl) == 0, "bply");
+
+    read_arg reads[] = {
+        {p_xyz, NULL, 0, 5, NULL},
+        {p_node, NULL, 0, 5, NULL},
+        {p_aply, NULL, 0, 4, NULL},
+        {p_bply, NULL, 0, 5, NULL},
+        {"mem.xyz", xyz_text, (size_t)xl, 5, NULL},
+        {"mem.ply", bply, bl, 5, NULL},
+    };
+    static const char *const reads_name[] = {
+        "read .xyz (long literal)", "read .node (attributes)",
+        "read ascii .ply (lists)", "read binary .ply (lists)",
+        "read_mem .xyz", "read_mem binary .ply"};
+    for (size_t i = 0; i < sizeof reads / sizeof reads[0]; i++) {
+        reference_read(&reads[i]);
+        scenario sc = {reads_name[i], FDT_IO_ENOMEM, sc_read, &reads[i]};
+        inject_all(&sc);
+        free(reads[i].want);
+    }
+    /* Every sample in tests/good (10 points each). */
+    DIR *d = opendir(good);
+    CHECK(d != NULL, "cannot open %s", good);
+    int ngood = 0;
+    if (d != NULL) {
+        struct dirent *de;
+        while ((de = readdir(d)) != NULL) {
+            if (de->d_name[0] == '.' || strcmp(de->d_name, "EXPECTED.txt") == 0)
+                continue;
+            char p[1100], nm[300];
+            snprintf(p, sizeof p, "%s/%s", good, de->d_name);
+            snprintf(nm, sizeof nm, "read good/%s", de->d_name);
+            read_arg ra = {p, NULL, 0, 10, NULL};
+            reference_read(&ra);
+            scenario sc = {nm, FDT_IO_ENOMEM, sc_read, &ra};
+            inject_all(&sc);
+            free(ra.want);
+            ngood++;
+        }
+        closedir(d);
+    }
+    CHECK(ngood >= 5, "only %d samples in %s", ngood, good);
+
+    /* --- the engine --- */
+    uint64_t rng = 0x9e3779b97f4a7c15u;
+    ptset sets[3] = {make_lattice(&rng), make_skew_lines(&rng),
+                     make_sphere(&rng)};
+    for (int si = 0; si < 3; si++) {
+        const ptset *ps = &sets[si];
+        for (int nb = 0; nb <= 1; nb++) {
+            fdt_result *r = NULL;
+            int rc = triangulate(ps, &serial_cfg, nb, &r);
+            CHECK(rc == FDT_OK, "%s: reference triangulation: %s", ps->name,
+                  fdt_strerror(rc));
+            if (rc != FDT_OK)
+                continue;
+            uint64_t h = 0;
+            CHECK(fdt_result_hash(r, &h) == FDT_OK, "reference hash");
+            size_t nt = fdt_result_num_tets(r);
+            fdt_result_free(&r);
+
+            static const char *const what[4] = {"triangulate", "result_sort",
+                                                "result_hash", "check"};
+            char nm[4][96];
+            for (int w = 0; w < 4; w++)
+                snprintf(nm[w], sizeof nm[w], "%s %s%s", what[w], ps->name,
+                         nb ? " (nbrs)" : "");
+            tri_arg ta = {ps, &serial_cfg, nb, h, nt};
+            scenario sc = {nm[0], FDT_ENOMEM, sc_triangulate, &ta};
+            inject_all(&sc);
+            for (int w = 0; w < 3; w++) {
+                post_arg pa = {ps, nb, w, h};
+                scenario post = {nm[w + 1], FDT_ENOMEM, sc_post, &pa};
+                inject_all(&post);
+            }
+        }
+    }
+
+    /* --- writers --- */
+    fdt_result *r = NULL;
+    int rc = triangulate(&sets[0], &serial_cfg, 1, &r);
+    CHECK(rc == FDT_OK && fdt_result_sort(r) == FDT_OK, "mesh for writing");
+    if (rc == FDT_OK) {
+        static const char *const exts[4] = {".tets", ".ele", ".vtu", ".vtk"};
+        for (int i = 0; i < 4; i++) {
+            char nm[64];
+            snprintf(nm, sizeof nm, "write %s", exts[i]);
+            write_arg wa = {&sets[0], outdir, exts[i], r};
+            scenario sc = {nm, FDT_IO_ENOMEM, sc_write, &wa};
+            inject_all(&sc);
+        }
+    }
+    fdt_result_free(&r);
+    for (int si = 0; si < 3; si++)
+        free(sets[si].xyz);
+
+    empty_dir(outdir);
+    rmdir(outdir);
+    empty_dir(dir);
+    rmdir(dir);
+    printf("%ld runs, %ld with an injected failure (%ld absorbed)\n",
+           total_runs, total_injected, total_absorbed);
+    if (failures) {
+        fprintf(stderr, "%d failure(s)\n", failures);
+        return 1;
+    }
+    printf("all fault-injection tests passed\n");
+    return 0;
+}
