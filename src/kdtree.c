@@ -602,13 +602,17 @@ static void apex_walk(fdt_apex *s, const fdt_kdtree *t, uint32_t root, fdt_kdq *
         const fdt_kdnode *l = &t->nodes[nd->left], *r = l + 1;
         const double *q = s->best != FDT_NONE ? s->center : s->target;
         double dl = box_dist2_sc(l->lo, l->hi, q, s->sc), dr = box_dist2_sc(r->lo, r->hi, q, s->sc);
-        if (dl <= dr) {
-            stack[sp++] = nd->left + 1;
-            stack[sp++] = nd->left;
-        } else {
-            stack[sp++] = nd->left;
-            stack[sp++] = nd->left + 1;
-        }
+        /* A child outside the current ball is dropped at once rather than
+         * when popped: later balls are spheres of the same pencil through
+         * a, b, c with a smaller parameter, whose open-side part lies
+         * inside this one's, so such a child can never become useful. */
+        uint32_t near = dl <= dr ? nd->left : nd->left + 1;
+        uint32_t far = dl <= dr ? nd->left + 1 : nd->left;
+        double dfar = dl <= dr ? dr : dl, dnear = dl <= dr ? dl : dr;
+        if (s->best == FDT_NONE || dfar <= s->r2)
+            stack[sp++] = far;
+        if (s->best == FDT_NONE || dnear <= s->r2)
+            stack[sp++] = near;
     }
 }
 
