@@ -74,8 +74,8 @@ typedef struct build_ctx {
     uint32_t cap;
 } build_ctx;
 
-static void node_box(const double *P, uint32_t begin, uint32_t end,
-                     double *lo, double *hi)
+void fdt_points_box(const double *P, uint32_t begin, uint32_t end,
+                    double *lo, double *hi)
 {
     for (int k = 0; k < 3; k++) {
         lo[k] = INFINITY;
@@ -100,7 +100,7 @@ static void build_rec(build_ctx *bc, uint32_t id, uint32_t begin, uint32_t end)
     nd->end = end;
     nd->left = 0;
     nd->dim = 0;
-    node_box(bc->P, begin, end, nd->lo, nd->hi);
+    fdt_points_box(bc->P, begin, end, nd->lo, nd->hi);
     if (end - begin <= bc->leaf)
         return;
     int dim = 0;
@@ -141,21 +141,6 @@ int fdt_kd_build(fdt_kdtree *t, double *P, fdt_vid *orig, uint32_t base,
     return FDT_OK;
 }
 
-/* Squared distance from c to the box; 0 inside. */
-static double box_dist2(const double *lo, const double *hi, const double *c)
-{
-    double d2 = 0.0;
-    for (int k = 0; k < 3; k++) {
-        double d = 0.0;
-        if (c[k] < lo[k])
-            d = lo[k] - c[k];
-        else if (c[k] > hi[k])
-            d = c[k] - hi[k];
-        d2 += d * d;
-    }
-    return d2;
-}
-
 static double dist2(const double *a, const double *b)
 {
     double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
@@ -193,8 +178,7 @@ static inline double dist2_sc(const double *a, const double *b, double sc)
     return dx * dx + dy * dy + dz * dz;
 }
 
-/* Squared scaled distance from c to the box; 0 inside. */
-static double box_dist2_sc(const double *lo, const double *hi, const double *c, double sc)
+double fdt_box_dist2_sc(const double *lo, const double *hi, const double *c, double sc)
 {
     double d2 = 0.0;
     for (int k = 0; k < 3; k++) {
@@ -236,7 +220,7 @@ uint32_t fdt_kd_nearest(const fdt_kdtree *t, const double *q,
     stack[sp++] = 0;
     while (sp > 0) {
         const fdt_kdnode *nd = &t->nodes[stack[--sp]];
-        if (box_dist2(nd->lo, nd->hi, q) > bd * (1.0 + NEAR_REL) + NEAR_ABS)
+        if (fdt_box_dist2_sc(nd->lo, nd->hi, q, 1.0) > bd * (1.0 + NEAR_REL) + NEAR_ABS)
             continue;
         if (kq)
             kq->nodes++;
@@ -263,7 +247,7 @@ uint32_t fdt_kd_nearest(const fdt_kdtree *t, const double *q,
             continue;
         }
         const fdt_kdnode *l = &t->nodes[nd->left], *r = l + 1;
-        double dl = box_dist2(l->lo, l->hi, q), dr = box_dist2(r->lo, r->hi, q);
+        double dl = fdt_box_dist2_sc(l->lo, l->hi, q, 1.0), dr = fdt_box_dist2_sc(r->lo, r->hi, q, 1.0);
         /* Push the farther child first so the nearer one is searched first. */
         if (dl <= dr) {
             stack[sp++] = nd->left + 1;
@@ -289,7 +273,7 @@ int fdt_kd_ball(const fdt_kdtree *t, const double *c, double r,
     stack[sp++] = 0;
     while (sp > 0) {
         const fdt_kdnode *nd = &t->nodes[stack[--sp]];
-        if (box_dist2_sc(nd->lo, nd->hi, c, sc) > r2)
+        if (fdt_box_dist2_sc(nd->lo, nd->hi, c, sc) > r2)
             continue;
         if (kq)
             kq->nodes++;
@@ -480,7 +464,14 @@ static void update_ball(fdt_apex *s)
     double det = u[0] * vw[0] + u[1] * vw[1] + u[2] * vw[2];
     double nu = norm3(u), nv = norm3(v), nw = norm3(w);
     double prod = nu * nv * nw;
-    if (!(det > 0.0) || !(prod < 1e6 * det) || !isfinite(prod)) {
+    /* In these units the longest difference is near 1; one shorter than
+     * 2^-200 (an edge 1e-164 long next to edges of 0.5, from an input that
+     * mixes magnitudes) may have underflowed in its norm, and a zero norm
+     * once made K look perfect: the floating centre was then off by 0.02
+     * with a tolerance of 1e-16 and a point strictly inside the sphere was
+     * missed (found by tests/fuzz/fuzz_mesh). Such tets go exact. */
+    double shortest = nu < nv ? (nu < nw ? nu : nw) : (nv < nw ? nv : nw);
+    if (!(det > 0.0) || !(prod < 1e6 * det) || !isfinite(prod) || !(shortest >= 0x1p-200)) {
         update_ball_exact(s);
         return;
     }
@@ -555,7 +546,7 @@ static int box_touches_open_side(const fdt_apex *s, const double *lo, const doub
 
 int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi)
 {
-    if (s->best != FDT_NONE && box_dist2_sc(lo, hi, s->center, s->sc) > s->r2)
+    if (s->best != FDT_NONE && fdt_box_dist2_sc(lo, hi, s->center, s->sc) > s->r2)
         return 0;
     /* Largest value of nrm . (x - a) over the box, against a margin for
      * rounding in the same spirit as open_side's. */
@@ -601,7 +592,7 @@ static void apex_walk(fdt_apex *s, const fdt_kdtree *t, uint32_t root, fdt_kdq *
         }
         const fdt_kdnode *l = &t->nodes[nd->left], *r = l + 1;
         const double *q = s->best != FDT_NONE ? s->center : s->target;
-        double dl = box_dist2_sc(l->lo, l->hi, q, s->sc), dr = box_dist2_sc(r->lo, r->hi, q, s->sc);
+        double dl = fdt_box_dist2_sc(l->lo, l->hi, q, s->sc), dr = fdt_box_dist2_sc(r->lo, r->hi, q, s->sc);
         /* A child outside the current ball is dropped at once rather than
          * when popped: later balls are spheres of the same pencil through
          * a, b, c with a smaller parameter, whose open-side part lies

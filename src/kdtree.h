@@ -55,6 +55,15 @@ void fdt_kd_free(fdt_kdtree *t);
 void fdt_kd_select(double *P, fdt_vid *orig, uint32_t lo, uint32_t hi,
                    uint32_t k, int dim);
 
+/* Bounding box of points [begin, end) of P (also the partitioner's). */
+void fdt_points_box(const double *P, uint32_t begin, uint32_t end,
+                    double *lo, double *hi);
+
+/* Squared distance from c to the box [lo, hi] (0 inside), with each
+ * difference scaled by the power of two sc first (1 for plain distances;
+ * an apex search passes its ball's sc, see fdt_apex). */
+double fdt_box_dist2_sc(const double *lo, const double *hi, const double *c, double sc);
+
 /* An exactly nearest point to q other than id `exclude` (the lowest id on
  * exact ties; floating distances, fdt_compare_dist on near-ties),
  * FDT_NONE if the tree holds no other point. */

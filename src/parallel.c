@@ -846,20 +846,6 @@ static int remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
     }
 }
 
-static double box_dist2(const double *lo, const double *hi, const double *c)
-{
-    double d2 = 0.0;
-    for (int k = 0; k < 3; k++) {
-        double d = 0.0;
-        if (c[k] < lo[k])
-            d = lo[k] - c[k];
-        else if (c[k] > hi[k])
-            d = c[k] - hi[k];
-        d2 += d * d;
-    }
-    return d2;
-}
-
 /*
  * Continues the apex search over the other parts: walks the bisection
  * tree, skipping our own part, empty parts, and every subtree whose box
@@ -893,9 +879,11 @@ static int search_others(worker *w, fdt_apex *s, qbuf *qb)
             continue;
         }
         const fdt_pnode *l = &pt->nodes[nd->left], *r = l + 1;
-        const double *q = s->best != FDT_NONE && isfinite(s->r2) ? s->center : s->target;
-        double dl = l->begin < l->end ? box_dist2(l->lo, l->hi, q) : INFINITY;
-        double dr = r->begin < r->end ? box_dist2(r->lo, r->hi, q) : INFINITY;
+        int ball = s->best != FDT_NONE && isfinite(s->r2);
+        const double *q = ball ? s->center : s->target;
+        double sc = ball ? s->sc : 1.0;
+        double dl = l->begin < l->end ? fdt_box_dist2_sc(l->lo, l->hi, q, sc) : INFINITY;
+        double dr = r->begin < r->end ? fdt_box_dist2_sc(r->lo, r->hi, q, sc) : INFINITY;
         if (dl <= dr) {
             stack[sp++] = nd->left + 1;
             stack[sp++] = nd->left;

@@ -16,23 +16,6 @@ void fdt_partition_free(fdt_partition *pt)
     memset(pt, 0, sizeof *pt);
 }
 
-static void range_box(const double *P, uint32_t begin, uint32_t end,
-                      double *lo, double *hi)
-{
-    for (int k = 0; k < 3; k++) {
-        lo[k] = INFINITY;
-        hi[k] = -INFINITY;
-    }
-    for (uint32_t i = begin; i < end; i++)
-        for (int k = 0; k < 3; k++) {
-            double x = P[3 * (size_t)i + k];
-            if (x < lo[k])
-                lo[k] = x;
-            if (x > hi[k])
-                hi[k] = x;
-        }
-}
-
 typedef struct rcb_ctx {
     fdt_partition *pt;
     double *P;
@@ -52,7 +35,7 @@ static void rcb(rcb_ctx *rc, int id, uint32_t begin, uint32_t end, int p0,
 {
     fdt_partition *pt = rc->pt;
     fdt_pnode *nd = &pt->nodes[id];
-    range_box(rc->P, begin, end, nd->lo, nd->hi);
+    fdt_points_box(rc->P, begin, end, nd->lo, nd->hi);
     nd->begin = begin;
     nd->end = end;
     if (k == 1) {

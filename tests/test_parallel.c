@@ -31,31 +31,7 @@
 #include "frontdt.h"
 #include "partition.h"
 
-#define CHECK(cond)                                                          \
-    do {                                                                     \
-        if (!(cond)) {                                                       \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, \
-                    #cond);                                                  \
-            exit(1);                                                         \
-        }                                                                    \
-    } while (0)
-
-#define CHECK_EQ(a, b)                                                       \
-    do {                                                                     \
-        long long va_ = (long long)(a), vb_ = (long long)(b);                \
-        if (va_ != vb_) {                                                    \
-            fprintf(stderr, "%s:%d: check failed: %s == %s (%lld != %lld)\n", \
-                    __FILE__, __LINE__, #a, #b, va_, vb_);                   \
-            exit(1);                                                         \
-        }                                                                    \
-    } while (0)
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "testutil.h"
 
 /* ---- inputs --------------------------------------------------------------- */
 

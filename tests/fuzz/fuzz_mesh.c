@@ -7,6 +7,7 @@
  * and on the same points in reverse order. A run must
  *  - return FDT_OK or FDT_EDEGENERATE (with a diagnostic), the same for
  *    both orders;
+ *  - on success equal the result of shared mode with three threads;
  *  - on success pass fdt_check() (the independent exact verifier), with
  *    and without neighbours, have as many hull faces as tet faces without
  *    a neighbour, and give the same tets for both orders once every vertex
@@ -19,6 +20,7 @@
  * point's power of two).
  */
 #include "frontdt.h"
+#include "predicates.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -70,18 +72,11 @@ static size_t fm_decode(const uint8_t *data, size_t size, double *xyz)
     return n;
 }
 
-/* Lexicographic order of points i and j; -0 equals +0 as in the
- * duplicate merge. */
+/* Lexicographic order of points i and j (src/predicates.c; -0 equals
+ * +0 there, as in the duplicate merge). */
 static int fm_cmp_pt(const double *xyz, int i, int j)
 {
-    const double *p = xyz + 3 * (size_t)i, *q = xyz + 3 * (size_t)j;
-    for (int k = 0; k < 3; k++) {
-        if (p[k] < q[k])
-            return -1;
-        if (p[k] > q[k])
-            return 1;
-    }
-    return 0;
+    return fdt_lex_compare(xyz + 3 * (size_t)i, xyz + 3 * (size_t)j);
 }
 
 static int fm_cmp_tet(const void *a, const void *b)
@@ -134,13 +129,13 @@ static int *fm_canonical(const fdt_result *r, const double *xyz, size_t n,
     return c;
 }
 
-static int fm_run(const double *xyz, size_t n, int neighbors,
-                  fdt_result **res, char *diag, size_t dlen)
+static int fm_run(const double *xyz, size_t n, int neighbors, fdt_mode mode,
+                  int threads, fdt_result **res, char *diag, size_t dlen)
 {
     fdt_settings s;
     fdt_default_settings(&s);
-    s.mode = FDT_MODE_SERIAL;
-    s.n_threads = 1;
+    s.mode = mode;
+    s.n_threads = threads;
     s.neighbors = neighbors;
     fdt_context *ctx = NULL;
     int rc = fdt_open(&ctx, &s);
@@ -190,8 +185,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     char d1[512], d2[512];
     fdt_result *r1 = NULL, *r2 = NULL;
-    int rc1 = fm_run(xyz, n, neighbors, &r1, d1, sizeof d1);
-    int rc2 = fm_run(rev, n, neighbors, &r2, d2, sizeof d2);
+    int rc1 = fm_run(xyz, n, neighbors, FDT_MODE_SERIAL, 1, &r1, d1, sizeof d1);
+    int rc2 = fm_run(rev, n, neighbors, FDT_MODE_SERIAL, 1, &r2, d2, sizeof d2);
     if (rc1 != rc2) {
         char both[1100];
         snprintf(both, sizeof both, "%s / %s: '%s' / '%s'", fdt_strerror(rc1),
@@ -218,6 +213,21 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         fm_violation("the two input orders give different tets", NULL);
     free(c1);
     free(c2);
+    /* Three threads in shared mode advance the faces in another order
+     * (three fronts, faces handed between them): a search that depends on
+     * the order showed up only that way (the underflowed norm in
+     * update_ball, src/kdtree.c). Same input order, so same hash. */
+    char d3[512];
+    fdt_result *r3 = NULL;
+    int rc3 = fm_run(xyz, n, 0, FDT_MODE_SHARED, 3, &r3, d3, sizeof d3);
+    if (rc3 != FDT_OK)
+        fm_violation("shared mode fails where serial succeeds", d3);
+    uint64_t h1 = 0, h3 = 0;
+    if (fdt_result_hash(r1, &h1) != FDT_OK || fdt_result_hash(r3, &h3) != FDT_OK)
+        fm_violation("fdt_result_hash failed", NULL);
+    if (h1 != h3)
+        fm_violation("shared mode (3 threads) and serial give different tets", NULL);
+    fdt_result_free(&r3);
     fdt_result_free(&r1);
     fdt_result_free(&r2);
     return 0;
