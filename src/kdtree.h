@@ -96,6 +96,7 @@ typedef struct fdt_apex {
     double sc;           /* a power of two: the ball test compares */
     double r2;           /* |(d - center) sc|^2 with r2 = (radius sc)^2, */
                          /* INFINITY while unknown or ill-conditioned */
+    uint32_t ver;        /* counts changes of best (and so of the ball) */
 } fdt_apex;
 
 void fdt_apex_init(fdt_apex *s, const double *a, const double *b,
