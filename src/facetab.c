@@ -17,20 +17,6 @@ void fdt_face_canon(uint32_t a, uint32_t b, uint32_t c, uint32_t out[3])
     }
 }
 
-/* With v[0] the smallest, the vertex set is (v0, min(v1,v2), max(v1,v2)):
- * hash that so both orientations of a face meet in the same chain. */
-static size_t face_hash(const uint32_t v[3])
-{
-    uint32_t lo = v[1] < v[2] ? v[1] : v[2], hi = v[1] < v[2] ? v[2] : v[1];
-    uint64_t h = (uint64_t)v[0] * 0x9E3779B97F4A7C15ull;
-    h ^= (uint64_t)lo * 0xC2B2AE3D27D4EB4Full;
-    h ^= (uint64_t)hi * 0x165667B19E3779F9ull;
-    h ^= h >> 32;
-    h *= 0xD6E8FEB86659FD93ull;
-    h ^= h >> 32;
-    return (size_t)h;
-}
-
 static int same_set(const uint32_t *a, const uint32_t *b)
 {
     return a[0] == b[0] && ((a[1] == b[1] && a[2] == b[2]) || (a[1] == b[2] && a[2] == b[1]));
@@ -59,7 +45,7 @@ void fdt_facetab_free(fdt_facetab *t)
 
 fdt_face *fdt_facetab_find(const fdt_facetab *t, const uint32_t v[3])
 {
-    size_t mask = t->cap - 1, h = face_hash(v) & mask;
+    size_t mask = t->cap - 1, h = fdt_face_hash(v) & mask;
     for (;;) {
         fdt_face *s = &t->slots[h];
         if (s->v[0] == UINT32_MAX)
@@ -81,7 +67,7 @@ static int grow(fdt_facetab *t)
     for (size_t i = 0; i < t->cap; i++) {
         if (t->slots[i].v[0] == UINT32_MAX)
             continue;
-        size_t h = face_hash(t->slots[i].v) & (ncap - 1);
+        size_t h = fdt_face_hash(t->slots[i].v) & (ncap - 1);
         while (ns[h].v[0] != UINT32_MAX)
             h = (h + 1) & (ncap - 1);
         ns[h] = t->slots[i];
@@ -98,7 +84,7 @@ fdt_face *fdt_facetab_find_or_insert(fdt_facetab *t, const fdt_face *f, int *err
     /* Keep the load at most 1/2 so probe chains stay short. */
     if (2 * (t->count + 1) > t->cap && (*err = grow(t)) != FDT_OK)
         return NULL;
-    size_t mask = t->cap - 1, h = face_hash(f->v) & mask;
+    size_t mask = t->cap - 1, h = fdt_face_hash(f->v) & mask;
     for (;;) {
         fdt_face *s = &t->slots[h];
         if (s->v[0] == UINT32_MAX) {
@@ -121,7 +107,7 @@ void fdt_facetab_remove(fdt_facetab *t, fdt_face *s)
         j = (j + 1) & mask;
         if (t->slots[j].v[0] == UINT32_MAX)
             break;
-        size_t home = face_hash(t->slots[j].v) & mask;
+        size_t home = fdt_face_hash(t->slots[j].v) & mask;
         int stays = (i <= j) ? (i < home && home <= j) : (i < home || home <= j);
         if (stays)
             continue;

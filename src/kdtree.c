@@ -654,7 +654,11 @@ static void apex_walk(fdt_apex *s, const fdt_kdtree *t, uint32_t root, fdt_kdq *
         sp--;
         const fdt_kdnode *nd = &t->nodes[stack[sp]];
         double d2 = sver[sp] == s->ver ? sd2[sp] : fdt_box_dist2_sc(nd->lo, nd->hi, s->center, s->sc);
-        if (d2 > s->r2 || !box_open(s, nd->lo, nd->hi))
+        /* The open-side test rejects only about 1.5 % of the inner nodes
+         * a finite ball leaves (200k uniform), so inner nodes take it
+         * only while there is no finite ball (hull faces, the first
+         * candidates), where it is the only pruning; leaves always. */
+        if (d2 > s->r2 || ((!nd->left | !(s->r2 < INFINITY)) && !box_open(s, nd->lo, nd->hi)))
             continue;
         kq->nodes++;
         if (!nd->left) {

@@ -651,10 +651,15 @@ static int build_tet(worker *w, const uint32_t v[4], int request)
     int64_t tid = fdt_meshbuf_add_tet(&w->out, v);
     if (tid < 0)
         return FDT_ENOMEM;
+    uint32_t fc[4][3];
+    /* all four table slots asked for first, as in src/front.c */
     for (int i = 0; i < 4; i++) {
-        uint32_t fv[3];
         fdt_face_canon(v[fdt_tet_face[i][0]], v[fdt_tet_face[i][1]],
-                       v[fdt_tet_face[i][2]], fv);
+                       v[fdt_tet_face[i][2]], fc[i]);
+        fdt_facetab_prefetch(&w->ft, fc[i]);
+    }
+    for (int i = 0; i < 4; i++) {
+        const uint32_t *fv = fc[i];
         int64_t link = (tid << 2) | i;
         int owner = i == lowi ? far_owner : w->id;
         int err = owner == w->id ? face_arrives(w, fv, w->id, link)
