@@ -103,17 +103,9 @@ struct input {
 /* Reads IN.xyz into in.xyz; prints the error and returns false on failure. */
 inline bool read_input(const char *name, const char *path, input &in)
 {
-    std::string err;
-    if (!fdt_ref::read_xyz(path, in.xyz, err)) {
-        std::fprintf(stderr, "%s: %s\n", name, err.c_str());
+    if (!fdt_ref::read_points(name, path, in.xyz))
         return false;
-    }
     in.n = in.xyz.size() / 3;
-    if (in.n > (size_t)INT32_MAX) {
-        std::fprintf(stderr, "%s: %zu points: more than int32 ids\n", name,
-                     in.n);
-        return false;
-    }
     return true;
 }
 

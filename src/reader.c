@@ -822,32 +822,37 @@ static void ply_hdr_free(ply_hdr *h)
     free(h->props);
 }
 
-static int ply_add_elem(ply_hdr *h)
+/* Makes room for one more item in the growable array *arr (item size
+ * `size`, *n items, capacity *cap, first capacity `first`) and counts it;
+ * 0 or -1 when out of memory (the array is then unchanged). */
+static int grow_one(void **arr, size_t size, size_t *n, size_t *cap, size_t first)
 {
-    if (h->n_elems == h->cap_elems) {
-        size_t cap = h->cap_elems ? 2 * h->cap_elems : 8;
-        ply_elem *x = realloc(h->elems, cap * sizeof *x);
+    if (*n == *cap) {
+        size_t ncap = *cap ? 2 * *cap : first;
+        void *x = realloc(*arr, ncap * size);
         if (x == NULL)
             return -1;
-        h->elems = x;
-        h->cap_elems = cap;
+        *arr = x;
+        *cap = ncap;
     }
-    h->n_elems++;
+    (*n)++;
     return 0;
+}
+
+static int ply_add_elem(ply_hdr *h)
+{
+    void *a = h->elems;
+    int rc = grow_one(&a, sizeof *h->elems, &h->n_elems, &h->cap_elems, 8);
+    h->elems = a;
+    return rc;
 }
 
 static int ply_add_prop(ply_hdr *h)
 {
-    if (h->n_props == h->cap_props) {
-        size_t cap = h->cap_props ? 2 * h->cap_props : 16;
-        ply_prop *x = realloc(h->props, cap * sizeof *x);
-        if (x == NULL)
-            return -1;
-        h->props = x;
-        h->cap_props = cap;
-    }
-    h->n_props++;
-    return 0;
+    void *a = h->props;
+    int rc = grow_one(&a, sizeof *h->props, &h->n_props, &h->cap_props, 16);
+    h->props = a;
+    return rc;
 }
 
 /* Text for messages: "vertex 3 of 10" or "element 'face' item 3 of 10",

@@ -539,6 +539,24 @@ static void put_node(out_file *o, const fdt_mesh_view *m)
     }
 }
 
+/* "<count><header>", then "<index> <v_1> ... <v_k>" a row, the values
+ * from vid or, where vid is NULL, from tid: the bodies of .ele, .face
+ * and .neigh. */
+static void put_rows(out_file *o, size_t count, const char *header, int k,
+                     const fdt_vid *vid, const fdt_tid *tid)
+{
+    out_i64(o, (int64_t)count);
+    out_str(o, header);
+    for (size_t r = 0; r < count && !o->err; r++) {
+        out_i64(o, (int64_t)r);
+        for (size_t at = (size_t)k * r; at < (size_t)k * (r + 1); at++) {
+            out_char(o, ' ');
+            out_i64(o, vid ? (int64_t)vid[at] : (int64_t)tid[at]);
+        }
+        out_char(o, '\n');
+    }
+}
+
 static void put_ele(out_file *o, const fdt_mesh_view *m)
 {
     /* "<tets> <nodes per tet> <region attribute>", then
@@ -546,47 +564,20 @@ static void put_ele(out_file *o, const fdt_mesh_view *m)
      * orientation, det(b-a, c-a, d-a) > 0, is TetGen's too (checked
      * against libtet's output), as are outward hull faces and neighbour i
      * opposite vertex i: TetGen readers need no conversion. */
-    out_i64(o, (int64_t)m->n_tets);
-    out_str(o, " 4 0\n");
-    for (size_t t = 0; t < m->n_tets && !o->err; t++) {
-        out_i64(o, (int64_t)t);
-        for (int c = 0; c < 4; c++) {
-            out_char(o, ' ');
-            out_i64(o, m->tets[4 * t + (size_t)c]);
-        }
-        out_char(o, '\n');
-    }
+    put_rows(o, m->n_tets, " 4 0\n", 4, m->tets, NULL);
 }
 
 static void put_face(out_file *o, const fdt_mesh_view *m)
 {
     /* "<faces> <boundary marker>", then "<index> <v0> <v1> <v2>". */
-    out_i64(o, (int64_t)m->n_hull);
-    out_str(o, " 0\n");
-    for (size_t f = 0; f < m->n_hull && !o->err; f++) {
-        out_i64(o, (int64_t)f);
-        for (int c = 0; c < 3; c++) {
-            out_char(o, ' ');
-            out_i64(o, m->hull[3 * f + (size_t)c]);
-        }
-        out_char(o, '\n');
-    }
+    put_rows(o, m->n_hull, " 0\n", 3, m->hull, NULL);
 }
 
 static void put_neigh(out_file *o, const fdt_mesh_view *m)
 {
     /* "<tets> 4", then "<index> <n0> <n1> <n2> <n3>": neighbour i is
      * opposite vertex i (TetGen's convention and ours), -1 on the hull. */
-    out_i64(o, (int64_t)m->n_tets);
-    out_str(o, " 4\n");
-    for (size_t t = 0; t < m->n_tets && !o->err; t++) {
-        out_i64(o, (int64_t)t);
-        for (int c = 0; c < 4; c++) {
-            out_char(o, ' ');
-            out_i64(o, m->nbrs[4 * t + (size_t)c]);
-        }
-        out_char(o, '\n');
-    }
+    put_rows(o, m->n_tets, " 4\n", 4, NULL, m->nbrs);
 }
 
 /* Case-insensitive "does s end with ext" (ext lowercase, with the dot). */

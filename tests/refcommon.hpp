@@ -179,6 +179,24 @@ inline bool read_xyz(const char *path, std::vector<double> &xyz,
     return true;
 }
 
+/* read_xyz for a program called `name`: prints "name: error" and returns
+ * false on failure, or when the file has more points than int32 ids. */
+inline bool read_points(const char *name, const char *path,
+                        std::vector<double> &xyz)
+{
+    std::string err;
+    if (!read_xyz(path, xyz, err)) {
+        std::fprintf(stderr, "%s: %s\n", name, err.c_str());
+        return false;
+    }
+    if (xyz.size() / 3 > (size_t)INT32_MAX) {
+        std::fprintf(stderr, "%s: %zu points: more than int32 ids\n", name,
+                     xyz.size() / 3);
+        return false;
+    }
+    return true;
+}
+
 /* ------------------------------------------------------ duplicate merging */
 
 /*

@@ -31,17 +31,9 @@ int main(int argc, char **argv)
     }
     const double t0 = fdt_ref::now_s();
     std::vector<double> xyz;
-    std::string err;
-    if (!fdt_ref::read_xyz(argv[1], xyz, err)) {
-        std::fprintf(stderr, "tetgen_ref: %s\n", err.c_str());
+    if (!fdt_ref::read_points("tetgen_ref", argv[1], xyz))
         return 1;
-    }
     const size_t n = xyz.size() / 3;
-    if (n > (size_t)INT32_MAX) {
-        std::fprintf(stderr, "tetgen_ref: %zu points: more than int32 ids\n",
-                     n);
-        return 1;
-    }
     const double t1 = fdt_ref::now_s();
 
     std::vector<int32_t> map, firsts;
@@ -92,6 +84,7 @@ int main(int argc, char **argv)
 
     fdt_ref::canonicalize(tets);
     uint64_t hash = 0;
+    std::string err;
     if (!fdt_ref::write_tets(argv[2], tets, &hash, err)) {
         std::fprintf(stderr, "tetgen_ref: %s\n", err.c_str());
         return 1;
