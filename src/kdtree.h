@@ -33,7 +33,8 @@ typedef struct fdt_kdtree {
     uint32_t base, n;
     /* Owned, set by fdt_kd_build (NULL in other trees): for the climb of
      * fdt_apex_search_from, each node's parent and cell ([0]: lo, [1]:
-     * hi; see that function) and each point's leaf (by id - base). */
+     * hi; how cells are bounded: climb_tables in src/kdtree.c) and each
+     * point's leaf (by id - base). */
     uint32_t *parent;
     double (*cell)[2][3];
     uint32_t *leafof;
