@@ -741,9 +741,11 @@ static void apex_walk(fdt_apex *s, const fdt_kdtree *t, uint32_t root, fdt_kdq *
             continue;
         }
         const fdt_kdnode *l = &t->nodes[nd->left], *r = l + 1;
-        int ball = s->best != FDT_NONE;
-        const double *q = ball ? s->center : s->target;
-        double dl = fdt_box_dist2_sc(l->lo, l->hi, q, s->sc), dr = fdt_box_dist2_sc(r->lo, r->hi, q, s->sc);
+        /* Without a best yet, center is the target (fdt_apex_init) and
+         * ver 0, which no later ball has: the distances order the
+         * children by the target and are never reused against a ball. */
+        double dl = fdt_box_dist2_sc(l->lo, l->hi, s->center, s->sc);
+        double dr = fdt_box_dist2_sc(r->lo, r->hi, s->center, s->sc);
         /* A child outside the current ball is dropped at once rather than
          * when popped: later balls are spheres of the same pencil through
          * a, b, c with a smaller parameter, whose open-side part lies
@@ -752,14 +754,13 @@ static void apex_walk(fdt_apex *s, const fdt_kdtree *t, uint32_t root, fdt_kdq *
         uint32_t sw = dr < dl;
         uint32_t near = nd->left + sw, far = nd->left + 1 - sw;
         double dnear = dr < dl ? dr : dl, dfar = dr < dl ? dl : dr;
-        uint32_t v = ball ? s->ver : UINT32_MAX;
         stack[sp] = far;
         sd2[sp] = dfar;
-        sver[sp] = v;
+        sver[sp] = s->ver;
         sp += !(dfar > s->r2);
         stack[sp] = near;
         sd2[sp] = dnear;
-        sver[sp] = v;
+        sver[sp] = s->ver;
         sp += !(dnear > s->r2);
     }
 }
