@@ -176,6 +176,19 @@ static int fault_disarm(void)
 static int failures;
 static long total_runs, total_injected, total_absorbed;
 
+/* The counts and the verdict at the end of a suite: main's exit status. */
+static int report(const char *which)
+{
+    printf("%ld runs, %ld with an injected failure (%ld absorbed)\n",
+           total_runs, total_injected, total_absorbed);
+    if (failures) {
+        fprintf(stderr, "%d failure(s)\n", failures);
+        return 1;
+    }
+    printf("all %sfault-injection tests passed\n", which);
+    return 0;
+}
+
 #define CHECK(cond, ...)                                                     \
     do {                                                                     \
         if (!(cond)) {                                                       \
@@ -654,14 +667,7 @@ static int run_parallel(void)
     }
     for (int si = 0; si < 2; si++)
         free(sets[si].xyz);
-    printf("%ld runs, %ld with an injected failure (%ld absorbed)\n",
-           total_runs, total_injected, total_absorbed);
-    if (failures) {
-        fprintf(stderr, "%d failure(s)\n", failures);
-        return 1;
-    }
-    printf("all parallel fault-injection tests passed\n");
-    return 0;
+    return report("parallel ");
 }
 
 /*
@@ -860,12 +866,5 @@ int main(int argc, char **argv)
     rmdir(outdir);
     empty_dir(dir);
     rmdir(dir);
-    printf("%ld runs, %ld with an injected failure (%ld absorbed)\n",
-           total_runs, total_injected, total_absorbed);
-    if (failures) {
-        fprintf(stderr, "%d failure(s)\n", failures);
-        return 1;
-    }
-    printf("all fault-injection tests passed\n");
-    return 0;
+    return report("");
 }
