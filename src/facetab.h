@@ -57,9 +57,18 @@ static inline size_t fdt_face_hash(const uint32_t v[3])
 
 /* Asks the memory system for the slot where v's search starts: the table
  * is larger than the caches on big inputs, and the front touches it at
- * random, so lookups issued back to back after their prefetches overlap
- * their cache misses instead of paying them one after the other (1M
- * uniform points: the table's share of the run fell from 20 % to 16 %). */
+ * random, so a lookup whose slot was asked for early enough finds it in
+ * the cache instead of waiting for memory (callers: src/front.c,
+ * src/parallel.c). */
+#if defined(__GNUC__)
+/* always_inline is not a detail: GCC counts __builtin_prefetch as free of
+ * side effects, so its IPA pass (local-pure-const) found an out-of-line
+ * copy of this function "const", and the calls, whose result is void,
+ * were deleted as dead code (GCC 12, -O1 and up): no prefetcht0 was in
+ * the object code of src/front.c or src/parallel.c until this attribute
+ * (`objdump -d` shows them now). */
+__attribute__((always_inline))
+#endif
 static inline void fdt_facetab_prefetch(const fdt_facetab *t, const uint32_t v[3])
 {
 #if defined(__GNUC__)
