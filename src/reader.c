@@ -168,6 +168,67 @@ static const double rd_pow10[23] = {
     1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
     1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
+#if defined(__SIZEOF_INT128__)
+#define RD_HAVE_U128 1
+__extension__ typedef unsigned __int128 rd_u128;
+
+/* 10^0 .. 10^19, the powers of ten below 2^64. */
+static const uint64_t rd_pow10_u64[20] = {
+    1ull, 10ull, 100ull, 1000ull, 10000ull, 100000ull, 1000000ull, 10000000ull,
+    100000000ull, 1000000000ull, 10000000000ull, 100000000000ull,
+    1000000000000ull, 10000000000000ull, 100000000000000ull,
+    1000000000000000ull, 10000000000000000ull, 100000000000000000ull,
+    1000000000000000000ull, 10000000000000000000ull};
+
+static int rd_bits128(rd_u128 x)
+{
+    uint64_t hi = (uint64_t)(x >> 64), lo = (uint64_t)x;
+    return hi ? 128 - __builtin_clzll(hi) : (lo ? 64 - __builtin_clzll(lo) : 0);
+}
+
+/*
+ * The double nearest to (q + f) 2^e2, ties to even, where q > 0 is an
+ * integer and 0 <= f < 1 is a fraction known only by whether it is zero
+ * (sticky). Exact integer work: the 53 leading bits of q are kept, and
+ * the bits below them with f decide the rounding. The caller keeps the
+ * result in the normal range, so the final scaling by 2^k is exact; q has
+ * more than 53 bits whenever f may be nonzero.
+ */
+static double rd_round_u128(rd_u128 q, int sticky, int e2)
+{
+    int nb = rd_bits128(q);
+    if (nb <= 53)
+        return ldexp((double)(uint64_t)q, e2);
+    int drop = nb - 53;
+    uint64_t mant = (uint64_t)(q >> drop);
+    rd_u128 rest = q & (((rd_u128)1 << drop) - 1), half = (rd_u128)1 << (drop - 1);
+    if (rest > half || (rest == half && (sticky || (mant & 1))))
+        mant++; /* 2^53 at most: still exact */
+    return ldexp((double)mant, e2 + drop);
+}
+
+/*
+ * w 10^e10 correctly rounded, for w < 2^64 and |e10| <= 19, in 128-bit
+ * integers: the 17-digit literals that printf("%.17g") writes (every
+ * coordinate a round trip produces) are beyond Clinger's fast path, and
+ * strtod took more than half of the time to read them. For e10 >= 0 the
+ * product w 10^e10 < 2^128 is exact. For e10 < 0, w 2^s (s puts its top
+ * bit at 2^126) divided by 10^-e10 gives a quotient of at least 62 bits
+ * and a remainder, which is the sticky fraction. The results lie in
+ * [1e-19, 2^64 1e19]: normal doubles.
+ */
+static double rd_exact_small(uint64_t w, int e10)
+{
+    if (e10 >= 0)
+        return rd_round_u128((rd_u128)w * rd_pow10_u64[e10], 0, 0);
+    int s = 127 - rd_bits128(w);
+    rd_u128 n = (rd_u128)w << s;
+    uint64_t d = rd_pow10_u64[-e10];
+    rd_u128 q = n / d;
+    return rd_round_u128(q, n - q * d != 0, -s);
+}
+#endif
+
 /* Whether s[0..len) spells nan, inf or infinity (any case, optional sign). */
 static int rd_is_nonfinite_word(const char *s, size_t len)
 {
@@ -265,6 +326,13 @@ static int rd_scan_real(const char *s, size_t len, double *out,
     }
 #else
     (void)slow;
+#endif
+#ifdef RD_HAVE_U128
+    if (!slow && e10 >= -19 && e10 <= 19) {
+        double v = rd_exact_small(w, (int)e10);
+        *out = neg ? -v : v;
+        return NUM_OK;
+    }
 #endif
     /* strtod needs a terminated copy, and the current locale's decimal
      * point in place of '.' (the CLI may have called setlocale). */

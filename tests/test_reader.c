@@ -282,7 +282,15 @@ static void test_xyz_good(tctx *t)
         "9007199254740993", "0.000000000000000000000000000001",
         "1e22", "1e23", "123456.789e-22", "8.5e-23", "3.14159265358979323846264338327950288419716939937510582097494459230781640628620899862803482534211706798214808651328230664709384460955058223172535940812848111745028410270193852110555964462294895493038196",
         "0e999", "-0.0e-999", "000000000000000000000000000012.5",
-        "-1e-22", "4.35e+15"};
+        "-1e-22", "4.35e+15",
+        /* the 128-bit path: exact ties (to even: 2^52, 2^52 + 2, 2^53 + 4),
+         * %.17g round trips, 19 digits at the ends of |e10| <= 19 */
+        "4503599627370496.5", "4503599627370497.5", "9007199254740995",
+        "0.70292183315885048", "637795.56999999995", "-0.071045216069212325",
+        "9999999999999999999e19", "1.000000000000000001e-1", "9999999999999999999e-19",
+        /* just above a tie, by less than the quotient's dropped bits can
+         * show: only the division's remainder rounds them up */
+        "4905581301898155611e-19", "6418770770843949536e-19", "-8622674343440708822e-19"};
     const size_t n = sizeof lits / sizeof lits[0];
     _Static_assert(sizeof lits / sizeof lits[0] % 3 == 0, "3 per point");
     double want[sizeof lits / sizeof lits[0]];
@@ -336,7 +344,7 @@ static void random_literal(tctx *t, char *out, size_t cap)
 {
     for (;;) {
         size_t o = 0;
-        int shape = (int)rnd_below(t, 4);
+        int shape = (int)rnd_below(t, 5);
         if (rnd_below(t, 2))
             out[o++] = rnd_below(t, 2) ? '-' : '+';
         if (shape == 0) {
@@ -348,6 +356,24 @@ static void random_literal(tctx *t, char *out, size_t cap)
             } while (!isfinite(v) || fabs(v) < DBL_MIN);
             snprintf(out + o, cap - o, "%.*g", 1 + (int)rnd_below(t, 17),
                      fabs(v));
+        } else if (shape == 4) {
+            /* the 128-bit path of src/reader.c (rd_exact_small): 16..19
+             * significant digits, a decimal point anywhere, |e10| <= 19
+             * and a little beyond, digits often ending in 5 (near ties) */
+            int nd = 16 + (int)rnd_below(t, 4), point = (int)rnd_below(t, (uint64_t)nd + 1);
+            for (int i = 0; i < nd; i++) {
+                if (i == point)
+                    out[o++] = '.';
+                int dig = (int)rnd_below(t, 10);
+                if (i == 0 && dig == 0)
+                    dig = 1;
+                if (i == nd - 1 && rnd_below(t, 2))
+                    dig = 5;
+                out[o++] = (char)('0' + dig);
+            }
+            if (rnd_below(t, 2))
+                o += (size_t)snprintf(out + o, cap - o, "e%d", (int)rnd_below(t, 43) - 21);
+            out[o] = '\0';
         } else {
             /* random digits around the fast path's limits (15..19 digits,
              * powers of ten up to 22) and beyond */
