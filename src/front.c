@@ -103,27 +103,50 @@ static int push_face(facestack *fs, const uint32_t v[3])
     return FDT_OK;
 }
 
+/* Tet tid's face i completes the front face in slot s (§2.2: "the new
+ * tetrahedron is the missing neighbor and another triangle is removed
+ * from the front"): the neighbours are linked and the face leaves. */
+static void complete_face(fdt_facetab *ft, fdt_meshbuf *mb, fdt_face *s,
+                          int64_t tid, int i)
+{
+    if (mb->nbrs) {
+        int64_t other = (int64_t)(s->tet >> 2);
+        mb->nbrs[4 * (size_t)other + (s->tet & 3)] = tid;
+        mb->nbrs[4 * (size_t)tid + i] = other;
+    }
+    fdt_facetab_remove(ft, s);
+}
+
 /*
  * Hands the four faces of new tet `tid` to the front: a face already in
  * the table is the other side of an existing front face, which the new tet
- * completes (§2.2: "the new tetrahedron is the missing neighbor and another
- * triangle is removed from the front"); a face not in the table becomes a
- * front face with its open side away from the new tet.
+ * completes; a face not in the table becomes a front face with its open
+ * side away from the new tet. `advanced` is the slot of the front face the
+ * tet was built on, its face 3 (the main loop's tets are (f0, f1, f2,
+ * apex), and fdt_tet_face[3] is f reversed), or NULL (the seed): that face
+ * is completed through its slot rather than looked up again.
  */
 static int add_tet_faces(fdt_facetab *ft, facestack *fs, fdt_meshbuf *mb,
-                         int64_t tid)
+                         int64_t tid, fdt_face *advanced)
 {
     const uint32_t *v = mb->tets + 4 * (size_t)tid;
+    int nf = 4;
+    if (advanced) {
+        /* First, while the slot is where the pop found it: later inserts
+         * may grow the table and removals shift slots. */
+        complete_face(ft, mb, advanced, tid, 3);
+        nf = 3;
+    }
     fdt_face fc[4];
-    /* All four slots are asked for first (fdt_facetab_prefetch): at 1M
-     * points the table outgrows the caches and these lookups were a fifth
-     * of the run, each waiting for memory in turn. */
-    for (int i = 0; i < 4; i++) {
+    /* All slots are asked for first (fdt_facetab_prefetch): at 1M points
+     * the table outgrows the caches, and lookups one after the other
+     * would each wait for memory. */
+    for (int i = 0; i < nf; i++) {
         fdt_face_canon(v[fdt_tet_face[i][0]], v[fdt_tet_face[i][1]],
                        v[fdt_tet_face[i][2]], fc[i].v);
         fdt_facetab_prefetch(ft, fc[i].v);
     }
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < nf; i++) {
         fdt_face f = fc[i];
         f.aux = 0;
         f.tet = ((uint64_t)tid << 2) | (uint64_t)i;
@@ -141,12 +164,7 @@ static int add_tet_faces(fdt_facetab *ft, facestack *fs, fdt_meshbuf *mb,
          * would mean two tets on one side of a face: an overlap. */
         if (s->v[1] == f.v[1])
             return FDT_EINTERNAL;
-        if (mb->nbrs) {
-            int64_t other = (int64_t)(s->tet >> 2);
-            mb->nbrs[4 * (size_t)other + (s->tet & 3)] = tid;
-            mb->nbrs[4 * (size_t)tid + i] = other;
-        }
-        fdt_facetab_remove(ft, s);
+        complete_face(ft, mb, s, tid, i);
     }
     return FDT_OK;
 }
@@ -169,7 +187,7 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
         err = FDT_ENOMEM;
         goto done;
     }
-    if ((err = add_tet_faces(&ft, &fs, out, tid)) != FDT_OK)
+    if ((err = add_tet_faces(&ft, &fs, out, tid, NULL)) != FDT_OK)
         goto done;
     /* A Delaunay tetrahedralization of n random points has about 6.5n
      * tets; the estimate only drives the progress bar. */
@@ -210,7 +228,8 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
             err = FDT_ENOMEM;
             goto done;
         }
-        if ((err = add_tet_faces(&ft, &fs, out, tid)) != FDT_OK)
+        /* The search left the table alone, so s still holds f. */
+        if ((err = add_tet_faces(&ft, &fs, out, tid, s)) != FDT_OK)
             goto done;
         if (out->ntets >= next_report) {
             next_report += 1u << 16;
