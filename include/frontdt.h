@@ -123,7 +123,9 @@ FDT_API size_t fdt_result_num_duplicates(const fdt_result *r);
 
 /* Puts the tets in canonical order: by their 4 ids sorted ascending,
  * compared as integer tuples. Each tet keeps its positive orientation;
- * neighbours are renumbered to match. Idempotent. */
+ * neighbours are renumbered to match. Idempotent. The arrays may move:
+ * take fdt_result_tets() and fdt_result_neighbors() again afterwards (and
+ * after fdt_result_hash, which sorts). */
 FDT_API int fdt_result_sort(fdt_result *r);
 
 /* A checksum of the tet set, independent of tet order, vertex order within
