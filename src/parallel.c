@@ -571,17 +571,20 @@ static int send_face(worker *w, int to, const uint32_t v[3], uint32_t apex,
 /*
  * A face of tet link (thread, (tid << 2) | i) arrives at its owner (us):
  * the first arrival makes it a front face, the second completes it
- * (§2.2). v is canonical and oriented outward from that tet.
+ * (§2.2). v is canonical and oriented outward from that tet. known: the
+ * face's slot when the caller holds it (the front face a tet was built
+ * on), so it is not looked up again; NULL otherwise.
  */
-static int face_arrives(worker *w, const uint32_t v[3], int thread, int64_t link)
+static int face_arrives(worker *w, const uint32_t v[3], int thread, int64_t link,
+                        fdt_face *known)
 {
     fdt_face f;
     memcpy(f.v, v, sizeof f.v);
     f.aux = (uint32_t)thread;
     f.tet = (uint64_t)link;
     ensure_active(w);
-    int err;
-    fdt_face *s = fdt_facetab_find_or_insert(&w->ft, &f, &err);
+    int err = FDT_OK;
+    fdt_face *s = known ? known : fdt_facetab_find_or_insert(&w->ft, &f, &err);
     if (err)
         return err;
     if (!s) {
@@ -612,9 +615,10 @@ static int face_arrives(worker *w, const uint32_t v[3], int thread, int64_t link
 /*
  * Builds the positively oriented tet v, which we own (its lowest id is
  * ours), and hands its faces to their owners. request: it was asked for by
- * FACESEND, so it may already exist.
+ * FACESEND, so it may already exist. advanced: the slot of our front face
+ * (v0, v1, v2) the tet was built on (its face 3, ours), or NULL.
  */
-static int build_tet(worker *w, const uint32_t v[4], int request)
+static int build_tet(worker *w, const uint32_t v[4], int request, fdt_face *advanced)
 {
     const fdt_partition *pt = w->e->pt;
     int lowi = 0;
@@ -652,17 +656,28 @@ static int build_tet(worker *w, const uint32_t v[4], int request)
     if (tid < 0)
         return FDT_ENOMEM;
     uint32_t fc[4][3];
-    /* all four table slots asked for first, as in src/front.c */
-    for (int i = 0; i < 4; i++) {
+    int nf = 4;
+    if (advanced) {
+        /* First, while the slot is where the pop found it (later faces
+         * may grow or shift the table), as in src/front.c. */
+        fdt_face_canon(v[fdt_tet_face[3][0]], v[fdt_tet_face[3][1]],
+                       v[fdt_tet_face[3][2]], fc[3]);
+        int err = face_arrives(w, fc[3], w->id, (tid << 2) | 3, advanced);
+        if (err)
+            return err;
+        nf = 3;
+    }
+    /* the other table slots asked for first, as in src/front.c */
+    for (int i = 0; i < nf; i++) {
         fdt_face_canon(v[fdt_tet_face[i][0]], v[fdt_tet_face[i][1]],
                        v[fdt_tet_face[i][2]], fc[i]);
         fdt_facetab_prefetch(&w->ft, fc[i]);
     }
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < nf; i++) {
         const uint32_t *fv = fc[i];
         int64_t link = (tid << 2) | i;
         int owner = i == lowi ? far_owner : w->id;
-        int err = owner == w->id ? face_arrives(w, fv, w->id, link)
+        int err = owner == w->id ? face_arrives(w, fv, w->id, link, NULL)
                                  : send_face(w, owner, fv, FDT_NONE, link);
         if (err)
             return err;
@@ -701,10 +716,10 @@ static int handle_face(worker *w, const pface *pf)
     if (f->apex == FDT_NONE) {
         if (f->v[0] > f->v[1] || f->v[0] > f->v[2] || !is_own(w, f->v[0]))
             return FDT_EINTERNAL;
-        err = face_arrives(w, f->v, pf->sender, f->tet);
+        err = face_arrives(w, f->v, pf->sender, f->tet, NULL);
     } else {
         uint32_t v[4] = {f->v[0], f->v[1], f->v[2], f->apex};
-        err = build_tet(w, v, 1);
+        err = build_tet(w, v, 1, NULL);
     }
     if (err)
         return err;
@@ -904,7 +919,7 @@ static int search_others(worker *w, fdt_apex *s, qbuf *qb)
  * no live face, or an error. */
 static int advance_one(worker *w)
 {
-    const fdt_face *s = NULL;
+    fdt_face *s = NULL;
     uint32_t f[3];
     while (w->fq.head < w->fq.n) {
         /* the slot of a face a few places ahead, as in src/front.c */
@@ -960,7 +975,8 @@ static int advance_one(worker *w)
         if (w->e->mode == FDT_MODE_MESSAGE && !is_own(w, p) &&
             (err = ghost_put(&w->ghosts, p, ap.bp)) != FDT_OK)
             return err;
-        err = build_tet(w, v, 0);
+        /* The search changed no table (above), so s still holds f. */
+        err = build_tet(w, v, 0, s);
     } else {
         /* p is the tet's lowest id: the owner reads its coordinates
          * itself, the message carries f's. */
@@ -989,7 +1005,7 @@ static int worker_loop(worker *w)
 {
     int rc;
     for (int i = 0; i < w->nseeds; i++)
-        if ((rc = build_tet(w, w->seeds[i], 0)) != FDT_OK)
+        if ((rc = build_tet(w, w->seeds[i], 0, NULL)) != FDT_OK)
             return rc;
     for (;;) {
         if (aborted(w->e))
