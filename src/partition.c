@@ -2,6 +2,8 @@
 #include "partition.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -66,8 +68,39 @@ static void rcb(rcb_ctx *rc, int id, uint32_t begin, uint32_t end, int p0,
     rcb(rc, left + 1, begin + nleft, end, p0 + a, k - a);
 }
 
+/* The parts' trees are independent (each permutes only its own id range
+ * of P and orig), so a few threads build them, taking parts in turn. */
+typedef struct tree_jobs {
+    fdt_partition *pt;
+    double *P;
+    fdt_vid *orig;
+    int leaf_size;
+    /* The next part to build. Relaxed: the counter only hands out each
+     * index once (fetch_add is atomic whatever the order); what a builder
+     * wrote is published to the caller by pthread_join. */
+    atomic_int next;
+    /* Set (relaxed) by a builder that ran out of memory; read after the
+     * joins, which order it. */
+    atomic_int failed;
+} tree_jobs;
+
+static void *build_trees(void *arg)
+{
+    tree_jobs *j = arg;
+    fdt_partition *pt = j->pt;
+    for (;;) {
+        int p = atomic_fetch_add_explicit(&j->next, 1, memory_order_relaxed);
+        if (p >= pt->nparts)
+            return NULL;
+        uint32_t n = pt->start[p + 1] - pt->start[p];
+        if (n > 0 && fdt_kd_build(&pt->trees[p], j->P, j->orig, pt->start[p], n,
+                                  j->leaf_size) != FDT_OK)
+            atomic_store_explicit(&j->failed, 1, memory_order_relaxed);
+    }
+}
+
 int fdt_partition_build(fdt_partition *pt, double *P, fdt_vid *orig,
-                        uint32_t m, int nparts, int leaf_size)
+                        uint32_t m, int nparts, int leaf_size, int nworkers)
 {
     memset(pt, 0, sizeof *pt);
     if (nparts < 1 || nparts > FDT_PARTITION_MAX)
@@ -85,14 +118,25 @@ int fdt_partition_build(fdt_partition *pt, double *P, fdt_vid *orig,
     rcb_ctx rc = {pt, P, orig};
     rcb(&rc, 0, 0, m, 0, nparts);
     pt->start[nparts] = m;
-    for (int p = 0; p < nparts; p++) {
-        uint32_t n = pt->start[p + 1] - pt->start[p];
-        if (n == 0)
-            continue;
-        if (fdt_kd_build(&pt->trees[p], P, orig, pt->start[p], n, leaf_size) != FDT_OK) {
-            fdt_partition_free(pt);
-            return FDT_ENOMEM;
-        }
+    tree_jobs j = {pt, P, orig, leaf_size, 0, 0};
+    atomic_init(&j.next, 0);
+    atomic_init(&j.failed, 0);
+    if (nworkers > nparts)
+        nworkers = nparts;
+    if (nworkers > FDT_BUILDERS_MAX)
+        nworkers = FDT_BUILDERS_MAX;
+    pthread_t th[FDT_BUILDERS_MAX];
+    int started = 0;
+    /* Helpers that cannot be started are not an error: the calling thread
+     * builds whatever is left. */
+    while (started < nworkers - 1 && pthread_create(&th[started], NULL, build_trees, &j) == 0)
+        started++;
+    build_trees(&j);
+    for (int i = 0; i < started; i++)
+        pthread_join(th[i], NULL);
+    if (atomic_load_explicit(&j.failed, memory_order_relaxed)) {
+        fdt_partition_free(pt);
+        return FDT_ENOMEM;
     }
     return FDT_OK;
 }

@@ -39,15 +39,19 @@ typedef struct fdt_partition {
                               n == 0 and no nodes */
 } fdt_partition;
 
+/* The most threads fdt_partition_build builds trees with. */
+#define FDT_BUILDERS_MAX 64
+
 /*
  * Splits ids [0, m) of P (3 doubles per id, permuted together with orig,
  * indexed by global id) into nparts parts (1 <= nparts <=
- * FDT_PARTITION_MAX) and builds each part's kd-tree with leaf_size. A part
- * is empty only when m < nparts. FDT_OK, FDT_EINVAL or FDT_ENOMEM (pt is
- * then zeroed).
+ * FDT_PARTITION_MAX) and builds each part's kd-tree with leaf_size, on up
+ * to nworkers threads (the caller's included; at most FDT_BUILDERS_MAX,
+ * 1 or less: the calling thread alone). A part is empty only when m <
+ * nparts. FDT_OK, FDT_EINVAL or FDT_ENOMEM (pt is then zeroed).
  */
 int fdt_partition_build(fdt_partition *pt, double *P, fdt_vid *orig,
-                        uint32_t m, int nparts, int leaf_size);
+                        uint32_t m, int nparts, int leaf_size, int nworkers);
 void fdt_partition_free(fdt_partition *pt);
 
 /* The part whose id range holds id (id < m). */

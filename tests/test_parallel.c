@@ -473,7 +473,7 @@ static void test_partition(void)
         for (size_t i = 0; i < p.n; i++)
             orig[i] = (fdt_vid)i;
         fdt_partition pt;
-        CHECK_EQ(fdt_partition_build(&pt, P, orig, (uint32_t)p.n, np, 18), FDT_OK);
+        CHECK_EQ(fdt_partition_build(&pt, P, orig, (uint32_t)p.n, np, 18, 1 + np % 5), FDT_OK);
         CHECK_EQ(pt.nparts, np);
         CHECK_EQ(pt.start[0], 0);
         CHECK_EQ(pt.start[np], p.n);
@@ -544,7 +544,7 @@ static void test_partition(void)
         double P[5 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
         fdt_vid orig[5] = {0, 1, 2, 3, 4};
         fdt_partition pt;
-        CHECK_EQ(fdt_partition_build(&pt, P, orig, 5, 16, 18), FDT_OK);
+        CHECK_EQ(fdt_partition_build(&pt, P, orig, 5, 16, 18, 4), FDT_OK);
         int nonempty = 0;
         for (int i = 0; i < 16; i++)
             nonempty += pt.start[i + 1] > pt.start[i];
@@ -564,8 +564,8 @@ static void test_partition(void)
     double P1[3] = {0, 0, 0};
     fdt_vid o1[1] = {0};
     fdt_partition pt;
-    CHECK_EQ(fdt_partition_build(&pt, P1, o1, 1, 0, 18), FDT_EINVAL);
-    CHECK_EQ(fdt_partition_build(&pt, P1, o1, 1, FDT_PARTITION_MAX + 1, 18), FDT_EINVAL);
+    CHECK_EQ(fdt_partition_build(&pt, P1, o1, 1, 0, 18, 1), FDT_EINVAL);
+    CHECK_EQ(fdt_partition_build(&pt, P1, o1, 1, FDT_PARTITION_MAX + 1, 18, 1), FDT_EINVAL);
     free(p.xyz);
     printf("partition: proportional parts, owners, boxes, composite tree\n");
 }
