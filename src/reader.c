@@ -191,8 +191,8 @@ static int rd_bits128(rd_u128 x)
  * integer and 0 <= f < 1 is a fraction known only by whether it is zero
  * (sticky). Exact integer work: the 53 leading bits of q are kept, and
  * the bits below them with f decide the rounding. The caller keeps the
- * result in the normal range, so the final scaling by 2^k is exact; q has
- * more than 53 bits whenever f may be nonzero.
+ * result in the normal range, so the final scaling by a power of two is
+ * exact; q has more than 53 bits whenever f may be nonzero.
  */
 static double rd_round_u128(rd_u128 q, int sticky, int e2)
 {
