@@ -3,6 +3,7 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include "faceq.h"
 #include "facetab.h"
 #include "seed.h"
 
@@ -73,36 +74,6 @@ int fdt_meshbuf_add_hull(fdt_meshbuf *mb, const uint32_t v[3])
     return FDT_OK;
 }
 
-/* Front faces waiting for their apex search, first in first out: the
- * front then grows as a compact shell around the seed (a LIFO order lets
- * it wander and grow to about one face per point). Faces completed while
- * queued stay in the queue and are skipped when they come up. */
-typedef struct facestack {
-    uint32_t *v;
-    size_t head, n, cap;   /* live entries are [head, n) */
-} facestack;
-
-static int push_face(facestack *fs, const uint32_t v[3])
-{
-    if (fs->n == fs->cap && fs->head > 0 && fs->head >= fs->cap / 2) {
-        /* Slide the live entries down instead of growing. */
-        memmove(fs->v, fs->v + 3 * fs->head, 3 * (fs->n - fs->head) * sizeof *fs->v);
-        fs->n -= fs->head;
-        fs->head = 0;
-    }
-    if (fs->n == fs->cap) {
-        size_t ncap = fs->cap ? fs->cap * 2 : 4096;
-        uint32_t *nv = realloc(fs->v, ncap * 3 * sizeof *nv);
-        if (!nv)
-            return FDT_ENOMEM;
-        fs->v = nv;
-        fs->cap = ncap;
-    }
-    memcpy(fs->v + 3 * fs->n, v, 3 * sizeof *v);
-    fs->n++;
-    return FDT_OK;
-}
-
 /* Tet tid's face i completes the front face in slot s (§2.2: "the new
  * tetrahedron is the missing neighbor and another triangle is removed
  * from the front"): the neighbours are linked and the face leaves. */
@@ -126,7 +97,7 @@ static void complete_face(fdt_facetab *ft, fdt_meshbuf *mb, fdt_face *s,
  * apex), and fdt_tet_face[3] is f reversed), or NULL (the seed): that face
  * is completed through its slot rather than looked up again.
  */
-static int add_tet_faces(fdt_facetab *ft, facestack *fs, fdt_meshbuf *mb,
+static int add_tet_faces(fdt_facetab *ft, fdt_faceq *fq, fdt_meshbuf *mb,
                          int64_t tid, fdt_face *advanced)
 {
     const uint32_t *v = mb->tets + 4 * (size_t)tid;
@@ -155,7 +126,7 @@ static int add_tet_faces(fdt_facetab *ft, facestack *fs, fdt_meshbuf *mb,
         if (err)
             return err;
         if (!s) {
-            if ((err = push_face(fs, f.v)) != FDT_OK)
+            if ((err = fdt_faceq_push(fq, f.v)) != FDT_OK)
                 return err;
             continue;
         }
@@ -174,34 +145,39 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
                      fdt_front_stats *st)
 {
     fdt_facetab ft;
-    facestack fs = {0};
+    fdt_faceq fq;
     uint32_t seed[4];
     int err = fdt_seed_tet(t, start, seed, &st->kq);
     if (err)
         return err;
     if ((err = fdt_facetab_init(&ft, 4096)) != FDT_OK)
         return err;
+    if ((err = fdt_faceq_init(&fq, t->base, t->n)) != FDT_OK) {
+        fdt_facetab_free(&ft);
+        return err;
+    }
     const double *P = t->P;
     int64_t tid = fdt_meshbuf_add_tet(out, seed);
     if (tid < 0) {
         err = FDT_ENOMEM;
         goto done;
     }
-    if ((err = add_tet_faces(&ft, &fs, out, tid, NULL)) != FDT_OK)
+    if ((err = add_tet_faces(&ft, &fq, out, tid, NULL)) != FDT_OK)
         goto done;
     /* A Delaunay tetrahedralization of n random points has about 6.5n
      * tets; the estimate only drives the progress bar. */
     double expect = 6.5 * (double)t->n + 1.0;
     size_t next_report = 1u << 16;
-    while (fs.head < fs.n) {
-        /* the slot of a face a few places ahead, so it has arrived when
+    uint32_t fv[3];
+    while (fdt_faceq_pop(&fq, fv)) {
+        /* the slot of a face a few pops ahead, so it has arrived when
          * that face comes up (see add_tet_faces) */
-        if (fs.head + 8 < fs.n)
-            fdt_facetab_prefetch(&ft, fs.v + 3 * (fs.head + 8));
-        const uint32_t *fv = fs.v + 3 * fs.head++;
+        const uint32_t *ahead = fdt_faceq_ahead(&fq, 8);
+        if (ahead)
+            fdt_facetab_prefetch(&ft, ahead);
         fdt_face *s = fdt_facetab_find(&ft, fv);
         /* Faces completed since they were pushed are skipped here rather
-         * than searched for in the stack when they complete. */
+         * than searched for in the queue when they complete. */
         if (!s || s->v[1] != fv[1])
             continue;
         if (ft.count > st->max_front)
@@ -229,7 +205,7 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
             goto done;
         }
         /* The search left the table alone, so s still holds f. */
-        if ((err = add_tet_faces(&ft, &fs, out, tid, s)) != FDT_OK)
+        if ((err = add_tet_faces(&ft, &fq, out, tid, s)) != FDT_OK)
             goto done;
         if (out->ntets >= next_report) {
             next_report += 1u << 16;
@@ -246,6 +222,6 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
         err = FDT_EINTERNAL;
 done:
     fdt_facetab_free(&ft);
-    free(fs.v);
+    fdt_faceq_free(&fq);
     return err;
 }

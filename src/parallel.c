@@ -116,6 +116,7 @@
 #include <hwloc.h>
 #endif
 
+#include "faceq.h"
 #include "facetab.h"
 #include "kdtree.h"
 #include "mailbox.h"
@@ -157,36 +158,6 @@ typedef struct pface {
 } pface;
 
 /* ---- small per-thread containers --------------------------------------- */
-
-/* A thread's own front faces waiting for their apex search, first in
- * first out as in the serial front (src/front.c): the front then grows as
- * a compact shell around the seed instead of wandering. Faces completed
- * while queued are skipped when they come up. */
-typedef struct fqueue {
-    uint32_t *v;
-    size_t head, n, cap;   /* live entries are [head, n) */
-} fqueue;
-
-static int fqueue_push(fqueue *q, const uint32_t v[3])
-{
-    if (q->n == q->cap && q->head > 0 && q->head >= q->cap / 2) {
-        /* Slide the live entries down instead of growing. */
-        memmove(q->v, q->v + 3 * q->head, 3 * (q->n - q->head) * sizeof *q->v);
-        q->n -= q->head;
-        q->head = 0;
-    }
-    if (q->n == q->cap) {
-        size_t ncap = q->cap ? q->cap * 2 : 1024;
-        uint32_t *nv = realloc(q->v, ncap * 3 * sizeof *nv);
-        if (!nv)
-            return FDT_ENOMEM;
-        q->v = nv;
-        q->cap = ncap;
-    }
-    memcpy(q->v + 3 * q->n, v, 3 * sizeof *v);
-    q->n++;
-    return FDT_OK;
-}
 
 /* Set of boundary tets, keyed on their sorted ids; open addressing, linear
  * probing, no deletion. k[0] == UINT32_MAX marks an empty slot. */
@@ -386,7 +357,7 @@ typedef struct worker {
     const fdt_kdtree *tree;    /* own part (n == 0: empty part) */
     uint32_t lo, hi;           /* own ids [lo, hi) */
     fdt_facetab ft;            /* own front faces */
-    fqueue fq;                 /* own faces still to advance (may be stale) */
+    fdt_faceq fq;              /* own faces still to advance (may be stale) */
     fdt_meshbuf out;           /* own tets, global ids; nbrs local ids */
     tetset built;              /* own boundary tets (duplicate requests) */
     ghostmap ghosts;           /* message mode: foreign coordinates */
@@ -590,7 +561,7 @@ static int face_arrives(worker *w, const uint32_t v[3], int thread, int64_t link
     if (!s) {
         if (w->ft.count > w->st.max_front)
             w->st.max_front = w->ft.count;
-        return fqueue_push(&w->fq, f.v);
+        return fdt_faceq_push(&w->fq, f.v);
     }
     /* Completed: the stored face has its open side towards the new tet,
      * so it is oriented opposite to f; equal orientation would mean two
@@ -921,21 +892,20 @@ static int advance_one(worker *w)
 {
     fdt_face *s = NULL;
     uint32_t f[3];
-    while (w->fq.head < w->fq.n) {
-        /* the slot of a face a few places ahead, as in src/front.c */
-        if (w->fq.head + 8 < w->fq.n)
-            fdt_facetab_prefetch(&w->ft, w->fq.v + 3 * (w->fq.head + 8));
-        const uint32_t *fv = w->fq.v + 3 * w->fq.head++;
+    uint32_t fv[3];
+    while (fdt_faceq_pop(&w->fq, fv)) {
+        /* the slot of a face a few pops ahead, as in src/front.c */
+        const uint32_t *ahead = fdt_faceq_ahead(&w->fq, 8);
+        if (ahead)
+            fdt_facetab_prefetch(&w->ft, ahead);
         s = fdt_facetab_find(&w->ft, fv);
         /* Faces completed since they were queued are skipped here. */
         if (s && s->v[1] == fv[1])
             break;
         s = NULL;
     }
-    if (!s) {
-        w->fq.head = w->fq.n = 0;
+    if (!s)
         return 0;
-    }
     memcpy(f, s->v, sizeof f);
     w->st.faces_advanced++;
     double a[3], b[3], c[3];
@@ -997,6 +967,9 @@ static int worker_setup(worker *w)
     if (fdt_meshbuf_init(&w->out, expect, w->e->want_nbrs) != FDT_OK)
         return FDT_ENOMEM;
     if (fdt_facetab_init(&w->ft, 1024) != FDT_OK)
+        return FDT_ENOMEM;
+    /* Own faces have an own lowest id (the ownership rule above). */
+    if (fdt_faceq_init(&w->fq, w->lo, w->hi - w->lo) != FDT_OK)
         return FDT_ENOMEM;
     return FDT_OK;
 }
@@ -1125,7 +1098,7 @@ static void *worker_main(void *arg)
 static void worker_free(worker *w)
 {
     fdt_facetab_free(&w->ft);
-    free(w->fq.v);
+    fdt_faceq_free(&w->fq);
     fdt_meshbuf_free(&w->out);
     free(w->built.k);
     free(w->ghosts.g);
