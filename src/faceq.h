@@ -12,8 +12,8 @@
  * stay in the cache. The first in first out queue this replaces grew the
  * front as a shell around the seed, visiting the whole shell (187k faces
  * at 1M uniform points) between two visits to one place; with buckets the
- * largest front is 35k faces and a 1M serial run takes 0.86 of the time
- * (bench/NOTES.md, entry 23).
+ * largest front is 34k faces and a 1M serial run takes 0.86 of the time
+ * (bench/NOTES.md, entry 24).
  *
  * Faces completed while queued stay queued; the caller skips them when
  * they come up (a face table lookup it makes anyway). One owner thread:
@@ -26,7 +26,7 @@
 #include <stdint.h>
 
 /* 32 ids a bucket, about two leaves of 18: 16 and 64 gave the same time,
- * 512 6 % more (1M uniform, paired runs; bench/NOTES.md entry 23). */
+ * 512 6 % more (1M uniform, paired runs; bench/NOTES.md entry 24). */
 #define FDT_FACEQ_SHIFT 5
 
 typedef struct fdt_faceq {
