@@ -3,21 +3,8 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include "bits.h"
 #include "frontdt.h"
-
-static inline int ctz64(uint64_t m)
-{
-#if defined(__GNUC__)
-    return __builtin_ctzll(m);
-#else
-    int k = 0;
-    while (!(m & 1)) {
-        m >>= 1;
-        k++;
-    }
-    return k;
-#endif
-}
 
 int fdt_faceq_init(fdt_faceq *q, uint32_t base, uint32_t nids)
 {
@@ -90,7 +77,7 @@ static size_t next_nonempty(const fdt_faceq *q, size_t k)
     size_t w = k >> 6;
     uint64_t m = q->bits[w] & (~(uint64_t)0 << (k & 63));
     if (m)
-        return (w << 6) + (size_t)ctz64(m);
+        return (w << 6) + (size_t)fdt_ctz64(m);
     /* words above w: the summary from bit w + 1 */
     size_t w1 = w + 1;
     if (w1 >= q->nwords)
@@ -102,8 +89,8 @@ static size_t next_nonempty(const fdt_faceq *q, size_t k)
             return q->nb;
         sm = q->summary[sw];
     }
-    size_t w2 = (sw << 6) + (size_t)ctz64(sm);
-    return (w2 << 6) + (size_t)ctz64(q->bits[w2]);
+    size_t w2 = (sw << 6) + (size_t)fdt_ctz64(sm);
+    return (w2 << 6) + (size_t)fdt_ctz64(q->bits[w2]);
 }
 
 int fdt_faceq_pop(fdt_faceq *q, uint32_t v[3])

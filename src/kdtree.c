@@ -8,6 +8,7 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#include "bits.h"
 
 void fdt_kd_free(fdt_kdtree *t)
 {
@@ -692,21 +693,6 @@ int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi)
     return box_open(s, lo, hi);
 }
 
-/* Index of the lowest set bit of m != 0. */
-static inline int ctz64(uint64_t m)
-{
-#if defined(__GNUC__)
-    return __builtin_ctzll(m);
-#else
-    int k = 0;
-    while (!(m & 1)) {
-        m >>= 1;
-        k++;
-    }
-    return k;
-#endif
-}
-
 /* c ? x : y by bit masks. gcc 12 compiled the walk's ternary on the
  * nearer child's distance to a branch, mispredicted at every other inner
  * node (8 % of a run's mispredictions, cachegrind --branch-sim, 50k). */
@@ -785,7 +771,7 @@ static void apex_walk(fdt_apex *s, const fdt_kdtree *t, uint32_t root,
             m &= ~(leaf_bit(s->ia, nd->begin, n) | leaf_bit(s->ib, nd->begin, n) |
                    leaf_bit(s->ic, nd->begin, n) | leaf_bit(s->best, nd->begin, n));
             while (m) {
-                uint32_t j = (uint32_t)ctz64(m);
+                uint32_t j = (uint32_t)fdt_ctz64(m);
                 m &= m - 1;
                 offer(s, nd->begin + j, P + 3 * (size_t)j, kq);
             }
