@@ -170,8 +170,9 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
     size_t next_report = 1u << 16;
     uint32_t fv[3];
     while (fdt_faceq_pop(&fq, fv)) {
-        /* the slot of a face a few pops ahead, so it has arrived when
-         * that face comes up (see add_tet_faces) */
+        /* the slot of the face 8 below the top of the current bucket:
+         * a guess at a face that comes up soon (faces pushed meanwhile
+         * come first), which costs one prefetch when wrong */
         const uint32_t *ahead = fdt_faceq_ahead(&fq, 8);
         if (ahead)
             fdt_facetab_prefetch(&ft, ahead);

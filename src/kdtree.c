@@ -810,8 +810,9 @@ void fdt_apex_search(fdt_apex *s, const fdt_kdtree *t, fdt_kdq *kq)
 
 /*
  * Offers first the point of the face vertices' leaves that floating point
- * says is the apex: every sphere through a, b, c has its centre at cc + t N (cc the
- * triangle's circumcentre, N its normal), and a point x on the open side
+ * says is the apex: every sphere through a, b, c has its centre at
+ * cc + t N (cc the triangle's circumcentre, N its normal), and a point x
+ * on the open side
  * lies inside the one with t > tau(x) = (|x - cc|^2 - |a - cc|^2) /
  * (2 N.(x - a)), so the apex is the point of least tau. Offered in index
  * order, the leaf's points improved the best candidate about 7 times a

@@ -894,7 +894,7 @@ static int advance_one(worker *w)
     uint32_t f[3];
     uint32_t fv[3];
     while (fdt_faceq_pop(&w->fq, fv)) {
-        /* the slot of a face a few pops ahead, as in src/front.c */
+        /* the slot of a face that may come up soon, as in src/front.c */
         const uint32_t *ahead = fdt_faceq_ahead(&w->fq, 8);
         if (ahead)
             fdt_facetab_prefetch(&w->ft, ahead);
