@@ -15,6 +15,12 @@
  * largest front is 34k faces and a 1M serial run takes 0.86 of the time
  * (bench/NOTES.md, entry 24).
  *
+ * The cost: the order decides which face of each tet is searched (the
+ * first to come up), and on points of one sphere, where every search is
+ * exhaustive, last in first out inside a bucket wanders and makes them
+ * three times slower than the old queue; first in first out inside the
+ * buckets fixes that but costs CFD grids 45 % (bench/NOTES.md, entry 30).
+ *
  * Faces completed while queued stay queued; the caller skips them when
  * they come up (a face table lookup it makes anyway). One owner thread:
  * no locking.
