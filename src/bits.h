@@ -1,4 +1,5 @@
-/* Small bit helpers shared by modules (src/kdtree.c, src/faceq.c). */
+/* Small helpers shared by modules: a bit scan (src/kdtree.c, src/faceq.c)
+ * and a prefetch hint (src/facetab.h, src/prepare.c, src/check.c). */
 #ifndef FDT_BITS_H
 #define FDT_BITS_H
 
@@ -16,6 +17,26 @@ static inline int fdt_ctz64(uint64_t m)
         k++;
     }
     return k;
+#endif
+}
+
+/* Asks the memory system for the line at p; a hint only, no effect on
+ * results. always_inline is not a detail: GCC counts __builtin_prefetch
+ * as free of side effects, so its IPA pass (local-pure-const) found an
+ * out-of-line copy of a wrapper like this "const", and the calls, whose
+ * result is void, were deleted as dead code (GCC 12, -O1 and up): no
+ * prefetcht0 was in the object code of src/front.c or src/parallel.c until
+ * the attribute (bench/NOTES.md, entry 16; `objdump -d` shows them now).
+ * Its callers that wrap it must be always_inline too. */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void fdt_prefetch(const void *p)
+{
+#if defined(__GNUC__)
+    __builtin_prefetch(p);
+#else
+    (void)p;
 #endif
 }
 

@@ -47,6 +47,7 @@
  * then each small bucket is sorted by the other two vertices.
  */
 #include "frontdt.h"
+#include "bits.h"
 #include "predicates.h"
 
 #include <math.h>
@@ -58,12 +59,7 @@
 
 /* The face pass reads tets, neighbours and points in bucket order, which is
  * random in memory on big meshes; asking for them a few entries ahead hides
- * most of the cache misses. A hint only: no effect on results. */
-#if defined(__GNUC__)
-#define CHK_PREFETCH(p) __builtin_prefetch(p)
-#else
-#define CHK_PREFETCH(p) ((void)(p))
-#endif
+ * most of the cache misses (fdt_prefetch, src/bits.h). */
 #define CHK_AHEAD 8
 
 /* Per-point flags. */
@@ -517,12 +513,12 @@ static int chk_faces(chk *c)
         for (size_t k = 0; k < m; k++) {
             if (k + CHK_AHEAD < m) {
                 uint64_t ra = chk_ref_get(c, lo + k + CHK_AHEAD);
-                CHK_PREFETCH(chk_tet(c, (size_t)(ra >> 2)));
+                fdt_prefetch(chk_tet(c, (size_t)(ra >> 2)));
                 if (c->nbrs)
-                    CHK_PREFETCH(c->nbrs + ra);
+                    fdt_prefetch(c->nbrs + ra);
             }
             uint64_t r = chk_ref_get(c, lo + k);
-            CHK_PREFETCH(chk_pt(c, chk_tet(c, (size_t)(r >> 2))[r & 3]));
+            fdt_prefetch(chk_pt(c, chk_tet(c, (size_t)(r >> 2))[r & 3]));
             fdt_vid f[3], s[3];
             chk_face_of(c, r, f);
             unsigned par = chk_sort3(f, s);

@@ -10,6 +10,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include "bits.h"
 
 typedef struct fdt_face {
     uint32_t v[3];   /* oriented: the open side is orient3d(v0,v1,v2,x) > 0;
@@ -59,24 +60,13 @@ static inline size_t fdt_face_hash(const uint32_t v[3])
  * is larger than the caches on big inputs, and the front touches it at
  * random, so a lookup whose slot was asked for early enough finds it in
  * the cache instead of waiting for memory (callers: src/front.c,
- * src/parallel.c). */
+ * src/parallel.c). always_inline: see fdt_prefetch (src/bits.h). */
 #if defined(__GNUC__)
-/* always_inline is not a detail: GCC counts __builtin_prefetch as free of
- * side effects, so its IPA pass (local-pure-const) found an out-of-line
- * copy of this function "const", and the calls, whose result is void,
- * were deleted as dead code (GCC 12, -O1 and up): no prefetcht0 was in
- * the object code of src/front.c or src/parallel.c until this attribute
- * (`objdump -d` shows them now). */
 __attribute__((always_inline))
 #endif
 static inline void fdt_facetab_prefetch(const fdt_facetab *t, const uint32_t v[3])
 {
-#if defined(__GNUC__)
-    __builtin_prefetch(&t->slots[fdt_face_hash(v) & (t->cap - 1)]);
-#else
-    (void)t;
-    (void)v;
-#endif
+    fdt_prefetch(&t->slots[fdt_face_hash(v) & (t->cap - 1)]);
 }
 
 /* Removes the face in slot s (a pointer returned by find). */

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "bits.h"
 
 /* Bit pattern of a coordinate with -0 folded onto +0, so that the two
  * zeros, which every predicate treats as equal, merge as duplicates. */
@@ -25,18 +26,6 @@ static uint64_t point_hash(const double *q)
     h ^= h >> 31;
     h *= 0xBF58476D1CE4E5B9ull;
     return h ^ (h >> 29);
-}
-
-#if defined(__GNUC__)
-__attribute__((always_inline)) /* see fdt_facetab_prefetch (src/facetab.h) */
-#endif
-static inline void prefetch_slot(const uint32_t *slot)
-{
-#if defined(__GNUC__)
-    __builtin_prefetch(slot);
-#else
-    (void)slot;
-#endif
 }
 
 static int same_point(const double *p, const double *q)
@@ -131,7 +120,7 @@ int fdt_prepare(const double *xyz, size_t n, fdt_prepared *pr, char *diag,
         /* The table (8 MB at 1M points) is probed at random: ask for the
          * slot a few points ahead so it has arrived when needed. */
         if (i + 8 < n)
-            prefetch_slot(slots + ((size_t)point_hash(xyz + 3 * (i + 8)) & (cap - 1)));
+            fdt_prefetch(slots + ((size_t)point_hash(xyz + 3 * (i + 8)) & (cap - 1)));
         size_t h = (size_t)point_hash(q) & (cap - 1);
         for (;;) {
             uint32_t s = slots[h];
