@@ -10,12 +10,22 @@
 #endif
 #include "bits.h"
 
+/* 2^k for -1022 <= k <= 1023, built from its bits. */
+static inline double pow2i(int k)
+{
+    uint64_t b = (uint64_t)(k + 1023) << 52;
+    double x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
 void fdt_kd_free(fdt_kdtree *t)
 {
     free(t->nodes);
     free(t->parent);
     free(t->cell);
     free(t->leafof);
+    free(t->fl);
     memset(t, 0, sizeof *t);
 }
 
@@ -170,6 +180,88 @@ static int climb_tables(fdt_kdtree *t)
     return FDT_OK;
 }
 
+/* ---- float blocks --------------------------------------------------------
+ *
+ * The apex search tests every point of a visited leaf against a ball, and
+ * its first guess computes a quotient for every point of up to three
+ * leaves: two thirds of its instructions (callgrind, 50k uniform), in
+ * double precision and one point at a time. The float blocks hold each
+ * leaf's points again, as floats, four to an SSE register: for the ball
+ * test only as a filter that may keep too many points (whose exact
+ * decision follows, as before), for the guess only as an order.
+ *
+ * Floats have 24 bits and a range of 2^+-126, so the coordinates go in a
+ * frame of the leaf's own: X = fl32((x - lo) s) per axis, lo the leaf's box
+ * corner and s = leaf_scale(), a power of two bringing the box's largest
+ * extent into [0.5, 1). Each X is then in [0, 1] and within 2^-23 of
+ * (x - lo) s (one double rounding of the difference, one float rounding;
+ * underflow below 2^-126 adds at most 2^-149), whatever the cloud's offset
+ * or magnitude: a lidar tile at 1e6 and a cloud 1e-150 wide get the same
+ * relative resolution. A leaf whose extent is subnormal or beyond
+ * 2^+-1000 gets no frame (s = 0), and its tests stay in double.
+ *
+ * Layout: a leaf of n points has a block of three rows, X, Y and Z, each n
+ * rounded up to a multiple of 4 floats (padding zeros), 16-byte aligned;
+ * the leaf's dim field gives the block's offset in units of 4 floats.
+ * 18 points take 240 bytes, against 432 for their doubles.
+ */
+
+/* The leaf's frame scale s (above), or 0 where it has none; a function of
+ * the node's box alone, so the build and every query agree on it. */
+static inline double leaf_scale(const fdt_kdnode *nd)
+{
+    double ext = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double e = nd->hi[k] - nd->lo[k];
+        ext = ext > e ? ext : e;
+    }
+    if (ext == 0.0)
+        return 1.0; /* one point, at lo: every X is 0 */
+    if (!(ext >= DBL_MIN && ext <= DBL_MAX))
+        return 0.0;
+    uint64_t bits;
+    memcpy(&bits, &ext, sizeof bits);
+    int e = (int)((bits >> 52) & 0x7ff) - 1022; /* ext in [2^(e-1), 2^e) */
+    return e >= -1000 && e <= 1000 ? pow2i(-e) : 0.0;
+}
+
+/* Rows of a leaf's block are this many floats apart. */
+static inline uint32_t block_row(uint32_t n)
+{
+    return (n + 3) & ~UINT32_C(3);
+}
+
+static void float_blocks(fdt_kdtree *t)
+{
+    size_t total = 0; /* in units of 4 floats */
+    for (uint32_t j = 0; j < t->nnodes; j++)
+        if (!t->nodes[j].left)
+            total += 3 * (size_t)(block_row(t->nodes[j].end - t->nodes[j].begin) / 4);
+    /* Offsets must fit the 32-bit dim field; beyond that (over a billion
+     * points) the tests run in double. */
+    if (total == 0 || total > UINT32_MAX)
+        return;
+    t->fl = aligned_alloc(16, total * 4 * sizeof(float));
+    if (!t->fl)
+        return; /* an optimisation only: its absence changes no result */
+    size_t off = 0;
+    for (uint32_t j = 0; j < t->nnodes; j++) {
+        fdt_kdnode *nd = &t->nodes[j];
+        if (nd->left)
+            continue;
+        uint32_t n = nd->end - nd->begin, row = block_row(n);
+        float *B = t->fl + 4 * off;
+        double sl = leaf_scale(nd);
+        for (int k = 0; k < 3; k++)
+            for (uint32_t i = 0; i < row; i++)
+                B[k * (size_t)row + i] =
+                    i < n && sl > 0.0 ? (float)((t->P[3 * (size_t)(nd->begin + i) + k] - nd->lo[k]) * sl)
+                                      : 0.0f;
+        nd->dim = (uint32_t)off;
+        off += 3 * (size_t)(row / 4);
+    }
+}
+
 int fdt_kd_build(fdt_kdtree *t, double *P, fdt_vid *orig, uint32_t base,
                  uint32_t n, int leaf_size)
 {
@@ -188,7 +280,10 @@ int fdt_kd_build(fdt_kdtree *t, double *P, fdt_vid *orig, uint32_t base,
     t->nnodes = 1;
     build_ctx bc = {t, P, orig, (uint32_t)leaf_size, (uint32_t)cap};
     build_rec(&bc, 0, base, base + n);
-    return climb_tables(t);
+    int err = climb_tables(t);
+    if (err == FDT_OK)
+        float_blocks(t);
+    return err;
 }
 
 static double dist2(const double *a, const double *b)
@@ -227,6 +322,14 @@ static void ball_scale(double rr, double *sc, double *r2)
     }
     double q = rr * *sc;
     *r2 = q * q;
+}
+
+/* The apex search's ball of radius rr: scaled as above, and unscaled for
+ * the float blocks' tests (INFINITY wherever r2 is). */
+static void set_ball(fdt_apex *s, double rr)
+{
+    ball_scale(rr, &s->sc, &s->r2);
+    s->rad = s->r2 < INFINITY ? rr : INFINITY;
 }
 
 static inline double dist2_sc(const double *a, const double *b, double sc)
@@ -418,6 +521,7 @@ void fdt_apex_init(fdt_apex *s, const double *a, const double *b,
     memcpy(s->center, s->target, sizeof s->center); /* see apex_walk */
     s->sc = 1.0;
     s->r2 = INFINITY;
+    s->rad = INFINITY;
     s->ver = 0;
 }
 
@@ -473,7 +577,7 @@ static void update_ball_exact(fdt_apex *s)
 {
     double x[3];
     if (fdt_circumcenter_exact(s->a, s->b, s->c, s->bp, x) != 0) {
-        ball_scale(INFINITY, &s->sc, &s->r2);
+        set_ball(s, INFINITY);
         return;
     }
     double xmax = 0.0, amax = 0.0;
@@ -488,16 +592,7 @@ static void update_ball_exact(fdt_apex *s)
         double y0 = x[0] / xmax, y1 = x[1] / xmax, y2 = x[2] / xmax;
         r = xmax * sqrt(y0 * y0 + y1 * y1 + y2 * y2);
     }
-    ball_scale(r + 16.0 * DBL_EPSILON * (r + amax + 2.0 * xmax), &s->sc, &s->r2);
-}
-
-/* 2^k for -1022 <= k <= 1023, built from its bits. */
-static inline double pow2i(int k)
-{
-    uint64_t b = (uint64_t)(k + 1023) << 52;
-    double x;
-    memcpy(&x, &b, sizeof x);
-    return x;
+    set_ball(s, r + 16.0 * DBL_EPSILON * (r + amax + 2.0 * xmax));
 }
 
 static void update_ball(fdt_apex *s)
@@ -575,7 +670,7 @@ static void update_ball(fdt_apex *s)
     L = up != 0.0 ? L * up : ldexp(L, e);
     r = up != 0.0 ? r * up : ldexp(r, e);
     double tol = 64.0 * DBL_EPSILON * K * (K + 1.0) * L + 8.0 * DBL_EPSILON * (amax + xmax);
-    ball_scale(r + tol, &s->sc, &s->r2);
+    set_ball(s, r + tol);
 }
 
 /* The offer past its first test (below): out of line, so that the walk's
@@ -713,6 +808,70 @@ static inline uint64_t leaf_bit(uint32_t id, uint32_t begin, uint32_t n)
     return (uint64_t)(o < n) << (o & 63);
 }
 
+/* All of a leaf's n <= 64 points, as a mask. */
+static inline uint64_t low_bits(uint32_t n)
+{
+    return n >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << n) - 1;
+}
+
+/*
+ * The mask of the points of leaf nd (n <= 64 points, a float block) that
+ * may lie in the ball (s->center, s->rad): it holds every point whose
+ * exact distance to the centre is at most rad, and so (the ball holds the
+ * sphere) every point that can improve s; it may hold more, which the
+ * exact offer turns away.
+ *
+ * Why the margins suffice, in the leaf's frame (units of 1/sl): each X is
+ * within 2^-23 of the scaled difference (float blocks, above), each of
+ * the centre's C = fl32((c - lo) sl) within 2^-23 M (M its largest
+ * |component|), so with eps = 2^-23 (1 + M) each float difference X - C
+ * is within eps + 2^-24 |X - C| of (x - c) sl. A point at distance at
+ * most R = rad sl then has |X - C| (1 - 2^-24) <= R + sqrt(3) eps, and
+ * the float sum of squares (four roundings, each relative 2^-24, plus
+ * underflow below 2^-146) is at most (R + 2 eps)^2 (1 + 2^-21) + 2^-146:
+ * below the threshold T, which adds a relative 2^-19 to cover its own
+ * rounding to float too. Balls 2^40 times the leaf or centres that far
+ * away keep every point (T would lose nothing worth the arithmetic);
+ * every comparison is "not greater", so a NaN keeps its point.
+ */
+static uint64_t leaf_mask_fl(const fdt_apex *s, const fdt_kdtree *t, const fdt_kdnode *nd,
+                             uint32_t n)
+{
+    double sl = leaf_scale(nd);
+    double R = s->rad * sl;
+    double c0 = (s->center[0] - nd->lo[0]) * sl, c1 = (s->center[1] - nd->lo[1]) * sl,
+           c2 = (s->center[2] - nd->lo[2]) * sl;
+    double M = fabs(c0) > fabs(c1) ? fabs(c0) : fabs(c1);
+    M = M > fabs(c2) ? M : fabs(c2);
+    if (!(sl > 0.0) || !(R <= 0x1p40) || !(M <= 0x1p40))
+        return low_bits(n);
+    double eps = 0x1p-23 * (1.0 + M);
+    double T = (R + 2.0 * eps) * (R + 2.0 * eps) * (1.0 + 0x1p-19) + 0x1p-140;
+    const float *B = t->fl + 4 * (size_t)nd->dim;
+    uint32_t row = block_row(n);
+    uint64_t m = 0;
+#if defined(__SSE2__)
+    __m128 C0 = _mm_set1_ps((float)c0), C1 = _mm_set1_ps((float)c1), C2 = _mm_set1_ps((float)c2);
+    __m128 TT = _mm_set1_ps((float)T);
+    for (uint32_t j = 0; j < n; j += 4) {
+        __m128 dx = _mm_sub_ps(_mm_load_ps(B + j), C0);
+        __m128 dy = _mm_sub_ps(_mm_load_ps(B + row + j), C1);
+        __m128 dz = _mm_sub_ps(_mm_load_ps(B + 2 * row + j), C2);
+        __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)),
+                               _mm_mul_ps(dz, dz));
+        m |= (uint64_t)_mm_movemask_ps(_mm_cmpngt_ps(d2, TT)) << j;
+    }
+#else
+    float C0 = (float)c0, C1 = (float)c1, C2 = (float)c2, TT = (float)T;
+    for (uint32_t j = 0; j < n; j++) {
+        float dx = B[j] - C0, dy = B[row + j] - C1, dz = B[2 * row + j] - C2;
+        float d2 = dx * dx + dy * dy + dz * dz;
+        m |= (uint64_t)!(d2 > TT) << j;
+    }
+#endif
+    return m & low_bits(n);
+}
+
 /* Top-down walk of the subtree at `root`, nearer child first, pruning
  * every node whose box cannot hold an improvement. A child's distance to
  * the ball, computed to order it, is kept with it on the stack and
@@ -762,8 +921,11 @@ static void apex_walk(fdt_apex *s, const fdt_kdtree *t, uint32_t root,
              * !(d2 > r2), as offer's is: a NaN distance must keep the
              * point or node, never drop it. */
             uint64_t m = 0;
-            for (uint32_t j = 0; j < n; j++)
-                m |= (uint64_t)!(dist2_sc(P + 3 * (size_t)j, s->center, s->sc) > s->r2) << j;
+            if (t->fl)
+                m = leaf_mask_fl(s, t, nd, n);
+            else
+                for (uint32_t j = 0; j < n; j++)
+                    m |= (uint64_t)!(dist2_sc(P + 3 * (size_t)j, s->center, s->sc) > s->r2) << j;
             /* a, b and c lie on every sphere of the pencil and best on
              * the current one, so they pass the ball test, to be turned
              * away by offer's id test: a branch mispredicted about twice
@@ -828,6 +990,130 @@ void fdt_apex_search(fdt_apex *s, const fdt_kdtree *t, fdt_kdq *kq)
  * are left out by id: on the sphere, their floating h and q are rounding
  * noise, and either could pose as the least tau (a's h is exactly 0).
  */
+/*
+ * The least tau over leaf nd's points from its float block, in the units
+ * of tau_c(x) = (|x - a|^2 - g.(x - a)) / (N.(x - a)) (g = 2 (cc - a); a
+ * positive multiple of tau): *best and *tau, or FDT_NONE and INFINITY.
+ * In the leaf's frame W = X - A and G = g sl are the differences scaled by
+ * sl, and ns is N times 2^-en (its largest component in [0.5, 1), so the
+ * floats neither overflow nor underflow), which makes the float quotient
+ * tau_c sl 2^en. Returns 0, and leaves the leaf to the double scan, where
+ * the leaf has no frame or a or the circumcentre is 2^40 leaf sizes
+ * away. The id and sign masks are those of the double scan below.
+ */
+static int guess_leaf_fl(const fdt_apex *s, const fdt_kdtree *t, const fdt_kdnode *nd,
+                         const double *g, const double *ns, double inv_en,
+                         uint32_t *best, double *tau)
+{
+    double sl = leaf_scale(nd), A[3], G[3], M = 0.0;
+    for (int k = 0; k < 3; k++) {
+        A[k] = (s->a[k] - nd->lo[k]) * sl;
+        G[k] = g[k] * sl;
+        M = M > fabs(A[k]) ? M : fabs(A[k]);
+        M = M > fabs(G[k]) ? M : fabs(G[k]);
+    }
+    if (!(sl > 0.0) || !(M <= 0x1p40))
+        return 0;
+    uint32_t n = nd->end - nd->begin, row = block_row(n);
+    const float *B = t->fl + 4 * (size_t)nd->dim;
+    /* b and c as offsets in the leaf: anything from 0 to n - 1 only if
+     * they are in it (the unsigned difference wraps otherwise) */
+    int32_t xb = (int32_t)(s->ib - nd->begin), xc = (int32_t)(s->ic - nd->begin);
+    float bt[4];
+    int32_t bi[4];
+#if defined(__SSE2__)
+    __m128 A0 = _mm_set1_ps((float)A[0]), A1 = _mm_set1_ps((float)A[1]), A2 = _mm_set1_ps((float)A[2]);
+    __m128 G0 = _mm_set1_ps((float)G[0]), G1 = _mm_set1_ps((float)G[1]), G2 = _mm_set1_ps((float)G[2]);
+    __m128 N0 = _mm_set1_ps((float)ns[0]), N1 = _mm_set1_ps((float)ns[1]), N2 = _mm_set1_ps((float)ns[2]);
+    __m128 inf = _mm_set1_ps(INFINITY), zero = _mm_setzero_ps(), vbt = inf;
+    __m128i lane = _mm_set_epi32(3, 2, 1, 0), vbi = _mm_set1_epi32(-1), four = _mm_set1_epi32(4);
+    __m128i vn = _mm_set1_epi32((int32_t)n), vb = _mm_set1_epi32(xb), vc = _mm_set1_epi32(xc);
+    for (uint32_t j = 0; j < n; j += 4) {
+        __m128 wx = _mm_sub_ps(_mm_load_ps(B + j), A0);
+        __m128 wy = _mm_sub_ps(_mm_load_ps(B + row + j), A1);
+        __m128 wz = _mm_sub_ps(_mm_load_ps(B + 2 * row + j), A2);
+        __m128 ww = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, wx), _mm_mul_ps(wy, wy)), _mm_mul_ps(wz, wz));
+        __m128 gw = _mm_add_ps(_mm_add_ps(_mm_mul_ps(G0, wx), _mm_mul_ps(G1, wy)), _mm_mul_ps(G2, wz));
+        __m128 h = _mm_add_ps(_mm_add_ps(_mm_mul_ps(N0, wx), _mm_mul_ps(N1, wy)), _mm_mul_ps(N2, wz));
+        __m128 q = _mm_div_ps(_mm_sub_ps(ww, gw), h);
+        /* usable: h > 0, in the leaf (padding lanes are not), not b or c */
+        __m128i bad = _mm_or_si128(_mm_cmpeq_epi32(lane, vb), _mm_cmpeq_epi32(lane, vc));
+        bad = _mm_or_si128(bad, _mm_xor_si128(_mm_cmpgt_epi32(vn, lane), _mm_set1_epi32(-1)));
+        __m128 ok = _mm_andnot_ps(_mm_castsi128_ps(bad), _mm_cmpgt_ps(h, zero));
+        q = _mm_or_ps(_mm_and_ps(ok, q), _mm_andnot_ps(ok, inf));
+        __m128i take = _mm_castps_si128(_mm_cmplt_ps(q, vbt));
+        vbt = _mm_min_ps(q, vbt);
+        vbi = _mm_or_si128(_mm_and_si128(take, lane), _mm_andnot_si128(take, vbi));
+        lane = _mm_add_epi32(lane, four);
+    }
+    _mm_storeu_ps(bt, vbt);
+    _mm_storeu_si128((__m128i *)bi, vbi);
+#else
+    for (int l = 0; l < 4; l++) {
+        bt[l] = INFINITY;
+        bi[l] = -1;
+    }
+    for (uint32_t j = 0; j < n; j++) {
+        float wx = B[j] - (float)A[0], wy = B[row + j] - (float)A[1], wz = B[2 * row + j] - (float)A[2];
+        float ww = wx * wx + wy * wy + wz * wz;
+        float gw = (float)G[0] * wx + (float)G[1] * wy + (float)G[2] * wz;
+        float h = (float)ns[0] * wx + (float)ns[1] * wy + (float)ns[2] * wz;
+        if (!(h > 0.0f) || (int32_t)j == xb || (int32_t)j == xc)
+            continue;
+        float q = (ww - gw) / h;
+        if (q < bt[j & 3]) {
+            bt[j & 3] = q;
+            bi[j & 3] = (int32_t)j;
+        }
+    }
+#endif
+    int lb = 0;
+    for (int l = 1; l < 4; l++)
+        if (bt[l] < bt[lb])
+            lb = l;
+    *best = bi[lb] >= 0 && bt[lb] < INFINITY ? nd->begin + (uint32_t)bi[lb] : FDT_NONE;
+    /* 1 / sl is a power of two too: its exponent field is mirrored */
+    uint64_t sb;
+    memcpy(&sb, &sl, sizeof sb);
+    sb = (UINT64_C(2046) - (sb >> 52)) << 52;
+    double inv_sl;
+    memcpy(&inv_sl, &sb, sizeof inv_sl);
+    *tau = *best != FDT_NONE ? (double)bt[lb] * inv_sl * inv_en : INFINITY;
+    return 1;
+}
+
+/* The same from the doubles, one point at a time. */
+static void guess_leaf_d(const fdt_apex *s, const fdt_kdtree *t, const fdt_kdnode *nd,
+                         const double *g, uint32_t *best, double *tau)
+{
+    const double *a = s->a, *N = s->nrm;
+    double best_tau = INFINITY;
+    uint32_t bi = FDT_NONE;
+    for (uint32_t i = nd->begin; i < nd->end; i++) {
+        const double *x = t->P + 3 * (size_t)i;
+        double w0 = x[0] - a[0], w1 = x[1] - a[1], w2 = x[2] - a[2];
+        double h = N[0] * w0 + N[1] * w1 + N[2] * w2;
+        double q = (w0 * w0 + w1 * w1 + w2 * w2) - (g[0] * w0 + g[1] * w1 + g[2] * w2);
+        /* tau = h > 0 ? q / h : INFINITY, with the sign of h (and
+         * the ids of b and c) as a bit mask: written as a select or
+         * as conditions of `take`, gcc 12 branched on them, on the
+         * sign a coin toss a point (perf, 1M uniform), on the ids a
+         * miss at b and at c (cachegrind, 50k). Where the mask is 0
+         * the quotient (inf, NaN, anything) is discarded; an
+         * overflowing one only spoils the order, never the result. */
+        double tq = q / h;
+        uint64_t tb, pos = (uint64_t)0 - (uint64_t)((h > 0.0) & (i != s->ib) & (i != s->ic));
+        memcpy(&tb, &tq, sizeof tb);
+        tb = (tb & pos) | (UINT64_C(0x7ff0000000000000) & ~pos);
+        memcpy(&tq, &tb, sizeof tq);
+        int take = tq < best_tau;
+        bi = take ? i : bi;
+        best_tau = take ? tq : best_tau;
+    }
+    *best = bi;
+    *tau = best_tau;
+}
+
 static void offer_likely_apex(fdt_apex *s, const fdt_kdtree *t, uint32_t leaf,
                               fdt_kdq *kq)
 {
@@ -844,7 +1130,7 @@ static void offer_likely_apex(fdt_apex *s, const fdt_kdtree *t, uint32_t leaf,
             leaves[nl++] = l;
     }
     const double *a = s->a, *N = s->nrm;
-    double u[3], v[3], m[3], cc[3];
+    double u[3], v[3], m[3], cc[3], g[3];
     for (int k = 0; k < 3; k++) {
         u[k] = s->b[k] - a[k];
         v[k] = s->c[k] - a[k];
@@ -857,34 +1143,33 @@ static void offer_likely_apex(fdt_apex *s, const fdt_kdtree *t, uint32_t leaf,
     for (int k = 0; k < 3; k++)
         m[k] = uu * v[k] - vv * u[k];
     cross3(m, N, cc); /* 2 nn (cc - a) */
-    double nn2 = 2.0 * nn, cc2[3] = {2.0 * cc[0], 2.0 * cc[1], 2.0 * cc[2]};
+    for (int k = 0; k < 3; k++)
+        g[k] = cc[k] / nn; /* 2 (cc - a): |x - cc|^2 - |a - cc|^2 = |w|^2 - g.w */
+    /* N scaled by 2^-en for the float scan (guess_leaf_fl) */
+    double nmax = fabs(N[0]) > fabs(N[1]) ? fabs(N[0]) : fabs(N[1]);
+    nmax = nmax > fabs(N[2]) ? nmax : fabs(N[2]);
+    double ns[3] = {0.0, 0.0, 0.0}, inv_en = 0.0;
+    if (t->fl && nmax >= DBL_MIN && nmax <= DBL_MAX) {
+        uint64_t bits;
+        memcpy(&bits, &nmax, sizeof bits);
+        int en = (int)((bits >> 52) & 0x7ff) - 1022;
+        if (en >= -1000 && en <= 1000) {
+            inv_en = pow2i(-en);
+            for (int k = 0; k < 3; k++)
+                ns[k] = N[k] * inv_en;
+        }
+    }
     double best_tau = INFINITY;
     uint32_t best = FDT_NONE;
     for (int li = 0; li < nl; li++) {
         const fdt_kdnode *nd = &t->nodes[leaves[li]];
-        for (uint32_t i = nd->begin; i < nd->end; i++) {
-            const double *x = t->P + 3 * (size_t)i;
-            double w0 = x[0] - a[0], w1 = x[1] - a[1], w2 = x[2] - a[2];
-            double h = N[0] * w0 + N[1] * w1 + N[2] * w2;
-            /* 2 nn (|x - cc|^2 - |a - cc|^2) = 2 nn |w|^2 - 2 (2 nn (cc - a)).w,
-             * so q / h is tau times the positive constant 4 nn |N| */
-            double q = nn2 * (w0 * w0 + w1 * w1 + w2 * w2) -
-                       (cc2[0] * w0 + cc2[1] * w1 + cc2[2] * w2);
-            /* tau = h > 0 ? q / h : INFINITY, with the sign of h (and
-             * the ids of b and c) as a bit mask: written as a select or
-             * as conditions of `take`, gcc 12 branched on them, on the
-             * sign a coin toss a point (perf, 1M uniform), on the ids a
-             * miss at b and at c (cachegrind, 50k). Where the mask is 0
-             * the quotient (inf, NaN, anything) is discarded; an
-             * overflowing one only spoils the order, never the result. */
-            double tau = q / h;
-            uint64_t tb, pos = (uint64_t)0 - (uint64_t)((h > 0.0) & (i != s->ib) & (i != s->ic));
-            memcpy(&tb, &tau, sizeof tb);
-            tb = (tb & pos) | (UINT64_C(0x7ff0000000000000) & ~pos);
-            memcpy(&tau, &tb, sizeof tau);
-            int take = tau < best_tau;
-            best = take ? i : best;
-            best_tau = take ? tau : best_tau;
+        uint32_t lb;
+        double lt;
+        if (!(inv_en > 0.0) || !guess_leaf_fl(s, t, nd, g, ns, inv_en, &lb, &lt))
+            guess_leaf_d(s, t, nd, g, &lb, &lt);
+        if (lt < best_tau) {
+            best_tau = lt;
+            best = lb;
         }
     }
     if (best != FDT_NONE)
@@ -917,7 +1202,7 @@ void fdt_apex_search_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start,
     apex_walk(s, t, node, fdt_box_dist2_sc(nd->lo, nd->hi, s->center, s->sc), kq);
     while (node != 0) {
         if (s->best != FDT_NONE && isfinite(s->r2)) {
-            double r = sqrt(s->r2) / s->sc;
+            double r = s->rad; /* the ball itself, unscaled */
             const double *c = s->center, (*cl)[3] = t->cell[node];
             int inside = (c[0] - r > cl[0][0]) & (c[0] + r < cl[1][0]) &
                          (c[1] - r > cl[0][1]) & (c[1] + r < cl[1][1]) &

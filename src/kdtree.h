@@ -23,7 +23,9 @@ typedef struct fdt_kdnode {
     double lo[3], hi[3];   /* exact bounding box of the node's points */
     uint32_t begin, end;   /* global ids [begin, end) */
     uint32_t left;         /* first child (right is left + 1); 0: a leaf */
-    uint32_t dim;          /* split dimension */
+    uint32_t dim;          /* split dimension; in a leaf of a tree with
+                            * float blocks (fl below), the offset of its
+                            * block in fl, in units of 4 floats */
 } fdt_kdnode;
 
 typedef struct fdt_kdtree {
@@ -38,6 +40,11 @@ typedef struct fdt_kdtree {
     uint32_t *parent;
     double (*cell)[2][3];
     uint32_t *leafof;
+    /* Owned, set by fdt_kd_build when the offsets fit (NULL otherwise and
+     * in other trees): every leaf's points again as floats in a frame of
+     * the leaf's own, for the apex search's first, conservative tests
+     * (src/kdtree.c, "Float blocks"). */
+    float *fl;
 } fdt_kdtree;
 
 /* Per-thread counters of the queries' work (owned by the querying thread). */
@@ -103,6 +110,7 @@ typedef struct fdt_apex {
     double sc;           /* a power of two: the ball test compares */
     double r2;           /* |(d - center) sc|^2 with r2 = (radius sc)^2, */
                          /* INFINITY while unknown or ill-conditioned */
+    double rad;          /* that radius, unscaled (INFINITY likewise) */
     uint32_t ver;        /* counts changes of best (and so of the ball) */
 } fdt_apex;
 

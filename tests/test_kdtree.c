@@ -36,8 +36,9 @@ static uint64_t rnd(void)
 }
 static double urand(void) { return (double)(rnd() >> 11) * 0x1p-53; }
 
-enum { UNIFORM, LATTICE, SPHERE_INT, GRID2D, OFFSET, NFAMILIES };
-static const char *family_name[] = {"uniform", "lattice", "intsphere", "grid2d", "offset"};
+enum { UNIFORM, LATTICE, SPHERE_INT, GRID2D, OFFSET, MIXED, NFAMILIES };
+static const char *family_name[] = {"uniform", "lattice", "intsphere", "grid2d", "offset",
+                                    "mixed"};
 
 /* Fills up to n distinct-ish points of a family; returns the count. */
 static size_t make_points(int fam, size_t n, double *p)
@@ -48,6 +49,15 @@ static size_t make_points(int fam, size_t n, double *p)
             for (int k = 0; k < 3; k++)
                 p[3 * m + k] = fam == UNIFORM ? urand()
                                               : 4.9e6 + floor(urand() * 20000.0) * 1e-3;
+    } else if (fam == MIXED) {
+        /* leaves of very different sizes side by side: half the points
+         * in the unit cube, half in a cube 1e-9 wide inside it, and a
+         * few 1e-300 from its corner (the float blocks' frames) */
+        for (; m < n; m++)
+            for (int k = 0; k < 3; k++)
+                p[3 * m + k] = m % 2 == 0 ? urand()
+                               : m % 11 == 1 ? 0.25 + urand() * 1e-300
+                                             : 0.5 + urand() * 1e-9;
     } else if (fam == LATTICE) {
         int s = (int)cbrt((double)n);
         for (int i = 0; i < s; i++)
@@ -119,6 +129,41 @@ static void test_family(int fam, size_t want, int leaf)
     const double *P = pr.p;
     fdt_kdq kq;
     memset(&kq, 0, sizeof kq);
+
+    /* The float blocks (src/kdtree.c): each leaf's block holds its points
+     * as (x - lo) 2^-e, e the exponent of the box's largest extent, each
+     * within 2^-23 of that value; padding lanes are 0. */
+    if (t.fl) {
+        for (uint32_t i = 0; i < t.nnodes; i++) {
+            const fdt_kdnode *nd = &t.nodes[i];
+            if (nd->left)
+                continue;
+            double ext = 0.0;
+            for (int k = 0; k < 3; k++)
+                ext = fmax(ext, nd->hi[k] - nd->lo[k]);
+            int e = 0;
+            if (ext > 0.0)
+                (void)frexp(ext, &e);
+            uint32_t ln = nd->end - nd->begin, row = (ln + 3) & ~3u;
+            const float *B = t.fl + 4 * (size_t)nd->dim;
+            CHECK(((uintptr_t)B & 15) == 0, "block of leaf %u not aligned", i);
+            for (int k = 0; k < 3; k++)
+                for (uint32_t j = 0; j < row; j++) {
+                    if (j >= ln) {
+                        CHECK(B[k * row + j] == 0.0f, "padding of leaf %u", i);
+                        continue;
+                    }
+                    if (e < -1000 || e > 1000)
+                        continue; /* no frame: the tests use the doubles */
+                    double x = ldexp(pr.p[3 * (size_t)(nd->begin + j) + k] - nd->lo[k], -e);
+                    CHECK(fabs((double)B[k * row + j] - x) <= 0x1p-23,
+                          "%s leaf %u point %u axis %d: %.9g against %.17g", family_name[fam], i, j,
+                          k, (double)B[k * row + j], x);
+                }
+        }
+    } else {
+        CHECK(0, "%s: no float blocks", family_name[fam]);
+    }
 
     /* Tree invariants: every node's box holds its points, leaves are
      * small, children partition the parent's range. */
