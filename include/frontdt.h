@@ -73,7 +73,7 @@ typedef struct fdt_settings {
     fdt_mode mode;
     int n_threads;           /* 0: one per physical core (hwloc) */
     int pin;                 /* nonzero: bind thread i to core i */
-    int leaf_size;           /* kd-tree points per leaf, default 18 (§4) */
+    int leaf_size;           /* kd-tree points per leaf, default 30 (the paper's 18, §4, tuned again) */
     int neighbors;           /* nonzero: compute tet neighbours */
     fdt_progress_fn progress;/* may be NULL */
     void *progress_user;     /* borrowed, passed back to progress */

@@ -42,7 +42,7 @@ void fdt_default_settings(fdt_settings *s)
     memset(s, 0, sizeof *s);
     s->mode = FDT_MODE_AUTO;
     s->n_threads = 0;
-    s->leaf_size = 18;
+    s->leaf_size = FDT_DEFAULT_LEAF;
 }
 
 int fdt_open(fdt_context **ctx, const fdt_settings *s)
@@ -58,7 +58,7 @@ int fdt_open(fdt_context **ctx, const fdt_settings *s)
         return FDT_ENOMEM;
     c->s = *s;
     if (c->s.leaf_size == 0)
-        c->s.leaf_size = 18;
+        c->s.leaf_size = FDT_DEFAULT_LEAF;
     *ctx = c;
     return FDT_OK;
 }

@@ -127,7 +127,13 @@ static void build_rec(build_ctx *bc, uint32_t id, uint32_t begin, uint32_t end)
             w = nd->hi[k] - nd->lo[k];
             dim = k;
         }
-    uint32_t mid = begin + (end - begin) / 2;
+    /* Split into the leaves this node needs, nl = ceil(c / leaf), half
+     * of them on each side, rather than into halves of the points: every
+     * leaf then holds c / nl, between leaf (1 - 1/nl) and leaf points,
+     * where halving gave anything from leaf / 2 to leaf as n varied
+     * (15.3 points a leaf at 1M with leaf 18, 12.2 at 200k). */
+    uint32_t c = end - begin, nl = (c + bc->leaf - 1) / bc->leaf;
+    uint32_t mid = begin + (uint32_t)(((uint64_t)c * (nl / 2)) / nl);
     select_k(bc->P, bc->orig, begin, end, mid, dim);
     uint32_t left = bc->t->nnodes;
     bc->t->nnodes += 2;
@@ -203,7 +209,7 @@ static int climb_tables(fdt_kdtree *t)
  * Layout: a leaf of n points has a block of three rows, X, Y and Z, each n
  * rounded up to a multiple of 4 floats (padding zeros), 16-byte aligned;
  * the leaf's dim field gives the block's offset in units of 4 floats.
- * 18 points take 240 bytes, against 432 for their doubles.
+ * 30 points take 384 bytes, against 720 for their doubles.
  */
 
 /* The leaf's frame scale s (above), or 0 where it has none; a function of
@@ -268,8 +274,9 @@ int fdt_kd_build(fdt_kdtree *t, double *P, fdt_vid *orig, uint32_t base,
     memset(t, 0, sizeof *t);
     if (leaf_size < 1)
         leaf_size = 1;
-    /* A node over c > leaf points splits into halves, so leaves hold at
-     * least leaf/2 points: at most 2n/leaf + 1 leaves, twice that nodes. */
+    /* A node over c > leaf points splits into nl >= 2 leaves' worth, so
+     * leaves hold at least leaf/2 points: at most 2n/leaf + 1 leaves,
+     * twice that nodes. */
     size_t cap = 4 * ((size_t)n / (size_t)leaf_size + 1) + 4;
     t->nodes = malloc(cap * sizeof *t->nodes);
     if (!t->nodes)
