@@ -1,5 +1,6 @@
-/* Small helpers shared by modules: a bit scan (src/kdtree.c, src/faceq.c)
- * and a prefetch hint (src/facetab.h, src/prepare.c, src/check.c). */
+/* Small helpers shared by modules: bit scans (src/kdtree.c, src/faceq.c,
+ * src/result.c) and a prefetch hint (src/facetab.h, src/prepare.c,
+ * src/check.c). */
 #ifndef FDT_BITS_H
 #define FDT_BITS_H
 
@@ -14,6 +15,21 @@ static inline int fdt_ctz64(uint64_t m)
     int k = 0;
     while (!(m & 1)) {
         m >>= 1;
+        k++;
+    }
+    return k;
+#endif
+}
+
+/* Number of leading zero bits of x != 0. */
+static inline int fdt_clz32(uint32_t x)
+{
+#if defined(__GNUC__)
+    return __builtin_clz(x);
+#else
+    int k = 0;
+    while (!(x & 0x80000000u)) {
+        x <<= 1;
         k++;
     }
     return k;

@@ -1,8 +1,14 @@
 /* Result accessors, canonical order and the canonical hash. */
 #include "result.h"
 
+#include <pthread.h>
+#include <sched.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+#include "bits.h"
 
 void fdt_result_free(fdt_result **r)
 {
@@ -82,6 +88,34 @@ static void orient_sorted(fdt_vid *t, int perm[4])
     }
 }
 
+/*
+ * orient_sorted without the permutation, for results without neighbours:
+ * a sorting network of five compare-exchanges whose swaps are counted for
+ * the parity, as selects rather than branches (the insertion sort's
+ * branches, a coin toss each, made this loop a third of the sort).
+ */
+static void orient_sorted_fast(fdt_vid *t)
+{
+    fdt_vid v0 = t[0], v1 = t[1], v2 = t[2], v3 = t[3], x;
+    int odd = 0, c;
+#define CSWAP(p, q)                                                            \
+    c = p > q;                                                                 \
+    odd ^= c;                                                                  \
+    x = c ? q : p;                                                             \
+    q = c ? p : q;                                                             \
+    p = x;
+    CSWAP(v0, v1)
+    CSWAP(v2, v3)
+    CSWAP(v0, v2)
+    CSWAP(v1, v3)
+    CSWAP(v1, v2)
+#undef CSWAP
+    t[0] = v0;
+    t[1] = v1;
+    t[2] = odd ? v3 : v2;
+    t[3] = odd ? v2 : v3;
+}
+
 static void key_of(const fdt_vid *t, uint32_t k[4])
 {
     k[0] = (uint32_t)t[0];
@@ -105,54 +139,132 @@ static int key_cmp(const uint32_t *x, const uint32_t *y)
  * the key is key_of of it), or with neighbours a key and the tet's old
  * index (6 words: key_of of a key is the key itself). */
 #define REC_MAX 6
+#define RADIX_BITS 11
 
-/*
- * Sorts the n records of `stride` words at *pa into key order. An LSD
- * radix sort on the first word only (the lowest vertex id), 11 bits a
- * pass: 2048 buckets keep the scatter's write streams inside the cache
- * (16-bit digits on all four words made eight passes whose 65536 streams
- * missed on nearly every write: the sort was 7 % of a 1M run). Records
- * with the same lowest vertex, about seven (the tets at which that vertex
- * is lowest), then get an insertion sort on the whole key. With an odd
- * number of passes the sorted records are in the scratch array, which
- * replaces *pa. The scratch is as large as the input, as before.
- */
-static int sort_records(uint32_t **pa, size_t n, int stride)
+/* The canonical hash (fdt_result_hash): FNV-1a over the text of a .tets
+ * file's tet lines, fed one bucket of sorted records at a time. */
+typedef struct text_hash {
+    uint64_t h;
+} text_hash;
+
+/* Two decimal digits of 0..99, for put_u32. */
+static const char digits2[] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
+/* x in decimal at buf; returns the length. Two digits a step: the hash's
+ * conversions were a third of its time with one division a digit. */
+static size_t put_u32(char *buf, uint32_t x)
 {
-    uint32_t *a = *pa, top = 0;
-    for (size_t i = 0; i < n; i++)
-        top = a[stride * i] > top ? a[stride * i] : top;
-    int passes = 0;
-    for (uint32_t m = top; m; m >>= 11)
-        passes++;
-    size_t bytes = (size_t)stride * sizeof *a;
-    uint32_t *b = malloc((n ? n : 1) * bytes);
-    if (!b)
-        return FDT_ENOMEM;
-    size_t cnt[2048];
-    for (int pass = 0; pass < passes; pass++) {
-        int shift = 11 * pass;
-        memset(cnt, 0, sizeof cnt);
-        for (size_t i = 0; i < n; i++)
-            cnt[(a[stride * i] >> shift) & 2047]++;
-        size_t sum = 0;
-        for (int d = 0; d < 2048; d++) {
-            size_t c = cnt[d];
-            cnt[d] = sum;
-            sum += c;
-        }
-        for (size_t i = 0; i < n; i++)
-            memcpy(b + stride * cnt[(a[stride * i] >> shift) & 2047]++, a + stride * i, bytes);
-        uint32_t *t = a;
-        a = b;
-        b = t;
+    /* The length from the bit length: floor(log10(2^bits)) digits or
+     * one more (1233 / 4096 is log10(2) rounded up, exact enough below
+     * 2^32); a division a digit made a chain, nine comparisons cost more. */
+    static const uint32_t pow10[10] = {1u, 10u, 100u, 1000u, 10000u, 100000u,
+                                       1000000u, 10000000u, 100000000u, 1000000000u};
+    unsigned bl = 32u - (unsigned)fdt_clz32(x | 1u), d = (bl * 1233u) >> 12;
+    size_t len = d + (x >= pow10[d]) + (x == 0);
+    char *p = buf + len;
+    while (x >= 100) {
+        uint32_t q = x / 100, r = x - 100 * q;
+        p -= 2;
+        memcpy(p, digits2 + 2 * r, 2);
+        x = q;
     }
-    free(b); /* the input (odd passes) or the scratch (even) */
-    *pa = a;
+    if (x >= 10) {
+        p -= 2;
+        memcpy(p, digits2 + 2 * x, 2);
+    } else {
+        *--p = (char)('0' + x);
+    }
+    return len;
+}
+
+static void hash_records(text_hash *th, const uint32_t *a, size_t n)
+{
+    uint64_t h = th->h;
+    char buf[48];
+    for (size_t i = 0; i < n; i++) {
+        uint32_t k[4];
+        key_of((const fdt_vid *)a + 4 * i, k);
+        size_t len = 0;
+        for (int j = 0; j < 4; j++) {
+            len += put_u32(buf + len, k[j]);
+            buf[len++] = j == 3 ? '\n' : ' ';
+        }
+        /* FNV-1a is one multiply after another: its chain, about four
+         * cycles a byte, is the floor of this loop. */
+        for (size_t j = 0; j < len; j++) {
+            h ^= (unsigned char)buf[j];
+            h *= 1099511628211ull;
+        }
+    }
+    th->h = h;
+}
+
+/* One counting-sort pass over n records of `stride` words from src to dst
+ * by bits [shift, shift + RADIX_BITS) of the first word. */
+static void radix_pass(const uint32_t *src, uint32_t *dst, size_t n, int stride, int shift,
+                       size_t *cnt)
+{
+    size_t bytes = (size_t)stride * sizeof *src;
+    memset(cnt, 0, ((size_t)1 << RADIX_BITS) * sizeof *cnt);
+    for (size_t i = 0; i < n; i++)
+        cnt[(src[stride * i] >> shift) & ((1u << RADIX_BITS) - 1)]++;
+    size_t sum = 0;
+    for (size_t d = 0; d < ((size_t)1 << RADIX_BITS); d++) {
+        size_t c = cnt[d];
+        cnt[d] = sum;
+        sum += c;
+    }
+    for (size_t i = 0; i < n; i++)
+        memcpy(dst + stride * cnt[(src[stride * i] >> shift) & ((1u << RADIX_BITS) - 1)]++,
+               src + stride * i, bytes);
+}
+
+/* The rest of a 4-word record's key after its first word, as one number:
+ * t1, then min(t2, t3), then max(t2, t3), 32 bits... and less: ids are
+ * below 2^32, so (t1, min) fills 64 bits and max breaks the ties. */
+static inline void key_rest(const uint32_t *t, uint64_t *hi, uint32_t *lo)
+{
+    uint32_t mn = t[2] < t[3] ? t[2] : t[3], mx = t[2] < t[3] ? t[3] : t[2];
+    *hi = ((uint64_t)t[1] << 32) | mn;
+    *lo = mx;
+}
+
+/* Records with the same first word (the lowest vertex: about seven, the
+ * tets at which that vertex is lowest) in key order, by insertion; for
+ * 4-word records on keys computed once a record rather than twice a
+ * comparison. */
+static void finish_groups(uint32_t *a, size_t n, int stride)
+{
+    size_t bytes = (size_t)stride * sizeof *a;
     for (size_t i = 0; i < n;) {
         size_t j = i + 1;
         while (j < n && a[stride * j] == a[stride * i])
             j++;
+        if (stride == 4 && j - i <= 64) {
+            uint64_t kh[64];
+            uint32_t kl[64], rec[64][4];
+            size_t g = j - i;
+            for (size_t x = 0; x < g; x++) {
+                uint64_t h;
+                uint32_t l;
+                key_rest(a + 4 * (i + x), &h, &l);
+                size_t y = x;
+                for (; y > 0 && (kh[y - 1] > h || (kh[y - 1] == h && kl[y - 1] > l)); y--) {
+                    kh[y] = kh[y - 1];
+                    kl[y] = kl[y - 1];
+                    memcpy(rec[y], rec[y - 1], sizeof rec[y]);
+                }
+                kh[y] = h;
+                kl[y] = l;
+                memcpy(rec[y], a + 4 * (i + x), sizeof rec[y]);
+            }
+            memcpy(a + 4 * i, rec, g * sizeof rec[0]);
+            i = j;
+            continue;
+        }
         for (size_t x = i + 1; x < j; x++) {
             uint32_t r[REC_MAX];
             memcpy(r, a + stride * x, bytes);
@@ -163,30 +275,258 @@ static int sort_records(uint32_t **pa, size_t n, int stride)
         }
         i = j;
     }
-    return FDT_OK;
 }
 
-int fdt_result_sort(fdt_result *r)
+/* ---- the sort on several threads ------------------------------------------
+ *
+ * Phases, each run by T workers (the caller is worker 0) and joined
+ * before the next, so pthread_create and pthread_join order every phase's
+ * writes before the next phase's reads:
+ *   A. each worker's slice of the records: orient (4-word records) and
+ *      the largest first word;
+ *   B. each slice's histogram of the top digit;
+ *   C. each slice scattered from a to b at its own offsets (from the
+ *      histograms, by the caller between B and C);
+ *   D. the buckets, taken in order from a shared counter: the bits below
+ *      the top digit, the vertex groups, and the hash, which only worker 0
+ *      computes, bucket after bucket in key order, sorting buckets itself
+ *      while the next one to hash is not ready.
+ */
+#define NBUCKETS ((size_t)1 << RADIX_BITS)
+
+typedef struct sort_job {
+    uint32_t *a, *b;
+    size_t n;
+    int stride, orient, T, shift, phase;
+    uint32_t *tops;        /* T: each slice's largest first word (A) */
+    size_t *hist;          /* T x NBUCKETS: counts (B), then offsets (C) */
+    size_t *start, *end;   /* NBUCKETS: each bucket's range in b (D) */
+    text_hash *th;         /* NULL: no hash */
+    /* Next bucket to sort (D). relaxed: each bucket number is handed out
+     * once by the read-modify-write; nothing else is published by it. */
+    atomic_size_t next;
+    /* done[d] != 0 once bucket d is final in a (D). Stored with release
+     * by the worker that sorted it, after the bucket's last write; worker
+     * 0 loads it with acquire before hashing the bucket, so it reads the
+     * final records. */
+    atomic_uchar *done;
+} sort_job;
+
+typedef struct sort_arg {
+    sort_job *j;
+    int t;
+} sort_arg;
+
+/* The bits below the top digit, the groups and (from worker 0's hash
+ * loop only) nothing else: bucket d made final in a. inner: NBUCKETS
+ * counts of the worker's own. */
+static void sort_bucket(sort_job *j, size_t d, size_t *inner)
 {
-    if (!r)
-        return FDT_EINVAL;
-    if (r->sorted)
-        return FDT_OK;
-    size_t n = r->ntets;
-    for (size_t i = 0; i < n; i++) {
-        int perm[4];
-        orient_sorted(r->tets + 4 * i, perm);
-        if (r->nbrs) {
-            fdt_tid o[4];
-            memcpy(o, r->nbrs + 4 * i, sizeof o);
-            for (int k = 0; k < 4; k++)
-                r->nbrs[4 * i + k] = o[perm[k]];
+    size_t lo = j->start[d], m = j->end[d] - lo, bytes = (size_t)j->stride * sizeof *j->a;
+    if (m == 0)
+        return;
+    /* Least significant first between b and a over the bucket's range; an
+     * odd number of passes leaves it in a, an even one (none included)
+     * copies it there. */
+    uint32_t *src = j->b + (size_t)j->stride * lo, *dst = j->a + (size_t)j->stride * lo;
+    for (int sh = 0; sh < j->shift; sh += RADIX_BITS) {
+        radix_pass(src, dst, m, j->stride, sh, inner);
+        uint32_t *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != j->a + (size_t)j->stride * lo)
+        memcpy(j->a + (size_t)j->stride * lo, src, m * bytes);
+    finish_groups(j->a + (size_t)j->stride * lo, m, j->stride);
+}
+
+static void *sort_worker(void *arg)
+{
+    sort_arg *sa = arg;
+    sort_job *j = sa->j;
+    int t = sa->t, st = j->stride;
+    size_t lo = j->n * (size_t)t / (size_t)j->T, hi = j->n * (size_t)(t + 1) / (size_t)j->T;
+    size_t *h = j->hist + NBUCKETS * (size_t)t;
+    if (j->phase == 0) {
+        uint32_t top = 0;
+        for (size_t i = lo; i < hi; i++) {
+            if (j->orient)
+                orient_sorted_fast((fdt_vid *)j->a + 4 * i);
+            top = j->a[st * i] > top ? j->a[st * i] : top;
+        }
+        j->tops[t] = top;
+    } else if (j->phase == 1) {
+        memset(h, 0, NBUCKETS * sizeof *h);
+        for (size_t i = lo; i < hi; i++)
+            h[(j->a[st * i] >> j->shift) & (NBUCKETS - 1)]++;
+    } else if (j->phase == 2) {
+        size_t bytes = (size_t)st * sizeof *j->a;
+        for (size_t i = lo; i < hi; i++)
+            memcpy(j->b + st * h[(j->a[st * i] >> j->shift) & (NBUCKETS - 1)]++, j->a + st * i,
+                   bytes);
+    } else {
+        size_t inner[NBUCKETS];
+        size_t hnext = 0;
+        for (;;) {
+            if (t == 0 && j->th) {
+                /* hash every bucket that is ready, in order */
+                while (hnext < NBUCKETS &&
+                       atomic_load_explicit(&j->done[hnext], memory_order_acquire)) {
+                    hash_records(j->th, j->a + (size_t)st * j->start[hnext],
+                                 j->end[hnext] - j->start[hnext]);
+                    hnext++;
+                }
+                if (hnext == NBUCKETS)
+                    break;
+            }
+            size_t d = atomic_fetch_add_explicit(&j->next, 1, memory_order_relaxed);
+            if (d >= NBUCKETS) {
+                if (t != 0 || !j->th)
+                    break;
+                /* Worker 0 with buckets still to hash that others are
+                 * sorting: give them the core (machines run more threads
+                 * than cores in the tests). */
+                sched_yield();
+                continue;
+            }
+            sort_bucket(j, d, inner);
+            atomic_store_explicit(&j->done[d], 1, memory_order_release);
         }
     }
+    return NULL;
+}
+
+/* Runs phase `phase` on workers 0..T-1, worker 0 on the calling thread.
+ * A worker whose thread cannot be created runs here after the others
+ * (phases A-C split the work by slice; in D any worker finishes all). */
+static void run_phase(sort_job *j, int phase, sort_arg *args, pthread_t *tid, int *made)
+{
+    j->phase = phase;
+    for (int t = 1; t < j->T; t++)
+        made[t] = pthread_create(&tid[t], NULL, sort_worker, &args[t]) == 0;
+    sort_worker(&args[0]);
+    for (int t = 1; t < j->T; t++)
+        if (made[t])
+            pthread_join(tid[t], NULL);
+    if (phase < 3)
+        for (int t = 1; t < j->T; t++)
+            if (!made[t])
+                sort_worker(&args[t]);
+}
+
+/*
+ * Sorts the n records of `stride` words at a into key order on T threads,
+ * orienting 4-word records first if `orient`, and feeds them to th in that
+ * order if th is not NULL.
+ *
+ * Most significant digit first: one pass scatters the records into 2^11
+ * buckets by the top bits of the lowest vertex id, then each bucket (about
+ * 3,300 records, 53 KB, at 1M points) is finished while it sits in the
+ * cache: least significant passes on the bits below, the insertion sort of
+ * each vertex's group, and the hash. The least-significant-first sort
+ * before this read and wrote the whole array once more, and the hash then
+ * read it again from memory: sort and hash were 1.2 s of a 9.5 s run at 1M
+ * (bench/NOTES.md, entry 33). 2048 buckets keep the scatter's write streams
+ * inside the cache (16-bit digits on all four words made eight passes
+ * whose 65536 streams missed on nearly every write). The scratch is as
+ * large as the input, as before.
+ */
+static int sort_records(uint32_t *a, size_t n, int stride, int orient, text_hash *th, int T)
+{
+    if (T < 1 || n < ((size_t)1 << 16))
+        T = 1; /* small inputs: threads would cost more than they save */
+    size_t bytes = (size_t)stride * sizeof *a;
+    sort_job j;
+    memset(&j, 0, sizeof j);
+    j.a = a;
+    j.n = n;
+    j.stride = stride;
+    j.orient = orient;
+    j.T = T;
+    j.th = th;
+    j.b = malloc((n ? n : 1) * bytes);
+    j.tops = malloc((size_t)T * sizeof *j.tops);
+    j.hist = malloc((size_t)T * NBUCKETS * sizeof *j.hist);
+    j.start = malloc(2 * NBUCKETS * sizeof *j.start);
+    j.done = malloc(NBUCKETS * sizeof *j.done);
+    sort_arg *args = malloc((size_t)T * sizeof *args);
+    pthread_t *tid = malloc((size_t)T * sizeof *tid);
+    int *made = calloc((size_t)T, sizeof *made);
+    int err = FDT_ENOMEM;
+    if (!j.b || !j.tops || !j.hist || !j.start || !j.done || !args || !tid || !made)
+        goto out;
+    err = FDT_OK;
+    j.end = j.start + NBUCKETS;
+    for (size_t d = 0; d < NBUCKETS; d++)
+        atomic_init(&j.done[d], 0);
+    atomic_init(&j.next, 0);
+    for (int t = 0; t < T; t++) {
+        args[t].j = &j;
+        args[t].t = t;
+    }
+    run_phase(&j, 0, args, tid, made);
+    uint32_t top = 0;
+    for (int t = 0; t < T; t++)
+        top = j.tops[t] > top ? j.tops[t] : top;
+    int bits = 0;
+    while (bits < 32 && (top >> bits) != 0)
+        bits++;
+    j.shift = bits > RADIX_BITS ? bits - RADIX_BITS : 0;
+    run_phase(&j, 1, args, tid, made);
+    /* Offsets: bucket d of slice t starts after all records of smaller
+     * buckets and after bucket d's records in slices before t. */
+    size_t sum = 0;
+    for (size_t d = 0; d < NBUCKETS; d++) {
+        j.start[d] = sum;
+        for (int t = 0; t < T; t++) {
+            size_t c = j.hist[NBUCKETS * (size_t)t + d];
+            j.hist[NBUCKETS * (size_t)t + d] = sum;
+            sum += c;
+        }
+        j.end[d] = sum;
+    }
+    run_phase(&j, 2, args, tid, made);
+    run_phase(&j, 3, args, tid, made);
+out:
+    free(j.b);
+    free(j.tops);
+    free(j.hist);
+    free(j.start);
+    free(j.done);
+    free(args);
+    free(tid);
+    free(made);
+    return err;
+}
+
+/* Threads for the sort: those of the triangulation (1 in serial mode, so
+ * that mode stays sequential from end to end), at most one a core. */
+static int sort_threads(const fdt_result *r)
+{
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int T = r->stats.threads;
+    if (cores >= 1 && T > cores)
+        T = (int)cores;
+    return T < 1 ? 1 : (T > 64 ? 64 : T);
+}
+
+/* fdt_result_sort, hashing on the way when th is not NULL (done in the
+ * sort's buckets where the records are the tets, after it otherwise). */
+static int sort_impl(fdt_result *r, text_hash *th)
+{
+    size_t n = r->ntets;
+    int T = sort_threads(r);
+    for (size_t i = 0; i < n && r->nbrs; i++) {
+        int perm[4];
+        orient_sorted(r->tets + 4 * i, perm);
+        fdt_tid o[4];
+        memcpy(o, r->nbrs + 4 * i, sizeof o);
+        for (int k = 0; k < 4; k++)
+            r->nbrs[4 * i + k] = o[perm[k]];
+    }
     if (!r->nbrs) {
-        uint32_t *t = (uint32_t *)r->tets; /* ids are non-negative */
-        int e = sort_records(&t, n, 4);
-        r->tets = (fdt_vid *)t;
+        /* ids are non-negative */
+        int e = sort_records((uint32_t *)r->tets, n, 4, 1, th, T);
         if (e == FDT_OK)
             r->sorted = 1;
         return e;
@@ -199,7 +539,7 @@ int fdt_result_sort(fdt_result *r)
         a[6 * i + 4] = (uint32_t)i;
         a[6 * i + 5] = (uint32_t)((uint64_t)i >> 32);
     }
-    int err = sort_records(&a, n, 6);
+    int err = sort_records(a, n, 6, 0, NULL, T);
     if (err) {
         free(a);
         return err;
@@ -234,39 +574,30 @@ int fdt_result_sort(fdt_result *r)
     r->tets = nt;
     free(a);
     r->sorted = 1;
+    if (th)
+        hash_records(th, (const uint32_t *)r->tets, n);
     return FDT_OK;
+}
+
+int fdt_result_sort(fdt_result *r)
+{
+    if (!r)
+        return FDT_EINVAL;
+    return r->sorted ? FDT_OK : sort_impl(r, NULL);
 }
 
 int fdt_result_hash(fdt_result *r, uint64_t *hash)
 {
     if (!r || !hash)
         return FDT_EINVAL;
-    int err = fdt_result_sort(r);
-    if (err)
-        return err;
-    uint64_t h = 14695981039346656037ull;
-    char buf[64];
-    for (size_t i = 0; i < r->ntets; i++) {
-        uint32_t k[4];
-        key_of(r->tets + 4 * i, k);
-        size_t len = 0;
-        for (int j = 0; j < 4; j++) {
-            char d[12];
-            int nd = 0;
-            uint32_t x = k[j];
-            do {
-                d[nd++] = (char)('0' + x % 10);
-                x /= 10;
-            } while (x);
-            while (nd)
-                buf[len++] = d[--nd];
-            buf[len++] = j == 3 ? '\n' : ' ';
-        }
-        for (size_t j = 0; j < len; j++) {
-            h ^= (unsigned char)buf[j];
-            h *= 1099511628211ull;
-        }
+    text_hash th = {14695981039346656037ull};
+    if (!r->sorted) {
+        int err = sort_impl(r, &th);
+        if (err)
+            return err;
+    } else {
+        hash_records(&th, (const uint32_t *)r->tets, r->ntets);
     }
-    *hash = h;
+    *hash = th.h;
     return FDT_OK;
 }

@@ -688,6 +688,60 @@ static int cancel_cb(void *user, double f)
     return ++*calls >= 1;
 }
 
+/* The canonical sort of src/result.c runs on the triangulation's threads
+ * (one a core) above 65,536 tets: 15,000 points make about 100,000. With
+ * and without neighbours (6- and 4-word records), its order and hash must
+ * be serial mode's, and the tets strictly increasing in canonical key. */
+static void test_sort_threads(void)
+{
+    pts p = fam_uniform(15000, 17);
+    for (int nbrs = 0; nbrs <= 1; nbrs++) {
+        fdt_result *ref = run(&p, FDT_MODE_SERIAL, 1, nbrs, FDT_OK);
+        uint64_t href, h;
+        CHECK_EQ(fdt_result_hash(ref, &href), FDT_OK);
+        size_t nt = fdt_result_num_tets(ref);
+        CHECK(nt > 65536);
+        const fdt_vid *t = fdt_result_tets(ref);
+        for (size_t i = 1; i < nt; i++) {
+            fdt_vid a[4], b[4];
+            for (int k = 0; k < 4; k++) {
+                a[k] = t[4 * (i - 1) + k];
+                b[k] = t[4 * i + k];
+            }
+            /* key: the first two, then the last two in increasing order */
+            for (fdt_vid *x = a; x; x = x == a ? b : NULL)
+                if (x[2] > x[3]) {
+                    fdt_vid y = x[2];
+                    x[2] = x[3];
+                    x[3] = y;
+                }
+            CHECK(a[0] < a[1] && a[1] < a[2] && a[2] < a[3]);
+            CHECK(memcmp(a, b, sizeof a) != 0);
+            int lt = 0;
+            for (int k = 0; k < 4; k++)
+                if (a[k] != b[k]) {
+                    lt = a[k] < b[k];
+                    break;
+                }
+            CHECK(lt);
+        }
+        for (int nthreads = 2; nthreads <= 5; nthreads += 3) {
+            fdt_result *r = run(&p, FDT_MODE_SHARED, nthreads, nbrs, FDT_OK);
+            CHECK_EQ(fdt_result_sort(r), FDT_OK);
+            CHECK_EQ(fdt_result_num_tets(r), nt);
+            CHECK(memcmp(fdt_result_tets(r), t, 4 * nt * sizeof *t) == 0);
+            if (nbrs)
+                CHECK(memcmp(fdt_result_neighbors(r), fdt_result_neighbors(ref),
+                             4 * nt * sizeof(fdt_tid)) == 0);
+            CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
+            CHECK(h == href);
+            fdt_result_free(&r);
+        }
+        fdt_result_free(&ref);
+    }
+    free(p.xyz);
+}
+
 static void test_cancel(void)
 {
     pts p = fam_uniform(400000, 11);
@@ -758,6 +812,7 @@ int main(int argc, char **argv)
     test_family(fam_clusters(quick ? 600 : 1500, 5), quick);
     test_family(fam_offset(quick ? 600 : 1500, 9), quick);
     test_tiny(quick ? 2 : 4);
+    test_sort_threads();
     if (!quick)
         test_cancel();
     printf("all parallel tests passed\n");
