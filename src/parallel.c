@@ -1366,7 +1366,7 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
      * of a second off a setup of 0.9 s. */
     int cores = fdt_parallel_default_threads();
     int err = fdt_partition_build(&pt, pr->p, pr->orig, (uint32_t)pr->m, nthreads,
-                                  s->leaf_size > 0 ? s->leaf_size : 18,
+                                  s->leaf_size > 0 ? s->leaf_size : FDT_DEFAULT_LEAF,
                                   cores < nthreads ? cores : nthreads);
     if (err)
         return err;
