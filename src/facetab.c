@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "frontdt.h"
+#include "mem.h"
 
 void fdt_face_canon(uint32_t a, uint32_t b, uint32_t c, uint32_t out[3])
 {
@@ -28,6 +29,7 @@ int fdt_facetab_init(fdt_facetab *t, size_t expected)
     while (cap < 2 * expected)
         cap <<= 1;
     t->slots = malloc(cap * sizeof *t->slots);
+    fdt_mem_advise_huge(t->slots, cap * sizeof *t->slots);
     if (!t->slots)
         return FDT_ENOMEM;
     for (size_t i = 0; i < cap; i++)
@@ -60,6 +62,7 @@ static int grow(fdt_facetab *t)
 {
     size_t ncap = t->cap * 2;
     fdt_face *ns = malloc(ncap * sizeof *ns);
+    fdt_mem_advise_huge(ns, ncap * sizeof *ns);
     if (!ns)
         return FDT_ENOMEM;
     for (size_t i = 0; i < ncap; i++)

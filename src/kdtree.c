@@ -9,6 +9,7 @@
 #include <emmintrin.h>
 #endif
 #include "bits.h"
+#include "mem.h"
 
 /* 2^k for -1022 <= k <= 1023, built from its bits. */
 static inline double pow2i(int k)
@@ -160,6 +161,8 @@ static int climb_tables(fdt_kdtree *t)
     t->parent = malloc((size_t)t->nnodes * sizeof *t->parent);
     t->cell = malloc((size_t)t->nnodes * sizeof *t->cell);
     t->leafof = malloc(((size_t)t->n + 1) * sizeof *t->leafof);
+    fdt_mem_advise_huge(t->cell, (size_t)t->nnodes * sizeof *t->cell);
+    fdt_mem_advise_huge(t->leafof, ((size_t)t->n + 1) * sizeof *t->leafof);
     if (!t->parent || !t->cell || !t->leafof) {
         fdt_kd_free(t);
         return FDT_ENOMEM;
@@ -248,6 +251,7 @@ static void float_blocks(fdt_kdtree *t)
     if (total == 0 || total > UINT32_MAX)
         return;
     t->fl = aligned_alloc(16, total * 4 * sizeof(float));
+    fdt_mem_advise_huge(t->fl, total * 4 * sizeof(float));
     if (!t->fl)
         return; /* an optimisation only: its absence changes no result */
     size_t off = 0;
@@ -279,6 +283,7 @@ int fdt_kd_build(fdt_kdtree *t, double *P, fdt_vid *orig, uint32_t base,
      * twice that nodes. */
     size_t cap = 4 * ((size_t)n / (size_t)leaf_size + 1) + 4;
     t->nodes = malloc(cap * sizeof *t->nodes);
+    fdt_mem_advise_huge(t->nodes, cap * sizeof *t->nodes);
     if (!t->nodes)
         return FDT_ENOMEM;
     t->P = P;

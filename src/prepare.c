@@ -1,6 +1,8 @@
 /* Input validation, duplicate merging and power-of-two scaling. */
 #include "prepare.h"
 
+#include "mem.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -94,6 +96,7 @@ int fdt_prepare(const double *xyz, size_t n, fdt_prepared *pr, char *diag,
     }
     pr->dupmap = malloc((n ? n : 1) * sizeof *pr->dupmap);
     pr->p = malloc((n ? n : 1) * 3 * sizeof *pr->p);
+    fdt_mem_advise_huge(pr->p, (n ? n : 1) * 3 * sizeof *pr->p);
     pr->orig = malloc((n ? n : 1) * sizeof *pr->orig);
     /* Open addressing at load <= 1/2: slots hold distinct-point numbers. */
     size_t cap = 16;

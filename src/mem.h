@@ -1,0 +1,21 @@
+/*
+ * Large allocations and the kernel's huge pages. The apex search reads
+ * the coordinates, the kd-tree and the float blocks all over tens of MB
+ * (1M points: 24 MB of coordinates alone), and with 4 KB pages nearly
+ * every node or leaf it visits is on a page the TLB does not hold; 2 MB
+ * pages cover the same data with a few dozen entries. Linux gives them to
+ * anonymous memory marked MADV_HUGEPAGE where transparent huge pages are
+ * set to "madvise" (Debian's default) or "always".
+ */
+#ifndef FDT_MEM_H
+#define FDT_MEM_H
+
+#include <stddef.h>
+
+/* Asks for huge pages over the 2 MB-aligned part of [p, p + bytes) when
+ * it spans at least 4 MB; a hint only (no error, no effect elsewhere).
+ * Best called before the memory is first written, so that the first
+ * touch already gets a huge page. */
+void fdt_mem_advise_huge(void *p, size_t bytes);
+
+#endif
