@@ -156,6 +156,22 @@ static void build_rec(build_ctx *bc, uint32_t id, uint32_t begin, uint32_t end)
  * them. About 60 bytes a leaf's worth of points (1M points: 13 MB); they
  * replaced a root-to-leaf descent a face (about 400 instructions).
  */
+/* Every node's cell from the root's (cell[0]): parents before children,
+ * as nodes are numbered, so one pass in index order. */
+static void fill_cells(fdt_kdtree *t)
+{
+    for (uint32_t j = 0; j < t->nnodes; j++) {
+        const fdt_kdnode *nd = &t->nodes[j];
+        if (!nd->left)
+            continue;
+        uint32_t l = nd->left, dim = nd->dim;
+        memcpy(t->cell[l], t->cell[j], sizeof t->cell[j]);
+        memcpy(t->cell[l + 1], t->cell[j], sizeof t->cell[j]);
+        t->cell[l][1][dim] = t->nodes[l + 1].lo[dim];
+        t->cell[l + 1][0][dim] = t->nodes[l].hi[dim];
+    }
+}
+
 static int climb_tables(fdt_kdtree *t)
 {
     t->parent = malloc((size_t)t->nnodes * sizeof *t->parent);
@@ -179,14 +195,20 @@ static int climb_tables(fdt_kdtree *t)
                 t->leafof[i - t->base] = j;
             continue;
         }
-        uint32_t l = nd->left, dim = nd->dim;
+        uint32_t l = nd->left;
         t->parent[l] = t->parent[l + 1] = j;
-        memcpy(t->cell[l], t->cell[j], sizeof t->cell[j]);
-        memcpy(t->cell[l + 1], t->cell[j], sizeof t->cell[j]);
-        t->cell[l][1][dim] = t->nodes[l + 1].lo[dim];
-        t->cell[l + 1][0][dim] = t->nodes[l].hi[dim];
     }
+    fill_cells(t);
     return FDT_OK;
+}
+
+void fdt_kd_set_region(fdt_kdtree *t, const double lo[3], const double hi[3])
+{
+    if (!t->cell)
+        return;
+    memcpy(t->cell[0][0], lo, sizeof t->cell[0][0]);
+    memcpy(t->cell[0][1], hi, sizeof t->cell[0][1]);
+    fill_cells(t);
 }
 
 /* ---- float blocks --------------------------------------------------------
@@ -1201,27 +1223,30 @@ static void offer_likely_apex(fdt_apex *s, const fdt_kdtree *t, uint32_t leaf,
  * box tests. The leaf, the parents and the cells come from the tables of
  * climb_tables.
  */
-void fdt_apex_search_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start,
-                          fdt_kdq *kq)
+/* Whether the ball of s lies strictly inside the cell of node. */
+static inline int ball_inside_cell(const fdt_apex *s, const fdt_kdtree *t, uint32_t node)
+{
+    if (s->best == FDT_NONE || !isfinite(s->r2))
+        return 0;
+    double r = s->rad; /* the ball itself, unscaled */
+    const double *c = s->center, (*cl)[3] = t->cell[node];
+    return (c[0] - r > cl[0][0]) & (c[0] + r < cl[1][0]) & (c[1] - r > cl[0][1]) &
+           (c[1] + r < cl[1][1]) & (c[2] - r > cl[0][2]) & (c[2] + r < cl[1][2]);
+}
+
+int fdt_apex_search_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start, fdt_kdq *kq)
 {
     if (!t->leafof) { /* not a tree of fdt_kd_build: no climb tables */
         fdt_apex_search(s, t, kq);
-        return;
+        return 0;
     }
     uint32_t node = t->leafof[start - t->base];
     offer_likely_apex(s, t, node, kq);
     const fdt_kdnode *nd = &t->nodes[node];
     apex_walk(s, t, node, fdt_box_dist2_sc(nd->lo, nd->hi, s->center, s->sc), kq);
     while (node != 0) {
-        if (s->best != FDT_NONE && isfinite(s->r2)) {
-            double r = s->rad; /* the ball itself, unscaled */
-            const double *c = s->center, (*cl)[3] = t->cell[node];
-            int inside = (c[0] - r > cl[0][0]) & (c[0] + r < cl[1][0]) &
-                         (c[1] - r > cl[0][1]) & (c[1] + r < cl[1][1]) &
-                         (c[2] - r > cl[0][2]) & (c[2] + r < cl[1][2]);
-            if (inside)
-                return;
-        }
+        if (ball_inside_cell(s, t, node))
+            return 1;
         uint32_t parent = t->parent[node], l = t->nodes[parent].left;
         uint32_t sib = l + (node == l);
         /* The sibling's ball test here rather than in a walk of its own:
@@ -1234,6 +1259,9 @@ void fdt_apex_search_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start,
             apex_walk(s, t, sib, d2, kq);
         node = parent;
     }
+    /* The whole tree is searched; the root's cell is its region
+     * (fdt_kd_set_region; all of space unless set). */
+    return ball_inside_cell(s, t, 0);
 }
 
 typedef struct inside_ctx {

@@ -127,9 +127,17 @@ void fdt_apex_init(fdt_apex *s, const double *a, const double *b,
 void fdt_apex_offer(fdt_apex *s, uint32_t id, const double *d, fdt_kdq *kq);
 void fdt_apex_search(fdt_apex *s, const fdt_kdtree *t, fdt_kdq *kq);
 /* The same search over tree t, starting from the leaf that holds point
- * `start` (in t) and climbing: cheaper when the apex is near `start`. */
-void fdt_apex_search_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start,
-                          fdt_kdq *kq);
+ * `start` (in t) and climbing: cheaper when the apex is near `start`.
+ * Returns 1 when the final ball lies strictly inside a cell of t, and so
+ * inside t's region (fdt_kd_set_region): no point outside that region can
+ * then improve s; 0 otherwise. */
+int fdt_apex_search_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start, fdt_kdq *kq);
+
+/* Sets the region of tree t, the box [lo, hi] that holds its points and
+ * no point of any other tree searched with it (a part's cell of the
+ * coordinate bisection; points of other parts may lie on its boundary,
+ * not inside). Default: all of space. The climb's cells are bounded by it. */
+void fdt_kd_set_region(fdt_kdtree *t, const double lo[3], const double hi[3]);
 /* Whether the box [lo, hi] could hold a point that improves s. */
 int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi);
 

@@ -918,11 +918,13 @@ static int advance_one(worker *w)
     fdt_apex ap;
     fdt_apex_init(&ap, a, b, c, f[0], f[1], f[2]);
     /* Our own tree first, climbing from the leaf of f[0] (ours): the apex
-     * is nearly always near the face, so the other parts are then mostly
-     * ruled out by their bounding boxes. */
-    fdt_apex_search_from(&ap, w->tree, f[0], &w->kq);
+     * is nearly always near the face. When the final ball lies inside our
+     * part's region (src/partition.c, regions()), no other part's point
+     * can be in it and the others are not asked at all; otherwise their
+     * bounding boxes rule most of them out. */
+    int inside = fdt_apex_search_from(&ap, w->tree, f[0], &w->kq);
     qbuf qb = {{{0}}, 0};
-    int err = search_others(w, &ap, &qb);
+    int err = inside ? FDT_OK : search_others(w, &ap, &qb);
     if (err)
         return err;
     if (ap.best == FDT_NONE) {

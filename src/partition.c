@@ -41,12 +41,14 @@ static void rcb(rcb_ctx *rc, int id, uint32_t begin, uint32_t end, int p0,
     nd->begin = begin;
     nd->end = end;
     if (k == 1) {
+        nd->dim = 0;
         nd->left = -1;
         nd->part = p0;
         pt->start[p0] = begin;
         return;
     }
     nd->part = -1;
+    nd->dim = 0;
     int a = k / 2;
     uint64_t count = end - begin;
     /* round(count * a / k), in integers: count < 2^32, a < 2^10. */
@@ -60,12 +62,46 @@ static void rcb(rcb_ctx *rc, int id, uint32_t begin, uint32_t end, int p0,
                 dim = d;
             }
         fdt_kd_select(rc->P, rc->orig, begin, end, begin + nleft, dim);
+        nd->dim = dim;
     }
     int left = pt->nnodes;
     pt->nnodes += 2;
     nd->left = left;
     rcb(rc, left, begin, begin + nleft, p0, a);
     rcb(rc, left + 1, begin + nleft, end, p0 + a, k - a);
+}
+
+/*
+ * The region of every part below node id, whose own region is [lo, hi]:
+ * as the kd-tree's cells (src/kdtree.c, climb_tables), the left child's
+ * region ends at the right child's smallest coordinate on the split axis
+ * and the right child's begins at the left child's largest, so each part's
+ * region holds its points and no other part's point inside it (they may
+ * lie on its boundary). An empty child's box (lo > hi) leaves its
+ * sibling's region unbounded on that side.
+ */
+static void regions(const fdt_partition *pt, int id, const double lo[3], const double hi[3],
+                    double (*out)[2][3])
+{
+    const fdt_pnode *nd = &pt->nodes[id];
+    if (nd->left < 0) {
+        memcpy(out[nd->part][0], lo, 3 * sizeof *lo);
+        memcpy(out[nd->part][1], hi, 3 * sizeof *hi);
+        return;
+    }
+    const fdt_pnode *l = &pt->nodes[nd->left], *r = l + 1;
+    int d = nd->dim;
+    double llo[3], lhi[3], rlo[3], rhi[3];
+    memcpy(llo, lo, sizeof llo);
+    memcpy(lhi, hi, sizeof lhi);
+    memcpy(rlo, lo, sizeof rlo);
+    memcpy(rhi, hi, sizeof rhi);
+    if (r->begin < r->end && r->lo[d] < lhi[d])
+        lhi[d] = r->lo[d];
+    if (l->begin < l->end && l->hi[d] > rlo[d])
+        rlo[d] = l->hi[d];
+    regions(pt, nd->left, llo, lhi, out);
+    regions(pt, nd->left + 1, rlo, rhi, out);
 }
 
 /* The parts' trees are independent (each permutes only its own id range
@@ -75,6 +111,7 @@ typedef struct tree_jobs {
     double *P;
     fdt_vid *orig;
     int leaf_size;
+    double (*region)[2][3]; /* each part's (regions()) */
     /* The next part to build. Relaxed: the counter only hands out each
      * index once (fetch_add is atomic whatever the order); what a builder
      * wrote is published to the caller by pthread_join. */
@@ -96,6 +133,8 @@ static void *build_trees(void *arg)
         if (n > 0 && fdt_kd_build(&pt->trees[p], j->P, j->orig, pt->start[p], n,
                                   j->leaf_size) != FDT_OK)
             atomic_store_explicit(&j->failed, 1, memory_order_relaxed);
+        else if (n > 0)
+            fdt_kd_set_region(&pt->trees[p], j->region[p][0], j->region[p][1]);
     }
 }
 
@@ -118,7 +157,15 @@ int fdt_partition_build(fdt_partition *pt, double *P, fdt_vid *orig,
     rcb_ctx rc = {pt, P, orig};
     rcb(&rc, 0, 0, m, 0, nparts);
     pt->start[nparts] = m;
-    tree_jobs j = {pt, P, orig, leaf_size, 0, 0};
+    double(*region)[2][3] = malloc((size_t)nparts * sizeof *region);
+    if (!region) {
+        fdt_partition_free(pt);
+        return FDT_ENOMEM;
+    }
+    const double all_lo[3] = {-INFINITY, -INFINITY, -INFINITY};
+    const double all_hi[3] = {INFINITY, INFINITY, INFINITY};
+    regions(pt, 0, all_lo, all_hi, region);
+    tree_jobs j = {pt, P, orig, leaf_size, region, 0, 0};
     atomic_init(&j.next, 0);
     atomic_init(&j.failed, 0);
     if (nworkers > nparts)
@@ -134,6 +181,7 @@ int fdt_partition_build(fdt_partition *pt, double *P, fdt_vid *orig,
     build_trees(&j);
     for (int i = 0; i < started; i++)
         pthread_join(th[i], NULL);
+    free(region);
     if (atomic_load_explicit(&j.failed, memory_order_relaxed)) {
         fdt_partition_free(pt);
         return FDT_ENOMEM;

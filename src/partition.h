@@ -26,6 +26,7 @@ typedef struct fdt_pnode {
     uint32_t begin, end;   /* global ids [begin, end) */
     int32_t left;          /* first child (right is left + 1); -1: a part */
     int32_t part;          /* the part of a leaf; -1 for inner nodes */
+    int32_t dim;           /* split dimension of an inner node */
 } fdt_pnode;
 
 typedef struct fdt_partition {

@@ -75,9 +75,12 @@ int main(void)
     memset(small, 1, sizeof small);
 
     size_t bytes = (size_t)16 << 20;
-    unsigned char *p = malloc(bytes), *ctl = malloc(bytes);
-    CHECK(p && ctl, "malloc");
-    if (!p || !ctl)
+    /* mmap, not malloc: meson's MALLOC_PERTURB_ makes malloc write the
+     * memory it returns, and a page written before the hint stays small */
+    unsigned char *p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    unsigned char *ctl = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    CHECK(p != MAP_FAILED && ctl != MAP_FAILED, "mmap");
+    if (p == MAP_FAILED || ctl == MAP_FAILED)
         return 1;
     fdt_mem_advise_huge(p + 3, bytes - 3);
     uintptr_t clo = ((uintptr_t)ctl + (2u << 20) - 1) & ~(uintptr_t)((2u << 20) - 1);
@@ -101,8 +104,8 @@ int main(void)
         printf("mem: no huge pages granted on request here (control %ld kB); usability only\n",
                ckb);
     }
-    free(p);
-    free(ctl);
+    munmap(p, bytes);
+    munmap(ctl, bytes);
     if (failures) {
         fprintf(stderr, "%d failures\n", failures);
         return 1;
