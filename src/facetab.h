@@ -69,6 +69,27 @@ static inline void fdt_facetab_prefetch(const fdt_facetab *t, const uint32_t v[3
     fdt_prefetch(&t->slots[fdt_face_hash(v) & (t->cap - 1)]);
 }
 
+/* The same for the three faces other than f of the tet (f0, f1, f2, d),
+ * the faces a tet built on front face f adds (nothing if d is FDT_NONE,
+ * UINT32_MAX). */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void fdt_facetab_prefetch_tet(const fdt_facetab *t, const uint32_t f[3], uint32_t d)
+{
+    if (d == UINT32_MAX)
+        return;
+    uint32_t fc[3];
+    /* faces 0-2 of fdt_tet_face (src/front.h) with the apex as vertex 3:
+     * (f1, f2, d), (f0, d, f2), (f0, f1, d); only the vertex sets matter */
+    fdt_face_canon(f[1], f[2], d, fc);
+    fdt_facetab_prefetch(t, fc);
+    fdt_face_canon(f[0], d, f[2], fc);
+    fdt_facetab_prefetch(t, fc);
+    fdt_face_canon(f[0], f[1], d, fc);
+    fdt_facetab_prefetch(t, fc);
+}
+
 /* Removes the face in slot s (a pointer returned by find). */
 void fdt_facetab_remove(fdt_facetab *t, fdt_face *s);
 

@@ -188,8 +188,13 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
         fdt_apex ap;
         fdt_apex_init(&ap, P + 3 * (size_t)f[0], P + 3 * (size_t)f[1], P + 3 * (size_t)f[2],
                       f[0], f[1], f[2]);
-        /* Start in f0's leaf and climb (src/kdtree.c): the apex is near. */
-        fdt_apex_search_from(&ap, t, f[0], &st->kq);
+        /* Start in f0's leaf and climb (src/kdtree.c): the apex is near.
+         * Between the guess and the climb, the table slots of the faces
+         * the guessed tet would add are asked for: the climb hides their
+         * latency, and the guess is the apex for most faces. */
+        fdt_apex_guess(&ap, t, f[0], &st->kq);
+        fdt_facetab_prefetch_tet(&ft, f, ap.best);
+        fdt_apex_verify_from(&ap, t, f[0], &st->kq);
         if (ap.best == FDT_NONE) {
             /* Nothing on the open side: a convex-hull face (§2.2). Its
              * open side is the outside, so f is already outward. */

@@ -1234,14 +1234,25 @@ static inline int ball_inside_cell(const fdt_apex *s, const fdt_kdtree *t, uint3
            (c[1] + r < cl[1][1]) & (c[2] - r > cl[0][2]) & (c[2] + r < cl[1][2]);
 }
 
+void fdt_apex_guess(fdt_apex *s, const fdt_kdtree *t, uint32_t start, fdt_kdq *kq)
+{
+    if (t->leafof)
+        offer_likely_apex(s, t, t->leafof[start - t->base], kq);
+}
+
 int fdt_apex_search_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start, fdt_kdq *kq)
+{
+    fdt_apex_guess(s, t, start, kq);
+    return fdt_apex_verify_from(s, t, start, kq);
+}
+
+int fdt_apex_verify_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start, fdt_kdq *kq)
 {
     if (!t->leafof) { /* not a tree of fdt_kd_build: no climb tables */
         fdt_apex_search(s, t, kq);
         return 0;
     }
     uint32_t node = t->leafof[start - t->base];
-    offer_likely_apex(s, t, node, kq);
     const fdt_kdnode *nd = &t->nodes[node];
     apex_walk(s, t, node, fdt_box_dist2_sc(nd->lo, nd->hi, s->center, s->sc), kq);
     while (node != 0) {

@@ -133,6 +133,13 @@ void fdt_apex_search(fdt_apex *s, const fdt_kdtree *t, fdt_kdq *kq);
  * then improve s; 0 otherwise. */
 int fdt_apex_search_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start, fdt_kdq *kq);
 
+/* fdt_apex_search_from in two halves, for callers with work to start in
+ * between: the first candidate from the leaves of the face's vertices
+ * (the apex for most faces), then the climb that verifies or improves it.
+ * fdt_apex_verify_from returns what fdt_apex_search_from does. */
+void fdt_apex_guess(fdt_apex *s, const fdt_kdtree *t, uint32_t start, fdt_kdq *kq);
+int fdt_apex_verify_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start, fdt_kdq *kq);
+
 /* Sets the region of tree t, the box [lo, hi] that holds its points and
  * no point of any other tree searched with it (a part's cell of the
  * coordinate bisection; points of other parts may lie on its boundary,

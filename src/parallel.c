@@ -922,7 +922,10 @@ static int advance_one(worker *w)
      * part's region (src/partition.c, regions()), no other part's point
      * can be in it and the others are not asked at all; otherwise their
      * bounding boxes rule most of them out. */
-    int inside = fdt_apex_search_from(&ap, w->tree, f[0], &w->kq);
+    fdt_apex_guess(&ap, w->tree, f[0], &w->kq);
+    /* the guessed tet's face slots, as in src/front.c */
+    fdt_facetab_prefetch_tet(&w->ft, f, ap.best);
+    int inside = fdt_apex_verify_from(&ap, w->tree, f[0], &w->kq);
     qbuf qb = {{{0}}, 0};
     int err = inside ? FDT_OK : search_others(w, &ap, &qb);
     if (err)
