@@ -542,6 +542,30 @@ void fdt_apex_init(fdt_apex *s, const double *a, const double *b,
     s->nabs[0] = fabs(u[1] * v[2]) + fabs(u[2] * v[1]);
     s->nabs[1] = fabs(u[2] * v[0]) + fabs(u[0] * v[2]);
     s->nabs[2] = fabs(u[0] * v[1]) + fabs(u[1] * v[0]);
+    s->best = FDT_NONE;
+    s->bp = NULL;
+    s->aimed = 0;
+    memcpy(s->center, a, sizeof s->center); /* the target once aimed */
+    s->sc = 1.0;
+    s->r2 = INFINITY;
+    s->rad = INFINITY;
+    s->ver = 0;
+}
+
+/* The target, computed only when a search runs without a candidate: the
+ * first guess (offer_likely_apex) nearly always gives one, and the target's
+ * three square roots were a tenth of the setup of every face. */
+void fdt_apex_aim(fdt_apex *s)
+{
+    if (s->aimed)
+        return;
+    s->aimed = 1;
+    const double *a = s->a, *b = s->b, *c = s->c;
+    double u[3], v[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = b[k] - a[k];
+        v[k] = c[k] - a[k];
+    }
     /* Look first where the apex of a well-shaped tet would be: above the
      * centroid by about half an edge. */
     double nn = norm3(s->nrm);
@@ -550,13 +574,8 @@ void fdt_apex_init(fdt_apex *s, const double *a, const double *b,
         double g = (a[k] + b[k] + c[k]) / 3.0;
         s->target[k] = nn > 0 ? g + s->nrm[k] / nn * len * 0.6 : g;
     }
-    s->best = FDT_NONE;
-    s->bp = NULL;
-    memcpy(s->center, s->target, sizeof s->center); /* see apex_walk */
-    s->sc = 1.0;
-    s->r2 = INFINITY;
-    s->rad = INFINITY;
-    s->ver = 0;
+    if (s->best == FDT_NONE)
+        memcpy(s->center, s->target, sizeof s->center); /* see apex_walk */
 }
 
 /*
@@ -917,6 +936,8 @@ static void apex_walk(fdt_apex *s, const fdt_kdtree *t, uint32_t root,
     uint32_t stack[WALK_STACK], sver[WALK_STACK];
     double sd2[WALK_STACK];
     int sp = 0;
+    if (s->best == FDT_NONE)
+        fdt_apex_aim(s); /* order the children by the target */
     /* root_d2: the root's distance to the current ball, from the caller */
     stack[sp] = root;
     sd2[sp] = root_d2;

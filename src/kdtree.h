@@ -109,7 +109,8 @@ typedef struct fdt_apex {
     uint32_t ia, ib, ic;
     double nrm[3];       /* (b-a) x (c-a): points to the open side */
     double nabs[3];      /* |components| permanent for the side filter */
-    double target[3];    /* where the search looks first */
+    double target[3];    /* where the search looks first, once aimed */
+    int aimed;           /* target set (fdt_apex_aim) */
     uint32_t best;       /* FDT_NONE until a candidate is found */
     const double *bp;    /* coordinates of best */
     double center[3];    /* conservative search ball of the best sphere */
@@ -122,6 +123,9 @@ typedef struct fdt_apex {
 
 void fdt_apex_init(fdt_apex *s, const double *a, const double *b,
                    const double *c, uint32_t ia, uint32_t ib, uint32_t ic);
+/* Sets s->target (and the centre while there is no candidate): done by
+ * the searches when they need it; callers that read target call it. */
+void fdt_apex_aim(fdt_apex *s);
 /* Offers one point (global id, coordinates) to the search: used by the
  * tree walk and by answers that arrive from other partitions. */
 void fdt_apex_offer(fdt_apex *s, uint32_t id, const double *d, fdt_kdq *kq);

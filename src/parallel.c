@@ -871,6 +871,8 @@ static int search_others(worker *w, fdt_apex *s, qbuf *qb)
         }
         const fdt_pnode *l = &pt->nodes[nd->left], *r = l + 1;
         int ball = s->best != FDT_NONE && isfinite(s->r2);
+        if (!ball)
+            fdt_apex_aim(s);
         const double *q = ball ? s->center : s->target;
         double sc = ball ? s->sc : 1.0;
         double dl = l->begin < l->end ? fdt_box_dist2_sc(l->lo, l->hi, q, sc) : INFINITY;
