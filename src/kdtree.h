@@ -51,6 +51,7 @@ typedef struct fdt_kdtree {
      * the leaf's own, for the apex search's first, conservative tests
      * (src/kdtree.c, "Float blocks"). */
     float *fl;
+    int avx2;              /* the float-block kernels may use AVX2 */
 } fdt_kdtree;
 
 /* Per-thread counters of the queries' work (owned by the querying thread). */
