@@ -222,9 +222,9 @@ static void radix_pass(const uint32_t *src, uint32_t *dst, size_t n, int stride,
                src + stride * i, bytes);
 }
 
-/* The rest of a 4-word record's key after its first word, as one number:
- * t1, then min(t2, t3), then max(t2, t3), 32 bits... and less: ids are
- * below 2^32, so (t1, min) fills 64 bits and max breaks the ties. */
+/* The rest of a 4-word record's key after its first word: t1 and
+ * min(t2, t3) packed into one 64-bit number (*hi), max(t2, t3) for the
+ * ties (*lo); comparing (hi, lo) is comparing the key. */
 static inline void key_rest(const uint32_t *t, uint64_t *hi, uint32_t *lo)
 {
     uint32_t mn = t[2] < t[3] ? t[2] : t[3], mx = t[2] < t[3] ? t[3] : t[2];
