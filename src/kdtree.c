@@ -138,9 +138,10 @@ static void build_rec(build_ctx *bc, uint32_t id, uint32_t begin, uint32_t end)
         }
     /* Split into the leaves this node needs, nl = ceil(c / leaf), half
      * of them on each side, rather than into halves of the points: every
-     * leaf then holds c / nl, between leaf (1 - 1/nl) and leaf points,
-     * where halving gave anything from leaf / 2 to leaf as n varied
-     * (15.3 points a leaf at 1M with leaf 18, 12.2 at 200k). */
+     * leaf then holds about c / nl points (at most leaf, at least leaf /
+     * 2), close to leaf wherever nl is large, where halving gave anything
+     * from leaf / 2 to leaf as n varied (15.3 points a leaf at 1M with
+     * leaf 18, 12.2 at 200k). */
     uint32_t c = end - begin, nl = (c + bc->leaf - 1) / bc->leaf;
     uint32_t mid = begin + (uint32_t)(((uint64_t)c * (nl / 2)) / nl);
     select_k(bc->P, bc->orig, begin, end, mid, dim);
@@ -152,18 +153,6 @@ static void build_rec(build_ctx *bc, uint32_t id, uint32_t begin, uint32_t end)
     build_rec(bc, left + 1, mid, end);
 }
 
-/*
- * The tables of fdt_apex_search_from's climb. A node's cell is the region
- * its ancestors' splits give it. The split value itself is not stored
- * (the children's later splits reorder their points), but every left
- * point is <= it <= every right point, so the right child's smallest
- * coordinate bounds the left cell from above and the left child's
- * largest bounds the right cell from below: cells a little larger than
- * the true ones, still disjoint from the sibling's points. Nodes are
- * numbered parents before children, so one pass in index order fills
- * them. About 60 bytes a leaf's worth of points (1M points: 13 MB); they
- * replaced a root-to-leaf descent a face (about 400 instructions).
- */
 /* Every node's cell from the root's (cell[0]): parents before children,
  * as nodes are numbered, so one pass in index order. */
 static void fill_cells(fdt_kdtree *t)
@@ -180,6 +169,18 @@ static void fill_cells(fdt_kdtree *t)
     }
 }
 
+/*
+ * The tables of fdt_apex_search_from's climb. A node's cell is the region
+ * its ancestors' splits give it. The split value itself is not stored
+ * (the children's later splits reorder their points), but every left
+ * point is <= it <= every right point, so the right child's smallest
+ * coordinate bounds the left cell from above and the left child's
+ * largest bounds the right cell from below: cells a little larger than
+ * the true ones, still disjoint from the sibling's points. Nodes are
+ * numbered parents before children, so one pass in index order fills
+ * them. About 60 bytes a leaf's worth of points (1M points: 13 MB); they
+ * replaced a root-to-leaf descent a face (about 400 instructions).
+ */
 static int climb_tables(fdt_kdtree *t)
 {
     t->parent = malloc((size_t)t->nnodes * sizeof *t->parent);
