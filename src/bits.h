@@ -1,10 +1,31 @@
 /* Small helpers shared by modules: bit scans (src/kdtree.c, src/faceq.c,
- * src/result.c) and a prefetch hint (src/facetab.h, src/prepare.c,
+ * src/result.c), powers of two from a double's bits (src/kdtree.c,
+ * src/prepare.c) and a prefetch hint (src/facetab.h, src/prepare.c,
  * src/check.c). */
 #ifndef FDT_BITS_H
 #define FDT_BITS_H
 
 #include <stdint.h>
+#include <string.h>
+
+/* 2^k for -1022 <= k <= 1023, built from its bits: exact, and several
+ * times cheaper than ldexp(1.0, k). */
+static inline double fdt_pow2i(int k)
+{
+    uint64_t b = (uint64_t)(k + 1023) << 52;
+    double x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+/* For a normal x > 0 (DBL_MIN <= x <= DBL_MAX): the e with x in
+ * [2^(e-1), 2^e), frexp's exponent, read from the bits. */
+static inline int fdt_exp2_normal(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return (int)((b >> 52) & 0x7ff) - 1022;
+}
 
 /* Index of the lowest set bit of m != 0. */
 static inline int fdt_ctz64(uint64_t m)

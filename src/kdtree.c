@@ -19,15 +19,6 @@
 #include "bits.h"
 #include "mem.h"
 
-/* 2^k for -1022 <= k <= 1023, built from its bits. */
-static inline double pow2i(int k)
-{
-    uint64_t b = (uint64_t)(k + 1023) << 52;
-    double x;
-    memcpy(&x, &b, sizeof x);
-    return x;
-}
-
 void fdt_kd_free(fdt_kdtree *t)
 {
     free(t->nodes);
@@ -261,10 +252,8 @@ static inline double leaf_scale(const fdt_kdnode *nd)
         return 1.0; /* one point, at lo: every X is 0 */
     if (!(ext >= DBL_MIN && ext <= DBL_MAX))
         return 0.0;
-    uint64_t bits;
-    memcpy(&bits, &ext, sizeof bits);
-    int e = (int)((bits >> 52) & 0x7ff) - 1022; /* ext in [2^(e-1), 2^e) */
-    return e >= -1000 && e <= 1000 ? pow2i(-e) : 0.0;
+    int e = fdt_exp2_normal(ext); /* ext in [2^(e-1), 2^e) */
+    return e >= -1000 && e <= 1000 ? fdt_pow2i(-e) : 0.0;
 }
 
 /* Rows of a leaf's block are this many floats apart. */
@@ -681,9 +670,7 @@ static void update_ball(fdt_apex *s)
      * input mixes magnitudes (1e-149 next to 1e151 after scaling). */
     int e;
     if (big >= DBL_MIN && big <= DBL_MAX) { /* normal: read the exponent */
-        uint64_t bits;
-        memcpy(&bits, &big, sizeof bits);
-        e = (int)((bits >> 52) & 0x7ff) - 1022; /* big in [2^(e-1), 2^e) */
+        e = fdt_exp2_normal(big); /* big in [2^(e-1), 2^e) */
     } else {
         (void)frexp(big, &e);
     }
@@ -693,8 +680,8 @@ static void update_ball(fdt_apex *s)
      * difference is not itself near the ends of the double range. */
     double down, up;
     if (e >= -1000 && e <= 1000) {
-        down = pow2i(-e);
-        up = pow2i(e);
+        down = fdt_pow2i(-e);
+        up = fdt_pow2i(e);
     } else {
         down = up = 0.0; /* marks the ldexp path */
     }
@@ -1219,12 +1206,9 @@ static int guess_leaf_fl(const fdt_apex *s, const fdt_kdtree *t, const fdt_kdnod
 #endif
         guess_sse(B, row, n, F, xb, xc, &bt, &bi);
     *best = bi >= 0 && bt < INFINITY ? nd->begin + (uint32_t)bi : FDT_NONE;
-    /* 1 / sl is a power of two too: its exponent field is mirrored */
-    uint64_t sb;
-    memcpy(&sb, &sl, sizeof sb);
-    sb = (UINT64_C(2046) - (sb >> 52)) << 52;
-    double inv_sl;
-    memcpy(&inv_sl, &sb, sizeof inv_sl);
+    /* sl = 2^(s - 1), s = fdt_exp2_normal(sl), so 1 / sl = 2^(1 - s),
+     * exactly and without a division */
+    double inv_sl = fdt_pow2i(1 - fdt_exp2_normal(sl));
     *tau = *best != FDT_NONE ? (double)bt * inv_sl * inv_en : INFINITY;
     return 1;
 }
@@ -1317,11 +1301,9 @@ static void offer_likely_apex(fdt_apex *s, const fdt_kdtree *t, uint32_t leaf,
     nmax = nmax > fabs(N[2]) ? nmax : fabs(N[2]);
     double ns[3] = {0.0, 0.0, 0.0}, inv_en = 0.0;
     if (t->fl && nmax >= DBL_MIN && nmax <= DBL_MAX) {
-        uint64_t bits;
-        memcpy(&bits, &nmax, sizeof bits);
-        int en = (int)((bits >> 52) & 0x7ff) - 1022;
+        int en = fdt_exp2_normal(nmax);
         if (en >= -1000 && en <= 1000) {
-            inv_en = pow2i(-en);
+            inv_en = fdt_pow2i(-en);
             for (int k = 0; k < 3; k++)
                 ns[k] = N[k] * inv_en;
         }
