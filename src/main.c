@@ -578,6 +578,19 @@ static int exit_for_engine(int err)
     }
 }
 
+/* Threads for reading a text file: those of the triangulation, at most
+ * one an online CPU (more only take turns); one in serial mode, so that
+ * mode stays sequential from end to end. */
+static int reader_threads(const cli *c)
+{
+    if (c->mode == FDT_MODE_SERIAL || c->threads == 1)
+        return 1;
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    if (cpus < 1)
+        return 1;
+    return c->threads > 1 && c->threads < cpus ? c->threads : (int)(cpus > 64 ? 64 : cpus);
+}
+
 static int exit_for_reader(int err)
 {
     return err == FDT_IO_ENOMEM ? CLI_RESOURCES : CLI_INPUT;
@@ -826,7 +839,8 @@ static int run(const cli *c)
         }
     } else {
         char err[1024];
-        int r = fdt_read_points(c->input, &xyz, &n, err, sizeof err);
+        int r = fdt_read_points_threads(c->input, reader_threads(c), 0, &xyz, &n, err,
+                                        sizeof err);
         if (r != FDT_IO_OK) {
             say("%s", err);
             return exit_for_reader(r);

@@ -26,6 +26,7 @@
 #include <float.h>
 #include <locale.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -60,7 +61,12 @@ typedef struct rd_ctx {
     size_t errlen;
     const char *buf; /* the whole file, NUL-terminated (owned by the caller) */
     size_t size;     /* bytes in the file (the NUL not counted) */
+    int threads;      /* for .xyz: slices parsed at once (rd_read_xyz) */
+    size_t min_slice; /* least bytes a slice; 0: RD_MIN_SLICE */
 } rd_ctx;
+
+/* Below a megabyte a slice's thread costs about what it saves. */
+#define RD_MIN_SLICE ((size_t)1 << 20)
 
 typedef struct rd_points {
     double *xyz; /* 3 * cap doubles */
@@ -576,16 +582,19 @@ static int rd_points_reserve(rd_points *pb, size_t cap)
 /* .xyz / .txt                                                        */
 /* ------------------------------------------------------------------ */
 
-static int rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb)
+/* The lines in [start, end) (end: c->buf + c->size or just after a '\n')
+ * appended to pb. Every line is parsed on its own: nothing carries from
+ * one line to the next, which is what lets rd_read_xyz cut the file. */
+static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end,
+                             rd_points *pb)
 {
-    size_t rem = c->size - (size_t)(start - c->buf);
     /* A guess from typical line lengths; the array doubles as needed. */
-    size_t guess = rem / 24 + 16;
+    size_t guess = (size_t)(end - start) / 24 + 16;
     if (guess > RD_MAX_POINTS) /* the growth below checks the limit at cap */
         guess = (size_t)RD_MAX_POINTS;
     if (rd_points_reserve(pb, guess) != 0)
         return rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
-    rd_lines L = {start, c->buf + c->size, 0};
+    rd_lines L = {start, end, 0};
     const char *s, *e;
     while (rd_next_line(&L, &s, &e)) {
         rd_fields f = {s, rd_cut_comment(s, e), 1, 0};
@@ -643,6 +652,103 @@ static int rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb)
         memcpy(pb->xyz + 3 * pb->n, v, sizeof v);
         pb->n++;
     }
+    return FDT_IO_OK;
+}
+
+/*
+ * .xyz on several threads: the text is cut into slices at line ends, one a
+ * thread, each parsed by rd_read_xyz_lines into its own array, and the
+ * arrays are joined in file order. The slices see no messages (their
+ * rd_ctx has no buffer, and their line numbers would count from the
+ * slice): if any slice fails, the whole text is parsed again on the
+ * calling thread, which finds the first error of the file and words it
+ * exactly as a one-thread read does. So results and messages never depend
+ * on the thread count, and bad files, rare and usually caught early, pay
+ * for a second pass.
+ */
+#define RD_SLICES_MAX 64
+
+typedef struct rd_slice {
+    rd_ctx c; /* no message buffer */
+    const char *start, *end;
+    rd_points pb;
+    int rc;
+} rd_slice;
+
+static void *rd_slice_run(void *arg)
+{
+    rd_slice *sl = arg;
+    sl->rc = rd_read_xyz_lines(&sl->c, sl->start, sl->end, &sl->pb);
+    return NULL;
+}
+
+static int rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb)
+{
+    const char *end = c->buf + c->size;
+    size_t len = (size_t)(end - start);
+    size_t min_slice = c->min_slice ? c->min_slice : RD_MIN_SLICE;
+    size_t T = c->threads > 1 ? (size_t)c->threads : 1;
+    if (T > RD_SLICES_MAX)
+        T = RD_SLICES_MAX;
+    if (T > len / min_slice)
+        T = len / min_slice;
+    if (T < 2)
+        return rd_read_xyz_lines(c, start, end, pb);
+
+    rd_slice sl[RD_SLICES_MAX];
+    pthread_t tid[RD_SLICES_MAX];
+    int made[RD_SLICES_MAX];
+    const char *cut = start;
+    for (size_t t = 0; t < T; t++) {
+        /* Slice t ends at the first line end at or after its share. */
+        const char *want = start + len * (t + 1) / T, *stop = end;
+        if (t + 1 < T && want > cut) {
+            const char *nl = memchr(want - 1, '\n', (size_t)(end - want + 1));
+            stop = nl != NULL ? nl + 1 : end;
+        } else if (t + 1 < T) {
+            stop = cut;
+        }
+        sl[t].c = *c;
+        sl[t].c.err = NULL;
+        sl[t].c.errlen = 0;
+        sl[t].start = cut;
+        sl[t].end = stop;
+        sl[t].pb = (rd_points){NULL, 0, 0};
+        sl[t].rc = FDT_IO_OK;
+        cut = stop;
+    }
+    /* Slice 0 on this thread; a slice whose thread cannot be created runs
+     * here after it (the result is the same, only slower). */
+    for (size_t t = 1; t < T; t++)
+        made[t] = pthread_create(&tid[t], NULL, rd_slice_run, &sl[t]) == 0;
+    rd_slice_run(&sl[0]);
+    int ok = sl[0].rc == FDT_IO_OK;
+    size_t total = sl[0].pb.n;
+    for (size_t t = 1; t < T; t++) {
+        if (made[t])
+            pthread_join(tid[t], NULL); /* orders the slice's writes before our reads */
+        else
+            rd_slice_run(&sl[t]);
+        ok = ok && sl[t].rc == FDT_IO_OK;
+        total += sl[t].pb.n;
+    }
+    /* Join into slice 0's array, grown in place where the allocator can. */
+    if (ok && total <= RD_MAX_POINTS && rd_points_reserve(&sl[0].pb, total) == 0) {
+        for (size_t t = 1; t < T; t++) {
+            memcpy(sl[0].pb.xyz + 3 * sl[0].pb.n, sl[t].pb.xyz, 3 * sl[t].pb.n * sizeof(double));
+            sl[0].pb.n += sl[t].pb.n;
+        }
+    } else {
+        ok = 0;
+    }
+    for (size_t t = 1; t < T; t++)
+        free(sl[t].pb.xyz);
+    if (!ok) {
+        free(sl[0].pb.xyz);
+        return rd_read_xyz_lines(c, start, end, pb);
+    }
+    free(pb->xyz);
+    *pb = sl[0].pb;
     return FDT_IO_OK;
 }
 
@@ -1651,10 +1757,10 @@ static int rd_bad_extension(const rd_ctx *c, const char *ext)
                    rd_quote(q, ext, strlen(ext)));
 }
 
-int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
-                    size_t errlen)
+static int rd_read_path(const char *path, int threads, size_t min_slice, double **xyz,
+                        size_t *n, char *err, size_t errlen)
 {
-    rd_ctx c = {path != NULL ? path : "(null)", err, errlen, NULL, 0};
+    rd_ctx c = {path != NULL ? path : "(null)", err, errlen, NULL, 0, threads, min_slice};
     rd_begin(&c, xyz, n);
     if (path == NULL || xyz == NULL || n == NULL)
         return rd_fail(&c, FDT_IO_EOPEN, ": invalid arguments");
@@ -1691,10 +1797,10 @@ int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
     return rc;
 }
 
-int fdt_read_points_mem(const char *name, const void *data, size_t len,
-                        double **xyz, size_t *n, char *err, size_t errlen)
+static int rd_read_mem(const char *name, const void *data, size_t len, int threads,
+                       size_t min_slice, double **xyz, size_t *n, char *err, size_t errlen)
 {
-    rd_ctx c = {name != NULL ? name : "(null)", err, errlen, NULL, 0};
+    rd_ctx c = {name != NULL ? name : "(null)", err, errlen, NULL, 0, threads, min_slice};
     rd_begin(&c, xyz, n);
     if (name == NULL || (data == NULL && len > 0) || xyz == NULL || n == NULL)
         return rd_fail(&c, FDT_IO_EOPEN, ": invalid arguments");
@@ -1719,4 +1825,29 @@ int fdt_read_points_mem(const char *name, const void *data, size_t len,
     int rc = rd_parse(&c, kind, xyz, n);
     free(buf);
     return rc;
+}
+
+int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
+                    size_t errlen)
+{
+    return rd_read_path(path, 1, 0, xyz, n, err, errlen);
+}
+
+int fdt_read_points_threads(const char *path, int threads, size_t min_slice, double **xyz,
+                            size_t *n, char *err, size_t errlen)
+{
+    return rd_read_path(path, threads, min_slice, xyz, n, err, errlen);
+}
+
+int fdt_read_points_mem(const char *name, const void *data, size_t len,
+                        double **xyz, size_t *n, char *err, size_t errlen)
+{
+    return rd_read_mem(name, data, len, 1, 0, xyz, n, err, errlen);
+}
+
+int fdt_read_points_mem_threads(const char *name, const void *data, size_t len, int threads,
+                                size_t min_slice, double **xyz, size_t *n, char *err,
+                                size_t errlen)
+{
+    return rd_read_mem(name, data, len, threads, min_slice, xyz, n, err, errlen);
 }

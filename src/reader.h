@@ -65,4 +65,19 @@ int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
 int fdt_read_points_mem(const char *name, const void *data, size_t len,
                         double **xyz, size_t *n, char *err, size_t errlen);
 
+/*
+ * The same reads on up to `threads` threads (1 or less: the calling thread
+ * alone, as above). A .xyz/.txt text is cut at line ends into slices of at
+ * least min_slice bytes (0: one megabyte), parsed at once and joined in
+ * file order; the other formats are read on the calling thread. Points,
+ * return codes and messages are those of the one-thread read, for every
+ * thread count: a file with an error is read again on one thread to find
+ * and word its first error.
+ */
+int fdt_read_points_threads(const char *path, int threads, size_t min_slice, double **xyz,
+                            size_t *n, char *err, size_t errlen);
+int fdt_read_points_mem_threads(const char *name, const void *data, size_t len, int threads,
+                                size_t min_slice, double **xyz, size_t *n, char *err,
+                                size_t errlen);
+
 #endif

@@ -478,6 +478,7 @@ typedef struct read_arg {
     size_t len;
     size_t want_n;
     double *want; /* 3 * want_n coordinates (read without injection) */
+    int threads;  /* > 1: the sliced read, slices of a byte and up */
 } read_arg;
 
 static int sc_read(void *arg, const char **bad)
@@ -486,7 +487,13 @@ static int sc_read(void *arg, const char **bad)
     double *xyz = NULL;
     size_t n = 0;
     char err[512];
-    int rc = a->data != NULL
+    int rc = a->threads > 1
+                 ? (a->data != NULL
+                        ? fdt_read_points_mem_threads(a->path, a->data, a->len, a->threads, 1,
+                                                      &xyz, &n, err, sizeof err)
+                        : fdt_read_points_threads(a->path, a->threads, 1, &xyz, &n, err,
+                                                  sizeof err))
+             : a->data != NULL
                  ? fdt_read_points_mem(a->path, a->data, a->len, &xyz, &n,
                                        err, sizeof err)
                  : fdt_read_points(a->path, &xyz, &n, err, sizeof err);
@@ -769,17 +776,20 @@ int main(int argc, char **argv)
     CHECK(lo == 1 && bl > 0 && write_file(p_bply, bply, bl) == 0, "bply");
 
     read_arg reads[] = {
-        {p_xyz, NULL, 0, 5, NULL},
-        {p_node, NULL, 0, 5, NULL},
-        {p_aply, NULL, 0, 4, NULL},
-        {p_bply, NULL, 0, 5, NULL},
-        {"mem.xyz", xyz_text, (size_t)xl, 5, NULL},
-        {"mem.ply", bply, bl, 5, NULL},
+        {p_xyz, NULL, 0, 5, NULL, 1},
+        {p_node, NULL, 0, 5, NULL, 1},
+        {p_aply, NULL, 0, 4, NULL, 1},
+        {p_bply, NULL, 0, 5, NULL, 1},
+        {"mem.xyz", xyz_text, (size_t)xl, 5, NULL, 1},
+        {"mem.ply", bply, bl, 5, NULL, 1},
+        {p_xyz, NULL, 0, 5, NULL, 3},
+        {"mem.xyz", xyz_text, (size_t)xl, 5, NULL, 4},
     };
     static const char *const reads_name[] = {
         "read .xyz (long literal)", "read .node (attributes)",
         "read ascii .ply (lists)", "read binary .ply (lists)",
-        "read_mem .xyz", "read_mem binary .ply"};
+        "read_mem .xyz", "read_mem binary .ply",
+        "read .xyz in 3 slices", "read_mem .xyz in 4 slices"};
     for (size_t i = 0; i < sizeof reads / sizeof reads[0]; i++) {
         reference_read(&reads[i]);
         scenario sc = {reads_name[i], FDT_IO_ENOMEM, sc_read, &reads[i]};
@@ -798,7 +808,7 @@ int main(int argc, char **argv)
             char p[1100], nm[300];
             snprintf(p, sizeof p, "%s/%s", good, de->d_name);
             snprintf(nm, sizeof nm, "read good/%s", de->d_name);
-            read_arg ra = {p, NULL, 0, 10, NULL};
+            read_arg ra = {p, NULL, 0, 10, NULL, 1};
             reference_read(&ra);
             scenario sc = {nm, FDT_IO_ENOMEM, sc_read, &ra};
             inject_all(&sc);

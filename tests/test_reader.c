@@ -209,6 +209,19 @@ static void check_read_ok(tctx *t, int line, const char *path,
             }
         }
     }
+    /* Sliced reads (src/reader.c, rd_read_xyz): slices of a byte and up,
+     * so that even these small files are cut, give the same points. */
+    static const int threads[] = {2, 3, 7};
+    for (size_t k = 0; k < sizeof threads / sizeof *threads && got == n; k++) {
+        double *px = NULL;
+        size_t pn = 0;
+        int prc = fdt_read_points_threads(path, threads[k], 1, &px, &pn, err, sizeof err);
+        t->checks++;
+        if (prc != FDT_IO_OK || pn != n || memcmp(px, xyz, 3 * n * sizeof *xyz) != 0)
+            fail_at(t, line, "%s: %d threads read %s (%zu points), not what one thread read",
+                    path, threads[k], code_name(prc), pn);
+        free(px);
+    }
     free(xyz);
 }
 
@@ -242,6 +255,22 @@ static void check_read_err(tctx *t, int line, const char *path, int code,
         fail_at(t, line, "%s: message is not one line: %s", path, err);
     if (substr != NULL && strstr(err, substr) == NULL)
         fail_at(t, line, "%s: message lacks \"%s\": %s", path, substr, err);
+    /* Sliced reads: the same code and the very same message. */
+    static const int threads[] = {2, 3, 7};
+    for (size_t k = 0; k < sizeof threads / sizeof *threads; k++) {
+        double *px = (double *)&px;
+        size_t pn = 12345;
+        char perr[512];
+        int prc = fdt_read_points_threads(path, threads[k], 1, &px, &pn, perr, sizeof perr);
+        t->checks++;
+        if (prc != rc || px != NULL || pn != 0 || strcmp(perr, err) != 0) {
+            fail_at(t, line, "%s: %d threads: %s \"%s\", one thread: %s \"%s\"", path,
+                    threads[k], code_name(prc), prc == FDT_IO_OK ? "" : perr, code_name(rc),
+                    err);
+            if (prc == FDT_IO_OK)
+                free(px);
+        }
+    }
 }
 
 #define EXPECT_OK(t, path, want, n) check_read_ok((t), __LINE__, path, want, n)
@@ -436,6 +465,73 @@ static void test_xyz_random(tctx *t, const char *tag, size_t npts,
         setlocale(LC_NUMERIC, "C");
     bb_free(&b);
     free(want);
+}
+
+/* A text of several megabytes read in slices at the default slice size
+ * (src/reader.c, rd_read_xyz): the same points for every thread count,
+ * and for errors anywhere (first line, slice ends, last line, two at
+ * once) the one-thread message with the file's own line number. */
+static void test_xyz_sliced(tctx *t)
+{
+    enum { NPTS = 60000 };
+    bbuf b = {0};
+    size_t *line_at = malloc((NPTS + 1) * sizeof *line_at);
+    double *want = malloc(3 * (size_t)NPTS * sizeof *want);
+    if (want == NULL || line_at == NULL)
+        exit(1);
+    char lit[128];
+    for (size_t i = 0; i < NPTS; i++) {
+        line_at[i] = b.n;
+        if (i % 1000 == 7) /* comments and blank lines shift line numbers */
+            bb_printf(&b, "# comment %zu\n\r\n", i);
+        for (int k = 0; k < 3; k++) {
+            random_literal(t, lit, sizeof lit);
+            want[3 * i + (size_t)k] = strtod(lit, NULL);
+            bb_printf(&b, "%s%s", lit, k == 2 ? (i & 1 ? "\r\n" : "\n") : " ");
+        }
+    }
+    line_at[NPTS] = b.n;
+    char path[1024];
+    write_file(t, "sliced.xyz", b.p, b.n, path, sizeof path);
+    for (int T = 1; T <= 8; T *= 2) {
+        double *xyz = NULL;
+        size_t n = 0;
+        char err[512];
+        int rc = fdt_read_points_threads(path, T, 0, &xyz, &n, err, sizeof err);
+        t->checks++;
+        if (rc != FDT_IO_OK || n != NPTS || memcmp(xyz, want, sizeof(double) * 3 * NPTS) != 0)
+            fail_at(t, __LINE__, "%s: %d threads: %s, %zu points", path, T, code_name(rc), n);
+        free(xyz);
+    }
+    /* Line numbers: point i's line is i + 1 plus two for each comment
+     * block before it (including its own). */
+    static const size_t bad_at[] = {0, NPTS / 4, NPTS / 2 - 1, NPTS / 2, NPTS / 2 + 1, NPTS - 1};
+    for (size_t k = 0; k <= sizeof bad_at / sizeof *bad_at; k++) {
+        size_t i = k < sizeof bad_at / sizeof *bad_at ? bad_at[k] : NPTS - 2;
+        char *text = malloc(b.n);
+        if (text == NULL)
+            exit(1);
+        memcpy(text, b.p, b.n);
+        /* the first byte of the point's numbers becomes a letter (after
+         * the comment block if the point has one) */
+        size_t at = line_at[i];
+        if (i % 1000 == 7)
+            at = (size_t)((char *)memchr(text + at, '\r', b.n - at) - text) + 2;
+        text[at] = 'q';
+        size_t lineno = i + 1 + 2 * ((i + 993) / 1000);
+        if (k == sizeof bad_at / sizeof *bad_at) { /* a second error later on */
+            text[line_at[NPTS - 1]] = 'q';
+        }
+        char name[64], sub[64];
+        snprintf(name, sizeof name, "sliced_bad%zu.xyz", k);
+        write_file(t, name, text, b.n, path, sizeof path);
+        snprintf(sub, sizeof sub, ":%zu: ", lineno);
+        EXPECT_ERR(t, path, FDT_IO_EFORMAT, sub);
+        free(text);
+    }
+    bb_free(&b);
+    free(want);
+    free(line_at);
 }
 
 static void test_xyz_bad(tctx *t)
@@ -1687,6 +1783,7 @@ int main(int argc, char **argv)
     test_xyz_good(&t);
     test_xyz_random(&t, "c", 20000, NULL);
     test_xyz_bad(&t);
+    test_xyz_sliced(&t);
     test_node(&t);
     test_ply_good(&t);
     test_ply_nonfinite(&t);

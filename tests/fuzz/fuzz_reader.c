@@ -55,6 +55,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     int rc = fdt_read_points_mem(name, data, size, &xyz, &n, err, sizeof err);
     if (memchr(err, '\0', sizeof err) == NULL)
         fuzz_violation("message not NUL-terminated", "(unterminated)");
+    /* The sliced read (slices of a byte and up, so every input is cut)
+     * must give the same code, points and message. */
+    double *pxyz = NULL;
+    size_t pn = 0;
+    char perr[512];
+    int prc = fdt_read_points_mem_threads(name, data, size, 3, 1, &pxyz, &pn, perr, sizeof perr);
+    if (prc != rc || pn != (rc == FDT_IO_OK ? n : 0) || strcmp(perr, err) != 0 ||
+        (rc == FDT_IO_OK && memcmp(pxyz, xyz, 3 * n * sizeof *xyz) != 0))
+        fuzz_violation("the sliced read differs from the one-thread read", perr);
+    free(pxyz);
     if (rc == FDT_IO_OK) {
         if (xyz == NULL || n == 0)
             fuzz_violation("success without points", err);
