@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "frontdt.h"
 #include "front.h"
@@ -117,7 +118,14 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     fdt_par_out par;
     memset(&par, 0, sizeof par);
     fdt_result *r = NULL;
-    int err = fdt_prepare(xyz, n, &pr, ctx->diag, sizeof ctx->diag);
+    /* The merge runs on the engine's threads in parallel modes; serial
+     * mode stays sequential from end to end. */
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    int err = fdt_prepare(xyz, n,
+                          mode == FDT_MODE_SERIAL ? 1
+                          : cpus >= 1 && nthreads > cpus ? (int)cpus
+                                                         : nthreads,
+                          &pr, ctx->diag, sizeof ctx->diag);
     if (err)
         return err;
     if ((err = fdt_seed_check_dimension(pr.p, pr.orig, (uint32_t)pr.m, ctx->diag,

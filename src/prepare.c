@@ -3,7 +3,10 @@
 
 #include "mem.h"
 
+#include <float.h>
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -67,7 +70,211 @@ static int choose_scale(double maxabs, double minabs)
     return k;
 }
 
-int fdt_prepare(const double *xyz, size_t n, fdt_prepared *pr, char *diag,
+/* ---- the merge on several threads -----------------------------------------
+ *
+ * The same result as the loop in fdt_prepare, bit for bit: vertex numbers
+ * in order of first occurrence, each class merged into its first input
+ * index. Phases, each run by T workers on their slice of the input (the
+ * caller is worker 0) and joined before the next, so pthread_create and
+ * pthread_join order every phase's writes before the next phase's reads:
+ *   A. the coordinate check and extremes, and the insertion of every point
+ *      into one shared table of input indices; the table slot of point i
+ *      is noted in dupmap[i];
+ *   B. dupmap[i] = the index its slot holds (the least index of i's
+ *      class), and each slice's count of first occurrences;
+ *   C. each slice's first occurrences scaled into p and orig, from the
+ *      slice's offset (the counts of the slices before it).
+ */
+#define PREP_SLICES_MAX 64
+#define PREP_EMPTY UINT32_MAX
+
+typedef struct prep_slice {
+    double maxabs, minabs;
+    size_t bad; /* first non-finite point of the slice, or SIZE_MAX */
+    int badk;
+    size_t firsts, m0;
+} prep_slice;
+
+typedef struct prep_job {
+    const double *xyz;
+    size_t n, cap;
+    int T, phase;
+    /* Input indices; PREP_EMPTY in a free slot. A slot goes from empty to
+     * an index once (compare-exchange) and then only to smaller indices of
+     * the same point (compare-exchange in a loop), so every point of a
+     * class probes the same slots and finds the class where the first of
+     * them put it, and after phase A the slot holds the class's least
+     * index. relaxed: a slot publishes nothing but its own value; the
+     * coordinates it leads to were written before the workers started and
+     * are only read, and phase B reads the slots after pthread_join. */
+    _Atomic uint32_t *slots;
+    fdt_prepared *pr;
+    double p2k;
+    int k;
+    prep_slice sl[PREP_SLICES_MAX];
+} prep_job;
+
+typedef struct prep_arg {
+    prep_job *j;
+    int t;
+} prep_arg;
+
+static void prep_insert(prep_job *j, size_t i, uint32_t *pos)
+{
+    const double *q = j->xyz + 3 * i;
+    size_t h = (size_t)point_hash(q) & (j->cap - 1);
+    for (;;) {
+        uint32_t s = atomic_load_explicit(&j->slots[h], memory_order_relaxed);
+        if (s == PREP_EMPTY &&
+            atomic_compare_exchange_strong_explicit(&j->slots[h], &s, (uint32_t)i,
+                                                    memory_order_relaxed, memory_order_relaxed))
+            break;
+        /* s: the index in the slot (the winner's if the exchange failed) */
+        if (same_point(j->xyz + 3 * (size_t)s, q)) {
+            while ((uint32_t)i < s &&
+                   !atomic_compare_exchange_weak_explicit(&j->slots[h], &s, (uint32_t)i,
+                                                          memory_order_relaxed,
+                                                          memory_order_relaxed))
+                ;
+            break;
+        }
+        h = (h + 1) & (j->cap - 1);
+    }
+    pos[i] = (uint32_t)h;
+}
+
+static void *prep_worker(void *arg)
+{
+    prep_arg *a = arg;
+    prep_job *j = a->j;
+    prep_slice *sl = &j->sl[a->t];
+    size_t lo = j->n * (size_t)a->t / (size_t)j->T, hi = j->n * (size_t)(a->t + 1) / (size_t)j->T;
+    fdt_prepared *pr = j->pr;
+    /* dupmap holds slot numbers between A and B: uint32_t may alias the
+     * int32_t array, and a table of up to 2^32 slots needs all 32 bits. */
+    uint32_t *pos = (uint32_t *)pr->dupmap;
+    if (j->phase == 0) {
+        sl->maxabs = 0.0;
+        sl->minabs = INFINITY;
+        sl->bad = SIZE_MAX;
+        for (size_t i = lo; i < hi; i++) {
+            for (int k = 0; k < 3; k++) {
+                double ax = fabs(j->xyz[3 * i + (size_t)k]);
+                if (!(ax <= DBL_MAX) && sl->bad == SIZE_MAX) {
+                    sl->bad = i;
+                    sl->badk = k;
+                }
+                if (ax > sl->maxabs)
+                    sl->maxabs = ax;
+                if (ax != 0.0 && ax < sl->minabs)
+                    sl->minabs = ax;
+            }
+            if (i + 8 < hi)
+                fdt_prefetch(j->slots + ((size_t)point_hash(j->xyz + 3 * (i + 8)) & (j->cap - 1)));
+            prep_insert(j, i, pos);
+        }
+    } else if (j->phase == 1) {
+        size_t c = 0;
+        for (size_t i = lo; i < hi; i++) {
+            uint32_t first = atomic_load_explicit(&j->slots[pos[i]], memory_order_relaxed);
+            pr->dupmap[i] = (fdt_vid)first;
+            c += first == (uint32_t)i;
+        }
+        sl->firsts = c;
+    } else {
+        size_t m = sl->m0;
+        for (size_t i = lo; i < hi; i++) {
+            if (pr->dupmap[i] != (fdt_vid)i)
+                continue;
+            const double *q = j->xyz + 3 * i;
+            for (int c = 0; c < 3; c++)
+                pr->p[3 * m + (size_t)c] = j->p2k != 0.0 ? q[c] * j->p2k : ldexp(q[c], j->k);
+            pr->orig[m] = (fdt_vid)i;
+            m++;
+        }
+    }
+    return NULL;
+}
+
+/* Runs phase `phase` on the T workers; a worker whose thread cannot be
+ * created runs on the caller after the others (phase A's inserts are
+ * safe in any order, B and C only touch the slice's own entries). */
+static void prep_phase(prep_job *j, int phase, prep_arg *args)
+{
+    pthread_t tid[PREP_SLICES_MAX];
+    int made[PREP_SLICES_MAX];
+    j->phase = phase;
+    for (int t = 1; t < j->T; t++)
+        made[t] = pthread_create(&tid[t], NULL, prep_worker, &args[t]) == 0;
+    prep_worker(&args[0]);
+    for (int t = 1; t < j->T; t++) {
+        if (made[t])
+            pthread_join(tid[t], NULL);
+        else
+            prep_worker(&args[t]);
+    }
+}
+
+static int choose_scale(double maxabs, double minabs);
+
+/* fdt_prepare's merge and scaling on T > 1 threads (pr's arrays are
+ * allocated, slots is cap entries of PREP_EMPTY). */
+static int prepare_threads(const double *xyz, size_t n, int T, fdt_prepared *pr,
+                           uint32_t *slots, size_t cap, char *diag, size_t dlen)
+{
+    prep_job j;
+    memset(&j, 0, sizeof j);
+    j.xyz = xyz;
+    j.n = n;
+    j.cap = cap;
+    j.T = T;
+    j.pr = pr;
+    /* _Atomic uint32_t has uint32_t's size and representation here
+     * (checked below), so the table is filled with memset as before. */
+    _Static_assert(sizeof(_Atomic uint32_t) == sizeof(uint32_t), "atomic slot size");
+    j.slots = (_Atomic uint32_t *)slots;
+    prep_arg args[PREP_SLICES_MAX];
+    for (int t = 0; t < T; t++) {
+        args[t].j = &j;
+        args[t].t = t;
+    }
+    prep_phase(&j, 0, args);
+    double maxabs = 0.0, minabs = INFINITY;
+    for (int t = 0; t < T; t++) {
+        if (j.sl[t].bad != SIZE_MAX) {
+            size_t i = j.sl[t].bad;
+            int k = j.sl[t].badk;
+            snprintf(diag, dlen, "point %zu has a non-finite %c coordinate (%g)", i, "xyz"[k],
+                     xyz[3 * i + (size_t)k]);
+            return FDT_ERANGE;
+        }
+        maxabs = j.sl[t].maxabs > maxabs ? j.sl[t].maxabs : maxabs;
+        minabs = j.sl[t].minabs < minabs ? j.sl[t].minabs : minabs;
+    }
+    prep_phase(&j, 1, args);
+    size_t m = 0;
+    for (int t = 0; t < T; t++) {
+        j.sl[t].m0 = m;
+        m += j.sl[t].firsts;
+    }
+    j.k = choose_scale(maxabs, minabs);
+    j.p2k = j.k >= -1022 && j.k <= 1023 ? fdt_pow2i(j.k) : 0.0;
+    prep_phase(&j, 2, args);
+    pr->scale_exp = j.k;
+    pr->m = m;
+    pr->ndup = n - m;
+    return FDT_OK;
+}
+
+/* Threads for the merge: one below 64k points, where starting threads
+ * costs more than it saves. */
+static int prepare_threads_for(size_t n, int threads)
+{
+    int T = threads > PREP_SLICES_MAX ? PREP_SLICES_MAX : threads;
+    return n < ((size_t)1 << 16) || T < 1 ? 1 : T;
+}
+
+int fdt_prepare(const double *xyz, size_t n, int threads, fdt_prepared *pr, char *diag,
                 size_t dlen)
 {
     int err = FDT_ENOMEM;
@@ -77,6 +284,25 @@ int fdt_prepare(const double *xyz, size_t n, fdt_prepared *pr, char *diag,
         snprintf(diag, dlen, "%zu points: more than the %d a vertex id holds",
                  n, FDT_VID_MAX);
         return FDT_ETOOBIG;
+    }
+    int T = prepare_threads_for(n, threads);
+    if (T > 1) {
+        pr->dupmap = malloc(n * sizeof *pr->dupmap);
+        pr->p = malloc(n * 3 * sizeof *pr->p);
+        fdt_mem_advise_huge(pr->p, n * 3 * sizeof *pr->p);
+        pr->orig = malloc(n * sizeof *pr->orig);
+        size_t cap = 16;
+        while (cap < 2 * n)
+            cap <<= 1;
+        slots = malloc(cap * sizeof *slots);
+        if (!pr->dupmap || !pr->p || !pr->orig || !slots)
+            goto fail;
+        memset(slots, 0xff, cap * sizeof *slots);
+        err = prepare_threads(xyz, n, T, pr, slots, cap, diag, dlen);
+        free(slots);
+        if (err != FDT_OK)
+            fdt_prepared_free(pr);
+        return err;
     }
     double maxabs = 0.0, minabs = INFINITY;
     for (size_t i = 0; i < n; i++) {

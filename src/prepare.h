@@ -24,9 +24,11 @@ typedef struct fdt_prepared {
     int scale_exp;    /* coordinates were multiplied by 2^scale_exp */
 } fdt_prepared;
 
-/* Fills pr from n input points. Errors: FDT_ERANGE (NaN/Inf, with the
- * point named in diag), FDT_ETOOBIG, FDT_ENOMEM. */
-int fdt_prepare(const double *xyz, size_t n, fdt_prepared *pr, char *diag,
+/* Fills pr from n input points, on `threads` threads (one below 64k
+ * points, at most 64): the same result for every count.
+ * Errors: FDT_ERANGE (NaN/Inf, the first such point named in diag),
+ * FDT_ETOOBIG, FDT_ENOMEM. */
+int fdt_prepare(const double *xyz, size_t n, int threads, fdt_prepared *pr, char *diag,
                 size_t dlen);
 void fdt_prepared_free(fdt_prepared *pr);
 

@@ -125,7 +125,7 @@ static void test_family(int fam, size_t want, int leaf)
     size_t n = make_points(fam, want, xyz);
     fdt_prepared pr;
     char diag[256];
-    CHECK(fdt_prepare(xyz, n, &pr, diag, sizeof diag) == FDT_OK, "prepare %s", family_name[fam]);
+    CHECK(fdt_prepare(xyz, n, 1, &pr, diag, sizeof diag) == FDT_OK, "prepare %s", family_name[fam]);
     uint32_t m = (uint32_t)pr.m;
     fdt_kdtree t;
     CHECK(fdt_kd_build(&t, pr.p, pr.orig, 0, m, leaf) == FDT_OK, "build");
@@ -316,6 +316,51 @@ static void test_family(int fam, size_t want, int leaf)
     free(xyz);
 }
 
+/* The merge on several threads (src/prepare.c, prepare_threads) gives
+ * the one-thread result bit for bit, duplicates and scaling included, and
+ * names the same first non-finite point. */
+static void test_prepare_threads(void)
+{
+    const size_t want = 90000;
+    double *xyz = malloc(want * 3 * sizeof *xyz);
+    for (int fam = 0; fam < NFAMILIES; fam++) {
+        size_t n = make_points(fam, want, xyz);
+        /* duplicates across slices: copies of points from the whole range */
+        for (size_t i = 0; i + 7 < n && n >= 1000; i += 97)
+            memcpy(xyz + 3 * i, xyz + 3 * ((i * 7919 + 13) % n), 3 * sizeof *xyz);
+        fdt_prepared one, par;
+        char diag[256];
+        CHECK(fdt_prepare(xyz, n, 1, &one, diag, sizeof diag) == FDT_OK, "prepare %s",
+              family_name[fam]);
+        for (int T = 2; T <= 8; T += 3) {
+            CHECK(fdt_prepare(xyz, n, T, &par, diag, sizeof diag) == FDT_OK, "prepare %s T=%d",
+                  family_name[fam], T);
+            CHECK(par.m == one.m && par.ndup == one.ndup && par.scale_exp == one.scale_exp &&
+                      !memcmp(par.p, one.p, 3 * one.m * sizeof *one.p) &&
+                      !memcmp(par.orig, one.orig, one.m * sizeof *one.orig) &&
+                      !memcmp(par.dupmap, one.dupmap, n * sizeof *one.dupmap),
+                  "%s (%zu points, %zu distinct): %d threads differ", family_name[fam], n, one.m,
+                  T);
+            fdt_prepared_free(&par);
+        }
+        if (n >= 80000) {
+            /* two bad points in different slices: the first is named */
+            double keep[2] = {xyz[3 * 70000 + 1], xyz[3 * 40000 + 2]};
+            xyz[3 * 70000 + 1] = NAN;
+            xyz[3 * 40000 + 2] = -INFINITY;
+            char d1[256], d2[256];
+            CHECK(fdt_prepare(xyz, n, 1, &par, d1, sizeof d1) == FDT_ERANGE &&
+                      fdt_prepare(xyz, n, 5, &par, d2, sizeof d2) == FDT_ERANGE &&
+                      strstr(d1, "point 40000 has a non-finite z") && !strcmp(d1, d2),
+                  "non-finite: '%s' against '%s'", d1, d2);
+            xyz[3 * 70000 + 1] = keep[0];
+            xyz[3 * 40000 + 2] = keep[1];
+        }
+        fdt_prepared_free(&one);
+    }
+    free(xyz);
+}
+
 static void test_prepare(void)
 {
     /* Duplicates merge into the first index, -0 == +0; scaling is a power
@@ -323,7 +368,7 @@ static void test_prepare(void)
     double xyz[] = {1, 2, 3, 0.0, 0, 0, 1, 2, 3, -0.0, 0, 0, 5, 6, 7, 1, 2, 3};
     fdt_prepared pr;
     char diag[256];
-    CHECK(fdt_prepare(xyz, 6, &pr, diag, sizeof diag) == FDT_OK, "prepare dups");
+    CHECK(fdt_prepare(xyz, 6, 1, &pr, diag, sizeof diag) == FDT_OK, "prepare dups");
     CHECK(pr.m == 3 && pr.ndup == 3, "distinct %zu dup %zu", pr.m, pr.ndup);
     CHECK(pr.dupmap[2] == 0 && pr.dupmap[3] == 1 && pr.dupmap[5] == 0 && pr.dupmap[4] == 4,
           "duplicate map");
@@ -332,18 +377,18 @@ static void test_prepare(void)
           ldexp(7.0, pr.scale_exp) >= 0.5, "scale 2^%d", pr.scale_exp);
     fdt_prepared_free(&pr);
     double big[] = {1e150, 2e150, 3e150, -1e150, 5e149, 1e148};
-    CHECK(fdt_prepare(big, 2, &pr, diag, sizeof diag) == FDT_OK && pr.p[0] < 1.0, "scale down 1e150");
+    CHECK(fdt_prepare(big, 2, 1, &pr, diag, sizeof diag) == FDT_OK && pr.p[0] < 1.0, "scale down 1e150");
     fdt_prepared_free(&pr);
     /* Mixed 1e-300 and 1e300: the scale must keep 1e-300 normal (exact). */
     double mixed[] = {1e300, 0, 0, 1e-300, 0, 0};
-    CHECK(fdt_prepare(mixed, 2, &pr, diag, sizeof diag) == FDT_OK, "mixed");
+    CHECK(fdt_prepare(mixed, 2, 1, &pr, diag, sizeof diag) == FDT_OK, "mixed");
     CHECK(ldexp(pr.p[3], -pr.scale_exp) == 1e-300, "mixed magnitudes not exact");
     fdt_prepared_free(&pr);
     double bad[] = {0, 0, 0, 1, NAN, 2};
-    CHECK(fdt_prepare(bad, 2, &pr, diag, sizeof diag) == FDT_ERANGE && strstr(diag, "point 1"),
+    CHECK(fdt_prepare(bad, 2, 1, &pr, diag, sizeof diag) == FDT_ERANGE && strstr(diag, "point 1"),
           "NaN not refused: %s", diag);
     double inf[] = {INFINITY, 0, 0};
-    CHECK(fdt_prepare(inf, 1, &pr, diag, sizeof diag) == FDT_ERANGE, "Inf not refused");
+    CHECK(fdt_prepare(inf, 1, 1, &pr, diag, sizeof diag) == FDT_ERANGE, "Inf not refused");
     /* Dimension check. */
     double flat[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 3, 0};
     CHECK(fdt_seed_check_dimension(flat, (const fdt_vid[]){0, 1, 2, 3, 4}, 5, diag, sizeof diag) ==
@@ -400,6 +445,7 @@ static void test_facetab(void)
 int main(void)
 {
     test_prepare();
+    test_prepare_threads();
     test_facetab();
     for (g_sse_only = 0; g_sse_only <= 1; g_sse_only++)
         for (int fam = 0; fam < NFAMILIES; fam++) {
