@@ -43,38 +43,69 @@ static void swap_pt(double *P, fdt_vid *orig, uint32_t i, uint32_t j)
     orig[j] = o;
 }
 
-/* Quickselect with a three-way partition (< pivot, == pivot, > pivot):
- * afterwards the point at k has the k-th smallest coordinate `dim` in
- * [lo, hi), smaller-or-equal ones before it, greater-or-equal after. The
- * equal block always holds the pivot, so every round makes progress, even
- * on the heavily repeated coordinates of lattices and lidar planes. */
-static void select_k(double *P, fdt_vid *orig, uint32_t lo, uint32_t hi,
-                     uint32_t k, int dim)
+/*
+ * Floyd and Rivest's selection (CACM 18(3), 1975, algorithm SELECT):
+ * afterwards the point at k has the k-th smallest coordinate `dim` of
+ * [left, right], smaller-or-equal ones before it, greater-or-equal after.
+ * Above 600 points it first selects k inside a sample of about n^(2/3)
+ * points around k, offset so that k falls just inside the smaller side,
+ * so the pivot it partitions on is nearly the answer and one partition
+ * pass over the range nearly finishes it: about 1.5 n comparisons for a
+ * median, where the three-way quickselect this replaced made about 3.4 n
+ * and a swap for every point off the pivot (the kd build was 6 % of a 1M
+ * serial run, bench/NOTES.md). Hoare's partition stops on points equal to
+ * the pivot from both sides, so runs of equal coordinates (lattices,
+ * lidar planes) split evenly and every round narrows the range.
+ */
+static void select_range(double *P, fdt_vid *orig, int64_t left, int64_t right, int64_t k,
+                         int dim)
 {
-    while (hi - lo > 1) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        double a = P[3 * (size_t)lo + dim], b = P[3 * (size_t)mid + dim],
-               c = P[3 * (size_t)(hi - 1) + dim];
-        double piv = a < b ? (b < c ? b : (a < c ? c : a))
-                           : (a < c ? a : (b < c ? c : b));
-        /* Invariant: [lo, lt) < piv, [lt, i) == piv, [gt, hi) > piv. */
-        uint32_t lt = lo, i = lo, gt = hi;
-        while (i < gt) {
-            double x = P[3 * (size_t)i + dim];
-            if (x < piv)
-                swap_pt(P, orig, lt++, i++);
-            else if (x > piv)
-                swap_pt(P, orig, i, --gt);
-            else
-                i++;
+#define SX(i) P[3 * (size_t)(i) + (size_t)dim]
+    while (right > left) {
+        if (right - left > 600) {
+            double n = (double)(right - left + 1), i = (double)(k - left + 1);
+            double z = log(n), s = 0.5 * exp(2.0 * z / 3.0);
+            double sd = 0.5 * sqrt(z * s * (n - s) / n) * (i < n / 2 ? -1.0 : 1.0);
+            int64_t nl = (int64_t)floor((double)k - i * s / n + sd);
+            int64_t nr = (int64_t)floor((double)k + (n - i) * s / n + sd);
+            select_range(P, orig, nl > left ? nl : left, nr < right ? nr : right, k, dim);
         }
-        if (k < lt)
-            hi = lt;
-        else if (k >= gt)
-            lo = gt;
-        else
-            return;
+        double t = SX(k);
+        int64_t i = left, j = right;
+        /* Sentinels: the pivot at left and something >= it at right (or
+         * the other way round), so neither scan below leaves the range. */
+        swap_pt(P, orig, (uint32_t)left, (uint32_t)k);
+        if (SX(right) > t)
+            swap_pt(P, orig, (uint32_t)right, (uint32_t)left);
+        while (i < j) {
+            swap_pt(P, orig, (uint32_t)i, (uint32_t)j);
+            i++;
+            j--;
+            while (SX(i) < t)
+                i++;
+            while (SX(j) > t)
+                j--;
+        }
+        if (SX(left) == t) {
+            swap_pt(P, orig, (uint32_t)left, (uint32_t)j);
+        } else {
+            j++;
+            swap_pt(P, orig, (uint32_t)j, (uint32_t)right);
+        }
+        /* The pivot is at j, its final place. */
+        if (j <= k)
+            left = j + 1;
+        if (k <= j)
+            right = j - 1;
     }
+#undef SX
+}
+
+/* The k-th smallest coordinate `dim` of [lo, hi) at k (select_range). */
+static void select_k(double *P, fdt_vid *orig, uint32_t lo, uint32_t hi, uint32_t k, int dim)
+{
+    if (hi - lo > 1)
+        select_range(P, orig, lo, (int64_t)hi - 1, k, dim);
 }
 
 void fdt_kd_select(double *P, fdt_vid *orig, uint32_t lo, uint32_t hi,
