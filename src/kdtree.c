@@ -129,7 +129,40 @@ void fdt_points_box(const double *P, uint32_t begin, uint32_t end,
         lo[k] = INFINITY;
         hi[k] = -INFINITY;
     }
-    for (uint32_t i = begin; i < end; i++)
+    uint32_t i = begin;
+#if defined(__SSE2__)
+    /* Two points (six doubles) a step in three registers, lanes (x0 y0),
+     * (z0 x1), (y1 z1): the build scans every point once a level, and
+     * the scalar loop was a fifth of the build (perf, 1M). min and max
+     * are exact, so the box is the same (up to the sign of a zero). */
+    if (end - begin >= 4) {
+        __m128d l0 = _mm_set1_pd(INFINITY), l1 = l0, l2 = l0;
+        __m128d h0 = _mm_set1_pd(-INFINITY), h1 = h0, h2 = h0;
+        for (; i + 2 <= end; i += 2) {
+            const double *q = P + 3 * (size_t)i;
+            __m128d a = _mm_loadu_pd(q), b = _mm_loadu_pd(q + 2), c = _mm_loadu_pd(q + 4);
+            l0 = _mm_min_pd(l0, a);
+            h0 = _mm_max_pd(h0, a);
+            l1 = _mm_min_pd(l1, b);
+            h1 = _mm_max_pd(h1, b);
+            l2 = _mm_min_pd(l2, c);
+            h2 = _mm_max_pd(h2, c);
+        }
+        double L[6], H[6];
+        _mm_storeu_pd(L, l0);
+        _mm_storeu_pd(L + 2, l1);
+        _mm_storeu_pd(L + 4, l2);
+        _mm_storeu_pd(H, h0);
+        _mm_storeu_pd(H + 2, h1);
+        _mm_storeu_pd(H + 4, h2);
+        /* x: lanes 0 and 3, y: 1 and 4, z: 2 and 5 */
+        for (int k = 0; k < 3; k++) {
+            lo[k] = L[k] < L[k + 3] ? L[k] : L[k + 3];
+            hi[k] = H[k] > H[k + 3] ? H[k] : H[k + 3];
+        }
+    }
+#endif
+    for (; i < end; i++)
         for (int k = 0; k < 3; k++) {
             double x = P[3 * (size_t)i + k];
             if (x < lo[k])
