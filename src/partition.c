@@ -25,12 +25,40 @@ typedef struct rcb_ctx {
 } rcb_ctx;
 
 /*
+ * Points to move from the left side of a cut to the right so that both
+ * build the same share of tets rather than hold the same share of points.
+ * The left side owns every tet across the cut (§3.2: the lowest id
+ * decides, and the left side's ids are the lower ones), about
+ * 7.8 A lambda^(2/3) of them for a cut of area A through lambda points a
+ * unit volume: measured at 1M uniform points, where a cube cut in half
+ * had 78k tets across it, a half cube's cut 40k and a quarter's 19k, and
+ * the first part built 2.3 % more tets than the last of two, 7 % more of
+ * eight. Half of that surplus, at 6.75 tets a point, is
+ * 0.578 n^(2/3) V^(1/3) / w points for n points in a box of volume V cut
+ * across its extent w. Where the density is far from uniform the estimate
+ * is only a guess, so it moves at most a sixteenth of the left side; a
+ * flat box (V = 0) and parts of fewer than 64 points move nothing.
+ */
+static uint32_t work_shift(const fdt_pnode *nd, uint32_t nleft, uint64_t count, double w,
+                           int a)
+{
+    double v = (nd->hi[0] - nd->lo[0]) * (nd->hi[1] - nd->lo[1]) * (nd->hi[2] - nd->lo[2]);
+    /* parts of fewer than 64 points: leave their counts as they are */
+    if (!(v > 0.0 && w > 0.0) || nleft / (uint32_t)a < 64)
+        return 0;
+    double c = (double)count, shift = 0.578 * cbrt(c * c * v) / w;
+    double most = (double)(nleft / 16);
+    return (uint32_t)(shift < most ? shift : most);
+}
+
+/*
  * Fills node `id` with ids [begin, end) shared by parts [p0, p0 + k).
  * The paper splits at the mean and alternates x, y, z (§3.1); we split at
  * an exact count (quickselect) along the widest extent, which gives equal
  * parts for any k (not only powers of two) and keeps parts compact on
  * flat or elongated clouds. With k = a + b, a = k / 2, the first a parts
- * get round(count * a / k) points. Depth is log2(k) <= 10.
+ * get round(count * a / k) points, less work_shift's share for the tets
+ * across the cut that they own. Depth is log2(k) <= 10.
  */
 static void rcb(rcb_ctx *rc, int id, uint32_t begin, uint32_t end, int p0,
                 int k)
@@ -61,6 +89,7 @@ static void rcb(rcb_ctx *rc, int id, uint32_t begin, uint32_t end, int p0,
                 w = nd->hi[d] - nd->lo[d];
                 dim = d;
             }
+        nleft -= work_shift(nd, nleft, count, w, a);
         fdt_kd_select(rc->P, rc->orig, begin, end, begin + nleft, dim);
         nd->dim = dim;
     }
