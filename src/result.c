@@ -180,26 +180,38 @@ static size_t put_u32(char *buf, uint32_t x)
     return len;
 }
 
-static void hash_records(text_hash *th, const uint32_t *a, size_t n)
+/* The .tets line of record a (4 words) at buf; returns its length, at
+ * most TEXT_LINE_MAX. */
+#define TEXT_LINE_MAX 44
+static size_t format_record(char *buf, const uint32_t *a)
+{
+    uint32_t k[4];
+    key_of((const fdt_vid *)a, k);
+    size_t len = 0;
+    for (int j = 0; j < 4; j++) {
+        len += put_u32(buf + len, k[j]);
+        buf[len++] = j == 3 ? '\n' : ' ';
+    }
+    return len;
+}
+
+static void hash_text(text_hash *th, const char *buf, size_t len)
 {
     uint64_t h = th->h;
-    char buf[48];
-    for (size_t i = 0; i < n; i++) {
-        uint32_t k[4];
-        key_of((const fdt_vid *)a + 4 * i, k);
-        size_t len = 0;
-        for (int j = 0; j < 4; j++) {
-            len += put_u32(buf + len, k[j]);
-            buf[len++] = j == 3 ? '\n' : ' ';
-        }
-        /* FNV-1a is one multiply after another: its chain, about four
-         * cycles a byte, is the floor of this loop. */
-        for (size_t j = 0; j < len; j++) {
-            h ^= (unsigned char)buf[j];
-            h *= 1099511628211ull;
-        }
+    /* FNV-1a is one multiply after another: its chain, about four cycles
+     * a byte, is the floor of the hash. */
+    for (size_t j = 0; j < len; j++) {
+        h ^= (unsigned char)buf[j];
+        h *= 1099511628211ull;
     }
     th->h = h;
+}
+
+static void hash_records(text_hash *th, const uint32_t *a, size_t n)
+{
+    char buf[TEXT_LINE_MAX];
+    for (size_t i = 0; i < n; i++)
+        hash_text(th, buf, format_record(buf, a + 4 * i));
 }
 
 /* One counting-sort pass over n records of `stride` words from src to dst
@@ -290,8 +302,14 @@ static void finish_groups(uint32_t *a, size_t n, int stride)
  *   D. the buckets, taken in order from a shared counter: the bits below
  *      the top digit, the vertex groups, and the hash, which only worker 0
  *      computes, bucket after bucket in key order, sorting buckets itself
- *      while the next one to hash is not ready.
+ *      while the next one to hash is not ready. Workers with no bucket
+ *      left to sort write the text of buckets ahead of worker 0 (at most
+ *      TEXT_AHEAD of them), so that worker 0 only runs the FNV chain over
+ *      it: the chain is the hash's floor (0.21 s at 1M), the formatting
+ *      beside it another 0.1 s (bench/NOTES.md, entry 47), and with the
+ *      hash on the critical path of phase D the other workers were idle.
  */
+#define TEXT_AHEAD 32
 #define NBUCKETS ((size_t)1 << RADIX_BITS)
 
 typedef struct sort_job {
@@ -307,10 +325,25 @@ typedef struct sort_job {
     atomic_size_t next;
     /* done[d] != 0 once bucket d is final in a (D). Stored with release
      * by the worker that sorted it, after the bucket's last write; worker
-     * 0 loads it with acquire before hashing the bucket, so it reads the
-     * final records. */
+     * 0 and the text writers load it with acquire before reading the
+     * bucket, so they read the final records. */
     atomic_uchar *done;
+    /* Bucket d's text (D, with a hash): TEXT_FREE, then claimed by one
+     * compare-exchange, by a text writer (TEXT_BUSY) or by worker 0, which
+     * then hashes the records itself (TEXT_OWN). A writer stores
+     * TEXT_READY with release after writing text[d] and tlen[d]; worker 0
+     * loads the state with acquire before reading them, and frees text[d]
+     * once chained. The claims are relaxed: the claim itself publishes
+     * nothing, and each state's data is ordered by the READY store. */
+    atomic_uchar *tstate;
+    char **text;
+    size_t *tlen;
+    /* The bucket worker 0 hashes next: writers stay within TEXT_AHEAD of
+     * it. relaxed: it only bounds how far ahead they write. */
+    atomic_size_t hpos;
 } sort_job;
+
+enum { TEXT_FREE, TEXT_BUSY, TEXT_READY, TEXT_OWN };
 
 typedef struct sort_arg {
     sort_job *j;
@@ -338,6 +371,80 @@ static void sort_bucket(sort_job *j, size_t d, size_t *inner)
     if (src != j->a + (size_t)j->stride * lo)
         memcpy(j->a + (size_t)j->stride * lo, src, m * bytes);
     finish_groups(j->a + (size_t)j->stride * lo, m, j->stride);
+}
+
+/* Worker 0: hashes every bucket from hnext on that is sorted, in order,
+ * from the text a writer left or from the records; returns the first
+ * bucket it could not hash yet. */
+static size_t hash_ready(sort_job *j, size_t hnext)
+{
+    while (hnext < NBUCKETS && atomic_load_explicit(&j->done[hnext], memory_order_acquire)) {
+        unsigned char want = TEXT_FREE;
+        if (atomic_compare_exchange_strong_explicit(&j->tstate[hnext], &want, TEXT_OWN,
+                                                    memory_order_relaxed,
+                                                    memory_order_relaxed)) {
+            hash_records(j->th, j->a + (size_t)j->stride * j->start[hnext],
+                         j->end[hnext] - j->start[hnext]);
+        } else {
+            /* a writer has it: wait for its text (it needs no lock we
+             * hold, and its bucket is sorted) */
+            while (atomic_load_explicit(&j->tstate[hnext], memory_order_acquire) != TEXT_READY)
+                sched_yield();
+            hash_text(j->th, j->text[hnext], j->tlen[hnext]);
+            free(j->text[hnext]);
+            j->text[hnext] = NULL;
+        }
+        hnext++;
+        atomic_store_explicit(&j->hpos, hnext, memory_order_relaxed);
+    }
+    return hnext;
+}
+
+/* A worker with no bucket left to sort: writes the text of sorted
+ * buckets ahead of worker 0 until worker 0 is done. Without memory for a
+ * text it stops; worker 0 then hashes those buckets from their records. */
+static void write_texts(sort_job *j)
+{
+    char *buf = NULL;
+    size_t cap = 0;
+    size_t d = 0;
+    for (;;) {
+        size_t h = atomic_load_explicit(&j->hpos, memory_order_relaxed);
+        if (h >= NBUCKETS)
+            break;
+        if (d <= h)
+            d = h + 1; /* worker 0 is at h (or past it): start beyond */
+        if (d >= NBUCKETS)
+            break;
+        if (d >= h + TEXT_AHEAD || !atomic_load_explicit(&j->done[d], memory_order_acquire)) {
+            sched_yield(); /* too far ahead, or d not sorted yet */
+            continue;
+        }
+        size_t m = j->end[d] - j->start[d];
+        if (cap < m * TEXT_LINE_MAX + 1) {
+            free(buf);
+            cap = m * TEXT_LINE_MAX + 1;
+            buf = malloc(cap);
+            if (!buf)
+                break;
+        }
+        unsigned char want = TEXT_FREE;
+        if (atomic_compare_exchange_strong_explicit(&j->tstate[d], &want, TEXT_BUSY,
+                                                    memory_order_relaxed,
+                                                    memory_order_relaxed)) {
+            const uint32_t *r = j->a + (size_t)j->stride * j->start[d];
+            size_t len = 0;
+            for (size_t i = 0; i < m; i++)
+                len += format_record(buf + len, r + 4 * i);
+            j->text[d] = buf;
+            j->tlen[d] = len;
+            atomic_store_explicit(&j->tstate[d], TEXT_READY, memory_order_release);
+            buf = NULL;
+            cap = 0;
+        }
+        d++;
+    }
+    free(buf);
 }
 
 static void *sort_worker(void *arg)
@@ -369,23 +476,20 @@ static void *sort_worker(void *arg)
         size_t hnext = 0;
         for (;;) {
             if (t == 0 && j->th) {
-                /* hash every bucket that is ready, in order */
-                while (hnext < NBUCKETS &&
-                       atomic_load_explicit(&j->done[hnext], memory_order_acquire)) {
-                    hash_records(j->th, j->a + (size_t)st * j->start[hnext],
-                                 j->end[hnext] - j->start[hnext]);
-                    hnext++;
-                }
+                hnext = hash_ready(j, hnext);
                 if (hnext == NBUCKETS)
                     break;
             }
             size_t d = atomic_fetch_add_explicit(&j->next, 1, memory_order_relaxed);
             if (d >= NBUCKETS) {
-                if (t != 0 || !j->th)
+                if (t != 0 || !j->th) {
+                    if (t != 0 && j->th)
+                        write_texts(j);
                     break;
+                }
                 /* Worker 0 with buckets still to hash that others are
-                 * sorting: give them the core (machines run more threads
-                 * than cores in the tests). */
+                 * sorting or writing: give them the core (machines run
+                 * more threads than cores in the tests). */
                 sched_yield();
                 continue;
             }
@@ -449,17 +553,24 @@ static int sort_records(uint32_t *a, size_t n, int stride, int orient, text_hash
     j.hist = malloc((size_t)T * NBUCKETS * sizeof *j.hist);
     j.start = malloc(2 * NBUCKETS * sizeof *j.start);
     j.done = malloc(NBUCKETS * sizeof *j.done);
+    j.tstate = malloc(NBUCKETS * sizeof *j.tstate);
+    j.text = calloc(NBUCKETS, sizeof *j.text);
+    j.tlen = malloc(NBUCKETS * sizeof *j.tlen);
     sort_arg *args = malloc((size_t)T * sizeof *args);
     pthread_t *tid = malloc((size_t)T * sizeof *tid);
     int *made = calloc((size_t)T, sizeof *made);
     int err = FDT_ENOMEM;
-    if (!j.b || !j.tops || !j.hist || !j.start || !j.done || !args || !tid || !made)
+    if (!j.b || !j.tops || !j.hist || !j.start || !j.done || !j.tstate || !j.text || !j.tlen ||
+        !args || !tid || !made)
         goto out;
     err = FDT_OK;
     j.end = j.start + NBUCKETS;
-    for (size_t d = 0; d < NBUCKETS; d++)
+    for (size_t d = 0; d < NBUCKETS; d++) {
         atomic_init(&j.done[d], 0);
+        atomic_init(&j.tstate[d], TEXT_FREE);
+    }
     atomic_init(&j.next, 0);
+    atomic_init(&j.hpos, 0);
     for (int t = 0; t < T; t++) {
         args[t].j = &j;
         args[t].t = t;
@@ -493,6 +604,12 @@ out:
     free(j.hist);
     free(j.start);
     free(j.done);
+    free(j.tstate);
+    if (j.text)
+        for (size_t d = 0; d < NBUCKETS; d++)
+            free(j.text[d]); /* none left unless a phase could not run */
+    free(j.text);
+    free(j.tlen);
     free(args);
     free(tid);
     free(made);
@@ -512,10 +629,9 @@ static int sort_threads(const fdt_result *r)
 
 /* fdt_result_sort, hashing on the way when th is not NULL (done in the
  * sort's buckets where the records are the tets, after it otherwise). */
-static int sort_impl(fdt_result *r, text_hash *th)
+static int sort_impl(fdt_result *r, text_hash *th, int T)
 {
     size_t n = r->ntets;
-    int T = sort_threads(r);
     for (size_t i = 0; i < n && r->nbrs; i++) {
         int perm[4];
         orient_sorted(r->tets + 4 * i, perm);
@@ -583,16 +699,21 @@ int fdt_result_sort(fdt_result *r)
 {
     if (!r)
         return FDT_EINVAL;
-    return r->sorted ? FDT_OK : sort_impl(r, NULL);
+    return r->sorted ? FDT_OK : sort_impl(r, NULL, sort_threads(r));
 }
 
 int fdt_result_hash(fdt_result *r, uint64_t *hash)
+{
+    return fdt_result_hash_threads(r, r ? sort_threads(r) : 1, hash);
+}
+
+int fdt_result_hash_threads(fdt_result *r, int threads, uint64_t *hash)
 {
     if (!r || !hash)
         return FDT_EINVAL;
     text_hash th = {14695981039346656037ull};
     if (!r->sorted) {
-        int err = sort_impl(r, &th);
+        int err = sort_impl(r, &th, threads < 1 ? 1 : (threads > 64 ? 64 : threads));
         if (err)
             return err;
     } else {

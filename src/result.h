@@ -18,4 +18,9 @@ struct fdt_result {
                                  (owned; NULL in serial mode) */
 };
 
+/* fdt_result_hash with the canonical sort (when the result is not sorted
+ * yet) on `threads` threads (1 to 64), however many cores there are: for
+ * tests that oversubscribe the sort's threads. */
+int fdt_result_hash_threads(fdt_result *r, int threads, uint64_t *hash);
+
 #endif

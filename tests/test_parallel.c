@@ -30,6 +30,7 @@
 
 #include "frontdt.h"
 #include "partition.h"
+#include "result.h"
 
 #include "testutil.h"
 
@@ -756,6 +757,24 @@ static void test_sort_threads(void)
         }
         fdt_result_free(&ref);
     }
+    free(p.xyz);
+    /* The hash while sorting (src/result.c, phase D): worker 0 chains the
+     * texts the other sort threads wrote ahead of it, on more threads than
+     * cores too. Buckets of a few hundred tets, so that worker 0 is still
+     * hashing when the sorting runs out and the writers start. */
+    p = fam_uniform(60000, 19);
+    fdt_result *ref = run(&p, FDT_MODE_SERIAL, 1, 0, FDT_OK);
+    uint64_t href, h;
+    CHECK_EQ(fdt_result_hash(ref, &href), FDT_OK);
+    for (int sorters = 2; sorters <= 9; sorters += 7) {
+        fdt_result *r = run(&p, FDT_MODE_SHARED, 2, 0, FDT_OK);
+        CHECK_EQ(fdt_result_hash_threads(r, sorters, &h), FDT_OK);
+        CHECK(h == href);
+        CHECK(memcmp(fdt_result_tets(r), fdt_result_tets(ref),
+                     4 * fdt_result_num_tets(ref) * sizeof(fdt_vid)) == 0);
+        fdt_result_free(&r);
+    }
+    fdt_result_free(&ref);
     free(p.xyz);
 }
 
