@@ -54,7 +54,7 @@ static uint32_t work_shift(const fdt_pnode *nd, uint32_t nleft, uint64_t count, 
 /*
  * Fills node `id` with ids [begin, end) shared by parts [p0, p0 + k).
  * The paper splits at the mean and alternates x, y, z (§3.1); we split at
- * an exact count (quickselect) along the widest extent, which gives equal
+ * an exact count (selection) along the widest extent, which gives equal
  * parts for any k (not only powers of two) and keeps parts compact on
  * flat or elongated clouds. With k = a + b, a = k / 2, the first a parts
  * get round(count * a / k) points, less work_shift's share for the tets

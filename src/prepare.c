@@ -215,8 +215,6 @@ static void prep_phase(prep_job *j, int phase, prep_arg *args)
     }
 }
 
-static int choose_scale(double maxabs, double minabs);
-
 /* fdt_prepare's merge and scaling on T > 1 threads (pr's arrays are
  * allocated, slots is cap entries of PREP_EMPTY). */
 static int prepare_threads(const double *xyz, size_t n, int T, fdt_prepared *pr,
