@@ -264,6 +264,26 @@ static int prepare_threads(const double *xyz, size_t n, int T, fdt_prepared *pr,
     return FDT_OK;
 }
 
+/* pr's arrays for n points and the merge's table of *cap empty slots
+ * (all bits set), open addressing at load <= 1/2. On failure the caller
+ * frees what was allocated (fdt_prepared_free, free(*slots)). */
+static int prep_alloc(fdt_prepared *pr, size_t n, uint32_t **slots, size_t *cap)
+{
+    size_t n1 = n ? n : 1;
+    pr->dupmap = malloc(n1 * sizeof *pr->dupmap);
+    pr->p = malloc(n1 * 3 * sizeof *pr->p);
+    fdt_mem_advise_huge(pr->p, n1 * 3 * sizeof *pr->p);
+    pr->orig = malloc(n1 * sizeof *pr->orig);
+    *cap = 16;
+    while (*cap < 2 * n)
+        *cap <<= 1;
+    *slots = malloc(*cap * sizeof **slots);
+    if (!pr->dupmap || !pr->p || !pr->orig || !*slots)
+        return FDT_ENOMEM;
+    memset(*slots, 0xff, *cap * sizeof **slots);
+    return FDT_OK;
+}
+
 /* Threads for the merge: one below 64k points, where starting threads
  * costs more than it saves. */
 static int prepare_threads_for(size_t n, int threads)
@@ -285,17 +305,9 @@ int fdt_prepare(const double *xyz, size_t n, int threads, fdt_prepared *pr, char
     }
     int T = prepare_threads_for(n, threads);
     if (T > 1) {
-        pr->dupmap = malloc(n * sizeof *pr->dupmap);
-        pr->p = malloc(n * 3 * sizeof *pr->p);
-        fdt_mem_advise_huge(pr->p, n * 3 * sizeof *pr->p);
-        pr->orig = malloc(n * sizeof *pr->orig);
-        size_t cap = 16;
-        while (cap < 2 * n)
-            cap <<= 1;
-        slots = malloc(cap * sizeof *slots);
-        if (!pr->dupmap || !pr->p || !pr->orig || !slots)
+        size_t cap;
+        if (prep_alloc(pr, n, &slots, &cap) != FDT_OK)
             goto fail;
-        memset(slots, 0xff, cap * sizeof *slots);
         err = prepare_threads(xyz, n, T, pr, slots, cap, diag, dlen);
         free(slots);
         if (err != FDT_OK)
@@ -318,18 +330,10 @@ int fdt_prepare(const double *xyz, size_t n, int threads, fdt_prepared *pr, char
                 minabs = ax;
         }
     }
-    pr->dupmap = malloc((n ? n : 1) * sizeof *pr->dupmap);
-    pr->p = malloc((n ? n : 1) * 3 * sizeof *pr->p);
-    fdt_mem_advise_huge(pr->p, (n ? n : 1) * 3 * sizeof *pr->p);
-    pr->orig = malloc((n ? n : 1) * sizeof *pr->orig);
-    /* Open addressing at load <= 1/2: slots hold distinct-point numbers. */
-    size_t cap = 16;
-    while (cap < 2 * n)
-        cap <<= 1;
-    slots = malloc(cap * sizeof *slots);
-    if (!pr->dupmap || !pr->p || !pr->orig || !slots)
+    /* slots hold distinct-point numbers here */
+    size_t cap;
+    if (prep_alloc(pr, n, &slots, &cap) != FDT_OK)
         goto fail;
-    memset(slots, 0xff, cap * sizeof *slots);
     int k = choose_scale(maxabs, minabs);
     pr->scale_exp = k;
     /* choose_scale keeps every nonzero scaled coordinate a normal double,
