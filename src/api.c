@@ -168,13 +168,16 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     if (!r)
         goto fail;
     /* Renumber into the caller's numbering in place: tree-order id i is
-     * input point pr.orig[i] (same width, so the buffers are reused). */
+     * input point pr.orig[i] (same width, so the buffers are reused). The
+     * parallel engine's threads did that as they gathered the mesh. */
     fdt_vid *tets = (fdt_vid *)mb.tets;
-    for (size_t i = 0; i < 4 * mb.ntets; i++)
-        tets[i] = pr.orig[mb.tets[i]];
     fdt_vid *hull = (fdt_vid *)mb.hull;
-    for (size_t i = 0; i < 3 * mb.nhull; i++)
-        hull[i] = pr.orig[mb.hull[i]];
+    if (mode == FDT_MODE_SERIAL) {
+        for (size_t i = 0; i < 4 * mb.ntets; i++)
+            tets[i] = pr.orig[mb.tets[i]];
+        for (size_t i = 0; i < 3 * mb.nhull; i++)
+            hull[i] = pr.orig[mb.hull[i]];
+    }
     r->tets = tets;
     r->ntets = mb.ntets;
     r->nbrs = mb.nbrs;

@@ -14,8 +14,9 @@
 #include "prepare.h"
 
 typedef struct fdt_par_out {
-    fdt_meshbuf mb;            /* every tet, global tree-order ids; neighbours
-                                  (if asked) in this meshbuf's tet numbering */
+    fdt_meshbuf mb;            /* every tet, input numbering (pr->orig of the
+                                  tree-order ids); neighbours (if asked) in
+                                  this meshbuf's tet numbering */
     fdt_front_stats fst;       /* work counters summed over the threads */
     fdt_stats pst;             /* only the parallel fields (sent .. pinned) */
     fdt_thread_stats *tstats;  /* nthreads entries (owned until taken) */
