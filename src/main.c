@@ -884,6 +884,11 @@ static int run(const cli *c)
     size_t dups = fdt_result_num_duplicates(res);
     if (dups > 0 && !c->quiet)
         say("%s: merged %zu duplicate points", name, dups);
+    /* --pin where the system refuses a binding (or hwloc is missing): the
+     * run went on unpinned, which the user who asked should hear once. */
+    fdt_stats pst;
+    if (c->pin && !c->quiet && fdt_result_stats(res, &pst) == FDT_OK && pst.pinned < 0)
+        say("--pin: a thread could not be bound to its core; ran unpinned");
 
     size_t nt = fdt_result_num_tets(res);
     if (c->check) {

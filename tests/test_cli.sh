@@ -15,7 +15,7 @@
 # during a long run and during the write (exit 6, nothing left), --demo,
 # repeatability (byte-identical .tets, identical --hash), independence of
 # input order (shuffled copy mapped back), --check, --stats/--stats-json,
-# duplicate reporting, every output format.
+# duplicate reporting, --pin refused (said once), every output format.
 set -u
 
 FRONTDT=${1:?usage: test_cli.sh FRONTDT BAD_DIR}
@@ -364,6 +364,18 @@ cmp -s out/dup.tets out/a.tets || fail "duplicates changed the tets"
 run dup_quiet "$FRONTDT" dup.xyz --quiet
 expect_rc dup_quiet 0
 [ -s dup_quiet.err ] && fail "dup --quiet still said: $(cat dup_quiet.err)"
+# --pin refused: hwloc told of cores whose CPUs (1000, 1001) this machine
+# lacks, so binding fails; the run goes on unpinned, says so once, and
+# the mesh is the same. (Without hwloc every --pin run is refused.)
+run pin_refused env HWLOC_SYNTHETIC="core:2 pu:1(indexes=1000,1001)" HWLOC_THISSYSTEM=1 \
+    "$FRONTDT" pts.xyz -t 2 --pin -o out/pin.tets
+expect_rc pin_refused 0 && expect_in pin_refused err "ran unpinned"
+[ "$(grep -c 'unpinned' pin_refused.err)" = 1 ] || fail "pin_refused: not said exactly once"
+cmp -s out/pin.tets out/a.tets || fail "pin_refused: another mesh"
+run pin_quiet env HWLOC_SYNTHETIC="core:2 pu:1(indexes=1000,1001)" HWLOC_THISSYSTEM=1 \
+    "$FRONTDT" pts.xyz -t 2 --pin --quiet
+expect_rc pin_quiet 0
+[ -s pin_quiet.err ] && fail "pin --quiet still said: $(cat pin_quiet.err)"
 run dup_vtu "$FRONTDT" dup.xyz -o out/dup.ele
 expect_rc dup_vtu 0
 [ "$(head -n1 out/dup.node)" = "304 3 0 0" ] || fail "dup .node must hold all 304 input points"
