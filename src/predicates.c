@@ -24,9 +24,12 @@
 #include "predicates.h"
 
 #include <float.h>
+#include <limits.h>
 #include <gmp.h>
 #include <math.h>
 #include <stdbool.h>
+#include <stdint.h>
+#include <string.h>
 
 /* Expansion arithmetic needs each operation rounded once to double. */
 #if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
@@ -248,12 +251,31 @@ static inline bool exact_diff3(const double *p, const double *q, double *out)
 /* ------------------------------------------------------------------ */
 /* Stage C helpers: doubles as scaled GMP integers. */
 
+/* x != 0 as |x| = m 2^k with m < 2^53 an integer, read from its bits
+ * (a subnormal keeps k = -1074): the library's frexp and ldexp and GMP's
+ * conversion from double took 13 % of a run on points normalised onto a
+ * sphere, where nearly every test reaches stage C (perf, bench/NOTES.md
+ * entry 50). */
+static uint64_t int_mantissa(double x, int *k)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    int be = (int)((b >> 52) & 0x7ff);
+    uint64_t m = b & ((UINT64_C(1) << 52) - 1);
+    if (be == 0) { /* subnormal: m 2^-1074 */
+        *k = -1074;
+        return m;
+    }
+    *k = be - 1075;
+    return m | (UINT64_C(1) << 52);
+}
+
 /* The exponent k of x = m 2^k with |m| < 2^53 an integer (x != 0). */
 static int int_exponent(double x)
 {
     int k;
-    (void)frexp(x, &k);
-    return k - 53;
+    (void)int_mantissa(x, &k);
+    return k;
 }
 
 static int min_int_exponent(const double *const *pts, int npts)
@@ -281,9 +303,17 @@ static void mpz_set_scaled(mpz_t z, double x, int kmin)
         return;
     }
     int k;
-    double f = frexp(x, &k);
-    mpz_set_d(z, ldexp(f, 53)); /* an integer below 2^53: exact */
-    mpz_mul_2exp(z, z, (mp_bitcnt_t)(k - 53 - kmin));
+    uint64_t m = int_mantissa(x, &k);
+#if ULONG_MAX >= UINT64_MAX
+    mpz_set_ui(z, (unsigned long)m);
+#else
+    mpz_set_ui(z, (unsigned long)(m >> 32));
+    mpz_mul_2exp(z, z, 32);
+    mpz_add_ui(z, z, (unsigned long)(m & 0xffffffffu));
+#endif
+    mpz_mul_2exp(z, z, (mp_bitcnt_t)(k - kmin));
+    if (x < 0.0)
+        mpz_neg(z, z);
 }
 
 /* r = det[u; v; w] for integer rows; t is scratch. */
@@ -560,12 +590,18 @@ static int insphere_stage_c(const double *a, const double *b, const double *c,
     const double *const pts[5] = {a, b, c, d, e};
     int kmin = min_int_exponent(pts, 5);
     mpz_t q[5][3], m3, lift, det, t;
+    /* Sized at creation for the usual spread of exponents (GMP would
+     * otherwise grow each from nothing: 12 % of a run on points
+     * normalised onto a sphere); wider inputs still grow them. */
     for (int i = 0; i < 5; i++)
         for (int k = 0; k < 3; k++) {
-            mpz_init(q[i][k]);
+            mpz_init2(q[i][k], 128);
             mpz_set_scaled(q[i][k], pts[i][k], kmin);
         }
-    mpz_inits(m3, lift, det, t, NULL);
+    mpz_init2(m3, 512);
+    mpz_init2(lift, 512);
+    mpz_init2(det, 512);
+    mpz_init2(t, 512);
     for (int i = 0; i < 4; i++)
         for (int k = 0; k < 3; k++)
             mpz_sub(q[i][k], q[i][k], q[4][k]);
