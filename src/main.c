@@ -6,12 +6,13 @@
  * Exit codes (also listed by --help; scripts and tests rely on them):
  *   0  success
  *   1  usage error (bad option or value, missing input, a setting the
- *      library refuses)
+ *      library refuses, unknown output extension, an output that would
+ *      overwrite the input)
  *   2  bad input: unreadable or malformed file, unknown input extension,
  *      NaN/Inf, fewer than 4 distinct points, all points coplanar
  *   3  --check found the mesh is not the Delaunay tetrahedralization
  *   4  out of resources: memory, index range, threads
- *   5  cannot write the output (or unknown output extension)
+ *   5  cannot write the output
  *   6  interrupted by SIGINT or SIGTERM (no output, no temporary file left)
  *   7  internal error (a bug: please report it)
  *
@@ -412,11 +413,44 @@ static int ends_with_ci(const char *s, const char *ext)
     return 1;
 }
 
-/* The extensions fdt_write_mesh() knows (src/writer.h lists them). */
-static int known_output(const char *path)
+/*
+ * Refuses, before anything is read, a run that would replace a file it
+ * reads: any file of the output's set (names[0..k), from
+ * fdt_output_files(), so "-o m.ele" covers m.node too) that is the input,
+ * and the --stats-json file, written after the mesh, where it is the
+ * input or one of the mesh's files. "Is" means the same file by any name
+ * (fdt_same_file: "./x", "d/../x", absolute, symbolic or hard links).
+ * Without this "frontdt m.node -o m.ele" rewrote m.node, its attributes,
+ * markers, comments and 1-based numbering lost. Returns -1 to go on, or
+ * CLI_USAGE after naming both files.
+ */
+static int refuse_overwrites(const cli *c, char names[][FDT_IO_PATH], int k)
 {
-    return ends_with_ci(path, ".tets") || ends_with_ci(path, ".ele") ||
-           ends_with_ci(path, ".vtu") || ends_with_ci(path, ".vtk");
+    const char *json = c->stats_json && strcmp(c->stats_json, "-") != 0
+                           ? c->stats_json
+                           : NULL;
+    for (int i = 0; i < k; i++) {
+        /* The set's other files are named with their -o: the user typed
+         * m.ele and should hear why m.node is at stake. */
+        char via[FDT_IO_PATH + 32] = "";
+        if (strcmp(names[i], c->output) != 0)
+            snprintf(via, sizeof via, " (written with -o %s)", c->output);
+        if (c->input && fdt_same_file(names[i], c->input)) {
+            say("output %s%s would overwrite the input %s", names[i], via,
+                c->input);
+            return CLI_USAGE;
+        }
+        if (json && fdt_same_file(names[i], json)) {
+            say("--stats-json file %s would overwrite the output %s%s", json,
+                names[i], via);
+            return CLI_USAGE;
+        }
+    }
+    if (json && c->input && fdt_same_file(json, c->input)) {
+        say("--stats-json file %s would overwrite the input %s", json, c->input);
+        return CLI_USAGE;
+    }
+    return -1;
 }
 
 /*
@@ -600,8 +634,9 @@ static int exit_for_writer(int err)
 {
     switch (err) {
     case FDT_IO_EWRITE:
-    case FDT_IO_EEXT:
         return CLI_WRITE;
+    case FDT_IO_EEXT: /* the CLI refuses it up front, as a usage error */
+        return CLI_USAGE;
     case FDT_IO_ENOMEM:
         return CLI_RESOURCES;
     default: /* FDT_IO_EFORMAT: we handed the writer a broken mesh */
@@ -815,16 +850,26 @@ static int run(const cli *c)
     /* stdout carries the JSON object alone when asked to. */
     FILE *info = json_stdout ? stderr : stdout;
 
-    /* Refuse doomed outputs before reading or computing anything. */
+    /* Refuse doomed or destructive outputs before reading or computing
+     * anything. */
+    char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+    int n_names = 0;
     if (c->output) {
-        if (!known_output(c->output)) {
-            say("%s: unknown output format (use .tets, .ele, .vtu or .vtk)",
-                c->output);
+        n_names = fdt_output_files(c->output, names);
+        if (n_names == 0)
+            return usage_error("%s: unknown output format (use .tets, .ele, "
+                               ".vtu or .vtk)", c->output);
+        if (n_names < 0) {
+            say("%s: %s", c->output, strerror(ENAMETOOLONG));
             return CLI_WRITE;
         }
-        if (!output_dir_ok(c->output))
-            return CLI_WRITE;
     }
+    code = refuse_overwrites(c, names, n_names);
+    if (code >= 0)
+        return code;
+    code = CLI_OK;
+    if (c->output && !output_dir_ok(c->output))
+        return CLI_WRITE;
     if (c->stats_json && !json_stdout && !output_dir_ok(c->stats_json))
         return CLI_WRITE;
 

@@ -54,7 +54,6 @@
  * The writer frees every slot before fdt_write_mesh() returns.
  */
 #define FDT_IO_SLOTS 8
-#define FDT_IO_PATH 4096
 
 enum { SLOT_FREE = 0, SLOT_TEMP = 1, SLOT_RENAMING = 2, SLOT_RENAMED = 3 };
 
@@ -354,6 +353,20 @@ static void out_abandon(out_file *o)
  * if any close or rename fails, every temporary and every target already
  * renamed in this set is removed (a .ele set with a stale .neigh beside a
  * new .ele would be worse than none).
+ *
+ * rename() replaces the directory entry, never the file behind it: a
+ * target that is a symbolic link is replaced by the new file and what it
+ * pointed to is left as it was; a target that is one of several hard
+ * links leaves the other names with the old contents. We keep it so
+ * rather than writing through the link: a link can then never lead the
+ * writer to a file other than the name it was given (an input reached
+ * through one, a file outside the output directory), and the temporary
+ * is made by mkstemp() (O_CREAT | O_EXCL), which never opens an existing
+ * file either. So the writer itself cannot destroy an input's bytes
+ * except by replacing the input's own name. The CLI refuses that, and
+ * also a target that is a link to or another name of its input
+ * (fdt_same_file): whoever names it expects the write to go through, and
+ * would instead find the link silently turned into a plain file.
  */
 static int commit_all(out_file *files, int k, char *err, size_t errlen)
 {
@@ -519,6 +532,143 @@ static int write_tets(const char *path, const fdt_mesh_view *m, char *err,
 }
 
 /* ------------------------------------------------------------------------ */
+/* File sets and file identity                                               */
+/* ------------------------------------------------------------------------ */
+
+/* Case-insensitive "does s end with ext" (ext lowercase, with the dot). */
+static int has_ext(const char *s, const char *ext)
+{
+    size_t ls = strlen(s), le = strlen(ext);
+    if (ls <= le)
+        return 0;
+    const char *p = s + ls - le;
+    for (size_t i = 0; i < le; i++) {
+        char c = p[i];
+        if (c >= 'A' && c <= 'Z')
+            c = (char)(c - 'A' + 'a');
+        if (c != ext[i])
+            return 0;
+    }
+    /* "dir/.ele" has an empty base name: not a mesh file name. */
+    return p[-1] != '/';
+}
+
+int fdt_output_files(const char *path,
+                     char names[FDT_IO_MAX_FILES][FDT_IO_PATH])
+{
+    size_t len = strlen(path);
+    if (has_ext(path, ".tets") || has_ext(path, ".vtu") ||
+        has_ext(path, ".vtk")) {
+        if (len + 1 > FDT_IO_PATH)
+            return -1;
+        memcpy(names[0], path, len + 1);
+        return 1;
+    }
+    if (!has_ext(path, ".ele"))
+        return 0;
+    static const char *const exts[4] = { ".node", ".ele", ".face",
+                                         ".neigh" };
+    size_t baselen = len - 4;
+    for (int i = 0; i < 4; i++) {
+        if (baselen + strlen(exts[i]) + 1 > FDT_IO_PATH)
+            return -1;
+        memcpy(names[i], path, baselen);
+        if (i == 1) /* keep the user's spelling of the .ele name itself */
+            memcpy(names[i] + baselen, path + baselen, 5);
+        else
+            memcpy(names[i] + baselen, exts[i], strlen(exts[i]) + 1);
+    }
+    return 4;
+}
+
+/*
+ * What a path reaches (fdt_same_file): an existing file, or a name in a
+ * directory where opening it would create one.
+ */
+enum { ID_UNKNOWN = 0, ID_FILE = 1, ID_NEW = 2 };
+
+typedef struct file_id {
+    int kind;
+    dev_t dev;                /* ID_FILE: the file's; ID_NEW: its directory's */
+    ino_t ino;
+    char name[FDT_IO_PATH];   /* ID_NEW: the last component */
+} file_id;
+
+/* At most this many dangling links in a row, like the kernel's own limit
+ * on links followed in one lookup (Linux: 40). */
+#define FDT_IO_MAX_HOPS 40
+
+static void file_id_of(const char *path, file_id *id)
+{
+    id->kind = ID_UNKNOWN;
+    char cur[FDT_IO_PATH];
+    size_t len = strlen(path);
+    if (len + 1 > sizeof cur)
+        return;
+    memcpy(cur, path, len + 1);
+    for (int hop = 0; hop < FDT_IO_MAX_HOPS; hop++) {
+        struct stat st;
+        if (stat(cur, &st) == 0) {
+            id->kind = ID_FILE;
+            id->dev = st.st_dev;
+            id->ino = st.st_ino;
+            return;
+        }
+        if (errno != ENOENT)
+            return;
+        char *slash = strrchr(cur, '/');
+        /* A dangling link: fopen(path, "w") creates the file it names
+         * (that is how --stats-json is written), so that file is the one
+         * to compare. A relative target counts from the link's directory. */
+        if (lstat(cur, &st) == 0 && S_ISLNK(st.st_mode)) {
+            char target[FDT_IO_PATH];
+            ssize_t k = readlink(cur, target, sizeof target - 1);
+            if (k <= 0)
+                return;
+            target[k] = '\0';
+            size_t dirlen = (target[0] == '/' || !slash)
+                                ? 0
+                                : (size_t)(slash - cur) + 1;
+            if (dirlen + (size_t)k + 1 > sizeof cur)
+                return;
+            memmove(cur + dirlen, target, (size_t)k + 1);
+            continue;
+        }
+        /* Not there: the directory it would be made in, and its name. */
+        const char *base = slash ? slash + 1 : cur;
+        if (!*base)
+            return;
+        size_t baselen = strlen(base) + 1;
+        memmove(id->name, base, baselen);
+        if (!slash)
+            memcpy(cur, ".", 2);
+        else if (slash == cur)
+            cur[1] = '\0'; /* "/name": the root directory */
+        else
+            *slash = '\0';
+        if (stat(cur, &st) != 0 || !S_ISDIR(st.st_mode))
+            return;
+        id->kind = ID_NEW;
+        id->dev = st.st_dev;
+        id->ino = st.st_ino;
+        return;
+    }
+}
+
+int fdt_same_file(const char *a, const char *b)
+{
+    if (strcmp(a, b) == 0)
+        return 1;
+    file_id ia, ib;
+    file_id_of(a, &ia);
+    file_id_of(b, &ib);
+    int same = ia.kind != ID_UNKNOWN && ia.kind == ib.kind &&
+               ia.dev == ib.dev && ia.ino == ib.ino &&
+               (ia.kind == ID_FILE || strcmp(ia.name, ib.name) == 0);
+    return same;
+}
+
+/* ------------------------------------------------------------------------ */
 /* TetGen .node / .ele / .face / .neigh                                       */
 /* ------------------------------------------------------------------------ */
 
@@ -580,24 +730,6 @@ static void put_neigh(out_file *o, const fdt_mesh_view *m)
     put_rows(o, m->n_tets, " 4\n", 4, NULL, m->nbrs);
 }
 
-/* Case-insensitive "does s end with ext" (ext lowercase, with the dot). */
-static int has_ext(const char *s, const char *ext)
-{
-    size_t ls = strlen(s), le = strlen(ext);
-    if (ls <= le)
-        return 0;
-    const char *p = s + ls - le;
-    for (size_t i = 0; i < le; i++) {
-        char c = p[i];
-        if (c >= 'A' && c <= 'Z')
-            c = (char)(c - 'A' + 'a');
-        if (c != ext[i])
-            return 0;
-    }
-    /* "dir/.ele" has an empty base name: not a mesh file name. */
-    return p[-1] != '/';
-}
-
 static int write_tetgen(const char *path, const fdt_mesh_view *m, char *err,
                         size_t errlen)
 {
@@ -605,22 +737,13 @@ static int write_tetgen(const char *path, const fdt_mesh_view *m, char *err,
         return set_err(err, errlen, FDT_IO_EFORMAT, path,
                        ".ele output needs tet neighbours "
                        "(settings.neighbors)");
-    size_t baselen = strlen(path) - 4; /* path ends with ".ele" */
-    static const char *const exts[4] = { ".node", ".ele", ".face",
-                                         ".neigh" };
     void (*const put[4])(out_file *, const fdt_mesh_view *) = {
         put_node, put_ele, put_face, put_neigh
     };
-    char names[4][FDT_IO_PATH];
-    for (int i = 0; i < 4; i++) {
-        if (baselen + strlen(exts[i]) + 1 > FDT_IO_PATH)
-            return set_errno_err(err, errlen, path, ENAMETOOLONG);
-        memcpy(names[i], path, baselen);
-        if (i == 1) /* keep the user's spelling of the .ele name itself */
-            memcpy(names[i] + baselen, path + baselen, 5);
-        else
-            memcpy(names[i] + baselen, exts[i], strlen(exts[i]) + 1);
-    }
+    /* fdt_output_files() lists .node, .ele, .face, .neigh in this order. */
+    char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+    if (fdt_output_files(path, names) != 4)
+        return set_errno_err(err, errlen, path, ENAMETOOLONG);
 
     out_file files[4];
     mode_t mode = creation_mode();

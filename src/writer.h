@@ -34,6 +34,39 @@ typedef struct fdt_mesh_view {
 int fdt_write_mesh(const char *path, const fdt_mesh_view *m, char *err,
                    size_t errlen);
 
+/* The longest path the writer takes (its temporary names live in fixed
+ * buffers a signal handler can read), and the most files one output
+ * family writes (.ele: four). */
+#define FDT_IO_PATH 4096
+#define FDT_IO_MAX_FILES 4
+
+/*
+ * The files fdt_write_mesh(path, ...) writes, in the order it writes them,
+ * into names[0..count): path alone for .tets, .vtu and .vtk; for .ele,
+ * BASE.node, path itself, BASE.face and BASE.neigh (BASE is path without
+ * ".ele"; the siblings' extensions are lowercase whatever the case of
+ * ".ele"). The writer builds its file set from this list, so a check made
+ * on it covers every file a run will replace. Returns the count, 0 for an
+ * unknown extension, -1 when a name would not fit FDT_IO_PATH.
+ */
+int fdt_output_files(const char *path,
+                     char names[FDT_IO_MAX_FILES][FDT_IO_PATH]);
+
+/*
+ * Do paths a and b reach the same file? 1 if so, else 0. Each path stands
+ * for the file that opening it would read or create, symbolic links
+ * followed (a dangling link stands for the file it would create):
+ *   - an existing file is known by (st_dev, st_ino), so "./x", "d/../x",
+ *     an absolute path, a symbolic link and a hard link all match it;
+ *   - a name not there yet is known by its directory's (st_dev, st_ino)
+ *     and its last component, compared byte for byte (a case-insensitive
+ *     file system's "A" and "a" are not matched while neither exists).
+ * Equal strings always match. A path that cannot be resolved (a missing
+ * directory, no permission, a loop of links) matches only its own string:
+ * whatever then tries to use it fails on its own.
+ */
+int fdt_same_file(const char *a, const char *b);
+
 /* Removes every temporary output file not yet renamed. Async-signal-safe. */
 void fdt_io_cleanup_temps(void);
 

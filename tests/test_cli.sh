@@ -9,8 +9,10 @@
 #
 # Covers: --help/--version, usage errors (exit 1), every hostile input
 # (its exit code and message, and no output or temporary file left), an
-# unknown output extension refused before any computation, an output
-# directory that does not exist (exit 5, nothing left), write errors part-
+# unknown output extension refused before any computation (exit 1), an
+# output that would overwrite the input refused (exit 1, every output family
+# against every way of naming the input, the input's bytes unchanged), an
+# output directory that does not exist (exit 5, nothing left), write errors part-
 # way (file size limit, /dev/full: exit 5, nothing left), SIGTERM and SIGINT
 # during a long run and during the write (exit 6, nothing left), --demo,
 # repeatability (byte-identical .tets, identical --hash), independence of
@@ -170,7 +172,7 @@ rm -rf out && mkdir out
 start=$(date +%s%N)
 run ext "$FRONTDT" --demo 3000000 -o out/mesh.xyz
 end=$(date +%s%N)
-expect_rc ext 5 && expect_in ext err "unknown output format"
+expect_rc ext 1 && expect_in ext err "frontdt: out/mesh.xyz: unknown output format"
 ms=$(((end - start) / 1000000))
 [ "$ms" -lt 2000 ] || fail "unknown output extension took ${ms} ms: not refused up front"
 expect_empty_dir ext out
@@ -202,6 +204,133 @@ expect_empty_dir isdir out
 run jsondir "$FRONTDT" pts.xyz --stats-json out/no/stats.json
 expect_rc jsondir 5
 expect_empty_dir jsondir out
+
+# ---------------------------------------------------------------------------
+# Never overwrite an input (issue 17 item 1)
+# ---------------------------------------------------------------------------
+# Every output family against every way of naming the input: the same path,
+# "./", "dir/../", absolute paths, a symbolic link to the input (as the
+# input or as the output), a hard link, the .ele family's .node sibling,
+# and --stats-json on the input or on one of the mesh's files. Each must
+# exit 1 before any work with a message naming both files, leave the
+# input's bytes as they were (cmp against a saved copy) and leave the
+# directory as it was: no temporary, no output, no link turned into a file.
+rm -rf ow ow_saved && mkdir -p ow/sub ow_saved
+# What a rewrite of a .node file would lose: a comment, 1-based numbering,
+# an attribute and a boundary marker.
+{
+    echo "# kept: comment, 1-based numbering, an attribute, a marker"
+    echo "300 3 1 1"
+    awk '{ printf "%d %s %s %s 0.5 %d\n", NR, $1, $2, $3, NR % 3 }' pts.xyz
+} >ow/m.node
+cp pts.xyz ow/r.xyz
+# Inputs named as the .tets/.vtu/.vtk output would be (the reader would
+# refuse these extensions, but only after the check, which comes first).
+for f in tets vtu vtk; do cp pts.xyz "ow/m.$f"; done
+cp ow/m.node ow/r.xyz ow/m.tets ow/m.vtu ow/m.vtk ow_saved/
+ow_listing() { find ow -printf '%y %p\n' | LC_ALL=C sort; }
+ow_listing >ow_before.txt
+
+# ow_case NAME OUTNAME INNAME ARGS...: exit 1, a message naming OUTNAME
+# and the input INNAME, and nothing in ow/ changed.
+ow_case() {
+    local name=$1 outname=$2 inname=$3 f
+    shift 3
+    run "$name" "$FRONTDT" "$@"
+    expect_rc "$name" 1
+    expect_in "$name" err "frontdt: "
+    expect_in "$name" err "$outname"
+    expect_in "$name" err "would overwrite the $inname"
+    for f in m.node r.xyz m.tets m.vtu m.vtk; do
+        if ! cmp -s "ow/$f" "ow_saved/$f"; then
+            fail "$name: the input ow/$f was changed"
+            cp "ow_saved/$f" "ow/$f"
+        fi
+    done
+    if ! ow_listing | cmp -s - ow_before.txt; then
+        fail "$name: ow/ changed: $(ow_listing | diff ow_before.txt - | tr '\n' ' ')"
+    fi
+}
+
+for fam in tets ele vtu vtk; do
+    if [ "$fam" = ele ]; then
+        clash=node # the file of the set that can be an input
+        real=ow/m.node # a readable input for the link cases
+    else
+        clash=$fam
+        real=ow/r.xyz
+    fi
+    in=ow/m.$clash
+    rb=${real#ow/}
+    ow_case "ow_${fam}_same" "output ow/m.$clash" "input $in" "$in" -o "ow/m.$fam"
+    ow_case "ow_${fam}_dot" "output ./ow/m.$clash" "input $in" "$in" -o "./ow/m.$fam"
+    ow_case "ow_${fam}_dotdot" "output ow/sub/../m.$clash" "input $in" "$in" -o "ow/sub/../m.$fam"
+    ow_case "ow_${fam}_abs_out" "output $PWD/ow/m.$clash" "input $in" "$in" -o "$PWD/ow/m.$fam"
+    ow_case "ow_${fam}_abs_in" "output ow/m.$clash" "input $PWD/$in" "$PWD/$in" -o "ow/m.$fam"
+    ow_case "ow_${fam}_dot_in" "output ow/m.$clash" "input ./$in" "./$in" -o "ow/m.$fam"
+    # The input named through a symbolic link (and through a linked
+    # directory): the output is the file behind it.
+    ln -s "m.$clash" "ow/lin.$clash"
+    ln -s .. ow/sub/up
+    ow_listing >ow_before.txt
+    ow_case "ow_${fam}_in_link" "output ow/m.$clash" "input ow/lin.$clash" "ow/lin.$clash" -o "ow/m.$fam"
+    ow_case "ow_${fam}_in_dirlink" "output ow/m.$clash" "input ow/sub/up/m.$clash" \
+        "ow/sub/up/m.$clash" -o "ow/m.$fam"
+    # The output (or, for .ele, its .node) a symbolic link to the input.
+    ln -s "$rb" "ow/lo.$clash"
+    # ... and a hard link to it; also the input named by a hard link.
+    ln "$real" "ow/hl.$clash"
+    ln "$in" "ow/hin.$clash"
+    ow_listing >ow_before.txt
+    ow_case "ow_${fam}_out_link" "output ow/lo.$clash" "input $real" "$real" -o "ow/lo.$fam"
+    ow_case "ow_${fam}_hard_link" "output ow/hl.$clash" "input $real" "$real" -o "ow/hl.$fam"
+    ow_case "ow_${fam}_hard_link_in" "output ow/m.$clash" "input ow/hin.$clash" \
+        "ow/hin.$clash" -o "ow/m.$fam"
+    # --stats-json on the input, by its name or through a link, beside a
+    # legitimate mesh output.
+    ow_case "ow_${fam}_json" "--stats-json file $real" "input $real" "$real" \
+        -o "ow/fine.$fam" --stats-json "$real"
+    ow_case "ow_${fam}_json_link" "--stats-json file ow/lo.$clash" "input $real" "$real" \
+        -o "ow/fine.$fam" --stats-json "ow/lo.$clash"
+    # --stats-json on a file of the mesh's own set (written after it).
+    ow_case "ow_${fam}_json_out" "--stats-json file ./ow/s.$clash" "output ow/s.$clash" "$real" \
+        -o "ow/s.$fam" --stats-json "./ow/s.$clash"
+    rm -f "ow/lin.$clash" ow/sub/up "ow/lo.$clash" "ow/hl.$clash" "ow/hin.$clash"
+    ow_listing >ow_before.txt
+done
+# The .ele family's siblings: "-o m.ele" writes m.node, whatever the case
+# of ".ele"; the message says which -o writes it.
+ow_case ow_sibling "output ow/m.node (written with -o ow/m.ele)" "input ow/m.node" ow/m.node -o ow/m.ele
+ow_case ow_sibling_case "output ow/m.node (written with -o ow/m.ELE)" "input ow/m.node" ow/m.node -o ow/m.ELE
+ow_case ow_sibling_neigh "--stats-json file ow/d.neigh" "output ow/d.neigh (written with -o ow/d.ele)" \
+    --demo 3000000 -o ow/d.ele --stats-json ow/d.neigh
+# "-o m.face" (or .node, .neigh) is no output format at all: refused as
+# such, the input untouched.
+for ext in face node neigh; do
+    run "ow_$ext" "$FRONTDT" ow/m.node -o "ow/m.$ext"
+    expect_rc "ow_$ext" 1 && expect_in "ow_$ext" err "ow/m.$ext: unknown output format"
+    cmp -s ow/m.node ow_saved/m.node || fail "ow_$ext: ow/m.node was changed"
+done
+ow_listing | cmp -s - ow_before.txt || fail "ow: unknown formats left files in ow/"
+
+# Controls: outputs beside the input (another name, or the same name in
+# another directory) and --stats-json beside it still work, and leave the
+# input as it was.
+for fam in tets ele vtu vtk; do
+    if [ "$fam" = ele ]; then real=ow/m.node; else real=ow/r.xyz; fi
+    run "ow_ok_$fam" "$FRONTDT" "$real" -o "ow/beside.$fam" --stats-json ow/beside.json --quiet
+    expect_rc "ow_ok_$fam" 0
+    [ -s "ow/beside.$fam" ] || fail "ow_ok_$fam: no ow/beside.$fam"
+    [ -s ow/beside.json ] || fail "ow_ok_$fam: no ow/beside.json"
+    base=${real#ow/}
+    run "ow_ok_sub_$fam" "$FRONTDT" "$real" -o "ow/sub/${base%.*}.$fam" --quiet
+    expect_rc "ow_ok_sub_$fam" 0
+    [ -s "ow/sub/${base%.*}.$fam" ] || fail "ow_ok_sub_$fam: no ow/sub/${base%.*}.$fam"
+    cmp -s "$real" "ow_saved/$base" || fail "ow_ok_$fam: $real was changed"
+done
+[ "$(head -n1 ow/beside.node)" = "300 3 0 0" ] || fail "ow_ok_ele: no .node written beside the input"
+compgen -G "ow/.*.tmp.*" >/dev/null && fail "ow: temporary files left: $(ls -A ow)"
+rm -rf ow ow_saved
 
 # ---------------------------------------------------------------------------
 # Write errors during the run: reported (exit 5), never ignored

@@ -6,7 +6,9 @@
  * failures (missing directory, a regular file as directory, read-only
  * directory, target is a directory, file size limit, failing rename in a
  * TetGen set) that must return FDT_IO_EWRITE and leave no temporary file
- * and no partial output.
+ * and no partial output; the file set of each output family
+ * (fdt_output_files) and file identity by any name (fdt_same_file), which
+ * the CLI uses to refuse an output that would overwrite its input.
  */
 #include "reader.h"
 #include "writer.h"
@@ -836,6 +838,122 @@ static void test_large(const char *dir)
     free(hull);
 }
 
+/* fdt_output_files: the set of each family, as the writer writes it. */
+static void test_output_files(const char *dir)
+{
+    char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+    CHECK(fdt_output_files("a/m.tets", names) == 1);
+    CHECK(!strcmp(names[0], "a/m.tets"));
+    CHECK(fdt_output_files("m.VTU", names) == 1);
+    CHECK(!strcmp(names[0], "m.VTU"));
+    CHECK(fdt_output_files("m.vtk", names) == 1);
+    CHECK(fdt_output_files("d/m.ELE", names) == 4);
+    CHECK(!strcmp(names[0], "d/m.node"));
+    CHECK(!strcmp(names[1], "d/m.ELE"));
+    CHECK(!strcmp(names[2], "d/m.face"));
+    CHECK(!strcmp(names[3], "d/m.neigh"));
+    CHECK(fdt_output_files("m.face", names) == 0);
+    CHECK(fdt_output_files("m.node", names) == 0);
+    CHECK(fdt_output_files("d/.ele", names) == 0);
+    CHECK(fdt_output_files("ele", names) == 0);
+    /* A .ele name that fits while "BASE.neigh" would not. */
+    static char longp[FDT_IO_PATH];
+    memset(longp, 'x', FDT_IO_PATH - 1);
+    memcpy(longp + FDT_IO_PATH - 6, ".ele", 5);
+    CHECK(fdt_output_files(longp, names) == -1);
+
+    /* The writer writes exactly that set (and nothing else). */
+    int before = count_entries(dir);
+    double xyz[12] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1 };
+    fdt_vid tet[4] = { 0, 1, 2, 3 };
+    fdt_tid nb[4] = { -1, -1, -1, -1 };
+    fdt_vid hull[12] = { 1, 2, 3, 0, 3, 2, 0, 1, 3, 0, 2, 1 };
+    fdt_mesh_view v = { .xyz = xyz, .n_points = 4, .tets = tet, .n_tets = 1,
+                        .nbrs = nb, .hull = hull, .n_hull = 4 };
+    char p[4096], e[256];
+    snprintf(p, sizeof p, "%s/set.Ele", dir);
+    CHECK(fdt_write_mesh(p, &v, e, sizeof e) == FDT_IO_OK);
+    CHECK(fdt_output_files(p, names) == 4);
+    for (int i = 0; i < 4; i++) {
+        struct stat st;
+        CHECK(stat(names[i], &st) == 0 && S_ISREG(st.st_mode));
+    }
+    CHECK(count_entries(dir) == before + 4);
+}
+
+static void touch(const char *path)
+{
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (f) {
+        fputs("0 0 0\n", f);
+        fclose(f);
+    }
+}
+
+/* fdt_same_file: every way of naming one file, and the near misses. */
+static void test_same_file(const char *dir)
+{
+    char a[4096], b[4096], c[4096], cwd[4096];
+    CHECK(getcwd(cwd, sizeof cwd) != NULL);
+    CHECK(chdir(dir) == 0);
+    mkdir("sub", 0755);
+    touch("in.node");
+    touch("other.node");
+
+    CHECK(fdt_same_file("in.node", "in.node"));
+    CHECK(fdt_same_file("in.node", "./in.node"));
+    CHECK(fdt_same_file("sub/../in.node", "in.node"));
+    snprintf(a, sizeof a, "%s/in.node", dir);
+    CHECK(fdt_same_file(a, "in.node"));
+    CHECK(fdt_same_file("in.node", a));
+    CHECK(!fdt_same_file("in.node", "other.node"));
+    CHECK(!fdt_same_file("in.node", "sub"));
+
+    /* Links: a symbolic link (relative or absolute target, through a
+     * linked directory) and a hard link all reach the file. */
+    CHECK(symlink("in.node", "sym.tets") == 0);
+    CHECK(fdt_same_file("sym.tets", "in.node"));
+    CHECK(symlink(a, "sub/abs.vtk") == 0);
+    CHECK(fdt_same_file("sub/abs.vtk", "./in.node"));
+    CHECK(symlink("..", "sub/up") == 0);
+    CHECK(fdt_same_file("sub/up/in.node", "in.node"));
+    CHECK(link("in.node", "hard.vtu") == 0);
+    CHECK(fdt_same_file("hard.vtu", "in.node"));
+    CHECK(!fdt_same_file("hard.vtu", "other.node"));
+
+    /* Names not there yet: same directory and name, however spelled. */
+    CHECK(fdt_same_file("new.neigh", "./new.neigh"));
+    CHECK(fdt_same_file("sub/../new.neigh", "new.neigh"));
+    snprintf(b, sizeof b, "%s/new.neigh", dir);
+    CHECK(fdt_same_file(b, "sub/up/new.neigh"));
+    CHECK(!fdt_same_file("new.neigh", "new.face"));
+    CHECK(!fdt_same_file("new.neigh", "sub/new.neigh"));
+    /* A missing name is not an existing file. */
+    CHECK(!fdt_same_file("new.neigh", "in.node"));
+
+    /* A dangling link stands for the file that writing through it would
+     * create, relative to the link's own directory, chains included. */
+    CHECK(symlink("../new.neigh", "sub/dangle.json") == 0);
+    CHECK(fdt_same_file("sub/dangle.json", "new.neigh"));
+    CHECK(!fdt_same_file("sub/dangle.json", "sub/new.neigh"));
+    CHECK(symlink("sub/dangle.json", "chain.json") == 0);
+    CHECK(fdt_same_file("chain.json", "./new.neigh"));
+    snprintf(c, sizeof c, "%s/new.face", dir);
+    CHECK(symlink(c, "absdangle.json") == 0);
+    CHECK(fdt_same_file("absdangle.json", "new.face"));
+
+    /* Unresolvable paths match only their own string. */
+    CHECK(symlink("loop.b", "loop.a") == 0);
+    CHECK(symlink("loop.a", "loop.b") == 0);
+    CHECK(fdt_same_file("loop.a", "loop.a"));
+    CHECK(!fdt_same_file("loop.a", "loop.b"));
+    CHECK(!fdt_same_file("no/such/x.tets", "no/such/../such/x.tets"));
+    CHECK(!fdt_same_file("in.node/x", "in.node"));
+
+    CHECK(chdir(cwd) == 0);
+}
+
 /* fdt_io_cleanup_temps() with nothing live is harmless. */
 static void test_cleanup_idle(const char *dir)
 {
@@ -855,10 +973,12 @@ int main(void)
         return 1;
     }
     char sub[4096];
-    const char *names[] = { "small", "refuse", "ids", "large" };
+    const char *names[] = { "small", "refuse", "ids", "large", "files",
+                            "same" };
     void (*fns[])(const char *) = { test_small_mesh, test_refusals,
-                                    test_big_ids, test_large };
-    for (int i = 0; i < 4; i++) {
+                                    test_big_ids, test_large,
+                                    test_output_files, test_same_file };
+    for (int i = 0; i < 6; i++) {
         snprintf(sub, sizeof sub, "%s/%s", dir, names[i]);
         mkdir(sub, 0755);
         int before = failures;
