@@ -36,6 +36,7 @@
 #endif
 
 #include "frontdt.h"
+#include "insert.h"
 #include "reader.h"
 #include "writer.h"
 
@@ -469,6 +470,126 @@ static int sc_post(void *arg, const char **bad)
 }
 
 /* ------------------------------------------------------------------ */
+/* Scenarios: the insertion kernel (src/insert.c)                     */
+/* ------------------------------------------------------------------ */
+
+typedef struct ins_arg {
+    const double *xyz;  /* n distinct points */
+    uint32_t n;
+    size_t want_tets;   /* finite tets, from an uninjected build */
+    uint32_t hub;       /* sc_find_face: a vertex with a star over 512 tets */
+} ins_arg;
+
+/* fdt_ins_build: FDT_ENOMEM with nothing kept, or the reference count. */
+static int sc_insert(void *arg, const char **bad)
+{
+    ins_arg *a = arg;
+    fdt_ins m;
+    int rc = fdt_ins_build(&m, a->xyz, 0, a->n, NULL);
+    if (rc != FDT_OK) {
+        if (m.T != NULL || m.vtet != NULL)
+            *bad = "a failed fdt_ins_build kept its arrays";
+    } else if (m.nfinite != a->want_tets) {
+        *bad = "wrong number of tets";
+    }
+    fdt_ins_free(&m);
+    return rc;
+}
+
+/* fdt_ins_find_face on faces around a big star, whose search takes a heap
+ * buffer: when that allocation fails it must still answer, and rightly. */
+static int sc_find_face(void *arg, const char **bad)
+{
+    ins_arg *a = arg;
+    long at = atomic_load(&fault_at);
+    atomic_store(&fault_at, 0);
+    fdt_ins m;
+    if (fdt_ins_build(&m, a->xyz, 0, a->n, NULL) != FDT_OK) {
+        *bad = "cannot build the kernel";
+        return FDT_OK;
+    }
+    atomic_store(&fault_at, at);
+    static const int face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+    int asked = 0;
+    for (uint32_t t = fdt_ins_next_finite(&m, 0); t != FDT_NONE && asked < 6;
+         t = fdt_ins_next_finite(&m, t + 1)) {
+        const uint32_t *v = fdt_ins_tet(&m, t);
+        for (int k = 0; k < 4 && asked < 6; k++) {
+            if (v[k] == a->hub)
+                continue;
+            uint32_t x = v[face[k][0]], y = v[face[k][1]], z = v[face[k][2]];
+            if (x != a->hub && y != a->hub && z != a->hub)
+                continue;
+            /* the hub first, so its star is the one searched */
+            while (x != a->hub) {
+                uint32_t tmp = x;
+                x = y;
+                y = z;
+                z = tmp;
+            }
+            uint32_t nt, ft;
+            int nk, fk;
+            fdt_ins_across(&m, t, k, &nt, &nk);
+            if (fdt_ins_find_face(&m, x, y, z, &ft, &fk) != 1 || ft != nt || fk != nk)
+                *bad = "fdt_ins_find_face disagrees with fdt_ins_across";
+            asked++;
+        }
+    }
+    if (asked < 6)
+        *bad = "too few faces around the hub";
+    atomic_store(&fault_at, 0);
+    fdt_ins_free(&m);
+    atomic_store(&fault_at, at);
+    return FDT_OK;
+}
+
+/* 600 points near a sphere and its centre, joined to every hull face:
+ * a star of about 1200 tets. */
+static ptset make_hub(uint64_t *rng)
+{
+    ptset s = {"hub", alloc_points(601), 601};
+    for (size_t i = 0; i < 600; i++) {
+        double z = 1.0 - (2.0 * (double)i + 1.0) / 600.0;
+        double r = sqrt(1.0 - z * z), ph = 2.399963229728653 * (double)i;
+        double rad = 1.0 + 1e-3 * rnd01(rng);
+        s.xyz[3 * i] = rad * r * cos(ph);
+        s.xyz[3 * i + 1] = rad * r * sin(ph);
+        s.xyz[3 * i + 2] = rad * z;
+    }
+    s.xyz[1800] = s.xyz[1801] = s.xyz[1802] = 0.0;
+    return s;
+}
+
+/* Every allocation of fdt_ins_build on the engine's sets (distinct points
+ * only) and the hub, then the star search's. */
+static void test_insert_faults(const ptset *sets, int nsets, uint64_t *rng)
+{
+    ptset hub = make_hub(rng);
+    for (int si = 0; si <= nsets; si++) {
+        const ptset *ps = si < nsets ? &sets[si] : &hub;
+        /* make_lattice ends with 3 duplicates: the kernel wants distinct
+         * points (fdt_ins_build refuses the others with FDT_EINVAL) */
+        uint32_t n = (uint32_t)(strcmp(ps->name, "lattice") == 0 ? ps->n - 3 : ps->n);
+        fdt_ins m;
+        int rc = fdt_ins_build(&m, ps->xyz, 0, n, NULL);
+        CHECK(rc == FDT_OK, "%s: reference fdt_ins_build: %s", ps->name, fdt_strerror(rc));
+        if (rc != FDT_OK)
+            continue;
+        ins_arg ia = {ps->xyz, n, m.nfinite, n - 1};
+        fdt_ins_free(&m);
+        char nm[96];
+        snprintf(nm, sizeof nm, "fdt_ins_build %s", ps->name);
+        scenario sc = {nm, FDT_ENOMEM, sc_insert, &ia};
+        inject_all(&sc);
+        if (ps == &hub) {
+            scenario sf = {"fdt_ins_find_face hub", FDT_ENOMEM, sc_find_face, &ia};
+            inject_all(&sf);
+        }
+    }
+    free(hub.xyz);
+}
+
+/* ------------------------------------------------------------------ */
 /* Scenarios: readers and writers                                     */
 /* ------------------------------------------------------------------ */
 
@@ -853,6 +974,9 @@ int main(int argc, char **argv)
             }
         }
     }
+
+    /* --- the insertion kernel --- */
+    test_insert_faults(sets, 3, &rng);
 
     /* --- writers --- */
     fdt_result *r = NULL;

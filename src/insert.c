@@ -1,0 +1,782 @@
+/*
+ * Incremental Delaunay insertion (Bowyer 1981, Watson 1981) under the
+ * symbolic perturbation of src/predicates.h; see src/insert.h for the
+ * representation and why the front wants it.
+ *
+ * One insertion: locate the new point p by a visibility walk, grow the
+ * cavity (the tets in conflict with p) breadth-first from the tet found,
+ * and replace the cavity by the tets joining p to its boundary faces.
+ * Because fdt_insphere_perturbed never answers 0, the perturbed points are
+ * in general position: the cavity is exactly the set of tets whose
+ * perturbed circumsphere holds p, it is connected and star-shaped from p,
+ * and the result is the unique perturbed DT whatever the insertion order.
+ *
+ * Hull. CGAL's convention: an infinite vertex, and one infinite tet over
+ * every hull face. The infinite tet over hull face abc (outside on the
+ * positive side of abc) is in conflict with p when p is strictly outside
+ * that face's plane, or exactly on the plane and inside the circumcircle
+ * of abc, with ties on the circle broken by the perturbation. That is
+ * Delaunay_triangulation_3::side_of_sphere for an infinite cell with
+ * perturb = true (its coplanar_side_of_bounded_circle). We evaluate the
+ * coplanar case as fdt_insphere_perturbed(a', b', c', d, p), where
+ * (a', b', c', d) is the finite tet on the other side of the hull face
+ * (positively oriented, d off the plane). Why that is the same test:
+ *   - unperturbed: every sphere through a, b, c meets their plane in the
+ *     circumcircle of abc, so for p in the plane, "inside the sphere of
+ *     abcd" is "inside the circle of abc";
+ *   - on the circle, both rules take the five (four) points in decreasing
+ *     lexicographic order and return the sign of the first nonzero
+ *     coefficient. p first: outside in both. d: its coefficient is
+ *     orient3d(a, b, c, p) = 0 (p on the plane), skipped. A face vertex x:
+ *     the 3-D coefficient is orient3d of the tet with x replaced by p; for p
+ *     on the plane that is the barycentric coordinate lambda_x(p) in
+ *     triangle abc times orient3d(a, b, c, d) > 0, and CGAL's 2-D
+ *     coefficient coplanar_orientation(.., p in x's place, ..) times
+ *     coplanar_orientation(a, b, c) is the sign of the same lambda_x(p).
+ *     So both rules return the same sign at every step.
+ * Using the inner tet also makes the two sides of a hull face agree
+ * exactly, which keeps the cavity free of flat tets: p on the plane of
+ * hull face abc is in conflict with the infinite tet over abc exactly when
+ * it is with the finite tet under it, so abc is never a cavity boundary
+ * face with p in its plane.
+ *
+ * Order: BRIO (Amenta, Choi, Rote 2003). Each point falls in a round by a
+ * hash of its id (half the points in the last round, a quarter in the one
+ * before, ...), rounds go from the smallest to the largest, and within a
+ * round the points go in id order, which is kd-tree order: spatially
+ * coherent, so each point is located from the last tet made, nearby.
+ *
+ * Location: the remembering stochastic visibility walk (Devillers, Pion,
+ * Teillaud 2002): from the current tet, cross a face that has p strictly on
+ * its far side, trying the faces from a pseudo-random start and never the
+ * one just crossed; stop in a tet that holds p (closed) or on reaching an
+ * infinite tet (p strictly outside that hull face). In a regular
+ * triangulation (the perturbed DT is one) the relation "in front of, seen
+ * from p" is acyclic (Edelsbrunner 1990), so any choice of exit face ends,
+ * visiting each tet at most once: a walk longer than the number of slots
+ * is an internal error.
+ */
+#include "insert.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include "bits.h"
+#include "front.h"
+#include "mem.h"
+
+/* Neighbour references are 4 * slot + face in 32 bits. */
+#define INS_MAX_SLOTS (UINT32_C(1) << 30)
+#define PACK(t, k) (((uint32_t)(t) << 2) | (uint32_t)(k))
+#define INF FDT_NONE
+
+/* Conflict marks of the build, per slot. */
+enum { MARK_NONE = 0, MARK_IN = 1, MARK_OUT = 2 };
+
+typedef struct edge_slot {
+    uint64_t key;     /* the two vertex ids, smaller first */
+    uint32_t val;     /* packed face (new tet, index) waiting for its twin */
+    uint32_t stamp;   /* valid when equal to the build's current stamp */
+} edge_slot;
+
+/* State of one build that the result does not keep. */
+typedef struct build {
+    fdt_ins *m;
+    fdt_pred_counts *cnt;
+    uint8_t *mark;                 /* cap entries */
+    uint32_t nfree;                /* slots on the free list */
+    uint32_t *cav;                 /* the cavity's tets */
+    size_t ncav, cavcap;
+    uint32_t *bnd;                 /* its boundary faces, packed (tet, k) */
+    size_t nbnd, bndcap;
+    uint32_t *outl;                /* tets tested and found not in conflict */
+    size_t nout, outcap;
+    edge_slot *eh;                 /* the new tets' edges (linking them) */
+    uint32_t ehbits;               /* eh has 2^ehbits slots (0: none yet) */
+    uint32_t stamp;
+    uint64_t rng;                  /* the walk's choices */
+} build;
+
+static inline const double *pt(const fdt_ins *m, uint32_t v)
+{
+    return m->P + 3 * (size_t)v;
+}
+
+/* The filters inline, the exact stages (and the rescaled filters) out of
+ * line: most calls end in the filter. */
+static inline int orient(const double *a, const double *b, const double *c, const double *d,
+                         fdt_pred_counts *cnt)
+{
+    int s = fdt_orient3d_filter(a, b, c, d);
+    if (s != FDT_PRED_UNSURE)
+        return s;
+    return fdt_orient3d(a, b, c, d, cnt);
+}
+
+static inline int insphere_p(const double *a, const double *b, const double *c, const double *d,
+                             const double *e, fdt_pred_counts *cnt)
+{
+    int s = fdt_insphere_filter(a, b, c, d, e);
+    if (s != FDT_PRED_UNSURE)
+        return s;
+    return fdt_insphere_perturbed(a, b, c, d, e, cnt);
+}
+
+/* ------------------------------------------------------------------ */
+/* Slots and scratch. */
+
+static int grow_u32(uint32_t **a, size_t *cap, size_t need)
+{
+    if (need <= *cap)
+        return FDT_OK;
+    size_t nc = *cap ? *cap : 64;
+    while (nc < need)
+        nc += nc / 2 + 1;
+    uint32_t *p = realloc(*a, nc * sizeof *p);
+    if (!p)
+        return FDT_ENOMEM;
+    *a = p;
+    *cap = nc;
+    return FDT_OK;
+}
+
+/* Makes room for `extra` more tets (free list plus unused capacity). */
+static int reserve_slots(build *b, uint32_t extra)
+{
+    fdt_ins *m = b->m;
+    if ((uint64_t)b->nfree + (m->cap - m->nslots) >= extra)
+        return FDT_OK;
+    uint64_t need = (uint64_t)m->nslots + extra - b->nfree;
+    if (need > INS_MAX_SLOTS)
+        return FDT_ETOOBIG;
+    uint64_t nc = (uint64_t)m->cap + m->cap / 2 + 64;
+    if (nc < need)
+        nc = need;
+    if (nc > INS_MAX_SLOTS)
+        nc = INS_MAX_SLOTS;
+    uint32_t *t = realloc(m->T, (size_t)nc * 8 * sizeof *t);
+    if (!t)
+        return FDT_ENOMEM;
+    m->T = t;
+    uint8_t *mk = realloc(b->mark, (size_t)nc);
+    if (!mk)
+        return FDT_ENOMEM;
+    memset(mk + m->cap, 0, (size_t)(nc - m->cap));
+    b->mark = mk;
+    m->cap = (uint32_t)nc;
+    return FDT_OK;
+}
+
+/* A slot for a new tet (reserve_slots first). Freed slots first: they
+ * were the last cavity's, in cache and near the next one. */
+static inline uint32_t alloc_slot(build *b)
+{
+    fdt_ins *m = b->m;
+    if (m->free_head != FDT_NONE) {
+        uint32_t t = m->free_head;
+        m->free_head = m->T[8 * (size_t)t + 4];
+        b->nfree--;
+        return t;
+    }
+    return m->nslots++;
+}
+
+static inline void free_slot(build *b, uint32_t t)
+{
+    fdt_ins *m = b->m;
+    uint32_t *v = m->T + 8 * (size_t)t;
+    v[0] = v[1] = INF;
+    v[4] = m->free_head;
+    m->free_head = t;
+    b->nfree++;
+}
+
+/* An edge table with room for `edges` keys at most half full, emptied:
+ * a new stamp invalidates every slot at once. */
+static int edges_begin(build *b, size_t edges)
+{
+    uint32_t bits = b->ehbits ? b->ehbits : 6;
+    while (((size_t)1 << bits) < 2 * edges)
+        bits++;
+    if (bits != b->ehbits) {
+        edge_slot *e = calloc((size_t)1 << bits, sizeof *e);
+        if (!e)
+            return FDT_ENOMEM;
+        free(b->eh);
+        b->eh = e;
+        b->ehbits = bits;
+        b->stamp = 0;
+    }
+    if (++b->stamp == 0) { /* wrapped: old stamps would read as valid */
+        memset(b->eh, 0, ((size_t)1 << b->ehbits) * sizeof *b->eh);
+        b->stamp = 1;
+    }
+    return FDT_OK;
+}
+
+/*
+ * Face `f` (packed) of a new tet contains the edge xy besides the new
+ * point: the other new tet through xy is its neighbour there. The first of
+ * the two to arrive waits in the table, the second links both. Returns 1
+ * when it linked.
+ */
+static inline int link_edge(build *b, uint32_t *T, uint32_t x, uint32_t y, uint32_t f)
+{
+    uint64_t key = x < y ? ((uint64_t)x << 32) | y : ((uint64_t)y << 32) | x;
+    uint32_t mask = (UINT32_C(1) << b->ehbits) - 1;
+    uint32_t h = (uint32_t)((key * UINT64_C(0x9E3779B97F4A7C15)) >> (64 - b->ehbits));
+    for (;; h = (h + 1) & mask) {
+        edge_slot *s = &b->eh[h];
+        if (s->stamp != b->stamp) {
+            s->stamp = b->stamp;
+            s->key = key;
+            s->val = f;
+            return 0;
+        }
+        if (s->key == key) {
+            uint32_t g = s->val;
+            T[8 * (size_t)(g >> 2) + 4 + (g & 3)] = f;
+            T[8 * (size_t)(f >> 2) + 4 + (f & 3)] = g;
+            s->key = UINT64_MAX; /* each edge is shared by exactly two faces */
+            return 1;
+        }
+    }
+}
+
+/* For a face opposite vertex k, the edge of that face opposite its vertex
+ * i (i != k) has the vertices at the two other indices. */
+static const uint8_t other2[4][4][2] = {
+    {{0, 0}, {2, 3}, {1, 3}, {1, 2}},
+    {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
+    {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
+    {{1, 2}, {0, 2}, {0, 1}, {0, 0}},
+};
+
+/* ------------------------------------------------------------------ */
+/* Insertion. */
+
+static inline uint32_t walk_rand(build *b)
+{
+    b->rng = b->rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
+    return (uint32_t)(b->rng >> 61);
+}
+
+/* The tet where the walk for p from `start` ends (see the top). */
+static int locate(build *b, const double *p, uint32_t start, uint32_t *out)
+{
+    fdt_ins *m = b->m;
+    const uint32_t *T = m->T;
+    uint32_t t = start;
+    for (int i = 0; i < 4; i++)
+        if (T[8 * (size_t)t + i] == INF) { /* start in the finite tet below */
+            t = T[8 * (size_t)t + 4 + i] >> 2;
+            break;
+        }
+    int from = -1;
+    for (size_t steps = 0;; steps++) {
+        if (steps > m->nslots)
+            return FDT_EINTERNAL; /* a cycle: impossible in a regular triangulation */
+        const uint32_t *v = T + 8 * (size_t)t;
+        if (v[0] == INF || v[1] == INF || v[2] == INF || v[3] == INF)
+            break;
+        const double *q[4] = {pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3])};
+        uint32_t r = walk_rand(b);
+        int exit = -1;
+        for (uint32_t j = 0; j < 4; j++) {
+            int k = (int)((r + j) & 3);
+            if (k == from)
+                continue;
+            const double *s[4] = {q[0], q[1], q[2], q[3]};
+            s[k] = p;
+            if (orient(s[0], s[1], s[2], s[3], b->cnt) < 0) {
+                exit = k;
+                break;
+            }
+        }
+        if (exit < 0)
+            break;
+        uint32_t nb = v[4 + exit];
+        t = nb >> 2;
+        from = (int)(nb & 3);
+        m->stats.walk_steps++;
+    }
+    *out = t;
+    return FDT_OK;
+}
+
+/* Whether tet t is in conflict with p (see the top for infinite tets). */
+static inline int conflict(build *b, uint32_t t, const double *p)
+{
+    const fdt_ins *m = b->m;
+    const uint32_t *v = m->T + 8 * (size_t)t;
+    b->m->stats.conflict_tests++;
+    int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
+    if (inf < 0)
+        return insphere_p(pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), p, b->cnt) > 0;
+    const double *q[4];
+    for (int i = 0; i < 4; i++)
+        q[i] = i == inf ? p : pt(m, v[i]);
+    int o = orient(q[0], q[1], q[2], q[3], b->cnt);
+    if (o != 0)
+        return o > 0;
+    const uint32_t *w = m->T + 8 * (size_t)(v[4 + inf] >> 2);
+    return insphere_p(pt(m, w[0]), pt(m, w[1]), pt(m, w[2]), pt(m, w[3]), p, b->cnt) > 0;
+}
+
+static int insert_point(build *b, uint32_t pid, uint32_t *last)
+{
+    fdt_ins *m = b->m;
+    const double *p = pt(m, pid);
+    uint32_t t0;
+    int err = locate(b, p, *last, &t0);
+    if (err)
+        return err;
+    const uint32_t *v0 = m->T + 8 * (size_t)t0;
+    /* A point equal to a vertex lies in the closed tet of that vertex only,
+     * so the walk ends in a tet that has it: refuse rather than break the
+     * perturbation's precondition (pairwise distinct points). */
+    for (int i = 0; i < 4; i++) {
+        if (v0[i] == INF)
+            continue;
+        const double *q = pt(m, v0[i]);
+        if (q[0] == p[0] && q[1] == p[1] && q[2] == p[2])
+            return FDT_EINVAL;
+    }
+
+    /* The cavity, breadth-first. The walk's tet holds p (closed), and a
+     * point of a closed tet other than its vertices is strictly inside its
+     * circumsphere; an infinite tet where the walk stops has p strictly
+     * outside its hull face. Either way it is in conflict. */
+    b->ncav = b->nbnd = b->nout = 0;
+    uint8_t *mark = b->mark;
+    mark[t0] = MARK_IN;
+    b->cav[b->ncav++] = t0;
+    for (size_t ci = 0; ci < b->ncav; ci++) {
+        uint32_t c = b->cav[ci];
+        for (int k = 0; k < 4; k++) {
+            uint32_t o = m->T[8 * (size_t)c + 4 + k] >> 2;
+            if (mark[o] == MARK_IN)
+                continue;
+            if (mark[o] == MARK_NONE) {
+                if (conflict(b, o, p)) {
+                    if (b->ncav == b->cavcap &&
+                        (err = grow_u32(&b->cav, &b->cavcap, b->ncav + 1)) != FDT_OK)
+                        return err;
+                    mark[o] = MARK_IN;
+                    b->cav[b->ncav++] = o;
+                    continue;
+                }
+                if (b->nout == b->outcap &&
+                    (err = grow_u32(&b->outl, &b->outcap, b->nout + 1)) != FDT_OK)
+                    return err;
+                mark[o] = MARK_OUT;
+                b->outl[b->nout++] = o;
+            }
+            if (b->nbnd == b->bndcap &&
+                (err = grow_u32(&b->bnd, &b->bndcap, b->nbnd + 1)) != FDT_OK)
+                return err;
+            b->bnd[b->nbnd++] = PACK(c, k);
+        }
+    }
+    if (b->nbnd > UINT32_MAX / 2)
+        return FDT_ETOOBIG;
+    if ((err = reserve_slots(b, (uint32_t)b->nbnd)) != FDT_OK)
+        return err;
+    if ((err = edges_begin(b, 3 * b->nbnd / 2)) != FDT_OK)
+        return err;
+    mark = b->mark; /* reserve_slots may have moved it */
+
+    /* The new tets: each boundary face (c, k) with p in place of vertex k,
+     * on the same side of the face as c's vertex k was (star-shaped
+     * cavity), so positively oriented. Allocated before the cavity is
+     * freed, so reading c is safe; the cavity's slots serve the next
+     * insertion. */
+    uint32_t *T = m->T;
+    size_t linked = 0;
+    uint32_t s = FDT_NONE;
+    for (size_t i = 0; i < b->nbnd; i++) {
+        uint32_t c = b->bnd[i] >> 2;
+        int k = (int)(b->bnd[i] & 3);
+        s = alloc_slot(b);
+        uint32_t *w = T + 8 * (size_t)s;
+        const uint32_t *cv = T + 8 * (size_t)c;
+        memcpy(w, cv, 4 * sizeof *w);
+        w[k] = pid;
+        uint32_t o = cv[4 + k];
+        w[4 + k] = o;
+        T[8 * (size_t)(o >> 2) + 4 + (o & 3)] = PACK(s, k);
+        for (int j = 0; j < 4; j++) {
+            if (j == k)
+                continue;
+            linked += (size_t)link_edge(b, T, w[other2[k][j][0]], w[other2[k][j][1]], PACK(s, j));
+        }
+    }
+    /* The boundary is a closed surface: every edge met exactly twice. */
+    if (2 * linked != 3 * b->nbnd)
+        return FDT_EINTERNAL;
+    for (size_t i = 0; i < b->ncav; i++) {
+        mark[b->cav[i]] = MARK_NONE;
+        free_slot(b, b->cav[i]);
+    }
+    for (size_t i = 0; i < b->nout; i++)
+        mark[b->outl[i]] = MARK_NONE;
+    m->stats.cavity_tets += b->ncav;
+    m->stats.created_tets += b->nbnd;
+    if (b->ncav > m->stats.max_cavity)
+        m->stats.max_cavity = b->ncav;
+    *last = s;
+    return FDT_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* Start: order and the first tetrahedron. */
+
+/* A hash of the id for the BRIO rounds (a murmur-style finalizer). */
+static inline uint32_t mix32(uint32_t x)
+{
+    x ^= x >> 16;
+    x *= UINT32_C(0x7feb352d);
+    x ^= x >> 15;
+    x *= UINT32_C(0x846ca68b);
+    x ^= x >> 16;
+    return x;
+}
+
+/* order[] = the ids by round (BRIO), the smallest round first, ids
+ * ascending within a round. Round L (the first) takes the points whose
+ * hash has at least L trailing zeros, round l < L those with exactly l:
+ * expected sizes n 2^-L, ..., n/4, n/2. L makes the first round about 128
+ * to 256 points. */
+static int brio_order(uint32_t base, uint32_t n, uint32_t *order)
+{
+    int L = 0;
+    while (L < 30 && (n >> (L + 1)) >= 128)
+        L++;
+    size_t count[32] = {0};
+    for (uint32_t i = 0; i < n; i++)
+        count[L - fdt_ctz64(mix32(base + i) | (UINT64_C(1) << L))]++;
+    size_t pos[32], acc = 0;
+    for (int r = 0; r <= L; r++) {
+        pos[r] = acc;
+        acc += count[r];
+    }
+    for (uint32_t i = 0; i < n; i++)
+        order[pos[L - fdt_ctz64(mix32(base + i) | (UINT64_C(1) << L))]++] = base + i;
+    return FDT_OK;
+}
+
+/*
+ * Exactly: are a, b, c collinear? Collinear iff the three projections onto
+ * the coordinate planes are degenerate; the projection dropping axis k is
+ * degenerate iff orient3d(a, b, c, d) = 0 for d = a moved along axis k
+ * (the determinant is the projected doubled area times the move). Every
+ * coordinate is a double, so the exact orient3d decides.
+ */
+static int collinear(const double *a, const double *b, const double *c, fdt_pred_counts *cnt)
+{
+    for (int k = 0; k < 3; k++) {
+        double d[3] = {a[0], a[1], a[2]};
+        d[k] = a[k] != 0.0 ? -a[k] : 1.0;
+        if (fdt_orient3d(a, b, c, d, cnt) != 0)
+            return 0;
+    }
+    return 1;
+}
+
+/*
+ * The first tetrahedron, from the start of the order, and the four
+ * infinite tets over its faces. FDT_EDEGENERATE if the points do not span
+ * 3-D space. first[] gets the four ids used.
+ */
+static int start_simplex(build *b, const uint32_t *order, uint32_t n, uint32_t first[4])
+{
+    fdt_ins *m = b->m;
+    if (n < 4)
+        return FDT_EDEGENERATE;
+    uint32_t a = order[0], c0 = order[1], c = FDT_NONE, d = FDT_NONE;
+    for (uint32_t i = 2; i < n && c == FDT_NONE; i++)
+        if (!collinear(pt(m, a), pt(m, c0), pt(m, order[i]), b->cnt))
+            c = order[i];
+    if (c == FDT_NONE)
+        return FDT_EDEGENERATE; /* all collinear */
+    int o = 0;
+    for (uint32_t i = 2; i < n && d == FDT_NONE; i++) {
+        if (order[i] == c)
+            continue;
+        o = fdt_orient3d(pt(m, a), pt(m, c0), pt(m, c), pt(m, order[i]), b->cnt);
+        if (o != 0)
+            d = order[i];
+    }
+    if (d == FDT_NONE)
+        return FDT_EDEGENERATE; /* all coplanar */
+    uint32_t v[4] = {a, c0, c, d};
+    if (o < 0) {
+        v[0] = c0;
+        v[1] = a;
+    }
+    memcpy(first, v, sizeof v);
+    int err = reserve_slots(b, 5);
+    if (err)
+        return err;
+    if ((err = edges_begin(b, 6)) != FDT_OK)
+        return err;
+    uint32_t *T = m->T;
+    uint32_t t0 = alloc_slot(b);
+    memcpy(T + 8 * (size_t)t0, v, sizeof v);
+    /* Over face k (outward order fdt_tet_face[k]: v[k] on its negative
+     * side, the outside on its positive side) the infinite tet
+     * (face, INF), positive in the sense of src/insert.h. */
+    for (int k = 0; k < 4; k++) {
+        uint32_t s = alloc_slot(b);
+        uint32_t *w = T + 8 * (size_t)s;
+        for (int j = 0; j < 3; j++)
+            w[j] = v[fdt_tet_face[k][j]];
+        w[3] = INF;
+        w[7] = PACK(t0, k);
+        T[8 * (size_t)t0 + 4 + k] = PACK(s, 3);
+        for (int j = 0; j < 3; j++)
+            link_edge(b, T, w[other2[3][j][0]], w[other2[3][j][1]], PACK(s, j));
+    }
+    return FDT_OK;
+}
+
+/* ------------------------------------------------------------------ */
+
+void fdt_ins_free(fdt_ins *m)
+{
+    if (!m)
+        return;
+    free(m->T);
+    free(m->vtet);
+    memset(m, 0, sizeof *m);
+}
+
+static void build_free(build *b)
+{
+    free(b->mark);
+    free(b->cav);
+    free(b->bnd);
+    free(b->outl);
+    free(b->eh);
+}
+
+int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                  fdt_pred_counts *cnt)
+{
+    memset(m, 0, sizeof *m);
+    m->P = P;
+    m->base = base;
+    m->n = n;
+    m->free_head = FDT_NONE;
+    if (n < 4)
+        return FDT_EDEGENERATE;
+    build b;
+    memset(&b, 0, sizeof b);
+    b.m = m;
+    b.cnt = cnt;
+    b.rng = UINT64_C(0x853c49e6748fea9b);
+    uint32_t *order = NULL;
+    int err = FDT_ENOMEM;
+    /* About 6.5 tets a point on uniform points, plus the hull: growing by
+     * realloc stays possible for inputs with more. */
+    uint64_t want = (uint64_t)n * 27 / 4 + 64;
+    if (want > INS_MAX_SLOTS)
+        want = INS_MAX_SLOTS;
+    m->T = malloc((size_t)want * 8 * sizeof *m->T);
+    b.mark = calloc((size_t)want, 1);
+    order = malloc((size_t)n * sizeof *order);
+    if (!m->T || !b.mark || !order)
+        goto fail;
+    fdt_mem_advise_huge(m->T, (size_t)want * 8 * sizeof *m->T);
+    m->cap = (uint32_t)want;
+    if ((err = grow_u32(&b.cav, &b.cavcap, 64)) != FDT_OK ||
+        (err = grow_u32(&b.bnd, &b.bndcap, 256)) != FDT_OK ||
+        (err = grow_u32(&b.outl, &b.outcap, 256)) != FDT_OK)
+        goto fail;
+    brio_order(base, n, order);
+    uint32_t first[4];
+    if ((err = start_simplex(&b, order, n, first)) != FDT_OK)
+        goto fail;
+    uint32_t last = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t id = order[i];
+        if (id == first[0] || id == first[1] || id == first[2] || id == first[3])
+            continue;
+        if ((err = insert_point(&b, id, &last)) != FDT_OK)
+            goto fail;
+    }
+    m->stats.inserted = n;
+    free(order);
+    order = NULL;
+
+    /* The incident-tet table, and the counts, from one pass over the
+     * slots: cheaper than keeping it current through the insertions. */
+    err = FDT_ENOMEM;
+    m->vtet = malloc((size_t)n * sizeof *m->vtet);
+    if (!m->vtet)
+        goto fail;
+    for (uint32_t i = 0; i < n; i++)
+        m->vtet[i] = FDT_NONE;
+    for (uint32_t t = 0; t < m->nslots; t++) {
+        const uint32_t *v = m->T + 8 * (size_t)t;
+        if (v[0] == INF && v[1] == INF)
+            continue; /* freed */
+        int inf = 0;
+        for (int i = 0; i < 4; i++) {
+            if (v[i] == INF)
+                inf = 1;
+            else
+                m->vtet[v[i] - base] = t;
+        }
+        if (inf)
+            m->ninfinite++;
+        else
+            m->nfinite++;
+    }
+    err = FDT_EINTERNAL;
+    for (uint32_t i = 0; i < n; i++)
+        if (m->vtet[i] == FDT_NONE)
+            goto fail; /* every point is a vertex of its DT */
+    build_free(&b);
+    return FDT_OK;
+fail:
+    free(order);
+    build_free(&b);
+    fdt_ins_free(m);
+    return err;
+}
+
+uint32_t fdt_ins_next_finite(const fdt_ins *m, uint32_t t)
+{
+    for (; t < m->nslots; t++)
+        if (fdt_ins_is_finite(m, t))
+            return t;
+    return FDT_NONE;
+}
+
+/* ------------------------------------------------------------------ */
+/* Queries. */
+
+/*
+ * If tet t (vertices v) has the vertices a, b, c, the tet on the open side
+ * of (a, b, c) and the index of that face in it: t itself when (a, b, c,
+ * v[k]) is an even permutation of t's order (then it is positive, so
+ * v[k] is on the open side), else t's neighbour across that face.
+ */
+static int face_in_tet(const fdt_ins *m, uint32_t t, uint32_t a, uint32_t b, uint32_t c,
+                       uint32_t *tet, int *k)
+{
+    const uint32_t *v = m->T + 8 * (size_t)t;
+    int pa = -1, pb = -1, pc = -1;
+    for (int i = 0; i < 4; i++) {
+        if (v[i] == a)
+            pa = i;
+        else if (v[i] == b)
+            pb = i;
+        else if (v[i] == c)
+            pc = i;
+    }
+    if (pa < 0 || pb < 0 || pc < 0)
+        return 0;
+    int pk = 6 - pa - pb - pc;
+    int perm[4] = {pa, pb, pc, pk}, inv = 0;
+    for (int i = 0; i < 4; i++)
+        for (int j = i + 1; j < 4; j++)
+            inv += perm[i] > perm[j];
+    if (inv % 2 == 0) {
+        *tet = t;
+        *k = pk;
+    } else {
+        uint32_t r = v[4 + pk];
+        *tet = r >> 2;
+        *k = (int)(r & 3);
+    }
+    return 1;
+}
+
+/* The visited set of the star search: an open-addressing table of slot
+ * ids (FDT_NONE: empty) and the BFS queue, which lists every tet seen. */
+typedef struct star_buf {
+    uint32_t *queue, *set;
+    size_t cap;      /* queue capacity; the set has 2 cap slots */
+} star_buf;
+
+static int star_insert(star_buf *s, uint32_t t)
+{
+    size_t mask = 2 * s->cap - 1;
+    size_t h = (size_t)((t * UINT64_C(0x9E3779B97F4A7C15)) >> 20) & mask;
+    for (;; h = (h + 1) & mask) {
+        if (s->set[h] == t)
+            return 0;
+        if (s->set[h] == FDT_NONE) {
+            s->set[h] = t;
+            return 1;
+        }
+    }
+}
+
+static int scan_all(const fdt_ins *m, uint32_t a, uint32_t b, uint32_t c, uint32_t *tet, int *k)
+{
+    for (uint32_t t = 0; t < m->nslots; t++) {
+        const uint32_t *v = m->T + 8 * (size_t)t;
+        if (v[0] == INF && v[1] == INF)
+            continue;
+        if (face_in_tet(m, t, a, b, c, tet, k))
+            return 1;
+    }
+    return 0;
+}
+
+int fdt_ins_find_face(const fdt_ins *m, uint32_t a, uint32_t b, uint32_t c,
+                      uint32_t *tet, int *k)
+{
+    if (!m->vtet || a - m->base >= m->n || b - m->base >= m->n || c - m->base >= m->n ||
+        a == b || b == c || a == c)
+        return 0;
+    enum { LOCAL = 512 };
+    uint32_t lq[LOCAL], ls[2 * LOCAL];
+    star_buf s = {lq, ls, LOCAL};
+    for (size_t i = 0; i < 2 * LOCAL; i++)
+        ls[i] = FDT_NONE;
+    int found = 0;
+    size_t nq = 0;
+    uint32_t t0 = m->vtet[a - m->base];
+    star_insert(&s, t0);
+    s.queue[nq++] = t0;
+    for (size_t qi = 0; qi < nq; qi++) {
+        uint32_t t = s.queue[qi];
+        if (face_in_tet(m, t, a, b, c, tet, k)) {
+            found = 1;
+            break;
+        }
+        const uint32_t *v = m->T + 8 * (size_t)t;
+        for (int j = 0; j < 4; j++) {
+            if (v[j] == a)
+                continue; /* the faces through a lead to a's other tets */
+            uint32_t o = v[4 + j] >> 2;
+            if (nq == s.cap) { /* a big star: a bigger buffer, or the scan */
+                size_t nc = 4 * s.cap;
+                uint32_t *q = malloc(3 * nc * sizeof *q);
+                if (!q) {
+                    found = scan_all(m, a, b, c, tet, k);
+                    goto done;
+                }
+                memcpy(q, s.queue, nq * sizeof *q);
+                if (s.queue != lq)
+                    free(s.queue);
+                s.queue = q;
+                s.set = q + nc;
+                s.cap = nc;
+                for (size_t i = 0; i < 2 * nc; i++)
+                    s.set[i] = FDT_NONE;
+                for (size_t i = 0; i < nq; i++)
+                    star_insert(&s, s.queue[i]);
+            }
+            if (star_insert(&s, o))
+                s.queue[nq++] = o;
+        }
+    }
+done:
+    if (s.queue != lq)
+        free(s.queue);
+    return found;
+}
