@@ -63,6 +63,18 @@ typedef enum fdt_mode {
 } fdt_mode;
 
 /*
+ * How a front face's apex is found. Every choice gives the same mesh (the
+ * perturbed Delaunay tetrahedralization is unique); they differ in cost.
+ */
+typedef enum fdt_search {
+    FDT_SEARCH_AUTO = 0,  /* the kd search (§2.2, §4), switching a part to
+                             its insertion mesh where searches get
+                             expensive (scans, CFD grids, cospherical sets) */
+    FDT_SEARCH_KD = 1,    /* the kd search only */
+    FDT_SEARCH_MESH = 2   /* each part's insertion mesh from the start */
+} fdt_search;
+
+/*
  * Progress callback: called now and then from the calling thread with the
  * fraction of tetrahedra believed built (an estimate in [0, 1]). Return
  * nonzero to cancel: fdt_triangulate() then returns FDT_ECANCELED.
@@ -77,6 +89,7 @@ typedef struct fdt_settings {
     int neighbors;           /* nonzero: compute tet neighbours */
     fdt_progress_fn progress;/* may be NULL */
     void *progress_user;     /* borrowed, passed back to progress */
+    fdt_search search;       /* default FDT_SEARCH_AUTO */
 } fdt_settings;
 
 FDT_API void fdt_default_settings(fdt_settings *s);
@@ -175,6 +188,10 @@ typedef struct fdt_stats {
     double load_imbalance;    /* max / mean tets built per thread (1: even) */
     int pinned;               /* 1: threads bound to cores; 0: not asked;
                                  -1: asked but refused or unavailable */
+    /* The insertion mesh (fdt_search). */
+    size_t mesh_faces;        /* faces whose apex the mesh gave */
+    size_t mesh_parts;        /* parts (fronts) that built a mesh */
+    double t_mesh;            /* seconds building meshes (summed over threads) */
 } fdt_stats;
 
 FDT_API int fdt_result_stats(const fdt_result *r, fdt_stats *st);

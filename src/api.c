@@ -151,7 +151,7 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
         if (fdt_meshbuf_init(&mb, (size_t)(6.9 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
             goto fail;
         t1 = now_s();
-        err = fdt_front_serial(&tree, central_point(&tree), &mb, ctx->s.progress,
+        err = fdt_front_serial(&tree, central_point(&tree), (int)ctx->s.search, &mb, ctx->s.progress,
                                ctx->s.progress_user, &fst);
     }
     if (err) {
@@ -199,6 +199,9 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     st->exact_orient = fst.kq.pc.orient_exact;
     st->exact_insphere = fst.kq.pc.insphere_exact;
     st->max_front = fst.max_front;
+    st->mesh_faces = fst.mesh_faces;
+    st->mesh_parts = fst.mesh_parts;
+    st->t_mesh = fst.t_mesh;
     st->threads = 1;
     st->mode = FDT_MODE_SERIAL;
     st->t_prepare = t1 - t0;

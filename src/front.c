@@ -5,6 +5,7 @@
 #include <string.h>
 #include "faceq.h"
 #include "facetab.h"
+#include "oracle.h"
 #include "seed.h"
 
 /* For a positively oriented (v0,v1,v2,v3), (v1,v2,v3,v0) is an odd
@@ -140,16 +141,18 @@ static int add_tet_faces(fdt_facetab *ft, fdt_faceq *fq, fdt_meshbuf *mb,
     return FDT_OK;
 }
 
-int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
+int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
                      fdt_progress_fn progress, void *puser,
                      fdt_front_stats *st)
 {
     fdt_facetab ft;
     fdt_faceq fq;
+    fdt_oracle orc;
     uint32_t seed[4];
     int err = fdt_seed_tet(t, start, seed, &st->kq);
     if (err)
         return err;
+    fdt_oracle_init(&orc, t, search);
     if ((err = fdt_facetab_init(&ft, 4096)) != FDT_OK)
         return err;
     if ((err = fdt_faceq_init(&fq, t->base, t->n)) != FDT_OK) {
@@ -184,18 +187,31 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
         if (ft.count > st->max_front)
             st->max_front = ft.count;
         uint32_t f[3] = {s->v[0], s->v[1], s->v[2]};
+        fdt_oracle_tick(&orc, st->faces_advanced, &st->kq);
         st->faces_advanced++;
-        fdt_apex ap;
-        fdt_apex_init(&ap, P + 3 * (size_t)f[0], P + 3 * (size_t)f[1], P + 3 * (size_t)f[2],
-                      f[0], f[1], f[2]);
-        /* Start in f0's leaf and climb (src/kdtree.c): the apex is near.
-         * Between the guess and the climb, the table slots of the faces
-         * the guessed tet would add are asked for: the climb hides their
-         * latency, and the guess is the apex for most faces. */
-        fdt_apex_guess(&ap, t, f[0], &st->kq);
-        fdt_facetab_prefetch_tet(&ft, f, ap.best);
-        fdt_apex_verify_from(&ap, t, f[0], &st->kq);
-        if (ap.best == FDT_NONE) {
+        /* The insertion mesh first, where the oracle switched to it: it
+         * holds every point, so its answer is the apex (or, FDT_NONE, a
+         * hull face). s->tet is the tet on the closed side and its face
+         * index, so out->tets[s->tet] is the vertex opposite f there. */
+        uint32_t apex, mtet = FDT_NONE;
+        if (!fdt_oracle_apex(&orc, f, (int64_t)(s->tet >> 2), out->tets[s->tet], &apex,
+                             &mtet)) {
+            fdt_apex ap;
+            fdt_apex_init(&ap, P + 3 * (size_t)f[0], P + 3 * (size_t)f[1],
+                          P + 3 * (size_t)f[2], f[0], f[1], f[2]);
+            /* Start in f0's leaf and climb (src/kdtree.c): the apex is
+             * near. Between the guess and the climb, the table slots of
+             * the faces the guessed tet would add are asked for: the climb
+             * hides their latency, and the guess is the apex for most
+             * faces. */
+            fdt_apex_guess(&ap, t, f[0], &st->kq);
+            fdt_facetab_prefetch_tet(&ft, f, ap.best);
+            fdt_apex_verify_from(&ap, t, f[0], &st->kq);
+            apex = ap.best;
+        } else {
+            fdt_facetab_prefetch_tet(&ft, f, apex);
+        }
+        if (apex == FDT_NONE) {
             /* Nothing on the open side: a convex-hull face (§2.2). Its
              * open side is the outside, so f is already outward. */
             if ((err = fdt_meshbuf_add_hull(out, f)) != FDT_OK)
@@ -205,8 +221,9 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
         }
         /* (f0, f1, f2, apex) is positively oriented: the apex is on the
          * open side, orient3d > 0. */
-        uint32_t v[4] = {f[0], f[1], f[2], ap.best};
-        if ((tid = fdt_meshbuf_add_tet(out, v)) < 0) {
+        uint32_t v[4] = {f[0], f[1], f[2], apex};
+        if ((tid = fdt_meshbuf_add_tet(out, v)) < 0 ||
+            fdt_oracle_note(&orc, tid, mtet) != FDT_OK) {
             err = FDT_ENOMEM;
             goto done;
         }
@@ -227,6 +244,11 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
     if (ft.count != 0)
         err = FDT_EINTERNAL;
 done:
+    st->mesh_faces = orc.mesh_faces;
+    st->star_walks = orc.star_walks;
+    st->mesh_parts = orc.switched_at != 0;
+    st->t_mesh = orc.t_mesh;
+    fdt_oracle_free(&orc);
     fdt_facetab_free(&ft);
     fdt_faceq_free(&fq);
     return err;

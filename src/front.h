@@ -30,11 +30,17 @@ int fdt_meshbuf_add_hull(fdt_meshbuf *mb, const uint32_t v[3]);
 typedef struct fdt_front_stats {
     size_t faces_advanced, max_front;
     fdt_kdq kq;
+    /* The insertion mesh (src/oracle.h): faces it answered, of those found
+     * by a walk around a vertex, fronts (parts) that built one, and the
+     * seconds they took. */
+    size_t mesh_faces, star_walks, mesh_parts;
+    double t_mesh;
 } fdt_front_stats;
 
 /* Triangulates all points of tree t (ids [t->base, t->base + t->n)),
- * starting from a seed near point `start`. */
-int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_meshbuf *out,
+ * starting from a seed near point `start`; search is an fdt_search
+ * (src/oracle.h: how each face's apex is found). */
+int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
                      fdt_progress_fn progress, void *puser,
                      fdt_front_stats *st);
 

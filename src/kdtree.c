@@ -1413,6 +1413,13 @@ static inline int ball_inside_cell(const fdt_apex *s, const fdt_kdtree *t, uint3
            (c[1] + r < cl[1][1]) & (c[2] - r > cl[0][2]) & (c[2] + r < cl[1][2]);
 }
 
+int fdt_apex_inside_region(const fdt_apex *s, const fdt_kdtree *t)
+{
+    /* The root's cell is the region (climb_tables); a tree without climb
+     * tables has no region but all of space. */
+    return t->cell ? ball_inside_cell(s, t, 0) : 0;
+}
+
 void fdt_apex_guess(fdt_apex *s, const fdt_kdtree *t, uint32_t start, fdt_kdq *kq)
 {
     if (t->leafof)

@@ -150,6 +150,11 @@ int fdt_apex_verify_from(fdt_apex *s, const fdt_kdtree *t, uint32_t start, fdt_k
  * coordinate bisection; points of other parts may lie on its boundary,
  * not inside). Default: all of space. The climb's cells are bounded by it. */
 void fdt_kd_set_region(fdt_kdtree *t, const double lo[3], const double hi[3]);
+/* 1 when s has a candidate whose ball lies strictly inside the region of
+ * tree t (fdt_kd_set_region): no point outside the region can improve s
+ * (what fdt_apex_verify_from returns after a whole search, for a candidate
+ * found another way: src/oracle.h). */
+int fdt_apex_inside_region(const fdt_apex *s, const fdt_kdtree *t);
 /* Whether the box [lo, hi] could hold a point that improves s. */
 int fdt_apex_box_useful(const fdt_apex *s, const double *lo, const double *hi);
 

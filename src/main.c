@@ -58,6 +58,7 @@ typedef struct cli {
     const char *output;     /* NULL: triangulate and report only */
     const char *stats_json; /* NULL, a path, or "-" for stdout */
     fdt_mode mode;
+    fdt_search search;
     int threads;            /* -1: the library's default */
     int pin, check, stats, hash, quiet;
     int demo;
@@ -78,6 +79,9 @@ static void usage(FILE *f)
         "Options:\n"
         "  -o, --output FILE      write the mesh (format by extension)\n"
         "      --mode MODE        serial, shared, message or auto (default)\n"
+        "      --search HOW       how apexes are found: auto (default: the kd\n"
+        "                         search, an insertion mesh where it gets\n"
+        "                         expensive), kd or mesh\n"
         "  -t, --threads N        worker threads (0: one per core)\n"
         "      --pin              bind thread i to core i\n"
         "      --check            verify the result exactly (exit 3 if not Delaunay)\n"
@@ -212,12 +216,13 @@ static int parse_count(const char *s, unsigned long long max,
 
 enum {
     OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH,
-    OPT_DEMO
+    OPT_DEMO, OPT_SEARCH
 };
 
 static const struct option long_opts[] = {
     { "output", required_argument, NULL, 'o' },
     { "mode", required_argument, NULL, OPT_MODE },
+    { "search", required_argument, NULL, OPT_SEARCH },
     { "threads", required_argument, NULL, 't' },
     { "pin", no_argument, NULL, OPT_PIN },
     { "check", no_argument, NULL, OPT_CHECK },
@@ -318,6 +323,16 @@ static int parse_args(int argc, char **argv, cli *c)
             else
                 return usage_error("unknown mode '%s' (serial, shared, "
                                    "message or auto)", optarg);
+            break;
+        case OPT_SEARCH:
+            if (!strcmp(optarg, "auto"))
+                c->search = FDT_SEARCH_AUTO;
+            else if (!strcmp(optarg, "kd"))
+                c->search = FDT_SEARCH_KD;
+            else if (!strcmp(optarg, "mesh"))
+                c->search = FDT_SEARCH_MESH;
+            else
+                return usage_error("unknown search '%s' (auto, kd or mesh)", optarg);
             break;
         case 't':
             if (parse_count(optarg, INT_MAX, &v) != 0)
@@ -726,6 +741,7 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  exact orient3d    %zu\n"
         "  exact insphere    %zu\n"
         "  largest front     %zu\n"
+        "  mesh faces        %zu (%zu parts built a mesh in %.3f s)\n"
         "  threads           %d\n"
         "  mode              %s\n"
         "  time prepare      %.3f s\n"
@@ -738,7 +754,8 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  time write        %.3f s\n",
         st->points, st->vertices, dups, st->tets, st->hull_faces,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
-        st->exact_orient, st->exact_insphere, st->max_front, st->threads,
+        st->exact_orient, st->exact_insphere, st->max_front, st->mesh_faces,
+        st->mesh_parts, st->t_mesh, st->threads,
         mode_name(st->mode), st->t_prepare, st->t_front, st->t_finish,
         tm->read, tm->triangulate, tm->check, tm->canon, tm->write);
     if (st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE)
@@ -791,13 +808,15 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         ", \"tets\": %zu, \"hull_faces\": %zu, \"faces_advanced\": %zu"
         ", \"kd_nodes_visited\": %zu, \"points_tested\": %zu"
         ", \"exact_orient\": %zu, \"exact_insphere\": %zu"
-        ", \"max_front\": %zu, \"threads\": %d, \"mode\": \"%s\""
+        ", \"max_front\": %zu, \"mesh_faces\": %zu, \"mesh_parts\": %zu"
+        ", \"t_mesh\": %.9g, \"threads\": %d, \"mode\": \"%s\""
         ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
         ", \"t_read\": %.9g, \"t_triangulate\": %.9g, \"t_check\": %.9g"
         ", \"t_canon\": %.9g, \"t_write\": %.9g",
         st->points, st->vertices, dups, st->tets, st->hull_faces,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
-        st->exact_orient, st->exact_insphere, st->max_front, st->threads,
+        st->exact_orient, st->exact_insphere, st->max_front, st->mesh_faces,
+        st->mesh_parts, finite_or_zero(st->t_mesh), st->threads,
         mode_name(st->mode), finite_or_zero(st->t_prepare),
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
@@ -897,6 +916,7 @@ static int run(const cli *c)
     fdt_settings s;
     fdt_default_settings(&s);
     s.mode = c->mode;
+    s.search = c->search;
     if (c->threads >= 0)
         s.n_threads = c->threads;
     s.pin = c->pin;

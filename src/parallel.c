@@ -121,6 +121,7 @@
 #include "facetab.h"
 #include "kdtree.h"
 #include "mailbox.h"
+#include "oracle.h"
 #include "partition.h"
 #include "seed.h"
 
@@ -369,6 +370,7 @@ typedef struct worker {
     int active;                /* holds an activity unit of e->work */
     uint32_t qid;              /* last range query id */
     fdt_kdq kq;
+    fdt_oracle orc;            /* kd search or the part's insertion mesh */
     fdt_thread_stats st;
     size_t report_at;
     pthread_t th;
@@ -402,6 +404,7 @@ typedef struct engine {
     const fdt_partition *pt;
     const double *P;
     fdt_mode mode;
+    int search;                /* fdt_search, for every part's oracle */
     int n;
     int want_nbrs;
     fdt_mailboxes *mbs;
@@ -941,15 +944,38 @@ static int advance_one(worker *w)
     memcpy(c, pc, sizeof c);
     fdt_apex ap;
     fdt_apex_init(&ap, a, b, c, f[0], f[1], f[2]);
-    /* Our own tree first, climbing from the leaf of f[0] (ours): the apex
-     * is nearly always near the face. When the final ball lies inside our
-     * part's region (src/partition.c, regions()), no other part's point
-     * can be in it and the others are not asked at all; otherwise their
-     * bounding boxes rule most of them out. */
-    fdt_apex_guess(&ap, w->tree, f[0], &w->kq);
-    /* the guessed tet's face slots, as in src/front.c */
-    fdt_facetab_prefetch_tet(&w->ft, f, ap.best);
-    int inside = fdt_apex_verify_from(&ap, w->tree, f[0], &w->kq);
+    fdt_oracle_tick(&w->orc, w->st.faces_advanced - 1, &w->kq);
+    /* Our part's insertion mesh, where the oracle switched to it: its
+     * answer is the first of our points in the pencil of spheres through
+     * f's circle (src/oracle.h), so only another part's point can come
+     * earlier, and only inside that sphere: the candidate is offered to
+     * the search state and the others are asked exactly as after our own
+     * kd search. The closed-side tet is ours when we built it (aux). */
+    int64_t ctid = s->aux == (uint32_t)w->id ? (int64_t)(s->tet >> 2) : -1;
+    uint32_t mapex = FDT_NONE, mtet = FDT_NONE;
+    int inside;
+    if (fdt_oracle_apex(&w->orc, f, ctid, ctid >= 0 ? w->out.tets[s->tet] : FDT_NONE,
+                        &mapex, &mtet)) {
+        if (mapex != FDT_NONE) {
+            fdt_apex_offer(&ap, mapex, coords(w, mapex), &w->kq);
+            /* The mesh's apex is on the open side by construction; an
+             * offer refused would mean the mesh and the search disagree. */
+            if (ap.best != mapex)
+                return FDT_EINTERNAL;
+        }
+        fdt_facetab_prefetch_tet(&w->ft, f, mapex);
+        inside = fdt_apex_inside_region(&ap, w->tree);
+    } else {
+        /* Our own tree first, climbing from the leaf of f[0] (ours): the
+         * apex is nearly always near the face. When the final ball lies
+         * inside our part's region (src/partition.c, regions()), no other
+         * part's point can be in it and the others are not asked at all;
+         * otherwise their bounding boxes rule most of them out. */
+        fdt_apex_guess(&ap, w->tree, f[0], &w->kq);
+        /* the guessed tet's face slots, as in src/front.c */
+        fdt_facetab_prefetch_tet(&w->ft, f, ap.best);
+        inside = fdt_apex_verify_from(&ap, w->tree, f[0], &w->kq);
+    }
     qbuf qb = {{{0}}, 0};
     int err = inside ? FDT_OK : search_others(w, &ap, &qb);
     if (err)
@@ -974,8 +1000,13 @@ static int advance_one(worker *w)
         if (w->e->mode == FDT_MODE_MESSAGE && !is_own(w, p) &&
             (err = ghost_put(&w->ghosts, p, ap.bp)) != FDT_OK)
             return err;
-        /* The search changed no table (above), so s still holds f. */
+        /* The search changed no table (above), so s still holds f. A
+         * local build always adds a tet (build_tet), the last of out; its
+         * mesh tet is known when the mesh gave its apex. */
         err = build_tet(w, v, 0, s);
+        if (!err)
+            err = fdt_oracle_note(&w->orc, (int64_t)w->out.ntets - 1,
+                                  p == mapex ? mtet : FDT_NONE);
     } else {
         /* p is the tet's lowest id: the owner reads its coordinates
          * itself, the message carries f's. */
@@ -1000,6 +1031,9 @@ static int worker_setup(worker *w)
     /* Own faces have an own lowest id (the ownership rule above). */
     if (fdt_faceq_init(&w->fq, w->lo, w->hi - w->lo) != FDT_OK)
         return FDT_ENOMEM;
+    /* The part's mesh, if it comes to one, is built by this thread: its
+     * pages are first touched here, near the core that reads them. */
+    fdt_oracle_init(&w->orc, w->tree, w->e->search);
     return FDT_OK;
 }
 
@@ -1184,6 +1218,7 @@ static void *worker_main(void *arg)
 
 static void worker_free(worker *w)
 {
+    fdt_oracle_free(&w->orc);
     fdt_facetab_free(&w->ft);
     fdt_faceq_free(&w->fq);
     fdt_meshbuf_free(&w->out);
@@ -1504,6 +1539,7 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
     e->mode = mode;
     e->n = nthreads;
     e->want_nbrs = s->neighbors != 0;
+    e->search = (int)s->search;
     e->pin = s->pin != 0;
     e->w = aligned_alloc(alignof(worker), (size_t)nthreads * sizeof(worker));
     if (!e->w)
@@ -1667,6 +1703,10 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
         out->fst.kq.points += w->kq.points;
         out->fst.kq.pc.orient_exact += w->kq.pc.orient_exact;
         out->fst.kq.pc.insphere_exact += w->kq.pc.insphere_exact;
+        out->fst.mesh_faces += w->orc.mesh_faces;
+        out->fst.star_walks += w->orc.star_walks;
+        out->fst.mesh_parts += w->orc.switched_at != 0;
+        out->fst.t_mesh += w->orc.t_mesh;
         if (ts->tets > maxt)
             maxt = ts->tets;
         sumt += ts->tets;

@@ -321,7 +321,7 @@ static meshset engine_mesh(const prepped *pp)
     CHECK_EQ(fdt_meshbuf_init(&mb, 7 * (size_t)pp->m + 64, 0), FDT_OK);
     fdt_front_stats st;
     memset(&st, 0, sizeof st);
-    CHECK_EQ(fdt_front_serial(&pp->tree, central_point(&pp->tree), &mb, NULL, NULL, &st),
+    CHECK_EQ(fdt_front_serial(&pp->tree, central_point(&pp->tree), FDT_SEARCH_KD, &mb, NULL, NULL, &st),
              FDT_OK);
     meshset s;
     s.nt = mb.ntets;

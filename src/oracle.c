@@ -1,0 +1,142 @@
+/* The choice of apex oracle; see oracle.h and bench/NOTES.md, entry 51. */
+#include "oracle.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/*
+ * The switching rule. A window's cost a face is estimated in units of one
+ * point tested by the kd search: cost = points + EXACT_WEIGHT * exact
+ * tests, per face. A point test costs ~8 ns inside the walk (uniform 1M:
+ * 0.77 us a face for 92 points and the nodes above them), an exact test
+ * that leaves the filter 0.3 us (expansions) to 2 us (GMP), so one exact
+ * test weighs as ~150 points. The mesh costs about one insertion per
+ * point, ~6.5 faces a point: CGAL's 4.5 us a point at 1M is 0.7 us a
+ * face, ~90 point units; ours may be slower on degenerate input, where
+ * insertion needs exact tests too. Uniform clouds (92 units a face)
+ * must never switch, and the gain must be large where we do: the
+ * threshold is three times uniform's cost.
+ */
+#define EXACT_WEIGHT 150
+#define SWITCH_COST 300
+/* The first decision comes early (a cylinder of 25k points costs 4 s on
+ * the kd search, 0.2 ms a face), later ones rarely (a check is cheap, but
+ * a short window of hard faces inside an easy input is not worth a mesh). */
+#define FIRST_WINDOW 2048
+#define WINDOW 16384
+
+static double mono_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy)
+{
+    memset(o, 0, sizeof *o);
+    o->t = t;
+    o->policy = policy;
+    o->state = policy == FDT_SEARCH_KD ? -1 : 0;
+    o->next_check = policy == FDT_SEARCH_MESH ? 0 : FIRST_WINDOW;
+}
+
+void fdt_oracle_free(fdt_oracle *o)
+{
+    if (o->state == 1)
+        fdt_ins_free(&o->mesh);
+    free(o->mt);
+    memset(o, 0, sizeof *o);
+    o->state = -1;
+}
+
+static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
+{
+    double t0 = mono_s();
+    int err = fdt_ins_build(&o->mesh, o->t->P, o->t->base, o->t->n, &kq->pc);
+    o->t_mesh += mono_s() - t0;
+    /* FDT_EDEGENERATE (a part whose points are coplanar: one layer of an
+     * extruded grid) or FDT_ENOMEM: the kd search is always right, only
+     * slower, so the front goes on with it. */
+    o->state = err == FDT_OK ? 1 : -1;
+    if (o->state == 1)
+        o->switched_at = faces ? faces : 1;
+}
+
+void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
+{
+    if (o->state != 0 || faces < o->next_check)
+        return;
+    if (o->policy == FDT_SEARCH_MESH || o->t->n == 0) {
+        if (o->t->n >= 4)
+            build_mesh(o, faces, kq);
+        else
+            o->state = -1;
+        return;
+    }
+    size_t df = faces - o->w_faces;
+    size_t points = kq->points - o->w_points;
+    size_t exact = kq->pc.orient_exact + kq->pc.insphere_exact - o->w_exact;
+    if (df > 0 && (double)points + EXACT_WEIGHT * (double)exact > (double)SWITCH_COST * (double)df) {
+        build_mesh(o, faces, kq);
+        return;
+    }
+    o->w_faces = faces;
+    o->w_points = kq->points;
+    o->w_exact = kq->pc.orient_exact + kq->pc.insphere_exact;
+    o->next_check = faces + WINDOW;
+}
+
+int fdt_oracle_note(fdt_oracle *o, int64_t tid, uint32_t mtet)
+{
+    if (o->state != 1 || tid < 0)
+        return FDT_OK;
+    size_t i = (size_t)tid;
+    if (i >= o->mtcap) {
+        size_t ncap = o->mtcap ? o->mtcap : 4096;
+        while (ncap <= i)
+            ncap += ncap / 2;
+        uint32_t *nm = realloc(o->mt, ncap * sizeof *nm);
+        if (!nm)
+            return FDT_ENOMEM;
+        /* Tets built before the mesh, or by the kd search since, have no
+         * mesh tet: their faces are found by a walk. */
+        memset(nm + o->mtcap, 0xff, (ncap - o->mtcap) * sizeof *nm);
+        o->mt = nm;
+        o->mtcap = ncap;
+    }
+    o->mt[i] = mtet;
+    return FDT_OK;
+}
+
+int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t copp,
+                    uint32_t *apex, uint32_t *mtet)
+{
+    if (o->state != 1)
+        return 0;
+    uint32_t m = ctid >= 0 && (size_t)ctid < o->mtcap ? o->mt[ctid] : FDT_NONE;
+    uint32_t nt;
+    int nk;
+    if (m != FDT_NONE) {
+        /* The closed-side tet is mesh tet m (same vertex set): f is its
+         * face opposite copp, and the tet across it holds the apex. */
+        const uint32_t *mv = fdt_ins_tet(&o->mesh, m);
+        for (int k = 0; k < 4; k++)
+            if (mv[k] == copp) {
+                *apex = fdt_ins_across(&o->mesh, m, k, &nt, &nk);
+                *mtet = *apex == FDT_NONE ? FDT_NONE : nt;
+                o->mesh_faces++;
+                return 1;
+            }
+        /* Not reached: the noted tet has the output tet's vertices. The
+         * walk below answers anyway. */
+    }
+    if (!fdt_ins_find_face(&o->mesh, f[0], f[1], f[2], &nt, &nk))
+        return 0;
+    *apex = fdt_ins_tet(&o->mesh, nt)[nk];
+    *mtet = *apex == FDT_NONE ? FDT_NONE : nt;
+    o->mesh_faces++;
+    o->star_walks++;
+    return 1;
+}

@@ -1,0 +1,79 @@
+/*
+ * Which apex oracle a front uses (bench/NOTES.md, entry 51).
+ *
+ * The apex of a front face is the first open-side point of the pencil of
+ * spheres through the face's circle (§2.2). Two exact ways find it:
+ *   - the kd search (src/kdtree.c): certifies the sphere empty by testing
+ *     every point the tree cannot exclude; ~90 points a face on uniform
+ *     clouds, but thousands where many points lie near the sphere
+ *     (cylinders, rotated lattices, near-cospherical sets, flat scans);
+ *   - the insertion mesh (src/insert.c): the part's own points
+ *     triangulated once by Bowyer-Watson insertion; the apex is the vertex
+ *     across the face, one array read when the face came from a tet the
+ *     mesh gave.
+ * The perturbed Delaunay tetrahedralization is unique, so both give the
+ * same apex and may be mixed face by face: a front starts on the kd
+ * search and switches to the mesh when a window of faces shows the
+ * searches are expensive. The mesh is a read-only certificate; tets are
+ * still emitted one by one by the front, final when built.
+ *
+ * In a part of the parallel engine the mesh holds only the part's points:
+ * its answer is the first of the part's points in the pencil, and the
+ * caller still asks the other parts (their points may come earlier), as
+ * after its own kd search.
+ */
+#ifndef FDT_ORACLE_H
+#define FDT_ORACLE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "frontdt.h"
+#include "insert.h"
+#include "kdtree.h"
+
+typedef struct fdt_oracle {
+    const fdt_kdtree *t;  /* borrowed: the part's tree (its points) */
+    int policy;           /* FDT_SEARCH_AUTO, _KD or _MESH */
+    int state;            /* 0: kd search; 1: mesh; -1: mesh unavailable */
+    fdt_ins mesh;         /* owned, valid when state == 1 */
+    uint32_t *mt;         /* owned: mesh tet of output tet i, FDT_NONE unknown */
+    size_t mtcap;
+    /* The switching window: counter values at its start. */
+    size_t next_check, w_faces, w_points, w_exact;
+    /* Statistics. */
+    size_t mesh_faces;    /* faces whose apex the mesh gave */
+    size_t star_walks;    /* of those, found by a walk around a vertex */
+    size_t switched_at;   /* faces advanced when the mesh was built (0: never) */
+    double t_mesh;        /* seconds building the mesh */
+} fdt_oracle;
+
+void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy);
+void fdt_oracle_free(fdt_oracle *o);
+
+/*
+ * Called before each face is advanced, with the front's running counters
+ * (faces advanced so far, and the kd work in kq). Decides at the end of
+ * each window whether the kd search has become expensive and, if so,
+ * builds the mesh (counting its exact tests in kq). A part whose points do
+ * not span 3-D, or a build that runs out of memory, stays on the kd
+ * search: never an error. Cheap between windows.
+ */
+void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq);
+
+/*
+ * The mesh's answer for front face f (open side orient3d(f0,f1,f2,x) > 0),
+ * whose closed-side tet is output tet ctid (-1: none known) with vertex
+ * copp opposite f. Returns 1 when the mesh holds f: *apex is the first of
+ * the part's points in the pencil (FDT_NONE: no point of the part on the
+ * open side) and *mtet the mesh tet of (f, apex) to note for the new tet.
+ * Returns 0 when the mesh is not in use or f is not one of its faces (a
+ * vertex of another part): the caller runs the kd search.
+ */
+int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t copp,
+                    uint32_t *apex, uint32_t *mtet);
+
+/* Notes that output tet tid is mesh tet mtet (FDT_NONE: not known). Only
+ * stores while the mesh is in use. FDT_OK or FDT_ENOMEM. */
+int fdt_oracle_note(fdt_oracle *o, int64_t tid, uint32_t mtet);
+
+#endif

@@ -1,0 +1,307 @@
+/*
+ * Tests of the apex oracle (src/oracle.c) through the library: the kd
+ * search, the insertion mesh from the start, and the automatic switch must
+ * give the same mesh -- the same canonical hash, tet for tet -- in serial,
+ * shared and message modes, for any thread count, on the families where the
+ * kd search degenerates (an exact cylinder, rotated and plain lattices,
+ * integer points on a sphere, two parallel grid layers whose parts hold one
+ * layer each, mixed magnitudes) and on uniform points. And:
+ *   - `--search mesh` results pass fdt_check (independent exact check);
+ *   - the mesh answers faces (stats.mesh_faces) where it is asked to, and
+ *     the automatic rule switches on the cylinder but not on uniform
+ *     points (so a broken rule or a mesh never consulted fails here);
+ *   - a part whose points are coplanar cannot build a mesh and falls back
+ *     to the kd search with the same result.
+ * Usage: test_oracle [--quick]   (--quick: fewer thread counts)
+ */
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "frontdt.h"
+
+#include "testutil.h"
+
+typedef struct rng {
+    uint64_t s;
+} rng;
+
+static uint64_t rnext(rng *r)
+{
+    uint64_t z = (r->s += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+static double runif(rng *r)
+{
+    return (double)(rnext(r) >> 11) * 0x1.0p-53;
+}
+
+typedef struct pts {
+    const char *name;
+    double *xyz;
+    size_t n;
+} pts;
+
+static pts pts_alloc(const char *name, size_t n)
+{
+    pts p = {name, malloc(3 * n * sizeof(double)), n};
+    CHECK(p.xyz);
+    return p;
+}
+
+static void put(pts *p, size_t i, double x, double y, double z)
+{
+    p->xyz[3 * i] = x;
+    p->xyz[3 * i + 1] = y;
+    p->xyz[3 * i + 2] = z;
+}
+
+static pts gen_uniform(size_t n, uint64_t seed)
+{
+    pts p = pts_alloc("uniform", n);
+    rng r = {seed};
+    for (size_t i = 0; i < n; i++)
+        put(&p, i, runif(&r), runif(&r), runif(&r));
+    return p;
+}
+
+/* Rings of equal angle steps on a cylinder of radius 1, empty inside: a
+ * pipe scan. Each ring's points are cocircular, pairs of rings
+ * cospherical. */
+static pts gen_cylinder(int rings, int per_ring)
+{
+    pts p = pts_alloc("cylinder", (size_t)rings * (size_t)per_ring);
+    size_t i = 0;
+    for (int k = 0; k < rings; k++)
+        for (int j = 0; j < per_ring; j++) {
+            double t = 6.283185307179586 * j / per_ring;
+            put(&p, i++, cos(t), sin(t), 0.05 * k);
+        }
+    return p;
+}
+
+/* A k^3 lattice, rotated by (ax, ay, az) about x, then y, then z (0: the
+ * exact lattice, where every unit cube is cospherical). */
+static pts gen_lattice(const char *name, int k, double ax, double ay, double az)
+{
+    pts p = pts_alloc(name, (size_t)k * k * k);
+    size_t i = 0;
+    for (int a = 0; a < k; a++)
+        for (int b = 0; b < k; b++)
+            for (int c = 0; c < k; c++) {
+                double x = a, y = b, z = c, t;
+                t = y * cos(ax) - z * sin(ax);
+                z = y * sin(ax) + z * cos(ax);
+                y = t;
+                t = x * cos(ay) + z * sin(ay);
+                z = -x * sin(ay) + z * cos(ay);
+                x = t;
+                t = x * cos(az) - y * sin(az);
+                y = x * sin(az) + y * cos(az);
+                x = t;
+                put(&p, i++, x, y, z);
+            }
+    return p;
+}
+
+/* Integer points with x^2 + y^2 + z^2 = R^2: exactly cospherical. */
+static pts gen_intsphere(int R)
+{
+    size_t n = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        pts p = pts_alloc("intsphere", n ? n : 1);
+        size_t i = 0;
+        for (int x = -R; x <= R; x++)
+            for (int y = -R; y <= R; y++) {
+                int z2 = R * R - x * x - y * y;
+                if (z2 < 0)
+                    continue;
+                int z = (int)lround(sqrt((double)z2));
+                if (z * z != z2)
+                    continue;
+                if (pass)
+                    put(&p, i, x, y, z);
+                i++;
+                if (z) {
+                    if (pass)
+                        put(&p, i, x, y, -z);
+                    i++;
+                }
+            }
+        if (pass)
+            return p;
+        free(p.xyz);
+        n = i;
+    }
+    abort();
+}
+
+/* Two layers of one jittered 2-D grid at z = 0 and z = 1 (an extruded 2-D
+ * CFD grid): cut along z, each part of two holds one plane. */
+static pts gen_layers(int k, uint64_t seed)
+{
+    pts p = pts_alloc("layers", 2 * (size_t)k * (size_t)k);
+    rng r = {seed};
+    size_t i = 0;
+    for (int a = 0; a < k; a++)
+        for (int b = 0; b < k; b++) {
+            double x = a + 0.3 * runif(&r), y = b + 0.3 * runif(&r);
+            put(&p, i++, x, y, 0.0);
+            put(&p, i++, x, y, 1.0);
+        }
+    return p;
+}
+
+/* Clusters at 1e-150, 1 and 1e150 scales in one cloud. */
+static pts gen_mixed(size_t n, uint64_t seed)
+{
+    pts p = pts_alloc("mixed", n);
+    rng r = {seed};
+    static const double sc[3] = {1e-150, 1.0, 1e150};
+    for (size_t i = 0; i < n; i++) {
+        double s = sc[i % 3];
+        put(&p, i, s * runif(&r), s * runif(&r), s * runif(&r));
+    }
+    return p;
+}
+
+static fdt_result *run(const pts *p, fdt_mode mode, int threads, fdt_search search,
+                       fdt_stats *st)
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = mode;
+    s.n_threads = threads;
+    s.search = search;
+    fdt_context *ctx = NULL;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    fdt_result *r = NULL;
+    int err = fdt_triangulate(ctx, p->xyz, p->n, &r);
+    if (err != FDT_OK)
+        fprintf(stderr, "%s: %s\n", p->name, fdt_context_diagnostic(ctx));
+    CHECK_EQ(err, FDT_OK);
+    fdt_close(&ctx);
+    CHECK_EQ(fdt_result_stats(r, st), FDT_OK);
+    return r;
+}
+
+static uint64_t hash_of(fdt_result *r)
+{
+    uint64_t h;
+    CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
+    return h;
+}
+
+/* Every search, mode and thread count against the kd search in serial
+ * mode. want_auto: 1 the automatic rule must switch in serial mode, 0 it
+ * must not, -1 either. */
+static void test_family(pts p, int want_auto, int quick)
+{
+    fdt_stats st;
+    fdt_result *ref = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_KD, &st);
+    uint64_t href = hash_of(ref);
+    CHECK_EQ(st.mesh_faces, 0);
+    CHECK_EQ(st.mesh_parts, 0);
+
+    fdt_result *r = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_MESH, &st);
+    /* The whole mesh came from the insertion mesh (all faces but the
+     * seed's own search), and it is the Delaunay tetrahedralization. */
+    CHECK_EQ(st.mesh_parts, 1);
+    CHECK(st.mesh_faces + 1 >= st.faces_advanced);
+    char msg[256];
+    int rc = fdt_check(p.xyz, p.n, fdt_result_tets(r), fdt_result_num_tets(r), NULL, msg,
+                       sizeof msg);
+    if (rc)
+        fprintf(stderr, "%s: --search mesh: %s\n", p.name, msg);
+    CHECK_EQ(rc, 0);
+    CHECK_EQ(hash_of(r), href);
+    fdt_result_free(&r);
+
+    r = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_AUTO, &st);
+    CHECK_EQ(hash_of(r), href);
+    if (want_auto >= 0)
+        CHECK_EQ(st.mesh_parts, (size_t)want_auto);
+    if (st.mesh_parts)
+        CHECK(st.mesh_faces > 0);
+    fdt_result_free(&r);
+
+    static const int all_threads[] = {2, 3, 5};
+    int nt = quick ? 1 : 3;
+    for (int m = 0; m < 2; m++) {
+        fdt_mode mode = m ? FDT_MODE_MESSAGE : FDT_MODE_SHARED;
+        for (int k = 0; k < nt; k++)
+            for (int srch = 0; srch < 3; srch++) {
+                fdt_search s = srch == 0 ? FDT_SEARCH_MESH
+                             : srch == 1 ? FDT_SEARCH_AUTO : FDT_SEARCH_KD;
+                r = run(&p, mode, all_threads[k], s, &st);
+                uint64_t h = hash_of(r);
+                if (h != href)
+                    fprintf(stderr, "%s: mode %d threads %d search %d: hash %016" PRIx64
+                            " != %016" PRIx64 "\n", p.name, (int)mode, all_threads[k],
+                            (int)s, h, href);
+                CHECK_EQ(h, href);
+                if (s == FDT_SEARCH_MESH)
+                    CHECK(st.mesh_faces > 0 || strcmp(p.name, "layers") == 0);
+                fdt_result_free(&r);
+            }
+    }
+    fdt_result_free(&ref);
+    free(p.xyz);
+    printf("ok %s (%zu points)\n", p.name, p.n);
+}
+
+/* Two layers, two threads: the bisection cuts z (the widest extent is
+ * made z by stretching), so a part within one layer is one plane and
+ * cannot build a mesh; the kd search answers there instead, with the same
+ * result. */
+static void test_flat_parts(void)
+{
+    pts p = gen_layers(12, 7);
+    for (size_t i = 0; i < p.n; i++)
+        p.xyz[3 * i + 2] *= 100.0;
+    fdt_stats st;
+    fdt_result *ref = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_KD, &st);
+    fdt_result *r = run(&p, FDT_MODE_SHARED, 2, FDT_SEARCH_MESH, &st);
+    CHECK_EQ(hash_of(r), hash_of(ref));
+    /* The first cut is moved off the median by the work its lower side
+     * owns (src/partition.c), so the lower part holds part of the z = 0
+     * layer only: flat, no mesh; the upper part has both layers. */
+    CHECK(st.mesh_parts < 2);
+    fdt_result_free(&r);
+    fdt_result_free(&ref);
+    free(p.xyz);
+    printf("ok flat parts\n");
+}
+
+int main(int argc, char **argv)
+{
+    int quick = argc > 1 && !strcmp(argv[1], "--quick");
+    alarm(600);
+    test_flat_parts();
+    test_family(gen_uniform(3000, 1), -1, quick);
+    /* 60 rings of 64: the kd search tests hundreds of points a face here,
+     * and the automatic rule must see it. */
+    test_family(gen_cylinder(60, 64), 1, quick);
+    test_family(gen_lattice("lattice", 9, 0, 0, 0), -1, quick);
+    test_family(gen_lattice("rotlattice", 10, 0.3, 0.5, 0.7), -1, quick);
+    test_family(gen_intsphere(25), -1, quick);
+    test_family(gen_layers(25, 3), -1, quick);
+    test_family(gen_mixed(600, 5), -1, quick);
+    /* Uniform points must never pay for a mesh. */
+    {
+        pts p = gen_uniform(40000, 11);
+        fdt_stats st;
+        fdt_result *r = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_AUTO, &st);
+        CHECK_EQ(st.mesh_parts, 0);
+        fdt_result_free(&r);
+        free(p.xyz);
+        printf("ok uniform stays on the kd search\n");
+    }
+    return 0;
+}
