@@ -339,7 +339,7 @@ static void finish_groups(uint32_t *a, size_t n, int stride, uint32_t *tmp)
             }
             memcpy(a + 4 * i, rec, g * sizeof rec[0]);
         } else if (g <= 64) {
-            insert_run(a + stride * i, g, 6);
+            insert_run(a + stride * i, g, 6); /* stride 6: with neighbours */
         } else if (stride == 4) {
             sort_group(a + 4 * i, g, 4, tmp); /* constant strides: inlined twice */
         } else {
@@ -587,8 +587,8 @@ static void run_phase(sort_job *j, int phase, sort_arg *args, pthread_t *tid, in
  * Most significant digit first: one pass scatters the records into 2^11
  * buckets by the top bits of the lowest vertex id, then each bucket (about
  * 3,300 records, 53 KB, at 1M points) is finished while it sits in the
- * cache: least significant passes on the bits below, the insertion sort of
- * each vertex's group, and the hash. The least-significant-first sort
+ * cache: least significant passes on the bits below, the sort of each
+ * vertex's group (finish_groups), and the hash. The least-significant-first sort
  * before this read and wrote the whole array once more, and the hash then
  * read it again from memory: sort and hash were 1.2 s of a 9.5 s run at 1M
  * (bench/NOTES.md, entry 33). 2048 buckets keep the scatter's write streams
