@@ -124,17 +124,6 @@ static void key_of(const fdt_vid *t, uint32_t k[4])
     k[3] = (uint32_t)(t[2] < t[3] ? t[3] : t[2]);
 }
 
-static int key_cmp(const uint32_t *x, const uint32_t *y)
-{
-    uint32_t a[4], b[4];
-    key_of((const fdt_vid *)x, a);
-    key_of((const fdt_vid *)y, b);
-    for (int i = 0; i < 4; i++)
-        if (a[i] != b[i])
-            return a[i] < b[i] ? -1 : 1;
-    return 0;
-}
-
 /* Records of the canonical sort: a tet in orient_sorted form (4 words:
  * the key is key_of of it), or with neighbours a key and the tet's old
  * index (6 words: key_of of a key is the key itself). */
@@ -244,21 +233,96 @@ static inline void key_rest(const uint32_t *t, uint64_t *hi, uint32_t *lo)
     *lo = mx;
 }
 
-/* Records with the same first word (the lowest vertex: about seven, the
- * tets at which that vertex is lowest) in key order, by insertion; for
- * 4-word records on keys computed once a record rather than twice a
- * comparison. */
-static void finish_groups(uint32_t *a, size_t n, int stride)
+/* Whether record x's key is below record y's, for two records with the
+ * same first word: for 4-word records key_rest is the rest of the key,
+ * and for 6-word ones (a key and an index) it is the key's words 1-3. */
+static inline int rest_less(const uint32_t *x, const uint32_t *y)
+{
+    uint64_t xh, yh;
+    uint32_t xl, yl;
+    key_rest(x, &xh, &xl);
+    key_rest(y, &yh, &yl);
+    return xh < yh || (xh == yh && xl < yl);
+}
+
+/* The g records at a (one group) in key order by insertion; stable. For
+ * short runs only: quadratic in g. */
+static inline void insert_run(uint32_t *a, size_t g, int stride)
 {
     size_t bytes = (size_t)stride * sizeof *a;
+    for (size_t x = 1; x < g; x++) {
+        uint32_t r[REC_MAX];
+        memcpy(r, a + stride * x, bytes);
+        size_t y = x;
+        for (; y > 0 && rest_less(r, a + stride * (y - 1)); y--)
+            memcpy(a + stride * y, a + stride * (y - 1), bytes);
+        memcpy(a + stride * y, r, bytes);
+    }
+}
+
+/* Runs [lo, mid) and [mid, hi) of src merged into dst; on equal keys the
+ * left run's record first, so the merge sort is stable as the insertion
+ * sort it replaces was (equal keys are the same tet twice, possibly in
+ * either orientation: the output keeps their input order). */
+static inline void merge_runs(const uint32_t *src, uint32_t *dst, size_t lo, size_t mid,
+                              size_t hi, int stride)
+{
+    size_t bytes = (size_t)stride * sizeof *src, i = lo, j = mid, k = lo;
+    while (i < mid && j < hi) {
+        if (rest_less(src + stride * j, src + stride * i))
+            memcpy(dst + stride * k++, src + stride * j++, bytes);
+        else
+            memcpy(dst + stride * k++, src + stride * i++, bytes);
+    }
+    memcpy(dst + stride * k, src + stride * i, (mid - i) * bytes);
+    k += mid - i;
+    memcpy(dst + stride * k, src + stride * j, (hi - j) * bytes);
+}
+
+/* Insertion-sorted runs of this many records before the merges. */
+#define GROUP_RUN 32
+
+/*
+ * One large group (g records at a with the same first word) in key order:
+ * insertion-sorted runs of GROUP_RUN, then bottom-up merges between a and
+ * tmp (room for g records), O(g log g) and stable. A vertex can be the
+ * lowest of tens of thousands of tets (a point at the centre of a sphere
+ * of points: every tet; issue 16's wind-study geometry: 67,675), and the
+ * insertion sort of such a group took seconds.
+ */
+static inline void sort_group(uint32_t *a, size_t g, int stride, uint32_t *tmp)
+{
+    for (size_t s = 0; s < g; s += GROUP_RUN)
+        insert_run(a + stride * s, g - s < GROUP_RUN ? g - s : GROUP_RUN, stride);
+    uint32_t *src = a, *dst = tmp;
+    for (size_t w = GROUP_RUN; w < g; w *= 2) {
+        for (size_t lo = 0; lo < g; lo += 2 * w) {
+            size_t mid = g - lo < w ? g : lo + w, hi = g - lo < 2 * w ? g : lo + 2 * w;
+            merge_runs(src, dst, lo, mid, hi, stride);
+        }
+        uint32_t *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != a)
+        memcpy(a, src, g * (size_t)stride * sizeof *a);
+}
+
+/* Records with the same first word (the lowest vertex: about seven, the
+ * tets at which that vertex is lowest, for uniform points) in key order:
+ * groups of at most 64 by insertion, for 4-word records on keys computed
+ * once a record rather than twice a comparison; larger ones by sort_group
+ * with tmp (room for n records) as its scratch. */
+static void finish_groups(uint32_t *a, size_t n, int stride, uint32_t *tmp)
+{
     for (size_t i = 0; i < n;) {
         size_t j = i + 1;
         while (j < n && a[stride * j] == a[stride * i])
             j++;
-        if (stride == 4 && j - i <= 64) {
+        size_t g = j - i;
+        if (stride == 4 && g <= 64) {
             uint64_t kh[64];
             uint32_t kl[64], rec[64][4];
-            size_t g = j - i;
             for (size_t x = 0; x < g; x++) {
                 uint64_t h;
                 uint32_t l;
@@ -274,16 +338,12 @@ static void finish_groups(uint32_t *a, size_t n, int stride)
                 memcpy(rec[y], a + 4 * (i + x), sizeof rec[y]);
             }
             memcpy(a + 4 * i, rec, g * sizeof rec[0]);
-            i = j;
-            continue;
-        }
-        for (size_t x = i + 1; x < j; x++) {
-            uint32_t r[REC_MAX];
-            memcpy(r, a + stride * x, bytes);
-            size_t y = x;
-            for (; y > i && key_cmp(a + stride * (y - 1), r) > 0; y--)
-                memcpy(a + stride * y, a + stride * (y - 1), bytes);
-            memcpy(a + stride * y, r, bytes);
+        } else if (g <= 64) {
+            insert_run(a + stride * i, g, 6); /* stride 6: with neighbours */
+        } else if (stride == 4) {
+            sort_group(a + 4 * i, g, 4, tmp); /* constant strides: inlined twice */
+        } else {
+            sort_group(a + 6 * i, g, 6, tmp);
         }
         i = j;
     }
@@ -370,7 +430,8 @@ static void sort_bucket(sort_job *j, size_t d, size_t *inner)
     }
     if (src != j->a + (size_t)j->stride * lo)
         memcpy(j->a + (size_t)j->stride * lo, src, m * bytes);
-    finish_groups(j->a + (size_t)j->stride * lo, m, j->stride);
+    /* the bucket's range of b is free now: scratch for large groups */
+    finish_groups(j->a + (size_t)j->stride * lo, m, j->stride, j->b + (size_t)j->stride * lo);
 }
 
 /* Worker 0: hashes every bucket from hnext on that is sorted, in order,
@@ -526,8 +587,8 @@ static void run_phase(sort_job *j, int phase, sort_arg *args, pthread_t *tid, in
  * Most significant digit first: one pass scatters the records into 2^11
  * buckets by the top bits of the lowest vertex id, then each bucket (about
  * 3,300 records, 53 KB, at 1M points) is finished while it sits in the
- * cache: least significant passes on the bits below, the insertion sort of
- * each vertex's group, and the hash. The least-significant-first sort
+ * cache: least significant passes on the bits below, the sort of each
+ * vertex's group (finish_groups), and the hash. The least-significant-first sort
  * before this read and wrote the whole array once more, and the hash then
  * read it again from memory: sort and hash were 1.2 s of a 9.5 s run at 1M
  * (bench/NOTES.md, entry 33). 2048 buckets keep the scatter's write streams
