@@ -350,6 +350,8 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
     uint8_t *mark = b->mark;
     mark[t0] = MARK_IN;
     b->cav[b->ncav++] = t0;
+    for (int j = 0; j < 4; j++)
+        fdt_prefetch(m->T + 8 * (size_t)(v0[4 + j] >> 2));
     for (size_t ci = 0; ci < b->ncav; ci++) {
         uint32_t c = b->cav[ci];
         for (int k = 0; k < 4; k++) {
@@ -363,6 +365,10 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
                         return err;
                     mark[o] = MARK_IN;
                     b->cav[b->ncav++] = o;
+                    /* its neighbours are tested next: ask for them now */
+                    const uint32_t *on = m->T + 8 * (size_t)o + 4;
+                    for (int j = 0; j < 4; j++)
+                        fdt_prefetch(m->T + 8 * (size_t)(on[j] >> 2));
                     continue;
                 }
                 if (b->nout == b->outcap &&

@@ -23,6 +23,7 @@
  */
 #include "predicates.h"
 
+#include "bits.h"
 #include <float.h>
 #include <limits.h>
 #include <gmp.h>
@@ -331,6 +332,117 @@ static void mpz_det3(mpz_t r, mpz_t *const u, mpz_t *const v, mpz_t *const w, mp
 }
 
 /* ------------------------------------------------------------------ */
+/* Stage G: points on a coarse binary grid, evaluated in plain doubles.
+ *
+ * Lattices, extruded 2-D grids and integer data reach the exact stages
+ * with determinants that are exactly 0 (cospherical and coplanar sets),
+ * where no filter can help; but there the filter's own floating-point
+ * evaluation has no rounding error at all, and its sign is exact. (CGAL's
+ * interval stage certifies the same cases, as degenerate intervals.)
+ *
+ * The argument. Let 2^k be the lowest set bit over all nonzero coordinates
+ * of the call (k = min over them of int_exponent(x) + ctz(mantissa)), so
+ * every coordinate is an integer multiple of 2^k, and so is every exact
+ * difference. Let M = the largest rounded difference component / 2^k. If
+ * M <= G (G below), every exact difference is at most G 2^k (1 + eps) <
+ * 2^53 2^k, an integer multiple of 2^k that a double holds, so the rounded
+ * differences are exact. The determinant formula of the filter is
+ * homogeneous: every intermediate of degree j is an integer multiple of
+ * 2^(jk), and sums only combine terms of one degree. An operation whose
+ * exact result is such a multiple with magnitude below 2^53 2^(jk) is
+ * exact in IEEE double (a subnormal result included, as long as
+ * 2^(jk) >= 2^-1074, and no overflow as long as 2^53 2^(jk) <= DBL_MAX).
+ * Bounds on the intermediates, in units of 2^(jk):
+ *   orient3d (degree 3): products M^2, 2x2 minors 2M^2, the three terms
+ *     2M^3 each, det 6M^3; G = 2^16 gives 6 2^48 < 2^53.
+ *   insphere (degree 5): xy products M^2, minors 2M^2, 3x3 minors 6M^3,
+ *     lifts 3M^2, lift * minor 18M^5, the sums 36M^5 and 72M^5; G = 2^9
+ *     gives 72 2^45 < 2^52.
+ * Range: -1074 <= 3k and 3k + 53 + 16 * 3 <= 1023 for orient3d
+ * (-358 <= k <= 307); -1074 <= 5k and 5k + 53 + 45 + 7 <= 1023 for
+ * insphere (-214 <= k <= 183). Outside, the call goes on to stage B or C.
+ */
+
+/* The exponent of the lowest set bit over the nonzero coordinates, or
+ * INT_MAX if all are 0. */
+static int grid_exponent(const double *const *pts, int npts)
+{
+    int k = INT_MAX;
+    for (int i = 0; i < npts; i++)
+        for (int j = 0; j < 3; j++) {
+            double x = pts[i][j];
+            if (x == 0.0)
+                continue;
+            int e;
+            uint64_t m = int_mantissa(x, &e);
+            e += fdt_ctz64(m);
+            if (e < k)
+                k = e;
+        }
+    return k;
+}
+
+/* The largest |component| of the rounded differences p_i - q, i < n. */
+static double max_diff(const double *const *p, int n, const double *q, double (*out)[3])
+{
+    double mx = 0.0;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < 3; j++) {
+            out[i][j] = p[i][j] - q[j];
+            double x = fabs(out[i][j]);
+            mx = x > mx ? x : mx; /* an infinite difference stays; no NaN from finite input */
+        }
+    return mx;
+}
+
+/* The exact orient3d sign when stage G applies (see above), else
+ * FDT_PRED_UNSURE. */
+static int orient_stage_g(const double *a, const double *b, const double *c, const double *d)
+{
+    const double *const pts[4] = {a, b, c, d};
+    int k = grid_exponent(pts, 4);
+    if (k == INT_MAX)
+        return 0; /* four times the origin */
+    if (k < -358 || k > 307)
+        return FDT_PRED_UNSURE;
+    double r[3][3];
+    if (!(max_diff(pts + 1, 3, a, r) <= ldexp(0x1p16, k)))
+        return FDT_PRED_UNSURE;
+    const double *u = r[0], *v = r[1], *w = r[2];
+    double det = u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2]) +
+                 u[2] * (v[0] * w[1] - v[1] * w[0]);
+    return (det > 0.0) - (det < 0.0);
+}
+
+/* The exact CGAL insphere sign when stage G applies, else
+ * FDT_PRED_UNSURE. The formula is fdt_insphere_filter_diff's. */
+static int insphere_stage_g(const double *a, const double *b, const double *c,
+                            const double *d, const double *e)
+{
+    const double *const pts[5] = {a, b, c, d, e};
+    int k = grid_exponent(pts, 5);
+    if (k == INT_MAX || k < -214 || k > 183)
+        return FDT_PRED_UNSURE; /* all zero: distinctness is broken; let B decide */
+    double r[4][3];
+    if (!(max_diff(pts, 4, e, r) <= ldexp(0x1p9, k)))
+        return FDT_PRED_UNSURE;
+    const double *A = r[0], *B = r[1], *C = r[2], *D = r[3];
+    const double ab = A[0] * B[1] - B[0] * A[1], bc = B[0] * C[1] - C[0] * B[1];
+    const double cd = C[0] * D[1] - D[0] * C[1], da = D[0] * A[1] - A[0] * D[1];
+    const double ac = A[0] * C[1] - C[0] * A[1], bd = B[0] * D[1] - D[0] * B[1];
+    const double abc = A[2] * bc - B[2] * ac + C[2] * ab;
+    const double bcd = B[2] * cd - C[2] * bd + D[2] * bc;
+    const double cda = C[2] * da + D[2] * ac + A[2] * cd;
+    const double dab = D[2] * ab + A[2] * bd + B[2] * da;
+    const double alift = A[0] * A[0] + A[1] * A[1] + A[2] * A[2];
+    const double blift = B[0] * B[0] + B[1] * B[1] + B[2] * B[2];
+    const double clift = C[0] * C[0] + C[1] * C[1] + C[2] * C[2];
+    const double dlift = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+    const double det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+    return (det < 0.0) - (det > 0.0);
+}
+
+/* ------------------------------------------------------------------ */
 /* orient3d, exact stages. */
 
 static int orient_stage_b(const double *u, const double *v, const double *w)
@@ -377,6 +489,9 @@ int fdt_orient3d_exact(const double *a, const double *b, const double *c,
 {
     if (cnt)
         cnt->orient_exact++;
+    int g = orient_stage_g(a, b, c, d);
+    if (g != FDT_PRED_UNSURE)
+        return g;
     double u[3], v[3], w[3];
     bool exact = exact_diff3(b, a, u);
     exact = exact_diff3(c, a, v) && exact;
@@ -635,6 +750,9 @@ int fdt_insphere_exact(const double *a, const double *b, const double *c,
 {
     if (cnt)
         cnt->insphere_exact++;
+    int g = insphere_stage_g(a, b, c, d, e);
+    if (g != FDT_PRED_UNSURE)
+        return g;
     double A[3], B[3], C[3], D[3];
     bool exact = exact_diff3(a, e, A);
     exact = exact_diff3(b, e, B) && exact;

@@ -981,6 +981,56 @@ static void bench(tctx *T)
 
 /* ------------------------------------------------------------------ */
 
+/* ------------------------------------------------------------------ */
+/*
+ * Stage G (src/predicates.c): points on a binary grid 2^k evaluated in
+ * plain doubles. Integer points scaled by 2^k, with spreads on both sides
+ * of the stage's bounds (differences up to 2^9 units for insphere, 2^16
+ * for orient3d) and k at and beyond both ends of its ranges (insphere
+ * -214..183, orient3d -358..307), random and exactly degenerate (coplanar,
+ * cospherical): every exact stage and fdt_* against the reference.
+ */
+static void test_grid_stage(tctx *T)
+{
+    static const int ks[] = {-359, -358, -215, -214, -213, -100, -7, 0, 30,
+                             182, 183, 184, 306, 307, 308};
+    static const long spreads[] = {3, 255, 256, 257, 300, 32767, 32768, 32769, 40000};
+    sphere_set S;
+    make_sphere(&S, 9 * 9 + 4 * 4 + 2 * 2);
+    for (size_t ki = 0; ki < sizeof ks / sizeof ks[0]; ki++)
+        for (size_t si = 0; si < sizeof spreads / sizeof spreads[0]; si++)
+            for (int rep = 0; rep < 40; rep++) {
+                long n = spreads[si];
+                double p[5][3];
+                /* points in [o - n/2, o + n/2]: differences up to n */
+                double o[3];
+                for (int j = 0; j < 3; j++)
+                    o[j] = (double)irand(T, -5000, 5000);
+                for (int i = 0; i < 5; i++)
+                    for (int j = 0; j < 3; j++)
+                        p[i][j] = o[j] + (double)irand(T, -n / 2, n - n / 2);
+                if (rep % 4 == 1) /* coplanar: one z for all */
+                    for (int i = 0; i < 5; i++)
+                        p[i][2] = o[2];
+                if (rep % 4 == 2) { /* cospherical: integer points of one sphere */
+                    for (int i = 0; i < 5; i++) {
+                        int q = (int)irand(T, 0, S.n - 1);
+                        for (int j = 0; j < 3; j++)
+                            p[i][j] = o[j] + S.pt[q][j] * (double)(n / 20 + 1);
+                    }
+                }
+                if (rep % 4 == 3) /* the extreme spread on one axis */
+                    p[0][0] = o[0] - (double)(n / 2), p[1][0] = o[0] + (double)(n - n / 2);
+                for (int i = 0; i < 5; i++)
+                    for (int j = 0; j < 3; j++)
+                        p[i][j] = ldexp(p[i][j], ks[ki]);
+                check_orient(T, p[0], p[1], p[2], p[3], "grid stage");
+                check_orient(T, p[1], p[2], p[3], p[4], "grid stage");
+                check_insphere(T, p[0], p[1], p[2], p[3], p[4], "grid stage");
+                check_insphere(T, p[4], p[2], p[1], p[3], p[0], "grid stage");
+            }
+}
+
 int main(int argc, char **argv)
 {
     tctx T;
@@ -1003,6 +1053,7 @@ int main(int argc, char **argv)
     double t1 = now_s();
     test_perturbed(&T, scale);
     test_triangulation(&T, scale);
+    test_grid_stage(&T);
     double t2 = now_s();
     bench(&T);
 
