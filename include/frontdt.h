@@ -209,6 +209,8 @@ typedef struct fdt_thread_stats {
     double t_idle, t_query_wait;
     double t_cpu;             /* CPU seconds the thread used (0 if unknown) */
     int core;                 /* core it was bound to, -1 if not pinned */
+    size_t mesh_queries;      /* faces another part's insertion mesh
+                                 answered for it (shared mode) */
 } fdt_thread_stats;
 
 /* Fills *ts for worker thread 0 <= thread < stats.threads. A serial run

@@ -786,3 +786,180 @@ done:
         free(s.queue);
     return found;
 }
+
+/* ------------------------------------------------------------------ */
+/* Read-only queries by another thread: the conflict region of a point
+ * that is not in the mesh. */
+
+/* Adds x to the open-addressing set (2 cap slots, FDT_NONE empty) and to
+ * the list behind it; 1 if new, 0 if there, FDT_ENOMEM. */
+static int qset_add(uint32_t **list, uint32_t **set, size_t *n, size_t *cap, uint32_t x)
+{
+    if (*n == *cap) {
+        size_t nc = *cap ? 2 * *cap : 64;
+        uint32_t *l = realloc(*list, nc * sizeof *l);
+        if (!l)
+            return FDT_ENOMEM;
+        *list = l;
+        uint32_t *s = malloc(2 * nc * sizeof *s);
+        if (!s)
+            return FDT_ENOMEM;
+        free(*set);
+        *set = s;
+        *cap = nc;
+        memset(s, 0xff, 2 * nc * sizeof *s);
+        for (size_t i = 0; i < *n; i++) {
+            size_t h = (size_t)((l[i] * UINT64_C(0x9E3779B97F4A7C15)) >> 20) & (2 * nc - 1);
+            while (s[h] != FDT_NONE)
+                h = (h + 1) & (2 * nc - 1);
+            s[h] = l[i];
+        }
+    }
+    size_t mask = 2 * *cap - 1;
+    size_t h = (size_t)((x * UINT64_C(0x9E3779B97F4A7C15)) >> 20) & mask;
+    for (;; h = (h + 1) & mask) {
+        if ((*set)[h] == x)
+            return 0;
+        if ((*set)[h] == FDT_NONE)
+            break;
+    }
+    (*set)[h] = x;
+    (*list)[(*n)++] = x;
+    return 1;
+}
+
+/* Whether x is in the set (cap 0: nothing is). */
+static int qset_has(const uint32_t *set, size_t cap, uint32_t x)
+{
+    if (!cap)
+        return 0;
+    size_t mask = 2 * cap - 1;
+    size_t h = (size_t)((x * UINT64_C(0x9E3779B97F4A7C15)) >> 20) & mask;
+    for (;; h = (h + 1) & mask) {
+        if (set[h] == x)
+            return 1;
+        if (set[h] == FDT_NONE)
+            return 0;
+    }
+}
+
+/* Empties a set by its list (the set's slots are found again by hash). */
+static void qset_clear(uint32_t *list, uint32_t *set, size_t *n, size_t cap)
+{
+    if (*n * 8 > cap) {
+        memset(set, 0xff, 2 * cap * sizeof *set);
+    } else {
+        size_t mask = 2 * cap - 1;
+        for (size_t i = 0; i < *n; i++) {
+            size_t h = (size_t)((list[i] * UINT64_C(0x9E3779B97F4A7C15)) >> 20) & mask;
+            while (set[h] != list[i])
+                h = (h + 1) & mask;
+            set[h] = FDT_NONE;
+        }
+        /* Backward-shift deletion is not needed: the whole set empties,
+         * and every probe chain of the set's members is emptied with it. */
+    }
+    *n = 0;
+}
+
+void fdt_ins_query_free(fdt_ins_query *qs)
+{
+    free(qs->tq);
+    free(qs->tset);
+    free(qs->vs);
+    free(qs->vset);
+    memset(qs, 0, sizeof *qs);
+}
+
+/* The conflict test of the build (conflict above), without its counters:
+ * the mesh is shared read-only by the querying threads. */
+static int conflict_ro(const fdt_ins *m, uint32_t t, const double *p, fdt_pred_counts *cnt)
+{
+    const uint32_t *v = m->T + 8 * (size_t)t;
+    int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
+    if (inf < 0)
+        return insphere_p(pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), p, cnt) > 0;
+    const double *q[4];
+    for (int i = 0; i < 4; i++)
+        q[i] = i == inf ? p : pt(m, v[i]);
+    int o = orient(q[0], q[1], q[2], q[3], cnt);
+    if (o != 0)
+        return o > 0;
+    const uint32_t *w = m->T + 8 * (size_t)(v[4 + inf] >> 2);
+    return insphere_p(pt(m, w[0]), pt(m, w[1]), pt(m, w[2]), pt(m, w[3]), p, cnt) > 0;
+}
+
+int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
+                              size_t max_tets, fdt_ins_query *qs, fdt_pred_counts *cnt)
+{
+    const uint32_t *T = m->T;
+    if (qs->tset)
+        qset_clear(qs->tq, qs->tset, &qs->ntq, qs->tcap);
+    if (qs->vset)
+        qset_clear(qs->vs, qs->vset, &qs->nvs, qs->vcap);
+    /* The walk of locate, read-only: from the hint if it is a live slot. */
+    uint32_t t = *hint;
+    if (t >= m->nslots || (T[8 * (size_t)t] == INF && T[8 * (size_t)t + 1] == INF))
+        t = m->vtet[0];
+    for (int i = 0; i < 4; i++)
+        if (T[8 * (size_t)t + i] == INF) {
+            t = T[8 * (size_t)t + 4 + i] >> 2;
+            break;
+        }
+    int from = -1;
+    for (size_t steps = 0;; steps++) {
+        if (steps > m->nslots)
+            return FDT_EINTERNAL;
+        const uint32_t *v = T + 8 * (size_t)t;
+        if (v[0] == INF || v[1] == INF || v[2] == INF || v[3] == INF)
+            break;
+        const double *p4[4] = {pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3])};
+        qs->rng = qs->rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
+        uint32_t r = (uint32_t)(qs->rng >> 61);
+        int exit = -1;
+        for (uint32_t j = 0; j < 4; j++) {
+            int k = (int)((r + j) & 3);
+            if (k == from)
+                continue;
+            const double *s[4] = {p4[0], p4[1], p4[2], p4[3]};
+            s[k] = q;
+            if (orient(s[0], s[1], s[2], s[3], cnt) < 0) {
+                exit = k;
+                break;
+            }
+        }
+        if (exit < 0)
+            break;
+        uint32_t nb = v[4 + exit];
+        t = nb >> 2;
+        from = (int)(nb & 3);
+    }
+    *hint = t;
+    /* q is not a vertex (the caller's point belongs to another part, and
+     * the points are pairwise distinct), so the tet found is in conflict
+     * (see insert_point); the region is connected: breadth-first. */
+    int rc = qset_add(&qs->tq, &qs->tset, &qs->ntq, &qs->tcap, t);
+    if (rc < 0)
+        return rc;
+    for (size_t i = 0; i < qs->ntq; i++) {
+        if (i >= max_tets)
+            return 1;
+        uint32_t c = qs->tq[i];
+        const uint32_t *v = T + 8 * (size_t)c;
+        for (int k = 0; k < 4; k++) {
+            if (v[k] != INF &&
+                (rc = qset_add(&qs->vs, &qs->vset, &qs->nvs, &qs->vcap, v[k])) < 0)
+                return rc;
+            uint32_t o = v[4 + k] >> 2;
+            /* Tets found not in conflict are tested again if met again:
+             * the region's boundary is small next to the work saved by
+             * not keeping a second set. */
+            if (qset_has(qs->tset, qs->tcap, o))
+                continue;
+            if (conflict_ro(m, o, q, cnt) && (rc = qset_add(&qs->tq, &qs->tset, &qs->ntq,
+                                                           &qs->tcap, o)) < 0)
+                return rc;
+        }
+    }
+    return FDT_OK;
+}

@@ -132,4 +132,37 @@ static inline uint32_t fdt_ins_across(const fdt_ins *m, uint32_t tet, int k,
 int fdt_ins_find_face(const fdt_ins *m, uint32_t a, uint32_t b, uint32_t c,
                       uint32_t *tet, int *k);
 
+/*
+ * Scratch of fdt_ins_conflict_vertices, owned by the querying thread:
+ * zero it to start, free it with fdt_ins_query_free.
+ */
+typedef struct fdt_ins_query {
+    uint32_t *tq, *tset;  /* the conflict region's tets, and their set */
+    size_t ntq, tcap;
+    uint32_t *vs, *vset;  /* the answer: its distinct finite vertices */
+    size_t nvs, vcap;
+    uint64_t rng;         /* the walk's choices */
+} fdt_ins_query;
+
+/*
+ * The vertices of the tets of m in conflict with the point q, which is not
+ * one of m's points: with m the DT of a point set S, they are the
+ * neighbours q would have in the DT of S + {q} (the cavity is star-shaped
+ * from q, so every vertex of a cavity tet is on its boundary). Adding more
+ * points never gives q a neighbour in S it did not have, so for a face
+ * (q, b, c) of the DT of any superset, the first point of S in the pencil
+ * of spheres through the face's circle is among them (src/parallel.c asks
+ * another part's mesh this way). Read-only on m: any number of threads may
+ * query one mesh at once, each with its own qs and hint (a slot to start
+ * the walk from, updated to where it ended; any value to start).
+ * On FDT_OK qs->vs[0 .. qs->nvs) holds the vertices; 1 when the region
+ * holds more than max_tets tets (no answer: a point just outside a large
+ * flat hull facet of m sees all of it); FDT_ENOMEM; FDT_EINTERNAL (a walk
+ * cycle, impossible in a regular triangulation). Cost: the walk plus the
+ * conflict region, a few dozen tets on well-spread points.
+ */
+int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
+                              size_t max_tets, fdt_ins_query *qs, fdt_pred_counts *cnt);
+void fdt_ins_query_free(fdt_ins_query *qs);
+
 #endif

@@ -11,7 +11,9 @@
  *     the automatic rule switches on the cylinder but not on uniform
  *     points (so a broken rule or a mesh never consulted fails here);
  *   - a part whose points are coplanar cannot build a mesh and falls back
- *     to the kd search with the same result.
+ *     to the kd search with the same result;
+ *   - in shared mode other parts' meshes answer the faces whose sphere
+ *     crosses a cut (thread stats mesh_queries).
  * Usage: test_oracle [--quick]   (--quick: fewer thread counts)
  */
 #include <inttypes.h>
@@ -248,6 +250,20 @@ static void test_family(pts p, int want_auto, int quick)
                 CHECK_EQ(h, href);
                 if (s == FDT_SEARCH_MESH)
                     CHECK(st.mesh_faces > 0 || strcmp(p.name, "layers") == 0);
+                /* Shared mode asks the other parts' meshes for the faces
+                 * whose sphere crosses a cut (src/parallel.c,
+                 * offer_from_mesh): on uniform points every part has a
+                 * mesh and small conflict regions, so some must be. */
+                if (s == FDT_SEARCH_MESH && mode == FDT_MODE_SHARED &&
+                    !strcmp(p.name, "uniform")) {
+                    size_t mq = 0;
+                    for (int i = 0; i < st.threads; i++) {
+                        fdt_thread_stats ts;
+                        CHECK_EQ(fdt_result_thread_stats(r, i, &ts), FDT_OK);
+                        mq += ts.mesh_queries;
+                    }
+                    CHECK(mq > 0);
+                }
                 fdt_result_free(&r);
             }
     }
