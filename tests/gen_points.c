@@ -636,9 +636,9 @@ static void octant_ring(double *x, double *y, size_t m)
 }
 
 /* ~N: an exact cylinder surface, empty inside, as a pipe or tank from a
- * CAD model or a structured scan: m rings (m a multiple of 8, ~sqrt N) of
- * m equal angle steps, radius 1, ring spacing 2*pi/m (the arc step), so
- * height ~2*pi. Every ring is the same symmetric ring (octant_ring) at
+ * CAD model or a structured scan: m + 1 rings (m a multiple of 8, ~sqrt N)
+ * of m equal angle steps, radius 1, ring spacing 2*pi/m (the arc step), so
+ * height 2*pi. Every ring is the same symmetric ring (octant_ring) at
  * another z, so any two generator lines and two rings make an exact
  * rectangle and each ring has exactly cocircular trapezoids: thousands of
  * 5-point cospherical sets, decided by the perturbation alone. Every point
@@ -807,14 +807,16 @@ static int city_gen(pts *p, double dens, size_t n, rng *r)
  * and walls sampled, every coordinate 1e6 m plus whole centimetres,
  * printed with 2 decimals. Ground and each roof are huge exactly coplanar
  * sets on a 1 cm lattice (exactly cocircular 4-sets among them), the walls
- * exactly vertical planes; the 1e6 offset leaves ~27 of the 53 bits to
- * vary, so filters fail constantly. */
+ * exactly vertical planes: orient3d is exactly zero on most flat
+ * neighbourhoods, which no floating-point filter can certify. The 1e6
+ * offset (a few hundred metres of city) spends ~12 of the 53 bits on the
+ * offset, and the decimals are not exact doubles. */
 static int fam_citylidar(pts *p, size_t n, rng *r)
 {
     return calibrated(p, n, r, city_gen, 1.0, 1.0);
 }
 
-/* ~N... exactly N: Fibonacci points on a sphere of radius 100 (the spiral
+/* N points: Fibonacci points on a sphere of radius 100 (the spiral
  * turned by a random phase), printed with 12 significant digits as many
  * programs write floats. The printing moves each point off the sphere by
  * up to ~5e-9 while the points are ~1 apart: every point is on the hull
@@ -922,8 +924,8 @@ static int fam_cubedsphere(pts *p, size_t n, rng *r)
             for (size_t l = 0; l <= c; l++) {
                 if (i != 0 && i != c && j != 0 && j != c && l != 0 && l != c)
                     continue;
-                /* The cube point with the coordinates +-1 on its face(s):
-                 * every tan value of an interior index is below 1. */
+                /* A point of the cube's surface (a coordinate is +-1
+                 * exactly), projected on the sphere. */
                 double a = t[i], b = t[j], e = t[l];
                 double s = sqrt(a * a + b * b + e * e);
                 d[k++] = a / s;
@@ -991,7 +993,8 @@ static int extruded_gen(pts *p, double s, size_t n, rng *r)
  * out to radius 30), the whole plane written at z = 0 and again at z = 1.
  * Two huge exactly coplanar layers; every pair of points over each other
  * with another such pair makes an exact rectangle (cocircular 4-set), and
- * the tets are as flat as the 60 : 1 extent ratio makes them. At least\n * ~900 points: the grid's structure has a floor. */
+ * the tets are as flat as the 60 : 1 extent ratio makes them. Never
+ * fewer than ~1,100 points: the grid's structure has a floor. */
 static int fam_extruded(pts *p, size_t n, rng *r)
 {
     pts plane = {NULL, 0, 0};
