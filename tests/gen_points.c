@@ -4,10 +4,15 @@
  *
  * Writes about N points of a named family of hard inputs (qhull's
  * q_benchmark idea: cospherical, nearly cospherical, lattice, ...) as
- * "x y z" lines with %.17g, which round-trips every double exactly. The
- * families imitate what scanned and CFD point clouds do to a Delaunay
- * code: exact cospherical and coplanar sets, huge offsets with tiny
- * extents, extreme magnitudes, near and exact duplicates.
+ * "x y z" lines with %.17g, which round-trips every double exactly, or,
+ * for the families that imitate a file format (citylidar, sphere12,
+ * statue), with the digits such files have. The families imitate what
+ * scanned and CFD point clouds do to a Delaunay code: exact cospherical
+ * and coplanar sets, huge offsets with tiny extents, extreme magnitudes,
+ * near and exact duplicates; the second group (cylinder onwards) the real
+ * input classes of issue 16, used by tests/e2e_reference.py at small
+ * sizes and by bench/run at large ones. `gen_points` without arguments
+ * lists them with one line each.
  *
  * The output is a pure function of (FAMILY, N, SEED) on a given platform,
  * so (family, N, seed) is a complete reproducer. Families marked "~N"
@@ -549,19 +554,691 @@ static int fam_lidar(pts *p, size_t n, rng *r)
     return 0;
 }
 
+/* ------------------------------------------------- real-input families */
+
+/* The families below imitate the classes of real input on which issue 16
+ * measured frontdt 2x-800x slower than CGAL, HXT and Geogram: surfaces
+ * with an empty inside, structured CFD grids with extreme stretching,
+ * rotated lattices, quantised city scans and CAD geometry. Each comment
+ * says what it imitates and why it is hard for an advancing front. */
+
+static const double two_pi = 6.283185307179586476925;
+
+/* Families whose point count follows from a continuous size (a spacing or
+ * a density) rather than from N directly. gen(p, s, n, r) writes the
+ * family at size s (n only picks the layout, never the count); points grow
+ * about as s^power (power < 0 for a spacing). Up to 8 passes aim at N:
+ * each steps by that power law, kept inside the sizes already seen to give
+ * too few and too many points, and they stop within 2% of N. Every pass
+ * starts from the same generator state, so the output is still a function
+ * of (N, SEED); a family whose structure has a floor (the fixed parts of a
+ * CFD grid) stays at its floor for small N. */
+typedef int (*scaled_fn)(pts *p, double s, size_t n, rng *r);
+
+static int calibrated(pts *p, size_t n, rng *r, scaled_fn gen, double s,
+                      double power)
+{
+    const rng start = *r;
+    double s_few = 0, s_many = 0;
+    for (int pass = 0; pass < 8; pass++) {
+        pts t = {NULL, 0, 0};
+        *r = start;
+        int rc = gen(&t, s, n, r);
+        size_t got = t.n;
+        free(t.xyz);
+        if (rc)
+            return rc;
+        if (got >= n - n / 50 && got <= n + n / 50)
+            break;
+        if (got < n)
+            s_few = s;
+        else
+            s_many = s;
+        double next = s * pow((double)n / (double)(got ? got : 1), 1.0 / power);
+        if (s_few > 0 && s_many > 0) {
+            double lo = fmin(s_few, s_many), hi = fmax(s_few, s_many);
+            if (!(next > lo && next < hi))
+                next = sqrt(lo * hi);
+        }
+        s = next;
+    }
+    *r = start;
+    return gen(p, s, n, r);
+}
+
+/* m unit-circle points at equal angle steps, m a multiple of 8, built from
+ * the first octant by the circle's eight reflections: the ring is exactly
+ * symmetric under x <-> y, x -> -x and y -> -y, as a CAD kernel or a mesh
+ * generator that mirrors its work makes it. Every mirror-image pair of
+ * chords then bounds an isosceles trapezoid, whose 4 corners are exactly
+ * cocircular. */
+static void octant_ring(double *x, double *y, size_t m)
+{
+    size_t q = m / 4, e = m / 8;
+    x[0] = 1, y[0] = 0;
+    x[q] = 0, y[q] = 1;
+    x[2 * q] = -1, y[2 * q] = 0;
+    x[3 * q] = 0, y[3 * q] = -1;
+    for (size_t k = 1; k <= e; k++) {
+        /* At 45 degrees cos and sin round differently: take one value for
+         * both so the point is its own mirror image in x = y. */
+        double c = k == e ? sqrt(0.5) : cos(two_pi * (double)k / (double)m);
+        double s = k == e ? c : sin(two_pi * (double)k / (double)m);
+        const size_t idx[8] = {k, q - k, q + k, 2 * q - k,
+                               2 * q + k, 3 * q - k, 3 * q + k, m - k};
+        const double vx[8] = {c, s, -s, -c, -c, -s, s, c};
+        const double vy[8] = {s, c, c, s, -s, -c, -c, -s};
+        for (int i = 0; i < 8; i++) {
+            x[idx[i]] = vx[i];
+            y[idx[i]] = vy[i];
+        }
+    }
+}
+
+/* ~N: an exact cylinder surface, empty inside, as a pipe or tank from a
+ * CAD model or a structured scan: m + 1 rings (m a multiple of 8, ~sqrt N)
+ * of m equal angle steps, radius 1, ring spacing 2*pi/m (the arc step), so
+ * height 2*pi. Every ring is the same symmetric ring (octant_ring) at
+ * another z, so any two generator lines and two rings make an exact
+ * rectangle and each ring has exactly cocircular trapezoids: thousands of
+ * 5-point cospherical sets, decided by the perturbation alone. Every point
+ * is on the convex hull, so the tets fill the empty inside with long flat
+ * slabs whose circumspheres hold many candidates. */
+static int fam_cylinder(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    size_t m = 8 * (size_t)llround(sqrt((double)n) / 8);
+    if (m < 8)
+        m = 8;
+    double *x = malloc(m * sizeof *x), *y = malloc(m * sizeof *y);
+    int rc = !x || !y ? -1 : 0;
+    if (!rc)
+        octant_ring(x, y, m);
+    double h = two_pi / (double)m;
+    for (size_t j = 0; j <= m && !rc; j++)
+        for (size_t i = 0; i < m && !rc; i++)
+            rc = pts_add(p, x[i], y[i], (double)j * h);
+    free(x);
+    free(y);
+    return rc;
+}
+
+/* ~N: the same pipe as a scanner sees it: m + 1 rings (exactly coplanar,
+ * one z each) of m points whose angles are jittered by up to 0.45 of a
+ * step, x = cos, y = sin of the angle. The radius is 1 to rounding, so no
+ * 4 points of a ring are exactly cocircular but every ring is nearly so:
+ * filters fail, exact insphere tests decide. Empty inside, all on the
+ * hull, as cylinder. */
+static int fam_cylscan(pts *p, size_t n, rng *r)
+{
+    size_t m = (size_t)llround(sqrt((double)n));
+    if (m < 4)
+        m = 4;
+    double h = two_pi / (double)m;
+    for (size_t j = 0; j <= m; j++)
+        for (size_t i = 0; i < m; i++) {
+            double a = two_pi * ((double)i + 0.9 * rng_u01(r) - 0.45) / (double)m;
+            if (pts_add(p, cos(a), sin(a), (double)j * h))
+                return -1;
+        }
+    return 0;
+}
+
+/* ~N: the k^3 integer lattice (k = round(cbrt N)) rotated about x by 0.3,
+ * then about y by 0.5, then about z by 0.7 radians, in doubles, as a user
+ * would rotate a structured block into place. The rotation's rounding
+ * breaks most of the lattice's exact cospherical cells into nearly
+ * cospherical ones (5 points within a few ulps of one sphere), so the
+ * floating-point filters fail on almost every insphere test, yet some
+ * cells may stay exactly degenerate. */
+static int fam_rotlattice(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    size_t k = round_cbrt(n);
+    const double ca = cos(0.3), sa = sin(0.3), cb = cos(0.5), sb = sin(0.5),
+                 cc = cos(0.7), sc = sin(0.7);
+    for (size_t i = 0; i < k; i++)
+        for (size_t j = 0; j < k; j++)
+            for (size_t l = 0; l < k; l++) {
+                double x = (double)i, y = (double)j, z = (double)l;
+                double y1 = ca * y - sa * z, z1 = sa * y + ca * z;
+                double x2 = cb * x + sb * z1, z2 = -sb * x + cb * z1;
+                double x3 = cc * x2 - sc * y1, y3 = sc * x2 + cc * y1;
+                if (pts_add(p, x3, y3, z2))
+                    return -1;
+            }
+    return 0;
+}
+
+/* A quantised city coordinate: 1e6 m plus a whole number of centimetres,
+ * the double nearest to the decimal that "%.2f" prints and a reader parses
+ * back, as in a LAS file's scaled integers converted to text. */
+static double city_m(int64_t cm)
+{
+    return (100000000.0 + (double)cm) / 100.0;
+}
+
+/* An axis-aligned box, in centimetres, for citylidar and windcity. */
+typedef struct box_cm {
+    int64_t x0, y0, x1, y1, h;
+} box_cm;
+
+static int in_box(const box_cm *b, size_t nb, int64_t x, int64_t y)
+{
+    for (size_t i = 0; i < nb; i++)
+        if (x >= b[i].x0 && x <= b[i].x1 && y >= b[i].y0 && y <= b[i].y1)
+            return 1;
+    return 0;
+}
+
+/* One citylidar at `dens` ground points per m^2 (walls get a quarter of
+ * it: the scanner sees them at a grazing angle). */
+static int city_gen(pts *p, double dens, size_t n, rng *r)
+{
+    /* 60 m blocks and 15 m streets; the city grows with N, the density is
+     * what calibration adjusts. */
+    const int64_t pitch = 7500, block = 6000;
+    size_t nbk = (size_t)llround(sqrt((double)n / 20000.0));
+    if (nbk < 2)
+        nbk = 2;
+    int64_t side = (int64_t)nbk * pitch;
+    size_t cap = nbk * nbk * 3, nb = 0;
+    box_cm *b = malloc(cap * sizeof *b);
+    if (!b)
+        return -1;
+    for (size_t bi = 0; bi < nbk; bi++)
+        for (size_t bj = 0; bj < nbk; bj++) {
+            /* 1 to 3 buildings side by side along x, 2-6 m apart. */
+            int64_t bx = (int64_t)bi * pitch, by = (int64_t)bj * pitch;
+            size_t k = 1 + (size_t)rng_below(r, 3);
+            int64_t w = block / (int64_t)k;
+            for (size_t q = 0; q < k; q++) {
+                int64_t gap = 200 + (int64_t)rng_below(r, 401);
+                box_cm c;
+                c.x0 = bx + (int64_t)q * w + gap / 2;
+                c.x1 = bx + (int64_t)(q + 1) * w - gap / 2;
+                c.y0 = by + (int64_t)rng_below(r, 1001);
+                c.y1 = by + block - (int64_t)rng_below(r, 1001);
+                c.h = 300 + (int64_t)rng_below(r, 3701);
+                b[nb++] = c;
+            }
+        }
+    int rc = 0;
+    /* Ground: flat at one height, hidden under the roofs. */
+    size_t ng = (size_t)llround(dens * (double)side * (double)side * 1e-4);
+    for (size_t i = 0; i < ng && !rc; i++) {
+        int64_t x = (int64_t)rng_below(r, (uint64_t)side + 1),
+                y = (int64_t)rng_below(r, (uint64_t)side + 1);
+        if (!in_box(b, nb, x, y))
+            rc = pts_add(p, city_m(x), city_m(y), city_m(0));
+    }
+    for (size_t i = 0; i < nb && !rc; i++) {
+        const box_cm *c = &b[i];
+        int64_t wx = c->x1 - c->x0, wy = c->y1 - c->y0;
+        /* Roof: exactly flat. */
+        size_t nr = (size_t)llround(dens * (double)wx * (double)wy * 1e-4);
+        for (size_t k = 0; k < nr && !rc; k++)
+            rc = pts_add(p, city_m(c->x0 + (int64_t)rng_below(r, (uint64_t)wx + 1)),
+                         city_m(c->y0 + (int64_t)rng_below(r, (uint64_t)wy + 1)),
+                         city_m(c->h));
+        /* Walls: exactly vertical planes. */
+        size_t nw = (size_t)llround(0.25 * dens * 2.0 * (double)(wx + wy) *
+                                    (double)c->h * 1e-4);
+        for (size_t k = 0; k < nw && !rc; k++) {
+            int64_t t = (int64_t)rng_below(r, (uint64_t)(2 * (wx + wy)));
+            int64_t z = (int64_t)rng_below(r, (uint64_t)c->h + 1), x, y;
+            if (t < wx)
+                x = c->x0 + t, y = c->y0;
+            else if (t < 2 * wx)
+                x = c->x0 + t - wx, y = c->y1;
+            else if (t < 2 * wx + wy)
+                x = c->x0, y = c->y0 + t - 2 * wx;
+            else
+                x = c->x1, y = c->y0 + t - 2 * wx - wy;
+            rc = pts_add(p, city_m(x), city_m(y), city_m(z));
+        }
+    }
+    free(b);
+    return rc;
+}
+
+/* ~N: airborne lidar over a city: a flat ground and flat-roof box
+ * buildings (60 m blocks, 1 to 3 buildings each, 3-40 m high) with roofs
+ * and walls sampled, every coordinate 1e6 m plus whole centimetres,
+ * printed with 2 decimals. Ground and each roof are huge exactly coplanar
+ * sets on a 1 cm lattice (exactly cocircular 4-sets among them), the walls
+ * exactly vertical planes: orient3d is exactly zero on most flat
+ * neighbourhoods, which no floating-point filter can certify. The 1e6
+ * offset (a few hundred metres of city) spends ~12 of the 53 bits on the
+ * offset, and the decimals are not exact doubles. */
+static int fam_citylidar(pts *p, size_t n, rng *r)
+{
+    return calibrated(p, n, r, city_gen, 1.0, 1.0);
+}
+
+/* N points: Fibonacci points on a sphere of radius 100 (the spiral
+ * turned by a random phase), printed with 12 significant digits as many
+ * programs write floats. The printing moves each point off the sphere by
+ * up to ~5e-9 while the points are ~1 apart: every point is on the hull
+ * and nearly cospherical with all the others, so nearly every insphere
+ * test needs exact arithmetic and each front face sees many candidates. */
+static int fam_sphere12(pts *p, size_t n, rng *r)
+{
+    const double golden = two_pi * (1.0 - 0.5 * (sqrt(5.0) - 1.0));
+    double phase = two_pi * rng_u01(r);
+    for (size_t i = 0; i < n; i++) {
+        double z = 1.0 - (2.0 * (double)i + 1.0) / (double)n;
+        double s = sqrt(1.0 - z * z), a = phase + golden * (double)i;
+        if (pts_add(p, 100.0 * s * cos(a), 100.0 * s * sin(a), 100.0 * z))
+            return -1;
+    }
+    return 0;
+}
+
+/* Radial layers of a CFD O-grid around the unit sphere: first cell 1e-4,
+ * each next 1.25 times thicker (at most 50 layers: the outer radius is
+ * then ~8). */
+static size_t shell_layers(size_t n)
+{
+    size_t L = (size_t)llround(1.46 * cbrt((double)n));
+    return L < 3 ? 3 : L > 50 ? 50 : L;
+}
+
+/* Writes the directions d (nd unit vectors) scaled by each layer radius,
+ * layer by layer: the radial lines share their direction exactly. */
+static int shell_layers_add(pts *p, const double *d, size_t nd, size_t layers)
+{
+    double rad = 1.0, t = 1e-4;
+    for (size_t k = 0; k < layers; k++) {
+        for (size_t i = 0; i < nd; i++)
+            if (pts_add(p, rad * d[3 * i], rad * d[3 * i + 1], rad * d[3 * i + 2]))
+                return -1;
+        rad += t;
+        t *= 1.25;
+    }
+    return 0;
+}
+
+/* ~N: a structured CFD O-grid around a sphere, body empty: a (theta, phi)
+ * grid of nt latitude rings of 2 nt points plus both poles, on layers of
+ * radius 1, 1 + 1e-4, ... (cells growing 1.25). Each ring is exactly
+ * coplanar and nearly cocircular, cells near the wall are 1e-4 thick and
+ * ~0.15 wide (aspect 1500), and the empty body is bounded by ~2 nt^2
+ * points on one sphere up to rounding: its inside is the sphere family's
+ * worst case. (The issue's 40,100 points: 50 layers of 20 x 40 + 2.) */
+static int fam_ogrid(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    size_t L = shell_layers(n);
+    double per = (double)n / (double)L;
+    size_t nt = per > 10 ? (size_t)llround(sqrt((per - 2) / 2)) : 2;
+    size_t np = 2 * nt, nd = nt * np + 2;
+    double *d = malloc(3 * nd * sizeof *d);
+    if (!d)
+        return -1;
+    size_t k = 0;
+    d[k++] = 0, d[k++] = 0, d[k++] = 1;
+    for (size_t i = 0; i < nt; i++) {
+        double th = 0.5 * two_pi * (double)(i + 1) / (double)(nt + 1);
+        for (size_t j = 0; j < np; j++) {
+            double ph = two_pi * (double)j / (double)np;
+            d[k++] = sin(th) * cos(ph);
+            d[k++] = sin(th) * sin(ph);
+            d[k++] = cos(th);
+        }
+    }
+    d[k++] = 0, d[k++] = 0, d[k++] = -1;
+    int rc = shell_layers_add(p, d, nd, L);
+    free(d);
+    return rc;
+}
+
+/* ~N: a cubed-sphere O-grid (six equiangular gnomonic n x n patches, the
+ * 6 n^2 + 2 distinct points of the cube's surface lattice projected on the
+ * sphere) on the radial layers of ogrid. The face coordinates tan(angle)
+ * are mirrored exactly (t[n - i] = -t[i], t[0] = -1), so the grid has the
+ * cube's symmetries bit for bit and its edges and corners, shared by two
+ * or three patches, are single points. (The issue's 76,900 points: 50
+ * layers of 6 x 16^2 + 2.) */
+static int fam_cubedsphere(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    size_t L = shell_layers(n);
+    double per = (double)n / (double)L;
+    size_t c = per > 14 ? (size_t)llround(sqrt((per - 2) / 6)) : 1;
+    double *t = malloc((c + 1) * sizeof *t);
+    size_t nd = 6 * c * c + 2;
+    double *d = malloc(3 * nd * sizeof *d);
+    if (!t || !d) {
+        free(t);
+        free(d);
+        return -1;
+    }
+    for (size_t i = 0; 2 * i <= c; i++) {
+        t[i] = i == 0 ? -1.0 : tan(two_pi / 8 * (2.0 * (double)i / (double)c - 1.0));
+        t[c - i] = 2 * i == c ? 0.0 : -t[i]; /* +0 in the middle, not -0 */
+    }
+    size_t k = 0;
+    for (size_t i = 0; i <= c; i++)
+        for (size_t j = 0; j <= c; j++)
+            for (size_t l = 0; l <= c; l++) {
+                if (i != 0 && i != c && j != 0 && j != c && l != 0 && l != c)
+                    continue;
+                /* A point of the cube's surface (a coordinate is +-1
+                 * exactly), projected on the sphere. */
+                double a = t[i], b = t[j], e = t[l];
+                double s = sqrt(a * a + b * b + e * e);
+                d[k++] = a / s;
+                d[k++] = b / s;
+                d[k++] = e / s;
+            }
+    int rc = shell_layers_add(p, d, nd, L);
+    free(t);
+    free(d);
+    return rc;
+}
+
+/* One plane of extruded: nc = round(s) points around the circle of
+ * radius 0.5. */
+static int extruded_gen(pts *p, double s, size_t n, rng *r)
+{
+    (void)n;
+    size_t nc = s < 8 ? 8 : s > 1e7 ? 10000000 : (size_t)llround(s);
+    double *cx = malloc(nc * sizeof *cx), *cy = malloc(nc * sizeof *cy);
+    if (!cx || !cy) {
+        free(cx);
+        free(cy);
+        return -1;
+    }
+    for (size_t i = 0; i < nc; i++) {
+        cx[i] = cos(two_pi * (double)i / (double)nc);
+        cy[i] = sin(two_pi * (double)i / (double)nc);
+    }
+    int rc = 0;
+    /* Structured boundary layer: first cell 1e-4, growing 1.2, until the
+     * cells are as thick as the wall's cells are wide. */
+    double rad = 0.5, t = 1e-4, wide = two_pi * 0.5 / (double)nc;
+    while (!rc && t < wide) {
+        for (size_t i = 0; i < nc && !rc; i++)
+            rc = pts_add(p, rad * cx[i], rad * cy[i], 0.0);
+        rad += t;
+        t *= 1.2;
+    }
+    /* Outside it, the rings of an advancing-front mesher out to radius
+     * 30: isotropic cells growing by 1 + 2 pi / nc per ring (1.1 at
+     * most, 1.5 at least: a coarse grid coarsens faster), each ring with
+     * its own phase and every point jittered by a fifth of a cell. */
+    double g = 1 + two_pi / (double)nc;
+    g = g < 1.1 ? 1.1 : g > 1.5 ? 1.5 : g;
+    while (!rc && rad < 30) {
+        size_t m = (size_t)llround(two_pi * rad / t);
+        double ph = two_pi * rng_u01(r);
+        for (size_t i = 0; i < m && !rc; i++) {
+            double a = ph + two_pi * ((double)i + 0.2 * (rng_u01(r) - 0.5)) / (double)m;
+            double rr = rad + 0.2 * t * (rng_u01(r) - 0.5);
+            rc = pts_add(p, rr * cos(a), rr * sin(a), 0.0);
+        }
+        rad += t;
+        t *= g;
+    }
+    free(cx);
+    free(cy);
+    return rc;
+}
+
+/* ~N: an extruded 2-D CFD grid, as a 2-D solver's mesh turned into a
+ * one-cell-thick 3-D case: an O-grid around a circle of diameter 1 (a
+ * structured boundary layer of equal-angle rings, first cell 1e-4,
+ * growth 1.2) inside an unstructured-looking far field (jittered rings
+ * out to radius 30), the whole plane written at z = 0 and again at z = 1.
+ * Two huge exactly coplanar layers; every pair of points over each other
+ * with another such pair makes an exact rectangle (cocircular 4-set), and
+ * the tets are as flat as the 60 : 1 extent ratio makes them. Never
+ * fewer than ~1,100 points: the grid's structure has a floor. */
+static int fam_extruded(pts *p, size_t n, rng *r)
+{
+    pts plane = {NULL, 0, 0};
+    int rc = calibrated(&plane, (n + 1) / 2, r, extruded_gen, 0.25 * sqrt((double)n), 1.3);
+    for (int layer = 0; layer < 2 && !rc; layer++)
+        for (size_t i = 0; i < plane.n && !rc; i++)
+            rc = pts_add(p, plane.xyz[3 * i], plane.xyz[3 * i + 1], (double)layer);
+    free(plane.xyz);
+    return rc;
+}
+
+/* The surface lattice of a box [x0, x0 + lx] x [y0, y0 + ly] x [z0, z0 +
+ * lz] divided into nx x ny x nz equal cells: its points on the four sides
+ * and the top (and the bottom when `bottom`), each corner, edge and face
+ * point once. The lengths are multiples of 0.5 m, so x0 + lx * i / nx
+ * lands exactly on the far face at i = nx. */
+static int box_lattice(pts *p, double x0, double y0, double z0, double lx,
+                       double ly, double lz, size_t nx, size_t ny, size_t nz,
+                       int bottom)
+{
+    for (size_t k = 0; k <= nz; k++)
+        for (size_t j = 0; j <= ny; j++)
+            for (size_t i = 0; i <= nx; i++) {
+                int side = i == 0 || i == nx || j == 0 || j == ny;
+                if (!side && k != nz && !(bottom && k == 0))
+                    continue;
+                if (pts_add(p, x0 + lx * (double)i / (double)nx,
+                            y0 + ly * (double)j / (double)ny,
+                            z0 + lz * (double)k / (double)nz))
+                    return -1;
+            }
+    return 0;
+}
+
+static size_t cells_of(double len, double h)
+{
+    size_t c = (size_t)llround(len / h);
+    return c < 1 ? 1 : c;
+}
+
+/* One windcity with face spacing h (m). */
+static int windcity_gen(pts *p, double h, size_t n, rng *r)
+{
+    if (!(h > 0.01))
+        h = 0.01; /* calibration's first steps may overshoot */
+    size_t nb = n / 700;
+    nb = nb < 4 ? 4 : nb > 300 ? 300 : nb;
+    /* Buildings on a 0.5 m grid, 5 m apart at least, footprints 8-40 m,
+     * heights 6-80 m with most of them low. Lengths in half metres. */
+    int64_t side = (int64_t)llround(sqrt((double)nb * 1600.0 * 3.0)) * 2;
+    box_cm *b = malloc(nb * sizeof *b);
+    if (!b)
+        return -1;
+    size_t placed = 0;
+    for (size_t tries = 0; placed < nb && tries < 200 * nb; tries++) {
+        box_cm c;
+        c.x0 = (int64_t)rng_below(r, (uint64_t)side);
+        c.y0 = (int64_t)rng_below(r, (uint64_t)side);
+        c.x1 = c.x0 + 16 + (int64_t)rng_below(r, 65);
+        c.y1 = c.y0 + 16 + (int64_t)rng_below(r, 65);
+        double u = rng_u01(r);
+        c.h = 12 + (int64_t)(u * u * u * 148.0);
+        if (c.x1 > side || c.y1 > side)
+            continue;
+        int clash = 0;
+        for (size_t i = 0; i < placed && !clash; i++)
+            clash = c.x0 < b[i].x1 + 10 && b[i].x0 < c.x1 + 10 &&
+                    c.y0 < b[i].y1 + 10 && b[i].y0 < c.y1 + 10;
+        if (!clash)
+            b[placed++] = c;
+    }
+    int rc = 0;
+    int64_t hmax = 0;
+    for (size_t i = 0; i < placed && !rc; i++) {
+        const box_cm *c = &b[i];
+        double lx = 0.5 * (double)(c->x1 - c->x0), ly = 0.5 * (double)(c->y1 - c->y0),
+               lz = 0.5 * (double)c->h;
+        if (c->h > hmax)
+            hmax = c->h;
+        rc = box_lattice(p, 0.5 * (double)c->x0, 0.5 * (double)c->y0, 0, lx, ly, lz,
+                         cells_of(lx, h), cells_of(ly, h), cells_of(lz, h), 0);
+    }
+    /* The city's ground, 4 times coarser, around the footprints. */
+    double city = 0.5 * (double)side, hg = 4 * h;
+    size_t ng = cells_of(city, hg);
+    for (size_t j = 0; j <= ng && !rc; j++)
+        for (size_t i = 0; i <= ng && !rc; i++) {
+            double x = city * (double)i / (double)ng, y = city * (double)j / (double)ng;
+            int inside = 0;
+            for (size_t q = 0; q < placed && !inside; q++)
+                inside = 2 * x >= (double)b[q].x0 && 2 * x <= (double)b[q].x1 &&
+                         2 * y >= (double)b[q].y0 && 2 * y <= (double)b[q].y1;
+            if (!inside)
+                rc = pts_add(p, x, y, 0.0);
+        }
+    free(b);
+    /* The domain box: 5 city widths upstream and to the sides, 10
+     * downstream, 6 times the tallest building high, each face a coarse
+     * grid (32 x 22 x 6 cells at 200,000 points); its ground points
+     * inside the city are left out. */
+    if (!rc) {
+        pts dom = {NULL, 0, 0};
+        double dx = 16 * city, dy = 11 * city, dz = 3.0 * (double)hmax;
+        size_t nx = (size_t)llround(sqrt((double)n) / 14);
+        nx = nx < 4 ? 4 : nx;
+        rc = box_lattice(&dom, -5 * city, -5 * city, 0, dx, dy, dz, nx,
+                         cells_of((double)nx * 11, 16), cells_of((double)nx * 6, 32), 1);
+        for (size_t i = 0; i < dom.n && !rc; i++) {
+            const double *q = &dom.xyz[3 * i];
+            if (q[2] == 0 && q[0] >= 0 && q[0] <= city && q[1] >= 0 && q[1] <= city)
+                continue;
+            rc = pts_add(p, q[0], q[1], q[2]);
+        }
+        free(dom.xyz);
+    }
+    return rc;
+}
+
+/* ~N: the surface vertices of an urban wind-study CAD model: up to 300
+ * box buildings of varied sizes (8-40 m footprints, 6-80 m high) on a
+ * ground plane, every wall and roof gridded into equal cells (spacing set
+ * by N), the city's ground 4 times coarser, inside a domain box 16 x 11
+ * city widths whose faces carry a coarse grid. Every face is a large
+ * exactly coplanar set and every cell's corners are exactly cocircular
+ * (cospherical with any fifth point); the domain's far corners dwarf the
+ * city, so the front also crosses vast empty regions with few points. */
+static int fam_windcity(pts *p, size_t n, rng *r)
+{
+    return calibrated(p, n, r, windcity_gen, 2.0, -2.0);
+}
+
+/* sign(c) |c|^e, the superquadric's signed power. */
+static double spow(double c, double e)
+{
+    return c < 0 ? -pow(-c, e) : pow(c, e);
+}
+
+/* N points: a scanned statue: a bumpy superquadric about 0.4 x 0.3 x 1.2
+ * m (in mm, printed with 6 decimals as scanner software writes), sampled
+ * at random parameters (denser where the parametrisation crowds: the
+ * poles and the rounded edges), with radial noise of ~0.03 mm, and about
+ * 5% of the lines exact copies of an earlier point (overlapping scans
+ * merged). A closed surface with an empty inside and a density contrast of
+ * 10-100, on which every duplicate must merge. */
+static int fam_statue(pts *p, size_t n, rng *r)
+{
+    for (size_t i = 0; i < n; i++) {
+        if (i > 0 && rng_below(r, 20) == 0) {
+            const double *q = &p->xyz[3 * rng_below(r, i)];
+            if (pts_add(p, q[0], q[1], q[2]))
+                return -1;
+            continue;
+        }
+        double eta = asin(2 * rng_u01(r) - 1), om = two_pi * rng_u01(r) - 0.5 * two_pi;
+        double bump = 1 + 0.04 * sin(5 * om + 1) * cos(3 * eta) +
+                      0.02 * sin(13 * om) * sin(9 * eta) + 0.01 * sin(31 * om + 17 * eta);
+        double f = bump * (1 + 5e-5 * rng_normal(r));
+        double ce = spow(cos(eta), 0.5);
+        double x = 200 * f * ce * spow(cos(om), 0.7);
+        double y = 150 * f * ce * spow(sin(om), 0.7);
+        double z = 600 * f * spow(sin(eta), 0.5);
+        /* Quantise as the file will: a duplicate is then bit for bit the
+         * point it copies, and no new duplicates arise from printing. */
+        if (pts_add(p, round(x * 1e6) / 1e6, round(y * 1e6) / 1e6, round(z * 1e6) / 1e6))
+            return -1;
+    }
+    return 0;
+}
+
+/* N points: N - 1 on the unit sphere with radial jitter 1e-7 and one at
+ * the centre, placed at a random line. The centre's Voronoi cell touches
+ * every other point's, so it is a vertex of ~2N tets (a cone over the
+ * whole surface mesh) and every front face near it sees it as a
+ * candidate; the shell is nearly cospherical, as in sphere. */
+static int fam_centre(pts *p, size_t n, rng *r)
+{
+    size_t at = (size_t)rng_below(r, n);
+    for (size_t i = 0; i < n; i++) {
+        if (i == at) {
+            if (pts_add(p, 0, 0, 0))
+                return -1;
+            continue;
+        }
+        double x, y, z, s;
+        do {
+            x = rng_normal(r), y = rng_normal(r), z = rng_normal(r);
+            s = sqrt(x * x + y * y + z * z);
+        } while (s < 1e-3);
+        double rad = (1 + 1e-7 * (2 * rng_u01(r) - 1)) / s;
+        if (pts_add(p, rad * x, rad * y, rad * z))
+            return -1;
+    }
+    return 0;
+}
+
+/* How a family's coordinates are printed: most as %.17g, which round-trips
+ * every double; a few the way their real files are written. */
+enum { FMT_17G, FMT_12G, FMT_2F, FMT_6F };
+
 static const struct family {
     const char *name;
     family_fn fn;
+    int fmt;
+    const char *help;
 } families[] = {
-    {"uniform", fam_uniform},     {"ball", fam_ball},
-    {"sphere", fam_sphere},       {"gaussian", fam_gaussian},
-    {"clusters", fam_clusters},   {"lattice", fam_lattice},
-    {"intsphere", fam_intsphere}, {"grid2d", fam_grid2d},
-    {"offset", fam_offset},       {"tiny", fam_tiny},
-    {"huge", fam_huge},           {"neardup", fam_neardup},
-    {"dup", fam_dup},             {"cfdgrid", fam_cfdgrid},
-    {"lidar", fam_lidar},         {"dupheavy", fam_dupheavy},
-    {"mixed", fam_mixed},         {"ulpgrid", fam_ulpgrid},
+    {"uniform", fam_uniform, FMT_17G, "uniform in the unit cube"},
+    {"ball", fam_ball, FMT_17G, "uniform in the unit ball"},
+    {"sphere", fam_sphere, FMT_17G, "on the unit sphere up to rounding"},
+    {"gaussian", fam_gaussian, FMT_17G, "standard normal in 3-D"},
+    {"clusters", fam_clusters, FMT_17G, "90% in five 1e-6 clusters, 10% uniform"},
+    {"lattice", fam_lattice, FMT_17G, "~N: the s^3 integer lattice"},
+    {"intsphere", fam_intsphere, FMT_17G, "~N: every integer point of one sphere"},
+    {"grid2d", fam_grid2d, FMT_17G, "~N: an m x m integer grid at z = 0 and z = 1"},
+    {"offset", fam_offset, FMT_17G, "1 mm grid in a 20 m cube at 4.9e6"},
+    {"tiny", fam_tiny, FMT_17G, "uniform scaled to 1e-150"},
+    {"huge", fam_huge, FMT_17G, "uniform scaled to 1e150"},
+    {"neardup", fam_neardup, FMT_17G, "uniform pairs 1e-8 apart"},
+    {"dup", fam_dup, FMT_17G, "N points from N/10 distinct ones"},
+    {"cfdgrid", fam_cfdgrid, FMT_17G, "~N: stretched structured CFD grid"},
+    {"lidar", fam_lidar, FMT_17G, "airborne lidar, 0.01 ft grid, five planes"},
+    {"dupheavy", fam_dupheavy, FMT_17G, "N points from sqrt(N) distinct ones"},
+    {"mixed", fam_mixed, FMT_17G, "magnitudes 1e-150, 1, 1e150 in one file"},
+    {"ulpgrid", fam_ulpgrid, FMT_17G, "2^40 plus multiples of 2^-12"},
+    {"cylinder", fam_cylinder, FMT_17G,
+     "~N: exact pipe surface, symmetric rings, empty inside"},
+    {"cylscan", fam_cylscan, FMT_17G, "~N: pipe scan, rings of jittered angles"},
+    {"rotlattice", fam_rotlattice, FMT_17G,
+     "~N: k^3 lattice rotated by (0.3, 0.5, 0.7) rad"},
+    {"citylidar", fam_citylidar, FMT_2F,
+     "~N: ground + flat-roof buildings, 1e6 offset, 1 cm steps, %.2f"},
+    {"sphere12", fam_sphere12, FMT_12G,
+     "Fibonacci sphere of radius 100 printed to 12 digits"},
+    {"ogrid", fam_ogrid, FMT_17G,
+     "~N: CFD O-grid around a sphere, first cell 1e-4 growing 1.25"},
+    {"cubedsphere", fam_cubedsphere, FMT_17G,
+     "~N: cubed-sphere O-grid, same radial spacing"},
+    {"extruded", fam_extruded, FMT_17G,
+     "~N: 2-D O-grid + far field around a circle, at z = 0 and 1"},
+    {"windcity", fam_windcity, FMT_17G,
+     "~N: CAD box buildings with gridded faces in a domain box"},
+    {"statue", fam_statue, FMT_6F,
+     "bumpy scanned surface, ~5% exact duplicates, %.6f"},
+    {"centre", fam_centre, FMT_17G,
+     "N - 1 on a sphere (radial jitter 1e-7) + its centre"},
 };
 #define N_FAMILIES (sizeof families / sizeof families[0])
 
@@ -569,11 +1246,12 @@ static int usage(const char *argv0)
 {
     fprintf(stderr,
             "usage: %s FAMILY N SEED OUT.xyz [--shuffle PERM_OUT]\n"
-            "       %s --list\nfamilies:",
+            "       %s --list\n"
+            "families (~N: the count is rounded to the family's structure;\n"
+            "tests/gen_points.c says what each imitates and why it is hard):\n",
             argv0, argv0);
     for (size_t i = 0; i < N_FAMILIES; i++)
-        fprintf(stderr, " %s", families[i].name);
-    fprintf(stderr, "\n");
+        fprintf(stderr, "  %-12s %s\n", families[i].name, families[i].help);
     return 2;
 }
 
@@ -651,7 +1329,21 @@ int main(int argc, char **argv)
     }
     for (size_t i = 0; i < p.n; i++) {
         const double *c = &p.xyz[3 * (perm ? perm[i] : i)];
-        if (fprintf(f, "%.17g %.17g %.17g\n", c[0], c[1], c[2]) < 0)
+        int w;
+        switch (fam->fmt) {
+        case FMT_12G:
+            w = fprintf(f, "%.12g %.12g %.12g\n", c[0], c[1], c[2]);
+            break;
+        case FMT_2F:
+            w = fprintf(f, "%.2f %.2f %.2f\n", c[0], c[1], c[2]);
+            break;
+        case FMT_6F:
+            w = fprintf(f, "%.6f %.6f %.6f\n", c[0], c[1], c[2]);
+            break;
+        default:
+            w = fprintf(f, "%.17g %.17g %.17g\n", c[0], c[1], c[2]);
+        }
+        if (w < 0)
             bad = 1;
     }
     if (fclose(f))
