@@ -924,6 +924,14 @@ static void test_triangulation(tctx *T, double scale)
  *     GMP rationals.
  */
 
+/* One line on stderr for a test function that failed (the first 30
+ * failures are printed in full, later ones only counted). */
+static void report_section(const tctx *T, const char *name, long failures_before)
+{
+    if (T->failures > failures_before)
+        fprintf(stderr, "%s: %ld failures\n", name, T->failures - failures_before);
+}
+
 /* A filter's arithmetic, replicated operation for operation from
  * src/predicates.h (the build contracts nothing, -ffp-contract=off, so the
  * doubles are the filter's own), with the outer terms of its permanent
@@ -1070,6 +1078,7 @@ static int ref_of(tctx *T, int insphere, double (*p)[3])
  */
 static void test_bound_windows(tctx *T, double scale, int verbose)
 {
+    const long failures_before = T->failures;
     for (int insphere = 0; insphere <= 1; insphere++) {
         const int mv = insphere ? 4 : 3; /* the point moved */
         /* at least 40: each term is caught on most window inputs */
@@ -1126,6 +1135,7 @@ static void test_bound_windows(tctx *T, double scale, int verbose)
                    insphere ? "insphere" : "orient3d", found, tries, caught[0], caught[1],
                    caught[2], insphere ? caught[3] : 0L);
     }
+    report_section(T, __func__, failures_before);
 }
 
 
@@ -1338,6 +1348,8 @@ static void gen_box(tctx *T, double (*p)[3], int stage_b)
  * magnitudes they mix. */
 typedef struct deg_tally {
     long cases[2][2];   /* [insphere][stage B] */
+    long failed[2][2];  /* failed calls (these and their one-ulp moves), by
+                         * the stage of the failed call */
     long full_range[2]; /* subnormal, normal and >= 2^500 in one call */
     long col_mix[2];    /* a column with subnormal and normal values */
 } deg_tally;
@@ -1353,7 +1365,8 @@ static void check_degenerate(tctx *T, deg_tally *D, int insphere, double (*p)[3]
         fail_at(T, what, __LINE__); /* the generator itself is wrong */
         return;
     }
-    D->cases[insphere][reaches_stage_b(insphere, p)]++;
+    const int stage_b = reaches_stage_b(insphere, p);
+    D->cases[insphere][stage_b]++;
     D->full_range[insphere] += magnitudes(p, n) == 7;
     D->col_mix[insphere] += column_mixes(p, n);
     int got = full_pred(T, insphere, p, &counted);
@@ -1361,6 +1374,7 @@ static void check_degenerate(tctx *T, deg_tally *D, int insphere, double (*p)[3]
                       : fdt_orient3d_exact(p[0], p[1], p[2], p[3], NULL);
     T->checks += 2;
     if (got != 0 || ex != 0 || !counted) {
+        D->failed[insphere][stage_b]++;
         T->failures++;
         if (T->failures <= 30) {
             fprintf(stderr, "%s [%s]: got %d exact %d counted %d, want 0\n",
@@ -1378,6 +1392,7 @@ static void check_degenerate(tctx *T, deg_tally *D, int insphere, double (*p)[3]
                   : fdt_orient3d_exact(q[0], q[1], q[2], q[3], NULL);
     T->checks += 2;
     if (got != ref || ex != ref) {
+        D->failed[insphere][reaches_stage_b(insphere, q)]++;
         T->failures++;
         if (T->failures <= 30) {
             fprintf(stderr, "%s [%s, one ulp off]: ref %d got %d exact %d\n",
@@ -1421,6 +1436,7 @@ static void test_degenerate_magnitudes(tctx *T, double scale, int verbose)
     static const int sph_b[] = {-150, -100, 0, 60, 97};
     deg_tally D;
     memset(&D, 0, sizeof D);
+    const long failures_before = T->failures;
     double p[5][3];
     const long need = (long)fmax(600 * scale, 100);
     for (long it = 0; it < need; it++) {
@@ -1466,6 +1482,11 @@ static void test_degenerate_magnitudes(tctx *T, double scale, int verbose)
                "columns); insphere %ld / %ld (%ld, %ld)\n",
                D.cases[0][1], D.cases[0][0], D.full_range[0], D.col_mix[0], D.cases[1][1],
                D.cases[1][0], D.full_range[1], D.col_mix[1]);
+    if (T->failures > failures_before)
+        fprintf(stderr, "test_degenerate_magnitudes: failed calls: orient3d %ld at stage B, "
+                "%ld at stage C; insphere %ld at stage B, %ld at stage C\n",
+                D.failed[0][1], D.failed[0][0], D.failed[1][1], D.failed[1][0]);
+    report_section(T, __func__, failures_before);
 }
 
 
@@ -1612,6 +1633,7 @@ static void test_circumcenter(tctx *T, double scale, int verbose)
 {
     cc_tally C;
     memset(&C, 0, sizeof C);
+    const long failures_before = T->failures;
     double p[5][3];
     const long need = (long)fmax(800 * scale, 100);
     static const int ex_mixed[3] = {-1050, 0, 900};
@@ -1643,6 +1665,7 @@ static void test_circumcenter(tctx *T, double scale, int verbose)
         printf("  circumcenter: %ld centres (%ld with a subnormal component), %ld coplanar, "
                "%ld overflowing\n",
                C.ok, C.subnormal_part, C.coplanar, C.overflow);
+    report_section(T, __func__, failures_before);
 }
 
 /* sign(|x - q|^2 - |y - q|^2) in rationals. */
@@ -1688,6 +1711,7 @@ static double fdist2(const double *q, const double *x)
 static void test_compare_dist(tctx *T, double scale, int verbose)
 {
     static const int pool[] = {-1074, -1060, -700, -60, 0, 50, 600, 960};
+    const long failures_before = T->failures;
     long n = 0, ties = 0, float_split_ties = 0, float_blind = 0;
     const long need = (long)fmax(6000 * scale, 3000);
     double p[5][3], q[3], x[3], y[3];
@@ -1754,6 +1778,7 @@ static void test_compare_dist(tctx *T, double scale, int verbose)
         printf("  compare_dist: %ld cases, %ld exact ties (%ld with unequal floating "
                "distances), %ld strict with equal floating distances\n",
                n, ties, float_split_ties, float_blind);
+    report_section(T, __func__, failures_before);
 }
 
 /* fdt_lex_compare against the test's own order on coordinates drawn from
@@ -1764,6 +1789,7 @@ static void test_lex_compare(tctx *T, double scale)
     static const double pool[] = {-DBL_MAX, -0x1p1000, -1.0, -0x1p-1074, -0.0, 0.0,
                                   0x1p-1074, 0x1p-1073, 0x1p-1022, 1.0, 0x1p1000, DBL_MAX};
     const long need = (long)fmax(3000 * scale, 300);
+    const long failures_before = T->failures;
     for (long it = 0; it < need; it++) {
         double a[3], b[3];
         for (int k = 0; k < 3; k++) {
@@ -1773,6 +1799,7 @@ static void test_lex_compare(tctx *T, double scale)
         int want = lex_greater(a, b) - lex_greater(b, a);
         CHECK(T, fdt_lex_compare(a, b) == want && fdt_lex_compare(b, a) == -want);
     }
+    report_section(T, __func__, failures_before);
 }
 
 /* ------------------------------------------------------------------ */
