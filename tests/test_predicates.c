@@ -35,6 +35,14 @@
  * outside), and that the perturbed-empty tets of 5 cospherical points
  * triangulate their hull.
  *
+ * Tests that bite (issue 20; see the section of that name): inputs in the
+ * window between 3/4 of each filter's bound and the bound, where the filter
+ * must defer; exact degeneracies whose coordinates mix subnormal, normal and
+ * huge magnitudes, at stage B and stage C; fdt_circumcenter_exact,
+ * fdt_compare_dist and fdt_lex_compare against rationals.
+ * scripts/mutants_issue20.py checks that each of them catches the fault it
+ * is built for.
+ *
  * Ends with a micro-benchmark (ns per call), printed, not checked.
  * Usage: test_predicates [seed [scale [verbose]]]; scale multiplies the
  * case counts (e.g. 0.05 under valgrind, 10 for a long run).
@@ -898,6 +906,903 @@ static void test_triangulation(tctx *T, double scale)
 }
 
 /* ------------------------------------------------------------------ */
+/*
+ * Tests that bite (issue 20). The families above check that a filter's
+ * answer, when it gives one, is right, and the exact stages on inputs
+ * degenerate at one magnitude. Neither sees a filter bound a little too
+ * small (the filter then answers where it should defer, and nearly always
+ * still correctly), nor a stage-C misreading of subnormal exponents, which
+ * only shows when subnormal and normal coordinates meet in one column of
+ * an exactly degenerate determinant. The tests below are built so that
+ * such faults fail them:
+ *   - bound windows: near-degenerate inputs whose floating determinant lies
+ *     between 3/4 of the filter's bound and the bound, where the filter
+ *     must defer, and the final sign must be the rational one;
+ *   - exact degeneracies (coplanar, cospherical) whose coordinates mix
+ *     subnormal, normal and huge magnitudes, reaching stage B and stage C;
+ *   - fdt_circumcenter_exact, fdt_compare_dist and fdt_lex_compare against
+ *     GMP rationals.
+ */
+
+/* One line on stderr for a test function that failed (the first 30
+ * failures are printed in full, later ones only counted). */
+static void report_section(const tctx *T, const char *name, long failures_before)
+{
+    if (T->failures > failures_before)
+        fprintf(stderr, "%s: %ld failures\n", name, T->failures - failures_before);
+}
+
+/* A filter's arithmetic, replicated operation for operation from
+ * src/predicates.h (the build contracts nothing, -ffp-contract=off, so the
+ * doubles are the filter's own), with the outer terms of its permanent
+ * kept apart: a bound that lost one of them is what the windows look for. */
+typedef struct filt_eval {
+    double det, perm, bound;
+    double term[4]; /* outer terms of perm, in the filter's order */
+    int nterm;
+    int in_range;   /* the range conditions of the bound hold */
+    int decision;   /* what the filter must answer */
+} filt_eval;
+
+static void orient_replica(const double *a, const double *b, const double *c, const double *d,
+                           filt_eval *r)
+{
+    const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+    const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
+    const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
+    const double vywz = vy * wz, vzwy = vz * wy;
+    const double vzwx = vz * wx, vxwz = vx * wz;
+    const double vxwy = vx * wy, vywx = vy * wx;
+    r->det = ux * (vywz - vzwy) + uy * (vzwx - vxwz) + uz * (vxwy - vywx);
+    const double aux = fabs(ux), auy = fabs(uy), auz = fabs(uz);
+    r->nterm = 3;
+    r->term[0] = aux * (fabs(vywz) + fabs(vzwy));
+    r->term[1] = auy * (fabs(vzwx) + fabs(vxwz));
+    r->term[2] = auz * (fabs(vxwy) + fabs(vywx));
+    r->term[3] = 0.0;
+    r->perm = r->term[0] + r->term[1] + r->term[2];
+    const double su = aux + auy + auz;
+    r->in_range = r->perm >= 0x1p-800 && r->perm <= DBL_MAX && su * 0x1p-980 <= r->perm;
+    r->bound = FDT_O3D_ERRBOUND * r->perm;
+    int s = (r->det > r->bound) - (r->det < -r->bound);
+    r->decision = r->in_range && s != 0 ? s : FDT_PRED_UNSURE;
+}
+
+static void isp_replica(const double *a, const double *b, const double *c, const double *d,
+                        const double *e, filt_eval *r)
+{
+    const double aex = a[0] - e[0], aey = a[1] - e[1], aez = a[2] - e[2];
+    const double bex = b[0] - e[0], bey = b[1] - e[1], bez = b[2] - e[2];
+    const double cex = c[0] - e[0], cey = c[1] - e[1], cez = c[2] - e[2];
+    const double dex = d[0] - e[0], dey = d[1] - e[1], dez = d[2] - e[2];
+    const double aexbey = aex * bey, bexaey = bex * aey;
+    const double bexcey = bex * cey, cexbey = cex * bey;
+    const double cexdey = cex * dey, dexcey = dex * cey;
+    const double dexaey = dex * aey, aexdey = aex * dey;
+    const double aexcey = aex * cey, cexaey = cex * aey;
+    const double bexdey = bex * dey, dexbey = dex * bey;
+    const double ab = aexbey - bexaey, bc = bexcey - cexbey;
+    const double cd = cexdey - dexcey, da = dexaey - aexdey;
+    const double ac = aexcey - cexaey, bd = bexdey - dexbey;
+    const double abc = aez * bc - bez * ac + cez * ab;
+    const double bcd = bez * cd - cez * bd + dez * bc;
+    const double cda = cez * da + dez * ac + aez * cd;
+    const double dab = dez * ab + aez * bd + bez * da;
+    const double alift = aex * aex + aey * aey + aez * aez;
+    const double blift = bex * bex + bey * bey + bez * bez;
+    const double clift = cex * cex + cey * cey + cez * cez;
+    const double dlift = dex * dex + dey * dey + dez * dez;
+    r->det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+    const double abP = fabs(aexbey) + fabs(bexaey), bcP = fabs(bexcey) + fabs(cexbey);
+    const double cdP = fabs(cexdey) + fabs(dexcey), daP = fabs(dexaey) + fabs(aexdey);
+    const double acP = fabs(aexcey) + fabs(cexaey), bdP = fabs(bexdey) + fabs(dexbey);
+    const double aezP = fabs(aez), bezP = fabs(bez), cezP = fabs(cez), dezP = fabs(dez);
+    const double abcP = aezP * bcP + bezP * acP + cezP * abP;
+    const double bcdP = bezP * cdP + cezP * bdP + dezP * bcP;
+    const double cdaP = cezP * daP + dezP * acP + aezP * cdP;
+    const double dabP = dezP * abP + aezP * bdP + bezP * daP;
+    r->nterm = 4;
+    r->term[0] = dlift * abcP;
+    r->term[1] = clift * dabP;
+    r->term[2] = blift * cdaP;
+    r->term[3] = alift * bcdP;
+    r->perm = (r->term[0] + r->term[1]) + (r->term[2] + r->term[3]);
+    const double lsum = (alift + blift) + (clift + dlift);
+    r->in_range = r->perm >= 0x1p-800 && r->perm <= DBL_MAX && lsum * (lsum * 0x1p-960) <= r->perm;
+    r->bound = FDT_ISP_ERRBOUND * r->perm;
+    int s = (r->det < -r->bound) - (r->det > r->bound);
+    r->decision = r->in_range && s != 0 ? s : FDT_PRED_UNSURE;
+}
+
+/* The bound as it would be with outer term i of the permanent left out
+ * (the rest summed in the filter's association: adding 0 is exact). */
+static double bound_without(const filt_eval *r, int i)
+{
+    double t[4];
+    for (int k = 0; k < 4; k++)
+        t[k] = k == i ? 0.0 : r->term[k];
+    double perm = r->nterm == 4 ? (t[0] + t[1]) + (t[2] + t[3]) : t[0] + t[1] + t[2];
+    return (r->nterm == 4 ? FDT_ISP_ERRBOUND : FDT_O3D_ERRBOUND) * perm;
+}
+
+/* The window: the bound holds and |det| lies in (3/4 bound, bound]. */
+static int in_window(const filt_eval *r)
+{
+    return r->in_range && fabs(r->det) > 0.75 * r->bound && fabs(r->det) <= r->bound;
+}
+
+static void eval_replica(int insphere, double (*p)[3], filt_eval *r)
+{
+    if (insphere)
+        isp_replica(p[0], p[1], p[2], p[3], p[4], r);
+    else
+        orient_replica(p[0], p[1], p[2], p[3], r);
+}
+
+static int filter_of(int insphere, double (*p)[3])
+{
+    return insphere ? fdt_insphere_filter(p[0], p[1], p[2], p[3], p[4])
+                    : fdt_orient3d_filter(p[0], p[1], p[2], p[3]);
+}
+
+/* fdt_orient3d / fdt_insphere on p, and whether the call left the filters
+ * (counted in cnt). */
+static int full_pred(tctx *T, int insphere, double (*p)[3], int *counted)
+{
+    size_t before = insphere ? T->cnt.insphere_exact : T->cnt.orient_exact;
+    int s = insphere ? fdt_insphere(p[0], p[1], p[2], p[3], p[4], &T->cnt)
+                     : fdt_orient3d(p[0], p[1], p[2], p[3], &T->cnt);
+    *counted = (insphere ? T->cnt.insphere_exact : T->cnt.orient_exact) != before;
+    return s;
+}
+
+static int ref_of(tctx *T, int insphere, double (*p)[3])
+{
+    return insphere ? ref_insphere(T, p[0], p[1], p[2], p[3], p[4])
+                    : ref_orient(T, p[0], p[1], p[2], p[3]);
+}
+
+/*
+ * Near-degenerate inputs in the window of each filter, found by search:
+ * a nearly coplanar (orient3d) or nearly cospherical (insphere) set whose
+ * last point is moved by random numbers of ulps until the replica's
+ * |det| / bound falls in (3/4, 1]. On each: the filter defers (it must:
+ * |det| is within its bound), fdt_orient3d / fdt_insphere leave the
+ * filters, also on copies scaled by 2^-+400 / 2^-+300 that only the
+ * rescaled second filter (src/predicates.c) can see, and return the
+ * rational sign. Every try, in the window or not, checks that the filter
+ * answers what the replica says, so the replica is the filter's. A bound
+ * short by one outer term of the permanent answers on every window input
+ * where that term exceeds bound - |det|; the test counts those per term
+ * and requires some for each, so each such fault is caught.
+ */
+static void test_bound_windows(tctx *T, double scale, int verbose)
+{
+    const long failures_before = T->failures;
+    for (int insphere = 0; insphere <= 1; insphere++) {
+        const int mv = insphere ? 4 : 3; /* the point moved */
+        /* at least 40: each term is caught on most window inputs */
+        const long need = (long)fmax(400 * scale, 40);
+        long found = 0, tries = 0, caught[4] = {0, 0, 0, 0};
+        double p[5][3], q[5][3];
+        filt_eval ev;
+        memset(&ev, 0, sizeof ev);
+        while (found < need && tries < need * 20000) {
+            if (insphere)
+                gen_near_cospherical(T, p, 0.0);
+            else
+                gen_near_coplanar(T, p);
+            double p0[3] = {p[mv][0], p[mv][1], p[mv][2]};
+            int hit = 0;
+            for (int t = 0; t < 64 && !hit; t++) {
+                int K = 1 << irand(T, 0, 6);
+                for (int k = 0; k < 3; k++)
+                    p[mv][k] = nudge(p0[k], (int)irand(T, -K, K));
+                eval_replica(insphere, p, &ev);
+                tries++;
+                CHECK(T, filter_of(insphere, p) == ev.decision);
+                hit = in_window(&ev);
+            }
+            if (!hit)
+                continue;
+            found++;
+            for (int i = 0; i < ev.nterm; i++)
+                caught[i] += fabs(ev.det) > bound_without(&ev, i);
+            CHECK(T, filter_of(insphere, p) == FDT_PRED_UNSURE);
+            int ref = ref_of(T, insphere, p), counted;
+            CHECK(T, ref != 0);
+            CHECK(T, full_pred(T, insphere, p, &counted) == ref && counted);
+            int ex = insphere ? fdt_insphere_exact(p[0], p[1], p[2], p[3], p[4], NULL)
+                              : fdt_orient3d_exact(p[0], p[1], p[2], p[3], NULL);
+            CHECK(T, ex == ref);
+            /* Scaled out of the bound's range: the first filter defers by
+             * its range test, the rescaled one sees the same ratio (power
+             * of two scalings commute with rounding) and must defer too. */
+            for (int sgn = -1; sgn <= 1; sgn += 2) {
+                double f = ldexp(1.0, sgn * (insphere ? 300 : 400));
+                for (int i = 0; i < 5; i++)
+                    for (int k = 0; k < 3; k++)
+                        q[i][k] = p[i][k] * f;
+                CHECK(T, full_pred(T, insphere, q, &counted) == ref && counted);
+            }
+        }
+        CHECK(T, found == need);
+        for (int i = 0; i < ev.nterm; i++)
+            CHECK(T, caught[i] > 0);
+        if (verbose)
+            printf("  bound window %-8s %5ld inputs in %7ld tries; a bound without term "
+                   "0/1/2/3 answers on %ld/%ld/%ld/%ld of them\n",
+                   insphere ? "insphere" : "orient3d", found, tries, caught[0], caught[1],
+                   caught[2], insphere ? caught[3] : 0L);
+    }
+    report_section(T, __func__, failures_before);
+}
+
+
+/* A random integer below 2^L in magnitude, L uniform in [0, maxbits], so
+ * that magnitudes spread over the whole range; negative half the time if
+ * sgn. */
+static int64_t rand_bits(tctx *T, int maxbits, int sgn)
+{
+    int L = (int)irand(T, 0, maxbits);
+    int64_t v = L == 0 ? 0 : (int64_t)(next_u64(T) >> (64 - L));
+    return sgn && (next_u64(T) & 1) ? -v : v;
+}
+
+/* Whether fl(p - q) is exact, decided in rationals. */
+static int diff_exact(double p, double q)
+{
+    mpq_t a, b;
+    mpq_inits(a, b, NULL);
+    mpq_set_d(a, p);
+    mpq_set_d(b, q);
+    mpq_sub(a, a, b);
+    mpq_set_d(b, p - q);
+    int ok = mpq_equal(a, b);
+    mpq_clears(a, b, NULL);
+    return ok;
+}
+
+/*
+ * Whether the exact stage takes stage B (expansions) on these points,
+ * by the admission rule of src/predicates.c: every coordinate 0 or of
+ * magnitude within [2^-lim, 2^lim] (lim = 300 for orient3d, 150 for
+ * insphere) and every difference to the last point (orient3d: to the
+ * first) exact. The tests require both classes to occur; that each class
+ * really reaches its stage is shown by the mutants that break one stage
+ * only (the issue-20 report).
+ */
+static int reaches_stage_b(int insphere, double (*p)[3])
+{
+    const int n = insphere ? 5 : 4, ref = insphere ? 4 : 0;
+    const double lo = insphere ? 0x1p-150 : 0x1p-300, hi = insphere ? 0x1p150 : 0x1p300;
+    for (int i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = fabs(p[i][k]);
+            if (x != 0.0 && !(x >= lo && x <= hi))
+                return 0;
+            if (!diff_exact(p[i][k], p[ref][k]))
+                return 0;
+        }
+    return 1;
+}
+
+/* Magnitude classes of the nonzero coordinates of n points, as bits:
+ * 1 subnormal, 2 normal below 2^500, 4 at least 2^500. */
+static int magnitudes(double (*p)[3], int n)
+{
+    int m = 0;
+    for (int i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = fabs(p[i][k]);
+            if (x == 0.0)
+                continue;
+            m |= x < DBL_MIN ? 1 : x < 0x1p500 ? 2 : 4;
+        }
+    return m;
+}
+
+/* Whether one coordinate axis holds both a subnormal and a normal value:
+ * where a misread subnormal exponent changes the determinant. */
+static int column_mixes(double (*p)[3], int n)
+{
+    for (int k = 0; k < 3; k++) {
+        int sub = 0, nor = 0;
+        for (int i = 0; i < n; i++) {
+            double x = fabs(p[i][k]);
+            sub |= x != 0.0 && x < DBL_MIN;
+            nor |= x >= DBL_MIN;
+        }
+        if (sub && nor)
+            return 1;
+    }
+    return 0;
+}
+
+static void random_axes(tctx *T, int ax[3])
+{
+    ax[0] = 0;
+    ax[1] = 1;
+    ax[2] = 2;
+    for (int i = 2; i > 0; i--) {
+        int j = (int)irand(T, 0, i), t = ax[i];
+        ax[i] = ax[j];
+        ax[j] = t;
+    }
+}
+
+/*
+ * n exactly coplanar points: integers on the plane x = k0 + ny y + nz z
+ * (|x| < 2^53, so exact), the three roles mapped to random axes and
+ * scaled by 2^ex[role] (exact: an integer below 2^53 times 2^e, e >= -1074,
+ * is a double). Each scaling multiplies the determinant by a power of two,
+ * so it stays 0. The solved coordinate takes every size up to 2^52: with
+ * ex[0] = -1050, say, its values below 2^28 become subnormal and the
+ * others normal, in one column.
+ */
+static void gen_coplanar_scaled(tctx *T, double (*p)[3], int n, const int ex[3])
+{
+    int64_t k0 = rand_bits(T, 50, 1);
+    int64_t ny = irand(T, -2, 2), nz = irand(T, -2, 2);
+    int ax[3];
+    random_axes(T, ax);
+    for (int i = 0; i < n; i++) {
+        int64_t y = rand_bits(T, 49, 1), z = rand_bits(T, 49, 1);
+        int64_t v[3] = {k0 + ny * y + nz * z, y, z};
+        for (int r = 0; r < 3; r++)
+            p[i][ax[r]] = ldexp((double)v[r], ex[r]);
+    }
+}
+
+/*
+ * Five distinct points exactly on one sphere: integer centre C and
+ * offsets of one integer length d, from the parametrisation of
+ * Pythagorean quadruples (a, b, c, d), a = m^2 + n^2 - r^2 - s^2,
+ * b = 2 (m s + n r), c = 2 (n s - m r), d = m^2 + n^2 + r^2 + s^2: the
+ * offsets are the signed permutations of (a, b, c) and (+-d, 0, 0). All
+ * integers stay below 2^52, so x 2^e is exact; the uniform scaling keeps
+ * the sphere. The centre, C 2^e, goes to ctr unless NULL. Returns 0 when
+ * the quadruple offers fewer than 5 offsets.
+ */
+static int gen_sphere_pyth(tctx *T, double (*p)[3], int e, double *ctr)
+{
+    int64_t m = rand_bits(T, 24, 0), n = rand_bits(T, 24, 0);
+    int64_t r = rand_bits(T, 24, 0), s = rand_bits(T, 24, 0);
+    int64_t base[3] = {m * m + n * n - r * r - s * s, 2 * (m * s + n * r), 2 * (n * s - m * r)};
+    int64_t d = m * m + n * n + r * r + s * s;
+    static const int perm6[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                    {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    int64_t off[54][3];
+    int no = 0;
+    for (int j = 0; j < 54; j++) {
+        int64_t v[3] = {0, 0, 0};
+        if (j < 48) {
+            for (int k = 0; k < 3; k++)
+                v[k] = base[perm6[j / 8][k]] * (((j >> k) & 1) ? -1 : 1);
+        } else {
+            v[(j - 48) / 2] = (j & 1) ? -d : d;
+        }
+        int dup = 0;
+        for (int i = 0; i < no && !dup; i++)
+            dup = off[i][0] == v[0] && off[i][1] == v[1] && off[i][2] == v[2];
+        if (!dup) {
+            memcpy(off[no], v, sizeof v);
+            no++;
+        }
+    }
+    if (no < 5)
+        return 0;
+    int64_t C[3];
+    for (int k = 0; k < 3; k++) {
+        C[k] = rand_bits(T, 51, 1);
+        if (ctr)
+            ctr[k] = ldexp((double)C[k], e);
+    }
+    for (int i = 0; i < 5; i++) {
+        int j = (int)irand(T, i, no - 1); /* a partial shuffle: distinct */
+        int64_t t[3];
+        memcpy(t, off[i], sizeof t);
+        memcpy(off[i], off[j], sizeof t);
+        memcpy(off[j], t, sizeof t);
+        for (int k = 0; k < 3; k++)
+            p[i][k] = ldexp((double)(C[k] + off[i][k]), e);
+    }
+    return 1;
+}
+
+/*
+ * Five distinct corners of the box [x0, x1] x [y0, y1] x [z0, z1]: the
+ * eight corners of any box lie on the sphere about its centre, exactly,
+ * whatever the doubles, so one insphere determinant can hold 2^-1074 and
+ * 2^1000 at once. For stage B (stage_b) each axis keeps its two values
+ * within one binade range [2^-140, 2^140] with an exact difference.
+ */
+static void gen_box(tctx *T, double (*p)[3], int stage_b)
+{
+    static const int pool[] = {-1074, -1070, -1040, -1022, -500, -20, 0, 300, 900, 1000};
+    static const int poolb[] = {-140, -60, 0, 60, 120};
+    double v[3][2];
+    for (int k = 0; k < 3; k++) {
+        int eb = poolb[irand(T, 0, 4)];
+        do {
+            for (int j = 0; j < 2; j++) {
+                double m = (double)irand(T, 1, 1 << 20) * (irand(T, 0, 1) ? 1 : -1);
+                if (stage_b)
+                    v[k][j] = ldexp(m, eb);
+                else
+                    v[k][j] = irand(T, 0, 9) == 0 ? 0.0 : ldexp(m, pool[irand(T, 0, 9)]);
+            }
+        } while (v[k][0] == v[k][1]);
+    }
+    int idx[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+    for (int i = 0; i < 5; i++) {
+        int j = (int)irand(T, i, 7), t = idx[i];
+        idx[i] = idx[j];
+        idx[j] = t;
+        for (int k = 0; k < 3; k++)
+            p[i][k] = v[k][(idx[i] >> k) & 1];
+    }
+}
+
+/* Per-predicate tallies of the degenerate cases by stage and by the
+ * magnitudes they mix. */
+typedef struct deg_tally {
+    long cases[2][2];   /* [insphere][stage B] */
+    long failed[2][2];  /* failed calls (these and their one-ulp moves), by
+                         * the stage of the failed call */
+    long full_range[2]; /* subnormal, normal and >= 2^500 in one call */
+    long col_mix[2];    /* a column with subnormal and normal values */
+} deg_tally;
+
+/* An exactly degenerate orient3d (p[0..3]) or insphere (p[0..4]) call:
+ * every route says 0, the call left the filter, and the same points moved
+ * by one ulp in one coordinate give the rational sign. */
+static void check_degenerate(tctx *T, deg_tally *D, int insphere, double (*p)[3],
+                             const char *what)
+{
+    int n = insphere ? 5 : 4, counted;
+    if (ref_of(T, insphere, p) != 0) {
+        fail_at(T, what, __LINE__); /* the generator itself is wrong */
+        return;
+    }
+    const int stage_b = reaches_stage_b(insphere, p);
+    D->cases[insphere][stage_b]++;
+    D->full_range[insphere] += magnitudes(p, n) == 7;
+    D->col_mix[insphere] += column_mixes(p, n);
+    int got = full_pred(T, insphere, p, &counted);
+    int ex = insphere ? fdt_insphere_exact(p[0], p[1], p[2], p[3], p[4], NULL)
+                      : fdt_orient3d_exact(p[0], p[1], p[2], p[3], NULL);
+    T->checks += 2;
+    if (got != 0 || ex != 0 || !counted) {
+        D->failed[insphere][stage_b]++;
+        T->failures++;
+        if (T->failures <= 30) {
+            fprintf(stderr, "%s [%s]: got %d exact %d counted %d, want 0\n",
+                    insphere ? "insphere" : "orient3d", what, got, ex, counted);
+            print_pts((const double (*)[3])p, n);
+        }
+    }
+    double q[5][3];
+    memcpy(q, p, sizeof q);
+    int i = (int)irand(T, 0, n - 1), k = (int)irand(T, 0, 2);
+    q[i][k] = nudge(q[i][k], irand(T, 0, 1) ? 1 : -1);
+    int ref = ref_of(T, insphere, q);
+    got = full_pred(T, insphere, q, &counted);
+    ex = insphere ? fdt_insphere_exact(q[0], q[1], q[2], q[3], q[4], NULL)
+                  : fdt_orient3d_exact(q[0], q[1], q[2], q[3], NULL);
+    T->checks += 2;
+    if (got != ref || ex != ref) {
+        D->failed[insphere][reaches_stage_b(insphere, q)]++;
+        T->failures++;
+        if (T->failures <= 30) {
+            fprintf(stderr, "%s [%s, one ulp off]: ref %d got %d exact %d\n",
+                    insphere ? "insphere" : "orient3d", what, ref, got, ex);
+            print_pts((const double (*)[3])q, n);
+        }
+    }
+}
+
+/* Five cospherical points: insphere 0, and with (a,b,c,d) ordered
+ * positively the perturbed sign (check_perturbed: the rational reference
+ * and the even permutations). Coplanar (a,b,c,d) are skipped. */
+static void check_cospherical(tctx *T, deg_tally *D, double (*p)[3], const char *what)
+{
+    for (int i = 0; i < 5; i++)
+        for (int j = 0; j < i; j++)
+            if (memcmp(p[i], p[j], sizeof p[i]) == 0)
+                return;
+    if (!orient_positive(T, p))
+        return;
+    check_degenerate(T, D, 1, p, what);
+    check_perturbed(T, p, 0, what);
+}
+
+/*
+ * Exact degeneracies across magnitudes, at both exact stages: coplanar
+ * quadruples whose axes are scaled apart (a column mixing subnormal and
+ * normal values next to a huge one), cospherical integer sets scaled
+ * uniformly (subnormal and normal in one column), box corners with any
+ * doubles (2^-1074 next to 2^1000), and their stage-B versions; every
+ * 4-subset of the box corners is checked with orient3d as well (the
+ * faces and diagonal planes are coplanar). The counts of stage-B and
+ * stage-C cases and of the magnitude mixes are required nonzero.
+ */
+static void test_degenerate_magnitudes(tctx *T, double scale, int verbose)
+{
+    static const int mixcol[] = {-1064, -1060, -1050, -1040, -1030};
+    static const int other[] = {-1074, -700, 0, 600, 970};
+    static const int ex_b[] = {-250, -120, 0, 120, 240};
+    static const int sph_c[] = {-1074, -1064, -1056, -1050, -1040, -600, 500, 960};
+    static const int sph_b[] = {-150, -100, 0, 60, 97};
+    deg_tally D;
+    memset(&D, 0, sizeof D);
+    const long failures_before = T->failures;
+    double p[5][3];
+    const long need = (long)fmax(600 * scale, 100);
+    for (long it = 0; it < need; it++) {
+        int ex[3];
+        /* stage C: a mixed column next to two others of any size */
+        ex[0] = mixcol[irand(T, 0, 4)];
+        ex[1] = other[irand(T, 0, 4)];
+        ex[2] = other[irand(T, 0, 4)];
+        gen_coplanar_scaled(T, p, 4, ex);
+        check_degenerate(T, &D, 0, p, "coplanar, axes scaled apart");
+        /* stage B: coordinates within 2^-+300, exact differences */
+        for (int r = 0; r < 3; r++)
+            ex[r] = ex_b[irand(T, 0, 4)];
+        gen_coplanar_scaled(T, p, 4, ex);
+        check_degenerate(T, &D, 0, p, "coplanar, stage B");
+
+        if (gen_sphere_pyth(T, p, sph_c[irand(T, 0, 7)], NULL))
+            check_cospherical(T, &D, p, "integer sphere scaled");
+        if (gen_sphere_pyth(T, p, sph_b[irand(T, 0, 4)], NULL))
+            check_cospherical(T, &D, p, "integer sphere, stage B");
+
+        for (int sb = 0; sb <= 1; sb++) {
+            gen_box(T, p, sb);
+            for (int skip = 0; skip < 5; skip++) {
+                double q[5][3];
+                for (int i = 0, j = 0; i < 5; i++)
+                    if (i != skip)
+                        memcpy(q[j++], p[i], sizeof p[i]);
+                if (ref_orient(T, q[0], q[1], q[2], q[3]) == 0)
+                    check_degenerate(T, &D, 0, q, sb ? "box face, stage B" : "box face");
+                else
+                    check_orient(T, q[0], q[1], q[2], q[3], "box corners");
+            }
+            check_cospherical(T, &D, p, sb ? "box corners, stage B" : "box corners");
+        }
+    }
+    for (int s = 0; s <= 1; s++) {
+        CHECK(T, D.cases[s][0] > 0 && D.cases[s][1] > 0);
+        CHECK(T, D.full_range[s] > 0 && D.col_mix[s] > 0);
+    }
+    if (verbose)
+        printf("  degenerate: orient3d %ld stage B / %ld stage C (%ld all magnitudes, %ld mixed "
+               "columns); insphere %ld / %ld (%ld, %ld)\n",
+               D.cases[0][1], D.cases[0][0], D.full_range[0], D.col_mix[0], D.cases[1][1],
+               D.cases[1][0], D.full_range[1], D.col_mix[1]);
+    if (T->failures > failures_before)
+        fprintf(stderr, "test_degenerate_magnitudes: failed calls: orient3d %ld at stage B, "
+                "%ld at stage C; insphere %ld at stage B, %ld at stage C\n",
+                D.failed[0][1], D.failed[0][0], D.failed[1][1], D.failed[1][0]);
+    report_section(T, __func__, failures_before);
+}
+
+
+/* The circumcentre of (a, b, c, d) relative to a, in rationals, by
+ * Gaussian elimination on 2 [u; v; w] x = (|u|^2, |v|^2, |w|^2) with
+ * u = b - a, v = c - a, w = d - a (a different route from the cofactor
+ * formula of src/predicates.c). Returns 0 if the system is singular (the
+ * points coplanar). */
+static int ref_circumcenter(const double *a, const double *b, const double *c, const double *d,
+                            mpq_t x[3])
+{
+    const double *pts[3] = {b, c, d};
+    mpq_t M[3][4], t, f;
+    mpq_inits(t, f, NULL);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++)
+            mpq_init(M[i][j]);
+    for (int i = 0; i < 3; i++) {
+        for (int k = 0; k < 3; k++) {
+            mpq_set_d(M[i][k], pts[i][k]);
+            mpq_set_d(t, a[k]);
+            mpq_sub(M[i][k], M[i][k], t);
+            mpq_mul(t, M[i][k], M[i][k]);
+            mpq_add(M[i][3], M[i][3], t);
+            mpq_add(M[i][k], M[i][k], M[i][k]); /* the factor 2 */
+        }
+    }
+    int ok = 1;
+    for (int col = 0; col < 3 && ok; col++) {
+        int piv = -1;
+        for (int i = col; i < 3 && piv < 0; i++)
+            if (mpq_sgn(M[i][col]) != 0)
+                piv = i;
+        if (piv < 0) {
+            ok = 0;
+            break;
+        }
+        for (int j = 0; j < 4; j++)
+            mpq_swap(M[col][j], M[piv][j]);
+        for (int i = 0; i < 3; i++) {
+            if (i == col || mpq_sgn(M[i][col]) == 0)
+                continue;
+            mpq_div(f, M[i][col], M[col][col]);
+            for (int j = col; j < 4; j++) {
+                mpq_mul(t, f, M[col][j]);
+                mpq_sub(M[i][j], M[i][j], t);
+            }
+        }
+    }
+    if (ok)
+        for (int k = 0; k < 3; k++)
+            mpq_div(x[k], M[k][3], M[k][k]);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++)
+            mpq_clear(M[i][j]);
+    mpq_clears(t, f, NULL);
+    return ok;
+}
+
+/* Outcome tallies of the circumcentre checks. */
+typedef struct cc_tally {
+    long ok, coplanar, overflow, subnormal_part;
+} cc_tally;
+
+/*
+ * fdt_circumcenter_exact against the rational centre: -1 when the points
+ * are coplanar or a component is at least 2^1024 in magnitude; 0 when
+ * every component is below 2^1023 (in between either answer is allowed:
+ * the last bits decide), and then each component within a relative
+ * 2^-51 of the true one, as src/predicates.h promises, plus 2^-1074 for
+ * a component in the subnormal range, where a double has fewer bits.
+ */
+static void check_circumcenter(tctx *T, cc_tally *C, const double *a, const double *b,
+                               const double *c, const double *d, const char *what)
+{
+    mpq_t x[3], err, tol, lim;
+    for (int k = 0; k < 3; k++)
+        mpq_init(x[k]);
+    mpq_inits(err, tol, lim, NULL);
+    double got[3] = {0, 0, 0};
+    int rc = fdt_circumcenter_exact(a, b, c, d, got);
+    int ok = ref_circumcenter(a, b, c, d, x), bad = 0;
+    if (!ok) {
+        C->coplanar++;
+        bad = rc != -1;
+    } else {
+        int over = 0, under = 0;
+        for (int k = 0; k < 3; k++) {
+            mpq_abs(err, x[k]);
+            mpq_set_ui(lim, 1, 1);
+            mpq_mul_2exp(lim, lim, 1024);
+            over |= mpq_cmp(err, lim) >= 0 ? 2 : 0;
+            mpq_div_2exp(lim, lim, 1);
+            over |= mpq_cmp(err, lim) >= 0 ? 1 : 0;
+            mpq_set_d(lim, DBL_MIN);
+            under |= mpq_sgn(err) != 0 && mpq_cmp(err, lim) < 0;
+        }
+        if (over & 2) {
+            C->overflow++;
+            bad = rc != -1;
+        } else if (!over && rc != 0) {
+            bad = 1;
+        } else if (rc == 0) {
+            C->ok++;
+            C->subnormal_part += under;
+            for (int k = 0; k < 3 && !bad; k++) {
+                mpq_set_d(err, got[k]);
+                mpq_sub(err, err, x[k]);
+                mpq_abs(err, err);
+                mpq_abs(tol, x[k]);
+                mpq_div_2exp(tol, tol, 51);
+                mpq_set_d(lim, 0x1p-1074);
+                mpq_add(tol, tol, lim);
+                bad = mpq_cmp(err, tol) > 0;
+            }
+        }
+    }
+    T->checks++;
+    if (bad) {
+        T->failures++;
+        if (T->failures <= 30) {
+            fprintf(stderr, "circumcenter [%s]: rc %d, got (%a, %a, %a)", what, rc, got[0],
+                    got[1], got[2]);
+            if (ok)
+                fprintf(stderr, " want (%.17g, %.17g, %.17g)", mpq_get_d(x[0]),
+                        mpq_get_d(x[1]), mpq_get_d(x[2]));
+            fprintf(stderr, "\n");
+            const double pts[4][3] = {{a[0], a[1], a[2]}, {b[0], b[1], b[2]},
+                                      {c[0], c[1], c[2]}, {d[0], d[1], d[2]}};
+            print_pts(pts, 4);
+        }
+    }
+    for (int k = 0; k < 3; k++)
+        mpq_clear(x[k]);
+    mpq_clears(err, tol, lim, NULL);
+}
+
+/*
+ * fdt_circumcenter_exact on well-shaped, flat (one ulp off coplanar),
+ * exactly coplanar, mixed-magnitude, subnormal, big-offset and huge tets,
+ * and on flat tets scaled to 2^900 whose centres overflow.
+ */
+static void test_circumcenter(tctx *T, double scale, int verbose)
+{
+    cc_tally C;
+    memset(&C, 0, sizeof C);
+    const long failures_before = T->failures;
+    double p[5][3];
+    const long need = (long)fmax(800 * scale, 100);
+    static const int ex_mixed[3] = {-1050, 0, 900};
+    for (long it = 0; it < need; it++) {
+        gen_random(T, p);
+        check_circumcenter(T, &C, p[0], p[1], p[2], p[3], "random");
+        gen_near_coplanar(T, p);
+        check_circumcenter(T, &C, p[0], p[1], p[2], p[3], "flat");
+        scale_all(p, 0x1p900);
+        check_circumcenter(T, &C, p[0], p[1], p[2], p[3], "flat, 2^900");
+        gen_mixed(T, p);
+        check_circumcenter(T, &C, p[0], p[1], p[2], p[3], "mixed");
+        gen_subnormal(T, p);
+        check_circumcenter(T, &C, p[0], p[1], p[2], p[3], "subnormal");
+        gen_offset(T, p, 2000);
+        check_circumcenter(T, &C, p[0], p[1], p[2], p[3], "offset");
+        gen_huge(T, p);
+        check_circumcenter(T, &C, p[0], p[1], p[2], p[3], "huge");
+        gen_coplanar_scaled(T, p, 4, ex_mixed);
+        check_circumcenter(T, &C, p[0], p[1], p[2], p[3], "coplanar");
+        gen_lattice(T, p, 2);
+        check_circumcenter(T, &C, p[0], p[1], p[2], p[3], "lattice");
+        gen_lattice(T, p, 40);
+        scale_all(p, 0x1p-1074); /* a tet a few ulps of 2^-1074 across */
+        check_circumcenter(T, &C, p[0], p[1], p[2], p[3], "subnormal lattice");
+    }
+    CHECK(T, C.ok > 0 && C.coplanar > 0 && C.overflow > 0 && C.subnormal_part > 0);
+    if (verbose)
+        printf("  circumcenter: %ld centres (%ld with a subnormal component), %ld coplanar, "
+               "%ld overflowing\n",
+               C.ok, C.subnormal_part, C.coplanar, C.overflow);
+    report_section(T, __func__, failures_before);
+}
+
+/* sign(|x - q|^2 - |y - q|^2) in rationals. */
+static int ref_compare_dist(const double *q, const double *x, const double *y)
+{
+    mpq_t s, t, u;
+    mpq_inits(s, t, u, NULL);
+    for (int k = 0; k < 3; k++) {
+        mpq_set_d(t, x[k]);
+        mpq_set_d(u, q[k]);
+        mpq_sub(t, t, u);
+        mpq_mul(t, t, t);
+        mpq_add(s, s, t);
+        mpq_set_d(t, y[k]);
+        mpq_sub(t, t, u);
+        mpq_mul(t, t, t);
+        mpq_sub(s, s, t);
+    }
+    int r = mpq_sgn(s);
+    mpq_clears(s, t, u, NULL);
+    return r;
+}
+
+static double fdist2(const double *q, const double *x)
+{
+    double dx = x[0] - q[0], dy = x[1] - q[1], dz = x[2] - q[2];
+    return dx * dx + dy * dy + dz * dz;
+}
+
+/*
+ * fdt_compare_dist against rationals on exact ties and near-ties:
+ *   - each axis on its own grid m 2^e (e from -1074 to 960, so one call
+ *     mixes magnitudes); y's offsets from q are x's with random signs, or
+ *     swapped between two axes of one grid (exact ties), then one offset
+ *     moved by a unit of its grid or not (near-ties that the floating
+ *     distances, dominated by the largest axis, cannot see);
+ *   - two points of an integer sphere about q (gen_sphere_pyth): ties
+ *     whose floating distances may differ, and one of them moved by an ulp;
+ *   - independent random points of mixed magnitudes.
+ * Counts of exact ties, of ties with unequal floating distances and of
+ * strict answers with equal floating distances are required nonzero.
+ */
+static void test_compare_dist(tctx *T, double scale, int verbose)
+{
+    static const int pool[] = {-1074, -1060, -700, -60, 0, 50, 600, 960};
+    const long failures_before = T->failures;
+    long n = 0, ties = 0, float_split_ties = 0, float_blind = 0;
+    const long need = (long)fmax(6000 * scale, 3000);
+    double p[5][3], q[3], x[3], y[3];
+    for (long it = 0; it < need; it++) {
+        int kind = (int)irand(T, 0, 2);
+        if (kind == 0) {
+            int e[3];
+            int64_t m[3], nx[3], ny[3];
+            for (int k = 0; k < 3; k++) {
+                e[k] = pool[irand(T, 0, 7)];
+                m[k] = rand_bits(T, 50, 1);
+                nx[k] = rand_bits(T, 50, 1);
+                ny[k] = irand(T, 0, 1) ? nx[k] : -nx[k];
+            }
+            int i = (int)irand(T, 0, 2), j = (int)irand(T, 0, 2);
+            if (e[i] == e[j] && irand(T, 0, 1)) {
+                int64_t t = ny[i];
+                ny[i] = ny[j];
+                ny[j] = t;
+            }
+            if (irand(T, 0, 1))
+                ny[i] += irand(T, 0, 1) ? 1 : -1;
+            for (int k = 0; k < 3; k++) {
+                q[k] = ldexp((double)m[k], e[k]);
+                x[k] = ldexp((double)(m[k] + nx[k]), e[k]);
+                y[k] = ldexp((double)(m[k] + ny[k]), e[k]);
+            }
+        } else if (kind == 1) {
+            if (!gen_sphere_pyth(T, p, pool[irand(T, 0, 7)], q))
+                continue;
+            memcpy(x, p[0], sizeof x);
+            memcpy(y, p[1], sizeof y);
+            if (irand(T, 0, 1)) {
+                int k = (int)irand(T, 0, 2);
+                y[k] = nudge(y[k], irand(T, 0, 1) ? 1 : -1);
+            }
+        } else {
+            gen_mixed(T, p);
+            memcpy(q, p[0], sizeof q);
+            memcpy(x, p[1], sizeof x);
+            memcpy(y, p[2], sizeof y);
+        }
+        n++;
+        int ref = ref_compare_dist(q, x, y);
+        int got = fdt_compare_dist(q, x, y), rev = fdt_compare_dist(q, y, x);
+        T->checks++;
+        if (got != ref || rev != -ref || fdt_compare_dist(q, x, x) != 0) {
+            T->failures++;
+            if (T->failures <= 30) {
+                fprintf(stderr, "compare_dist (kind %d): ref %d got %d reversed %d\n", kind,
+                        ref, got, rev);
+                const double pts[3][3] = {{q[0], q[1], q[2]}, {x[0], x[1], x[2]},
+                                          {y[0], y[1], y[2]}};
+                print_pts(pts, 3);
+            }
+        }
+        double fx = fdist2(q, x), fy = fdist2(q, y);
+        ties += ref == 0;
+        float_split_ties += ref == 0 && fx != fy;
+        float_blind += ref != 0 && fx == fy;
+    }
+    CHECK(T, ties > 0 && float_split_ties > 0 && float_blind > 0);
+    if (verbose)
+        printf("  compare_dist: %ld cases, %ld exact ties (%ld with unequal floating "
+               "distances), %ld strict with equal floating distances\n",
+               n, ties, float_split_ties, float_blind);
+    report_section(T, __func__, failures_before);
+}
+
+/* fdt_lex_compare against the test's own order on coordinates drawn from
+ * a small pool (so that ties on x and y are common) with signed zeros,
+ * subnormals and huge values. */
+static void test_lex_compare(tctx *T, double scale)
+{
+    static const double pool[] = {-DBL_MAX, -0x1p1000, -1.0, -0x1p-1074, -0.0, 0.0,
+                                  0x1p-1074, 0x1p-1073, 0x1p-1022, 1.0, 0x1p1000, DBL_MAX};
+    const long need = (long)fmax(3000 * scale, 300);
+    const long failures_before = T->failures;
+    for (long it = 0; it < need; it++) {
+        double a[3], b[3];
+        for (int k = 0; k < 3; k++) {
+            a[k] = pool[irand(T, 0, 11)];
+            b[k] = irand(T, 0, 2) ? a[k] : pool[irand(T, 0, 11)];
+        }
+        int want = lex_greater(a, b) - lex_greater(b, a);
+        CHECK(T, fdt_lex_compare(a, b) == want && fdt_lex_compare(b, a) == -want);
+    }
+    report_section(T, __func__, failures_before);
+}
+
+/* ------------------------------------------------------------------ */
 /* Micro-benchmark: ns per call on random points (filtered path). */
 
 
@@ -1055,10 +1960,17 @@ int main(int argc, char **argv)
     test_triangulation(&T, scale);
     test_grid_stage(&T);
     double t2 = now_s();
+    test_bound_windows(&T, scale, verbose);
+    test_degenerate_magnitudes(&T, scale, verbose);
+    test_circumcenter(&T, scale, verbose);
+    test_compare_dist(&T, scale, verbose);
+    test_lex_compare(&T, scale);
+    double t3 = now_s();
     bench(&T);
 
-    printf("test_predicates: %ld checks, %ld failures (families %.2f s, perturbation %.2f s)\n",
-           T.checks, T.failures, t1 - t0, t2 - t1);
+    printf("test_predicates: %ld checks, %ld failures (families %.2f s, perturbation %.2f s, "
+           "issue-20 tests %.2f s)\n",
+           T.checks, T.failures, t1 - t0, t2 - t1, t3 - t2);
     for (int i = 0; i < 5; i++)
         for (int j = 0; j < 5; j++) {
             mpq_clear(T.q[i][j]);
