@@ -198,6 +198,8 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     st->points_tested = fst.kq.points;
     st->exact_orient = fst.kq.pc.orient_exact;
     st->exact_insphere = fst.kq.pc.insphere_exact;
+    st->adapt_orient = fst.kq.pc.orient_adapt;
+    st->adapt_insphere = fst.kq.pc.insphere_adapt;
     st->max_front = fst.max_front;
     st->threads = 1;
     st->mode = FDT_MODE_SERIAL;

@@ -690,6 +690,8 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  points tested     %zu\n"
         "  exact orient3d    %zu\n"
         "  exact insphere    %zu\n"
+        "  adaptive orient3d %zu\n"
+        "  adaptive insphere %zu\n"
         "  largest front     %zu\n"
         "  threads           %d\n"
         "  mode              %s\n"
@@ -703,9 +705,9 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  time write        %.3f s\n",
         st->points, st->vertices, dups, st->tets, st->hull_faces,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
-        st->exact_orient, st->exact_insphere, st->max_front, st->threads,
-        mode_name(st->mode), st->t_prepare, st->t_front, st->t_finish,
-        tm->read, tm->triangulate, tm->check, tm->canon, tm->write);
+        st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
+        st->max_front, st->threads, mode_name(st->mode), st->t_prepare, st->t_front,
+        st->t_finish, tm->read, tm->triangulate, tm->check, tm->canon, tm->write);
     if (st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE)
         print_parallel_stats(res, st);
 }
@@ -756,14 +758,15 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         ", \"tets\": %zu, \"hull_faces\": %zu, \"faces_advanced\": %zu"
         ", \"kd_nodes_visited\": %zu, \"points_tested\": %zu"
         ", \"exact_orient\": %zu, \"exact_insphere\": %zu"
+        ", \"adapt_orient\": %zu, \"adapt_insphere\": %zu"
         ", \"max_front\": %zu, \"threads\": %d, \"mode\": \"%s\""
         ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
         ", \"t_read\": %.9g, \"t_triangulate\": %.9g, \"t_check\": %.9g"
         ", \"t_canon\": %.9g, \"t_write\": %.9g",
         st->points, st->vertices, dups, st->tets, st->hull_faces,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
-        st->exact_orient, st->exact_insphere, st->max_front, st->threads,
-        mode_name(st->mode), finite_or_zero(st->t_prepare),
+        st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
+        st->max_front, st->threads, mode_name(st->mode), finite_or_zero(st->t_prepare),
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
         finite_or_zero(tm->check), finite_or_zero(tm->canon), finite_or_zero(tm->write));
