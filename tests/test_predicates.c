@@ -1243,7 +1243,7 @@ static void rand_mpz(tctx *T, mpz_t z, int lo, int hi)
 
 /* Bound-test inputs for orient3d: u = (p, q, 0), v = (r, s, 0) with
  * p s - q r = 1, w = (x, y, 1), so det[u; v; w] = 1 while the permanent
- * is about 2 p s; a = small offsets below half an ulp of p, so three
+ * is about 2 p s; a = small offsets (below half an ulp of p), so most
  * differences are inexact and the tails move F by O(1). */
 static void gen_bound_orient(tctx *T, double (*pt)[3], mpz_t *z)
 {
@@ -1270,7 +1270,7 @@ static void gen_bound_orient(tctx *T, double (*pt)[3], mpz_t *z)
 /* Bound-test inputs for insphere: rows (relative to e) A = (x1, 0, 0),
  * B = (0, y1, 0), C = (0, 0, z1), D, so det4 = x1 y1 z1 g with
  * g = |D|^2 - D . (x1, y1, z1); x1 and y1 solve Dx x1 + Dy y1 =
- * |D|^2 - Dz z1 - k, so g = k is small while every term is about 2^97.
+ * |D|^2 - Dz z1 - k, so g = k is small while its terms are about 2^99.
  * e = small offsets: the differences' tails move det4 by about itself. */
 static int gen_bound_insphere(tctx *T, double (*pt)[3], mpz_t *z)
 {
