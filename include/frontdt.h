@@ -168,6 +168,9 @@ typedef struct fdt_stats {
     size_t points_tested;     /* points examined by range queries */
     size_t exact_orient;      /* orient3d calls that needed exact arithmetic */
     size_t exact_insphere;    /* insphere calls that needed exact arithmetic */
+    size_t adapt_orient;      /* orient3d calls the filters left undecided and
+                                 the adaptive stage decided (not in exact_) */
+    size_t adapt_insphere;    /* insphere calls likewise */
     size_t max_front;         /* largest front size */
     int threads;
     fdt_mode mode;

@@ -198,6 +198,8 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     st->points_tested = fst.kq.points;
     st->exact_orient = fst.kq.pc.orient_exact;
     st->exact_insphere = fst.kq.pc.insphere_exact;
+    st->adapt_orient = fst.kq.pc.orient_adapt;
+    st->adapt_insphere = fst.kq.pc.insphere_adapt;
     st->max_front = fst.max_front;
     st->mesh_faces = fst.mesh_faces;
     st->mesh_parts = fst.mesh_parts;

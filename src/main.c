@@ -740,6 +740,8 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  points tested     %zu\n"
         "  exact orient3d    %zu\n"
         "  exact insphere    %zu\n"
+        "  adaptive orient3d %zu\n"
+        "  adaptive insphere %zu\n"
         "  largest front     %zu\n"
         "  mesh faces        %zu (%zu parts built a mesh in %.3f s)\n"
         "  threads           %d\n"
@@ -754,8 +756,8 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  time write        %.3f s\n",
         st->points, st->vertices, dups, st->tets, st->hull_faces,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
-        st->exact_orient, st->exact_insphere, st->max_front, st->mesh_faces,
-        st->mesh_parts, st->t_mesh, st->threads,
+        st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
+        st->max_front, st->mesh_faces, st->mesh_parts, st->t_mesh, st->threads,
         mode_name(st->mode), st->t_prepare, st->t_front, st->t_finish,
         tm->read, tm->triangulate, tm->check, tm->canon, tm->write);
     if (st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE)
@@ -808,6 +810,7 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         ", \"tets\": %zu, \"hull_faces\": %zu, \"faces_advanced\": %zu"
         ", \"kd_nodes_visited\": %zu, \"points_tested\": %zu"
         ", \"exact_orient\": %zu, \"exact_insphere\": %zu"
+        ", \"adapt_orient\": %zu, \"adapt_insphere\": %zu"
         ", \"max_front\": %zu, \"mesh_faces\": %zu, \"mesh_parts\": %zu"
         ", \"t_mesh\": %.9g, \"threads\": %d, \"mode\": \"%s\""
         ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
@@ -815,9 +818,9 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         ", \"t_canon\": %.9g, \"t_write\": %.9g",
         st->points, st->vertices, dups, st->tets, st->hull_faces,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
-        st->exact_orient, st->exact_insphere, st->max_front, st->mesh_faces,
-        st->mesh_parts, finite_or_zero(st->t_mesh), st->threads,
-        mode_name(st->mode), finite_or_zero(st->t_prepare),
+        st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
+        st->max_front, st->mesh_faces, st->mesh_parts, finite_or_zero(st->t_mesh),
+        st->threads, mode_name(st->mode), finite_or_zero(st->t_prepare),
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
         finite_or_zero(tm->check), finite_or_zero(tm->canon), finite_or_zero(tm->write));

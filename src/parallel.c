@@ -1785,6 +1785,8 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
         out->fst.star_walks += w->orc.star_walks;
         out->fst.mesh_parts += w->orc.switched_at != 0;
         out->fst.t_mesh += w->orc.t_mesh;
+        out->fst.kq.pc.orient_adapt += w->kq.pc.orient_adapt;
+        out->fst.kq.pc.insphere_adapt += w->kq.pc.insphere_adapt;
         if (ts->tets > maxt)
             maxt = ts->tets;
         sumt += ts->tets;
@@ -1793,6 +1795,8 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
     out->fst.kq.points += kq0.points;
     out->fst.kq.pc.orient_exact += kq0.pc.orient_exact;
     out->fst.kq.pc.insphere_exact += kq0.pc.insphere_exact;
+    out->fst.kq.pc.orient_adapt += kq0.pc.orient_adapt;
+    out->fst.kq.pc.insphere_adapt += kq0.pc.insphere_adapt;
     ps->load_imbalance = sumt ? (double)maxt * nthreads / (double)sumt : 1.0;
     ps->pinned = e->pin ? (atomic_load_explicit(&e->pin_refused, memory_order_relaxed) ? -1 : 1) : 0;
     if (memcmp(&ps->sent, &ps->received, sizeof ps->sent) != 0 ||

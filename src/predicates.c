@@ -2,8 +2,16 @@
  * Exact orient3d / insphere for all finite doubles, and the symbolic
  * perturbation of Devillers & Teillaud. Sign conventions and the
  * floating-point filters (stage A, with their error bounds) are in
- * src/predicates.h. This file holds the two exact stages:
+ * src/predicates.h. This file holds an adaptive stage and the two exact
+ * stages:
  *
+ *   adaptive: coordinates in stage B's range, differences exact or not:
+ *            the determinant of the rounded differences in double-word
+ *            arithmetic plus the first-order terms of the differences'
+ *            tails, decided when it exceeds a proven bound of order eps^2
+ *            times the permanent (analysis above fdt_orient3d_adapt).
+ *            Points rounded onto a sphere or a rotated lattice are decided
+ *            here; exact zeros never are (they go on to B or C).
  *   stage B: the coordinate differences are exact doubles and every
  *            intermediate stays clear of underflow and overflow: the
  *            determinant of the differences is evaluated exactly with
@@ -18,7 +26,7 @@
  *            |m| < 2^53, so scaling all coordinates by 2^-kmin makes them
  *            integers, and the determinant is evaluated in GMP integers.
  *
- * Both stages compute the same polynomial as the filters, so the sign
+ * All three compute the same polynomial as the filters, so the sign
  * conventions carry over unchanged.
  */
 #include "predicates.h"
@@ -443,6 +451,373 @@ static int insphere_stage_g(const double *a, const double *b, const double *c,
 }
 
 /* ------------------------------------------------------------------ */
+/* The adaptive stage, between the filters and stages B/C.
+ *
+ * Why: points near but not exactly on a common sphere or plane whose
+ * coordinate differences are inexact (points rounded onto a sphere or
+ * printed to 12 digits, rotated lattices) fail the filters, whose bounds
+ * are of order eps times the permanent, and stage B refuses them, so they
+ * went to GMP at 1-3 us a call (bench/NOTES.md, "Open leads"). Their
+ * determinants are typically of order eps times the permanent, far above
+ * eps^2 times it, which this stage resolves without GMP.
+ *
+ * Method. Each coordinate difference is x = r + t, r = fl(x) the rounded
+ * difference and t its tail from Two-Diff (exact; |t| <= eps |r| since the
+ * rounding error of a normal result is at most half an ulp of it). The
+ * determinant F (orient3d's det3, insphere's det4, degree d = 3 or 5) is a
+ * sum of monomials, each a product of d differences, so
+ *   F(r + t) = F(r) + T1 + R2,
+ * T1 = dF(r)[t] the terms with exactly one tail, R2 those with two or
+ * more. The stage evaluates F(r) in double-word arithmetic (hi + lo pairs,
+ * error of order eps^2), T1 in plain doubles (T1 is itself of order eps),
+ * drops R2, and decides when z = fl(hi + fl(lo + T1)) exceeds the bound
+ * fl(C perm) in magnitude, perm the filter's permanent of r; otherwise it
+ * defers to stage B or C. It never answers 0.
+ *
+ * Admission: no point shares a coordinate with a (orient3d) or e
+ * (insphere), a cheap test for grids, whose near-degeneracies are exact
+ * zeros (shares_coordinate); stage B's range (coordinates 0 or of
+ * magnitude in [2^-300, 2^300] for orient3d, [2^-150, 2^150] for
+ * insphere); and perm >= 2^-800 (so fl(C perm) is normal). Stage B's
+ * argument applies to everything below: differences, tails, Veltkamp
+ * halves, the tails of Two-Sum and Two-Product and every rounded result
+ * are multiples of 2^(-k(lo+52)) for a value of degree k <= d (rounding a
+ * multiple of 2^-m to a double keeps it one), hence of 2^-1056 resp.
+ * 2^-1010, and below 2^910 resp. 2^770. So nothing overflows, every split
+ * operand is below 2^995, and nothing is lost to underflow (a result below
+ * 2^-1022 is then a multiple of 2^-1074 with fewer than 53 bits: exact).
+ * Every operation obeys fl(x op y) = (x op y)(1 + delta), |delta| <= eps,
+ * and Two-Sum, Fast-Two-Sum (|a| >= |b|) and Two-Product are exact.
+ *
+ * Error accounting. Give each computed X^ of a polynomial X its formal
+ * permanent P_X: |leaf| at a leaf, P_X + P_Y for X +- Y, P_X P_Y for X Y
+ * (the sum of |monomials| of the expression as written; for F(r) it is
+ * what perm computes, before rounding). If |X^ - X| <= a_X P_X, an
+ * operation whose own error is at most c (|X^| + |Y^|) (sums) or c |X^ Y^|
+ * (products) gives, as |X^| <= (1 + a_X) P_X,
+ *   sum:     1 + a_Z <= (1 + max(a_X, a_Y)) (1 + c),
+ *   product: 1 + a_Z <= (1 + a_X) (1 + a_Y) (1 + c).
+ * So a_F <= exp(K) - 1 with K the largest sum of c along the expression, a
+ * product adding both operands' sums. Plain roundings have c = eps, and
+ * a <= (1 + eps)^n - 1 with n counted as in the filters. A value within
+ * eps (1 + 16 eps) P_X of X counts as one rounding (the hi part of a
+ * double word X^ whose a_X is below 15 eps^2: |lo| <= eps |hi|).
+ *
+ * Double words x = xh + xl, always normalized (|xl| <= eps |xh|: each is
+ * the output of an exact transformation):
+ *   dw_add: Two-Sum(xh, yh) = s + e, t = fl(e + fl(xl + yl)),
+ *     Two-Sum(s, t) (t may exceed s after cancellation). Errors:
+ *     eps (|xl| + |yl|) <= eps^2 (|xh| + |yh|) and
+ *     eps (|e| + |fl(xl + yl)|) <= eps^2 (2 + eps)(|xh| + |yh|); with
+ *     |xh| <= |x| / (1 - eps): c <= (3 + eps) eps^2 / (1 - eps).
+ *   dw_scale (a double x times y): Two-Product(x, yh) = p + q,
+ *     t = fl(q + fl(x yl)), Fast-Two-Sum(p, t) (|t| < 3 eps |p|). Errors
+ *     eps^2 |x yh| and eps^2 (2 + eps) |x yh|: c <= (3 + eps) eps^2 / (1 - eps).
+ *   dw_mul: Two-Product(xh, yh) = p + q,
+ *     t = fl(q + fl(fl(xh yl) + fl(xl yh))), Fast-Two-Sum(p, t), xl yl
+ *     dropped. Errors, times |xh yh| <= |x y| / (1 - eps)^2: eps^2
+ *     (dropped), eps^2 twice (products), 2 eps^2 (1 + eps) (inner sum),
+ *     eps^2 (1 + 2 (1 + eps)^2) (outer sum): c <= 8.0001 eps^2.
+ * Below, K counts c = 3 for dw_add and dw_scale and 8 for dw_mul; the
+ * true constants exceed these by a factor below 1 + 2^-40.
+ *
+ * The remainder: with |t| <= eps |r| factor by factor, a monomial's terms
+ * with two or more tails sum to at most ((1 + eps)^d - 1 - d eps) times
+ * |monomial of r|: |R2| <= (3 eps^2 + eps^3) P (orient3d),
+ * <= (10 eps^2 + 10 eps^3 + ...) P (insphere), P the exact permanent. T1's
+ * monomials are F's with one factor replaced by its tail, so its formal
+ * permanent is at most d eps P whenever T1 is written as below (each
+ * 3x3 determinant's derivative as the sum over its rows of
+ * tail . (cross product of the other two rows): the six Leibniz terms with
+ * that row's factor replaced; the lift's derivative 2 X . t_X: the two
+ * places for the tail in X_k X_k).
+ *
+ * The last two roundings: w = fl(lo + T1^) errs by at most
+ * eps (|lo| + |T1^|), and z = fl(hi + w) by at most eps |z| / (1 - eps).
+ * If |F - z| <= E + eps |z| / (1 - eps), then z > E (1 - eps)/(1 - 2 eps)
+ * implies F > 0 (and z < -that, F < 0). perm, nonnegative terms rounded n
+ * times, is at least (1 - eps)^n P, and fl(C perm) >= C perm (1 - eps).
+ *
+ * orient3d, F = u . (v x w), rows u, v, w = b-a, c-a, d-a:
+ *   F(r): minors of v, w (two exact products, dw_add: K = 3), scaled by
+ *   u's components (K = 6), two dw_adds (K = 12): 12.01 eps^2 P.
+ *   T1 = t_u . (v x w) + t_v . (w x u) + t_w . (u x v): crossed products
+ *   2 roundings (v x w: the minors' hi parts, fewer), times a tail 1, dot
+ *   product 2, outer sum 2: n = 7, error <= 7.01 eps * 3 eps P.
+ *   R2 <= 3.01 eps^2 P; w: eps (1.01 eps + 3.01 eps) P.
+ *   E = (12.01 + 21.03 + 3.01 + 4.02) eps^2 P = 40.07 eps^2 P; perm has
+ *   n = 5: C = 40.07 eps^2 (1 + 8 eps) < 41 eps^2 = FDT_O3D_ADAPT_ERRBOUND.
+ * insphere, F = det4 of the filter (rows A..D = a-e .. d-e):
+ *   F(r): xy minors K = 3; 3x3 minors (scaled: 6, two dw_adds: 12);
+ *   lifts (three exact squares, two dw_adds: 6); lift times minor
+ *   (dw_mul: 6 + 12 + 8 = 26); two levels of dw_add: K = 32,
+ *   32.01 eps^2 P.
+ *   T1 = (tD - tC) + (tB - tA), tX = dL M + L dM for row X with lift L and
+ *   3x3 minor M (their double words' hi parts: one rounding each),
+ *   dL = 2 X . t_X, dM as above from the six pairwise cross products of
+ *   A..D. Roundings: cross product 2, times a tail 1, dot 2, sum of three
+ *   dots 2, times L 1 + 1: 9 (dL M: 3 + 1 + 1 = 5); tX 1; outer sums 2:
+ *   n = 12, error <= 12.01 eps * 5 eps P.
+ *   R2 <= 10.01 eps^2 P; w: eps (1.01 eps + 5.01 eps) P.
+ *   E = (32.01 + 60.05 + 10.01 + 6.02) eps^2 P = 108.09 eps^2 P; perm has
+ *   n = 11: C = 108.09 eps^2 (1 + 14 eps) < 109 eps^2 =
+ *   FDT_ISP_ADAPT_ERRBOUND.
+ * tests/test_predicates.c checks that calls whose |F| lies just inside
+ * the bound defer and just outside it are decided.
+ */
+
+/* A double word hi + lo, |lo| <= eps |hi|. */
+typedef struct dword {
+    double hi, lo;
+} dword;
+
+/* A double and its Veltkamp halves: a coordinate difference takes part in
+ * many products, and is split once. (With a hardware FMA the halves are
+ * unused.) */
+typedef struct sdouble {
+    double v, hi, lo;
+} sdouble;
+
+static inline sdouble split_once(double a)
+{
+    sdouble s = {a, a, 0.0};
+#if !defined(__FP_FAST_FMA)
+    split(a, &s.hi, &s.lo);
+#endif
+    return s;
+}
+
+/* a b exactly, as a double word (Two-Product on split operands). */
+static inline dword prod_s(sdouble a, sdouble b)
+{
+    double p = a.v * b.v;
+#if defined(__FP_FAST_FMA)
+    return (dword){p, __builtin_fma(a.v, b.v, -p)};
+#else
+    double err1 = p - a.hi * b.hi;
+    double err2 = err1 - a.lo * b.hi;
+    double err3 = err2 - a.hi * b.lo;
+    return (dword){p, a.lo * b.lo - err3};
+#endif
+}
+
+static inline dword dw_add(dword x, dword y)
+{
+    double s, e, h, l;
+    two_sum(x.hi, y.hi, &s, &e);
+    double t = e + (x.lo + y.lo);
+    two_sum(s, t, &h, &l);
+    return (dword){h, l};
+}
+
+static inline dword dw_sub(dword x, dword y)
+{
+    return dw_add(x, (dword){-y.hi, -y.lo});
+}
+
+static inline dword dw_scale(sdouble x, dword y)
+{
+    dword p = prod_s(x, split_once(y.hi));
+    double t = p.lo + x.v * y.lo;
+    double h, l;
+    fast_two_sum(p.hi, t, &h, &l);
+    return (dword){h, l};
+}
+
+static inline dword dw_mul(dword x, dword y)
+{
+    dword p = prod_s(split_once(x.hi), split_once(y.hi));
+    double t = p.lo + (x.hi * y.lo + x.lo * y.hi);
+    double h, l;
+    fast_two_sum(p.hi, t, &h, &l);
+    return (dword){h, l};
+}
+
+/* |x|^2: three exact squares, two dw_adds. */
+static inline dword dw_lift(const sdouble *x)
+{
+    return dw_add(dw_add(prod_s(x[0], x[0]), prod_s(x[1], x[1])), prod_s(x[2], x[2]));
+}
+
+/* Whether one of the n points p[i] shares a coordinate with q (then a
+ * difference component is 0; the test comes first, as it is cheap):
+ * axis-aligned input (grids), whose near-degeneracies are exact zeros (a
+ * grid cell's corners are cospherical, its faces' points coplanar) that
+ * the adaptive stage can only defer. On `tests/gen_points cfdgrid 20000 1`,
+ * serial, the calls that left the filters with such a component were
+ * exact zeros but for 102 of 676,921 orient3d and 655 of 238,504 insphere
+ * calls, and running the stage on them cost 14 % of the run's
+ * instructions (callgrind). Corners of rotated lattice cubes and points
+ * rounded onto a sphere share no coordinate. */
+static inline bool shares_coordinate(const double *const *p, int n, const double *q)
+{
+    bool s = false;
+    for (int i = 0; i < n; i++)
+        s = s || p[i][0] == q[0] || p[i][1] == q[1] || p[i][2] == q[2];
+    return s;
+}
+
+/* Rounded differences r = fl(p - q) and their tails t (exact). Returns
+ * whether any tail is nonzero. */
+static inline bool diff_tails(const double *p, const double *q, double *r, double *t)
+{
+    for (int k = 0; k < 3; k++)
+        two_diff(p[k], q[k], &r[k], &t[k]);
+    return t[0] != 0.0 || t[1] != 0.0 || t[2] != 0.0;
+}
+
+static inline double dot3(const double *x, const double *y)
+{
+    return (x[0] * y[0] + x[1] * y[1]) + x[2] * y[2];
+}
+
+static inline void cross3(const double *x, const double *y, double *z)
+{
+    z[0] = x[1] * y[2] - x[2] * y[1];
+    z[1] = x[2] * y[0] - x[0] * y[2];
+    z[2] = x[0] * y[1] - x[1] * y[0];
+}
+
+/* +1 / -1 when |z| > bound proves the sign of F, FDT_PRED_UNSURE else. */
+static inline int adapt_sign(dword f, double t1, double bound)
+{
+    const double z = f.hi + (f.lo + t1);
+    if (z > bound)
+        return 1;
+    if (z < -bound)
+        return -1;
+    return FDT_PRED_UNSURE;
+}
+
+int fdt_orient3d_adapt(const double *a, const double *b, const double *c,
+                       const double *d)
+{
+    const double *const rows[3] = {b, c, d};
+    if (shares_coordinate(rows, 3, a))
+        return FDT_PRED_UNSURE;
+    const double lo = 0x1p-300, hi = 0x1p+300;
+    if (!(coords_in_range(a, lo, hi) && coords_in_range(b, lo, hi) &&
+          coords_in_range(c, lo, hi) && coords_in_range(d, lo, hi)))
+        return FDT_PRED_UNSURE;
+    double u[3], v[3], w[3], ut[3], vt[3], wt[3];
+    bool tails = diff_tails(b, a, u, ut);
+    tails = diff_tails(c, a, v, vt) || tails;
+    tails = diff_tails(d, a, w, wt) || tails;
+    /* As in fdt_orient3d_filter_diff (the same association). */
+    const double perm = fabs(u[0]) * (fabs(v[1] * w[2]) + fabs(v[2] * w[1])) +
+                        fabs(u[1]) * (fabs(v[2] * w[0]) + fabs(v[0] * w[2])) +
+                        fabs(u[2]) * (fabs(v[0] * w[1]) + fabs(v[1] * w[0]));
+    if (!(perm >= 0x1p-800))
+        return FDT_PRED_UNSURE;
+    sdouble sv[3], sw[3];
+    for (int k = 0; k < 3; k++) {
+        sv[k] = split_once(v[k]);
+        sw[k] = split_once(w[k]);
+    }
+    const dword mx = dw_sub(prod_s(sv[1], sw[2]), prod_s(sv[2], sw[1]));
+    const dword my = dw_sub(prod_s(sv[2], sw[0]), prod_s(sv[0], sw[2]));
+    const dword mz = dw_sub(prod_s(sv[0], sw[1]), prod_s(sv[1], sw[0]));
+    const dword f = dw_add(dw_add(dw_scale(split_once(u[0]), mx), dw_scale(split_once(u[1]), my)),
+                           dw_scale(split_once(u[2]), mz));
+    double t1 = 0.0;
+    if (tails) {
+        const double vw[3] = {mx.hi, my.hi, mz.hi};
+        double wu[3], uv[3];
+        cross3(w, u, wu);
+        cross3(u, v, uv);
+        t1 = (dot3(ut, vw) + dot3(vt, wu)) + dot3(wt, uv);
+    }
+    return adapt_sign(f, t1, FDT_O3D_ADAPT_ERRBOUND * perm);
+}
+
+int fdt_insphere_adapt(const double *a, const double *b, const double *c,
+                       const double *d, const double *e)
+{
+    const double *const rows[4] = {a, b, c, d};
+    if (shares_coordinate(rows, 4, e))
+        return FDT_PRED_UNSURE;
+    const double lo = 0x1p-150, hi = 0x1p+150;
+    if (!(coords_in_range(a, lo, hi) && coords_in_range(b, lo, hi) &&
+          coords_in_range(c, lo, hi) && coords_in_range(d, lo, hi) &&
+          coords_in_range(e, lo, hi)))
+        return FDT_PRED_UNSURE;
+    double A[3], B[3], C[3], D[3], At[3], Bt[3], Ct[3], Dt[3];
+    bool tails = diff_tails(a, e, A, At);
+    tails = diff_tails(b, e, B, Bt) || tails;
+    tails = diff_tails(c, e, C, Ct) || tails;
+    tails = diff_tails(d, e, D, Dt) || tails;
+
+    /* perm, as in fdt_insphere_filter_diff (the same association). */
+    const double abP = fabs(A[0] * B[1]) + fabs(B[0] * A[1]);
+    const double bcP = fabs(B[0] * C[1]) + fabs(C[0] * B[1]);
+    const double cdP = fabs(C[0] * D[1]) + fabs(D[0] * C[1]);
+    const double daP = fabs(D[0] * A[1]) + fabs(A[0] * D[1]);
+    const double acP = fabs(A[0] * C[1]) + fabs(C[0] * A[1]);
+    const double bdP = fabs(B[0] * D[1]) + fabs(D[0] * B[1]);
+    const double azP = fabs(A[2]), bzP = fabs(B[2]), czP = fabs(C[2]), dzP = fabs(D[2]);
+    const double abcP = azP * bcP + bzP * acP + czP * abP;
+    const double bcdP = bzP * cdP + czP * bdP + dzP * bcP;
+    const double cdaP = czP * daP + dzP * acP + azP * cdP;
+    const double dabP = dzP * abP + azP * bdP + bzP * daP;
+    const double alP = A[0] * A[0] + A[1] * A[1] + A[2] * A[2];
+    const double blP = B[0] * B[0] + B[1] * B[1] + B[2] * B[2];
+    const double clP = C[0] * C[0] + C[1] * C[1] + C[2] * C[2];
+    const double dlP = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+    const double perm = (dlP * abcP + clP * dabP) + (blP * cdaP + alP * bcdP);
+    if (!(perm >= 0x1p-800))
+        return FDT_PRED_UNSURE;
+
+    sdouble sA[3], sB[3], sC[3], sD[3];
+    for (int k = 0; k < 3; k++) {
+        sA[k] = split_once(A[k]);
+        sB[k] = split_once(B[k]);
+        sC[k] = split_once(C[k]);
+        sD[k] = split_once(D[k]);
+    }
+    const dword ab = dw_sub(prod_s(sA[0], sB[1]), prod_s(sB[0], sA[1]));
+    const dword bc = dw_sub(prod_s(sB[0], sC[1]), prod_s(sC[0], sB[1]));
+    const dword cd = dw_sub(prod_s(sC[0], sD[1]), prod_s(sD[0], sC[1]));
+    const dword da = dw_sub(prod_s(sD[0], sA[1]), prod_s(sA[0], sD[1]));
+    const dword ac = dw_sub(prod_s(sA[0], sC[1]), prod_s(sC[0], sA[1]));
+    const dword bd = dw_sub(prod_s(sB[0], sD[1]), prod_s(sD[0], sB[1]));
+    const dword abc = dw_add(dw_sub(dw_scale(sA[2], bc), dw_scale(sB[2], ac)), dw_scale(sC[2], ab));
+    const dword bcd = dw_add(dw_sub(dw_scale(sB[2], cd), dw_scale(sC[2], bd)), dw_scale(sD[2], bc));
+    const dword cda = dw_add(dw_add(dw_scale(sC[2], da), dw_scale(sD[2], ac)), dw_scale(sA[2], cd));
+    const dword dab = dw_add(dw_add(dw_scale(sD[2], ab), dw_scale(sA[2], bd)), dw_scale(sB[2], da));
+    const dword al = dw_lift(sA), bl = dw_lift(sB), cl = dw_lift(sC), dl = dw_lift(sD);
+    const dword f = dw_add(dw_sub(dw_mul(dl, abc), dw_mul(cl, dab)),
+                           dw_sub(dw_mul(bl, cda), dw_mul(al, bcd)));
+
+    double t1 = 0.0;
+    if (tails) {
+        /* Each 3x3 minor is, in turn, every one of its rows dotted with
+         * the cross product of the two that follow it cyclically:
+         * abc = A.(BxC) = B.(CxA) = C.(AxB), dab = D.(AxB) = A.(BxD) =
+         * B.(DxA), cda = C.(DxA) = -D.(CxA) = A.(CxD), bcd = B.(CxD) =
+         * -C.(BxD) = D.(BxC); its derivative puts the tail in each row. */
+        double AB[3], BC[3], CA[3], DA[3], BD[3], CD[3];
+        cross3(A, B, AB);
+        cross3(B, C, BC);
+        cross3(C, A, CA);
+        cross3(D, A, DA);
+        cross3(B, D, BD);
+        cross3(C, D, CD);
+        const double dabc = (dot3(At, BC) + dot3(Bt, CA)) + dot3(Ct, AB);
+        const double ddab = (dot3(Dt, AB) + dot3(At, BD)) + dot3(Bt, DA);
+        const double dcda = (dot3(Ct, DA) - dot3(Dt, CA)) + dot3(At, CD);
+        const double dbcd = (dot3(Bt, CD) - dot3(Ct, BD)) + dot3(Dt, BC);
+        const double tD = 2.0 * dot3(D, Dt) * abc.hi + dl.hi * dabc;
+        const double tC = 2.0 * dot3(C, Ct) * dab.hi + cl.hi * ddab;
+        const double tB = 2.0 * dot3(B, Bt) * cda.hi + bl.hi * dcda;
+        const double tA = 2.0 * dot3(A, At) * bcd.hi + al.hi * dbcd;
+        t1 = (tD - tC) + (tB - tA);
+    }
+    /* det4 > 0: e outside, CGAL sign -1. */
+    const int s = adapt_sign(f, t1, FDT_ISP_ADAPT_ERRBOUND * perm);
+    return s == FDT_PRED_UNSURE ? s : -s;
+}
+
+/* ------------------------------------------------------------------ */
 /* orient3d, exact stages. */
 
 static int orient_stage_b(const double *u, const double *v, const double *w)
@@ -580,6 +955,12 @@ int fdt_orient3d(const double *a, const double *b, const double *c,
     s = orient3d_filter_rescaled(a, b, c, d);
     if (s != FDT_PRED_UNSURE)
         return s;
+    s = fdt_orient3d_adapt(a, b, c, d);
+    if (s != FDT_PRED_UNSURE) {
+        if (cnt)
+            cnt->orient_adapt++;
+        return s;
+    }
     return fdt_orient3d_exact(a, b, c, d, cnt);
 }
 
@@ -775,6 +1156,12 @@ int fdt_insphere(const double *a, const double *b, const double *c,
     s = insphere_filter_rescaled(a, b, c, d, e);
     if (s != FDT_PRED_UNSURE)
         return s;
+    s = fdt_insphere_adapt(a, b, c, d, e);
+    if (s != FDT_PRED_UNSURE) {
+        if (cnt)
+            cnt->insphere_adapt++;
+        return s;
+    }
     return fdt_insphere_exact(a, b, c, d, e, cnt);
 }
 

@@ -11,9 +11,11 @@
  *       (CGAL side_of_oriented_sphere: ON_POSITIVE_SIDE is +1).
  *
  * Every function is exact for all finite doubles: a floating-point filter
- * with a proven error bound decides most calls; the rest are evaluated
- * exactly (expansion arithmetic when no intermediate can underflow, GMP
- * integers otherwise). No global mutable state; thread-safe.
+ * with a proven error bound decides most calls; an adaptive stage with a
+ * bound of order eps^2 most of the rest (near-degenerate inputs); the
+ * remainder, exact zeros among them, are evaluated exactly (expansion
+ * arithmetic when no intermediate can underflow, GMP integers otherwise).
+ * No global mutable state; thread-safe.
  *
  * The filters are static inline below (the hot path, called tens of
  * millions of times); the exact stages are out of line in
@@ -31,10 +33,14 @@
 #include <stddef.h>
 
 /* Counters of calls that left the filter; per thread, owned by the caller.
- * May be NULL everywhere below. */
+ * May be NULL everywhere below. *_exact: calls that reached an exact
+ * stage (B or C); *_adapt: calls the adaptive stage decided, which then
+ * need no exact arithmetic (the two are disjoint). */
 typedef struct fdt_pred_counts {
     size_t orient_exact;
     size_t insphere_exact;
+    size_t orient_adapt;
+    size_t insphere_adapt;
 } fdt_pred_counts;
 
 int fdt_orient3d(const double *a, const double *b, const double *c,
@@ -86,13 +92,33 @@ int fdt_insphere_exact(const double *a, const double *b, const double *c,
                        const double *d, const double *e, fdt_pred_counts *cnt);
 
 /*
+ * The adaptive stage alone (src/predicates.c, between the filters and the
+ * exact stages): +1 / -1 when it can prove the sign (same conventions as
+ * fdt_orient3d / fdt_insphere), FDT_PRED_UNSURE otherwise, and always
+ * FDT_PRED_UNSURE for coordinates outside its range (stage B's) or when a
+ * point shares a coordinate with a (orient3d) or e (insphere). It never
+ * returns 0 and counts nothing. Exposed for tests.
+ */
+int fdt_orient3d_adapt(const double *a, const double *b, const double *c,
+                       const double *d);
+int fdt_insphere_adapt(const double *a, const double *b, const double *c,
+                       const double *d, const double *e);
+
+/*
  * Error-bound constants of the filters (derivations at the filters).
  * eps = 2^-53 is the unit roundoff.
  *   FDT_O3D_ERRBOUND = 8 eps (1 + 2^-12)
  *   FDT_ISP_ERRBOUND = 16 eps (1 + 2^-12)
+ * And of the adaptive stage (derivation in src/predicates.c): it decides
+ * when |estimate| > bound = fl(C perm), perm the filter's permanent of the
+ * rounded differences, computed as in the filters below.
+ *   FDT_O3D_ADAPT_ERRBOUND = 41 eps^2
+ *   FDT_ISP_ADAPT_ERRBOUND = 109 eps^2
  */
 #define FDT_O3D_ERRBOUND 0x1.001p-50
 #define FDT_ISP_ERRBOUND 0x1.001p-49
+#define FDT_O3D_ADAPT_ERRBOUND 0x1.48p-101
+#define FDT_ISP_ADAPT_ERRBOUND 0x1.b4p-100
 
 /*
  * Floating-point filter for orient3d: +1 or -1 when that is certainly the

@@ -613,7 +613,7 @@ static void test_set(pts p, int extra)
     meshset ref = engine_mesh(&pp);
     double t1 = now_s();
     fdt_ins m;
-    fdt_pred_counts cnt = {0, 0};
+    fdt_pred_counts cnt = {0};
     CHECK_EQ(fdt_ins_build(&m, pp.pr.p, 0, pp.m, &cnt), FDT_OK);
     double t2 = now_s();
     t_engine += t1 - t0;
@@ -774,7 +774,7 @@ static int time_file(const char *path, int reps)
     if (reps > 64)
         reps = 64;
     fdt_ins m;
-    fdt_pred_counts cnt = {0, 0};
+    fdt_pred_counts cnt = {0};
     for (int r = 0; r < reps; r++) {
         memset(&cnt, 0, sizeof cnt);
         double a = now_s(), ca = cpu_now();

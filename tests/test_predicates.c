@@ -43,7 +43,14 @@
  * scripts/mutants_issue20.py checks that each of them catches the fault it
  * is built for.
  *
- * Ends with a micro-benchmark (ns per call), printed, not checked.
+ * The adaptive stage (between the filters and the exact stages):
+ * near-degenerate inputs with inexact differences (rotated lattice cubes,
+ * points rounded onto a sphere, 12-digit sphere points) against the
+ * reference, how many of them it decides (the counters), and a bound test
+ * (inputs just inside the documented bound defer, just outside are
+ * decided).
+ *
+ * Ends with micro-benchmarks (ns per call), printed, not checked.
  * Usage: test_predicates [seed [scale [verbose]]]; scale multiplies the
  * case counts (e.g. 0.05 under valgrind, 10 for a long run).
  */
@@ -1049,10 +1056,14 @@ static int filter_of(int insphere, double (*p)[3])
  * (counted in cnt). */
 static int full_pred(tctx *T, int insphere, double (*p)[3], int *counted)
 {
-    size_t before = insphere ? T->cnt.insphere_exact : T->cnt.orient_exact;
+    /* Leaving the filters means reaching the adaptive stage (counted when
+     * it decides) or the exact stages (counted when they do). */
+    size_t before = insphere ? T->cnt.insphere_exact + T->cnt.insphere_adapt
+                             : T->cnt.orient_exact + T->cnt.orient_adapt;
     int s = insphere ? fdt_insphere(p[0], p[1], p[2], p[3], p[4], &T->cnt)
                      : fdt_orient3d(p[0], p[1], p[2], p[3], &T->cnt);
-    *counted = (insphere ? T->cnt.insphere_exact : T->cnt.orient_exact) != before;
+    *counted = (insphere ? T->cnt.insphere_exact + T->cnt.insphere_adapt
+                         : T->cnt.orient_exact + T->cnt.orient_adapt) != before;
     return s;
 }
 
@@ -1820,7 +1831,7 @@ enum { BENCH_NP = 4096, BENCH_MASK = BENCH_NP - 1 };
 static double bench_one(int which, const double (*P)[3], int n, long *acc)
 {
     double best = INFINITY;
-    fdt_pred_counts cnt = {0, 0};
+    fdt_pred_counts cnt = {0};
     for (int round = 0; round < 3; round++) {
         double t0 = cpu_s();
         long s = 0;
@@ -1882,6 +1893,426 @@ static void bench(tctx *T)
     free(P);
     free(L);
     free(M);
+}
+
+/* ------------------------------------------------------------------ */
+/* The adaptive stage (src/predicates.c, between the filters and the
+ * exact stages B/C). */
+
+/* Rotation by (0.3, 0.5, 0.7) rad about x, then y, then z, in doubles. */
+static void rotate_xyz(const double *p, double *q)
+{
+    const double cx = cos(0.3), sx = sin(0.3), cy = cos(0.5), sy = sin(0.5);
+    const double cz = cos(0.7), sz = sin(0.7);
+    double x = p[0], y = p[1] * cx - p[2] * sx, z = p[1] * sx + p[2] * cx;
+    double x2 = x * cy + z * sy, z2 = -x * sy + z * cy;
+    q[0] = x2 * cz - y * sz;
+    q[1] = x2 * sz + y * cz;
+    q[2] = z2;
+}
+
+/* Five distinct corners of a random unit cube of the 20^3 lattice,
+ * rotated: all eight corners are cospherical and each face coplanar, up
+ * to the rounding of the rotation (inexact differences). */
+static void gen_rotated_cube(tctx *T, double (*p)[3])
+{
+    const double base[3] = {(double)irand(T, 0, 18), (double)irand(T, 0, 18),
+                            (double)irand(T, 0, 18)};
+    int used = 0;
+    for (int i = 0; i < 5; i++) {
+        int c;
+        do
+            c = (int)irand(T, 0, 7);
+        while (used & (1 << c));
+        used |= 1 << c;
+        const double q[3] = {base[0] + (c & 1), base[1] + ((c >> 1) & 1), base[2] + (c >> 2)};
+        rotate_xyz(q, p[i]);
+    }
+}
+
+/* Points on a sphere of radius 100 about (0.3, -0.2, 0.1): a random
+ * direction normalised in doubles and scaled, so cospherical only within
+ * rounding; with digits > 0 each coordinate is then printed to that many
+ * significant digits and read back (as from a text file). The first four
+ * lie in a small cap (a flat tet, as the faces of a fine sphere mesh
+ * give), the fifth in the same cap or anywhere on the sphere. */
+static void gen_sphere_cap(tctx *T, double (*p)[3], int digits)
+{
+    static const double caps[] = {0.01, 0.001, 0.0001};
+    const double ctr[3] = {0.3, -0.2, 0.1}, cap = caps[irand(T, 0, 2)];
+    double axis[3];
+    for (int k = 0; k < 3; k++)
+        axis[k] = sunif(T);
+    const int far = (int)irand(T, 0, 1);
+    for (int i = 0; i < 5; i++) {
+        double v[3], n;
+        for (int k = 0; k < 3; k++)
+            v[k] = i == 4 && far ? sunif(T) : axis[k] + cap * sunif(T);
+        n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        for (int k = 0; k < 3; k++) {
+            p[i][k] = ctr[k] + 100.0 * (v[k] / n);
+            if (digits > 0) {
+                char buf[64];
+                snprintf(buf, sizeof buf, "%.*g", digits, p[i][k]);
+                p[i][k] = strtod(buf, NULL);
+            }
+        }
+    }
+}
+
+/* The adaptive stage alone against the reference on the calls of
+ * check_five: when it decides, its sign is the reference's. Adds to
+ * zeros[0] / zeros[1] the orient3d / insphere calls whose exact sign is 0
+ * (no stage short of the exact ones may decide those). */
+static void check_adapt(tctx *T, double (*p)[3], const char *what, long *zeros)
+{
+    int ro[2], ao[2];
+    for (int j = 0; j < 2; j++) {
+        ro[j] = ref_orient(T, p[j], p[j + 1], p[j + 2], p[j + 3]);
+        ao[j] = fdt_orient3d_adapt(p[j], p[j + 1], p[j + 2], p[j + 3]);
+        zeros[0] += ro[j] == 0;
+    }
+    int ri = ref_insphere(T, p[0], p[1], p[2], p[3], p[4]);
+    int ai = fdt_insphere_adapt(p[0], p[1], p[2], p[3], p[4]);
+    zeros[1] += ri == 0;
+    T->checks += 3;
+    if ((ao[0] != FDT_PRED_UNSURE && ao[0] != ro[0]) ||
+        (ao[1] != FDT_PRED_UNSURE && ao[1] != ro[1]) || (ai != FDT_PRED_UNSURE && ai != ri)) {
+        T->failures++;
+        if (T->failures <= 30) {
+            fprintf(stderr, "adaptive stage mismatch [%s]: orient ref %d %d adapt %d %d, "
+                    "insphere ref %d adapt %d\n", what, ro[0], ro[1], ao[0], ao[1], ri, ai);
+            print_pts((const double (*)[3])p, 5);
+        }
+    }
+}
+
+/*
+ * Near-degenerate inputs with inexact differences, the ones the stage is
+ * for: corners of a rotated lattice cube, points rounded onto a sphere,
+ * and sphere points printed to 12 digits. Each call is checked against
+ * the rational reference (fdt_*, the exact stages and the adaptive stage
+ * alone), and of the calls that left the filters the adaptive stage must
+ * decide at least 90 % (fdt_pred_counts), where each case's true sign is
+ * far above eps^2 times the permanent. Then the existing families (exact
+ * zeros, mixed magnitudes, subnormals, overflowing differences) through
+ * the adaptive stage alone: it must never contradict the reference.
+ */
+static void test_adapt_families(tctx *T, double scale, int verbose)
+{
+    static const char *const names[] = {"rotated-lattice", "sphere-rounded", "sphere-12-digits"};
+    double p[5][3];
+    for (int f = 0; f < 3; f++) {
+        const fdt_pred_counts c0 = T->cnt;
+        long fails = T->failures, zeros[2] = {0, 0};
+        const long count = (long)(4000 * scale) + 1;
+        for (long it = 0; it < count; it++) {
+            if (f == 0)
+                gen_rotated_cube(T, p);
+            else
+                gen_sphere_cap(T, p, f == 1 ? 0 : 12);
+            check_five(T, p, names[f]);
+            check_adapt(T, p, names[f], zeros);
+        }
+        const size_t oa = T->cnt.orient_adapt - c0.orient_adapt;
+        const size_t oe = T->cnt.orient_exact - c0.orient_exact;
+        const size_t ia = T->cnt.insphere_adapt - c0.insphere_adapt;
+        const size_t ie = T->cnt.insphere_exact - c0.insphere_exact;
+        if (verbose)
+            printf("  adaptive %-17s %6ld cases: orient3d %zu adaptive / %zu exact (%ld zero), "
+                   "insphere %zu adaptive / %zu exact (%ld zero), %ld failures\n",
+                   names[f], count, oa, oe, zeros[0], ia, ie, zeros[1], T->failures - fails);
+        /* Most insphere calls leave the filters here, and the lattice's
+         * coplanar faces send orient3d calls too. Exact zeros go to the
+         * exact stages (counted there); of the rest the adaptive stage
+         * decides nearly all. */
+        CHECK(T, ia + ie >= (size_t)(count / 4));
+        if (f == 0)
+            CHECK(T, oa + oe >= (size_t)(count / 10));
+        CHECK(T, 10 * ia >= 9 * (ia + ie - (size_t)zeros[1]));
+        CHECK(T, 10 * oa >= 9 * (oa + oe - (size_t)zeros[0]));
+    }
+    long zeros[2] = {0, 0};
+    for (size_t f = 0; f < sizeof families / sizeof families[0]; f++) {
+        const long count = (long)(families[f].count * scale / 4) + 1;
+        for (long it = 0; it < count; it++) {
+            families[f].gen(T, p);
+            check_adapt(T, p, families[f].name, zeros);
+        }
+    }
+}
+
+/* The permanents the adaptive stage compares with (src/predicates.h: the
+ * filters' perm of the rounded differences), recomputed here. */
+static double adapt_perm_orient(const double *a, const double *b, const double *c,
+                                const double *d)
+{
+    double u[3], v[3], w[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = b[k] - a[k];
+        v[k] = c[k] - a[k];
+        w[k] = d[k] - a[k];
+    }
+    double perm = 0.0;
+    for (int k = 0; k < 3; k++) {
+        int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+        perm += fabs(u[k]) * (fabs(v[k1] * w[k2]) + fabs(v[k2] * w[k1]));
+    }
+    return perm;
+}
+
+static double adapt_perm_insphere(const double *a, const double *b, const double *c,
+                                  const double *d, const double *e)
+{
+    const double *p[4] = {a, b, c, d};
+    double r[4][3];
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++)
+            r[i][k] = p[i][k] - e[k];
+    /* sum over rows i of |r_i|^2 times the permanent of the 3x3 minor of
+     * the other three rows */
+    double perm = 0.0;
+    for (int i = 0; i < 4; i++) {
+        const double *q[3];
+        for (int j = 0, m = 0; j < 4; j++)
+            if (j != i)
+                q[m++] = r[j];
+        double m3 = 0.0;
+        for (int k = 0; k < 3; k++) {
+            int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+            m3 += fabs(q[0][k]) * (fabs(q[1][k1] * q[2][k2]) + fabs(q[1][k2] * q[2][k1]));
+        }
+        perm += (r[i][0] * r[i][0] + r[i][1] * r[i][1] + r[i][2] * r[i][2]) * m3;
+    }
+    return perm;
+}
+
+/* |F| exactly, rounded to a double: the determinant of the difference
+ * rows (orient3d: b-a, c-a, d-a; insphere: p-e with the lift |p-e|^2),
+ * by Gaussian elimination over the rationals (n <= 4). */
+static double ref_abs_det_rows(tctx *T, const double *const *p, int n, const double *base,
+                               int lifted)
+{
+    mpq_t s;
+    mpq_init(s);
+    for (int i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++) {
+            mpq_set_d(T->q[i][k], p[i][k]);
+            mpq_set_d(s, base[k]);
+            mpq_sub(T->q[i][k], T->q[i][k], s);
+        }
+        if (lifted) {
+            mpq_set_ui(T->q[i][3], 0, 1);
+            for (int k = 0; k < 3; k++) {
+                mpq_mul(s, T->q[i][k], T->q[i][k]);
+                mpq_add(T->q[i][3], T->q[i][3], s);
+            }
+        }
+    }
+    double det = 1.0;
+    for (int k = 0; k < n && det != 0.0; k++) {
+        int piv = -1;
+        for (int i = k; i < n && piv < 0; i++)
+            if (mpq_sgn(T->q[i][k]) != 0)
+                piv = i;
+        if (piv < 0) {
+            det = 0.0;
+            break;
+        }
+        for (int j = 0; j < n; j++)
+            mpq_swap(T->q[k][j], T->q[piv][j]);
+        det *= fabs(mpq_get_d(T->q[k][k]));
+        for (int i = k + 1; i < n; i++) {
+            mpq_div(s, T->q[i][k], T->q[k][k]);
+            for (int j = k; j < n; j++) {
+                mpq_t m;
+                mpq_init(m);
+                mpq_mul(m, s, T->q[k][j]);
+                mpq_sub(T->q[i][j], T->q[i][j], m);
+                mpq_clear(m);
+            }
+        }
+    }
+    mpq_clear(s);
+    return det;
+}
+
+/* A random integer in [2^lo, 2^hi), as an mpz. */
+static void rand_mpz(tctx *T, mpz_t z, int lo, int hi)
+{
+    int bits = (int)irand(T, lo, hi - 1);
+    mpz_set_ui(z, 1);
+    mpz_mul_2exp(z, z, (mp_bitcnt_t)bits);
+    mpz_set_ui(T->t, (unsigned long)(next_u64(T) >> 11));
+    mpz_mul_2exp(T->t, T->t, (mp_bitcnt_t)(bits > 53 ? bits - 53 : 0));
+    if (bits < 53)
+        mpz_tdiv_q_2exp(T->t, T->t, (mp_bitcnt_t)(53 - bits));
+    mpz_add(z, z, T->t);
+}
+
+/* Bound-test inputs for orient3d: u = (p, q, 0), v = (r, s, 0) with
+ * p s - q r = 1, w = (x, y, 1), so det[u; v; w] = 1 while the permanent
+ * is about 2 p s; a = small offsets (below half an ulp of p), so most
+ * differences are inexact and the tails move F by O(1). */
+static void gen_bound_orient(tctx *T, double (*pt)[3], mpz_t *z)
+{
+    for (;;) {
+        rand_mpz(T, z[0], 49, 53); /* p */
+        rand_mpz(T, z[1], 49, 53); /* q */
+        if (mpz_invert(z[3], z[0], z[1]) != 0) /* s = p^-1 mod q */
+            break;
+    }
+    mpz_mul(z[2], z[0], z[3]); /* r = (p s - 1) / q */
+    mpz_sub_ui(z[2], z[2], 1);
+    mpz_divexact(z[2], z[2], z[1]);
+    const double p = mpz_get_d(z[0]), q = mpz_get_d(z[1]);
+    const double r = mpz_get_d(z[2]), s = mpz_get_d(z[3]);
+    for (int k = 0; k < 3; k++)
+        pt[0][k] = ldexp((double)irand(T, -(1L << 22), 1L << 22), -72);
+    const double b[3] = {p, q, 0}, c[3] = {r, s, 0};
+    const double d[3] = {(double)irand(T, -9, 9), (double)irand(T, -9, 9), 1};
+    memcpy(pt[1], b, sizeof b);
+    memcpy(pt[2], c, sizeof c);
+    memcpy(pt[3], d, sizeof d);
+}
+
+/* Bound-test inputs for insphere: rows (relative to e) A = (x1, 0, 0),
+ * B = (0, y1, 0), C = (0, 0, z1), D, so det4 = x1 y1 z1 g with
+ * g = |D|^2 - D . (x1, y1, z1); x1 and y1 solve Dx x1 + Dy y1 =
+ * |D|^2 - Dz z1 - k, so g = k is small while its terms are about 2^99.
+ * e = small offsets: the differences' tails move det4 by about itself. */
+static int gen_bound_insphere(tctx *T, double (*pt)[3], mpz_t *z)
+{
+    /* z[0..2] = D, z[3] = z1, z[4] = rhs, z[5] = x1, z[6] = y1 */
+    for (int k = 0; k < 3; k++)
+        rand_mpz(T, z[k], 48, 50);
+    rand_mpz(T, z[3], 48, 50);
+    if (mpz_invert(z[5], z[0], z[1]) == 0)
+        return 0;
+    mpz_mul(z[4], z[0], z[0]);
+    mpz_addmul(z[4], z[1], z[1]);
+    mpz_addmul(z[4], z[2], z[2]);
+    mpz_submul(z[4], z[2], z[3]);
+    long k = irand(T, -8, 8);
+    if (k >= 0)
+        mpz_sub_ui(z[4], z[4], (unsigned long)k);
+    else
+        mpz_add_ui(z[4], z[4], (unsigned long)-k);
+    mpz_mul(z[5], z[5], z[4]); /* x1 = rhs Dx^-1 mod Dy */
+    mpz_mod(z[5], z[5], z[1]);
+    mpz_set(z[6], z[4]); /* y1 = (rhs - Dx x1) / Dy */
+    mpz_submul(z[6], z[0], z[5]);
+    mpz_divexact(z[6], z[6], z[1]);
+    for (int i = 3; i < 7; i++)
+        if (i != 4 && (mpz_sgn(z[i]) == 0 || mpz_sizeinbase(z[i], 2) > 53))
+            return 0;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 3; j++)
+            pt[i][j] = 0.0;
+    pt[0][0] = mpz_get_d(z[5]);
+    pt[1][1] = mpz_get_d(z[6]);
+    pt[2][2] = mpz_get_d(z[3]);
+    for (int j = 0; j < 3; j++) {
+        pt[3][j] = mpz_get_d(z[j]);
+        pt[4][j] = ldexp((double)irand(T, -(1L << 22), 1L << 22), -74);
+    }
+    return 1;
+}
+
+/*
+ * The bound test: inputs whose exact |F| lies at 0.80-0.97 times the
+ * documented bound C perm (FDT_O3D_ADAPT_ERRBOUND,
+ * FDT_ISP_ADAPT_ERRBOUND) must defer, those at 1.03-1.20 times it must be
+ * decided, with the reference's sign. The stage's estimate is within a
+ * tiny fraction of the bound of F on these inputs (integers below 2^53,
+ * small tails), so the windows test the comparison itself: a bound
+ * smaller by a quarter decides the first window, a larger one defers the
+ * second. Each window must be hit often enough to mean something.
+ */
+static void test_adapt_bound(tctx *T, double scale, int verbose)
+{
+    mpz_t z[7];
+    for (int i = 0; i < 7; i++)
+        mpz_init(z[i]);
+    double pt[5][3];
+    long in[2] = {0, 0}, out[2] = {0, 0}, tried[2] = {0, 0};
+    const long need = (long)(60 * scale) + 3;
+    for (int which = 0; which < 2; which++) {
+        while ((in[which] < need || out[which] < need) && tried[which] < 4000 * need) {
+            tried[which]++;
+            double ratio;
+            int ref, got;
+            if (which == 0) {
+                gen_bound_orient(T, pt, z);
+                const double *rows[3] = {pt[1], pt[2], pt[3]};
+                ratio = ref_abs_det_rows(T, rows, 3, pt[0], 0) /
+                        (FDT_O3D_ADAPT_ERRBOUND * adapt_perm_orient(pt[0], pt[1], pt[2], pt[3]));
+                ref = ref_orient(T, pt[0], pt[1], pt[2], pt[3]);
+                got = fdt_orient3d_adapt(pt[0], pt[1], pt[2], pt[3]);
+            } else {
+                if (!gen_bound_insphere(T, pt, z))
+                    continue;
+                const double *rows[4] = {pt[0], pt[1], pt[2], pt[3]};
+                ratio = ref_abs_det_rows(T, rows, 4, pt[4], 1) /
+                        (FDT_ISP_ADAPT_ERRBOUND *
+                         adapt_perm_insphere(pt[0], pt[1], pt[2], pt[3], pt[4]));
+                ref = ref_insphere(T, pt[0], pt[1], pt[2], pt[3], pt[4]);
+                got = fdt_insphere_adapt(pt[0], pt[1], pt[2], pt[3], pt[4]);
+            }
+            if (ratio >= 0.80 && ratio <= 0.97 && in[which] < need) {
+                in[which]++;
+                CHECK(T, got == FDT_PRED_UNSURE);
+            } else if (ratio >= 1.03 && ratio <= 1.20 && out[which] < need) {
+                out[which]++;
+                CHECK(T, got == ref && ref != 0);
+            }
+        }
+        if (verbose)
+            printf("  adaptive bound %s: %ld inside, %ld outside, %ld tried\n",
+                   which ? "insphere" : "orient3d", in[which], out[which], tried[which]);
+        CHECK(T, in[which] == need && out[which] == need);
+    }
+    for (int i = 0; i < 7; i++)
+        mpz_clear(z[i]);
+}
+
+/* Micro-benchmark of the adaptive stage: ns per call on corners of
+ * rotated lattice cubes (every call leaves the filters), the adaptive
+ * stage alone against the exact stages alone (stage C here: inexact
+ * differences), CPU time, best of 3. Printed, not checked. */
+static void bench_adapt(tctx *T)
+{
+    enum { NCASE = 1024 };
+    double(*P)[5][3] = malloc(sizeof(double[5][3]) * NCASE);
+    if (!P)
+        return;
+    for (int i = 0; i < NCASE; i++)
+        gen_rotated_cube(T, P[i]);
+    double best[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+    long acc = 0;
+    for (int which = 0; which < 4; which++) {
+        const int n = which < 2 ? 1 << 18 : 1 << 13;
+        for (int round = 0; round < 3; round++) {
+            double t0 = cpu_s();
+            for (int i = 0; i < n; i++) {
+                double(*q)[3] = P[i & (NCASE - 1)];
+                switch (which) {
+                case 0: acc += fdt_orient3d_adapt(q[0], q[1], q[2], q[3]); break;
+                case 1: acc += fdt_insphere_adapt(q[0], q[1], q[2], q[3], q[4]); break;
+                case 2: acc += fdt_orient3d_exact(q[0], q[1], q[2], q[3], NULL); break;
+                default: acc += fdt_insphere_exact(q[0], q[1], q[2], q[3], q[4], NULL); break;
+                }
+            }
+            double t = (cpu_s() - t0) * 1e9 / n;
+            if (t < best[which])
+                best[which] = t;
+        }
+    }
+    printf("bench adaptive stage (ns/call, rotated lattice cube corners, CPU time, best of 3):\n"
+           "  adaptive alone: orient3d %.0f, insphere %.0f; exact stages alone: orient3d %.0f, "
+           "insphere %.0f  [checksum %ld]\n",
+           best[0], best[1], best[2], best[3], acc);
+    free(P);
 }
 
 /* ------------------------------------------------------------------ */
@@ -1959,6 +2390,8 @@ int main(int argc, char **argv)
     test_perturbed(&T, scale);
     test_triangulation(&T, scale);
     test_grid_stage(&T);
+    test_adapt_families(&T, scale, verbose);
+    test_adapt_bound(&T, scale, verbose);
     double t2 = now_s();
     test_bound_windows(&T, scale, verbose);
     test_degenerate_magnitudes(&T, scale, verbose);
@@ -1967,6 +2400,7 @@ int main(int argc, char **argv)
     test_lex_compare(&T, scale);
     double t3 = now_s();
     bench(&T);
+    bench_adapt(&T);
 
     printf("test_predicates: %ld checks, %ld failures (families %.2f s, perturbation %.2f s, "
            "issue-20 tests %.2f s)\n",
