@@ -9,6 +9,7 @@
 #include "frontdt.h"
 #include "front.h"
 #include "kdtree.h"
+#include "oracle.h"
 #include "parallel.h"
 #include "prepare.h"
 #include "result.h"
@@ -131,6 +132,13 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     if ((err = fdt_seed_check_dimension(pr.p, pr.orig, (uint32_t)pr.m, ctx->diag,
                                         sizeof ctx->diag)) != FDT_OK)
         goto fail;
+    /* AUTO with threads, and inputs where the kd search degenerates: one
+     * thread with the insertion mesh beats two parts today (src/oracle.h,
+     * fdt_oracle_probe). An explicit mode is kept as asked. */
+    if (ctx->s.mode == FDT_MODE_AUTO && mode != FDT_MODE_SERIAL &&
+        ctx->s.search == FDT_SEARCH_AUTO &&
+        fdt_oracle_probe(pr.p, (uint32_t)pr.m, ctx->s.leaf_size))
+        mode = FDT_MODE_SERIAL;
     double t1;
     fdt_front_stats fst;
     memset(&fst, 0, sizeof fst);

@@ -141,9 +141,11 @@ static int add_tet_faces(fdt_facetab *ft, fdt_faceq *fq, fdt_meshbuf *mb,
     return FDT_OK;
 }
 
-int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
-                     fdt_progress_fn progress, void *puser,
-                     fdt_front_stats *st)
+/* The serial front, stopped after max_faces faces (SIZE_MAX: the whole
+ * triangulation; fdt_front_probe: a few hundred). */
+static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
+                     fdt_progress_fn progress, void *puser, fdt_front_stats *st,
+                     size_t max_faces)
 {
     fdt_facetab ft;
     fdt_faceq fq;
@@ -172,7 +174,7 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
     double expect = 6.5 * (double)t->n + 1.0;
     size_t next_report = 1u << 16;
     uint32_t fv[3];
-    while (fdt_faceq_pop(&fq, fv)) {
+    while (st->faces_advanced < max_faces && fdt_faceq_pop(&fq, fv)) {
         /* the slot of the face 8 below the top of the current bucket:
          * a guess at a face that comes up soon (faces pushed meanwhile
          * come first), which costs one prefetch when wrong */
@@ -241,7 +243,7 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
             }
         }
     }
-    if (ft.count != 0)
+    if (ft.count != 0 && st->faces_advanced < max_faces)
         err = FDT_EINTERNAL;
 done:
     st->mesh_faces = orc.mesh_faces;
@@ -251,5 +253,22 @@ done:
     fdt_oracle_free(&orc);
     fdt_facetab_free(&ft);
     fdt_faceq_free(&fq);
+    return err;
+}
+
+int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
+                     fdt_progress_fn progress, void *puser, fdt_front_stats *st)
+{
+    return front_run(t, start, search, out, progress, puser, st, SIZE_MAX);
+}
+
+int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces, fdt_front_stats *st)
+{
+    fdt_meshbuf mb;
+    int err = fdt_meshbuf_init(&mb, 4 * faces + 64, 0);
+    if (err)
+        return err;
+    err = front_run(t, start, FDT_SEARCH_KD, &mb, NULL, NULL, st, faces);
+    fdt_meshbuf_free(&mb);
     return err;
 }

@@ -44,6 +44,11 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
                      fdt_progress_fn progress, void *puser,
                      fdt_front_stats *st);
 
+/* The kd search's first `faces` faces of the front over tree t, for their
+ * work counters in st only (the tets are dropped): what src/oracle.c's
+ * probe measures. */
+int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces, fdt_front_stats *st);
+
 /* The outward faces of a positively oriented tet: face i is opposite
  * vertex i and has that vertex on its negative side. */
 extern const int fdt_tet_face[4][3];

@@ -1,6 +1,9 @@
 /* The choice of apex oracle; see oracle.h and bench/NOTES.md, entry 51. */
 #include "oracle.h"
 
+#include "front.h"
+#include "seed.h"
+
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -153,4 +156,53 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
     o->mesh_faces++;
     o->star_walks++;
     return 1;
+}
+
+/*
+ * The probe (oracle.h). A sample, not all points: its tree costs a few
+ * milliseconds where the whole input's would cost a tenth of a second at
+ * 1M. The structures that make the kd search expensive (a surface, rings,
+ * lattice planes, cospherical shells) survive taking every k-th point, and
+ * the cost a face on them still grows with the points, so 32,768 of them
+ * show it: an exact cylinder of 100k points tests thousands of points a
+ * face, its every third point still over a thousand, uniform points ~90.
+ */
+#define PROBE_POINTS 32768
+#define PROBE_FACES 256
+
+int fdt_oracle_probe(const double *P, uint32_t m, int leaf_size)
+{
+    uint32_t stride = m > PROBE_POINTS ? m / PROBE_POINTS : 1;
+    uint32_t k = m / stride;
+    if (k < 4)
+        return 0;
+    double *S = malloc(3 * (size_t)k * sizeof *S);
+    fdt_vid *orig = malloc((size_t)k * sizeof *orig);
+    int expensive = 0;
+    fdt_kdtree t = {0};
+    if (!S || !orig)
+        goto done;
+    for (uint32_t i = 0; i < k; i++) {
+        memcpy(S + 3 * (size_t)i, P + 3 * (size_t)i * stride, 3 * sizeof *S);
+        orig[i] = (fdt_vid)i;
+    }
+    /* A flat sample has no tetrahedra to probe; the engine runs as asked. */
+    char diag[8];
+    if (fdt_seed_check_dimension(S, orig, k, diag, sizeof diag) != FDT_OK)
+        goto done;
+    if (fdt_kd_build(&t, S, orig, 0, k, leaf_size > 0 ? leaf_size : FDT_DEFAULT_LEAF) != FDT_OK)
+        goto done;
+    fdt_front_stats st;
+    memset(&st, 0, sizeof st);
+    if (fdt_front_probe(&t, k / 2, PROBE_FACES, &st) != FDT_OK || st.faces_advanced == 0)
+        goto done;
+    double cost = ((double)st.kq.points +
+                   EXACT_WEIGHT * (double)(st.kq.pc.orient_exact + st.kq.pc.insphere_exact)) /
+                  (double)st.faces_advanced;
+    expensive = cost > SWITCH_COST;
+done:
+    fdt_kd_free(&t);
+    free(S);
+    free(orig);
+    return expensive;
 }

@@ -76,4 +76,16 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
  * stores while the mesh is in use. FDT_OK or FDT_ENOMEM. */
 int fdt_oracle_note(fdt_oracle *o, int64_t tid, uint32_t mtet);
 
+/*
+ * Whether the kd search is expensive on these points (the m distinct
+ * points P, 3 doubles each): the first faces of a serial front over a
+ * sample of them, costed as fdt_oracle_tick does. The parallel modes pay
+ * for such inputs twice: each part builds its mesh, and a face whose
+ * sphere crosses a cut still asks the other parts, where a pipe's or a
+ * grid's spheres are as wide as the object (bench/NOTES.md, entry 52);
+ * src/api.c then runs FDT_MODE_AUTO serially. 0 on any failure (no
+ * memory, a flat sample): the caller's choice stands.
+ */
+int fdt_oracle_probe(const double *P, uint32_t m, int leaf_size);
+
 #endif
