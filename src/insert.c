@@ -254,16 +254,13 @@ static const uint8_t other2[4][4][2] = {
 /* ------------------------------------------------------------------ */
 /* Insertion. */
 
-static inline uint32_t walk_rand(build *b)
+/* The walk (see the top) from `start` to the tet holding p, or to the
+ * infinite tet over a hull face p is strictly outside. rng: the walk's
+ * pseudo-random choices (the caller's); steps counts the tets crossed
+ * (may be NULL). Reads m only, so other threads may walk a built mesh. */
+static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng,
+                fdt_pred_counts *cnt, size_t *steps_out, uint32_t *out)
 {
-    b->rng = b->rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
-    return (uint32_t)(b->rng >> 61);
-}
-
-/* The tet where the walk for p from `start` ends (see the top). */
-static int locate(build *b, const double *p, uint32_t start, uint32_t *out)
-{
-    fdt_ins *m = b->m;
     const uint32_t *T = m->T;
     uint32_t t = start;
     for (int i = 0; i < 4; i++)
@@ -272,14 +269,16 @@ static int locate(build *b, const double *p, uint32_t start, uint32_t *out)
             break;
         }
     int from = -1;
-    for (size_t steps = 0;; steps++) {
+    size_t steps = 0;
+    for (;; steps++) {
         if (steps > m->nslots)
             return FDT_EINTERNAL; /* a cycle: impossible in a regular triangulation */
         const uint32_t *v = T + 8 * (size_t)t;
         if (v[0] == INF || v[1] == INF || v[2] == INF || v[3] == INF)
             break;
         const double *q[4] = {pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3])};
-        uint32_t r = walk_rand(b);
+        *rng = *rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
+        uint32_t r = (uint32_t)(*rng >> 61);
         int exit = -1;
         for (uint32_t j = 0; j < 4; j++) {
             int k = (int)((r + j) & 3);
@@ -287,7 +286,7 @@ static int locate(build *b, const double *p, uint32_t start, uint32_t *out)
                 continue;
             const double *s[4] = {q[0], q[1], q[2], q[3]};
             s[k] = p;
-            if (orient(s[0], s[1], s[2], s[3], b->cnt) < 0) {
+            if (orient(s[0], s[1], s[2], s[3], cnt) < 0) {
                 exit = k;
                 break;
             }
@@ -297,10 +296,17 @@ static int locate(build *b, const double *p, uint32_t start, uint32_t *out)
         uint32_t nb = v[4 + exit];
         t = nb >> 2;
         from = (int)(nb & 3);
-        m->stats.walk_steps++;
     }
+    if (steps_out)
+        *steps_out += steps;
     *out = t;
     return FDT_OK;
+}
+
+/* The tet where the build's walk for p from `start` ends. */
+static int locate(build *b, const double *p, uint32_t start, uint32_t *out)
+{
+    return walk(b->m, p, start, &b->rng, b->cnt, &b->m->stats.walk_steps, out);
 }
 
 /* Whether tet t is in conflict with p (see the top for infinite tets). */
@@ -897,43 +903,13 @@ int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
         qset_clear(qs->tq, qs->tset, &qs->ntq, qs->tcap);
     if (qs->vset)
         qset_clear(qs->vs, qs->vset, &qs->nvs, qs->vcap);
-    /* The walk of locate, read-only: from the hint if it is a live slot. */
+    /* The walk, from the hint if it is a live slot. */
     uint32_t t = *hint;
     if (t >= m->nslots || (T[8 * (size_t)t] == INF && T[8 * (size_t)t + 1] == INF))
         t = m->vtet[0];
-    for (int i = 0; i < 4; i++)
-        if (T[8 * (size_t)t + i] == INF) {
-            t = T[8 * (size_t)t + 4 + i] >> 2;
-            break;
-        }
-    int from = -1;
-    for (size_t steps = 0;; steps++) {
-        if (steps > m->nslots)
-            return FDT_EINTERNAL;
-        const uint32_t *v = T + 8 * (size_t)t;
-        if (v[0] == INF || v[1] == INF || v[2] == INF || v[3] == INF)
-            break;
-        const double *p4[4] = {pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3])};
-        qs->rng = qs->rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
-        uint32_t r = (uint32_t)(qs->rng >> 61);
-        int exit = -1;
-        for (uint32_t j = 0; j < 4; j++) {
-            int k = (int)((r + j) & 3);
-            if (k == from)
-                continue;
-            const double *s[4] = {p4[0], p4[1], p4[2], p4[3]};
-            s[k] = q;
-            if (orient(s[0], s[1], s[2], s[3], cnt) < 0) {
-                exit = k;
-                break;
-            }
-        }
-        if (exit < 0)
-            break;
-        uint32_t nb = v[4 + exit];
-        t = nb >> 2;
-        from = (int)(nb & 3);
-    }
+    int err = walk(m, q, t, &qs->rng, cnt, NULL, &t);
+    if (err)
+        return err;
     *hint = t;
     /* q is not a vertex (the caller's point belongs to another part, and
      * the points are pairwise distinct), so the tet found is in conflict

@@ -66,10 +66,7 @@ static pts pts_alloc(const char *name, size_t n)
 static uint64_t rng_s = 0x2545F4914F6CDD1DULL;
 static uint64_t rnext(void)
 {
-    uint64_t z = (rng_s += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
+    return test_rand64(&rng_s);
 }
 
 /* Reads "x y z" lines (what gen_points writes, %.17g: exact). */
