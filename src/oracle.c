@@ -34,17 +34,60 @@
 #define MESH_FACE_COST 20
 /* The first decision comes early: on a 12-digit sphere of 20,950 points
  * a face costs ~6,700 points tested, so a first window of 2,048 faces
- * took 0.25 s of a 0.39 s run, one of 256 faces 0.03 s. Later ones come
- * rarely (a check is cheap, but a short window of hard faces inside an
- * easy input is not worth a mesh). */
+ * took 0.25 s of a 0.39 s run, one of 256 faces 0.03 s. The windows then
+ * double up to WINDOW: a rotated lattice's first 256 faces (around the
+ * seed) cost 98 points a face and the next ones 3,030, and a fixed second
+ * window of 16,384 faces spent 2.1 s of a 2.9 s run before the switch
+ * (100k points; 0.7 s with doubling windows, bench/NOTES.md entry 53). */
 #define FIRST_WINDOW 256
 #define WINDOW 16384
+
+/*
+ * The second rule measures time, because points tested do not say what a
+ * point costs: a city model's flat roofs and walls make the walk open
+ * more nodes for its points, 0.9-1.05 us a face (thread CPU, this loaded
+ * 2-core machine) at ~130 points and ~22 kd nodes a face, where airborne
+ * lidar (autzen, lonestar in ../shared/data) takes 0.6-0.8 us at ~120
+ * points and ~15 nodes, and uniform clouds 0.55 us at 95 points and 10
+ * nodes (bench/NOTES.md entry 53). The mesh costs about MESH_BUILD_US a
+ * point to build (uniform 1M: 3.1 s) and MESH_WALK_US a face to read, so
+ * the kd search's remaining cost, c a face for `left` faces, pays for it
+ * when c * left > MESH_BUILD_US * n + MESH_WALK_US * left. The rule takes
+ * c and the nodes a face over all faces since the first TIMED_FROM (cold
+ * caches: uniform's first 256 faces take twice its later ones), once
+ * TIMED_MIN more have passed, and switches when c exceeds TIME_MARGIN
+ * times that and the walk visited SLOW_NODES nodes a face or more. A time
+ * alone is noisy on a shared machine, the node count alone does not
+ * separate the city from the lidar (1.2x), and single windows do not
+ * either: lonestar has a dense region of windows at 220 points, 27 nodes
+ * and 1 us a face, after which the mesh cost it 3.2-3.5 s against the kd
+ * search's 2.3 s. The rule only moves the switch; the mesh and the kd
+ * search give the same apex, so the output never depends on timing. On a
+ * faster machine the kd search looks cheaper against these constants and
+ * the switch comes later: the safe direction.
+ */
+#define MESH_BUILD_US 3.0
+#define MESH_WALK_US 0.2
+#define TIME_MARGIN 1.25
+#define SLOW_NODES 18.0
+#define TIMED_FROM 4096
+#define TIMED_MIN 8192
 
 static double mono_s(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* This thread's CPU time: a window's cost without the time other
+ * processes or threads held the core. */
+static double thread_cpu_us(void)
+{
+    struct timespec ts;
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0)
+        return 0.0;
+    return 1e6 * (double)ts.tv_sec + 1e-3 * (double)ts.tv_nsec;
 }
 
 void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy)
@@ -99,10 +142,27 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
         build_mesh(o, faces, kq);
         return;
     }
+    /* The time rule over everything since TIMED_FROM faces (see above). */
+    double now = thread_cpu_us();
+    if (o->t_faces == 0 && faces >= TIMED_FROM && now > 0.0) {
+        o->t_faces = faces;
+        o->t_cpu = now;
+        o->t_nodes = kq->nodes;
+    } else if (o->t_faces > 0 && faces >= o->t_faces + TIMED_MIN && now > 0.0) {
+        double nf = (double)(faces - o->t_faces);
+        double us = (now - o->t_cpu) / nf;
+        double nodes = (double)(kq->nodes - o->t_nodes) / nf;
+        if (nodes >= SLOW_NODES &&
+            us * left > TIME_MARGIN * (MESH_BUILD_US * (double)o->t->n + MESH_WALK_US * left)) {
+            build_mesh(o, faces, kq);
+            return;
+        }
+    }
     o->w_faces = faces;
     o->w_points = kq->points;
     o->w_exact = kq->pc.orient_exact + kq->pc.insphere_exact;
-    o->next_check = faces + WINDOW;
+    size_t win = faces < FIRST_WINDOW ? FIRST_WINDOW : faces < WINDOW ? faces : WINDOW;
+    o->next_check = faces + win;
 }
 
 int fdt_oracle_note(fdt_oracle *o, int64_t tid, uint32_t mtet)

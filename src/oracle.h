@@ -40,6 +40,10 @@ typedef struct fdt_oracle {
     size_t mtcap;
     /* The switching window: counter values at its start. */
     size_t next_check, w_faces, w_points, w_exact;
+    /* The time rule's start: faces advanced (0: not started), thread CPU
+     * (us) and kd nodes visited then. */
+    size_t t_faces, t_nodes;
+    double t_cpu;
     /* Statistics. */
     size_t mesh_faces;    /* faces whose apex the mesh gave */
     size_t star_walks;    /* of those, found by a walk around a vertex */

@@ -474,9 +474,10 @@ static int insphere_stage_g(const double *a, const double *b, const double *c,
  * fl(C perm) in magnitude, perm the filter's permanent of r; otherwise it
  * defers to stage B or C. It never answers 0.
  *
- * Admission: no point shares a coordinate with a (orient3d) or e
- * (insphere), a cheap test for grids, whose near-degeneracies are exact
- * zeros (shares_coordinate); stage B's range (coordinates 0 or of
+ * Admission: for orient3d, no point shares a coordinate with a, a cheap
+ * test for grids, whose near-degeneracies are exact zeros
+ * (shares_coordinate); for insphere, at most three zero difference
+ * components (see fdt_insphere_adapt); stage B's range (coordinates 0 or of
  * magnitude in [2^-300, 2^300] for orient3d, [2^-150, 2^150] for
  * insphere); and perm >= 2^-800 (so fl(C perm) is normal). Stage B's
  * argument applies to everything below: differences, tails, Veltkamp
@@ -733,9 +734,6 @@ int fdt_orient3d_adapt(const double *a, const double *b, const double *c,
 int fdt_insphere_adapt(const double *a, const double *b, const double *c,
                        const double *d, const double *e)
 {
-    const double *const rows[4] = {a, b, c, d};
-    if (shares_coordinate(rows, 4, e))
-        return FDT_PRED_UNSURE;
     const double lo = 0x1p-150, hi = 0x1p+150;
     if (!(coords_in_range(a, lo, hi) && coords_in_range(b, lo, hi) &&
           coords_in_range(c, lo, hi) && coords_in_range(d, lo, hi) &&
@@ -746,6 +744,24 @@ int fdt_insphere_adapt(const double *a, const double *b, const double *c,
     tails = diff_tails(b, e, B, Bt) || tails;
     tails = diff_tails(c, e, C, Ct) || tails;
     tails = diff_tails(d, e, D, Dt) || tails;
+    /* Admission (insphere): at most three of the twelve difference
+     * components are 0. The corners of an axis-aligned grid cell
+     * (lattices, stretched CFD grids) are cospherical, an exact zero this
+     * stage can only defer, and five corners of a box have at least four
+     * zero components (each corner shares two coordinates with e but the
+     * opposite one, which shares none). A pipe scan's rings (one z each)
+     * give two or three zeros, and those determinants are not zero: with
+     * orient3d's rule (any shared coordinate defers) `tests/gen_points
+     * cylscan 100000 1` sent 0.56 M of them to stage B. Measured, serial,
+     * whole process, CPU s, this rule against that one (bench/NOTES.md
+     * entry 53): cylscan 1.86 / 3.58, cylinder 1.77 / 2.92, ogrid 0.82 /
+     * 1.92; cfdgrid 1.66 / 1.68, lattice 0.79 / 0.73, grid2d 0.54 / 0.52
+     * (no rule at all: lattice 0.93, grid2d 0.67, cfdgrid 1.85). */
+    int zeros = 0;
+    for (int k = 0; k < 3; k++)
+        zeros += (A[k] == 0.0) + (B[k] == 0.0) + (C[k] == 0.0) + (D[k] == 0.0);
+    if (zeros >= 4)
+        return FDT_PRED_UNSURE;
 
     /* perm, as in fdt_insphere_filter_diff (the same association). */
     const double abP = fabs(A[0] * B[1]) + fabs(B[0] * A[1]);
@@ -859,11 +875,35 @@ static int orient_stage_c(const double *a, const double *b, const double *c, con
     return s;
 }
 
+/* Whether the n points all have the same value in one coordinate: then
+ * every difference to the last point has a 0 in that column, so the
+ * orient3d determinant (3 x 3 of differences) and the insphere
+ * determinant (4 x 4 of differences and their squared lengths) have a
+ * zero column and are exactly 0. Points of one plane of a grid, a flat
+ * roof or one ring of a scanned pipe give such tests by the hundred
+ * thousand, and each went through stage B or GMP to learn it (bench/
+ * NOTES.md entry 53). The perturbation then decides, as for any other
+ * zero. */
+static inline bool share_axis_plane(const double *const *p, int n)
+{
+    for (int k = 0; k < 3; k++) {
+        bool all = true;
+        for (int i = 1; i < n && all; i++)
+            all = p[i][k] == p[0][k];
+        if (all)
+            return true;
+    }
+    return false;
+}
+
 int fdt_orient3d_exact(const double *a, const double *b, const double *c,
                        const double *d, fdt_pred_counts *cnt)
 {
     if (cnt)
         cnt->orient_exact++;
+    const double *const pts[4] = {a, b, c, d};
+    if (share_axis_plane(pts, 4))
+        return 0;
     int g = orient_stage_g(a, b, c, d);
     if (g != FDT_PRED_UNSURE)
         return g;
@@ -1131,6 +1171,9 @@ int fdt_insphere_exact(const double *a, const double *b, const double *c,
 {
     if (cnt)
         cnt->insphere_exact++;
+    const double *const pts[5] = {a, b, c, d, e};
+    if (share_axis_plane(pts, 5))
+        return 0;
     int g = insphere_stage_g(a, b, c, d, e);
     if (g != FDT_PRED_UNSURE)
         return g;
