@@ -61,7 +61,7 @@ typedef struct cli {
     const char *outputs[MAX_OUTPUTS]; /* every -o, in order ("-": stdout) */
     const char *out_format[MAX_OUTPUTS]; /* its --format, NULL: by extension */
     int n_outputs;
-    const char *format;     /* the last --format, for the -o's after it */
+    const char *format;     /* a --format not yet taken by an -o */
     int all_faces;          /* --all-faces: TetGen .face with every face */
     const char *stats_json; /* NULL, a path, or "-" for stdout */
     fdt_mode mode;
@@ -87,9 +87,9 @@ static void usage(FILE *f)
         "Options:\n"
         "  -o, --output FILE      write the mesh (format by extension); may be\n"
         "                         given up to %d times; '-': standard output\n"
-        "      --format NAME      format of the -o's that follow it (of the\n"
-        "                         last -o when it comes after): tets, tetgen,\n"
-        "                         vtu, vtk, msh, msh2, medit, openfoam\n"
+        "      --format NAME      format of the next -o (of the last -o when\n"
+        "                         none follows): tets, tetgen, vtu, vtk, msh,\n"
+        "                         msh2, medit, openfoam\n"
         "      --all-faces        TetGen .face lists every face (TetGen -f)\n"
         "      --mode MODE        serial, shared, message or auto (default)\n"
         "      --search HOW       how apexes are found: auto (default: the kd\n"
@@ -332,6 +332,7 @@ static int parse_args(int argc, char **argv, cli *c)
                 c->output = optarg;
             c->out_format[c->n_outputs] = c->format;
             c->outputs[c->n_outputs++] = optarg;
+            c->format = NULL; /* --format is one -o's */
             format_last = 0;
             break;
         case OPT_FORMAT:
