@@ -50,12 +50,19 @@ enum {
 };
 
 #define DEMO_DEFAULT_N 1000000u
+/* -o given more often than this is a usage error */
+#define MAX_OUTPUTS 8
 /* Fixed so that "--demo N" is the same point set on every run and host. */
 #define DEMO_SEED UINT64_C(0x5eed0f0f1992)
 
 typedef struct cli {
     const char *input;      /* NULL with --demo */
-    const char *output;     /* NULL: triangulate and report only */
+    const char *output;     /* the first -o; NULL: triangulate and report only */
+    const char *outputs[MAX_OUTPUTS]; /* every -o, in order ("-": stdout) */
+    const char *out_format[MAX_OUTPUTS]; /* its --format, NULL: by extension */
+    int n_outputs;
+    const char *format;     /* a --format not yet taken by an -o */
+    int all_faces;          /* --all-faces: TetGen .face with every face */
     const char *stats_json; /* NULL, a path, or "-" for stdout */
     fdt_mode mode;
     fdt_search search;
@@ -74,10 +81,16 @@ static void usage(FILE *f)
         "\n"
         "INPUT:  .xyz/.txt (x y z per line), .node (TetGen), .ply\n"
         "OUTPUT: .tets (canonical sorted text), .ele (TetGen .node/.ele/\n"
-        "        .face/.neigh), .vtu (VTK XML, ParaView), .vtk (VTK legacy)\n"
+        "        .face/.neigh), .vtu (VTK XML, ParaView), .vtk (VTK legacy),\n"
+        "        .msh (gmsh 4.1), .mesh (Medit), DIR/polyMesh (OpenFOAM)\n"
         "\n"
         "Options:\n"
-        "  -o, --output FILE      write the mesh (format by extension)\n"
+        "  -o, --output FILE      write the mesh (format by extension); may be\n"
+        "                         given up to %d times; '-': standard output\n"
+        "      --format NAME      format of the next -o (of the last -o when\n"
+        "                         none follows): tets, tetgen, vtu, vtk, msh,\n"
+        "                         msh2, medit, openfoam\n"
+        "      --all-faces        TetGen .face lists every face (TetGen -f)\n"
         "      --mode MODE        serial, shared, message or auto (default)\n"
         "      --search HOW       how apexes are found: auto (default: the kd\n"
         "                         search, an insertion mesh where it gets\n"
@@ -98,7 +111,7 @@ static void usage(FILE *f)
         "  0 success             1 usage error        2 bad input\n"
         "  3 --check failed      4 out of resources   5 cannot write output\n"
         "  6 interrupted         7 internal error\n",
-        DEMO_DEFAULT_N);
+        MAX_OUTPUTS, DEMO_DEFAULT_N);
 }
 
 static void say(const char *fmt, ...)
@@ -216,11 +229,13 @@ static int parse_count(const char *s, unsigned long long max,
 
 enum {
     OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH,
-    OPT_DEMO, OPT_SEARCH
+    OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES
 };
 
 static const struct option long_opts[] = {
     { "output", required_argument, NULL, 'o' },
+    { "format", required_argument, NULL, OPT_FORMAT },
+    { "all-faces", no_argument, NULL, OPT_ALL_FACES },
     { "mode", required_argument, NULL, OPT_MODE },
     { "search", required_argument, NULL, OPT_SEARCH },
     { "threads", required_argument, NULL, 't' },
@@ -302,14 +317,33 @@ static int parse_args(int argc, char **argv, cli *c)
     optind = 1;
     int ch;
     unsigned long long v;
+    int format_last = 0; /* the last --format came after every -o */
     while ((ch = getopt_long(argc, argv, ":o:t:qhV", long_opts, NULL)) != -1) {
         switch (ch) {
         case 'o':
-            if (c->output)
-                return usage_error("-o given twice");
+            if (c->n_outputs == MAX_OUTPUTS)
+                return usage_error("-o given more than %d times", MAX_OUTPUTS);
             if (!*optarg)
                 return usage_error("empty output file name");
-            c->output = optarg;
+            for (int i = 0; i < c->n_outputs; i++)
+                if (!strcmp(c->outputs[i], optarg))
+                    return usage_error("-o %s given twice", optarg);
+            if (!c->output)
+                c->output = optarg;
+            c->out_format[c->n_outputs] = c->format;
+            c->outputs[c->n_outputs++] = optarg;
+            c->format = NULL; /* --format is one -o's */
+            format_last = 0;
+            break;
+        case OPT_FORMAT:
+            if (!fdt_format_by_name(optarg))
+                return usage_error("unknown output format '%s' (%s)", optarg,
+                                   fdt_format_list());
+            c->format = optarg;
+            format_last = 1;
+            break;
+        case OPT_ALL_FACES:
+            c->all_faces = 1;
             break;
         case OPT_MODE:
             if (!strcmp(optarg, "serial"))
@@ -393,6 +427,10 @@ static int parse_args(int argc, char **argv, cli *c)
                                argv[optind - 1]);
         }
     }
+    /* "-o m.msh --format msh2": a --format after the last -o is that
+     * -o's (the others keep their extensions) */
+    if (format_last && c->n_outputs > 0 && !c->out_format[c->n_outputs - 1])
+        c->out_format[c->n_outputs - 1] = c->format;
     int npos = argc - optind;
     if (c->demo) {
         if (npos > 0)
@@ -413,21 +451,6 @@ static int parse_args(int argc, char **argv, cli *c)
 /* Output pre-checks (before the long computation)                          */
 /* ------------------------------------------------------------------------ */
 
-static int ends_with_ci(const char *s, const char *ext)
-{
-    size_t ls = strlen(s), le = strlen(ext);
-    if (ls <= le || s[ls - le - 1] == '/')
-        return 0;
-    for (size_t i = 0; i < le; i++) {
-        char ch = s[ls - le + i];
-        if (ch >= 'A' && ch <= 'Z')
-            ch = (char)(ch - 'A' + 'a');
-        if (ch != ext[i])
-            return 0;
-    }
-    return 1;
-}
-
 /*
  * Refuses, before anything is read, a run that would replace a file it
  * reads: any file of the output's set (names[0..k), from
@@ -439,7 +462,8 @@ static int ends_with_ci(const char *s, const char *ext)
  * markers, comments and 1-based numbering lost. Returns -1 to go on, or
  * CLI_USAGE after naming both files.
  */
-static int refuse_overwrites(const cli *c, char names[][FDT_IO_PATH], int k)
+static int refuse_overwrites(const cli *c, const char *output, char names[][FDT_IO_PATH],
+                             int k)
 {
     const char *json = c->stats_json && strcmp(c->stats_json, "-") != 0
                            ? c->stats_json
@@ -448,8 +472,8 @@ static int refuse_overwrites(const cli *c, char names[][FDT_IO_PATH], int k)
         /* The set's other files are named with their -o: the user typed
          * m.ele and should hear why m.node is at stake. */
         char via[FDT_IO_PATH + 32] = "";
-        if (strcmp(names[i], c->output) != 0)
-            snprintf(via, sizeof via, " (written with -o %s)", c->output);
+        if (strcmp(names[i], output) != 0)
+            snprintf(via, sizeof via, " (written with -o %s)", output);
         if (c->input && fdt_same_file(names[i], c->input)) {
             say("output %s%s would overwrite the input %s", names[i], via,
                 c->input);
@@ -873,27 +897,76 @@ static int run(const cli *c)
     FILE *info = json_stdout ? stderr : stdout;
 
     /* Refuse doomed or destructive outputs before reading or computing
-     * anything. */
-    char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
-    int n_names = 0;
-    if (c->output) {
-        n_names = fdt_output_files(c->output, names);
-        if (n_names == 0)
-            return usage_error("%s: unknown output format (use .tets, .ele, "
-                               ".vtu or .vtk)", c->output);
-        if (n_names < 0) {
-            say("%s: %s", c->output, strerror(ENAMETOOLONG));
+     * anything: each -o's format, its files against the input, the
+     * --stats-json file and every other -o's files. */
+    const fdt_format *fmts[MAX_OUTPUTS];
+    int need = 0, to_stdout = 0;
+    for (int o = 0; o < c->n_outputs; o++) {
+        const char *out = c->outputs[o];
+        if (!strcmp(out, "-")) {
+            /* standard output: text only, the canonical .tets by default */
+            fmts[o] = fdt_format_by_name(c->out_format[o] ? c->out_format[o] : "tets");
+            if (!fdt_format_is_text(fmts[o]) || !strcmp(fdt_format_name(fmts[o]), "tetgen") ||
+                !strcmp(fdt_format_name(fmts[o]), "openfoam"))
+                return usage_error("-o -: format %s cannot go to standard output "
+                                   "(one text file only: tets, vtk, msh, msh2, medit)",
+                                   fdt_format_name(fmts[o]));
+            if (json_stdout)
+                return usage_error("-o - and --stats-json - both want standard output");
+            to_stdout = 1;
+            need |= fdt_format_needs(fmts[o], c->all_faces);
+            continue;
+        }
+        fmts[o] = c->out_format[o] ? fdt_format_by_name(c->out_format[o])
+                                   : fdt_format_by_path(out);
+        if (!fmts[o])
+            return usage_error("%s: unknown output format (use %s, or --format)", out,
+                               fdt_format_list());
+        need |= fdt_format_needs(fmts[o], c->all_faces);
+        char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+        int n_names = fdt_output_files_as(out, fmts[o], names);
+        if (n_names <= 0) {
+            say("%s: %s", out, strerror(ENAMETOOLONG));
             return CLI_WRITE;
         }
+        code = refuse_overwrites(c, out, names, n_names);
+        if (code >= 0)
+            return code;
+        for (int p = 0; p < o; p++) {
+            if (!strcmp(c->outputs[p], "-"))
+                continue;
+            char other[FDT_IO_MAX_FILES][FDT_IO_PATH];
+            int k = fdt_output_files_as(c->outputs[p], fmts[p], other);
+            for (int i = 0; i < n_names; i++)
+                for (int j = 0; j < k; j++)
+                    if (fdt_same_file(names[i], other[j])) {
+                        say("output %s (-o %s) is also written by -o %s", names[i], out,
+                            c->outputs[p]);
+                        return CLI_USAGE;
+                    }
+        }
+        /* a directory format's path may be an existing directory: then
+         * its files are what must be creatable */
+        struct stat dst;
+        const char *probe = fmts[o] == fdt_format_by_name("openfoam") &&
+                                    stat(out, &dst) == 0 && S_ISDIR(dst.st_mode)
+                                ? names[0]
+                                : out;
+        if (!output_dir_ok(probe))
+            return CLI_WRITE;
     }
-    code = refuse_overwrites(c, names, n_names);
-    if (code >= 0)
-        return code;
+    {
+        char none[1][FDT_IO_PATH];
+        code = refuse_overwrites(c, "", none, 0); /* --stats-json vs the input */
+        if (code >= 0)
+            return code;
+    }
     code = CLI_OK;
-    if (c->output && !output_dir_ok(c->output))
-        return CLI_WRITE;
     if (c->stats_json && !json_stdout && !output_dir_ok(c->stats_json))
         return CLI_WRITE;
+    /* the summary goes to stderr when the mesh goes to stdout */
+    if (to_stdout)
+        info = stderr;
 
     /* Points. */
     double t0 = now_s();
@@ -923,7 +996,7 @@ static int run(const cli *c)
     if (c->threads >= 0)
         s.n_threads = c->threads;
     s.pin = c->pin;
-    s.neighbors = c->check || (c->output && ends_with_ci(c->output, ".ele"));
+    s.neighbors = c->check || (need & FDT_NEED_NBRS);
     progress prog = { 0, 0 };
     if (!c->quiet && isatty(STDERR_FILENO)) {
         s.progress = progress_cb;
@@ -987,7 +1060,7 @@ static int run(const cli *c)
             code = exit_for_engine(r);
             goto done;
         }
-    } else if (c->output && ends_with_ci(c->output, ".tets")) {
+    } else if (need & FDT_NEED_SORTED) {
         r = fdt_result_sort(res);
         if (r != FDT_OK) {
             say("%s: sorting the tets failed: %s", name, fdt_strerror(r));
@@ -997,22 +1070,39 @@ static int run(const cli *c)
     }
     tm.canon = now_s() - t0;
 
-    if (c->output) {
+    if (c->n_outputs > 0) {
         fdt_mesh_view v = {
             .xyz = xyz, .n_points = n, .tets = fdt_result_tets(res),
             .n_tets = nt, .nbrs = fdt_result_neighbors(res),
             .hull = fdt_result_hull_faces(res),
             .n_hull = fdt_result_num_hull_faces(res),
+            .all_faces = c->all_faces,
         };
-        char err[1024];
         t0 = now_s();
-        r = fdt_write_mesh(c->output, &v, err, sizeof err);
-        tm.write = now_s() - t0;
-        if (r != FDT_IO_OK) {
-            say("%s", err);
-            code = exit_for_writer(r);
-            goto done;
+        if (need & FDT_NEED_FACES) {
+            /* after the sort: the face list names tets by their numbers */
+            r = fdt_result_faces(res, &v.n_faces, &v.faces, &v.face_tets);
+            if (r != FDT_OK) {
+                say("%s: the face list failed: %s", name, fdt_strerror(r));
+                code = exit_for_engine(r);
+                goto done;
+            }
         }
+        char err[1024];
+        for (int o = 0; o < c->n_outputs; o++) {
+            if (!strcmp(c->outputs[o], "-"))
+                r = fdt_write_mesh_stream(stdout, "standard output", fmts[o], &v, err,
+                                          sizeof err);
+            else
+                r = fdt_write_mesh_as(c->outputs[o], fmts[o], &v, err, sizeof err);
+            if (r != FDT_IO_OK) {
+                say("%s", err);
+                code = exit_for_writer(r);
+                tm.write = now_s() - t0;
+                goto done;
+            }
+        }
+        tm.write = now_s() - t0;
     }
 
     fdt_stats st;

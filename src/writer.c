@@ -1,6 +1,8 @@
 /*
- * Mesh writers (src/writer.h): canonical .tets, TetGen .node/.ele/.face/
- * .neigh, VTK XML .vtu and legacy .vtk.
+ * Mesh writers (src/writer.h): the table of output formats, one row per
+ * format (the writer functions are in src/fmt_*.c), the temporary files
+ * and their renames, and the identity of files for the never-overwrite-
+ * an-input check.
  *
  * Every file goes to a temporary ".NAME.tmp.XXXXXX" beside its target and
  * is renamed over the target only once every byte of it (and, for TetGen,
@@ -8,16 +10,14 @@
  * failed, full-disk or interrupted run never leaves a truncated mesh that
  * a later stage could mistake for a complete one.
  *
- * Output goes through our own large buffer and is handed to stdio in big
- * chunks: formatting millions of integers with fprintf would cost seconds,
- * while the hand-rolled formatter below writes 6.5M tets in a fraction of
- * one. Every fwrite/fprintf/fflush/fclose result is checked and the first
- * errno is kept for the message.
+ * Output goes through our own large buffer (src/outfile.h) and is handed
+ * to stdio in big chunks. Every fwrite/fflush/fclose result is checked and
+ * the first errno is kept for the message.
  *
  * Not thread-safe: the CLI and tests write one mesh at a time.
  */
 #include "writer.h"
-#include "reader.h" /* FDT_IO_* codes */
+#include "formats.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -60,6 +60,11 @@ enum { SLOT_FREE = 0, SLOT_TEMP = 1, SLOT_RENAMING = 2, SLOT_RENAMED = 3 };
 static char fdt_io_tmp_path[FDT_IO_SLOTS][FDT_IO_PATH];
 static char fdt_io_dst_path[FDT_IO_SLOTS][FDT_IO_PATH];
 static volatile sig_atomic_t fdt_io_state[FDT_IO_SLOTS];
+/* The temporary directory of a directory format (an OpenFOAM polyMesh)
+ * being filled: written only while the flag is 0, removed by the handler
+ * after the files in it (the slots above) while the flag is 1. */
+static char fdt_io_tmpdir[FDT_IO_PATH];
+static volatile sig_atomic_t fdt_io_tmpdir_live;
 
 void fdt_io_cleanup_temps(void)
 {
@@ -71,155 +76,10 @@ void fdt_io_cleanup_temps(void)
             unlink(fdt_io_dst_path[i]);
         fdt_io_state[i] = SLOT_FREE;
     }
-}
-
-/* ------------------------------------------------------------------------ */
-/* Buffered output file                                                     */
-/* ------------------------------------------------------------------------ */
-
-#define OUT_BUF_SIZE (1u << 20)
-/* The longest item put in one go: a %.17g double is at most 24 chars. */
-#define OUT_MAX_ITEM 64
-
-typedef struct out_file {
-    FILE *f;
-    int slot;          /* registry slot, -1 when none */
-    const char *path;  /* the target (for messages) */
-    char *buf;
-    size_t len;
-    int err;           /* first errno seen, 0 while all is well */
-} out_file;
-
-static void out_fail(out_file *o, int e)
-{
-    if (o->err == 0)
-        o->err = e ? e : EIO;
-}
-
-static void out_flush(out_file *o)
-{
-    if (o->len == 0 || o->err)
-        return;
-    errno = 0;
-    if (fwrite(o->buf, 1, o->len, o->f) != o->len)
-        out_fail(o, errno);
-    o->len = 0;
-}
-
-/* Makes room for n more bytes (n <= OUT_BUF_SIZE). */
-static inline char *out_room(out_file *o, size_t n)
-{
-    if (OUT_BUF_SIZE - o->len < n) {
-        out_flush(o);
-        if (o->err)
-            o->len = 0; /* keep going into the bin; the error is final */
+    if (fdt_io_tmpdir_live) {
+        rmdir(fdt_io_tmpdir); /* empty now, unless renamed already */
+        fdt_io_tmpdir_live = 0;
     }
-    return o->buf + o->len;
-}
-
-static void out_bytes(out_file *o, const void *p, size_t n)
-{
-    const char *s = p;
-    while (n > 0) {
-        size_t room = OUT_BUF_SIZE - o->len;
-        if (room == 0) {
-            out_flush(o);
-            if (o->err)
-                return;
-            room = OUT_BUF_SIZE;
-        }
-        size_t k = n < room ? n : room;
-        memcpy(o->buf + o->len, s, k);
-        o->len += k;
-        s += k;
-        n -= k;
-    }
-}
-
-static void out_str(out_file *o, const char *s)
-{
-    out_bytes(o, s, strlen(s));
-}
-
-/* Two decimal digits per lookup halves the divisions. */
-static const char digit_pairs[201] =
-    "00010203040506070809101112131415161718192021222324252627282930313233"
-    "34353637383940414243444546474849505152535455565758596061626364656667"
-    "68697071727374757677787980818283848586878889909192939495969798990";
-
-/* Writes v in decimal at p, returns the number of chars (at most 20). */
-static inline size_t fmt_u64(char *p, uint64_t v)
-{
-    char tmp[20];
-    char *e = tmp + sizeof tmp, *s = e;
-    while (v >= 100) {
-        unsigned r = (unsigned)(v % 100);
-        v /= 100;
-        s -= 2;
-        memcpy(s, digit_pairs + 2 * r, 2);
-    }
-    if (v >= 10) {
-        s -= 2;
-        memcpy(s, digit_pairs + 2 * v, 2);
-    } else {
-        *--s = (char)('0' + v);
-    }
-    size_t n = (size_t)(e - s);
-    memcpy(p, s, n);
-    return n;
-}
-
-static inline size_t fmt_i64(char *p, int64_t v)
-{
-    if (v < 0) {
-        *p = '-';
-        return 1 + fmt_u64(p + 1, (uint64_t)0 - (uint64_t)v);
-    }
-    return fmt_u64(p, (uint64_t)v);
-}
-
-static inline void out_i64(out_file *o, int64_t v)
-{
-    char *p = out_room(o, 21);
-    o->len += fmt_i64(p, v);
-}
-
-static inline void out_char(out_file *o, char c)
-{
-    char *p = out_room(o, 1);
-    *p = c;
-    o->len++;
-}
-
-/* %.17g: enough digits that strtod gives back the very same double. */
-static void out_double(out_file *o, double x)
-{
-    char *p = out_room(o, OUT_MAX_ITEM);
-    int k = snprintf(p, OUT_MAX_ITEM, "%.17g", x);
-    if (k < 0 || k >= OUT_MAX_ITEM)
-        out_fail(o, EINVAL);
-    else
-        o->len += (size_t)k;
-}
-
-/* ------------------------------------------------------------------------ */
-/* Errors                                                                    */
-/* ------------------------------------------------------------------------ */
-
-static int set_err(char *err, size_t errlen, int code, const char *path,
-                   const char *what)
-{
-    if (err && errlen > 0)
-        snprintf(err, errlen, "%s: %s", path ? path : "(null)", what);
-    return code;
-}
-
-/* An errno as FDT_IO_EWRITE, except ENOMEM (our buffer, or stdio's):
- * running out of memory is not a write failure and the CLI says so. */
-static int set_errno_err(char *err, size_t errlen, const char *path, int e)
-{
-    return set_err(err, errlen, e == ENOMEM ? FDT_IO_ENOMEM : FDT_IO_EWRITE,
-                   path, strerror(e ? e : EIO));
 }
 
 /* ------------------------------------------------------------------------ */
@@ -368,7 +228,7 @@ static void out_abandon(out_file *o)
  * (fdt_same_file): whoever names it expects the write to go through, and
  * would instead find the link silently turned into a plain file.
  */
-static int commit_all(out_file *files, int k, char *err, size_t errlen)
+static int commit_all(out_file *files, int k, char *err, size_t errlen, int keep)
 {
     for (int i = 0; i < k; i++) {
         int e = out_close(&files[i]);
@@ -391,6 +251,8 @@ static int commit_all(out_file *files, int k, char *err, size_t errlen)
         }
         fdt_io_state[slot] = SLOT_RENAMED;
     }
+    if (keep)
+        return FDT_IO_OK; /* the caller frees the slots */
     for (int i = 0; i < k; i++) {
         fdt_io_state[files[i].slot] = SLOT_FREE;
         files[i].slot = -1;
@@ -450,85 +312,24 @@ static int validate(const char *path, const fdt_mesh_view *m, char *err,
             }
         }
     }
-    return FDT_IO_OK;
-}
-
-/* ------------------------------------------------------------------------ */
-/* .tets                                                                      */
-/* ------------------------------------------------------------------------ */
-
-static inline void sort4(fdt_vid s[4])
-{
-    /* A 5-comparator sorting network. */
-#define FDT_CSWAP(i, j)                                                      \
-    do {                                                                     \
-        if (s[j] < s[i]) {                                                   \
-            fdt_vid t_ = s[i];                                               \
-            s[i] = s[j];                                                     \
-            s[j] = t_;                                                       \
-        }                                                                    \
-    } while (0)
-    FDT_CSWAP(0, 1);
-    FDT_CSWAP(2, 3);
-    FDT_CSWAP(0, 2);
-    FDT_CSWAP(1, 3);
-    FDT_CSWAP(1, 2);
-#undef FDT_CSWAP
-}
-
-/* -1, 0, 1 as a < b, a == b, a > b (4-tuples). */
-static inline int cmp4(const fdt_vid *a, const fdt_vid *b)
-{
-    for (int i = 0; i < 4; i++)
-        if (a[i] != b[i])
-            return a[i] < b[i] ? -1 : 1;
-    return 0;
-}
-
-static int write_tets(const char *path, const fdt_mesh_view *m, char *err,
-                      size_t errlen)
-{
-    out_file o;
-    int e = out_open(&o, path, creation_mode());
-    if (e)
-        return set_errno_err(err, errlen, path, e);
-
-    fdt_vid prev[4] = { -1, -1, -1, -1 };
-    char what[160];
-    for (size_t t = 0; t < m->n_tets; t++) {
-        fdt_vid s[4];
-        memcpy(s, m->tets + 4 * t, sizeof s);
-        sort4(s);
-        /* Distinct ids within the tet and a strictly increasing line
-         * order: what fdt_result_sort() guarantees. We check instead of
-         * sorting so a caller who forgot to sort hears about it. */
-        if (s[0] == s[1] || s[1] == s[2] || s[2] == s[3]) {
-            snprintf(what, sizeof what, "tet %zu repeats vertex %ld", t,
-                     (long)(s[0] == s[1] ? s[1] : s[1] == s[2] ? s[2] : s[3]));
-            out_abandon(&o);
-            return set_err(err, errlen, FDT_IO_EFORMAT, path, what);
+    if (m->faces) {
+        if (!m->face_tets)
+            return set_err(err, errlen, FDT_IO_EFORMAT, path, "face list without its tets");
+        for (size_t i = 0; i < m->n_faces; i++) {
+            int bad = 0;
+            for (int k = 0; k < 3; k++)
+                bad |= m->faces[3 * i + k] < 0 || (size_t)m->faces[3 * i + k] >= m->n_points;
+            for (int k = 0; k < 2; k++) {
+                fdt_tid t = m->face_tets[2 * i + k];
+                bad |= t < -(fdt_tid)k || (t >= 0 && (uint64_t)t >= m->n_tets);
+            }
+            if (bad) {
+                snprintf(what, sizeof what, "face %zu has a vertex or tet out of range", i);
+                return set_err(err, errlen, FDT_IO_EFORMAT, path, what);
+            }
         }
-        if (t > 0 && cmp4(prev, s) >= 0) {
-            snprintf(what, sizeof what,
-                     "tets are not in canonical order at tet %zu "
-                     "(call fdt_result_sort first)", t);
-            out_abandon(&o);
-            return set_err(err, errlen, FDT_IO_EFORMAT, path, what);
-        }
-        memcpy(prev, s, sizeof s);
-        /* 4 ids of at most 10 digits, 3 spaces and a newline. */
-        char *p = out_room(&o, 48);
-        size_t k = fmt_u64(p, (uint64_t)s[0]);
-        p[k++] = ' ';
-        k += fmt_u64(p + k, (uint64_t)s[1]);
-        p[k++] = ' ';
-        k += fmt_u64(p + k, (uint64_t)s[2]);
-        p[k++] = ' ';
-        k += fmt_u64(p + k, (uint64_t)s[3]);
-        p[k++] = '\n';
-        o.len += k;
     }
-    return commit_all(&o, 1, err, errlen);
+    return FDT_IO_OK;
 }
 
 /* ------------------------------------------------------------------------ */
@@ -553,34 +354,134 @@ static int has_ext(const char *s, const char *ext)
     return p[-1] != '/';
 }
 
-int fdt_output_files(const char *path,
-                     char names[FDT_IO_MAX_FILES][FDT_IO_PATH])
+/* The extension of f's that path ends with, or NULL. A directory
+ * format matches path's last component (trailing slashes ignored). */
+static const char *matching_ext(const char *path, const fdt_format *f)
 {
+    for (int i = 0; i < 3 && f->exts[i]; i++) {
+        if (f->layout != FDT_LAYOUT_DIR) {
+            if (has_ext(path, f->exts[i]))
+                return f->exts[i];
+            continue;
+        }
+        size_t len = strlen(path), le = strlen(f->exts[i]);
+        while (len > 1 && path[len - 1] == '/')
+            len--;
+        if (len < le || (len > le && path[len - le - 1] != '/'))
+            continue;
+        const char *p = path + len - le;
+        size_t k = 0;
+        while (k < le && (p[k] | 0x20) == (f->exts[i][k] | 0x20))
+            k++;
+        if (k == le)
+            return f->exts[i];
+    }
+    return NULL;
+}
+
+const fdt_format *fdt_format_by_name(const char *name)
+{
+    for (const fdt_format *f = fdt_formats; name && f->name; f++)
+        if (strcmp(f->name, name) == 0)
+            return f;
+    return NULL;
+}
+
+const fdt_format *fdt_format_by_path(const char *path)
+{
+    for (const fdt_format *f = fdt_formats; path && f->name; f++)
+        if (matching_ext(path, f))
+            return f;
+    return NULL;
+}
+
+const char *fdt_format_name(const fdt_format *f) { return f ? f->name : NULL; }
+int fdt_format_is_text(const fdt_format *f) { return f && !f->binary; }
+
+int fdt_format_needs(const fdt_format *f, int all_faces)
+{
+    int n = f ? f->needs : 0;
+    if (all_faces && f && f->put[0] == fdt_put_tetgen_node)
+        n |= FDT_NEED_FACES;
+    return n;
+}
+
+const char *fdt_format_list(void)
+{
+    static char list[512];
+    if (list[0])
+        return list;
+    size_t k = 0;
+    for (const fdt_format *f = fdt_formats; f->name; f++) {
+        int w = snprintf(list + k, sizeof list - k, "%s%s", k ? ", " : "", f->name);
+        if (w < 0 || (size_t)w >= sizeof list - k)
+            break;
+        k += (size_t)w;
+        for (int i = 0; i < 3 && f->exts[i]; i++) {
+            w = snprintf(list + k, sizeof list - k, "%s%s", i ? " " : " (",
+                         f->exts[i]);
+            if (w < 0 || (size_t)w >= sizeof list - k)
+                break;
+            k += (size_t)w;
+        }
+        if (f->exts[0] && k + 1 < sizeof list)
+            list[k++] = ')';
+        list[k] = '\0';
+    }
+    return list;
+}
+
+int fdt_output_files_as(const char *path, const fdt_format *f,
+                        char names[FDT_IO_MAX_FILES][FDT_IO_PATH])
+{
+    if (!f)
+        f = fdt_format_by_path(path);
+    if (!f)
+        return 0;
     size_t len = strlen(path);
-    if (has_ext(path, ".tets") || has_ext(path, ".vtu") ||
-        has_ext(path, ".vtk")) {
+    if (f->layout == FDT_LAYOUT_FILE) {
         if (len + 1 > FDT_IO_PATH)
             return -1;
         memcpy(names[0], path, len + 1);
         return 1;
     }
-    if (!has_ext(path, ".ele"))
-        return 0;
-    static const char *const exts[4] = { ".node", ".ele", ".face",
-                                         ".neigh" };
-    size_t baselen = len - 4;
-    for (int i = 0; i < 4; i++) {
-        if (baselen + strlen(exts[i]) + 1 > FDT_IO_PATH)
+    if (f->layout == FDT_LAYOUT_DIR) {
+        while (len > 1 && path[len - 1] == '/')
+            len--;
+        for (int i = 0; i < f->nparts; i++) {
+            size_t pl = strlen(f->parts[i]);
+            if (len + 1 + pl + 1 > FDT_IO_PATH)
+                return -1;
+            memcpy(names[i], path, len);
+            names[i][len] = '/';
+            memcpy(names[i] + len + 1, f->parts[i], pl + 1);
+        }
+        return f->nparts;
+    }
+    /* A family: the base name and each part's extension. The part the
+     * path names keeps the user's spelling of its extension; the siblings'
+     * are lowercase. A path without the format's extension (chosen by
+     * --format) is the base name itself. */
+    const char *ext = matching_ext(path, f);
+    size_t baselen = ext ? len - strlen(ext) : len;
+    for (int i = 0; i < f->nparts; i++) {
+        size_t pl = strlen(f->parts[i]);
+        if (baselen + pl + 1 > FDT_IO_PATH)
             return -1;
         memcpy(names[i], path, baselen);
-        if (i == 1) /* keep the user's spelling of the .ele name itself */
-            memcpy(names[i] + baselen, path + baselen, 5);
+        if (ext && strcmp(f->parts[i], ext) == 0)
+            memcpy(names[i] + baselen, path + baselen, pl + 1);
         else
-            memcpy(names[i] + baselen, exts[i], strlen(exts[i]) + 1);
+            memcpy(names[i] + baselen, f->parts[i], pl + 1);
     }
-    return 4;
+    return f->nparts;
 }
 
+int fdt_output_files(const char *path,
+                     char names[FDT_IO_MAX_FILES][FDT_IO_PATH])
+{
+    return fdt_output_files_as(path, NULL, names);
+}
 /*
  * What a path reaches (fdt_same_file): an existing file, or a name in a
  * directory where opening it would create one.
@@ -669,264 +570,220 @@ int fdt_same_file(const char *a, const char *b)
 }
 
 /* ------------------------------------------------------------------------ */
-/* TetGen .node / .ele / .face / .neigh                                       */
+
+
+/* ------------------------------------------------------------------------ */
+/* The table                                                                  */
 /* ------------------------------------------------------------------------ */
 
-static void put_node(out_file *o, const fdt_mesh_view *m)
+const fdt_format fdt_formats[] = {
+    {"tets", {".tets"}, "canonical sorted text, one tet a line (the hash's bytes)", 0,
+     FDT_LAYOUT_FILE, FDT_NEED_SORTED, 1, {NULL}, {fdt_put_tets}, NULL},
+    {"tetgen", {".ele"}, "TetGen .node/.ele/.face/.neigh, 0-based", 0, FDT_LAYOUT_FAMILY,
+     FDT_NEED_NBRS, 4, {".node", ".ele", ".face", ".neigh"},
+     {fdt_put_tetgen_node, fdt_put_tetgen_ele, fdt_put_tetgen_face, fdt_put_tetgen_neigh},
+     NULL},
+    {"vtu", {".vtu"}, "VTK XML unstructured grid (ParaView), appended raw", 1,
+     FDT_LAYOUT_FILE, 0, 1, {NULL}, {fdt_put_vtu}, NULL},
+    {"vtk", {".vtk"}, "VTK legacy ASCII unstructured grid", 0, FDT_LAYOUT_FILE, 0, 1,
+     {NULL}, {fdt_put_vtk}, NULL},
+    {"msh", {".msh"}, "gmsh MSH 4.1 ASCII: tets and hull triangles", 0, FDT_LAYOUT_FILE, 0,
+     1, {NULL}, {fdt_put_msh41}, NULL},
+    {"msh2", {NULL}, "gmsh MSH 2.2 ASCII (--format msh2)", 0, FDT_LAYOUT_FILE, 0, 1,
+     {NULL}, {fdt_put_msh22}, NULL},
+    {"medit", {".mesh"}, "Medit .mesh (MMG, meshio): tets and hull triangles", 0,
+     FDT_LAYOUT_FILE, 0, 1, {NULL}, {fdt_put_medit}, NULL},
+    {"openfoam", {"polyMesh"}, "OpenFOAM polyMesh directory, the hull one patch", 0,
+     FDT_LAYOUT_DIR, FDT_NEED_FACES, 5,
+     {"points", "faces", "owner", "neighbour", "boundary"},
+     {fdt_put_foam_points, fdt_put_foam_faces, fdt_put_foam_owner, fdt_put_foam_neighbour,
+      fdt_put_foam_boundary},
+     fdt_foam_prepare},
+    {NULL, {NULL}, NULL, 0, FDT_LAYOUT_FILE, 0, 0, {NULL}, {NULL}, NULL},
+};
+
+/* ------------------------------------------------------------------------ */
+/* Dispatch                                                                   */
+/* ------------------------------------------------------------------------ */
+
+/* What the row needs that the view lacks, as a message; NULL if nothing. */
+static const char *missing(const fdt_format *f, const fdt_mesh_view *m)
 {
-    /* "<points> <dimension> <attributes> <boundary markers>", then
-     * "<index> <x> <y> <z>", first index 0 (TetGen accepts either base
-     * and follows the first index it reads). */
-    out_i64(o, (int64_t)m->n_points);
-    out_str(o, " 3 0 0\n");
-    for (size_t i = 0; i < m->n_points && !o->err; i++) {
-        out_i64(o, (int64_t)i);
-        for (int c = 0; c < 3; c++) {
-            out_char(o, ' ');
-            out_double(o, m->xyz[3 * i + (size_t)c]);
-        }
-        out_char(o, '\n');
-    }
+    int needs = fdt_format_needs(f, m->all_faces);
+    if ((needs & FDT_NEED_NBRS) && !m->nbrs)
+        return "this format needs tet neighbours (settings.neighbors)";
+    if ((needs & FDT_NEED_FACES) && !m->faces && (m->n_tets > 0))
+        return "this format needs the face list (fdt_result_faces)";
+    return NULL;
 }
 
-/* "<count><header>", then "<index> <v_1> ... <v_k>" a row, the values
- * from vid or, where vid is NULL, from tid: the bodies of .ele, .face
- * and .neigh. */
-static void put_rows(out_file *o, size_t count, const char *header, int k,
-                     const fdt_vid *vid, const fdt_tid *tid)
+/* Opens names[0..k) as temporaries, writes part i with put[i] and commits
+ * them all or none; keep: leave the slots live (SLOT_RENAMED) for a
+ * directory still to be renamed. */
+static int write_parts(const fdt_format *f, char names[FDT_IO_MAX_FILES][FDT_IO_PATH],
+                       int k, const fdt_mesh_view *m, const void *prep, out_file *files,
+                       char *err, size_t errlen, int keep)
 {
-    out_i64(o, (int64_t)count);
-    out_str(o, header);
-    for (size_t r = 0; r < count && !o->err; r++) {
-        out_i64(o, (int64_t)r);
-        for (size_t at = (size_t)k * r; at < (size_t)k * (r + 1); at++) {
-            out_char(o, ' ');
-            out_i64(o, vid ? (int64_t)vid[at] : (int64_t)tid[at]);
-        }
-        out_char(o, '\n');
-    }
-}
-
-static void put_ele(out_file *o, const fdt_mesh_view *m)
-{
-    /* "<tets> <nodes per tet> <region attribute>", then
-     * "<index> <v0> <v1> <v2> <v3>" in the tet's own order. Our positive
-     * orientation, det(b-a, c-a, d-a) > 0, is TetGen's too (checked
-     * against libtet's output), as are outward hull faces and neighbour i
-     * opposite vertex i: TetGen readers need no conversion. */
-    put_rows(o, m->n_tets, " 4 0\n", 4, m->tets, NULL);
-}
-
-static void put_face(out_file *o, const fdt_mesh_view *m)
-{
-    /* "<faces> <boundary marker>", then "<index> <v0> <v1> <v2>". */
-    put_rows(o, m->n_hull, " 0\n", 3, m->hull, NULL);
-}
-
-static void put_neigh(out_file *o, const fdt_mesh_view *m)
-{
-    /* "<tets> 4", then "<index> <n0> <n1> <n2> <n3>": neighbour i is
-     * opposite vertex i (TetGen's convention and ours), -1 on the hull. */
-    put_rows(o, m->n_tets, " 4\n", 4, NULL, m->nbrs);
-}
-
-static int write_tetgen(const char *path, const fdt_mesh_view *m, char *err,
-                        size_t errlen)
-{
-    if (!m->nbrs)
-        return set_err(err, errlen, FDT_IO_EFORMAT, path,
-                       ".ele output needs tet neighbours "
-                       "(settings.neighbors)");
-    void (*const put[4])(out_file *, const fdt_mesh_view *) = {
-        put_node, put_ele, put_face, put_neigh
-    };
-    /* fdt_output_files() lists .node, .ele, .face, .neigh in this order. */
-    char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
-    if (fdt_output_files(path, names) != 4)
-        return set_errno_err(err, errlen, path, ENAMETOOLONG);
-
-    out_file files[4];
     mode_t mode = creation_mode();
-    int opened = 0;
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < k; i++) {
         int e = out_open(&files[i], names[i], mode);
         if (e) {
-            for (int j = 0; j < opened; j++)
+            for (int j = 0; j < i; j++)
                 out_abandon(&files[j]);
             return set_errno_err(err, errlen, names[i], e);
         }
-        opened++;
-        put[i](&files[i], m);
-        /* Stop at the first write error instead of formatting on. */
-        if (files[i].err) {
+        int r = f->put[i](&files[i], m, prep, err, errlen);
+        /* Stop at the first error instead of formatting on. */
+        if (r != FDT_IO_OK || files[i].err) {
             int e2 = files[i].err;
-            for (int j = 0; j < opened; j++)
+            for (int j = 0; j <= i; j++)
                 out_abandon(&files[j]);
-            return set_errno_err(err, errlen, names[i], e2);
+            return r != FDT_IO_OK ? r : set_errno_err(err, errlen, names[i], e2);
         }
     }
-    /* files[i].path points into names[], which outlives commit_all. */
-    return commit_all(files, 4, err, errlen);
+    return commit_all(files, k, err, errlen, keep);
 }
 
-/* ------------------------------------------------------------------------ */
-/* VTK                                                                        */
-/* ------------------------------------------------------------------------ */
-
-static int host_is_little_endian(void)
+/* The directory of a fresh polyMesh: made as ".NAME.tmp.XXXXXX" beside
+ * path, filled, renamed to path. */
+static int write_new_dir(const fdt_format *f, const char *path, const fdt_mesh_view *m,
+                         const void *prep, char *err, size_t errlen)
 {
-    const uint16_t one = 1;
-    unsigned char b;
-    memcpy(&b, &one, 1);
-    return b == 1;
+    size_t len = strlen(path);
+    while (len > 1 && path[len - 1] == '/')
+        len--;
+    char target[FDT_IO_PATH];
+    if (len + 1 > sizeof target)
+        return set_errno_err(err, errlen, path, ENAMETOOLONG);
+    memcpy(target, path, len);
+    target[len] = '\0';
+    const char *slash = strrchr(target, '/');
+    size_t dirlen = slash ? (size_t)(slash + 1 - target) : 0;
+    static const char suffix[] = ".tmp.XXXXXX";
+    if (len + 1 + sizeof suffix > FDT_IO_PATH)
+        return set_errno_err(err, errlen, path, ENAMETOOLONG);
+    /* the handler may read fdt_io_tmpdir only while the flag is set */
+    memcpy(fdt_io_tmpdir, target, dirlen);
+    fdt_io_tmpdir[dirlen] = '.';
+    memcpy(fdt_io_tmpdir + dirlen + 1, target + dirlen, len - dirlen);
+    memcpy(fdt_io_tmpdir + len + 1, suffix, sizeof suffix);
+    if (!mkdtemp(fdt_io_tmpdir))
+        return set_errno_err(err, errlen, path, errno);
+    fdt_io_tmpdir_live = 1;
+    int r = FDT_IO_OK;
+    /* mkdtemp makes mode 0700: give it a plain mkdir's mode */
+    if (chmod(fdt_io_tmpdir, creation_mode() | 0111) != 0) {
+        r = set_errno_err(err, errlen, path, errno);
+        goto out;
+    }
+    char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+    int k = fdt_output_files_as(fdt_io_tmpdir, f, names);
+    if (k != f->nparts) {
+        r = set_errno_err(err, errlen, path, ENAMETOOLONG);
+        goto out;
+    }
+    out_file files[FDT_IO_MAX_FILES];
+    r = write_parts(f, names, k, m, prep, files, err, errlen, 1);
+    if (r != FDT_IO_OK)
+        goto out;
+    if (rename(fdt_io_tmpdir, target) != 0) {
+        r = set_errno_err(err, errlen, path, errno);
+        for (int i = 0; i < k; i++)
+            out_abandon(&files[i]); /* unlinks the renamed parts */
+        goto out;
+    }
+    /* Renamed: the parts' names in the registry are gone with the
+     * temporary directory; free the slots, then the directory's. */
+    for (int i = 0; i < k; i++) {
+        fdt_io_state[files[i].slot] = SLOT_FREE;
+        files[i].slot = -1;
+    }
+    fdt_io_tmpdir_live = 0;
+    return FDT_IO_OK;
+out:
+    rmdir(fdt_io_tmpdir);
+    fdt_io_tmpdir_live = 0;
+    return r;
 }
 
-#define VTK_TETRA 10
-
-static int write_vtu(const char *path, const fdt_mesh_view *m, char *err,
-                     size_t errlen)
-{
-    out_file o;
-    int e = out_open(&o, path, creation_mode());
-    if (e)
-        return set_errno_err(err, errlen, path, e);
-
-    /* Appended raw data: each array is a UInt64 byte count followed by the
-     * bytes, in host order (byte_order says which); the offset attributes
-     * count from the first byte after '_'. */
-    uint64_t n = m->n_points, nt = m->n_tets;
-    uint64_t sz_pts = 3 * n * sizeof(double);
-    uint64_t sz_conn = 4 * nt * sizeof(int64_t);
-    uint64_t sz_off = nt * sizeof(int64_t);
-    uint64_t sz_typ = nt;
-    uint64_t off_pts = 0;
-    uint64_t off_conn = off_pts + 8 + sz_pts;
-    uint64_t off_off = off_conn + 8 + sz_conn;
-    uint64_t off_typ = off_off + 8 + sz_off;
-
-    char head[2048];
-    int k = snprintf(head, sizeof head,
-        "<?xml version=\"1.0\"?>\n"
-        "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
-        "byte_order=\"%s\" header_type=\"UInt64\">\n"
-        "  <UnstructuredGrid>\n"
-        "    <Piece NumberOfPoints=\"%llu\" NumberOfCells=\"%llu\">\n"
-        "      <Points>\n"
-        "        <DataArray type=\"Float64\" Name=\"Points\" "
-        "NumberOfComponents=\"3\" format=\"appended\" offset=\"%llu\"/>\n"
-        "      </Points>\n"
-        "      <Cells>\n"
-        "        <DataArray type=\"Int64\" Name=\"connectivity\" "
-        "format=\"appended\" offset=\"%llu\"/>\n"
-        "        <DataArray type=\"Int64\" Name=\"offsets\" "
-        "format=\"appended\" offset=\"%llu\"/>\n"
-        "        <DataArray type=\"UInt8\" Name=\"types\" "
-        "format=\"appended\" offset=\"%llu\"/>\n"
-        "      </Cells>\n"
-        "    </Piece>\n"
-        "  </UnstructuredGrid>\n"
-        "  <AppendedData encoding=\"raw\">\n"
-        "   _",
-        host_is_little_endian() ? "LittleEndian" : "BigEndian",
-        (unsigned long long)n, (unsigned long long)nt,
-        (unsigned long long)off_pts, (unsigned long long)off_conn,
-        (unsigned long long)off_off, (unsigned long long)off_typ);
-    if (k < 0 || (size_t)k >= sizeof head) {
-        out_abandon(&o);
-        return set_errno_err(err, errlen, path, EOVERFLOW);
-    }
-    out_bytes(&o, head, (size_t)k);
-
-    out_bytes(&o, &sz_pts, 8);
-    out_bytes(&o, m->xyz, (size_t)sz_pts);
-
-    out_bytes(&o, &sz_conn, 8);
-    for (size_t i = 0; i < 4 * m->n_tets && !o.err; i++) {
-        int64_t v = m->tets[i];
-        char *p = out_room(&o, 8);
-        memcpy(p, &v, 8);
-        o.len += 8;
-    }
-    out_bytes(&o, &sz_off, 8);
-    for (size_t t = 0; t < m->n_tets && !o.err; t++) {
-        int64_t v = 4 * (int64_t)(t + 1);
-        char *p = out_room(&o, 8);
-        memcpy(p, &v, 8);
-        o.len += 8;
-    }
-    out_bytes(&o, &sz_typ, 8);
-    for (size_t t = 0; t < m->n_tets && !o.err; t++)
-        out_char(&o, VTK_TETRA);
-    out_str(&o, "\n  </AppendedData>\n</VTKFile>\n");
-    return commit_all(&o, 1, err, errlen);
-}
-
-static int write_vtk(const char *path, const fdt_mesh_view *m, char *err,
-                     size_t errlen)
-{
-    out_file o;
-    int e = out_open(&o, path, creation_mode());
-    if (e)
-        return set_errno_err(err, errlen, path, e);
-
-    out_str(&o, "# vtk DataFile Version 3.0\n"
-                "frontdt Delaunay tetrahedralization\n"
-                "ASCII\n"
-                "DATASET UNSTRUCTURED_GRID\n"
-                "POINTS ");
-    out_i64(&o, (int64_t)m->n_points);
-    out_str(&o, " double\n");
-    for (size_t i = 0; i < m->n_points && !o.err; i++) {
-        out_double(&o, m->xyz[3 * i]);
-        out_char(&o, ' ');
-        out_double(&o, m->xyz[3 * i + 1]);
-        out_char(&o, ' ');
-        out_double(&o, m->xyz[3 * i + 2]);
-        out_char(&o, '\n');
-    }
-    /* CELLS <cells> <list size>: each cell is its count then its ids. */
-    out_str(&o, "CELLS ");
-    out_i64(&o, (int64_t)m->n_tets);
-    out_char(&o, ' ');
-    out_i64(&o, 5 * (int64_t)m->n_tets);
-    out_char(&o, '\n');
-    for (size_t t = 0; t < m->n_tets && !o.err; t++) {
-        out_char(&o, '4');
-        for (int c = 0; c < 4; c++) {
-            out_char(&o, ' ');
-            out_i64(&o, m->tets[4 * t + (size_t)c]);
-        }
-        out_char(&o, '\n');
-    }
-    out_str(&o, "CELL_TYPES ");
-    out_i64(&o, (int64_t)m->n_tets);
-    out_char(&o, '\n');
-    for (size_t t = 0; t < m->n_tets && !o.err; t++)
-        out_str(&o, "10\n");
-    return commit_all(&o, 1, err, errlen);
-}
-
-/* ------------------------------------------------------------------------ */
-
-int fdt_write_mesh(const char *path, const fdt_mesh_view *m, char *err,
-                   size_t errlen)
+int fdt_write_mesh_as(const char *path, const fdt_format *f, const fdt_mesh_view *m,
+                      char *err, size_t errlen)
 {
     if (err && errlen > 0)
         err[0] = '\0';
     if (!path || !m)
-        return set_err(err, errlen, FDT_IO_EFORMAT, path,
-                       "no path or no mesh");
+        return set_err(err, errlen, FDT_IO_EFORMAT, path, "no path or no mesh");
+    if (!f)
+        f = fdt_format_by_path(path);
+    if (!f) {
+        char what[700];
+        snprintf(what, sizeof what, "unknown output format (use %s)", fdt_format_list());
+        return set_err(err, errlen, FDT_IO_EEXT, path, what);
+    }
     int r = validate(path, m, err, errlen);
     if (r != FDT_IO_OK)
         return r;
-    if (has_ext(path, ".tets"))
-        return write_tets(path, m, err, errlen);
-    if (has_ext(path, ".ele"))
-        return write_tetgen(path, m, err, errlen);
-    if (has_ext(path, ".vtu"))
-        return write_vtu(path, m, err, errlen);
-    if (has_ext(path, ".vtk"))
-        return write_vtk(path, m, err, errlen);
-    return set_err(err, errlen, FDT_IO_EEXT, path,
-                   "unknown output format (use .tets, .ele, .vtu or .vtk)");
+    const char *lack = missing(f, m);
+    if (lack)
+        return set_err(err, errlen, FDT_IO_EFORMAT, path, lack);
+    void *prep = NULL;
+    if (f->prepare && (r = f->prepare(m, &prep, path, err, errlen)) != FDT_IO_OK)
+        return r;
+    struct stat st;
+    if (f->layout == FDT_LAYOUT_DIR && stat(path, &st) != 0 && errno == ENOENT) {
+        r = write_new_dir(f, path, m, prep, err, errlen);
+    } else if (f->layout == FDT_LAYOUT_DIR && stat(path, &st) == 0 && !S_ISDIR(st.st_mode)) {
+        r = set_errno_err(err, errlen, path, ENOTDIR);
+    } else {
+        char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+        int k = fdt_output_files_as(path, f, names);
+        out_file files[FDT_IO_MAX_FILES];
+        if (k != f->nparts)
+            r = set_errno_err(err, errlen, path, ENAMETOOLONG);
+        else
+            r = write_parts(f, names, k, m, prep, files, err, errlen, 0);
+    }
+    free(prep);
+    return r;
+}
+
+int fdt_write_mesh(const char *path, const fdt_mesh_view *m, char *err,
+                   size_t errlen)
+{
+    return fdt_write_mesh_as(path, NULL, m, err, errlen);
+}
+
+int fdt_write_mesh_stream(FILE *stream, const char *name, const fdt_format *f,
+                          const fdt_mesh_view *m, char *err, size_t errlen)
+{
+    if (err && errlen > 0)
+        err[0] = '\0';
+    if (!stream || !f || !m)
+        return set_err(err, errlen, FDT_IO_EFORMAT, name, "no stream, format or mesh");
+    if (f->binary || f->layout != FDT_LAYOUT_FILE)
+        return set_err(err, errlen, FDT_IO_EEXT, name,
+                       "only a single-file text format can go to a stream");
+    int r = validate(name, m, err, errlen);
+    if (r != FDT_IO_OK)
+        return r;
+    const char *lack = missing(f, m);
+    if (lack)
+        return set_err(err, errlen, FDT_IO_EFORMAT, name, lack);
+    out_file o;
+    memset(&o, 0, sizeof o);
+    o.f = stream;
+    o.slot = -1;
+    o.path = name;
+    o.buf = malloc(OUT_BUF_SIZE);
+    if (!o.buf)
+        return set_errno_err(err, errlen, name, ENOMEM);
+    r = f->put[0](&o, m, NULL, err, errlen);
+    out_flush(&o);
+    errno = 0;
+    if (fflush(stream) != 0 || ferror(stream))
+        out_fail(&o, errno);
+    free(o.buf);
+    if (r == FDT_IO_OK && o.err)
+        r = set_errno_err(err, errlen, name, o.err);
+    return r;
 }

@@ -9,6 +9,7 @@
 #define FDT_WRITER_H
 
 #include <stddef.h>
+#include <stdio.h>
 #include "frontdt.h"
 
 typedef struct fdt_mesh_view {
@@ -19,7 +20,37 @@ typedef struct fdt_mesh_view {
     const fdt_tid *nbrs;     /* 4 per tet or NULL (required for .ele) */
     const fdt_vid *hull;     /* 3 per hull face, outward */
     size_t n_hull;
+    /* The face list of fdt_result_faces, or NULL (required by the formats
+     * whose row needs FDT_NEED_FACES, and by all_faces). */
+    const fdt_vid *faces;    /* 3 per face, tets[2i] on the positive side */
+    const fdt_tid *face_tets;/* 2 per face, -1 on the hull */
+    size_t n_faces;
+    int all_faces;           /* TetGen .face: every face (TetGen -f) */
 } fdt_mesh_view;
+
+typedef struct fdt_format fdt_format; /* a row of src/formats.h's table */
+
+/* What a row needs in the fdt_mesh_view beyond points and tets. */
+enum {
+    FDT_NEED_NBRS = 1,  /* tet neighbours */
+    FDT_NEED_FACES = 2, /* the face list (fdt_result_faces) */
+    FDT_NEED_SORTED = 4 /* canonical tet order (fdt_result_sort) */
+};
+
+
+/* The row named name (--format), or NULL. */
+const fdt_format *fdt_format_by_name(const char *name);
+/* The row path's extension chooses (a directory format: its last
+ * component, "polyMesh"), or NULL. */
+const fdt_format *fdt_format_by_path(const char *path);
+/* The row's name and whether it is text (may go to standard output). */
+const char *fdt_format_name(const fdt_format *f);
+int fdt_format_is_text(const fdt_format *f);
+/* Whether writing with f needs tet neighbours, the face list, canonical
+ * order (FDT_NEED_* of src/formats.h, or'ed). */
+int fdt_format_needs(const fdt_format *f, int all_faces);
+/* "name (.ext, .ext)" of every row, comma separated, for messages. */
+const char *fdt_format_list(void);
 
 /*
  * Writes the mesh in the format given by path's extension:
@@ -33,12 +64,23 @@ typedef struct fdt_mesh_view {
  */
 int fdt_write_mesh(const char *path, const fdt_mesh_view *m, char *err,
                    size_t errlen);
+/* The same in format f (NULL: by path's extension). A directory format
+ * (OpenFOAM polyMesh) is written to a temporary directory beside path and
+ * renamed to path at the end when path does not exist yet; when path is an
+ * existing directory, each of its files is replaced by its own
+ * temporary-and-rename, all or none (other files there are left alone). */
+int fdt_write_mesh_as(const char *path, const fdt_format *f, const fdt_mesh_view *m,
+                      char *err, size_t errlen);
+/* A text format written to an open stream (standard output: no temporary,
+ * nothing renamed). Only single-file text formats. */
+int fdt_write_mesh_stream(FILE *stream, const char *name, const fdt_format *f,
+                          const fdt_mesh_view *m, char *err, size_t errlen);
 
 /* The longest path the writer takes (its temporary names live in fixed
  * buffers a signal handler can read), and the most files one output
- * family writes (.ele: four). */
+ * family writes (an OpenFOAM polyMesh: five). */
 #define FDT_IO_PATH 4096
-#define FDT_IO_MAX_FILES 4
+#define FDT_IO_MAX_FILES 5
 
 /*
  * The files fdt_write_mesh(path, ...) writes, in the order it writes them,
@@ -51,6 +93,10 @@ int fdt_write_mesh(const char *path, const fdt_mesh_view *m, char *err,
  */
 int fdt_output_files(const char *path,
                      char names[FDT_IO_MAX_FILES][FDT_IO_PATH]);
+/* The same for format f (NULL: by extension); a directory format lists
+ * the files in the directory path. */
+int fdt_output_files_as(const char *path, const fdt_format *f,
+                        char names[FDT_IO_MAX_FILES][FDT_IO_PATH]);
 
 /*
  * Do paths a and b reach the same file? 1 if so, else 0. Each path stands
