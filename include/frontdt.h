@@ -134,6 +134,46 @@ FDT_API const fdt_vid *fdt_result_hull_faces(const fdt_result *r);
 FDT_API const fdt_vid *fdt_result_duplicate_map(const fdt_result *r);
 FDT_API size_t fdt_result_num_duplicates(const fdt_result *r);
 
+/*
+ * The face list of Merriam §2: every face once, with its three vertices
+ * and the tets on either side (the paper's connectivity of the finished
+ * triangulation).
+ *
+ * Every face once (3 vertex ids, input numbering, oriented so tets[2i] is on
+ * its positive side: orient3d(v0,v1,v2,x) > 0 for x the tet's 4th vertex),
+ * and the tets on either side (tets[2i+1] = -1 on the hull). Computed on
+ * first call (O(n log n) or O(n) expected); arrays owned by the result,
+ * valid until fdt_result_free or fdt_result_sort.
+ *
+ * Precisely: orient3d(a,b,c,d) is the sign of det[b-a; c-a; d-a], positive
+ * when d lies on the side of the plane abc towards which the right-hand
+ * normal (b-a) x (c-a) points (the sign convention of the tets, above). So
+ * face i's right-hand normal points into tet tets[2i] and, for an interior
+ * face, out of tets[2i+1]. Further:
+ *  - interior faces have tets[2i] < tets[2i+1];
+ *  - v0 is the lowest of the three ids (a rotation, which keeps the
+ *    orientation);
+ *  - faces are in ascending order of their three ids sorted ascending, so
+ *    the list is the same for every thread count and mode once the tets
+ *    are sorted (fdt_result_sort);
+ *  - a hull face (tets[2i+1] = -1) is a face of fdt_result_hull_faces
+ *    with the opposite orientation (those have the interior on the
+ *    negative side); n_faces = (4 T + H) / 2 for T tets and H hull faces.
+ * Returns FDT_ENOMEM (the result unchanged: call again), FDT_EINVAL for a
+ * NULL argument.
+ */
+FDT_API int fdt_result_faces(fdt_result *r, size_t *n_faces, const fdt_vid **verts,
+                             const fdt_tid **tets);
+/* Every edge once, as (a, b) with a < b, sorted. Owned by the result (valid
+ * until fdt_result_free; fdt_result_sort does not change it). */
+FDT_API int fdt_result_edges(fdt_result *r, size_t *n_edges, const fdt_vid **verts);
+/* The Delaunay neighbours of vertex v, ascending; *ids owned by the result (valid until the
+ * next call on r). FDT_EINVAL for a bad v (negative, or not below the number of input
+ * points). A duplicate point merged into another (fdt_result_duplicate_map) has no
+ * neighbours: *count = 0. */
+FDT_API int fdt_result_vertex_neighbors(fdt_result *r, fdt_vid v, size_t *count,
+                                        const fdt_vid **ids);
+
 /* Puts the tets in canonical order: by their 4 ids sorted ascending,
  * compared as integer tuples. Each tet keeps its positive orientation;
  * neighbours are renumbered to match. Idempotent. The arrays may move:

@@ -19,6 +19,7 @@ void fdt_result_free(fdt_result **r)
     free((*r)->hull);
     free((*r)->dupmap);
     free((*r)->tstats);
+    fdt_result_drop_derived(*r);
     free(*r);
     *r = NULL;
 }
@@ -693,6 +694,7 @@ static int sort_threads(const fdt_result *r)
 static int sort_impl(fdt_result *r, text_hash *th, int T)
 {
     size_t n = r->ntets;
+    fdt_result_drop_faces(r); /* it names tets by their old numbers */
     for (size_t i = 0; i < n && r->nbrs; i++) {
         int perm[4];
         orient_sorted(r->tets + 4 * i, perm);

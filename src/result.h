@@ -16,7 +16,22 @@ struct fdt_result {
     fdt_stats stats;
     fdt_thread_stats *tstats; /* stats.threads entries, parallel modes only
                                  (owned; NULL in serial mode) */
+    /* Derived on request by src/faces.c, NULL until then (owned). The
+     * face list names tets, so fdt_result_sort drops it; the edges and
+     * the adjacency name vertices only and survive the sort. */
+    fdt_vid *face_verts; /* 3 per face */
+    fdt_tid *face_tets;  /* 2 per face */
+    size_t nfaces;
+    fdt_vid *edges;      /* 2 per edge, (a, b) a < b, ascending */
+    size_t nedges;
+    size_t *adj_start;   /* n + 1 offsets into adj */
+    fdt_vid *adj;        /* each vertex's neighbours, ascending */
 };
+
+/* Frees the face list (src/faces.c): the tets were renumbered. */
+void fdt_result_drop_faces(fdt_result *r);
+/* Frees everything src/faces.c derived (fdt_result_free). */
+void fdt_result_drop_derived(fdt_result *r);
 
 /* fdt_result_hash with the canonical sort (when the result is not sorted
  * yet) on `threads` threads (1 to 64), however many cores there are: for
