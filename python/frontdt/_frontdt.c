@@ -15,8 +15,12 @@
  * arrays never move again; it also makes `simplices` the canonical order,
  * the same for every thread count and mode.
  *
- * The object never changes after construction, so check() may release the
- * GIL while other threads read the same Triangulation.
+ * The tets never change after construction, so check() may release the
+ * GIL while other threads read the same Triangulation. The face and edge
+ * lists (fdt_result_faces, fdt_result_edges) are derived inside the result
+ * on first use; those calls write the result, so they run under the
+ * object's own lock (with the GIL released: they take a while on big
+ * meshes), and once built their arrays stay until the result is freed.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -25,6 +29,7 @@
 
 #include <inttypes.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -147,11 +152,14 @@ typedef struct {
     fdt_result *r;          /* owned; sorted, never changed again */
     PyArrayObject *points;  /* owned copy, (n, 3) float64 */
     uint64_t hash;
+    PyThread_type_lock lock;/* serialises the calls that derive lists in r */
 } TriObject;
 
 static void tri_dealloc(TriObject *self)
 {
     fdt_result_free(&self->r);
+    if (self->lock)
+        PyThread_free_lock(self->lock);
     Py_XDECREF(self->points);
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
@@ -182,6 +190,92 @@ static PyObject *tri_duplicates(TriObject *self, void *closure)
     (void)closure;
     return view((PyObject *)self, fdt_result_duplicate_map(self->r),
                 PyArray_DIM(self->points, 0), 0, NPY_INT32);
+}
+
+/* The face list: computed once (fdt_result_faces), then the same arrays. */
+static int tri_faces_impl(TriObject *self, size_t *nf, const fdt_vid **fv,
+                          const fdt_tid **ft)
+{
+    int err;
+    Py_BEGIN_ALLOW_THREADS
+    PyThread_acquire_lock(self->lock, WAIT_LOCK);
+    err = fdt_result_faces(self->r, nf, fv, ft);
+    PyThread_release_lock(self->lock);
+    Py_END_ALLOW_THREADS
+    if (err)
+        raise_fdt(err, NULL);
+    return err;
+}
+
+static PyObject *tri_faces(TriObject *self, void *closure)
+{
+    (void)closure;
+    size_t nf;
+    const fdt_vid *fv;
+    const fdt_tid *ft;
+    if (tri_faces_impl(self, &nf, &fv, &ft))
+        return NULL;
+    return view((PyObject *)self, fv, (npy_intp)nf, 3, NPY_INT32);
+}
+
+static PyObject *tri_face_tets(TriObject *self, void *closure)
+{
+    (void)closure;
+    size_t nf;
+    const fdt_vid *fv;
+    const fdt_tid *ft;
+    if (tri_faces_impl(self, &nf, &fv, &ft))
+        return NULL;
+    return view((PyObject *)self, ft, (npy_intp)nf, 2, NPY_INT64);
+}
+
+static PyObject *tri_edges(TriObject *self, void *closure)
+{
+    (void)closure;
+    size_t ne;
+    const fdt_vid *ev;
+    int err;
+    Py_BEGIN_ALLOW_THREADS
+    PyThread_acquire_lock(self->lock, WAIT_LOCK);
+    err = fdt_result_edges(self->r, &ne, &ev);
+    PyThread_release_lock(self->lock);
+    Py_END_ALLOW_THREADS
+    if (err)
+        return raise_fdt(err, NULL);
+    return view((PyObject *)self, ev, (npy_intp)ne, 2, NPY_INT32);
+}
+
+/* A copy: the library's array is valid only until its next call on r. */
+static PyObject *tri_vertex_neighbors(TriObject *self, PyObject *arg)
+{
+    long v = PyLong_AsLong(arg);
+    if (v == -1 && PyErr_Occurred())
+        return NULL;
+    if (v < 0 || v >= (long)PyArray_DIM(self->points, 0))
+        return PyErr_Format(PyExc_IndexError, "vertex %ld out of range [0, %zd)", v,
+                            (Py_ssize_t)PyArray_DIM(self->points, 0));
+    size_t cnt = 0;
+    const fdt_vid *ids = NULL;
+    fdt_vid *copy = NULL;
+    int err;
+    /* copied under the lock: another thread's call would replace ids */
+    Py_BEGIN_ALLOW_THREADS
+    PyThread_acquire_lock(self->lock, WAIT_LOCK);
+    err = fdt_result_vertex_neighbors(self->r, (fdt_vid)v, &cnt, &ids);
+    if (!err && !(copy = malloc((cnt ? cnt : 1) * sizeof *copy)))
+        err = FDT_ENOMEM;
+    if (!err)
+        memcpy(copy, ids, cnt * sizeof *copy);
+    PyThread_release_lock(self->lock);
+    Py_END_ALLOW_THREADS
+    if (err)
+        return raise_fdt(err, NULL);
+    npy_intp dim = (npy_intp)cnt;
+    PyObject *out = PyArray_SimpleNew(1, &dim, NPY_INT32);
+    if (out)
+        memcpy(PyArray_DATA((PyArrayObject *)out), copy, cnt * sizeof *copy);
+    free(copy);
+    return out;
 }
 
 static PyObject *tri_points(TriObject *self, void *closure)
@@ -311,6 +405,15 @@ static PyGetSetDef tri_getset[] = {
     {"duplicates", (getter)tri_duplicates, NULL,
      "int32 (n,): the index each point was merged into (bit-identical "
      "coordinates; itself for the first of its coordinates).", NULL},
+    {"faces", (getter)tri_faces, NULL,
+     "Every face once, int32 (f, 3) (fdt_result_faces, Merriam §2): "
+     "oriented so face_tets[i, 0] is on its positive side (its right-hand "
+     "normal points into that tet), lowest id first, rows ascending.", NULL},
+    {"face_tets", (getter)tri_face_tets, NULL,
+     "int64 (f, 2): the tets on either side of faces[i] (rows of "
+     "simplices); face_tets[i, 1] = -1 on the hull.", NULL},
+    {"edges", (getter)tri_edges, NULL,
+     "Every edge once, int32 (e, 2), (a, b) with a < b, rows ascending.", NULL},
     {"stats", (getter)tri_stats, NULL,
      "A new dict of the run's statistics (fdt_result_stats).", NULL},
     {"hash", (getter)tri_hash, NULL,
@@ -323,6 +426,9 @@ static PyMethodDef tri_methods[] = {
     {"check", (PyCFunction)tri_check, METH_NOARGS,
      "check()\n--\n\nVerifies exactly that the mesh is the Delaunay "
      "tetrahedralization of the points (fdt_check); raises CheckError if not."},
+    {"vertex_neighbors", (PyCFunction)tri_vertex_neighbors, METH_O,
+     "vertex_neighbors(v)\n--\n\nThe Delaunay neighbours of point v, int32, "
+     "ascending (a new array; empty for a duplicate merged into another)."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -400,6 +506,11 @@ static PyObject *py_delaunay(PyObject *mod, PyObject *args, PyObject *kw)
     self->r = NULL;
     self->points = pts;
     self->hash = 0;
+    self->lock = PyThread_allocate_lock();
+    if (!self->lock) {
+        Py_DECREF(self);
+        return PyErr_NoMemory();
+    }
 
     fdt_context *ctx = NULL;
     int err = fdt_open(&ctx, &s);
