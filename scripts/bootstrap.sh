@@ -11,8 +11,9 @@ packages=(
   libhwloc-dev hwloc libgmp-dev libmpfr-dev
   libcgal-dev libtet1.5-dev tetgen libboost-dev
   libtbb-dev libqhull-dev
-  python3 python3-vtk9 python3-dev python3-numpy python3-scipy
+  python3 python3-vtk9
   gnuplot-nox valgrind clang libclang-rt-14-dev
+  python3-dev python3-numpy python3-scipy
 )
 
 missing=()
