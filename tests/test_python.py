@@ -2,7 +2,7 @@
 """The Python module frontdt (python/frontdt/, issue 17 item 3).
 
 usage: test_python.py PKG_DIR FRONTDT GEN_POINTS
-       test_python.py --not-built      (exit 77: meson's "skipped")
+       test_python.py --not-built WHY  (exit 77: meson's "skipped")
 
 PKG_DIR is the build's python/ directory, which holds the freshly built
 package (frontdt/__init__.py and the extension); meson puts it first on
@@ -33,9 +33,10 @@ import _thread
 
 SKIP = 77
 
-if len(sys.argv) == 2 and sys.argv[1] == "--not-built":
-    print("skipped: the Python module was not built (meson -Dpython=disabled, "
-          "or python3-dev / python3-numpy missing: scripts/bootstrap.sh installs them)")
+if len(sys.argv) >= 2 and sys.argv[1] == "--not-built":
+    print("skipped: the Python module was not built (%s; scripts/bootstrap.sh installs "
+          "python3-dev and python3-numpy, meson -Dpython=enabled insists)"
+          % (sys.argv[2] if len(sys.argv) > 2 else "see meson's summary"))
     sys.exit(SKIP)
 if len(sys.argv) != 4:
     sys.exit(__doc__)
