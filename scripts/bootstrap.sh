@@ -13,6 +13,7 @@ packages=(
   libtbb-dev libqhull-dev
   python3 python3-vtk9 python3-meshio gmsh openfoam
   gnuplot-nox valgrind clang libclang-rt-14-dev
+  python3-dev python3-numpy python3-scipy
 )
 
 missing=()

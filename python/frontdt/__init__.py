@@ -1,0 +1,15 @@
+"""frontdt: the exact 3D Delaunay tetrahedralization (Tanemura's advancing
+front, parallelised after Merriam, NASA TM-103951, 1992) from Python.
+
+    import numpy as np, frontdt
+    t = frontdt.delaunay(np.random.rand(10000, 3))
+    t.simplices     # int32 (m, 4), positively oriented, input numbering
+    t.neighbors     # int64 (m, 4), -1 on the hull, opposite vertex k
+    t.check()       # exact verification; raises frontdt.CheckError
+
+The arrays are read-only views of the library's result, which lives as
+long as any of them. See help(frontdt.delaunay) and README.md, "Python".
+"""
+from ._frontdt import CheckError, Triangulation, __version__, check, delaunay
+
+__all__ = ["CheckError", "Triangulation", "check", "delaunay", "__version__"]

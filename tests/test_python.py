@@ -1,0 +1,383 @@
+#!/usr/bin/python3
+"""The Python module frontdt (python/frontdt/, issue 17 item 3).
+
+usage: test_python.py PKG_DIR FRONTDT GEN_POINTS
+       test_python.py --not-built WHY  (exit 77: meson's "skipped")
+
+PKG_DIR is the build's python/ directory, which holds the freshly built
+package (frontdt/__init__.py and the extension); meson puts it first on
+PYTHONPATH and this test checks the module it imports came from there.
+
+Checks:
+ - scipy.spatial.Delaunay (qhull) on non-degenerate random inputs: the same
+   simplex set, hull face set and neighbour relation; every tet positive;
+ - the CLI's --hash on degenerate inputs from tests/gen_points (lattice,
+   duplicates, cospherical, coplanar grids) and the duplicate map;
+ - faces/face_tets: every face once, oriented towards face_tets[:, 0];
+ - errors: NaN, Inf, fewer than 4 points, coplanar, collinear, wrong
+   shapes, bad mode/search/threads; check() and CheckError;
+ - threads=2 and the parallel modes give the serial hash and the same
+   canonical simplices;
+ - the GIL is released (a Python thread counts while a triangulation runs)
+   and KeyboardInterrupt cancels a long one;
+ - arrays keep the result alive; RSS does not grow over repeated runs.
+"""
+import gc
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import _thread
+
+SKIP = 77
+
+if len(sys.argv) >= 2 and sys.argv[1] == "--not-built":
+    print("skipped: the Python module was not built (%s; scripts/bootstrap.sh installs "
+          "python3-dev and python3-numpy, meson -Dpython=enabled insists)"
+          % (sys.argv[2] if len(sys.argv) > 2 else "see meson's summary"))
+    sys.exit(SKIP)
+if len(sys.argv) != 4:
+    sys.exit(__doc__)
+PKG_DIR, FRONTDT, GEN_POINTS = (os.path.abspath(a) for a in sys.argv[1:])
+
+import numpy as np  # noqa: E402  (after the skip: numpy is there if built)
+import frontdt  # noqa: E402
+
+try:
+    import scipy.spatial
+except ImportError:
+    scipy = None
+
+FAILS = []
+
+
+def check(cond, what):
+    """The shared CHECK idea of tests/testutil.h: record, name, go on."""
+    if not cond:
+        FAILS.append(what)
+        print("FAIL:", what, flush=True)
+    return cond
+
+
+def raises(exc, fn, *args, **kw):
+    try:
+        fn(*args, **kw)
+    except exc as e:
+        return str(e) or type(e).__name__
+    except Exception as e:  # the wrong kind
+        print("  %s raised %s: %s" % (getattr(fn, "__name__", fn), type(e).__name__, e))
+    return None
+
+
+def tetset(s):
+    return set(map(tuple, np.sort(np.asarray(s), axis=1).tolist()))
+
+
+def orient(p, a, b, c, d):
+    """det(b-a, c-a, d-a) per row, in floating point (general position)."""
+    return np.linalg.det(np.stack([p[b] - p[a], p[c] - p[a], p[d] - p[a]], axis=1))
+
+
+def neighbour_relation(simp, nbrs):
+    """{(sorted tet, vertex opposite) -> sorted neighbour tet or None}."""
+    rel = {}
+    st = [tuple(sorted(t)) for t in simp.tolist()]
+    for i, t in enumerate(simp.tolist()):
+        for k in range(4):
+            j = int(nbrs[i][k])
+            rel[(st[i], t[k])] = st[j] if j >= 0 else None
+    return rel
+
+
+def test_origin():
+    f = os.path.realpath(frontdt._frontdt.__file__)
+    check(f.startswith(os.path.realpath(PKG_DIR) + os.sep),
+          "frontdt imported from %s, not the build's %s" % (f, PKG_DIR))
+
+
+def test_scipy():
+    if scipy is None:
+        print("scipy not installed: the qhull comparison is skipped "
+              "(Debian python3-scipy)")
+        return
+    rng = np.random.default_rng(17)
+    inputs = {
+        "uniform 3000": rng.random((3000, 3)),
+        "gaussian 2000": rng.standard_normal((2000, 3)),
+        "ball 2000 (list of lists)": [list(map(float, r)) for r in
+                                      (lambda q: q[np.sum(q * q, 1) < 1])(
+                                          rng.random((4000, 3)) * 2 - 1)[:2000]],
+        "int grid jittered 1500": (rng.integers(0, 1000, (1500, 3))
+                                   + rng.random((1500, 3)) * 1e-3),
+    }
+    for name, pts in inputs.items():
+        t = frontdt.delaunay(pts)
+        p = np.asarray(pts, dtype=float)
+        q = scipy.spatial.Delaunay(p)
+        s = t.simplices
+        check(s.dtype == np.int32 and s.shape[1] == 4, name + ": simplices int32 (m, 4)")
+        check(t.neighbors.dtype == np.int64 and t.neighbors.shape == s.shape,
+              name + ": neighbors int64 (m, 4)")
+        check(tetset(s) == tetset(q.simplices),
+              name + ": tet set differs from scipy's (%d vs %d tets)"
+              % (len(s), len(q.simplices)))
+        check(tetset(t.convex_hull) == tetset(q.convex_hull), name + ": hull differs from scipy's")
+        check(neighbour_relation(s, t.neighbors) ==
+              neighbour_relation(q.simplices, q.neighbors), name + ": neighbours differ from scipy's")
+        check(np.all(orient(p, *s.T) > 0), name + ": a tet is not positively oriented")
+        h = t.convex_hull  # outward: the centroid is on the negative side
+        c = p.mean(axis=0)
+        check(np.all(np.linalg.det(np.stack([p[h[:, 1]] - p[h[:, 0]], p[h[:, 2]] - p[h[:, 0]],
+                                             c - p[h[:, 0]]], axis=1)) < 0),
+              name + ": a hull face is not oriented outward")
+        check(np.array_equal(t.points, p), name + ": points are not the input")
+        qs = q.simplices.copy()  # qhull's orientation varies: make each positive
+        neg = orient(p, *qs.T) < 0
+        qs[neg, 0], qs[neg, 1] = q.simplices[neg, 1], q.simplices[neg, 0]
+        check(frontdt.check(p, qs) is None, name + ": check() refused scipy's mesh")
+        t.check()
+
+
+def test_faces():
+    rng = np.random.default_rng(5)
+    p = rng.random((1500, 3))
+    t = frontdt.delaunay(p)
+    f, ft, s = t.faces, t.face_tets, t.simplices
+    T, H = len(s), len(t.convex_hull)
+    check(f.shape == (len(ft), 3) and ft.shape[1] == 2 and f.dtype == np.int32
+          and ft.dtype == np.int64, "faces int32 (f, 3), face_tets int64 (f, 2)")
+    check(len(f) == (4 * T + H) // 2, "faces: %d, expected (4T + H) / 2" % len(f))
+    all_faces = set()
+    for tet in s.tolist():
+        for k in range(4):
+            all_faces.add(tuple(sorted(tet[:k] + tet[k + 1:])))
+    check(tetset(f) == all_faces and len(tetset(f)) == len(f), "faces: not every face once")
+    apex = [next(v for v in s[a] if v not in fr) for fr, a in zip(f.tolist(), ft[:, 0])]
+    check(np.all(orient(p, f[:, 0], f[:, 1], f[:, 2], np.array(apex)) > 0),
+          "faces: face_tets[:, 0] is not on the positive side")
+    hull = ft[:, 1] < 0
+    check(hull.sum() == H and tetset(f[hull]) == tetset(t.convex_hull),
+          "faces: the -1 faces are not the hull")
+    for fr, (a, b) in zip(f[~hull].tolist(), ft[~hull].tolist()):
+        if not (set(fr) < set(s[a].tolist()) and set(fr) < set(s[b].tolist())):
+            check(False, "faces: face %s is not in tets %d and %d" % (fr, a, b))
+            break
+    e = t.edges
+    check(e.shape[1] == 2 and np.all(e[:, 0] < e[:, 1]), "edges: (a, b) with a < b")
+    nb = t.vertex_neighbors(7)
+    check(set(nb.tolist()) == set(e[e[:, 0] == 7, 1].tolist()) | set(e[e[:, 1] == 7, 0].tolist()),
+          "vertex_neighbors(7) is not the edges at 7")
+    check(raises(IndexError, t.vertex_neighbors, 1500) is not None, "vertex_neighbors(n) not refused")
+
+
+def cli_hash(path):
+    out = subprocess.run([FRONTDT, path, "--hash", "--quiet"], capture_output=True,
+                         text=True, check=True).stdout
+    return next(line.split()[1] for line in out.splitlines() if line.startswith("hash:"))
+
+
+def test_cli_degenerate(tmp):
+    for fam, n in [("lattice", 1000), ("dup", 2000), ("intsphere", 400), ("grid2d", 800),
+                   ("sphere", 600), ("dupheavy", 1000), ("cylinder", 1500)]:
+        path = os.path.join(tmp, fam + ".xyz")
+        subprocess.run([GEN_POINTS, fam, str(n), "3", path], check=True)
+        p = np.loadtxt(path, ndmin=2)
+        t = frontdt.delaunay(p)
+        check(t.hash == cli_hash(path), "%s: hash %s, CLI %s" % (fam, t.hash, cli_hash(path)))
+        t.check()
+        # the duplicate map: each point's first index with equal coordinates
+        first = {}
+        want = np.array([first.setdefault(tuple(r), i) for i, r in
+                         enumerate((p + 0.0).tolist())])  # -0 = +0
+        check(np.array_equal(t.duplicates, want), fam + ": duplicate map")
+        check(t.stats["duplicates"] == int(np.sum(want != np.arange(len(p)))) and
+              t.stats["vertices"] == len(first), fam + ": stats duplicates/vertices")
+        check(np.isin(t.simplices, np.nonzero(want == np.arange(len(p)))[0]).all(),
+              fam + ": a tet uses a merged duplicate")
+
+
+def test_errors():
+    rng = np.random.default_rng(3)
+    p = rng.random((10, 3))
+    bad = p.copy()
+    bad[3, 1] = np.nan
+    m = raises(ValueError, frontdt.delaunay, bad)
+    check(m is not None and "point 3" in m, "NaN: ValueError naming point 3 (%r)" % m)
+    bad[3, 1] = np.inf
+    check(raises(ValueError, frontdt.delaunay, bad) is not None, "Inf: ValueError")
+    m = raises(ValueError, frontdt.delaunay, p[:3])
+    check(m is not None and "3 distinct" in m, "3 points: ValueError (%r)" % m)
+    check(raises(ValueError, frontdt.delaunay, np.repeat(p[:3], 5, axis=0)) is not None,
+          "15 points, 3 distinct: ValueError")
+    flat = np.c_[p[:, :2], np.full(10, 0.5)]
+    m = raises(ValueError, frontdt.delaunay, flat)
+    check(m is not None and "coplanar" in m, "coplanar: ValueError (%r)" % m)
+    m = raises(ValueError, frontdt.delaunay, np.outer(np.arange(6.0), [1, 2, 3]))
+    check(m is not None and "collinear" in m, "collinear: ValueError (%r)" % m)
+    for shape in [(10, 2), (10,), (2, 5, 3), (10, 4), (0, 3)]:
+        check(raises(ValueError, frontdt.delaunay, np.zeros(shape)) is not None,
+              "shape %s: ValueError" % (shape,))
+    check(raises(ValueError, frontdt.delaunay, [[1, 2], [3, 4, 5]]) is not None, "ragged: ValueError")
+    check(raises((ValueError, TypeError), frontdt.delaunay, [["a", "b", "c"]] * 5) is not None,
+          "strings refused")
+    check(raises(TypeError, frontdt.delaunay, p.astype(complex)) is not None, "complex: TypeError")
+    for kw, exc in [({"mode": "fast"}, ValueError), ({"search": "bsp"}, ValueError),
+                    ({"threads": 0}, ValueError), ({"threads": -2}, ValueError),
+                    ({"threads": 5000}, ValueError), ({"threads": "2"}, TypeError)]:
+        check(raises(exc, frontdt.delaunay, p, **kw) is not None, "%s: %s" % (kw, exc.__name__))
+    # check(): a mesh with a tet missing, a flipped tet, wrong neighbours
+    t = frontdt.delaunay(rng.random((200, 3)))
+    s = np.array(t.simplices)
+    check(raises(frontdt.CheckError, frontdt.check, t.points, s[1:]) is not None,
+          "check: a missing tet not found")
+    s2 = s.copy()
+    s2[0, [0, 1]] = s2[0, [1, 0]]
+    check(raises(frontdt.CheckError, frontdt.check, t.points, s2) is not None,
+          "check: a flipped tet not found")
+    nb = np.array(t.neighbors)
+    nb[0, 0] = -1 if nb[0, 0] >= 0 else 1
+    check(raises(frontdt.CheckError, frontdt.check, t.points, s, nb) is not None,
+          "check: a wrong neighbour not found")
+    check(frontdt.check(t.points, s, t.neighbors) is None, "check: the mesh itself refused")
+    check(issubclass(frontdt.CheckError, RuntimeError), "CheckError is a RuntimeError")
+
+
+def test_threads():
+    p = np.random.default_rng(11).random((20000, 3))
+    ref = frontdt.delaunay(p, threads=1, mode="serial")
+    check(ref.stats["mode"] == "serial" and ref.stats["threads"] == 1, "serial stats")
+    for kw in [{"threads": 2}, {"threads": 2, "mode": "shared"}, {"threads": 2, "mode": "message"},
+               {"threads": 3, "mode": "shared", "search": "mesh"}, {"search": "kd"}]:
+        t = frontdt.delaunay(p, **kw)
+        check(t.hash == ref.hash, "%s: hash %s, serial %s" % (kw, t.hash, ref.hash))
+        check(np.array_equal(t.simplices, ref.simplices) and
+              np.array_equal(t.neighbors, ref.neighbors),
+              "%s: canonical arrays differ from serial" % kw)
+    t = frontdt.delaunay(p, threads=2, mode="shared")
+    check(t.stats["threads"] == 2 and t.stats["mode"] == "shared", "threads=2 shared ran on 2 threads")
+
+
+def test_gil_and_interrupt():
+    p = np.random.default_rng(23).random((300000, 3))
+    count = [0]
+    stop = threading.Event()
+
+    def counter():
+        while not stop.is_set():
+            count[0] += 1
+
+    t0 = time.monotonic()
+    frontdt.delaunay(p, threads=1)
+    t_plain = time.monotonic() - t0
+    th = threading.Thread(target=counter)
+    th.start()
+    # the counter's rate with the main thread asleep (GIL free)
+    c0, t0 = count[0], time.monotonic()
+    time.sleep(0.3)
+    free_rate = (count[0] - c0) / (time.monotonic() - t0)
+    c0, t0 = count[0], time.monotonic()
+    t = frontdt.delaunay(p, threads=1)
+    dt, c1 = time.monotonic() - t0, count[0]
+    stop.set()
+    th.join()
+    # Held GIL: the counter runs only in switch intervals (5 ms) around the
+    # call and when the progress callback looks for signals: 274k
+    # increments in a 5.2 s run against 32M with the GIL released.
+    print("GIL: %d increments in the other thread during a %.2f s triangulation "
+          "(%.0f a second with the GIL free)" % (c1 - c0, dt, free_rate))
+    check(c1 - c0 > 0.1 * free_rate * dt,
+          "the GIL is not released: the other thread counted %d in %.2f s (free: %.0f/s)"
+          % (c1 - c0, dt, free_rate))
+    n_tets = len(t.simplices)
+    del t
+
+    # KeyboardInterrupt while the engine runs: canceled well before the end.
+    timer = threading.Timer(0.2, _thread.interrupt_main)
+    t0 = time.monotonic()
+    timer.start()
+    try:
+        t = frontdt.delaunay(p, threads=1)
+        got = "finished (%d tets)" % len(t.simplices)
+    except KeyboardInterrupt:
+        got = "interrupted"
+    el = time.monotonic() - t0
+    timer.join()
+    # Without the callback's signal check the run goes to its end and the
+    # interrupt is raised after it (el about t_plain).
+    print("interrupt: %s after %.2f s (a whole run: %.2f s)" % (got, el, t_plain))
+    check(got == "interrupted" and el < 0.2 + 0.5 * t_plain,
+          "KeyboardInterrupt did not cancel: %s after %.2f s of %.2f s" % (got, el, t_plain))
+    check(n_tets > 0, "the GIL run built tets")
+
+
+def rss_bytes():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def test_lifetime_and_memory():
+    p = np.random.default_rng(31).random((10000, 3))
+    s = frontdt.delaunay(p).simplices  # the Triangulation goes, its view stays
+    gc.collect()
+    junk = [np.ones(len(s) * 4, dtype=np.int32) * 7 for _ in range(4)]
+    check(isinstance(s.base, frontdt.Triangulation), "simplices' base is the Triangulation")
+    check(not s.flags.writeable, "simplices are read-only")
+    check(frontdt.check(p, s) is None, "a view outliving its Triangulation changed")
+    del junk
+    for name in ["simplices", "neighbors", "convex_hull", "duplicates", "faces", "face_tets",
+                 "edges", "points"]:
+        t = frontdt.delaunay(p[:500])
+        a = getattr(t, name)
+        copy = np.array(a)
+        del t
+        gc.collect()
+        junk = [np.full(copy.size + 64, 3, dtype=copy.dtype) for _ in range(8)]
+        check(a.size > 0 and np.array_equal(a, copy) and not a.flags.writeable,
+              name + ": view changed after its Triangulation went")
+        del junk
+    del s
+
+    # A leak of one result (about 48 bytes a tet: 66k tets) would add 3 MB
+    # a run, of the copied points 0.24 MB; errors leak nothing either.
+    def one():
+        t = frontdt.delaunay(p)
+        t.faces, t.edges, t.stats, t.hash, t.vertex_neighbors(3)
+        t.check()
+        raises(ValueError, frontdt.delaunay, np.r_[p, [[np.nan, 0, 0]]])
+        raises(ValueError, frontdt.delaunay, p[:3])
+        frontdt.check(p, t.simplices)
+
+    for _ in range(5):
+        one()
+    gc.collect()
+    r0 = rss_bytes()
+    runs = 25
+    for _ in range(runs):
+        one()
+    gc.collect()
+    grew = rss_bytes() - r0
+    print("RSS grew %.1f MB over %d runs after 5 warm-up runs" % (grew / 2**20, runs))
+    check(grew < 16 * 2**20, "RSS grew %.1f MB over %d runs" % (grew / 2**20, runs))
+
+
+def main():
+    print("frontdt", frontdt.__version__, "from", frontdt._frontdt.__file__)
+    with tempfile.TemporaryDirectory() as tmp:
+        for test in [test_origin, test_scipy, test_faces, lambda: test_cli_degenerate(tmp),
+                     test_errors, test_threads, test_gil_and_interrupt,
+                     test_lifetime_and_memory]:
+            t0 = time.monotonic()
+            test()
+            print("%s: %.1f s" % (getattr(test, "__name__", "?"), time.monotonic() - t0),
+                  flush=True)
+    if FAILS:
+        print("%d check(s) failed" % len(FAILS))
+        return 1
+    print("all checks passed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
