@@ -11,7 +11,7 @@
  * Lines and vertices are counted from 1; offending tokens are quoted, cut
  * to 24 bytes, with non-printable bytes as \xHH.
  *
- * Details (src/reader.c):
+ * Details (src/read_text.c, src/read_xyz.c, src/read_node.c, src/read_ply.c):
  * - Text numbers: [+-]? (digits [. digits?] | . digits) ([eE] [+-]? digits)?
  *   correctly rounded. Rejected: hex floats, nan/inf/infinity (any case),
  *   literals beyond DBL_MAX, nonzero literals below DBL_MIN (subnormal or
