@@ -41,7 +41,25 @@ typedef struct rd_ctx {
     size_t size;     /* bytes in the file (the NUL not counted) */
     int threads;      /* for .xyz: slices parsed at once (fdt_rd_read_xyz) */
     size_t min_slice; /* least bytes a slice; 0: RD_MIN_SLICE */
+    int col[3];       /* .xyz: 0-based columns of x, y, z */
+    int custom_cols;  /* col[] is not 0, 1, 2 (the messages say so) */
+    fdt_rd_progress_fn progress; /* NULL on threads other than the caller's */
+    void *progress_user;
+    size_t progress_scale; /* parsed bytes are reported times this */
 } rd_ctx;
+
+/* Reports done bytes parsed (times c->progress_scale, at most c->size). */
+static inline void fdt_rd_progress(const rd_ctx *c, size_t done)
+{
+    if (c->progress == NULL)
+        return;
+    size_t s = c->progress_scale > 1 ? c->progress_scale : 1;
+    done = done > c->size / s ? c->size : done * s;
+    c->progress(c->progress_user, FDT_RD_PARSING, done, c->size);
+}
+
+/* Lines or items between two progress reports. */
+#define RD_PROGRESS_EVERY 8192
 
 typedef struct rd_points {
     double *xyz; /* 3 * cap doubles */

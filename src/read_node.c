@@ -96,6 +96,8 @@ int fdt_rd_read_node(const rd_ctx *c, const char *start, rd_points *pb)
     uint64_t nfields = 4 + nattr + marker;
     int64_t base = 0;
     while (fdt_rd_next_line(&L, &s, &e)) {
+        if ((L.lineno & (RD_PROGRESS_EVERY - 1)) == 0)
+            fdt_rd_progress(c, (size_t)(L.p - c->buf));
         rd_fields f = {s, fdt_rd_cut_comment(s, e), 1, 0};
         if (fdt_rd_blank(f.p, f.e))
             continue;

@@ -464,6 +464,8 @@ static int ply_bin_skip(const rd_ctx *c, const ply_hdr *h, const ply_elem *el,
         return FDT_IO_OK;
     }
     for (uint64_t i = 0; i < el->count; i++) {
+        if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
+            fdt_rd_progress(c, *off);
         int r = ply_bin_item(c, h, el, off, big, NULL);
         if (r == 1)
             return fdt_rd_fail(c, FDT_IO_EFORMAT,
@@ -537,6 +539,8 @@ static int ply_bin_vertex(const rd_ctx *c, const ply_hdr *h,
         }
     }
     for (uint64_t i = 0; i < el->count; i++) {
+        if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
+            fdt_rd_progress(c, *off);
         if (el->has_list) {
             int r = ply_bin_item(c, h, el, off, big, roff);
             if (r == 1)
@@ -694,6 +698,8 @@ static int ply_read_ascii(const rd_ctx *c, const ply_hdr *h, rd_points *pb)
                 return rc;
         }
         for (uint64_t i = 0; i < el->count; i++) {
+            if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
+                fdt_rd_progress(c, (size_t)(L.p - c->buf));
             int got = 0;
             while ((got = fdt_rd_next_line(&L, &s, &e)) != 0 && fdt_rd_blank(s, e))
                 ;

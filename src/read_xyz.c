@@ -17,11 +17,74 @@
 /* .xyz / .txt                                                        */
 /* ------------------------------------------------------------------ */
 
+/* Whether the first content line s..e is a header: printable ASCII and
+ * no field (between blanks and commas) that reads as a number, finite or
+ * not, so that a first line of data, or of binary garbage, is never
+ * skipped unseen. */
+static int rd_is_header(const char *s, const char *e)
+{
+    for (const char *p = s; p < e; p++) {
+        unsigned char ch = (unsigned char)*p;
+        if (!(ch >= 0x20 && ch < 0x7f) && ch != '\t' && ch != '\r')
+            return 0;
+    }
+    const char *p = s;
+    while (p < e) {
+        while (p < e && (rd_is_space(*p) || *p == ','))
+            p++;
+        const char *t = p;
+        while (p < e && !rd_is_space(*p) && *p != ',')
+            p++;
+        if (p > t) {
+            double v;
+            if (fdt_rd_parse_real(t, (size_t)(p - t), &v, 0) != NUM_SYNTAX)
+                return 0;
+        }
+    }
+    return 1;
+}
+
+/* The first line of [start, end) with content (before a '#' comment):
+ * 1 with its bounds and number (1-based), 0 if there is none. */
+static int rd_first_content(const char *start, const char *end, const char **s,
+                            const char **e, size_t *lineno)
+{
+    rd_lines L = {start, end, 0};
+    while (fdt_rd_next_line(&L, s, e)) {
+        *e = fdt_rd_cut_comment(*s, *e);
+        if (!fdt_rd_blank(*s, *e)) {
+            *lineno = L.lineno;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Fields of the line s..e (a stray comma's empty field not counted: the
+ * parse reports it). */
+static size_t rd_count_fields(const char *s, const char *e)
+{
+    rd_fields f = {s, e, 1, 0};
+    size_t k = 0;
+    const char *ts;
+    size_t tl;
+    int r;
+    while ((r = fdt_rd_next_field(&f, &ts, &tl)) != 0)
+        if (r > 0)
+            k++;
+        else
+            f.p++;
+    return k;
+}
+
 /* The lines in [start, end) (end: c->buf + c->size or just after a '\n')
- * appended to pb. Every line is parsed on its own: nothing carries from
- * one line to the next, which is what lets fdt_rd_read_xyz cut the file. */
-static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end,
-                             rd_points *pb)
+ * appended to pb; line numbers count from line0 + 1. Every line must hold
+ * ncols fields (the first point line's count); x, y, z are columns
+ * c->col[] and the others are skipped unread. Every line is parsed on its
+ * own: nothing carries from one line to the next, which is what lets
+ * fdt_rd_read_xyz cut the file. */
+static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end, size_t line0,
+                             size_t ncols, rd_points *pb)
 {
     /* A guess from typical line lengths; the array doubles as needed. */
     size_t guess = (size_t)(end - start) / 24 + 16;
@@ -29,9 +92,14 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
         guess = (size_t)RD_MAX_POINTS;
     if (!pb->fixed && fdt_rd_points_reserve(pb, guess) != 0)
         return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
-    rd_lines L = {start, end, 0};
+    const size_t c0 = (size_t)c->col[0], c1 = (size_t)c->col[1], c2 = (size_t)c->col[2];
+    size_t need = (c0 > c1 ? c0 : c1);
+    need = (need > c2 ? need : c2) + 1;
+    rd_lines L = {start, end, line0};
     const char *s, *e;
     while (fdt_rd_next_line(&L, &s, &e)) {
+        if ((L.lineno & (RD_PROGRESS_EVERY - 1)) == 0)
+            fdt_rd_progress(c, (size_t)(L.p - start));
         rd_fields f = {s, fdt_rd_cut_comment(s, e), 1, 0};
         double v[3];
         size_t k = 0;
@@ -42,8 +110,9 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
             if (r < 0)
                 return fdt_rd_fail(c, FDT_IO_EFORMAT,
                                ":%zu: empty field (stray comma)", L.lineno);
-            if (k >= 3) {
-                /* only counted, for the message */
+            int which = k == c0 ? 0 : k == c1 ? 1 : k == c2 ? 2 : -1;
+            if (which < 0) {
+                /* not a coordinate: skipped, only counted */
                 fdt_rd_next_field(&f, &ts, &tl);
                 k++;
                 continue;
@@ -52,10 +121,10 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
              * a separator follows the literal. */
             size_t used = 0;
             ts = f.p;
-            int st = fdt_rd_scan_real(ts, (size_t)(f.e - ts), &v[k], 1, 0, &used);
+            int st = fdt_rd_scan_real(ts, (size_t)(f.e - ts), &v[which], 1, 0, &used);
             if (!fdt_rd_is_sep(&f, ts + used)) {
                 fdt_rd_next_field(&f, &ts, &tl);
-                st = fdt_rd_parse_real(ts, tl, &v[k], 1);
+                st = fdt_rd_parse_real(ts, tl, &v[which], 1);
                 if (st == NUM_OK) /* cannot happen: the scan stopped early */
                     st = NUM_SYNTAX;
                 return fdt_rd_num_fail(c, L.lineno, "", st, ts, tl);
@@ -68,9 +137,17 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
         }
         if (k == 0)
             continue; /* blank or comment line */
-        if (k != 3)
+        if (k < need && c->custom_cols)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: columns %d,%d,%d need %zu fields, found %zu", L.lineno,
+                               c->col[0] + 1, c->col[1] + 1, c->col[2] + 1, need, k);
+        if (k < 3 || (k != ncols && ncols == 3))
             return fdt_rd_fail(c, FDT_IO_EFORMAT,
                            ":%zu: expected 3 numbers, found %zu", L.lineno, k);
+        if (k != ncols)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: expected %zu columns as on the first line, found %zu",
+                               L.lineno, ncols, k);
         if (pb->n == pb->cap) {
             if (pb->n >= RD_MAX_POINTS)
                 return fdt_rd_fail(c, FDT_IO_EFORMAT,
@@ -117,6 +194,7 @@ typedef struct rd_slice {
     const char *start, *end;
     size_t count; /* lines with content (pass 1) */
     rd_points pb; /* its place in the joint array (pass 2) */
+    size_t ncols; /* fields a line (the file's first point line's) */
     int pass, rc;
 } rd_slice;
 
@@ -148,7 +226,8 @@ static void *rd_slice_run(void *arg)
     if (sl->pass == 0) {
         sl->count = rd_count_content_lines(sl->start, sl->end);
     } else {
-        sl->rc = rd_read_xyz_lines(&sl->c, sl->start, sl->end, &sl->pb);
+        /* line numbers only matter in messages, which slices do not give */
+        sl->rc = rd_read_xyz_lines(&sl->c, sl->start, sl->end, 0, sl->ncols, &sl->pb);
         if (sl->rc == FDT_IO_OK && sl->pb.n != sl->count)
             sl->rc = FDT_IO_EFORMAT; /* cannot happen: the counts are exact */
     }
@@ -178,6 +257,23 @@ static void rd_slices_pass(rd_slice *sl, size_t T, int pass)
 int fdt_rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb)
 {
     const char *end = c->buf + c->size;
+    /* A header line (rd_is_header) is skipped; the first point line then
+     * sets the column count of every line, which the slices need before
+     * they start. */
+    size_t line0 = 0, ncols = 3;
+    const char *fs, *fe;
+    size_t fl;
+    if (rd_first_content(start, end, &fs, &fe, &fl)) {
+        if (rd_is_header(fs, fe)) {
+            const char *nl = memchr(fe, '\n', (size_t)(end - fe));
+            start = nl != NULL ? nl + 1 : end;
+            line0 = fl;
+            if (!rd_first_content(start, end, &fs, &fe, &fl))
+                fs = fe = NULL;
+        }
+        if (fs != NULL)
+            ncols = rd_count_fields(fs, fe);
+    }
     size_t len = (size_t)(end - start);
     size_t min_slice = c->min_slice ? c->min_slice : RD_MIN_SLICE;
     size_t T = c->threads > 1 ? (size_t)c->threads : 1;
@@ -186,7 +282,7 @@ int fdt_rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb)
     if (T > len / min_slice)
         T = len / min_slice;
     if (T < 2)
-        return rd_read_xyz_lines(c, start, end, pb);
+        return rd_read_xyz_lines(c, start, end, line0, ncols, pb);
 
     rd_slice sl[RD_SLICES_MAX];
     const char *cut = start;
@@ -203,6 +299,12 @@ int fdt_rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb)
         sl[t].c = *c;
         sl[t].c.err = NULL;
         sl[t].c.errlen = 0;
+        /* Progress only from the calling thread's slice 0, scaled to the
+         * whole: the slices are of about equal size. */
+        sl[t].c.progress_scale = T;
+        if (t > 0)
+            sl[t].c.progress = NULL;
+        sl[t].ncols = ncols;
         sl[t].start = cut;
         sl[t].end = stop;
         cut = stop;
@@ -212,10 +314,10 @@ int fdt_rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb)
     for (size_t t = 0; t < T; t++)
         total += sl[t].count;
     if (total == 0 || total > RD_MAX_POINTS) /* the one-thread read words it */
-        return rd_read_xyz_lines(c, start, end, pb);
+        return rd_read_xyz_lines(c, start, end, line0, ncols, pb);
     rd_points all = {NULL, 0, 0, 0};
     if (fdt_rd_points_reserve(&all, total) != 0)
-        return rd_read_xyz_lines(c, start, end, pb); /* which may need less */
+        return rd_read_xyz_lines(c, start, end, line0, ncols, pb); /* which may need less */
     for (size_t t = 0, at = 0; t < T; t++) {
         sl[t].pb = (rd_points){all.xyz + 3 * at, 0, sl[t].count, 1};
         at += sl[t].count;
@@ -224,7 +326,7 @@ int fdt_rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb)
     for (size_t t = 0; t < T; t++)
         if (sl[t].rc != FDT_IO_OK) {
             free(all.xyz);
-            return rd_read_xyz_lines(c, start, end, pb);
+            return rd_read_xyz_lines(c, start, end, line0, ncols, pb);
         }
     all.n = total;
     free(pb->xyz);

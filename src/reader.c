@@ -100,35 +100,90 @@ int fdt_rd_points_reserve(rd_points *pb, size_t cap)
 /* Files                                                              */
 /* ------------------------------------------------------------------ */
 
-enum { EXT_NONE, EXT_XYZ, EXT_NODE, EXT_PLY };
+/*
+ * The formats, one row each: the names that choose it (extensions, and
+ * --input-format words) and its parser. A parser gets the text after a
+ * UTF-8 byte order mark (PLY, binary, gets the whole buffer).
+ */
+typedef struct rd_format {
+    int id;                 /* FDT_RD_* */
+    const char *names[4];   /* lowercase, NULL-terminated */
+    int (*parse)(const rd_ctx *c, const char *start, rd_points *pb);
+    int has_columns;        /* fdt_rd_opts.columns applies */
+} rd_format;
 
-static int rd_extension(const char *path, const char **ext)
+static int rd_parse_ply(const rd_ctx *c, const char *start, rd_points *pb)
+{
+    (void)start;
+    return fdt_rd_read_ply(c, pb);
+}
+
+static const rd_format rd_formats[] = {
+    {FDT_RD_XYZ, {"xyz", "txt", "csv", NULL}, fdt_rd_read_xyz, 1},
+    {FDT_RD_NODE, {"node", NULL, NULL, NULL}, fdt_rd_read_node, 0},
+    {FDT_RD_PLY, {"ply", NULL, NULL, NULL}, rd_parse_ply, 0},
+};
+#define RD_N_FORMATS (sizeof rd_formats / sizeof rd_formats[0])
+
+static const rd_format *rd_format_row(int id)
+{
+    for (size_t i = 0; i < RD_N_FORMATS; i++)
+        if (rd_formats[i].id == id)
+            return &rd_formats[i];
+    return NULL;
+}
+
+int fdt_rd_format_by_name(const char *name)
+{
+    if (name == NULL)
+        return FDT_RD_AUTO;
+    size_t len = strlen(name);
+    for (size_t i = 0; i < RD_N_FORMATS; i++)
+        for (const char *const *w = rd_formats[i].names; *w != NULL; w++)
+            if (rd_word_ieq(name, len, *w))
+                return rd_formats[i].id;
+    return FDT_RD_AUTO;
+}
+
+/* The extension of path's last component ("" if none): *ext. */
+static const char *rd_ext(const char *path)
 {
     const char *slash = strrchr(path, '/');
     const char *base = slash != NULL ? slash + 1 : path;
     const char *dot = strrchr(base, '.');
-    *ext = dot != NULL ? dot : "";
-    if (dot == NULL)
-        return EXT_NONE;
-    size_t len = strlen(dot + 1);
-    if (rd_word_ieq(dot + 1, len, "xyz") || rd_word_ieq(dot + 1, len, "txt"))
-        return EXT_XYZ;
-    if (rd_word_ieq(dot + 1, len, "node"))
-        return EXT_NODE;
-    if (rd_word_ieq(dot + 1, len, "ply"))
-        return EXT_PLY;
-    return EXT_NONE;
+    return dot != NULL ? dot : "";
 }
+
+int fdt_rd_format_of_path(const char *path)
+{
+    if (path == NULL)
+        return FDT_RD_AUTO;
+    const char *ext = rd_ext(path);
+    return ext[0] == '.' ? fdt_rd_format_by_name(ext + 1) : FDT_RD_AUTO;
+}
+
+void fdt_rd_opts_default(fdt_rd_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->format = FDT_RD_AUTO;
+    o->threads = 1;
+}
+
+/* Bytes read between two loading reports (and a read's largest request
+ * when someone watches: one read() of a whole file would say nothing
+ * until the end). */
+#define RD_LOAD_CHUNK ((size_t)16 << 20)
 
 /* Reads the whole of fd into a NUL-terminated buffer. */
 static int rd_slurp(rd_ctx *c, int fd, const struct stat *st, char **out)
 {
-    size_t cap = 1 << 16;
+    size_t cap = 1 << 16, total = 0;
     if (S_ISREG(st->st_mode)) {
         if ((uintmax_t)st->st_size > (uintmax_t)SIZE_MAX - 2)
             return fdt_rd_fail(c, FDT_IO_ENOMEM, ": file too large for memory");
         /* one spare byte shows whether the file grew since fstat */
         cap = (size_t)st->st_size + 2;
+        total = (size_t)st->st_size;
     }
     char *buf = malloc(cap);
     if (buf == NULL)
@@ -150,7 +205,10 @@ static int rd_slurp(rd_ctx *c, int fd, const struct stat *st, char **out)
             buf = nb;
             cap *= 2;
         }
-        ssize_t r = read(fd, buf + len, cap - 1 - len);
+        size_t want = cap - 1 - len;
+        if (c->progress != NULL && want > RD_LOAD_CHUNK)
+            want = RD_LOAD_CHUNK;
+        ssize_t r = read(fd, buf + len, want);
         if (r == 0)
             break;
         if (r < 0) {
@@ -163,6 +221,8 @@ static int rd_slurp(rd_ctx *c, int fd, const struct stat *st, char **out)
             return fdt_rd_fail(c, FDT_IO_EOPEN, ": cannot read: %s", strerror(e));
         }
         len += (size_t)r;
+        if (c->progress != NULL)
+            c->progress(c->progress_user, FDT_RD_LOADING, len, total > len ? total : len * (total > 0));
     }
     buf[len] = '\0';
     *out = buf;
@@ -184,24 +244,21 @@ static void rd_begin(rd_ctx *c, double **xyz, size_t *n)
 
 /*
  * Parses c->buf (c->size bytes and a NUL, owned by the caller) as a file of
- * the given kind. On success *xyz and *n are set; on failure they are left
- * alone and the message is in c->err.
+ * format f. On success *xyz and *n are set; on failure they are left alone
+ * and the message is in c->err.
  */
-static int rd_parse(rd_ctx *c, int kind, double **xyz, size_t *n)
+static int rd_parse(rd_ctx *c, const rd_format *f, double **xyz, size_t *n)
 {
     rd_points pb = {NULL, 0, 0, 0};
     int rc;
     if (c->size == 0) {
         rc = fdt_rd_fail(c, FDT_IO_EFORMAT, ": no points (empty file)");
-    } else if (kind == EXT_PLY) {
-        rc = fdt_rd_read_ply(c, &pb);
     } else {
         const char *start = c->buf;
         /* a UTF-8 byte order mark, as some Windows tools write */
         if (c->size >= 3 && memcmp(c->buf, "\xef\xbb\xbf", 3) == 0)
             start += 3;
-        rc = kind == EXT_NODE ? fdt_rd_read_node(c, start, &pb)
-                              : fdt_rd_read_xyz(c, start, &pb);
+        rc = f->parse(c, start, &pb);
     }
     if (rc == FDT_IO_OK && pb.n == 0)
         rc = fdt_rd_fail(c, FDT_IO_EFORMAT, ": no points");
@@ -209,6 +266,8 @@ static int rd_parse(rd_ctx *c, int kind, double **xyz, size_t *n)
         free(pb.xyz);
         return rc;
     }
+    if (c->progress != NULL)
+        c->progress(c->progress_user, FDT_RD_PARSING, c->size, c->size);
     if (pb.cap > pb.n) {
         double *x = realloc(pb.xyz, pb.n * 3 * sizeof(double));
         if (x != NULL) /* shrinking cannot lose data; keep the old block */
@@ -219,67 +278,106 @@ static int rd_parse(rd_ctx *c, int kind, double **xyz, size_t *n)
     return FDT_IO_OK;
 }
 
-/* The "unknown extension" refusal shared by both entry points. */
-static int rd_bad_extension(const rd_ctx *c, const char *ext)
+/*
+ * Sets up c from the options and picks the format: the one the options
+ * name, else the name's extension's. NULL after wording the refusal (an
+ * unknown extension, columns for a format without them) in c->err.
+ */
+static const rd_format *rd_setup(rd_ctx *c, const char *name, const fdt_rd_opts *o, int *rc)
 {
-    char q[RD_QUOTE_CAP];
-    return fdt_rd_fail(c, FDT_IO_EEXT,
-                   ": unknown extension %s (expected .xyz, .txt, .node or "
-                   ".ply)",
-                   fdt_rd_quote(q, ext, strlen(ext)));
+    c->threads = o->threads;
+    c->min_slice = o->min_slice;
+    c->progress = o->progress;
+    c->progress_user = o->progress_user;
+    c->progress_scale = 1;
+    int custom = o->columns[0] != 0 || o->columns[1] != 0 || o->columns[2] != 0;
+    for (int k = 0; k < 3; k++) {
+        if (custom && o->columns[k] < 1) {
+            *rc = fdt_rd_fail(c, FDT_IO_EFORMAT, ": column %d is not a column (they count from 1)",
+                              o->columns[k]);
+            return NULL;
+        }
+        c->col[k] = custom ? o->columns[k] - 1 : k;
+    }
+    c->custom_cols = custom && !(c->col[0] == 0 && c->col[1] == 1 && c->col[2] == 2);
+    int id = o->format != FDT_RD_AUTO ? o->format : fdt_rd_format_of_path(name);
+    const rd_format *f = rd_format_row(id);
+    if (f == NULL) {
+        char q[RD_QUOTE_CAP];
+        const char *ext = rd_ext(name);
+        if (strcmp(name, "-") == 0)
+            *rc = fdt_rd_fail(c, FDT_IO_EEXT, ": standard input needs its format named "
+                                              "(xyz, node or ply)");
+        else
+            *rc = fdt_rd_fail(c, FDT_IO_EEXT,
+                              ": unknown extension %s (expected .xyz, .txt, .csv, .node or "
+                              ".ply)",
+                              fdt_rd_quote(q, ext, strlen(ext)));
+        return NULL;
+    }
+    if (c->custom_cols && !f->has_columns) {
+        *rc = fdt_rd_fail(c, FDT_IO_EFORMAT, ": columns apply to .xyz, .txt and .csv only");
+        return NULL;
+    }
+    return f;
 }
 
-static int rd_read_path(const char *path, int threads, size_t min_slice, double **xyz,
-                        size_t *n, char *err, size_t errlen)
+int fdt_read_points_with(const char *path, const fdt_rd_opts *o, double **xyz, size_t *n,
+                         char *err, size_t errlen)
 {
-    rd_ctx c = {path != NULL ? path : "(null)", err, errlen, NULL, 0, threads, min_slice};
+    int is_stdin = path != NULL && strcmp(path, "-") == 0;
+    rd_ctx c;
+    memset(&c, 0, sizeof c);
+    c.path = path == NULL ? "(null)" : is_stdin ? "stdin" : path;
+    c.err = err;
+    c.errlen = errlen;
     rd_begin(&c, xyz, n);
-    if (path == NULL || xyz == NULL || n == NULL)
+    if (path == NULL || o == NULL || xyz == NULL || n == NULL)
         return fdt_rd_fail(&c, FDT_IO_EOPEN, ": invalid arguments");
 
-    int fd;
-    do
-        fd = open(path, O_RDONLY | O_CLOEXEC);
-    while (fd < 0 && errno == EINTR);
-    if (fd < 0)
-        return fdt_rd_fail(&c, FDT_IO_EOPEN, ": cannot open: %s", strerror(errno));
+    int fd = STDIN_FILENO;
+    if (!is_stdin) {
+        do
+            fd = open(path, O_RDONLY | O_CLOEXEC);
+        while (fd < 0 && errno == EINTR);
+        if (fd < 0)
+            return fdt_rd_fail(&c, FDT_IO_EOPEN, ": cannot open: %s", strerror(errno));
+    }
     struct stat st;
-    if (fstat(fd, &st) != 0) {
-        int e = errno;
-        close(fd);
-        return fdt_rd_fail(&c, FDT_IO_EOPEN, ": cannot open: %s", strerror(e));
-    }
-    if (S_ISDIR(st.st_mode)) {
-        close(fd);
-        return fdt_rd_fail(&c, FDT_IO_EOPEN, ": is a directory");
-    }
-    const char *ext;
-    int kind = rd_extension(path, &ext);
-    if (kind == EXT_NONE) {
-        close(fd);
-        return rd_bad_extension(&c, ext);
-    }
+    int rc = FDT_IO_OK;
+    const rd_format *f = NULL;
     char *buf = NULL;
-    int rc = rd_slurp(&c, fd, &st, &buf);
-    close(fd);
+    if (fstat(fd, &st) != 0)
+        rc = fdt_rd_fail(&c, FDT_IO_EOPEN, ": cannot open: %s", strerror(errno));
+    else if (S_ISDIR(st.st_mode))
+        rc = fdt_rd_fail(&c, FDT_IO_EOPEN, ": is a directory");
+    else if ((f = rd_setup(&c, path, o, &rc)) != NULL)
+        rc = rd_slurp(&c, fd, &st, &buf);
+    if (!is_stdin)
+        close(fd);
     if (rc != FDT_IO_OK)
         return rc;
-    rc = rd_parse(&c, kind, xyz, n);
+    rc = rd_parse(&c, f, xyz, n);
     free(buf);
     return rc;
 }
 
-static int rd_read_mem(const char *name, const void *data, size_t len, int threads,
-                       size_t min_slice, double **xyz, size_t *n, char *err, size_t errlen)
+int fdt_read_points_mem_with(const char *name, const void *data, size_t len,
+                             const fdt_rd_opts *o, double **xyz, size_t *n, char *err,
+                             size_t errlen)
 {
-    rd_ctx c = {name != NULL ? name : "(null)", err, errlen, NULL, 0, threads, min_slice};
+    rd_ctx c;
+    memset(&c, 0, sizeof c);
+    c.path = name != NULL ? name : "(null)";
+    c.err = err;
+    c.errlen = errlen;
     rd_begin(&c, xyz, n);
-    if (name == NULL || (data == NULL && len > 0) || xyz == NULL || n == NULL)
+    if (name == NULL || o == NULL || (data == NULL && len > 0) || xyz == NULL || n == NULL)
         return fdt_rd_fail(&c, FDT_IO_EOPEN, ": invalid arguments");
-    const char *ext;
-    int kind = rd_extension(name, &ext);
-    if (kind == EXT_NONE)
-        return rd_bad_extension(&c, ext);
+    int rc = FDT_IO_OK;
+    const rd_format *f = rd_setup(&c, name, o, &rc);
+    if (f == NULL)
+        return rc;
     /* The parsers expect what rd_slurp gives them: a private copy with a
      * NUL after the last byte. Copying keeps the two entry points one code
      * path (and lets the fuzzers find reads past that NUL). */
@@ -294,7 +392,7 @@ static int rd_read_mem(const char *name, const void *data, size_t len, int threa
     buf[len] = '\0';
     c.buf = buf;
     c.size = len;
-    int rc = rd_parse(&c, kind, xyz, n);
+    rc = rd_parse(&c, f, xyz, n);
     free(buf);
     return rc;
 }
@@ -302,24 +400,32 @@ static int rd_read_mem(const char *name, const void *data, size_t len, int threa
 int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
                     size_t errlen)
 {
-    return rd_read_path(path, 1, 0, xyz, n, err, errlen);
+    return fdt_read_points_threads(path, 1, 0, xyz, n, err, errlen);
 }
 
 int fdt_read_points_threads(const char *path, int threads, size_t min_slice, double **xyz,
                             size_t *n, char *err, size_t errlen)
 {
-    return rd_read_path(path, threads, min_slice, xyz, n, err, errlen);
+    fdt_rd_opts o;
+    fdt_rd_opts_default(&o);
+    o.threads = threads;
+    o.min_slice = min_slice;
+    return fdt_read_points_with(path, &o, xyz, n, err, errlen);
 }
 
 int fdt_read_points_mem(const char *name, const void *data, size_t len,
                         double **xyz, size_t *n, char *err, size_t errlen)
 {
-    return rd_read_mem(name, data, len, 1, 0, xyz, n, err, errlen);
+    return fdt_read_points_mem_threads(name, data, len, 1, 0, xyz, n, err, errlen);
 }
 
 int fdt_read_points_mem_threads(const char *name, const void *data, size_t len, int threads,
                                 size_t min_slice, double **xyz, size_t *n, char *err,
                                 size_t errlen)
 {
-    return rd_read_mem(name, data, len, threads, min_slice, xyz, n, err, errlen);
+    fdt_rd_opts o;
+    fdt_rd_opts_default(&o);
+    o.threads = threads;
+    o.min_slice = min_slice;
+    return fdt_read_points_mem_with(name, data, len, &o, xyz, n, err, errlen);
 }
