@@ -104,7 +104,7 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
         double v[3];
         size_t k = 0;
         const char *ts;
-        size_t tl;
+        size_t tl = 0; /* set by fdt_rd_next_field before any use */
         int r;
         while ((r = fdt_rd_skip_sep(&f)) != 0) {
             if (r < 0)
