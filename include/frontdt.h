@@ -9,6 +9,21 @@
  * Ownership: pointers passed in are borrowed for the duration of the call
  * unless a comment says otherwise; pointers returned by fdt_result_* getters
  * are owned by the result and live until fdt_result_free().
+ *
+ * ABI: the structs that may grow (fdt_settings, fdt_stats,
+ * fdt_thread_stats) start with `size_t struct_size`, the sizeof the caller
+ * compiled against. The inline wrappers below (fdt_default_settings,
+ * fdt_result_stats, fdt_result_thread_stats) pass that sizeof to the
+ * exported *_sized functions, so a program built against this header keeps
+ * working with a later library whose structs are longer: the library reads
+ * and writes only the caller's bytes. Rules:
+ *   - fields are only ever added at the end, never removed or reordered;
+ *   - the library accepts the sizes of this and of every earlier release
+ *     of a struct; any other size (0, too small, larger than the library
+ *     knows) is refused with FDT_EINVAL and nothing is written;
+ *   - an fdt_settings must come from fdt_default_settings() (which sets
+ *     struct_size); one zeroed by hand is refused by fdt_open().
+ * Today every struct has one size (the first release): sizeof of it.
  */
 #ifndef FRONTDT_H
 #define FRONTDT_H
@@ -82,6 +97,8 @@ typedef enum fdt_search {
 typedef int (*fdt_progress_fn)(void *user, double fraction);
 
 typedef struct fdt_settings {
+    size_t struct_size;      /* sizeof(fdt_settings) as compiled by the caller:
+                                set by fdt_default_settings (ABI, above) */
     fdt_mode mode;
     int n_threads;           /* 0: one per physical core (hwloc) */
     int pin;                 /* nonzero: bind thread i to core i */
@@ -92,12 +109,25 @@ typedef struct fdt_settings {
     fdt_search search;       /* default FDT_SEARCH_AUTO */
 } fdt_settings;
 
-FDT_API void fdt_default_settings(fdt_settings *s);
+/*
+ * Fills the first struct_size bytes of *s with the defaults and sets
+ * s->struct_size. FDT_EINVAL for a size this library does not know (ABI,
+ * above): then only s->struct_size is written, as 0, when the size leaves
+ * room for it, so that fdt_open() refuses the settings.
+ */
+FDT_API int fdt_default_settings_sized(fdt_settings *s, size_t struct_size);
+/* The defaults for the fdt_settings of this header. */
+static inline void fdt_default_settings(fdt_settings *s)
+{
+    (void)fdt_default_settings_sized(s, sizeof *s);
+}
 
 typedef struct fdt_context fdt_context;
 typedef struct fdt_result fdt_result;
 
-/* Creates a context from settings (copied). *ctx is NULL on failure. */
+/* Creates a context from settings (copied). *ctx is NULL on failure;
+ * FDT_EINVAL for an invalid setting or a struct_size this library does not
+ * know (ABI, above). */
 FDT_API int fdt_open(fdt_context **ctx, const fdt_settings *s);
 /* Frees the context and sets *ctx to NULL; NULL is fine. */
 FDT_API void fdt_close(fdt_context **ctx);
@@ -199,6 +229,8 @@ typedef struct fdt_msg_counts {
 } fdt_msg_counts;
 
 typedef struct fdt_stats {
+    size_t struct_size;       /* bytes the library filled: the caller's
+                                 sizeof(fdt_stats) (ABI, above) */
     size_t points;            /* input points */
     size_t vertices;          /* distinct points */
     size_t tets;
@@ -237,10 +269,17 @@ typedef struct fdt_stats {
     double t_mesh;            /* seconds building meshes (summed over threads) */
 } fdt_stats;
 
-FDT_API int fdt_result_stats(const fdt_result *r, fdt_stats *st);
+/* Fills the first struct_size bytes of *st (its struct_size included).
+ * FDT_EINVAL for a NULL argument or an unknown size (nothing written). */
+FDT_API int fdt_result_stats_sized(const fdt_result *r, fdt_stats *st, size_t struct_size);
+static inline int fdt_result_stats(const fdt_result *r, fdt_stats *st)
+{
+    return fdt_result_stats_sized(r, st, sizeof *st);
+}
 
 /* Statistics of one worker thread of a parallel run. */
 typedef struct fdt_thread_stats {
+    size_t struct_size;       /* bytes the library filled (ABI, above) */
     size_t points;            /* points of its partition */
     size_t tets;              /* tets it built (it owns) */
     size_t hull_faces;
@@ -257,9 +296,15 @@ typedef struct fdt_thread_stats {
 } fdt_thread_stats;
 
 /* Fills *ts for worker thread 0 <= thread < stats.threads. A serial run
- * reports its one thread. FDT_EINVAL if thread is out of range. */
-FDT_API int fdt_result_thread_stats(const fdt_result *r, int thread,
-                                    fdt_thread_stats *ts);
+ * reports its one thread. FDT_EINVAL if thread is out of range or the size
+ * unknown (nothing written). */
+FDT_API int fdt_result_thread_stats_sized(const fdt_result *r, int thread,
+                                          fdt_thread_stats *ts, size_t struct_size);
+static inline int fdt_result_thread_stats(const fdt_result *r, int thread,
+                                          fdt_thread_stats *ts)
+{
+    return fdt_result_thread_stats_sized(r, thread, ts, sizeof *ts);
+}
 
 /*
  * Independent exact verification of a mesh on n points (xyz as above, tets

@@ -39,12 +39,36 @@ const char *fdt_strerror(int err)
 
 const char *fdt_version(void) { return FDT_VERSION_STRING; }
 
-void fdt_default_settings(fdt_settings *s)
+/*
+ * The fdt_settings sizes this library accepts (include/frontdt.h, ABI):
+ * this release's, and, once a field is added, each earlier release's
+ * (offsetof the first field it lacks), whose missing fields then take
+ * their defaults in fdt_open.
+ */
+static int settings_size_known(size_t size)
 {
-    memset(s, 0, sizeof *s);
-    s->mode = FDT_MODE_AUTO;
-    s->n_threads = 0;
-    s->leaf_size = FDT_DEFAULT_LEAF;
+    return size == sizeof(fdt_settings);
+}
+
+int fdt_default_settings_sized(fdt_settings *s, size_t struct_size)
+{
+    if (!s)
+        return FDT_EINVAL;
+    if (!settings_size_known(struct_size)) {
+        /* A caller built against a later header: leave it a size fdt_open
+         * refuses, rather than defaults it would take for its own. */
+        if (struct_size >= sizeof s->struct_size)
+            s->struct_size = 0;
+        return FDT_EINVAL;
+    }
+    fdt_settings d;
+    memset(&d, 0, sizeof d);
+    d.struct_size = struct_size;
+    d.mode = FDT_MODE_AUTO;
+    d.n_threads = 0;
+    d.leaf_size = FDT_DEFAULT_LEAF;
+    memcpy(s, &d, struct_size);
+    return FDT_OK;
 }
 
 int fdt_open(fdt_context **ctx, const fdt_settings *s)
@@ -52,13 +76,21 @@ int fdt_open(fdt_context **ctx, const fdt_settings *s)
     if (!ctx)
         return FDT_EINVAL;
     *ctx = NULL;
-    if (!s || s->n_threads < 0 || s->n_threads > 1024 || s->leaf_size < 0 ||
-        s->mode < FDT_MODE_AUTO || s->mode > FDT_MODE_MESSAGE)
+    if (!s || !settings_size_known(s->struct_size))
+        return FDT_EINVAL;
+    /* The caller's bytes over the defaults: fields of a later release than
+     * the caller's keep their defaults. */
+    fdt_settings all;
+    fdt_default_settings_sized(&all, sizeof all);
+    memcpy(&all, s, s->struct_size);
+    if (all.n_threads < 0 || all.n_threads > 1024 || all.leaf_size < 0 ||
+        all.mode < FDT_MODE_AUTO || all.mode > FDT_MODE_MESSAGE)
         return FDT_EINVAL;
     fdt_context *c = calloc(1, sizeof *c);
     if (!c)
         return FDT_ENOMEM;
-    c->s = *s;
+    c->s = all;
+    c->s.struct_size = sizeof c->s;
     if (c->s.leaf_size == 0)
         c->s.leaf_size = FDT_DEFAULT_LEAF;
     *ctx = c;

@@ -21,6 +21,7 @@
  * "--stats-json -" claims stdout for the JSON object alone).
  */
 #include "frontdt.h"
+#include "progress.h"
 #include "reader.h"
 #include "writer.h"
 
@@ -56,7 +57,10 @@ enum {
 #define DEMO_SEED UINT64_C(0x5eed0f0f1992)
 
 typedef struct cli {
-    const char *input;      /* NULL with --demo */
+    const char *input;      /* NULL with --demo; "-": standard input */
+    int input_format;       /* FDT_RD_AUTO: by the input's extension */
+    int columns[3];         /* --columns, from 1; {0, 0, 0}: 1, 2, 3 */
+    int progress;           /* --progress: draw even when not a terminal */
     const char *output;     /* the first -o; NULL: triangulate and report only */
     const char *outputs[MAX_OUTPUTS]; /* every -o, in order ("-": stdout) */
     const char *out_format[MAX_OUTPUTS]; /* its --format, NULL: by extension */
@@ -79,7 +83,9 @@ static void usage(FILE *f)
         "       frontdt --demo [N] [options] [-o OUTPUT]\n"
         "Exact 3D Delaunay tetrahedralization by the advancing front.\n"
         "\n"
-        "INPUT:  .xyz/.txt (x y z per line), .node (TetGen), .ply\n"
+        "INPUT:  .xyz/.txt/.csv (x y z per line; more columns skipped; a first\n"
+        "        line of words is a header), .node (TetGen), .ply; '-' is standard\n"
+        "        input (needs --input-format)\n"
         "OUTPUT: .tets (canonical sorted text), .ele (TetGen .node/.ele/\n"
         "        .face/.neigh), .vtu (VTK XML, ParaView), .vtk (VTK legacy),\n"
         "        .msh (gmsh 4.1), .mesh (Medit), DIR/polyMesh (OpenFOAM)\n"
@@ -91,6 +97,10 @@ static void usage(FILE *f)
         "                         none follows): tets, tetgen, vtu, vtk, msh,\n"
         "                         msh2, medit, openfoam\n"
         "      --all-faces        TetGen .face lists every face (TetGen -f)\n"
+        "      --input-format FMT xyz (also txt, csv), node or ply: the input's\n"
+        "                         format whatever its name (needed for '-')\n"
+        "      --columns X,Y,Z    the columns of x, y and z in .xyz/.txt/.csv,\n"
+        "                         counted from 1 as cut -f and awk do (1,2,3)\n"
         "      --mode MODE        serial, shared, message or auto (default)\n"
         "      --search HOW       how apexes are found: auto (default: the kd\n"
         "                         search, an insertion mesh where it gets\n"
@@ -102,13 +112,16 @@ static void usage(FILE *f)
         "      --stats-json FILE  write statistics as JSON ('-': stdout)\n"
         "      --hash             print the canonical hash of the tet set\n"
         "  -q, --quiet            no summary, no progress, no notes\n"
+        "      --progress         draw the progress line on stderr even when it\n"
+        "                         is not a terminal (it is drawn on terminals)\n"
         "      --demo [N]         triangulate N random points in the unit cube\n"
         "                         (fixed seed; default %u)\n"
         "  -h, --help             this help\n"
         "  -V, --version          version\n"
         "\n"
         "Exit codes:\n"
-        "  0 success             1 usage error        2 bad input\n"
+        "  0 success             1 usage error (also '-' without --input-format,\n"
+        "                          --columns for .node/.ply)   2 bad input\n"
         "  3 --check failed      4 out of resources   5 cannot write output\n"
         "  6 interrupted         7 internal error\n",
         MAX_OUTPUTS, DEMO_DEFAULT_N);
@@ -229,7 +242,8 @@ static int parse_count(const char *s, unsigned long long max,
 
 enum {
     OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH,
-    OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES
+    OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
+    OPT_PROGRESS
 };
 
 static const struct option long_opts[] = {
@@ -246,6 +260,9 @@ static const struct option long_opts[] = {
     { "hash", no_argument, NULL, OPT_HASH },
     { "quiet", no_argument, NULL, 'q' },
     { "demo", optional_argument, NULL, OPT_DEMO },
+    { "input-format", required_argument, NULL, OPT_INPUT_FORMAT },
+    { "columns", required_argument, NULL, OPT_COLUMNS },
+    { "progress", no_argument, NULL, OPT_PROGRESS },
     { "help", no_argument, NULL, 'h' },
     { "version", no_argument, NULL, 'V' },
     { NULL, 0, NULL, 0 },
@@ -304,6 +321,29 @@ static int short_opt(char **argv, int ind)
 {
     return optopt > 0 && optopt < 128 && ind > 0 && argv[ind - 1] &&
            strncmp(argv[ind - 1], "--", 2) != 0;
+}
+
+/* "3,4,5": three distinct columns counted from 1 (cut -f, awk, gnuplot's
+ * "using 3:4:5"). 0 or -1 on anything else. */
+static int parse_columns(const char *s, int cols[3])
+{
+    for (int k = 0; k < 3; k++) {
+        const char *end = strchr(s, ',');
+        size_t len = end ? (size_t)(end - s) : strlen(s);
+        char word[16];
+        unsigned long long v;
+        if ((k < 2) != (end != NULL) || len == 0 || len >= sizeof word)
+            return -1;
+        memcpy(word, s, len);
+        word[len] = '\0';
+        if (parse_count(word, 1000000, &v) != 0 || v == 0)
+            return -1;
+        cols[k] = (int)v;
+        s = end ? end + 1 : s + len;
+    }
+    if (cols[0] == cols[1] || cols[0] == cols[2] || cols[1] == cols[2])
+        return -1;
+    return 0;
 }
 
 /* Returns -1 to go on, or an exit code (0 after --help/--version). */
@@ -394,6 +434,20 @@ static int parse_args(int argc, char **argv, cli *c)
         case 'q':
             c->quiet = 1;
             break;
+        case OPT_INPUT_FORMAT:
+            c->input_format = fdt_rd_format_by_name(optarg);
+            if (c->input_format == FDT_RD_AUTO)
+                return usage_error("unknown input format '%s' (xyz, txt, csv, node or "
+                                   "ply)", optarg);
+            break;
+        case OPT_COLUMNS:
+            if (parse_columns(optarg, c->columns) != 0)
+                return usage_error("--columns wants three different column numbers "
+                                   "from 1, as 3,4,5, not '%s'", optarg);
+            break;
+        case OPT_PROGRESS:
+            c->progress = 1;
+            break;
         case OPT_DEMO:
             c->demo = 1;
             if (optarg) {
@@ -443,7 +497,18 @@ static int parse_args(int argc, char **argv, cli *c)
             return usage_error("one input file only (got '%s' and '%s')",
                                argv[optind], argv[optind + 1]);
         c->input = argv[optind];
+        /* "-" has no extension to go by; a format without columns cannot
+         * take --columns. Both refused before anything is read. */
+        int fmt = c->input_format != FDT_RD_AUTO ? c->input_format
+                                                 : fdt_rd_format_of_path(c->input);
+        if (!strcmp(c->input, "-") && c->input_format == FDT_RD_AUTO)
+            return usage_error("reading standard input ('-') needs --input-format "
+                               "xyz, node or ply");
+        if (c->columns[0] && fmt != FDT_RD_XYZ && fmt != FDT_RD_AUTO)
+            return usage_error("--columns applies to .xyz, .txt and .csv input only");
     }
+    if (c->demo && (c->input_format != FDT_RD_AUTO || c->columns[0]))
+        return usage_error("--input-format and --columns need an input file, not --demo");
     return -1;
 }
 
@@ -468,15 +533,16 @@ static int refuse_overwrites(const cli *c, const char *output, char names[][FDT_
     const char *json = c->stats_json && strcmp(c->stats_json, "-") != 0
                            ? c->stats_json
                            : NULL;
+    /* Standard input is no file of ours to overwrite. */
+    const char *in = c->input && strcmp(c->input, "-") != 0 ? c->input : NULL;
     for (int i = 0; i < k; i++) {
         /* The set's other files are named with their -o: the user typed
          * m.ele and should hear why m.node is at stake. */
         char via[FDT_IO_PATH + 32] = "";
         if (strcmp(names[i], output) != 0)
             snprintf(via, sizeof via, " (written with -o %s)", output);
-        if (c->input && fdt_same_file(names[i], c->input)) {
-            say("output %s%s would overwrite the input %s", names[i], via,
-                c->input);
+        if (in && fdt_same_file(names[i], in)) {
+            say("output %s%s would overwrite the input %s", names[i], via, in);
             return CLI_USAGE;
         }
         if (json && fdt_same_file(names[i], json)) {
@@ -485,8 +551,8 @@ static int refuse_overwrites(const cli *c, const char *output, char names[][FDT_
             return CLI_USAGE;
         }
     }
-    if (json && c->input && fdt_same_file(json, c->input)) {
-        say("--stats-json file %s would overwrite the input %s", json, c->input);
+    if (json && in && fdt_same_file(json, in)) {
+        say("--stats-json file %s would overwrite the input %s", json, in);
         return CLI_USAGE;
     }
     return -1;
@@ -581,49 +647,6 @@ static double *demo_points(size_t n)
     for (size_t i = 0; i < 3 * n; i++)
         xyz[i] = (double)(xoshiro_next(s) >> 11) * 0x1.0p-53;
     return xyz;
-}
-
-/* ------------------------------------------------------------------------ */
-/* Progress bar                                                              */
-/* ------------------------------------------------------------------------ */
-
-typedef struct progress {
-    double last;  /* time of the last redraw */
-    int drawn;    /* something is on the line */
-} progress;
-
-static int progress_cb(void *user, double fraction)
-{
-    progress *p = user;
-    double t = now_s();
-    /* At most ~10 redraws a second: a terminal is slow, and the engine may
-     * call far more often than anyone can read. */
-    if (p->drawn && t - p->last < 0.1)
-        return 0;
-    if (!(fraction >= 0))
-        fraction = 0;
-    if (fraction > 1)
-        fraction = 1;
-    enum { WIDTH = 40 };
-    char bar[WIDTH + 1];
-    int full = (int)(fraction * WIDTH + 0.5);
-    for (int i = 0; i < WIDTH; i++)
-        bar[i] = i < full ? '#' : '.';
-    bar[WIDTH] = '\0';
-    fprintf(stderr, "\rfrontdt: [%s] %3d%%", bar, (int)(fraction * 100 + 0.5));
-    fflush(stderr);
-    p->last = t;
-    p->drawn = 1;
-    return 0;
-}
-
-static void progress_clear(progress *p)
-{
-    if (p->drawn) {
-        fprintf(stderr, "\r%*s\r", 60, "");
-        fflush(stderr);
-        p->drawn = 0;
-    }
 }
 
 /* ------------------------------------------------------------------------ */
@@ -891,7 +914,10 @@ static int run(const cli *c)
     fdt_context *ctx = NULL;
     fdt_result *res = NULL;
     timings tm = { 0 };
-    const char *name = c->input ? c->input : "demo";
+    const char *name = !c->input ? "demo" : strcmp(c->input, "-") ? c->input : "stdin";
+    /* The progress line (src/progress.h): on a terminal, or asked for. */
+    progress prog;
+    progress_init(&prog, !c->quiet && (c->progress || isatty(STDERR_FILENO)));
     int json_stdout = c->stats_json && !strcmp(c->stats_json, "-");
     /* stdout carries the JSON object alone when asked to. */
     FILE *info = json_stdout ? stderr : stdout;
@@ -979,8 +1005,18 @@ static int run(const cli *c)
         }
     } else {
         char err[1024];
-        int r = fdt_read_points_threads(c->input, reader_threads(c), 0, &xyz, &n, err,
-                                        sizeof err);
+        fdt_rd_opts ro;
+        fdt_rd_opts_default(&ro);
+        ro.format = c->input_format;
+        memcpy(ro.columns, c->columns, sizeof ro.columns);
+        ro.threads = reader_threads(c);
+        if (prog.enabled) {
+            ro.progress = progress_reader;
+            ro.progress_user = &prog;
+        }
+        progress_phase(&prog, "read");
+        int r = fdt_read_points_with(c->input, &ro, &xyz, &n, err, sizeof err);
+        progress_clear(&prog);
         if (r != FDT_IO_OK) {
             say("%s", err);
             return exit_for_reader(r);
@@ -997,9 +1033,8 @@ static int run(const cli *c)
         s.n_threads = c->threads;
     s.pin = c->pin;
     s.neighbors = c->check || (need & FDT_NEED_NBRS);
-    progress prog = { 0, 0 };
-    if (!c->quiet && isatty(STDERR_FILENO)) {
-        s.progress = progress_cb;
+    if (prog.enabled) {
+        s.progress = progress_engine;
         s.progress_user = &prog;
     }
     int r = fdt_open(&ctx, &s);
@@ -1009,6 +1044,7 @@ static int run(const cli *c)
         goto done;
     }
     t0 = now_s();
+    progress_phase(&prog, "merge"); /* "triangulate" at the library's first report */
     r = fdt_triangulate(ctx, xyz, n, &res);
     tm.triangulate = now_s() - t0;
     progress_clear(&prog);
@@ -1035,8 +1071,10 @@ static int run(const cli *c)
     if (c->check) {
         char msg[1024];
         t0 = now_s();
+        progress_phase(&prog, "check");
         r = fdt_check(xyz, n, fdt_result_tets(res), nt,
                       fdt_result_neighbors(res), msg, sizeof msg);
+        progress_clear(&prog);
         tm.check = now_s() - t0;
         if (r != FDT_OK) {
             if (r == FDT_ECHECK)
@@ -1052,9 +1090,12 @@ static int run(const cli *c)
      * count and mode; the other formats do not need it. */
     t0 = now_s();
     uint64_t hash = 0;
+    if (c->hash || (need & FDT_NEED_SORTED))
+        progress_phase(&prog, "sort");
     if (c->hash) {
         /* sorts too, hashing each part of the sort while it is in cache */
         r = fdt_result_hash(res, &hash);
+        progress_clear(&prog);
         if (r != FDT_OK) {
             say("%s: sorting and hashing the tets failed: %s", name, fdt_strerror(r));
             code = exit_for_engine(r);
@@ -1062,12 +1103,14 @@ static int run(const cli *c)
         }
     } else if (need & FDT_NEED_SORTED) {
         r = fdt_result_sort(res);
+        progress_clear(&prog);
         if (r != FDT_OK) {
             say("%s: sorting the tets failed: %s", name, fdt_strerror(r));
             code = exit_for_engine(r);
             goto done;
         }
     }
+    progress_clear(&prog);
     tm.canon = now_s() - t0;
 
     if (c->n_outputs > 0) {
@@ -1089,6 +1132,9 @@ static int run(const cli *c)
             }
         }
         char err[1024];
+        /* Phase start and end only: the writers do not report bytes yet
+         * (progress_bytes is their hook, src/progress.h). */
+        progress_phase(&prog, "write");
         for (int o = 0; o < c->n_outputs; o++) {
             if (!strcmp(c->outputs[o], "-"))
                 r = fdt_write_mesh_stream(stdout, "standard output", fmts[o], &v, err,
@@ -1096,12 +1142,14 @@ static int run(const cli *c)
             else
                 r = fdt_write_mesh_as(c->outputs[o], fmts[o], &v, err, sizeof err);
             if (r != FDT_IO_OK) {
+                progress_clear(&prog);
                 say("%s", err);
                 code = exit_for_writer(r);
                 tm.write = now_s() - t0;
                 goto done;
             }
         }
+        progress_clear(&prog);
         tm.write = now_s() - t0;
     }
 

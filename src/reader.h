@@ -11,14 +11,24 @@
  * Lines and vertices are counted from 1; offending tokens are quoted, cut
  * to 24 bytes, with non-printable bytes as \xHH.
  *
- * Details (src/reader.c):
+ * Details (src/read_text.c, src/read_xyz.c, src/read_node.c, src/read_ply.c):
  * - Text numbers: [+-]? (digits [. digits?] | . digits) ([eE] [+-]? digits)?
  *   correctly rounded. Rejected: hex floats, nan/inf/infinity (any case),
  *   literals beyond DBL_MAX, nonzero literals below DBL_MIN (subnormal or
  *   zero). The locale's decimal point does not matter.
- * - .xyz/.txt: fields separated by blanks and/or at most one comma (a
+ * - .xyz/.txt/.csv: fields separated by blanks and/or at most one comma (a
  *   leading, trailing or doubled comma is an error); '#' to end of line is a
- *   comment; CRLF and a UTF-8 byte order mark are accepted.
+ *   comment; CRLF and a UTF-8 byte order mark are accepted. Columns: x, y, z
+ *   are columns 1, 2, 3 (or those of fdt_rd_opts.columns, counted from 1
+ *   as cut -f and awk do); other columns (lidar intensity, colour) are
+ *   skipped unread. Every point line has the column count of the first
+ *   one: a line with fewer or more is an error naming it. A header: the
+ *   first line with content is skipped when it is printable ASCII and none
+ *   of its fields is a number ("X,Y,Z,Intensity", PDAL's '"X","Y","Z"',
+ *   CloudCompare's "//X,Y,Z").
+ * - Standard input: the path "-" (messages call it "stdin"); it has no
+ *   extension, so fdt_rd_opts.format must name the format. Pipes, FIFOs
+ *   and character devices are read to their end like files.
  * - .node: the header may leave out trailing fields as in TetGen (dim 3, 0
  *   attributes, 0 markers); every data line must have exactly index, x, y,
  *   z, the attributes and the marker; indices start at 0 or 1 and are
@@ -79,5 +89,57 @@ int fdt_read_points_threads(const char *path, int threads, size_t min_slice, dou
 int fdt_read_points_mem_threads(const char *name, const void *data, size_t len, int threads,
                                 size_t min_slice, double **xyz, size_t *n, char *err,
                                 size_t errlen);
+
+/* Formats (fdt_rd_opts.format). */
+enum {
+    FDT_RD_AUTO = 0, /* by the name's extension */
+    FDT_RD_XYZ = 1,  /* .xyz .txt .csv */
+    FDT_RD_NODE = 2, /* .node */
+    FDT_RD_PLY = 3   /* .ply */
+};
+
+/* Progress stages (fdt_rd_progress_fn). */
+enum {
+    FDT_RD_LOADING = 0, /* bytes read from the file or pipe */
+    FDT_RD_PARSING = 1  /* bytes parsed */
+};
+
+/*
+ * Called now and then on the calling thread while a read goes on: done
+ * bytes of total (total 0 while loading from a pipe, whose size is not
+ * known). Parsing with several threads reports the calling thread's share
+ * scaled to the whole (an estimate).
+ */
+typedef void (*fdt_rd_progress_fn)(void *user, int stage, size_t done, size_t total);
+
+typedef struct fdt_rd_opts {
+    int format;        /* FDT_RD_AUTO (by extension), or FDT_RD_XYZ/NODE/PLY */
+    int columns[3];    /* x, y, z columns of the text point formats,
+                          counted from 1; {0, 0, 0}: 1, 2, 3 */
+    int threads;       /* as fdt_read_points_threads */
+    size_t min_slice;  /* as fdt_read_points_threads; 0: a megabyte */
+    fdt_rd_progress_fn progress; /* may be NULL */
+    void *progress_user;
+} fdt_rd_opts;
+
+/* Defaults: by extension, columns 1, 2, 3, one thread, no progress. */
+void fdt_rd_opts_default(fdt_rd_opts *o);
+
+/* The format of a name ("xyz", "txt", "csv", "node", "ply"; any case), or
+ * FDT_RD_AUTO when it is none of them. */
+int fdt_rd_format_by_name(const char *name);
+/* The format path's extension gives, FDT_RD_AUTO if none ("-": none). */
+int fdt_rd_format_of_path(const char *path);
+
+/*
+ * The reads above with options: path "-" is standard input. Columns other
+ * than 1, 2, 3 with a format that has no columns (.node, .ply) are refused
+ * with FDT_IO_EFORMAT. Same results and messages otherwise.
+ */
+int fdt_read_points_with(const char *path, const fdt_rd_opts *o, double **xyz, size_t *n,
+                         char *err, size_t errlen);
+int fdt_read_points_mem_with(const char *name, const void *data, size_t len,
+                             const fdt_rd_opts *o, double **xyz, size_t *n, char *err,
+                             size_t errlen);
 
 #endif

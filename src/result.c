@@ -32,31 +32,50 @@ const fdt_vid *fdt_result_hull_faces(const fdt_result *r) { return r ? r->hull :
 const fdt_vid *fdt_result_duplicate_map(const fdt_result *r) { return r ? r->dupmap : NULL; }
 size_t fdt_result_num_duplicates(const fdt_result *r) { return r ? r->ndup : 0; }
 
-int fdt_result_stats(const fdt_result *r, fdt_stats *st)
+/* The sizes of fdt_stats and fdt_thread_stats this library fills
+ * (include/frontdt.h, ABI): this release's; earlier releases' join here
+ * when a field is added. */
+static int stats_size_known(size_t size)
 {
-    if (!r || !st)
+    return size == sizeof(fdt_stats);
+}
+
+static int thread_stats_size_known(size_t size)
+{
+    return size == sizeof(fdt_thread_stats);
+}
+
+int fdt_result_stats_sized(const fdt_result *r, fdt_stats *st, size_t struct_size)
+{
+    if (!r || !st || !stats_size_known(struct_size))
         return FDT_EINVAL;
-    *st = r->stats;
+    fdt_stats all = r->stats;
+    all.struct_size = struct_size;
+    memcpy(st, &all, struct_size);
     return FDT_OK;
 }
 
-int fdt_result_thread_stats(const fdt_result *r, int thread,
-                            fdt_thread_stats *ts)
+int fdt_result_thread_stats_sized(const fdt_result *r, int thread, fdt_thread_stats *ts,
+                                  size_t struct_size)
 {
-    if (!r || !ts || thread < 0 || thread >= r->stats.threads)
+    if (!r || !ts || thread < 0 || thread >= r->stats.threads ||
+        !thread_stats_size_known(struct_size))
         return FDT_EINVAL;
+    fdt_thread_stats all;
     if (r->tstats) {
-        *ts = r->tstats[thread];
-        return FDT_OK;
+        all = r->tstats[thread];
+    } else {
+        /* Serial: the one thread did everything. */
+        memset(&all, 0, sizeof all);
+        all.points = r->stats.vertices;
+        all.tets = r->stats.tets;
+        all.hull_faces = r->stats.hull_faces;
+        all.faces_advanced = r->stats.faces_advanced;
+        all.max_front = r->stats.max_front;
+        all.core = -1;
     }
-    /* Serial: the one thread did everything. */
-    memset(ts, 0, sizeof *ts);
-    ts->points = r->stats.vertices;
-    ts->tets = r->stats.tets;
-    ts->hull_faces = r->stats.hull_faces;
-    ts->faces_advanced = r->stats.faces_advanced;
-    ts->max_front = r->stats.max_front;
-    ts->core = -1;
+    all.struct_size = struct_size;
+    memcpy(ts, &all, struct_size);
     return FDT_OK;
 }
 

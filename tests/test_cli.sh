@@ -17,7 +17,10 @@
 # during a long run and during the write (exit 6, nothing left), --demo,
 # repeatability (byte-identical .tets, identical --hash), independence of
 # input order (shuffled copy mapped back), --check, --stats/--stats-json,
-# duplicate reporting, --pin refused (said once), every output format.
+# duplicate reporting, --pin refused (said once), every output format;
+# standard input ('-', pipes, FIFOs, /dev/stdin; text and binary PLY),
+# --input-format, extra columns, --columns and headers, the progress line
+# (--progress: phases named, width, none with --quiet).
 set -u
 
 FRONTDT=${1:?usage: test_cli.sh FRONTDT BAD_DIR}
@@ -164,6 +167,90 @@ for f in flat three line; do
     expect_rc "degenerate_$f" 2 && expect_in "degenerate_$f" err "frontdt: $f.xyz: "
     expect_empty_dir "degenerate_$f" out
 done
+
+# ---------------------------------------------------------------------------
+# Standard input, --input-format, columns, headers, the progress line
+# ---------------------------------------------------------------------------
+gen_points 300 11 >io.xyz
+run io_ref "$FRONTDT" --hash io.xyz
+expect_rc io_ref 0
+io_hash=$(grep '^hash:' io_ref.out)
+# '-' from a pipe (not seekable), and a named pipe and /dev/stdin by path.
+cat io.xyz | "$FRONTDT" --hash --input-format xyz - >io_pipe.out 2>io_pipe.err
+RC=$?
+expect_rc io_pipe 0 && expect_in io_pipe out "$io_hash"
+mkfifo io.fifo
+cat io.xyz >io.fifo &
+run io_fifo "$FRONTDT" --hash --input-format xyz io.fifo
+expect_rc io_fifo 0 && expect_in io_fifo out "$io_hash"
+wait
+run io_devstdin "$FRONTDT" --hash --input-format txt /dev/stdin <io.xyz
+expect_rc io_devstdin 0 && expect_in io_devstdin out "$io_hash"
+# Binary PLY from a pipe.
+awk 'BEGIN { printf "ply\nformat ascii 1.0\nelement vertex 300\nproperty double x\nproperty double y\nproperty double z\nend_header\n" } { print }' io.xyz >io_ascii.ply
+cat io_ascii.ply | "$FRONTDT" --hash --input-format ply - >io_ply.out 2>io_ply.err
+RC=$?
+expect_rc io_ply 0 && expect_in io_ply out "$io_hash"
+if command -v python3 >/dev/null; then
+    python3 -c '
+import struct, sys
+pts = [tuple(float(v) for v in l.split()) for l in open("io.xyz")]
+sys.stdout.buffer.write(b"ply\nformat binary_big_endian 1.0\nelement vertex %d\nproperty double x\nproperty double y\nproperty double z\nend_header\n" % len(pts))
+for p in pts:
+    sys.stdout.buffer.write(struct.pack(">3d", *p))' | "$FRONTDT" --hash --input-format ply - >io_bply.out 2>io_bply.err
+    RC=$?
+    expect_rc io_bply 0 && expect_in io_bply out "$io_hash"
+fi
+# Usage errors (exit 1): '-' without a format, an unknown format, bad
+# --columns, --columns for .node/.ply; nothing read.
+run io_noformat "$FRONTDT" - </dev/null
+expect_rc io_noformat 1 && expect_in io_noformat err "needs --input-format"
+run io_badformat "$FRONTDT" --input-format las io.xyz
+expect_rc io_badformat 1 && expect_in io_badformat err "unknown input format 'las'"
+for bad in 0,1,2 1,2 1,2,3,4 1,1,2 a,b,c 1,,2; do
+    run io_badcols "$FRONTDT" --columns "$bad" io.xyz
+    expect_rc io_badcols 1 && expect_in io_badcols err "--columns wants three"
+done
+printf '4\n' >io.node
+run io_colsnode "$FRONTDT" --columns 2,3,4 io.node
+expect_rc io_colsnode 1 && expect_in io_colsnode err "--columns applies to .xyz"
+# Bad input read from stdin is named "stdin" (exit 2).
+printf '0 0 0\n1 0 x\n' | "$FRONTDT" --input-format xyz - >io_stdinbad.out 2>io_stdinbad.err
+RC=$?
+expect_rc io_stdinbad 2 && expect_in io_stdinbad err "stdin:2: not a number: 'x'"
+# Lidar-style CSV: a header, an id and a name before x y z, colour after:
+# --columns 3,4,5 gives the plain file's mesh; extra columns alone are
+# skipped without --columns.
+awk 'BEGIN { print "id,name,X,Y,Z,R,G,B" } { printf "%d,p%d,%s,%s,%s,255,0,0\n", NR, NR, $1, $2, $3 }' io.xyz >io_lidar.csv
+run io_csv "$FRONTDT" --hash --columns 3,4,5 io_lidar.csv
+expect_rc io_csv 0 && expect_in io_csv out "$io_hash"
+awk '{ print $0, 17, 200, 100, 50 }' io.xyz >io_extra.txt
+run io_extra "$FRONTDT" --hash io_extra.txt
+expect_rc io_extra 0 && expect_in io_extra out "$io_hash"
+awk 'NR == 5 { print $1, $2, $3; next } { print $0, 17 }' io.xyz >io_ragged.xyz
+run io_ragged "$FRONTDT" io_ragged.xyz
+expect_rc io_ragged 2 && expect_in io_ragged err "io_ragged.xyz:5: expected 4 columns as on the first line, found 3"
+run io_fewcols "$FRONTDT" --columns 3,4,9 io_lidar.csv
+expect_rc io_fewcols 2 && expect_in io_fewcols err "io_lidar.csv:2: columns 3,4,9 need 9 fields, found 8"
+# The progress line, forced onto a file (stderr is no terminal here): each
+# phase named; none without --progress, none with --quiet.
+run io_prog "$FRONTDT" --progress --hash io.xyz -o out/io_prog.tets
+expect_rc io_prog 0
+for phase in read parse merge triangulate sort write; do
+    expect_in io_prog err "frontdt: $phase"
+done
+rm -f out/io_prog.tets
+run io_noprog "$FRONTDT" --hash io.xyz
+grep -q 'frontdt: read' io_noprog.err && fail "io_noprog: a progress line without --progress on a non-terminal"
+run io_quietprog "$FRONTDT" --progress --quiet --hash io.xyz
+[ -s io_quietprog.err ] && fail "io_quietprog: --quiet still drew: $(head -c 200 io_quietprog.err)"
+# The line fits $COLUMNS (no terminal to ask): every redraw, and a narrow
+# one drops the bar but keeps the phase.
+COLUMNS=50 "$FRONTDT" --progress --demo 20000 >io_w50.out 2>io_w50.err
+tr '\r' '\n' <io_w50.err | awk 'length($0) > 49 { bad = 1 } END { exit bad }' ||
+    fail "io_w50: a progress line wider than COLUMNS=50 - 1"
+COLUMNS=20 "$FRONTDT" --progress --demo 2000 >io_w20.out 2>io_w20.err
+grep -q 'frontdt: trian' io_w20.err || fail "io_w20: no phase on a 20-column line"
 
 # ---------------------------------------------------------------------------
 # Output refusals before any computation

@@ -19,6 +19,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <float.h>
 #include <locale.h>
 #include <math.h>
@@ -29,6 +30,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <pthread.h>
 #include <unistd.h>
 
 #define SKIP_CODE 77
@@ -1434,10 +1436,10 @@ static void test_open(tctx *t)
                    "locked.xyz: cannot open: Permission denied");
         chmod(path, 0600);
     }
-    write_file(t, "points.csv", "0 0 0\n", 6, path, sizeof path);
+    write_file(t, "points.las", "0 0 0\n", 6, path, sizeof path);
     EXPECT_ERR(t, path, FDT_IO_EEXT,
-               "points.csv: unknown extension '.csv' (expected .xyz, .txt, "
-               ".node or .ply)");
+               "points.las: unknown extension '.las' (expected .xyz, .txt, "
+               ".csv, .node or .ply)");
     write_file(t, "points", "0 0 0\n", 6, path, sizeof path);
     EXPECT_ERR(t, path, FDT_IO_EEXT, "points: unknown extension ''");
     write_file(t, "points.xyz.gz", "0 0 0\n", 6, path, sizeof path);
@@ -1760,6 +1762,302 @@ static int run_data(const char *dir)
     return failures ? 1 : 0;
 }
 
+/* ------------------------------------------------------------------ */
+/* Columns, headers, standard input, pipes and progress (issue 17)    */
+/* ------------------------------------------------------------------ */
+
+/* Reads text named name through fdt_read_points_mem_with with columns
+ * cols (NULL: the defaults) on `threads` threads (slices of a byte);
+ * returns the code, the points in *xyz (caller frees) and the message. */
+static int read_cols(const char *name, const char *text, const int *cols, int threads,
+                     double **xyz, size_t *n, char *err, size_t errlen)
+{
+    fdt_rd_opts o;
+    fdt_rd_opts_default(&o);
+    if (cols != NULL)
+        memcpy(o.columns, cols, sizeof o.columns);
+    o.threads = threads;
+    o.min_slice = 1;
+    return fdt_read_points_mem_with(name, text, strlen(text), &o, xyz, n, err, errlen);
+}
+
+/* The text must read as want[0..3n) on 1 and 3 threads. */
+#define COLS_OK(t, name, text, cols, want, nw) cols_ok((t), __LINE__, name, text, cols, want, nw)
+static void cols_ok(tctx *t, int line, const char *name, const char *text, const int *cols,
+                    const double *want, size_t nw)
+{
+    for (int T = 1; T <= 3; T += 2) {
+        double *xyz = NULL;
+        size_t n = 0;
+        char err[256];
+        int rc = read_cols(name, text, cols, T, &xyz, &n, err, sizeof err);
+        t->checks++;
+        if (rc != FDT_IO_OK || n != nw || memcmp(xyz, want, 3 * nw * sizeof *want) != 0)
+            fail_at(t, line, "%s (%d threads): %s, %zu points: %s", name, T, code_name(rc), n,
+                    rc ? err : "wrong coordinates");
+        free(xyz);
+    }
+}
+
+/* The text must be refused with a message holding sub, on 1 and 3 threads. */
+#define COLS_ERR(t, name, text, cols, sub) cols_err((t), __LINE__, name, text, cols, sub)
+static void cols_err(tctx *t, int line, const char *name, const char *text, const int *cols,
+                     const char *sub)
+{
+    for (int T = 1; T <= 3; T += 2) {
+        double *xyz = NULL;
+        size_t n = 0;
+        char err[256];
+        int rc = read_cols(name, text, cols, T, &xyz, &n, err, sizeof err);
+        t->checks++;
+        if (rc == FDT_IO_OK || strstr(err, sub) == NULL)
+            fail_at(t, line, "%s (%d threads): want an error with \"%s\", got %s: %s", name, T,
+                    sub, code_name(rc), err);
+        free(xyz);
+    }
+}
+
+static void test_columns(tctx *t)
+{
+    static const double sq[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    /* Lidar exports: x y z intensity r g b; extra columns skipped unread
+     * (even words), with blanks or commas. */
+    COLS_OK(t, "lidar.xyz",
+            "0 0 0 17 255 0 0\n1 0 0 3 0 255 0\n0 1 0 9 0 0 255\n0 0 1 1 nan x y\n", NULL, sq, 4);
+    COLS_OK(t, "lidar.csv", "0,0,0,17\n1,0,0,3\n0,1,0,9\n0,0,1,1\n", NULL, sq, 4);
+    COLS_OK(t, "lidar.txt", "0 0 0 a\n# note\n\n1 0 0 b\n0 1 0 c\n0 0 1 d\n", NULL, sq, 4);
+    /* Every line has the first line's count. */
+    COLS_ERR(t, "short.xyz", "0 0 0 1\n1 0 0 1\n0 1 0\n0 0 1 1\n", NULL,
+             "short.xyz:3: expected 4 columns as on the first line, found 3");
+    COLS_ERR(t, "long.xyz", "0 0 0\n1 0 0 1\n", NULL, "long.xyz:2: expected 3 numbers, found 4");
+    COLS_ERR(t, "two.xyz", "0 0\n1 0\n", NULL, "two.xyz:1: expected 3 numbers, found 2");
+    /* A bad number in a coordinate column still names its line. */
+    COLS_ERR(t, "badnum.xyz", "0 0 0 1\n1 0 q 1\n", NULL, "badnum.xyz:2: not a number: 'q'");
+
+    /* --columns 3,4,5 (from 1): x, y, z wherever they are, in any order. */
+    static const int c345[3] = {3, 4, 5}, c321[3] = {3, 2, 1};
+    COLS_OK(t, "id.csv", "7,a,0,0,0\n8,b,1,0,0\n9,c,0,1,0\n10,d,0,0,1\n", c345, sq, 4);
+    COLS_OK(t, "rev.xyz", "0 0 0\n0 0 1\n0 1 0\n1 0 0\n", c321, sq, 4);
+    COLS_ERR(t, "few.csv", "1,2,3,4,5\n1,2,3\n", c345,
+             "few.csv:2: columns 3,4,5 need 5 fields, found 3");
+    COLS_ERR(t, "few1.csv", "1,2,3\n", c345, "few1.csv:1: columns 3,4,5 need 5 fields, found 3");
+    static const int c0[3] = {0, 1, 2};
+    COLS_ERR(t, "zero.xyz", "0 0 0\n", c0, "zero.xyz: column 0 is not a column");
+    COLS_ERR(t, "pts.node", "1 3 0 0\n0 0 0 0\n", c345,
+             "pts.node: columns apply to .xyz, .txt and .csv only");
+    COLS_ERR(t, "pts.ply", "ply\n", c345, "pts.ply: columns apply to .xyz, .txt and .csv only");
+    /* 1,2,3 spelled out is the default, .node included. */
+    static const int c123[3] = {1, 2, 3};
+    COLS_OK(t, "n.node", "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n", c123, sq, 4);
+
+    /* Headers: a first content line of printable words, none a number. */
+    COLS_OK(t, "hdr.csv", "X,Y,Z,Intensity\n0,0,0,1\n1,0,0,1\n0,1,0,1\n0,0,1,1\n", NULL, sq, 4);
+    COLS_OK(t, "pdal.txt", "\"X\",\"Y\",\"Z\"\n0,0,0\n1,0,0\n0,1,0\n0,0,1\n", NULL, sq, 4);
+    COLS_OK(t, "cc.txt", "# exported\n\n//X,Y,Z,R,G,B\n0,0,0,1,2,3\n1,0,0,1,2,3\n0,1,0,1,2,3\n"
+                         "0,0,1,1,2,3\n", NULL, sq, 4);
+    COLS_OK(t, "hdr345.csv", "id,name,x,y,z\n1,a,0,0,0\n2,b,1,0,0\n3,c,0,1,0\n4,d,0,0,1\n", c345,
+            sq, 4);
+    /* Line numbers after a header stay those of the file. */
+    COLS_ERR(t, "hdrbad.csv", "X,Y,Z\n0,0,0\n1,0,q\n", NULL, "hdrbad.csv:3: not a number: 'q'");
+    /* Only the first content line; a second one is an error. */
+    COLS_ERR(t, "hdr2.csv", "X,Y,Z\nX,Y,Z\n0,0,0\n", NULL, "hdr2.csv:2: not a number: 'X'");
+    /* Not headers: a number among the words, nan, non-printable bytes. */
+    COLS_ERR(t, "mixed.csv", "X,1,Z\n0,0,0\n", NULL, "mixed.csv:1: not a number: 'X'");
+    COLS_ERR(t, "nanfirst.xyz", "nan nan nan\n0 0 0\n", NULL,
+             "nanfirst.xyz:1: not a finite number: 'nan'");
+    COLS_ERR(t, "bin.xyz", "X\x01 Y Z\n0 0 0\n", NULL, "bin.xyz:1: not a number: 'X\\x01'");
+    COLS_ERR(t, "hdronly.csv", "X,Y,Z\n", NULL, "hdronly.csv: no points");
+
+    /* Larger, on several threads with real slices: header and columns. */
+    bbuf b = {0};
+    bb_printf(&b, "a,b,x,y,z\n");
+    enum { NP = 5000 };
+    double *want = malloc(3 * NP * sizeof *want);
+    if (want == NULL)
+        exit(1);
+    for (size_t i = 0; i < NP; i++) {
+        for (int k = 0; k < 3; k++)
+            want[3 * i + (size_t)k] = (double)(rnd(t) % 100000) / 64;
+        bb_printf(&b, "%zu,w%zu,%.17g,%.17g,%.17g\n", i, i, want[3 * i], want[3 * i + 1],
+                  want[3 * i + 2]);
+    }
+    bb_put(&b, "", 1);
+    COLS_OK(t, "big.csv", (const char *)b.p, c345, want, NP);
+    bb_free(&b);
+    free(want);
+}
+
+/* A writer thread for a pipe or FIFO: writes len bytes of data to fd (or,
+ * with path set, opens path for writing first) and closes it. */
+typedef struct pipe_writer {
+    const char *path;
+    int fd;
+    const void *data;
+    size_t len;
+} pipe_writer;
+
+static void *pipe_writer_run(void *arg)
+{
+    pipe_writer *w = arg;
+    int fd = w->path != NULL ? open(w->path, O_WRONLY) : w->fd;
+    const char *p = w->data;
+    size_t left = w->len;
+    while (fd >= 0 && left > 0) {
+        ssize_t k = write(fd, p, left);
+        if (k <= 0)
+            break;
+        p += k;
+        left -= (size_t)k;
+    }
+    if (fd >= 0)
+        close(fd);
+    return NULL;
+}
+
+/* Reads data through a pipe standing in for standard input ("-"). */
+static int read_stdin(const void *data, size_t len, int format, double **xyz, size_t *n,
+                      char *err, size_t errlen)
+{
+    int fds[2];
+    if (pipe(fds) != 0)
+        exit(1);
+    int saved = dup(STDIN_FILENO);
+    if (saved < 0 || dup2(fds[0], STDIN_FILENO) < 0)
+        exit(1);
+    close(fds[0]);
+    pipe_writer w = {NULL, fds[1], data, len};
+    pthread_t tid;
+    if (pthread_create(&tid, NULL, pipe_writer_run, &w) != 0)
+        exit(1);
+    fdt_rd_opts o;
+    fdt_rd_opts_default(&o);
+    o.format = format;
+    int rc = fdt_read_points_with("-", &o, xyz, n, err, errlen);
+    pthread_join(tid, NULL);
+    dup2(saved, STDIN_FILENO);
+    close(saved);
+    return rc;
+}
+
+typedef struct prog_log {
+    size_t calls[2], last_done[2], last_total[2];
+    int backwards;
+} prog_log;
+
+static void prog_cb(void *user, int stage, size_t done, size_t total)
+{
+    prog_log *l = user;
+    if (stage < 0 || stage > 1)
+        return;
+    if (l->calls[stage] > 0 && done < l->last_done[stage])
+        l->backwards = 1;
+    l->calls[stage]++;
+    l->last_done[stage] = done;
+    l->last_total[stage] = total;
+}
+
+static void test_stdin(tctx *t)
+{
+    /* Text, larger than a pipe's buffer, so the reader must wait for it. */
+    bbuf b = {0};
+    enum { NP = 20000 };
+    double *want = malloc(3 * NP * sizeof *want);
+    if (want == NULL)
+        exit(1);
+    for (size_t i = 0; i < NP; i++) {
+        for (int k = 0; k < 3; k++)
+            want[3 * i + (size_t)k] = (double)(rnd(t) % 1000000) / 128;
+        bb_printf(&b, "%.17g %.17g %.17g\n", want[3 * i], want[3 * i + 1], want[3 * i + 2]);
+    }
+    double *xyz = NULL;
+    size_t n = 0;
+    char err[256];
+    int rc = read_stdin(b.p, b.n, FDT_RD_XYZ, &xyz, &n, err, sizeof err);
+    CHECK(t, rc == FDT_IO_OK && n == NP && memcmp(xyz, want, 3 * NP * sizeof *want) == 0,
+          "stdin xyz: %s, %zu points: %s", code_name(rc), n, err);
+    free(xyz);
+
+    /* Binary PLY (little endian doubles) through the pipe. */
+    bbuf p = {0};
+    bb_printf(&p, "ply\nformat binary_little_endian 1.0\nelement vertex %d\n"
+                  "property double x\nproperty double y\nproperty double z\nend_header\n", NP);
+    for (size_t i = 0; i < 3 * (size_t)NP; i++) {
+        uint64_t u;
+        memcpy(&u, &want[i], 8);
+        unsigned char le[8];
+        for (int k = 0; k < 8; k++)
+            le[k] = (unsigned char)(u >> (8 * k));
+        bb_put(&p, le, 8);
+    }
+    rc = read_stdin(p.p, p.n, FDT_RD_PLY, &xyz, &n, err, sizeof err);
+    CHECK(t, rc == FDT_IO_OK && n == NP && memcmp(xyz, want, 3 * NP * sizeof *want) == 0,
+          "stdin ply: %s, %zu points: %s", code_name(rc), n, err);
+    free(xyz);
+
+    /* Messages name stdin; without a format it is refused. */
+    rc = read_stdin("0 0 0\n1 0 q\n", 12, FDT_RD_XYZ, &xyz, &n, err, sizeof err);
+    CHECK(t, rc == FDT_IO_EFORMAT && strcmp(err, "stdin:2: not a number: 'q'") == 0,
+          "stdin error: %s: %s", code_name(rc), err);
+    rc = read_stdin("0 0 0\n", 6, FDT_RD_AUTO, &xyz, &n, err, sizeof err);
+    CHECK(t, rc == FDT_IO_EEXT && strstr(err, "stdin: standard input needs its format") == err,
+          "stdin without a format: %s: %s", code_name(rc), err);
+
+    /* A named pipe, by a path with no extension and the format named. */
+    char fifo[1024];
+    snprintf(fifo, sizeof fifo, "%s/cloud_fifo", t->dir);
+    if (mkfifo(fifo, 0600) != 0) {
+        fprintf(stderr, "test_reader: mkfifo %s: %s\n", fifo, strerror(errno));
+        exit(1);
+    }
+    pipe_writer w = {fifo, -1, b.p, b.n};
+    pthread_t tid;
+    if (pthread_create(&tid, NULL, pipe_writer_run, &w) != 0)
+        exit(1);
+    fdt_rd_opts o;
+    fdt_rd_opts_default(&o);
+    o.format = FDT_RD_XYZ;
+    prog_log lg;
+    memset(&lg, 0, sizeof lg);
+    o.progress = prog_cb;
+    o.progress_user = &lg;
+    rc = fdt_read_points_with(fifo, &o, &xyz, &n, err, sizeof err);
+    pthread_join(tid, NULL);
+    CHECK(t, rc == FDT_IO_OK && n == NP && memcmp(xyz, want, 3 * NP * sizeof *want) == 0,
+          "fifo: %s, %zu points: %s", code_name(rc), n, err);
+    free(xyz);
+    /* Progress from a pipe: loading with no total, then parsing to the end. */
+    CHECK(t, lg.calls[FDT_RD_LOADING] > 0 && lg.last_done[FDT_RD_LOADING] == b.n &&
+                 lg.last_total[FDT_RD_LOADING] == 0,
+          "fifo progress: loading %zu calls, %zu of %zu", lg.calls[0], lg.last_done[0],
+          lg.last_total[0]);
+    CHECK(t, lg.calls[FDT_RD_PARSING] > 0 && lg.last_done[FDT_RD_PARSING] == b.n &&
+                 lg.last_total[FDT_RD_PARSING] == b.n && !lg.backwards,
+          "fifo progress: parsing %zu calls, %zu of %zu", lg.calls[1], lg.last_done[1],
+          lg.last_total[1]);
+
+    /* A regular file, on 1 and 3 threads: totals known, parsing never
+     * backwards (reports every 8192 lines: several for one thread). */
+    char path[1024];
+    write_file(t, "progress.xyz", b.p, b.n, path, sizeof path);
+    for (int T = 1; T <= 3; T += 2) {
+        memset(&lg, 0, sizeof lg);
+        o.format = FDT_RD_AUTO;
+        o.threads = T;
+        o.min_slice = 4096;
+        rc = fdt_read_points_with(path, &o, &xyz, &n, err, sizeof err);
+        CHECK(t, rc == FDT_IO_OK && n == NP, "progress.xyz: %s: %s", code_name(rc), err);
+        free(xyz);
+        CHECK(t, lg.last_done[FDT_RD_LOADING] == b.n && lg.last_total[FDT_RD_LOADING] == b.n &&
+                     lg.calls[FDT_RD_PARSING] >= (T == 1 ? 3u : 1u) &&
+                     lg.last_done[FDT_RD_PARSING] == b.n && !lg.backwards,
+              "progress.xyz (%d threads): loading %zu/%zu, parsing %zu calls", T,
+              lg.last_done[0], lg.last_total[0], lg.calls[1]);
+    }
+    bb_free(&b);
+    bb_free(&p);
+    free(want);
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 3 && strcmp(argv[1], "--data") == 0)
@@ -1792,6 +2090,8 @@ int main(int argc, char **argv)
     test_fuzz(&t);
     test_open(&t);
     test_locale(&t);
+    test_columns(&t);
+    test_stdin(&t);
     replay_bad(&t, argv[1]);
     replay_good(&t, argv[2]);
     remove_tree(t.dir);

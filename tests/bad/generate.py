@@ -53,7 +53,7 @@ def bad():
     put(BAD, 'crlf_four.txt', '0 0 0\r\n1 0 0\r\n0 1 0 1\r\n0 0 1\r\n')
     rnd = random.Random(20240601)
     put(BAD, 'random_bytes.xyz', bytes(rnd.randrange(256) for _ in range(300)))
-    put(BAD, 'unknown_ext.csv', '0,0,0\n1,0,0\n0,1,0\n0,0,1\n')
+    put(BAD, 'unknown_ext.las', '0,0,0\n1,0,0\n0,1,0\n0,0,1\n')
 
     node = ['%d %s\n' % (i, ' '.join(repr(float(v)) for v in p))
             for i, p in enumerate(POINTS[:4])]

@@ -1,0 +1,260 @@
+/*
+ * What the point readers share (src/reader.c, src/read_text.c and one
+ * module a format: src/read_xyz.c, src/read_node.c, src/read_ply.c).
+ * Internal to the readers: the CLI and tests use src/reader.h.
+ *
+ * A read holds the whole input in one NUL-terminated buffer (rd_ctx.buf,
+ * loaded by src/reader.c from a file, a pipe or memory); a format's
+ * function parses it into an rd_points and words its first error with
+ * fdt_rd_fail ("PATH:LINE: ..." or "PATH: byte N: ...").
+ */
+#ifndef FDT_READ_COMMON_H
+#define FDT_READ_COMMON_H
+
+#include "reader.h"
+
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#if defined(__GNUC__)
+#define RD_PRINTF(f, a) __attribute__((format(printf, f, a)))
+#else
+#define RD_PRINTF(f, a)
+/* The fields of a line (inline: the parsers' innermost loop). */
+
+/*
+ * Next field of a line: 1 and the field, 0 at the end of the line, -1 on an
+ * empty field (a comma at the start or end of the line, or two commas with
+ * nothing between). Fields are separated by whitespace and, when commas is
+ * set, by at most one comma.
+ */
+/* Moves f->p to the start of the next field; same results as below. */
+static inline int fdt_rd_skip_sep(rd_fields *f)
+{
+    const char *p = f->p, *e = f->e;
+    while (p < e && rd_is_space(*p))
+        p++;
+    if (f->commas && p < e && *p == ',') {
+        if (f->n == 0) {
+            f->p = p;
+            return -1;
+        }
+        p++;
+        while (p < e && rd_is_space(*p))
+            p++;
+        if (p == e || *p == ',') {
+            f->p = p;
+            return -1;
+        }
+    }
+    f->p = p;
+    return p < e;
+}
+
+static inline int fdt_rd_is_sep(const rd_fields *f, const char *p)
+{
+    return p == f->e || rd_is_space(*p) || (f->commas && *p == ',');
+}
+
+static inline int fdt_rd_next_field(rd_fields *f, const char **ts, size_t *tl)
+{
+    int r = fdt_rd_skip_sep(f);
+    if (r <= 0)
+        return r;
+    const char *s = f->p, *p = s;
+    while (!fdt_rd_is_sep(f, p))
+        p++;
+    f->p = p;
+    f->n++;
+    *ts = s;
+    *tl = (size_t)(p - s);
+    return 1;
+}
+
+#endif
+
+/* fdt_vid is int32_t: more points cannot be numbered. */
+#define RD_MAX_POINTS ((uint64_t)INT32_MAX)
+
+/* Bytes of an offending token quoted in a message. */
+#define RD_QUOTE_BYTES 24
+#define RD_QUOTE_CAP (RD_QUOTE_BYTES * 4 + 8)
+
+/* Below a megabyte a slice's thread costs about what it saves. */
+#define RD_MIN_SLICE ((size_t)1 << 20)
+
+typedef struct rd_ctx {
+    const char *path;
+    char *err;
+    size_t errlen;
+    const char *buf; /* the whole file, NUL-terminated (owned by the caller) */
+    size_t size;     /* bytes in the file (the NUL not counted) */
+    int threads;      /* for .xyz: slices parsed at once (fdt_rd_read_xyz) */
+    size_t min_slice; /* least bytes a slice; 0: RD_MIN_SLICE */
+    int col[3];       /* .xyz: 0-based columns of x, y, z */
+    int custom_cols;  /* col[] is not 0, 1, 2 (the messages say so) */
+    fdt_rd_progress_fn progress; /* NULL on threads other than the caller's */
+    void *progress_user;
+    size_t progress_scale; /* parsed bytes are reported times this */
+} rd_ctx;
+
+/* Reports done bytes parsed (times c->progress_scale, at most c->size). */
+static inline void fdt_rd_progress(const rd_ctx *c, size_t done)
+{
+    if (c->progress == NULL)
+        return;
+    size_t s = c->progress_scale > 1 ? c->progress_scale : 1;
+    done = done > c->size / s ? c->size : done * s;
+    c->progress(c->progress_user, FDT_RD_PARSING, done, c->size);
+}
+
+/* Lines or items between two progress reports. */
+#define RD_PROGRESS_EVERY 8192
+
+typedef struct rd_points {
+    double *xyz; /* 3 * cap doubles */
+    size_t n, cap;
+    int fixed;   /* xyz is a slice of another array: it cannot grow */
+} rd_points;
+
+/* src/reader.c: messages and point storage. */
+
+/* Writes "PATH" followed by the formatted text; always returns code. */
+int fdt_rd_fail(const rd_ctx *c, int code, const char *fmt, ...) RD_PRINTF(3, 4);
+/* The token s[0..len) as 'text' for a message (see src/reader.c). */
+const char *fdt_rd_quote(char out[RD_QUOTE_CAP], const char *s, size_t len);
+/* Grows pb to cap points; -1 when out of memory or pb is fixed. */
+int fdt_rd_points_reserve(rd_points *pb, size_t cap);
+
+/* src/read_text.c: numbers, lines and fields of the text formats. */
+
+enum {
+    NUM_OK = 0,
+    NUM_SYNTAX,    /* not a number of our grammar */
+    NUM_NONFINITE, /* nan, inf, infinity */
+    NUM_OVERFLOW,  /* beyond DBL_MAX (or, for integers, beyond int64) */
+    NUM_UNDERFLOW, /* nonzero literal that rounds to a subnormal or zero */
+    NUM_NOMEM
+};
+
+/* The literal s[0..len) (or, without full, its longest prefix: *used). */
+int fdt_rd_scan_real(const char *s, size_t len, double *out, int check_range, int full,
+                     size_t *used);
+int fdt_rd_parse_real(const char *s, size_t len, double *out, int check_range);
+int fdt_rd_parse_int(const char *s, size_t len, int64_t *out);
+int fdt_rd_parse_count(const char *s, size_t len, uint64_t *out);
+/* "PATH:LINE: [what: ]problem 'token'"; returns the code to give back. */
+int fdt_rd_num_fail(const rd_ctx *c, size_t line, const char *what, int status, const char *s,
+                    size_t len);
+
+typedef struct rd_lines {
+    const char *p, *end;
+    size_t lineno; /* number of the line last returned (1-based) */
+} rd_lines;
+
+int fdt_rd_next_line(rd_lines *L, const char **s, const char **e);
+const char *fdt_rd_cut_comment(const char *s, const char *e);
+int fdt_rd_blank(const char *s, const char *e);
+
+typedef struct rd_fields {
+    const char *p, *e;
+    int commas; /* ',' separates fields (text point formats) */
+    size_t n;   /* fields returned so far */
+} rd_fields;
+
+/* fdt_rd_skip_sep, fdt_rd_is_sep, fdt_rd_next_field: inline, below (the
+ * .xyz loop calls them for every field). */
+size_t fdt_rd_count_rest(rd_fields *f);
+
+/* The formats (one module each). start: the text after a byte order mark. */
+int fdt_rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb);
+int fdt_rd_read_node(const rd_ctx *c, const char *start, rd_points *pb);
+int fdt_rd_read_ply(const rd_ctx *c, rd_points *pb);
+
+/* Small helpers of every parser. */
+
+static inline int rd_is_space(char ch)
+{
+    return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\v' || ch == '\f';
+}
+
+static inline int rd_is_digit(char ch)
+{
+    return ch >= '0' && ch <= '9';
+}
+
+static inline char rd_lower(char ch)
+{
+    return (ch >= 'A' && ch <= 'Z') ? (char)(ch - 'A' + 'a') : ch;
+}
+
+/* Case-insensitive comparison of s[0..len) with the lowercase word w. */
+static inline int rd_word_ieq(const char *s, size_t len, const char *w)
+{
+    size_t wl = strlen(w);
+    if (len != wl)
+        return 0;
+    for (size_t i = 0; i < len; i++)
+        if (rd_lower(s[i]) != w[i])
+            return 0;
+    return 1;
+}
+
+static inline int rd_tok_is(const char *s, size_t len, const char *w)
+{
+    return len == strlen(w) && memcmp(s, w, len) == 0;
+}
+
+/* The fields of a line (inline: the parsers' innermost loop). */
+
+/*
+ * Next field of a line: 1 and the field, 0 at the end of the line, -1 on an
+ * empty field (a comma at the start or end of the line, or two commas with
+ * nothing between). Fields are separated by whitespace and, when commas is
+ * set, by at most one comma.
+ */
+/* Moves f->p to the start of the next field; same results as below. */
+static inline int fdt_rd_skip_sep(rd_fields *f)
+{
+    const char *p = f->p, *e = f->e;
+    while (p < e && rd_is_space(*p))
+        p++;
+    if (f->commas && p < e && *p == ',') {
+        if (f->n == 0) {
+            f->p = p;
+            return -1;
+        }
+        p++;
+        while (p < e && rd_is_space(*p))
+            p++;
+        if (p == e || *p == ',') {
+            f->p = p;
+            return -1;
+        }
+    }
+    f->p = p;
+    return p < e;
+}
+
+static inline int fdt_rd_is_sep(const rd_fields *f, const char *p)
+{
+    return p == f->e || rd_is_space(*p) || (f->commas && *p == ',');
+}
+
+static inline int fdt_rd_next_field(rd_fields *f, const char **ts, size_t *tl)
+{
+    int r = fdt_rd_skip_sep(f);
+    if (r <= 0)
+        return r;
+    const char *s = f->p, *p = s;
+    while (!fdt_rd_is_sep(f, p))
+        p++;
+    f->p = p;
+    f->n++;
+    *ts = s;
+    *tl = (size_t)(p - s);
+    return 1;
+}
+
+#endif

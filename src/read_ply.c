@@ -1,0 +1,737 @@
+/*
+ * PLY point files, ASCII and binary (src/reader.h).
+ */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#endif
+
+#include "read_common.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+_Static_assert(sizeof(float) == 4 && sizeof(double) == 8,
+               "binary PLY decoding assumes IEEE binary32/binary64");
+
+/* ------------------------------------------------------------------ */
+/* PLY                                                                */
+/* ------------------------------------------------------------------ */
+
+enum {
+    PT_INT8,
+    PT_UINT8,
+    PT_INT16,
+    PT_UINT16,
+    PT_INT32,
+    PT_UINT32,
+    PT_FLOAT32,
+    PT_FLOAT64,
+    PT_COUNT
+};
+
+static const unsigned char ply_size[PT_COUNT] = {1, 1, 2, 2, 4, 4, 4, 8};
+static const int64_t ply_min[PT_COUNT] = {-128, 0, -32768, 0, INT32_MIN, 0,
+                                          0, 0};
+static const int64_t ply_max[PT_COUNT] = {127, 255, 32767, 65535, INT32_MAX,
+                                          UINT32_MAX, 0, 0};
+
+/* The first eight entries are in PT_ order: messages index them by type. */
+static const struct {
+    const char *name;
+    int type;
+} ply_type_names[] = {
+    {"char", PT_INT8},     {"uchar", PT_UINT8},    {"short", PT_INT16},
+    {"ushort", PT_UINT16}, {"int", PT_INT32},      {"uint", PT_UINT32},
+    {"float", PT_FLOAT32}, {"double", PT_FLOAT64}, {"int8", PT_INT8},
+    {"uint8", PT_UINT8},   {"int16", PT_INT16},    {"uint16", PT_UINT16},
+    {"int32", PT_INT32},   {"uint32", PT_UINT32},  {"float32", PT_FLOAT32},
+    {"float64", PT_FLOAT64},
+};
+
+static int ply_is_float(int t)
+{
+    return t == PT_FLOAT32 || t == PT_FLOAT64;
+}
+
+static int ply_type_lookup(const char *s, size_t len)
+{
+    for (size_t i = 0; i < sizeof ply_type_names / sizeof ply_type_names[0];
+         i++)
+        if (rd_tok_is(s, len, ply_type_names[i].name))
+            return ply_type_names[i].type;
+    return -1;
+}
+
+enum { PLY_ASCII, PLY_LE, PLY_BE };
+
+typedef struct ply_prop {
+    unsigned char type;       /* scalar type, or the item type of a list */
+    unsigned char count_type; /* a list's length type */
+    unsigned char is_list;
+    unsigned char role; /* 1, 2, 3: x, y, z of the vertex element */
+} ply_prop;
+
+typedef struct ply_elem {
+    const char *name; /* points into the file buffer */
+    size_t name_len;
+    uint64_t count;
+    size_t first_prop, n_props;
+    size_t line;      /* header line that declares it */
+    int has_list;
+    size_t min_bytes; /* binary bytes per item with every list empty */
+    size_t n_scalar;  /* scalar properties */
+} ply_elem;
+
+typedef struct ply_hdr {
+    int format;
+    ply_elem *elems;
+    size_t n_elems, cap_elems;
+    ply_prop *props;
+    size_t n_props, cap_props;
+    size_t vertex;   /* index of the vertex element */
+    size_t data_off; /* first byte after end_header's newline */
+    size_t data_line;
+} ply_hdr;
+
+static void ply_hdr_free(ply_hdr *h)
+{
+    free(h->elems);
+    free(h->props);
+}
+
+/* Makes room for one more item in the growable array *arr (item size
+ * `size`, *n items, capacity *cap, first capacity `first`) and counts it;
+ * 0 or -1 when out of memory (the array is then unchanged). */
+static int grow_one(void **arr, size_t size, size_t *n, size_t *cap, size_t first)
+{
+    if (*n == *cap) {
+        size_t ncap = *cap ? 2 * *cap : first;
+        void *x = realloc(*arr, ncap * size);
+        if (x == NULL)
+            return -1;
+        *arr = x;
+        *cap = ncap;
+    }
+    (*n)++;
+    return 0;
+}
+
+static int ply_add_elem(ply_hdr *h)
+{
+    void *a = h->elems;
+    int rc = grow_one(&a, sizeof *h->elems, &h->n_elems, &h->cap_elems, 8);
+    h->elems = a;
+    return rc;
+}
+
+static int ply_add_prop(ply_hdr *h)
+{
+    void *a = h->props;
+    int rc = grow_one(&a, sizeof *h->props, &h->n_props, &h->cap_props, 16);
+    h->props = a;
+    return rc;
+}
+
+/* Text for messages: "vertex 3 of 10" or "element 'face' item 3 of 10",
+ * counting from 1. */
+static const char *ply_item_label(char *out, size_t cap, const ply_hdr *h,
+                                  const ply_elem *el, uint64_t i)
+{
+    if (el == &h->elems[h->vertex]) {
+        snprintf(out, cap, "vertex %llu of %llu", (unsigned long long)i + 1,
+                 (unsigned long long)el->count);
+    } else {
+        char q[RD_QUOTE_CAP];
+        snprintf(out, cap, "element %s item %llu of %llu",
+                 fdt_rd_quote(q, el->name, el->name_len),
+                 (unsigned long long)i + 1, (unsigned long long)el->count);
+    }
+    return out;
+}
+
+static int ply_parse_header(const rd_ctx *c, ply_hdr *h)
+{
+    rd_lines L = {c->buf, c->buf + c->size, 0};
+    const char *s = c->buf, *e = c->buf, *ts;
+    size_t tl;
+    char q[RD_QUOTE_CAP], q2[RD_QUOTE_CAP];
+
+    h->format = -1;
+    h->vertex = SIZE_MAX;
+    if (fdt_rd_next_line(&L, &s, &e)) {
+        rd_fields f = {s, e, 0, 0};
+        int r = fdt_rd_next_field(&f, &ts, &tl);
+        if (r <= 0 || !rd_tok_is(ts, tl, "ply") || fdt_rd_count_rest(&f) != 0)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":1: not a PLY file (the first line is %s, "
+                           "expected 'ply')",
+                           fdt_rd_quote(q, s, (size_t)(e - s)));
+    }
+    int ended = 0;
+    while (!ended && fdt_rd_next_line(&L, &s, &e)) {
+        rd_fields f = {s, e, 0, 0};
+        const char *tk[5] = {0};
+        size_t tn[5] = {0};
+        size_t nt = 0;
+        while (nt < 5 && fdt_rd_next_field(&f, &tk[nt], &tn[nt]) > 0)
+            nt++;
+        if (nt == 0)
+            continue;
+        if (rd_tok_is(tk[0], tn[0], "comment") ||
+            rd_tok_is(tk[0], tn[0], "obj_info"))
+            continue;
+        nt += fdt_rd_count_rest(&f);
+        size_t ln = L.lineno;
+        if (rd_tok_is(tk[0], tn[0], "format")) {
+            if (h->format >= 0)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: second format line", ln);
+            int fm = -1;
+            if (nt == 3 && rd_tok_is(tk[1], tn[1], "ascii"))
+                fm = PLY_ASCII;
+            else if (nt == 3 &&
+                     rd_tok_is(tk[1], tn[1], "binary_little_endian"))
+                fm = PLY_LE;
+            else if (nt == 3 && rd_tok_is(tk[1], tn[1], "binary_big_endian"))
+                fm = PLY_BE;
+            if (fm < 0 || !rd_tok_is(tk[2], tn[2], "1.0"))
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: expected 'format ascii|"
+                               "binary_little_endian|binary_big_endian 1.0'",
+                               ln);
+            h->format = fm;
+        } else if (rd_tok_is(tk[0], tn[0], "element")) {
+            if (h->format < 0)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: element before the format line", ln);
+            if (nt != 3)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: expected 'element NAME COUNT'", ln);
+            uint64_t cnt;
+            int st = fdt_rd_parse_count(tk[2], tn[2], &cnt);
+            if (st == NUM_OVERFLOW)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: element count %s is too large", ln,
+                               fdt_rd_quote(q, tk[2], tn[2]));
+            if (st != NUM_OK)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: element count %s is not a non-negative "
+                               "integer",
+                               ln, fdt_rd_quote(q, tk[2], tn[2]));
+            int is_vertex = rd_tok_is(tk[1], tn[1], "vertex");
+            if (is_vertex && h->vertex != SIZE_MAX)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: second 'vertex' element", ln);
+            if (h->n_elems > 0 && h->elems[h->n_elems - 1].n_props == 0)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: element %s has no properties",
+                               h->elems[h->n_elems - 1].line,
+                               fdt_rd_quote(q, h->elems[h->n_elems - 1].name,
+                                        h->elems[h->n_elems - 1].name_len));
+            if (ply_add_elem(h) != 0)
+                return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+            ply_elem *el = &h->elems[h->n_elems - 1];
+            memset(el, 0, sizeof *el);
+            el->name = tk[1];
+            el->name_len = tn[1];
+            el->count = cnt;
+            el->first_prop = h->n_props;
+            el->line = ln;
+            if (is_vertex)
+                h->vertex = h->n_elems - 1;
+        } else if (rd_tok_is(tk[0], tn[0], "property")) {
+            if (h->n_elems == 0)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: property before any element", ln);
+            ply_prop p = {0, 0, 0, 0};
+            const char *name;
+            size_t name_len;
+            if (nt == 5 && rd_tok_is(tk[1], tn[1], "list")) {
+                int ct = ply_type_lookup(tk[2], tn[2]);
+                int it = ply_type_lookup(tk[3], tn[3]);
+                if (ct < 0 || it < 0)
+                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                                   ":%zu: unknown property type %s",
+                                   ln, ct < 0 ? fdt_rd_quote(q, tk[2], tn[2])
+                                              : fdt_rd_quote(q, tk[3], tn[3]));
+                if (ply_is_float(ct))
+                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                                   ":%zu: list length type %s is not an "
+                                   "integer type",
+                                   ln, fdt_rd_quote(q, tk[2], tn[2]));
+                p.is_list = 1;
+                p.count_type = (unsigned char)ct;
+                p.type = (unsigned char)it;
+                name = tk[4];
+                name_len = tn[4];
+            } else if (nt == 3) {
+                int t = ply_type_lookup(tk[1], tn[1]);
+                if (t < 0)
+                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                                   ":%zu: unknown property type %s", ln,
+                                   fdt_rd_quote(q, tk[1], tn[1]));
+                p.type = (unsigned char)t;
+                name = tk[2];
+                name_len = tn[2];
+            } else {
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: expected 'property TYPE NAME' or "
+                               "'property list COUNTTYPE ITEMTYPE NAME'",
+                               ln);
+            }
+            ply_elem *el = &h->elems[h->n_elems - 1];
+            if (h->vertex == h->n_elems - 1 && name_len == 1 &&
+                name[0] >= 'x' && name[0] <= 'z') {
+                int role = name[0] - 'x' + 1;
+                for (size_t i = el->first_prop; i < h->n_props; i++)
+                    if (h->props[i].role == role)
+                        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                                       ":%zu: second vertex property %s", ln,
+                                       fdt_rd_quote(q, name, name_len));
+                if (p.is_list)
+                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                                   ":%zu: vertex property %s is a list", ln,
+                                   fdt_rd_quote(q, name, name_len));
+                p.role = (unsigned char)role;
+            }
+            if (ply_add_prop(h) != 0)
+                return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+            h->props[h->n_props - 1] = p;
+            el->n_props++;
+            if (p.is_list) {
+                el->has_list = 1;
+                el->min_bytes += ply_size[p.count_type];
+            } else {
+                el->n_scalar++;
+                el->min_bytes += ply_size[p.type];
+            }
+        } else if (rd_tok_is(tk[0], tn[0], "end_header")) {
+            if (nt != 1)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: unexpected text after end_header", ln);
+            ended = 1;
+        } else {
+            /* a number here is data: the end_header line is missing */
+            int data = rd_is_digit(tk[0][0]) || tk[0][0] == '-' ||
+                       tk[0][0] == '+' || tk[0][0] == '.';
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: unknown header keyword %s%s", ln,
+                           fdt_rd_quote(q, tk[0], tn[0]),
+                           data ? " (no end_header line before the data?)"
+                                : "");
+        }
+    }
+    if (!ended)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: the header has no end_header line", L.lineno);
+    h->data_off = (size_t)(L.p - c->buf);
+    h->data_line = L.lineno;
+    if (h->format < 0)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT, ": the header has no format line");
+    if (h->n_elems > 0 && h->elems[h->n_elems - 1].n_props == 0)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT, ":%zu: element %s has no properties",
+                       h->elems[h->n_elems - 1].line,
+                       fdt_rd_quote(q, h->elems[h->n_elems - 1].name,
+                                h->elems[h->n_elems - 1].name_len));
+    if (h->vertex == SIZE_MAX)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ": no points (the header has no 'vertex' element)");
+    const ply_elem *v = &h->elems[h->vertex];
+    int have[4] = {0, 0, 0, 0};
+    for (size_t i = 0; i < v->n_props; i++)
+        have[h->props[v->first_prop + i].role] = 1;
+    for (int k = 1; k <= 3; k++)
+        if (!have[k]) {
+            char nm[2] = {(char)('x' + k - 1), '\0'};
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: the vertex element has no %s property",
+                           v->line, fdt_rd_quote(q2, nm, 1));
+        }
+    if (v->count == 0)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ": no points (the vertex element on line %zu has "
+                       "count 0)",
+                       v->line);
+    return FDT_IO_OK;
+}
+
+/* Loads an unsigned integer of sz bytes in the file's byte order. */
+static uint64_t ply_load(const unsigned char *b, size_t sz, int big)
+{
+    uint64_t u = 0;
+    if (big) {
+        for (size_t i = 0; i < sz; i++)
+            u = (u << 8) | b[i];
+    } else {
+        for (size_t i = sz; i-- > 0;)
+            u = (u << 8) | b[i];
+    }
+    return u;
+}
+
+/* Sign-extends the low 8*sz bits of u (no implementation-defined casts). */
+static int64_t ply_signed(uint64_t u, size_t sz)
+{
+    uint64_t sign = (uint64_t)1 << (8 * sz - 1);
+    if (u & sign)
+        return -(int64_t)((sign << 1) - u);
+    return (int64_t)u;
+}
+
+static int64_t ply_get_int(const unsigned char *b, int type, int big)
+{
+    size_t sz = ply_size[type];
+    uint64_t u = ply_load(b, sz, big);
+    if (type == PT_INT8 || type == PT_INT16 || type == PT_INT32)
+        return ply_signed(u, sz);
+    return (int64_t)u;
+}
+
+static double ply_get(const unsigned char *b, int type, int big)
+{
+    if (type == PT_FLOAT32) {
+        uint32_t w = (uint32_t)ply_load(b, 4, big);
+        float f;
+        memcpy(&f, &w, sizeof f);
+        return (double)f;
+    }
+    if (type == PT_FLOAT64) {
+        uint64_t w = ply_load(b, 8, big);
+        double d;
+        memcpy(&d, &w, sizeof d);
+        return d;
+    }
+    return (double)ply_get_int(b, type, big);
+}
+
+/*
+ * Walks one binary item of el from *off. Fills roff[0..2] with the offsets
+ * of x, y, z when roff is not NULL. Returns 0, 1 when the data ends inside
+ * the item (*off then tells where the shortfall was found), or 2 on a
+ * negative list length (*off at that length).
+ */
+static int ply_bin_item(const rd_ctx *c, const ply_hdr *h, const ply_elem *el,
+                        size_t *off, int big, size_t roff[3])
+{
+    const unsigned char *b = (const unsigned char *)c->buf;
+    size_t o = *off;
+    for (size_t i = 0; i < el->n_props; i++) {
+        const ply_prop *p = &h->props[el->first_prop + i];
+        if (!p->is_list) {
+            size_t sz = ply_size[p->type];
+            if (c->size - o < sz)
+                return 1;
+            if (p->role && roff != NULL)
+                roff[p->role - 1] = o;
+            o += sz;
+            continue;
+        }
+        size_t csz = ply_size[p->count_type];
+        if (c->size - o < csz)
+            return 1;
+        int64_t len = ply_get_int(b + o, p->count_type, big);
+        if (len < 0) {
+            *off = o;
+            return 2;
+        }
+        o += csz;
+        size_t isz = ply_size[p->type];
+        if ((uint64_t)len > (c->size - o) / isz)
+            return 1;
+        o += (size_t)len * isz;
+    }
+    *off = o;
+    return 0;
+}
+
+/* Walks the binary items of an element that is not read. */
+static int ply_bin_skip(const rd_ctx *c, const ply_hdr *h, const ply_elem *el,
+                        size_t *off, int big)
+{
+    char lab[160];
+    if (!el->has_list) {
+        size_t rem = c->size - *off;
+        uint64_t fit = rem / el->min_bytes;
+        if (el->count > fit)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ": byte %zu: file ends %s %s", c->size,
+                           rem % el->min_bytes ? "inside" : "before",
+                           ply_item_label(lab, sizeof lab, h, el, fit));
+        *off += (size_t)el->count * el->min_bytes;
+        return FDT_IO_OK;
+    }
+    for (uint64_t i = 0; i < el->count; i++) {
+        if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
+            fdt_rd_progress(c, *off);
+        int r = ply_bin_item(c, h, el, off, big, NULL);
+        if (r == 1)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ": byte %zu: file ends inside %s", c->size,
+                           ply_item_label(lab, sizeof lab, h, el, i));
+        if (r == 2)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ": byte %zu: %s: negative list length", *off,
+                           ply_item_label(lab, sizeof lab, h, el, i));
+    }
+    return FDT_IO_OK;
+}
+
+static int ply_check_count(const rd_ctx *c, const ply_elem *el,
+                           rd_points *pb)
+{
+    if (el->count > RD_MAX_POINTS)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: the vertex element declares %llu points, more "
+                       "than the %lld supported",
+                       el->line, (unsigned long long)el->count,
+                       (long long)RD_MAX_POINTS);
+    if (fdt_rd_points_reserve(pb, (size_t)el->count) != 0)
+        return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory for %llu points",
+                       (unsigned long long)el->count);
+    return FDT_IO_OK;
+}
+
+static int ply_bin_vertex(const rd_ctx *c, const ply_hdr *h,
+                          const ply_elem *el, size_t *off, int big,
+                          rd_points *pb)
+{
+    char lab[160];
+    size_t rem = c->size - *off;
+    uint64_t fit = rem / el->min_bytes;
+    /* Refuse before allocating: the header's count must fit the bytes
+     * left (exactly for fixed-size vertices, at least for ones with lists). */
+    if (el->count > fit) {
+        if (!el->has_list)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ": byte %zu: file ends %s %s (the header declares "
+                           "%llu vertices of %zu bytes, %zu bytes follow it)",
+                           c->size, rem % el->min_bytes ? "inside" : "before",
+                           ply_item_label(lab, sizeof lab, h, el, fit),
+                           (unsigned long long)el->count, el->min_bytes, rem);
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ": byte %zu: the header declares %llu vertices of at "
+                       "least %zu bytes, only %zu bytes follow: refused",
+                       *off, (unsigned long long)el->count, el->min_bytes,
+                       rem);
+    }
+    int rc = ply_check_count(c, el, pb);
+    if (rc != FDT_IO_OK)
+        return rc;
+    const unsigned char *b = (const unsigned char *)c->buf;
+    int type[3];
+    size_t roff[3] = {0, 0, 0};
+    for (size_t i = 0; i < el->n_props; i++) {
+        const ply_prop *p = &h->props[el->first_prop + i];
+        if (p->role)
+            type[p->role - 1] = p->type;
+    }
+    size_t fixed_off[3] = {0, 0, 0};
+    if (!el->has_list) {
+        size_t o = 0;
+        for (size_t i = 0; i < el->n_props; i++) {
+            const ply_prop *p = &h->props[el->first_prop + i];
+            if (p->role)
+                fixed_off[p->role - 1] = o;
+            o += ply_size[p->type];
+        }
+    }
+    for (uint64_t i = 0; i < el->count; i++) {
+        if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
+            fdt_rd_progress(c, *off);
+        if (el->has_list) {
+            int r = ply_bin_item(c, h, el, off, big, roff);
+            if (r == 1)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ": byte %zu: file ends inside %s", c->size,
+                               ply_item_label(lab, sizeof lab, h, el, i));
+            if (r == 2)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ": byte %zu: %s: negative list length", *off,
+                               ply_item_label(lab, sizeof lab, h, el, i));
+        } else {
+            for (int k = 0; k < 3; k++)
+                roff[k] = *off + fixed_off[k];
+            *off += el->min_bytes;
+        }
+        double *dst = pb->xyz + 3 * pb->n;
+        for (int k = 0; k < 3; k++) {
+            double v = ply_get(b + roff[k], type[k], big);
+            if (!isfinite(v))
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ": byte %zu: %s: %c is %s", roff[k],
+                               ply_item_label(lab, sizeof lab, h, el, i),
+                               'x' + k, isnan(v) ? "NaN" : "infinite");
+            dst[k] = v;
+        }
+        pb->n++;
+    }
+    return FDT_IO_OK;
+}
+
+static int ply_read_binary(const rd_ctx *c, const ply_hdr *h, rd_points *pb)
+{
+    int big = h->format == PLY_BE;
+    size_t off = h->data_off;
+    for (size_t ei = 0; ei < h->n_elems; ei++) {
+        const ply_elem *el = &h->elems[ei];
+        int rc = ei == h->vertex ? ply_bin_vertex(c, h, el, &off, big, pb)
+                                 : ply_bin_skip(c, h, el, &off, big);
+        if (rc != FDT_IO_OK)
+            return rc;
+    }
+    if (off != c->size)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ": byte %zu: %zu bytes of extra data after the last "
+                       "element (the header's counts are too small?)",
+                       off, c->size - off);
+    return FDT_IO_OK;
+}
+
+/*
+ * Reads one ASCII item (one line) of el. For the vertex element, dst
+ * receives x, y, z.
+ */
+static int ply_ascii_item(const rd_ctx *c, const ply_hdr *h,
+                          const ply_elem *el, uint64_t idx, size_t line,
+                          const char *s, const char *e, double *dst)
+{
+    char lab[160], q[RD_QUOTE_CAP];
+    rd_fields f = {s, e, 0, 0};
+    const char *ts;
+    size_t tl, found = 0;
+    for (size_t i = 0; i < el->n_props; i++) {
+        const ply_prop *p = &h->props[el->first_prop + i];
+        uint64_t nvals = 1;
+        int type = p->type;
+        if (p->is_list) {
+            if (fdt_rd_next_field(&f, &ts, &tl) <= 0)
+                goto too_few;
+            found++;
+            int64_t len;
+            if (fdt_rd_parse_int(ts, tl, &len) != NUM_OK || len < 0 ||
+                len > ply_max[p->count_type])
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: %s: list length %s is not a valid %s",
+                               line, ply_item_label(lab, sizeof lab, h, el,
+                                                    idx),
+                               fdt_rd_quote(q, ts, tl), "count");
+            nvals = (uint64_t)len;
+        }
+        for (uint64_t j = 0; j < nvals; j++) {
+            if (fdt_rd_next_field(&f, &ts, &tl) <= 0)
+                goto too_few;
+            found++;
+            double v = 0.0;
+            int st;
+            if (ply_is_float(type)) {
+                st = fdt_rd_parse_real(ts, tl, &v, p->role != 0);
+                /* ignored properties may hold nan/inf (normals often do) */
+                if (p->role == 0 && st == NUM_NONFINITE)
+                    st = NUM_OK;
+            } else {
+                int64_t iv;
+                st = fdt_rd_parse_int(ts, tl, &iv);
+                if (st == NUM_OK && (iv < ply_min[type] || iv > ply_max[type]))
+                    st = NUM_OVERFLOW;
+                if (st != NUM_OK)
+                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                                   ":%zu: %s: %s is not a valid %s", line,
+                                   ply_item_label(lab, sizeof lab, h, el,
+                                                  idx),
+                                   fdt_rd_quote(q, ts, tl),
+                                   ply_type_names[type].name);
+                v = (double)iv;
+            }
+            if (st != NUM_OK)
+                return fdt_rd_num_fail(c, line,
+                                   ply_item_label(lab, sizeof lab, h, el,
+                                                  idx),
+                                   st, ts, tl);
+            if (p->role && dst != NULL)
+                dst[p->role - 1] = v;
+        }
+    }
+    if (fdt_rd_next_field(&f, &ts, &tl) > 0) {
+        size_t extra = 1 + fdt_rd_count_rest(&f);
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: %s: expected %zu values, found %zu", line,
+                       ply_item_label(lab, sizeof lab, h, el, idx), found,
+                       found + extra);
+    }
+    return FDT_IO_OK;
+too_few:
+    if (!el->has_list)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: %s: expected %zu values, found %zu", line,
+                       ply_item_label(lab, sizeof lab, h, el, idx),
+                       el->n_scalar, found);
+    return fdt_rd_fail(c, FDT_IO_EFORMAT, ":%zu: %s: too few values (found %zu)",
+                   line, ply_item_label(lab, sizeof lab, h, el, idx), found);
+}
+
+static int ply_read_ascii(const rd_ctx *c, const ply_hdr *h, rd_points *pb)
+{
+    char lab[160];
+    rd_lines L = {c->buf + h->data_off, c->buf + c->size, h->data_line};
+    const char *s, *e;
+    for (size_t ei = 0; ei < h->n_elems; ei++) {
+        const ply_elem *el = &h->elems[ei];
+        int is_vertex = ei == h->vertex;
+        if (is_vertex) {
+            /* Each item is a line of at least 2 bytes per field. */
+            size_t rem = (size_t)(L.end - L.p);
+            uint64_t per = 2 * (uint64_t)(el->n_scalar +
+                                          (el->n_props - el->n_scalar));
+            uint64_t maxn = ((uint64_t)rem + 1) / per;
+            if (el->count > maxn)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: the header declares %llu vertices but "
+                               "the %zu bytes left can hold at most %llu: "
+                               "refused",
+                               el->line, (unsigned long long)el->count, rem,
+                               (unsigned long long)maxn);
+            int rc = ply_check_count(c, el, pb);
+            if (rc != FDT_IO_OK)
+                return rc;
+        }
+        for (uint64_t i = 0; i < el->count; i++) {
+            if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
+                fdt_rd_progress(c, (size_t)(L.p - c->buf));
+            int got = 0;
+            while ((got = fdt_rd_next_line(&L, &s, &e)) != 0 && fdt_rd_blank(s, e))
+                ;
+            if (!got)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: file ends before %s", L.lineno,
+                               ply_item_label(lab, sizeof lab, h, el, i));
+            double *dst = is_vertex ? pb->xyz + 3 * pb->n : NULL;
+            int rc = ply_ascii_item(c, h, el, i, L.lineno, s, e, dst);
+            if (rc != FDT_IO_OK)
+                return rc;
+            if (is_vertex)
+                pb->n++;
+        }
+    }
+    while (fdt_rd_next_line(&L, &s, &e))
+        if (!fdt_rd_blank(s, e))
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: extra data after the last element (the "
+                           "header's counts are too small?)",
+                           L.lineno);
+    return FDT_IO_OK;
+}
+
+int fdt_rd_read_ply(const rd_ctx *c, rd_points *pb)
+{
+    ply_hdr h;
+    memset(&h, 0, sizeof h);
+    int rc = ply_parse_header(c, &h);
+    if (rc == FDT_IO_OK)
+        rc = h.format == PLY_ASCII ? ply_read_ascii(c, &h, pb)
+                                   : ply_read_binary(c, &h, pb);
+    ply_hdr_free(&h);
+    return rc;
+}
