@@ -24,6 +24,8 @@
  *   - an fdt_settings must come from fdt_default_settings() (which sets
  *     struct_size); one zeroed by hand is refused by fdt_open().
  * Today every struct has one size (the first release): sizeof of it.
+ * fdt_read_options and fdt_write_options (file formats, at the end) follow
+ * the same rule.
  */
 #ifndef FRONTDT_H
 #define FRONTDT_H
@@ -63,7 +65,11 @@ enum {
     FDT_ECHECK = -6,      /* fdt_check found the mesh is not the Delaunay mesh */
     FDT_ECANCELED = -7,   /* the progress callback asked to stop */
     FDT_EINTERNAL = -8,   /* an internal invariant failed (a bug: please report) */
-    FDT_ETHREAD = -9      /* a thread could not be created */
+    FDT_ETHREAD = -9,     /* a thread could not be created */
+    FDT_EIO = -10,        /* a file could not be opened, read, written or
+                             renamed (fdt_read_points, fdt_write_mesh) */
+    FDT_EFORMAT = -11     /* a malformed input file: bad line or byte,
+                             NaN/Inf, counts that do not match, no points */
 };
 
 /* A static English description of an FDT_E* code (never NULL). */
@@ -318,6 +324,165 @@ static inline int fdt_result_thread_stats(const fdt_result *r, int thread,
 FDT_API int fdt_check(const double *xyz, size_t n, const fdt_vid *tets,
                       size_t ntets, const fdt_tid *nbrs, char *msg,
                       size_t len);
+
+/* ------------------------------------------------------------------------ */
+/* File formats: reading point clouds, writing meshes                       */
+/* ------------------------------------------------------------------------ */
+
+/*
+ * The readers and writers of the frontdt CLI, for programs that want the
+ * formats without it. Diagnostics (diag, NUL-terminated, cut to diag_size;
+ * diag may be NULL when diag_size is 0) are one line naming the file and,
+ * for a malformed input, the line (text, counted from 1) or the byte offset
+ * (binary PLY), e.g.
+ *   "pts.xyz:17: expected 3 numbers, found 2"
+ *   "cloud.ply: byte 1032: file ends inside vertex 40 of 1000"
+ * They are "" on success. Not for signal handlers; calls on different
+ * files may run on different threads (fdt_write_mesh serializes itself).
+ */
+
+/* Progress of a read or a write, called now and then on the calling
+ * thread: done bytes of total. total is 0 while a pipe is loaded (size not
+ * known); for FDT_STAGE_WRITE it is an estimate of the bytes every file of
+ * the output will hold, raised to done where that is more. */
+typedef void (*fdt_io_progress_fn)(void *user, int stage, uint64_t done, uint64_t total);
+enum {
+    FDT_STAGE_LOAD = 0,   /* bytes read from the file or pipe */
+    FDT_STAGE_PARSE = 1,  /* bytes parsed */
+    FDT_STAGE_WRITE = 2   /* bytes written (all files of the output) */
+};
+
+typedef struct fdt_read_options {
+    size_t struct_size;   /* set by fdt_default_read_options (ABI, above) */
+    const char *format;   /* "xyz", "txt", "csv", "node", "ply" (any case),
+                             or NULL: by the path's extension (borrowed) */
+    int columns[3];       /* x, y, z columns of xyz/txt/csv text, counted
+                             from 1 as cut -f counts; {0, 0, 0}: 1, 2, 3.
+                             Other columns than 1, 2, 3 with node or ply:
+                             FDT_EINVAL */
+    int n_threads;        /* threads parsing xyz/txt/csv text (cut at line
+                             ends, joined in file order: same points and
+                             messages for every count); 0 or 1: the
+                             calling thread only */
+    fdt_io_progress_fn progress; /* may be NULL; stages LOAD and PARSE */
+    void *progress_user;  /* borrowed, passed back to progress */
+} fdt_read_options;
+
+/* Fills the first struct_size bytes of *o with the defaults (format by
+ * extension, columns 1 2 3, one thread, no progress). FDT_EINVAL for a
+ * size this library does not know (then only struct_size is written, as
+ * 0, when it fits, so that the read refuses the options). */
+FDT_API int fdt_default_read_options_sized(fdt_read_options *o, size_t struct_size);
+static inline void fdt_default_read_options(fdt_read_options *o)
+{
+    (void)fdt_default_read_options_sized(o, sizeof *o);
+}
+
+/*
+ * Reads every point of a file: x y z text (.xyz .txt .csv: blanks or one
+ * comma between fields, '#' comments, a header line of names skipped,
+ * further columns ignored), TetGen .node, or .ply (ascii, binary little or
+ * big endian; any scalar type). format: as fdt_read_options.format. path
+ * "-" is standard input (read to its end; it has no extension, so format
+ * must be given; messages call it "stdin"). The rules of each format are
+ * the CLI's (README, "Using the CLI" and "Limits").
+ *
+ * On success *xyz holds 3 * *n doubles (x0 y0 z0 x1 ...), allocated by the
+ * library and owned by the caller, who frees it with fdt_free(). On
+ * failure *xyz is NULL, *n is 0 and diag says why:
+ *   FDT_EIO      missing or unreadable file, a directory;
+ *   FDT_EFORMAT  malformed content (diag names the line or byte), NaN or
+ *                Inf, numbers out of double range, no points, more than
+ *                FDT_VID_MAX points;
+ *   FDT_EINVAL   a NULL argument, an unknown format or extension, "-"
+ *                without a format, columns the format does not have, an
+ *                options struct_size this library does not know;
+ *   FDT_ENOMEM   out of memory (nothing leaked).
+ * A header count the file cannot hold is refused before any allocation.
+ */
+FDT_API int fdt_read_points(const char *path, const char *format, double **xyz, size_t *n,
+                            char *diag, size_t diag_size);
+/* The same with options (o: borrowed; NULL: the defaults). */
+FDT_API int fdt_read_points_opts(const char *path, const fdt_read_options *o, double **xyz,
+                                 size_t *n, char *diag, size_t diag_size);
+
+typedef struct fdt_write_options {
+    size_t struct_size;   /* set by fdt_default_write_options (ABI, above) */
+    const char *format;   /* a format name below, or NULL: by the path's
+                             extension (borrowed) */
+    int all_faces;        /* TetGen .face: every face (TetGen -f), marker 1
+                             on the hull and 0 inside; 0: hull faces only */
+    fdt_io_progress_fn progress; /* may be NULL; stage WRITE */
+    void *progress_user;  /* borrowed, passed back to progress */
+} fdt_write_options;
+
+/* As fdt_default_read_options: no format (by extension), hull faces only,
+ * no progress. */
+FDT_API int fdt_default_write_options_sized(fdt_write_options *o, size_t struct_size);
+static inline void fdt_default_write_options(fdt_write_options *o)
+{
+    (void)fdt_default_write_options_sized(o, sizeof *o);
+}
+
+/*
+ * Writes the mesh r of the n points xyz (those given to fdt_triangulate,
+ * borrowed) to path, in the format named (NULL: by path's extension):
+ *   tets     .tets   canonical text: each tet's 4 ids ascending, one a
+ *                    line, lines ascending (the bytes fdt_result_hash hashes)
+ *   tetgen   .ele    TetGen BASE.node, BASE.ele, BASE.face, BASE.neigh,
+ *                    0-based (needs settings.neighbors)
+ *   vtu      .vtu    VTK XML unstructured grid (ParaView), binary appended
+ *   vtk      .vtk    VTK legacy ASCII
+ *   msh      .msh    gmsh 4.1 ASCII: tets and outward hull triangles
+ *   msh2             gmsh 2.2 ASCII (by name only)
+ *   medit    .mesh   Medit (MMG, meshio)
+ *   openfoam polyMesh  an OpenFOAM polyMesh directory (a path whose last
+ *                    component is polyMesh): points, faces, owner,
+ *                    neighbour, boundary (the hull one patch)
+ * Every file is written to a temporary beside its target and renamed over
+ * it only when complete; several files (TetGen, OpenFOAM) are renamed all
+ * or none. A failed write leaves neither a temporary nor a partial mesh.
+ * path "-" writes a single-file text format (tets, vtk, msh, msh2, medit)
+ * to standard output, with no temporary.
+ *
+ * The target is replaced whatever it is: this function cannot know which
+ * file was your input, so never passing your input's path (or, for
+ * TetGen, its BASE.node) is the caller's duty (the CLI refuses an output
+ * that is its input by any name). A symbolic link at the target is
+ * replaced by the new file, not written through.
+ *
+ * r is not const: the tets format needs canonical order and sorts r in
+ * place first (fdt_result_sort, as fdt_result_hash does: take
+ * fdt_result_tets and fdt_result_neighbors again afterwards), and openfoam
+ * and all_faces compute r's face list (fdt_result_faces). Other formats
+ * leave r as it is.
+ *
+ * Returns FDT_OK, or with diag (naming the file):
+ *   FDT_EIO      a file could not be created, written, closed or renamed
+ *                (no permission, a missing directory, a full disk);
+ *   FDT_EINVAL   a NULL argument, an unknown format or extension, n not the
+ *                result's point count, tetgen without neighbours, a binary
+ *                or multi-file format to "-", an unknown struct_size;
+ *   FDT_ENOMEM   out of memory (nothing left behind).
+ * One write runs at a time in a process (an internal lock). A process
+ * killed while writing leaves the temporary (".NAME.tmp.XXXXXX" beside the
+ * target) behind unless its signal handler calls fdt_write_cleanup.
+ */
+FDT_API int fdt_write_mesh(fdt_result *r, const double *xyz, size_t n, const char *path,
+                           const char *format, char *diag, size_t diag_size);
+/* The same with options (o: borrowed; NULL: the defaults). */
+FDT_API int fdt_write_mesh_opts(fdt_result *r, const double *xyz, size_t n, const char *path,
+                                const fdt_write_options *o, char *diag, size_t diag_size);
+
+/* Async-signal-safe, for a SIGINT/SIGTERM handler that then ends the
+ * process (_exit): removes the temporary files of a write in progress and
+ * the targets already renamed of a multi-file output not yet complete, so
+ * nothing partial is left. The interrupted write must not go on after. */
+FDT_API void fdt_write_cleanup(void);
+
+/* Frees memory the library allocated for the caller (the points of
+ * fdt_read_points). NULL is fine. */
+FDT_API void fdt_free(void *p);
 
 #ifdef __cplusplus
 }

@@ -33,11 +33,18 @@ const char *fdt_strerror(int err)
     case FDT_ECANCELED: return "canceled";
     case FDT_EINTERNAL: return "internal error (a bug: please report it)";
     case FDT_ETHREAD: return "could not create a thread";
+    case FDT_EIO: return "a file could not be opened, read, written or renamed";
+    case FDT_EFORMAT: return "malformed input file";
     default: return "unknown error";
     }
 }
 
 const char *fdt_version(void) { return FDT_VERSION_STRING; }
+
+/* What the library allocates for the caller (fdt_read_points) comes from
+ * malloc; freeing it here keeps a caller with another allocator, or a
+ * Windows-style split C runtime, from freeing it with the wrong one. */
+void fdt_free(void *p) { free(p); }
 
 /*
  * The fdt_settings sizes this library accepts (include/frontdt.h, ABI):

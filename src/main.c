@@ -1015,7 +1015,7 @@ static int run(const cli *c)
             ro.progress_user = &prog;
         }
         progress_phase(&prog, "read");
-        int r = fdt_read_points_with(c->input, &ro, &xyz, &n, err, sizeof err);
+        int r = fdt_rd_points_with(c->input, &ro, &xyz, &n, err, sizeof err);
         progress_clear(&prog);
         if (r != FDT_IO_OK) {
             say("%s", err);
@@ -1137,10 +1137,10 @@ static int run(const cli *c)
         progress_phase(&prog, "write");
         for (int o = 0; o < c->n_outputs; o++) {
             if (!strcmp(c->outputs[o], "-"))
-                r = fdt_write_mesh_stream(stdout, "standard output", fmts[o], &v, err,
+                r = fdt_wr_mesh_stream(stdout, "standard output", fmts[o], &v, err,
                                           sizeof err);
             else
-                r = fdt_write_mesh_as(c->outputs[o], fmts[o], &v, err, sizeof err);
+                r = fdt_wr_mesh_as(c->outputs[o], fmts[o], &v, err, sizeof err);
             if (r != FDT_IO_OK) {
                 progress_clear(&prog);
                 say("%s", err);

@@ -18,14 +18,27 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "reader.h" /* FDT_IO_* codes */
+#include "reader.h" /* FDT_IO_* codes; frontdt.h */
 
 #define OUT_BUF_SIZE (1u << 20)
 /* The longest item put in one go: a %.17g double is at most 24 chars. */
 #define OUT_MAX_ITEM 64
 
+/*
+ * Bytes written so far by one output (all of its files) and whom to tell:
+ * every byte passes through out_flush, which reports them (the write
+ * progress of include/frontdt.h, FDT_STAGE_WRITE). total is an estimate.
+ */
+typedef struct out_meter {
+    fdt_io_progress_fn fn;
+    void *user;
+    uint64_t done;
+    uint64_t total;
+} out_meter;
+
 typedef struct out_file {
     FILE *f;
+    out_meter *meter;  /* NULL: nobody watches */
     int slot;          /* registry slot, -1 when none */
     const char *path;  /* the target (for messages) */
     char *buf;
@@ -46,6 +59,13 @@ static inline void out_flush(out_file *o)
     errno = 0;
     if (fwrite(o->buf, 1, o->len, o->f) != o->len)
         out_fail(o, errno);
+    else if (o->meter != NULL && o->meter->fn != NULL) {
+        out_meter *mt = o->meter;
+        mt->done += o->len;
+        /* an estimate: never below what is done */
+        mt->fn(mt->user, FDT_STAGE_WRITE, mt->done,
+               mt->total > mt->done ? mt->total : mt->done);
+    }
     o->len = 0;
 }
 

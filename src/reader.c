@@ -322,7 +322,7 @@ static const rd_format *rd_setup(rd_ctx *c, const char *name, const fdt_rd_opts 
     return f;
 }
 
-int fdt_read_points_with(const char *path, const fdt_rd_opts *o, double **xyz, size_t *n,
+int fdt_rd_points_with(const char *path, const fdt_rd_opts *o, double **xyz, size_t *n,
                          char *err, size_t errlen)
 {
     int is_stdin = path != NULL && strcmp(path, "-") == 0;
@@ -362,7 +362,7 @@ int fdt_read_points_with(const char *path, const fdt_rd_opts *o, double **xyz, s
     return rc;
 }
 
-int fdt_read_points_mem_with(const char *name, const void *data, size_t len,
+int fdt_rd_points_mem_with(const char *name, const void *data, size_t len,
                              const fdt_rd_opts *o, double **xyz, size_t *n, char *err,
                              size_t errlen)
 {
@@ -397,29 +397,29 @@ int fdt_read_points_mem_with(const char *name, const void *data, size_t len,
     return rc;
 }
 
-int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
+int fdt_rd_points(const char *path, double **xyz, size_t *n, char *err,
                     size_t errlen)
 {
-    return fdt_read_points_threads(path, 1, 0, xyz, n, err, errlen);
+    return fdt_rd_points_threads(path, 1, 0, xyz, n, err, errlen);
 }
 
-int fdt_read_points_threads(const char *path, int threads, size_t min_slice, double **xyz,
+int fdt_rd_points_threads(const char *path, int threads, size_t min_slice, double **xyz,
                             size_t *n, char *err, size_t errlen)
 {
     fdt_rd_opts o;
     fdt_rd_opts_default(&o);
     o.threads = threads;
     o.min_slice = min_slice;
-    return fdt_read_points_with(path, &o, xyz, n, err, errlen);
+    return fdt_rd_points_with(path, &o, xyz, n, err, errlen);
 }
 
-int fdt_read_points_mem(const char *name, const void *data, size_t len,
+int fdt_rd_points_mem(const char *name, const void *data, size_t len,
                         double **xyz, size_t *n, char *err, size_t errlen)
 {
-    return fdt_read_points_mem_threads(name, data, len, 1, 0, xyz, n, err, errlen);
+    return fdt_rd_points_mem_threads(name, data, len, 1, 0, xyz, n, err, errlen);
 }
 
-int fdt_read_points_mem_threads(const char *name, const void *data, size_t len, int threads,
+int fdt_rd_points_mem_threads(const char *name, const void *data, size_t len, int threads,
                                 size_t min_slice, double **xyz, size_t *n, char *err,
                                 size_t errlen)
 {
@@ -427,5 +427,129 @@ int fdt_read_points_mem_threads(const char *name, const void *data, size_t len, 
     fdt_rd_opts_default(&o);
     o.threads = threads;
     o.min_slice = min_slice;
-    return fdt_read_points_mem_with(name, data, len, &o, xyz, n, err, errlen);
+    return fdt_rd_points_mem_with(name, data, len, &o, xyz, n, err, errlen);
+}
+
+/* ------------------------------------------------------------------ */
+/* The public reader (include/frontdt.h): an adaptor over the above    */
+/* ------------------------------------------------------------------ */
+
+/* The fdt_read_options sizes this library accepts (include/frontdt.h,
+ * ABI): this release's only, so far. */
+static int read_options_size_known(size_t size)
+{
+    return size == sizeof(fdt_read_options);
+}
+
+int fdt_default_read_options_sized(fdt_read_options *o, size_t struct_size)
+{
+    if (o == NULL)
+        return FDT_EINVAL;
+    if (!read_options_size_known(struct_size)) {
+        if (struct_size >= sizeof o->struct_size)
+            o->struct_size = 0;
+        return FDT_EINVAL;
+    }
+    memset(o, 0, struct_size);
+    o->struct_size = struct_size;
+    return FDT_OK;
+}
+
+/* The public callback behind the reader's own (sizes widened). */
+typedef struct rd_public_progress {
+    fdt_io_progress_fn fn;
+    void *user;
+} rd_public_progress;
+
+static void rd_progress_adaptor(void *user, int stage, size_t done, size_t total)
+{
+    const rd_public_progress *p = user;
+    p->fn(p->user, stage == FDT_RD_LOADING ? FDT_STAGE_LOAD : FDT_STAGE_PARSE,
+          (uint64_t)done, (uint64_t)total);
+}
+
+/* A refusal of the public reader before any file is touched. */
+static int rd_refuse(char *diag, size_t diag_size, const char *path, const char *fmt,
+                     const char *arg)
+{
+    if (diag != NULL && diag_size > 0) {
+        char q[RD_QUOTE_CAP];
+        const char *shown = arg != NULL ? fdt_rd_quote(q, arg, strlen(arg)) : "";
+        int k = snprintf(diag, diag_size, "%s: ",
+                         path == NULL ? "(null)" : strcmp(path, "-") == 0 ? "stdin" : path);
+        size_t used = k < 0 ? 0 : (size_t)k < diag_size ? (size_t)k : diag_size - 1;
+        snprintf(diag + used, diag_size - used, fmt, shown);
+    }
+    return FDT_EINVAL;
+}
+
+int fdt_read_points_opts(const char *path, const fdt_read_options *o, double **xyz, size_t *n,
+                         char *diag, size_t diag_size)
+{
+    if (xyz != NULL)
+        *xyz = NULL;
+    if (n != NULL)
+        *n = 0;
+    if (diag != NULL && diag_size > 0)
+        diag[0] = '\0';
+    fdt_read_options defaults;
+    if (o == NULL) {
+        fdt_default_read_options(&defaults);
+        o = &defaults;
+    }
+    if (path == NULL || xyz == NULL || n == NULL || (diag == NULL && diag_size > 0))
+        return rd_refuse(diag, diag_size, path, "a NULL argument%s", NULL);
+    if (!read_options_size_known(o->struct_size))
+        return rd_refuse(diag, diag_size, path,
+                         "fdt_read_options of an unknown size (fdt_default_read_options "
+                         "sets it)%s", NULL);
+    fdt_rd_opts ro;
+    fdt_rd_opts_default(&ro);
+    if (o->format != NULL) {
+        ro.format = fdt_rd_format_by_name(o->format);
+        if (ro.format == FDT_RD_AUTO)
+            return rd_refuse(diag, diag_size, path,
+                             "unknown format %s (xyz, txt, csv, node or ply)", o->format);
+    }
+    /* The refusals the internal reader words as malformed input are the
+     * caller's argument here: say them first, as FDT_EINVAL. */
+    int custom = o->columns[0] != 0 || o->columns[1] != 0 || o->columns[2] != 0;
+    for (int k = 0; k < 3 && custom; k++)
+        if (o->columns[k] < 1)
+            return rd_refuse(diag, diag_size, path,
+                             "a column below 1 (they count from 1)%s", NULL);
+    int id = ro.format != FDT_RD_AUTO ? ro.format : fdt_rd_format_of_path(path);
+    if (custom && !(o->columns[0] == 1 && o->columns[1] == 2 && o->columns[2] == 3) &&
+        id != FDT_RD_AUTO && id != FDT_RD_XYZ)
+        return rd_refuse(diag, diag_size, path,
+                         "columns apply to .xyz, .txt and .csv only%s", NULL);
+    memcpy(ro.columns, o->columns, sizeof ro.columns);
+    ro.threads = o->n_threads > 1 ? o->n_threads : 1;
+    rd_public_progress pp = {o->progress, o->progress_user};
+    if (o->progress != NULL) {
+        ro.progress = rd_progress_adaptor;
+        ro.progress_user = &pp;
+    }
+    int rc = fdt_rd_points_with(path, &ro, xyz, n, diag, diag_size);
+    switch (rc) {
+    case FDT_IO_OK:
+        return FDT_OK;
+    case FDT_IO_EOPEN:
+        return FDT_EIO;
+    case FDT_IO_ENOMEM:
+        return FDT_ENOMEM;
+    case FDT_IO_EEXT:
+        return FDT_EINVAL;
+    default: /* FDT_IO_EFORMAT */
+        return FDT_EFORMAT;
+    }
+}
+
+int fdt_read_points(const char *path, const char *format, double **xyz, size_t *n, char *diag,
+                    size_t diag_size)
+{
+    fdt_read_options o;
+    fdt_default_read_options(&o);
+    o.format = format;
+    return fdt_read_points_opts(path, &o, xyz, n, diag, diag_size);
 }

@@ -1,5 +1,7 @@
 /*
- * Point-cloud readers for the CLI and tests (not part of the library API).
+ * Point-cloud readers: the internal entry points behind the public
+ * fdt_read_points / fdt_read_points_opts (include/frontdt.h, whose adaptor
+ * is at the end of src/reader.c), used directly by the CLI and the tests.
  * Format by extension (case-insensitive): .xyz .txt (x y z per line,
  * whitespace or commas, '#' comments, exponents), .node (TetGen), .ply
  * (ascii, binary_little_endian, binary_big_endian; float or double x y z,
@@ -46,6 +48,8 @@
 
 #include <stddef.h>
 
+#include "frontdt.h"
+
 enum {
     FDT_IO_OK = 0,
     FDT_IO_EOPEN = -101,   /* missing file, a directory, no permission */
@@ -62,17 +66,17 @@ enum {
  * A header count that the file size cannot hold is refused before any
  * allocation.
  */
-int fdt_read_points(const char *path, double **xyz, size_t *n, char *err,
+int fdt_rd_points(const char *path, double **xyz, size_t *n, char *err,
                     size_t errlen);
 
 /*
  * The same parse of len bytes already in memory (data: borrowed, need not
  * be NUL-terminated). name stands in for the path: its extension picks the
  * format and messages start with it. Same results and messages as
- * fdt_read_points() on a file holding those bytes. For the fuzzers
+ * fdt_rd_points() on a file holding those bytes. For the fuzzers
  * (tests/fuzz/) and for callers that have the bytes already.
  */
-int fdt_read_points_mem(const char *name, const void *data, size_t len,
+int fdt_rd_points_mem(const char *name, const void *data, size_t len,
                         double **xyz, size_t *n, char *err, size_t errlen);
 
 /*
@@ -84,9 +88,9 @@ int fdt_read_points_mem(const char *name, const void *data, size_t len,
  * thread count: a file with an error is read again on one thread to find
  * and word its first error.
  */
-int fdt_read_points_threads(const char *path, int threads, size_t min_slice, double **xyz,
+int fdt_rd_points_threads(const char *path, int threads, size_t min_slice, double **xyz,
                             size_t *n, char *err, size_t errlen);
-int fdt_read_points_mem_threads(const char *name, const void *data, size_t len, int threads,
+int fdt_rd_points_mem_threads(const char *name, const void *data, size_t len, int threads,
                                 size_t min_slice, double **xyz, size_t *n, char *err,
                                 size_t errlen);
 
@@ -116,8 +120,8 @@ typedef struct fdt_rd_opts {
     int format;        /* FDT_RD_AUTO (by extension), or FDT_RD_XYZ/NODE/PLY */
     int columns[3];    /* x, y, z columns of the text point formats,
                           counted from 1; {0, 0, 0}: 1, 2, 3 */
-    int threads;       /* as fdt_read_points_threads */
-    size_t min_slice;  /* as fdt_read_points_threads; 0: a megabyte */
+    int threads;       /* as fdt_rd_points_threads */
+    size_t min_slice;  /* as fdt_rd_points_threads; 0: a megabyte */
     fdt_rd_progress_fn progress; /* may be NULL */
     void *progress_user;
 } fdt_rd_opts;
@@ -136,9 +140,9 @@ int fdt_rd_format_of_path(const char *path);
  * than 1, 2, 3 with a format that has no columns (.node, .ply) are refused
  * with FDT_IO_EFORMAT. Same results and messages otherwise.
  */
-int fdt_read_points_with(const char *path, const fdt_rd_opts *o, double **xyz, size_t *n,
+int fdt_rd_points_with(const char *path, const fdt_rd_opts *o, double **xyz, size_t *n,
                          char *err, size_t errlen);
-int fdt_read_points_mem_with(const char *name, const void *data, size_t len,
+int fdt_rd_points_mem_with(const char *name, const void *data, size_t len,
                              const fdt_rd_opts *o, double **xyz, size_t *n, char *err,
                              size_t errlen);
 

@@ -14,13 +14,16 @@
  * to stdio in big chunks. Every fwrite/fflush/fclose result is checked and
  * the first errno is kept for the message.
  *
- * Not thread-safe: the CLI and tests write one mesh at a time.
+ * The internal entry points are not thread-safe (the CLI and tests write
+ * one mesh at a time); the public fdt_write_mesh takes a lock.
  */
 #include "writer.h"
 #include "formats.h"
+#include "result.h"
 
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -51,7 +54,7 @@
  *                  unlink both, so an interrupted run leaves no output.
  *   SLOT_RENAMED   the target is complete, but the rest of its file set
  *                  (TetGen writes four) is not yet: unlink the target.
- * The writer frees every slot before fdt_write_mesh() returns.
+ * The writer frees every slot before fdt_wr_mesh() returns.
  */
 #define FDT_IO_SLOTS 8
 
@@ -622,7 +625,7 @@ static const char *missing(const fdt_format *f, const fdt_mesh_view *m)
  * directory still to be renamed. */
 static int write_parts(const fdt_format *f, char names[FDT_IO_MAX_FILES][FDT_IO_PATH],
                        int k, const fdt_mesh_view *m, const void *prep, out_file *files,
-                       char *err, size_t errlen, int keep)
+                       out_meter *meter, char *err, size_t errlen, int keep)
 {
     mode_t mode = creation_mode();
     for (int i = 0; i < k; i++) {
@@ -632,6 +635,7 @@ static int write_parts(const fdt_format *f, char names[FDT_IO_MAX_FILES][FDT_IO_
                 out_abandon(&files[j]);
             return set_errno_err(err, errlen, names[i], e);
         }
+        files[i].meter = meter;
         int r = f->put[i](&files[i], m, prep, err, errlen);
         /* Stop at the first error instead of formatting on. */
         if (r != FDT_IO_OK || files[i].err) {
@@ -647,7 +651,7 @@ static int write_parts(const fdt_format *f, char names[FDT_IO_MAX_FILES][FDT_IO_
 /* The directory of a fresh polyMesh: made as ".NAME.tmp.XXXXXX" beside
  * path, filled, renamed to path. */
 static int write_new_dir(const fdt_format *f, const char *path, const fdt_mesh_view *m,
-                         const void *prep, char *err, size_t errlen)
+                         const void *prep, out_meter *meter, char *err, size_t errlen)
 {
     size_t len = strlen(path);
     while (len > 1 && path[len - 1] == '/')
@@ -683,7 +687,7 @@ static int write_new_dir(const fdt_format *f, const char *path, const fdt_mesh_v
         goto out;
     }
     out_file files[FDT_IO_MAX_FILES];
-    r = write_parts(f, names, k, m, prep, files, err, errlen, 1);
+    r = write_parts(f, names, k, m, prep, files, meter, err, errlen, 1);
     if (r != FDT_IO_OK)
         goto out;
     if (rename(fdt_io_tmpdir, target) != 0) {
@@ -706,8 +710,14 @@ out:
     return r;
 }
 
-int fdt_write_mesh_as(const char *path, const fdt_format *f, const fdt_mesh_view *m,
+int fdt_wr_mesh_as(const char *path, const fdt_format *f, const fdt_mesh_view *m,
                       char *err, size_t errlen)
+{
+    return fdt_wr_mesh_ex(path, f, m, NULL, NULL, err, errlen);
+}
+
+int fdt_wr_mesh_ex(const char *path, const fdt_format *f, const fdt_mesh_view *m,
+                   fdt_io_progress_fn progress, void *progress_user, char *err, size_t errlen)
 {
     if (err && errlen > 0)
         err[0] = '\0';
@@ -729,9 +739,11 @@ int fdt_write_mesh_as(const char *path, const fdt_format *f, const fdt_mesh_view
     void *prep = NULL;
     if (f->prepare && (r = f->prepare(m, &prep, path, err, errlen)) != FDT_IO_OK)
         return r;
+    out_meter meter = {progress, progress_user, 0, fdt_wr_estimate(f, m)};
+    out_meter *mt = progress ? &meter : NULL;
     struct stat st;
     if (f->layout == FDT_LAYOUT_DIR && stat(path, &st) != 0 && errno == ENOENT) {
-        r = write_new_dir(f, path, m, prep, err, errlen);
+        r = write_new_dir(f, path, m, prep, mt, err, errlen);
     } else if (f->layout == FDT_LAYOUT_DIR && stat(path, &st) == 0 && !S_ISDIR(st.st_mode)) {
         r = set_errno_err(err, errlen, path, ENOTDIR);
     } else {
@@ -741,20 +753,27 @@ int fdt_write_mesh_as(const char *path, const fdt_format *f, const fdt_mesh_view
         if (k != f->nparts)
             r = set_errno_err(err, errlen, path, ENAMETOOLONG);
         else
-            r = write_parts(f, names, k, m, prep, files, err, errlen, 0);
+            r = write_parts(f, names, k, m, prep, files, mt, err, errlen, 0);
     }
     free(prep);
     return r;
 }
 
-int fdt_write_mesh(const char *path, const fdt_mesh_view *m, char *err,
+int fdt_wr_mesh(const char *path, const fdt_mesh_view *m, char *err,
                    size_t errlen)
 {
-    return fdt_write_mesh_as(path, NULL, m, err, errlen);
+    return fdt_wr_mesh_as(path, NULL, m, err, errlen);
 }
 
-int fdt_write_mesh_stream(FILE *stream, const char *name, const fdt_format *f,
+int fdt_wr_mesh_stream(FILE *stream, const char *name, const fdt_format *f,
                           const fdt_mesh_view *m, char *err, size_t errlen)
+{
+    return fdt_wr_mesh_stream_ex(stream, name, f, m, NULL, NULL, err, errlen);
+}
+
+int fdt_wr_mesh_stream_ex(FILE *stream, const char *name, const fdt_format *f,
+                          const fdt_mesh_view *m, fdt_io_progress_fn progress,
+                          void *progress_user, char *err, size_t errlen)
 {
     if (err && errlen > 0)
         err[0] = '\0';
@@ -774,6 +793,8 @@ int fdt_write_mesh_stream(FILE *stream, const char *name, const fdt_format *f,
     o.f = stream;
     o.slot = -1;
     o.path = name;
+    out_meter meter = {progress, progress_user, 0, fdt_wr_estimate(f, m)};
+    o.meter = progress ? &meter : NULL;
     o.buf = malloc(OUT_BUF_SIZE);
     if (!o.buf)
         return set_errno_err(err, errlen, name, ENOMEM);
@@ -786,4 +807,196 @@ int fdt_write_mesh_stream(FILE *stream, const char *name, const fdt_format *f,
     if (r == FDT_IO_OK && o.err)
         r = set_errno_err(err, errlen, name, o.err);
     return r;
+}
+
+/* ------------------------------------------------------------------------ */
+/* The progress total                                                        */
+/* ------------------------------------------------------------------------ */
+
+/* Characters of the decimal ids below count, and a separator. */
+static uint64_t id_chars(uint64_t count)
+{
+    uint64_t d = 1;
+    for (uint64_t v = count; v >= 10; v /= 10)
+        d++;
+    return d + 1;
+}
+
+/* One file's bytes, roughly: a text coordinate is about 20 characters
+ * ("%.17g" of a value in [0, 1) is 19 and a separator), an id as many as
+ * the largest id has; binary VTU is exact but for its XML. */
+static uint64_t part_estimate(fdt_put_fn put, const fdt_mesh_view *m)
+{
+    uint64_t n = m->n_points, t = m->n_tets, h = m->n_hull;
+    uint64_t f = m->n_faces ? m->n_faces : (4 * t + h) / 2;
+    uint64_t dv = id_chars(n), dt = id_chars(t), xyz = 3 * 20;
+    if (put == fdt_put_tets)
+        return 4 * dv * t;
+    if (put == fdt_put_tetgen_node)
+        return n * (dv + xyz);
+    if (put == fdt_put_tetgen_ele)
+        return t * (dt + 4 * dv);
+    if (put == fdt_put_tetgen_face)
+        return (m->all_faces ? f : h) * (id_chars(f) + 3 * dv + 2);
+    if (put == fdt_put_tetgen_neigh)
+        return t * 5 * dt;
+    if (put == fdt_put_vtu)
+        return 24 * n + (32 + 8 + 1) * t + 1024;
+    if (put == fdt_put_vtk)
+        return n * xyz + t * (2 + 4 * dv) + 3 * t;
+    if (put == fdt_put_msh41 || put == fdt_put_msh22)
+        return n * (dv + xyz) + (t + h) * (id_chars(t + h) + 4 * dv + 8);
+    if (put == fdt_put_medit)
+        return n * (xyz + 2) + t * (4 * dv + 2) + h * (3 * dv + 2);
+    if (put == fdt_put_foam_points)
+        return n * (xyz + 2);
+    if (put == fdt_put_foam_faces)
+        return f * (3 + 3 * dv);
+    if (put == fdt_put_foam_owner)
+        return f * dt;
+    if (put == fdt_put_foam_neighbour)
+        return (f > h ? f - h : 0) * dt;
+    return 1024; /* headers and the OpenFOAM boundary */
+}
+
+uint64_t fdt_wr_estimate(const fdt_format *f, const fdt_mesh_view *m)
+{
+    uint64_t sum = 0;
+    for (int i = 0; f && m && i < f->nparts; i++)
+        sum += part_estimate(f->put[i], m);
+    return sum;
+}
+
+/* ------------------------------------------------------------------------ */
+/* The public writer (include/frontdt.h)                                     */
+/* ------------------------------------------------------------------------ */
+
+/* The fdt_write_options sizes this library accepts (ABI): this release's. */
+static int write_options_size_known(size_t size)
+{
+    return size == sizeof(fdt_write_options);
+}
+
+int fdt_default_write_options_sized(fdt_write_options *o, size_t struct_size)
+{
+    if (!o)
+        return FDT_EINVAL;
+    if (!write_options_size_known(struct_size)) {
+        if (struct_size >= sizeof o->struct_size)
+            o->struct_size = 0;
+        return FDT_EINVAL;
+    }
+    memset(o, 0, struct_size);
+    o->struct_size = struct_size;
+    return FDT_OK;
+}
+
+/* One public write at a time: the temporary-file registry above (and the
+ * one temporary directory) are process-wide, and creation_mode() sets the
+ * umask for an instant. */
+static pthread_mutex_t write_lock = PTHREAD_MUTEX_INITIALIZER;
+
+static int wr_public_code(int io)
+{
+    switch (io) {
+    case FDT_IO_OK:
+        return FDT_OK;
+    case FDT_IO_EWRITE:
+        return FDT_EIO;
+    case FDT_IO_ENOMEM:
+        return FDT_ENOMEM;
+    case FDT_IO_EEXT:
+        return FDT_EINVAL;
+    default:
+        /* FDT_IO_EFORMAT: the writer refused the mesh a result gave it
+         * (out-of-range ids, .tets out of order): ours, not the caller's */
+        return FDT_EINTERNAL;
+    }
+}
+
+static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const char *path,
+                           const fdt_write_options *o, char *diag, size_t diag_size)
+{
+    int to_stdout = strcmp(path, "-") == 0;
+    const char *name = to_stdout ? "stdout" : path;
+    const fdt_format *f = o->format ? fdt_format_by_name(o->format) : NULL;
+    char what[700];
+    if (o->format && !f) {
+        snprintf(what, sizeof what, "unknown format '%.40s' (use %s)", o->format,
+                 fdt_format_list());
+        return set_err(diag, diag_size, FDT_EINVAL, name, what);
+    }
+    if (!f && !to_stdout)
+        f = fdt_format_by_path(path);
+    if (!f) {
+        snprintf(what, sizeof what, "unknown output format (use %s)", fdt_format_list());
+        return set_err(diag, diag_size, FDT_EINVAL, name, what);
+    }
+    if (to_stdout && (f->binary || f->layout != FDT_LAYOUT_FILE)) {
+        snprintf(what, sizeof what, "format %s cannot go to standard output "
+                 "(one text file only: tets, vtk, msh, msh2, medit)", f->name);
+        return set_err(diag, diag_size, FDT_EINVAL, name, what);
+    }
+    if (n != r->n) {
+        snprintf(what, sizeof what, "%zu points given for a mesh of %zu", n, r->n);
+        return set_err(diag, diag_size, FDT_EINVAL, name, what);
+    }
+    int needs = fdt_format_needs(f, o->all_faces);
+    if ((needs & FDT_NEED_NBRS) && !r->nbrs) {
+        snprintf(what, sizeof what, "format %s needs tet neighbours (fdt_settings.neighbors)",
+                 f->name);
+        return set_err(diag, diag_size, FDT_EINVAL, name, what);
+    }
+    int e;
+    if ((needs & FDT_NEED_SORTED) && (e = fdt_result_sort(r)) != FDT_OK)
+        return set_err(diag, diag_size, e, name, fdt_strerror(e));
+    fdt_mesh_view v = {
+        .xyz = xyz, .n_points = n, .tets = r->tets, .n_tets = r->ntets, .nbrs = r->nbrs,
+        .hull = r->hull, .n_hull = r->nhull, .all_faces = o->all_faces,
+    };
+    /* after the sort: the face list names tets by their numbers */
+    if ((needs & FDT_NEED_FACES) &&
+        (e = fdt_result_faces(r, &v.n_faces, &v.faces, &v.face_tets)) != FDT_OK)
+        return set_err(diag, diag_size, e, name, fdt_strerror(e));
+    int io = to_stdout ? fdt_wr_mesh_stream_ex(stdout, name, f, &v, o->progress,
+                                               o->progress_user, diag, diag_size)
+                       : fdt_wr_mesh_ex(path, f, &v, o->progress, o->progress_user, diag,
+                                        diag_size);
+    return wr_public_code(io);
+}
+
+int fdt_write_mesh_opts(fdt_result *r, const double *xyz, size_t n, const char *path,
+                        const fdt_write_options *o, char *diag, size_t diag_size)
+{
+    if (diag && diag_size > 0)
+        diag[0] = '\0';
+    fdt_write_options defaults;
+    if (!o) {
+        fdt_default_write_options(&defaults);
+        o = &defaults;
+    }
+    if (!r || !path || (!xyz && n > 0) || (!diag && diag_size > 0))
+        return set_err(diag, diag_size, FDT_EINVAL, path, "a NULL argument");
+    if (!write_options_size_known(o->struct_size))
+        return set_err(diag, diag_size, FDT_EINVAL, path,
+                       "fdt_write_options of an unknown size (fdt_default_write_options "
+                       "sets it)");
+    pthread_mutex_lock(&write_lock);
+    int rc = wr_write_locked(r, xyz, n, path, o, diag, diag_size);
+    pthread_mutex_unlock(&write_lock);
+    return rc;
+}
+
+void fdt_write_cleanup(void)
+{
+    fdt_io_cleanup_temps();
+}
+
+int fdt_write_mesh(fdt_result *r, const double *xyz, size_t n, const char *path,
+                   const char *format, char *diag, size_t diag_size)
+{
+    fdt_write_options o;
+    fdt_default_write_options(&o);
+    o.format = format;
+    return fdt_write_mesh_opts(r, xyz, n, path, &o, diag, diag_size);
 }

@@ -1,5 +1,7 @@
 /*
- * Mesh writers for the CLI and tests (not part of the library API).
+ * Mesh writers: the internal entry points behind the public fdt_write_mesh
+ * (include/frontdt.h; its adaptor is at the end of src/writer.c), used
+ * directly by the CLI and the tests.
  * Every file is written to a temporary file in the same directory and
  * renamed over the target only when complete: an interrupted or failed run
  * leaves no partial output. fdt_io_cleanup_temps() is async-signal-safe and
@@ -9,6 +11,7 @@
 #define FDT_WRITER_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include "frontdt.h"
 
@@ -62,19 +65,31 @@ const char *fdt_format_list(void);
  *   .vtk   VTK legacy unstructured grid.
  * Returns FDT_IO_OK or an FDT_IO_* code with a message in err.
  */
-int fdt_write_mesh(const char *path, const fdt_mesh_view *m, char *err,
+int fdt_wr_mesh(const char *path, const fdt_mesh_view *m, char *err,
                    size_t errlen);
 /* The same in format f (NULL: by path's extension). A directory format
  * (OpenFOAM polyMesh) is written to a temporary directory beside path and
  * renamed to path at the end when path does not exist yet; when path is an
  * existing directory, each of its files is replaced by its own
  * temporary-and-rename, all or none (other files there are left alone). */
-int fdt_write_mesh_as(const char *path, const fdt_format *f, const fdt_mesh_view *m,
+int fdt_wr_mesh_as(const char *path, const fdt_format *f, const fdt_mesh_view *m,
                       char *err, size_t errlen);
+/* fdt_wr_mesh_as reporting the bytes written through progress (NULL:
+ * none), stage FDT_STAGE_WRITE, done of an estimated total
+ * (fdt_wr_estimate) summed over the output's files. */
+int fdt_wr_mesh_ex(const char *path, const fdt_format *f, const fdt_mesh_view *m,
+                   fdt_io_progress_fn progress, void *progress_user, char *err, size_t errlen);
+/* An estimate of the bytes format f writes for m, all files together:
+ * the progress total. Within a few tens of percent for the text formats
+ * (coordinates taken as 20 characters each). */
+uint64_t fdt_wr_estimate(const fdt_format *f, const fdt_mesh_view *m);
 /* A text format written to an open stream (standard output: no temporary,
  * nothing renamed). Only single-file text formats. */
-int fdt_write_mesh_stream(FILE *stream, const char *name, const fdt_format *f,
+int fdt_wr_mesh_stream(FILE *stream, const char *name, const fdt_format *f,
                           const fdt_mesh_view *m, char *err, size_t errlen);
+int fdt_wr_mesh_stream_ex(FILE *stream, const char *name, const fdt_format *f,
+                          const fdt_mesh_view *m, fdt_io_progress_fn progress,
+                          void *progress_user, char *err, size_t errlen);
 
 /* The longest path the writer takes (its temporary names live in fixed
  * buffers a signal handler can read), and the most files one output
@@ -83,7 +98,7 @@ int fdt_write_mesh_stream(FILE *stream, const char *name, const fdt_format *f,
 #define FDT_IO_MAX_FILES 5
 
 /*
- * The files fdt_write_mesh(path, ...) writes, in the order it writes them,
+ * The files fdt_wr_mesh(path, ...) writes, in the order it writes them,
  * into names[0..count): path alone for .tets, .vtu and .vtk; for .ele,
  * BASE.node, path itself, BASE.face and BASE.neigh (BASE is path without
  * ".ele"; the siblings' extensions are lowercase whatever the case of

@@ -595,7 +595,7 @@ static void test_insert_faults(const ptset *sets, int nsets, uint64_t *rng)
 
 typedef struct read_arg {
     const char *path;
-    const char *data; /* non-NULL: fdt_read_points_mem on these bytes */
+    const char *data; /* non-NULL: fdt_rd_points_mem on these bytes */
     size_t len;
     size_t want_n;
     double *want; /* 3 * want_n coordinates (read without injection) */
@@ -610,14 +610,14 @@ static int sc_read(void *arg, const char **bad)
     char err[512];
     int rc = a->threads > 1
                  ? (a->data != NULL
-                        ? fdt_read_points_mem_threads(a->path, a->data, a->len, a->threads, 1,
+                        ? fdt_rd_points_mem_threads(a->path, a->data, a->len, a->threads, 1,
                                                       &xyz, &n, err, sizeof err)
-                        : fdt_read_points_threads(a->path, a->threads, 1, &xyz, &n, err,
+                        : fdt_rd_points_threads(a->path, a->threads, 1, &xyz, &n, err,
                                                   sizeof err))
              : a->data != NULL
-                 ? fdt_read_points_mem(a->path, a->data, a->len, &xyz, &n,
+                 ? fdt_rd_points_mem(a->path, a->data, a->len, &xyz, &n,
                                        err, sizeof err)
-                 : fdt_read_points(a->path, &xyz, &n, err, sizeof err);
+                 : fdt_rd_points(a->path, &xyz, &n, err, sizeof err);
     if (rc == FDT_OK && (n != a->want_n || a->want == NULL ||
                          memcmp(xyz, a->want, 3 * n * sizeof *xyz) != 0))
         *bad = "wrong points";
@@ -635,9 +635,9 @@ static void reference_read(read_arg *a)
     size_t n = 0;
     char err[512];
     int rc = a->data != NULL
-                 ? fdt_read_points_mem(a->path, a->data, a->len, &a->want, &n,
+                 ? fdt_rd_points_mem(a->path, a->data, a->len, &a->want, &n,
                                        err, sizeof err)
-                 : fdt_read_points(a->path, &a->want, &n, err, sizeof err);
+                 : fdt_rd_points(a->path, &a->want, &n, err, sizeof err);
     CHECK(rc == FDT_IO_OK && n == a->want_n, "%s: %s (%zu points)", a->path,
           rc == FDT_IO_OK ? "read" : err, n);
 }
@@ -693,7 +693,7 @@ static int sc_write(void *arg, const char **bad)
         .hull = fdt_result_hull_faces(a->res),
         .n_hull = fdt_result_num_hull_faces(a->res),
     };
-    int rc = fdt_write_mesh(path, &v, err, sizeof err);
+    int rc = fdt_wr_mesh(path, &v, err, sizeof err);
     int left = count_entries(a->dir);
     int want = rc != FDT_IO_OK ? 0 : strcmp(a->ext, ".ele") == 0 ? 4 : 1;
     if (left != want)
@@ -825,7 +825,7 @@ static void check_bad_sizes(const char *bad)
         double *xyz = NULL;
         size_t n = 0;
         char err[512];
-        fdt_read_points(p, &xyz, &n, err, sizeof err);
+        fdt_rd_points(p, &xyz, &n, err, sizeof err);
         free(xyz);
         size_t got = atomic_load(&fault_max);
         CHECK(got <= limit, "%s (%lld bytes): an allocation of %zu bytes", p,

@@ -192,7 +192,7 @@ static void check_read_ok(tctx *t, int line, const char *path,
     double *xyz = (double *)&xyz; /* must be overwritten */
     size_t got = 12345;
     char err[512];
-    int rc = fdt_read_points(path, &xyz, &got, err, sizeof err);
+    int rc = fdt_rd_points(path, &xyz, &got, err, sizeof err);
     t->checks++;
     if (rc != FDT_IO_OK) {
         fail_at(t, line, "%s: expected OK, got %s: %s", path, code_name(rc),
@@ -217,7 +217,7 @@ static void check_read_ok(tctx *t, int line, const char *path,
     for (size_t k = 0; k < sizeof threads / sizeof *threads && got == n; k++) {
         double *px = NULL;
         size_t pn = 0;
-        int prc = fdt_read_points_threads(path, threads[k], 1, &px, &pn, err, sizeof err);
+        int prc = fdt_rd_points_threads(path, threads[k], 1, &px, &pn, err, sizeof err);
         t->checks++;
         if (prc != FDT_IO_OK || pn != n || memcmp(px, xyz, 3 * n * sizeof *xyz) != 0)
             fail_at(t, line, "%s: %d threads read %s (%zu points), not what one thread read",
@@ -235,7 +235,7 @@ static void check_read_err(tctx *t, int line, const char *path, int code,
     size_t n = 12345;
     char err[512];
     memset(err, 'X', sizeof err);
-    int rc = fdt_read_points(path, &xyz, &n, err, sizeof err);
+    int rc = fdt_rd_points(path, &xyz, &n, err, sizeof err);
     t->checks++;
     if (rc != code) {
         fail_at(t, line, "%s: expected %s, got %s: %.*s", path,
@@ -263,7 +263,7 @@ static void check_read_err(tctx *t, int line, const char *path, int code,
         double *px = (double *)&px;
         size_t pn = 12345;
         char perr[512];
-        int prc = fdt_read_points_threads(path, threads[k], 1, &px, &pn, perr, sizeof perr);
+        int prc = fdt_rd_points_threads(path, threads[k], 1, &px, &pn, perr, sizeof perr);
         t->checks++;
         if (prc != rc || px != NULL || pn != 0 || strcmp(perr, err) != 0) {
             fail_at(t, line, "%s: %d threads: %s \"%s\", one thread: %s \"%s\"", path,
@@ -499,7 +499,7 @@ static void test_xyz_sliced(tctx *t)
         double *xyz = NULL;
         size_t n = 0;
         char err[512];
-        int rc = fdt_read_points_threads(path, T, 0, &xyz, &n, err, sizeof err);
+        int rc = fdt_rd_points_threads(path, T, 0, &xyz, &n, err, sizeof err);
         t->checks++;
         if (rc != FDT_IO_OK || n != NPTS || memcmp(xyz, want, sizeof(double) * 3 * NPTS) != 0)
             fail_at(t, __LINE__, "%s: %d threads: %s, %zu points", path, T, code_name(rc), n);
@@ -1388,7 +1388,7 @@ static void test_fuzz(tctx *t)
             double *pts = NULL;
             size_t n = 0;
             char err[256];
-            int rc = fdt_read_points(path, &pts, &n, err, sizeof err);
+            int rc = fdt_rd_points(path, &pts, &n, err, sizeof err);
             t->checks++;
             if (rc == FDT_IO_OK) {
                 int finite = n > 0;
@@ -1449,32 +1449,32 @@ static void test_open(tctx *t)
     double *xyz = (double *)&xyz;
     size_t n = 7;
     char err[64];
-    CHECK(t, fdt_read_points(NULL, &xyz, &n, err, sizeof err) ==
+    CHECK(t, fdt_rd_points(NULL, &xyz, &n, err, sizeof err) ==
                  FDT_IO_EOPEN && xyz == NULL && n == 0,
           "NULL path accepted");
     write_file(t, "fine.xyz", "0 0 0\n", 6, path, sizeof path);
-    CHECK(t, fdt_read_points(path, NULL, &n, err, sizeof err) == FDT_IO_EOPEN,
+    CHECK(t, fdt_rd_points(path, NULL, &n, err, sizeof err) == FDT_IO_EOPEN,
           "NULL xyz accepted");
-    CHECK(t, fdt_read_points(path, &xyz, NULL, err, sizeof err) ==
+    CHECK(t, fdt_rd_points(path, &xyz, NULL, err, sizeof err) ==
                  FDT_IO_EOPEN,
           "NULL n accepted");
     write_file(t, "bad.xyz", "0 0\n", 4, path, sizeof path);
-    CHECK(t, fdt_read_points(path, &xyz, &n, NULL, 0) == FDT_IO_EFORMAT,
+    CHECK(t, fdt_rd_points(path, &xyz, &n, NULL, 0) == FDT_IO_EFORMAT,
           "no message buffer");
     char tiny[8];
     memset(tiny, 'X', sizeof tiny);
-    CHECK(t, fdt_read_points(path, &xyz, &n, tiny, sizeof tiny) ==
+    CHECK(t, fdt_rd_points(path, &xyz, &n, tiny, sizeof tiny) ==
                      FDT_IO_EFORMAT &&
                  tiny[7] == '\0' && strncmp(tiny, path, 7) == 0,
           "message not cut to the buffer");
     char big[512];
-    CHECK(t, fdt_read_points(path, &xyz, &n, big, sizeof big) ==
+    CHECK(t, fdt_rd_points(path, &xyz, &n, big, sizeof big) ==
                      FDT_IO_EFORMAT &&
                  strstr(big, "bad.xyz:1: expected 3 numbers, found 2") != NULL,
           "full message: %s", big);
     /* a successful read clears the message */
     write_file(t, "fine.xyz", "0 0 0\n", 6, path, sizeof path);
-    CHECK(t, fdt_read_points(path, &xyz, &n, big, sizeof big) == FDT_IO_OK &&
+    CHECK(t, fdt_rd_points(path, &xyz, &n, big, sizeof big) == FDT_IO_OK &&
                  n == 1 && big[0] == '\0',
           "successful read");
     free(xyz);
@@ -1527,7 +1527,7 @@ static void check_read_some(tctx *t, int line, const char *path)
     double *xyz = NULL;
     size_t n = 0;
     char err[512];
-    int rc = fdt_read_points(path, &xyz, &n, err, sizeof err);
+    int rc = fdt_rd_points(path, &xyz, &n, err, sizeof err);
     t->checks++;
     if (rc != FDT_IO_OK)
         fail_at(t, line, "%s: expected OK, got %s: %s", path, code_name(rc),
@@ -1538,8 +1538,8 @@ static void check_read_some(tctx *t, int line, const char *path)
 }
 
 /*
- * fdt_read_points_mem() on the bytes of path, named by its base name, must
- * give what fdt_read_points() gives on path: the same code, the same
+ * fdt_rd_points_mem() on the bytes of path, named by its base name, must
+ * give what fdt_rd_points() gives on path: the same code, the same
  * points, the same message after the name. Directories and missing files
  * have no bytes: skipped.
  */
@@ -1562,8 +1562,8 @@ static void check_mem_same(tctx *t, const char *path, const char *name)
     double *a = NULL, *b = NULL;
     size_t na = 0, nb = 0;
     char ea[512], eb[512];
-    int ra = fdt_read_points(path, &a, &na, ea, sizeof ea);
-    int rb = fdt_read_points_mem(name, buf, got, &b, &nb, eb, sizeof eb);
+    int ra = fdt_rd_points(path, &a, &na, ea, sizeof ea);
+    int rb = fdt_rd_points_mem(name, buf, got, &b, &nb, eb, sizeof eb);
     t->checks++;
     size_t lp = strlen(path), ln = strlen(name);
     if (ra != rb)
@@ -1734,7 +1734,7 @@ static int run_data(const char *dir)
         size_t n = 0;
         char err[512];
         double t0 = now();
-        int rc = fdt_read_points(path, &xyz, &n, err, sizeof err);
+        int rc = fdt_rd_points(path, &xyz, &n, err, sizeof err);
         double dt = now() - t0;
         files++;
         if (rc != FDT_IO_OK) {
@@ -1766,7 +1766,7 @@ static int run_data(const char *dir)
 /* Columns, headers, standard input, pipes and progress (issue 17)    */
 /* ------------------------------------------------------------------ */
 
-/* Reads text named name through fdt_read_points_mem_with with columns
+/* Reads text named name through fdt_rd_points_mem_with with columns
  * cols (NULL: the defaults) on `threads` threads (slices of a byte);
  * returns the code, the points in *xyz (caller frees) and the message. */
 static int read_cols(const char *name, const char *text, const int *cols, int threads,
@@ -1778,7 +1778,7 @@ static int read_cols(const char *name, const char *text, const int *cols, int th
         memcpy(o.columns, cols, sizeof o.columns);
     o.threads = threads;
     o.min_slice = 1;
-    return fdt_read_points_mem_with(name, text, strlen(text), &o, xyz, n, err, errlen);
+    return fdt_rd_points_mem_with(name, text, strlen(text), &o, xyz, n, err, errlen);
 }
 
 /* The text must read as want[0..3n) on 1 and 3 threads. */
@@ -1932,7 +1932,7 @@ static int read_stdin(const void *data, size_t len, int format, double **xyz, si
     fdt_rd_opts o;
     fdt_rd_opts_default(&o);
     o.format = format;
-    int rc = fdt_read_points_with("-", &o, xyz, n, err, errlen);
+    int rc = fdt_rd_points_with("-", &o, xyz, n, err, errlen);
     pthread_join(tid, NULL);
     dup2(saved, STDIN_FILENO);
     close(saved);
@@ -2020,7 +2020,7 @@ static void test_stdin(tctx *t)
     memset(&lg, 0, sizeof lg);
     o.progress = prog_cb;
     o.progress_user = &lg;
-    rc = fdt_read_points_with(fifo, &o, &xyz, &n, err, sizeof err);
+    rc = fdt_rd_points_with(fifo, &o, &xyz, &n, err, sizeof err);
     pthread_join(tid, NULL);
     CHECK(t, rc == FDT_IO_OK && n == NP && memcmp(xyz, want, 3 * NP * sizeof *want) == 0,
           "fifo: %s, %zu points: %s", code_name(rc), n, err);
@@ -2044,7 +2044,7 @@ static void test_stdin(tctx *t)
         o.format = FDT_RD_AUTO;
         o.threads = T;
         o.min_slice = 4096;
-        rc = fdt_read_points_with(path, &o, &xyz, &n, err, sizeof err);
+        rc = fdt_rd_points_with(path, &o, &xyz, &n, err, sizeof err);
         CHECK(t, rc == FDT_IO_OK && n == NP, "progress.xyz: %s: %s", code_name(rc), err);
         free(xyz);
         CHECK(t, lg.last_done[FDT_RD_LOADING] == b.n && lg.last_total[FDT_RD_LOADING] == b.n &&

@@ -361,7 +361,7 @@ static void test_centre(void)
     double *xyz = NULL;
     size_t np = 0;
     char err[256];
-    int e = fdt_read_points(path, &xyz, &np, err, sizeof err);
+    int e = fdt_rd_points(path, &xyz, &np, err, sizeof err);
     unlink(path);
     rmdir(dir);
     if (e != 0)

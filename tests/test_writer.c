@@ -561,25 +561,25 @@ static void test_small_mesh(const char *dir)
     char p[4096], err[512];
 
     snprintf(p, sizeof p, "%s/cube.tets", dir);
-    CHECK(fdt_write_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
     check_tets_file(p, m.tets, NT);
 
     snprintf(p, sizeof p, "%s/cube.ele", dir);
-    CHECK(fdt_write_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
     check_tetgen_set(dir, "cube", &v);
 
     snprintf(p, sizeof p, "%s/cube.vtk", dir);
-    CHECK(fdt_write_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
     check_vtk_file(p, m.xyz, NP, m.tets, NT);
 
     snprintf(p, sizeof p, "%s/cube.vtu", dir);
-    CHECK(fdt_write_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
     check_vtu_file(p, m.xyz, NP, m.tets, NT);
 
     /* Upper-case extensions are recognised; the TetGen companions get the
      * lower-case extensions, the .ele keeps the caller's spelling. */
     snprintf(p, sizeof p, "%s/upper.ELE", dir);
-    CHECK(fdt_write_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
     snprintf(p, sizeof p, "%s/upper.node", dir);
     CHECK(file_exists(p));
     snprintf(p, sizeof p, "%s/upper.ELE", dir);
@@ -596,7 +596,7 @@ static void test_small_mesh(const char *dir)
     fputs("stale\n", f);
     fclose(f);
     chmod(p, 0600);
-    CHECK(fdt_write_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
     check_tets_file(p, m.tets, NT);
     struct stat st;
     CHECK(stat(p, &st) == 0 && (st.st_mode & 0777) == 0644);
@@ -609,7 +609,7 @@ static void expect_fail(const char *dir, const char *path,
 {
     char err[512] = "untouched";
     int before = count_entries(dir);
-    int r = fdt_write_mesh(path, v, err, sizeof err);
+    int r = fdt_wr_mesh(path, v, err, sizeof err);
     if (r != code || !strstr(err, msg))
         fprintf(stderr, "  %s: got %d \"%s\", want %d \"%s\"\n", path, r, err,
                 code, msg);
@@ -673,7 +673,7 @@ static void test_refusals(const char *dir)
     expect_fail(dir, p, &nv, FDT_IO_EFORMAT, "needs tet neighbours");
     /* ... while the other formats do not need them. */
     snprintf(p, sizeof p, "%s/nonbrs.vtk", dir);
-    CHECK(fdt_write_mesh(p, &nv, q, sizeof q) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &nv, q, sizeof q) == FDT_IO_OK);
     unlink(p);
 
     /* Unknown or missing extension. */
@@ -778,7 +778,7 @@ static void test_big_ids(const char *dir)
                         .tets = tets, .n_tets = nt };
     char p[4096], err[256];
     snprintf(p, sizeof p, "%s/big_ids.tets", dir);
-    CHECK(fdt_write_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
     check_tets_file(p, tets, nt);
     unlink(p);
     free(tets);
@@ -820,16 +820,16 @@ static void test_large(const char *dir)
                         .n_hull = nt };
     char p[4096], err[256];
     snprintf(p, sizeof p, "%s/large.tets", dir);
-    CHECK(fdt_write_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
     check_tets_file(p, tets, nt);
     snprintf(p, sizeof p, "%s/large.ele", dir);
-    CHECK(fdt_write_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
     check_tetgen_set(dir, "large", &v);
     snprintf(p, sizeof p, "%s/large.vtk", dir);
-    CHECK(fdt_write_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
     check_vtk_file(p, xyz, n, tets, nt);
     snprintf(p, sizeof p, "%s/large.vtu", dir);
-    CHECK(fdt_write_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, err, sizeof err) == FDT_IO_OK);
     check_vtu_file(p, xyz, n, tets, nt);
     CHECK(count_temps(dir) == 0);
     free(xyz);
@@ -872,7 +872,7 @@ static void test_output_files(const char *dir)
                         .nbrs = nb, .hull = hull, .n_hull = 4 };
     char p[4096], e[256];
     snprintf(p, sizeof p, "%s/set.Ele", dir);
-    CHECK(fdt_write_mesh(p, &v, e, sizeof e) == FDT_IO_OK);
+    CHECK(fdt_wr_mesh(p, &v, e, sizeof e) == FDT_IO_OK);
     CHECK(fdt_output_files(p, names) == 4);
     for (int i = 0; i < 4; i++) {
         struct stat st;

@@ -1,8 +1,8 @@
 /*
  * libFuzzer target for the point readers (src/reader.c), one build per
  * format: FDT_FUZZ_FORMAT is 1 (.xyz), 2 (.node) or 3 (.ply). The input
- * bytes are the file; fdt_read_points_mem() parses them exactly as
- * fdt_read_points() would parse a file holding them.
+ * bytes are the file; fdt_rd_points_mem() parses them exactly as
+ * fdt_rd_points() would parse a file holding them.
  *
  * Beyond "no crash, no leak, no undefined behaviour" (the sanitizers'
  * part), every outcome is checked against the reader's contract
@@ -52,7 +52,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t n = 12345;
     char err[512];
     memset(err, 'Z', sizeof err);
-    int rc = fdt_read_points_mem(name, data, size, &xyz, &n, err, sizeof err);
+    int rc = fdt_rd_points_mem(name, data, size, &xyz, &n, err, sizeof err);
     if (memchr(err, '\0', sizeof err) == NULL)
         fuzz_violation("message not NUL-terminated", "(unterminated)");
     /* The sliced read (slices of a byte and up, so every input is cut)
@@ -60,7 +60,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     double *pxyz = NULL;
     size_t pn = 0;
     char perr[512];
-    int prc = fdt_read_points_mem_threads(name, data, size, 3, 1, &pxyz, &pn, perr, sizeof perr);
+    int prc = fdt_rd_points_mem_threads(name, data, size, 3, 1, &pxyz, &pn, perr, sizeof perr);
     if (prc != rc || pn != (rc == FDT_IO_OK ? n : 0) || strcmp(perr, err) != 0 ||
         (rc == FDT_IO_OK && memcmp(pxyz, xyz, 3 * n * sizeof *xyz) != 0))
         fuzz_violation("the sliced read differs from the one-thread read", perr);
