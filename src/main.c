@@ -59,6 +59,7 @@ enum {
 typedef struct cli {
     const char *input;      /* NULL with --demo; "-": standard input */
     int input_format;       /* FDT_RD_AUTO: by the input's extension */
+    const char *input_format_name; /* --input-format as given, or NULL */
     int columns[3];         /* --columns, from 1; {0, 0, 0}: 1, 2, 3 */
     int progress;           /* --progress: draw even when not a terminal */
     const char *output;     /* the first -o; NULL: triangulate and report only */
@@ -163,13 +164,13 @@ static double now_s(void)
 /*
  * SIGINT/SIGTERM: remove the temporary (or just renamed, if its file set
  * is incomplete) output files and leave with exit code 6. Only
- * async-signal-safe calls here: unlink() inside fdt_io_cleanup_temps(),
+ * async-signal-safe calls here: unlink() inside fdt_write_cleanup(),
  * write() and _exit().
  */
 static void on_signal(int sig)
 {
     (void)sig;
-    fdt_io_cleanup_temps();
+    fdt_write_cleanup();
     static const char msg[] = "\nfrontdt: interrupted\n";
     ssize_t w = write(STDERR_FILENO, msg, sizeof msg - 1);
     (void)w;
@@ -436,6 +437,7 @@ static int parse_args(int argc, char **argv, cli *c)
             break;
         case OPT_INPUT_FORMAT:
             c->input_format = fdt_rd_format_by_name(optarg);
+            c->input_format_name = optarg;
             if (c->input_format == FDT_RD_AUTO)
                 return usage_error("unknown input format '%s' (xyz, txt, csv, node or "
                                    "ply)", optarg);
@@ -687,21 +689,24 @@ static int reader_threads(const cli *c)
     return c->threads > 1 && c->threads < cpus ? c->threads : (int)(cpus > 64 ? 64 : cpus);
 }
 
+/* fdt_read_points_opts: everything but memory is the input's fault (the
+ * CLI refuses a bad --input-format, "-" without it and misplaced
+ * --columns up front, as usage errors). */
 static int exit_for_reader(int err)
 {
-    return err == FDT_IO_ENOMEM ? CLI_RESOURCES : CLI_INPUT;
+    return err == FDT_ENOMEM ? CLI_RESOURCES : CLI_INPUT;
 }
 
+/* fdt_write_mesh_opts: formats, standard output and neighbours were
+ * settled before the run, so FDT_EINVAL here is ours, as FDT_EINTERNAL. */
 static int exit_for_writer(int err)
 {
     switch (err) {
-    case FDT_IO_EWRITE:
+    case FDT_EIO:
         return CLI_WRITE;
-    case FDT_IO_EEXT: /* the CLI refuses it up front, as a usage error */
-        return CLI_USAGE;
-    case FDT_IO_ENOMEM:
+    case FDT_ENOMEM:
         return CLI_RESOURCES;
-    default: /* FDT_IO_EFORMAT: we handed the writer a broken mesh */
+    default:
         return CLI_INTERNAL;
     }
 }
@@ -1005,19 +1010,19 @@ static int run(const cli *c)
         }
     } else {
         char err[1024];
-        fdt_rd_opts ro;
-        fdt_rd_opts_default(&ro);
-        ro.format = c->input_format;
+        fdt_read_options ro;
+        fdt_default_read_options(&ro);
+        ro.format = c->input_format_name;
         memcpy(ro.columns, c->columns, sizeof ro.columns);
-        ro.threads = reader_threads(c);
+        ro.n_threads = reader_threads(c);
         if (prog.enabled) {
-            ro.progress = progress_reader;
+            ro.progress = progress_io;
             ro.progress_user = &prog;
         }
         progress_phase(&prog, "read");
-        int r = fdt_rd_points_with(c->input, &ro, &xyz, &n, err, sizeof err);
+        int r = fdt_read_points_opts(c->input, &ro, &xyz, &n, err, sizeof err);
         progress_clear(&prog);
-        if (r != FDT_IO_OK) {
+        if (r != FDT_OK) {
             say("%s", err);
             return exit_for_reader(r);
         }
@@ -1114,34 +1119,23 @@ static int run(const cli *c)
     tm.canon = now_s() - t0;
 
     if (c->n_outputs > 0) {
-        fdt_mesh_view v = {
-            .xyz = xyz, .n_points = n, .tets = fdt_result_tets(res),
-            .n_tets = nt, .nbrs = fdt_result_neighbors(res),
-            .hull = fdt_result_hull_faces(res),
-            .n_hull = fdt_result_num_hull_faces(res),
-            .all_faces = c->all_faces,
-        };
         t0 = now_s();
-        if (need & FDT_NEED_FACES) {
-            /* after the sort: the face list names tets by their numbers */
-            r = fdt_result_faces(res, &v.n_faces, &v.faces, &v.face_tets);
-            if (r != FDT_OK) {
-                say("%s: the face list failed: %s", name, fdt_strerror(r));
-                code = exit_for_engine(r);
-                goto done;
-            }
-        }
         char err[1024];
-        /* Phase start and end only: the writers do not report bytes yet
-         * (progress_bytes is their hook, src/progress.h). */
+        /* The public writer computes the face list where a format needs
+         * it (after the sort above: it names tets by their numbers) and
+         * reports its bytes (progress_io: the write phase moves). */
+        fdt_write_options wo;
+        fdt_default_write_options(&wo);
+        wo.all_faces = c->all_faces;
+        if (prog.enabled) {
+            wo.progress = progress_io;
+            wo.progress_user = &prog;
+        }
         progress_phase(&prog, "write");
         for (int o = 0; o < c->n_outputs; o++) {
-            if (!strcmp(c->outputs[o], "-"))
-                r = fdt_wr_mesh_stream(stdout, "standard output", fmts[o], &v, err,
-                                          sizeof err);
-            else
-                r = fdt_wr_mesh_as(c->outputs[o], fmts[o], &v, err, sizeof err);
-            if (r != FDT_IO_OK) {
+            wo.format = fdt_format_name(fmts[o]);
+            r = fdt_write_mesh_opts(res, xyz, n, c->outputs[o], &wo, err, sizeof err);
+            if (r != FDT_OK) {
                 progress_clear(&prog);
                 say("%s", err);
                 code = exit_for_writer(r);

@@ -5,7 +5,7 @@
 
 #include "progress.h"
 
-#include "reader.h"
+#include "frontdt.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -144,6 +144,7 @@ void progress_phase(progress *p, const char *name)
     if (!p->enabled)
         return;
     p->phase = name;
+    p->approx = 0;
     p->t_phase = now_s();
     p->t_drawn = -1;
     draw(p, p->t_phase, "", -1, "...");
@@ -169,7 +170,7 @@ void progress_bytes(progress *p, uint64_t done, uint64_t total)
     if (total > 0) {
         char tt[32];
         fmt_bytes(tt, sizeof tt, (double)total);
-        snprintf(what, sizeof what, "%s of %s", d, tt);
+        snprintf(what, sizeof what, "%s of %s%s", d, p->approx ? "~" : "", tt);
         draw(p, t, what, (double)done / (double)total, "");
     } else {
         /* no total (a pipe): the amount and the rate keep it moving */
@@ -208,11 +209,15 @@ int progress_engine(void *user, double fraction)
     return 0;
 }
 
-void progress_reader(void *user, int stage, size_t done, size_t total)
+void progress_io(void *user, int stage, uint64_t done, uint64_t total)
 {
     progress *p = user;
-    const char *want = stage == FDT_RD_PARSING ? "parse" : "read";
+    const char *want = stage == FDT_STAGE_PARSE ? "parse"
+                       : stage == FDT_STAGE_WRITE ? "write"
+                                                  : "read";
     if (p->enabled && (p->phase == NULL || strcmp(p->phase, want) != 0))
         progress_phase(p, want);
+    /* the writers' total is their estimate (include/frontdt.h) */
+    p->approx = stage == FDT_STAGE_WRITE;
     progress_bytes(p, done, total);
 }

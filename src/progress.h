@@ -6,6 +6,7 @@
  *   frontdt: read 1.2 GB of 3.4 GB [####......]  35% ETA 0:09
  *   frontdt: read 812.0 MB (64.1 MB/s)                 (a pipe: no total)
  *   frontdt: sort 1.3 s                                (no measure of it)
+ *   frontdt: write 12.0 MB of ~40.1 MB [###.......]  29% ETA 0:05
  * Phases: read (loading the input), parse, merge (the library's validation,
  * duplicate merge and kd-tree, before its first report), triangulate,
  * check, sort (canonical order and hash), write. Not part of the library.
@@ -31,6 +32,7 @@ typedef struct progress {
     double t_drawn;    /* last redraw; a negative value: redraw now */
     int drawn;         /* something is on the line */
     int engine_seen;   /* the library has reported (merge -> triangulate) */
+    int approx;        /* the phase's byte total is an estimate: "of ~N" */
 } progress;
 
 /* Sets p up; nothing is ever drawn when enabled is 0. */
@@ -40,17 +42,18 @@ void progress_init(progress *p, int enabled);
 void progress_phase(progress *p, const char *name);
 /* The phase's share done, in [0, 1]. */
 void progress_fraction(progress *p, double fraction);
-/* Bytes of the phase done of total (total 0: not known, e.g. a pipe).
- * The writers' hook: a writer given this (or a callback calling it) keeps
- * the line moving while a large mesh is written. */
+/* Bytes of the phase done of total (total 0: not known, e.g. a pipe). */
 void progress_bytes(progress *p, uint64_t done, uint64_t total);
 /* Clears the line (before any other message, and at the end). */
 void progress_clear(progress *p);
 
-/* Callbacks in the shapes the library and the reader want (user: a
- * progress). progress_engine: fdt_settings.progress; the phase turns from
- * "merge" to "triangulate" at the library's first report. Never cancels. */
+/* Callbacks in the shapes the library wants (user: a progress).
+ * progress_engine: fdt_settings.progress; the phase turns from "merge" to
+ * "triangulate" at the library's first report. Never cancels.
+ * progress_io: fdt_read_options.progress and fdt_write_options.progress;
+ * the stage names the phase (read, parse, write), bytes as progress_bytes,
+ * a write's total shown as the estimate it is ("12.0 MB of ~40.1 MB"). */
 int progress_engine(void *user, double fraction);
-void progress_reader(void *user, int stage, size_t done, size_t total);
+void progress_io(void *user, int stage, uint64_t done, uint64_t total);
 
 #endif
