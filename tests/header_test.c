@@ -8,6 +8,8 @@
 _Static_assert(offsetof(fdt_settings, struct_size) == 0, "struct_size first");
 _Static_assert(offsetof(fdt_stats, struct_size) == 0, "struct_size first");
 _Static_assert(offsetof(fdt_thread_stats, struct_size) == 0, "struct_size first");
+_Static_assert(offsetof(fdt_read_options, struct_size) == 0, "struct_size first");
+_Static_assert(offsetof(fdt_write_options, struct_size) == 0, "struct_size first");
 
 int main(void)
 {
