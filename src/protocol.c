@@ -1,0 +1,251 @@
+/*
+ * The messages of the parallel engine; see protocol.h.
+ *
+ * Modes (§4). Shared: the apex search walks the own tree, then every other
+ * part's tree whose box may hold a better apex (via the bisection tree, so
+ * whole groups of parts are skipped at once, nearest first). Message: the
+ * same walk, but for another part it sends NODESEND (face coordinates, best
+ * so far) to that part's thread and waits for NODERECV, answering the
+ * NODESENDs in its own mailbox meanwhile (so waiting threads cannot
+ * deadlock, §4) and deferring FACESENDs until the face is done. Message-mode
+ * threads read only their own part's coordinates: a FACESEND carries the
+ * coordinates of every id but the lowest (which the receiver owns), and
+ * each thread caches the foreign coordinates it has been sent ("ghosts").
+ */
+#include "protocol.h"
+
+#include <sched.h>
+#include <string.h>
+
+#include "engine.h"
+#include "termination.h"
+
+
+int fdt_pfq_push(pfqueue *q, const pface *f)
+{
+    if (q->head + q->n == q->cap) {
+        if (q->head > 0) {
+            memmove(q->q, q->q + q->head, q->n * sizeof *q->q);
+            q->head = 0;
+        }
+        if (q->n == q->cap) {
+            size_t ncap = q->cap ? q->cap * 2 : 64;
+            pface *nq = realloc(q->q, ncap * sizeof *nq);
+            if (!nq)
+                return FDT_ENOMEM;
+            q->q = nq;
+            q->cap = ncap;
+        }
+    }
+    q->q[q->head + q->n++] = *f;
+    return FDT_OK;
+}
+
+/* Posts a FACESEND of face v (and apex, or FDT_NONE) to thread `to`,
+ * adding its unit first (R1). */
+int fdt_proto_send_face(worker *w, int to, const uint32_t v[3], uint32_t apex,
+                     int64_t link)
+{
+    face_payload fp;
+    memset(&fp, 0, sizeof fp);
+    memcpy(fp.f.v, v, sizeof fp.f.v);
+    fp.f.apex = apex;
+    fp.f.tet = link;
+    if (w->e->mode == FDT_MODE_MESSAGE) {
+        uint32_t ids[4] = {v[0], v[1], v[2], apex};
+        int nid = apex == FDT_NONE ? 3 : 4, low = 0;
+        for (int i = 1; i < nid; i++)
+            if (ids[i] < ids[low])
+                low = i;
+        int j = 0;
+        for (int i = 0; i < nid; i++) {
+            if (i == low)
+                continue;
+            const double *x = coords(w, ids[i]);
+            if (!x)
+                return FDT_EINTERNAL;
+            memcpy(fp.xyz[j++], x, 3 * sizeof *x);
+        }
+    }
+    fdt_msg *m;
+    int rc = fdt_mailbox_alloc(w->mbox, &m);
+    if (rc)
+        return rc;
+    m->kind = FDT_MSG_FACESEND;
+    memcpy(&m->u, &fp, sizeof fp);
+    /* R1, relaxed (see engine.work): sequenced before the post, whose
+     * release CAS the receiver's poll acquires before it removes the
+     * unit, so the add precedes the removal in work's order. */
+    atomic_fetch_add_explicit(&w->e->work, 1, memory_order_relaxed);
+    if (fdt_mailbox_post(w->mbox, to, m) < 0)
+        return FDT_EINTERNAL;
+    return FDT_OK;
+}
+
+/* Handles one FACESEND; then removes its unit (R2). */
+int fdt_proto_handle_face(worker *w, const pface *pf)
+{
+    const fdt_msg_facesend *f = &pf->p.f;
+    if (w->e->mode == FDT_MODE_MESSAGE) {
+        uint32_t ids[4] = {f->v[0], f->v[1], f->v[2], f->apex};
+        int nid = f->apex == FDT_NONE ? 3 : 4, low = 0;
+        for (int i = 1; i < nid; i++)
+            if (ids[i] < ids[low])
+                low = i;
+        int j = 0;
+        for (int i = 0; i < nid; i++) {
+            if (i == low)
+                continue;
+            if (!is_own(w, ids[i])) {
+                int err = fdt_ghost_put(&w->ghosts, ids[i], pf->p.xyz[j]);
+                if (err)
+                    return err;
+            }
+            j++;
+        }
+    }
+    int err;
+    if (f->apex == FDT_NONE) {
+        if (f->v[0] > f->v[1] || f->v[0] > f->v[2] || !is_own(w, f->v[0]))
+            return FDT_EINTERNAL;
+        err = fdt_eng_face_arrives(w, f->v, pf->sender, f->tet, NULL);
+    } else {
+        uint32_t v[4] = {f->v[0], f->v[1], f->v[2], f->apex};
+        err = fdt_eng_build_tet(w, v, 1, NULL);
+    }
+    if (err)
+        return err;
+    return fdt_term_release_unit(w);
+}
+
+void fdt_proto_unpack_face(const fdt_msg *m, pface *pf)
+{
+    memcpy(&pf->p, &m->u, sizeof pf->p);
+    pf->sender = m->sender;
+}
+
+/* ---- range queries -------------------------------------------------------- */
+
+/* Answers a NODESEND: the apex search over our own tree with the asker's
+ * state rebuilt from the message (the face's and the best point's
+ * coordinates; offering the asker's best to a fresh state reproduces its
+ * conservative ball exactly, the same arithmetic on the same doubles). */
+int fdt_proto_answer_query(worker *w, const fdt_msg *m)
+{
+    const fdt_msg_nodesend *q = &m->u.nodesend;
+    double a[3], b[3], c[3], bx[3];
+    memcpy(a, q->xyz[0], sizeof a);
+    memcpy(b, q->xyz[1], sizeof b);
+    memcpy(c, q->xyz[2], sizeof c);
+    memcpy(bx, q->best_xyz, sizeof bx);
+    fdt_apex s;
+    fdt_apex_init(&s, a, b, c, q->v[0], q->v[1], q->v[2]);
+    if (q->best != FDT_MSG_NONE) {
+        fdt_apex_offer(&s, q->best, bx, &w->kq);
+        if (s.best != q->best)
+            return FDT_EINTERNAL;
+    }
+    size_t tested = w->kq.points;
+    if (w->tree->n)
+        fdt_apex_search(&s, w->tree, &w->kq);
+    fdt_msg *r;
+    int rc = fdt_mailbox_alloc(w->mbox, &r);
+    if (rc)
+        return rc;
+    r->kind = FDT_MSG_NODERECV;
+    r->tag = m->tag;
+    r->u.noderecv.tested = (uint32_t)(w->kq.points - tested);
+    if (s.best != q->best) {
+        r->u.noderecv.best = s.best;
+        memcpy(r->u.noderecv.best_xyz, s.bp, sizeof r->u.noderecv.best_xyz);
+    } else {
+        r->u.noderecv.best = FDT_MSG_NONE;
+    }
+    w->st.remote_answered++;
+    if (fdt_mailbox_post(w->mbox, m->sender, r) < 0)
+        return FDT_EINTERNAL;
+    return FDT_OK;
+}
+
+/* Blocks until the mailbox holds something (or a kick), after a short
+ * spin: a range query's answer usually takes microseconds. */
+int fdt_proto_wait_mail(worker *w, int spin, double *acc)
+{
+    for (int i = 0; i < spin; i++) {
+        if (fdt_mailbox_pending(w->mbox) || aborted(w->e))
+            return FDT_OK;
+        sched_yield();
+    }
+    double t = now_s();
+    int rc = fdt_mailbox_wait(w->mbox, -1);
+    *acc += now_s() - t;
+    return rc < 0 ? FDT_EINTERNAL : FDT_OK;
+}
+
+/* Message mode: asks part j whether it holds a better apex than s's. */
+int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
+{
+    fdt_msg *m;
+    int rc = fdt_mailbox_alloc(w->mbox, &m);
+    if (rc)
+        return rc;
+    uint32_t qid = ++w->qid;
+    m->kind = FDT_MSG_NODESEND;
+    m->tag = qid;
+    fdt_msg_nodesend *q = &m->u.nodesend;
+    memcpy(q->xyz[0], s->a, sizeof q->xyz[0]);
+    memcpy(q->xyz[1], s->b, sizeof q->xyz[1]);
+    memcpy(q->xyz[2], s->c, sizeof q->xyz[2]);
+    q->v[0] = s->ia;
+    q->v[1] = s->ib;
+    q->v[2] = s->ic;
+    q->best = s->best == FDT_NONE ? FDT_MSG_NONE : s->best;
+    if (s->best != FDT_NONE)
+        memcpy(q->best_xyz, s->bp, sizeof q->best_xyz);
+    w->st.remote_queries++;
+    if (fdt_mailbox_post(w->mbox, j, m) < 0)
+        return FDT_EINTERNAL;
+    double t0 = now_s(), waited = 0.0;
+    for (;;) {
+        if (aborted(w->e))
+            return FDT_ECANCELED; /* someone else's error is reported */
+        fdt_msg in;
+        if (!fdt_mailbox_poll(w->mbox, &in)) {
+            if ((rc = fdt_proto_wait_mail(w, 64, &waited)) != FDT_OK)
+                return rc;
+            continue;
+        }
+        switch (in.kind) {
+        case FDT_MSG_NODERECV:
+            if (in.tag != qid || in.sender != j)
+                return FDT_EINTERNAL;
+            w->st.t_query_wait += now_s() - t0;
+            if (in.u.noderecv.best != FDT_MSG_NONE) {
+                double *x = qb->x[qb->next];
+                qb->next ^= 1;
+                memcpy(x, in.u.noderecv.best_xyz, 3 * sizeof *x);
+                fdt_apex_offer(s, in.u.noderecv.best, x, &w->kq);
+                /* The same exact tests accepted it over there. */
+                if (s->best != in.u.noderecv.best)
+                    return FDT_EINTERNAL;
+                w->st.remote_improved++;
+            }
+            return FDT_OK;
+        case FDT_MSG_NODESEND:
+            if ((rc = fdt_proto_answer_query(w, &in)) != FDT_OK)
+                return rc;
+            break;
+        case FDT_MSG_FACESEND: {
+            pface pf;
+            fdt_proto_unpack_face(&in, &pf);
+            if ((rc = fdt_pfq_push(&w->deferred, &pf)) != FDT_OK)
+                return rc;
+            break;
+        }
+        default:
+            /* IAMDONE cannot come while we hold a face; FACERECV is never
+             * sent. */
+            return FDT_EINTERNAL;
+        }
+    }
+}
