@@ -288,47 +288,37 @@ static int advance_one(worker *w)
     memcpy(a, pa, sizeof a);
     memcpy(b, pb, sizeof b);
     memcpy(c, pc, sizeof c);
-    fdt_apex ap;
-    fdt_apex_init(&ap, a, b, c, f[0], f[1], f[2]);
     fdt_oracle_tick(&w->orc, w->st.faces_advanced - 1, &w->kq);
     if (w->orc.state == 1 && !w->published) {
         /* release: see mesh_pub */
         atomic_store_explicit(&w->mesh_pub, 1, memory_order_release);
         w->published = 1;
     }
-    /* Our part's insertion mesh, where the oracle switched to it: its
-     * answer is the first of our points in the pencil of spheres through
-     * f's circle (src/oracle.h), so only another part's point can come
-     * earlier, and only inside that sphere: the candidate is offered to
-     * the search state and the others are asked exactly as after our own
-     * kd search. The closed-side tet is ours when we built it (aux). */
+    /* The step shared with src/front.c (fdt_front_apex). Our part's
+     * insertion mesh, where the oracle switched to it: its answer is the
+     * first of our points in the pencil of spheres through f's circle
+     * (src/oracle.h), so only another part's point can come earlier, and
+     * only inside that sphere: the candidate is offered to the search
+     * state and the others are asked exactly as after our own kd search.
+     * Else our own tree, climbing from the leaf of f[0] (ours): the apex
+     * is nearly always near the face. When the final ball lies inside our
+     * part's region (src/partition.c, regions()), no other part's point
+     * can be in it and the others are not asked at all; otherwise their
+     * bounding boxes rule most of them out. The closed-side tet is ours
+     * when we built it (aux). */
     int64_t ctid = s->aux == (uint32_t)w->id ? (int64_t)(s->tet >> 2) : -1;
     uint32_t mapex = FDT_NONE, mtet = FDT_NONE;
-    int inside;
-    if (fdt_oracle_apex(&w->orc, f, ctid, ctid >= 0 ? w->out.tets[s->tet] : FDT_NONE,
-                        &mapex, &mtet)) {
-        if (mapex != FDT_NONE) {
-            fdt_apex_offer(&ap, mapex, coords(w, mapex), &w->kq);
-            /* The mesh's apex is on the open side by construction; an
-             * offer refused would mean the mesh and the search disagree. */
-            if (ap.best != mapex)
-                return FDT_EINTERNAL;
-        }
-        fdt_facetab_prefetch_tet(&w->ft, f, mapex);
-        inside = fdt_apex_inside_region(&ap, w->tree);
-    } else {
-        /* Our own tree first, climbing from the leaf of f[0] (ours): the
-         * apex is nearly always near the face. When the final ball lies
-         * inside our part's region (src/partition.c, regions()), no other
-         * part's point can be in it and the others are not asked at all;
-         * otherwise their bounding boxes rule most of them out. */
-        fdt_apex_guess(&ap, w->tree, f[0], &w->kq);
-        /* the guessed tet's face slots, as in src/front.c */
-        fdt_facetab_prefetch_tet(&w->ft, f, ap.best);
-        inside = fdt_apex_verify_from(&ap, w->tree, f[0], &w->kq);
-    }
+    int inside = 0;
+    fdt_apex ap;
+    int err = fdt_front_apex(&w->orc, w->tree, &w->ft, f, a, b, c, ctid,
+                             ctid >= 0 ? w->out.tets[s->tet] : FDT_NONE, 1, &ap, &inside,
+                             &mapex, &mtet, &w->kq);
+    if (err)
+        return err;
+    /* fdt_front_apex sets mapex to the kd search's answer when the mesh
+     * was not asked; the mesh tet (mtet) stays FDT_NONE then. */
     qbuf qb = {{{0}}, 0};
-    int err = inside ? FDT_OK : search_others(w, &ap, &qb);
+    err = inside ? FDT_OK : search_others(w, &ap, &qb);
     if (err)
         return err;
     if (ap.best == FDT_NONE) {
