@@ -397,24 +397,7 @@ int fdt_eng_worker_loop(worker *w)
         }
         fdt_msg m;
         while (fdt_mailbox_poll(w->mbox, &m)) {
-            switch (m.kind) {
-            case FDT_MSG_FACESEND: {
-                pface pf;
-                fdt_proto_unpack_face(&m, &pf);
-                rc = fdt_proto_handle_face(w, &pf);
-                break;
-            }
-            case FDT_MSG_NODESEND:
-                rc = fdt_proto_answer_query(w, &m);
-                break;
-            case FDT_MSG_IAMDONE:
-                /* Work is 0: we hold nothing. */
-                rc = w->active || w->ft.count || w->deferred.n ? FDT_EINTERNAL : RUN_DONE;
-                break;
-            default:
-                rc = FDT_EINTERNAL;
-                break;
-            }
+            rc = fdt_proto_dispatch(w, &m, NULL);
             if (rc != RUN_ON)
                 return rc;
         }

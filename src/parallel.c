@@ -91,13 +91,11 @@ done:
     return err;
 }
 
-static void msg_counts_add(fdt_msg_counts *c, const uint64_t *k)
+/* c[k] += k_[k] for every kind k. */
+static void msg_counts_add(size_t *c, const uint64_t *k)
 {
-    c->iamdone += (size_t)k[FDT_MSG_IAMDONE];
-    c->nodesend += (size_t)k[FDT_MSG_NODESEND];
-    c->noderecv += (size_t)k[FDT_MSG_NODERECV];
-    c->facesend += (size_t)k[FDT_MSG_FACESEND];
-    c->facerecv += (size_t)k[FDT_MSG_FACERECV];
+    for (int i = 0; i < FDT_MSG_KIND_END; i++)
+        c[i] += (size_t)k[i];
 }
 
 void fdt_par_out_free(fdt_par_out *out)
@@ -111,8 +109,8 @@ void fdt_parallel_fill_stats(const fdt_par_out *o, fdt_mode mode,
                              fdt_stats *st)
 {
     const fdt_stats *p = &o->pst;
-    st->sent = p->sent;
-    st->received = p->received;
+    memcpy(st->sent, p->sent, sizeof st->sent);
+    memcpy(st->received, p->received, sizeof st->received);
     st->remote_queries = p->remote_queries;
     st->remote_answered = p->remote_answered;
     st->remote_improved = p->remote_improved;
@@ -318,10 +316,10 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
         fdt_mailbox_counts_get(w->mbox, &mc);
         *ts = w->st;
         ts->tets = w->out.ntets;
-        msg_counts_add(&ts->sent, mc.sent);
-        msg_counts_add(&ts->received, mc.received);
-        msg_counts_add(&ps->sent, mc.sent);
-        msg_counts_add(&ps->received, mc.received);
+        msg_counts_add(ts->sent, mc.sent);
+        msg_counts_add(ts->received, mc.received);
+        msg_counts_add(ps->sent, mc.sent);
+        msg_counts_add(ps->received, mc.received);
         ps->remote_queries += ts->remote_queries;
         ps->remote_answered += ts->remote_answered;
         ps->remote_improved += ts->remote_improved;
@@ -355,9 +353,10 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
     out->fst.kq.pc.insphere_adapt += kq0.pc.insphere_adapt;
     ps->load_imbalance = sumt ? (double)maxt * nthreads / (double)sumt : 1.0;
     ps->pinned = e->pin ? (atomic_load_explicit(&e->pin_refused, memory_order_relaxed) ? -1 : 1) : 0;
-    if (memcmp(&ps->sent, &ps->received, sizeof ps->sent) != 0 ||
+    if (memcmp(ps->sent, ps->received, sizeof ps->sent) != 0 ||
         ps->remote_queries != ps->remote_answered ||
-        ps->sent.nodesend != ps->remote_queries || ps->sent.iamdone != (size_t)nthreads - 1) {
+        ps->sent[FDT_MSG_NODESEND] != ps->remote_queries ||
+        ps->sent[FDT_MSG_IAMDONE] != (size_t)nthreads - 1) {
         snprintf(diag, dlen, "internal error: messages sent and received differ");
         err = FDT_EINTERNAL;
         goto fail;

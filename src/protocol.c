@@ -206,6 +206,7 @@ int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
     if (fdt_mailbox_post(w->mbox, j, m) < 0)
         return FDT_EINTERNAL;
     double t0 = now_s(), waited = 0.0;
+    pwait pw = {qid, j, s, qb, 0};
     for (;;) {
         if (aborted(w->e))
             return FDT_ECANCELED; /* someone else's error is reported */
@@ -215,37 +216,110 @@ int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
                 return rc;
             continue;
         }
-        switch (in.kind) {
-        case FDT_MSG_NODERECV:
-            if (in.tag != qid || in.sender != j)
-                return FDT_EINTERNAL;
-            w->st.t_query_wait += now_s() - t0;
-            if (in.u.noderecv.best != FDT_MSG_NONE) {
-                double *x = qb->x[qb->next];
-                qb->next ^= 1;
-                memcpy(x, in.u.noderecv.best_xyz, 3 * sizeof *x);
-                fdt_apex_offer(s, in.u.noderecv.best, x, &w->kq);
-                /* The same exact tests accepted it over there. */
-                if (s->best != in.u.noderecv.best)
-                    return FDT_EINTERNAL;
-                w->st.remote_improved++;
-            }
-            return FDT_OK;
-        case FDT_MSG_NODESEND:
-            if ((rc = fdt_proto_answer_query(w, &in)) != FDT_OK)
-                return rc;
-            break;
-        case FDT_MSG_FACESEND: {
-            pface pf;
-            fdt_proto_unpack_face(&in, &pf);
-            if ((rc = fdt_pfq_push(&w->deferred, &pf)) != FDT_OK)
-                return rc;
-            break;
-        }
-        default:
-            /* IAMDONE cannot come while we hold a face; FACERECV is never
-             * sent. */
+        if ((rc = fdt_proto_dispatch(w, &in, &pw)) < 0)
+            return rc;
+        if (rc != RUN_ON)
             return FDT_EINTERNAL;
+        if (pw.answered) {
+            w->st.t_query_wait += now_s() - t0;
+            return FDT_OK;
         }
     }
+}
+
+/* ---- the kinds: one row each ------------------------------------------------ */
+
+/* IAMDONE: the work counter is 0, so we hold nothing; it cannot come while
+ * we wait on a query (we hold a face then). */
+static int on_iamdone(worker *w, const fdt_msg *m, pwait *pw)
+{
+    (void)m;
+    if (pw || w->active || w->ft.count || w->deferred.n)
+        return FDT_EINTERNAL;
+    return RUN_DONE;
+}
+
+static int on_nodesend(worker *w, const fdt_msg *m, pwait *pw)
+{
+    (void)pw;
+    return fdt_proto_answer_query(w, m);
+}
+
+/* NODERECV: the answer to the query pw waits on (the only one out: a part
+ * asks one part at a time); its better point, if any, is offered. */
+static int on_noderecv(worker *w, const fdt_msg *m, pwait *pw)
+{
+    if (!pw || m->tag != pw->qid || m->sender != pw->part)
+        return FDT_EINTERNAL;
+    if (m->u.noderecv.best != FDT_MSG_NONE) {
+        double *x = pw->qb->x[pw->qb->next];
+        pw->qb->next ^= 1;
+        memcpy(x, m->u.noderecv.best_xyz, 3 * sizeof *x);
+        fdt_apex_offer(pw->s, m->u.noderecv.best, x, &w->kq);
+        /* The same exact tests accepted it over there. */
+        if (pw->s->best != m->u.noderecv.best)
+            return FDT_EINTERNAL;
+        w->st.remote_improved++;
+    }
+    pw->answered = 1;
+    return RUN_ON;
+}
+
+/* FACESEND: handled at once in the loop; while a search waits it is
+ * deferred until the face is done (the search must not change the face
+ * table under it). */
+static int on_facesend(worker *w, const fdt_msg *m, pwait *pw)
+{
+    pface pf;
+    fdt_proto_unpack_face(m, &pf);
+    if (pw)
+        return fdt_pfq_push(&w->deferred, &pf);
+    return fdt_proto_handle_face(w, &pf);
+}
+
+/* FACERECV: the threaded engine sends none (src/termination.c). */
+static int on_facerecv(worker *w, const fdt_msg *m, pwait *pw)
+{
+    (void)w;
+    (void)m;
+    (void)pw;
+    return FDT_EINTERNAL;
+}
+
+/*
+ * The message kinds (§4): name, payload (the bytes of the message's union
+ * a kind uses: what a transport that copies bytes, such as MPI, moves),
+ * handler. A new kind is a number in include/frontdt.h and one row here.
+ */
+static const struct msg_kind_row {
+    const char *name;
+    size_t payload;
+    int (*on)(worker *w, const fdt_msg *m, pwait *pw);
+} msg_kinds[FDT_MSG_KIND_END] = {
+    [FDT_MSG_IAMDONE] = {"IAMDONE", sizeof(fdt_msg_iamdone), on_iamdone},
+    [FDT_MSG_NODESEND] = {"NODESEND", sizeof(fdt_msg_nodesend), on_nodesend},
+    [FDT_MSG_NODERECV] = {"NODERECV", sizeof(fdt_msg_noderecv), on_noderecv},
+    [FDT_MSG_FACESEND] = {"FACESEND", sizeof(face_payload), on_facesend},
+    [FDT_MSG_FACERECV] = {"FACERECV", sizeof(fdt_msg_facerecv), on_facerecv},
+};
+
+const char *fdt_msg_kind_name(int kind)
+{
+    if (kind <= 0 || kind >= FDT_MSG_KIND_END || !msg_kinds[kind].name)
+        return "?";
+    return msg_kinds[kind].name;
+}
+
+size_t fdt_proto_payload_size(int kind)
+{
+    if (kind <= 0 || kind >= FDT_MSG_KIND_END)
+        return 0;
+    return msg_kinds[kind].payload;
+}
+
+int fdt_proto_dispatch(worker *w, const fdt_msg *m, pwait *pw)
+{
+    if (m->kind == 0 || m->kind >= FDT_MSG_KIND_END || !msg_kinds[m->kind].on)
+        return FDT_EINTERNAL;
+    return msg_kinds[m->kind].on(w, m, pw);
 }

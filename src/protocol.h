@@ -55,6 +55,24 @@ typedef struct qbuf {
     int next;
 } qbuf;
 
+/* A range query a part waits on (fdt_proto_remote_query): its id, the
+ * part asked, the search state and the buffers its answer goes to, and
+ * whether the answer came. */
+typedef struct pwait {
+    uint32_t qid;
+    int part;
+    fdt_apex *s;
+    qbuf *qb;
+    int answered;
+} pwait;
+
+/* Handles message m by its kind's row (src/protocol.c): pw is the query
+ * the part waits on, NULL in its main loop. RUN_ON, RUN_DONE or an
+ * error (FDT_EINTERNAL for a kind that cannot come here). */
+int fdt_proto_dispatch(struct worker *w, const fdt_msg *m, pwait *pw);
+/* The bytes of the message's union kind uses (0: not a kind). */
+size_t fdt_proto_payload_size(int kind);
+
 /* Posts a FACESEND of face v (and apex, or FDT_NONE) to thread `to`,
  * adding its unit first (R1 of src/termination.c). link: the sender's tet
  * and face index, (tid << 2) | i, or -1. */
