@@ -396,7 +396,7 @@ int fdt_eng_worker_loop(worker *w)
                 return rc;
         }
         fdt_msg m;
-        while (fdt_mailbox_poll(w->mbox, &m)) {
+        while (fdt_tp_poll(w->e->tp, w->id, &m)) {
             rc = fdt_proto_dispatch(w, &m, NULL);
             if (rc != RUN_ON)
                 return rc;

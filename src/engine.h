@@ -28,6 +28,7 @@
 #include "partition.h"
 #include "partsets.h"
 #include "protocol.h"
+#include "transport.h"
 
 /* A worker's result for the main loop: keep going, or the run is over. */
 enum { RUN_ON = 0, RUN_DONE = 1 };
@@ -51,7 +52,6 @@ typedef struct worker {
     alignas(64) atomic_size_t tets_done;
     alignas(64) struct engine *e;
     int id;
-    fdt_mailbox *mbox;
     const fdt_kdtree *tree;    /* own part (n == 0: empty part) */
     uint32_t lo, hi;           /* own ids [lo, hi) */
     fdt_facetab ft;            /* own front faces */
@@ -100,7 +100,7 @@ typedef struct engine {
      * caller after pthread_join, which orders them). */
     alignas(64) atomic_int error;
     /* Abort flag: stored (release) after `error`, then every mailbox is
-     * kicked (seq_cst store in fdt_mailbox_kick, consumed by an acquire
+     * kicked (fdt_tp_kick; the mailbox's seq_cst store in fdt_mailbox_kick, consumed by an acquire
      * exchange), so a thread woken by the kick sees the flag. Loops load
      * it with acquire; a stale 0 only delays the exit by one iteration. */
     atomic_int abort;
@@ -115,7 +115,7 @@ typedef struct engine {
     int search;                /* fdt_search, for every part's oracle */
     int n;
     int want_nbrs;
-    fdt_mailboxes *mbs;
+    fdt_transport *tp;         /* messages between the parts */
     worker *w;
     /* The calling thread waits here for the workers to finish their
      * loops (finished, under lock), then sets gather (under lock; 1: copy

@@ -128,6 +128,12 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
                              fdt_mode mode, int nthreads, fdt_par_out *out,
                              char *diag, size_t dlen)
 {
+    return fdt_parallel_run(pr, s, mode, nthreads, NULL, out, diag, dlen);
+}
+
+int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int nthreads,
+                     const fdt_par_opts *opt, fdt_par_out *out, char *diag, size_t dlen)
+{
     memset(out, 0, sizeof *out);
     if ((mode != FDT_MODE_SHARED && mode != FDT_MODE_MESSAGE) || nthreads < 1 ||
         nthreads > FDT_PARTITION_MAX || pr->m < 4 || pr->m > UINT32_MAX - 1)
@@ -177,8 +183,18 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
     memset(e->w, 0, (size_t)nthreads * sizeof(worker));
     for (int i = 0; i < nthreads; i++)
         atomic_init(&e->w[i].mesh_pub, 0);
-    if (fdt_mailboxes_create(&e->mbs, nthreads, 0, 0) != 0)
+    if (opt && opt->shuffle)
+        err = fdt_transport_shuffle(&e->tp, nthreads, opt->seed, opt->delay_pct);
+    else
+        err = fdt_transport_mailbox(&e->tp, nthreads);
+    if (err) {
+        /* FDT_EINVAL: a bad test option; otherwise out of memory (a mutex
+         * that cannot be made counts as that, as before) */
+        if (err != FDT_EINVAL)
+            err = FDT_ENOMEM;
         goto fail;
+    }
+    err = FDT_ENOMEM;
     if (pthread_mutex_init(&e->lock, NULL) != 0)
         goto fail;
     if (pthread_cond_init(&e->cv, NULL) != 0) {
@@ -216,7 +232,6 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
         atomic_init(&w->tets_done, 0);
         w->e = e;
         w->id = i;
-        w->mbox = fdt_mailboxes_at(e->mbs, i);
         w->tree = &pt.trees[i];
         w->lo = pt.start[i];
         w->hi = pt.start[i + 1];
@@ -313,7 +328,7 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
         worker *w = &e->w[i];
         fdt_thread_stats *ts = &out->tstats[i];
         fdt_mailbox_counts mc;
-        fdt_mailbox_counts_get(w->mbox, &mc);
+        fdt_tp_counts(e->tp, i, &mc);
         *ts = w->st;
         ts->tets = w->out.ntets;
         msg_counts_add(ts->sent, mc.sent);
@@ -377,7 +392,7 @@ fail:
             for (int i = 0; i < nthreads; i++)
                 fdt_eng_worker_free(&e->w[i]);
         free(e->w);
-        fdt_mailboxes_destroy(&e->mbs);
+        fdt_transport_destroy(&e->tp);
         if (sync_ok) {
             pthread_cond_destroy(&e->go);
             pthread_cond_destroy(&e->cv);

@@ -68,7 +68,7 @@ int fdt_proto_send_face(worker *w, int to, const uint32_t v[3], uint32_t apex,
         }
     }
     fdt_msg *m;
-    int rc = fdt_mailbox_alloc(w->mbox, &m);
+    int rc = fdt_tp_alloc(w->e->tp, w->id, &m);
     if (rc)
         return rc;
     m->kind = FDT_MSG_FACESEND;
@@ -77,7 +77,7 @@ int fdt_proto_send_face(worker *w, int to, const uint32_t v[3], uint32_t apex,
      * release CAS the receiver's poll acquires before it removes the
      * unit, so the add precedes the removal in work's order. */
     atomic_fetch_add_explicit(&w->e->work, 1, memory_order_relaxed);
-    if (fdt_mailbox_post(w->mbox, to, m) < 0)
+    if (fdt_tp_post(w->e->tp, w->id, to, m) < 0)
         return FDT_EINTERNAL;
     return FDT_OK;
 }
@@ -149,7 +149,7 @@ int fdt_proto_answer_query(worker *w, const fdt_msg *m)
     if (w->tree->n)
         fdt_apex_search(&s, w->tree, &w->kq);
     fdt_msg *r;
-    int rc = fdt_mailbox_alloc(w->mbox, &r);
+    int rc = fdt_tp_alloc(w->e->tp, w->id, &r);
     if (rc)
         return rc;
     r->kind = FDT_MSG_NODERECV;
@@ -162,7 +162,7 @@ int fdt_proto_answer_query(worker *w, const fdt_msg *m)
         r->u.noderecv.best = FDT_MSG_NONE;
     }
     w->st.remote_answered++;
-    if (fdt_mailbox_post(w->mbox, m->sender, r) < 0)
+    if (fdt_tp_post(w->e->tp, w->id, m->sender, r) < 0)
         return FDT_EINTERNAL;
     return FDT_OK;
 }
@@ -172,12 +172,12 @@ int fdt_proto_answer_query(worker *w, const fdt_msg *m)
 int fdt_proto_wait_mail(worker *w, int spin, double *acc)
 {
     for (int i = 0; i < spin; i++) {
-        if (fdt_mailbox_pending(w->mbox) || aborted(w->e))
+        if (fdt_tp_pending(w->e->tp, w->id) || aborted(w->e))
             return FDT_OK;
         sched_yield();
     }
     double t = now_s();
-    int rc = fdt_mailbox_wait(w->mbox, -1);
+    int rc = fdt_tp_wait(w->e->tp, w->id, -1);
     *acc += now_s() - t;
     return rc < 0 ? FDT_EINTERNAL : FDT_OK;
 }
@@ -186,7 +186,7 @@ int fdt_proto_wait_mail(worker *w, int spin, double *acc)
 int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
 {
     fdt_msg *m;
-    int rc = fdt_mailbox_alloc(w->mbox, &m);
+    int rc = fdt_tp_alloc(w->e->tp, w->id, &m);
     if (rc)
         return rc;
     uint32_t qid = ++w->qid;
@@ -203,7 +203,7 @@ int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
     if (s->best != FDT_NONE)
         memcpy(q->best_xyz, s->bp, sizeof q->best_xyz);
     w->st.remote_queries++;
-    if (fdt_mailbox_post(w->mbox, j, m) < 0)
+    if (fdt_tp_post(w->e->tp, w->id, j, m) < 0)
         return FDT_EINTERNAL;
     double t0 = now_s(), waited = 0.0;
     pwait pw = {qid, j, s, qb, 0};
@@ -211,7 +211,7 @@ int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
         if (aborted(w->e))
             return FDT_ECANCELED; /* someone else's error is reported */
         fdt_msg in;
-        if (!fdt_mailbox_poll(w->mbox, &in)) {
+        if (!fdt_tp_poll(w->e->tp, w->id, &in)) {
             if ((rc = fdt_proto_wait_mail(w, 64, &waited)) != FDT_OK)
                 return rc;
             continue;

@@ -67,7 +67,7 @@ void fdt_eng_set_error(engine *e, int err, int thread, const char *what)
     }
     atomic_store_explicit(&e->abort, 1, memory_order_release);
     for (int i = 0; i < e->n; i++)
-        fdt_mailbox_kick(fdt_mailboxes_at(e->mbs, i));
+        fdt_tp_kick(e->tp, i);
 }
 
 /* Sends IAMDONE to every other thread: the caller brought work to 0. */
@@ -77,13 +77,13 @@ static int broadcast_done(worker *w)
         if (j == w->id)
             continue;
         fdt_msg *m;
-        int rc = fdt_mailbox_alloc(w->mbox, &m);
+        int rc = fdt_tp_alloc(w->e->tp, w->id, &m);
         if (rc)
             return rc;
         m->kind = FDT_MSG_IAMDONE;
         m->u.iamdone.epoch = 1;
         m->u.iamdone.count = 0;
-        if ((rc = fdt_mailbox_post(w->mbox, j, m)) < 0)
+        if ((rc = fdt_tp_post(w->e->tp, w->id, j, m)) < 0)
             return FDT_EINTERNAL;
     }
     return RUN_DONE;
