@@ -158,9 +158,10 @@ typedef enum fdt_msg_kind {
     FDT_MSG_NODESEND = 2, /* range queries to another partition */
     FDT_MSG_NODERECV = 3, /* their answers */
     FDT_MSG_FACESEND = 4, /* faces, and found apexes, for their owner */
-    FDT_MSG_FACERECV = 5, /* acknowledgements of FACESEND (the threaded
-                             engine needs none: 0, see src/termination.c) */
-    FDT_MSG_KIND_END = 6  /* arrays indexed by kind have this many slots */
+    FDT_MSG_FACERECV = 5, /* acknowledgements of FACESEND (message mode;
+                             shared mode needs none: 0, src/termination.c) */
+    FDT_MSG_ABORT = 6,    /* a part failed: stop (message mode) */
+    FDT_MSG_KIND_END = 7  /* arrays indexed by kind have this many slots */
 } fdt_msg_kind;
 
 /* The name of a kind, "IAMDONE", "NODESEND", ...; "?" for anything else.

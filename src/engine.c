@@ -403,14 +403,14 @@ int fdt_eng_worker_loop(worker *w)
         }
         if ((rc = advance_one(w)) < 0)
             return rc;
+        if (w->id == w->e->fail_part && w->st.faces_advanced >= w->e->fail_after)
+            return FDT_EINTERNAL; /* a test's injected failure (fdt_par_opts) */
         if (rc == 1 || w->deferred.n > 0)
             continue;
-        if (w->active && w->ft.count == 0) {
-            /* Queue exhausted and table empty: give up our unit (R2). */
-            w->active = 0;
-            if ((rc = fdt_term_release_unit(w)) != RUN_ON)
-                return rc;
-        }
+        /* Nothing to do: shared mode gives up its unit, message mode
+         * may detach (src/termination.c). */
+        if ((rc = fdt_term_idle(w)) != RUN_ON)
+            return rc;
         if ((rc = fdt_proto_wait_mail(w, 0, &w->st.t_idle)) != FDT_OK)
             return rc;
     }

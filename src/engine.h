@@ -63,7 +63,16 @@ typedef struct worker {
     pfqueue deferred;          /* message mode: FACESENDs for later */
     uint32_t (*seeds)[4];      /* seed tets to build first (borrowed) */
     int nseeds;
-    int active;                /* holds an activity unit of e->work */
+    int active;                /* shared mode: holds an activity unit of
+                                  e->work */
+    /* Message mode (src/termination.c): Dijkstra-Scholten over FACESEND
+     * and its FACERECV. All plain: only this worker's thread uses them. */
+    int engaged;               /* in a tree of the computation */
+    int parent;                /* whose FACESEND engaged us (-1: a root) */
+    long long deficit;         /* our FACESENDs not yet acknowledged */
+    int trees_done;            /* part 0: trees reported finished */
+    int err;                   /* message mode: our own failure (0: none) */
+    int aborted_by;            /* message mode: ABORT received from (-1) */
     uint32_t qid;              /* last range query id */
     fdt_kdq kq;
     fdt_oracle orc;            /* kd search or the part's insertion mesh */
@@ -115,7 +124,15 @@ typedef struct engine {
     int search;                /* fdt_search, for every part's oracle */
     int n;
     int want_nbrs;
-    fdt_transport *tp;         /* messages between the parts */
+    fdt_transport *tp;         /* messages between the parts: endpoints
+                                  0..n-1 the parts, n the calling thread */
+    int msg_term;              /* message mode: termination and abort by
+                                  messages alone (src/termination.c) */
+    int roots;                 /* message mode: parts holding seeds */
+    int fail_part;             /* a test's injected failure (-1: none) */
+    size_t fail_after;
+    int ctl_err;               /* message mode: the calling thread's error
+                                  (plain: written and read by it alone) */
     worker *w;
     /* The calling thread waits here for the workers to finish their
      * loops (finished, under lock), then sets gather (under lock; 1: copy

@@ -7,10 +7,10 @@
  * threads' tets into one array anyway, applies the list. This replaces a
  * FACERECV reply carrying the tet id when a face completes (one to two
  * messages per boundary face, and writes into another thread's arrays) by
- * nothing at all; our
- * termination protocol needs no acknowledgement either, and the mailboxes
- * are FIFO per sender, so FACERECV, "returned for synchronization only" in
- * §4, is never sent (its counters stay 0, checked like the others).
+ * nothing at all. FACERECV, "returned for synchronization only" in §4,
+ * therefore carries no tet: shared mode sends none (its counters stay 0,
+ * checked like the others), message mode sends one for every FACESEND as
+ * the acknowledgement its termination detection needs (src/termination.c).
  */
 #include "gather.h"
 

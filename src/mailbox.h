@@ -129,7 +129,14 @@ typedef struct fdt_msg_noderecv {
     uint32_t tested;
 } fdt_msg_noderecv;
 
-/* IAMDONE: a termination-protocol counter and epoch, as the lead defines. */
+/* ABORT: the sender failed with err (an FDT_E* code); part is the part
+ * that failed (the sender, or the calling thread's endpoint). */
+typedef struct fdt_msg_abort {
+    int32_t err;
+    int32_t part;
+} fdt_msg_abort;
+
+/* IAMDONE: a termination-protocol counter and epoch (src/termination.c). */
 typedef struct fdt_msg_iamdone {
     uint64_t epoch;
     int64_t count;
@@ -152,6 +159,7 @@ typedef struct fdt_msg {
         fdt_msg_noderecv noderecv;
         fdt_msg_facesend facesend;
         fdt_msg_facerecv facerecv;
+        fdt_msg_abort abort;
     } u;
 } fdt_msg;
 

@@ -21,6 +21,7 @@
 #include "engine.h"
 #include "gather.h"
 #include "seed.h"
+#include "termination.h"
 #include "threads.h"
 
 static int key_cmp(const void *x, const void *y)
@@ -184,9 +185,9 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     for (int i = 0; i < nthreads; i++)
         atomic_init(&e->w[i].mesh_pub, 0);
     if (opt && opt->shuffle)
-        err = fdt_transport_shuffle(&e->tp, nthreads, opt->seed, opt->delay_pct);
+        err = fdt_transport_shuffle(&e->tp, nthreads + 1, opt->seed, opt->delay_pct);
     else
-        err = fdt_transport_mailbox(&e->tp, nthreads);
+        err = fdt_transport_mailbox(&e->tp, nthreads + 1);
     if (err) {
         /* FDT_EINVAL: a bad test option; otherwise out of memory (a mutex
          * that cannot be made counts as that, as before) */
@@ -288,11 +289,26 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
                         goto fail;
                 }
         }
-    for (int i = 0; i < nthreads; i++)
-        if (e->w[i].nseeds > 0) {
-            e->w[i].active = 1;
+    /* Shared mode: every part with seeds holds an activity unit. Message
+     * mode: every part with seeds is a root of Dijkstra-Scholten, engaged
+     * with no parent (src/termination.c). */
+    e->msg_term = mode == FDT_MODE_MESSAGE;
+    e->fail_part = opt && opt->fail ? opt->fail_part : -1;
+    e->fail_after = opt ? opt->fail_after : 0;
+    for (int i = 0; i < nthreads; i++) {
+        worker *w = &e->w[i];
+        w->parent = -1;
+        w->aborted_by = -1;
+        if (w->nseeds == 0)
+            continue;
+        if (e->msg_term) {
+            w->engaged = 1;
+            e->roots++;
+        } else {
+            w->active = 1;
             active++;
         }
+    }
     /* Every thread with seeds starts holding its activity unit. Thread
      * creation orders this before everything the workers do. */
     atomic_init(&e->work, active);
@@ -301,7 +317,8 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     err = fdt_threads_run(e, s, &t2);
     /* After pthread_join: any order would do; acquire documents that the
      * recorded err_thread/err_what are read after the CAS that chose them. */
-    int werr = atomic_load_explicit(&e->error, memory_order_acquire);
+    int werr = e->msg_term ? fdt_term_error(e, &e->err_thread, &e->err_what)
+                           : atomic_load_explicit(&e->error, memory_order_acquire);
     if (werr) {
         err = werr;
         if (werr == FDT_ENOMEM)
@@ -368,10 +385,16 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     out->fst.kq.pc.insphere_adapt += kq0.pc.insphere_adapt;
     ps->load_imbalance = sumt ? (double)maxt * nthreads / (double)sumt : 1.0;
     ps->pinned = e->pin ? (atomic_load_explicit(&e->pin_refused, memory_order_relaxed) ? -1 : 1) : 0;
+    /* IAMDONE: shared mode, one to every other part; message mode also
+     * one from each root but part 0 to part 0 (its tree finished). FACERECV:
+     * one for each FACESEND in message mode, none in shared mode. */
+    size_t iamdones = (size_t)nthreads - 1 +
+                      (e->msg_term ? (size_t)e->roots - (e->w[0].nseeds > 0) : 0);
     if (memcmp(ps->sent, ps->received, sizeof ps->sent) != 0 ||
         ps->remote_queries != ps->remote_answered ||
         ps->sent[FDT_MSG_NODESEND] != ps->remote_queries ||
-        ps->sent[FDT_MSG_IAMDONE] != (size_t)nthreads - 1) {
+        ps->sent[FDT_MSG_IAMDONE] != iamdones || ps->sent[FDT_MSG_ABORT] != 0 ||
+        ps->sent[FDT_MSG_FACERECV] != (e->msg_term ? ps->sent[FDT_MSG_FACESEND] : 0)) {
         snprintf(diag, dlen, "internal error: messages sent and received differ");
         err = FDT_EINTERNAL;
         goto fail;

@@ -51,6 +51,10 @@ typedef struct fdt_par_opts {
                            senders, instead of the mailboxes */
     uint64_t seed;      /* its schedule */
     int delay_pct;      /* its delay, 0..90 */
+    int fail;           /* nonzero: part fail_part fails (FDT_EINTERNAL)
+                           once it has advanced fail_after faces */
+    int fail_part;
+    size_t fail_after;
 } fdt_par_opts;
 
 /* fdt_parallel_triangulate with options (NULL: none, what it does). */

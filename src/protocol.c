@@ -73,10 +73,7 @@ int fdt_proto_send_face(worker *w, int to, const uint32_t v[3], uint32_t apex,
         return rc;
     m->kind = FDT_MSG_FACESEND;
     memcpy(&m->u, &fp, sizeof fp);
-    /* R1, relaxed (see engine.work): sequenced before the post, whose
-     * release CAS the receiver's poll acquires before it removes the
-     * unit, so the add precedes the removal in work's order. */
-    atomic_fetch_add_explicit(&w->e->work, 1, memory_order_relaxed);
+    fdt_term_face_sent(w);
     if (fdt_tp_post(w->e->tp, w->id, to, m) < 0)
         return FDT_EINTERNAL;
     return FDT_OK;
@@ -115,7 +112,7 @@ int fdt_proto_handle_face(worker *w, const pface *pf)
     }
     if (err)
         return err;
-    return fdt_term_release_unit(w);
+    return fdt_term_face_done(w, pf->sender);
 }
 
 void fdt_proto_unpack_face(const fdt_msg *m, pface *pf)
@@ -208,8 +205,12 @@ int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
     double t0 = now_s(), waited = 0.0;
     pwait pw = {qid, j, s, qb, 0};
     for (;;) {
-        if (aborted(w->e))
-            return FDT_ECANCELED; /* someone else's error is reported */
+        if (aborted(w->e)) {
+            /* someone else's error is reported (message mode: the
+             * fallback of an ABORT that could not be allocated) */
+            w->aborted_by = w->e->n;
+            return FDT_ECANCELED;
+        }
         fdt_msg in;
         if (!fdt_tp_poll(w->e->tp, w->id, &in)) {
             if ((rc = fdt_proto_wait_mail(w, 64, &waited)) != FDT_OK)
@@ -229,14 +230,10 @@ int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
 
 /* ---- the kinds: one row each ------------------------------------------------ */
 
-/* IAMDONE: the work counter is 0, so we hold nothing; it cannot come while
- * we wait on a query (we hold a face then). */
+/* IAMDONE: the end of the run (src/termination.c). */
 static int on_iamdone(worker *w, const fdt_msg *m, pwait *pw)
 {
-    (void)m;
-    if (pw || w->active || w->ft.count || w->deferred.n)
-        return FDT_EINTERNAL;
-    return RUN_DONE;
+    return fdt_term_on_iamdone(w, m, pw != NULL);
 }
 
 static int on_nodesend(worker *w, const fdt_msg *m, pwait *pw)
@@ -277,13 +274,24 @@ static int on_facesend(worker *w, const fdt_msg *m, pwait *pw)
     return fdt_proto_handle_face(w, &pf);
 }
 
-/* FACERECV: the threaded engine sends none (src/termination.c). */
+/* FACERECV: a FACESEND of ours was handled (message mode only,
+ * src/termination.c). */
 static int on_facerecv(worker *w, const fdt_msg *m, pwait *pw)
 {
-    (void)w;
     (void)m;
     (void)pw;
-    return FDT_EINTERNAL;
+    return fdt_term_ack(w);
+}
+
+/* ABORT: another part (or the calling thread) failed; we stop, also in
+ * the middle of a search (message mode only). */
+static int on_abort(worker *w, const fdt_msg *m, pwait *pw)
+{
+    (void)pw;
+    if (!w->e->msg_term)
+        return FDT_EINTERNAL;
+    w->aborted_by = m->u.abort.part;
+    return FDT_ECANCELED;
 }
 
 /*
@@ -301,6 +309,7 @@ static const struct msg_kind_row {
     [FDT_MSG_NODERECV] = {"NODERECV", sizeof(fdt_msg_noderecv), on_noderecv},
     [FDT_MSG_FACESEND] = {"FACESEND", sizeof(face_payload), on_facesend},
     [FDT_MSG_FACERECV] = {"FACERECV", sizeof(fdt_msg_facerecv), on_facerecv},
+    [FDT_MSG_ABORT] = {"ABORT", sizeof(fdt_msg_abort), on_abort},
 };
 
 const char *fdt_msg_kind_name(int kind)

@@ -121,7 +121,7 @@ int fdt_threads_run(engine *e, const fdt_settings *s, double *t_loops)
     for (; created < e->n; created++)
         if (pthread_create(&e->w[created].th, &attr, worker_main, &e->w[created]) != 0) {
             err = FDT_ETHREAD;
-            fdt_eng_set_error(e, FDT_ETHREAD, created, "could not create a thread");
+            fdt_term_ctl_fail(e, FDT_ETHREAD, created, "could not create a thread");
             break;
         }
     pthread_attr_destroy(&attr);
@@ -148,15 +148,21 @@ int fdt_threads_run(engine *e, const fdt_settings *s, double *t_loops)
             built += atomic_load_explicit(&e->w[i].tets_done, memory_order_relaxed);
         double fr = (double)built / expect;
         if (s->progress(s->progress_user, fr > 0.99 ? 0.99 : fr))
-            fdt_eng_set_error(e, FDT_ECANCELED, -1, "canceled");
+            fdt_term_ctl_fail(e, FDT_ECANCELED, -1, "canceled");
         pthread_mutex_lock(&e->lock);
     }
     *t_loops = now_s();
     /* Every worker waits on `go` now. Gather only a complete run: with an
      * error (relaxed is enough: a worker's fdt_eng_set_error precedes its
-     * finished++ under the lock we hold) the workers just exit. */
+     * finished++ under the lock we hold; message mode: the workers'
+     * own error fields, written before finished++ too) the workers just
+     * exit. */
     int go = -1;
-    if (!err && atomic_load_explicit(&e->error, memory_order_relaxed) == 0) {
+    int wt;
+    const char *ww;
+    int failed = e->msg_term ? fdt_term_error(e, &wt, &ww) != 0
+                             : atomic_load_explicit(&e->error, memory_order_relaxed) != 0;
+    if (!err && !failed) {
         err = fdt_gather_prepare(e);
         go = err ? -1 : 1;
     }

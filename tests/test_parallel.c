@@ -9,7 +9,9 @@
  *     equal serial mode's (so the threads' neighbour links are right);
  *   - every message kind was received as often as it was sent, in total and
  *     summed over the per-thread statistics; IAMDONE went to every other
- *     thread once, FACERECV never; NODESEND only in message mode;
+ *     thread once (message mode: also from each root's tree to part 0);
+ *     FACERECV once per FACESEND in message mode, never in shared mode;
+ *     ABORT never; NODESEND only in message mode;
  *   - the partition module: proportional part sizes for any N, contiguous
  *     ranges, owner lookup, the composite tree.
  * Then many threads on tiny inputs (where nearly every tet straddles parts:
@@ -293,8 +295,17 @@ static void check_stats(const fdt_result *r, fdt_mode mode, int nthreads)
     }
     CHECK(strcmp(fdt_msg_kind_name(0), "?") == 0);
     CHECK(strcmp(fdt_msg_kind_name(FDT_MSG_KIND_END), "?") == 0);
-    CHECK_EQ(st.sent[FDT_MSG_IAMDONE], nthreads - 1);
-    CHECK_EQ(st.sent[FDT_MSG_FACERECV], 0);
+    CHECK_EQ(st.sent[FDT_MSG_ABORT], 0);
+    if (mode == FDT_MODE_MESSAGE) {
+        /* every FACESEND acknowledged; IAMDONE: the final one to every
+         * other part, and at most one a root (part with seeds) to part 0 */
+        CHECK_EQ(st.sent[FDT_MSG_FACERECV], st.sent[FDT_MSG_FACESEND]);
+        CHECK(st.sent[FDT_MSG_IAMDONE] >= (size_t)nthreads - 1 &&
+              st.sent[FDT_MSG_IAMDONE] <= 2 * (size_t)nthreads - 2);
+    } else {
+        CHECK_EQ(st.sent[FDT_MSG_IAMDONE], nthreads - 1);
+        CHECK_EQ(st.sent[FDT_MSG_FACERECV], 0);
+    }
     CHECK_EQ(st.sent[FDT_MSG_NODESEND], st.sent[FDT_MSG_NODERECV]);
     CHECK_EQ(st.remote_queries, st.sent[FDT_MSG_NODESEND]);
     CHECK_EQ(st.remote_answered, st.sent[FDT_MSG_NODESEND]);
@@ -327,9 +338,21 @@ static void check_stats(const fdt_result *r, fdt_mode mode, int nthreads)
         }
         CHECK_EQ(ts.core, -1);
         CHECK(ts.t_idle >= 0.0 && ts.t_query_wait >= 0.0 && ts.t_cpu >= 0.0);
-        /* Each thread got exactly one IAMDONE, or sent them all. */
-        CHECK(ts.received[FDT_MSG_IAMDONE] == 1 || (ts.received[FDT_MSG_IAMDONE] == 0 &&
-                                           ts.sent[FDT_MSG_IAMDONE] == (size_t)nthreads - 1));
+        /* Each thread got exactly one IAMDONE, or sent them all (shared
+         * mode); message mode: part 0 sends the final ones, every other
+         * part gets one and sends at most one (its tree finished). */
+        if (mode == FDT_MODE_MESSAGE) {
+            if (i == 0) {
+                CHECK_EQ(ts.sent[FDT_MSG_IAMDONE], nthreads - 1);
+            } else {
+                CHECK_EQ(ts.received[FDT_MSG_IAMDONE], 1);
+                CHECK(ts.sent[FDT_MSG_IAMDONE] <= 1);
+            }
+        } else {
+            CHECK(ts.received[FDT_MSG_IAMDONE] == 1 ||
+                  (ts.received[FDT_MSG_IAMDONE] == 0 &&
+                   ts.sent[FDT_MSG_IAMDONE] == (size_t)nthreads - 1));
+        }
     }
     fdt_thread_stats ts;
     CHECK_EQ(fdt_result_thread_stats(r, nthreads, &ts), FDT_EINVAL);

@@ -202,7 +202,7 @@ static void run_shuffled(const input *in, const fdt_vid *ref, size_t nref, uint6
     CHECK_EQ(fdt_prepare(in->xyz, in->n, 1, &pr, diag, sizeof diag), FDT_OK);
     fdt_settings s;
     fdt_default_settings(&s);
-    fdt_par_opts opt = {1, seed, (int)(seed % 4) * 20};
+    fdt_par_opts opt = {1, seed, (int)(seed % 4) * 20, 0, 0, 0};
     fdt_par_out out;
     int err = fdt_parallel_run(&pr, &s, mode, nthreads, &opt, &out, diag, sizeof diag);
     if (err) {
@@ -226,9 +226,42 @@ static void run_shuffled(const input *in, const fdt_vid *ref, size_t nref, uint6
         CHECK_EQ(out.pst.sent[k], sent[k]);
         CHECK_EQ(out.pst.received[k], recv[k]);
     }
-    if (mode == FDT_MODE_SHARED)
+    CHECK_EQ(sent[FDT_MSG_ABORT], 0);
+    if (mode == FDT_MODE_SHARED) {
         CHECK_EQ(sent[FDT_MSG_NODESEND], 0);
+        CHECK_EQ(sent[FDT_MSG_FACERECV], 0);
+    } else {
+        /* FACERECV acknowledges every FACESEND (src/termination.c) */
+        CHECK_EQ(sent[FDT_MSG_FACERECV], sent[FDT_MSG_FACESEND]);
+        /* the final IAMDONE reached every other part */
+        for (int i = 1; i < out.nthreads; i++)
+            CHECK_EQ(out.tstats[i].received[FDT_MSG_IAMDONE], 1);
+    }
     fdt_par_out_free(&out);
+    fdt_prepared_free(&pr);
+    runs++;
+}
+
+/* A part that fails (injected) ends every part with its error: no hang
+ * (alarm), no mesh, the failing part named. */
+static void run_failing(const input *in, fdt_mode mode, int nthreads, uint64_t seed)
+{
+    fdt_prepared pr;
+    char diag[256] = "";
+    CHECK_EQ(fdt_prepare(in->xyz, in->n, 1, &pr, diag, sizeof diag), FDT_OK);
+    fdt_settings s;
+    fdt_default_settings(&s);
+    int part = (int)(seed % (uint64_t)nthreads);
+    fdt_par_opts opt = {1, seed, (int)(seed % 4) * 20, 1, part, 1 + (size_t)(seed % 7)};
+    fdt_par_out out;
+    int err = fdt_parallel_run(&pr, &s, mode, nthreads, &opt, &out, diag, sizeof diag);
+    CHECK_EQ(err, FDT_EINTERNAL);
+    char want[64];
+    snprintf(want, sizeof want, "worker thread %d:", part);
+    if (!strstr(diag, want))
+        fprintf(stderr, "diag: %s (want %s)\n", diag, want);
+    CHECK(strstr(diag, want) != NULL);
+    CHECK(out.mb.tets == NULL && out.tstats == NULL);
     fdt_prepared_free(&pr);
     runs++;
 }
@@ -272,5 +305,15 @@ int main(int argc, char **argv)
         free(in.xyz);
     }
     printf("engine over the shuffle transport: %d runs ok in %.1f s\n", runs, now_s() - t0);
+    /* failures: ABORT in message mode, the flag in shared mode */
+    runs = 0;
+    input in = make_input("uniform", 77);
+    for (size_t ti = 0; ti < sizeof threads / sizeof *threads; ti++)
+        for (int m = 0; m < 2; m++)
+            for (int sd = 0; sd < nseeds; sd++)
+                run_failing(&in, m ? FDT_MODE_MESSAGE : FDT_MODE_SHARED, threads[ti],
+                            (uint64_t)(ti * 100 + (size_t)m * 10 + (size_t)sd));
+    free(in.xyz);
+    printf("an injected failure of one part ends every part: %d runs ok\n", runs);
     return 0;
 }
