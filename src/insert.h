@@ -46,6 +46,7 @@ typedef struct fdt_ins_stats {
     size_t created_tets;  /* tets created */
     size_t max_cavity;    /* largest cavity */
     size_t conflict_tests;/* conflict (insphere / hull side) tests */
+    size_t serial_finish; /* fdt_ins_build_parallel: points left to its serial end */
 } fdt_ins_stats;
 
 typedef struct fdt_ins {

@@ -106,6 +106,8 @@ typedef struct worker {
     int nrounds;
     uint32_t *def;             /* deferred points */
     size_t ndef, defcap;
+    uint32_t *todo;            /* owned: a later pass's points (pts) */
+    size_t todocap;
     fdt_pred_counts cnt;
     fdt_ins_stats st;
     pthread_t th;
@@ -639,6 +641,7 @@ static void worker_free(worker *w)
     free(w->bnd);
     free(w->edges.eh);
     free(w->def);
+    free(w->todo);
 }
 
 static int worker_init(worker *w, shared *sh, int id)
@@ -781,16 +784,45 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
     order = NULL;
 
     /* Phase 2. pthread_create orders everything above before the
-     * workers; a worker that cannot start leaves its points to phase 3. */
-    for (int i = 1; i < nw; i++)
-        ws[i].started = pthread_create(&ws[i].th, NULL, worker_main, &ws[i]) == 0;
-    worker_main(&ws[0]);
-    for (int i = 1; i < nw; i++)
-        if (ws[i].started)
-            pthread_join(ws[i].th, NULL);
-    /* The joins order the workers' writes before what follows. */
-    if ((err = atomic_load_explicit(&sh.err, memory_order_relaxed)) != 0)
-        goto fail;
+     * workers; a worker that cannot start leaves its points to phase 3.
+     * When the slots run out, the workers stop, the arrays grow here
+     * (no thread runs) and the workers go on with what they left. */
+    for (int pass = 0;; pass++) {
+        for (int i = 1; i < nw; i++)
+            ws[i].started = pthread_create(&ws[i].th, NULL, worker_main, &ws[i]) == 0;
+        worker_main(&ws[0]);
+        for (int i = 1; i < nw; i++)
+            if (ws[i].started)
+                pthread_join(ws[i].th, NULL);
+        /* The joins order the workers' writes before what follows. */
+        if ((err = atomic_load_explicit(&sh.err, memory_order_relaxed)) != 0)
+            goto fail;
+        uint64_t next = atomic_load_explicit(&sh.next, memory_order_relaxed);
+        int started = 1;
+        for (int i = 1; i < nw; i++)
+            started &= ws[i].started;
+        if (next < m->cap || !started || pass >= 8)
+            break; /* not stopped for slots (or give up: phase 3 grows) */
+        /* Every slot below the capacity was handed out: go on above it. */
+        atomic_store_explicit(&sh.next, m->cap, memory_order_relaxed);
+        if ((err = grow_arrays(&sh, (uint64_t)m->cap + m->cap / 2)) != FDT_OK)
+            goto fail;
+        atomic_store_explicit(&sh.stop, 0, memory_order_relaxed);
+        for (int i = 0; i < nw; i++) { /* the deferred points are the new list */
+            worker *w = &ws[i];
+            uint32_t *t = w->todo;
+            size_t c = w->todocap;
+            w->todo = w->def;
+            w->todocap = w->defcap;
+            w->pts = w->todo;
+            w->npts = w->ndef;
+            w->def = t;
+            w->defcap = c;
+            w->ndef = 0;
+            rend[32 * (size_t)i] = w->npts;
+            w->nrounds = 1;
+        }
+    }
 
     /* Phase 3 on this thread, as worker 0: every freed or unused slot
      * becomes its own (locked by it), every other lock is free. */
@@ -828,6 +860,7 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
         m->nslots = next < m->cap ? (uint32_t)next : m->cap;
         atomic_store_explicit(&sh.next, m->nslots, memory_order_relaxed);
     }
+    m->stats.serial_finish = w0->ndef;
     for (size_t j = 0; j < w0->ndef; j++) {
         int rc = insert_point(w0, w0->def[j]);
         if (rc != FDT_OK) {
