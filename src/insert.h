@@ -47,6 +47,11 @@ typedef struct fdt_ins_stats {
     size_t max_cavity;    /* largest cavity */
     size_t conflict_tests;/* conflict (insphere / hull side) tests */
     size_t serial_finish; /* fdt_ins_build_parallel: points left to its serial end */
+    /* fdt_ins_build_parallel: thread CPU seconds of its serial start, of
+     * its workers (the busiest one, and all together) and of its serial
+     * end (finish included). start + workers_max + finish is the wall
+     * time with a free core a worker. */
+    double cpu_start_s, cpu_workers_max_s, cpu_workers_sum_s, cpu_finish_s;
 } fdt_ins_stats;
 
 typedef struct fdt_ins {

@@ -59,6 +59,7 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include "bits.h"
 
 enum {
@@ -112,7 +113,17 @@ typedef struct worker {
     fdt_ins_stats st;
     pthread_t th;
     int started;
+    double cpu_s;              /* thread CPU seconds in worker_main */
 } worker;
+
+/* CPU seconds of the calling thread (the phase timings of the stats). */
+static double thread_cpu(void)
+{
+    struct timespec ts;
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0)
+        return 0.0;
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 /* ------------------------------------------------------------------ */
 /* Locks. */
@@ -588,6 +599,7 @@ static void *worker_main(void *arg)
 {
     worker *w = arg;
     shared *sh = w->sh;
+    double c0 = thread_cpu();
     size_t i = 0;
     int err = FDT_OK;
     for (int r = 0; r < w->nrounds && !err; r++) {
@@ -629,6 +641,7 @@ static void *worker_main(void *arg)
     }
     if (err)
         fail_all(sh, err);
+    w->cpu_s += thread_cpu() - c0;
     return NULL;
 }
 
@@ -700,9 +713,11 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
         r0++;
     uint32_t prefix = round_end[r0 - 1];
     uint64_t slots = (uint64_t)n * 8 + (uint64_t)nw * 2 * CHUNK + 1024;
+    double c0 = thread_cpu();
     err = fdt_ins_build_prefix(m, P, base, n, order, prefix, slots, first, cnt);
     if (err)
         goto out;
+    double c1 = thread_cpu();
     err = FDT_ENOMEM;
     sh.lock = malloc((size_t)m->cap * sizeof *sh.lock);
     sh.mark = calloc((size_t)m->cap, 1);
@@ -827,6 +842,7 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
     /* Phase 3 on this thread, as worker 0: every freed or unused slot
      * becomes its own (locked by it), every other lock is free. */
     worker *w0 = &ws[0];
+    double c2 = thread_cpu();
     sh.single = 1;
     err = FDT_ENOMEM;
     for (int i = 0; i < nw; i++) {
@@ -894,6 +910,15 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
         }
     }
     err = fdt_ins_finish(m);
+    if (err == FDT_OK) {
+        m->stats.cpu_start_s = c1 - c0;
+        m->stats.cpu_finish_s = thread_cpu() - c2;
+        for (int i = 0; i < nw; i++) {
+            m->stats.cpu_workers_sum_s += ws[i].cpu_s;
+            if (ws[i].cpu_s > m->stats.cpu_workers_max_s)
+                m->stats.cpu_workers_max_s = ws[i].cpu_s;
+        }
+    }
     goto out;
 fail:
     fdt_ins_free(m);
