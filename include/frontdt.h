@@ -71,7 +71,11 @@ FDT_API const char *fdt_strerror(int err);
 FDT_API const char *fdt_version(void);
 
 typedef enum fdt_mode {
-    FDT_MODE_AUTO = 0,    /* serial for one thread, shared otherwise */
+    FDT_MODE_AUTO = 0,    /* serial for one thread, shared otherwise; where
+                             the kd search degenerates (scans, grids,
+                             cospherical sets) the threads first build the
+                             Delaunay mesh of every point together and
+                             every part's front reads its apexes from it */
     FDT_MODE_SERIAL = 1,  /* one thread, no mailbox: the reference */
     FDT_MODE_SHARED = 2,  /* threads read each other's points (Cray-2 style) */
     FDT_MODE_MESSAGE = 3  /* remote range queries travel as NODESEND/NODERECV */

@@ -289,7 +289,7 @@ static int advance_one(worker *w)
     memcpy(b, pb, sizeof b);
     memcpy(c, pc, sizeof c);
     fdt_oracle_tick(&w->orc, w->st.faces_advanced - 1, &w->kq);
-    if (w->orc.state == 1 && !w->published) {
+    if (w->orc.state == 1 && !w->orc.gm && !w->published) {
         /* release: see mesh_pub */
         atomic_store_explicit(&w->mesh_pub, 1, memory_order_release);
         w->published = 1;
@@ -374,6 +374,8 @@ int fdt_eng_worker_setup(worker *w)
     /* The part's mesh, if it comes to one, is built by this thread: its
      * pages are first touched here, near the core that reads them. */
     fdt_oracle_init(&w->orc, w->tree, w->e->search);
+    if (w->e->gmesh_ok)
+        fdt_oracle_share(&w->orc, &w->e->gmesh);
     w->qcache_part = -1;
     return FDT_OK;
 }

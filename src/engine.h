@@ -122,6 +122,10 @@ typedef struct engine {
     const double *P;
     fdt_mode mode;
     int search;                /* fdt_search, for every part's oracle */
+    fdt_ins gmesh;             /* the DT of every point, when gmesh_ok:
+                                  built before the threads start, read-only
+                                  after (thread creation publishes it) */
+    int gmesh_ok;
     int n;
     int want_nbrs;
     fdt_transport *tp;         /* messages between the parts: endpoints

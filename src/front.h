@@ -93,8 +93,9 @@ static inline int fdt_front_apex(fdt_oracle *orc, const fdt_kdtree *t, fdt_facet
                 return FDT_EINTERNAL;
         }
         fdt_facetab_prefetch_tet(ft, f, *apex);
+        /* A mesh of every point (fdt_oracle_share) gives the apex itself. */
         if (keep)
-            *inside = fdt_apex_inside_region(ap, t);
+            *inside = orc->gm ? 1 : fdt_apex_inside_region(ap, t);
         return FDT_OK;
     }
     if (!keep)

@@ -309,6 +309,27 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
             active++;
         }
     }
+    /* The DT of every point, for inputs where the kd search degenerates
+     * (src/api.c decides, by fdt_oracle_probe): built here on the run's
+     * threads, then every part reads its faces' apexes from it and asks
+     * no other part (bench/NOTES.md entry 54). Tets are still made and
+     * owned by the parts' fronts. A build that cannot be made (no memory)
+     * leaves the parts on their own oracles. */
+    double t_gm = 0.0;
+    if (opt && opt->global_mesh && mode == FDT_MODE_SHARED) {
+        double tg = now_s();
+        int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads,
+                                          &kq0.pc);
+        t_gm = now_s() - tg;
+        if (gerr == FDT_OK)
+            e->gmesh_ok = 1;
+        else if (gerr != FDT_ENOMEM && gerr != FDT_EDEGENERATE) {
+            err = gerr;
+            if (gerr == FDT_EINTERNAL)
+                snprintf(diag, dlen, "internal error: the parallel insertion mesh failed");
+            goto fail;
+        }
+    }
     /* Every thread with seeds starts holding its activity unit. Thread
      * creation orders this before everything the workers do. */
     atomic_init(&e->work, active);
@@ -369,7 +390,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         out->fst.kq.pc.insphere_exact += w->kq.pc.insphere_exact;
         out->fst.mesh_faces += w->orc.mesh_faces;
         out->fst.star_walks += w->orc.star_walks;
-        out->fst.mesh_parts += w->orc.switched_at != 0;
+        out->fst.mesh_parts += w->orc.switched_at != 0 || w->orc.gm;
         out->fst.t_mesh += w->orc.t_mesh;
         out->fst.kq.pc.orient_adapt += w->kq.pc.orient_adapt;
         out->fst.kq.pc.insphere_adapt += w->kq.pc.insphere_adapt;
@@ -377,6 +398,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
             maxt = ts->tets;
         sumt += ts->tets;
     }
+    out->fst.t_mesh += t_gm;
     out->fst.kq.nodes += kq0.nodes;
     out->fst.kq.points += kq0.points;
     out->fst.kq.pc.orient_exact += kq0.pc.orient_exact;
@@ -415,6 +437,7 @@ fail:
             for (int i = 0; i < nthreads; i++)
                 fdt_eng_worker_free(&e->w[i]);
         free(e->w);
+        fdt_ins_free(&e->gmesh);
         fdt_transport_destroy(&e->tp);
         if (sync_ok) {
             pthread_cond_destroy(&e->go);

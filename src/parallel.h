@@ -55,6 +55,9 @@ typedef struct fdt_par_opts {
                            once it has advanced fail_after faces */
     int fail_part;
     size_t fail_after;
+    int global_mesh;    /* shared mode: build the DT of every point first
+                           (fdt_ins_build_parallel, on nthreads threads)
+                           and let every part read its apexes from it */
 } fdt_par_opts;
 
 /* fdt_parallel_triangulate with options (NULL: none, what it does). */
