@@ -77,7 +77,11 @@ FDT_API const char *fdt_strerror(int err);
 FDT_API const char *fdt_version(void);
 
 typedef enum fdt_mode {
-    FDT_MODE_AUTO = 0,    /* serial for one thread, shared otherwise */
+    FDT_MODE_AUTO = 0,    /* serial for one thread, shared otherwise; where
+                             the kd search degenerates (scans, grids,
+                             cospherical sets) the threads first build the
+                             Delaunay mesh of every point together and
+                             every part's front reads its apexes from it */
     FDT_MODE_SERIAL = 1,  /* one thread, no mailbox: the reference */
     FDT_MODE_SHARED = 2,  /* threads read each other's points (Cray-2 style) */
     FDT_MODE_MESSAGE = 3  /* remote range queries travel as NODESEND/NODERECV */
@@ -224,15 +228,25 @@ FDT_API int fdt_result_sort(fdt_result *r);
  * content of a .tets file). Sorts r first (fdt_result_sort). */
 FDT_API int fdt_result_hash(fdt_result *r, uint64_t *hash);
 
-/* Message counts by kind (Merriam §4; DESIGN.md, Mailboxes). */
-typedef struct fdt_msg_counts {
-    size_t iamdone;           /* "no work left anywhere": ends a run */
-    size_t nodesend;          /* range queries to another partition */
-    size_t noderecv;          /* their answers */
-    size_t facesend;          /* faces, and found apexes, for their owner */
-    size_t facerecv;          /* acknowledgements of FACESEND (the engine
-                                 needs none: 0, see src/parallel.c) */
-} fdt_msg_counts;
+/*
+ * The kinds of message between parts (Merriam §4; DESIGN.md, Transport),
+ * the index of the message statistics (fdt_stats.sent, .received). 0 is
+ * not a kind (its slot stays 0); a new kind takes the next number.
+ */
+typedef enum fdt_msg_kind {
+    FDT_MSG_IAMDONE = 1,  /* "no work left anywhere": ends a run */
+    FDT_MSG_NODESEND = 2, /* range queries to another partition */
+    FDT_MSG_NODERECV = 3, /* their answers */
+    FDT_MSG_FACESEND = 4, /* faces, and found apexes, for their owner */
+    FDT_MSG_FACERECV = 5, /* acknowledgements of FACESEND (message mode;
+                             shared mode needs none: 0, src/termination.c) */
+    FDT_MSG_ABORT = 6,    /* a part failed: stop (message mode) */
+    FDT_MSG_KIND_END = 7  /* arrays indexed by kind have this many slots */
+} fdt_msg_kind;
+
+/* The name of a kind, "IAMDONE", "NODESEND", ...; "?" for anything else.
+ * Never NULL; a static string. */
+FDT_API const char *fdt_msg_kind_name(int kind);
 
 typedef struct fdt_stats {
     size_t struct_size;       /* bytes the library filled: the caller's
@@ -256,8 +270,10 @@ typedef struct fdt_stats {
     double t_front;           /* seconds: advancing the front */
     double t_finish;          /* seconds: renumbering, neighbours */
     /* The parallel modes (shared, message); zero in serial mode. */
-    fdt_msg_counts sent;      /* messages sent, summed over threads */
-    fdt_msg_counts received;  /* messages received (equal to sent: checked) */
+    size_t sent[FDT_MSG_KIND_END];     /* messages sent by kind, summed over
+                                          threads (slot 0 unused) */
+    size_t received[FDT_MSG_KIND_END]; /* received by kind (equal to sent:
+                                          checked) */
     size_t remote_queries;    /* range queries sent to other partitions */
     size_t remote_answered;   /* range queries answered for other partitions */
     size_t remote_improved;   /* answers that improved the asker's apex */
@@ -293,7 +309,7 @@ typedef struct fdt_thread_stats {
     size_t max_front;         /* largest size of its face table */
     size_t remote_queries, remote_answered, remote_improved;
     size_t tet_requests, duplicate_requests;
-    fdt_msg_counts sent, received;
+    size_t sent[FDT_MSG_KIND_END], received[FDT_MSG_KIND_END]; /* by kind */
     double t_idle, t_query_wait;
     double t_cpu;             /* CPU seconds the thread used (0 if unknown) */
     int core;                 /* core it was bound to, -1 if not pinned */

@@ -196,23 +196,12 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
          * hull face). s->tet is the tet on the closed side and its face
          * index, so out->tets[s->tet] is the vertex opposite f there. */
         uint32_t apex, mtet = FDT_NONE;
-        if (!fdt_oracle_apex(&orc, f, (int64_t)(s->tet >> 2), out->tets[s->tet], &apex,
-                             &mtet)) {
-            fdt_apex ap;
-            fdt_apex_init(&ap, P + 3 * (size_t)f[0], P + 3 * (size_t)f[1],
-                          P + 3 * (size_t)f[2], f[0], f[1], f[2]);
-            /* Start in f0's leaf and climb (src/kdtree.c): the apex is
-             * near. Between the guess and the climb, the table slots of
-             * the faces the guessed tet would add are asked for: the climb
-             * hides their latency, and the guess is the apex for most
-             * faces. */
-            fdt_apex_guess(&ap, t, f[0], &st->kq);
-            fdt_facetab_prefetch_tet(&ft, f, ap.best);
-            fdt_apex_verify_from(&ap, t, f[0], &st->kq);
-            apex = ap.best;
-        } else {
-            fdt_facetab_prefetch_tet(&ft, f, apex);
-        }
+        fdt_apex ap;
+        if ((err = fdt_front_apex(&orc, t, &ft, f, P + 3 * (size_t)f[0], P + 3 * (size_t)f[1],
+                                  P + 3 * (size_t)f[2], (int64_t)(s->tet >> 2),
+                                  out->tets[s->tet], 0, &ap, NULL, &apex, &mtet,
+                                  &st->kq)) != FDT_OK)
+            goto done;
         if (apex == FDT_NONE) {
             /* Nothing on the open side: a convex-hull face (§2.2). Its
              * open side is the outside, so f is already outward. */

@@ -8,7 +8,9 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "frontdt.h"
+#include "facetab.h"
 #include "kdtree.h"
+#include "oracle.h"
 
 /* Growable output: tets (4 global ids each, positively oriented), their
  * neighbours (optional) and hull faces (3 ids, outward). */
@@ -52,5 +54,61 @@ int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces, fdt_front
 /* The outward faces of a positively oriented tet: face i is opposite
  * vertex i and has that vertex on its negative side. */
 extern const int fdt_tet_face[4][3];
+
+/*
+ * The apex of front face f (§2.2), the step the serial front and a part of
+ * the parallel engine share: the oracle's insertion mesh where it switched
+ * to it (src/oracle.h: ctid, copp are the closed-side tet and its vertex
+ * opposite f, or -1 and FDT_NONE), else the kd search of t from f[0]'s
+ * leaf. Between the kd guess and the climb (or after the mesh's answer)
+ * the table slots of the faces the apex's tet would add are asked for
+ * (fdt_facetab_prefetch_tet): the search hides their latency.
+ * keep == 0 (serial: t holds every point): *apex is the apex (FDT_NONE: a
+ * hull face); ap is scratch, initialized only where the kd search runs.
+ * keep != 0 (a part of the parallel engine): ap is initialized from a, b, c
+ * and left holding the search state so far, which other parts may still
+ * improve; *inside says whether its ball lies inside t's region (then no
+ * other part need be asked). *mtet: the mesh tet of a mesh answer
+ * (fdt_oracle_note). Static inline so each caller gets its own copy with
+ * keep constant (the serial loop pays for nothing it does not use).
+ * Returns FDT_OK, or FDT_EINTERNAL if the mesh's apex is refused by the
+ * search state (the mesh and the exact tests disagree).
+ */
+static inline int fdt_front_apex(fdt_oracle *orc, const fdt_kdtree *t, fdt_facetab *ft,
+                                 const uint32_t f[3], const double *a, const double *b,
+                                 const double *c, int64_t ctid, uint32_t copp, int keep,
+                                 fdt_apex *ap, int *inside, uint32_t *apex, uint32_t *mtet,
+                                 fdt_kdq *kq)
+{
+    if (keep)
+        fdt_apex_init(ap, a, b, c, f[0], f[1], f[2]);
+    if (fdt_oracle_apex(orc, f, ctid, copp, apex, mtet)) {
+        /* The mesh's answer is the first of t's points in the pencil of
+         * spheres through f's circle: with keep it is offered to the
+         * search state, where only another part's point can beat it. */
+        if (keep && *apex != FDT_NONE) {
+            fdt_apex_offer(ap, *apex, t->P + 3 * (size_t)*apex, kq);
+            /* on the open side by construction: a refusal is a bug */
+            if (ap->best != *apex)
+                return FDT_EINTERNAL;
+        }
+        fdt_facetab_prefetch_tet(ft, f, *apex);
+        /* A mesh of every point (fdt_oracle_share) gives the apex itself. */
+        if (keep)
+            *inside = orc->gm ? 1 : fdt_apex_inside_region(ap, t);
+        return FDT_OK;
+    }
+    if (!keep)
+        fdt_apex_init(ap, a, b, c, f[0], f[1], f[2]);
+    /* Start in f0's leaf and climb (src/kdtree.c): the apex is near, and
+     * the guess is the apex for most faces. */
+    fdt_apex_guess(ap, t, f[0], kq);
+    fdt_facetab_prefetch_tet(ft, f, ap->best);
+    int in = fdt_apex_verify_from(ap, t, f[0], kq);
+    if (keep)
+        *inside = in;
+    *apex = ap->best;
+    return FDT_OK;
+}
 
 #endif

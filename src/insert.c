@@ -57,26 +57,13 @@
  * is an internal error.
  */
 #include "insert.h"
+#include "insert_impl.h"
 
 #include <stdlib.h>
 #include <string.h>
 #include "bits.h"
 #include "front.h"
 #include "mem.h"
-
-/* Neighbour references are 4 * slot + face in 32 bits. */
-#define INS_MAX_SLOTS (UINT32_C(1) << 30)
-#define PACK(t, k) (((uint32_t)(t) << 2) | (uint32_t)(k))
-#define INF FDT_NONE
-
-/* Conflict marks of the build, per slot. */
-enum { MARK_NONE = 0, MARK_IN = 1, MARK_OUT = 2 };
-
-typedef struct edge_slot {
-    uint64_t key;     /* the two vertex ids, smaller first */
-    uint32_t val;     /* packed face (new tet, index) waiting for its twin */
-    uint32_t stamp;   /* valid when equal to the build's current stamp */
-} edge_slot;
 
 /* State of one build that the result does not keep. */
 typedef struct build {
@@ -90,54 +77,12 @@ typedef struct build {
     size_t nbnd, bndcap;
     uint32_t *outl;                /* tets tested and found not in conflict */
     size_t nout, outcap;
-    edge_slot *eh;                 /* the new tets' edges (linking them) */
-    uint32_t ehbits;               /* eh has 2^ehbits slots (0: none yet) */
-    uint32_t stamp;
+    ins_edges edges;               /* the new tets' edges (linking them) */
     uint64_t rng;                  /* the walk's choices */
 } build;
 
-static inline const double *pt(const fdt_ins *m, uint32_t v)
-{
-    return m->P + 3 * (size_t)v;
-}
-
-/* The filters inline, the exact stages (and the rescaled filters) out of
- * line: most calls end in the filter. */
-static inline int orient(const double *a, const double *b, const double *c, const double *d,
-                         fdt_pred_counts *cnt)
-{
-    int s = fdt_orient3d_filter(a, b, c, d);
-    if (s != FDT_PRED_UNSURE)
-        return s;
-    return fdt_orient3d(a, b, c, d, cnt);
-}
-
-static inline int insphere_p(const double *a, const double *b, const double *c, const double *d,
-                             const double *e, fdt_pred_counts *cnt)
-{
-    int s = fdt_insphere_filter(a, b, c, d, e);
-    if (s != FDT_PRED_UNSURE)
-        return s;
-    return fdt_insphere_perturbed(a, b, c, d, e, cnt);
-}
-
 /* ------------------------------------------------------------------ */
 /* Slots and scratch. */
-
-static int grow_u32(uint32_t **a, size_t *cap, size_t need)
-{
-    if (need <= *cap)
-        return FDT_OK;
-    size_t nc = *cap ? *cap : 64;
-    while (nc < need)
-        nc += nc / 2 + 1;
-    uint32_t *p = realloc(*a, nc * sizeof *p);
-    if (!p)
-        return FDT_ENOMEM;
-    *a = p;
-    *cap = nc;
-    return FDT_OK;
-}
 
 /* Makes room for `extra` more tets (free list plus unused capacity). */
 static int reserve_slots(build *b, uint32_t extra)
@@ -190,67 +135,6 @@ static inline void free_slot(build *b, uint32_t t)
     b->nfree++;
 }
 
-/* An edge table with room for `edges` keys at most half full, emptied:
- * a new stamp invalidates every slot at once. */
-static int edges_begin(build *b, size_t edges)
-{
-    uint32_t bits = b->ehbits ? b->ehbits : 6;
-    while (((size_t)1 << bits) < 2 * edges)
-        bits++;
-    if (bits != b->ehbits) {
-        edge_slot *e = calloc((size_t)1 << bits, sizeof *e);
-        if (!e)
-            return FDT_ENOMEM;
-        free(b->eh);
-        b->eh = e;
-        b->ehbits = bits;
-        b->stamp = 0;
-    }
-    if (++b->stamp == 0) { /* wrapped: old stamps would read as valid */
-        memset(b->eh, 0, ((size_t)1 << b->ehbits) * sizeof *b->eh);
-        b->stamp = 1;
-    }
-    return FDT_OK;
-}
-
-/*
- * Face `f` (packed) of a new tet contains the edge xy besides the new
- * point: the other new tet through xy is its neighbour there. The first of
- * the two to arrive waits in the table, the second links both. Returns 1
- * when it linked.
- */
-static inline int link_edge(build *b, uint32_t *T, uint32_t x, uint32_t y, uint32_t f)
-{
-    uint64_t key = x < y ? ((uint64_t)x << 32) | y : ((uint64_t)y << 32) | x;
-    uint32_t mask = (UINT32_C(1) << b->ehbits) - 1;
-    uint32_t h = (uint32_t)((key * UINT64_C(0x9E3779B97F4A7C15)) >> (64 - b->ehbits));
-    for (;; h = (h + 1) & mask) {
-        edge_slot *s = &b->eh[h];
-        if (s->stamp != b->stamp) {
-            s->stamp = b->stamp;
-            s->key = key;
-            s->val = f;
-            return 0;
-        }
-        if (s->key == key) {
-            uint32_t g = s->val;
-            T[8 * (size_t)(g >> 2) + 4 + (g & 3)] = f;
-            T[8 * (size_t)(f >> 2) + 4 + (f & 3)] = g;
-            s->key = UINT64_MAX; /* each edge is shared by exactly two faces */
-            return 1;
-        }
-    }
-}
-
-/* For a face opposite vertex k, the edge of that face opposite its vertex
- * i (i != k) has the vertices at the two other indices. */
-static const uint8_t other2[4][4][2] = {
-    {{0, 0}, {2, 3}, {1, 3}, {1, 2}},
-    {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
-    {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
-    {{1, 2}, {0, 2}, {0, 1}, {0, 0}},
-};
-
 /* ------------------------------------------------------------------ */
 /* Insertion. */
 
@@ -276,7 +160,7 @@ static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng
         const uint32_t *v = T + 8 * (size_t)t;
         if (v[0] == INF || v[1] == INF || v[2] == INF || v[3] == INF)
             break;
-        const double *q[4] = {pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3])};
+        const double *q[4] = {ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3])};
         *rng = *rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
         uint32_t r = (uint32_t)(*rng >> 61);
         int exit = -1;
@@ -286,7 +170,7 @@ static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng
                 continue;
             const double *s[4] = {q[0], q[1], q[2], q[3]};
             s[k] = p;
-            if (orient(s[0], s[1], s[2], s[3], cnt) < 0) {
+            if (ins_orient(s[0], s[1], s[2], s[3], cnt) < 0) {
                 exit = k;
                 break;
             }
@@ -317,21 +201,21 @@ static inline int conflict(build *b, uint32_t t, const double *p)
     b->m->stats.conflict_tests++;
     int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
     if (inf < 0)
-        return insphere_p(pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), p, b->cnt) > 0;
+        return ins_insphere(ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3]), p, b->cnt) > 0;
     const double *q[4];
     for (int i = 0; i < 4; i++)
-        q[i] = i == inf ? p : pt(m, v[i]);
-    int o = orient(q[0], q[1], q[2], q[3], b->cnt);
+        q[i] = i == inf ? p : ins_pt(m, v[i]);
+    int o = ins_orient(q[0], q[1], q[2], q[3], b->cnt);
     if (o != 0)
         return o > 0;
     const uint32_t *w = m->T + 8 * (size_t)(v[4 + inf] >> 2);
-    return insphere_p(pt(m, w[0]), pt(m, w[1]), pt(m, w[2]), pt(m, w[3]), p, b->cnt) > 0;
+    return ins_insphere(ins_pt(m, w[0]), ins_pt(m, w[1]), ins_pt(m, w[2]), ins_pt(m, w[3]), p, b->cnt) > 0;
 }
 
 static int insert_point(build *b, uint32_t pid, uint32_t *last)
 {
     fdt_ins *m = b->m;
-    const double *p = pt(m, pid);
+    const double *p = ins_pt(m, pid);
     uint32_t t0;
     int err = locate(b, p, *last, &t0);
     if (err)
@@ -343,7 +227,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
     for (int i = 0; i < 4; i++) {
         if (v0[i] == INF)
             continue;
-        const double *q = pt(m, v0[i]);
+        const double *q = ins_pt(m, v0[i]);
         if (q[0] == p[0] && q[1] == p[1] && q[2] == p[2])
             return FDT_EINVAL;
     }
@@ -367,7 +251,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
             if (mark[o] == MARK_NONE) {
                 if (conflict(b, o, p)) {
                     if (b->ncav == b->cavcap &&
-                        (err = grow_u32(&b->cav, &b->cavcap, b->ncav + 1)) != FDT_OK)
+                        (err = ins_grow_u32(&b->cav, &b->cavcap, b->ncav + 1)) != FDT_OK)
                         return err;
                     mark[o] = MARK_IN;
                     b->cav[b->ncav++] = o;
@@ -378,13 +262,13 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
                     continue;
                 }
                 if (b->nout == b->outcap &&
-                    (err = grow_u32(&b->outl, &b->outcap, b->nout + 1)) != FDT_OK)
+                    (err = ins_grow_u32(&b->outl, &b->outcap, b->nout + 1)) != FDT_OK)
                     return err;
                 mark[o] = MARK_OUT;
                 b->outl[b->nout++] = o;
             }
             if (b->nbnd == b->bndcap &&
-                (err = grow_u32(&b->bnd, &b->bndcap, b->nbnd + 1)) != FDT_OK)
+                (err = ins_grow_u32(&b->bnd, &b->bndcap, b->nbnd + 1)) != FDT_OK)
                 return err;
             b->bnd[b->nbnd++] = PACK(c, k);
         }
@@ -393,7 +277,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
         return FDT_ETOOBIG;
     if ((err = reserve_slots(b, (uint32_t)b->nbnd)) != FDT_OK)
         return err;
-    if ((err = edges_begin(b, 3 * b->nbnd / 2)) != FDT_OK)
+    if ((err = ins_edges_begin(&b->edges, 3 * b->nbnd / 2)) != FDT_OK)
         return err;
     mark = b->mark; /* reserve_slots may have moved it */
 
@@ -419,7 +303,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
         for (int j = 0; j < 4; j++) {
             if (j == k)
                 continue;
-            linked += (size_t)link_edge(b, T, w[other2[k][j][0]], w[other2[k][j][1]], PACK(s, j));
+            linked += (size_t)ins_link_edge(&b->edges, T, w[ins_other2[k][j][0]], w[ins_other2[k][j][1]], PACK(s, j));
         }
     }
     /* The boundary is a closed surface: every edge met exactly twice. */
@@ -458,7 +342,7 @@ static inline uint32_t mix32(uint32_t x)
  * hash has at least L trailing zeros, round l < L those with exactly l:
  * expected sizes n 2^-L, ..., n/4, n/2. L makes the first round about 128
  * to 256 points. */
-static int brio_order(uint32_t base, uint32_t n, uint32_t *order)
+void fdt_ins_brio(uint32_t base, uint32_t n, uint32_t *order, uint32_t *round_end, int *nrounds)
 {
     int L = 0;
     while (L < 30 && (n >> (L + 1)) >= 128)
@@ -470,10 +354,11 @@ static int brio_order(uint32_t base, uint32_t n, uint32_t *order)
     for (int r = 0; r <= L; r++) {
         pos[r] = acc;
         acc += count[r];
+        round_end[r] = (uint32_t)acc;
     }
+    *nrounds = L + 1;
     for (uint32_t i = 0; i < n; i++)
         order[pos[L - fdt_ctz64(mix32(base + i) | (UINT64_C(1) << L))]++] = base + i;
-    return FDT_OK;
 }
 
 /*
@@ -506,7 +391,7 @@ static int start_simplex(build *b, const uint32_t *order, uint32_t n, uint32_t f
         return FDT_EDEGENERATE;
     uint32_t a = order[0], c0 = order[1], c = FDT_NONE, d = FDT_NONE;
     for (uint32_t i = 2; i < n && c == FDT_NONE; i++)
-        if (!collinear(pt(m, a), pt(m, c0), pt(m, order[i]), b->cnt))
+        if (!collinear(ins_pt(m, a), ins_pt(m, c0), ins_pt(m, order[i]), b->cnt))
             c = order[i];
     if (c == FDT_NONE)
         return FDT_EDEGENERATE; /* all collinear */
@@ -514,7 +399,7 @@ static int start_simplex(build *b, const uint32_t *order, uint32_t n, uint32_t f
     for (uint32_t i = 2; i < n && d == FDT_NONE; i++) {
         if (order[i] == c)
             continue;
-        o = fdt_orient3d(pt(m, a), pt(m, c0), pt(m, c), pt(m, order[i]), b->cnt);
+        o = fdt_orient3d(ins_pt(m, a), ins_pt(m, c0), ins_pt(m, c), ins_pt(m, order[i]), b->cnt);
         if (o != 0)
             d = order[i];
     }
@@ -529,7 +414,7 @@ static int start_simplex(build *b, const uint32_t *order, uint32_t n, uint32_t f
     int err = reserve_slots(b, 5);
     if (err)
         return err;
-    if ((err = edges_begin(b, 6)) != FDT_OK)
+    if ((err = ins_edges_begin(&b->edges, 6)) != FDT_OK)
         return err;
     uint32_t *T = m->T;
     uint32_t t0 = alloc_slot(b);
@@ -546,7 +431,7 @@ static int start_simplex(build *b, const uint32_t *order, uint32_t n, uint32_t f
         w[7] = PACK(t0, k);
         T[8 * (size_t)t0 + 4 + k] = PACK(s, 3);
         for (int j = 0; j < 3; j++)
-            link_edge(b, T, w[other2[3][j][0]], w[other2[3][j][1]], PACK(s, j));
+            ins_link_edge(&b->edges, T, w[ins_other2[3][j][0]], w[ins_other2[3][j][1]], PACK(s, j));
     }
     return FDT_OK;
 }
@@ -568,11 +453,12 @@ static void build_free(build *b)
     free(b->cav);
     free(b->bnd);
     free(b->outl);
-    free(b->eh);
+    free(b->edges.eh);
 }
 
-int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
-                  fdt_pred_counts *cnt)
+int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                         const uint32_t *order, uint32_t prefix, uint64_t slots,
+                         uint32_t first[4], fdt_pred_counts *cnt)
 {
     memset(m, 0, sizeof *m);
     m->P = P;
@@ -586,75 +472,106 @@ int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
     b.m = m;
     b.cnt = cnt;
     b.rng = UINT64_C(0x853c49e6748fea9b);
-    uint32_t *order = NULL;
     int err = FDT_ENOMEM;
-    /* About 6.5 tets a point on uniform points, plus the hull: growing by
-     * realloc stays possible for inputs with more. */
-    uint64_t want = (uint64_t)n * 27 / 4 + 64;
-    if (want > INS_MAX_SLOTS)
-        want = INS_MAX_SLOTS;
-    m->T = malloc((size_t)want * 8 * sizeof *m->T);
-    b.mark = calloc((size_t)want, 1);
-    order = malloc((size_t)n * sizeof *order);
-    if (!m->T || !b.mark || !order)
+    if (slots > INS_MAX_SLOTS)
+        slots = INS_MAX_SLOTS;
+    if (slots < 64)
+        slots = 64;
+    m->T = malloc((size_t)slots * 8 * sizeof *m->T);
+    b.mark = calloc((size_t)slots, 1);
+    if (!m->T || !b.mark)
         goto fail;
-    fdt_mem_advise_huge(m->T, (size_t)want * 8 * sizeof *m->T);
-    m->cap = (uint32_t)want;
-    if ((err = grow_u32(&b.cav, &b.cavcap, 64)) != FDT_OK ||
-        (err = grow_u32(&b.bnd, &b.bndcap, 256)) != FDT_OK ||
-        (err = grow_u32(&b.outl, &b.outcap, 256)) != FDT_OK)
+    fdt_mem_advise_huge(m->T, (size_t)slots * 8 * sizeof *m->T);
+    m->cap = (uint32_t)slots;
+    if ((err = ins_grow_u32(&b.cav, &b.cavcap, 64)) != FDT_OK ||
+        (err = ins_grow_u32(&b.bnd, &b.bndcap, 256)) != FDT_OK ||
+        (err = ins_grow_u32(&b.outl, &b.outcap, 256)) != FDT_OK)
         goto fail;
-    brio_order(base, n, order);
-    uint32_t first[4];
     if ((err = start_simplex(&b, order, n, first)) != FDT_OK)
         goto fail;
     uint32_t last = 0;
-    for (uint32_t i = 0; i < n; i++) {
+    for (uint32_t i = 0; i < prefix; i++) {
         uint32_t id = order[i];
         if (id == first[0] || id == first[1] || id == first[2] || id == first[3])
             continue;
         if ((err = insert_point(&b, id, &last)) != FDT_OK)
             goto fail;
     }
-    m->stats.inserted = n;
-    free(order);
-    order = NULL;
+    build_free(&b);
+    return FDT_OK;
+fail:
+    build_free(&b);
+    fdt_ins_free(m);
+    return err;
+}
 
-    /* The incident-tet table, and the counts, from one pass over the
-     * slots: cheaper than keeping it current through the insertions. */
-    err = FDT_ENOMEM;
-    m->vtet = malloc((size_t)n * sizeof *m->vtet);
-    if (!m->vtet)
-        goto fail;
-    for (uint32_t i = 0; i < n; i++)
+int fdt_ins_finish(fdt_ins *m)
+{
+    /* The incident-tet table, the counts and the free list, from one pass
+     * over the slots: cheaper than keeping them current through the
+     * insertions (and the parallel build has one free list a thread). */
+    m->stats.inserted = m->n;
+    m->nfinite = m->ninfinite = 0;
+    m->free_head = FDT_NONE;
+    m->vtet = malloc((size_t)m->n * sizeof *m->vtet);
+    if (!m->vtet) {
+        fdt_ins_free(m);
+        return FDT_ENOMEM;
+    }
+    for (uint32_t i = 0; i < m->n; i++)
         m->vtet[i] = FDT_NONE;
-    for (uint32_t t = 0; t < m->nslots; t++) {
-        const uint32_t *v = m->T + 8 * (size_t)t;
-        if (v[0] == INF && v[1] == INF)
-            continue; /* freed */
+    for (uint32_t t = m->nslots; t-- > 0;) {
+        uint32_t *v = m->T + 8 * (size_t)t;
+        if (v[0] == INF && v[1] == INF) { /* freed */
+            v[4] = m->free_head;
+            m->free_head = t;
+            continue;
+        }
         int inf = 0;
         for (int i = 0; i < 4; i++) {
             if (v[i] == INF)
                 inf = 1;
             else
-                m->vtet[v[i] - base] = t;
+                m->vtet[v[i] - m->base] = t;
         }
         if (inf)
             m->ninfinite++;
         else
             m->nfinite++;
     }
-    err = FDT_EINTERNAL;
-    for (uint32_t i = 0; i < n; i++)
-        if (m->vtet[i] == FDT_NONE)
-            goto fail; /* every point is a vertex of its DT */
-    build_free(&b);
+    for (uint32_t i = 0; i < m->n; i++)
+        if (m->vtet[i] == FDT_NONE) {
+            fdt_ins_free(m);
+            return FDT_EINTERNAL; /* every point is a vertex of its DT */
+        }
     return FDT_OK;
-fail:
+}
+
+int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                  fdt_pred_counts *cnt)
+{
+    memset(m, 0, sizeof *m);
+    if (n < 4) {
+        m->P = P;
+        m->base = base;
+        m->n = n;
+        m->free_head = FDT_NONE;
+        return FDT_EDEGENERATE;
+    }
+    uint32_t *order = malloc((size_t)n * sizeof *order);
+    if (!order)
+        return FDT_ENOMEM;
+    uint32_t round_end[32], first[4];
+    int nrounds;
+    fdt_ins_brio(base, n, order, round_end, &nrounds);
+    /* About 6.5 tets a point on uniform points, plus the hull: growing by
+     * realloc stays possible for inputs with more. */
+    int err = fdt_ins_build_prefix(m, P, base, n, order, n, (uint64_t)n * 27 / 4 + 64, first,
+                                   cnt);
     free(order);
-    build_free(&b);
-    fdt_ins_free(m);
-    return err;
+    if (err)
+        return err;
+    return fdt_ins_finish(m);
 }
 
 uint32_t fdt_ins_next_finite(const fdt_ins *m, uint32_t t)
@@ -884,15 +801,15 @@ static int conflict_ro(const fdt_ins *m, uint32_t t, const double *p, fdt_pred_c
     const uint32_t *v = m->T + 8 * (size_t)t;
     int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
     if (inf < 0)
-        return insphere_p(pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), p, cnt) > 0;
+        return ins_insphere(ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3]), p, cnt) > 0;
     const double *q[4];
     for (int i = 0; i < 4; i++)
-        q[i] = i == inf ? p : pt(m, v[i]);
-    int o = orient(q[0], q[1], q[2], q[3], cnt);
+        q[i] = i == inf ? p : ins_pt(m, v[i]);
+    int o = ins_orient(q[0], q[1], q[2], q[3], cnt);
     if (o != 0)
         return o > 0;
     const uint32_t *w = m->T + 8 * (size_t)(v[4 + inf] >> 2);
-    return insphere_p(pt(m, w[0]), pt(m, w[1]), pt(m, w[2]), pt(m, w[3]), p, cnt) > 0;
+    return ins_insphere(ins_pt(m, w[0]), ins_pt(m, w[1]), ins_pt(m, w[2]), ins_pt(m, w[3]), p, cnt) > 0;
 }
 
 int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,

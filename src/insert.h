@@ -25,8 +25,9 @@
  * bytes a point kept. During the build also 1 byte a slot (conflict
  * marks) and 4 bytes a point (insertion order), and the cavity scratch.
  *
- * Threads: fdt_ins_build runs on one thread; afterwards the structure is
- * immutable and any thread may query it.
+ * Threads: fdt_ins_build runs on one thread, fdt_ins_build_parallel on
+ * several; afterwards the structure is immutable and any thread may query
+ * it.
  */
 #ifndef FDT_INSERT_H
 #define FDT_INSERT_H
@@ -45,6 +46,12 @@ typedef struct fdt_ins_stats {
     size_t created_tets;  /* tets created */
     size_t max_cavity;    /* largest cavity */
     size_t conflict_tests;/* conflict (insphere / hull side) tests */
+    size_t serial_finish; /* fdt_ins_build_parallel: points left to its serial end */
+    /* fdt_ins_build_parallel: thread CPU seconds of its serial start, of
+     * its workers (the busiest one, and all together) and of its serial
+     * end (finish included). start + workers_max + finish is the wall
+     * time with a free core a worker. */
+    double cpu_start_s, cpu_workers_max_s, cpu_workers_sum_s, cpu_finish_s;
 } fdt_ins_stats;
 
 typedef struct fdt_ins {
@@ -76,6 +83,20 @@ typedef struct fdt_ins {
  */
 int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                   fdt_pred_counts *cnt);
+/*
+ * The same DT as fdt_ins_build (the same set of tets and hull faces; the
+ * slot numbering differs), built by nthreads threads (src/insert_par.c):
+ * the first BRIO rounds serially, then the threads insert the rest
+ * concurrently, each from its own region of the id (kd) order, under
+ * per-tet try-locks; points whose cavities keep meeting another thread's
+ * are inserted at the end on the calling thread. nthreads < 1 counts as
+ * 1, over 255 as 255; the caller's thread is one of them. Same arguments,
+ * results and errors as fdt_ins_build; on any error m holds nothing.
+ * Extra memory during the build: 1 byte a slot (locks) and 4 bytes a
+ * point (start hints) besides fdt_ins_build's.
+ */
+int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                           int nthreads, fdt_pred_counts *cnt);
 /* Frees what m owns and zeroes it; m may be zeroed or freed already. */
 void fdt_ins_free(fdt_ins *m);
 

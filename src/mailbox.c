@@ -99,18 +99,6 @@ struct fdt_mailboxes {
     size_t max_chunks; /* 0: unlimited */
 };
 
-const char *fdt_msg_kind_name(int kind)
-{
-    switch (kind) {
-    case FDT_MSG_IAMDONE: return "IAMDONE";
-    case FDT_MSG_NODESEND: return "NODESEND";
-    case FDT_MSG_NODERECV: return "NODERECV";
-    case FDT_MSG_FACESEND: return "FACESEND";
-    case FDT_MSG_FACERECV: return "FACERECV";
-    default: return "?";
-    }
-}
-
 static void destroy_set(fdt_mailboxes *s)
 {
     for (int i = 0; i < s->n; i++) {
@@ -495,20 +483,4 @@ void fdt_mailbox_counts_get(const fdt_mailbox *self, fdt_mailbox_counts *c)
 size_t fdt_mailbox_chunks(const fdt_mailbox *self)
 {
     return self->nchunks;
-}
-
-int fdt_msg_dispatch(const fdt_msg *m, const fdt_msg_handlers *h, void *user)
-{
-    fdt_msg_handler fn = NULL;
-    switch (m->kind) {
-    case FDT_MSG_IAMDONE: fn = h->on_iamdone; break;
-    case FDT_MSG_NODESEND: fn = h->on_nodesend; break;
-    case FDT_MSG_NODERECV: fn = h->on_noderecv; break;
-    case FDT_MSG_FACESEND: fn = h->on_facesend; break;
-    case FDT_MSG_FACERECV: fn = h->on_facerecv; break;
-    default: break;
-    }
-    if (!fn)
-        return FDT_EINTERNAL;
-    return fn(user, m);
 }

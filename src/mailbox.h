@@ -78,21 +78,11 @@
 
 #include "frontdt.h"
 
-/* The message kinds, Merriam §4. 0 is not a kind: a freshly allocated
- * message has kind 0 and fdt_mailbox_post refuses it, so a forgotten kind is
- * an error, not a silent IAMDONE. */
-typedef enum fdt_msg_kind {
-    FDT_MSG_IAMDONE = 1,  /* "I am out of work, except for answering queries" */
-    FDT_MSG_NODESEND = 2, /* range query on the receiver's points */
-    FDT_MSG_NODERECV = 3, /* answer to a NODESEND */
-    FDT_MSG_FACESEND = 4, /* a face (and maybe its apex) for the receiver */
-    FDT_MSG_FACERECV = 5, /* acknowledgement of a FACESEND */
-    FDT_MSG_KIND_END = 6  /* arrays indexed by kind have this many slots;
-                             slot 0 is unused and stays 0 */
-} fdt_msg_kind;
-
-/* "IAMDONE", "NODESEND", ...; "?" for anything else. Never NULL. */
-const char *fdt_msg_kind_name(int kind);
+/* The message kinds (fdt_msg_kind, Merriam §4) are public, in
+ * include/frontdt.h, with their names (fdt_msg_kind_name); their payloads
+ * and handlers are one table in src/protocol.c. 0 is not a kind: a freshly
+ * allocated message has kind 0 and fdt_mailbox_post refuses it, so a
+ * forgotten kind is an error, not a silent IAMDONE. */
 
 /* A vertex id slot holding no vertex (equal to FDT_NONE of src/kdtree.h). */
 #define FDT_MSG_NONE UINT32_MAX
@@ -139,7 +129,14 @@ typedef struct fdt_msg_noderecv {
     uint32_t tested;
 } fdt_msg_noderecv;
 
-/* IAMDONE: a termination-protocol counter and epoch, as the lead defines. */
+/* ABORT: the sender failed with err (an FDT_E* code); part is the part
+ * that failed (the sender, or the calling thread's endpoint). */
+typedef struct fdt_msg_abort {
+    int32_t err;
+    int32_t part;
+} fdt_msg_abort;
+
+/* IAMDONE: a termination-protocol counter and epoch (src/termination.c). */
 typedef struct fdt_msg_iamdone {
     uint64_t epoch;
     int64_t count;
@@ -162,6 +159,7 @@ typedef struct fdt_msg {
         fdt_msg_noderecv noderecv;
         fdt_msg_facesend facesend;
         fdt_msg_facerecv facerecv;
+        fdt_msg_abort abort;
     } u;
 } fdt_msg;
 
@@ -271,20 +269,5 @@ void fdt_mailbox_counts_get(const fdt_mailbox *self, fdt_mailbox_counts *c);
 
 /* Chunks the pool of self has allocated (never decreases). */
 size_t fdt_mailbox_chunks(const fdt_mailbox *self);
-
-/*
- * Dispatch: calls the handler for m->kind with (user, m) and returns what it
- * returns. A NULL handler or an unknown kind returns FDT_EINTERNAL.
- */
-typedef int (*fdt_msg_handler)(void *user, const fdt_msg *m);
-typedef struct fdt_msg_handlers {
-    fdt_msg_handler on_iamdone;
-    fdt_msg_handler on_nodesend;
-    fdt_msg_handler on_noderecv;
-    fdt_msg_handler on_facesend;
-    fdt_msg_handler on_facerecv;
-} fdt_msg_handlers;
-
-int fdt_msg_dispatch(const fdt_msg *m, const fdt_msg_handlers *h, void *user);
 
 #endif

@@ -733,30 +733,14 @@ typedef struct timings {
     double read, triangulate, check, canon, write;
 } timings;
 
-/* The five message kinds of Merriam's §4, by name, in one order for the
- * text and JSON forms. */
-static const char *const msg_names[5] = {"IAMDONE", "NODESEND", "NODERECV", "FACESEND", "FACERECV"};
-static const char *const msg_keys[5] = {"iamdone", "nodesend", "noderecv", "facesend", "facerecv"};
-
-static void msg_array(const fdt_msg_counts *m, size_t out[5])
-{
-    out[0] = m->iamdone;
-    out[1] = m->nodesend;
-    out[2] = m->noderecv;
-    out[3] = m->facesend;
-    out[4] = m->facerecv;
-}
-
 /* Per-thread and per-kind figures of a parallel run (§4-§5): what the
  * bench harness and the issue notes report. */
 static void print_parallel_stats(const fdt_result *res, const fdt_stats *st)
 {
-    size_t sent[5], recv[5];
-    msg_array(&st->sent, sent);
-    msg_array(&st->received, recv);
     fprintf(stderr, "  messages          sent / received\n");
-    for (int k = 0; k < 5; k++)
-        fprintf(stderr, "    %-15s %zu / %zu\n", msg_names[k], sent[k], recv[k]);
+    for (int k = 1; k < FDT_MSG_KIND_END; k++)
+        fprintf(stderr, "    %-15s %zu / %zu\n", fdt_msg_kind_name(k), st->sent[k],
+                st->received[k]);
     fprintf(stderr,
         "  remote queries    %zu made, %zu answered, %zu improved the apex\n"
         "  tet requests      %zu (%zu for tets already built)\n"
@@ -774,7 +758,7 @@ static void print_parallel_stats(const fdt_result *res, const fdt_stats *st)
             break;
         fprintf(stderr, "  %6d %7zu %9zu %10zu %8zu/%-6zu %7zu/%-6zu %7.3f %5d\n", i, ts.points,
                 ts.tets, ts.faces_advanced, ts.remote_queries, ts.remote_answered,
-                ts.sent.facesend, ts.received.facesend, ts.t_idle, ts.core);
+                ts.sent[FDT_MSG_FACESEND], ts.received[FDT_MSG_FACESEND], ts.t_idle, ts.core);
     }
 }
 
@@ -836,13 +820,17 @@ static double finite_or_zero(double x)
     return (x == x && x - x == 0) ? x : 0;
 }
 
-static void json_msgs(FILE *f, const char *key, const fdt_msg_counts *m)
+/* The counts by kind as {"iamdone": n, ...}: each kind's name in lower
+ * case. */
+static void json_msgs(FILE *f, const char *key, const size_t *m)
 {
-    size_t v[5];
-    msg_array(m, v);
     fprintf(f, ", \"%s\": {", key);
-    for (int k = 0; k < 5; k++)
-        fprintf(f, "%s\"%s\": %zu", k ? ", " : "", msg_keys[k], v[k]);
+    for (int k = 1; k < FDT_MSG_KIND_END; k++) {
+        fprintf(f, "%s\"", k > 1 ? ", " : "");
+        for (const char *c = fdt_msg_kind_name(k); *c; c++)
+            fputc(*c >= 'A' && *c <= 'Z' ? *c - 'A' + 'a' : *c, f);
+        fprintf(f, "\": %zu", m[k]);
+    }
     fputc('}', f);
 }
 
@@ -876,8 +864,8 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
         finite_or_zero(tm->check), finite_or_zero(tm->canon), finite_or_zero(tm->write));
-    json_msgs(f, "sent", &st->sent);
-    json_msgs(f, "received", &st->received);
+    json_msgs(f, "sent", st->sent);
+    json_msgs(f, "received", st->received);
     fprintf(f,
         ", \"remote_queries\": %zu, \"remote_answered\": %zu, \"remote_improved\": %zu"
         ", \"tet_requests\": %zu, \"duplicate_requests\": %zu, \"t_idle\": %.9g"
@@ -895,8 +883,8 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
                    ", \"t_idle\": %.9g, \"t_cpu\": %.9g, \"core\": %d",
                 i ? ", " : "", ts.points, ts.tets, ts.faces_advanced, ts.remote_queries,
                 ts.remote_answered, finite_or_zero(ts.t_idle), finite_or_zero(ts.t_cpu), ts.core);
-        json_msgs(f, "sent", &ts.sent);
-        json_msgs(f, "received", &ts.received);
+        json_msgs(f, "sent", ts.sent);
+        json_msgs(f, "received", ts.received);
         fputc('}', f);
     }
     fputc(']', f);

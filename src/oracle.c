@@ -101,7 +101,7 @@ void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy)
 
 void fdt_oracle_free(fdt_oracle *o)
 {
-    if (o->state == 1)
+    if (o->state == 1 && !o->gm)
         fdt_ins_free(&o->mesh);
     free(o->mt);
     memset(o, 0, sizeof *o);
@@ -165,6 +165,12 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
     o->next_check = faces + win;
 }
 
+void fdt_oracle_share(fdt_oracle *o, const fdt_ins *gm)
+{
+    o->gm = gm;
+    o->state = 1;
+}
+
 int fdt_oracle_note(fdt_oracle *o, int64_t tid, uint32_t mtet)
 {
     if (o->state != 1 || tid < 0)
@@ -192,16 +198,17 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
 {
     if (o->state != 1)
         return 0;
+    const fdt_ins *mesh = o->gm ? o->gm : &o->mesh;
     uint32_t m = ctid >= 0 && (size_t)ctid < o->mtcap ? o->mt[ctid] : FDT_NONE;
     uint32_t nt;
     int nk;
     if (m != FDT_NONE) {
         /* The closed-side tet is mesh tet m (same vertex set): f is its
          * face opposite copp, and the tet across it holds the apex. */
-        const uint32_t *mv = fdt_ins_tet(&o->mesh, m);
+        const uint32_t *mv = fdt_ins_tet(mesh, m);
         for (int k = 0; k < 4; k++)
             if (mv[k] == copp) {
-                *apex = fdt_ins_across(&o->mesh, m, k, &nt, &nk);
+                *apex = fdt_ins_across(mesh, m, k, &nt, &nk);
                 *mtet = *apex == FDT_NONE ? FDT_NONE : nt;
                 o->mesh_faces++;
                 return 1;
@@ -209,9 +216,9 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
         /* Not reached: the noted tet has the output tet's vertices. The
          * walk below answers anyway. */
     }
-    if (!fdt_ins_find_face(&o->mesh, f[0], f[1], f[2], &nt, &nk))
+    if (!fdt_ins_find_face(mesh, f[0], f[1], f[2], &nt, &nk))
         return 0;
-    *apex = fdt_ins_tet(&o->mesh, nt)[nk];
+    *apex = fdt_ins_tet(mesh, nt)[nk];
     *mtet = *apex == FDT_NONE ? FDT_NONE : nt;
     o->mesh_faces++;
     o->star_walks++;

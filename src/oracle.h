@@ -35,7 +35,9 @@ typedef struct fdt_oracle {
     const fdt_kdtree *t;  /* borrowed: the part's tree (its points) */
     int policy;           /* FDT_SEARCH_AUTO, _KD or _MESH */
     int state;            /* 0: kd search; 1: mesh; -1: mesh unavailable */
-    fdt_ins mesh;         /* owned, valid when state == 1 */
+    fdt_ins mesh;         /* owned, valid when state == 1 and !gm */
+    const fdt_ins *gm;    /* borrowed: a mesh of every point (shared by
+                             all parts, fdt_oracle_share), or NULL */
     uint32_t *mt;         /* owned: mesh tet of output tet i, FDT_NONE unknown */
     size_t mtcap;
     /* The switching window: counter values at its start. */
@@ -75,6 +77,14 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq);
  */
 int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t copp,
                     uint32_t *apex, uint32_t *mtet);
+
+/*
+ * Makes o answer from gm, the DT of every point of the run (built once by
+ * fdt_ins_build_parallel and read by every part): then each answer is the
+ * apex itself, not just the first of the part's points, and no other part
+ * need be asked. gm is borrowed and must outlive o; o never switches.
+ */
+void fdt_oracle_share(fdt_oracle *o, const fdt_ins *gm);
 
 /* Notes that output tet tid is mesh tet mtet (FDT_NONE: not known). Only
  * stores while the mesh is in use. FDT_OK or FDT_ENOMEM. */

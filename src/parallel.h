@@ -9,6 +9,7 @@
 #define FDT_PARALLEL_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include "frontdt.h"
 #include "front.h"
 #include "prepare.h"
@@ -42,6 +43,26 @@ int fdt_parallel_default_threads(void);
 int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
                              fdt_mode mode, int nthreads, fdt_par_out *out,
                              char *diag, size_t dlen);
+
+/* How a run is carried out beyond the settings (tests). */
+typedef struct fdt_par_opts {
+    int shuffle;        /* nonzero: the test transport of src/transport.h,
+                           which delays and reorders messages across
+                           senders, instead of the mailboxes */
+    uint64_t seed;      /* its schedule */
+    int delay_pct;      /* its delay, 0..90 */
+    int fail;           /* nonzero: part fail_part fails (FDT_EINTERNAL)
+                           once it has advanced fail_after faces */
+    int fail_part;
+    size_t fail_after;
+    int global_mesh;    /* shared mode: build the DT of every point first
+                           (fdt_ins_build_parallel, on nthreads threads)
+                           and let every part read its apexes from it */
+} fdt_par_opts;
+
+/* fdt_parallel_triangulate with options (NULL: none, what it does). */
+int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int nthreads,
+                     const fdt_par_opts *opt, fdt_par_out *out, char *diag, size_t dlen);
 
 /* Copies the parallel fields (sent .. pinned, threads, mode) into st. */
 void fdt_parallel_fill_stats(const fdt_par_out *o, fdt_mode mode,

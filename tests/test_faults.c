@@ -496,6 +496,24 @@ static int sc_insert(void *arg, const char **bad)
     return rc;
 }
 
+/* fdt_ins_build_parallel on 2 threads (3 when the set is the uniform
+ * one, so an allocation can fail on a worker thread too): FDT_ENOMEM with
+ * nothing kept, or the serial build's count. */
+static int sc_insert_par(void *arg, const char **bad)
+{
+    ins_arg *a = arg;
+    fdt_ins m;
+    int rc = fdt_ins_build_parallel(&m, a->xyz, 0, a->n, 3, NULL);
+    if (rc != FDT_OK) {
+        if (m.T != NULL || m.vtet != NULL)
+            *bad = "a failed fdt_ins_build_parallel kept its arrays";
+    } else if (m.nfinite != a->want_tets) {
+        *bad = "wrong number of tets";
+    }
+    fdt_ins_free(&m);
+    return rc;
+}
+
 /* fdt_ins_find_face on faces around a big star, whose search takes a heap
  * buffer: when that allocation fails it must still answer, and rightly. */
 static int sc_find_face(void *arg, const char **bad)
@@ -581,11 +599,26 @@ static void test_insert_faults(const ptset *sets, int nsets, uint64_t *rng)
         snprintf(nm, sizeof nm, "fdt_ins_build %s", ps->name);
         scenario sc = {nm, FDT_ENOMEM, sc_insert, &ia};
         inject_all(&sc);
+        snprintf(nm, sizeof nm, "fdt_ins_build_parallel %s", ps->name);
+        scenario sp = {nm, FDT_ENOMEM, sc_insert_par, &ia};
+        inject_all(&sp);
         if (ps == &hub) {
             scenario sf = {"fdt_ins_find_face hub", FDT_ENOMEM, sc_find_face, &ia};
             inject_all(&sf);
         }
     }
+    /* Enough points for the parallel build's threads to run (its first
+     * BRIO round alone is serial). */
+    ptset u = {"uniform 3000", alloc_points(3000), 3000};
+    for (size_t i = 0; i < 3 * u.n; i++)
+        u.xyz[i] = rnd01(rng);
+    fdt_ins m;
+    CHECK(fdt_ins_build(&m, u.xyz, 0, (uint32_t)u.n, NULL) == FDT_OK, "uniform 3000");
+    ins_arg ua = {u.xyz, (uint32_t)u.n, m.nfinite, 0};
+    fdt_ins_free(&m);
+    scenario sp = {"fdt_ins_build_parallel uniform 3000", FDT_ENOMEM, sc_insert_par, &ua};
+    inject_all(&sp);
+    free(u.xyz);
     free(hub.xyz);
 }
 

@@ -21,11 +21,19 @@
  *   - refusals: fewer than 4 points, collinear and coplanar sets
  *     (FDT_EDEGENERATE), a duplicate point (FDT_EINVAL), each leaving the
  *     structure empty.
+ * With --parallel: fdt_ins_build_parallel gives fdt_ins_build's tets and
+ * hull faces on the issue-16 families and the lattices, at 1, 2, 3, 5 and
+ * 8 threads (oversubscribed on small machines), several runs each, with
+ * the structure checks; and its refusals (coplanar, duplicates in either
+ * phase) leave the structure empty.
  *
  * Usage: test_insert GEN_POINTS          the default suite
- *        test_insert --time FILE.xyz [R] time fdt_ins_build alone (R runs;
- *                                        medians of wall and CPU time) and
- *                                        print a SUMMARY line
+ *        test_insert --parallel GEN_POINTS  the parallel build's tests
+ *        test_insert --time FILE.xyz [R [T]] time fdt_ins_build alone (R
+ *                                        runs; medians of wall and CPU
+ *                                        time) and print a SUMMARY line;
+ *                                        T > 0: fdt_ins_build_parallel on
+ *                                        T threads (CPU: all threads)
  */
 #include <inttypes.h>
 #include <math.h>
@@ -741,6 +749,129 @@ static void test_refusals(void)
     fdt_ins_free(&m);
 }
 
+/* ---- the parallel build ------------------------------------------------ */
+
+/* fdt_ins_build_parallel against fdt_ins_build (the same tets and hull
+ * faces: the perturbed DT is unique), for several thread counts, each
+ * several times (the schedule, hence who inserts what and which points
+ * are deferred, differs from run to run); full structure checks on the
+ * first run of each count. */
+static void test_parallel_set(pts p, int reps)
+{
+    prepped pp;
+    prep(&p, &pp);
+    fdt_ins m;
+    CHECK_EQ(fdt_ins_build(&m, pp.pr.p, 0, pp.m, NULL), FDT_OK);
+    meshset ref = kernel_mesh(&m, NULL);
+    fdt_ins_free(&m);
+    static const int threads[] = {1, 2, 3, 5, 8};
+    for (size_t ti = 0; ti < sizeof threads / sizeof threads[0]; ti++) {
+        for (int r = 0; r < reps; r++) {
+            fdt_pred_counts cnt = {0};
+            double t0 = now_s();
+            CHECK_EQ(fdt_ins_build_parallel(&m, pp.pr.p, 0, pp.m, threads[ti], &cnt), FDT_OK);
+            t_kernel += now_s() - t0;
+            char nm[96];
+            snprintf(nm, sizeof nm, "%s parallel t%d run %d", p.name, threads[ti], r);
+            meshset got = kernel_mesh(&m, NULL);
+            same_mesh(&got, &ref, nm);
+            CHECK_EQ(m.stats.inserted, (size_t)pp.m);
+            if (r == 0) {
+                check_structure(&m, nm);
+                if (pp.m <= 5000)
+                    check_find_face(&m);
+            }
+            meshset_free(&got);
+            fdt_ins_free(&m);
+        }
+    }
+    /* A sub-range [base, base + len): global ids, the same tets as the
+     * serial build of that range. */
+    uint32_t base = pp.m / 3, len = pp.m - pp.m / 3 - pp.m / 5;
+    fdt_ins m0;
+    if (fdt_ins_build(&m0, pp.pr.p, base, len, NULL) == FDT_OK) {
+        CHECK_EQ(fdt_ins_build_parallel(&m, pp.pr.p, base, len, 3, NULL), FDT_OK);
+        check_structure(&m, "parallel sub-range");
+        meshset a = kernel_mesh(&m, NULL), b = kernel_mesh(&m0, NULL);
+        same_mesh(&a, &b, "parallel sub-range");
+        meshset_free(&a);
+        meshset_free(&b);
+        fdt_ins_free(&m);
+        fdt_ins_free(&m0);
+    }
+    printf("parallel %-22s %6u points %7zu tets: same as serial for 1, 2, 3, 5, 8 threads x %d\n",
+           p.name, pp.m, ref.nt, reps);
+    fflush(stdout);
+    meshset_free(&ref);
+    prep_free(&pp);
+    free(p.xyz);
+}
+
+static void expect_refusal_par(const double *xyz, uint32_t n, int want, const char *what)
+{
+    for (int t = 1; t <= 4; t++) {
+        fdt_ins m;
+        int rc = fdt_ins_build_parallel(&m, xyz, 0, n, t, NULL);
+        if (rc != want)
+            fprintf(stderr, "%s (parallel, %d threads): status %d, want %d\n", what, t, rc, want);
+        CHECK_EQ(rc, want);
+        CHECK(m.T == NULL && m.vtet == NULL && m.nslots == 0);
+        fdt_ins_free(&m);
+    }
+}
+
+static void test_parallel_refusals(const char *gen)
+{
+    double xyz[3 * 400] = {0};
+    expect_refusal_par(xyz, 3, FDT_EDEGENERATE, "3 points");
+    for (int i = 0; i < 400; i++) { /* coplanar: a grid in x + y + z = 30 */
+        xyz[3 * i] = i % 20;
+        xyz[3 * i + 1] = i / 20;
+        xyz[3 * i + 2] = 30.0 - (i % 20) - (i / 20);
+    }
+    expect_refusal_par(xyz, 400, FDT_EDEGENERATE, "coplanar");
+    /* duplicates, early (in the serial rounds) and late (in the threads'
+     * rounds): every point's copy, so some copy falls in each phase */
+    pts u = gen_family(gen, "uniform", 20000, 3);
+    size_t n = u.n;
+    double *d = malloc(2 * n * 3 * sizeof *d);
+    CHECK(d);
+    memcpy(d, u.xyz, n * 3 * sizeof *d);
+    for (size_t k = 0; k < 3; k++) {
+        /* one duplicate at a time, at spread positions */
+        size_t src = (k * 7919) % n, dst = n - 1 - k * 4001;
+        memcpy(d, u.xyz, n * 3 * sizeof *d);
+        memcpy(d + 3 * dst, d + 3 * src, 3 * sizeof *d);
+        char nm[64];
+        snprintf(nm, sizeof nm, "duplicate %zu of %zu", dst, src);
+        expect_refusal_par(d, (uint32_t)n, FDT_EINVAL, nm);
+    }
+    free(d);
+    free(u.xyz);
+}
+
+static void run_parallel(const char *gen)
+{
+    test_parallel_refusals(gen);
+    static const struct {
+        const char *fam;
+        size_t n;
+        int reps;
+    } fams[] = {
+        {"uniform", 2000, 3},    {"uniform", 50000, 2},   {"clusters", 20000, 2},
+        {"lattice", 8000, 2},    {"cylinder", 20000, 2},  {"cylscan", 20000, 2},
+        {"rotlattice", 8000, 2}, {"sphere12", 5000, 2},   {"grid2d", 10000, 2},
+        {"citylidar", 20000, 2}, {"clusters", 2000, 3},   {"citylidar", 2000, 3},
+    };
+    for (size_t i = 0; i < sizeof fams / sizeof fams[0]; i++)
+        test_parallel_set(gen_family(gen, fams[i].fam, fams[i].n, (int)i + 1), fams[i].reps);
+    test_parallel_set(lattice(12, "lattice-12^3"), 2);
+    test_parallel_set(rotated_lattice(14), 2);
+    test_parallel_set(cylinder(60), 2);
+    test_parallel_set(two_planes(40), 2);
+    printf("test_insert --parallel: all checks passed (parallel kernel %.3f s)\n", t_kernel);
+}
+
 /* ---- timing driver ----------------------------------------------------- */
 
 static int cmp_double(const void *x, const void *y)
@@ -758,7 +889,16 @@ static double cpu_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static int time_file(const char *path, int reps)
+static double proc_cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* threads 0: fdt_ins_build; else fdt_ins_build_parallel with that many
+ * (CPU time is then the whole process's, all threads). */
+static int time_file(const char *path, int reps, int threads)
 {
     pts p = read_xyz(path, path);
     prepped pp;
@@ -774,10 +914,11 @@ static int time_file(const char *path, int reps)
     fdt_pred_counts cnt = {0};
     for (int r = 0; r < reps; r++) {
         memset(&cnt, 0, sizeof cnt);
-        double a = now_s(), ca = cpu_now();
-        int rc = fdt_ins_build(&m, pp.pr.p, 0, pp.m, &cnt);
+        double a = now_s(), ca = threads ? proc_cpu_now() : cpu_now();
+        int rc = threads ? fdt_ins_build_parallel(&m, pp.pr.p, 0, pp.m, threads, &cnt)
+                         : fdt_ins_build(&m, pp.pr.p, 0, pp.m, &cnt);
         ts[r] = now_s() - a;
-        cs[r] = cpu_now() - ca;
+        cs[r] = (threads ? proc_cpu_now() : cpu_now()) - ca;
         if (rc != FDT_OK) {
             fprintf(stderr, "fdt_ins_build: %s\n", fdt_strerror(rc));
             return 1;
@@ -790,13 +931,14 @@ static int time_file(const char *path, int reps)
     qsort(sorted, (size_t)reps, sizeof *sorted, cmp_double);
     double med = sorted[reps / 2];
     qsort(cs, (size_t)reps, sizeof *cs, cmp_double);
-    printf("SUMMARY code=insert file=%s points=%u tets=%zu hull=%zu build_s=%.4f min_s=%.4f "
+    printf("SUMMARY code=insert threads=%d file=%s points=%u tets=%zu hull=%zu build_s=%.4f min_s=%.4f "
            "max_s=%.4f cpu_s=%.4f reps=%d prep_kd_s=%.4f walk_steps=%zu cavity_tets=%zu max_cavity=%zu "
-           "conflict_tests=%zu exact_orient=%zu exact_insphere=%zu slots=%u bytes_per_point=%.1f\n",
-           path, pp.m, m.nfinite, m.ninfinite, med, sorted[0], sorted[reps - 1], cs[reps / 2],
+           "conflict_tests=%zu serial_finish=%zu cpu_start=%.3f cpu_workers_max=%.3f cpu_workers_sum=%.3f cpu_finish=%.3f exact_orient=%zu exact_insphere=%zu slots=%u bytes_per_point=%.1f\n",
+           threads, path, pp.m, m.nfinite, m.ninfinite, med, sorted[0], sorted[reps - 1], cs[reps / 2],
            reps, t_prep,
            m.stats.walk_steps, m.stats.cavity_tets, m.stats.max_cavity, m.stats.conflict_tests,
-           cnt.orient_exact, cnt.insphere_exact, m.nslots,
+           m.stats.serial_finish, m.stats.cpu_start_s, m.stats.cpu_workers_max_s,
+           m.stats.cpu_workers_sum_s, m.stats.cpu_finish_s, cnt.orient_exact, cnt.insphere_exact, m.nslots,
            ((double)m.cap * 32.0 + (double)m.n * 4.0) / (double)m.n);
     fdt_ins_free(&m);
     prep_free(&pp);
@@ -807,9 +949,14 @@ static int time_file(const char *path, int reps)
 int main(int argc, char **argv)
 {
     if (argc >= 3 && strcmp(argv[1], "--time") == 0)
-        return time_file(argv[2], argc > 3 ? atoi(argv[3]) : 3);
+        return time_file(argv[2], argc > 3 ? atoi(argv[3]) : 3, argc > 4 ? atoi(argv[4]) : 0);
+    if (argc == 3 && strcmp(argv[1], "--parallel") == 0) {
+        run_parallel(argv[2]);
+        return 0;
+    }
     if (argc != 2) {
-        fprintf(stderr, "usage: %s GEN_POINTS | --time FILE.xyz [REPS]\n", argv[0]);
+        fprintf(stderr, "usage: %s GEN_POINTS | --parallel GEN_POINTS | --time FILE.xyz [REPS "
+                        "[THREADS]]\n", argv[0]);
         return 2;
     }
     const char *gen = argv[1];

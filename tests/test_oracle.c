@@ -12,7 +12,8 @@
  *     points (so a broken rule or a mesh never consulted fails here);
  *   - a part whose points are coplanar cannot build a mesh and falls back
  *     to the kd search with the same result;
- *   - FDT_MODE_AUTO with threads runs the cylinder serially (the probe),
+ *   - FDT_MODE_AUTO with threads builds one mesh of every point for the
+ *     cylinder (the probe) and its parts read it,
  *     uniform points on two parts;
  *   - in shared mode other parts' meshes answer the faces whose sphere
  *     crosses a cut (thread stats mesh_queries).
@@ -303,18 +304,29 @@ int main(int argc, char **argv)
     test_family(gen_intsphere(25), -1, quick);
     test_family(gen_layers(25, 3), -1, quick);
     test_family(gen_mixed(600, 5), -1, quick);
-    /* FDT_MODE_AUTO with threads: the probe (fdt_oracle_probe) runs the
-     * cylinder on one thread with its mesh, uniform points on two parts;
-     * an explicit mode is kept. Same hashes as the kd search in serial. */
+    /* FDT_MODE_AUTO with threads: the probe (fdt_oracle_probe) makes the
+     * threads build one mesh of every point for the cylinder, which every
+     * part reads; uniform points run on two parts with the kd search; an
+     * explicit mode is kept. Same hashes as the kd search in serial. */
     {
         pts p = gen_cylinder(60, 64);
         fdt_stats st;
         fdt_result *ref = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_KD, &st);
         fdt_result *r = run(&p, FDT_MODE_AUTO, 2, FDT_SEARCH_AUTO, &st);
-        CHECK_EQ(st.mode, FDT_MODE_SERIAL);
-        CHECK_EQ(st.mesh_parts, 1);
+        /* two parts reading one mesh of every point: no part asks another */
+        CHECK_EQ(st.mode, FDT_MODE_SHARED);
+        CHECK_EQ(st.mesh_parts, 2);
+        CHECK_EQ(st.remote_queries, 0);
+        CHECK(st.mesh_faces > 0);
         CHECK_EQ(hash_of(r), hash_of(ref));
         fdt_result_free(&r);
+        for (int t = 3; t <= 7; t += 2) {
+            r = run(&p, FDT_MODE_AUTO, t, FDT_SEARCH_AUTO, &st);
+            CHECK_EQ(st.mode, FDT_MODE_SHARED);
+            CHECK_EQ(st.remote_queries, 0);
+            CHECK_EQ(hash_of(r), hash_of(ref));
+            fdt_result_free(&r);
+        }
         r = run(&p, FDT_MODE_SHARED, 2, FDT_SEARCH_AUTO, &st);
         CHECK_EQ(st.mode, FDT_MODE_SHARED);
         CHECK_EQ(hash_of(r), hash_of(ref));

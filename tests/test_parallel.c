@@ -9,7 +9,9 @@
  *     equal serial mode's (so the threads' neighbour links are right);
  *   - every message kind was received as often as it was sent, in total and
  *     summed over the per-thread statistics; IAMDONE went to every other
- *     thread once, FACERECV never; NODESEND only in message mode;
+ *     thread once (message mode: also from each root's tree to part 0);
+ *     FACERECV once per FACESEND in message mode, never in shared mode;
+ *     ABORT never; NODESEND only in message mode;
  *   - the partition module: proportional part sizes for any N, contiguous
  *     ranges, owner lookup, the composite tree.
  * Then many threads on tiny inputs (where nearly every tet straddles parts:
@@ -286,29 +288,40 @@ static void check_stats(const fdt_result *r, fdt_mode mode, int nthreads)
     CHECK_EQ(st.threads, nthreads);
     CHECK_EQ(st.mode, mode);
     CHECK_EQ(st.tets, fdt_result_num_tets(r));
-    CHECK_EQ(st.sent.iamdone, st.received.iamdone);
-    CHECK_EQ(st.sent.nodesend, st.received.nodesend);
-    CHECK_EQ(st.sent.noderecv, st.received.noderecv);
-    CHECK_EQ(st.sent.facesend, st.received.facesend);
-    CHECK_EQ(st.sent.facerecv, st.received.facerecv);
-    CHECK_EQ(st.sent.iamdone, nthreads - 1);
-    CHECK_EQ(st.sent.facerecv, 0);
-    CHECK_EQ(st.sent.nodesend, st.sent.noderecv);
-    CHECK_EQ(st.remote_queries, st.sent.nodesend);
-    CHECK_EQ(st.remote_answered, st.sent.nodesend);
+    /* Every kind has a name, and was received as often as it was sent. */
+    for (int k = 1; k < FDT_MSG_KIND_END; k++) {
+        CHECK(strcmp(fdt_msg_kind_name(k), "?") != 0);
+        CHECK_EQ(st.sent[k], st.received[k]);
+    }
+    CHECK(strcmp(fdt_msg_kind_name(0), "?") == 0);
+    CHECK(strcmp(fdt_msg_kind_name(FDT_MSG_KIND_END), "?") == 0);
+    CHECK_EQ(st.sent[FDT_MSG_ABORT], 0);
+    if (mode == FDT_MODE_MESSAGE) {
+        /* every FACESEND acknowledged; IAMDONE: the final one to every
+         * other part, and at most one a root (part with seeds) to part 0 */
+        CHECK_EQ(st.sent[FDT_MSG_FACERECV], st.sent[FDT_MSG_FACESEND]);
+        CHECK(st.sent[FDT_MSG_IAMDONE] >= (size_t)nthreads - 1 &&
+              st.sent[FDT_MSG_IAMDONE] <= 2 * (size_t)nthreads - 2);
+    } else {
+        CHECK_EQ(st.sent[FDT_MSG_IAMDONE], nthreads - 1);
+        CHECK_EQ(st.sent[FDT_MSG_FACERECV], 0);
+    }
+    CHECK_EQ(st.sent[FDT_MSG_NODESEND], st.sent[FDT_MSG_NODERECV]);
+    CHECK_EQ(st.remote_queries, st.sent[FDT_MSG_NODESEND]);
+    CHECK_EQ(st.remote_answered, st.sent[FDT_MSG_NODESEND]);
     CHECK(st.remote_improved <= st.remote_queries);
-    CHECK(st.tet_requests <= st.sent.facesend);
+    CHECK(st.tet_requests <= st.sent[FDT_MSG_FACESEND]);
     CHECK(st.duplicate_requests <= st.tet_requests);
     if (mode == FDT_MODE_SHARED)
-        CHECK_EQ(st.sent.nodesend, 0);
+        CHECK_EQ(st.sent[FDT_MSG_NODESEND], 0);
     if (nthreads == 1) {
-        CHECK_EQ(st.sent.facesend, 0);
-        CHECK_EQ(st.sent.nodesend, 0);
+        CHECK_EQ(st.sent[FDT_MSG_FACESEND], 0);
+        CHECK_EQ(st.sent[FDT_MSG_NODESEND], 0);
     }
     CHECK(st.load_imbalance >= 1.0 - 1e-12 && st.load_imbalance <= nthreads + 1e-9);
     CHECK_EQ(st.pinned, 0);
     /* Per-thread statistics add up to the totals. */
-    fdt_msg_counts s = {0, 0, 0, 0, 0}, rc = {0, 0, 0, 0, 0};
+    size_t s[FDT_MSG_KIND_END] = {0}, rc[FDT_MSG_KIND_END] = {0};
     size_t tets = 0, pts_ = 0, hull = 0, adv = 0, rq = 0, ra = 0;
     for (int i = 0; i < nthreads; i++) {
         fdt_thread_stats ts;
@@ -319,21 +332,27 @@ static void check_stats(const fdt_result *r, fdt_mode mode, int nthreads)
         adv += ts.faces_advanced;
         rq += ts.remote_queries;
         ra += ts.remote_answered;
-        s.iamdone += ts.sent.iamdone;
-        s.nodesend += ts.sent.nodesend;
-        s.noderecv += ts.sent.noderecv;
-        s.facesend += ts.sent.facesend;
-        s.facerecv += ts.sent.facerecv;
-        rc.iamdone += ts.received.iamdone;
-        rc.nodesend += ts.received.nodesend;
-        rc.noderecv += ts.received.noderecv;
-        rc.facesend += ts.received.facesend;
-        rc.facerecv += ts.received.facerecv;
+        for (int k = 0; k < FDT_MSG_KIND_END; k++) {
+            s[k] += ts.sent[k];
+            rc[k] += ts.received[k];
+        }
         CHECK_EQ(ts.core, -1);
         CHECK(ts.t_idle >= 0.0 && ts.t_query_wait >= 0.0 && ts.t_cpu >= 0.0);
-        /* Each thread got exactly one IAMDONE, or sent them all. */
-        CHECK(ts.received.iamdone == 1 || (ts.received.iamdone == 0 &&
-                                           ts.sent.iamdone == (size_t)nthreads - 1));
+        /* Each thread got exactly one IAMDONE, or sent them all (shared
+         * mode); message mode: part 0 sends the final ones, every other
+         * part gets one and sends at most one (its tree finished). */
+        if (mode == FDT_MODE_MESSAGE) {
+            if (i == 0) {
+                CHECK_EQ(ts.sent[FDT_MSG_IAMDONE], nthreads - 1);
+            } else {
+                CHECK_EQ(ts.received[FDT_MSG_IAMDONE], 1);
+                CHECK(ts.sent[FDT_MSG_IAMDONE] <= 1);
+            }
+        } else {
+            CHECK(ts.received[FDT_MSG_IAMDONE] == 1 ||
+                  (ts.received[FDT_MSG_IAMDONE] == 0 &&
+                   ts.sent[FDT_MSG_IAMDONE] == (size_t)nthreads - 1));
+        }
     }
     fdt_thread_stats ts;
     CHECK_EQ(fdt_result_thread_stats(r, nthreads, &ts), FDT_EINVAL);
@@ -344,8 +363,8 @@ static void check_stats(const fdt_result *r, fdt_mode mode, int nthreads)
     CHECK_EQ(adv, st.faces_advanced);
     CHECK_EQ(rq, st.remote_queries);
     CHECK_EQ(ra, st.remote_answered);
-    CHECK(memcmp(&s, &st.sent, sizeof s) == 0);
-    CHECK(memcmp(&rc, &st.received, sizeof rc) == 0);
+    CHECK(memcmp(s, st.sent, sizeof s) == 0);
+    CHECK(memcmp(rc, st.received, sizeof rc) == 0);
     /* Hull faces each close one front face: every face advanced is either
      * a hull face or yields a tet (built here or asked of its owner). */
     CHECK(st.faces_advanced >= st.hull_faces);
@@ -380,7 +399,7 @@ static void compare_run(const pts *p, const reference *ref, fdt_mode mode,
         fdt_stats st;
         fdt_result_stats(r, &st);
         printf("  %-18s %-7s N=%-3d tets %zu facesend %zu nodesend %zu dup %zu imb %.2f\n",
-               p->name, mode_name(mode), nthreads, nt, st.sent.facesend, st.sent.nodesend,
+               p->name, mode_name(mode), nthreads, nt, st.sent[FDT_MSG_FACESEND], st.sent[FDT_MSG_NODESEND],
                st.duplicate_requests, st.load_imbalance);
     }
     fdt_result_free(&r);

@@ -303,14 +303,29 @@ static const char *mode_name(fdt_mode m)
     }
 }
 
-static PyObject *msg_dict(const fdt_msg_counts *m)
+/* Messages by kind, keyed by fdt_msg_kind_name ("iamdone", ...); slot 0
+ * is no kind. */
+static PyObject *msg_dict(const size_t *m)
 {
-    return Py_BuildValue("{s:n,s:n,s:n,s:n,s:n}",
-                         "iamdone", (Py_ssize_t)m->iamdone,
-                         "nodesend", (Py_ssize_t)m->nodesend,
-                         "noderecv", (Py_ssize_t)m->noderecv,
-                         "facesend", (Py_ssize_t)m->facesend,
-                         "facerecv", (Py_ssize_t)m->facerecv);
+    PyObject *d = PyDict_New();
+    if (!d)
+        return NULL;
+    for (int k = 1; k < FDT_MSG_KIND_END; k++) {
+        char key[32];
+        const char *name = fdt_msg_kind_name(k);
+        size_t i = 0;
+        for (; name[i] && i + 1 < sizeof key; i++)
+            key[i] = (char)((name[i] >= 'A' && name[i] <= 'Z') ? name[i] - 'A' + 'a' : name[i]);
+        key[i] = '\0';
+        PyObject *v = PyLong_FromSize_t(m[k]);
+        if (!v || PyDict_SetItemString(d, key, v) != 0) {
+            Py_XDECREF(v);
+            Py_DECREF(d);
+            return NULL;
+        }
+        Py_DECREF(v);
+    }
+    return d;
 }
 
 /* Sets d[key] = v and drops v; 0 or -1 (v NULL counts as the error). */
@@ -345,7 +360,7 @@ static PyObject *tri_stats(TriObject *self, void *closure)
         PUT_SIZE(d, st, max_front) || put(d, "threads", PyLong_FromLong(st.threads)) ||
         put(d, "mode", PyUnicode_FromString(mode_name(st.mode))) ||
         PUT_DBL(d, st, t_prepare) || PUT_DBL(d, st, t_front) || PUT_DBL(d, st, t_finish) ||
-        put(d, "sent", msg_dict(&st.sent)) || put(d, "received", msg_dict(&st.received)) ||
+        put(d, "sent", msg_dict(st.sent)) || put(d, "received", msg_dict(st.received)) ||
         PUT_SIZE(d, st, remote_queries) || PUT_SIZE(d, st, remote_answered) ||
         PUT_SIZE(d, st, remote_improved) || PUT_SIZE(d, st, tet_requests) ||
         PUT_SIZE(d, st, duplicate_requests) || PUT_DBL(d, st, t_idle) ||

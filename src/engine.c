@@ -1,0 +1,433 @@
+/*
+ * The per-part step of the parallel engine; see engine.h.
+ *
+ * Ownership (§3.2). The owner of a face or tet is the part holding its
+ * lowest global id. A thread advances only faces it owns and builds only
+ * tets it owns. Two consequences shape the messages:
+ *  - A tet's three faces through its lowest vertex have that vertex as
+ *    their lowest too, so they belong to the tet's owner: building a tet
+ *    sends at most ONE face away, the one opposite its lowest vertex.
+ *  - When the apex p found for a face f makes a tet t = f + p owned by
+ *    someone else, p is the lowest id of t (f's lowest is ours), and the
+ *    only face of t we own is f itself. We send FACESEND(f, p) to t's
+ *    owner, who builds t unless it exists. t can exist only if its owner
+ *    built it from one of its own three faces, and it then sent us f
+ *    (completing it here). So a duplicate request is possible only for a
+ *    tet with a face owned elsewhere (a "boundary" tet), and only those go
+ *    into the per-thread set `built` that tells "already built" from "never
+ *    seen" (a face table cannot: a completed face has left it).
+ */
+#include "engine.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "termination.h"
+
+/*
+ * A face of tet link (thread, (tid << 2) | i) arrives at its owner (us):
+ * the first arrival makes it a front face, the second completes it
+ * (§2.2). v is canonical and oriented outward from that tet. known: the
+ * face's slot when the caller holds it (the front face a tet was built
+ * on), so it is not looked up again; NULL otherwise.
+ */
+int fdt_eng_face_arrives(worker *w, const uint32_t v[3], int thread, int64_t link,
+                        fdt_face *known)
+{
+    fdt_face f;
+    memcpy(f.v, v, sizeof f.v);
+    f.aux = (uint32_t)thread;
+    f.tet = (uint64_t)link;
+    ensure_active(w);
+    int err = FDT_OK;
+    fdt_face *s = known ? known : fdt_facetab_find_or_insert(&w->ft, &f, &err);
+    if (err)
+        return err;
+    if (!s) {
+        if (w->ft.count > w->st.max_front)
+            w->st.max_front = w->ft.count;
+        return fdt_faceq_push(&w->fq, f.v);
+    }
+    /* Completed: the stored face has its open side towards the new tet,
+     * so it is oriented opposite to f; equal orientation would mean two
+     * tets on one side of a face. */
+    if (s->v[1] == f.v[1])
+        return FDT_EINTERNAL;
+    if (w->e->want_nbrs) {
+        int ta = (int)s->aux;
+        int64_t la = (int64_t)s->tet;
+        if (ta == w->id && thread == w->id) {
+            /* (tid << 2) | i is exactly the index of slot i of tet tid. */
+            w->out.nbrs[la] = link >> 2;
+            w->out.nbrs[link] = la >> 2;
+        } else if ((err = fdt_link_add(&w->links, ta, la, thread, link)) != FDT_OK) {
+            return err;
+        }
+    }
+    fdt_facetab_remove(&w->ft, s);
+    return FDT_OK;
+}
+
+/*
+ * Builds the positively oriented tet v, which we own (its lowest id is
+ * ours), and hands its faces to their owners. request: it was asked for by
+ * FACESEND, so it may already exist. advanced: the slot of our front face
+ * (v0, v1, v2) the tet was built on (its face 3, ours), or NULL.
+ */
+int fdt_eng_build_tet(worker *w, const uint32_t v[4], int request, fdt_face *advanced)
+{
+    const fdt_partition *pt = w->e->pt;
+    int lowi = 0;
+    for (int i = 1; i < 4; i++)
+        if (v[i] < v[lowi])
+            lowi = i;
+    if (!is_own(w, v[lowi]))
+        return FDT_EINTERNAL;
+    /* The face opposite the lowest vertex is the only one that may belong
+     * to another part: its lowest id is the tet's second lowest (a min
+     * without branches; sorting all four for it cost mispredictions on
+     * every tet, and only tets across a cut need the sorted ids). */
+    uint32_t second = UINT32_MAX;
+    for (int i = 0; i < 4; i++)
+        second = i != lowi && v[i] < second ? v[i] : second;
+    int far_owner = is_own(w, second) ? w->id : fdt_partition_owner(pt, second);
+    if (far_owner != w->id) {
+        uint32_t k[4];
+        memcpy(k, v, sizeof k);
+        for (int i = 1; i < 4; i++)
+            for (int j = i; j > 0 && k[j - 1] > k[j]; j--) {
+                uint32_t x = k[j];
+                k[j] = k[j - 1];
+                k[j - 1] = x;
+            }
+        int rc = fdt_tetset_insert(&w->built, k);
+        if (rc < 0)
+            return rc;
+        if (rc == 0) {
+            /* Built before from one of our own faces; that build sent the
+             * requester its face, so there is nothing left to do. A local
+             * build cannot repeat (its face was completed by the first). */
+            if (!request)
+                return FDT_EINTERNAL;
+            w->st.duplicate_requests++;
+            return FDT_OK;
+        }
+    }
+    int64_t tid = fdt_meshbuf_add_tet(&w->out, v);
+    if (tid < 0)
+        return FDT_ENOMEM;
+    uint32_t fc[4][3];
+    int nf = 4;
+    if (advanced) {
+        /* First, while the slot is where the pop found it (later faces
+         * may grow or shift the table), as in src/front.c. */
+        fdt_face_canon(v[fdt_tet_face[3][0]], v[fdt_tet_face[3][1]],
+                       v[fdt_tet_face[3][2]], fc[3]);
+        int err = fdt_eng_face_arrives(w, fc[3], w->id, (tid << 2) | 3, advanced);
+        if (err)
+            return err;
+        nf = 3;
+    }
+    /* the other table slots asked for first, as in src/front.c */
+    for (int i = 0; i < nf; i++) {
+        fdt_face_canon(v[fdt_tet_face[i][0]], v[fdt_tet_face[i][1]],
+                       v[fdt_tet_face[i][2]], fc[i]);
+        fdt_facetab_prefetch(&w->ft, fc[i]);
+    }
+    for (int i = 0; i < nf; i++) {
+        const uint32_t *fv = fc[i];
+        int64_t link = (tid << 2) | i;
+        int owner = i == lowi ? far_owner : w->id;
+        int err = owner == w->id ? fdt_eng_face_arrives(w, fv, w->id, link, NULL)
+                                 : fdt_proto_send_face(w, owner, fv, FDT_NONE, link);
+        if (err)
+            return err;
+    }
+    if (w->out.ntets >= w->report_at) {
+        w->report_at = w->out.ntets + 4096;
+        /* relaxed: a progress estimate only (see worker.tets_done). */
+        atomic_store_explicit(&w->tets_done, w->out.ntets, memory_order_relaxed);
+    }
+    return FDT_OK;
+}
+
+/*
+ * Continues the apex search over the other parts: walks the bisection
+ * tree, skipping our own part, empty parts, and every subtree whose box
+ * cannot hold a better apex (§4.1), nearer child first. In message mode a
+ * part's bounding box is all we test before asking it: we tried testing
+ * the boxes of the top six levels of its kd-tree (setup data, like the
+ * bounding box), and even its leaf boxes, and they removed only 1% and 14%
+ * of the queries (200k uniform points, 2 threads): a search ball that
+ * crosses the cut nearly always reaches a box next to it.
+ */
+/*
+ * Shared mode, part j's mesh published: the first of j's points in the
+ * pencil of the face (ia, ib, ic) is a neighbour that ia would have in
+ * the DT of j's points and ia (fdt_ins_conflict_vertices: every front face
+ * is a face of the DT of all points, so of the DT of j's points and the
+ * face's vertices, where the first point is joined to ia, and adding the
+ * other vertices takes edges from ia, never gives it new ones). Offering
+ * those few to the search state replaces the kd search of j, which on
+ * cylinders and cospherical sets tests thousands of points a face. The
+ * faces come in runs with the same lowest vertex (the bucket order of
+ * src/faceq.c), so the last answer is kept.
+ */
+/* Conflict regions larger than this are not used: a point just outside a
+ * part's large flat hull facet (the cut of a grid) is in conflict with
+ * every infinite tet over it, and walking them all for each query cost
+ * more than the kd search (an O-grid of 40k points on two threads: 2.6 s
+ * CPU with the kd search of the other part, 15.5 s with whole regions). */
+#define MESH_QUERY_MAX_TETS 256
+
+static int offer_from_mesh(worker *w, fdt_apex *s, int part)
+{
+    const fdt_ins *m = &w->e->w[part].orc.mesh;
+    if (w->qcache_part != part || w->qcache_v != s->ia) {
+        if (!w->qhint) {
+            w->qhint = malloc((size_t)w->e->n * sizeof *w->qhint);
+            if (!w->qhint)
+                return FDT_ENOMEM;
+            memset(w->qhint, 0xff, (size_t)w->e->n * sizeof *w->qhint);
+        }
+        w->qcache_part = -1;
+        int rc = fdt_ins_conflict_vertices(m, s->a, &w->qhint[part], MESH_QUERY_MAX_TETS,
+                                           &w->iq, &w->kq.pc);
+        if (rc < 0)
+            return rc;
+        w->qcache_part = part;
+        w->qcache_v = s->ia;
+        w->qcache_big = rc == 1;
+    }
+    if (w->qcache_big) {
+        fdt_apex_search(s, &w->e->pt->trees[part], &w->kq);
+        return FDT_OK;
+    }
+    const double *P = w->e->P;
+    for (size_t i = 0; i < w->iq.nvs; i++)
+        fdt_apex_offer(s, w->iq.vs[i], P + 3 * (size_t)w->iq.vs[i], &w->kq);
+    w->st.mesh_queries++;
+    return FDT_OK;
+}
+
+static int search_others(worker *w, fdt_apex *s, qbuf *qb)
+{
+    const fdt_partition *pt = w->e->pt;
+    int stack[64];
+    int sp = 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const fdt_pnode *nd = &pt->nodes[stack[--sp]];
+        if (nd->begin == nd->end || nd->part == w->id)
+            continue;
+        if (!fdt_apex_box_useful(s, nd->lo, nd->hi))
+            continue;
+        if (nd->left < 0) {
+            if (w->e->mode == FDT_MODE_SHARED) {
+                /* acquire: pairs with the owner's release (mesh_pub) */
+                if (atomic_load_explicit(&w->e->w[nd->part].mesh_pub, memory_order_acquire)) {
+                    int rc = offer_from_mesh(w, s, nd->part);
+                    if (rc)
+                        return rc;
+                } else {
+                    fdt_apex_search(s, &pt->trees[nd->part], &w->kq);
+                }
+            } else {
+                int rc = fdt_proto_remote_query(w, s, nd->part, qb);
+                if (rc)
+                    return rc;
+            }
+            continue;
+        }
+        const fdt_pnode *l = &pt->nodes[nd->left], *r = l + 1;
+        int ball = s->best != FDT_NONE && isfinite(s->r2);
+        if (!ball)
+            fdt_apex_aim(s);
+        const double *q = ball ? s->center : s->target;
+        double sc = ball ? s->sc : 1.0;
+        double dl = l->begin < l->end ? fdt_box_dist2_sc(l->lo, l->hi, q, sc) : INFINITY;
+        double dr = r->begin < r->end ? fdt_box_dist2_sc(r->lo, r->hi, q, sc) : INFINITY;
+        if (dl <= dr) {
+            stack[sp++] = nd->left + 1;
+            stack[sp++] = nd->left;
+        } else {
+            stack[sp++] = nd->left;
+            stack[sp++] = nd->left + 1;
+        }
+    }
+    return FDT_OK;
+}
+
+/* Advances one own front face. Returns 1 if it did, 0 if the queue held
+ * no live face, or an error. */
+static int advance_one(worker *w)
+{
+    fdt_face *s = NULL;
+    uint32_t f[3];
+    uint32_t fv[3];
+    while (fdt_faceq_pop(&w->fq, fv)) {
+        /* the slot of a face that may come up soon, as in src/front.c */
+        const uint32_t *ahead = fdt_faceq_ahead(&w->fq, 8);
+        if (ahead)
+            fdt_facetab_prefetch(&w->ft, ahead);
+        s = fdt_facetab_find(&w->ft, fv);
+        /* Faces completed since they were queued are skipped here. */
+        if (s && s->v[1] == fv[1])
+            break;
+        s = NULL;
+    }
+    if (!s)
+        return 0;
+    memcpy(f, s->v, sizeof f);
+    w->st.faces_advanced++;
+    double a[3], b[3], c[3];
+    const double *pa = coords(w, f[0]), *pb = coords(w, f[1]), *pc = coords(w, f[2]);
+    if (!pa || !pb || !pc)
+        return FDT_EINTERNAL;
+    memcpy(a, pa, sizeof a);
+    memcpy(b, pb, sizeof b);
+    memcpy(c, pc, sizeof c);
+    fdt_oracle_tick(&w->orc, w->st.faces_advanced - 1, &w->kq);
+    if (w->orc.state == 1 && !w->orc.gm && !w->published) {
+        /* release: see mesh_pub */
+        atomic_store_explicit(&w->mesh_pub, 1, memory_order_release);
+        w->published = 1;
+    }
+    /* The step shared with src/front.c (fdt_front_apex). Our part's
+     * insertion mesh, where the oracle switched to it: its answer is the
+     * first of our points in the pencil of spheres through f's circle
+     * (src/oracle.h), so only another part's point can come earlier, and
+     * only inside that sphere: the candidate is offered to the search
+     * state and the others are asked exactly as after our own kd search.
+     * Else our own tree, climbing from the leaf of f[0] (ours): the apex
+     * is nearly always near the face. When the final ball lies inside our
+     * part's region (src/partition.c, regions()), no other part's point
+     * can be in it and the others are not asked at all; otherwise their
+     * bounding boxes rule most of them out. The closed-side tet is ours
+     * when we built it (aux). */
+    int64_t ctid = s->aux == (uint32_t)w->id ? (int64_t)(s->tet >> 2) : -1;
+    uint32_t mapex = FDT_NONE, mtet = FDT_NONE;
+    int inside = 0;
+    fdt_apex ap;
+    int err = fdt_front_apex(&w->orc, w->tree, &w->ft, f, a, b, c, ctid,
+                             ctid >= 0 ? w->out.tets[s->tet] : FDT_NONE, 1, &ap, &inside,
+                             &mapex, &mtet, &w->kq);
+    if (err)
+        return err;
+    /* fdt_front_apex sets mapex to the kd search's answer when the mesh
+     * was not asked; the mesh tet (mtet) stays FDT_NONE then. */
+    qbuf qb = {{{0}}, 0};
+    err = inside ? FDT_OK : search_others(w, &ap, &qb);
+    if (err)
+        return err;
+    if (ap.best == FDT_NONE) {
+        /* Nothing on the open side: a hull face, already outward. The
+         * search changed no table (message mode deferred its FACESENDs). */
+        fdt_face *live = fdt_facetab_find(&w->ft, f);
+        if (!live)
+            return FDT_EINTERNAL;
+        if ((err = fdt_meshbuf_add_hull(&w->out, f)) != FDT_OK)
+            return err;
+        w->st.hull_faces++;
+        fdt_facetab_remove(&w->ft, live);
+        return 1;
+    }
+    uint32_t p = ap.best;
+    uint32_t v[4] = {f[0], f[1], f[2], p};
+    /* f[0] is the face's lowest id, and ours. */
+    int owner = p > f[0] || is_own(w, p) ? w->id : fdt_partition_owner(w->e->pt, p);
+    if (owner == w->id) {
+        if (w->e->mode == FDT_MODE_MESSAGE && !is_own(w, p) &&
+            (err = fdt_ghost_put(&w->ghosts, p, ap.bp)) != FDT_OK)
+            return err;
+        /* The search changed no table (above), so s still holds f. A
+         * local build always adds a tet (fdt_eng_build_tet), the last of out; its
+         * mesh tet is known when the mesh gave its apex. */
+        err = fdt_eng_build_tet(w, v, 0, s);
+        if (!err)
+            err = fdt_oracle_note(&w->orc, (int64_t)w->out.ntets - 1,
+                                  p == mapex ? mtet : FDT_NONE);
+    } else {
+        /* p is the tet's lowest id: the owner reads its coordinates
+         * itself, the message carries f's. */
+        w->st.tet_requests++;
+        err = fdt_proto_send_face(w, owner, f, p, -1);
+    }
+    return err ? err : 1;
+}
+
+
+int fdt_eng_worker_setup(worker *w)
+{
+    size_t np = w->hi - w->lo;
+    /* A part of n points owns about 6.5 n tets and a front of a few
+     * n^(2/3) faces; these are only first sizes. */
+    size_t expect = (size_t)(7.0 * (double)np) + 64;
+    if (fdt_meshbuf_init(&w->out, expect, w->e->want_nbrs) != FDT_OK)
+        return FDT_ENOMEM;
+    if (fdt_facetab_init(&w->ft, 1024) != FDT_OK)
+        return FDT_ENOMEM;
+    /* Own faces have an own lowest id (the ownership rule above). */
+    if (fdt_faceq_init(&w->fq, w->lo, w->hi - w->lo) != FDT_OK)
+        return FDT_ENOMEM;
+    /* The part's mesh, if it comes to one, is built by this thread: its
+     * pages are first touched here, near the core that reads them. */
+    fdt_oracle_init(&w->orc, w->tree, w->e->search);
+    if (w->e->gmesh_ok)
+        fdt_oracle_share(&w->orc, &w->e->gmesh);
+    w->qcache_part = -1;
+    return FDT_OK;
+}
+
+int fdt_eng_worker_loop(worker *w)
+{
+    int rc;
+    for (int i = 0; i < w->nseeds; i++)
+        if ((rc = fdt_eng_build_tet(w, w->seeds[i], 0, NULL)) != FDT_OK)
+            return rc;
+    for (;;) {
+        if (aborted(w->e))
+            return FDT_OK;
+        /* FACESENDs deferred by a search are older than the mailbox. */
+        while (w->deferred.n > 0) {
+            pface pf = w->deferred.q[w->deferred.head];
+            w->deferred.head++;
+            w->deferred.n--;
+            if ((rc = fdt_proto_handle_face(w, &pf)) != RUN_ON)
+                return rc;
+        }
+        fdt_msg m;
+        while (fdt_tp_poll(w->e->tp, w->id, &m)) {
+            rc = fdt_proto_dispatch(w, &m, NULL);
+            if (rc != RUN_ON)
+                return rc;
+        }
+        if ((rc = advance_one(w)) < 0)
+            return rc;
+        if (w->id == w->e->fail_part && w->st.faces_advanced >= w->e->fail_after)
+            return FDT_EINTERNAL; /* a test's injected failure (fdt_par_opts) */
+        if (rc == 1 || w->deferred.n > 0)
+            continue;
+        /* Nothing to do: shared mode gives up its unit, message mode
+         * may detach (src/termination.c). */
+        if ((rc = fdt_term_idle(w)) != RUN_ON)
+            return rc;
+        if ((rc = fdt_proto_wait_mail(w, 0, &w->st.t_idle)) != FDT_OK)
+            return rc;
+    }
+}
+
+void fdt_eng_worker_free(worker *w)
+{
+    fdt_oracle_free(&w->orc);
+    fdt_ins_query_free(&w->iq);
+    free(w->qhint);
+    fdt_facetab_free(&w->ft);
+    fdt_faceq_free(&w->fq);
+    fdt_meshbuf_free(&w->out);
+    free(w->built.k);
+    free(w->ghosts.g);
+    free(w->links.r);
+    free(w->deferred.q);
+}
