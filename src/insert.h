@@ -46,6 +46,8 @@ typedef struct fdt_ins_stats {
     size_t created_tets;  /* tets created */
     size_t max_cavity;    /* largest cavity */
     size_t conflict_tests;/* conflict (insphere / hull side) tests */
+    size_t deferred;      /* fdt_ins_build_parallel: insertions put off (a tet held
+                           * by another thread, or the slots spent) */
     size_t serial_finish; /* fdt_ins_build_parallel: points left to its serial end */
     /* fdt_ins_build_parallel: thread CPU seconds of its serial start, of
      * its workers (the busiest one, and all together) and of its serial

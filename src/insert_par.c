@@ -147,7 +147,7 @@ static inline void unlock_slot(shared *sh, uint32_t t)
     atomic_store_explicit(&sh->lock[t], 0, memory_order_release);
 }
 
-static int push_held(worker *w, uint32_t t)
+static inline int push_held(worker *w, uint32_t t)
 {
     if (w->nheld == w->heldcap && ins_grow_u32(&w->held, &w->heldcap, w->nheld + 1) != FDT_OK)
         return FDT_ENOMEM;
@@ -163,9 +163,14 @@ static int push_held(worker *w, uint32_t t)
  * slot this worker freed is locked by it too, but a live tet's neighbour
  * is never a freed slot, and only neighbours reach here.)
  */
-static int lock_live(worker *w, uint32_t t)
+static inline int lock_live(worker *w, uint32_t t)
 {
-    unsigned char exp = 0;
+    /* A plain look first (relaxed: the CAS below is what acquires): most
+     * neighbours met are this insertion's own cavity tets, and a CAS that
+     * fails still takes the cache line. */
+    unsigned char exp = atomic_load_explicit(&w->sh->lock[t], memory_order_relaxed);
+    if (exp != 0)
+        return exp == w->me;
     if (atomic_compare_exchange_strong_explicit(&w->sh->lock[t], &exp, w->me,
                                                 memory_order_acquire, memory_order_relaxed)) {
         if (push_held(w, t) != FDT_OK) {
@@ -414,7 +419,7 @@ static int locate(worker *w, uint32_t pid, const double *p, uint32_t *out)
 
 /* Whether tet t (held) is in conflict with p: src/insert.c's rule. The
  * coplanar case reads the finite tet under a hull face: taken too. */
-static int conflict(worker *w, uint32_t t, const double *p)
+static inline int conflict(worker *w, uint32_t t, const double *p)
 {
     const fdt_ins *m = w->sh->m;
     const uint32_t *v = m->T + 8 * (size_t)t;
@@ -463,6 +468,8 @@ static int insert_point(worker *w, uint32_t pid)
     w->ncav = w->nbnd = 0;
     mark[t0] = MARK_IN;
     w->cav[w->ncav++] = t0;
+    for (int j = 0; j < 4; j++)
+        fdt_prefetch(m->T + 8 * (size_t)(v0[4 + j] >> 2));
     for (size_t ci = 0; ci < w->ncav; ci++) {
         uint32_t c = w->cav[ci];
         for (int k = 0; k < 4; k++) {
@@ -486,6 +493,12 @@ static int insert_point(worker *w, uint32_t pid)
                         goto abort;
                     mark[o] = MARK_IN;
                     w->cav[w->ncav++] = o;
+                    /* its neighbours are tested next: ask for them now */
+                    const uint32_t *on = m->T + 8 * (size_t)o + 4;
+                    for (int j = 0; j < 4; j++) {
+                        fdt_prefetch(m->T + 8 * (size_t)(on[j] >> 2));
+                        fdt_prefetch(&sh->lock[on[j] >> 2]);
+                    }
                     continue;
                 }
                 mark[o] = MARK_OUT;
@@ -552,6 +565,7 @@ abort:
 
 static int defer(worker *w, uint32_t pid)
 {
+    w->st.deferred++;
     if (w->ndef == w->defcap && ins_grow_u32(&w->def, &w->defcap, w->ndef + 1) != FDT_OK)
         return FDT_ENOMEM;
     w->def[w->ndef++] = pid;
@@ -581,6 +595,7 @@ static int retry_deferred(worker *w, size_t *done)
         }
         int r = insert_point(w, pid);
         if (r == BUSY || r == FULL) {
+            w->st.deferred++;
             w->def[keep++] = pid;
             if (r == FULL)
                 atomic_store_explicit(&w->sh->stop, 1, memory_order_relaxed);
@@ -900,6 +915,7 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
         m->stats.cavity_tets += s->cavity_tets;
         m->stats.created_tets += s->created_tets;
         m->stats.conflict_tests += s->conflict_tests;
+        m->stats.deferred += s->deferred;
         if (s->max_cavity > m->stats.max_cavity)
             m->stats.max_cavity = s->max_cavity;
         if (cnt) {

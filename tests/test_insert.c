@@ -933,11 +933,11 @@ static int time_file(const char *path, int reps, int threads)
     qsort(cs, (size_t)reps, sizeof *cs, cmp_double);
     printf("SUMMARY code=insert threads=%d file=%s points=%u tets=%zu hull=%zu build_s=%.4f min_s=%.4f "
            "max_s=%.4f cpu_s=%.4f reps=%d prep_kd_s=%.4f walk_steps=%zu cavity_tets=%zu max_cavity=%zu "
-           "conflict_tests=%zu serial_finish=%zu cpu_start=%.3f cpu_workers_max=%.3f cpu_workers_sum=%.3f cpu_finish=%.3f exact_orient=%zu exact_insphere=%zu slots=%u bytes_per_point=%.1f\n",
+           "conflict_tests=%zu deferred=%zu serial_finish=%zu cpu_start=%.3f cpu_workers_max=%.3f cpu_workers_sum=%.3f cpu_finish=%.3f exact_orient=%zu exact_insphere=%zu slots=%u bytes_per_point=%.1f\n",
            threads, path, pp.m, m.nfinite, m.ninfinite, med, sorted[0], sorted[reps - 1], cs[reps / 2],
            reps, t_prep,
            m.stats.walk_steps, m.stats.cavity_tets, m.stats.max_cavity, m.stats.conflict_tests,
-           m.stats.serial_finish, m.stats.cpu_start_s, m.stats.cpu_workers_max_s,
+           m.stats.deferred, m.stats.serial_finish, m.stats.cpu_start_s, m.stats.cpu_workers_max_s,
            m.stats.cpu_workers_sum_s, m.stats.cpu_finish_s, cnt.orient_exact, cnt.insphere_exact, m.nslots,
            ((double)m.cap * 32.0 + (double)m.n * 4.0) / (double)m.n);
     fdt_ins_free(&m);
