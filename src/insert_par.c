@@ -689,6 +689,12 @@ static int worker_init(worker *w, shared *sh, int id)
 int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t n, int nthreads,
                            fdt_pred_counts *cnt)
 {
+    return fdt_ins_build_parallel_slots(m, P, base, n, nthreads, 0.0, cnt);
+}
+
+int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                                 int nthreads, double slots_a_point, fdt_pred_counts *cnt)
+{
     if (nthreads < 1)
         nthreads = 1;
     if (nthreads > MAX_WORKERS)
@@ -727,7 +733,8 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
     while (r0 < nrounds && round_end[r0 - 1] < n / 32)
         r0++;
     uint32_t prefix = round_end[r0 - 1];
-    uint64_t slots = (uint64_t)n * 8 + (uint64_t)nw * 2 * CHUNK + 1024;
+    uint64_t slots = slots_a_point > 0.0 ? (uint64_t)(slots_a_point * n) + 64
+                                         : (uint64_t)n * 8 + (uint64_t)nw * 2 * CHUNK + 1024;
     double c0 = thread_cpu();
     err = fdt_ins_build_prefix(m, P, base, n, order, prefix, slots, first, cnt);
     if (err)
@@ -746,7 +753,7 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
                         (uint64_t)nw * 2 * CHUNK + 1024;
         if (want > INS_MAX_SLOTS)
             want = INS_MAX_SLOTS;
-        if (want > m->cap) {
+        if (want > m->cap && slots_a_point <= 0.0) {
             uint32_t *t = realloc(m->T, (size_t)want * 8 * sizeof *t);
             if (!t)
                 goto fail;
