@@ -38,9 +38,10 @@
  * names it fails to lock, as any slot in use by another thread does, and
  * no thread ever reads a freed slot it does not own.
  *
- * Slots. One capacity, allocated before the threads start (about 8 slots
- * a point: 6.5 tets a point on uniform points, plus the hull and the
- * threads' chunks) and never moved while they run. Fresh slots come in
+ * Slots. One capacity, allocated before the threads start (the slots a
+ * point the serial rounds used, times 1.35, times n: 9-10 a point on
+ * uniform points, 15-19 on a pipe scan; untouched pages cost no memory)
+ * and never moved while they run. Fresh slots come in
  * chunks of CHUNK from one atomic counter; freed slots go to the freeing
  * worker's own list. A worker that finds the capacity spent stops every
  * worker cleanly (before writing anything); phase 3 grows the arrays.
