@@ -161,4 +161,13 @@ int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
  */
 int fdt_ins_finish(fdt_ins *m);
 
+/*
+ * fdt_ins_build_parallel with the slots' first capacity forced to
+ * slots_a_point a point (0: its own estimate): the tests make it small,
+ * so the workers run out of slots and the arrays grow between passes,
+ * then in the serial finish.
+ */
+int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                                 int nthreads, double slots_a_point, fdt_pred_counts *cnt);
+
 #endif

@@ -38,9 +38,10 @@
  * names it fails to lock, as any slot in use by another thread does, and
  * no thread ever reads a freed slot it does not own.
  *
- * Slots. One capacity, allocated before the threads start (about 8 slots
- * a point: 6.5 tets a point on uniform points, plus the hull and the
- * threads' chunks) and never moved while they run. Fresh slots come in
+ * Slots. One capacity, allocated before the threads start (the slots a
+ * point the serial rounds used, times 1.35, times n: 9-10 a point on
+ * uniform points, 15-19 on a pipe scan; untouched pages cost no memory)
+ * and never moved while they run. Fresh slots come in
  * chunks of CHUNK from one atomic counter; freed slots go to the freeing
  * worker's own list. A worker that finds the capacity spent stops every
  * worker cleanly (before writing anything); phase 3 grows the arrays.
@@ -147,7 +148,7 @@ static inline void unlock_slot(shared *sh, uint32_t t)
     atomic_store_explicit(&sh->lock[t], 0, memory_order_release);
 }
 
-static int push_held(worker *w, uint32_t t)
+static inline int push_held(worker *w, uint32_t t)
 {
     if (w->nheld == w->heldcap && ins_grow_u32(&w->held, &w->heldcap, w->nheld + 1) != FDT_OK)
         return FDT_ENOMEM;
@@ -163,9 +164,14 @@ static int push_held(worker *w, uint32_t t)
  * slot this worker freed is locked by it too, but a live tet's neighbour
  * is never a freed slot, and only neighbours reach here.)
  */
-static int lock_live(worker *w, uint32_t t)
+static inline int lock_live(worker *w, uint32_t t)
 {
-    unsigned char exp = 0;
+    /* A plain look first (relaxed: the CAS below is what acquires): most
+     * neighbours met are this insertion's own cavity tets, and a CAS that
+     * fails still takes the cache line. */
+    unsigned char exp = atomic_load_explicit(&w->sh->lock[t], memory_order_relaxed);
+    if (exp != 0)
+        return exp == w->me;
     if (atomic_compare_exchange_strong_explicit(&w->sh->lock[t], &exp, w->me,
                                                 memory_order_acquire, memory_order_relaxed)) {
         if (push_held(w, t) != FDT_OK) {
@@ -414,7 +420,7 @@ static int locate(worker *w, uint32_t pid, const double *p, uint32_t *out)
 
 /* Whether tet t (held) is in conflict with p: src/insert.c's rule. The
  * coplanar case reads the finite tet under a hull face: taken too. */
-static int conflict(worker *w, uint32_t t, const double *p)
+static inline int conflict(worker *w, uint32_t t, const double *p)
 {
     const fdt_ins *m = w->sh->m;
     const uint32_t *v = m->T + 8 * (size_t)t;
@@ -463,6 +469,8 @@ static int insert_point(worker *w, uint32_t pid)
     w->ncav = w->nbnd = 0;
     mark[t0] = MARK_IN;
     w->cav[w->ncav++] = t0;
+    for (int j = 0; j < 4; j++)
+        fdt_prefetch(m->T + 8 * (size_t)(v0[4 + j] >> 2));
     for (size_t ci = 0; ci < w->ncav; ci++) {
         uint32_t c = w->cav[ci];
         for (int k = 0; k < 4; k++) {
@@ -486,6 +494,12 @@ static int insert_point(worker *w, uint32_t pid)
                         goto abort;
                     mark[o] = MARK_IN;
                     w->cav[w->ncav++] = o;
+                    /* its neighbours are tested next: ask for them now */
+                    const uint32_t *on = m->T + 8 * (size_t)o + 4;
+                    for (int j = 0; j < 4; j++) {
+                        fdt_prefetch(m->T + 8 * (size_t)(on[j] >> 2));
+                        fdt_prefetch(&sh->lock[on[j] >> 2]);
+                    }
                     continue;
                 }
                 mark[o] = MARK_OUT;
@@ -552,6 +566,7 @@ abort:
 
 static int defer(worker *w, uint32_t pid)
 {
+    w->st.deferred++;
     if (w->ndef == w->defcap && ins_grow_u32(&w->def, &w->defcap, w->ndef + 1) != FDT_OK)
         return FDT_ENOMEM;
     w->def[w->ndef++] = pid;
@@ -581,6 +596,7 @@ static int retry_deferred(worker *w, size_t *done)
         }
         int r = insert_point(w, pid);
         if (r == BUSY || r == FULL) {
+            w->st.deferred++;
             w->def[keep++] = pid;
             if (r == FULL)
                 atomic_store_explicit(&w->sh->stop, 1, memory_order_relaxed);
@@ -674,6 +690,12 @@ static int worker_init(worker *w, shared *sh, int id)
 int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t n, int nthreads,
                            fdt_pred_counts *cnt)
 {
+    return fdt_ins_build_parallel_slots(m, P, base, n, nthreads, 0.0, cnt);
+}
+
+int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                                 int nthreads, double slots_a_point, fdt_pred_counts *cnt)
+{
     if (nthreads < 1)
         nthreads = 1;
     if (nthreads > MAX_WORKERS)
@@ -712,13 +734,34 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
     while (r0 < nrounds && round_end[r0 - 1] < n / 32)
         r0++;
     uint32_t prefix = round_end[r0 - 1];
-    uint64_t slots = (uint64_t)n * 8 + (uint64_t)nw * 2 * CHUNK + 1024;
+    uint64_t slots = slots_a_point > 0.0 ? (uint64_t)(slots_a_point * n) + 64
+                                         : (uint64_t)n * 8 + (uint64_t)nw * 2 * CHUNK + 1024;
     double c0 = thread_cpu();
     err = fdt_ins_build_prefix(m, P, base, n, order, prefix, slots, first, cnt);
     if (err)
         goto out;
     double c1 = thread_cpu();
     err = FDT_ENOMEM;
+    {
+        /* The slots a point the serial rounds used, with a third more
+         * (later rounds are denser; the chunks): a family with more
+         * tets a point than uniform points' 6.5 (a pipe scan: 13) then
+         * rarely stops the workers for more. */
+        uint32_t nfree = 0;
+        for (uint32_t t = m->free_head; t != FDT_NONE; t = m->T[8 * (size_t)t + 4])
+            nfree++;
+        uint64_t want = (uint64_t)((double)(m->nslots - nfree) / (double)prefix * 1.35 * n) +
+                        (uint64_t)nw * 2 * CHUNK + 1024;
+        if (want > INS_MAX_SLOTS)
+            want = INS_MAX_SLOTS;
+        if (want > m->cap && slots_a_point <= 0.0) {
+            uint32_t *t = realloc(m->T, (size_t)want * 8 * sizeof *t);
+            if (!t)
+                goto fail;
+            m->T = t;
+            m->cap = (uint32_t)want;
+        }
+    }
     sh.lock = malloc((size_t)m->cap * sizeof *sh.lock);
     sh.mark = calloc((size_t)m->cap, 1);
     sh.hint = malloc((size_t)n * sizeof *sh.hint);
@@ -900,6 +943,7 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
         m->stats.cavity_tets += s->cavity_tets;
         m->stats.created_tets += s->created_tets;
         m->stats.conflict_tests += s->conflict_tests;
+        m->stats.deferred += s->deferred;
         if (s->max_cavity > m->stats.max_cavity)
             m->stats.max_cavity = s->max_cavity;
         if (cnt) {

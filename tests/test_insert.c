@@ -46,6 +46,7 @@
 #include "frontdt.h"
 #include "front.h"
 #include "insert.h"
+#include "insert_impl.h"
 #include "kdtree.h"
 #include "predicates.h"
 #include "prepare.h"
@@ -756,6 +757,8 @@ static void test_refusals(void)
  * several times (the schedule, hence who inserts what and which points
  * are deferred, differs from run to run); full structure checks on the
  * first run of each count. */
+static size_t serial_finished; /* points of the parallel builds' serial ends */
+
 static void test_parallel_set(pts p, int reps)
 {
     prepped pp;
@@ -769,7 +772,15 @@ static void test_parallel_set(pts p, int reps)
         for (int r = 0; r < reps; r++) {
             fdt_pred_counts cnt = {0};
             double t0 = now_s();
-            CHECK_EQ(fdt_ins_build_parallel(&m, pp.pr.p, 0, pp.m, threads[ti], &cnt), FDT_OK);
+            /* the second run with room for 1.5 or 0.25 slots a point at
+             * first: the workers run out, the arrays grow between their
+             * passes (1.5) or, after 8 passes, in the serial finish */
+            double spp = r == 1 ? (ti % 2 ? 0.25 : 1.5) : 0.0;
+            CHECK_EQ(fdt_ins_build_parallel_slots(&m, pp.pr.p, 0, pp.m, threads[ti], spp, &cnt),
+                     FDT_OK);
+            if (spp > 0.0)
+                CHECK(m.stats.deferred > 0); /* the slots did run out */
+            serial_finished += m.stats.serial_finish;
             t_kernel += now_s() - t0;
             char nm[96];
             snprintf(nm, sizeof nm, "%s parallel t%d run %d", p.name, threads[ti], r);
@@ -869,7 +880,10 @@ static void run_parallel(const char *gen)
     test_parallel_set(rotated_lattice(14), 2);
     test_parallel_set(cylinder(60), 2);
     test_parallel_set(two_planes(40), 2);
-    printf("test_insert --parallel: all checks passed (parallel kernel %.3f s)\n", t_kernel);
+    /* the serial finish (and its growing arrays) was reached */
+    CHECK(serial_finished > 0);
+    printf("test_insert --parallel: all checks passed (parallel kernel %.3f s, %zu points "
+           "by the serial finishes)\n", t_kernel, serial_finished);
 }
 
 /* ---- timing driver ----------------------------------------------------- */
@@ -933,11 +947,11 @@ static int time_file(const char *path, int reps, int threads)
     qsort(cs, (size_t)reps, sizeof *cs, cmp_double);
     printf("SUMMARY code=insert threads=%d file=%s points=%u tets=%zu hull=%zu build_s=%.4f min_s=%.4f "
            "max_s=%.4f cpu_s=%.4f reps=%d prep_kd_s=%.4f walk_steps=%zu cavity_tets=%zu max_cavity=%zu "
-           "conflict_tests=%zu serial_finish=%zu cpu_start=%.3f cpu_workers_max=%.3f cpu_workers_sum=%.3f cpu_finish=%.3f exact_orient=%zu exact_insphere=%zu slots=%u bytes_per_point=%.1f\n",
+           "conflict_tests=%zu deferred=%zu serial_finish=%zu cpu_start=%.3f cpu_workers_max=%.3f cpu_workers_sum=%.3f cpu_finish=%.3f exact_orient=%zu exact_insphere=%zu slots=%u bytes_per_point=%.1f\n",
            threads, path, pp.m, m.nfinite, m.ninfinite, med, sorted[0], sorted[reps - 1], cs[reps / 2],
            reps, t_prep,
            m.stats.walk_steps, m.stats.cavity_tets, m.stats.max_cavity, m.stats.conflict_tests,
-           m.stats.serial_finish, m.stats.cpu_start_s, m.stats.cpu_workers_max_s,
+           m.stats.deferred, m.stats.serial_finish, m.stats.cpu_start_s, m.stats.cpu_workers_max_s,
            m.stats.cpu_workers_sum_s, m.stats.cpu_finish_s, cnt.orient_exact, cnt.insphere_exact, m.nslots,
            ((double)m.cap * 32.0 + (double)m.n * 4.0) / (double)m.n);
     fdt_ins_free(&m);
