@@ -1146,35 +1146,44 @@ static int run(const cli *c)
     if (c->stats)
         print_stats(res, &st, dups, &tm);
     if (c->stats_json) {
-        /* Only a regular file (or a new one) is ours to remove if the
-         * write fails: "--stats-json /dev/full" must not unlink the
-         * device, nor a symbolic link the file it stands for. */
+        /* A file goes through a temporary renamed at the end, as the
+         * mesh does: a failed or interrupted write leaves what was there.
+         * A device or a pipe (named, or reached through a link) is
+         * written in place: renaming over it would replace a /dev node
+         * or a FIFO someone reads with a plain file. */
+        char jerr[1024];
+        fdt_wr_side *side = NULL;
         struct stat jst;
-        int removable = !json_stdout &&
-                        (lstat(c->stats_json, &jst) != 0
-                             ? errno == ENOENT
-                             : S_ISREG(jst.st_mode));
-        FILE *f = json_stdout ? stdout : fopen(c->stats_json, "w");
+        int in_place = json_stdout || (stat(c->stats_json, &jst) == 0 && !S_ISREG(jst.st_mode));
+        FILE *f = json_stdout ? stdout
+                  : in_place  ? fopen(c->stats_json, "w")
+                              : fdt_wr_side_open(c->stats_json, &side, jerr, sizeof jerr);
         if (!f) {
-            say("%s: %s", c->stats_json, strerror(errno));
+            if (in_place)
+                say("%s: %s", c->stats_json, strerror(errno));
+            else
+                say("%s", jerr);
             code = CLI_WRITE;
             goto done;
         }
         errno = 0;
         write_stats_json(f, c, res, &st, dups, &tm, c->hash, hash);
         int e = ferror(f) ? (errno ? errno : EIO) : 0;
-        if (json_stdout) {
-            if (fflush(f) != 0 && !e)
+        if (in_place) {
+            if ((json_stdout ? fflush(f) : fclose(f)) != 0 && !e)
                 e = errno ? errno : EIO;
-        } else {
-            if (fclose(f) != 0 && !e)
-                e = errno ? errno : EIO;
-            if (e && removable)
-                unlink(c->stats_json);
-        }
-        if (e) {
-            say("%s: %s", json_stdout ? "stdout" : c->stats_json,
-                strerror(e));
+            if (e) {
+                say("%s: %s", json_stdout ? "stdout" : c->stats_json, strerror(e));
+                code = CLI_WRITE;
+                goto done;
+            }
+        } else if (e) {
+            fdt_wr_side_abandon(side);
+            say("%s: %s", c->stats_json, strerror(e));
+            code = CLI_WRITE;
+            goto done;
+        } else if (fdt_wr_side_commit(side, jerr, sizeof jerr) != FDT_IO_OK) {
+            say("%s", jerr);
             code = CLI_WRITE;
             goto done;
         }

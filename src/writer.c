@@ -274,6 +274,47 @@ static mode_t creation_mode(void)
 }
 
 /* ------------------------------------------------------------------------ */
+/* Side files (the CLI's --stats-json)                                       */
+/* ------------------------------------------------------------------------ */
+
+struct fdt_wr_side {
+    out_file o;
+};
+
+FILE *fdt_wr_side_open(const char *target, fdt_wr_side **side, char *err, size_t errlen)
+{
+    *side = calloc(1, sizeof **side);
+    if (!*side) {
+        snprintf(err, errlen, "%s: out of memory", target);
+        return NULL;
+    }
+    int e = out_open(&(*side)->o, target, creation_mode());
+    if (e) {
+        free(*side);
+        *side = NULL;
+        set_errno_err(err, errlen, target, e);
+        return NULL;
+    }
+    /* The caller writes with stdio: the buffer of out_file is not used. */
+    return (*side)->o.f;
+}
+
+int fdt_wr_side_commit(fdt_wr_side *side, char *err, size_t errlen)
+{
+    int r = commit_all(&side->o, 1, err, errlen, 0);
+    free(side);
+    return r;
+}
+
+void fdt_wr_side_abandon(fdt_wr_side *side)
+{
+    if (!side)
+        return;
+    out_abandon(&side->o);
+    free(side);
+}
+
+/* ------------------------------------------------------------------------ */
 /* Mesh validation                                                           */
 /* ------------------------------------------------------------------------ */
 

@@ -128,6 +128,19 @@ int fdt_output_files_as(const char *path, const fdt_format *f,
  */
 int fdt_same_file(const char *a, const char *b);
 
+/*
+ * A small file written with stdio through the same temporary-and-rename
+ * (and signal cleanup) as the mesh: the CLI's --stats-json. open returns
+ * the stream of the temporary (NULL and a message in err on failure);
+ * commit closes it and renames it over target (FDT_IO_OK or a writer
+ * code, the message in err, the temporary removed); abandon removes it.
+ * Either frees side.
+ */
+typedef struct fdt_wr_side fdt_wr_side;
+FILE *fdt_wr_side_open(const char *target, fdt_wr_side **side, char *err, size_t errlen);
+int fdt_wr_side_commit(fdt_wr_side *side, char *err, size_t errlen);
+void fdt_wr_side_abandon(fdt_wr_side *side);
+
 /* Removes every temporary output file not yet renamed. Async-signal-safe. */
 void fdt_io_cleanup_temps(void);
 
