@@ -269,6 +269,15 @@ static reference make_ref(const pts *p)
     ref.nhull = fdt_result_num_hull_faces(ref.r);
     ref.hull = canon_hull(ref.r);
     CHECK(ref.ntets > 0);
+    /* The reference itself is checked (fdt_check: orientation, links,
+     * hull, empty spheres): equal to serial alone would let one bug in
+     * both engines through. */
+    char msg[256];
+    if (fdt_check(p->xyz, p->n, fdt_result_tets(ref.r), ref.ntets, fdt_result_neighbors(ref.r),
+                  msg, sizeof msg) != FDT_OK)
+        fprintf(stderr, "%s: serial mesh fails fdt_check: %s\n", p->name, msg);
+    CHECK(fdt_check(p->xyz, p->n, fdt_result_tets(ref.r), ref.ntets, fdt_result_neighbors(ref.r),
+                    msg, sizeof msg) == FDT_OK);
     return ref;
 }
 
@@ -374,6 +383,13 @@ static void compare_run(const pts *p, const reference *ref, fdt_mode mode,
     fdt_vid *hull = canon_hull(r);
     CHECK(memcmp(hull, ref->hull, 3 * ref->nhull * sizeof *hull) == 0);
     free(hull);
+    char msg[256];
+    if (fdt_check(p->xyz, p->n, fdt_result_tets(r), nt, fdt_result_neighbors(r), msg,
+                  sizeof msg) != FDT_OK)
+        fprintf(stderr, "%s: %s with %d threads fails fdt_check: %s\n", p->name,
+                mode_name(mode), nthreads, msg);
+    CHECK(fdt_check(p->xyz, p->n, fdt_result_tets(r), nt, fdt_result_neighbors(r), msg,
+                    sizeof msg) == FDT_OK);
     check_stats(r, mode, nthreads);
     if (g_verbose) {
         fdt_stats st;
@@ -663,29 +679,52 @@ static void test_sort_threads(void)
     free(p.xyz);
 }
 
+/* Cancellation of a parallel run, in both modes: the first report (after
+ * 50 ms, src/parallel.c) cancels. 400,000 points take seconds on every
+ * thread count here, so the run cannot finish first: FDT_OK would mean the
+ * callback's answer was ignored. */
 static void test_cancel(void)
 {
     pts p = fam_uniform(400000, 11);
-    fdt_settings s;
-    fdt_default_settings(&s);
-    s.mode = FDT_MODE_MESSAGE;
-    s.n_threads = 3;
-    int calls = 0;
-    s.progress = cancel_cb;
-    s.progress_user = &calls;
-    fdt_context *ctx = NULL;
-    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
-    fdt_result *r = NULL;
-    int err = fdt_triangulate(ctx, p.xyz, p.n, &r);
-    /* On a very fast machine the run may finish before the first report
-     * (every 50 ms); then the final report cannot cancel any more. */
-    CHECK(err == FDT_ECANCELED || (err == FDT_OK && calls <= 1));
-    if (err == FDT_ECANCELED)
+    for (int m = FDT_MODE_SHARED; m <= FDT_MODE_MESSAGE; m++) {
+        fdt_settings s;
+        fdt_default_settings(&s);
+        s.mode = (fdt_mode)m;
+        s.n_threads = 3;
+        int calls = 0;
+        s.progress = cancel_cb;
+        s.progress_user = &calls;
+        fdt_context *ctx = NULL;
+        CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+        fdt_result *r = (fdt_result *)ctx; /* must be set to NULL */
+        double t0 = now_s();
+        int err = fdt_triangulate(ctx, p.xyz, p.n, &r);
+        double dt = now_s() - t0;
+        CHECK_EQ(err, FDT_ECANCELED);
         CHECK(r == NULL);
-    fdt_result_free(&r);
-    fdt_close(&ctx);
+        CHECK(calls >= 1); /* reports go on until the workers stop */
+        fdt_close(&ctx);
+        printf("cancel: progress callback stops a %s run after %.2f s\n", mode_name((fdt_mode)m),
+               dt);
+    }
     free(p.xyz);
-    printf("cancel: progress callback stops a message-mode run (%s)\n", fdt_strerror(err));
+}
+
+/* Message mode caches foreign coordinates in a per-thread ghost map of
+ * 1,024 slots at first, doubled at half load (src/parallel.c, ghost_put).
+ * The small families never fill it; 40,000 uniform points cut in two or
+ * four give each part a layer of thousands of foreign points, so the map
+ * is rehashed several times during the run: the mesh must still be
+ * serial mode's. */
+static void test_ghost_rehash(void)
+{
+    pts p = fam_uniform(40000, 23);
+    reference ref = make_ref(&p);
+    compare_run(&p, &ref, FDT_MODE_MESSAGE, 2);
+    compare_run(&p, &ref, FDT_MODE_MESSAGE, 4);
+    free_ref(&ref);
+    free(p.xyz);
+    printf("message mode, 40000 points, 2 and 4 threads (ghost map rehashed): equal serial\n");
 }
 
 static void test_long(void)
@@ -733,6 +772,7 @@ int main(int argc, char **argv)
     test_family(fam_offset(quick ? 600 : 1500, 9), quick);
     test_tiny(quick ? 2 : 4);
     test_sort_threads();
+    test_ghost_rehash();
     if (!quick)
         test_cancel();
     printf("all parallel tests passed\n");
