@@ -40,7 +40,7 @@
  * must defer; exact degeneracies whose coordinates mix subnormal, normal and
  * huge magnitudes, at stage B and stage C; fdt_circumcenter_exact,
  * fdt_compare_dist and fdt_lex_compare against rationals.
- * scripts/mutants_issue20.py checks that each of them catches the fault it
+ * tests/mutants/run.py checks that each of them catches the fault it
  * is built for.
  *
  * The adaptive stage (between the filters and the exact stages):
