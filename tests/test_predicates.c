@@ -67,6 +67,16 @@
 
 #include "testutil.h"
 
+/* The filters' error-bound constants from their derivations (src/predicates.h:
+ * C eps, eps = 2^-53, with a 2^-12 margin for the filters; C eps^2 for the
+ * adaptive stage), not from the header's macros: a wrong constant there
+ * must fail test_conventions, not move the bound windows along with it. */
+#define TEST_EPS 0x1p-53
+static const double O3D_ERRBOUND = 8.0 * TEST_EPS * (1.0 + 0x1p-12);
+static const double ISP_ERRBOUND = 16.0 * TEST_EPS * (1.0 + 0x1p-12);
+static const double O3D_ADAPT_ERRBOUND = 41.0 * TEST_EPS * TEST_EPS;
+static const double ISP_ADAPT_ERRBOUND = 109.0 * TEST_EPS * TEST_EPS;
+
 /* ------------------------------------------------------------------ */
 /* Context: RNG, reference workspace, failure count. */
 
@@ -948,7 +958,7 @@ static void orient_replica(const double *a, const double *b, const double *c, co
     r->perm = r->term[0] + r->term[1] + r->term[2];
     const double su = aux + auy + auz;
     r->in_range = r->perm >= 0x1p-800 && r->perm <= DBL_MAX && su * 0x1p-980 <= r->perm;
-    r->bound = FDT_O3D_ERRBOUND * r->perm;
+    r->bound = O3D_ERRBOUND * r->perm;
     int s = (r->det > r->bound) - (r->det < -r->bound);
     r->decision = r->in_range && s != 0 ? s : FDT_PRED_UNSURE;
 }
@@ -994,7 +1004,7 @@ static void isp_replica(const double *a, const double *b, const double *c, const
     r->perm = (r->term[0] + r->term[1]) + (r->term[2] + r->term[3]);
     const double lsum = (alift + blift) + (clift + dlift);
     r->in_range = r->perm >= 0x1p-800 && r->perm <= DBL_MAX && lsum * (lsum * 0x1p-960) <= r->perm;
-    r->bound = FDT_ISP_ERRBOUND * r->perm;
+    r->bound = ISP_ERRBOUND * r->perm;
     int s = (r->det < -r->bound) - (r->det > r->bound);
     r->decision = r->in_range && s != 0 ? s : FDT_PRED_UNSURE;
 }
@@ -1007,7 +1017,7 @@ static double bound_without(const filt_eval *r, int i)
     for (int k = 0; k < 4; k++)
         t[k] = k == i ? 0.0 : r->term[k];
     double perm = r->nterm == 4 ? (t[0] + t[1]) + (t[2] + t[3]) : t[0] + t[1] + t[2];
-    return (r->nterm == 4 ? FDT_ISP_ERRBOUND : FDT_O3D_ERRBOUND) * perm;
+    return (r->nterm == 4 ? ISP_ERRBOUND : O3D_ERRBOUND) * perm;
 }
 
 /* The window: the bound holds and |det| lies in (3/4 bound, bound]. */
@@ -2220,7 +2230,7 @@ static void test_adapt_bound(tctx *T, double scale, int verbose)
                 gen_bound_orient(T, pt, z);
                 const double *rows[3] = {pt[1], pt[2], pt[3]};
                 ratio = ref_abs_det_rows(T, rows, 3, pt[0], 0) /
-                        (FDT_O3D_ADAPT_ERRBOUND * adapt_perm_orient(pt[0], pt[1], pt[2], pt[3]));
+                        (O3D_ADAPT_ERRBOUND * adapt_perm_orient(pt[0], pt[1], pt[2], pt[3]));
                 ref = ref_orient(T, pt[0], pt[1], pt[2], pt[3]);
                 got = fdt_orient3d_adapt(pt[0], pt[1], pt[2], pt[3]);
             } else {
@@ -2228,7 +2238,7 @@ static void test_adapt_bound(tctx *T, double scale, int verbose)
                     continue;
                 const double *rows[4] = {pt[0], pt[1], pt[2], pt[3]};
                 ratio = ref_abs_det_rows(T, rows, 4, pt[4], 1) /
-                        (FDT_ISP_ADAPT_ERRBOUND *
+                        (ISP_ADAPT_ERRBOUND *
                          adapt_perm_insphere(pt[0], pt[1], pt[2], pt[3], pt[4]));
                 ref = ref_insphere(T, pt[0], pt[1], pt[2], pt[3], pt[4]);
                 got = fdt_insphere_adapt(pt[0], pt[1], pt[2], pt[3], pt[4]);
