@@ -263,11 +263,56 @@ static void test_progress(void)
     free(xyz);
 }
 
+/* Every search policy in every mode gives the same mesh (the perturbed
+ * Delaunay tetrahedralization is unique), also with more threads than a
+ * part can hold points (parts of fewer than 4 points build no mesh). */
+static void test_search(void)
+{
+    const size_t sizes[2] = {300, 20};
+    for (int z = 0; z < 2; z++) {
+        size_t n = sizes[z];
+        double *xyz = malloc(3 * n * sizeof *xyz);
+        CHECK(xyz);
+        uint64_t seed = 5 + (uint64_t)z;
+        for (size_t i = 0; i < 3 * n; i++)
+            xyz[i] = test_unif(&seed);
+        uint64_t ref = 0;
+        const fdt_search searches[3] = {FDT_SEARCH_KD, FDT_SEARCH_MESH, FDT_SEARCH_AUTO};
+        for (int si = 0; si < 3; si++)
+            for (int mode = FDT_MODE_SERIAL; mode <= FDT_MODE_MESSAGE; mode++)
+                for (int threads = 1; threads <= 16; threads *= 4) {
+                    if (mode == FDT_MODE_SERIAL && threads > 1)
+                        continue;
+                    fdt_settings s;
+                    fdt_default_settings(&s);
+                    s.mode = (fdt_mode)mode;
+                    s.n_threads = threads;
+                    s.search = searches[si];
+                    fdt_context *ctx = NULL;
+                    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+                    fdt_result *r = NULL;
+                    uint64_t h = 1;
+                    EXPECTF(fdt_triangulate(ctx, xyz, n, &r) == FDT_OK &&
+                                fdt_result_hash(r, &h) == FDT_OK,
+                            "%zu points, search %d, mode %d, %d threads: %s", n, (int)s.search,
+                            mode, threads, fdt_context_diagnostic(ctx));
+                    if (ref == 0)
+                        ref = h;
+                    EXPECTF(h == ref, "%zu points, search %d, mode %d, %d threads: another mesh",
+                            n, (int)s.search, mode, threads);
+                    fdt_result_free(&r);
+                    fdt_close(&ctx);
+                }
+        free(xyz);
+    }
+}
+
 int main(void)
 {
     test_settings();
     test_errors();
     test_result();
     test_progress();
+    test_search();
     return test_report("test_api");
 }

@@ -482,6 +482,64 @@ EOF
 fi
 
 # ---------------------------------------------------------------------------
+# Options: every search and mode gives the same hash; bad values are usage
+# errors; statistics of a parallel run; JSON escaping; the progress bar
+# ---------------------------------------------------------------------------
+run opt_ref "$FRONTDT" pts.xyz --hash --quiet
+expect_rc opt_ref 0
+href=$(grep '^hash: ' opt_ref.out)
+for opt in "--search auto" "--search kd" "--search mesh" "--mode auto" "--mode auto -t 2" \
+    "-t 0" "--mode message -t 3 --search mesh"; do
+    # shellcheck disable=SC2086
+    run opt_ok "$FRONTDT" pts.xyz --hash --quiet $opt
+    expect_rc opt_ok 0 && [ "$(grep '^hash: ' opt_ok.out)" = "$href" ] ||
+        fail "'$opt': '$(grep '^hash: ' opt_ok.out)', want '$href'"
+done
+usage_case u_search "unknown search 'fast'" pts.xyz --search fast
+usage_case u_mode "unknown mode 'gpu'" pts.xyz --mode gpu
+usage_case u_o_twice "-o given twice" pts.xyz -o out/a.tets -o out/b.tets
+usage_case u_o_empty "empty output file name" pts.xyz -o ""
+usage_case u_json_empty "empty --stats-json file name" pts.xyz --stats-json ""
+usage_case u_threads "--threads wants a count, not 'x'" pts.xyz -t x
+# "--" ends the options: a file named like an option is an input.
+cp pts.xyz ./-dash.xyz
+run dashdash "$FRONTDT" --hash --quiet -- -dash.xyz
+expect_rc dashdash 0 && [ "$(grep '^hash: ' dashdash.out)" = "$href" ] || fail "-- -dash.xyz"
+rm -f ./-dash.xyz
+# --stats of a parallel run: the per-thread table, one row per thread.
+run pstats "$FRONTDT" pts.xyz --stats --mode message -t 3 --quiet
+expect_rc pstats 0
+expect_in pstats err "message"
+# (the table's header, then rows "  0  points  tets ...": threads 0, 1, 2)
+grep -q '^ *thread  *points  *tets' pstats.err &&
+    [ "$(awk '/^ *thread  *points/ { t = 1; next } t && $1 ~ /^[0-9]+$/ { n++ } END { print n + 0 }' pstats.err)" = 3 ] ||
+    fail "pstats: no per-thread table of 3 rows: $(tail -c 400 pstats.err)"
+# JSON strings escape quotes, backslashes and control characters (an
+# input named q"b\c<TAB>.xyz); python3 must parse the file back.
+qname=$(printf 'q"b\\c\t.xyz')
+cp pts.xyz "$qname"
+run jsonesc "$FRONTDT" "$qname" --stats-json out/esc.json --quiet --mode shared -t 2
+expect_rc jsonesc 0
+if command -v python3 >/dev/null; then
+    python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); s = json.dumps(d)
+assert "q\\\"b\\\\c\\t.xyz" in s, s[:300]' out/esc.json 2>jsonesc.py.err ||
+        fail "jsonesc: out/esc.json does not hold the escaped name: $(head -c 300 jsonesc.py.err)"
+else
+    grep -qF 'q\"b\\c\u0009.xyz' out/esc.json || fail "jsonesc: name not escaped"
+fi
+rm -f "$qname"
+# The progress bar is drawn only on a terminal: script(1) gives one.
+if command -v script >/dev/null; then
+    script -qec "$FRONTDT --demo 300000 --mode serial" /dev/null >tty.out 2>&1
+    RC=$?
+    [ "$RC" = 0 ] || fail "progress on a tty: exit $RC: $(head -c 300 tty.out)"
+    grep -q 'frontdt: \[##*\.*\]  *[0-9]*%' tty.out ||
+        fail "progress on a tty: no bar drawn: $(head -c 300 tty.out)"
+    script -qec "$FRONTDT --demo 300000 --mode shared -t 2 --quiet" /dev/null >tty_q.out 2>&1
+    grep -q '#' tty_q.out && fail "progress with --quiet on a tty: a bar was drawn"
+fi
+
+# ---------------------------------------------------------------------------
 # Repeatability: byte-identical .tets and identical --hash
 # ---------------------------------------------------------------------------
 gen_points 2000 5 >rep.xyz

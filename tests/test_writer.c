@@ -657,6 +657,51 @@ static void test_refusals(const char *dir)
     snprintf(p, sizeof p, "%s/range.ele", dir);
     expect_fail(dir, p, &bv, FDT_IO_EFORMAT, "tet 0 has neighbour 5");
 
+    /* The other end of each range, and missing arrays. */
+    bad = m;
+    bad.tets[2] = -1;
+    bv = view_of(&bad);
+    expect_fail(dir, p, &bv, FDT_IO_EFORMAT, "tet 0 uses vertex -1");
+    bad = m;
+    bad.hull[3] = NP;
+    bv = view_of(&bad);
+    expect_fail(dir, p, &bv, FDT_IO_EFORMAT, "hull face 1 uses vertex 9");
+    bad = m;
+    bad.nbrs[6] = -2;
+    bv = view_of(&bad);
+    expect_fail(dir, p, &bv, FDT_IO_EFORMAT, "tet 1 has neighbour -2");
+    for (int k = 0; k < 3; k++) {
+        fdt_mesh_view mv = v;
+        if (k == 0)
+            mv.tets = NULL;
+        else if (k == 1)
+            mv.hull = NULL;
+        else
+            mv.xyz = NULL;
+        snprintf(p, sizeof p, "%s/missing%d.vtu", dir, k);
+        expect_fail(dir, p, &mv, FDT_IO_EFORMAT, "mesh arrays missing");
+    }
+    /* A repeated id in each position of the sorted tet is named. */
+    snprintf(p, sizeof p, "%s/order.tets", dir);
+    for (int k = 0; k < 3; k++) {
+        bad = m;
+        fdt_vid s4[4];
+        memcpy(s4, m.tets + 4 * 4, sizeof s4);
+        /* the tet's ids in ascending order, then two made equal */
+        for (int a = 1; a < 4; a++)
+            for (int b = a; b > 0 && s4[b - 1] > s4[b]; b--) {
+                fdt_vid x = s4[b];
+                s4[b] = s4[b - 1];
+                s4[b - 1] = x;
+            }
+        s4[k + 1] = s4[k];
+        memcpy(bad.tets + 4 * 4, s4, sizeof s4);
+        bv = view_of(&bad);
+        char want[64];
+        snprintf(want, sizeof want, "tet 4 repeats vertex %ld", (long)s4[k]);
+        expect_fail(dir, p, &bv, FDT_IO_EFORMAT, want);
+    }
+
     /* .ele without neighbours. */
     fdt_mesh_view nv = v;
     nv.nbrs = NULL;
