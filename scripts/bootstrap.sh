@@ -14,6 +14,7 @@ packages=(
   python3 python3-vtk9 python3-meshio gmsh openfoam
   gnuplot-nox valgrind clang libclang-rt-14-dev
   python3-dev python3-numpy python3-scipy
+  locales gcovr
 )
 
 missing=()
@@ -33,6 +34,18 @@ if ((${#missing[@]})); then
   export DEBIAN_FRONTEND=noninteractive
   "${sudo[@]}" apt-get update -qq
   "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# A locale with a decimal comma for tests/test_reader.c's locale test
+# (which fails without one when CI=true): de_DE.UTF-8, generated once.
+if ! locale -a 2>/dev/null | grep -qix 'de_DE.utf8'; then
+    echo "bootstrap: generating the de_DE.UTF-8 locale"
+    sudo=()
+    [[ $(id -u) -ne 0 ]] && sudo=(sudo)
+    if ! grep -qx 'de_DE.UTF-8 UTF-8' /etc/locale.gen 2>/dev/null; then
+        echo 'de_DE.UTF-8 UTF-8' | "${sudo[@]}" tee -a /etc/locale.gen >/dev/null
+    fi
+    "${sudo[@]}" locale-gen >/dev/null
 fi
 
 if [[ ! -f build/build.ninja ]]; then

@@ -1,13 +1,314 @@
 /*
- * The public API through the installed shared library (not the internal
- * archive): the ABI rules of include/frontdt.h for the structs that may
- * grow (struct_size first, sizes the library does not know refused with
- * FDT_EINVAL and nothing written beyond them).
+ * The public API's contract (include/frontdt.h, src/api.c, src/result.c)
+ * through the public header alone: settings and their defaults, refused
+ * arguments, every error code's text and the diagnostics that name the
+ * point, the result getters (NULL-safe), the duplicate map, and the
+ * progress callback and cancellation of a serial run (the parallel modes'
+ * are in tests/test_parallel.c); and the ABI rules for the structs that
+ * may grow (struct_size first, sizes the library does not know refused
+ * with FDT_EINVAL and nothing written beyond them), through the installed
+ * shared library rather than the internal archive.
  */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
 #include "frontdt.h"
 #include "testutil.h"
 
-#include <string.h>
+static void test_settings(void)
+{
+    fdt_settings s;
+    memset(&s, 0x5a, sizeof s);
+    fdt_default_settings(&s);
+    EXPECT(s.mode == FDT_MODE_AUTO && s.n_threads == 0 && s.pin == 0 && s.neighbors == 0);
+    EXPECT(s.leaf_size > 0 && s.progress == NULL && s.progress_user == NULL);
+    EXPECT(s.search == FDT_SEARCH_AUTO);
+    EXPECT(strcmp(fdt_version(), FDT_VERSION_STRING) == 0);
+
+    fdt_context *ctx = (fdt_context *)&s; /* must be set to NULL on failure */
+    EXPECT(fdt_open(NULL, &s) == FDT_EINVAL);
+    EXPECT(fdt_open(&ctx, NULL) == FDT_EINVAL && ctx == NULL);
+    const struct {
+        int mode, threads, leaf;
+    } bad[] = {{-1, 1, 0}, {FDT_MODE_MESSAGE + 1, 1, 0}, {0, -1, 0}, {0, 1025, 0}, {0, 1, -1}};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        fdt_default_settings(&s);
+        s.mode = (fdt_mode)bad[i].mode;
+        s.n_threads = bad[i].threads;
+        s.leaf_size = bad[i].leaf;
+        ctx = (fdt_context *)&s;
+        EXPECTF(fdt_open(&ctx, &s) == FDT_EINVAL && ctx == NULL, "bad setting %zu accepted", i);
+    }
+    fdt_default_settings(&s);
+    s.n_threads = 1024;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    EXPECT(ctx != NULL && strcmp(fdt_context_diagnostic(ctx), "") == 0);
+    fdt_close(&ctx);
+    EXPECT(ctx == NULL);
+    fdt_close(&ctx); /* NULL is fine */
+    fdt_close(NULL);
+    EXPECT(strcmp(fdt_context_diagnostic(NULL), "") == 0);
+
+    /* Every code has its own text; unknown codes too. */
+    const int codes[] = {FDT_OK, FDT_EINVAL, FDT_ENOMEM, FDT_EDEGENERATE, FDT_ERANGE,
+                         FDT_ETOOBIG, FDT_ECHECK, FDT_ECANCELED, FDT_EINTERNAL, FDT_ETHREAD};
+    const int nc = (int)(sizeof codes / sizeof *codes);
+    for (int i = 0; i < nc; i++) {
+        const char *t = fdt_strerror(codes[i]);
+        EXPECTF(t && *t && strcmp(t, fdt_strerror(-100)) != 0, "code %d", codes[i]);
+        for (int j = 0; j < i; j++)
+            EXPECTF(strcmp(t, fdt_strerror(codes[j])) != 0, "codes %d and %d share a text",
+                    codes[i], codes[j]);
+    }
+    EXPECT(strcmp(fdt_strerror(-100), "unknown error") == 0 && fdt_strerror(1) != NULL);
+}
+
+static fdt_context *open_serial(int nbrs, fdt_progress_fn fn, void *user)
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = FDT_MODE_SERIAL;
+    s.neighbors = nbrs;
+    s.progress = fn;
+    s.progress_user = user;
+    fdt_context *ctx = NULL;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    return ctx;
+}
+
+static void test_errors(void)
+{
+    fdt_context *ctx = open_serial(0, NULL, NULL);
+    fdt_result *r = (fdt_result *)ctx;
+    double cube[8 * 3];
+    for (int i = 0; i < 8; i++)
+        for (int k = 0; k < 3; k++)
+            cube[3 * i + k] = (i >> k) & 1;
+    EXPECT(fdt_triangulate(NULL, cube, 8, &r) == FDT_EINVAL);
+    EXPECT(fdt_triangulate(ctx, cube, 8, NULL) == FDT_EINVAL);
+    EXPECT(fdt_triangulate(ctx, NULL, 8, &r) == FDT_EINVAL);
+    /* a NaN names its point and axis; the result stays NULL */
+    cube[3 * 5 + 1] = NAN;
+    r = (fdt_result *)ctx;
+    EXPECT(fdt_triangulate(ctx, cube, 8, &r) == FDT_ERANGE && r == NULL);
+    EXPECTF(strstr(fdt_context_diagnostic(ctx), "point 5") != NULL, "diagnostic '%s'",
+            fdt_context_diagnostic(ctx));
+    cube[3 * 5 + 1] = INFINITY;
+    EXPECT(fdt_triangulate(ctx, cube, 8, &r) == FDT_ERANGE && r == NULL);
+    cube[3 * 5 + 1] = 0.0;
+    /* coplanar: the bottom face four times over */
+    double flat[12 * 3];
+    for (int i = 0; i < 12; i++) {
+        flat[3 * i] = i % 4;
+        flat[3 * i + 1] = i / 4;
+        flat[3 * i + 2] = 2.0;
+    }
+    EXPECT(fdt_triangulate(ctx, flat, 12, &r) == FDT_EDEGENERATE && r == NULL);
+    EXPECTF(strstr(fdt_context_diagnostic(ctx), "coplanar") != NULL, "diagnostic '%s'",
+            fdt_context_diagnostic(ctx));
+    EXPECT(fdt_triangulate(ctx, cube, 3, &r) == FDT_EDEGENERATE && r == NULL);
+    EXPECT(fdt_triangulate(ctx, cube, 0, &r) == FDT_EDEGENERATE && r == NULL);
+    /* a success clears the diagnostic */
+    EXPECT(fdt_triangulate(ctx, cube, 8, &r) == FDT_OK && r != NULL);
+    EXPECT(strcmp(fdt_context_diagnostic(ctx), "") == 0);
+    fdt_result_free(&r);
+    EXPECT(r == NULL);
+    fdt_result_free(&r);
+    fdt_result_free(NULL);
+    fdt_close(&ctx);
+}
+
+/* The getters on NULL, and the result of a cube with repeated points:
+ * the duplicate map sends each copy to the first index of its
+ * coordinates (-0 == +0), the tets use first indices only and pass
+ * fdt_check, the hull is the cube's 12 triangles. */
+static void test_result(void)
+{
+    EXPECT(fdt_result_num_tets(NULL) == 0 && fdt_result_tets(NULL) == NULL);
+    EXPECT(fdt_result_neighbors(NULL) == NULL && fdt_result_num_hull_faces(NULL) == 0);
+    EXPECT(fdt_result_hull_faces(NULL) == NULL && fdt_result_duplicate_map(NULL) == NULL);
+    EXPECT(fdt_result_num_duplicates(NULL) == 0);
+    fdt_stats st;
+    fdt_thread_stats ts;
+    uint64_t h;
+    EXPECT(fdt_result_stats(NULL, &st) == FDT_EINVAL);
+    EXPECT(fdt_result_thread_stats(NULL, 0, &ts) == FDT_EINVAL);
+    EXPECT(fdt_result_sort(NULL) == FDT_EINVAL);
+    EXPECT(fdt_result_hash(NULL, &h) == FDT_EINVAL);
+
+    /* 8 corners, then copies: 8 = 0, 9 = 3 (-0 for 0), 10 = 8's copy, 11 = 7 */
+    double xyz[12 * 3];
+    for (int i = 0; i < 8; i++)
+        for (int k = 0; k < 3; k++)
+            xyz[3 * i + k] = (i >> k) & 1;
+    const int src[4] = {0, 3, 0, 7};
+    for (int i = 0; i < 4; i++)
+        memcpy(xyz + 3 * (8 + i), xyz + 3 * src[i], 3 * sizeof *xyz);
+    xyz[3 * 9 + 2] = -0.0;
+    const fdt_vid want_map[12] = {0, 1, 2, 3, 4, 5, 6, 7, 0, 3, 0, 7};
+    fdt_context *ctx = open_serial(1, NULL, NULL);
+    fdt_result *r = NULL;
+    CHECK_EQ(fdt_triangulate(ctx, xyz, 12, &r), FDT_OK);
+    const fdt_vid *map = fdt_result_duplicate_map(r);
+    CHECK(map != NULL);
+    EXPECT(memcmp(map, want_map, sizeof want_map) == 0);
+    EXPECT(fdt_result_num_duplicates(r) == 4);
+    size_t nt = fdt_result_num_tets(r);
+    const fdt_vid *t = fdt_result_tets(r);
+    EXPECTF(nt >= 5 && nt <= 6, "%zu tets in a cube", nt);
+    for (size_t i = 0; i < 4 * nt; i++)
+        EXPECTF(t[i] >= 0 && t[i] < 8, "tet vertex %d is not a first index", (int)t[i]);
+    char msg[256];
+    EXPECTF(fdt_check(xyz, 12, t, nt, fdt_result_neighbors(r), msg, sizeof msg) == FDT_OK, "%s",
+            msg);
+    EXPECT(fdt_result_num_hull_faces(r) == 12 && fdt_result_hull_faces(r) != NULL);
+    CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
+    EXPECT(st.points == 12 && st.vertices == 8 && st.tets == nt && st.hull_faces == 12);
+    EXPECT(st.threads == 1 && st.mode == FDT_MODE_SERIAL && st.faces_advanced > 0);
+    EXPECT(fdt_result_stats(r, NULL) == FDT_EINVAL);
+    EXPECT(fdt_result_thread_stats(r, 0, &ts) == FDT_OK && ts.tets == nt);
+    EXPECT(fdt_result_thread_stats(r, 1, &ts) == FDT_EINVAL);
+    EXPECT(fdt_result_thread_stats(r, -1, &ts) == FDT_EINVAL);
+    /* hash: sorts, is idempotent, and is the FNV-1a of the canonical text */
+    uint64_t h2;
+    CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
+    CHECK_EQ(fdt_result_hash(r, &h2), FDT_OK);
+    EXPECT(h == h2);
+    EXPECT(fdt_result_hash(r, NULL) == FDT_EINVAL);
+    t = fdt_result_tets(r);
+    uint64_t f = 14695981039346656037ull;
+    for (size_t i = 0; i < nt; i++) {
+        fdt_vid v[4];
+        memcpy(v, t + 4 * i, sizeof v);
+        for (int a = 1; a < 4; a++)
+            for (int k = a; k > 0 && v[k - 1] > v[k]; k--) {
+                fdt_vid s = v[k];
+                v[k] = v[k - 1];
+                v[k - 1] = s;
+            }
+        char line[64];
+        int len = snprintf(line, sizeof line, "%d %d %d %d\n", v[0], v[1], v[2], v[3]);
+        for (int k = 0; k < len; k++)
+            f = (f ^ (unsigned char)line[k]) * 1099511628211ull;
+    }
+    EXPECTF(f == h, "hash %016llx, canonical text %016llx", (unsigned long long)h,
+            (unsigned long long)f);
+    EXPECT(fdt_check(xyz, 12, fdt_result_tets(r), nt, fdt_result_neighbors(r), msg, sizeof msg) ==
+           FDT_OK);
+    fdt_result_free(&r);
+
+    /* No duplicates: the identity map, never NULL. */
+    CHECK_EQ(fdt_triangulate(ctx, xyz, 8, &r), FDT_OK);
+    map = fdt_result_duplicate_map(r);
+    CHECK(map != NULL);
+    for (fdt_vid i = 0; i < 8; i++)
+        EXPECT(map[i] == i);
+    EXPECT(fdt_result_num_duplicates(r) == 0 && fdt_result_neighbors(r) != NULL);
+    fdt_result_free(&r);
+    fdt_close(&ctx);
+}
+
+/* Serial progress: fractions in [0, 1], not decreasing, the last one 1;
+ * a nonzero return cancels with FDT_ECANCELED and no result. */
+typedef struct prog {
+    int calls, stop_at, bad;
+    double last;
+} prog;
+
+static int prog_cb(void *user, double f)
+{
+    prog *p = user;
+    if (!(f >= p->last && f <= 1.0))
+        p->bad = 1;
+    p->last = f;
+    return ++p->calls == p->stop_at;
+}
+
+static void test_progress(void)
+{
+    const size_t n = 30000; /* about 195,000 tets: reports every 65,536 */
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    CHECK(xyz);
+    uint64_t seed = 21;
+    for (size_t i = 0; i < 3 * n; i++)
+        xyz[i] = test_unif(&seed);
+    prog p = {0, -1, 0, 0.0};
+    fdt_context *ctx = open_serial(0, prog_cb, &p);
+    fdt_result *r = NULL;
+    EXPECT(fdt_triangulate(ctx, xyz, n, &r) == FDT_OK && r != NULL);
+    EXPECTF(p.calls >= 3 && !p.bad && p.last == 1.0, "%d reports, last %g, bad %d", p.calls,
+            p.last, p.bad);
+    fdt_stats st;
+    CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
+    EXPECT(st.mode == FDT_MODE_SERIAL);
+    fdt_result_free(&r);
+    fdt_close(&ctx);
+    /* cancel at the first report (a partial mesh is never returned) and
+     * at the second */
+    for (int stop = 1; stop <= 2; stop++) {
+        prog c = {0, stop, 0, 0.0};
+        ctx = open_serial(0, prog_cb, &c);
+        r = (fdt_result *)ctx;
+        EXPECTF(fdt_triangulate(ctx, xyz, n, &r) == FDT_ECANCELED && r == NULL,
+                "cancel at report %d", stop);
+        EXPECTF(c.calls == stop && c.last < 1.0, "canceled at %d: %d calls, last %g", stop, c.calls,
+                c.last);
+        /* the context stays usable */
+        c.stop_at = -1;
+        c.last = 0.0;
+        EXPECT(fdt_triangulate(ctx, xyz, 200, &r) == FDT_OK);
+        fdt_result_free(&r);
+        fdt_close(&ctx);
+    }
+    free(xyz);
+}
+
+/* Every search policy in every mode gives the same mesh (the perturbed
+ * Delaunay tetrahedralization is unique), also with more threads than a
+ * part can hold points (parts of fewer than 4 points build no mesh). */
+static void test_search(void)
+{
+    const size_t sizes[2] = {300, 20};
+    for (int z = 0; z < 2; z++) {
+        size_t n = sizes[z];
+        double *xyz = malloc(3 * n * sizeof *xyz);
+        CHECK(xyz);
+        uint64_t seed = 5 + (uint64_t)z;
+        for (size_t i = 0; i < 3 * n; i++)
+            xyz[i] = test_unif(&seed);
+        uint64_t ref = 0;
+        const fdt_search searches[3] = {FDT_SEARCH_KD, FDT_SEARCH_MESH, FDT_SEARCH_AUTO};
+        for (int si = 0; si < 3; si++)
+            for (int mode = FDT_MODE_SERIAL; mode <= FDT_MODE_MESSAGE; mode++)
+                for (int threads = 1; threads <= 16; threads *= 4) {
+                    if (mode == FDT_MODE_SERIAL && threads > 1)
+                        continue;
+                    fdt_settings s;
+                    fdt_default_settings(&s);
+                    s.mode = (fdt_mode)mode;
+                    s.n_threads = threads;
+                    s.search = searches[si];
+                    fdt_context *ctx = NULL;
+                    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+                    fdt_result *r = NULL;
+                    uint64_t h = 1;
+                    EXPECTF(fdt_triangulate(ctx, xyz, n, &r) == FDT_OK &&
+                                fdt_result_hash(r, &h) == FDT_OK,
+                            "%zu points, search %d, mode %d, %d threads: %s", n, (int)s.search,
+                            mode, threads, fdt_context_diagnostic(ctx));
+                    if (ref == 0)
+                        ref = h;
+                    EXPECTF(h == ref, "%zu points, search %d, mode %d, %d threads: another mesh",
+                            n, (int)s.search, mode, threads);
+                    fdt_result_free(&r);
+                    fdt_close(&ctx);
+                }
+        free(xyz);
+    }
+}
 
 /* A struct followed by canary bytes, to see what a call writes. */
 #define CANARY 0xa5
@@ -21,7 +322,7 @@ static int canary_intact(const unsigned char *p, size_t from, size_t to)
     return 1;
 }
 
-static void test_settings(void)
+static void test_abi_settings(void)
 {
     fdt_settings s;
     fdt_default_settings(&s);
@@ -69,7 +370,7 @@ static void test_settings(void)
     fdt_close(&ctx);
 }
 
-static void test_stats(void)
+static void test_abi_stats(void)
 {
     /* The unit cube's corners and its centre: 12 tets. */
     static const double xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 1,
@@ -119,8 +420,12 @@ static void test_stats(void)
 
 int main(void)
 {
+    test_abi_settings();
+    test_abi_stats();
     test_settings();
-    test_stats();
-    printf("api: ok\n");
-    return 0;
+    test_errors();
+    test_result();
+    test_progress();
+    test_search();
+    return test_report("test_api");
 }

@@ -28,17 +28,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "testutil.h"
 
-static int failures;
-
-#define CHECK(cond)                                                          \
-    do {                                                                     \
-        if (!(cond)) {                                                       \
-            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, \
-                    #cond);                                                  \
-            failures++;                                                      \
-        }                                                                    \
-    } while (0)
 
 /* ------------------------------------------------------------------------ */
 /* Meshes                                                                    */
@@ -262,14 +253,14 @@ static void expect_ok(const char *what, const mesh *m)
     int rc = run(m, 0);
     if (rc != 0)
         fprintf(stderr, "%s: refused: %s\n", what, msgbuf);
-    CHECK(rc == 0);
-    CHECK(msgbuf[0] == '\0');
+    EXPECT(rc == 0);
+    EXPECT(msgbuf[0] == '\0');
     if (m->nbrs) {
         rc = run(m, 1);
         if (rc != 0)
             fprintf(stderr, "%s (with neighbours): refused: %s\n", what,
                     msgbuf);
-        CHECK(rc == 0);
+        EXPECT(rc == 0);
     }
 }
 
@@ -280,8 +271,8 @@ static void expect_fail(const char *what, const mesh *m, const char *want)
     if (rc != FDT_ECHECK || !strstr(msgbuf, want))
         fprintf(stderr, "%s: expected FDT_ECHECK with \"%s\", got %d: %s\n",
                 what, want, rc, msgbuf);
-    CHECK(rc == FDT_ECHECK);
-    CHECK(strstr(msgbuf, want) != NULL);
+    EXPECT(rc == FDT_ECHECK);
+    EXPECT(strstr(msgbuf, want) != NULL);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -442,7 +433,7 @@ static void faults(const char *name, const mesh *m0)
         remove_tet(&f, k);
         snprintf(what, sizeof what, "%s: tet %zu missing", name, k);
         expect_fail(what, &f, "");
-        CHECK(strlen(msgbuf) > 10);
+        EXPECT(strlen(msgbuf) > 10);
         mesh_free(&f);
     }
     /* A duplicated tet, listed again with its vertices rotated. */
@@ -560,7 +551,7 @@ static void faults(const char *name, const mesh *m0)
 static void full(const char *name, mesh *m)
 {
     brute_dt(m);
-    CHECK(m->nt > 0);
+    EXPECT(m->nt > 0);
     expect_ok(name, m);
     brute_nbrs(m);
     expect_ok(name, m);
@@ -580,45 +571,45 @@ static void test_args(void)
     double xyz[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
     fdt_vid tet[4] = {0, 1, 2, 3};
     char msg[64];
-    CHECK(fdt_check(xyz, 4, tet, 1, NULL, msg, sizeof msg) == 0);
-    CHECK(fdt_check(xyz, 4, tet, 1, NULL, NULL, 0) == 0);
-    CHECK(fdt_check(NULL, 4, tet, 1, NULL, msg, sizeof msg) == FDT_EINVAL);
-    CHECK(fdt_check(xyz, 4, NULL, 1, NULL, msg, sizeof msg) == FDT_EINVAL);
+    EXPECT(fdt_check(xyz, 4, tet, 1, NULL, msg, sizeof msg) == 0);
+    EXPECT(fdt_check(xyz, 4, tet, 1, NULL, NULL, 0) == 0);
+    EXPECT(fdt_check(NULL, 4, tet, 1, NULL, msg, sizeof msg) == FDT_EINVAL);
+    EXPECT(fdt_check(xyz, 4, NULL, 1, NULL, msg, sizeof msg) == FDT_EINVAL);
     /* n beyond the id type: refused before xyz is read. */
-    CHECK(fdt_check(xyz, (size_t)FDT_VID_MAX + 1, tet, 1, NULL, msg,
+    EXPECT(fdt_check(xyz, (size_t)FDT_VID_MAX + 1, tet, 1, NULL, msg,
                     sizeof msg) == FDT_EINVAL);
-    CHECK(fdt_check(xyz, 4, tet, SIZE_MAX / 2, NULL, msg, sizeof msg) ==
+    EXPECT(fdt_check(xyz, 4, tet, SIZE_MAX / 2, NULL, msg, sizeof msg) ==
           FDT_EINVAL);
-    CHECK(fdt_check(xyz, 4, tet, 0, NULL, msg, sizeof msg) == FDT_ECHECK);
-    CHECK(strcmp(msg, "no tetrahedra") == 0);
-    CHECK(fdt_check(NULL, 0, NULL, 0, NULL, msg, sizeof msg) == FDT_ECHECK);
-    CHECK(fdt_check(NULL, 0, tet, 1, NULL, msg, sizeof msg) == FDT_ECHECK);
-    CHECK(strstr(msg, "out of range") != NULL);
+    EXPECT(fdt_check(xyz, 4, tet, 0, NULL, msg, sizeof msg) == FDT_ECHECK);
+    EXPECT(strcmp(msg, "no tetrahedra") == 0);
+    EXPECT(fdt_check(NULL, 0, NULL, 0, NULL, msg, sizeof msg) == FDT_ECHECK);
+    EXPECT(fdt_check(NULL, 0, tet, 1, NULL, msg, sizeof msg) == FDT_ECHECK);
+    EXPECT(strstr(msg, "out of range") != NULL);
 
     /* The message is truncated and NUL-terminated; no write past len. */
     char small[8];
     memset(small, '#', sizeof small);
     fdt_vid flipped[4] = {1, 0, 2, 3};
-    CHECK(fdt_check(xyz, 4, flipped, 1, NULL, small, 5) == FDT_ECHECK);
-    CHECK(strlen(small) == 4 && small[5] == '#');
-    CHECK(fdt_check(xyz, 4, flipped, 1, NULL, msg, sizeof msg) == FDT_ECHECK);
-    CHECK(strcmp(msg, "tet 0 (1 0 2 3) is not positively oriented") == 0);
+    EXPECT(fdt_check(xyz, 4, flipped, 1, NULL, small, 5) == FDT_ECHECK);
+    EXPECT(strlen(small) == 4 && small[5] == '#');
+    EXPECT(fdt_check(xyz, 4, flipped, 1, NULL, msg, sizeof msg) == FDT_ECHECK);
+    EXPECT(strcmp(msg, "tet 0 (1 0 2 3) is not positively oriented") == 0);
 
     /* A single tet with neighbours: all hull. */
     fdt_tid nb[4] = {-1, -1, -1, -1};
-    CHECK(fdt_check(xyz, 4, tet, 1, nb, msg, sizeof msg) == 0);
+    EXPECT(fdt_check(xyz, 4, tet, 1, nb, msg, sizeof msg) == 0);
     nb[2] = 0;
-    CHECK(fdt_check(xyz, 4, tet, 1, nb, msg, sizeof msg) == FDT_ECHECK);
+    EXPECT(fdt_check(xyz, 4, tet, 1, nb, msg, sizeof msg) == FDT_ECHECK);
 
     /* A flat tet; a NaN. */
     double flat[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
-    CHECK(fdt_check(flat, 4, tet, 1, NULL, msg, sizeof msg) == FDT_ECHECK);
-    CHECK(strstr(msg, "flat") != NULL);
+    EXPECT(fdt_check(flat, 4, tet, 1, NULL, msg, sizeof msg) == FDT_ECHECK);
+    EXPECT(strstr(msg, "flat") != NULL);
     double bad[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, NAN};
-    CHECK(fdt_check(bad, 4, tet, 1, NULL, msg, sizeof msg) == FDT_ECHECK);
-    CHECK(strstr(msg, "non-finite") != NULL);
+    EXPECT(fdt_check(bad, 4, tet, 1, NULL, msg, sizeof msg) == FDT_ECHECK);
+    EXPECT(strstr(msg, "non-finite") != NULL);
     bad[11] = INFINITY;
-    CHECK(fdt_check(bad, 4, tet, 1, NULL, msg, sizeof msg) == FDT_ECHECK);
+    EXPECT(fdt_check(bad, 4, tet, 1, NULL, msg, sizeof msg) == FDT_ECHECK);
 }
 
 /* Five points: triangle abc with apexes d above and e below, segment de
@@ -637,8 +628,8 @@ static void test_five_points(void)
         add_point(&m, 1, 1, h);
         add_point(&m, 1, 1, -h);
         brute_dt(&m);
-        CHECK(m.nt == (tall ? 2u : 3u));
-        CHECK(six_volume(&m) == 32 * h); /* 6 * (8 * 2h / 3) */
+        EXPECT(m.nt == (tall ? 2u : 3u));
+        EXPECT(six_volume(&m) == 32 * h); /* 6 * (8 * 2h / 3) */
         expect_ok(tall ? "five tall" : "five flat", &m);
         mesh o;
         memset(&o, 0, sizeof o);
@@ -670,8 +661,8 @@ static void test_cube_center(void)
         add_point(&m, i & 1, (i >> 1) & 1, (i >> 2) & 1);
     add_point(&m, 0.5, 0.5, 0.5);
     brute_dt(&m);
-    CHECK(m.nt == 12);
-    CHECK(six_volume(&m) == 6);
+    EXPECT(m.nt == 12);
+    EXPECT(six_volume(&m) == 6);
     full("cube+center", &m);
     mesh_free(&m);
 
@@ -680,8 +671,8 @@ static void test_cube_center(void)
     for (int i = 0; i < 8; i++)
         add_point(&m, i & 1, (i >> 1) & 1, (i >> 2) & 1);
     brute_dt(&m);
-    CHECK(m.nt == 5 || m.nt == 6);
-    CHECK(six_volume(&m) == 6);
+    EXPECT(m.nt == 5 || m.nt == 6);
+    EXPECT(six_volume(&m) == 6);
     full("cube", &m);
     mesh_free(&m);
 }
@@ -693,7 +684,7 @@ static void test_lattice(void)
     for (int i = 0; i < 27; i++)
         add_point(&m, i % 3, (i / 3) % 3, i / 9);
     brute_dt(&m);
-    CHECK(six_volume(&m) == 48);
+    EXPECT(six_volume(&m) == 48);
     full("lattice 3x3x3", &m);
     mesh_free(&m);
 
@@ -706,7 +697,7 @@ static void test_lattice(void)
             add_point(&m, x, y ? y : -0.0, z);
     }
     brute_dt(&m);
-    CHECK(six_volume(&m) == 48);
+    EXPECT(six_volume(&m) == 48);
     full("lattice 3x3x3 with duplicates", &m);
     mesh_free(&m);
 }
@@ -744,7 +735,7 @@ static void test_random(void)
                   1.0e3 + (double)rng_below(8) * 0.25);
     full("far and quantised", &m);
     mesh_free(&m);
-    CHECK(flips_done >= 6);
+    EXPECT(flips_done >= 6);
 }
 
 /*
@@ -859,10 +850,5 @@ int main(void)
     test_random();
     test_covers();
     test_overlaps();
-    if (failures) {
-        fprintf(stderr, "test_check: %d failure(s)\n", failures);
-        return 1;
-    }
-    printf("test_check: all passed\n");
-    return 0;
+    return test_report("test_check");
 }

@@ -13,17 +13,7 @@
 
 #include "faceq.h"
 #include "frontdt.h"
-
-static int failures;
-#define CHECK(cond, ...)                                                     \
-    do {                                                                     \
-        if (!(cond)) {                                                       \
-            failures++;                                                      \
-            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);             \
-            fprintf(stderr, __VA_ARGS__);                                    \
-            fputc('\n', stderr);                                             \
-        }                                                                    \
-    } while (0)
+#include "testutil.h"
 
 static uint64_t rng_state = 0x2545F4914F6CDD1Dull;
 static uint64_t rnd(void)
@@ -92,28 +82,28 @@ static void run_case(uint32_t base, uint32_t nids, int steps)
 {
     fdt_faceq q;
     model m = {0};
-    CHECK(fdt_faceq_init(&q, base, nids) == FDT_OK, "init %u %u", base, nids);
+    EXPECTF(fdt_faceq_init(&q, base, nids) == FDT_OK, "init %u %u", base, nids);
     for (int round = 0; round < 2; round++) {
         for (int s = 0; s < steps; s++) {
             int push = m.n == 0 || rnd() % 100 < 55;
             if (push) {
                 uint32_t v[3];
                 random_face(base, nids, v);
-                CHECK(fdt_faceq_push(&q, v) == FDT_OK, "push");
+                EXPECTF(fdt_faceq_push(&q, v) == FDT_OK, "push");
                 model_push(&m, v);
                 continue;
             }
             size_t want = model_next(&m, base);
             const uint32_t *ahead = fdt_faceq_ahead(&q, 0);
             uint32_t got[3];
-            CHECK(fdt_faceq_pop(&q, got) == 1, "pop from a queue of %zu", m.n);
-            CHECK(memcmp(got, m.f[want].v, sizeof got) == 0,
+            EXPECTF(fdt_faceq_pop(&q, got) == 1, "pop from a queue of %zu", m.n);
+            EXPECTF(memcmp(got, m.f[want].v, sizeof got) == 0,
                   "base %u nids %u: popped (%u %u %u), expected (%u %u %u)", base, nids,
                   got[0], got[1], got[2], m.f[want].v[0], m.f[want].v[1], m.f[want].v[2]);
             if (ahead)
-                CHECK(memcmp(ahead, got, sizeof got) == 0, "ahead(0) named another face");
+                EXPECTF(memcmp(ahead, got, sizeof got) == 0, "ahead(0) named another face");
             m.f[want] = m.f[--m.n];
-            CHECK(q.count == m.n, "count %zu, model %zu", q.count, m.n);
+            EXPECTF(q.count == m.n, "count %zu, model %zu", q.count, m.n);
         }
         if (round == 0) {
             /* drain: every face comes back exactly once, in order */
@@ -126,33 +116,33 @@ static void run_case(uint32_t base, uint32_t nids, int steps)
             int k = 0;
             while (m.n) {
                 size_t want = model_next(&m, base);
-                CHECK(fdt_faceq_pop(&q, got) == 1, "drain pop");
-                CHECK(memcmp(got, m.f[want].v, sizeof got) == 0, "drain order");
+                EXPECTF(fdt_faceq_pop(&q, got) == 1, "drain pop");
+                EXPECTF(memcmp(got, m.f[want].v, sizeof got) == 0, "drain order");
                 if (k == 2 && have_a2)
-                    CHECK(memcmp(got, a2v, sizeof got) == 0, "ahead(2) named another face");
+                    EXPECTF(memcmp(got, a2v, sizeof got) == 0, "ahead(2) named another face");
                 m.f[want] = m.f[--m.n];
                 k++;
             }
-            CHECK(fdt_faceq_pop(&q, got) == 0, "pop from an empty queue");
-            CHECK(q.count == 0, "count after drain");
+            EXPECTF(fdt_faceq_pop(&q, got) == 0, "pop from an empty queue");
+            EXPECTF(q.count == 0, "count after drain");
         } else {
             fdt_faceq_clear(&q);
             m.n = 0;
             uint32_t got[3];
-            CHECK(fdt_faceq_pop(&q, got) == 0, "pop after clear");
-            CHECK(q.count == 0, "count after clear");
+            EXPECTF(fdt_faceq_pop(&q, got) == 0, "pop after clear");
+            EXPECTF(q.count == 0, "count after clear");
             /* usable again after clear */
             uint32_t v[3] = {base + nids - 1, base + nids, base + nids + 1};
-            CHECK(fdt_faceq_push(&q, v) == FDT_OK, "push after clear");
-            CHECK(fdt_faceq_pop(&q, got) == 1 && got[0] == v[0], "pop after clear and push");
+            EXPECTF(fdt_faceq_push(&q, v) == FDT_OK, "push after clear");
+            EXPECTF(fdt_faceq_pop(&q, got) == 1 && got[0] == v[0], "pop after clear and push");
         }
     }
     /* ids outside [base, base + nids) are a caller's bug, refused */
     uint32_t lowv[3] = {base - 1, base, base + 1}, highv[3] = {base + nids, base + nids + 1, base + nids + 2};
     if (base > 0)
-        CHECK(fdt_faceq_push(&q, lowv) == FDT_EINTERNAL, "id below the range accepted");
-    CHECK(fdt_faceq_push(&q, highv) == FDT_EINTERNAL, "id above the range accepted");
-    CHECK(q.count == 0, "a refused push was counted");
+        EXPECTF(fdt_faceq_push(&q, lowv) == FDT_EINTERNAL, "id below the range accepted");
+    EXPECTF(fdt_faceq_push(&q, highv) == FDT_EINTERNAL, "id above the range accepted");
+    EXPECTF(q.count == 0, "a refused push was counted");
     fdt_faceq_free(&q);
     fdt_faceq_free(&q); /* freeing twice is harmless: the struct is zeroed */
     free(m.f);
@@ -168,10 +158,5 @@ int main(void)
     run_case(0, 300000, 20000);
     run_case(1000000, 70000, 20000);
     run_case(UINT32_MAX - 100000, 99990, 5000);
-    if (failures) {
-        fprintf(stderr, "%d failures\n", failures);
-        return 1;
-    }
-    printf("faceq: all checks passed\n");
-    return 0;
+    return test_report("test_faceq");
 }

@@ -51,6 +51,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include "testutil.h"
 
 /* ------------------------------------------------------------------ */
 /* The allocation hooks                                               */
@@ -174,7 +175,6 @@ static int fault_disarm(void)
 /* Test bookkeeping                                                   */
 /* ------------------------------------------------------------------ */
 
-static int failures;
 static long total_runs, total_injected, total_absorbed;
 
 /* The counts and the verdict at the end of a suite: main's exit status. */
@@ -182,24 +182,10 @@ static int report(const char *which)
 {
     printf("%ld runs, %ld with an injected failure (%ld absorbed)\n",
            total_runs, total_injected, total_absorbed);
-    if (failures) {
-        fprintf(stderr, "%d failure(s)\n", failures);
-        return 1;
-    }
-    printf("all %sfault-injection tests passed\n", which);
-    return 0;
+    if (test_failures() == 0)
+        printf("all %sfault-injection tests passed\n", which);
+    return test_report("test_faults");
 }
-
-#define CHECK(cond, ...)                                                     \
-    do {                                                                     \
-        if (!(cond)) {                                                       \
-            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, \
-                    #cond);                                                  \
-            fprintf(stderr, __VA_ARGS__);                                    \
-            fputc('\n', stderr);                                             \
-            failures++;                                                      \
-        }                                                                    \
-    } while (0)
 
 /*
  * A scenario: one call (or a short sequence) that cleans up after itself
@@ -227,18 +213,18 @@ static void inject_all(const scenario *sc)
             int hit = fault_disarm();
             long leaked = atomic_load(&fault_live) - live0;
             total_runs++;
-            CHECK(leaked == 0, "%s, %s allocation %ld: %ld blocks leaked",
+            EXPECTF(leaked == 0, "%s, %s allocation %ld: %ld blocks leaked",
                   sc->name, sticky ? "from" : "only", k, leaked);
-            CHECK(bad == NULL, "%s, %s allocation %ld failed: %s", sc->name,
+            EXPECTF(bad == NULL, "%s, %s allocation %ld failed: %s", sc->name,
                   sticky ? "from" : "only", k, bad ? bad : "");
             if (!hit) {
-                CHECK(rc == 0, "%s: status %d with no failure injected",
+                EXPECTF(rc == 0, "%s: status %d with no failure injected",
                       sc->name, rc);
                 break;
             }
             total_injected++;
             if (k > 100000) {
-                CHECK(0, "%s: more than 100000 allocations?", sc->name);
+                EXPECTF(0, "%s: more than 100000 allocations?", sc->name);
                 break;
             }
             if (rc == 0) { /* done without the memory: bad says if wrongly */
@@ -246,7 +232,7 @@ static void inject_all(const scenario *sc)
                 total_absorbed++;
                 continue;
             }
-            CHECK(rc == sc->enomem,
+            EXPECTF(rc == sc->enomem,
                   "%s, %s allocation %ld failed: status %d, want %d",
                   sc->name, sticky ? "from" : "only", k, rc, sc->enomem);
         }
@@ -590,7 +576,7 @@ static void test_insert_faults(const ptset *sets, int nsets, uint64_t *rng)
         uint32_t n = (uint32_t)(strcmp(ps->name, "lattice") == 0 ? ps->n - 3 : ps->n);
         fdt_ins m;
         int rc = fdt_ins_build(&m, ps->xyz, 0, n, NULL);
-        CHECK(rc == FDT_OK, "%s: reference fdt_ins_build: %s", ps->name, fdt_strerror(rc));
+        EXPECTF(rc == FDT_OK, "%s: reference fdt_ins_build: %s", ps->name, fdt_strerror(rc));
         if (rc != FDT_OK)
             continue;
         ins_arg ia = {ps->xyz, n, m.nfinite, n - 1};
@@ -613,7 +599,7 @@ static void test_insert_faults(const ptset *sets, int nsets, uint64_t *rng)
     for (size_t i = 0; i < 3 * u.n; i++)
         u.xyz[i] = rnd01(rng);
     fdt_ins m;
-    CHECK(fdt_ins_build(&m, u.xyz, 0, (uint32_t)u.n, NULL) == FDT_OK, "uniform 3000");
+    EXPECTF(fdt_ins_build(&m, u.xyz, 0, (uint32_t)u.n, NULL) == FDT_OK, "uniform 3000");
     ins_arg ua = {u.xyz, (uint32_t)u.n, m.nfinite, 0};
     fdt_ins_free(&m);
     scenario sp = {"fdt_ins_build_parallel uniform 3000", FDT_ENOMEM, sc_insert_par, &ua};
@@ -671,7 +657,7 @@ static void reference_read(read_arg *a)
                  ? fdt_rd_points_mem(a->path, a->data, a->len, &a->want, &n,
                                        err, sizeof err)
                  : fdt_rd_points(a->path, &a->want, &n, err, sizeof err);
-    CHECK(rc == FDT_IO_OK && n == a->want_n, "%s: %s (%zu points)", a->path,
+    EXPECTF(rc == FDT_IO_OK && n == a->want_n, "%s: %s (%zu points)", a->path,
           rc == FDT_IO_OK ? "read" : err, n);
 }
 
@@ -807,11 +793,11 @@ static int run_parallel(void)
         for (int nb = 0; nb <= 1; nb++) {
             fdt_result *r = NULL;
             int rc = triangulate(&sets[si], &serial_cfg, nb, &r);
-            CHECK(rc == FDT_OK, "%s: reference: %s", sets[si].name,
+            EXPECTF(rc == FDT_OK, "%s: reference: %s", sets[si].name,
                   fdt_strerror(rc));
             uint64_t h = 0;
             if (rc == FDT_OK)
-                CHECK(fdt_result_hash(r, &h) == FDT_OK, "reference hash");
+                EXPECTF(fdt_result_hash(r, &h) == FDT_OK, "reference hash");
             size_t nt = fdt_result_num_tets(r);
             fdt_result_free(&r);
             if (rc != FDT_OK)
@@ -841,7 +827,7 @@ static int run_parallel(void)
 static void check_bad_sizes(const char *bad)
 {
     DIR *d = opendir(bad);
-    CHECK(d != NULL, "cannot open %s", bad);
+    EXPECTF(d != NULL, "cannot open %s", bad);
     if (d == NULL)
         return;
     int files = 0;
@@ -861,14 +847,14 @@ static void check_bad_sizes(const char *bad)
         fdt_rd_points(p, &xyz, &n, err, sizeof err);
         free(xyz);
         size_t got = atomic_load(&fault_max);
-        CHECK(got <= limit, "%s (%lld bytes): an allocation of %zu bytes", p,
+        EXPECTF(got <= limit, "%s (%lld bytes): an allocation of %zu bytes", p,
               (long long)st.st_size, got);
         if (got > worst)
             worst = got;
         files++;
     }
     closedir(d);
-    CHECK(files >= 40, "only %d files in %s", files, bad);
+    EXPECTF(files >= 40, "only %d files in %s", files, bad);
     printf("hostile corpus: %d files read, largest allocation %zu bytes\n",
            files, worst);
 }
@@ -924,10 +910,10 @@ int main(int argc, char **argv)
         "end_header\n0 0 0 nan\n1 0 0 1\n0 1 0 1\n0 0 1 1\n3 0 1 2\n";
     char bply[512];
     size_t bl = make_ply_le(bply, sizeof bply);
-    CHECK(write_file(p_xyz, xyz_text, (size_t)xl) == 0, "write %s", p_xyz);
-    CHECK(write_file(p_node, node_text, sizeof node_text - 1) == 0, "node");
-    CHECK(write_file(p_aply, aply_text, sizeof aply_text - 1) == 0, "aply");
-    CHECK(lo == 1 && bl > 0 && write_file(p_bply, bply, bl) == 0, "bply");
+    EXPECTF(write_file(p_xyz, xyz_text, (size_t)xl) == 0, "write %s", p_xyz);
+    EXPECTF(write_file(p_node, node_text, sizeof node_text - 1) == 0, "node");
+    EXPECTF(write_file(p_aply, aply_text, sizeof aply_text - 1) == 0, "aply");
+    EXPECTF(lo == 1 && bl > 0 && write_file(p_bply, bply, bl) == 0, "bply");
 
     read_arg reads[] = {
         {p_xyz, NULL, 0, 5, NULL, 1},
@@ -952,7 +938,7 @@ int main(int argc, char **argv)
     }
     /* Every sample in tests/good (10 points each). */
     DIR *d = opendir(good);
-    CHECK(d != NULL, "cannot open %s", good);
+    EXPECTF(d != NULL, "cannot open %s", good);
     int ngood = 0;
     if (d != NULL) {
         struct dirent *de;
@@ -971,7 +957,7 @@ int main(int argc, char **argv)
         }
         closedir(d);
     }
-    CHECK(ngood >= 5, "only %d samples in %s", ngood, good);
+    EXPECTF(ngood >= 5, "only %d samples in %s", ngood, good);
 
     /* --- the engine --- */
     uint64_t rng = 0x9e3779b97f4a7c15u;
@@ -982,12 +968,12 @@ int main(int argc, char **argv)
         for (int nb = 0; nb <= 1; nb++) {
             fdt_result *r = NULL;
             int rc = triangulate(ps, &serial_cfg, nb, &r);
-            CHECK(rc == FDT_OK, "%s: reference triangulation: %s", ps->name,
+            EXPECTF(rc == FDT_OK, "%s: reference triangulation: %s", ps->name,
                   fdt_strerror(rc));
             if (rc != FDT_OK)
                 continue;
             uint64_t h = 0;
-            CHECK(fdt_result_hash(r, &h) == FDT_OK, "reference hash");
+            EXPECTF(fdt_result_hash(r, &h) == FDT_OK, "reference hash");
             size_t nt = fdt_result_num_tets(r);
             fdt_result_free(&r);
 
@@ -1014,7 +1000,7 @@ int main(int argc, char **argv)
     /* --- writers --- */
     fdt_result *r = NULL;
     int rc = triangulate(&sets[0], &serial_cfg, 1, &r);
-    CHECK(rc == FDT_OK && fdt_result_sort(r) == FDT_OK, "mesh for writing");
+    EXPECTF(rc == FDT_OK && fdt_result_sort(r) == FDT_OK, "mesh for writing");
     if (rc == FDT_OK) {
         static const char *const exts[4] = {".tets", ".ele", ".vtu", ".vtk"};
         for (int i = 0; i < 4; i++) {

@@ -17,17 +17,7 @@
 #include <sys/mman.h>
 
 #include "mem.h"
-
-static int failures;
-#define CHECK(cond, ...)                                                     \
-    do {                                                                     \
-        if (!(cond)) {                                                       \
-            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);             \
-            fprintf(stderr, __VA_ARGS__);                                    \
-            fputc('\n', stderr);                                             \
-            failures++;                                                      \
-        }                                                                    \
-    } while (0)
+#include "testutil.h"
 
 /* The kernel's setting: 1 if it grants huge pages on request. */
 static int thp_on_request(void)
@@ -79,7 +69,7 @@ int main(void)
      * memory it returns, and a page written before the hint stays small */
     unsigned char *p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     unsigned char *ctl = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    CHECK(p != MAP_FAILED && ctl != MAP_FAILED, "mmap");
+    EXPECTF(p != MAP_FAILED && ctl != MAP_FAILED, "mmap");
     if (p == MAP_FAILED || ctl == MAP_FAILED)
         return 1;
     fdt_mem_advise_huge(p + 3, bytes - 3);
@@ -92,12 +82,12 @@ int main(void)
     size_t bad = 0;
     for (size_t i = 0; i < bytes; i++)
         bad += p[i] != (unsigned char)(i * 7);
-    CHECK(bad == 0, "%zu bytes changed", bad);
+    EXPECTF(bad == 0, "%zu bytes changed", bad);
     long kb = huge_kb(p, bytes), ckb = huge_kb(ctl, bytes);
     if (thp_on_request() && kb >= 0 && ckb >= 2048) {
         /* The kernel granted the control's request: it must grant ours
          * (16 MB hold at least six aligned 2 MB pages). */
-        CHECK(kb >= 2048, "no huge page over an advised 16 MB range (%ld kB; control %ld kB)",
+        EXPECTF(kb >= 2048, "no huge page over an advised 16 MB range (%ld kB; control %ld kB)",
               kb, ckb);
         printf("mem: %ld kB of huge pages over 16 MB advised (control %ld kB)\n", kb, ckb);
     } else {
@@ -106,10 +96,5 @@ int main(void)
     }
     munmap(p, bytes);
     munmap(ctl, bytes);
-    if (failures) {
-        fprintf(stderr, "%d failures\n", failures);
-        return 1;
-    }
-    printf("mem: all passed\n");
-    return 0;
+    return test_report("test_mem");
 }

@@ -1,5 +1,6 @@
 /*
- * Tests of the parallel engine (src/parallel.c, src/partition.c): shared
+ * Tests of the parallel engine (src/parallel.c; the partition has
+ * tests/test_partition.c): shared
  * and message modes must give the serial tetrahedralization exactly, for
  * any thread count, on the named hard families (uniform, lattice, integer
  * points on a sphere, extruded 2-D grid, clusters, big offset with 1 mm
@@ -12,8 +13,6 @@
  *     thread once (message mode: also from each root's tree to part 0);
  *     FACERECV once per FACESEND in message mode, never in shared mode;
  *     ABORT never; NODESEND only in message mode;
- *   - the partition module: proportional part sizes for any N, contiguous
- *     ranges, owner lookup, the composite tree.
  * Then many threads on tiny inputs (where nearly every tet straddles parts:
  * the §5 "pockets"), repeated, and error paths (bad arguments).
  *
@@ -272,6 +271,15 @@ static reference make_ref(const pts *p)
     ref.nhull = fdt_result_num_hull_faces(ref.r);
     ref.hull = canon_hull(ref.r);
     CHECK(ref.ntets > 0);
+    /* The reference itself is checked (fdt_check: orientation, links,
+     * hull, empty spheres): equal to serial alone would let one bug in
+     * both engines through. */
+    char msg[256];
+    if (fdt_check(p->xyz, p->n, fdt_result_tets(ref.r), ref.ntets, fdt_result_neighbors(ref.r),
+                  msg, sizeof msg) != FDT_OK)
+        fprintf(stderr, "%s: serial mesh fails fdt_check: %s\n", p->name, msg);
+    CHECK(fdt_check(p->xyz, p->n, fdt_result_tets(ref.r), ref.ntets, fdt_result_neighbors(ref.r),
+                    msg, sizeof msg) == FDT_OK);
     return ref;
 }
 
@@ -394,6 +402,13 @@ static void compare_run(const pts *p, const reference *ref, fdt_mode mode,
     fdt_vid *hull = canon_hull(r);
     CHECK(memcmp(hull, ref->hull, 3 * ref->nhull * sizeof *hull) == 0);
     free(hull);
+    char msg[256];
+    if (fdt_check(p->xyz, p->n, fdt_result_tets(r), nt, fdt_result_neighbors(r), msg,
+                  sizeof msg) != FDT_OK)
+        fprintf(stderr, "%s: %s with %d threads fails fdt_check: %s\n", p->name,
+                mode_name(mode), nthreads, msg);
+    CHECK(fdt_check(p->xyz, p->n, fdt_result_tets(r), nt, fdt_result_neighbors(r), msg,
+                    sizeof msg) == FDT_OK);
     check_stats(r, mode, nthreads);
     if (g_verbose) {
         fdt_stats st;
@@ -476,120 +491,6 @@ static void test_family(pts p, int quick)
     free(perm);
     free(sp.xyz);
     free(p.xyz);
-}
-
-/* ---- partition module ------------------------------------------------------ */
-
-static void test_partition(void)
-{
-    pts p = fam_uniform(1000, 7);
-    const int counts[] = {1, 2, 3, 5, 7, 64, 100, 1000, 1024};
-    for (size_t c = 0; c < sizeof counts / sizeof *counts; c++) {
-        int np = counts[c];
-        double *P = malloc(3 * p.n * sizeof *P);
-        fdt_vid *orig = malloc(p.n * sizeof *orig);
-        CHECK(P && orig);
-        memcpy(P, p.xyz, 3 * p.n * sizeof *P);
-        for (size_t i = 0; i < p.n; i++)
-            orig[i] = (fdt_vid)i;
-        fdt_partition pt;
-        CHECK_EQ(fdt_partition_build(&pt, P, orig, (uint32_t)p.n, np, 18, 1 + np % 5), FDT_OK);
-        CHECK_EQ(pt.nparts, np);
-        CHECK_EQ(pt.start[0], 0);
-        CHECK_EQ(pt.start[np], p.n);
-        size_t lo = p.n, hi = 0;
-        for (int i = 0; i < np; i++) {
-            CHECK(pt.start[i] <= pt.start[i + 1]);
-            size_t sz = pt.start[i + 1] - pt.start[i];
-            if (sz < lo)
-                lo = sz;
-            if (sz > hi)
-                hi = sz;
-            /* Every id of the part maps back to it; its tree covers it. */
-            for (uint32_t id = pt.start[i]; id < pt.start[i + 1]; id++)
-                CHECK_EQ(fdt_partition_owner(&pt, id), i);
-            CHECK_EQ(pt.trees[i].n, sz);
-            if (sz)
-                CHECK_EQ(pt.trees[i].base, pt.start[i]);
-        }
-        /* Proportional splits, less the work shift (src/partition.c,
-         * work_shift: at most a sixteenth of a left side a level, and none
-         * below 16 points): sizes near m / N, nobody empty while m >= N. */
-        double mean = (double)p.n / np;
-        CHECK((double)hi <= 1.5 * mean + 10 && (double)lo >= 0.5 * mean - 10);
-        if ((size_t)np <= p.n)
-            CHECK(lo >= 1);
-        /* The permutation kept every point (orig is a permutation and P
-         * follows it). */
-        char *seen = calloc(p.n, 1);
-        CHECK(seen);
-        for (size_t i = 0; i < p.n; i++) {
-            CHECK(orig[i] >= 0 && (size_t)orig[i] < p.n && !seen[orig[i]]);
-            seen[orig[i]] = 1;
-            CHECK(memcmp(P + 3 * i, p.xyz + 3 * (size_t)orig[i], 3 * sizeof *P) == 0);
-        }
-        free(seen);
-        /* Bisection boxes contain their points. */
-        for (int j = 0; j < pt.nnodes; j++) {
-            const fdt_pnode *nd = &pt.nodes[j];
-            for (uint32_t id = nd->begin; id < nd->end; id++)
-                for (int k = 0; k < 3; k++)
-                    CHECK(P[3 * id + k] >= nd->lo[k] && P[3 * id + k] <= nd->hi[k]);
-        }
-        /* The composite tree finds the true nearest point. */
-        fdt_kdtree all;
-        CHECK_EQ(fdt_partition_global_tree(&pt, &all), FDT_OK);
-        CHECK_EQ(all.n, p.n);
-        rng r = {99};
-        for (int q = 0; q < 50; q++) {
-            double c3[3] = {runif(&r), runif(&r), runif(&r)};
-            uint32_t b = fdt_kd_nearest(&all, c3, FDT_NONE, NULL);
-            double bd = INFINITY;
-            uint32_t bi = 0;
-            for (uint32_t i = 0; i < p.n; i++) {
-                double dx = P[3 * i] - c3[0], dy = P[3 * i + 1] - c3[1], dz = P[3 * i + 2] - c3[2];
-                double d = dx * dx + dy * dy + dz * dz;
-                if (d < bd) {
-                    bd = d;
-                    bi = i;
-                }
-            }
-            CHECK_EQ(b, bi);
-        }
-        fdt_kd_free(&all);
-        fdt_partition_free(&pt);
-        free(P);
-        free(orig);
-    }
-    /* More parts than points: empty parts, and owner() skips them. */
-    {
-        double P[5 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
-        fdt_vid orig[5] = {0, 1, 2, 3, 4};
-        fdt_partition pt;
-        CHECK_EQ(fdt_partition_build(&pt, P, orig, 5, 16, 18, 4), FDT_OK);
-        int nonempty = 0;
-        for (int i = 0; i < 16; i++)
-            nonempty += pt.start[i + 1] > pt.start[i];
-        CHECK_EQ(nonempty, 5);
-        for (uint32_t id = 0; id < 5; id++) {
-            int o = fdt_partition_owner(&pt, id);
-            CHECK(pt.start[o] <= id && id < pt.start[o + 1]);
-        }
-        fdt_kdtree all;
-        CHECK_EQ(fdt_partition_global_tree(&pt, &all), FDT_OK);
-        double q[3] = {0.9, 0.9, 0.9};
-        uint32_t b = fdt_kd_nearest(&all, q, FDT_NONE, NULL);
-        CHECK(P[3 * b] == 1 && P[3 * b + 1] == 1 && P[3 * b + 2] == 1);
-        fdt_kd_free(&all);
-        fdt_partition_free(&pt);
-    }
-    double P1[3] = {0, 0, 0};
-    fdt_vid o1[1] = {0};
-    fdt_partition pt;
-    CHECK_EQ(fdt_partition_build(&pt, P1, o1, 1, 0, 18, 1), FDT_EINVAL);
-    CHECK_EQ(fdt_partition_build(&pt, P1, o1, 1, FDT_PARTITION_MAX + 1, 18, 1), FDT_EINVAL);
-    free(p.xyz);
-    printf("partition: proportional parts, owners, boxes, composite tree\n");
 }
 
 /* ---- many threads on tiny inputs ------------------------------------------ */
@@ -797,29 +698,52 @@ static void test_sort_threads(void)
     free(p.xyz);
 }
 
+/* Cancellation of a parallel run, in both modes: the first report (after
+ * 50 ms, src/parallel.c) cancels. 400,000 points take seconds on every
+ * thread count here, so the run cannot finish first: FDT_OK would mean the
+ * callback's answer was ignored. */
 static void test_cancel(void)
 {
     pts p = fam_uniform(400000, 11);
-    fdt_settings s;
-    fdt_default_settings(&s);
-    s.mode = FDT_MODE_MESSAGE;
-    s.n_threads = 3;
-    int calls = 0;
-    s.progress = cancel_cb;
-    s.progress_user = &calls;
-    fdt_context *ctx = NULL;
-    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
-    fdt_result *r = NULL;
-    int err = fdt_triangulate(ctx, p.xyz, p.n, &r);
-    /* On a very fast machine the run may finish before the first report
-     * (every 50 ms); then the final report cannot cancel any more. */
-    CHECK(err == FDT_ECANCELED || (err == FDT_OK && calls <= 1));
-    if (err == FDT_ECANCELED)
+    for (int m = FDT_MODE_SHARED; m <= FDT_MODE_MESSAGE; m++) {
+        fdt_settings s;
+        fdt_default_settings(&s);
+        s.mode = (fdt_mode)m;
+        s.n_threads = 3;
+        int calls = 0;
+        s.progress = cancel_cb;
+        s.progress_user = &calls;
+        fdt_context *ctx = NULL;
+        CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+        fdt_result *r = (fdt_result *)ctx; /* must be set to NULL */
+        double t0 = now_s();
+        int err = fdt_triangulate(ctx, p.xyz, p.n, &r);
+        double dt = now_s() - t0;
+        CHECK_EQ(err, FDT_ECANCELED);
         CHECK(r == NULL);
-    fdt_result_free(&r);
-    fdt_close(&ctx);
+        CHECK(calls >= 1); /* reports go on until the workers stop */
+        fdt_close(&ctx);
+        printf("cancel: progress callback stops a %s run after %.2f s\n", mode_name((fdt_mode)m),
+               dt);
+    }
     free(p.xyz);
-    printf("cancel: progress callback stops a message-mode run (%s)\n", fdt_strerror(err));
+}
+
+/* Message mode caches foreign coordinates in a per-thread ghost map of
+ * 1,024 slots at first, doubled at half load (src/parallel.c, ghost_put).
+ * The small families never fill it; 40,000 uniform points cut in two or
+ * four give each part a layer of thousands of foreign points, so the map
+ * is rehashed several times during the run: the mesh must still be
+ * serial mode's. */
+static void test_ghost_rehash(void)
+{
+    pts p = fam_uniform(40000, 23);
+    reference ref = make_ref(&p);
+    compare_run(&p, &ref, FDT_MODE_MESSAGE, 2);
+    compare_run(&p, &ref, FDT_MODE_MESSAGE, 4);
+    free_ref(&ref);
+    free(p.xyz);
+    printf("message mode, 40000 points, 2 and 4 threads (ghost map rehashed): equal serial\n");
 }
 
 static void test_long(void)
@@ -858,7 +782,6 @@ int main(int argc, char **argv)
         test_long();
         return 0;
     }
-    test_partition();
     test_api();
     test_family(fam_uniform(quick ? 600 : 2000, 1), quick);
     test_family(fam_lattice(quick ? 6 : 9), quick);
@@ -868,6 +791,7 @@ int main(int argc, char **argv)
     test_family(fam_offset(quick ? 600 : 1500, 9), quick);
     test_tiny(quick ? 2 : 4);
     test_sort_threads();
+    test_ghost_rehash();
     if (!quick)
         test_cancel();
     printf("all parallel tests passed\n");

@@ -1,13 +1,22 @@
 /*
- * Helpers shared by the threaded tests (tests/test_mailbox.c,
- * tests/test_parallel.c): CHECK and CHECK_EQ end the test with the file,
- * line and failing expression (and both values for CHECK_EQ); now_s is a
- * monotonic clock for watchdogs and timings; test_rand64 and test_unif a
- * deterministic random stream for inputs.
+ * The helpers every C test shares (issue 20: one CHECK for all).
+ * - CHECK and CHECK_EQ end the test at once with the file, line and
+ *   failing expression (and both values for CHECK_EQ): for a state the
+ *   rest of the test cannot go on from.
+ * - EXPECT(cond) and EXPECTF(cond, fmt, ...) record a failure (printed
+ *   with file, line and expression, EXPECTF adding a printf message) and
+ *   go on, so one run shows every failing case; test_report(name) at the
+ *   end of main prints the tally and gives the exit status. Only the first
+ *   TEST_PRINT_LIMIT failures are printed, all are counted.
+ * - test_note_failure() counts a failure a test prints itself (a point
+ *   set, a matrix) and says whether it is still within the print limit.
+ * - now_s is a monotonic clock for watchdogs and timings; test_rand64 and
+ *   test_unif a deterministic random stream for inputs.
  */
 #ifndef FDT_TESTUTIL_H
 #define FDT_TESTUTIL_H
 
+#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,6 +40,91 @@
             exit(1);                                                         \
         }                                                                    \
     } while (0)
+
+#define TEST_PRINT_LIMIT 50
+
+/* The tally of EXPECT checks and failures of this test program. A static
+ * inside a static inline function: one per program, no unused-variable
+ * warning in tests that use only CHECK. */
+typedef struct test_tally {
+    long checks;
+    long failures;
+} test_tally;
+
+static inline test_tally *test_tally_(void)
+{
+    static test_tally t;
+    return &t;
+}
+
+/* Counts checks made without EXPECT (a test that compares several
+ * answers at once). */
+static inline void test_count_checks(long n) { test_tally_()->checks += n; }
+static inline long test_failures(void) { return test_tally_()->failures; }
+
+/* Counts one failure; nonzero while it should still be printed. */
+static inline int test_note_failure(void)
+{
+    return ++test_tally_()->failures <= TEST_PRINT_LIMIT;
+}
+
+/* Counts a failure and prints "FILE:LINE: check failed: COND: MESSAGE"
+ * (COND and MESSAGE each may be NULL) while within the print limit. */
+static inline void test_failv_(const char *file, int line, const char *cond, const char *fmt,
+                               va_list ap)
+{
+    if (!test_note_failure())
+        return;
+    fprintf(stderr, "%s:%d: check failed", file, line);
+    if (cond)
+        fprintf(stderr, ": %s", cond);
+    if (fmt) {
+        fputs(": ", stderr);
+        vfprintf(stderr, fmt, ap);
+    }
+    fputc('\n', stderr);
+}
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 4, 5)))
+#endif
+static inline void test_fail_(const char *file, int line, const char *cond, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    test_failv_(file, line, cond, fmt, ap);
+    va_end(ap);
+}
+
+#define EXPECT(cond)                                                         \
+    do {                                                                     \
+        test_tally_()->checks++;                                             \
+        if (!(cond))                                                         \
+            test_fail_(__FILE__, __LINE__, #cond, NULL);                     \
+    } while (0)
+
+#define EXPECTF(cond, ...)                                                   \
+    do {                                                                     \
+        test_tally_()->checks++;                                             \
+        if (!(cond))                                                         \
+            test_fail_(__FILE__, __LINE__, #cond, __VA_ARGS__);              \
+    } while (0)
+
+/* The end of main: the tally on stdout (failures on stderr); the exit
+ * status, 1 if any EXPECT failed. */
+static inline int test_report(const char *name)
+{
+    const test_tally *t = test_tally_();
+    if (t->failures) {
+        fprintf(stderr, "%s: %ld of %ld checks failed\n", name, t->failures, t->checks);
+        return 1;
+    }
+    if (t->checks)
+        printf("%s: %ld checks passed\n", name, t->checks);
+    else
+        printf("%s: passed\n", name);
+    return 0;
+}
 
 /* splitmix64: a deterministic stream for test inputs, the same everywhere;
  * state *s, any start value. */

@@ -1,0 +1,140 @@
+/*
+ * The partition module (src/partition.c): proportional part sizes for any
+ * N (less the work shift), contiguous ranges, owner lookup (empty parts
+ * skipped), the permutation kept, bisection boxes holding their points,
+ * the composite tree's nearest point against brute force, and refusals.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "frontdt.h"
+#include "partition.h"
+#include "testutil.h"
+
+static void test_partition(void)
+{
+    struct {
+        double *xyz;
+        size_t n;
+    } p = {malloc(3000 * sizeof(double)), 1000};
+    CHECK(p.xyz);
+    uint64_t seed = 7;
+    for (size_t i = 0; i < 3 * p.n; i++)
+        p.xyz[i] = test_unif(&seed);
+    const int counts[] = {1, 2, 3, 5, 7, 64, 100, 1000, 1024};
+    for (size_t c = 0; c < sizeof counts / sizeof *counts; c++) {
+        int np = counts[c];
+        double *P = malloc(3 * p.n * sizeof *P);
+        fdt_vid *orig = malloc(p.n * sizeof *orig);
+        CHECK(P && orig);
+        memcpy(P, p.xyz, 3 * p.n * sizeof *P);
+        for (size_t i = 0; i < p.n; i++)
+            orig[i] = (fdt_vid)i;
+        fdt_partition pt;
+        CHECK_EQ(fdt_partition_build(&pt, P, orig, (uint32_t)p.n, np, 18, 1 + np % 5), FDT_OK);
+        CHECK_EQ(pt.nparts, np);
+        CHECK_EQ(pt.start[0], 0);
+        CHECK_EQ(pt.start[np], p.n);
+        size_t lo = p.n, hi = 0;
+        for (int i = 0; i < np; i++) {
+            CHECK(pt.start[i] <= pt.start[i + 1]);
+            size_t sz = pt.start[i + 1] - pt.start[i];
+            if (sz < lo)
+                lo = sz;
+            if (sz > hi)
+                hi = sz;
+            /* Every id of the part maps back to it; its tree covers it. */
+            for (uint32_t id = pt.start[i]; id < pt.start[i + 1]; id++)
+                CHECK_EQ(fdt_partition_owner(&pt, id), i);
+            CHECK_EQ(pt.trees[i].n, sz);
+            if (sz)
+                CHECK_EQ(pt.trees[i].base, pt.start[i]);
+        }
+        /* Proportional splits, less the work shift (src/partition.c,
+         * work_shift: at most a sixteenth of a left side a level, and none
+         * below 16 points): sizes near m / N, nobody empty while m >= N. */
+        double mean = (double)p.n / np;
+        CHECK((double)hi <= 1.5 * mean + 10 && (double)lo >= 0.5 * mean - 10);
+        if ((size_t)np <= p.n)
+            CHECK(lo >= 1);
+        /* The permutation kept every point (orig is a permutation and P
+         * follows it). */
+        char *seen = calloc(p.n, 1);
+        CHECK(seen);
+        for (size_t i = 0; i < p.n; i++) {
+            CHECK(orig[i] >= 0 && (size_t)orig[i] < p.n && !seen[orig[i]]);
+            seen[orig[i]] = 1;
+            CHECK(memcmp(P + 3 * i, p.xyz + 3 * (size_t)orig[i], 3 * sizeof *P) == 0);
+        }
+        free(seen);
+        /* Bisection boxes contain their points. */
+        for (int j = 0; j < pt.nnodes; j++) {
+            const fdt_pnode *nd = &pt.nodes[j];
+            for (uint32_t id = nd->begin; id < nd->end; id++)
+                for (int k = 0; k < 3; k++)
+                    CHECK(P[3 * id + k] >= nd->lo[k] && P[3 * id + k] <= nd->hi[k]);
+        }
+        /* The composite tree finds the true nearest point. */
+        fdt_kdtree all;
+        CHECK_EQ(fdt_partition_global_tree(&pt, &all), FDT_OK);
+        CHECK_EQ(all.n, p.n);
+        uint64_t r = 99;
+        for (int q = 0; q < 50; q++) {
+            double c3[3] = {test_unif(&r), test_unif(&r), test_unif(&r)};
+            uint32_t b = fdt_kd_nearest(&all, c3, FDT_NONE, NULL);
+            double bd = INFINITY;
+            uint32_t bi = 0;
+            for (uint32_t i = 0; i < p.n; i++) {
+                double dx = P[3 * i] - c3[0], dy = P[3 * i + 1] - c3[1], dz = P[3 * i + 2] - c3[2];
+                double d = dx * dx + dy * dy + dz * dz;
+                if (d < bd) {
+                    bd = d;
+                    bi = i;
+                }
+            }
+            CHECK_EQ(b, bi);
+        }
+        fdt_kd_free(&all);
+        fdt_partition_free(&pt);
+        free(P);
+        free(orig);
+    }
+    /* More parts than points: empty parts, and owner() skips them. */
+    {
+        double P[5 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
+        fdt_vid orig[5] = {0, 1, 2, 3, 4};
+        fdt_partition pt;
+        CHECK_EQ(fdt_partition_build(&pt, P, orig, 5, 16, 18, 4), FDT_OK);
+        int nonempty = 0;
+        for (int i = 0; i < 16; i++)
+            nonempty += pt.start[i + 1] > pt.start[i];
+        CHECK_EQ(nonempty, 5);
+        for (uint32_t id = 0; id < 5; id++) {
+            int o = fdt_partition_owner(&pt, id);
+            CHECK(pt.start[o] <= id && id < pt.start[o + 1]);
+        }
+        fdt_kdtree all;
+        CHECK_EQ(fdt_partition_global_tree(&pt, &all), FDT_OK);
+        double q[3] = {0.9, 0.9, 0.9};
+        uint32_t b = fdt_kd_nearest(&all, q, FDT_NONE, NULL);
+        CHECK(P[3 * b] == 1 && P[3 * b + 1] == 1 && P[3 * b + 2] == 1);
+        fdt_kd_free(&all);
+        fdt_partition_free(&pt);
+    }
+    double P1[3] = {0, 0, 0};
+    fdt_vid o1[1] = {0};
+    fdt_partition pt;
+    CHECK_EQ(fdt_partition_build(&pt, P1, o1, 1, 0, 18, 1), FDT_EINVAL);
+    CHECK_EQ(fdt_partition_build(&pt, P1, o1, 1, FDT_PARTITION_MAX + 1, 18, 1), FDT_EINVAL);
+    free(p.xyz);
+    printf("partition: proportional parts, owners, boxes, composite tree\n");
+}
+
+int main(void)
+{
+    test_partition();
+    return test_report("test_partition");
+}

@@ -1,0 +1,97 @@
+/*
+ * Input preparation (src/prepare.c): duplicate merge into the first index
+ * (-0 == +0), power-of-two scaling (exact, mixed magnitudes kept normal),
+ * NaN and Inf refused with the point named, and the merge on several
+ * threads equal to one thread's bit for bit.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "prepare.h"
+#include "testutil.h"
+#include "testpoints.h"
+
+/* The merge on several threads (src/prepare.c, prepare_threads) gives
+ * the one-thread result bit for bit, duplicates and scaling included, and
+ * names the same first non-finite point. */
+static void test_prepare_threads(void)
+{
+    const size_t want = 90000;
+    double *xyz = malloc(want * 3 * sizeof *xyz);
+    for (int fam = 0; fam < NFAMILIES; fam++) {
+        size_t n = make_points(fam, want, xyz);
+        /* duplicates across slices: copies of points from the whole range */
+        for (size_t i = 0; i + 7 < n && n >= 1000; i += 97)
+            memcpy(xyz + 3 * i, xyz + 3 * ((i * 7919 + 13) % n), 3 * sizeof *xyz);
+        fdt_prepared one, par;
+        char diag[256];
+        EXPECTF(fdt_prepare(xyz, n, 1, &one, diag, sizeof diag) == FDT_OK, "prepare %s",
+              family_name[fam]);
+        for (int T = 2; T <= 8; T += 3) {
+            EXPECTF(fdt_prepare(xyz, n, T, &par, diag, sizeof diag) == FDT_OK, "prepare %s T=%d",
+                  family_name[fam], T);
+            EXPECTF(par.m == one.m && par.ndup == one.ndup && par.scale_exp == one.scale_exp &&
+                      !memcmp(par.p, one.p, 3 * one.m * sizeof *one.p) &&
+                      !memcmp(par.orig, one.orig, one.m * sizeof *one.orig) &&
+                      !memcmp(par.dupmap, one.dupmap, n * sizeof *one.dupmap),
+                  "%s (%zu points, %zu distinct): %d threads differ", family_name[fam], n, one.m,
+                  T);
+            fdt_prepared_free(&par);
+        }
+        if (n >= 80000) {
+            /* two bad points in different slices: the first is named */
+            double keep[2] = {xyz[3 * 70000 + 1], xyz[3 * 40000 + 2]};
+            xyz[3 * 70000 + 1] = NAN;
+            xyz[3 * 40000 + 2] = -INFINITY;
+            char d1[256], d2[256];
+            EXPECTF(fdt_prepare(xyz, n, 1, &par, d1, sizeof d1) == FDT_ERANGE &&
+                      fdt_prepare(xyz, n, 5, &par, d2, sizeof d2) == FDT_ERANGE &&
+                      strstr(d1, "point 40000 has a non-finite z") && !strcmp(d1, d2),
+                  "non-finite: '%s' against '%s'", d1, d2);
+            xyz[3 * 70000 + 1] = keep[0];
+            xyz[3 * 40000 + 2] = keep[1];
+        }
+        fdt_prepared_free(&one);
+    }
+    free(xyz);
+}
+
+static void test_prepare(void)
+{
+    /* Duplicates merge into the first index, -0 == +0; scaling is a power
+     * of two; NaN and Inf are refused with the point named. */
+    double xyz[] = {1, 2, 3, 0.0, 0, 0, 1, 2, 3, -0.0, 0, 0, 5, 6, 7, 1, 2, 3};
+    fdt_prepared pr;
+    char diag[256];
+    EXPECTF(fdt_prepare(xyz, 6, 1, &pr, diag, sizeof diag) == FDT_OK, "prepare dups");
+    EXPECTF(pr.m == 3 && pr.ndup == 3, "distinct %zu dup %zu", pr.m, pr.ndup);
+    EXPECTF(pr.dupmap[2] == 0 && pr.dupmap[3] == 1 && pr.dupmap[5] == 0 && pr.dupmap[4] == 4,
+          "duplicate map");
+    EXPECTF(pr.orig[0] == 0 && pr.orig[1] == 1 && pr.orig[2] == 4, "first indices");
+    EXPECTF(ldexp(7.0, pr.scale_exp) == pr.p[8] && ldexp(7.0, pr.scale_exp) < 1.0 &&
+          ldexp(7.0, pr.scale_exp) >= 0.5, "scale 2^%d", pr.scale_exp);
+    fdt_prepared_free(&pr);
+    double big[] = {1e150, 2e150, 3e150, -1e150, 5e149, 1e148};
+    EXPECTF(fdt_prepare(big, 2, 1, &pr, diag, sizeof diag) == FDT_OK && pr.p[0] < 1.0, "scale down 1e150");
+    fdt_prepared_free(&pr);
+    /* Mixed 1e-300 and 1e300: the scale must keep 1e-300 normal (exact). */
+    double mixed[] = {1e300, 0, 0, 1e-300, 0, 0};
+    EXPECTF(fdt_prepare(mixed, 2, 1, &pr, diag, sizeof diag) == FDT_OK, "mixed");
+    EXPECTF(ldexp(pr.p[3], -pr.scale_exp) == 1e-300, "mixed magnitudes not exact");
+    fdt_prepared_free(&pr);
+    double bad[] = {0, 0, 0, 1, NAN, 2};
+    EXPECTF(fdt_prepare(bad, 2, 1, &pr, diag, sizeof diag) == FDT_ERANGE && strstr(diag, "point 1"),
+          "NaN not refused: %s", diag);
+    double inf[] = {INFINITY, 0, 0};
+    EXPECTF(fdt_prepare(inf, 1, 1, &pr, diag, sizeof diag) == FDT_ERANGE, "Inf not refused");
+}
+
+int main(void)
+{
+    test_prepare();
+    test_prepare_threads();
+    return test_report("test_prepare");
+}
