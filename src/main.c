@@ -96,7 +96,8 @@ static void usage(FILE *f)
         "                         given up to %d times; '-': standard output\n"
         "      --format NAME      format of the next -o (of the last -o when\n"
         "                         none follows): tets, tetgen, vtu, vtk, msh,\n"
-        "                         msh2, medit, openfoam\n"
+        "                         msh2, medit, openfoam; or, named xyz, txt,\n"
+        "                         csv, node or ply, the input's (--input-format)\n"
         "      --all-faces        TetGen .face lists every face (TetGen -f)\n"
         "      --input-format FMT xyz (also txt, csv), node or ply: the input's\n"
         "                         format whatever its name (needed for '-')\n"
@@ -377,9 +378,19 @@ static int parse_args(int argc, char **argv, cli *c)
             format_last = 0;
             break;
         case OPT_FORMAT:
+            /* One option names both, as issue 17 asks (--format xyz for
+             * standard input, --format msh2 for an output): the input
+             * formats' names (xyz, txt, csv, node, ply) and the output
+             * formats' never meet, so the name says which is meant. */
+            if (!fdt_format_by_name(optarg) &&
+                fdt_rd_format_by_name(optarg) != FDT_RD_AUTO) {
+                c->input_format = fdt_rd_format_by_name(optarg);
+                c->input_format_name = optarg;
+                break;
+            }
             if (!fdt_format_by_name(optarg))
-                return usage_error("unknown output format '%s' (%s)", optarg,
-                                   fdt_format_list());
+                return usage_error("unknown format '%s' (input: xyz, txt, csv, node, ply; "
+                                   "output: %s)", optarg, fdt_format_list());
             c->format = optarg;
             format_last = 1;
             break;

@@ -187,6 +187,14 @@ expect_rc io_fifo 0 && expect_in io_fifo out "$io_hash"
 wait
 run io_devstdin "$FRONTDT" --hash --input-format txt /dev/stdin <io.xyz
 expect_rc io_devstdin 0 && expect_in io_devstdin out "$io_hash"
+# --format names the input's format too (issue 17's spelling), before or
+# after the input, and still the output's with an output name.
+cat io.xyz | "$FRONTDT" --hash --format xyz - -o io_fmt.vtu --format vtu >io_fmt.out 2>io_fmt.err
+RC=$?
+expect_rc io_fmt 0 && expect_in io_fmt out "$io_hash"
+[ -s io_fmt.vtu ] || fail "io_fmt: --format xyz with -o io_fmt.vtu wrote no mesh"
+run io_fmtbad "$FRONTDT" --format las io.xyz
+expect_rc io_fmtbad 1 && expect_in io_fmtbad err "unknown format 'las' (input: xyz"
 # Binary PLY from a pipe.
 awk 'BEGIN { printf "ply\nformat ascii 1.0\nelement vertex 300\nproperty double x\nproperty double y\nproperty double z\nend_header\n" } { print }' io.xyz >io_ascii.ply
 cat io_ascii.ply | "$FRONTDT" --hash --input-format ply - >io_ply.out 2>io_ply.err
@@ -584,7 +592,7 @@ for opt in "--search auto" "--search kd" "--search mesh" "--mode auto" "--mode a
 done
 usage_case u_search "unknown search 'fast'" pts.xyz --search fast
 usage_case u_mode "unknown mode 'gpu'" pts.xyz --mode gpu
-usage_case u_o_twice "-o given twice" pts.xyz -o out/a.tets -o out/b.tets
+usage_case u_o_twice "-o out/a.tets given twice" pts.xyz -o out/a.tets -o out/a.tets
 usage_case u_o_empty "empty output file name" pts.xyz -o ""
 usage_case u_json_empty "empty --stats-json file name" pts.xyz --stats-json ""
 usage_case u_threads "--threads wants a count, not 'x'" pts.xyz -t x
@@ -620,7 +628,7 @@ if command -v script >/dev/null; then
     script -qec "$FRONTDT --demo 300000 --mode serial" /dev/null >tty.out 2>&1
     RC=$?
     [ "$RC" = 0 ] || fail "progress on a tty: exit $RC: $(head -c 300 tty.out)"
-    grep -q 'frontdt: \[##*\.*\]  *[0-9]*%' tty.out ||
+    grep -q 'frontdt: triangulate \[##*\.*\]  *[0-9]*%' tty.out ||
         fail "progress on a tty: no bar drawn: $(head -c 300 tty.out)"
     script -qec "$FRONTDT --demo 300000 --mode shared -t 2 --quiet" /dev/null >tty_q.out 2>&1
     grep -q '#' tty_q.out && fail "progress with --quiet on a tty: a bar was drawn"
