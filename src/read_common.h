@@ -21,57 +21,6 @@
 #define RD_PRINTF(f, a) __attribute__((format(printf, f, a)))
 #else
 #define RD_PRINTF(f, a)
-/* The fields of a line (inline: the parsers' innermost loop). */
-
-/*
- * Next field of a line: 1 and the field, 0 at the end of the line, -1 on an
- * empty field (a comma at the start or end of the line, or two commas with
- * nothing between). Fields are separated by whitespace and, when commas is
- * set, by at most one comma.
- */
-/* Moves f->p to the start of the next field; same results as below. */
-static inline int fdt_rd_skip_sep(rd_fields *f)
-{
-    const char *p = f->p, *e = f->e;
-    while (p < e && rd_is_space(*p))
-        p++;
-    if (f->commas && p < e && *p == ',') {
-        if (f->n == 0) {
-            f->p = p;
-            return -1;
-        }
-        p++;
-        while (p < e && rd_is_space(*p))
-            p++;
-        if (p == e || *p == ',') {
-            f->p = p;
-            return -1;
-        }
-    }
-    f->p = p;
-    return p < e;
-}
-
-static inline int fdt_rd_is_sep(const rd_fields *f, const char *p)
-{
-    return p == f->e || rd_is_space(*p) || (f->commas && *p == ',');
-}
-
-static inline int fdt_rd_next_field(rd_fields *f, const char **ts, size_t *tl)
-{
-    int r = fdt_rd_skip_sep(f);
-    if (r <= 0)
-        return r;
-    const char *s = f->p, *p = s;
-    while (!fdt_rd_is_sep(f, p))
-        p++;
-    f->p = p;
-    f->n++;
-    *ts = s;
-    *tl = (size_t)(p - s);
-    return 1;
-}
-
 #endif
 
 /* fdt_vid is int32_t: more points cannot be numbered. */
