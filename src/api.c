@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "frontdt.h"
+#include "clock.h"
 #include "front.h"
 #include "kdtree.h"
 #include "oracle.h"
@@ -117,13 +118,6 @@ const char *fdt_context_diagnostic(const fdt_context *ctx)
     return ctx ? ctx->diag : "";
 }
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* The point whose coordinates are nearest the centre of the root box
  * (§2.1: "a node near the center of the cloud"). */
 static uint32_t central_point(const fdt_kdtree *t)
@@ -151,7 +145,7 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
         nthreads = fdt_parallel_default_threads();
     if (mode == FDT_MODE_AUTO)
         mode = nthreads == 1 ? FDT_MODE_SERIAL : FDT_MODE_SHARED;
-    double t0 = now_s();
+    double t0 = fdt_now_s();
     fdt_prepared pr;
     fdt_kdtree tree = {0};
     fdt_meshbuf mb = {0};
@@ -188,7 +182,7 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     fdt_front_stats fst;
     memset(&fst, 0, sizeof fst);
     if (mode != FDT_MODE_SERIAL) {
-        double tp = now_s();
+        double tp = fdt_now_s();
         err = fdt_parallel_run(&pr, &ctx->s, mode, nthreads, &popt, &par, ctx->diag,
                                sizeof ctx->diag);
         if (err)
@@ -203,7 +197,7 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
             goto fail;
         if (fdt_meshbuf_init(&mb, (size_t)(6.9 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
             goto fail;
-        t1 = now_s();
+        t1 = fdt_now_s();
         err = fdt_front_serial(&tree, central_point(&tree), (int)ctx->s.search, &mb, ctx->s.progress,
                                ctx->s.progress_user, &fst);
     }
@@ -215,7 +209,7 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
                      "internal error: the front became inconsistent after %zu tetrahedra", mb.ntets);
         goto fail;
     }
-    double t2 = now_s();
+    double t2 = fdt_now_s();
     err = FDT_ENOMEM;
     r = calloc(1, sizeof *r);
     if (!r)
@@ -261,7 +255,7 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     st->mode = FDT_MODE_SERIAL;
     st->t_prepare = t1 - t0;
     st->t_front = t2 - t1;
-    st->t_finish = now_s() - t2;
+    st->t_finish = fdt_now_s() - t2;
     if (mode != FDT_MODE_SERIAL) {
         fdt_parallel_fill_stats(&par, mode, st);
         st->t_front = par.t_front;

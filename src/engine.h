@@ -19,6 +19,7 @@
 #include <hwloc.h>
 #endif
 
+#include "clock.h"
 #include "faceq.h"
 #include "facetab.h"
 #include "front.h"
@@ -32,13 +33,6 @@
 
 /* A worker's result for the main loop: keep going, or the run is over. */
 enum { RUN_ON = 0, RUN_DONE = 1 };
-
-static inline double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* ---- the engine and its workers ----------------------------------------- */
 

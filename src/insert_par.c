@@ -54,6 +54,7 @@
  */
 #include "insert.h"
 #include "insert_impl.h"
+#include "clock.h"
 
 #include <pthread.h>
 #include <sched.h>
@@ -116,15 +117,6 @@ typedef struct worker {
     int started;
     double cpu_s;              /* thread CPU seconds in worker_main */
 } worker;
-
-/* CPU seconds of the calling thread (the phase timings of the stats). */
-static double thread_cpu(void)
-{
-    struct timespec ts;
-    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0)
-        return 0.0;
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* ------------------------------------------------------------------ */
 /* Locks. */
@@ -615,7 +607,7 @@ static void *worker_main(void *arg)
 {
     worker *w = arg;
     shared *sh = w->sh;
-    double c0 = thread_cpu();
+    double c0 = fdt_thread_cpu_s();
     size_t i = 0;
     int err = FDT_OK;
     for (int r = 0; r < w->nrounds && !err; r++) {
@@ -657,7 +649,7 @@ static void *worker_main(void *arg)
     }
     if (err)
         fail_all(sh, err);
-    w->cpu_s += thread_cpu() - c0;
+    w->cpu_s += fdt_thread_cpu_s() - c0;
     return NULL;
 }
 
@@ -736,11 +728,11 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
     uint32_t prefix = round_end[r0 - 1];
     uint64_t slots = slots_a_point > 0.0 ? (uint64_t)(slots_a_point * n) + 64
                                          : (uint64_t)n * 8 + (uint64_t)nw * 2 * CHUNK + 1024;
-    double c0 = thread_cpu();
+    double c0 = fdt_thread_cpu_s();
     err = fdt_ins_build_prefix(m, P, base, n, order, prefix, slots, first, cnt);
     if (err)
         goto out;
-    double c1 = thread_cpu();
+    double c1 = fdt_thread_cpu_s();
     err = FDT_ENOMEM;
     {
         /* The slots a point the serial rounds used, with a third more
@@ -885,7 +877,7 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
     /* Phase 3 on this thread, as worker 0: every freed or unused slot
      * becomes its own (locked by it), every other lock is free. */
     worker *w0 = &ws[0];
-    double c2 = thread_cpu();
+    double c2 = fdt_thread_cpu_s();
     sh.single = 1;
     err = FDT_ENOMEM;
     for (int i = 0; i < nw; i++) {
@@ -956,7 +948,7 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
     err = fdt_ins_finish(m);
     if (err == FDT_OK) {
         m->stats.cpu_start_s = c1 - c0;
-        m->stats.cpu_finish_s = thread_cpu() - c2;
+        m->stats.cpu_finish_s = fdt_thread_cpu_s() - c2;
         for (int i = 0; i < nw; i++) {
             m->stats.cpu_workers_sum_s += ws[i].cpu_s;
             if (ws[i].cpu_s > m->stats.cpu_workers_max_s)

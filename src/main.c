@@ -21,6 +21,7 @@
  * "--stats-json -" claims stdout for the JSON object alone).
  */
 #include "frontdt.h"
+#include "clock.h"
 #include "progress.h"
 #include "reader.h"
 #include "writer.h"
@@ -149,13 +150,6 @@ static int usage_error(const char *fmt, ...)
     va_end(ap);
     fputs("Try 'frontdt --help' for more information.\n", stderr);
     return CLI_USAGE;
-}
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* ------------------------------------------------------------------------ */
@@ -999,7 +993,7 @@ static int run(const cli *c)
         info = stderr;
 
     /* Points. */
-    double t0 = now_s();
+    double t0 = fdt_now_s();
     if (c->demo) {
         n = c->demo_n;
         xyz = demo_points(n);
@@ -1026,7 +1020,7 @@ static int run(const cli *c)
             return exit_for_reader(r);
         }
     }
-    tm.read = now_s() - t0;
+    tm.read = fdt_now_s() - t0;
 
     /* Triangulation. */
     fdt_settings s;
@@ -1047,10 +1041,10 @@ static int run(const cli *c)
         code = exit_for_engine(r);
         goto done;
     }
-    t0 = now_s();
+    t0 = fdt_now_s();
     progress_phase(&prog, "merge"); /* "triangulate" at the library's first report */
     r = fdt_triangulate(ctx, xyz, n, &res);
-    tm.triangulate = now_s() - t0;
+    tm.triangulate = fdt_now_s() - t0;
     progress_clear(&prog);
     if (r != FDT_OK) {
         const char *diag = fdt_context_diagnostic(ctx);
@@ -1074,12 +1068,12 @@ static int run(const cli *c)
     size_t nt = fdt_result_num_tets(res);
     if (c->check) {
         char msg[1024];
-        t0 = now_s();
+        t0 = fdt_now_s();
         progress_phase(&prog, "check");
         r = fdt_check(xyz, n, fdt_result_tets(res), nt,
                       fdt_result_neighbors(res), msg, sizeof msg);
         progress_clear(&prog);
-        tm.check = now_s() - t0;
+        tm.check = fdt_now_s() - t0;
         if (r != FDT_OK) {
             if (r == FDT_ECHECK)
                 say("%s: check failed: %s", name, msg);
@@ -1092,7 +1086,7 @@ static int run(const cli *c)
 
     /* The canonical order makes .tets and the hash independent of thread
      * count and mode; the other formats do not need it. */
-    t0 = now_s();
+    t0 = fdt_now_s();
     uint64_t hash = 0;
     if (c->hash || (need & FDT_NEED_SORTED))
         progress_phase(&prog, "sort");
@@ -1115,10 +1109,10 @@ static int run(const cli *c)
         }
     }
     progress_clear(&prog);
-    tm.canon = now_s() - t0;
+    tm.canon = fdt_now_s() - t0;
 
     if (c->n_outputs > 0) {
-        t0 = now_s();
+        t0 = fdt_now_s();
         char err[1024];
         /* The public writer computes the face list where a format needs
          * it (after the sort above: it names tets by their numbers) and
@@ -1138,12 +1132,12 @@ static int run(const cli *c)
                 progress_clear(&prog);
                 say("%s", err);
                 code = exit_for_writer(r);
-                tm.write = now_s() - t0;
+                tm.write = fdt_now_s() - t0;
                 goto done;
             }
         }
         progress_clear(&prog);
-        tm.write = now_s() - t0;
+        tm.write = fdt_now_s() - t0;
     }
 
     fdt_stats st;

@@ -1,5 +1,6 @@
 /* The choice of apex oracle; see oracle.h and bench/NOTES.md, entry 51. */
 #include "oracle.h"
+#include "clock.h"
 
 #include "front.h"
 #include "seed.h"
@@ -73,23 +74,6 @@
 #define TIMED_FROM 4096
 #define TIMED_MIN 8192
 
-static double mono_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* This thread's CPU time: a window's cost without the time other
- * processes or threads held the core. */
-static double thread_cpu_us(void)
-{
-    struct timespec ts;
-    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0)
-        return 0.0;
-    return 1e6 * (double)ts.tv_sec + 1e-3 * (double)ts.tv_nsec;
-}
-
 void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy)
 {
     memset(o, 0, sizeof *o);
@@ -110,9 +94,9 @@ void fdt_oracle_free(fdt_oracle *o)
 
 static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
 {
-    double t0 = mono_s();
+    double t0 = fdt_now_s();
     int err = fdt_ins_build(&o->mesh, o->t->P, o->t->base, o->t->n, &kq->pc);
-    o->t_mesh += mono_s() - t0;
+    o->t_mesh += fdt_now_s() - t0;
     /* FDT_EDEGENERATE (a part whose points are coplanar: one layer of an
      * extruded grid) or FDT_ENOMEM: the kd search is always right, only
      * slower, so the front goes on with it. */
@@ -143,14 +127,14 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
         return;
     }
     /* The time rule over everything since TIMED_FROM faces (see above). */
-    double now = thread_cpu_us();
+    double now = fdt_thread_cpu_s();
     if (o->t_faces == 0 && faces >= TIMED_FROM && now > 0.0) {
         o->t_faces = faces;
         o->t_cpu = now;
         o->t_nodes = kq->nodes;
     } else if (o->t_faces > 0 && faces >= o->t_faces + TIMED_MIN && now > 0.0) {
         double nf = (double)(faces - o->t_faces);
-        double us = (now - o->t_cpu) / nf;
+        double us = 1e6 * (now - o->t_cpu) / nf;
         double nodes = (double)(kq->nodes - o->t_nodes) / nf;
         if (nodes >= SLOW_NODES &&
             us * left > TIME_MARGIN * (MESH_BUILD_US * (double)o->t->n + MESH_WALK_US * left)) {

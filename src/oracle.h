@@ -43,7 +43,7 @@ typedef struct fdt_oracle {
     /* The switching window: counter values at its start. */
     size_t next_check, w_faces, w_points, w_exact;
     /* The time rule's start: faces advanced (0: not started), thread CPU
-     * (us) and kd nodes visited then. */
+     * (s) and kd nodes visited then. */
     size_t t_faces, t_nodes;
     double t_cpu;
     /* Statistics. */

@@ -139,7 +139,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     if ((mode != FDT_MODE_SHARED && mode != FDT_MODE_MESSAGE) || nthreads < 1 ||
         nthreads > FDT_PARTITION_MAX || pr->m < 4 || pr->m > UINT32_MAX - 1)
         return FDT_EINVAL;
-    double t0 = now_s();
+    double t0 = fdt_now_s();
     fdt_partition pt;
     engine *e = NULL;
     uint32_t(*seeds)[4] = NULL;
@@ -317,10 +317,10 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * leaves the parts on their own oracles. */
     double t_gm = 0.0;
     if (opt && opt->global_mesh && mode == FDT_MODE_SHARED) {
-        double tg = now_s();
+        double tg = fdt_now_s();
         int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads,
                                           &kq0.pc);
-        t_gm = now_s() - tg;
+        t_gm = fdt_now_s() - tg;
         if (gerr == FDT_OK)
             e->gmesh_ok = 1;
         else if (gerr != FDT_ENOMEM && gerr != FDT_EDEGENERATE) {
@@ -333,7 +333,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     /* Every thread with seeds starts holding its activity unit. Thread
      * creation orders this before everything the workers do. */
     atomic_init(&e->work, active);
-    double t1 = now_s();
+    double t1 = fdt_now_s();
     double t2 = t1;
     err = fdt_threads_run(e, s, &t2);
     /* After pthread_join: any order would do; acquire documents that the
@@ -430,7 +430,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     out->nthreads = nthreads;
     out->t_setup = t1 - t0;
     out->t_front = t2 - t1;
-    out->t_gather = now_s() - t2;
+    out->t_gather = fdt_now_s() - t2;
 fail:
     if (e) {
         if (e->w)

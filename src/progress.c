@@ -4,6 +4,7 @@
 #endif
 
 #include "progress.h"
+#include "clock.h"
 
 #include "frontdt.h"
 
@@ -18,13 +19,6 @@
 #define MIN_BAR 10
 /* The longest line drawn (a very wide terminal gets no wider bar). */
 #define MAX_LINE 160
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* The terminal's columns: TIOCGWINSZ on fd, else $COLUMNS, else 80. */
 static int term_width(int fd)
@@ -145,14 +139,14 @@ void progress_phase(progress *p, const char *name)
         return;
     p->phase = name;
     p->approx = 0;
-    p->t_phase = now_s();
+    p->t_phase = fdt_now_s();
     p->t_drawn = -1;
     draw(p, p->t_phase, "", -1, "...");
 }
 
 void progress_fraction(progress *p, double fraction)
 {
-    double t = now_s();
+    double t = fdt_now_s();
     if (!due(p, t))
         return;
     if (!(fraction >= 0))
@@ -162,7 +156,7 @@ void progress_fraction(progress *p, double fraction)
 
 void progress_bytes(progress *p, uint64_t done, uint64_t total)
 {
-    double t = now_s();
+    double t = fdt_now_s();
     if (!due(p, t))
         return;
     char d[32], what[80];

@@ -173,9 +173,9 @@ int fdt_proto_wait_mail(worker *w, int spin, double *acc)
             return FDT_OK;
         sched_yield();
     }
-    double t = now_s();
+    double t = fdt_now_s();
     int rc = fdt_tp_wait(w->e->tp, w->id, -1);
-    *acc += now_s() - t;
+    *acc += fdt_now_s() - t;
     return rc < 0 ? FDT_EINTERNAL : FDT_OK;
 }
 
@@ -202,7 +202,7 @@ int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
     w->st.remote_queries++;
     if (fdt_tp_post(w->e->tp, w->id, j, m) < 0)
         return FDT_EINTERNAL;
-    double t0 = now_s(), waited = 0.0;
+    double t0 = fdt_now_s(), waited = 0.0;
     pwait pw = {qid, j, s, qb, 0};
     for (;;) {
         if (aborted(w->e)) {
@@ -222,7 +222,7 @@ int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
         if (rc != RUN_ON)
             return FDT_EINTERNAL;
         if (pw.answered) {
-            w->st.t_query_wait += now_s() - t0;
+            w->st.t_query_wait += fdt_now_s() - t0;
             return FDT_OK;
         }
     }

@@ -1,5 +1,6 @@
 /* Hardware and threads of the parallel engine; see threads.h. */
 #include "threads.h"
+#include "clock.h"
 
 #include <errno.h>
 #include <stdlib.h>
@@ -42,22 +43,11 @@ static void pin_thread(worker *w)
 #endif
 }
 
-/* CPU seconds used by the calling thread so far (0 if the clock is
- * missing): with the idle and wait times it tells, on a loaded machine,
- * what the run would take with a core per thread. */
-static double thread_cpu_s(void)
-{
-    struct timespec ts;
-    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0)
-        return 0.0;
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static void *worker_main(void *arg)
 {
     worker *w = arg;
     engine *e = w->e;
-    double cpu0 = thread_cpu_s();
+    double cpu0 = fdt_thread_cpu_s();
     if (e->pin)
         pin_thread(w);
     int rc = fdt_eng_worker_setup(w);
@@ -67,7 +57,7 @@ static void *worker_main(void *arg)
         fdt_eng_set_error(e, rc, w->id, rc == FDT_ENOMEM ? "out of memory" : "inconsistent front");
     /* relaxed: a progress estimate only. */
     atomic_store_explicit(&w->tets_done, w->out.ntets, memory_order_relaxed);
-    w->st.t_cpu = thread_cpu_s() - cpu0;
+    w->st.t_cpu = fdt_thread_cpu_s() - cpu0;
     pthread_mutex_lock(&e->lock);
     e->finished++;
     pthread_cond_signal(&e->cv);
@@ -151,7 +141,7 @@ int fdt_threads_run(engine *e, const fdt_settings *s, double *t_loops)
             fdt_term_ctl_fail(e, FDT_ECANCELED, -1, "canceled");
         pthread_mutex_lock(&e->lock);
     }
-    *t_loops = now_s();
+    *t_loops = fdt_now_s();
     /* Every worker waits on `go` now. Gather only a complete run: with an
      * error (relaxed is enough: a worker's fdt_eng_set_error precedes its
      * finished++ under the lock we hold; message mode: the workers'
