@@ -14,6 +14,7 @@
 #endif
 
 #include "read_common.h"
+#include "abi.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -443,16 +444,7 @@ static int read_options_size_known(size_t size)
 
 int fdt_default_read_options_sized(fdt_read_options *o, size_t struct_size)
 {
-    if (o == NULL)
-        return FDT_EINVAL;
-    if (!read_options_size_known(struct_size)) {
-        if (struct_size >= sizeof o->struct_size)
-            o->struct_size = 0;
-        return FDT_EINVAL;
-    }
-    memset(o, 0, struct_size);
-    o->struct_size = struct_size;
-    return FDT_OK;
+    return fdt_abi_reset(o, struct_size, read_options_size_known(struct_size));
 }
 
 /* The public callback behind the reader's own (sizes widened). */

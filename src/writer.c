@@ -18,6 +18,7 @@
  * one mesh at a time); the public fdt_write_mesh takes a lock.
  */
 #include "writer.h"
+#include "abi.h"
 #include "formats.h"
 #include "result.h"
 
@@ -920,16 +921,7 @@ static int write_options_size_known(size_t size)
 
 int fdt_default_write_options_sized(fdt_write_options *o, size_t struct_size)
 {
-    if (!o)
-        return FDT_EINVAL;
-    if (!write_options_size_known(struct_size)) {
-        if (struct_size >= sizeof o->struct_size)
-            o->struct_size = 0;
-        return FDT_EINVAL;
-    }
-    memset(o, 0, struct_size);
-    o->struct_size = struct_size;
-    return FDT_OK;
+    return fdt_abi_reset(o, struct_size, write_options_size_known(struct_size));
 }
 
 /* One public write at a time: the temporary-file registry above (and the
