@@ -281,30 +281,14 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
         return err;
     mark = b->mark; /* reserve_slots may have moved it */
 
-    /* The new tets: each boundary face (c, k) with p in place of vertex k,
-     * on the same side of the face as c's vertex k was (star-shaped
-     * cavity), so positively oriented. Allocated before the cavity is
-     * freed, so reading c is safe; the cavity's slots serve the next
-     * insertion. */
+    /* The new tets (ins_star_tet), allocated before the cavity is freed,
+     * so reading it is safe; the cavity's slots serve the next insertion. */
     uint32_t *T = m->T;
     size_t linked = 0;
     uint32_t s = FDT_NONE;
     for (size_t i = 0; i < b->nbnd; i++) {
-        uint32_t c = b->bnd[i] >> 2;
-        int k = (int)(b->bnd[i] & 3);
         s = alloc_slot(b);
-        uint32_t *w = T + 8 * (size_t)s;
-        const uint32_t *cv = T + 8 * (size_t)c;
-        memcpy(w, cv, 4 * sizeof *w);
-        w[k] = pid;
-        uint32_t o = cv[4 + k];
-        w[4 + k] = o;
-        T[8 * (size_t)(o >> 2) + 4 + (o & 3)] = PACK(s, k);
-        for (int j = 0; j < 4; j++) {
-            if (j == k)
-                continue;
-            linked += (size_t)ins_link_edge(&b->edges, T, w[ins_other2[k][j][0]], w[ins_other2[k][j][1]], PACK(s, j));
-        }
+        linked += ins_star_tet(T, &b->edges, b->bnd[i], pid, s);
     }
     /* The boundary is a closed surface: every edge met exactly twice. */
     if (2 * linked != 3 * b->nbnd)

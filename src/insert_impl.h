@@ -136,6 +136,37 @@ static inline int ins_link_edge(ins_edges *e, uint32_t *T, uint32_t x, uint32_t 
 }
 
 /*
+ * One tet of an insertion's star, in slot s: the cavity's boundary face
+ * bnd (packed: cavity tet c, face opposite its vertex k) with pid in place
+ * of vertex k, on the same side of the face as c's vertex k was (the
+ * cavity is star-shaped), so positively oriented. It takes over c's
+ * neighbour across the face and links its three other faces through the
+ * edge table (ins_link_edge). c must still be readable (its slot is freed
+ * after the star is built). Returns the number of faces it linked.
+ */
+static inline size_t ins_star_tet(uint32_t *T, ins_edges *e, uint32_t bnd, uint32_t pid,
+                                  uint32_t s)
+{
+    uint32_t c = bnd >> 2;
+    int k = (int)(bnd & 3);
+    uint32_t *nw = T + 8 * (size_t)s;
+    const uint32_t *cv = T + 8 * (size_t)c;
+    memcpy(nw, cv, 4 * sizeof *nw);
+    nw[k] = pid;
+    uint32_t o = cv[4 + k];
+    nw[4 + k] = o;
+    T[8 * (size_t)(o >> 2) + 4 + (o & 3)] = PACK(s, k);
+    size_t linked = 0;
+    for (int j = 0; j < 4; j++) {
+        if (j == k)
+            continue;
+        linked += (size_t)ins_link_edge(e, T, nw[ins_other2[k][j][0]], nw[ins_other2[k][j][1]],
+                                        PACK(s, j));
+    }
+    return linked;
+}
+
+/*
  * order[] = the ids [base, base + n) by BRIO round (src/insert.c), the
  * first round first; round_end[r] (r = 0 .. *nrounds - 1) is the end of
  * round r in order[]. round_end has room for 32 entries.

@@ -510,27 +510,13 @@ static int insert_point(worker *w, uint32_t pid)
         goto abort;
     mark = sh->mark;
 
-    /* The new tets, as in src/insert.c. */
+    /* The new tets (ins_star_tet), as in src/insert.c. */
     uint32_t *T = m->T;
     size_t linked = 0;
     uint32_t s = FDT_NONE;
     for (size_t i = 0; i < w->nbnd; i++) {
-        uint32_t c = w->bnd[i] >> 2;
-        int k = (int)(w->bnd[i] & 3);
         s = alloc_slot(w);
-        uint32_t *nw = T + 8 * (size_t)s;
-        const uint32_t *cv = T + 8 * (size_t)c;
-        memcpy(nw, cv, 4 * sizeof *nw);
-        nw[k] = pid;
-        uint32_t o = cv[4 + k];
-        nw[4 + k] = o;
-        T[8 * (size_t)(o >> 2) + 4 + (o & 3)] = PACK(s, k);
-        for (int j = 0; j < 4; j++) {
-            if (j == k)
-                continue;
-            linked += (size_t)ins_link_edge(&w->edges, T, nw[ins_other2[k][j][0]],
-                                            nw[ins_other2[k][j][1]], PACK(s, j));
-        }
+        linked += ins_star_tet(T, &w->edges, w->bnd[i], pid, s);
     }
     if (2 * linked != 3 * w->nbnd) {
         release_all(w);
