@@ -41,6 +41,23 @@ int fdt_pfq_push(pfqueue *q, const pface *f)
     return FDT_OK;
 }
 
+/* The ids of face v and its apex (FDT_NONE: none) whose coordinates a
+ * message-mode FACESEND carries, in payload order: all but the lowest,
+ * which the receiver owns. Sender and receiver both use this order. */
+static int carried_ids(const uint32_t v[3], uint32_t apex, uint32_t out[3])
+{
+    uint32_t ids[4] = {v[0], v[1], v[2], apex};
+    int nid = apex == FDT_NONE ? 3 : 4, low = 0;
+    for (int i = 1; i < nid; i++)
+        if (ids[i] < ids[low])
+            low = i;
+    int n = 0;
+    for (int i = 0; i < nid; i++)
+        if (i != low)
+            out[n++] = ids[i];
+    return n;
+}
+
 /* Posts a FACESEND of face v (and apex, or FDT_NONE) to thread `to`,
  * adding its unit first (R1). */
 int fdt_proto_send_face(worker *w, int to, const uint32_t v[3], uint32_t apex,
@@ -52,19 +69,13 @@ int fdt_proto_send_face(worker *w, int to, const uint32_t v[3], uint32_t apex,
     fp.f.apex = apex;
     fp.f.tet = link;
     if (w->e->mode == FDT_MODE_MESSAGE) {
-        uint32_t ids[4] = {v[0], v[1], v[2], apex};
-        int nid = apex == FDT_NONE ? 3 : 4, low = 0;
-        for (int i = 1; i < nid; i++)
-            if (ids[i] < ids[low])
-                low = i;
-        int j = 0;
-        for (int i = 0; i < nid; i++) {
-            if (i == low)
-                continue;
-            const double *x = coords(w, ids[i]);
+        uint32_t ids[3];
+        int n = carried_ids(v, apex, ids);
+        for (int j = 0; j < n; j++) {
+            const double *x = coords(w, ids[j]);
             if (!x)
                 return FDT_EINTERNAL;
-            memcpy(fp.xyz[j++], x, 3 * sizeof *x);
+            memcpy(fp.xyz[j], x, 3 * sizeof *x);
         }
     }
     fdt_msg *m;
@@ -84,22 +95,14 @@ int fdt_proto_handle_face(worker *w, const pface *pf)
 {
     const fdt_msg_facesend *f = &pf->p.f;
     if (w->e->mode == FDT_MODE_MESSAGE) {
-        uint32_t ids[4] = {f->v[0], f->v[1], f->v[2], f->apex};
-        int nid = f->apex == FDT_NONE ? 3 : 4, low = 0;
-        for (int i = 1; i < nid; i++)
-            if (ids[i] < ids[low])
-                low = i;
-        int j = 0;
-        for (int i = 0; i < nid; i++) {
-            if (i == low)
-                continue;
-            if (!is_own(w, ids[i])) {
-                int err = fdt_ghost_put(&w->ghosts, ids[i], pf->p.xyz[j]);
+        uint32_t ids[3];
+        int n = carried_ids(f->v, f->apex, ids);
+        for (int j = 0; j < n; j++)
+            if (!is_own(w, ids[j])) {
+                int err = fdt_ghost_put(&w->ghosts, ids[j], pf->p.xyz[j]);
                 if (err)
                     return err;
             }
-            j++;
-        }
     }
     int err;
     if (f->apex == FDT_NONE) {
