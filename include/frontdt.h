@@ -228,6 +228,44 @@ FDT_API int fdt_result_sort(fdt_result *r);
  * content of a .tets file). Sorts r first (fdt_result_sort). */
 FDT_API int fdt_result_hash(fdt_result *r, uint64_t *hash);
 
+/* The set hash of r's tets (src/sethash.h): an order-independent 64-bit
+ * hash of the tet set, the same for every mode, thread count and order of
+ * emission, with no sort (r is not changed). It differs from
+ * fdt_result_hash's value. A streamed result (fdt_triangulate_stream),
+ * which holds no tets, gives the set hash of the tets it emitted. */
+FDT_API int fdt_result_set_hash(const fdt_result *r, uint64_t *hash);
+
+/*
+ * Streaming (issue 18): the tets leave as the front builds them (they are
+ * final when built, DESIGN.md, Output) instead of being kept in the result.
+ *
+ * tets: called with batches of finished tets, 4 ids each, in the caller's
+ *   numbering (as fdt_result_tets), positively oriented; every tet of the
+ *   mesh exactly once, in no particular order. The library serializes the
+ *   calls (never two at once) but may make them from any of its threads.
+ *   A nonzero return stops the run: fdt_triangulate_stream then returns
+ *   FDT_ECANCELED (or the value, if it is a negative FDT_E* code).
+ * hull: as tets for the hull faces, 3 ids each, outward (may be NULL).
+ * The pointers passed are valid during the call only.
+ */
+typedef struct fdt_sink {
+    size_t struct_size; /* sizeof(fdt_sink) as compiled by the caller */
+    int (*tets)(void *user, const fdt_vid *tets, size_t count);
+    int (*hull)(void *user, const fdt_vid *faces, size_t count);
+    void *user;
+} fdt_sink;
+
+/*
+ * As fdt_triangulate, but the tets and hull faces go to sink as they are
+ * built. *out is a result with no tets and no hull faces (num_tets 0):
+ * its stats (stats.tets counts the tets emitted), its duplicate map and
+ * its set hash (fdt_result_set_hash). settings.neighbors is refused
+ * (FDT_EINVAL). On failure *out is NULL and some tets may already have
+ * gone to the sink.
+ */
+FDT_API int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
+                                   const fdt_sink *sink, fdt_result **out);
+
 /*
  * The kinds of message between parts (Merriam §4; DESIGN.md, Transport),
  * the index of the message statistics (fdt_stats.sent, .received). 0 is

@@ -15,6 +15,7 @@
 #include "prepare.h"
 #include "result.h"
 #include "seed.h"
+#include "sethash.h"
 
 struct fdt_context {
     fdt_settings s;
@@ -278,4 +279,56 @@ fail:
     fdt_prepared_free(&pr);
     fdt_result_free(&r);
     return err;
+}
+
+/* Hands count records of width w (ids) to fn in batches, so a caller's
+ * writer sees bounded calls. */
+static int sink_batches(int (*fn)(void *, const fdt_vid *, size_t), void *user,
+                        const fdt_vid *v, size_t count, size_t w)
+{
+    enum { BATCH = 1 << 16 };
+    for (size_t i = 0; i < count; i += BATCH) {
+        size_t k = count - i < BATCH ? count - i : BATCH;
+        int rc = fn(user, v + w * i, k);
+        if (rc)
+            return rc < 0 && rc >= FDT_EFORMAT ? rc : FDT_ECANCELED;
+    }
+    return FDT_OK;
+}
+
+int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
+                           const fdt_sink *sink, fdt_result **out)
+{
+    if (!ctx || !out || !sink || sink->struct_size < sizeof(fdt_sink) || !sink->tets)
+        return FDT_EINVAL;
+    *out = NULL;
+    if (ctx->s.neighbors) {
+        snprintf(ctx->diag, sizeof ctx->diag, "a streamed run has no neighbours");
+        return FDT_EINVAL;
+    }
+    /* First stage: the whole mesh is built, then handed over and dropped;
+     * the sink's contract (batches, input numbering, any order) is the one
+     * the engine's own emission keeps (issue 18). */
+    fdt_result *r = NULL;
+    int err = fdt_triangulate(ctx, xyz, n, &r);
+    if (err)
+        return err;
+    fdt_sethash h = {0, 0};
+    fdt_sethash_add_n(&h, (const uint32_t *)r->tets, r->ntets);
+    err = sink_batches(sink->tets, sink->user, r->tets, r->ntets, 4);
+    if (!err && sink->hull)
+        err = sink_batches(sink->hull, sink->user, r->hull, r->nhull, 3);
+    if (err) {
+        fdt_result_free(&r);
+        return err;
+    }
+    free(r->tets);
+    free(r->hull);
+    r->tets = NULL;
+    r->hull = NULL;
+    r->ntets = r->nhull = 0;
+    r->streamed = 1;
+    r->set_hash = fdt_sethash_value(&h);
+    *out = r;
+    return FDT_OK;
 }

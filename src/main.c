@@ -73,7 +73,7 @@ typedef struct cli {
     fdt_mode mode;
     fdt_search search;
     int threads;            /* -1: the library's default */
-    int pin, check, stats, hash, quiet;
+    int pin, check, stats, hash, set_hash, quiet;
     int demo;
     size_t demo_n;
 } cli;
@@ -114,6 +114,7 @@ static void usage(FILE *f)
         "      --stats            print statistics to stderr\n"
         "      --stats-json FILE  write statistics as JSON ('-': stdout)\n"
         "      --hash             print the canonical hash of the tet set\n"
+        "      --set-hash         print the set hash (order-independent, no sort)\n"
         "  -q, --quiet            no summary, no progress, no notes\n"
         "      --progress         draw the progress line on stderr even when it\n"
         "                         is not a terminal (it is drawn on terminals)\n"
@@ -237,7 +238,7 @@ static int parse_count(const char *s, unsigned long long max,
 }
 
 enum {
-    OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH,
+    OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH, OPT_SET_HASH,
     OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
     OPT_PROGRESS
 };
@@ -254,6 +255,7 @@ static const struct option long_opts[] = {
     { "stats", no_argument, NULL, OPT_STATS },
     { "stats-json", required_argument, NULL, OPT_STATS_JSON },
     { "hash", no_argument, NULL, OPT_HASH },
+    { "set-hash", no_argument, NULL, OPT_SET_HASH },
     { "quiet", no_argument, NULL, 'q' },
     { "demo", optional_argument, NULL, OPT_DEMO },
     { "input-format", required_argument, NULL, OPT_INPUT_FORMAT },
@@ -436,6 +438,9 @@ static int parse_args(int argc, char **argv, cli *c)
             break;
         case OPT_HASH:
             c->hash = 1;
+            break;
+        case OPT_SET_HASH:
+            c->set_hash = 1;
             break;
         case 'q':
             c->quiet = 1;
@@ -1087,7 +1092,9 @@ static int run(const cli *c)
     /* The canonical order makes .tets and the hash independent of thread
      * count and mode; the other formats do not need it. */
     t0 = fdt_now_s();
-    uint64_t hash = 0;
+    uint64_t hash = 0, set_hash = 0;
+    if (c->set_hash)
+        (void)fdt_result_set_hash(res, &set_hash); /* res is not NULL: cannot fail */
     if (c->hash || (need & FDT_NEED_SORTED))
         progress_phase(&prog, "sort");
     if (c->hash) {
@@ -1196,6 +1203,8 @@ static int run(const cli *c)
 
     if (c->hash)
         fprintf(info, "hash: %016" PRIx64 "\n", hash);
+    if (c->set_hash)
+        fprintf(info, "set-hash: %016" PRIx64 "\n", set_hash);
     if (!c->quiet) {
         size_t nh = fdt_result_num_hull_faces(res);
         if (c->demo)

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "bits.h"
+#include "sethash.h"
 
 void fdt_result_free(fdt_result **r)
 {
@@ -802,5 +803,19 @@ int fdt_result_hash_threads(fdt_result *r, int threads, uint64_t *hash)
         hash_records(&th, (const uint32_t *)r->tets, r->ntets);
     }
     *hash = th.h;
+    return FDT_OK;
+}
+
+int fdt_result_set_hash(const fdt_result *r, uint64_t *hash)
+{
+    if (!r || !hash)
+        return FDT_EINVAL;
+    if (r->streamed) {
+        *hash = r->set_hash;
+        return FDT_OK;
+    }
+    fdt_sethash h = {0, 0};
+    fdt_sethash_add_n(&h, (const uint32_t *)r->tets, r->ntets);
+    *hash = fdt_sethash_value(&h);
     return FDT_OK;
 }

@@ -13,6 +13,9 @@ struct fdt_result {
     fdt_vid *dupmap;     /* n (owned) */
     size_t n, ndup;
     int sorted;          /* tets are in canonical order */
+    int streamed;        /* fdt_triangulate_stream: no tets kept; set_hash
+                            holds the emitted tets' set hash */
+    uint64_t set_hash;
     fdt_stats stats;
     fdt_thread_stats *tstats; /* stats.threads entries, parallel modes only
                                  (owned; NULL in serial mode) */
