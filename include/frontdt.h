@@ -534,6 +534,52 @@ FDT_API int fdt_write_mesh_opts(fdt_result *r, const double *xyz, size_t n, cons
  * nothing partial is left. The interrupted write must not go on after. */
 FDT_API void fdt_write_cleanup(void);
 
+/*
+ * Streaming writers (issue 18): a mesh file written while the tets are
+ * still being built (fdt_triangulate_stream), never holding the mesh. The
+ * formats that can (the others need the whole mesh: canonical order,
+ * neighbours, a face list):
+ *   tetgen   .ele    BASE.node, BASE.ele, BASE.face (hull), 0-based; no
+ *                    .neigh (a stale BASE.neigh is removed at the commit:
+ *                    it would describe another mesh)
+ *   vtu      .vtu    as fdt_write_mesh's
+ *   bin      .fdtb   frontdt's compact binary mesh (README, "Binary mesh")
+ * The tets are in the order they were given, which a streamed run does
+ * not fix: compare two files by their tet sets (fdt_result_set_hash).
+ * Every file goes to a temporary beside its target, renamed over it at
+ * the commit (all or none); fdt_write_cleanup removes them too.
+ */
+typedef struct fdt_stream_writer fdt_stream_writer;
+enum {
+    FDT_STREAM_IDS64 = 1,     /* bin: 64-bit vertex ids (default 32-bit) */
+    FDT_STREAM_NO_POINTS = 2  /* bin: leave the points out */
+};
+/* Whether the format named (NULL: chosen by path's extension) can stream:
+ * 1, 0, or FDT_EINVAL for an unknown format. */
+FDT_API int fdt_stream_format_ok(const char *path, const char *format);
+/* Opens the temporaries of path in format (NULL: by extension) and writes
+ * what precedes the tets (the n points xyz, read during this call only).
+ * flags: FDT_STREAM_*, 0 for the defaults. On failure *w is NULL, nothing
+ * is left on disk and diag says why: FDT_EINVAL (an unknown format, one
+ * that cannot stream, a NULL argument), FDT_EIO, FDT_ENOMEM. */
+FDT_API int fdt_stream_writer_open(fdt_stream_writer **w, const char *path, const char *format,
+                                   const double *xyz, size_t n, int flags, char *diag,
+                                   size_t diag_size);
+/* Fills *sink with callbacks writing to w (sink->user is w); pass it to
+ * fdt_triangulate_stream. A failed write makes the callback return FDT_EIO
+ * (FDT_ENOMEM, FDT_EINVAL for an id outside 0..n-1), which stops the
+ * run; fdt_stream_writer_close then reports it. */
+FDT_API int fdt_stream_writer_sink(fdt_stream_writer *w, fdt_sink *sink);
+/* commit 1: finishes the files (counts patched), closes them and renames
+ * them over their targets, all or none; commit 0 (or an earlier error):
+ * removes the temporaries, the targets untouched. Frees *w and sets it to
+ * NULL. FDT_OK, or the first error with diag. */
+FDT_API int fdt_stream_writer_close(fdt_stream_writer **w, int commit, char *diag,
+                                    size_t diag_size);
+/* Tets and hull faces written so far (NULL arguments are skipped). */
+FDT_API void fdt_stream_writer_counts(const fdt_stream_writer *w, uint64_t *tets,
+                                      uint64_t *hull);
+
 /* Frees memory the library allocated for the caller (the points of
  * fdt_read_points). NULL is fine. */
 FDT_API void fdt_free(void *p);

@@ -100,3 +100,70 @@ int fdt_put_tetgen_neigh(out_file *o, const fdt_mesh_view *m, const void *prep, 
     return FDT_IO_OK;
 }
 
+
+/* ------------------------------------------------------------------------ */
+/* Streaming (src/formats.h): .node at the start, .ele and .face rows as    */
+/* they come, their counts patched at the end                               */
+/* ------------------------------------------------------------------------ */
+
+/* A count placeholder: as wide as the largest count (2^64 - 1). TetGen and
+ * the other readers split the first line on blanks, so the padding is
+ * harmless. */
+#define TG_COUNT_WIDTH 20
+
+static void tg_count_line(out_file *o, uint64_t *mark, const char *rest)
+{
+    *mark = out_tell(o);
+    char *p = out_room(o, TG_COUNT_WIDTH);
+    fmt_u64_width(p, 0, TG_COUNT_WIDTH);
+    o->len += TG_COUNT_WIDTH;
+    out_str(o, rest);
+}
+
+static int tg_begin(fdt_stream_out *s, char *err, size_t errlen)
+{
+    fdt_mesh_view v = {.xyz = s->xyz, .n_points = s->n_points};
+    int r = fdt_put_tetgen_node(&s->files[0], &v, NULL, err, errlen);
+    tg_count_line(&s->files[1], &s->mark[0], " 4 0\n");
+    tg_count_line(&s->files[2], &s->mark[1], " 0\n");
+    return r;
+}
+
+/* Rows "<index> <v_1> ... <v_k>", the index going on from first. */
+static void tg_rows(out_file *o, uint64_t first, const fdt_vid *v, size_t count, int k)
+{
+    for (size_t r = 0; r < count && !o->err; r++) {
+        char *p = out_room(o, 21 + (size_t)k * 12 + 1);
+        char *q = p + fmt_u64(p, first + r);
+        for (int c = 0; c < k; c++) {
+            *q++ = ' ';
+            q += fmt_i64(q, v[(size_t)k * r + (size_t)c]);
+        }
+        *q++ = '\n';
+        o->len += (size_t)(q - p);
+    }
+}
+
+static void tg_tets(fdt_stream_out *s, const fdt_vid *t, size_t count)
+{
+    tg_rows(&s->files[1], s->n_tets, t, count, 4);
+}
+
+static void tg_hull(fdt_stream_out *s, const fdt_vid *f, size_t count)
+{
+    tg_rows(&s->files[2], s->n_hull, f, count, 3);
+}
+
+static int tg_finish(fdt_stream_out *s, char *err, size_t errlen)
+{
+    (void)err;
+    (void)errlen;
+    char p[TG_COUNT_WIDTH];
+    fmt_u64_width(p, s->n_tets, TG_COUNT_WIDTH);
+    out_patch(&s->files[1], s->mark[0], p, TG_COUNT_WIDTH);
+    fmt_u64_width(p, s->n_hull, TG_COUNT_WIDTH);
+    out_patch(&s->files[2], s->mark[1], p, TG_COUNT_WIDTH);
+    return FDT_IO_OK;
+}
+
+const fdt_stream_fmt fdt_stream_tetgen = {3, tg_begin, tg_tets, tg_hull, tg_finish};

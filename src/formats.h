@@ -25,6 +25,41 @@ typedef enum fdt_layout {
     FDT_LAYOUT_DIR     /* a directory: the path, each part a file in it */
 } fdt_layout;
 
+/*
+ * Streaming (issue 18): a writer that takes the tets while the front is
+ * still building them, for the formats that can be laid out without the
+ * whole mesh: the points are known up front, the tets and hull faces come
+ * in batches, in any order, and the counts a format must state before its
+ * data are left as fixed-width placeholders patched at the end
+ * (out_patch). src/writer_stream.c owns the files (temporaries renamed
+ * at the end, as every writer); the format fills them.
+ */
+typedef struct fdt_stream_out {
+    out_file files[FDT_IO_MAX_FILES];
+    int nfiles;              /* the row's first stream->nparts parts */
+    const double *xyz;       /* during begin only */
+    size_t n_points;
+    uint64_t n_tets, n_hull; /* what has come so far */
+    int flags;               /* FDT_STREAM_* of include/frontdt.h */
+    uint64_t mark[4];        /* the format's byte offsets to patch */
+    fdt_vid *hull;           /* a format that writes the hull after the
+                                tets (binary) keeps it here, 3 a face */
+    size_t hull_cap;
+} fdt_stream_out;
+
+typedef struct fdt_stream_fmt {
+    int nparts; /* files written: the row's parts [0, nparts) */
+    /* Writes what comes before the tets. FDT_IO_OK or a code with err. */
+    int (*begin)(fdt_stream_out *s, char *err, size_t errlen);
+    /* Append a batch (ids already checked in range); errors go to the
+     * files' err. n_tets / n_hull count the batch only after the call. */
+    void (*tets)(fdt_stream_out *s, const fdt_vid *t, size_t count);
+    void (*hull)(fdt_stream_out *s, const fdt_vid *f, size_t count);
+    /* Writes what follows and patches the counts; the caller closes and
+     * renames. FDT_IO_OK or a code with err. */
+    int (*finish)(fdt_stream_out *s, char *err, size_t errlen);
+} fdt_stream_fmt;
+
 typedef struct fdt_format {
     const char *name;                  /* --format NAME */
     const char *exts[3];               /* lowercase, with the dot; for a
@@ -40,10 +75,24 @@ typedef struct fdt_format {
      * free(). Returns FDT_IO_OK or an FDT_IO_* code with err. */
     int (*prepare)(const fdt_mesh_view *m, void **prep, const char *path, char *err,
                    size_t errlen);
+    /* NULL: the format needs the whole mesh (sorted order, neighbours,
+     * a face list, or counts it cannot patch); else how it streams. */
+    const fdt_stream_fmt *stream;
 } fdt_format;
 
 /* The table, terminated by a row whose name is NULL. */
 extern const fdt_format fdt_formats[];
+
+/* src/writer.c, for src/writer_stream.c: a temporary for target (0 or
+ * an errno), its removal, and the all-or-none close and rename of a set
+ * (FDT_IO_OK or a code with err; on failure every file is abandoned). */
+int fdt_out_open(out_file *o, const char *target);
+void fdt_out_abandon(out_file *o);
+int fdt_out_commit(out_file *files, int k, char *err, size_t errlen);
+/* The lock of the public writers (the registry of temporaries is
+ * process-wide). */
+void fdt_write_lock(void);
+void fdt_write_unlock(void);
 
 /* src/fmt_tets.c */
 int fdt_put_tets(out_file *o, const fdt_mesh_view *m, const void *prep, char *err, size_t errlen);
@@ -59,6 +108,13 @@ int fdt_put_tetgen_neigh(out_file *o, const fdt_mesh_view *m, const void *prep, 
 /* src/fmt_vtk.c */
 int fdt_put_vtu(out_file *o, const fdt_mesh_view *m, const void *prep, char *err, size_t errlen);
 int fdt_put_vtk(out_file *o, const fdt_mesh_view *m, const void *prep, char *err, size_t errlen);
+extern const fdt_stream_fmt fdt_stream_vtu;
+/* src/fmt_tetgen.c: .node, .ele, .face (no .neigh: no neighbours) */
+extern const fdt_stream_fmt fdt_stream_tetgen;
+/* src/fmt_bin.c: the compact binary format (README, "Binary mesh") */
+int fdt_put_bin(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
+                size_t errlen);
+extern const fdt_stream_fmt fdt_stream_bin;
 /* src/fmt_gmsh.c */
 int fdt_put_msh41(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
                   size_t errlen);

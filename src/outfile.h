@@ -17,6 +17,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/types.h>
+#include <unistd.h>
 
 #include "reader.h" /* FDT_IO_* codes; frontdt.h */
 
@@ -163,6 +165,56 @@ static inline void out_double(out_file *o, double x)
         out_fail(o, EINVAL);
     else
         o->len += (size_t)k;
+}
+
+/* The byte offset the next byte put goes to. */
+static inline uint64_t out_tell(out_file *o)
+{
+    off_t at = ftello(o->f);
+    if (at < 0) {
+        out_fail(o, errno);
+        return 0;
+    }
+    return (uint64_t)at + o->len;
+}
+
+/* Rewrites n bytes at offset at, already written or still in the buffer
+ * (a count left as a placeholder by a streaming writer). Flushes first,
+ * so the bytes are in the file, then writes in place with pwrite: the
+ * stream's own position is left at the end. */
+static inline void out_patch(out_file *o, uint64_t at, const void *p, size_t n)
+{
+    out_flush(o);
+    if (o->err)
+        return;
+    errno = 0;
+    if (fflush(o->f) != 0) {
+        out_fail(o, errno);
+        return;
+    }
+    const char *s = p;
+    while (n > 0) {
+        ssize_t k = pwrite(fileno(o->f), s, n, (off_t)at);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0) {
+            out_fail(o, k < 0 ? errno : EIO);
+            return;
+        }
+        s += k;
+        n -= (size_t)k;
+        at += (uint64_t)k;
+    }
+}
+
+/* A count as exactly w decimal characters, right-aligned in blanks (the
+ * placeholders of the streamed text formats: readers split on blanks). */
+static inline void fmt_u64_width(char *p, uint64_t v, size_t w)
+{
+    char tmp[24];
+    size_t k = fmt_u64(tmp, v);
+    memset(p, ' ', w - k);
+    memcpy(p + w - k, tmp, k);
 }
 
 static inline int set_err(char *err, size_t errlen, int code, const char *path,

@@ -57,7 +57,9 @@
  *                  (TetGen writes four) is not yet: unlink the target.
  * The writer frees every slot before fdt_wr_mesh() returns.
  */
-#define FDT_IO_SLOTS 8
+/* 32: eight -o outputs streamed at once, three files each, and a
+ * --stats-json beside them. */
+#define FDT_IO_SLOTS 32
 
 enum { SLOT_FREE = 0, SLOT_TEMP = 1, SLOT_RENAMING = 2, SLOT_RENAMED = 3 };
 
@@ -272,6 +274,23 @@ static mode_t creation_mode(void)
     mode_t mask = umask(0);
     umask(mask);
     return (mode_t)(0666 & ~mask);
+}
+
+/* For the streaming writers (src/writer_stream.c, src/formats.h): the
+ * same temporaries, commit and cleanup as every other output. */
+int fdt_out_open(out_file *o, const char *target)
+{
+    return out_open(o, target, creation_mode());
+}
+
+void fdt_out_abandon(out_file *o)
+{
+    out_abandon(o);
+}
+
+int fdt_out_commit(out_file *files, int k, char *err, size_t errlen)
+{
+    return commit_all(files, k, err, errlen, 0);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -623,28 +642,30 @@ int fdt_same_file(const char *a, const char *b)
 
 const fdt_format fdt_formats[] = {
     {"tets", {".tets"}, "canonical sorted text, one tet a line (the hash's bytes)", 0,
-     FDT_LAYOUT_FILE, FDT_NEED_SORTED, 1, {NULL}, {fdt_put_tets}, NULL},
+     FDT_LAYOUT_FILE, FDT_NEED_SORTED, 1, {NULL}, {fdt_put_tets}, NULL, NULL},
     {"tetgen", {".ele"}, "TetGen .node/.ele/.face/.neigh, 0-based", 0, FDT_LAYOUT_FAMILY,
      FDT_NEED_NBRS, 4, {".node", ".ele", ".face", ".neigh"},
      {fdt_put_tetgen_node, fdt_put_tetgen_ele, fdt_put_tetgen_face, fdt_put_tetgen_neigh},
-     NULL},
+     NULL, &fdt_stream_tetgen},
     {"vtu", {".vtu"}, "VTK XML unstructured grid (ParaView), appended raw", 1,
-     FDT_LAYOUT_FILE, 0, 1, {NULL}, {fdt_put_vtu}, NULL},
+     FDT_LAYOUT_FILE, 0, 1, {NULL}, {fdt_put_vtu}, NULL, &fdt_stream_vtu},
+    {"bin", {".fdtb"}, "frontdt binary: header, points, int32/int64 tets, hull", 1,
+     FDT_LAYOUT_FILE, 0, 1, {NULL}, {fdt_put_bin}, NULL, &fdt_stream_bin},
     {"vtk", {".vtk"}, "VTK legacy ASCII unstructured grid", 0, FDT_LAYOUT_FILE, 0, 1,
-     {NULL}, {fdt_put_vtk}, NULL},
+     {NULL}, {fdt_put_vtk}, NULL, NULL},
     {"msh", {".msh"}, "gmsh MSH 4.1 ASCII: tets and hull triangles", 0, FDT_LAYOUT_FILE, 0,
-     1, {NULL}, {fdt_put_msh41}, NULL},
+     1, {NULL}, {fdt_put_msh41}, NULL, NULL},
     {"msh2", {NULL}, "gmsh MSH 2.2 ASCII (--format msh2)", 0, FDT_LAYOUT_FILE, 0, 1,
-     {NULL}, {fdt_put_msh22}, NULL},
+     {NULL}, {fdt_put_msh22}, NULL, NULL},
     {"medit", {".mesh"}, "Medit .mesh (MMG, meshio): tets and hull triangles", 0,
-     FDT_LAYOUT_FILE, 0, 1, {NULL}, {fdt_put_medit}, NULL},
+     FDT_LAYOUT_FILE, 0, 1, {NULL}, {fdt_put_medit}, NULL, NULL},
     {"openfoam", {"polyMesh"}, "OpenFOAM polyMesh directory, the hull one patch", 0,
      FDT_LAYOUT_DIR, FDT_NEED_FACES, 5,
      {"points", "faces", "owner", "neighbour", "boundary"},
      {fdt_put_foam_points, fdt_put_foam_faces, fdt_put_foam_owner, fdt_put_foam_neighbour,
       fdt_put_foam_boundary},
-     fdt_foam_prepare},
-    {NULL, {NULL}, NULL, 0, FDT_LAYOUT_FILE, 0, 0, {NULL}, {NULL}, NULL},
+     fdt_foam_prepare, NULL},
+    {NULL, {NULL}, NULL, 0, FDT_LAYOUT_FILE, 0, 0, {NULL}, {NULL}, NULL, NULL},
 };
 
 /* ------------------------------------------------------------------------ */
@@ -884,6 +905,8 @@ static uint64_t part_estimate(fdt_put_fn put, const fdt_mesh_view *m)
         return t * 5 * dt;
     if (put == fdt_put_vtu)
         return 24 * n + (32 + 8 + 1) * t + 1024;
+    if (put == fdt_put_bin)
+        return 64 + 24 * n + 16 * t + 12 * h;
     if (put == fdt_put_vtk)
         return n * xyz + t * (2 + 4 * dv) + 3 * t;
     if (put == fdt_put_msh41 || put == fdt_put_msh22)
@@ -928,6 +951,16 @@ int fdt_default_write_options_sized(fdt_write_options *o, size_t struct_size)
  * one temporary directory) are process-wide, and creation_mode() sets the
  * umask for an instant. */
 static pthread_mutex_t write_lock = PTHREAD_MUTEX_INITIALIZER;
+
+void fdt_write_lock(void)
+{
+    pthread_mutex_lock(&write_lock);
+}
+
+void fdt_write_unlock(void)
+{
+    pthread_mutex_unlock(&write_lock);
+}
 
 static int wr_public_code(int io)
 {
