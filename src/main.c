@@ -74,6 +74,8 @@ typedef struct cli {
     fdt_search search;
     int threads;            /* -1: the library's default */
     int pin, check, stats, hash, set_hash, quiet;
+    int stream;             /* --stream 1, --no-stream -1, else 0: when
+                               every output can (stream_refusal) */
     int demo;
     size_t demo_n;
 } cli;
@@ -90,7 +92,8 @@ static void usage(FILE *f)
         "        input (needs --input-format)\n"
         "OUTPUT: .tets (canonical sorted text), .ele (TetGen .node/.ele/\n"
         "        .face/.neigh), .vtu (VTK XML, ParaView), .vtk (VTK legacy),\n"
-        "        .msh (gmsh 4.1), .mesh (Medit), DIR/polyMesh (OpenFOAM)\n"
+        "        .msh (gmsh 4.1), .mesh (Medit), DIR/polyMesh (OpenFOAM),\n"
+        "        .fdtb (frontdt binary)\n"
         "\n"
         "Options:\n"
         "  -o, --output FILE      write the mesh (format by extension); may be\n"
@@ -115,6 +118,11 @@ static void usage(FILE *f)
         "      --stats-json FILE  write statistics as JSON ('-': stdout)\n"
         "      --hash             print the canonical hash of the tet set\n"
         "      --set-hash         print the set hash (order-independent, no sort)\n"
+        "      --stream           write the tets as they are built, never holding\n"
+        "                         the mesh (.ele without .neigh, .vtu, .fdtb);\n"
+        "                         refuses an output or option that needs the mesh\n"
+        "      --no-stream        keep the whole mesh (default streams when every\n"
+        "                         -o is .vtu or .fdtb and nothing needs the mesh)\n"
         "  -q, --quiet            no summary, no progress, no notes\n"
         "      --progress         draw the progress line on stderr even when it\n"
         "                         is not a terminal (it is drawn on terminals)\n"
@@ -240,7 +248,7 @@ static int parse_count(const char *s, unsigned long long max,
 enum {
     OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH, OPT_SET_HASH,
     OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
-    OPT_PROGRESS
+    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM
 };
 
 static const struct option long_opts[] = {
@@ -261,6 +269,8 @@ static const struct option long_opts[] = {
     { "input-format", required_argument, NULL, OPT_INPUT_FORMAT },
     { "columns", required_argument, NULL, OPT_COLUMNS },
     { "progress", no_argument, NULL, OPT_PROGRESS },
+    { "stream", no_argument, NULL, OPT_STREAM },
+    { "no-stream", no_argument, NULL, OPT_NO_STREAM },
     { "help", no_argument, NULL, 'h' },
     { "version", no_argument, NULL, 'V' },
     { NULL, 0, NULL, 0 },
@@ -441,6 +451,12 @@ static int parse_args(int argc, char **argv, cli *c)
             break;
         case OPT_SET_HASH:
             c->set_hash = 1;
+            break;
+        case OPT_STREAM:
+        case OPT_NO_STREAM:
+            if (c->stream != 0 && c->stream != (ch == OPT_STREAM ? 1 : -1))
+                return usage_error("--stream and --no-stream together");
+            c->stream = ch == OPT_STREAM ? 1 : -1;
             break;
         case 'q':
             c->quiet = 1;
@@ -909,6 +925,91 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
 /* The run                                                                   */
 /* ------------------------------------------------------------------------ */
 
+/* ------------------------------------------------------------------------ */
+/* Streaming (issue 18)                                                      */
+/* ------------------------------------------------------------------------ */
+
+/* Why this command cannot stream, or NULL: every -o a file in a format
+ * with a streaming writer, and nothing that needs the whole mesh. In the
+ * default mode a TetGen output is not streamed either: its .neigh needs
+ * the neighbours, so only --stream (which drops .neigh) streams it. */
+static const char *stream_refusal(const cli *c, const fdt_format *const *fmts, int forced,
+                                  char *why, size_t len)
+{
+    if (c->check)
+        return "--check needs the whole mesh";
+    if (c->hash)
+        return "--hash sorts the whole mesh (--set-hash needs no sort)";
+    if (c->all_faces)
+        return "--all-faces needs the face list of the whole mesh";
+    for (int o = 0; o < c->n_outputs; o++) {
+        if (!strcmp(c->outputs[o], "-"))
+            return "-o - (standard output) cannot stream";
+        const char *name = fdt_format_name(fmts[o]);
+        if (fdt_stream_format_ok(c->outputs[o], name) != 1 ||
+            (!forced && !strcmp(name, "tetgen"))) {
+            snprintf(why, len, "-o %s: format %s needs the whole mesh (tetgen, vtu and bin "
+                     "stream)", c->outputs[o], name);
+            return why;
+        }
+    }
+    return NULL;
+}
+
+/* The sink of a streamed run: each batch to every -o's writer in turn;
+ * counts what went by (the summary's tets and hull faces). */
+typedef struct fanout {
+    fdt_stream_writer *w[MAX_OUTPUTS];
+    fdt_sink sink[MAX_OUTPUTS];
+    int n;
+    int failed;      /* the writer that refused a batch, -1: none */
+    uint64_t tets, hull;
+} fanout;
+
+static int fanout_tets(void *user, const fdt_vid *t, size_t count)
+{
+    fanout *fo = user;
+    for (int i = 0; i < fo->n; i++) {
+        int r = fo->sink[i].tets(fo->sink[i].user, t, count);
+        if (r) {
+            fo->failed = i;
+            return r;
+        }
+    }
+    fo->tets += count;
+    return 0;
+}
+
+static int fanout_hull(void *user, const fdt_vid *f, size_t count)
+{
+    fanout *fo = user;
+    for (int i = 0; i < fo->n; i++) {
+        int r = fo->sink[i].hull(fo->sink[i].user, f, count);
+        if (r) {
+            fo->failed = i;
+            return r;
+        }
+    }
+    fo->hull += count;
+    return 0;
+}
+
+/* Closes every writer: commits them all when commit is set and each
+ * commit succeeds, else removes what is left. Returns the exit code. */
+static int fanout_close(fanout *fo, int commit)
+{
+    int code = CLI_OK;
+    for (int i = 0; i < fo->n; i++) {
+        char err[1024];
+        int r = fdt_stream_writer_close(&fo->w[i], commit && code == CLI_OK, err, sizeof err);
+        if (r != FDT_OK && code == CLI_OK && (commit || i == fo->failed)) {
+            say("%s", err);
+            code = exit_for_writer(r);
+        }
+    }
+    return code;
+}
+
 static int run(const cli *c)
 {
     int code = CLI_OK;
@@ -990,6 +1091,13 @@ static int run(const cli *c)
         if (code >= 0)
             return code;
     }
+    /* Stream (the tets go to the files as they are built) when asked, or
+     * when every output can and nothing needs the mesh. */
+    char why[FDT_IO_PATH + 200];
+    const char *refusal = stream_refusal(c, fmts, c->stream > 0, why, sizeof why);
+    if (c->stream > 0 && refusal)
+        return usage_error("--stream: %s", refusal);
+    int streaming = c->stream > 0 || (c->stream == 0 && !refusal && c->n_outputs > 0);
     code = CLI_OK;
     if (c->stats_json && !json_stdout && !output_dir_ok(c->stats_json))
         return CLI_WRITE;
@@ -1035,7 +1143,7 @@ static int run(const cli *c)
     if (c->threads >= 0)
         s.n_threads = c->threads;
     s.pin = c->pin;
-    s.neighbors = c->check || (need & FDT_NEED_NBRS);
+    s.neighbors = !streaming && (c->check || (need & FDT_NEED_NBRS));
     if (prog.enabled) {
         s.progress = progress_engine;
         s.progress_user = &prog;
@@ -1046,11 +1154,49 @@ static int run(const cli *c)
         code = exit_for_engine(r);
         goto done;
     }
+    fanout fo;
+    memset(&fo, 0, sizeof fo);
+    fo.failed = -1;
+    if (streaming) {
+        for (int o = 0; o < c->n_outputs; o++) {
+            char err[1024];
+            r = fdt_stream_writer_open(&fo.w[o], c->outputs[o], fdt_format_name(fmts[o]), xyz,
+                                       n, 0, err, sizeof err);
+            if (r != FDT_OK) {
+                say("%s", err);
+                (void)fanout_close(&fo, 0);
+                code = exit_for_writer(r);
+                goto done;
+            }
+            fo.n = o + 1;
+            (void)fdt_stream_writer_sink(fo.w[o], &fo.sink[o]);
+        }
+    }
     t0 = fdt_now_s();
     progress_phase(&prog, "merge"); /* "triangulate" at the library's first report */
-    r = fdt_triangulate(ctx, xyz, n, &res);
+    if (streaming) {
+        fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &fo};
+        r = fdt_triangulate_stream(ctx, xyz, n, &sink, &res);
+    } else {
+        r = fdt_triangulate(ctx, xyz, n, &res);
+    }
     tm.triangulate = fdt_now_s() - t0;
     progress_clear(&prog);
+    if (streaming) {
+        /* the writers end with the run: committed (counts patched, all
+         * renamed) after a whole run, removed after a failed one */
+        t0 = fdt_now_s();
+        int wcode = fanout_close(&fo, r == FDT_OK);
+        tm.write = fdt_now_s() - t0;
+        if (fo.failed >= 0) {
+            code = wcode; /* the run stopped for the writer's error */
+            goto done;
+        }
+        if (r == FDT_OK && wcode != CLI_OK) {
+            code = wcode;
+            goto done;
+        }
+    }
     if (r != FDT_OK) {
         const char *diag = fdt_context_diagnostic(ctx);
         say("%s: %s", name, diag && *diag ? diag : fdt_strerror(r));
@@ -1070,7 +1216,7 @@ static int run(const cli *c)
     if (c->pin && !c->quiet && fdt_result_stats(res, &pst) == FDT_OK && pst.pinned < 0)
         say("--pin: a thread could not be bound to its core; ran unpinned");
 
-    size_t nt = fdt_result_num_tets(res);
+    size_t nt = streaming ? (size_t)fo.tets : fdt_result_num_tets(res);
     if (c->check) {
         char msg[1024];
         t0 = fdt_now_s();
@@ -1118,7 +1264,7 @@ static int run(const cli *c)
     progress_clear(&prog);
     tm.canon = fdt_now_s() - t0;
 
-    if (c->n_outputs > 0) {
+    if (c->n_outputs > 0 && !streaming) {
         t0 = fdt_now_s();
         char err[1024];
         /* The public writer computes the face list where a format needs
@@ -1206,7 +1352,7 @@ static int run(const cli *c)
     if (c->set_hash)
         fprintf(info, "set-hash: %016" PRIx64 "\n", set_hash);
     if (!c->quiet) {
-        size_t nh = fdt_result_num_hull_faces(res);
+        size_t nh = streaming ? (size_t)fo.hull : fdt_result_num_hull_faces(res);
         if (c->demo)
             fprintf(info, "demo: %zu random points in the unit cube\n", n);
         else
