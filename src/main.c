@@ -99,7 +99,7 @@ static void usage(FILE *f)
         "  -o, --output FILE      write the mesh (format by extension); may be\n"
         "                         given up to %d times; '-': standard output\n"
         "      --format NAME      format of the next -o (of the last -o when\n"
-        "                         none follows): tets, tetgen, vtu, vtk, msh,\n"
+        "                         none follows): tets, tetgen, vtu, bin, vtk, msh,\n"
         "                         msh2, medit, openfoam; or, named xyz, txt,\n"
         "                         csv, node or ply, the input's (--input-format)\n"
         "      --all-faces        TetGen .face lists every face (TetGen -f)\n"

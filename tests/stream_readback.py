@@ -1,0 +1,281 @@
+#!/usr/bin/python3
+"""Streamed outputs against the in-memory ones, and interrupted streamed writes.
+
+usage: stream_readback.py FRONTDT README
+
+1. A random point set (one duplicate point) is written by the CLI twice: in
+   memory (--no-stream: .ele with .node/.face/.neigh, .vtu, .fdtb) and
+   streamed (--stream, two threads: .ele with .node/.face, .vtu, .fdtb).
+   Each file is parsed back (the .fdtb with the numpy reader of README.md,
+   "Binary mesh", when numpy is installed, else with struct): every file
+   holds the same set of tets, each the same way round (the same even
+   permutation), the same hull faces, the same points (.node byte for byte,
+   .vtu and .fdtb bit for bit), and the streamed and in-memory --set-hash
+   agree. The .vtu is read by VTK too when its python module is there.
+2. A streamed write stopped by SIGTERM while its temporaries exist: exit 6,
+   no temporary left, the targets as they were.
+3. A streamed write that fails (file size limit, RLIMIT_FSIZE: EFBIG):
+   exit 5, no temporary left, the targets as they were.
+4. --stream with an output that cannot stream: exit 1, nothing written.
+"""
+import os
+import random
+import re
+import resource
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+FRONTDT = os.path.abspath(sys.argv[1])
+README = sys.argv[2]
+failures = []
+
+
+def fail(msg):
+    failures.append(msg)
+    print("FAIL: " + msg)
+
+
+def run(args, **kw):
+    return subprocess.run([FRONTDT] + args, capture_output=True, text=True, **kw)
+
+
+def canon_tet(t):
+    """(sorted ids, parity of the permutation that sorts t)."""
+    t = list(t)
+    parity = 0
+    for i in range(4):
+        for j in range(i + 1, 4):
+            if t[i] > t[j]:
+                parity ^= 1
+    return (tuple(sorted(t)), parity)
+
+
+def canon_face(f):
+    """The rotation that starts at the smallest id (keeps the orientation)."""
+    f = list(f)
+    k = f.index(min(f))
+    return tuple(f[k:] + f[:k])
+
+
+def read_table(path, k):
+    with open(path) as fh:
+        first = fh.readline().split()
+        count = int(first[0])
+        rows = [tuple(int(x) for x in line.split()[1:1 + k]) for line in fh]
+    if count != len(rows):
+        fail("%s: header says %d rows, %d found" % (path, count, len(rows)))
+    for i, line in enumerate(open(path).read().splitlines()[1:]):
+        if int(line.split()[0]) != i:
+            fail("%s: row %d numbered %s" % (path, i, line.split()[0]))
+            break
+    return rows
+
+
+def read_vtu(path):
+    data = open(path, "rb").read()
+    head = data[:data.index(b"_", data.index(b"<AppendedData")) + 1].decode()
+    m = re.search(r'NumberOfPoints="(\d+)" NumberOfCells="(\d+)"', head)
+    n, nt = int(m.group(1)), int(m.group(2))
+    offs = [int(x) for x in re.findall(r'offset="(\d+)"', head)]
+    base = len(head)
+
+    def array(i, fmt, size):
+        at = base + offs[i]
+        (nbytes,) = struct.unpack_from("<Q", data, at)
+        if nbytes != size * struct.calcsize(fmt):
+            fail("%s: array %d holds %d bytes, %d expected" % (path, i, nbytes, size))
+        return struct.unpack_from("<%d%s" % (size, fmt), data, at + 8)
+
+    pts = array(0, "d", 3 * n)
+    conn = array(1, "q", 4 * nt)
+    off = array(2, "q", nt)
+    types = array(3, "B", nt)
+    if list(off) != [4 * (i + 1) for i in range(nt)] or set(types) - {10}:
+        fail("%s: offsets or types wrong" % path)
+    if not data.endswith(b"</VTKFile>\n"):
+        fail("%s: no closing tag" % path)
+    return pts, [conn[4 * i:4 * i + 4] for i in range(nt)]
+
+
+def readme_reader():
+    text = open(README).read()
+    m = re.search(r"<!-- fdtb-reader[^>]*-->\n```python\n(.*?)```", text, re.S)
+    if not m:
+        fail("README.md has no fdtb-reader block")
+        return None
+    if len(m.group(1).splitlines()) > 20:
+        fail("README.md's fdtb reader is over 20 lines")
+    try:
+        import numpy  # noqa: F401
+    except ImportError:
+        print("numpy not installed: the .fdtb is read with struct")
+        return None
+    env = {}
+    exec(m.group(1), env)
+    return env["read_fdtb"]
+
+
+def read_fdtb(path, numpy_reader):
+    if numpy_reader:
+        pts, tets, hull = numpy_reader(path)
+        return ([float(x) for x in pts.reshape(-1)], [tuple(int(x) for x in t) for t in tets],
+                [tuple(int(x) for x in f) for f in hull])
+    data = open(path, "rb").read()
+    magic, version, flags, n, nt, nh = struct.unpack_from("<8sIIQQQ", data, 0)
+    if magic != b"FDTMESH\0" or version != 1 or flags != 6:
+        fail("%s: header %r %d %d" % (path, magic, version, flags))
+    at = 64
+    pts = struct.unpack_from("<%dd" % (3 * n), data, at)
+    at += 24 * n
+    ids = struct.unpack_from("<%di" % (4 * nt), data, at)
+    at += 16 * nt
+    hull = struct.unpack_from("<%di" % (3 * nh), data, at)
+    if at + 12 * nh != len(data):
+        fail("%s: %d bytes, %d expected" % (path, len(data), at + 12 * nh))
+    return (list(pts), [ids[4 * i:4 * i + 4] for i in range(nt)],
+            [hull[3 * i:3 * i + 3] for i in range(nh)])
+
+
+def set_hash(out):
+    m = re.search(r"set-hash: ([0-9a-f]{16})", out)
+    return m.group(1) if m else None
+
+
+def listing(d):
+    return sorted(os.listdir(d))
+
+
+def snapshot(d):
+    return {f: open(os.path.join(d, f), "rb").read() for f in listing(d)}
+
+
+def compare(tmp):
+    rnd = random.Random(1992)
+    pts = [(rnd.random(), rnd.random(), rnd.random()) for _ in range(3000)]
+    pts.append(pts[17])  # a duplicate: merged, still an output point
+    xyz = os.path.join(tmp, "p.xyz")
+    with open(xyz, "w") as fh:
+        for p in pts:
+            fh.write("%r %r %r\n" % p)
+    m, s = os.path.join(tmp, "m"), os.path.join(tmp, "s")
+    rm = run([xyz, "--no-stream", "-t", "1", "-o", m + ".ele", "-o", m + ".vtu",
+              "-o", m + ".fdtb", "--set-hash"])
+    rs = run([xyz, "--stream", "-t", "2", "-o", s + ".ele", "-o", s + ".vtu",
+              "-o", s + ".fdtb", "--set-hash"])
+    if rm.returncode or rs.returncode:
+        fail("runs failed: %s %s" % (rm.stderr, rs.stderr))
+        return
+    if set_hash(rm.stdout) is None or set_hash(rm.stdout) != set_hash(rs.stdout):
+        fail("set hashes differ: %s / %s" % (set_hash(rm.stdout), set_hash(rs.stdout)))
+    if os.path.exists(s + ".neigh"):
+        fail("a streamed .ele wrote a .neigh")
+    if open(m + ".node", "rb").read() != open(s + ".node", "rb").read():
+        fail(".node files differ")
+    ref = read_table(m + ".ele", 4)
+    ref_set = set(canon_tet(t) for t in ref)
+    ref_hull = set(canon_face(f) for f in read_table(m + ".face", 3))
+    if len(ref_set) != len(ref) or not ref:
+        fail("in-memory .ele has repeated tets or none")
+    flat = [c for p in pts for c in p]
+    numpy_reader = readme_reader()
+    meshes = {"s.ele": (None, read_table(s + ".ele", 4), read_table(s + ".face", 3))}
+    for tag, base in (("m", m), ("s", s)):
+        vp, vt = read_vtu(base + ".vtu")
+        meshes[tag + ".vtu"] = (vp, vt, None)
+        meshes[tag + ".fdtb"] = read_fdtb(base + ".fdtb", numpy_reader)
+    for name, (p, tets, hull) in meshes.items():
+        if sorted(canon_tet(t) for t in tets) != sorted(ref_set):
+            fail("%s: not the in-memory tets (or not the same way round)" % name)
+        if hull is not None and sorted(canon_face(f) for f in hull) != sorted(ref_hull):
+            fail("%s: not the in-memory hull" % name)
+        if p is not None and list(p) != flat:
+            fail("%s: points differ from the input" % name)
+    try:
+        import vtk
+    except ImportError:
+        print("vtk not installed: the .vtu is not read by VTK")
+        return
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(s + ".vtu")
+    reader.Update()
+    g = reader.GetOutput()
+    if g.GetNumberOfCells() != len(ref) or g.GetNumberOfPoints() != len(pts):
+        fail("VTK reads %d cells, %d points" % (g.GetNumberOfCells(), g.GetNumberOfPoints()))
+
+
+def interrupted(tmp):
+    d = os.path.join(tmp, "sig")
+    os.mkdir(d)
+    for name in ("x.vtu", "x.fdtb", "x.ele"):
+        with open(os.path.join(d, name), "w") as fh:
+            fh.write("old %s\n" % name)
+    before = snapshot(d)
+    # large enough that the run is still going when its temporaries appear
+    p = subprocess.Popen([FRONTDT, "--demo", "400000", "-q", "--stream", "-t", "1",
+                          "-o", os.path.join(d, "x.vtu"), "-o", os.path.join(d, "x.fdtb"),
+                          "-o", os.path.join(d, "x.ele")],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.time() + 60
+    seen = False
+    while time.time() < deadline and p.poll() is None:
+        if any(".tmp." in f for f in listing(d)):
+            seen = True
+            break
+        time.sleep(0.005)
+    if not seen:
+        p.kill()
+        p.wait()
+        fail("signal: no temporary seen before the run ended (rc %s)" % p.returncode)
+        return
+    time.sleep(0.2)
+    p.send_signal(signal.SIGTERM)
+    rc = p.wait()
+    if rc != 6:
+        fail("signal: exit %d, 6 expected" % rc)
+    if snapshot(d) != before:
+        fail("signal: files changed or left: %s" % listing(d))
+
+
+def write_fails(tmp):
+    d = os.path.join(tmp, "full")
+    os.mkdir(d)
+    with open(os.path.join(d, "y.fdtb"), "w") as fh:
+        fh.write("old\n")
+    before = snapshot(d)
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (200000, 200000))
+
+    r = subprocess.run([FRONTDT, "--demo", "20000", "-q", "--stream",
+                        "-o", os.path.join(d, "y.fdtb"), "-o", os.path.join(d, "y.vtu")],
+                       capture_output=True, text=True, preexec_fn=limit)
+    if r.returncode != 5:
+        fail("size limit: exit %d, 5 expected (%s)" % (r.returncode, r.stderr.strip()))
+    if snapshot(d) != before:
+        fail("size limit: files changed or left: %s" % listing(d))
+
+
+def refused(tmp):
+    d = os.path.join(tmp, "ref")
+    os.mkdir(d)
+    for out, opt in ((os.path.join(d, "z.tets"), []), (os.path.join(d, "z.vtu"), ["--check"]),
+                     (os.path.join(d, "z.vtu"), ["--hash"]), ("-", [])):
+        r = run(["--demo", "100", "-q", "--stream", "-o", out] + opt)
+        if r.returncode != 1 or "--stream" not in r.stderr:
+            fail("--stream -o %s %s: exit %d (%s)" % (out, opt, r.returncode, r.stderr.strip()))
+    if listing(d):
+        fail("refused runs left %s" % listing(d))
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    compare(tmp)
+    interrupted(tmp)
+    write_fails(tmp)
+    refused(tmp)
+if failures:
+    sys.exit(1)
+print("stream_readback: all checks passed")
