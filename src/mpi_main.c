@@ -12,10 +12,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "frontdt.h"
 #include "mpi_run.h"
 #include "prepare.h"
+#include "reader.h"
 #include "result.h"
 #include "seed.h"
 #include "writer.h"
@@ -35,14 +37,135 @@ static const char usage[] =
     "  one part per MPI rank; every rank reads INPUT.\n"
     "  -o FILE             write the mesh, gathered to rank 0 (.tets .vtu .vtk\n"
     "                      .msh .mesh polyMesh; not .ele: no neighbours yet)\n"
+    "  -o BASE.pvtu        one piece a rank, BASE_RANK.vtu, and the index BASE.pvtu\n"
     "  --input-format F    xyz, node or ply (default: by extension)\n"
     "  --set-hash          print the mesh's set hash (equals frontdt's)\n"
     "  --stats             per-rank tets and message counts, and their totals\n"
     "  --leaf N            kd-tree leaf size (default 30)\n"
     "  -q                  print nothing but errors (and what is asked)\n";
 
+/* ---- -o BASE.pvtu: one .vtu piece a rank and an index ------------------- */
+
+/* BASE_RANK.vtu beside BASE.pvtu (path), and its name relative to the
+ * index's directory (*rel points into out). 0, or -1 if it does not fit. */
+static int piece_name(const char *path, int rank, char *out, size_t len, const char **rel)
+{
+    size_t n = strlen(path);
+    if (n < 5)
+        return -1;
+    int k = snprintf(out, len, "%.*s_%d.vtu", (int)(n - 5), path, rank);
+    if (k < 0 || (size_t)k >= len)
+        return -1;
+    const char *slash = strrchr(out, '/');
+    *rel = slash ? slash + 1 : out;
+    return 0;
+}
+
+static int is_pvtu(const char *path)
+{
+    size_t n = strlen(path);
+    return n > 5 && strcasecmp(path + n - 5, ".pvtu") == 0;
+}
+
+/* Writes this rank's piece: its tets (input numbering) over the points
+ * they use, renumbered 0..k-1 in input order. FDT_OK or an error, diag. */
+static int write_piece(const char *name, const double *xyz, size_t n, const fdt_vid *tets,
+                       size_t nt, char *diag, size_t dlen)
+{
+    int32_t *map = malloc((n ? n : 1) * sizeof *map);
+    fdt_vid *lt = malloc((4 * nt + 1) * sizeof *lt);
+    double *px = NULL;
+    int err = FDT_ENOMEM;
+    if (!map || !lt)
+        goto done;
+    for (size_t i = 0; i < n; i++)
+        map[i] = -1;
+    for (size_t i = 0; i < 4 * nt; i++)
+        map[tets[i]] = 0;
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++)
+        if (map[i] == 0)
+            map[i] = (int32_t)k++;
+    if (!(px = malloc((3 * k + 1) * sizeof *px)))
+        goto done;
+    for (size_t i = 0; i < n; i++)
+        if (map[i] >= 0)
+            memcpy(px + 3 * (size_t)map[i], xyz + 3 * i, 3 * sizeof *px);
+    for (size_t i = 0; i < 4 * nt; i++)
+        lt[i] = map[tets[i]];
+    fdt_mesh_view v;
+    memset(&v, 0, sizeof v);
+    v.xyz = px;
+    v.n_points = k;
+    v.tets = lt;
+    v.n_tets = nt;
+    err = fdt_wr_mesh_as(name, fdt_format_by_name("vtu"), &v, diag, dlen) == FDT_IO_OK
+              ? FDT_OK
+              : FDT_EIO;
+done:
+    if (err == FDT_ENOMEM)
+        snprintf(diag, dlen, "out of memory writing a piece");
+    free(map);
+    free(lt);
+    free(px);
+    return err;
+}
+
+static int little_endian(void)
+{
+    const uint16_t one = 1;
+    unsigned char b;
+    memcpy(&b, &one, 1);
+    return b == 1;
+}
+
+/* s with XML's five special characters escaped, to f. */
+static void put_xml(FILE *f, const char *s)
+{
+    for (; *s; s++)
+        switch (*s) {
+        case '&': fputs("&amp;", f); break;
+        case '<': fputs("&lt;", f); break;
+        case '>': fputs("&gt;", f); break;
+        case '"': fputs("&quot;", f); break;
+        case '\'': fputs("&apos;", f); break;
+        default: fputc(*s, f);
+        }
+}
+
+/* The index: ParaView reads the pieces it names. Rank 0. */
+static int write_index(const char *path, int size, char *diag, size_t dlen)
+{
+    fdt_wr_side *side;
+    FILE *f = fdt_wr_side_open(path, &side, diag, dlen);
+    if (!f)
+        return FDT_EIO;
+    fprintf(f, "<?xml version=\"1.0\"?>\n"
+               "<VTKFile type=\"PUnstructuredGrid\" version=\"0.1\" byte_order=\"%s\" "
+               "header_type=\"UInt64\">\n"
+               "  <PUnstructuredGrid GhostLevel=\"0\">\n"
+               "    <PPoints>\n"
+               "      <PDataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"/>\n"
+               "    </PPoints>\n",
+            little_endian() ? "LittleEndian" : "BigEndian");
+    char name[FDT_IO_PATH];
+    const char *rel;
+    for (int r = 0; r < size; r++) {
+        if (piece_name(path, r, name, sizeof name, &rel) != 0) {
+            fdt_wr_side_abandon(side);
+            snprintf(diag, dlen, "%s: piece name too long", path);
+            return FDT_EIO;
+        }
+        fputs("    <Piece Source=\"", f);
+        put_xml(f, rel);
+        fputs("\"/>\n", f);
+    }
+    fprintf(f, "  </PUnstructuredGrid>\n</VTKFile>\n");
+    return fdt_wr_side_commit(side, diag, dlen) == FDT_IO_OK ? FDT_OK : FDT_EIO;
+}
+
 /* -1: go on; else an exit code. Only rank 0 prints. */
-static int parse(int argc, char **argv, opts *o, int rank)
+static int parse(int argc, char **argv, opts *o, int rank, int size)
 {
     memset(o, 0, sizeof *o);
     o->fail_rank = -1;
@@ -107,7 +230,26 @@ static int parse(int argc, char **argv, opts *o, int rank)
             fprintf(stderr, "frontdt-mpi: no input file\n%s", usage);
         return EX_USAGE;
     }
-    if (o->output) {
+    if (o->output && is_pvtu(o->output)) {
+        /* pieces: none of them (nor the index) may be the input */
+        char name[FDT_IO_PATH];
+        const char *rel;
+        for (int r = -1; r < size; r++) {
+            const char *x = name;
+            if (r < 0)
+                x = o->output;
+            else if (piece_name(o->output, r, name, sizeof name, &rel) != 0) {
+                if (rank == 0)
+                    fprintf(stderr, "frontdt-mpi: '%s': piece names too long\n", o->output);
+                return EX_USAGE;
+            }
+            if (fdt_same_file(x, o->input)) {
+                if (rank == 0)
+                    fprintf(stderr, "frontdt-mpi: output '%s' is the input '%s'\n", x, o->input);
+                return EX_USAGE;
+            }
+        }
+    } else if (o->output) {
         const fdt_format *f = fdt_format_by_path(o->output);
         char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
         int nf = fdt_output_files(o->output, names);
@@ -172,7 +314,7 @@ static void print_stats(const fdt_mpi_out *r, int size, double t_read)
 static int run(int argc, char **argv, int rank, int size)
 {
     opts o;
-    int rc = parse(argc, argv, &o, rank);
+    int rc = parse(argc, argv, &o, rank, size);
     if (rc >= 0)
         return rc;
     char diag[512] = "";
@@ -205,7 +347,9 @@ static int run(int argc, char **argv, int rank, int size)
             fprintf(stderr, "frontdt-mpi: %s\n", fail ? diag : "failed on another rank");
         goto out;
     }
-    fdt_mpi_opts mo = {o.leaf, FDT_SEARCH_AUTO, o.output != NULL, o.fail_rank, o.fail_after};
+    int pieces = o.output && is_pvtu(o.output);
+    fdt_mpi_opts mo = {o.leaf, FDT_SEARCH_AUTO, o.output && !pieces, pieces, o.fail_rank,
+                       o.fail_after};
     err = fdt_mpi_run(MPI_COMM_WORLD, &pr, &mo, &r, diag, sizeof diag);
     if (err) {
         if (rank == 0)
@@ -232,7 +376,7 @@ static int run(int argc, char **argv, int rank, int size)
                     n, pr.m, r.hash.count, size);
         if (o.set_hash)
             printf("set-hash: %016" PRIx64 "\n", fdt_sethash_value(&r.hash));
-        if (!rc && o.output) {
+        if (!rc && o.output && !pieces) {
             /* Gathered to rank 0 in input numbering: one result, written
              * by the CLI's writers (temporary file, renamed at the end). */
             res = calloc(1, sizeof *res);
@@ -259,6 +403,27 @@ static int run(int argc, char **argv, int rank, int size)
         fflush(stdout);
     }
     MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!rc && pieces) {
+        /* Each rank its piece (temporary and rename, by the writer), then
+         * rank 0 the index once every piece is there; if any write fails,
+         * every piece is removed again: all or nothing. */
+        char name[FDT_IO_PATH];
+        const char *rel;
+        int perr = piece_name(o.output, rank, name, sizeof name, &rel) != 0 ? FDT_EIO
+                   : write_piece(name, xyz, n, r.own_tets, r.own_ntets, diag, sizeof diag);
+        if (perr)
+            fprintf(stderr, "frontdt-mpi: rank %d: %s\n", rank, diag);
+        int bad = perr == FDT_ENOMEM ? EX_RESOURCES : perr ? EX_WRITE : 0, worst = 0;
+        MPI_Allreduce(&bad, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+        if (!worst && rank == 0 && write_index(o.output, size, diag, sizeof diag) != FDT_OK) {
+            fprintf(stderr, "frontdt-mpi: %s\n", diag);
+            worst = EX_WRITE;
+        }
+        MPI_Bcast(&worst, 1, MPI_INT, 0, MPI_COMM_WORLD);
+        if (worst && !perr)
+            (void)remove(name);
+        rc = worst;
+    }
 out:
     fdt_result_free(&res);
     fdt_mpi_out_free(&r);

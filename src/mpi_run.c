@@ -45,6 +45,8 @@ void fdt_mpi_out_free(fdt_mpi_out *out)
     free(out->rank_tets);
     free(out->all_tets);
     free(out->all_hull);
+    free(out->own_tets);
+    out->own_tets = NULL;
     out->rank_counts = NULL;
     out->rank_tets = NULL;
     out->all_tets = NULL;
@@ -310,7 +312,11 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     MPI_Reduce(hv, hs, 2, MPI_UINT64_T, MPI_SUM, 0, comm);
     out->hash.sum = hs[0];
     out->hash.count = hs[1];
-    if (o->gather) {
+    if (o->keep_own && !o->gather) {
+        out->own_tets = mine;
+        out->own_ntets = w->out.ntets;
+        mine = NULL;
+    } else if (o->gather) {
         err = gather_ids(comm, rank, size, mine, w->out.ntets, 4, &out->all_tets, &out->ntets);
         if (!err) {
             for (size_t i = 0; i < n3; i++)

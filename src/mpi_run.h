@@ -29,6 +29,8 @@ typedef struct fdt_mpi_opts {
     int leaf_size;       /* 0: the default */
     int search;          /* fdt_search */
     int gather;          /* nonzero: every tet and hull face to rank 0 */
+    int keep_own;        /* nonzero (not with gather): this rank's tets in
+                            input numbering stay in out->own_tets */
     int fail_rank;       /* a test's injected failure: rank fail_rank fails
                             (FDT_EINTERNAL) once it advanced fail_after
                             faces; -1: none */
@@ -41,6 +43,8 @@ typedef struct fdt_mpi_out {
     size_t tets;         /* this rank's tets */
     uint64_t sent[FDT_MSG_KIND_END], received[FDT_MSG_KIND_END]; /* this rank */
     double t_setup, t_front, t_out; /* seconds, this rank */
+    fdt_vid *own_tets;     /* keep_own: 4 per tet, input numbering (owned) */
+    size_t own_ntets;
     /* On rank 0 only (reduced over the ranks): */
     fdt_sethash hash;
     uint64_t all_sent[FDT_MSG_KIND_END], all_received[FDT_MSG_KIND_END];

@@ -7,10 +7,12 @@
 # total equals its received total and FACERECV = FACESEND; -o gathers the
 # same mesh as the serial run's, byte for byte; a rank that fails (the
 # hidden --inject-failure) ends every rank with the error, no hang, no
-# output.
-# Usage: test_mpi.sh FRONTDT FRONTDT_MPI GEN_POINTS MPIRUN DATA_DIR
+# output; -o BASE.pvtu writes one piece a rank and an index that VTK reads
+# as the serial mesh.
+# Usage: test_mpi.sh FRONTDT FRONTDT_MPI GEN_POINTS MPIRUN DATA_DIR [PYTHON3]
 set -u
-frontdt=$1 fmpi=$2 gen=$3 mpirun=$4 data=$5
+frontdt=$1 fmpi=$2 gen=$3 mpirun=$4 data=$5 python=${6:-python3}
+pvtu_check=$(dirname "$0")/pvtu_check.py
 if [[ $(id -u) -eq 0 ]]; then
   # Open MPI refuses root unless told
   export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
@@ -102,6 +104,28 @@ mpi 4 120 "$fmpi" -q -o "$work/m4.vtu" "$work/clusters.xyz" || fail "-o .vtu, 4 
 checks=$((checks + 1))
 mpi 2 60 "$fmpi" -q -o "$work/m.ele" "$work/clusters.xyz" 2>/dev/null
 [[ $? -eq 1 && ! -e $work/m.node ]] || fail ".ele not refused with exit 1"
+
+# -o BASE.pvtu: one .vtu piece a rank and the index, read back through VTK
+# (pvtu_check.py; skipped without python3 VTK) against the serial tets.
+checks=$((checks + 1))
+mkdir -p "$work/pv"
+if mpi 3 120 "$fmpi" -q -o "$work/pv/mesh.pvtu" "$work/clusters.xyz"; then
+  for f in mesh.pvtu mesh_0.vtu mesh_1.vtu mesh_2.vtu; do
+    [[ -s $work/pv/$f ]] || fail ".pvtu, 3 ranks: no $f"
+  done
+  [[ $(grep -c '<Piece Source="mesh_[0-2].vtu"/>' "$work/pv/mesh.pvtu") -eq 3 ]] ||
+    fail ".pvtu, 3 ranks: the index does not name the 3 pieces"
+  "$python" "$pvtu_check" "$work/pv/mesh.pvtu" "$work/clusters.xyz" "$work/ref.tets"
+  prc=$?
+  [[ $prc -eq 0 || $prc -eq 77 ]] || fail ".pvtu, 3 ranks: VTK reads another mesh"
+else
+  fail "-o .pvtu, 3 ranks"
+fi
+# a piece that cannot be written: exit 5, no piece and no index left
+checks=$((checks + 1))
+mpi 2 60 "$fmpi" -q -o "$work/none/mesh.pvtu" "$work/clusters.xyz" 2>/dev/null
+rc=$?
+[[ $rc -eq 5 && ! -e $work/none ]] || fail ".pvtu into a missing directory: exit $rc"
 
 # A failing rank: every rank ends with the error (exit 7), quickly, and
 # nothing is written. The wrapper reports each rank's exit code and exits
