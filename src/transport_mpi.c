@@ -53,6 +53,9 @@ typedef struct tmpi {
     MPI_Comm comm;
     int rank, size;
     fdt_msg *free;             /* buffers to reuse (linked by next) */
+    fdt_msg *reserve;          /* `size` buffers made at the start, used
+                                  only when malloc fails: the ABORTs of a
+                                  rank out of memory still go out */
     MPI_Request *req;          /* sends in flight ... */
     fdt_msg **fly;             /* ... and their buffers */
     int nfly, capfly;
@@ -74,8 +77,11 @@ static int tm_alloc(fdt_transport *t, int self, fdt_msg **m)
     fdt_msg *x = s->free;
     if (x)
         s->free = x->next;
-    else if (!(x = aligned_alloc(alignof(fdt_msg), sizeof *x)))
-        return FDT_ENOMEM;
+    else if (!(x = aligned_alloc(alignof(fdt_msg), sizeof *x))) {
+        if (!(x = s->reserve))
+            return FDT_ENOMEM;
+        s->reserve = x->next;
+    }
     memset(x, 0, sizeof *x);
     x->sender = (uint16_t)s->rank;
     *m = x;
@@ -237,6 +243,15 @@ static void tm_counts(const fdt_transport *t, int self, fdt_mailbox_counts *c)
     memcpy(c->received, s->received, sizeof c->received);
 }
 
+static void free_list(fdt_msg *m)
+{
+    while (m) {
+        fdt_msg *n = m->next;
+        free(m);
+        m = n;
+    }
+}
+
 static void tm_destroy(fdt_transport *t)
 {
     tmpi *s = priv(t);
@@ -252,11 +267,8 @@ static void tm_destroy(fdt_transport *t)
     }
     for (int i = 0; i < s->nfly; i++)
         free(s->fly[i]);
-    while (s->free) {
-        fdt_msg *n = s->free->next;
-        free(s->free);
-        s->free = n;
-    }
+    free_list(s->free);
+    free_list(s->reserve);
     free(s->req);
     free(s->fly);
     free(s->done);
@@ -286,6 +298,19 @@ int fdt_transport_mpi(fdt_transport **out, MPI_Comm comm)
     }
     MPI_Comm_rank(s->comm, &s->rank);
     MPI_Comm_size(s->comm, &s->size);
+    /* One ABORT for every other rank (src/termination.c sends them when
+     * this rank fails, also out of memory). */
+    for (int i = 0; i < s->size; i++) {
+        fdt_msg *m = aligned_alloc(alignof(fdt_msg), sizeof *m);
+        if (!m) {
+            t->priv = s;
+            t->ops = &mpi_ops;
+            fdt_transport_destroy(&t);
+            return FDT_ENOMEM;
+        }
+        m->next = s->reserve;
+        s->reserve = m;
+    }
     t->ops = &mpi_ops;
     t->n = s->size;
     t->mbs = NULL;
