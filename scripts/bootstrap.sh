@@ -15,6 +15,7 @@ packages=(
   gnuplot-nox valgrind clang libclang-rt-14-dev
   python3-dev python3-numpy python3-scipy
   locales gcovr
+  mpi-default-dev mpi-default-bin
 )
 
 missing=()

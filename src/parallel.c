@@ -36,9 +36,10 @@ static int key_cmp(const void *x, const void *y)
 /* Seeds: one per nonempty part, the Delaunay tet (src/seed.c) at the part's
  * point nearest its box centre, found in a tree over all points (the setup
  * may read every part); identical seeds are dropped. *out gets *nout
- * positively oriented tets (owned by the caller). */
-static int make_seeds(const fdt_partition *pt, uint32_t (**out)[4], int *nout,
-                      fdt_kdq *kq)
+ * positively oriented tets (owned by the caller). Also every rank of an
+ * MPI run (src/mpi_run.c), which computes the same seeds. */
+int fdt_par_make_seeds(const fdt_partition *pt, uint32_t (**out)[4], int *nout,
+                       fdt_kdq *kq)
 {
     fdt_kdtree all;
     int err = fdt_partition_global_tree(pt, &all);
@@ -155,7 +156,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
                                   cores < nthreads ? cores : nthreads);
     if (err)
         return err;
-    if ((err = make_seeds(&pt, &seeds, &nseeds, &kq0)) != FDT_OK) {
+    if ((err = fdt_par_make_seeds(&pt, &seeds, &nseeds, &kq0)) != FDT_OK) {
         if (err == FDT_EINTERNAL)
             snprintf(diag, dlen, "internal error: no seed tetrahedron found");
         goto fail;

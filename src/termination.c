@@ -113,8 +113,9 @@
  * The calling thread (progress cancel, a thread that could not be
  * created) has its own endpoint (fdt_term_ctl) and does the same. If the
  * ABORT itself cannot be allocated (out of memory) the in-process flag of
- * shared mode is the fallback, the one place message mode touches it; a
- * transport between processes would send it from a reserved buffer.
+ * shared mode is the fallback, the one place message mode touches it; the
+ * MPI transport (src/transport_mpi.c), where no flag is shared, keeps one
+ * buffer for each other rank in reserve, so its ABORTs always go out.
  * Shared mode keeps its counter: one RMW on a shared line per FACESEND and
  * activation is cheaper than a FACERECV per FACESEND through the
  * mailboxes, and in one address space nothing is lost by sharing it.

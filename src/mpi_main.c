@@ -1,0 +1,447 @@
+/*
+ * frontdt-mpi: the distributed run (issue 19) under mpirun, one part per
+ * rank (src/mpi_run.h). Every rank reads the whole input (the first stage
+ * of the setup, mpi_run.h); rank 0 prints and writes. Exit codes are the
+ * CLI's (README, Exit codes), the same on every rank.
+ *
+ *   mpirun -np 4 frontdt-mpi [-o OUT] [--set-hash] [--stats] [-q] INPUT
+ */
+#include <inttypes.h>
+#include <limits.h>
+#include <mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "frontdt.h"
+#include "mpi_run.h"
+#include "prepare.h"
+#include "reader.h"
+#include "result.h"
+#include "seed.h"
+#include "writer.h"
+
+enum { EX_OK = 0, EX_USAGE = 1, EX_INPUT = 2, EX_RESOURCES = 4, EX_WRITE = 5, EX_INTERNAL = 7 };
+
+typedef struct opts {
+    const char *input, *output, *format;
+    int set_hash, stats, quiet, leaf;
+    int fail_rank;
+    size_t fail_after;
+} opts;
+
+static const char usage[] =
+    "Usage: mpirun -np N frontdt-mpi [options] INPUT\n"
+    "  The Delaunay tetrahedralization of INPUT (.xyz .txt .csv .node .ply),\n"
+    "  one part per MPI rank; every rank reads INPUT.\n"
+    "  -o FILE             write the mesh, gathered to rank 0 (.tets .vtu .vtk\n"
+    "                      .msh .mesh polyMesh; not .ele: no neighbours yet)\n"
+    "  -o BASE.pvtu        one piece a rank, BASE_RANK.vtu, and the index BASE.pvtu\n"
+    "  --input-format F    xyz, node or ply (default: by extension)\n"
+    "  --set-hash          print the mesh's set hash (equals frontdt's)\n"
+    "  --stats             per-rank tets and message counts, and their totals\n"
+    "  --leaf N            kd-tree leaf size (default 30)\n"
+    "  -q                  print nothing but errors (and what is asked)\n";
+
+/* ---- -o BASE.pvtu: one .vtu piece a rank and an index ------------------- */
+
+/* BASE_RANK.vtu beside BASE.pvtu (path), and its name relative to the
+ * index's directory (*rel points into out). 0, or -1 if it does not fit. */
+static int piece_name(const char *path, int rank, char *out, size_t len, const char **rel)
+{
+    size_t n = strlen(path);
+    if (n < 5)
+        return -1;
+    int k = snprintf(out, len, "%.*s_%d.vtu", (int)(n - 5), path, rank);
+    if (k < 0 || (size_t)k >= len)
+        return -1;
+    const char *slash = strrchr(out, '/');
+    *rel = slash ? slash + 1 : out;
+    return 0;
+}
+
+static int is_pvtu(const char *path)
+{
+    size_t n = strlen(path);
+    return n > 5 && strcasecmp(path + n - 5, ".pvtu") == 0;
+}
+
+/* Writes this rank's piece: its tets (input numbering) over the points
+ * they use, renumbered 0..k-1 in input order. FDT_OK or an error, diag. */
+static int write_piece(const char *name, const double *xyz, size_t n, const fdt_vid *tets,
+                       size_t nt, char *diag, size_t dlen)
+{
+    int32_t *map = malloc((n ? n : 1) * sizeof *map);
+    fdt_vid *lt = malloc((4 * nt + 1) * sizeof *lt);
+    double *px = NULL;
+    int err = FDT_ENOMEM;
+    if (!map || !lt)
+        goto done;
+    for (size_t i = 0; i < n; i++)
+        map[i] = -1;
+    for (size_t i = 0; i < 4 * nt; i++)
+        map[tets[i]] = 0;
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++)
+        if (map[i] == 0)
+            map[i] = (int32_t)k++;
+    if (!(px = malloc((3 * k + 1) * sizeof *px)))
+        goto done;
+    for (size_t i = 0; i < n; i++)
+        if (map[i] >= 0)
+            memcpy(px + 3 * (size_t)map[i], xyz + 3 * i, 3 * sizeof *px);
+    for (size_t i = 0; i < 4 * nt; i++)
+        lt[i] = map[tets[i]];
+    fdt_mesh_view v;
+    memset(&v, 0, sizeof v);
+    v.xyz = px;
+    v.n_points = k;
+    v.tets = lt;
+    v.n_tets = nt;
+    err = fdt_wr_mesh_as(name, fdt_format_by_name("vtu"), &v, diag, dlen) == FDT_IO_OK
+              ? FDT_OK
+              : FDT_EIO;
+done:
+    if (err == FDT_ENOMEM)
+        snprintf(diag, dlen, "out of memory writing a piece");
+    free(map);
+    free(lt);
+    free(px);
+    return err;
+}
+
+static int little_endian(void)
+{
+    const uint16_t one = 1;
+    unsigned char b;
+    memcpy(&b, &one, 1);
+    return b == 1;
+}
+
+/* s with XML's five special characters escaped, to f. */
+static void put_xml(FILE *f, const char *s)
+{
+    for (; *s; s++)
+        switch (*s) {
+        case '&': fputs("&amp;", f); break;
+        case '<': fputs("&lt;", f); break;
+        case '>': fputs("&gt;", f); break;
+        case '"': fputs("&quot;", f); break;
+        case '\'': fputs("&apos;", f); break;
+        default: fputc(*s, f);
+        }
+}
+
+/* The index: ParaView reads the pieces it names. Rank 0. */
+static int write_index(const char *path, int size, char *diag, size_t dlen)
+{
+    fdt_wr_side *side;
+    FILE *f = fdt_wr_side_open(path, &side, diag, dlen);
+    if (!f)
+        return FDT_EIO;
+    fprintf(f, "<?xml version=\"1.0\"?>\n"
+               "<VTKFile type=\"PUnstructuredGrid\" version=\"0.1\" byte_order=\"%s\" "
+               "header_type=\"UInt64\">\n"
+               "  <PUnstructuredGrid GhostLevel=\"0\">\n"
+               "    <PPoints>\n"
+               "      <PDataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"/>\n"
+               "    </PPoints>\n",
+            little_endian() ? "LittleEndian" : "BigEndian");
+    char name[FDT_IO_PATH];
+    const char *rel;
+    for (int r = 0; r < size; r++) {
+        if (piece_name(path, r, name, sizeof name, &rel) != 0) {
+            fdt_wr_side_abandon(side);
+            snprintf(diag, dlen, "%s: piece name too long", path);
+            return FDT_EIO;
+        }
+        fputs("    <Piece Source=\"", f);
+        put_xml(f, rel);
+        fputs("\"/>\n", f);
+    }
+    fprintf(f, "  </PUnstructuredGrid>\n</VTKFile>\n");
+    return fdt_wr_side_commit(side, diag, dlen) == FDT_IO_OK ? FDT_OK : FDT_EIO;
+}
+
+/* -1: go on; else an exit code. Only rank 0 prints. */
+static int parse(int argc, char **argv, opts *o, int rank, int size)
+{
+    memset(o, 0, sizeof *o);
+    o->fail_rank = -1;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            if (rank == 0)
+                fputs(usage, stdout);
+            return EX_OK;
+        } else if (!strcmp(a, "-o") && v) {
+            o->output = v;
+            i++;
+        } else if (!strcmp(a, "--input-format") && v) {
+            o->format = v;
+            i++;
+        } else if (!strcmp(a, "--set-hash")) {
+            o->set_hash = 1;
+        } else if (!strcmp(a, "--stats")) {
+            o->stats = 1;
+        } else if (!strcmp(a, "-q")) {
+            o->quiet = 1;
+        } else if (!strcmp(a, "--leaf") && v) {
+            char *end;
+            long x = strtol(v, &end, 10);
+            if (*end || x < 1 || x > 1000000) {
+                if (rank == 0)
+                    fprintf(stderr, "frontdt-mpi: --leaf wants 1..1000000, not '%s'\n", v);
+                return EX_USAGE;
+            }
+            o->leaf = (int)x;
+            i++;
+        } else if (!strcmp(a, "--inject-failure") && v) {
+            /* Hidden, for tests/test_mpi.sh: RANK:FACES, rank RANK fails
+             * once it advanced FACES faces. */
+            char *end;
+            long r = strtol(v, &end, 10);
+            unsigned long long f = *end == ':' ? strtoull(end + 1, &end, 10) : 0;
+            if (*end || r < 0 || r > INT_MAX) {
+                if (rank == 0)
+                    fprintf(stderr, "frontdt-mpi: --inject-failure wants RANK:FACES\n");
+                return EX_USAGE;
+            }
+            o->fail_rank = (int)r;
+            o->fail_after = (size_t)f;
+            i++;
+        } else if (a[0] == '-' && a[1]) {
+            if (rank == 0)
+                fprintf(stderr, "frontdt-mpi: unknown option or missing value: '%s'\n%s", a,
+                        usage);
+            return EX_USAGE;
+        } else if (!o->input) {
+            o->input = a;
+        } else {
+            if (rank == 0)
+                fprintf(stderr, "frontdt-mpi: one input only ('%s')\n", a);
+            return EX_USAGE;
+        }
+    }
+    if (!o->input) {
+        if (rank == 0)
+            fprintf(stderr, "frontdt-mpi: no input file\n%s", usage);
+        return EX_USAGE;
+    }
+    if (o->output && is_pvtu(o->output)) {
+        /* pieces: none of them (nor the index) may be the input */
+        char name[FDT_IO_PATH];
+        const char *rel;
+        for (int r = -1; r < size; r++) {
+            const char *x = name;
+            if (r < 0)
+                x = o->output;
+            else if (piece_name(o->output, r, name, sizeof name, &rel) != 0) {
+                if (rank == 0)
+                    fprintf(stderr, "frontdt-mpi: '%s': piece names too long\n", o->output);
+                return EX_USAGE;
+            }
+            if (fdt_same_file(x, o->input)) {
+                if (rank == 0)
+                    fprintf(stderr, "frontdt-mpi: output '%s' is the input '%s'\n", x, o->input);
+                return EX_USAGE;
+            }
+        }
+    } else if (o->output) {
+        const fdt_format *f = fdt_format_by_path(o->output);
+        char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+        int nf = fdt_output_files(o->output, names);
+        if (!f || nf <= 0) {
+            if (rank == 0)
+                fprintf(stderr, "frontdt-mpi: unknown output extension: '%s'\n", o->output);
+            return EX_USAGE;
+        }
+        if (fdt_format_needs(f, 0) & FDT_NEED_NBRS) {
+            if (rank == 0)
+                fprintf(stderr, "frontdt-mpi: %s needs tet neighbours, which the MPI run "
+                                "does not gather yet; use frontdt\n", fdt_format_name(f));
+            return EX_USAGE;
+        }
+        for (int k = 0; k < nf; k++)
+            if (fdt_same_file(names[k], o->input)) {
+                if (rank == 0)
+                    fprintf(stderr, "frontdt-mpi: output '%s' is the input '%s'\n", names[k],
+                            o->input);
+                return EX_USAGE;
+            }
+    }
+    return -1;
+}
+
+static int exit_code(int err)
+{
+    switch (err) {
+    case FDT_OK:
+        return EX_OK;
+    case FDT_ENOMEM:
+    case FDT_ETOOBIG:
+        return EX_RESOURCES;
+    default:
+        return EX_INTERNAL;
+    }
+}
+
+static void print_stats(const fdt_mpi_out *r, int size, double t_read)
+{
+    fprintf(stderr, "frontdt-mpi: %d ranks\n  rank        tets", size);
+    for (int k = 1; k < FDT_MSG_KIND_END; k++)
+        fprintf(stderr, "  %s sent/recv", fdt_msg_kind_name(k));
+    fputc('\n', stderr);
+    for (int q = 0; q < size; q++) {
+        const uint64_t *c = r->rank_counts + (size_t)q * 2 * FDT_MSG_KIND_END;
+        fprintf(stderr, "  %4d %11zu", q, r->rank_tets[q]);
+        for (int k = 1; k < FDT_MSG_KIND_END; k++)
+            fprintf(stderr, "  %*" PRIu64 "/%-*" PRIu64, (int)strlen(fdt_msg_kind_name(k)), c[k],
+                    9, c[FDT_MSG_KIND_END + k]);
+        fputc('\n', stderr);
+    }
+    fprintf(stderr, "  messages          sent / received (all ranks)\n");
+    for (int k = 1; k < FDT_MSG_KIND_END; k++)
+        fprintf(stderr, "    %-15s %" PRIu64 " / %" PRIu64 "\n", fdt_msg_kind_name(k),
+                r->all_sent[k], r->all_received[k]);
+    fprintf(stderr, "  time (rank 0)     read %.3f s, setup %.3f s, front %.3f s, output %.3f s\n",
+            t_read, r->t_setup, r->t_front, r->t_out);
+}
+
+/* The run after MPI_Init; every rank returns the same code. */
+static int run(int argc, char **argv, int rank, int size)
+{
+    opts o;
+    int rc = parse(argc, argv, &o, rank, size);
+    if (rc >= 0)
+        return rc;
+    char diag[512] = "";
+    double t0 = MPI_Wtime();
+    double *xyz = NULL;
+    size_t n = 0;
+    fdt_prepared pr;
+    memset(&pr, 0, sizeof pr);
+    fdt_mpi_out r;
+    memset(&r, 0, sizeof r);
+    fdt_result *res = NULL;
+    /* Every rank reads the same file and prepares the same points; read
+     * and input errors are therefore the same on every rank (mpi_run.h)
+     * but for memory: the ranks agree on the worst exit code. */
+    int fail = 0;
+    int err = fdt_read_points(o.input, o.format, &xyz, &n, diag, sizeof diag);
+    if (err) {
+        fail = err == FDT_ENOMEM ? EX_RESOURCES : err == FDT_EINVAL ? EX_USAGE : EX_INPUT;
+    } else {
+        err = fdt_prepare(xyz, n, 1, &pr, diag, sizeof diag);
+        if (!err)
+            err = fdt_seed_check_dimension(pr.p, pr.orig, (uint32_t)pr.m, diag, sizeof diag);
+        if (err)
+            fail = err == FDT_ENOMEM || err == FDT_ETOOBIG ? EX_RESOURCES : EX_INPUT;
+    }
+    double t_read = MPI_Wtime() - t0;
+    MPI_Allreduce(&fail, &rc, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (rc) {
+        if (rank == 0)
+            fprintf(stderr, "frontdt-mpi: %s\n", fail ? diag : "failed on another rank");
+        goto out;
+    }
+    int pieces = o.output && is_pvtu(o.output);
+    fdt_mpi_opts mo = {o.leaf, FDT_SEARCH_AUTO, o.output && !pieces, pieces, o.fail_rank,
+                       o.fail_after};
+    err = fdt_mpi_run(MPI_COMM_WORLD, &pr, &mo, &r, diag, sizeof diag);
+    if (err) {
+        if (rank == 0)
+            fprintf(stderr, "frontdt-mpi: %s (%s)\n", diag, fdt_strerror(err));
+        rc = exit_code(err);
+        goto out;
+    }
+    rc = EX_OK;
+    if (rank == 0) {
+        /* The balance over all ranks: every message sent was received, one
+         * FACERECV per FACESEND (src/termination.c), no ABORT. */
+        for (int k = 1; k < FDT_MSG_KIND_END; k++)
+            if (r.all_sent[k] != r.all_received[k])
+                rc = EX_INTERNAL;
+        if (r.all_sent[FDT_MSG_FACERECV] != r.all_sent[FDT_MSG_FACESEND] ||
+            r.all_sent[FDT_MSG_ABORT] != 0)
+            rc = EX_INTERNAL;
+        if (rc)
+            fprintf(stderr, "frontdt-mpi: internal error: messages sent and received differ\n");
+        if (o.stats)
+            print_stats(&r, size, t_read);
+        if (!o.quiet)
+            fprintf(stderr, "frontdt-mpi: %zu points, %zu vertices, %" PRIu64 " tets on %d ranks\n",
+                    n, pr.m, r.hash.count, size);
+        if (o.set_hash)
+            printf("set-hash: %016" PRIx64 "\n", fdt_sethash_value(&r.hash));
+        if (!rc && o.output && !pieces) {
+            /* Gathered to rank 0 in input numbering: one result, written
+             * by the CLI's writers (temporary file, renamed at the end). */
+            res = calloc(1, sizeof *res);
+            if (!res) {
+                rc = EX_RESOURCES;
+            } else {
+                res->tets = r.all_tets;
+                res->ntets = r.ntets;
+                res->hull = r.all_hull;
+                res->nhull = r.nhull;
+                res->dupmap = pr.dupmap;
+                res->n = n;
+                res->ndup = pr.ndup;
+                r.all_tets = NULL;
+                r.all_hull = NULL;
+                pr.dupmap = NULL;
+                err = fdt_write_mesh(res, xyz, n, o.output, NULL, diag, sizeof diag);
+                if (err) {
+                    fprintf(stderr, "frontdt-mpi: %s\n", diag);
+                    rc = err == FDT_ENOMEM ? EX_RESOURCES : EX_WRITE;
+                }
+            }
+        }
+        fflush(stdout);
+    }
+    MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!rc && pieces) {
+        /* Each rank its piece (temporary and rename, by the writer), then
+         * rank 0 the index once every piece is there; if any write fails,
+         * every piece is removed again: all or nothing. */
+        char name[FDT_IO_PATH];
+        const char *rel;
+        int perr = piece_name(o.output, rank, name, sizeof name, &rel) != 0 ? FDT_EIO
+                   : write_piece(name, xyz, n, r.own_tets, r.own_ntets, diag, sizeof diag);
+        if (perr)
+            fprintf(stderr, "frontdt-mpi: rank %d: %s\n", rank, diag);
+        int bad = perr == FDT_ENOMEM ? EX_RESOURCES : perr ? EX_WRITE : 0, worst = 0;
+        MPI_Allreduce(&bad, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+        if (!worst && rank == 0 && write_index(o.output, size, diag, sizeof diag) != FDT_OK) {
+            fprintf(stderr, "frontdt-mpi: %s\n", diag);
+            worst = EX_WRITE;
+        }
+        MPI_Bcast(&worst, 1, MPI_INT, 0, MPI_COMM_WORLD);
+        if (worst && !perr)
+            (void)remove(name);
+        rc = worst;
+    }
+out:
+    fdt_result_free(&res);
+    fdt_mpi_out_free(&r);
+    fdt_prepared_free(&pr);
+    fdt_free(xyz);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    if (MPI_Init(&argc, &argv) != MPI_SUCCESS) {
+        fprintf(stderr, "frontdt-mpi: MPI_Init failed\n");
+        return EX_INTERNAL;
+    }
+    int rank = 0, size = 1;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    int rc = run(argc, argv, rank, size);
+    MPI_Finalize();
+    return rc;
+}
