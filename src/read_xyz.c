@@ -370,6 +370,7 @@ int fdt_rd_stream_xyz(rd_ctx *c, rd_points *pb)
     size_t done = 0;    /* input bytes before buf[0] */
     size_t lineno = 0;  /* lines before buf[0] */
     int rc = FDT_IO_OK, first = 1;
+    size_t bom = 0; /* bytes of a byte order mark at buf[0], until parsed */
     for (;;) {
         ptrdiff_t r = fdt_rd_src_read(c, buf + len, cap - len);
         if (r < 0) {
@@ -379,7 +380,6 @@ int fdt_rd_stream_xyz(rd_ctx *c, rd_points *pb)
         len += (size_t)r;
         int eof = c->src->eof;
         buf[len] = '\0';
-        const char *s = buf;
         if (first) {
             if (len == 0) {
                 rc = fdt_rd_fail(c, FDT_IO_EFORMAT, ": no points (empty file)");
@@ -387,11 +387,12 @@ int fdt_rd_stream_xyz(rd_ctx *c, rd_points *pb)
             }
             /* a UTF-8 byte order mark, as some Windows tools write */
             if (len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0)
-                s += 3;
+                bom = 3;
             else if (len < 3 && !eof && memcmp(buf, "\xef\xbb\xbf", len) == 0)
                 continue; /* cannot tell yet */
             first = 0;
         }
+        const char *s = buf + bom;
         const char *end = buf + len;
         if (!eof) {
             const char *nl = rd_last_newline(s, end);
@@ -454,6 +455,7 @@ int fdt_rd_stream_xyz(rd_ctx *c, rd_points *pb)
             break;
         memmove(buf, end, len - used);
         len -= used;
+        bom = 0;
     }
     free(buf);
     return rc;
