@@ -31,6 +31,7 @@
 #include <sys/stat.h>
 #include <time.h>
 #include <pthread.h>
+#include <signal.h>
 #include <unistd.h>
 #include "testutil.h"
 
@@ -2165,6 +2166,9 @@ static void put_le(bbuf *b, const void *v, size_t size)
 
 static void test_chunks(tctx *t)
 {
+    /* a read that stops at an error leaves its pipe's writer with bytes
+     * no one reads: EPIPE for it, not a signal for the test */
+    signal(SIGPIPE, SIG_IGN);
     static const double w9[] = {1, 2, 3, 4.5, 50, -6, 7, 8, 9};
     /* lines, numbers and exponents split at every byte */
     CHUNK_OK(t, "split.xyz", "1 2 3\n4.5 5e1 -6\n7 8 9\n", w9);
