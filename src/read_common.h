@@ -3,10 +3,14 @@
  * module a format: src/read_xyz.c, src/read_node.c, src/read_ply.c).
  * Internal to the readers: the CLI and tests use src/reader.h.
  *
- * A read holds the whole input in one NUL-terminated buffer (rd_ctx.buf,
- * loaded by src/reader.c from a file, a pipe or memory); a format's
- * function parses it into an rd_points and words its first error with
- * fdt_rd_fail ("PATH:LINE: ..." or "PATH: byte N: ...").
+ * Text point files (.xyz/.txt/.csv) and binary PLY are streamed: they pull
+ * their bytes from an rd_src through a bounded buffer (rd_ctx.chunk bytes,
+ * RD_CHUNK by default) and keep only the points, so a read's peak memory
+ * is the points array (24 bytes a point) and that buffer (issue 18). .node
+ * and ASCII PLY, rarely large, are parsed from one NUL-terminated buffer
+ * holding the whole input (rd_ctx.buf, loaded by src/reader.c). Either way
+ * a format words its first error with fdt_rd_fail ("PATH:LINE: ..." or
+ * "PATH: byte N: ...").
  */
 #ifndef FDT_READ_COMMON_H
 #define FDT_READ_COMMON_H
@@ -33,13 +37,41 @@
 /* Below a megabyte a slice's thread costs about what it saves. */
 #define RD_MIN_SLICE ((size_t)1 << 20)
 
+/* The streamed formats' buffer: large enough that a read() or a slice's
+ * thread costs nothing beside the parse of its bytes, small beside the
+ * points of any file worth streaming (8 MiB: 350,000 text points). With
+ * several threads a block holds two slices a thread (src/read_xyz.c). */
+#define RD_CHUNK ((size_t)8 << 20)
+
+/* A streamed read's first buffer when the input's size is not known (a
+ * pipe): small inputs stay small; it doubles up to the chunk while the
+ * input fills it. */
+#define RD_FIRST_CHUNK ((size_t)64 << 10)
+
+
+/* Where a streamed read's bytes come from: a file descriptor (a file, a
+ * pipe, a FIFO) or, for fdt_rd_points_mem, bytes in memory. */
+typedef struct rd_src {
+    int fd;            /* -1: mem[0..mem_len) */
+    const char *mem;
+    size_t mem_len;
+    size_t pos;        /* bytes delivered so far */
+    int eof;           /* a read found the end */
+} rd_src;
+
 typedef struct rd_ctx {
     const char *path;
     char *err;
     size_t errlen;
-    const char *buf; /* the whole file, NUL-terminated (owned by the caller) */
-    size_t size;     /* bytes in the file (the NUL not counted) */
-    int threads;      /* for .xyz: slices parsed at once (fdt_rd_read_xyz) */
+    const char *buf; /* buffered formats: the whole file, NUL-terminated
+                        (owned by the caller) */
+    size_t size;     /* bytes in the file (the NUL not counted); while a
+                        streamed read goes on, the size fstat gave a
+                        regular file, else 0 (not known yet) */
+    int size_known;  /* size is the input's (a regular file, memory) */
+    rd_src *src;     /* streamed formats: the input */
+    size_t chunk;    /* streamed formats: buffer bytes; 0: RD_CHUNK */
+    int threads;      /* for .xyz: slices of a block parsed at once */
     size_t min_slice; /* least bytes a slice; 0: RD_MIN_SLICE */
     int col[3];       /* .xyz: 0-based columns of x, y, z */
     int custom_cols;  /* col[] is not 0, 1, 2 (the messages say so) */
@@ -48,13 +80,26 @@ typedef struct rd_ctx {
     size_t progress_scale; /* parsed bytes are reported times this */
 } rd_ctx;
 
-/* Reports done bytes parsed (times c->progress_scale, at most c->size). */
+/* The buffer to start a streamed read of c with: the chunk, or less when
+ * the input is known to be smaller or its size is not known. */
+static inline size_t fdt_rd_first_cap(const rd_ctx *c, size_t chunk, size_t left)
+{
+    if (c->size_known)
+        return left < chunk ? left : chunk;
+    return RD_FIRST_CHUNK < chunk ? RD_FIRST_CHUNK : chunk;
+}
+
+/* Reports done bytes parsed (times c->progress_scale, at most c->size
+ * when the size is known; total 0 while it is not, as from a pipe). */
 static inline void fdt_rd_progress(const rd_ctx *c, size_t done)
 {
     if (c->progress == NULL)
         return;
     size_t s = c->progress_scale > 1 ? c->progress_scale : 1;
-    done = done > c->size / s ? c->size : done * s;
+    if (c->size > 0)
+        done = done > c->size / s ? c->size : done * s;
+    else
+        done = done > SIZE_MAX / s ? SIZE_MAX : done * s;
     c->progress(c->progress_user, FDT_RD_PARSING, done, c->size);
 }
 
@@ -75,6 +120,16 @@ int fdt_rd_fail(const rd_ctx *c, int code, const char *fmt, ...) RD_PRINTF(3, 4)
 const char *fdt_rd_quote(char out[RD_QUOTE_CAP], const char *s, size_t len);
 /* Grows pb to cap points; -1 when out of memory or pb is fixed. */
 int fdt_rd_points_reserve(rd_points *pb, size_t cap);
+/* Room for more points beyond pb->n: grows to at least pb->n + more,
+ * doubling (a large array grows by mremap, its untouched tail never
+ * resident); -1 when out of memory, fixed, or beyond RD_MAX_POINTS. */
+int fdt_rd_points_room(rd_points *pb, size_t more);
+/*
+ * Reads up to len bytes of the input into dst, fewer only at its end
+ * (then c->src->eof is set): the count, or -1 after wording a read error
+ * in c (as the buffered read words it: ": cannot read: ...").
+ */
+ptrdiff_t fdt_rd_src_read(const rd_ctx *c, void *dst, size_t len);
 
 /* src/read_text.c: numbers, lines and fields of the text formats. */
 
@@ -116,10 +171,13 @@ typedef struct rd_fields {
  * .xyz loop calls them for every field). */
 size_t fdt_rd_count_rest(rd_fields *f);
 
-/* The formats (one module each). start: the text after a byte order mark. */
-int fdt_rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb);
+/* The formats (one module each). start: the text after a byte order mark.
+ * The streamed ones (fdt_rd_stream_*) read c->src themselves; an ASCII
+ * PLY is loaded whole into *owned (freed by the caller, c->buf points to
+ * it) and parsed there. */
+int fdt_rd_stream_xyz(rd_ctx *c, rd_points *pb);
+int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned);
 int fdt_rd_read_node(const rd_ctx *c, const char *start, rd_points *pb);
-int fdt_rd_read_ply(const rd_ctx *c, rd_points *pb);
 
 /* Small helpers of every parser. */
 

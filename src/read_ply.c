@@ -1,5 +1,10 @@
 /*
- * PLY point files, ASCII and binary (src/reader.h).
+ * PLY point files, ASCII and binary (src/reader.h). The header is read
+ * line by line from the input; a binary body is then streamed, its x, y, z
+ * decoded into the points array and everything else skipped, through a
+ * buffer of rd_ctx.chunk bytes (the common layout, three little-endian
+ * doubles a vertex, is read straight into the array); an ASCII body is
+ * loaded whole and parsed as before.
  */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
@@ -94,6 +99,7 @@ typedef struct ply_hdr {
     size_t vertex;   /* index of the vertex element */
     size_t data_off; /* first byte after end_header's newline */
     size_t data_line;
+    int no_end;      /* the lines ran out before end_header */
 } ply_hdr;
 
 static void ply_hdr_free(ply_hdr *h)
@@ -324,9 +330,11 @@ static int ply_parse_header(const rd_ctx *c, ply_hdr *h)
                                 : "");
         }
     }
-    if (!ended)
+    if (!ended) {
+        h->no_end = 1;
         return fdt_rd_fail(c, FDT_IO_EFORMAT,
                        ":%zu: the header has no end_header line", L.lineno);
+    }
     h->data_off = (size_t)(L.p - c->buf);
     h->data_line = L.lineno;
     if (h->format < 0)
@@ -407,78 +415,6 @@ static double ply_get(const unsigned char *b, int type, int big)
     return (double)ply_get_int(b, type, big);
 }
 
-/*
- * Walks one binary item of el from *off. Fills roff[0..2] with the offsets
- * of x, y, z when roff is not NULL. Returns 0, 1 when the data ends inside
- * the item (*off then tells where the shortfall was found), or 2 on a
- * negative list length (*off at that length).
- */
-static int ply_bin_item(const rd_ctx *c, const ply_hdr *h, const ply_elem *el,
-                        size_t *off, int big, size_t roff[3])
-{
-    const unsigned char *b = (const unsigned char *)c->buf;
-    size_t o = *off;
-    for (size_t i = 0; i < el->n_props; i++) {
-        const ply_prop *p = &h->props[el->first_prop + i];
-        if (!p->is_list) {
-            size_t sz = ply_size[p->type];
-            if (c->size - o < sz)
-                return 1;
-            if (p->role && roff != NULL)
-                roff[p->role - 1] = o;
-            o += sz;
-            continue;
-        }
-        size_t csz = ply_size[p->count_type];
-        if (c->size - o < csz)
-            return 1;
-        int64_t len = ply_get_int(b + o, p->count_type, big);
-        if (len < 0) {
-            *off = o;
-            return 2;
-        }
-        o += csz;
-        size_t isz = ply_size[p->type];
-        if ((uint64_t)len > (c->size - o) / isz)
-            return 1;
-        o += (size_t)len * isz;
-    }
-    *off = o;
-    return 0;
-}
-
-/* Walks the binary items of an element that is not read. */
-static int ply_bin_skip(const rd_ctx *c, const ply_hdr *h, const ply_elem *el,
-                        size_t *off, int big)
-{
-    char lab[160];
-    if (!el->has_list) {
-        size_t rem = c->size - *off;
-        uint64_t fit = rem / el->min_bytes;
-        if (el->count > fit)
-            return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                           ": byte %zu: file ends %s %s", c->size,
-                           rem % el->min_bytes ? "inside" : "before",
-                           ply_item_label(lab, sizeof lab, h, el, fit));
-        *off += (size_t)el->count * el->min_bytes;
-        return FDT_IO_OK;
-    }
-    for (uint64_t i = 0; i < el->count; i++) {
-        if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
-            fdt_rd_progress(c, *off);
-        int r = ply_bin_item(c, h, el, off, big, NULL);
-        if (r == 1)
-            return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                           ": byte %zu: file ends inside %s", c->size,
-                           ply_item_label(lab, sizeof lab, h, el, i));
-        if (r == 2)
-            return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                           ": byte %zu: %s: negative list length", *off,
-                           ply_item_label(lab, sizeof lab, h, el, i));
-    }
-    return FDT_IO_OK;
-}
-
 static int ply_check_count(const rd_ctx *c, const ply_elem *el,
                            rd_points *pb)
 {
@@ -491,102 +427,6 @@ static int ply_check_count(const rd_ctx *c, const ply_elem *el,
     if (fdt_rd_points_reserve(pb, (size_t)el->count) != 0)
         return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory for %llu points",
                        (unsigned long long)el->count);
-    return FDT_IO_OK;
-}
-
-static int ply_bin_vertex(const rd_ctx *c, const ply_hdr *h,
-                          const ply_elem *el, size_t *off, int big,
-                          rd_points *pb)
-{
-    char lab[160];
-    size_t rem = c->size - *off;
-    uint64_t fit = rem / el->min_bytes;
-    /* Refuse before allocating: the header's count must fit the bytes
-     * left (exactly for fixed-size vertices, at least for ones with lists). */
-    if (el->count > fit) {
-        if (!el->has_list)
-            return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                           ": byte %zu: file ends %s %s (the header declares "
-                           "%llu vertices of %zu bytes, %zu bytes follow it)",
-                           c->size, rem % el->min_bytes ? "inside" : "before",
-                           ply_item_label(lab, sizeof lab, h, el, fit),
-                           (unsigned long long)el->count, el->min_bytes, rem);
-        return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                       ": byte %zu: the header declares %llu vertices of at "
-                       "least %zu bytes, only %zu bytes follow: refused",
-                       *off, (unsigned long long)el->count, el->min_bytes,
-                       rem);
-    }
-    int rc = ply_check_count(c, el, pb);
-    if (rc != FDT_IO_OK)
-        return rc;
-    const unsigned char *b = (const unsigned char *)c->buf;
-    int type[3];
-    size_t roff[3] = {0, 0, 0};
-    for (size_t i = 0; i < el->n_props; i++) {
-        const ply_prop *p = &h->props[el->first_prop + i];
-        if (p->role)
-            type[p->role - 1] = p->type;
-    }
-    size_t fixed_off[3] = {0, 0, 0};
-    if (!el->has_list) {
-        size_t o = 0;
-        for (size_t i = 0; i < el->n_props; i++) {
-            const ply_prop *p = &h->props[el->first_prop + i];
-            if (p->role)
-                fixed_off[p->role - 1] = o;
-            o += ply_size[p->type];
-        }
-    }
-    for (uint64_t i = 0; i < el->count; i++) {
-        if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
-            fdt_rd_progress(c, *off);
-        if (el->has_list) {
-            int r = ply_bin_item(c, h, el, off, big, roff);
-            if (r == 1)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ": byte %zu: file ends inside %s", c->size,
-                               ply_item_label(lab, sizeof lab, h, el, i));
-            if (r == 2)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ": byte %zu: %s: negative list length", *off,
-                               ply_item_label(lab, sizeof lab, h, el, i));
-        } else {
-            for (int k = 0; k < 3; k++)
-                roff[k] = *off + fixed_off[k];
-            *off += el->min_bytes;
-        }
-        double *dst = pb->xyz + 3 * pb->n;
-        for (int k = 0; k < 3; k++) {
-            double v = ply_get(b + roff[k], type[k], big);
-            if (!isfinite(v))
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ": byte %zu: %s: %c is %s", roff[k],
-                               ply_item_label(lab, sizeof lab, h, el, i),
-                               'x' + k, isnan(v) ? "NaN" : "infinite");
-            dst[k] = v;
-        }
-        pb->n++;
-    }
-    return FDT_IO_OK;
-}
-
-static int ply_read_binary(const rd_ctx *c, const ply_hdr *h, rd_points *pb)
-{
-    int big = h->format == PLY_BE;
-    size_t off = h->data_off;
-    for (size_t ei = 0; ei < h->n_elems; ei++) {
-        const ply_elem *el = &h->elems[ei];
-        int rc = ei == h->vertex ? ply_bin_vertex(c, h, el, &off, big, pb)
-                                 : ply_bin_skip(c, h, el, &off, big);
-        if (rc != FDT_IO_OK)
-            return rc;
-    }
-    if (off != c->size)
-        return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                       ": byte %zu: %zu bytes of extra data after the last "
-                       "element (the header's counts are too small?)",
-                       off, c->size - off);
     return FDT_IO_OK;
 }
 
@@ -724,14 +564,551 @@ static int ply_read_ascii(const rd_ctx *c, const ply_hdr *h, rd_points *pb)
     return FDT_IO_OK;
 }
 
-int fdt_rd_read_ply(const rd_ctx *c, rd_points *pb)
+/* An ASCII PLY in c->buf (fdt_rd_stream_ply loads it there). */
+static int ply_read_buffered(const rd_ctx *c, rd_points *pb)
 {
     ply_hdr h;
     memset(&h, 0, sizeof h);
     int rc = ply_parse_header(c, &h);
+    if (rc == FDT_IO_OK && h.format != PLY_ASCII) /* cannot happen: the header was read */
+        rc = fdt_rd_fail(c, FDT_IO_EFORMAT, ": the format changed while it was read");
     if (rc == FDT_IO_OK)
-        rc = h.format == PLY_ASCII ? ply_read_ascii(c, &h, pb)
-                                   : ply_read_binary(c, &h, pb);
+        rc = ply_read_ascii(c, &h, pb);
     ply_hdr_free(&h);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ */
+/* Streamed binary PLY                                                */
+/* ------------------------------------------------------------------ */
+
+/*
+ * The body's bytes: a window buf[lo..hi) of the input, whose first byte is
+ * at input offset off. Every check of the buffered reader above that needs
+ * the input's size (a fixed-size element's count against the bytes left,
+ * the vertices' count before the array is allocated) is made once the size
+ * is known: when the data ends, or, on a pipe, at the first error, after
+ * reading the rest (ply_total). So a pipe, a file and memory give the same
+ * messages, and a header's count costs memory only as its data arrives.
+ */
+typedef struct ply_in {
+    rd_ctx *c;
+    unsigned char *buf;
+    size_t cap, lo, hi;
+    size_t off; /* input offset of buf[lo] */
+    int failed; /* a read failed (the message is in c->err) */
+} ply_in;
+
+/* At least n (<= cap) bytes in the window, unless the input ends first:
+ * whether they are there. */
+static int ply_need(ply_in *in, size_t n)
+{
+    if (in->hi - in->lo >= n)
+        return 1;
+    if (in->failed || in->c->src->eof)
+        return 0;
+    if (in->lo > 0) {
+        memmove(in->buf, in->buf + in->lo, in->hi - in->lo);
+        in->hi -= in->lo;
+        in->lo = 0;
+    }
+    ptrdiff_t r = fdt_rd_src_read(in->c, in->buf + in->hi, in->cap - in->hi);
+    if (r < 0) {
+        in->failed = 1;
+        return 0;
+    }
+    in->hi += (size_t)r;
+    return in->hi - in->lo >= n;
+}
+
+static void ply_take(ply_in *in, size_t n)
+{
+    in->lo += n;
+    in->off += n;
+}
+
+/* Skips n bytes: the bytes skipped (fewer at the input's end). */
+static uint64_t ply_skip(ply_in *in, uint64_t n)
+{
+    uint64_t left = n;
+    while (left > 0) {
+        if (in->hi == in->lo && !ply_need(in, 1))
+            break;
+        size_t k = in->hi - in->lo;
+        if ((uint64_t)k > left)
+            k = (size_t)left;
+        ply_take(in, k);
+        left -= k;
+    }
+    return n - left;
+}
+
+/* The input's size: reads (and drops) what is left of it, the window
+ * included (only an error's message needs it). */
+static size_t ply_total(ply_in *in)
+{
+    in->off += in->hi - in->lo;
+    in->lo = in->hi = 0;
+    while (!in->failed && !in->c->src->eof) {
+        ptrdiff_t r = fdt_rd_src_read(in->c, in->buf, in->cap);
+        if (r < 0)
+            in->failed = 1;
+        else
+            in->off += (size_t)r;
+    }
+    return in->off;
+}
+
+/* A failed read's code (its message is written), else 0. */
+#define PLY_READ_FAILED(in) ((in)->failed ? FDT_IO_EOPEN : 0)
+
+/* The size check of the buffered reader (ply_bin_skip) for an element
+ * without lists starting at start, the input being total bytes. */
+static int ply_fixed_short(const rd_ctx *c, const ply_hdr *h, const ply_elem *el, size_t start,
+                           size_t total)
+{
+    char lab[160];
+    size_t rem = total - start;
+    uint64_t fit = rem / el->min_bytes;
+    return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: file ends %s %s", total,
+                       rem % el->min_bytes ? "inside" : "before",
+                       ply_item_label(lab, sizeof lab, h, el, fit));
+}
+
+/* Walks one item with lists from the window (the streamed ply_bin_item):
+ * 0, 1 when the data ends inside it, 2 on a negative list length (*at:
+ * its offset). x, y, z go to dst when it is not NULL; their offsets to
+ * roff. */
+static int ply_st_item(ply_in *in, const ply_hdr *h, const ply_elem *el, int big,
+                       double *dst, size_t roff[3], size_t *at)
+{
+    for (size_t i = 0; i < el->n_props; i++) {
+        const ply_prop *p = &h->props[el->first_prop + i];
+        if (!p->is_list) {
+            size_t sz = ply_size[p->type];
+            if (!ply_need(in, sz))
+                return 1;
+            if (p->role && dst != NULL) {
+                roff[p->role - 1] = in->off;
+                dst[p->role - 1] = ply_get(in->buf + in->lo, p->type, big);
+            }
+            ply_take(in, sz);
+            continue;
+        }
+        size_t csz = ply_size[p->count_type];
+        if (!ply_need(in, csz))
+            return 1;
+        int64_t len = ply_get_int(in->buf + in->lo, p->count_type, big);
+        if (len < 0) {
+            *at = in->off;
+            return 2;
+        }
+        ply_take(in, csz);
+        uint64_t isz = ply_size[p->type];
+        if ((uint64_t)len > UINT64_MAX / isz ||
+            ply_skip(in, (uint64_t)len * isz) != (uint64_t)len * isz)
+            return 1;
+    }
+    return 0;
+}
+
+/* An element that is not read (the streamed ply_bin_skip). */
+static int ply_st_skip(ply_in *in, const ply_hdr *h, const ply_elem *el, int big)
+{
+    const rd_ctx *c = in->c;
+    char lab[160];
+    size_t start = in->off;
+    if (!el->has_list) {
+        uint64_t want = el->count > UINT64_MAX / el->min_bytes ? UINT64_MAX
+                                                                 : el->count * el->min_bytes;
+        if (ply_skip(in, want) == want)
+            return FDT_IO_OK;
+        if (in->failed)
+            return FDT_IO_EOPEN;
+        return ply_fixed_short(c, h, el, start, ply_total(in));
+    }
+    for (uint64_t i = 0; i < el->count; i++) {
+        if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
+            fdt_rd_progress(c, in->off);
+        size_t at = 0;
+        int r = ply_st_item(in, h, el, big, NULL, NULL, &at);
+        if (in->failed)
+            return FDT_IO_EOPEN;
+        if (r == 1)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: file ends inside %s",
+                               ply_total(in), ply_item_label(lab, sizeof lab, h, el, i));
+        if (r == 2)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: %s: negative list length", at,
+                               ply_item_label(lab, sizeof lab, h, el, i));
+    }
+    return FDT_IO_OK;
+}
+
+/*
+ * The checks the buffered ply_bin_vertex makes before it allocates, for
+ * the vertex element that starts at start of an input of total bytes:
+ * FDT_IO_OK when they pass. The streamed read makes them at its first
+ * error, whose message they take over as they do in the buffered read.
+ */
+static int ply_vertex_precheck(const rd_ctx *c, const ply_hdr *h, const ply_elem *el,
+                               size_t start, size_t total)
+{
+    char lab[160];
+    size_t rem = total - start;
+    uint64_t fit = rem / el->min_bytes;
+    if (el->count > fit) {
+        if (!el->has_list)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ": byte %zu: file ends %s %s (the header declares "
+                               "%llu vertices of %zu bytes, %zu bytes follow it)",
+                               total, rem % el->min_bytes ? "inside" : "before",
+                               ply_item_label(lab, sizeof lab, h, el, fit),
+                               (unsigned long long)el->count, el->min_bytes, rem);
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ": byte %zu: the header declares %llu vertices of at "
+                           "least %zu bytes, only %zu bytes follow: refused",
+                           start, (unsigned long long)el->count, el->min_bytes, rem);
+    }
+    if (el->count > RD_MAX_POINTS)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: the vertex element declares %llu points, more "
+                           "than the %lld supported",
+                           el->line, (unsigned long long)el->count, (long long)RD_MAX_POINTS);
+    return FDT_IO_OK;
+}
+
+/* Points reserved first when the header's count is not yet backed by
+ * bytes (a pipe, or a file shorter than the count); the array then
+ * doubles as vertices arrive, so it never holds more than twice them. */
+#define PLY_GROW ((size_t)1 << 10)
+
+/* Room for vertex i (counting from 0) of the count: the whole count when
+ * the input's known size holds it, else growing as the data comes. */
+static int ply_vertex_room(rd_points *pb, uint64_t count, size_t i)
+{
+    if (i < pb->cap)
+        return 0;
+    size_t want = pb->cap * 2 > PLY_GROW ? pb->cap * 2 : PLY_GROW;
+    if ((uint64_t)want > count)
+        want = (size_t)count;
+    return fdt_rd_points_reserve(pb, want);
+}
+
+/* Whether el is three little-endian doubles x, y, z and nothing else, on
+ * a little-endian machine: then its bytes are the points array's. */
+static int ply_plain_doubles(const ply_hdr *h, const ply_elem *el, int big)
+{
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    if (big || el->n_props != 3 || el->has_list)
+        return 0;
+    for (size_t k = 0; k < 3; k++) {
+        const ply_prop *p = &h->props[el->first_prop + k];
+        if (p->type != PT_FLOAT64 || p->role != k + 1)
+            return 0;
+    }
+    return 1;
+#else
+    (void)h;
+    (void)el;
+    (void)big;
+    return 0;
+#endif
+}
+
+/* The vertex element (the streamed ply_bin_vertex). */
+static int ply_st_vertex(ply_in *in, const ply_hdr *h, const ply_elem *el, int big,
+                         rd_points *pb)
+{
+    const rd_ctx *c = in->c;
+    char lab[160];
+    size_t start = in->off;
+    /* A count the file's known size holds is allocated at once (the
+     * usual file); otherwise the array grows as vertices arrive. */
+    if (c->size > start && el->count <= (c->size - start) / el->min_bytes &&
+        el->count <= RD_MAX_POINTS) {
+        if (fdt_rd_points_reserve(pb, (size_t)el->count) != 0)
+            return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory for %llu points",
+                               (unsigned long long)el->count);
+    } else if (el->count > RD_MAX_POINTS) {
+        if (in->failed)
+            return FDT_IO_EOPEN;
+        int rc = ply_vertex_precheck(c, h, el, start, ply_total(in));
+        return in->failed ? FDT_IO_EOPEN : rc;
+    }
+    int rc = FDT_IO_OK;
+    size_t bad_at = 0;
+    int bad_k = -1;
+    double bad_v = 0.0;
+    uint64_t i = 0;
+    if (ply_plain_doubles(h, el, big)) {
+        /* Straight into the array: the window's bytes first, then read()
+         * into place, a buffer's worth at a time (progress, growth). */
+        unsigned char *dst = (unsigned char *)pb->xyz;
+        uint64_t bytes = el->count * 24, got = 0;
+        while (got < bytes) {
+            if (ply_vertex_room(pb, el->count, (size_t)(got / 24)) != 0) {
+                rc = FDT_IO_ENOMEM;
+                break;
+            }
+            dst = (unsigned char *)pb->xyz;
+            size_t room = pb->cap * 24 - (size_t)got, k;
+            if (room > in->cap)
+                room = in->cap;
+            if (in->hi > in->lo) {
+                k = in->hi - in->lo < room ? in->hi - in->lo : room;
+                memcpy(dst + got, in->buf + in->lo, k);
+                in->lo += k;
+            } else {
+                ptrdiff_t r = in->failed ? -1 : fdt_rd_src_read(c, dst + got, room);
+                if (r < 0) {
+                    in->failed = 1;
+                    return FDT_IO_EOPEN;
+                }
+                k = (size_t)r;
+            }
+            /* every double now complete is checked, in file order */
+            for (uint64_t v = got / 8; v < (got + k) / 8; v++) {
+                double x = pb->xyz[v];
+                if (!isfinite(x)) {
+                    bad_at = start + (size_t)v * 8;
+                    bad_k = (int)(v % 3);
+                    bad_v = x;
+                    i = v / 3;
+                    break;
+                }
+            }
+            got += k;
+            in->off += k;
+            fdt_rd_progress(c, in->off);
+            if (bad_k >= 0 || k == 0)
+                break;
+        }
+        if (bad_k < 0 && rc == FDT_IO_OK) {
+            if (got == bytes) {
+                pb->n = (size_t)el->count;
+                return FDT_IO_OK;
+            }
+            rc = 1; /* the data ended inside vertex got / 24 */
+        }
+        if (bad_k < 0)
+            i = got / 24;
+    } else {
+        int type[3] = {0, 0, 0};
+        size_t fixed_off[3] = {0, 0, 0};
+        for (size_t j = 0, o = 0; j < el->n_props; j++) {
+            const ply_prop *p = &h->props[el->first_prop + j];
+            if (p->role) {
+                type[p->role - 1] = p->type;
+                fixed_off[p->role - 1] = o;
+            }
+            o += ply_size[p->type];
+        }
+        int r = 0;
+        for (; i < el->count; i++) {
+            if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
+                fdt_rd_progress(c, in->off);
+            if (ply_vertex_room(pb, el->count, (size_t)i) != 0) {
+                rc = FDT_IO_ENOMEM;
+                break;
+            }
+            double *d = pb->xyz + 3 * i;
+            size_t roff[3];
+            if (el->has_list) {
+                r = ply_st_item(in, h, el, big, d, roff, &bad_at);
+            } else if (!ply_need(in, el->min_bytes)) {
+                r = 1;
+            } else {
+                for (int k = 0; k < 3; k++) {
+                    roff[k] = in->off + fixed_off[k];
+                    d[k] = ply_get(in->buf + in->lo + fixed_off[k], type[k], big);
+                }
+                ply_take(in, el->min_bytes);
+            }
+            if (in->failed)
+                return FDT_IO_EOPEN;
+            if (r != 0) {
+                rc = r; /* 1: ends inside; 2: negative list length at bad_at */
+                break;
+            }
+            for (int k = 0; k < 3 && bad_k < 0; k++)
+                if (!isfinite(d[k])) {
+                    bad_k = k;
+                    bad_at = roff[k];
+                    bad_v = d[k];
+                }
+            if (bad_k >= 0)
+                break;
+        }
+        if (rc == FDT_IO_OK && bad_k < 0) {
+            pb->n = (size_t)el->count;
+            return FDT_IO_OK;
+        }
+    }
+    /* The first error: the size checks come first, as in the buffered
+     * read, which makes them before it reads a vertex. */
+    size_t total = ply_total(in);
+    if (in->failed)
+        return FDT_IO_EOPEN;
+    int pre = ply_vertex_precheck(c, h, el, start, total);
+    if (pre != FDT_IO_OK)
+        return pre;
+    if (rc == FDT_IO_ENOMEM)
+        return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory for %llu points",
+                           (unsigned long long)el->count);
+    if (rc == 1)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: file ends inside %s", total,
+                           ply_item_label(lab, sizeof lab, h, el, i));
+    if (rc == 2)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: %s: negative list length", bad_at,
+                           ply_item_label(lab, sizeof lab, h, el, i));
+    return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: %s: %c is %s", bad_at,
+                       ply_item_label(lab, sizeof lab, h, el, i), 'x' + bad_k,
+                       isnan(bad_v) ? "NaN" : "infinite");
+}
+
+/* The body of a binary PLY whose header h was read; in holds the bytes
+ * read after it. */
+static int ply_st_binary(ply_in *in, const ply_hdr *h, rd_points *pb)
+{
+    int big = h->format == PLY_BE;
+    for (size_t ei = 0; ei < h->n_elems; ei++) {
+        const ply_elem *el = &h->elems[ei];
+        int rc = ei == h->vertex ? ply_st_vertex(in, h, el, big, pb)
+                                 : ply_st_skip(in, h, el, big);
+        if (rc != FDT_IO_OK)
+            return rc;
+    }
+    size_t off = in->off;
+    if (ply_need(in, 1)) {
+        size_t total = ply_total(in);
+        if (in->failed)
+            return FDT_IO_EOPEN;
+        return fdt_rd_fail(in->c, FDT_IO_EFORMAT,
+                           ": byte %zu: %zu bytes of extra data after the last "
+                           "element (the header's counts are too small?)",
+                           off, total - off);
+    }
+    return PLY_READ_FAILED(in);
+}
+
+int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned)
+{
+    /* The header: complete lines read until one is end_header. Its parse
+     * sees only whole lines, so that a line cut by the buffer's end is
+     * never taken for a bad one; running out of lines before end_header
+     * means reading more (or, at the end of the input, the error). */
+    size_t cap = c->chunk ? c->chunk : RD_CHUNK, len = 0;
+    if (cap > ((size_t)64 << 10))
+        cap = (size_t)64 << 10; /* headers are short; the body gets its own buffer */
+    if (cap < 16)
+        cap = 16;
+    char *hb = NULL;
+    ply_hdr h;
+    memset(&h, 0, sizeof h);
+    int rc;
+    for (;;) {
+        char *nb = realloc(hb, cap + 1);
+        if (nb == NULL) {
+            free(hb);
+            return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+        }
+        hb = nb;
+        ptrdiff_t r = fdt_rd_src_read(c, hb + len, cap - len);
+        if (r < 0) {
+            free(hb);
+            return FDT_IO_EOPEN;
+        }
+        len += (size_t)r;
+        hb[len] = '\0';
+        if (len == 0) {
+            free(hb);
+            return fdt_rd_fail(c, FDT_IO_EFORMAT, ": no points (empty file)");
+        }
+        int eof = c->src->eof;
+        size_t lines = len;
+        if (!eof) {
+            while (lines > 0 && hb[lines - 1] != '\n')
+                lines--;
+        }
+        rd_ctx hc = *c;
+        hc.buf = hb;
+        hc.size = lines;
+        ply_hdr_free(&h);
+        memset(&h, 0, sizeof h);
+        rc = ply_parse_header(&hc, &h);
+        if (rc == FDT_IO_OK || eof || !h.no_end)
+            break;
+        if (cap > (SIZE_MAX - 1) / 2) {
+            rc = fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+            break;
+        }
+        cap *= 2; /* more lines of header */
+    }
+    if (rc != FDT_IO_OK) {
+        ply_hdr_free(&h);
+        free(hb);
+        return rc;
+    }
+    if (h.format == PLY_ASCII) {
+        /* ASCII: the rest loaded too, and the whole parsed as a buffer
+         * (the header again: its names point into the buffer, which
+         * grows). */
+        ply_hdr_free(&h);
+        while (!c->src->eof) {
+            if (len == cap) {
+                if (cap > (SIZE_MAX - 1) / 2) {
+                    free(hb);
+                    return fdt_rd_fail(c, FDT_IO_ENOMEM, ": file too large for memory");
+                }
+                char *nb = realloc(hb, 2 * cap + 1);
+                if (nb == NULL) {
+                    free(hb);
+                    return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory reading the file");
+                }
+                hb = nb;
+                cap *= 2;
+            }
+            ptrdiff_t r = fdt_rd_src_read(c, hb + len, cap - len);
+            if (r < 0) {
+                free(hb);
+                return FDT_IO_EOPEN;
+            }
+            len += (size_t)r;
+            if (c->progress != NULL)
+                c->progress(c->progress_user, FDT_RD_LOADING, len, c->size > len ? c->size : 0);
+        }
+        hb[len] = '\0';
+        *owned = hb;
+        c->buf = hb;
+        c->size = len;
+        return ply_read_buffered(c, pb);
+    }
+    /* Binary: the header's buffer stays (the elements' names point into
+     * it); the body streams through its own. */
+    ply_in in;
+    memset(&in, 0, sizeof in);
+    in.c = c;
+    size_t chunk = c->chunk ? c->chunk : RD_CHUNK;
+    in.cap = fdt_rd_first_cap(c, chunk, c->size > h.data_off ? c->size - h.data_off + 1 : 1);
+    if (in.cap < 8)
+        in.cap = 8; /* the largest scalar */
+    for (size_t ei = 0; ei < h.n_elems; ei++)
+        if (in.cap < h.elems[ei].min_bytes)
+            in.cap = h.elems[ei].min_bytes; /* a whole item without lists */
+    size_t extra = len - h.data_off;
+    if (in.cap < extra)
+        in.cap = extra;
+    in.buf = malloc(in.cap);
+    if (in.buf == NULL) {
+        rc = fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+    } else {
+        memcpy(in.buf, hb + h.data_off, extra);
+        in.hi = extra;
+        in.off = h.data_off;
+        rc = ply_st_binary(&in, &h, pb);
+    }
+    free(in.buf);
+    ply_hdr_free(&h);
+    free(hb);
     return rc;
 }

@@ -1,6 +1,9 @@
 /*
- * .xyz / .txt point files (src/reader.h): x y z per line; parsed in slices
- * on several threads for large files.
+ * .xyz / .txt point files (src/reader.h): x y z per line, streamed: the
+ * input is read in blocks of rd_ctx.chunk bytes cut after their last line
+ * end (the partial line is carried to the next block), and each block is
+ * parsed in slices on several threads when it is large enough. Only the
+ * points and one block are held (issue 18).
  */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
@@ -77,20 +80,20 @@ static size_t rd_count_fields(const char *s, const char *e)
     return k;
 }
 
-/* The lines in [start, end) (end: c->buf + c->size or just after a '\n')
+/* The lines in [start, end) (end: the input's end or just after a '\n')
  * appended to pb; line numbers count from line0 + 1. Every line must hold
  * ncols fields (the first point line's count); x, y, z are columns
  * c->col[] and the others are skipped unread. Every line is parsed on its
  * own: nothing carries from one line to the next, which is what lets
- * fdt_rd_read_xyz cut the file. */
+ * rd_xyz_block cut a block. */
 static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end, size_t line0,
-                             size_t ncols, rd_points *pb)
+                             size_t ncols, rd_points *pb, size_t *lines)
 {
     /* A guess from typical line lengths; the array doubles as needed. */
     size_t guess = (size_t)(end - start) / 24 + 16;
-    if (guess > RD_MAX_POINTS) /* the growth below checks the limit at cap */
-        guess = (size_t)RD_MAX_POINTS;
-    if (!pb->fixed && fdt_rd_points_reserve(pb, guess) != 0)
+    if (guess > RD_MAX_POINTS - pb->n) /* the growth below checks the limit */
+        guess = (size_t)RD_MAX_POINTS - pb->n;
+    if (!pb->fixed && fdt_rd_points_room(pb, guess) != 0)
         return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
     const size_t c0 = (size_t)c->col[0], c1 = (size_t)c->col[1], c2 = (size_t)c->col[2];
     size_t need = (c0 > c1 ? c0 : c1);
@@ -164,6 +167,8 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
         memcpy(pb->xyz + 3 * pb->n, v, sizeof v);
         pb->n++;
     }
+    if (lines != NULL)
+        *lines = L.lineno - line0;
     return FDT_IO_OK;
 }
 
@@ -193,16 +198,18 @@ typedef struct rd_slice {
     rd_ctx c; /* no message buffer */
     const char *start, *end;
     size_t count; /* lines with content (pass 1) */
+    size_t lines; /* line ends (pass 1) */
     rd_points pb; /* its place in the joint array (pass 2) */
     size_t ncols; /* fields a line (the file's first point line's) */
     int pass, rc;
 } rd_slice;
 
 /* Lines of [s, e) with a byte before their comment that is not a blank:
- * the lines rd_read_xyz_lines turns into points (or refuses). */
-static size_t rd_count_content_lines(const char *s, const char *e)
+ * the lines rd_read_xyz_lines turns into points (or refuses); *lines:
+ * the line ends among them. */
+static size_t rd_count_content_lines(const char *s, const char *e, size_t *lines)
 {
-    size_t k = 0;
+    size_t k = 0, nl_count = 0;
     while (s < e) {
         const char *nl = memchr(s, '\n', (size_t)(e - s)), *le = nl ? nl : e;
         /* the usual line starts with its first number */
@@ -215,8 +222,10 @@ static size_t rd_count_content_lines(const char *s, const char *e)
                     break;
                 }
         }
+        nl_count += nl != NULL;
         s = le + 1;
     }
+    *lines = nl_count;
     return k;
 }
 
@@ -224,10 +233,10 @@ static void *rd_slice_run(void *arg)
 {
     rd_slice *sl = arg;
     if (sl->pass == 0) {
-        sl->count = rd_count_content_lines(sl->start, sl->end);
+        sl->count = rd_count_content_lines(sl->start, sl->end, &sl->lines);
     } else {
         /* line numbers only matter in messages, which slices do not give */
-        sl->rc = rd_read_xyz_lines(&sl->c, sl->start, sl->end, 0, sl->ncols, &sl->pb);
+        sl->rc = rd_read_xyz_lines(&sl->c, sl->start, sl->end, 0, sl->ncols, &sl->pb, NULL);
         if (sl->rc == FDT_IO_OK && sl->pb.n != sl->count)
             sl->rc = FDT_IO_EFORMAT; /* cannot happen: the counts are exact */
     }
@@ -254,26 +263,17 @@ static void rd_slices_pass(rd_slice *sl, size_t T, int pass)
     }
 }
 
-int fdt_rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb)
+/*
+ * The complete lines [start, end) of a block (end: just after a '\n', or
+ * the input's end), whose first line is line line0 + 1, appended to pb on
+ * up to c->threads threads; *lines: the line ends among them. A block's
+ * slices see no messages: when one fails, the block is parsed again on the
+ * calling thread, which words its first error exactly as a one-thread read
+ * does (every block before it was read without error).
+ */
+static int rd_xyz_block(const rd_ctx *c, const char *start, const char *end, size_t line0,
+                        size_t ncols, rd_points *pb, size_t *lines)
 {
-    const char *end = c->buf + c->size;
-    /* A header line (rd_is_header) is skipped; the first point line then
-     * sets the column count of every line, which the slices need before
-     * they start. */
-    size_t line0 = 0, ncols = 3;
-    const char *fs, *fe;
-    size_t fl;
-    if (rd_first_content(start, end, &fs, &fe, &fl)) {
-        if (rd_is_header(fs, fe)) {
-            const char *nl = memchr(fe, '\n', (size_t)(end - fe));
-            start = nl != NULL ? nl + 1 : end;
-            line0 = fl;
-            if (!rd_first_content(start, end, &fs, &fe, &fl))
-                fs = fe = NULL;
-        }
-        if (fs != NULL)
-            ncols = rd_count_fields(fs, fe);
-    }
     size_t len = (size_t)(end - start);
     size_t min_slice = c->min_slice ? c->min_slice : RD_MIN_SLICE;
     size_t T = c->threads > 1 ? (size_t)c->threads : 1;
@@ -282,7 +282,7 @@ int fdt_rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb)
     if (T > len / min_slice)
         T = len / min_slice;
     if (T < 2)
-        return rd_read_xyz_lines(c, start, end, line0, ncols, pb);
+        return rd_read_xyz_lines(c, start, end, line0, ncols, pb, lines);
 
     rd_slice sl[RD_SLICES_MAX];
     const char *cut = start;
@@ -299,37 +299,164 @@ int fdt_rd_read_xyz(const rd_ctx *c, const char *start, rd_points *pb)
         sl[t].c = *c;
         sl[t].c.err = NULL;
         sl[t].c.errlen = 0;
-        /* Progress only from the calling thread's slice 0, scaled to the
-         * whole: the slices are of about equal size. */
-        sl[t].c.progress_scale = T;
-        if (t > 0)
-            sl[t].c.progress = NULL;
+        sl[t].c.progress = NULL; /* the block's driver reports */
         sl[t].ncols = ncols;
         sl[t].start = cut;
         sl[t].end = stop;
         cut = stop;
     }
     rd_slices_pass(sl, T, 0);
-    size_t total = 0;
-    for (size_t t = 0; t < T; t++)
+    size_t total = 0, nls = 0;
+    for (size_t t = 0; t < T; t++) {
         total += sl[t].count;
-    if (total == 0 || total > RD_MAX_POINTS) /* the one-thread read words it */
-        return rd_read_xyz_lines(c, start, end, line0, ncols, pb);
-    rd_points all = {NULL, 0, 0, 0};
-    if (fdt_rd_points_reserve(&all, total) != 0)
-        return rd_read_xyz_lines(c, start, end, line0, ncols, pb); /* which may need less */
-    for (size_t t = 0, at = 0; t < T; t++) {
-        sl[t].pb = (rd_points){all.xyz + 3 * at, 0, sl[t].count, 1};
+        nls += sl[t].lines;
+    }
+    if (total == 0 || fdt_rd_points_room(pb, total) != 0) /* the one-thread read words it */
+        return rd_read_xyz_lines(c, start, end, line0, ncols, pb, lines);
+    for (size_t t = 0, at = pb->n; t < T; t++) {
+        sl[t].pb = (rd_points){pb->xyz + 3 * at, 0, sl[t].count, 1};
         at += sl[t].count;
     }
     rd_slices_pass(sl, T, 1);
     for (size_t t = 0; t < T; t++)
-        if (sl[t].rc != FDT_IO_OK) {
-            free(all.xyz);
-            return rd_read_xyz_lines(c, start, end, line0, ncols, pb);
-        }
-    all.n = total;
-    free(pb->xyz);
-    *pb = all;
+        if (sl[t].rc != FDT_IO_OK)
+            return rd_read_xyz_lines(c, start, end, line0, ncols, pb, lines);
+    pb->n += total;
+    *lines = nls;
     return FDT_IO_OK;
+}
+
+/* Line ends in [s, e). */
+static size_t rd_count_newlines(const char *s, const char *e)
+{
+    size_t k = 0;
+    for (const char *nl; s < e && (nl = memchr(s, '\n', (size_t)(e - s))) != NULL; s = nl + 1)
+        k++;
+    return k;
+}
+
+/* The last '\n' of [s, e), or NULL. */
+static const char *rd_last_newline(const char *s, const char *e)
+{
+    while (e > s)
+        if (*--e == '\n')
+            return e;
+    return NULL;
+}
+
+int fdt_rd_stream_xyz(rd_ctx *c, rd_points *pb)
+{
+    size_t T = c->threads > 1 ? (size_t)c->threads : 1;
+    if (T > RD_SLICES_MAX)
+        T = RD_SLICES_MAX;
+    size_t chunk = c->chunk ? c->chunk : RD_CHUNK;
+    if (c->chunk == 0 && T > 2 && chunk / 2 / T < RD_MIN_SLICE)
+        chunk = 2 * T * RD_MIN_SLICE; /* two slices a thread of a megabyte each */
+    if (chunk < 4)
+        chunk = 4; /* room to tell a byte order mark */
+    /* a known size + 1: the read that finds the end fits */
+    size_t cap = fdt_rd_first_cap(c, chunk, c->size < chunk ? c->size + 1 : chunk);
+    if (cap < 4)
+        cap = 4;
+    char *buf = malloc(cap + 1);
+    if (buf == NULL)
+        return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+    /* Lines before the first content line are blank or comments; the
+     * first content line may be a header (rd_is_header), skipped; the
+     * first point line then sets the column count of every line. */
+    enum { FIND_FIRST, FIND_COLUMNS, PARSE } st = FIND_FIRST;
+    size_t ncols = 3;
+    size_t len = 0;     /* bytes in buf: a carried partial line, then new ones */
+    size_t done = 0;    /* input bytes before buf[0] */
+    size_t lineno = 0;  /* lines before buf[0] */
+    int rc = FDT_IO_OK, first = 1;
+    size_t bom = 0; /* bytes of a byte order mark at buf[0], until parsed */
+    for (;;) {
+        ptrdiff_t r = fdt_rd_src_read(c, buf + len, cap - len);
+        if (r < 0) {
+            rc = FDT_IO_EOPEN;
+            break;
+        }
+        len += (size_t)r;
+        int eof = c->src->eof;
+        buf[len] = '\0';
+        if (first) {
+            if (len == 0) {
+                rc = fdt_rd_fail(c, FDT_IO_EFORMAT, ": no points (empty file)");
+                break;
+            }
+            /* a UTF-8 byte order mark, as some Windows tools write */
+            if (len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0)
+                bom = 3;
+            else if (len < 3 && !eof && memcmp(buf, "\xef\xbb\xbf", len) == 0)
+                continue; /* cannot tell yet */
+            first = 0;
+        }
+        const char *s = buf + bom;
+        const char *end = buf + len;
+        if (!eof) {
+            const char *nl = rd_last_newline(s, end);
+            if (nl == NULL || (len == cap && cap < chunk)) {
+                /* one line longer than the buffer, or a pipe that fills
+                 * its first buffer: make room */
+                if (len == cap) {
+                    if (cap > (SIZE_MAX - 1) / 2) {
+                        rc = fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+                        break;
+                    }
+                    size_t ncap = nl != NULL && 2 * cap > chunk ? chunk : 2 * cap;
+                    char *nb = realloc(buf, ncap + 1);
+                    if (nb == NULL) {
+                        rc = fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+                        break;
+                    }
+                    buf = nb;
+                    cap = ncap;
+                }
+                continue;
+            }
+            end = nl + 1;
+        }
+        size_t line0 = lineno;
+        const char *fs, *fe;
+        size_t fl;
+        if (st == FIND_FIRST && rd_first_content(s, end, &fs, &fe, &fl)) {
+            if (rd_is_header(fs, fe)) {
+                const char *nl = memchr(fe, '\n', (size_t)(end - fe));
+                line0 += fl;
+                s = nl != NULL ? nl + 1 : end;
+                st = FIND_COLUMNS;
+            } else {
+                ncols = rd_count_fields(fs, fe);
+                st = PARSE;
+            }
+        }
+        if (st == FIND_COLUMNS && rd_first_content(s, end, &fs, &fe, &fl)) {
+            ncols = rd_count_fields(fs, fe);
+            st = PARSE;
+        }
+        size_t lines = 0;
+        if (st == PARSE) {
+            /* progress is reported by block, below: a block's own reports
+             * would count from its start */
+            rd_ctx bc = *c;
+            bc.progress = NULL;
+            rc = rd_xyz_block(&bc, s, end, line0, ncols, pb, &lines);
+            if (rc != FDT_IO_OK)
+                break;
+        } else {
+            lines = rd_count_newlines(s, end); /* blank lines, comments */
+        }
+        lineno = line0 + lines;
+        size_t used = (size_t)(end - buf);
+        done += used;
+        fdt_rd_progress(c, done);
+        if (eof)
+            break;
+        memmove(buf, end, len - used);
+        len -= used;
+        bom = 0;
+    }
+    free(buf);
+    return rc;
 }

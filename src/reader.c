@@ -4,10 +4,12 @@
  * src/read_xyz.c, src/read_node.c and src/read_ply.c; numbers, lines and
  * fields of the text formats src/read_text.c.
  *
- * The whole file is read into one NUL-terminated buffer and parsed in
- * memory. Every header count is checked against the bytes that follow it
- * before anything proportional to the count is allocated, so a 100-byte
- * file claiming four billion points costs nothing.
+ * Text point files and binary PLY stream from an rd_src (a descriptor or,
+ * for the _mem entry points, the caller's bytes) through a bounded buffer
+ * (src/read_xyz.c, src/read_ply.c); .node and ASCII PLY are read into one
+ * NUL-terminated buffer and parsed in memory. Nothing proportional to a
+ * header count is allocated before the bytes that back it are seen, so a
+ * 100-byte file claiming four billion points costs nothing.
  */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
@@ -97,6 +99,63 @@ int fdt_rd_points_reserve(rd_points *pb, size_t cap)
     return 0;
 }
 
+int fdt_rd_points_room(rd_points *pb, size_t more)
+{
+    if (more > RD_MAX_POINTS || pb->n > RD_MAX_POINTS - more)
+        return -1;
+    size_t want = pb->n + more;
+    if (want <= pb->cap)
+        return 0;
+    size_t dbl = pb->cap > RD_MAX_POINTS / 2 ? (size_t)RD_MAX_POINTS : 2 * pb->cap;
+    return fdt_rd_points_reserve(pb, want > dbl ? want : dbl);
+}
+
+/* ------------------------------------------------------------------ */
+/* Streamed input                                                     */
+/* ------------------------------------------------------------------ */
+
+/* Bytes a single read() asks for: a bounded request keeps a signal's
+ * EINTR cheap and is all the kernel gives a pipe at once anyway. */
+#define RD_READ_MAX ((size_t)1 << 30)
+
+ptrdiff_t fdt_rd_src_read(const rd_ctx *c, void *dst, size_t len)
+{
+    rd_src *s = c->src;
+    if (len > (size_t)PTRDIFF_MAX)
+        len = (size_t)PTRDIFF_MAX;
+    if (s->fd < 0) {
+        size_t k = s->mem_len - s->pos < len ? s->mem_len - s->pos : len;
+        if (k > 0)
+            memcpy(dst, s->mem + s->pos, k);
+        s->pos += k;
+        if (k < len)
+            s->eof = 1;
+        return (ptrdiff_t)k;
+    }
+    size_t got = 0;
+    while (got < len && !s->eof) {
+        size_t want = len - got < RD_READ_MAX ? len - got : RD_READ_MAX;
+        ssize_t r = read(s->fd, (char *)dst + got, want);
+        if (r == 0) {
+            s->eof = 1;
+            break;
+        }
+        if (r < 0) {
+            if (errno == EINTR)
+                continue;
+            int e = errno;
+            if (e == EISDIR)
+                fdt_rd_fail(c, FDT_IO_EOPEN, ": is a directory");
+            else
+                fdt_rd_fail(c, FDT_IO_EOPEN, ": cannot read: %s", strerror(e));
+            return -1;
+        }
+        got += (size_t)r;
+        s->pos += (size_t)r;
+    }
+    return (ptrdiff_t)got;
+}
+
 /* ------------------------------------------------------------------ */
 /* Files                                                              */
 /* ------------------------------------------------------------------ */
@@ -110,19 +169,22 @@ typedef struct rd_format {
     int id;                 /* FDT_RD_* */
     const char *names[4];   /* lowercase, NULL-terminated */
     int (*parse)(const rd_ctx *c, const char *start, rd_points *pb);
+    /* streamed formats (parse NULL): reads c->src; may leave a buffer it
+     * loaded in *owned */
+    int (*stream)(rd_ctx *c, rd_points *pb, char **owned);
     int has_columns;        /* fdt_rd_opts.columns applies */
 } rd_format;
 
-static int rd_parse_ply(const rd_ctx *c, const char *start, rd_points *pb)
+static int rd_stream_xyz(rd_ctx *c, rd_points *pb, char **owned)
 {
-    (void)start;
-    return fdt_rd_read_ply(c, pb);
+    (void)owned;
+    return fdt_rd_stream_xyz(c, pb);
 }
 
 static const rd_format rd_formats[] = {
-    {FDT_RD_XYZ, {"xyz", "txt", "csv", NULL}, fdt_rd_read_xyz, 1},
-    {FDT_RD_NODE, {"node", NULL, NULL, NULL}, fdt_rd_read_node, 0},
-    {FDT_RD_PLY, {"ply", NULL, NULL, NULL}, rd_parse_ply, 0},
+    {FDT_RD_XYZ, {"xyz", "txt", "csv", NULL}, NULL, rd_stream_xyz, 1},
+    {FDT_RD_NODE, {"node", NULL, NULL, NULL}, fdt_rd_read_node, NULL, 0},
+    {FDT_RD_PLY, {"ply", NULL, NULL, NULL}, NULL, fdt_rd_stream_ply, 0},
 };
 #define RD_N_FORMATS (sizeof rd_formats / sizeof rd_formats[0])
 
@@ -244,9 +306,34 @@ static void rd_begin(rd_ctx *c, double **xyz, size_t *n)
 }
 
 /*
+ * Finishes a parse that gave rc and the points in pb: on success sets *xyz
+ * and *n (the array cut to its points); on failure frees pb and leaves them
+ * alone (the message is in c->err).
+ */
+static int rd_finish(rd_ctx *c, int rc, rd_points *pb, double **xyz, size_t *n)
+{
+    if (rc == FDT_IO_OK && pb->n == 0)
+        rc = fdt_rd_fail(c, FDT_IO_EFORMAT, ": no points");
+    if (rc != FDT_IO_OK) {
+        free(pb->xyz);
+        return rc;
+    }
+    if (c->progress != NULL)
+        c->progress(c->progress_user, FDT_RD_PARSING, c->size, c->size);
+    if (pb->cap > pb->n) {
+        double *x = realloc(pb->xyz, pb->n * 3 * sizeof(double));
+        if (x != NULL) /* shrinking cannot lose data; keep the old block */
+            pb->xyz = x;
+    }
+    *xyz = pb->xyz;
+    *n = pb->n;
+    return FDT_IO_OK;
+}
+
+/*
  * Parses c->buf (c->size bytes and a NUL, owned by the caller) as a file of
- * format f. On success *xyz and *n are set; on failure they are left alone
- * and the message is in c->err.
+ * a buffered format f. On success *xyz and *n are set; on failure they are
+ * left alone and the message is in c->err.
  */
 static int rd_parse(rd_ctx *c, const rd_format *f, double **xyz, size_t *n)
 {
@@ -261,22 +348,25 @@ static int rd_parse(rd_ctx *c, const rd_format *f, double **xyz, size_t *n)
             start += 3;
         rc = f->parse(c, start, &pb);
     }
-    if (rc == FDT_IO_OK && pb.n == 0)
-        rc = fdt_rd_fail(c, FDT_IO_EFORMAT, ": no points");
-    if (rc != FDT_IO_OK) {
-        free(pb.xyz);
-        return rc;
-    }
-    if (c->progress != NULL)
-        c->progress(c->progress_user, FDT_RD_PARSING, c->size, c->size);
-    if (pb.cap > pb.n) {
-        double *x = realloc(pb.xyz, pb.n * 3 * sizeof(double));
-        if (x != NULL) /* shrinking cannot lose data; keep the old block */
-            pb.xyz = x;
-    }
-    *xyz = pb.xyz;
-    *n = pb.n;
-    return FDT_IO_OK;
+    return rd_finish(c, rc, &pb, xyz, n);
+}
+
+/*
+ * Streams src as a file of a streamed format f. c->size holds the size of
+ * a regular file (0 when not known); it is the bytes read at the end.
+ */
+static int rd_stream(rd_ctx *c, const rd_format *f, rd_src *src, double **xyz, size_t *n)
+{
+    rd_points pb = {NULL, 0, 0, 0};
+    char *owned = NULL;
+    c->src = src;
+    int rc = f->stream(c, &pb, &owned);
+    free(owned);
+    c->buf = NULL;
+    c->size = src->pos;
+    c->size_known = 1;
+    c->src = NULL;
+    return rd_finish(c, rc, &pb, xyz, n);
 }
 
 /*
@@ -288,6 +378,7 @@ static const rd_format *rd_setup(rd_ctx *c, const char *name, const fdt_rd_opts 
 {
     c->threads = o->threads;
     c->min_slice = o->min_slice;
+    c->chunk = o->chunk;
     c->progress = o->progress;
     c->progress_user = o->progress_user;
     c->progress_scale = 1;
@@ -352,8 +443,19 @@ int fdt_rd_points_with(const char *path, const fdt_rd_opts *o, double **xyz, siz
         rc = fdt_rd_fail(&c, FDT_IO_EOPEN, ": cannot open: %s", strerror(errno));
     else if (S_ISDIR(st.st_mode))
         rc = fdt_rd_fail(&c, FDT_IO_EOPEN, ": is a directory");
-    else if ((f = rd_setup(&c, path, o, &rc)) != NULL)
+    else if ((f = rd_setup(&c, path, o, &rc)) != NULL && f->stream == NULL)
         rc = rd_slurp(&c, fd, &st, &buf);
+    if (rc == FDT_IO_OK && f != NULL && f->stream != NULL) {
+        rd_src src = {fd, NULL, 0, 0, 0};
+        if (S_ISREG(st.st_mode)) /* a hint for readahead: failure is harmless */
+            (void)posix_fadvise(fd, 0, 0, POSIX_FADV_SEQUENTIAL);
+        c.size_known = S_ISREG(st.st_mode) && (uintmax_t)st.st_size <= SIZE_MAX;
+        c.size = c.size_known ? (size_t)st.st_size : 0;
+        rc = rd_stream(&c, f, &src, xyz, n);
+        if (!is_stdin)
+            close(fd);
+        return rc;
+    }
     if (!is_stdin)
         close(fd);
     if (rc != FDT_IO_OK)
@@ -379,7 +481,15 @@ int fdt_rd_points_mem_with(const char *name, const void *data, size_t len,
     const rd_format *f = rd_setup(&c, name, o, &rc);
     if (f == NULL)
         return rc;
-    /* The parsers expect what rd_slurp gives them: a private copy with a
+    if (f->stream != NULL) {
+        /* the streamed formats copy the bytes chunk by chunk, as they
+         * would read them from a file */
+        rd_src src = {-1, data, len, 0, 0};
+        c.size = len;
+        c.size_known = 1;
+        return rd_stream(&c, f, &src, xyz, n);
+    }
+    /* The buffered parsers expect what rd_slurp gives them: a private copy with a
      * NUL after the last byte. Copying keeps the two entry points one code
      * path (and lets the fuzzers find reads past that NUL). */
     if (len > SIZE_MAX - 1)

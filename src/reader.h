@@ -60,6 +60,11 @@ enum {
 };
 
 /*
+ * Memory: .xyz/.txt/.csv and binary .ply are streamed through a buffer of
+ * fdt_rd_opts.chunk bytes (8 MiB; 2 a thread more with several threads),
+ * so a read holds the points (24 bytes each) and that buffer, never the
+ * file; .node and ASCII .ply are read whole first.
+ *
  * Reads all points of path. On success *xyz is a malloc'd array of 3 * *n
  * doubles owned by the caller (free()). On failure *xyz is NULL, *n is 0
  * and err holds a one-line message (NUL-terminated, truncated to errlen).
@@ -110,9 +115,10 @@ enum {
 
 /*
  * Called now and then on the calling thread while a read goes on: done
- * bytes of total (total 0 while loading from a pipe, whose size is not
- * known). Parsing with several threads reports the calling thread's share
- * scaled to the whole (an estimate).
+ * bytes of total (total 0 while reading a pipe, whose size is not known
+ * until its end). The streamed formats (.xyz/.txt/.csv, binary .ply) parse
+ * as they read and report FDT_RD_PARSING only, a block at a time; .node and
+ * ASCII .ply report FDT_RD_LOADING, then FDT_RD_PARSING.
  */
 typedef void (*fdt_rd_progress_fn)(void *user, int stage, size_t done, size_t total);
 
@@ -122,6 +128,10 @@ typedef struct fdt_rd_opts {
                           counted from 1; {0, 0, 0}: 1, 2, 3 */
     int threads;       /* as fdt_rd_points_threads */
     size_t min_slice;  /* as fdt_rd_points_threads; 0: a megabyte */
+    size_t chunk;      /* bytes of the streamed reads' buffer (.xyz/.txt/
+                          .csv, binary .ply); 0: 8 MiB. Results do not
+                          depend on it: the tests make it tiny so that
+                          lines and items straddle many refills */
     fdt_rd_progress_fn progress; /* may be NULL */
     void *progress_user;
 } fdt_rd_opts;

@@ -22,6 +22,13 @@
  * writes it to PERM_OUT: line i holds the original index of output point
  * i, so tests can map a mesh of the shuffled file back and check that the
  * tetrahedralization does not depend on input order.
+ *
+ * An OUT ending in .ply gets the same points as binary little-endian PLY
+ * (x, y, z as doubles: the values the text file holds, rounded as the
+ * family writes them), for the
+ * large runs of issue 18, whose text alone would be 6 GB at 10^8 points.
+ * The uniform family without --shuffle is then written as it is drawn, a
+ * block at a time, so 10^8 points need a few megabytes beside the file.
  */
 #include <errno.h>
 #include <math.h>
@@ -1245,7 +1252,7 @@ static const struct family {
 static int usage(const char *argv0)
 {
     fprintf(stderr,
-            "usage: %s FAMILY N SEED OUT.xyz [--shuffle PERM_OUT]\n"
+            "usage: %s FAMILY N SEED OUT.xyz|OUT.ply [--shuffle PERM_OUT]\n"
             "       %s --list\n"
             "families (~N: the count is rounded to the family's structure;\n"
             "tests/gen_points.c says what each imitates and why it is hard):\n",
@@ -1263,6 +1270,62 @@ static int parse_u64(const char *s, uint64_t *v)
     if (errno || end == s || *end || s[0] == '-')
         return -1;
     *v = x;
+    return 0;
+}
+
+/* Whether path ends in .ply (any case): binary output. */
+static int is_ply(const char *path)
+{
+    size_t len = strlen(path);
+    if (len < 4 || path[len - 4] != '.')
+        return 0;
+    const char *e = path + len - 3;
+    return (e[0] == 'p' || e[0] == 'P') && (e[1] == 'l' || e[1] == 'L') &&
+           (e[2] == 'y' || e[2] == 'Y');
+}
+
+static int ply_header(FILE *f, const char *family, uint64_t n, uint64_t seed)
+{
+    return fprintf(f,
+                   "ply\nformat binary_little_endian 1.0\n"
+                   "comment gen_points %s %llu %llu\n"
+                   "element vertex %llu\nproperty double x\nproperty double y\n"
+                   "property double z\nend_header\n",
+                   family, (unsigned long long)n, (unsigned long long)seed,
+                   (unsigned long long)n) < 0;
+}
+
+/* Doubles as little-endian bytes into out (8 each), whatever the host. */
+static void put_le(unsigned char *out, const double *v, size_t k)
+{
+    for (size_t i = 0; i < k; i++) {
+        uint64_t u;
+        memcpy(&u, &v[i], sizeof u);
+        for (int b = 0; b < 8; b++)
+            out[8 * i + (size_t)b] = (unsigned char)(u >> (8 * b));
+    }
+}
+
+/* Points per block of the binary writers (1.5 MiB). */
+#define PLY_BLOCK 65536
+
+/* The uniform family drawn straight into a binary PLY: the draws of
+ * fam_uniform, in its order, never all in memory. */
+static int stream_uniform_ply(FILE *f, uint64_t n, uint64_t seed, rng *r)
+{
+    static double v[3 * PLY_BLOCK];
+    static unsigned char b[24 * PLY_BLOCK];
+    if (ply_header(f, "uniform", n, seed))
+        return 1;
+    for (uint64_t i = 0; i < n;) {
+        size_t k = n - i < PLY_BLOCK ? (size_t)(n - i) : PLY_BLOCK;
+        for (size_t j = 0; j < 3 * k; j++)
+            v[j] = rng_u01(r);
+        put_le(b, v, 3 * k);
+        if (fwrite(b, 24, k, f) != k)
+            return 1;
+        i += k;
+    }
     return 0;
 }
 
@@ -1289,6 +1352,22 @@ int main(int argc, char **argv)
 
     rng r;
     rng_seed(&r, seed);
+    int ply = is_ply(argv[4]);
+    if (ply && !perm_path && fam->fn == fam_uniform) {
+        FILE *f = fopen(argv[4], "wb");
+        if (!f) {
+            fprintf(stderr, "gen_points: %s: %s\n", argv[4], strerror(errno));
+            return 1;
+        }
+        int bad = stream_uniform_ply(f, n, seed, &r);
+        if (fclose(f))
+            bad = 1;
+        if (bad) {
+            fprintf(stderr, "gen_points: writing output failed\n");
+            return 1;
+        }
+        return 0;
+    }
     pts p = {NULL, 0, 0};
     int rc = fam->fn(&p, (size_t)n, &r);
     if (rc) {
@@ -1320,14 +1399,32 @@ int main(int argc, char **argv)
     }
 
     int bad = 0;
-    FILE *f = fopen(argv[4], "w");
+    FILE *f = fopen(argv[4], ply ? "wb" : "w");
     if (!f) {
         fprintf(stderr, "gen_points: %s: %s\n", argv[4], strerror(errno));
         free(p.xyz);
         free(perm);
         return 1;
     }
-    for (size_t i = 0; i < p.n; i++) {
+    if (ply) {
+        bad = ply_header(f, fam->name, p.n, seed);
+        unsigned char b[24];
+        for (size_t i = 0; i < p.n && !bad; i++) {
+            double c[3];
+            memcpy(c, &p.xyz[3 * (perm ? perm[i] : i)], sizeof c);
+            /* the values the family's text holds, rounded as it writes them */
+            const char *fmt = fam->fmt == FMT_12G ? "%.12g" : fam->fmt == FMT_2F ? "%.2f"
+                              : fam->fmt == FMT_6F ? "%.6f" : NULL;
+            for (int k = 0; k < 3 && fmt != NULL; k++) {
+                char t[64];
+                snprintf(t, sizeof t, fmt, c[k]);
+                c[k] = strtod(t, NULL);
+            }
+            put_le(b, c, 3);
+            bad = fwrite(b, 24, 1, f) != 1;
+        }
+    }
+    for (size_t i = 0; i < p.n && !ply; i++) {
         const double *c = &p.xyz[3 * (perm ? perm[i] : i)];
         int w;
         switch (fam->fmt) {

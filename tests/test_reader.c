@@ -31,6 +31,7 @@
 #include <sys/stat.h>
 #include <time.h>
 #include <pthread.h>
+#include <signal.h>
 #include <unistd.h>
 #include "testutil.h"
 
@@ -1938,6 +1939,7 @@ static int read_stdin(const void *data, size_t len, int format, double **xyz, si
 
 typedef struct prog_log {
     size_t calls[2], last_done[2], last_total[2];
+    size_t zero_total; /* reports with total 0 */
     int backwards;
 } prog_log;
 
@@ -1949,6 +1951,7 @@ static void prog_cb(void *user, int stage, size_t done, size_t total)
     if (l->calls[stage] > 0 && done < l->last_done[stage])
         l->backwards = 1;
     l->calls[stage]++;
+    l->zero_total += total == 0;
     l->last_done[stage] = done;
     l->last_total[stage] = total;
 }
@@ -2017,42 +2020,284 @@ static void test_stdin(tctx *t)
     memset(&lg, 0, sizeof lg);
     o.progress = prog_cb;
     o.progress_user = &lg;
+    o.chunk = 65536; /* several blocks: reports while the size is unknown */
     rc = fdt_rd_points_with(fifo, &o, &xyz, &n, err, sizeof err);
     pthread_join(tid, NULL);
     EXPECTF(rc == FDT_IO_OK && n == NP && memcmp(xyz, want, 3 * NP * sizeof *want) == 0,
           "fifo: %s, %zu points: %s", code_name(rc), n, err);
     free(xyz);
-    /* Progress from a pipe: loading with no total, then parsing to the end. */
-    EXPECTF(lg.calls[FDT_RD_LOADING] > 0 && lg.last_done[FDT_RD_LOADING] == b.n &&
-                 lg.last_total[FDT_RD_LOADING] == 0,
-          "fifo progress: loading %zu calls, %zu of %zu", lg.calls[0], lg.last_done[0],
-          lg.last_total[0]);
-    EXPECTF(lg.calls[FDT_RD_PARSING] > 0 && lg.last_done[FDT_RD_PARSING] == b.n &&
+    /* Progress from a pipe: the text is streamed, so it is parsed as it
+     * is read: parsing reports with no total (a pipe's size is unknown)
+     * until the last, which has it; nothing is loaded first. */
+    EXPECTF(lg.calls[FDT_RD_LOADING] == 0 && lg.calls[FDT_RD_PARSING] >= 3 &&
+                 lg.zero_total > 0 && lg.last_done[FDT_RD_PARSING] == b.n &&
                  lg.last_total[FDT_RD_PARSING] == b.n && !lg.backwards,
-          "fifo progress: parsing %zu calls, %zu of %zu", lg.calls[1], lg.last_done[1],
-          lg.last_total[1]);
+          "fifo progress: loading %zu calls, parsing %zu calls (%zu without a total), last %zu "
+          "of %zu",
+          lg.calls[0], lg.calls[1], lg.zero_total, lg.last_done[1], lg.last_total[1]);
 
-    /* A regular file, on 1 and 3 threads: totals known, parsing never
-     * backwards (reports every 8192 lines: several for one thread). */
+    /* A regular file, on 1 and 3 threads, in blocks of 4 KiB: the total
+     * known from the start, parsing never backwards, a report a block. */
     char path[1024];
     write_file(t, "progress.xyz", b.p, b.n, path, sizeof path);
     for (int T = 1; T <= 3; T += 2) {
         memset(&lg, 0, sizeof lg);
         o.format = FDT_RD_AUTO;
         o.threads = T;
-        o.min_slice = 4096;
+        o.min_slice = 1024;
+        o.chunk = 4096;
         rc = fdt_rd_points_with(path, &o, &xyz, &n, err, sizeof err);
-        EXPECTF(rc == FDT_IO_OK && n == NP, "progress.xyz: %s: %s", code_name(rc), err);
+        EXPECTF(rc == FDT_IO_OK && n == NP && memcmp(xyz, want, 3 * NP * sizeof *want) == 0,
+              "progress.xyz: %s: %s", code_name(rc), err);
         free(xyz);
-        EXPECTF(lg.last_done[FDT_RD_LOADING] == b.n && lg.last_total[FDT_RD_LOADING] == b.n &&
-                     lg.calls[FDT_RD_PARSING] >= (T == 1 ? 3u : 1u) &&
-                     lg.last_done[FDT_RD_PARSING] == b.n && !lg.backwards,
-              "progress.xyz (%d threads): loading %zu/%zu, parsing %zu calls", T,
-              lg.last_done[0], lg.last_total[0], lg.calls[1]);
+        EXPECTF(lg.calls[FDT_RD_LOADING] == 0 && lg.calls[FDT_RD_PARSING] >= b.n / 4096 &&
+                     lg.zero_total == 0 && lg.last_done[FDT_RD_PARSING] == b.n && !lg.backwards,
+              "progress.xyz (%d threads): parsing %zu calls, %zu without a total", T,
+              lg.calls[1], lg.zero_total);
     }
     bb_free(&b);
     bb_free(&p);
     free(want);
+}
+
+/* ------------------------------------------------------------------ */
+/* Chunk boundaries (issue 18: streamed .xyz and binary .ply)         */
+/* ------------------------------------------------------------------ */
+
+/* Reads len bytes named name in blocks of chunk bytes (0: the default,
+ * one block for these inputs) on threads threads (slices of a byte and
+ * up): from memory, or, with pipe set, through a pipe as standard input
+ * (format from name's extension; messages then start "stdin"). */
+static int read_chunked(const char *name, const void *data, size_t len, size_t chunk,
+                        int threads, int pipe_in, double **xyz, size_t *n, char *err,
+                        size_t errlen)
+{
+    fdt_rd_opts o;
+    fdt_rd_opts_default(&o);
+    o.chunk = chunk;
+    o.threads = threads;
+    o.min_slice = 1;
+    if (!pipe_in)
+        return fdt_rd_points_mem_with(name, data, len, &o, xyz, n, err, errlen);
+    int fds[2];
+    if (pipe(fds) != 0)
+        exit(1);
+    int saved = dup(STDIN_FILENO);
+    if (saved < 0 || dup2(fds[0], STDIN_FILENO) < 0)
+        exit(1);
+    close(fds[0]);
+    pipe_writer w = {NULL, fds[1], data, len};
+    pthread_t tid;
+    if (pthread_create(&tid, NULL, pipe_writer_run, &w) != 0)
+        exit(1);
+    o.format = fdt_rd_format_of_path(name);
+    int rc = fdt_rd_points_with("-", &o, xyz, n, err, errlen);
+    pthread_join(tid, NULL);
+    dup2(saved, STDIN_FILENO);
+    close(saved);
+    return rc;
+}
+
+/*
+ * The input read in blocks of every size from 1 byte to past its length,
+ * on 1 and 3 threads, from memory and (for some sizes) through a pipe,
+ * gives the points want (nw of them) or, when msg is not NULL, exactly
+ * the code and message msg (as for the name; "stdin" through a pipe),
+ * as the one-block read does. Small blocks put a block boundary inside
+ * every line, number, CRLF pair, comment, header line and PLY item.
+ */
+static void chunk_case(tctx *t, int line, const char *name, const void *data, size_t len,
+                       int code, const char *msg, const double *want, size_t nw)
+{
+    size_t last = len + 2;
+    for (size_t chunk = 0; chunk <= last; chunk++) {
+        for (int threads = 1; threads <= 3; threads += 2) {
+            for (int via = 0; via < 2; via++) {
+                if (via == 1 && !(chunk == 1 || chunk == 5 || chunk == 17 || chunk == last))
+                    continue; /* pipes cost a thread each: a few sizes */
+                double *xyz = NULL;
+                size_t n = 0;
+                char err[512];
+                err[0] = '\0';
+                int rc = read_chunked(name, data, len, chunk, threads, via, &xyz, &n, err,
+                                      sizeof err);
+                char wmsg[600];
+                if (msg != NULL)
+                    snprintf(wmsg, sizeof wmsg, "%s%s", via ? "stdin" : name,
+                             msg + strlen(name));
+                if (msg == NULL && (rc != FDT_IO_OK || n != nw ||
+                                    memcmp(xyz, want, 3 * nw * sizeof *want) != 0))
+                    fail_at(t, line, "%s, chunk %zu, %d threads%s: %s, %zu points (want %zu): %s",
+                            name, chunk, threads, via ? ", pipe" : "", code_name(rc), n, nw,
+                            err);
+                if (msg != NULL && (rc != code || strcmp(err, wmsg) != 0 || xyz != NULL))
+                    fail_at(t, line, "%s, chunk %zu, %d threads%s: %s '%s', want %s '%s'",
+                            name, chunk, threads, via ? ", pipe" : "", code_name(rc), err,
+                            code_name(code), wmsg);
+                free(xyz);
+            }
+        }
+    }
+}
+#define CHUNK_OK(t, name, text, want)                                                  \
+    chunk_case((t), __LINE__, name, text, strlen(text), FDT_IO_OK, NULL, want,            \
+               sizeof(want) / sizeof(want)[0] / 3)
+#define CHUNK_ERR(t, name, text, code, msg)                                            \
+    chunk_case((t), __LINE__, name, text, strlen(text), code, msg, NULL, 0)
+
+/* A binary little-endian PLY header for nv vertices of three doubles
+ * (+ extra lines before end_header). */
+static void ply_le_header(bbuf *b, size_t nv, const char *props, const char *more)
+{
+    bb_printf(b, "ply\nformat binary_little_endian 1.0\ncomment chunks\nelement vertex %zu\n%s%s"
+                 "end_header\n",
+              nv, props, more);
+}
+
+static void put_le(bbuf *b, const void *v, size_t size)
+{
+    unsigned char out[8];
+    uint64_t u = 0;
+    memcpy(&u, v, size); /* little-endian hosts only: see below */
+    for (size_t i = 0; i < size; i++)
+        out[i] = (unsigned char)(u >> (8 * i));
+    bb_put(b, out, size);
+}
+
+static void test_chunks(tctx *t)
+{
+    /* a read that stops at an error leaves its pipe's writer with bytes
+     * no one reads: EPIPE for it, not a signal for the test */
+    signal(SIGPIPE, SIG_IGN);
+    static const double w9[] = {1, 2, 3, 4.5, 50, -6, 7, 8, 9};
+    /* lines, numbers and exponents split at every byte */
+    CHUNK_OK(t, "split.xyz", "1 2 3\n4.5 5e1 -6\n7 8 9\n", w9);
+    /* CRLF: a boundary between '\r' and '\n' */
+    CHUNK_OK(t, "crlf.xyz", "1 2 3\r\n4.5 5e1 -6\r\n7 8 9\r\n", w9);
+    /* the last line without its newline */
+    CHUNK_OK(t, "nolf.xyz", "1 2 3\n4.5 5e1 -6\n7 8 9", w9);
+    CHUNK_OK(t, "nolfcr.csv", "1,2,3\r\n4.5,5e1,-6\r\n7,8,9\r", w9);
+    /* a byte order mark, a comment and a header line longer than small
+     * blocks, blank lines, comments between points */
+    CHUNK_OK(t, "header.csv",
+             "\xef\xbb\xbf# exported by a scanner, a comment line\n\n  X, Y, Z  # names\n"
+             "1,2,3\n# between\n\n4.5,5e1,-6 # trailing\n7,8,9\n",
+             w9);
+    /* a line longer than every small block (blanks and a skipped column) */
+    CHUNK_OK(t, "long.xyz",
+             "1                                                  2 3\n"
+             "4.5 5e1 -6\n7 8 9\n",
+             w9);
+    /* errors after boundaries keep their line numbers */
+    CHUNK_ERR(t, "bad.xyz", "1 2 3\r\n# c\n\n4 5 6\n7 8 q9\n", FDT_IO_EFORMAT,
+              "bad.xyz:5: not a number: 'q9'");
+    CHUNK_ERR(t, "hdrbad.xyz", "X Y Z\n\n1 2 3\n4 5\n", FDT_IO_EFORMAT,
+              "hdrbad.xyz:4: expected 3 numbers, found 2");
+    CHUNK_ERR(t, "cols.xyz", "1 2 3 4\n5 6 7 8\n9 10 11\n", FDT_IO_EFORMAT,
+              "cols.xyz:3: expected 4 columns as on the first line, found 3");
+    CHUNK_ERR(t, "comma.csv", "1,2,3\n4,,6\n", FDT_IO_EFORMAT,
+              "comma.csv:2: empty field (stray comma)");
+    CHUNK_ERR(t, "empty.xyz", "", FDT_IO_EFORMAT, "empty.xyz: no points (empty file)");
+    CHUNK_ERR(t, "comments.xyz", "# nothing\n\n   \n# here\n", FDT_IO_EFORMAT,
+              "comments.xyz: no points");
+    CHUNK_ERR(t, "onlyhdr.csv", "x,y,z\n", FDT_IO_EFORMAT, "onlyhdr.csv: no points");
+
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    /* Binary PLY: three doubles a vertex (read straight into the array). */
+    bbuf b = {0};
+    ply_le_header(&b, 3, "property double x\nproperty double y\nproperty double z\n", "");
+    for (size_t i = 0; i < 9; i++)
+        put_le(&b, &w9[i], 8);
+    chunk_case(t, __LINE__, "le.ply", b.p, b.n, FDT_IO_OK, NULL, w9, 3);
+    /* a short body: the error names the byte where the data ends */
+    size_t hdr = b.n - 72;
+    char msg[300];
+    snprintf(msg, sizeof msg,
+             "short.ply: byte %zu: file ends inside vertex 3 of 3 (the header declares 3 "
+             "vertices of 24 bytes, 50 bytes follow it)",
+             hdr + 50);
+    chunk_case(t, __LINE__, "short.ply", b.p, hdr + 50, FDT_IO_EFORMAT, msg, NULL, 0);
+    snprintf(msg, sizeof msg,
+             "before.ply: byte %zu: file ends before vertex 3 of 3 (the header declares 3 "
+             "vertices of 24 bytes, 48 bytes follow it)",
+             hdr + 48);
+    chunk_case(t, __LINE__, "before.ply", b.p, hdr + 48, FDT_IO_EFORMAT, msg, NULL, 0);
+    /* extra bytes after the last element */
+    bb_put(&b, "xyz", 3);
+    snprintf(msg, sizeof msg,
+             "extra.ply: byte %zu: 3 bytes of extra data after the last element (the header's "
+             "counts are too small?)",
+             hdr + 72);
+    chunk_case(t, __LINE__, "extra.ply", b.p, b.n, FDT_IO_EFORMAT, msg, NULL, 0);
+    /* a NaN in the middle: its byte, and a short body still wins, as the
+     * buffered reader refused it before reading a vertex */
+    b.n = hdr;
+    double nan = NAN;
+    for (size_t i = 0; i < 9; i++)
+        put_le(&b, i == 4 ? &nan : &w9[i], 8);
+    snprintf(msg, sizeof msg, "nan.ply: byte %zu: vertex 2 of 3: y is NaN", hdr + 32);
+    chunk_case(t, __LINE__, "nan.ply", b.p, b.n, FDT_IO_EFORMAT, msg, NULL, 0);
+    snprintf(msg, sizeof msg,
+             "nanshort.ply: byte %zu: file ends inside vertex 3 of 3 (the header declares 3 "
+             "vertices of 24 bytes, 60 bytes follow it)",
+             hdr + 60);
+    chunk_case(t, __LINE__, "nanshort.ply", b.p, hdr + 60, FDT_IO_EFORMAT, msg, NULL, 0);
+
+    /* float x, y, z with a colour, then faces with a list: decoded through
+     * the buffer, items cut at every byte */
+    bb_free(&b);
+    ply_le_header(&b, 3,
+                  "property float x\nproperty uchar red\nproperty float y\nproperty float z\n",
+                  "element face 2\nproperty list uchar int vertex_indices\n");
+    for (size_t i = 0; i < 3; i++) {
+        for (int k = 0; k < 3; k++) {
+            float f = (float)w9[3 * i + (size_t)k];
+            put_le(&b, &f, 4);
+            if (k == 0)
+                bb_put(&b, "\x7f", 1);
+        }
+    }
+    for (int f = 0; f < 2; f++) {
+        bb_put(&b, "\x03", 1);
+        for (int32_t v = 0; v < 3; v++)
+            put_le(&b, &v, 4);
+    }
+    chunk_case(t, __LINE__, "mixed.ply", b.p, b.n, FDT_IO_OK, NULL, w9, 3);
+    hdr = b.n - 3 * 13 - 2 * 13;
+    snprintf(msg, sizeof msg, "mixedshort.ply: byte %zu: file ends inside element 'face' item "
+                              "2 of 2", b.n - 1);
+    chunk_case(t, __LINE__, "mixedshort.ply", b.p, b.n - 1, FDT_IO_EFORMAT, msg, NULL, 0);
+    /* a vertex with a list: read item by item, a negative length named */
+    bb_free(&b);
+    ply_le_header(&b, 2,
+                  "property double x\nproperty list char short n\nproperty double y\n"
+                  "property double z\n",
+                  "");
+    hdr = b.n;
+    for (size_t i = 0; i < 2; i++) {
+        put_le(&b, &w9[3 * i], 8);
+        bb_put(&b, i == 0 ? "\x02" : "\xff", 1);
+        if (i == 0)
+            bb_put(&b, "\x01\x00\x02\x00", 4);
+        put_le(&b, &w9[3 * i + 1], 8);
+        put_le(&b, &w9[3 * i + 2], 8);
+    }
+    snprintf(msg, sizeof msg, "neglist.ply: byte %zu: vertex 2 of 2: negative list length",
+             hdr + 29 + 8);
+    chunk_case(t, __LINE__, "neglist.ply", b.p, b.n, FDT_IO_EFORMAT, msg, NULL, 0);
+    bb_free(&b);
+#endif
+    /* ASCII PLY and a header cut anywhere, with or without its end */
+    CHUNK_OK(t, "ascii.ply",
+             "ply\nformat ascii 1.0\ncomment a comment longer than a small block\n"
+             "element vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
+             "end_header\n1 2 3\n4.5 5e1 -6\n7 8 9\n",
+             w9);
+    CHUNK_ERR(t, "noend.ply",
+              "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty double x\n",
+              FDT_IO_EFORMAT, "noend.ply:4: the header has no end_header line");
+    CHUNK_ERR(t, "notply.ply", "plyx\nformat ascii 1.0\n", FDT_IO_EFORMAT,
+              "notply.ply:1: not a PLY file (the first line is 'plyx', expected 'ply')");
 }
 
 int main(int argc, char **argv)
@@ -2089,6 +2334,7 @@ int main(int argc, char **argv)
     test_locale(&t);
     test_columns(&t);
     test_stdin(&t);
+    test_chunks(&t);
     replay_bad(&t, argv[1]);
     replay_good(&t, argv[2]);
     remove_tree(t.dir);
