@@ -41,10 +41,18 @@ typedef struct fdt_front_stats {
 
 /* Triangulates all points of tree t (ids [t->base, t->base + t->n)),
  * starting from a seed near point `start`; search is an fdt_search
- * (src/oracle.h: how each face's apex is found). */
+ * (src/oracle.h: how each face's apex is found). The tets and hull faces
+ * go to `out` (tree-order ids: an in-memory meshbuf, with neighbours if
+ * it keeps them). */
 int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
                      fdt_progress_fn progress, void *puser,
                      fdt_front_stats *st);
+
+/* The same, every tet and hull face emitted through em (src/sink.h: kept
+ * in memory, streamed to a caller's sink or dropped) as it is built. */
+struct fdt_emit;
+int fdt_front_emit(const fdt_kdtree *t, uint32_t start, int search, struct fdt_emit *em,
+                   fdt_progress_fn progress, void *puser, fdt_front_stats *st);
 
 /* The kd search's first `faces` faces of the front over tree t, for their
  * work counters in st only (the tets are dropped): what src/oracle.c's
