@@ -9,6 +9,8 @@ int fdt_tsink_init(fdt_tsink *s, const fdt_vid *orig, const fdt_sink *user)
     memset(s, 0, sizeof *s);
     s->orig = orig;
     s->user = user;
+    s->batch = FDT_SINK_BATCH;
+    s->hbatch = FDT_SINK_HBATCH;
     if (pthread_mutex_init(&s->lock, NULL) != 0)
         return FDT_ENOMEM;
     s->lock_ok = 1;
@@ -29,8 +31,10 @@ int fdt_emit_init(fdt_emit *em, fdt_tsink *s, fdt_meshbuf *mb)
     em->mb = s->user ? NULL : mb;
     em->packed = !(em->mb && em->mb->nbrs);
     if (s->user) {
-        em->tb = malloc((size_t)FDT_SINK_BATCH * 4 * sizeof *em->tb);
-        em->hb = malloc((size_t)FDT_SINK_HBATCH * 3 * sizeof *em->hb);
+        if (s->batch < 1 || s->hbatch < 1)
+            return FDT_EINVAL;
+        em->tb = malloc(s->batch * 4 * sizeof *em->tb);
+        em->hb = malloc(s->hbatch * 3 * sizeof *em->hb);
         if (!em->tb || !em->hb) {
             fdt_emit_free(em);
             return FDT_ENOMEM;
@@ -95,7 +99,7 @@ int64_t fdt_emit_tet(fdt_emit *em, const uint32_t v[4])
         fdt_vid *d = em->tb + 4 * em->tn;
         fdt_sink_renumber(em->s->orig, d, v, 4);
         fdt_sethash_add(&em->h, (const uint32_t *)d);
-        if (++em->tn == FDT_SINK_BATCH) {
+        if (++em->tn == em->s->batch) {
             int rc = hand_on(em);
             if (rc)
                 return rc;
@@ -112,7 +116,7 @@ int fdt_emit_hull(fdt_emit *em, const uint32_t f[3])
     if (!em->hb)
         return FDT_OK;
     fdt_sink_renumber(em->s->orig, em->hb + 3 * em->hn, f, 3);
-    if (++em->hn == FDT_SINK_HBATCH)
+    if (++em->hn == em->s->hbatch)
         return hand_on(em);
     return FDT_OK;
 }

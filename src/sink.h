@@ -42,6 +42,10 @@
 typedef struct fdt_tsink {
     const fdt_vid *orig;      /* tree-order id -> input index (borrowed) */
     const fdt_sink *user;     /* NULL: memory or nothing (borrowed) */
+    size_t batch, hbatch;     /* tets and hull faces a batch holds: set by
+                                 fdt_tsink_init (FDT_SINK_BATCH,
+                                 FDT_SINK_HBATCH); tests make them small
+                                 before any fdt_emit_init */
     /* Serializes the caller's callbacks (the contract: never two at once)
      * and guards rc, hash, ntets, nhull. A thread's unlock after its
      * callback releases what the callback wrote; the next thread's lock
