@@ -117,6 +117,17 @@ typedef struct fdt_settings {
     fdt_progress_fn progress;/* may be NULL */
     void *progress_user;     /* borrowed, passed back to progress */
     fdt_search search;       /* default FDT_SEARCH_AUTO */
+    int permute_input;       /* nonzero: fdt_triangulate and
+                                fdt_triangulate_stream may keep their
+                                copy of the points in the caller's xyz
+                                array (which must then be writable: the
+                                const is cast away), saving 24 bytes a
+                                point; on return, success or not, xyz
+                                holds the distinct points scaled by a
+                                power of two in an unspecified order.
+                                Default 0: xyz is only read. (Added after
+                                the first release in what was padding:
+                                sizeof(fdt_settings) did not change.) */
 } fdt_settings;
 
 /*
@@ -327,6 +338,23 @@ typedef struct fdt_stats {
     size_t mesh_faces;        /* faces whose apex the mesh gave */
     size_t mesh_parts;        /* parts (fronts) that built a mesh */
     double t_mesh;            /* seconds building meshes (summed over threads) */
+    /* Memory (issue 18): the bytes each structure held at its largest
+     * (all threads together). Added after the first release: a caller
+     * compiled without them passes the shorter size and gets the rest. */
+    size_t mem_points;        /* the points in tree order (24 a vertex:
+                                 in the caller's array with
+                                 settings.permute_input), their input
+                                 indices (4) and the duplicate map (4 an
+                                 input point) */
+    size_t mem_merge;         /* the duplicate merge's hash table (freed
+                                 before the front starts) */
+    size_t mem_tree;          /* the kd-trees: nodes, cells, leaf maps,
+                                 float blocks */
+    size_t mem_front;         /* face tables (at their largest capacity)
+                                 and face queues (at the end) */
+    size_t mem_mesh;          /* tets and hull faces kept in memory (0
+                                 when streamed), neighbours included */
+    size_t mem_sink;          /* the stream's batches (one per thread) */
 } fdt_stats;
 
 /* Fills the first struct_size bytes of *st (its struct_size included).

@@ -1,5 +1,7 @@
 /* The public entry points: settings, context, the triangulation pipeline
  * (DESIGN.md, Data flow). */
+#include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -55,6 +57,13 @@ void fdt_free(void *p) { free(p); }
  * (offsetof the first field it lacks), whose missing fields then take
  * their defaults in fdt_open.
  */
+/* permute_input took what was padding after search: the struct kept its
+ * size, so every caller's struct_size is still this one. */
+_Static_assert(sizeof(fdt_settings) ==
+                   (offsetof(fdt_settings, search) + sizeof(fdt_search) +
+                    _Alignof(fdt_settings) - 1) / _Alignof(fdt_settings) * _Alignof(fdt_settings),
+               "permute_input inside the first release's size");
+
 static int settings_size_known(size_t size)
 {
     return size == sizeof(fdt_settings);
@@ -168,11 +177,16 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     /* The merge runs on the engine's threads in parallel modes; serial
      * mode stays sequential from end to end. */
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    int err = fdt_prepare(xyz, n,
-                          mode == FDT_MODE_SERIAL ? 1
-                          : cpus >= 1 && nthreads > cpus ? (int)cpus
-                                                         : nthreads,
-                          &pr, ctx->diag, sizeof ctx->diag);
+    /* permute_input: the caller's array becomes the point store (the
+     * const was the caller's to give up, include/frontdt.h). */
+    int err = ctx->s.permute_input
+                  ? fdt_prepare_inplace((double *)(uintptr_t)xyz, n, &pr, ctx->diag,
+                                        sizeof ctx->diag)
+                  : fdt_prepare(xyz, n,
+                                mode == FDT_MODE_SERIAL          ? 1
+                                : cpus >= 1 && nthreads > cpus ? (int)cpus
+                                                               : nthreads,
+                                &pr, ctx->diag, sizeof ctx->diag);
     if (err) {
         fdt_tsink_free(&sink);
         return err;
@@ -197,6 +211,7 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
         fdt_oracle_probe(pr.p, (uint32_t)pr.m, ctx->s.leaf_size))
         popt.global_mesh = 1;
     double t1;
+    size_t mem_tree = 0, mem_mesh = 0, mem_sink = 0;
     fdt_front_stats fst;
     memset(&fst, 0, sizeof fst);
     if (mode != FDT_MODE_SERIAL) {
@@ -213,6 +228,7 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
         err = FDT_ENOMEM;
         if (fdt_kd_build(&tree, pr.p, pr.orig, 0, (uint32_t)pr.m, ctx->s.leaf_size) != FDT_OK)
             goto fail;
+        mem_tree = fdt_kd_bytes(&tree);
         if (!user &&
             fdt_meshbuf_init(&mb, (size_t)(6.9 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
             goto fail;
@@ -223,6 +239,8 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
                              ctx->s.progress, ctx->s.progress_user, &fst);
         if (!err)
             err = fdt_emit_flush(&em);
+        mem_mesh = fdt_meshbuf_bytes(&mb);
+        mem_sink = fdt_emit_bytes(&em);
     }
     if (err) {
         if (err == FDT_ENOMEM)
@@ -281,6 +299,14 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     st->t_mesh = fst.t_mesh;
     st->threads = 1;
     st->mode = FDT_MODE_SERIAL;
+    /* Memory (include/frontdt.h): the points' three arrays, then each
+     * structure at its largest. */
+    st->mem_points = pr.m * (3 * sizeof *pr.p + sizeof *pr.orig) + n * sizeof *pr.dupmap;
+    st->mem_merge = pr.merge_bytes;
+    st->mem_tree = mem_tree;
+    st->mem_front = fst.mem_front;
+    st->mem_mesh = mem_mesh;
+    st->mem_sink = mem_sink;
     st->t_prepare = t1 - t0;
     st->t_front = t2 - t1;
     st->t_finish = fdt_now_s() - t2;
@@ -290,6 +316,10 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
         st->t_finish += par.t_gather;
         r->tstats = par.tstats;
         par.tstats = NULL;
+        st->mem_tree = par.pst.mem_tree;
+        st->mem_front = par.pst.mem_front;
+        st->mem_mesh = par.pst.mem_mesh;
+        st->mem_sink = par.pst.mem_sink;
     }
     fdt_emit_free(&em);
     fdt_tsink_free(&sink);

@@ -38,6 +38,16 @@ void fdt_meshbuf_free(fdt_meshbuf *mb)
     memset(mb, 0, sizeof *mb);
 }
 
+size_t fdt_meshbuf_bytes(const fdt_meshbuf *mb)
+{
+    size_t b = mb->tets ? mb->tcap * 4 * sizeof *mb->tets : 0;
+    if (mb->nbrs)
+        b += mb->tcap * 4 * sizeof *mb->nbrs;
+    if (mb->hull)
+        b += mb->hcap * 3 * sizeof *mb->hull;
+    return b;
+}
+
 int64_t fdt_meshbuf_add_tet(fdt_meshbuf *mb, const uint32_t v[4])
 {
     if (mb->ntets == mb->tcap) {
@@ -241,6 +251,7 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *
     if (ft.count != 0 && st->faces_advanced < max_faces)
         err = FDT_EINTERNAL;
 done:
+    st->mem_front = fdt_front_bytes(&ft, &fq);
     st->mesh_faces = orc.mesh_faces;
     st->star_walks = orc.star_walks;
     st->mesh_parts = orc.switched_at != 0;
@@ -249,6 +260,17 @@ done:
     fdt_facetab_free(&ft);
     fdt_faceq_free(&fq);
     return err;
+}
+
+size_t fdt_front_bytes(const fdt_facetab *ft, const fdt_faceq *fq)
+{
+    size_t b = ft->cap * sizeof *ft->slots;
+    b += fq->nb * (sizeof *fq->face + sizeof *fq->n + sizeof *fq->cap) +
+         fq->nwords * sizeof *fq->bits + (fq->nwords + 63) / 64 * sizeof *fq->summary;
+    for (size_t k = 0; k < fq->nb; k++)
+        if (fq->face[k])
+            b += (size_t)fq->cap[k] * 3 * sizeof(uint32_t);
+    return b;
 }
 
 int fdt_front_emit(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *out,

@@ -379,6 +379,10 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         fdt_tp_counts(e->tp, i, &mc);
         *ts = w->st;
         ts->tets = (size_t)w->em.ntets;
+        ps->mem_tree += fdt_kd_bytes(&pt.trees[i]);
+        ps->mem_front += fdt_front_bytes(&w->ft, &w->fq);
+        ps->mem_mesh += fdt_meshbuf_bytes(&w->out);
+        ps->mem_sink += fdt_emit_bytes(&w->em);
         msg_counts_add(ts->sent, mc.sent);
         msg_counts_add(ts->received, mc.received);
         msg_counts_add(ps->sent, mc.sent);

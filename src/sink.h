@@ -88,6 +88,12 @@ void fdt_tsink_free(fdt_tsink *s);
 int fdt_emit_init(fdt_emit *em, fdt_tsink *s, fdt_meshbuf *mb);
 void fdt_emit_free(fdt_emit *em);
 
+/* The bytes of em's batches (fdt_stats.mem_sink). */
+static inline size_t fdt_emit_bytes(const fdt_emit *em)
+{
+    return em->tb ? em->s->batch * 4 * sizeof *em->tb + em->s->hbatch * 3 * sizeof *em->hb : 0;
+}
+
 /* Emits positively oriented tet v (tree-order ids). Returns its id (per
  * thread, from 0), or a negative FDT_E* code: FDT_ENOMEM, or the sink's
  * stop code (FDT_ECANCELED or the caller's negative FDT_E*). */
