@@ -6,9 +6,11 @@
  * front and the parallel engine streaming through small batches (many
  * calls a run) with the in-memory run's tets, stopped mid-run by the sink
  * or the progress callback in every mode and thread count (2, 3 and 5
- * threads on 2 cores: no hang).
+ * threads on 2 cores: no hang); settings.permute_input and the memory
+ * statistics through the public API.
  */
 #include <pthread.h>
+#include <stddef.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -360,6 +362,52 @@ static void test_engine(void)
                     runs[i].threads, err, k.nt, k.after_stop);
         }
     }
+    /* The public entry point with permute_input: the points prepared in
+     * the caller's array (left scaled and reordered), the same tets; the
+     * memory statistics say where the bytes went, and a caller compiled
+     * before them (the first release's fdt_stats) gets the rest. */
+    for (size_t i = 0; i < 3; i++) {
+        s.mode = runs[i].mode;
+        s.n_threads = runs[i].threads;
+        s.permute_input = 1;
+        CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+        double *own = malloc(sizeof *own * 3 * n);
+        CHECK(own);
+        memcpy(own, p, sizeof *own * 3 * n);
+        tally k;
+        tally_init(&k);
+        fdt_sink us = {sizeof us, tally_tets, tally_hull, &k};
+        fdt_result *r = NULL;
+        CHECK_EQ(fdt_triangulate_stream(ctx, own, n, &us, &r), FDT_OK);
+        uint64_t h;
+        fdt_stats st;
+        CHECK_EQ(fdt_result_set_hash(r, &h), FDT_OK);
+        CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
+        EXPECTF(h == h0 && k.nt == nt && st.tets == nt && memcmp(own, p, sizeof *own * 3 * n) != 0,
+                "permute_input, mode %d", (int)runs[i].mode);
+        EXPECT(st.mem_mesh == 0 && st.mem_sink >= (size_t)runs[i].threads * 16 * FDT_SINK_BATCH &&
+               st.mem_points == n * 32 && st.mem_tree > 16 * n && st.mem_front > 0 &&
+               st.mem_merge >= 8 * n);
+        unsigned char buf[sizeof(fdt_stats) + 16];
+        memset(buf, 0xA5, sizeof buf);
+        size_t old = offsetof(fdt_stats, mem_points);
+        CHECK_EQ(fdt_result_stats_sized(r, (fdt_stats *)buf, old), FDT_OK);
+        EXPECT(((fdt_stats *)buf)->struct_size == old && ((fdt_stats *)buf)->tets == nt &&
+               buf[old] == 0xA5 && buf[sizeof buf - 1] == 0xA5);
+        EXPECT(fdt_result_stats_sized(r, (fdt_stats *)buf, old + 8) == FDT_EINVAL);
+        fdt_result_free(&r);
+        /* in memory: the mesh's bytes, no batches */
+        s.permute_input = 0;
+        fdt_close(&ctx);
+        CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+        CHECK_EQ(fdt_triangulate(ctx, p, n, &r), FDT_OK);
+        CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
+        EXPECT(st.mem_mesh >= 16 * nt && st.mem_sink == 0 && st.mem_points == n * 32);
+        fdt_result_free(&r);
+        fdt_close(&ctx);
+        free(own);
+    }
+
     /* The progress callback cancels a streamed run too (public API; the
      * parallel engine's calling thread asks every 50 ms, the serial front
      * every 64k tets: 40k points). */
