@@ -253,7 +253,9 @@ FDT_API int fdt_result_set_hash(const fdt_result *r, uint64_t *hash);
  * tets: called with batches of finished tets, 4 ids each, in the caller's
  *   numbering (as fdt_result_tets), positively oriented; every tet of the
  *   mesh exactly once, in no particular order. The library serializes the
- *   calls (never two at once) but may make them from any of its threads.
+ *   calls (never two at once) but may make them from any of its threads:
+ *   each of its threads fills a batch of its own (up to 65,536 tets) and
+ *   hands it over under one lock, so what a call wrote is seen by the next.
  *   A nonzero return stops the run: fdt_triangulate_stream then returns
  *   FDT_ECANCELED (or the value, if it is a negative FDT_E* code).
  * hull: as tets for the hull faces, 3 ids each, outward (may be NULL).
@@ -272,7 +274,9 @@ typedef struct fdt_sink {
  * its stats (stats.tets counts the tets emitted), its duplicate map and
  * its set hash (fdt_result_set_hash). settings.neighbors is refused
  * (FDT_EINVAL). On failure *out is NULL and some tets may already have
- * gone to the sink.
+ * gone to the sink. Memory is the points, the search structure and the
+ * front, not the mesh (with settings.permute_input about 60 bytes a
+ * uniform point; README, Streaming).
  */
 FDT_API int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
                                    const fdt_sink *sink, fdt_result **out);

@@ -19,7 +19,13 @@
  * with neighbours the face index, to link the two tets. Without
  * neighbours a face's link (fdt_face.tet) carries the opposite vertex
  * itself (fdt_emit_link), so no front ever reads a tet back and a
- * streamed run keeps none.
+ * streamed run keeps none. The rest of what the fronts keep of built tets
+ * is independent of the sink: the oracle's map from tet id to insertion-
+ * mesh tet (4 bytes a tet, only while a part reads its apexes from a mesh,
+ * src/oracle.h), the parallel engine's `built` set (the sorted ids of the
+ * tets with a face owned by another part: duplicate requests, src/engine.c;
+ * it grows with the cuts, not the volume) and its link lists (between
+ * parts, with neighbours only).
  */
 #ifndef FDT_SINK_H
 #define FDT_SINK_H
