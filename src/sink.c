@@ -86,7 +86,7 @@ static int hand_on(fdt_emit *em)
     return rc;
 }
 
-int64_t fdt_emit_tet(fdt_emit *em, const uint32_t v[4])
+int64_t fdt_emit_tet_any(fdt_emit *em, const uint32_t v[4])
 {
     if (em->mb) {
         int64_t tid = fdt_meshbuf_add_tet(em->mb, v);
