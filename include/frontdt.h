@@ -23,7 +23,9 @@
  *     knows) is refused with FDT_EINVAL and nothing is written;
  *   - an fdt_settings must come from fdt_default_settings() (which sets
  *     struct_size); one zeroed by hand is refused by fdt_open().
- * Today every struct has one size (the first release): sizeof of it.
+ * Today every struct has one size (the first release's), except
+ * fdt_stats, which has two: the first release's (ending at t_mesh) and
+ * this one's, with the memory fields (mem_points ..).
  * fdt_read_options and fdt_write_options (file formats, at the end) follow
  * the same rule.
  */
