@@ -23,7 +23,9 @@
  *     knows) is refused with FDT_EINVAL and nothing is written;
  *   - an fdt_settings must come from fdt_default_settings() (which sets
  *     struct_size); one zeroed by hand is refused by fdt_open().
- * Today every struct has one size (the first release): sizeof of it.
+ * Today every struct has one size (the first release's), except
+ * fdt_stats, which has two: the first release's (ending at t_mesh) and
+ * this one's, with the memory fields (mem_points ..).
  * fdt_read_options and fdt_write_options (file formats, at the end) follow
  * the same rule.
  */
@@ -117,6 +119,17 @@ typedef struct fdt_settings {
     fdt_progress_fn progress;/* may be NULL */
     void *progress_user;     /* borrowed, passed back to progress */
     fdt_search search;       /* default FDT_SEARCH_AUTO */
+    int permute_input;       /* nonzero: fdt_triangulate and
+                                fdt_triangulate_stream may keep their
+                                copy of the points in the caller's xyz
+                                array (which must then be writable: the
+                                const is cast away), saving 24 bytes a
+                                point; on return, success or not, xyz
+                                holds the distinct points scaled by a
+                                power of two in an unspecified order.
+                                Default 0: xyz is only read. (Added after
+                                the first release in what was padding:
+                                sizeof(fdt_settings) did not change.) */
 } fdt_settings;
 
 /*
@@ -242,7 +255,9 @@ FDT_API int fdt_result_set_hash(const fdt_result *r, uint64_t *hash);
  * tets: called with batches of finished tets, 4 ids each, in the caller's
  *   numbering (as fdt_result_tets), positively oriented; every tet of the
  *   mesh exactly once, in no particular order. The library serializes the
- *   calls (never two at once) but may make them from any of its threads.
+ *   calls (never two at once) but may make them from any of its threads:
+ *   each of its threads fills a batch of its own (up to 65,536 tets) and
+ *   hands it over under one lock, so what a call wrote is seen by the next.
  *   A nonzero return stops the run: fdt_triangulate_stream then returns
  *   FDT_ECANCELED (or the value, if it is a negative FDT_E* code).
  * hull: as tets for the hull faces, 3 ids each, outward (may be NULL).
@@ -261,7 +276,9 @@ typedef struct fdt_sink {
  * its stats (stats.tets counts the tets emitted), its duplicate map and
  * its set hash (fdt_result_set_hash). settings.neighbors is refused
  * (FDT_EINVAL). On failure *out is NULL and some tets may already have
- * gone to the sink.
+ * gone to the sink. Memory is the points, the search structure and the
+ * front, not the mesh (with settings.permute_input about 60 bytes a
+ * uniform point; README, Streaming).
  */
 FDT_API int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
                                    const fdt_sink *sink, fdt_result **out);
@@ -327,6 +344,23 @@ typedef struct fdt_stats {
     size_t mesh_faces;        /* faces whose apex the mesh gave */
     size_t mesh_parts;        /* parts (fronts) that built a mesh */
     double t_mesh;            /* seconds building meshes (summed over threads) */
+    /* Memory (issue 18): the bytes each structure held at its largest
+     * (all threads together). Added after the first release: a caller
+     * compiled without them passes the shorter size and gets the rest. */
+    size_t mem_points;        /* the points in tree order (24 a vertex:
+                                 in the caller's array with
+                                 settings.permute_input), their input
+                                 indices (4) and the duplicate map (4 an
+                                 input point) */
+    size_t mem_merge;         /* the duplicate merge's hash table (freed
+                                 before the front starts) */
+    size_t mem_tree;          /* the kd-trees: nodes, cells, leaf maps,
+                                 float blocks */
+    size_t mem_front;         /* face tables (at their largest capacity)
+                                 and face queues (at the end) */
+    size_t mem_mesh;          /* tets and hull faces kept in memory (0
+                                 when streamed), neighbours included */
+    size_t mem_sink;          /* the stream's batches (one per thread) */
 } fdt_stats;
 
 /* Fills the first struct_size bytes of *st (its struct_size included).

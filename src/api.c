@@ -1,5 +1,7 @@
 /* The public entry points: settings, context, the triangulation pipeline
  * (DESIGN.md, Data flow). */
+#include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,6 +18,7 @@
 #include "result.h"
 #include "seed.h"
 #include "sethash.h"
+#include "sink.h"
 
 struct fdt_context {
     fdt_settings s;
@@ -54,6 +57,13 @@ void fdt_free(void *p) { free(p); }
  * (offsetof the first field it lacks), whose missing fields then take
  * their defaults in fdt_open.
  */
+/* permute_input took what was padding after search: the struct kept its
+ * size, so every caller's struct_size is still this one. */
+_Static_assert(sizeof(fdt_settings) ==
+                   (offsetof(fdt_settings, search) + sizeof(fdt_search) +
+                    _Alignof(fdt_settings) - 1) / _Alignof(fdt_settings) * _Alignof(fdt_settings),
+               "permute_input inside the first release's size");
+
 static int settings_size_known(size_t size)
 {
     return size == sizeof(fdt_settings);
@@ -130,8 +140,14 @@ static uint32_t central_point(const fdt_kdtree *t)
     return fdt_kd_nearest(t, c, FDT_NONE, NULL);
 }
 
-int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
-                    fdt_result **out)
+/*
+ * The pipeline of fdt_triangulate and fdt_triangulate_stream: user NULL
+ * keeps the mesh (the in-memory sink: each thread's meshbuf, gathered and
+ * renumbered at the end), else every tet and hull face leaves through the
+ * caller's sink as it is built (src/sink.h) and the result keeps none.
+ */
+static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *user,
+               fdt_result **out)
 {
     if (!ctx || !out || (!xyz && n))
         return FDT_EINVAL;
@@ -153,16 +169,29 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     fdt_par_out par;
     memset(&par, 0, sizeof par);
     fdt_result *r = NULL;
+    fdt_tsink sink;
+    fdt_emit em;
+    memset(&em, 0, sizeof em);
+    if (fdt_tsink_init(&sink, NULL, user) != FDT_OK)
+        return FDT_ENOMEM;
     /* The merge runs on the engine's threads in parallel modes; serial
      * mode stays sequential from end to end. */
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    int err = fdt_prepare(xyz, n,
-                          mode == FDT_MODE_SERIAL ? 1
-                          : cpus >= 1 && nthreads > cpus ? (int)cpus
-                                                         : nthreads,
-                          &pr, ctx->diag, sizeof ctx->diag);
-    if (err)
+    /* permute_input: the caller's array becomes the point store (the
+     * const was the caller's to give up, include/frontdt.h). */
+    int err = ctx->s.permute_input
+                  ? fdt_prepare_inplace((double *)(uintptr_t)xyz, n, &pr, ctx->diag,
+                                        sizeof ctx->diag)
+                  : fdt_prepare(xyz, n,
+                                mode == FDT_MODE_SERIAL          ? 1
+                                : cpus >= 1 && nthreads > cpus ? (int)cpus
+                                                               : nthreads,
+                                &pr, ctx->diag, sizeof ctx->diag);
+    if (err) {
+        fdt_tsink_free(&sink);
         return err;
+    }
+    sink.orig = pr.orig;
     if ((err = fdt_seed_check_dimension(pr.p, pr.orig, (uint32_t)pr.m, ctx->diag,
                                         sizeof ctx->diag)) != FDT_OK)
         goto fail;
@@ -175,11 +204,14 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
      * 54). An explicit mode is kept as asked. */
     fdt_par_opts popt;
     memset(&popt, 0, sizeof popt);
+    if (user)
+        popt.sink = &sink;
     if (ctx->s.mode == FDT_MODE_AUTO && mode == FDT_MODE_SHARED &&
         ctx->s.search == FDT_SEARCH_AUTO &&
         fdt_oracle_probe(pr.p, (uint32_t)pr.m, ctx->s.leaf_size))
         popt.global_mesh = 1;
     double t1;
+    size_t mem_tree = 0, mem_mesh = 0, mem_sink = 0;
     fdt_front_stats fst;
     memset(&fst, 0, sizeof fst);
     if (mode != FDT_MODE_SERIAL) {
@@ -196,18 +228,28 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
         err = FDT_ENOMEM;
         if (fdt_kd_build(&tree, pr.p, pr.orig, 0, (uint32_t)pr.m, ctx->s.leaf_size) != FDT_OK)
             goto fail;
-        if (fdt_meshbuf_init(&mb, (size_t)(6.9 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
+        mem_tree = fdt_kd_bytes(&tree);
+        if (!user &&
+            fdt_meshbuf_init(&mb, (size_t)(6.9 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
+            goto fail;
+        if (fdt_emit_init(&em, &sink, &mb) != FDT_OK)
             goto fail;
         t1 = fdt_now_s();
-        err = fdt_front_serial(&tree, central_point(&tree), (int)ctx->s.search, &mb, ctx->s.progress,
-                               ctx->s.progress_user, &fst);
+        err = fdt_front_emit(&tree, central_point(&tree), (int)ctx->s.search, &em,
+                             ctx->s.progress, ctx->s.progress_user, &fst);
+        if (!err)
+            err = fdt_emit_flush(&em);
+        mem_mesh = fdt_meshbuf_bytes(&mb);
+        mem_sink = fdt_emit_bytes(&em);
     }
     if (err) {
         if (err == FDT_ENOMEM)
-            snprintf(ctx->diag, sizeof ctx->diag, "out of memory after %zu tetrahedra", mb.ntets);
+            snprintf(ctx->diag, sizeof ctx->diag, "out of memory after %lld tetrahedra",
+                     (long long)em.ntets);
         else if (err == FDT_EINTERNAL)
             snprintf(ctx->diag, sizeof ctx->diag,
-                     "internal error: the front became inconsistent after %zu tetrahedra", mb.ntets);
+                     "internal error: the front became inconsistent after %lld tetrahedra",
+                     (long long)em.ntets);
         goto fail;
     }
     double t2 = fdt_now_s();
@@ -215,16 +257,19 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     r = calloc(1, sizeof *r);
     if (!r)
         goto fail;
-    /* Renumber into the caller's numbering in place: tree-order id i is
-     * input point pr.orig[i] (same width, so the buffers are reused). The
-     * parallel engine's threads did that as they gathered the mesh. */
+    /* Renumber into the caller's numbering in place (the sink's one rule,
+     * fdt_sink_renumber; same width, so the buffers are reused). The
+     * parallel engine's threads did that as they gathered the mesh; a
+     * streamed run's tets were renumbered as they left. */
     fdt_vid *tets = (fdt_vid *)mb.tets;
     fdt_vid *hull = (fdt_vid *)mb.hull;
-    if (mode == FDT_MODE_SERIAL) {
-        for (size_t i = 0; i < 4 * mb.ntets; i++)
-            tets[i] = pr.orig[mb.tets[i]];
-        for (size_t i = 0; i < 3 * mb.nhull; i++)
-            hull[i] = pr.orig[mb.hull[i]];
+    if (mode == FDT_MODE_SERIAL && !user) {
+        fdt_sink_renumber(pr.orig, tets, mb.tets, 4 * mb.ntets);
+        fdt_sink_renumber(pr.orig, hull, mb.hull, 3 * mb.nhull);
+    }
+    if (user) {
+        r->streamed = 1;
+        r->set_hash = fdt_sethash_value(&sink.hash);
     }
     r->tets = tets;
     r->ntets = mb.ntets;
@@ -239,8 +284,8 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     fdt_stats *st = &r->stats;
     st->points = n;
     st->vertices = pr.m;
-    st->tets = r->ntets;
-    st->hull_faces = r->nhull;
+    st->tets = user ? sink.ntets : r->ntets;
+    st->hull_faces = user ? sink.nhull : r->nhull;
     st->faces_advanced = fst.faces_advanced;
     st->kd_nodes_visited = fst.kq.nodes;
     st->points_tested = fst.kq.points;
@@ -254,6 +299,14 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
     st->t_mesh = fst.t_mesh;
     st->threads = 1;
     st->mode = FDT_MODE_SERIAL;
+    /* Memory (include/frontdt.h): the points' three arrays, then each
+     * structure at its largest. */
+    st->mem_points = pr.m * (3 * sizeof *pr.p + sizeof *pr.orig) + n * sizeof *pr.dupmap;
+    st->mem_merge = pr.merge_bytes;
+    st->mem_tree = mem_tree;
+    st->mem_front = fst.mem_front;
+    st->mem_mesh = mem_mesh;
+    st->mem_sink = mem_sink;
     st->t_prepare = t1 - t0;
     st->t_front = t2 - t1;
     st->t_finish = fdt_now_s() - t2;
@@ -263,7 +316,13 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
         st->t_finish += par.t_gather;
         r->tstats = par.tstats;
         par.tstats = NULL;
+        st->mem_tree = par.pst.mem_tree;
+        st->mem_front = par.pst.mem_front;
+        st->mem_mesh = par.pst.mem_mesh;
+        st->mem_sink = par.pst.mem_sink;
     }
+    fdt_emit_free(&em);
+    fdt_tsink_free(&sink);
     fdt_kd_free(&tree);
     fdt_prepared_free(&pr);
     if (ctx->s.progress)
@@ -273,6 +332,10 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n,
 fail:
     if (err == FDT_ENOMEM && !ctx->diag[0])
         snprintf(ctx->diag, sizeof ctx->diag, "out of memory triangulating %zu points", n);
+    if (err == FDT_ECANCELED && !ctx->diag[0])
+        snprintf(ctx->diag, sizeof ctx->diag, "canceled");
+    fdt_emit_free(&em);
+    fdt_tsink_free(&sink);
     fdt_meshbuf_free(&mb);
     fdt_par_out_free(&par);
     fdt_kd_free(&tree);
@@ -281,19 +344,9 @@ fail:
     return err;
 }
 
-/* Hands count records of width w (ids) to fn in batches, so a caller's
- * writer sees bounded calls. */
-static int sink_batches(int (*fn)(void *, const fdt_vid *, size_t), void *user,
-                        const fdt_vid *v, size_t count, size_t w)
+int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n, fdt_result **out)
 {
-    enum { BATCH = 1 << 16 };
-    for (size_t i = 0; i < count; i += BATCH) {
-        size_t k = count - i < BATCH ? count - i : BATCH;
-        int rc = fn(user, v + w * i, k);
-        if (rc)
-            return rc < 0 && rc >= FDT_EFORMAT ? rc : FDT_ECANCELED;
-    }
-    return FDT_OK;
+    return run(ctx, xyz, n, NULL, out);
 }
 
 int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
@@ -306,29 +359,5 @@ int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
         snprintf(ctx->diag, sizeof ctx->diag, "a streamed run has no neighbours");
         return FDT_EINVAL;
     }
-    /* First stage: the whole mesh is built, then handed over and dropped;
-     * the sink's contract (batches, input numbering, any order) is the one
-     * the engine's own emission keeps (issue 18). */
-    fdt_result *r = NULL;
-    int err = fdt_triangulate(ctx, xyz, n, &r);
-    if (err)
-        return err;
-    fdt_sethash h = {0, 0};
-    fdt_sethash_add_n(&h, (const uint32_t *)r->tets, r->ntets);
-    err = sink_batches(sink->tets, sink->user, r->tets, r->ntets, 4);
-    if (!err && sink->hull)
-        err = sink_batches(sink->hull, sink->user, r->hull, r->nhull, 3);
-    if (err) {
-        fdt_result_free(&r);
-        return err;
-    }
-    free(r->tets);
-    free(r->hull);
-    r->tets = NULL;
-    r->hull = NULL;
-    r->ntets = r->nhull = 0;
-    r->streamed = 1;
-    r->set_hash = fdt_sethash_value(&h);
-    *out = r;
-    return FDT_OK;
+    return run(ctx, xyz, n, sink, out);
 }

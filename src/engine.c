@@ -58,7 +58,8 @@ int fdt_eng_face_arrives(worker *w, const uint32_t v[3], int thread, int64_t lin
         int ta = (int)s->aux;
         int64_t la = (int64_t)s->tet;
         if (ta == w->id && thread == w->id) {
-            /* (tid << 2) | i is exactly the index of slot i of tet tid. */
+            /* (tid << 2) | i is exactly the index of slot i of tet tid
+             * (with neighbours the links are not packed, src/sink.h). */
             w->out.nbrs[la] = link >> 2;
             w->out.nbrs[link] = la >> 2;
         } else if ((err = fdt_link_add(&w->links, ta, la, thread, link)) != FDT_OK) {
@@ -114,9 +115,9 @@ int fdt_eng_build_tet(worker *w, const uint32_t v[4], int request, fdt_face *adv
             return FDT_OK;
         }
     }
-    int64_t tid = fdt_meshbuf_add_tet(&w->out, v);
+    int64_t tid = fdt_emit_tet(&w->em, v);
     if (tid < 0)
-        return FDT_ENOMEM;
+        return (int)tid;
     uint32_t fc[4][3];
     int nf = 4;
     if (advanced) {
@@ -124,7 +125,8 @@ int fdt_eng_build_tet(worker *w, const uint32_t v[4], int request, fdt_face *adv
          * may grow or shift the table), as in src/front.c. */
         fdt_face_canon(v[fdt_tet_face[3][0]], v[fdt_tet_face[3][1]],
                        v[fdt_tet_face[3][2]], fc[3]);
-        int err = fdt_eng_face_arrives(w, fc[3], w->id, (tid << 2) | 3, advanced);
+        int err = fdt_eng_face_arrives(w, fc[3], w->id,
+                                       (int64_t)fdt_emit_link(&w->em, tid, 3, v[3]), advanced);
         if (err)
             return err;
         nf = 3;
@@ -137,17 +139,18 @@ int fdt_eng_build_tet(worker *w, const uint32_t v[4], int request, fdt_face *adv
     }
     for (int i = 0; i < nf; i++) {
         const uint32_t *fv = fc[i];
-        int64_t link = (tid << 2) | i;
+        int64_t link = (int64_t)fdt_emit_link(&w->em, tid, i, v[i]);
         int owner = i == lowi ? far_owner : w->id;
         int err = owner == w->id ? fdt_eng_face_arrives(w, fv, w->id, link, NULL)
                                  : fdt_proto_send_face(w, owner, fv, FDT_NONE, link);
         if (err)
             return err;
     }
-    if (w->out.ntets >= w->report_at) {
-        w->report_at = w->out.ntets + 4096;
+    size_t nt = (size_t)w->em.ntets;
+    if (nt >= w->report_at) {
+        w->report_at = nt + 4096;
         /* relaxed: a progress estimate only (see worker.tets_done). */
-        atomic_store_explicit(&w->tets_done, w->out.ntets, memory_order_relaxed);
+        atomic_store_explicit(&w->tets_done, nt, memory_order_relaxed);
     }
     return FDT_OK;
 }
@@ -305,14 +308,17 @@ static int advance_one(worker *w)
      * part's region (src/partition.c, regions()), no other part's point
      * can be in it and the others are not asked at all; otherwise their
      * bounding boxes rule most of them out. The closed-side tet is ours
-     * when we built it (aux). */
-    int64_t ctid = s->aux == (uint32_t)w->id ? (int64_t)(s->tet >> 2) : -1;
+     * when we built it (aux); then its link names it and its vertex
+     * opposite f (fdt_emit_unlink). */
+    int64_t ctid = -1;
+    uint32_t copp = FDT_NONE;
+    if (s->aux == (uint32_t)w->id)
+        fdt_emit_unlink(&w->em, s->tet, &ctid, &copp);
     uint32_t mapex = FDT_NONE, mtet = FDT_NONE;
     int inside = 0;
     fdt_apex ap;
-    int err = fdt_front_apex(&w->orc, w->tree, &w->ft, f, a, b, c, ctid,
-                             ctid >= 0 ? w->out.tets[s->tet] : FDT_NONE, 1, &ap, &inside,
-                             &mapex, &mtet, &w->kq);
+    int err = fdt_front_apex(&w->orc, w->tree, &w->ft, f, a, b, c, ctid, copp, 1, &ap,
+                             &inside, &mapex, &mtet, &w->kq);
     if (err)
         return err;
     /* fdt_front_apex sets mapex to the kd search's answer when the mesh
@@ -327,7 +333,7 @@ static int advance_one(worker *w)
         fdt_face *live = fdt_facetab_find(&w->ft, f);
         if (!live)
             return FDT_EINTERNAL;
-        if ((err = fdt_meshbuf_add_hull(&w->out, f)) != FDT_OK)
+        if ((err = fdt_emit_hull(&w->em, f)) != FDT_OK)
             return err;
         w->st.hull_faces++;
         fdt_facetab_remove(&w->ft, live);
@@ -346,7 +352,7 @@ static int advance_one(worker *w)
          * mesh tet is known when the mesh gave its apex. */
         err = fdt_eng_build_tet(w, v, 0, s);
         if (!err)
-            err = fdt_oracle_note(&w->orc, (int64_t)w->out.ntets - 1,
+            err = fdt_oracle_note(&w->orc, w->em.ntets - 1,
                                   p == mapex ? mtet : FDT_NONE);
     } else {
         /* p is the tet's lowest id: the owner reads its coordinates
@@ -364,7 +370,10 @@ int fdt_eng_worker_setup(worker *w)
     /* A part of n points owns about 6.5 n tets and a front of a few
      * n^(2/3) faces; these are only first sizes. */
     size_t expect = (size_t)(7.0 * (double)np) + 64;
-    if (fdt_meshbuf_init(&w->out, expect, w->e->want_nbrs) != FDT_OK)
+    if (!w->e->sink->user &&
+        fdt_meshbuf_init(&w->out, expect, w->e->want_nbrs) != FDT_OK)
+        return FDT_ENOMEM;
+    if (fdt_emit_init(&w->em, w->e->sink, &w->out) != FDT_OK)
         return FDT_ENOMEM;
     if (fdt_facetab_init(&w->ft, 1024) != FDT_OK)
         return FDT_ENOMEM;
@@ -426,6 +435,7 @@ void fdt_eng_worker_free(worker *w)
     fdt_facetab_free(&w->ft);
     fdt_faceq_free(&w->fq);
     fdt_meshbuf_free(&w->out);
+    fdt_emit_free(&w->em);
     free(w->built.k);
     free(w->ghosts.g);
     free(w->links.r);

@@ -29,6 +29,7 @@
 #include "partition.h"
 #include "partsets.h"
 #include "protocol.h"
+#include "sink.h"
 #include "transport.h"
 
 /* A worker's result for the main loop: keep going, or the run is over. */
@@ -50,7 +51,9 @@ typedef struct worker {
     uint32_t lo, hi;           /* own ids [lo, hi) */
     fdt_facetab ft;            /* own front faces */
     fdt_faceq fq;              /* own faces still to advance (may be stale) */
-    fdt_meshbuf out;           /* own tets, global ids; nbrs local ids */
+    fdt_meshbuf out;           /* in memory: own tets, global ids; nbrs
+                                  local ids (empty when streaming) */
+    fdt_emit em;               /* where own tets go (src/sink.h) */
     tetset built;              /* own boundary tets (duplicate requests) */
     ghostmap ghosts;           /* message mode: foreign coordinates */
     linklist links;            /* completed faces between two threads */
@@ -114,6 +117,7 @@ typedef struct engine {
     const char *err_what;
     const fdt_partition *pt;
     const double *P;
+    fdt_tsink *sink;           /* the run's sink (src/sink.h) */
     fdt_mode mode;
     int search;                /* fdt_search, for every part's oracle */
     fdt_ins gmesh;             /* the DT of every point, when gmesh_ok:

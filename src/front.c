@@ -7,6 +7,7 @@
 #include "facetab.h"
 #include "oracle.h"
 #include "seed.h"
+#include "sink.h"
 
 /* For a positively oriented (v0,v1,v2,v3), (v1,v2,v3,v0) is an odd
  * permutation, so v0 is on the negative side of (v1,v2,v3): that face is
@@ -35,6 +36,16 @@ void fdt_meshbuf_free(fdt_meshbuf *mb)
     free(mb->nbrs);
     free(mb->hull);
     memset(mb, 0, sizeof *mb);
+}
+
+size_t fdt_meshbuf_bytes(const fdt_meshbuf *mb)
+{
+    size_t b = mb->tets ? mb->tcap * 4 * sizeof *mb->tets : 0;
+    if (mb->nbrs)
+        b += mb->tcap * 4 * sizeof *mb->nbrs;
+    if (mb->hull)
+        b += mb->hcap * 3 * sizeof *mb->hull;
+    return b;
 }
 
 int64_t fdt_meshbuf_add_tet(fdt_meshbuf *mb, const uint32_t v[4])
@@ -78,10 +89,11 @@ int fdt_meshbuf_add_hull(fdt_meshbuf *mb, const uint32_t v[3])
 /* Tet tid's face i completes the front face in slot s (§2.2: "the new
  * tetrahedron is the missing neighbor and another triangle is removed
  * from the front"): the neighbours are linked and the face leaves. */
-static void complete_face(fdt_facetab *ft, fdt_meshbuf *mb, fdt_face *s,
-                          int64_t tid, int i)
+static void complete_face(fdt_facetab *ft, fdt_emit *em, fdt_face *s, int64_t tid, int i)
 {
-    if (mb->nbrs) {
+    if (!em->packed) {
+        /* with neighbours the link is (tid << 2) | face (src/sink.h) */
+        fdt_meshbuf *mb = em->mb;
         int64_t other = (int64_t)(s->tet >> 2);
         mb->nbrs[4 * (size_t)other + (s->tet & 3)] = tid;
         mb->nbrs[4 * (size_t)tid + i] = other;
@@ -90,23 +102,23 @@ static void complete_face(fdt_facetab *ft, fdt_meshbuf *mb, fdt_face *s,
 }
 
 /*
- * Hands the four faces of new tet `tid` to the front: a face already in
- * the table is the other side of an existing front face, which the new tet
- * completes; a face not in the table becomes a front face with its open
- * side away from the new tet. `advanced` is the slot of the front face the
- * tet was built on, its face 3 (the main loop's tets are (f0, f1, f2,
- * apex), and fdt_tet_face[3] is f reversed), or NULL (the seed): that face
- * is completed through its slot rather than looked up again.
+ * Hands the four faces of new tet `tid` (vertices v) to the front: a face
+ * already in the table is the other side of an existing front face, which
+ * the new tet completes; a face not in the table becomes a front face with
+ * its open side away from the new tet, linked to it (fdt_emit_link).
+ * `advanced` is the slot of the front face the tet was built on, its face
+ * 3 (the main loop's tets are (f0, f1, f2, apex), and fdt_tet_face[3] is f
+ * reversed), or NULL (the seed): that face is completed through its slot
+ * rather than looked up again.
  */
-static int add_tet_faces(fdt_facetab *ft, fdt_faceq *fq, fdt_meshbuf *mb,
+static int add_tet_faces(fdt_facetab *ft, fdt_faceq *fq, fdt_emit *em, const uint32_t v[4],
                          int64_t tid, fdt_face *advanced)
 {
-    const uint32_t *v = mb->tets + 4 * (size_t)tid;
     int nf = 4;
     if (advanced) {
         /* First, while the slot is where the pop found it: later inserts
          * may grow the table and removals shift slots. */
-        complete_face(ft, mb, advanced, tid, 3);
+        complete_face(ft, em, advanced, tid, 3);
         nf = 3;
     }
     fdt_face fc[4];
@@ -121,7 +133,7 @@ static int add_tet_faces(fdt_facetab *ft, fdt_faceq *fq, fdt_meshbuf *mb,
     for (int i = 0; i < nf; i++) {
         fdt_face f = fc[i];
         f.aux = 0;
-        f.tet = ((uint64_t)tid << 2) | (uint64_t)i;
+        f.tet = fdt_emit_link(em, tid, i, v[i]);
         int err;
         fdt_face *s = fdt_facetab_find_or_insert(ft, &f, &err);
         if (err)
@@ -136,14 +148,14 @@ static int add_tet_faces(fdt_facetab *ft, fdt_faceq *fq, fdt_meshbuf *mb,
          * would mean two tets on one side of a face: an overlap. */
         if (s->v[1] == f.v[1])
             return FDT_EINTERNAL;
-        complete_face(ft, mb, s, tid, i);
+        complete_face(ft, em, s, tid, i);
     }
     return FDT_OK;
 }
 
 /* The serial front, stopped after max_faces faces (SIZE_MAX: the whole
  * triangulation; fdt_front_probe: a few hundred). */
-static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
+static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *out,
                      fdt_progress_fn progress, void *puser, fdt_front_stats *st,
                      size_t max_faces)
 {
@@ -162,12 +174,12 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
         return err;
     }
     const double *P = t->P;
-    int64_t tid = fdt_meshbuf_add_tet(out, seed);
+    int64_t tid = fdt_emit_tet(out, seed);
     if (tid < 0) {
-        err = FDT_ENOMEM;
+        err = (int)tid;
         goto done;
     }
-    if ((err = add_tet_faces(&ft, &fq, out, tid, NULL)) != FDT_OK)
+    if ((err = add_tet_faces(&ft, &fq, out, seed, tid, NULL)) != FDT_OK)
         goto done;
     /* A Delaunay tetrahedralization of n random points has about 6.5n
      * tets; the estimate only drives the progress bar. */
@@ -193,19 +205,20 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
         st->faces_advanced++;
         /* The insertion mesh first, where the oracle switched to it: it
          * holds every point, so its answer is the apex (or, FDT_NONE, a
-         * hull face). s->tet is the tet on the closed side and its face
-         * index, so out->tets[s->tet] is the vertex opposite f there. */
-        uint32_t apex, mtet = FDT_NONE;
+         * hull face). s->tet links the tet on the closed side: its id
+         * and its vertex opposite f (fdt_emit_unlink). */
+        uint32_t apex, mtet = FDT_NONE, copp;
+        int64_t ctid;
+        fdt_emit_unlink(out, s->tet, &ctid, &copp);
         fdt_apex ap;
         if ((err = fdt_front_apex(&orc, t, &ft, f, P + 3 * (size_t)f[0], P + 3 * (size_t)f[1],
-                                  P + 3 * (size_t)f[2], (int64_t)(s->tet >> 2),
-                                  out->tets[s->tet], 0, &ap, NULL, &apex, &mtet,
+                                  P + 3 * (size_t)f[2], ctid, copp, 0, &ap, NULL, &apex, &mtet,
                                   &st->kq)) != FDT_OK)
             goto done;
         if (apex == FDT_NONE) {
             /* Nothing on the open side: a convex-hull face (§2.2). Its
              * open side is the outside, so f is already outward. */
-            if ((err = fdt_meshbuf_add_hull(out, f)) != FDT_OK)
+            if ((err = fdt_emit_hull(out, f)) != FDT_OK)
                 goto done;
             fdt_facetab_remove(&ft, s);
             continue;
@@ -213,15 +226,18 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
         /* (f0, f1, f2, apex) is positively oriented: the apex is on the
          * open side, orient3d > 0. */
         uint32_t v[4] = {f[0], f[1], f[2], apex};
-        if ((tid = fdt_meshbuf_add_tet(out, v)) < 0 ||
-            fdt_oracle_note(&orc, tid, mtet) != FDT_OK) {
+        if ((tid = fdt_emit_tet(out, v)) < 0) {
+            err = (int)tid;
+            goto done;
+        }
+        if (fdt_oracle_note(&orc, tid, mtet) != FDT_OK) {
             err = FDT_ENOMEM;
             goto done;
         }
         /* The search left the table alone, so s still holds f. */
-        if ((err = add_tet_faces(&ft, &fq, out, tid, s)) != FDT_OK)
+        if ((err = add_tet_faces(&ft, &fq, out, v, tid, s)) != FDT_OK)
             goto done;
-        if (out->ntets >= next_report) {
+        if ((size_t)out->ntets >= next_report) {
             next_report += 1u << 16;
             if (progress) {
                 double fr = (double)out->ntets / expect;
@@ -235,6 +251,7 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
     if (ft.count != 0 && st->faces_advanced < max_faces)
         err = FDT_EINTERNAL;
 done:
+    st->mem_front = fdt_front_bytes(&ft, &fq);
     st->mesh_faces = orc.mesh_faces;
     st->star_walks = orc.star_walks;
     st->mesh_parts = orc.switched_at != 0;
@@ -245,19 +262,49 @@ done:
     return err;
 }
 
-int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
-                     fdt_progress_fn progress, void *puser, fdt_front_stats *st)
+size_t fdt_front_bytes(const fdt_facetab *ft, const fdt_faceq *fq)
+{
+    size_t b = ft->cap * sizeof *ft->slots;
+    b += fq->nb * (sizeof *fq->face + sizeof *fq->n + sizeof *fq->cap) +
+         fq->nwords * sizeof *fq->bits + (fq->nwords + 63) / 64 * sizeof *fq->summary;
+    for (size_t k = 0; k < fq->nb; k++)
+        if (fq->face[k])
+            b += (size_t)fq->cap[k] * 3 * sizeof(uint32_t);
+    return b;
+}
+
+int fdt_front_emit(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *out,
+                   fdt_progress_fn progress, void *puser, fdt_front_stats *st)
 {
     return front_run(t, start, search, out, progress, puser, st, SIZE_MAX);
 }
 
-int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces, fdt_front_stats *st)
+int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
+                     fdt_progress_fn progress, void *puser, fdt_front_stats *st)
 {
-    fdt_meshbuf mb;
-    int err = fdt_meshbuf_init(&mb, 4 * faces + 64, 0);
+    fdt_tsink s;
+    fdt_emit em;
+    int err = fdt_tsink_init(&s, NULL, NULL);
     if (err)
         return err;
-    err = front_run(t, start, FDT_SEARCH_KD, &mb, NULL, NULL, st, faces);
-    fdt_meshbuf_free(&mb);
+    if ((err = fdt_emit_init(&em, &s, out)) == FDT_OK)
+        err = front_run(t, start, search, &em, progress, puser, st, SIZE_MAX);
+    fdt_emit_free(&em);
+    fdt_tsink_free(&s);
+    return err;
+}
+
+int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces, fdt_front_stats *st)
+{
+    /* The tets are dropped as built: the sink keeps nothing. */
+    fdt_tsink s;
+    fdt_emit em;
+    int err = fdt_tsink_init(&s, NULL, NULL);
+    if (err)
+        return err;
+    if ((err = fdt_emit_init(&em, &s, NULL)) == FDT_OK)
+        err = front_run(t, start, FDT_SEARCH_KD, &em, NULL, NULL, st, faces);
+    fdt_emit_free(&em);
+    fdt_tsink_free(&s);
     return err;
 }

@@ -27,6 +27,8 @@ void fdt_meshbuf_free(fdt_meshbuf *mb);
 /* Appends tet v (positively oriented); returns its id or -1 (no memory). */
 int64_t fdt_meshbuf_add_tet(fdt_meshbuf *mb, const uint32_t v[4]);
 int fdt_meshbuf_add_hull(fdt_meshbuf *mb, const uint32_t v[3]);
+/* The bytes mb holds (its capacities): fdt_stats.mem_mesh. */
+size_t fdt_meshbuf_bytes(const fdt_meshbuf *mb);
 
 /* Work counters filled by the front. */
 typedef struct fdt_front_stats {
@@ -37,14 +39,28 @@ typedef struct fdt_front_stats {
      * seconds they took. */
     size_t mesh_faces, star_walks, mesh_parts;
     double t_mesh;
+    size_t mem_front;   /* bytes of the face table (its largest capacity)
+                           and of the face queue (at the end) */
 } fdt_front_stats;
+
+/* The bytes of a face table and a face queue (fdt_front_stats.mem_front). */
+struct fdt_faceq;
+size_t fdt_front_bytes(const fdt_facetab *ft, const struct fdt_faceq *fq);
 
 /* Triangulates all points of tree t (ids [t->base, t->base + t->n)),
  * starting from a seed near point `start`; search is an fdt_search
- * (src/oracle.h: how each face's apex is found). */
+ * (src/oracle.h: how each face's apex is found). The tets and hull faces
+ * go to `out` (tree-order ids: an in-memory meshbuf, with neighbours if
+ * it keeps them). */
 int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
                      fdt_progress_fn progress, void *puser,
                      fdt_front_stats *st);
+
+/* The same, every tet and hull face emitted through em (src/sink.h: kept
+ * in memory, streamed to a caller's sink or dropped) as it is built. */
+struct fdt_emit;
+int fdt_front_emit(const fdt_kdtree *t, uint32_t start, int search, struct fdt_emit *em,
+                   fdt_progress_fn progress, void *puser, fdt_front_stats *st);
 
 /* The kd search's first `faces` faces of the front over tree t, for their
  * work counters in st only (the tets are dropped): what src/oracle.c's

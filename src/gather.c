@@ -28,7 +28,7 @@ static void slice_of(size_t lo, size_t hi, size_t k, size_t n, size_t *a, size_t
  * The worker's share of the gather, on its own thread once the calling
  * thread has grown thread 0's buffers to the whole mesh (fdt_gather_prepare):
  * its slice of thread 0's tets and hull faces, renumbered where they lie
- * into input numbering (tree-order id i is input point orig[i]), and its
+ * into input numbering by the sink's one rule (fdt_sink_renumber), and its
  * slice of the other threads' ones, copied after them the same way, with
  * the neighbours shifted by their thread's first tet. Two slices, not a
  * thread its own part: the copies write fresh pages, and with two threads
@@ -51,8 +51,9 @@ void fdt_gather_copy(worker *w)
         const uint32_t *st = r ? o->tets : e->gtets, *sh = r ? o->hull : e->ghull;
         size_t t0 = e->toff[i], h0 = e->hoff[i];
         size_t a = ta[r] > t0 ? ta[r] : t0, b = tb[r] < e->toff[i + 1] ? tb[r] : e->toff[i + 1];
-        for (size_t j = 4 * a; j < 4 * b; j++)
-            e->gtets[j] = (uint32_t)orig[st[j - 4 * t0]];
+        if (b > a)
+            fdt_sink_renumber(orig, (fdt_vid *)e->gtets + 4 * a, st + 4 * (a - t0),
+                              4 * (b - a));
         if (e->gnbrs && r)
             for (size_t j = 4 * a; j < 4 * b; j++) {
                 int64_t x = o->nbrs[j - 4 * t0];
@@ -60,8 +61,9 @@ void fdt_gather_copy(worker *w)
             }
         a = ha[r] > h0 ? ha[r] : h0;
         b = hb[r] < e->hoff[i + 1] ? hb[r] : e->hoff[i + 1];
-        for (size_t j = 3 * a; j < 3 * b; j++)
-            e->ghull[j] = (uint32_t)orig[sh[j - 3 * h0]];
+        if (b > a)
+            fdt_sink_renumber(orig, (fdt_vid *)e->ghull + 3 * a, sh + 3 * (a - h0),
+                              3 * (b - a));
     }
 }
 

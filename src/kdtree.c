@@ -326,6 +326,19 @@ static inline uint32_t block_row(uint32_t n)
     return (n + 7) & ~UINT32_C(7);
 }
 
+size_t fdt_kd_bytes(const fdt_kdtree *t)
+{
+    size_t b = (size_t)t->nnodes * sizeof *t->nodes;
+    if (t->parent)
+        b += (size_t)t->nnodes * (sizeof *t->parent + sizeof *t->cell) +
+             ((size_t)t->n + 1) * sizeof *t->leafof;
+    if (t->fl)
+        for (uint32_t j = 0; j < t->nnodes; j++)
+            if (!t->nodes[j].left)
+                b += 3 * (size_t)block_row(t->nodes[j].end - t->nodes[j].begin) * sizeof(float);
+    return b;
+}
+
 static void float_blocks(fdt_kdtree *t)
 {
     size_t total = 0; /* in units of 4 floats */

@@ -68,6 +68,8 @@ typedef struct fdt_kdq {
 int fdt_kd_build(fdt_kdtree *t, double *P, fdt_vid *orig, uint32_t base,
                  uint32_t n, int leaf_size);
 void fdt_kd_free(fdt_kdtree *t);
+/* The bytes t owns (nodes, climb tables, float blocks): fdt_stats.mem_tree. */
+size_t fdt_kd_bytes(const fdt_kdtree *t);
 
 /* Quickselect on coordinate dim (0..2) over ids [lo, hi), lo <= k < hi:
  * afterwards the point at k has the (k - lo)-th smallest coordinate, the

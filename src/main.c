@@ -30,12 +30,14 @@
 #include <getopt.h>
 #include <inttypes.h>
 #include <limits.h>
+#include <math.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -76,6 +78,7 @@ typedef struct cli {
     int pin, check, stats, hash, set_hash, quiet;
     int stream;             /* --stream 1, --no-stream -1, else 0: when
                                every output can (stream_refusal) */
+    unsigned long long memory_limit; /* --memory-limit bytes; 0: none */
     int demo;
     size_t demo_n;
 } cli;
@@ -119,10 +122,14 @@ static void usage(FILE *f)
         "      --hash             print the canonical hash of the tet set\n"
         "      --set-hash         print the set hash (order-independent, no sort)\n"
         "      --stream           write the tets as they are built, never holding\n"
-        "                         the mesh (.ele without .neigh, .vtu, .fdtb);\n"
-        "                         refuses an output or option that needs the mesh\n"
+        "                         the mesh (.ele without .neigh, .vtu, .fdtb; no\n"
+        "                         -o: count them); the points are stored once\n"
+        "                         (about 60 bytes a point); refuses an output or\n"
+        "                         option that needs the mesh\n"
         "      --no-stream        keep the whole mesh (default streams when every\n"
         "                         -o is .vtu or .fdtb and nothing needs the mesh)\n"
+        "      --memory-limit B   refuse (exit 4) a run whose estimated memory\n"
+        "                         exceeds B bytes (suffixes K, M, G: 2^10..2^30)\n"
         "  -q, --quiet            no summary, no progress, no notes\n"
         "      --progress         draw the progress line on stderr even when it\n"
         "                         is not a terminal (it is drawn on terminals)\n"
@@ -134,7 +141,8 @@ static void usage(FILE *f)
         "Exit codes:\n"
         "  0 success             1 usage error (also '-' without --input-format,\n"
         "                          --columns for .node/.ply)   2 bad input\n"
-        "  3 --check failed      4 out of resources   5 cannot write output\n"
+        "  3 --check failed      4 out of resources (also over --memory-limit)\n"
+        "  5 cannot write output\n"
         "  6 interrupted         7 internal error\n",
         MAX_OUTPUTS, DEMO_DEFAULT_N);
 }
@@ -245,10 +253,41 @@ static int parse_count(const char *s, unsigned long long max,
     return 0;
 }
 
+/* A byte count for --memory-limit: digits, then K, M or G (binary:
+ * 2^10, 2^20, 2^30; any case, an optional trailing B or iB). 0 refused. */
+static int parse_bytes(const char *s, unsigned long long *v)
+{
+    size_t d = 0;
+    while (s[d] >= '0' && s[d] <= '9')
+        d++;
+    if (d == 0 || d > 19)
+        return -1;
+    errno = 0;
+    char *end;
+    unsigned long long x = strtoull(s, &end, 10);
+    if (errno || x == 0)
+        return -1;
+    unsigned shift = 0;
+    switch (*end) {
+    case 'k': case 'K': shift = 10; end++; break;
+    case 'm': case 'M': shift = 20; end++; break;
+    case 'g': case 'G': shift = 30; end++; break;
+    default: break;
+    }
+    if (shift && *end == 'i')
+        end++;
+    if (*end == 'b' || *end == 'B')
+        end++;
+    if (*end || (shift && x > (ULLONG_MAX >> shift)))
+        return -1;
+    *v = x << shift;
+    return 0;
+}
+
 enum {
     OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH, OPT_SET_HASH,
     OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
-    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM
+    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT
 };
 
 static const struct option long_opts[] = {
@@ -271,6 +310,7 @@ static const struct option long_opts[] = {
     { "progress", no_argument, NULL, OPT_PROGRESS },
     { "stream", no_argument, NULL, OPT_STREAM },
     { "no-stream", no_argument, NULL, OPT_NO_STREAM },
+    { "memory-limit", required_argument, NULL, OPT_MEMORY_LIMIT },
     { "help", no_argument, NULL, 'h' },
     { "version", no_argument, NULL, 'V' },
     { NULL, 0, NULL, 0 },
@@ -475,6 +515,11 @@ static int parse_args(int argc, char **argv, cli *c)
             break;
         case OPT_PROGRESS:
             c->progress = 1;
+            break;
+        case OPT_MEMORY_LIMIT:
+            if (parse_bytes(optarg, &c->memory_limit) != 0)
+                return usage_error("--memory-limit wants a byte count > 0 (suffix K, M or G), "
+                                   "not '%s'", optarg);
             break;
         case OPT_DEMO:
             c->demo = 1;
@@ -826,6 +871,32 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         print_parallel_stats(res, st);
 }
 
+/* --stats, memory: each structure's bytes, a point and in all, the
+ * estimate (--memory-limit's) and the measured peak. */
+static void print_memory(const fdt_stats *st, size_t n, unsigned long long estimate,
+                         unsigned long long peak)
+{
+    double pn = n ? (double)n : 1.0;
+    const struct {
+        const char *name;
+        size_t bytes;
+    } m[] = {{"points", st->mem_points}, {"merge table", st->mem_merge},
+             {"kd-trees", st->mem_tree},  {"front", st->mem_front},
+             {"mesh", st->mem_mesh},      {"sink buffers", st->mem_sink}};
+    for (size_t i = 0; i < sizeof m / sizeof *m; i++)
+        fprintf(stderr, "  memory %-12s %8.1f MiB %6.1f B/point\n", m[i].name,
+                (double)m[i].bytes / 1048576.0, (double)m[i].bytes / pn);
+    if (st->max_front)
+        fprintf(stderr, "  memory a front face %.1f B (largest front %zu faces)\n",
+                (double)st->mem_front / (double)st->max_front, st->max_front);
+    fprintf(stderr, "  memory estimate     %8.1f MiB %6.1f B/point\n",
+            (double)estimate / 1048576.0, (double)estimate / pn);
+    if (peak)
+        fprintf(stderr, "  memory peak RSS     %8.1f MiB %6.1f B/point (%+.0f%% of the estimate)\n",
+                (double)peak / 1048576.0, (double)peak / pn,
+                100.0 * ((double)peak - (double)estimate) / (double)estimate);
+}
+
 static void json_string(FILE *f, const char *s)
 {
     fputc('"', f);
@@ -1010,6 +1081,57 @@ static int fanout_close(fanout *fo, int commit)
     return code;
 }
 
+/*
+ * The bytes a run on n points is expected to need at its peak (for
+ * --memory-limit, and printed by --stats beside the measured peak): the
+ * points as read (24 a point, the CLI's array; a streamed run prepares
+ * them in it, fdt_settings.permute_input), the library's own copy (24
+ * otherwise), input indices and duplicate map (8), the merge's table
+ * (4 bytes a slot, slots the power of two >= 2n, freed before the
+ * trees), the kd-trees (about 26 a point with leaves of 30: 24.5
+ * measured on 1M uniform points), the front (the queue's buckets, 1 a
+ * point, and 110 bytes a front face, for 8 n^(2/3) faces: a front is a
+ * surface; 1M uniform points measured 34k faces serial, 50k on two
+ * threads, 3.6 bytes a point in all) and, in memory, the tets: 6.5 a
+ * point, 16 bytes each and 32 more with neighbours, twice over in the
+ * parallel gather's worst case (thread 0's buffer grown to the whole mesh
+ * while the others still hold theirs), plus the writers' and the face
+ * list's needs, which this does not count. Streamed: a 1 MiB batch a
+ * thread. Plus 16 MiB for the program, its libraries and stacks.
+ */
+static unsigned long long memory_estimate(size_t n, int stream, int threads, int nbrs)
+{
+    double pts = 24.0 * (double)n;
+    double own = stream ? 0.0 : 24.0 * (double)n;
+    double idx = 8.0 * (double)n;
+    double merge = 16.0;
+    while (merge < 2.0 * (double)n)
+        merge *= 2.0;
+    merge *= 4.0;
+    double tree = 26.0 * (double)n;
+    double front = 1.0 * (double)n + 110.0 * 8.0 * cbrt((double)n) * cbrt((double)n);
+    double mesh = 0.0;
+    if (!stream) {
+        mesh = 6.5 * (double)n * (16.0 + (nbrs ? 32.0 : 0.0));
+        if (threads > 1)
+            mesh *= 2.0;
+    }
+    double sinks = stream ? (double)(threads > 1 ? threads : 1) * 1.2 * 1048576.0 : 0.0;
+    double during_merge = pts + own + idx + merge;
+    double during_front = pts + own + idx + tree + front + mesh + sinks;
+    double peak = during_merge > during_front ? during_merge : during_front;
+    return (unsigned long long)(peak + 16.0 * 1048576.0);
+}
+
+/* The process's peak resident set in bytes (0 if unknown). */
+static unsigned long long peak_rss_bytes(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0)
+        return 0;
+    return (unsigned long long)ru.ru_maxrss * 1024ull; /* Linux: KiB */
+}
+
 static int run(const cli *c)
 {
     int code = CLI_OK;
@@ -1147,6 +1269,21 @@ static int run(const cli *c)
     if (prog.enabled) {
         s.progress = progress_engine;
         s.progress_user = &prog;
+    }
+    /* A streamed run prepares the points in the array we read them into
+     * (the writers took what they need of it when they were opened,
+     * below, before the run): the points are stored once. */
+    s.permute_input = streaming;
+    int run_threads = c->mode == FDT_MODE_SERIAL ? 1
+                      : c->threads > 0           ? c->threads
+                                                 : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    unsigned long long estimate = memory_estimate(n, streaming, run_threads, s.neighbors);
+    if (c->memory_limit && estimate > c->memory_limit) {
+        say("%s: %zu points need about %llu MiB (%s%s), more than --memory-limit %llu MiB",
+            name, n, estimate >> 20, streaming ? "streamed" : "in memory",
+            s.neighbors ? ", with neighbours" : "", c->memory_limit >> 20);
+        code = CLI_RESOURCES;
+        goto done;
     }
     int r = fdt_open(&ctx, &s);
     if (r != FDT_OK) {
@@ -1301,8 +1438,10 @@ static int run(const cli *c)
         code = exit_for_engine(r);
         goto done;
     }
-    if (c->stats)
+    if (c->stats) {
         print_stats(res, &st, dups, &tm);
+        print_memory(&st, n, estimate, peak_rss_bytes());
+    }
     if (c->stats_json) {
         /* A file goes through a temporary renamed at the end, as the
          * mesh does: a failed or interrupted write leaves what was there.

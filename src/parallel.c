@@ -145,6 +145,8 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     engine *e = NULL;
     uint32_t(*seeds)[4] = NULL;
     int nseeds = 0, sync_ok = 0;
+    fdt_tsink mem_sink;
+    int mem_sink_ok = 0;
     fdt_kdq kq0;
     memset(&kq0, 0, sizeof kq0);
     /* The parts' trees are built on as many threads as there are cores
@@ -174,6 +176,14 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     e->pt = &pt;
     e->P = pr->p;
     e->orig = pr->orig;
+    if (opt && opt->sink) {
+        e->sink = opt->sink;
+    } else {
+        if (fdt_tsink_init(&mem_sink, pr->orig, NULL) != FDT_OK)
+            goto fail;
+        mem_sink_ok = 1;
+        e->sink = &mem_sink;
+    }
     e->mode = mode;
     e->n = nthreads;
     e->want_nbrs = s->neighbors != 0;
@@ -369,7 +379,11 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         fdt_mailbox_counts mc;
         fdt_tp_counts(e->tp, i, &mc);
         *ts = w->st;
-        ts->tets = w->out.ntets;
+        ts->tets = (size_t)w->em.ntets;
+        ps->mem_tree += fdt_kd_bytes(&pt.trees[i]);
+        ps->mem_front += fdt_front_bytes(&w->ft, &w->fq);
+        ps->mem_mesh += fdt_meshbuf_bytes(&w->out);
+        ps->mem_sink += fdt_emit_bytes(&w->em);
         msg_counts_add(ts->sent, mc.sent);
         msg_counts_add(ts->received, mc.received);
         msg_counts_add(ps->sent, mc.sent);
@@ -422,7 +436,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         err = FDT_EINTERNAL;
         goto fail;
     }
-    err = fdt_gather_finish(e, &out->mb);
+    err = e->sink->user ? FDT_OK : fdt_gather_finish(e, &out->mb);
     if (err) {
         if (err == FDT_EINTERNAL)
             snprintf(diag, dlen, "internal error: a face between threads was not linked");
@@ -455,6 +469,8 @@ fail:
     }
     free(seeds);
     fdt_partition_free(&pt);
+    if (mem_sink_ok)
+        fdt_tsink_free(&mem_sink);
     if (err)
         fdt_par_out_free(out);
     return err;

@@ -59,6 +59,10 @@ typedef struct fdt_par_opts {
     int global_mesh;    /* shared mode: build the DT of every point first
                            (fdt_ins_build_parallel, on nthreads threads)
                            and let every part read its apexes from it */
+    struct fdt_tsink *sink; /* where the tets go (src/sink.h); NULL: into
+                           out->mb. A sink with a caller's fdt_sink streams:
+                           out->mb stays empty, nothing is gathered, and
+                           each thread flushes its batches itself */
 } fdt_par_opts;
 
 /* fdt_parallel_triangulate with options (NULL: none, what it does). */

@@ -40,7 +40,9 @@ static int same_point(const double *p, const double *q)
 
 void fdt_prepared_free(fdt_prepared *pr)
 {
-    free(pr->p);
+    if (!pr->p_borrowed)
+        free(pr->p);
+    pr->p = NULL;
     free(pr->orig);
     free(pr->dupmap);
     memset(pr, 0, sizeof *pr);
@@ -271,12 +273,15 @@ static int prep_alloc(fdt_prepared *pr, size_t n, uint32_t **slots, size_t *cap)
 {
     size_t n1 = n ? n : 1;
     pr->dupmap = malloc(n1 * sizeof *pr->dupmap);
-    pr->p = malloc(n1 * 3 * sizeof *pr->p);
-    fdt_mem_advise_huge(pr->p, n1 * 3 * sizeof *pr->p);
+    if (!pr->p_borrowed) {
+        pr->p = malloc(n1 * 3 * sizeof *pr->p);
+        fdt_mem_advise_huge(pr->p, n1 * 3 * sizeof *pr->p);
+    }
     pr->orig = malloc(n1 * sizeof *pr->orig);
     *cap = 16;
     while (*cap < 2 * n)
         *cap <<= 1;
+    pr->merge_bytes = *cap * sizeof **slots;
     *slots = malloc(*cap * sizeof **slots);
     if (!pr->dupmap || !pr->p || !pr->orig || !*slots)
         return FDT_ENOMEM;
@@ -292,12 +297,17 @@ static int prepare_threads_for(size_t n, int threads)
     return n < ((size_t)1 << 16) || T < 1 ? 1 : T;
 }
 
-int fdt_prepare(const double *xyz, size_t n, int threads, fdt_prepared *pr, char *diag,
-                size_t dlen)
+static int prepare_any(const double *xyz, double *into, size_t n, int threads,
+                       fdt_prepared *pr, char *diag, size_t dlen)
 {
     int err = FDT_ENOMEM;
     uint32_t *slots = NULL;
     memset(pr, 0, sizeof *pr);
+    if (into) {
+        pr->p = into;
+        pr->p_borrowed = 1;
+        threads = 1; /* the parallel merge writes slices out of order */
+    }
     if (n > (size_t)FDT_VID_MAX) {
         snprintf(diag, dlen, "%zu points: more than the %d a vertex id holds",
                  n, FDT_VID_MAX);
@@ -343,25 +353,32 @@ int fdt_prepare(const double *xyz, size_t n, int threads, fdt_prepared *pr, char
     double p2k = k >= -1022 && k <= 1023 ? fdt_pow2i(k) : 0.0;
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
-        const double *q = xyz + 3 * i;
+        /* Read before any write: in place (into), p[m] with m <= i is
+         * written over the input, at or before point i, never after. */
+        const double q[3] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
         /* The table (8 MB at 1M points) is probed at random: ask for the
          * slot a few points ahead so it has arrived when needed. */
         if (i + 8 < n)
             fdt_prefetch(slots + ((size_t)point_hash(xyz + 3 * (i + 8)) & (cap - 1)));
         size_t h = (size_t)point_hash(q) & (cap - 1);
+        double sq[3];
+        /* Scaled copy: exact, see choose_scale. */
+        for (int c = 0; c < 3; c++)
+            sq[c] = p2k != 0.0 ? q[c] * p2k : ldexp(q[c], k);
         for (;;) {
             uint32_t s = slots[h];
             if (s == UINT32_MAX) {
                 slots[h] = (uint32_t)m;
-                /* Scaled copy: exact, see choose_scale. */
-                for (int c = 0; c < 3; c++)
-                    pr->p[3 * m + c] = p2k != 0.0 ? q[c] * p2k : ldexp(q[c], k);
+                memcpy(pr->p + 3 * m, sq, sizeof sq);
                 pr->orig[m] = (fdt_vid)i;
                 pr->dupmap[i] = (fdt_vid)i;
                 m++;
                 break;
             }
-            if (same_point(xyz + 3 * (size_t)pr->orig[s], q)) {
+            /* Compared scaled (the input's copy may be overwritten in
+             * place): scaling by 2^k is exact and one-to-one on these
+             * values, and -0 == +0 either way. */
+            if (same_point(pr->p + 3 * (size_t)s, sq)) {
                 pr->dupmap[i] = pr->orig[s];
                 pr->ndup++;
                 break;
@@ -377,4 +394,15 @@ fail:
     fdt_prepared_free(pr);
     snprintf(diag, dlen, "out of memory preparing %zu points", n);
     return err;
+}
+
+int fdt_prepare(const double *xyz, size_t n, int threads, fdt_prepared *pr, char *diag,
+                size_t dlen)
+{
+    return prepare_any(xyz, NULL, n, threads, pr, diag, dlen);
+}
+
+int fdt_prepare_inplace(double *xyz, size_t n, fdt_prepared *pr, char *diag, size_t dlen)
+{
+    return prepare_any(xyz, xyz, n, 1, pr, diag, dlen);
 }

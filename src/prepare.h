@@ -22,6 +22,9 @@ typedef struct fdt_prepared {
     fdt_vid *dupmap;  /* n: vertex (first input index) of each input point */
     size_t ndup;      /* input points merged into an earlier one */
     int scale_exp;    /* coordinates were multiplied by 2^scale_exp */
+    int p_borrowed;   /* p is the caller's array (fdt_prepare_inplace):
+                         not freed by fdt_prepared_free */
+    size_t merge_bytes; /* the merge's hash table (freed on return) */
 } fdt_prepared;
 
 /* Fills pr from n input points, on `threads` threads (one below 64k
@@ -30,6 +33,11 @@ typedef struct fdt_prepared {
  * FDT_ETOOBIG, FDT_ENOMEM. */
 int fdt_prepare(const double *xyz, size_t n, int threads, fdt_prepared *pr, char *diag,
                 size_t dlen);
+/* The same on one thread, with xyz itself as pr->p: the distinct points
+ * are compacted to its front (first occurrence order) and scaled there,
+ * so the points are stored once (settings.permute_input). On failure xyz
+ * is unchanged. */
+int fdt_prepare_inplace(double *xyz, size_t n, fdt_prepared *pr, char *diag, size_t dlen);
 void fdt_prepared_free(fdt_prepared *pr);
 
 #endif

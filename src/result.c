@@ -4,6 +4,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <stdatomic.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -36,9 +37,11 @@ size_t fdt_result_num_duplicates(const fdt_result *r) { return r ? r->ndup : 0; 
 /* The sizes of fdt_stats and fdt_thread_stats this library fills
  * (include/frontdt.h, ABI): this release's; earlier releases' join here
  * when a field is added. */
+/* This release's fdt_stats and the first release's, which ended before
+ * the memory fields (include/frontdt.h, ABI). */
 static int stats_size_known(size_t size)
 {
-    return size == sizeof(fdt_stats);
+    return size == sizeof(fdt_stats) || size == offsetof(fdt_stats, mem_points);
 }
 
 static int thread_stats_size_known(size_t size)

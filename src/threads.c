@@ -53,10 +53,20 @@ static void *worker_main(void *arg)
     int rc = fdt_eng_worker_setup(w);
     if (rc == FDT_OK)
         rc = fdt_eng_worker_loop(w);
+    /* A streamed run's last partial batch goes to the caller's sink from
+     * here, under the sink's lock (src/sink.h), unless the run failed. */
+    if (rc >= 0 && !aborted(e)) {
+        int frc = fdt_emit_flush(&w->em);
+        if (frc)
+            rc = frc;
+    }
     if (rc < 0)
-        fdt_eng_set_error(e, rc, w->id, rc == FDT_ENOMEM ? "out of memory" : "inconsistent front");
+        fdt_eng_set_error(e, rc, w->id,
+                          rc == FDT_ENOMEM      ? "out of memory"
+                          : rc == FDT_EINTERNAL ? "inconsistent front"
+                                                : "the sink stopped the run");
     /* relaxed: a progress estimate only. */
-    atomic_store_explicit(&w->tets_done, w->out.ntets, memory_order_relaxed);
+    atomic_store_explicit(&w->tets_done, (size_t)w->em.ntets, memory_order_relaxed);
     w->st.t_cpu = fdt_thread_cpu_s() - cpu0;
     pthread_mutex_lock(&e->lock);
     e->finished++;
@@ -152,7 +162,8 @@ int fdt_threads_run(engine *e, const fdt_settings *s, double *t_loops)
     const char *ww;
     int failed = e->msg_term ? fdt_term_error(e, &wt, &ww) != 0
                              : atomic_load_explicit(&e->error, memory_order_relaxed) != 0;
-    if (!err && !failed) {
+    /* A streamed run's tets have all left: nothing to gather. */
+    if (!err && !failed && !e->sink->user) {
         err = fdt_gather_prepare(e);
         go = err ? -1 : 1;
     }

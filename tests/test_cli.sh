@@ -21,7 +21,8 @@
 # duplicate reporting, --pin refused (said once), every output format;
 # standard input ('-', pipes, FIFOs, /dev/stdin; text and binary PLY),
 # --input-format, extra columns, --columns and headers, the progress line
-# (--progress: phases named, width, none with --quiet).
+# (--progress: phases named, width, none with --quiet), --stream with
+# --set-hash in every mode, --memory-limit.
 set -u
 
 FRONTDT=${1:?usage: test_cli.sh FRONTDT BAD_DIR}
@@ -779,6 +780,43 @@ for target in big.ele big.vtk; do
     expect_empty_dir "SIGTERM while writing $target" out
 done
 set +m
+
+# --stream (issue 18): the streamed mesh's set hash equals the in-memory
+# run's in every mode; what a stream cannot do is refused; --memory-limit
+# refuses a run over its estimate (exit 4) before it starts and lets one
+# under it run; --stats shows the memory lines.
+gen_points 3000 21 >st.xyz
+run st_mem "$FRONTDT" st.xyz --set-hash -q
+expect_rc st_mem 0
+want=$(grep set-hash st_mem.out)
+[ -n "$want" ] || fail "st_mem: no set-hash line"
+for m in "--mode serial" "--mode shared -t 2" "--mode message -t 3"; do
+    # shellcheck disable=SC2086 # the mode's words
+    run st_stream "$FRONTDT" st.xyz --stream --set-hash $m
+    expect_rc st_stream 0 && {
+        [ "$(grep set-hash st_stream.out)" = "$want" ] ||
+            fail "--stream $m: $(grep set-hash st_stream.out), in memory $want"
+    }
+done
+run st_count "$FRONTDT" st.xyz --mode serial
+run st_count_s "$FRONTDT" st.xyz --mode serial --stream
+[ "$(grep '^tets:' st_count.out)" = "$(grep '^tets:' st_count_s.out)" ] ||
+    fail "--stream counts $(grep '^tets:' st_count_s.out), in memory $(grep '^tets:' st_count.out)"
+usage_case u_stream_o "format tets needs the whole mesh" st.xyz --stream -o st.tets
+usage_case u_stream_check "--check needs the whole mesh" st.xyz --stream --check
+usage_case u_stream_hash "--hash sorts the whole mesh" st.xyz --stream --hash
+[ ! -e st.tets ] || fail "--stream -o left st.tets"
+usage_case u_memlimit "--memory-limit wants" st.xyz --memory-limit 12X
+usage_case u_memlimit0 "--memory-limit wants" st.xyz --memory-limit 0
+usage_case u_memlimit_big "--memory-limit wants" st.xyz --memory-limit 99999999999999999G
+run st_limit "$FRONTDT" st.xyz --memory-limit 1M
+expect_rc st_limit 4 && expect_in st_limit err "more than --memory-limit 1 MiB"
+run st_limit_ok "$FRONTDT" st.xyz --memory-limit 2G --stream --stats
+expect_rc st_limit_ok 0 && {
+    expect_in st_limit_ok err "memory estimate"
+    expect_in st_limit_ok err "memory peak RSS"
+    expect_in st_limit_ok err "memory mesh              0.0 MiB"
+}
 
 if [ "$FAILS" -gt 0 ]; then
     echo "$FAILS failure(s)" >&2

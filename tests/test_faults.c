@@ -405,6 +405,55 @@ static int sc_triangulate(void *arg, const char **bad)
     return rc;
 }
 
+/* A streamed run (fdt_triangulate_stream) under injection: it succeeds
+ * with the in-memory run's set hash and tet count, or fails with nothing
+ * returned; the sink counts what reached it (less than the mesh on a
+ * failure is fine: the contract allows a partial stream). */
+typedef struct stream_arg {
+    const ptset *ps;
+    const engine_cfg *cfg;
+    uint64_t want_set;
+    size_t want_tets;
+} stream_arg;
+
+static int count_sink(void *user, const fdt_vid *t, size_t count)
+{
+    (void)t;
+    *(size_t *)user += count;
+    return 0;
+}
+
+static int sc_stream(void *arg, const char **bad)
+{
+    stream_arg *a = arg;
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = a->cfg->mode;
+    s.n_threads = a->cfg->threads;
+    fdt_context *ctx = NULL;
+    int rc = fdt_open(&ctx, &s);
+    if (rc != FDT_OK)
+        return rc;
+    size_t got = 0;
+    fdt_sink sink = {sizeof sink, count_sink, NULL, &got};
+    fdt_result *r = NULL;
+    rc = fdt_triangulate_stream(ctx, a->ps->xyz, a->ps->n, &sink, &r);
+    if (rc == FDT_ENOMEM && fdt_context_diagnostic(ctx)[0] == '\0')
+        *bad = "FDT_ENOMEM without a diagnostic";
+    fdt_close(&ctx);
+    if (rc != FDT_OK) {
+        if (r != NULL)
+            *bad = "a failed fdt_triangulate_stream returned a result";
+        fdt_result_free(&r);
+        return rc;
+    }
+    uint64_t h = 0;
+    if (fdt_result_set_hash(r, &h) != FDT_OK || h != a->want_set || got != a->want_tets)
+        *bad = "wrong streamed mesh";
+    fdt_result_free(&r);
+    return rc;
+}
+
 typedef struct post_arg {
     const ptset *ps;
     int neighbors;
@@ -810,6 +859,21 @@ static int run_parallel(void)
                 scenario sc = {nm, FDT_ENOMEM, sc_triangulate, &ta};
                 inject_all(&sc);
             }
+            if (nb)
+                continue;
+            /* streamed: the same mesh or a clean failure */
+            rc = triangulate(&sets[si], &serial_cfg, 0, &r);
+            uint64_t sh = 0;
+            if (rc == FDT_OK)
+                EXPECT(fdt_result_set_hash(r, &sh) == FDT_OK);
+            fdt_result_free(&r);
+            for (int c = 0; c < 4 && rc == FDT_OK; c++) {
+                char nm[96];
+                snprintf(nm, sizeof nm, "stream %s %s", sets[si].name, cfg_name[c]);
+                stream_arg sa = {&sets[si], &cfgs[c], sh, nt};
+                scenario sc = {nm, FDT_ENOMEM, sc_stream, &sa};
+                inject_all(&sc);
+            }
         }
     }
     for (int si = 0; si < 2; si++)
@@ -986,6 +1050,18 @@ int main(int argc, char **argv)
             tri_arg ta = {ps, &serial_cfg, nb, h, nt};
             scenario sc = {nm[0], FDT_ENOMEM, sc_triangulate, &ta};
             inject_all(&sc);
+            if (!nb) {
+                /* streamed: the same mesh or a clean failure */
+                uint64_t sh = 0;
+                CHECK_EQ(triangulate(ps, &serial_cfg, 0, &r), FDT_OK);
+                EXPECT(fdt_result_set_hash(r, &sh) == FDT_OK);
+                fdt_result_free(&r);
+                char snm[96];
+                snprintf(snm, sizeof snm, "stream %s", ps->name);
+                stream_arg sa = {ps, &serial_cfg, sh, nt};
+                scenario ss = {snm, FDT_ENOMEM, sc_stream, &sa};
+                inject_all(&ss);
+            }
             for (int w = 0; w < 3; w++) {
                 post_arg pa = {ps, nb, w, h};
                 scenario post = {nm[w + 1], FDT_ENOMEM, sc_post, &pa};

@@ -1,8 +1,9 @@
 /*
  * Input preparation (src/prepare.c): duplicate merge into the first index
  * (-0 == +0), power-of-two scaling (exact, mixed magnitudes kept normal),
- * NaN and Inf refused with the point named, and the merge on several
- * threads equal to one thread's bit for bit.
+ * NaN and Inf refused with the point named, the merge on several
+ * threads equal to one thread's bit for bit, and the merge in the
+ * caller's array (fdt_prepare_inplace) equal to the copying one.
  */
 #include <math.h>
 #include <stdint.h>
@@ -89,9 +90,56 @@ static void test_prepare(void)
     EXPECTF(fdt_prepare(inf, 1, 1, &pr, diag, sizeof diag) == FDT_ERANGE, "Inf not refused");
 }
 
+/* fdt_prepare_inplace (settings.permute_input): the same result as the
+ * copying merge, with the points compacted into the caller's array (every
+ * family, duplicates across the range, -0 against +0); the array left as
+ * it was when a point is refused. */
+static void test_prepare_inplace(void)
+{
+    const size_t want = 30000;
+    double *xyz = malloc(want * 3 * sizeof *xyz);
+    double *work = malloc(want * 3 * sizeof *work);
+    CHECK(xyz && work);
+    for (int fam = 0; fam < NFAMILIES; fam++) {
+        size_t n = make_points(fam, want, xyz);
+        for (size_t i = 0; i + 7 < n && n >= 1000; i += 97)
+            memcpy(xyz + 3 * i, xyz + 3 * ((i * 7919 + 13) % n), 3 * sizeof *xyz);
+        if (n > 10) {
+            xyz[3 * 5] = 0.0;
+            xyz[3 * 9] = -0.0;
+            memcpy(xyz + 3 * 9 + 1, xyz + 3 * 5 + 1, 2 * sizeof *xyz);
+        }
+        memcpy(work, xyz, 3 * n * sizeof *xyz);
+        fdt_prepared ref, in;
+        char diag[256];
+        CHECK_EQ(fdt_prepare(xyz, n, 1, &ref, diag, sizeof diag), FDT_OK);
+        EXPECTF(fdt_prepare_inplace(work, n, &in, diag, sizeof diag) == FDT_OK, "%s",
+                family_name[fam]);
+        EXPECTF(in.p == work && in.p_borrowed && in.m == ref.m && in.ndup == ref.ndup &&
+                    in.scale_exp == ref.scale_exp &&
+                    !memcmp(in.p, ref.p, 3 * ref.m * sizeof *ref.p) &&
+                    !memcmp(in.orig, ref.orig, ref.m * sizeof *ref.orig) &&
+                    !memcmp(in.dupmap, ref.dupmap, n * sizeof *ref.dupmap),
+                "%s (%zu points, %zu distinct): in place differs", family_name[fam], n, ref.m);
+        fdt_prepared_free(&in); /* frees the library's arrays, not work */
+        EXPECT(in.p == NULL);
+        fdt_prepared_free(&ref);
+    }
+    memcpy(work, xyz, 3 * 100 * sizeof *xyz);
+    work[3 * 60 + 1] = NAN;
+    memcpy(xyz, work, 3 * 100 * sizeof *xyz);
+    fdt_prepared pr;
+    char diag[256];
+    EXPECT(fdt_prepare_inplace(work, 100, &pr, diag, sizeof diag) == FDT_ERANGE &&
+           strstr(diag, "point 60") && !memcmp(work, xyz, 3 * 60 * sizeof *xyz));
+    free(work);
+    free(xyz);
+}
+
 int main(void)
 {
     test_prepare();
     test_prepare_threads();
+    test_prepare_inplace();
     return test_report("test_prepare");
 }
