@@ -145,7 +145,7 @@ static int add_tet_faces(fdt_facetab *ft, fdt_faceq *fq, fdt_meshbuf *mb,
  * triangulation; fdt_front_probe: a few hundred). */
 static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
                      fdt_progress_fn progress, void *puser, fdt_front_stats *st,
-                     size_t max_faces)
+                     size_t max_faces, const fdt_probe_budget *budget)
 {
     fdt_facetab ft;
     fdt_faceq fq;
@@ -174,7 +174,15 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
     double expect = 6.5 * (double)t->n + 1.0;
     size_t next_report = 1u << 16;
     uint32_t fv[3];
+    int over = 0; /* the probe's budget was spent */
     while (st->faces_advanced < max_faces && fdt_faceq_pop(&fq, fv)) {
+        if (budget && (double)st->kq.points +
+                              budget->exact_weight *
+                                  (double)(st->kq.pc.orient_exact + st->kq.pc.insphere_exact) >
+                          budget->cost) {
+            over = 1;
+            break;
+        }
         /* the slot of the face 8 below the top of the current bucket:
          * a guess at a face that comes up soon (faces pushed meanwhile
          * come first), which costs one prefetch when wrong */
@@ -232,7 +240,7 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
             }
         }
     }
-    if (ft.count != 0 && st->faces_advanced < max_faces)
+    if (ft.count != 0 && st->faces_advanced < max_faces && !over)
         err = FDT_EINTERNAL;
 done:
     st->mesh_faces = orc.mesh_faces;
@@ -248,16 +256,17 @@ done:
 int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
                      fdt_progress_fn progress, void *puser, fdt_front_stats *st)
 {
-    return front_run(t, start, search, out, progress, puser, st, SIZE_MAX);
+    return front_run(t, start, search, out, progress, puser, st, SIZE_MAX, NULL);
 }
 
-int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces, fdt_front_stats *st)
+int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces,
+                    const fdt_probe_budget *budget, fdt_front_stats *st)
 {
     fdt_meshbuf mb;
     int err = fdt_meshbuf_init(&mb, 4 * faces + 64, 0);
     if (err)
         return err;
-    err = front_run(t, start, FDT_SEARCH_KD, &mb, NULL, NULL, st, faces);
+    err = front_run(t, start, FDT_SEARCH_KD, &mb, NULL, NULL, st, faces, budget);
     fdt_meshbuf_free(&mb);
     return err;
 }

@@ -221,6 +221,28 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
 #define PROBE_POINTS 32768
 #define PROBE_FACES 256
 
+/*
+ * Two samples: every k-th point (the whole object at a lower density: a
+ * pipe's rings, a sphere's shell survive it) and a run of consecutive
+ * input points (the local density of files written in scan or grid
+ * order: an O-grid's boundary layer, an extruded grid's planes, which
+ * thinning hides: 111 and 44 points a face thinned, 198 and 365 in a
+ * run). Either above PROBE_COST is expensive. The threshold is lower than
+ * the serial switch's (SWITCH_COST) because the other choice costs more:
+ * parts with meshes of their own points ask each other across the cuts
+ * (entry 52), so two threads on an O-grid took 1.3 s wall against 0.75 s
+ * serial. Measured (bench/NOTES.md entry 54), thinned / run: uniform 89
+ * / 69, ball 113 / 105, clusters 83 / 86, lidar 124 / 81, lonestar 128 /
+ * 124 stay on the kd search; citylidar 147 / 116, ogrid 111 / 198,
+ * cubedsphere 184 / 141, extruded 44 / 365, bunny 167 / 167, autzen 180 /
+ * 256 and every family that the serial rule switches early share one
+ * mesh. The margins are thin (lonestar at 128, citylidar at 147): a wrong
+ * choice costs at most the difference between the two parallel paths
+ * (lonestar with one mesh: 1.65 s against 1.62 s wall on two threads;
+ * autzen 0.32 s against 0.25 s), never correctness.
+ */
+#define PROBE_COST 140
+
 /* The kd search's cost a face (as fdt_oracle_tick costs it) over the k
  * points P[first + i * stride], i < k; -1 if it cannot be measured (no
  * memory, a flat sample). */
@@ -244,11 +266,19 @@ static double probe_cost(const double *P, size_t first, uint32_t stride, uint32_
         goto done;
     fdt_front_stats st;
     memset(&st, 0, sizeof st);
-    if (fdt_front_probe(&t, k / 2, PROBE_FACES, &st) != FDT_OK || st.faces_advanced == 0)
+    /* The decision is "above PROBE_COST a face on average": once the
+     * running cost passes PROBE_COST * PROBE_FACES, the average over
+     * however many faces the front would still run (at most PROBE_FACES)
+     * can only end above it, so the front stops there with the same
+     * answer. A rotated lattice's sample costs 12,392 units a face: 3 faces
+     * instead of 256, 0.19 s of CPU on one thread saved before the build
+     * (bench/NOTES.md entry 55). */
+    const fdt_probe_budget budget = {(double)PROBE_COST * PROBE_FACES, EXACT_WEIGHT};
+    if (fdt_front_probe(&t, k / 2, PROBE_FACES, &budget, &st) != FDT_OK || st.faces_advanced == 0)
         goto done;
-    cost = ((double)st.kq.points +
-            EXACT_WEIGHT * (double)(st.kq.pc.orient_exact + st.kq.pc.insphere_exact)) /
-           (double)st.faces_advanced;
+    double work = (double)st.kq.points +
+                  EXACT_WEIGHT * (double)(st.kq.pc.orient_exact + st.kq.pc.insphere_exact);
+    cost = work > budget.cost ? work / PROBE_FACES : work / (double)st.faces_advanced;
 done:
     fdt_kd_free(&t);
     free(S);
@@ -256,28 +286,7 @@ done:
     return cost;
 }
 
-/*
- * Two samples: every k-th point (the whole object at a lower density: a
- * pipe's rings, a sphere's shell survive it) and a run of consecutive
- * input points (the local density of files written in scan or grid
- * order: an O-grid's boundary layer, an extruded grid's planes, which
- * thinning hides: 111 and 44 points a face thinned, 198 and 365 in a
- * run). Either above PROBE_COST is expensive. The threshold is lower than
- * the serial switch's (SWITCH_COST) because the other choice costs more:
- * parts with meshes of their own points ask each other across the cuts
- * (entry 52), so two threads on an O-grid took 1.3 s wall against 0.75 s
- * serial. Measured (bench/NOTES.md entry 54), thinned / run: uniform 89
- * / 69, ball 113 / 105, clusters 83 / 86, lidar 124 / 81, lonestar 128 /
- * 124 stay on the kd search; citylidar 147 / 116, ogrid 111 / 198,
- * cubedsphere 184 / 141, extruded 44 / 365, bunny 167 / 167, autzen 180 /
- * 256 and every family that the serial rule switches early share one
- * mesh. The margins are thin (lonestar at 128, citylidar at 147): a wrong
- * choice costs at most the difference between the two parallel paths
- * (lonestar with one mesh: 1.65 s against 1.62 s wall on two threads;
- * autzen 0.32 s against 0.25 s), never correctness.
- */
-#define PROBE_COST 140
-
+/* Both samples, the first that is expensive decides (above). */
 int fdt_oracle_probe(const double *P, uint32_t m, int leaf_size)
 {
     uint32_t stride = m > PROBE_POINTS ? m / PROBE_POINTS : 1;
