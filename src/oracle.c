@@ -81,6 +81,34 @@
 #define TIMED_FROM 4096
 #define TIMED_MIN 8192
 
+/* The window's work so far is measured in these units. */
+static inline size_t work_units(const fdt_kdq *kq)
+{
+    return kq->points + EXACT_WEIGHT * (kq->pc.orient_exact + kq->pc.insphere_exact);
+}
+
+/*
+ * The work at which a window that started at work w0 and ends after len
+ * faces, at faces_end, has already decided to switch: its cost a face at
+ * the end is at least (work now - w0) / len, and the rule in
+ * fdt_oracle_tick switches when that exceeds MESH_FACE_COST + (SWITCH_COST
+ * - MESH_FACE_COST) * total / left, with left the faces left at the end,
+ * known now. So passing it mid-window gives the window's own decision,
+ * only earlier: a 12-digit sphere of 100k points tests ~42,000 points a
+ * face, and its first window of 256 faces took 0.17 s of a 0.44 s run
+ * where the mesh path takes 0.27 s (bench/NOTES.md entry 55).
+ */
+static size_t window_budget(const fdt_oracle *o, size_t w0, size_t faces_end, size_t len)
+{
+    double total = FACES_PER_POINT * (double)o->t->n;
+    double left = total - (double)faces_end;
+    if (left <= 0.0)
+        return SIZE_MAX;
+    double b = (double)w0 + (double)len * (MESH_FACE_COST +
+                                           (SWITCH_COST - MESH_FACE_COST) * total / left);
+    return b < (double)SIZE_MAX / 2 ? (size_t)b : SIZE_MAX;
+}
+
 void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy)
 {
     memset(o, 0, sizeof *o);
@@ -88,6 +116,8 @@ void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy)
     o->policy = policy;
     o->state = policy == FDT_SEARCH_KD ? -1 : 0;
     o->next_check = policy == FDT_SEARCH_MESH ? 0 : FIRST_WINDOW;
+    o->w_budget = policy == FDT_SEARCH_AUTO ? window_budget(o, 0, FIRST_WINDOW, FIRST_WINDOW)
+                                            : SIZE_MAX;
 }
 
 void fdt_oracle_free(fdt_oracle *o)
@@ -114,8 +144,13 @@ static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
 
 void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
 {
-    if (o->state != 0 || faces < o->next_check)
+    if (o->state != 0)
         return;
+    if (faces < o->next_check) {
+        if (work_units(kq) > o->w_budget)
+            build_mesh(o, faces, kq);
+        return;
+    }
     if (o->policy == FDT_SEARCH_MESH || o->t->n == 0) {
         if (o->t->n >= 4)
             build_mesh(o, faces, kq);
@@ -154,6 +189,7 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
     o->w_exact = kq->pc.orient_exact + kq->pc.insphere_exact;
     size_t win = faces < FIRST_WINDOW ? FIRST_WINDOW : faces < WINDOW ? faces : WINDOW;
     o->next_check = faces + win;
+    o->w_budget = window_budget(o, work_units(kq), o->next_check, win);
 }
 
 void fdt_oracle_share(fdt_oracle *o, const fdt_ins *gm)
