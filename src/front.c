@@ -157,7 +157,7 @@ static int add_tet_faces(fdt_facetab *ft, fdt_faceq *fq, fdt_emit *em, const uin
  * triangulation; fdt_front_probe: a few hundred). */
 static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *out,
                      fdt_progress_fn progress, void *puser, fdt_front_stats *st,
-                     size_t max_faces)
+                     size_t max_faces, const fdt_probe_budget *budget)
 {
     fdt_facetab ft;
     fdt_faceq fq;
@@ -186,7 +186,15 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *
     double expect = 6.5 * (double)t->n + 1.0;
     size_t next_report = 1u << 16;
     uint32_t fv[3];
+    int over = 0; /* the probe's budget was spent */
     while (st->faces_advanced < max_faces && fdt_faceq_pop(&fq, fv)) {
+        if (budget && (double)st->kq.points +
+                              budget->exact_weight *
+                                  (double)(st->kq.pc.orient_exact + st->kq.pc.insphere_exact) >
+                          budget->cost) {
+            over = 1;
+            break;
+        }
         /* the slot of the face 8 below the top of the current bucket:
          * a guess at a face that comes up soon (faces pushed meanwhile
          * come first), which costs one prefetch when wrong */
@@ -248,7 +256,7 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *
             }
         }
     }
-    if (ft.count != 0 && st->faces_advanced < max_faces)
+    if (ft.count != 0 && st->faces_advanced < max_faces && !over)
         err = FDT_EINTERNAL;
 done:
     st->mem_front = fdt_front_bytes(&ft, &fq);
@@ -276,7 +284,7 @@ size_t fdt_front_bytes(const fdt_facetab *ft, const fdt_faceq *fq)
 int fdt_front_emit(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *out,
                    fdt_progress_fn progress, void *puser, fdt_front_stats *st)
 {
-    return front_run(t, start, search, out, progress, puser, st, SIZE_MAX);
+    return front_run(t, start, search, out, progress, puser, st, SIZE_MAX, NULL);
 }
 
 int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
@@ -288,13 +296,14 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
     if (err)
         return err;
     if ((err = fdt_emit_init(&em, &s, out)) == FDT_OK)
-        err = front_run(t, start, search, &em, progress, puser, st, SIZE_MAX);
+        err = front_run(t, start, search, &em, progress, puser, st, SIZE_MAX, NULL);
     fdt_emit_free(&em);
     fdt_tsink_free(&s);
     return err;
 }
 
-int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces, fdt_front_stats *st)
+int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces,
+                    const fdt_probe_budget *budget, fdt_front_stats *st)
 {
     /* The tets are dropped as built: the sink keeps nothing. */
     fdt_tsink s;
@@ -303,7 +312,7 @@ int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces, fdt_front
     if (err)
         return err;
     if ((err = fdt_emit_init(&em, &s, NULL)) == FDT_OK)
-        err = front_run(t, start, FDT_SEARCH_KD, &em, NULL, NULL, st, faces);
+        err = front_run(t, start, FDT_SEARCH_KD, &em, NULL, NULL, st, faces, budget);
     fdt_emit_free(&em);
     fdt_tsink_free(&s);
     return err;

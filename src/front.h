@@ -62,10 +62,18 @@ struct fdt_emit;
 int fdt_front_emit(const fdt_kdtree *t, uint32_t start, int search, struct fdt_emit *em,
                    fdt_progress_fn progress, void *puser, fdt_front_stats *st);
 
+/* A cap on the probe's work: it stops before the next face once
+ * points tested + exact_weight * exact tests exceed cost. */
+typedef struct fdt_probe_budget {
+    double cost, exact_weight;
+} fdt_probe_budget;
+
 /* The kd search's first `faces` faces of the front over tree t, for their
  * work counters in st only (the tets are dropped): what src/oracle.c's
- * probe measures. */
-int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces, fdt_front_stats *st);
+ * probe measures. With a budget (NULL: none) it may stop earlier, with
+ * st->faces_advanced < faces and the budget spent. */
+int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces,
+                    const fdt_probe_budget *budget, fdt_front_stats *st);
 
 /* The outward faces of a positively oriented tet: face i is opposite
  * vertex i and has that vertex on its negative side. */

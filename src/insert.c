@@ -321,12 +321,65 @@ static inline uint32_t mix32(uint32_t x)
     return x;
 }
 
+/* The squared distance of p from c (inf where it overflows). */
+static inline double dist2(const double *p, const double *c)
+{
+    double dx = p[0] - c[0], dy = p[1] - c[1], dz = p[2] - c[2];
+    return dx * dx + dy * dy + dz * dz;
+}
+
+/*
+ * Moves the point nearest the centre of the points' bounding box to
+ * order[0], the first point inserted. A point inside a shell (a scanner's
+ * position in its scan, a probe at the centre of a sphere: gen_points
+ * `centre`) is a vertex of a cone over the whole shell. Inserted late (it
+ * was at 93,735 of 100,000 there), it finds the shell's interior filled
+ * with tets spanning the shell, every shell point's cavity runs through
+ * them, and its own cavity is all of them: in the parallel build the two
+ * workers' cavities met 62k-185k times and the build took 0.30 s CPU;
+ * inserted first, the interior is its cone from the start, cavities stay
+ * on the shell, and the build takes 0.12 s (bench/NOTES.md entry 55).
+ * Elsewhere it is one point out of BRIO order. The DT is unique, so the
+ * order changes nothing but the slot numbering.
+ */
+static void centre_first(const double *P, uint32_t *order, uint32_t n)
+{
+    double lo[3], hi[3];
+    const double *p0 = P + 3 * (size_t)order[0];
+    for (int k = 0; k < 3; k++)
+        lo[k] = hi[k] = p0[k];
+    for (uint32_t i = 1; i < n; i++) {
+        const double *p = P + 3 * (size_t)order[i];
+        for (int k = 0; k < 3; k++) {
+            lo[k] = p[k] < lo[k] ? p[k] : lo[k];
+            hi[k] = p[k] > hi[k] ? p[k] : hi[k];
+        }
+    }
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = lo[k] * 0.5 + hi[k] * 0.5; /* no overflow at 1e308 */
+    uint32_t best = 0;
+    double bd = dist2(p0, c);
+    for (uint32_t i = 1; i < n; i++) {
+        double d = dist2(P + 3 * (size_t)order[i], c);
+        if (d < bd) {
+            bd = d;
+            best = i;
+        }
+    }
+    uint32_t t = order[0];
+    order[0] = order[best];
+    order[best] = t;
+}
+
 /* order[] = the ids by round (BRIO), the smallest round first, ids
- * ascending within a round. Round L (the first) takes the points whose
+ * ascending within a round but for the point nearest the centre, which
+ * goes first (centre_first). Round L (the first) takes the points whose
  * hash has at least L trailing zeros, round l < L those with exactly l:
  * expected sizes n 2^-L, ..., n/4, n/2. L makes the first round about 128
  * to 256 points. */
-void fdt_ins_brio(uint32_t base, uint32_t n, uint32_t *order, uint32_t *round_end, int *nrounds)
+void fdt_ins_brio(const double *P, uint32_t base, uint32_t n, uint32_t *order,
+                  uint32_t *round_end, int *nrounds)
 {
     int L = 0;
     while (L < 30 && (n >> (L + 1)) >= 128)
@@ -343,6 +396,8 @@ void fdt_ins_brio(uint32_t base, uint32_t n, uint32_t *order, uint32_t *round_en
     *nrounds = L + 1;
     for (uint32_t i = 0; i < n; i++)
         order[pos[L - fdt_ctz64(mix32(base + i) | (UINT64_C(1) << L))]++] = base + i;
+    if (n > 0)
+        centre_first(P, order, n);
 }
 
 /*
@@ -547,7 +602,7 @@ int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
         return FDT_ENOMEM;
     uint32_t round_end[32], first[4];
     int nrounds;
-    fdt_ins_brio(base, n, order, round_end, &nrounds);
+    fdt_ins_brio(P, base, n, order, round_end, &nrounds);
     /* About 6.5 tets a point on uniform points, plus the hull: growing by
      * realloc stays possible for inputs with more. */
     int err = fdt_ins_build_prefix(m, P, base, n, order, n, (uint64_t)n * 27 / 4 + 64, first,

@@ -167,11 +167,13 @@ static inline size_t ins_star_tet(uint32_t *T, ins_edges *e, uint32_t bnd, uint3
 }
 
 /*
- * order[] = the ids [base, base + n) by BRIO round (src/insert.c), the
- * first round first; round_end[r] (r = 0 .. *nrounds - 1) is the end of
- * round r in order[]. round_end has room for 32 entries.
+ * order[] = the ids [base, base + n) of P's points by BRIO round
+ * (src/insert.c), the first round first, the point nearest the centre of
+ * their bounding box at order[0]; round_end[r] (r = 0 .. *nrounds - 1) is
+ * the end of round r in order[]. round_end has room for 32 entries.
  */
-void fdt_ins_brio(uint32_t base, uint32_t n, uint32_t *order, uint32_t *round_end, int *nrounds);
+void fdt_ins_brio(const double *P, uint32_t base, uint32_t n, uint32_t *order,
+                  uint32_t *round_end, int *nrounds);
 
 /*
  * The serial start of a build: m is set up for the points [base, base +

@@ -706,7 +706,7 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
     }
     uint32_t round_end[32], first[4];
     int nrounds;
-    fdt_ins_brio(base, n, order, round_end, &nrounds);
+    fdt_ins_brio(P, base, n, order, round_end, &nrounds);
     /* Phase 1: the first rounds up to n/32 points (at least one round). */
     int r0 = 1;
     while (r0 < nrounds && round_end[r0 - 1] < n / 32)

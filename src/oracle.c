@@ -65,14 +65,49 @@
  * search's 2.3 s. The rule only moves the switch; the mesh and the kd
  * search give the same apex, so the output never depends on timing. On a
  * faster machine the kd search looks cheaper against these constants and
- * the switch comes later: the safe direction.
+ * the switch comes later: the safe direction. TIME_MARGIN was 1.25; city
+ * lidar at 25k points (seed 1) stayed on the kd search with its checks at
+ * 1.18-1.23 times the mesh's predicted cost and took 0.16 s CPU where the
+ * mesh takes 0.12-0.13 s (CGAL 0.11 s). At 1.15 no other switch moves
+ * over 15 gen_points families at 25k and 100k and ../shared/data (lonestar
+ * and autzen stay below SLOW_NODES), and the constants hold: the mesh
+ * reads a face in 0.18-0.23 us and builds in 2.9-3.5 us a point on the
+ * city, uniform and bunny (bench/NOTES.md entry 55).
  */
 #define MESH_BUILD_US 3.0
 #define MESH_WALK_US 0.2
-#define TIME_MARGIN 1.25
+#define TIME_MARGIN 1.15
 #define SLOW_NODES 18.0
 #define TIMED_FROM 4096
 #define TIMED_MIN 8192
+
+/* The window's work so far is measured in these units. */
+static inline size_t work_units(const fdt_kdq *kq)
+{
+    return kq->points + EXACT_WEIGHT * (kq->pc.orient_exact + kq->pc.insphere_exact);
+}
+
+/*
+ * The work at which a window that started at work w0 and ends after len
+ * faces, at faces_end, has already decided to switch: its cost a face at
+ * the end is at least (work now - w0) / len, and the rule in
+ * fdt_oracle_tick switches when that exceeds MESH_FACE_COST + (SWITCH_COST
+ * - MESH_FACE_COST) * total / left, with left the faces left at the end,
+ * known now. So passing it mid-window gives the window's own decision,
+ * only earlier: a 12-digit sphere of 100k points tests ~42,000 points a
+ * face, and its first window of 256 faces took 0.17 s of a 0.44 s run
+ * where the mesh path takes 0.27 s (bench/NOTES.md entry 55).
+ */
+static size_t window_budget(const fdt_oracle *o, size_t w0, size_t faces_end, size_t len)
+{
+    double total = FACES_PER_POINT * (double)o->t->n;
+    double left = total - (double)faces_end;
+    if (left <= 0.0)
+        return SIZE_MAX;
+    double b = (double)w0 + (double)len * (MESH_FACE_COST +
+                                           (SWITCH_COST - MESH_FACE_COST) * total / left);
+    return b < (double)SIZE_MAX / 2 ? (size_t)b : SIZE_MAX;
+}
 
 void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy)
 {
@@ -81,6 +116,8 @@ void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy)
     o->policy = policy;
     o->state = policy == FDT_SEARCH_KD ? -1 : 0;
     o->next_check = policy == FDT_SEARCH_MESH ? 0 : FIRST_WINDOW;
+    o->w_budget = policy == FDT_SEARCH_AUTO ? window_budget(o, 0, FIRST_WINDOW, FIRST_WINDOW)
+                                            : SIZE_MAX;
 }
 
 void fdt_oracle_free(fdt_oracle *o)
@@ -107,8 +144,13 @@ static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
 
 void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
 {
-    if (o->state != 0 || faces < o->next_check)
+    if (o->state != 0)
         return;
+    if (faces < o->next_check) {
+        if (work_units(kq) > o->w_budget)
+            build_mesh(o, faces, kq);
+        return;
+    }
     if (o->policy == FDT_SEARCH_MESH || o->t->n == 0) {
         if (o->t->n >= 4)
             build_mesh(o, faces, kq);
@@ -147,6 +189,7 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
     o->w_exact = kq->pc.orient_exact + kq->pc.insphere_exact;
     size_t win = faces < FIRST_WINDOW ? FIRST_WINDOW : faces < WINDOW ? faces : WINDOW;
     o->next_check = faces + win;
+    o->w_budget = window_budget(o, work_units(kq), o->next_check, win);
 }
 
 void fdt_oracle_share(fdt_oracle *o, const fdt_ins *gm)
@@ -221,6 +264,28 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
 #define PROBE_POINTS 32768
 #define PROBE_FACES 256
 
+/*
+ * Two samples: every k-th point (the whole object at a lower density: a
+ * pipe's rings, a sphere's shell survive it) and a run of consecutive
+ * input points (the local density of files written in scan or grid
+ * order: an O-grid's boundary layer, an extruded grid's planes, which
+ * thinning hides: 111 and 44 points a face thinned, 198 and 365 in a
+ * run). Either above PROBE_COST is expensive. The threshold is lower than
+ * the serial switch's (SWITCH_COST) because the other choice costs more:
+ * parts with meshes of their own points ask each other across the cuts
+ * (entry 52), so two threads on an O-grid took 1.3 s wall against 0.75 s
+ * serial. Measured (bench/NOTES.md entry 54), thinned / run: uniform 89
+ * / 69, ball 113 / 105, clusters 83 / 86, lidar 124 / 81, lonestar 128 /
+ * 124 stay on the kd search; citylidar 147 / 116, ogrid 111 / 198,
+ * cubedsphere 184 / 141, extruded 44 / 365, bunny 167 / 167, autzen 180 /
+ * 256 and every family that the serial rule switches early share one
+ * mesh. The margins are thin (lonestar at 128, citylidar at 147): a wrong
+ * choice costs at most the difference between the two parallel paths
+ * (lonestar with one mesh: 1.65 s against 1.62 s wall on two threads;
+ * autzen 0.32 s against 0.25 s), never correctness.
+ */
+#define PROBE_COST 140
+
 /* The kd search's cost a face (as fdt_oracle_tick costs it) over the k
  * points P[first + i * stride], i < k; -1 if it cannot be measured (no
  * memory, a flat sample). */
@@ -244,11 +309,19 @@ static double probe_cost(const double *P, size_t first, uint32_t stride, uint32_
         goto done;
     fdt_front_stats st;
     memset(&st, 0, sizeof st);
-    if (fdt_front_probe(&t, k / 2, PROBE_FACES, &st) != FDT_OK || st.faces_advanced == 0)
+    /* The decision is "above PROBE_COST a face on average": once the
+     * running cost passes PROBE_COST * PROBE_FACES, the average over
+     * however many faces the front would still run (at most PROBE_FACES)
+     * can only end above it, so the front stops there with the same
+     * answer. A rotated lattice's sample costs 12,392 units a face: 3 faces
+     * instead of 256, 0.19 s of CPU on one thread saved before the build
+     * (bench/NOTES.md entry 55). */
+    const fdt_probe_budget budget = {(double)PROBE_COST * PROBE_FACES, EXACT_WEIGHT};
+    if (fdt_front_probe(&t, k / 2, PROBE_FACES, &budget, &st) != FDT_OK || st.faces_advanced == 0)
         goto done;
-    cost = ((double)st.kq.points +
-            EXACT_WEIGHT * (double)(st.kq.pc.orient_exact + st.kq.pc.insphere_exact)) /
-           (double)st.faces_advanced;
+    double work = (double)st.kq.points +
+                  EXACT_WEIGHT * (double)(st.kq.pc.orient_exact + st.kq.pc.insphere_exact);
+    cost = work > budget.cost ? work / PROBE_FACES : work / (double)st.faces_advanced;
 done:
     fdt_kd_free(&t);
     free(S);
@@ -256,28 +329,7 @@ done:
     return cost;
 }
 
-/*
- * Two samples: every k-th point (the whole object at a lower density: a
- * pipe's rings, a sphere's shell survive it) and a run of consecutive
- * input points (the local density of files written in scan or grid
- * order: an O-grid's boundary layer, an extruded grid's planes, which
- * thinning hides: 111 and 44 points a face thinned, 198 and 365 in a
- * run). Either above PROBE_COST is expensive. The threshold is lower than
- * the serial switch's (SWITCH_COST) because the other choice costs more:
- * parts with meshes of their own points ask each other across the cuts
- * (entry 52), so two threads on an O-grid took 1.3 s wall against 0.75 s
- * serial. Measured (bench/NOTES.md entry 54), thinned / run: uniform 89
- * / 69, ball 113 / 105, clusters 83 / 86, lidar 124 / 81, lonestar 128 /
- * 124 stay on the kd search; citylidar 147 / 116, ogrid 111 / 198,
- * cubedsphere 184 / 141, extruded 44 / 365, bunny 167 / 167, autzen 180 /
- * 256 and every family that the serial rule switches early share one
- * mesh. The margins are thin (lonestar at 128, citylidar at 147): a wrong
- * choice costs at most the difference between the two parallel paths
- * (lonestar with one mesh: 1.65 s against 1.62 s wall on two threads;
- * autzen 0.32 s against 0.25 s), never correctness.
- */
-#define PROBE_COST 140
-
+/* Both samples, the first that is expensive decides (above). */
 int fdt_oracle_probe(const double *P, uint32_t m, int leaf_size)
 {
     uint32_t stride = m > PROBE_POINTS ? m / PROBE_POINTS : 1;

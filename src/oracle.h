@@ -42,6 +42,10 @@ typedef struct fdt_oracle {
     size_t mtcap;
     /* The switching window: counter values at its start. */
     size_t next_check, w_faces, w_points, w_exact;
+    /* Work (points tested + EXACT_WEIGHT x exact tests, since the run's
+     * start) past which the window in progress must end in a switch:
+     * the switch is made as soon as it is passed (SIZE_MAX: never). */
+    size_t w_budget;
     /* The time rule's start: faces advanced (0: not started), thread CPU
      * (s) and kd nodes visited then. */
     size_t t_faces, t_nodes;

@@ -159,8 +159,23 @@ static void test_progress(void)
     fdt_meshbuf_free(&mb);
     /* the probe: exactly the faces asked for */
     memset(&st, 0, sizeof st);
-    EXPECT(fdt_front_probe(&b.t, 0, 256, &st) == FDT_OK);
+    EXPECT(fdt_front_probe(&b.t, 0, 256, NULL, &st) == FDT_OK);
     EXPECTF(st.faces_advanced == 256, "probe advanced %zu faces", st.faces_advanced);
+    /* with a budget: it stops at the first face that starts with the
+     * budget spent (not an error), having spent just over it */
+    double full_cost = (double)st.kq.points;
+    memset(&st, 0, sizeof st);
+    fdt_probe_budget bud = {full_cost / 4, 0.0};
+    EXPECT(fdt_front_probe(&b.t, 0, 256, &bud, &st) == FDT_OK);
+    EXPECTF(st.faces_advanced > 0 && st.faces_advanced < 256 && (double)st.kq.points > bud.cost,
+            "budgeted probe: %zu faces, %zu points tested (budget %g)", st.faces_advanced,
+            st.kq.points, bud.cost);
+    /* a budget never reached changes nothing */
+    memset(&st, 0, sizeof st);
+    bud.cost = 2 * full_cost;
+    EXPECT(fdt_front_probe(&b.t, 0, 256, &bud, &st) == FDT_OK);
+    EXPECTF(st.faces_advanced == 256 && (double)st.kq.points == full_cost,
+            "unreached budget: %zu faces", st.faces_advanced);
     unbuild(&b);
 }
 

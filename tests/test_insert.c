@@ -700,6 +700,45 @@ static void expect_refusal(const double *xyz, uint32_t n, int want, const char *
     fdt_ins_free(&m);
 }
 
+/* fdt_ins_brio: a permutation of the ids by round, with the point nearest
+ * the centre of the bounding box first wherever its id falls (a hub inside
+ * a shell inserted late makes every cavity span the shell: src/insert.c,
+ * centre_first). */
+static void test_brio_order(void)
+{
+    enum { N = 3000, BASE = 7 };
+    static double P[3 * (BASE + N)];
+    static uint32_t order[N];
+    uint64_t s = 12345;
+    for (int at = 0; at < N; at += 499) {
+        for (int i = 0; i < BASE + N; i++)
+            for (int k = 0; k < 3; k++) {
+                s = s * 6364136223846793005u + 1442695040888963407u;
+                /* a shell of radius 1 around (2, 2, 2), well away from it */
+                P[3 * i + k] = (double)(s >> 11) * 0x1p-53 < 0.5 ? 1.0 : 3.0;
+                P[3 * i + k] += 1e-3 * ((double)(s >> 20) * 0x1p-44);
+            }
+        double *c = P + 3 * (BASE + at);
+        c[0] = 2.0005, c[1] = 2.0, c[2] = 2.0; /* the nearest to the box centre */
+        uint32_t round_end[32];
+        int nr = 0;
+        fdt_ins_brio(P, BASE, N, order, round_end, &nr);
+        EXPECTF(order[0] == (uint32_t)(BASE + at), "brio: centre id %d at order[0] = %u", BASE + at,
+                order[0]);
+        EXPECT(nr >= 1 && nr <= 32 && round_end[nr - 1] == N);
+        static unsigned char seen[N];
+        memset(seen, 0, sizeof seen);
+        int ok = 1;
+        for (int j = 0; j < N; j++) {
+            uint32_t id = order[j];
+            ok &= id >= BASE && id < BASE + N && !seen[id - BASE];
+            if (id >= BASE && id < BASE + N)
+                seen[id - BASE] = 1;
+        }
+        EXPECTF(ok, "brio: not a permutation (centre at %d)", at);
+    }
+}
+
 static void test_refusals(void)
 {
     double xyz[3 * 400];
@@ -975,6 +1014,7 @@ int main(int argc, char **argv)
     }
     const char *gen = argv[1];
     test_refusals();
+    test_brio_order();
 
     /* Every family of gen_points; sizes keep the reference (the front,
      * quadratic on cospherical sets) within a few seconds. */

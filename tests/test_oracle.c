@@ -271,6 +271,24 @@ static void test_family(pts p, int want_auto, int quick)
  * made z by stretching), so a part within one layer is one plane and
  * cannot build a mesh; the kd search answers there instead, with the same
  * result. */
+/* The switch comes as soon as the window in progress has spent enough to
+ * decide it (src/oracle.c, window_budget), not at the window's end: on a
+ * cylinder, whose first faces test hundreds of points each, before the
+ * first window's 256 faces are done. Work counts, not times: deterministic. */
+static void test_early_switch(void)
+{
+    pts p = gen_cylinder(60, 64);
+    fdt_stats st;
+    fdt_result *r = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_AUTO, &st);
+    CHECK_EQ(st.mesh_parts, 1);
+    if (!(st.mesh_faces + 256 > st.faces_advanced))
+        fprintf(stderr, "early switch: %zu of %zu faces from the mesh\n", st.mesh_faces,
+                st.faces_advanced);
+    CHECK(st.mesh_faces + 256 > st.faces_advanced);
+    fdt_result_free(&r);
+    free(p.xyz);
+}
+
 static void test_flat_parts(void)
 {
     pts p = gen_layers(12, 7);
@@ -295,6 +313,7 @@ int main(int argc, char **argv)
     int quick = argc > 1 && !strcmp(argv[1], "--quick");
     alarm(600);
     test_flat_parts();
+    test_early_switch();
     test_family(gen_uniform(3000, 1), -1, quick);
     /* 60 rings of 64: the kd search tests hundreds of points a face here,
      * and the automatic rule must see it. */
