@@ -536,13 +536,6 @@ static void test_api(void)
     CHECK_EQ(ts.tets, st.tets);
     CHECK_EQ(fdt_result_thread_stats(r, 1, &ts), FDT_EINVAL);
     fdt_result_free(&r);
-    /* n_threads 0: the core count, any mode. */
-    r = run(&p, FDT_MODE_MESSAGE, 0, 0, FDT_OK);
-    CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
-    CHECK(st.threads >= 1 && st.threads <= 1024);
-    CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
-    CHECK(h == ref.hash);
-    fdt_result_free(&r);
     /* Every point twice: merged before partitioning, same mesh. */
     {
         pts d = pts_alloc("uniform-twice", 2 * p.n);
@@ -561,30 +554,6 @@ static void test_api(void)
     r = run(&p, FDT_MODE_SHARED, 4, 0, FDT_OK);
     CHECK(fdt_result_neighbors(r) == NULL);
     fdt_result_free(&r);
-    /* Pinning: bound (1, each thread on a core) or refused (-1, unpinned);
-     * either way the same mesh. */
-    {
-        fdt_settings s;
-        fdt_default_settings(&s);
-        s.mode = FDT_MODE_SHARED;
-        s.n_threads = 3;
-        s.pin = 1;
-        fdt_context *ctx = NULL;
-        CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
-        CHECK_EQ(fdt_triangulate(ctx, p.xyz, p.n, &r), FDT_OK);
-        CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
-        CHECK(st.pinned == 1 || st.pinned == -1);
-        for (int i = 0; i < 3; i++) {
-            CHECK_EQ(fdt_result_thread_stats(r, i, &ts), FDT_OK);
-            if (st.pinned == 1)
-                CHECK(ts.core >= 0);
-        }
-        CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
-        CHECK(h == ref.hash);
-        printf("pin: %s\n", st.pinned == 1 ? "threads bound to cores" : "binding refused, ran unpinned");
-        fdt_result_free(&r);
-        fdt_close(&ctx);
-    }
     /* The work shift balances tets, not points: on uniform points the
      * first part, owner of every tet across the cuts (§3.2), built 2.3 %
      * more tets than the last of two and 7 % more of eight without it. */
@@ -615,15 +584,6 @@ static void test_api(void)
     free_ref(&ref);
     free(p.xyz);
     printf("api: auto mode, thread count 0, no neighbours, refusals\n");
-}
-
-/* A progress callback that cancels: the run stops with FDT_ECANCELED,
- * without hanging, and leaks nothing (run under a leak checker). */
-static int cancel_cb(void *user, double f)
-{
-    (void)f;
-    int *calls = user;
-    return ++*calls >= 1;
 }
 
 /* The canonical sort of src/result.c runs on the triangulation's threads
@@ -698,37 +658,6 @@ static void test_sort_threads(void)
     free(p.xyz);
 }
 
-/* Cancellation of a parallel run, in both modes: the first report (after
- * 50 ms, src/parallel.c) cancels. 400,000 points take seconds on every
- * thread count here, so the run cannot finish first: FDT_OK would mean the
- * callback's answer was ignored. */
-static void test_cancel(void)
-{
-    pts p = fam_uniform(400000, 11);
-    for (int m = FDT_MODE_SHARED; m <= FDT_MODE_MESSAGE; m++) {
-        fdt_settings s;
-        fdt_default_settings(&s);
-        s.mode = (fdt_mode)m;
-        s.n_threads = 3;
-        int calls = 0;
-        s.progress = cancel_cb;
-        s.progress_user = &calls;
-        fdt_context *ctx = NULL;
-        CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
-        fdt_result *r = (fdt_result *)ctx; /* must be set to NULL */
-        double t0 = now_s();
-        int err = fdt_triangulate(ctx, p.xyz, p.n, &r);
-        double dt = now_s() - t0;
-        CHECK_EQ(err, FDT_ECANCELED);
-        CHECK(r == NULL);
-        CHECK(calls >= 1); /* reports go on until the workers stop */
-        fdt_close(&ctx);
-        printf("cancel: progress callback stops a %s run after %.2f s\n", mode_name((fdt_mode)m),
-               dt);
-    }
-    free(p.xyz);
-}
-
 /* Message mode caches foreign coordinates in a per-thread ghost map of
  * 1,024 slots at first, doubled at half load (src/parallel.c, ghost_put).
  * The small families never fill it; 40,000 uniform points cut in two or
@@ -792,8 +721,6 @@ int main(int argc, char **argv)
     test_tiny(quick ? 2 : 4);
     test_sort_threads();
     test_ghost_rehash();
-    if (!quick)
-        test_cancel();
     printf("all parallel tests passed\n");
     return 0;
 }
