@@ -113,6 +113,23 @@ usage_case u_demo_input "--demo takes no input" --demo 1000 pts.xyz
 usage_case u_demo_word "--demo takes no input" --demo abc
 usage_case u_demo_eq "--demo wants a point count" --demo=12x
 usage_case u_pin_arg "option --pin=3" --pin=3 pts.xyz
+usage_case u_long_missing "option --threads needs a value" pts.xyz --threads
+usage_case u_o_nine "-o given more than 8 times" pts.xyz -o a1.tets -o a2.tets -o a3.tets \
+    -o a4.tets -o a5.tets -o a6.tets -o a7.tets -o a8.tets -o a9.tets
+usage_case u_demo_format "need an input file, not --demo" --demo 100 --input-format xyz
+usage_case u_two_stdout "both want standard output" pts.xyz -o - --stats-json -
+usage_case u_stdout_tetgen "cannot go to standard output" pts.xyz -o - --format tetgen
+# --help and --version that cannot be written: exit 5, the reason said.
+run help_full bash -c '"$1" --help >/dev/full' _ "$FRONTDT"
+expect_rc help_full 5 && expect_in help_full err "stdout:"
+run version_full bash -c '"$1" --version >/dev/full' _ "$FRONTDT"
+expect_rc version_full 5
+# An output name too long for the file system's paths: exit 5, nothing made.
+mkdir -p out
+long_name=out/$(printf 'n%.0s' $(seq 1 5000)).tets
+run o_toolong "$FRONTDT" pts.xyz -o "$long_name"
+expect_rc o_toolong 5 && expect_in o_toolong err "File name too long"
+expect_empty_dir o_toolong out
 # A usage error must not create the output.
 mkdir -p out
 run u_nooutput "$FRONTDT" --mode turbo pts.xyz -o out/x.tets
