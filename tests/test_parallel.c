@@ -30,7 +30,9 @@
 #include <unistd.h>
 
 #include "frontdt.h"
+#include "parallel.h"
 #include "partition.h"
+#include "prepare.h"
 #include "result.h"
 
 #include "testutil.h"
@@ -586,6 +588,57 @@ static void test_api(void)
     printf("api: auto mode, thread count 0, no neighbours, refusals\n");
 }
 
+/* fdt_parallel_run's refusals: a mode that is not a parallel one, a
+ * thread count outside 1..1024, fewer than four distinct points; each
+ * FDT_EINVAL with an empty output. And the settings' leaf size reaches
+ * the parts' trees: any leaf size, the same mesh. */
+static void test_run_args(void)
+{
+    pts p = fam_uniform(400, 41);
+    reference ref = make_ref(&p);
+    fdt_prepared pr;
+    char diag[256] = "";
+    CHECK_EQ(fdt_prepare(p.xyz, p.n, 1, &pr, diag, sizeof diag), FDT_OK);
+    fdt_settings s;
+    fdt_default_settings(&s);
+    fdt_par_out out;
+    const struct { fdt_mode mode; int threads; } bad[] = {
+        {FDT_MODE_SERIAL, 2}, {FDT_MODE_AUTO, 2}, {FDT_MODE_SHARED, 0},
+        {FDT_MODE_MESSAGE, 1025}, {FDT_MODE_SHARED, -3}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        memset(&out, 0x55, sizeof out);
+        EXPECTF(fdt_parallel_run(&pr, &s, bad[i].mode, bad[i].threads, NULL, &out, diag,
+                                 sizeof diag) == FDT_EINVAL,
+                "mode %d, %d threads", (int)bad[i].mode, bad[i].threads);
+        EXPECT(out.mb.tets == NULL && out.tstats == NULL && out.nthreads == 0);
+    }
+    size_t m = pr.m;
+    pr.m = 3;
+    EXPECT(fdt_parallel_run(&pr, &s, FDT_MODE_SHARED, 2, NULL, &out, diag, sizeof diag) ==
+           FDT_EINVAL);
+    pr.m = m;
+    fdt_prepared_free(&pr);
+    for (int leaf = 1; leaf <= 64; leaf *= 64)
+        for (int mode = FDT_MODE_SHARED; mode <= FDT_MODE_MESSAGE; mode++) {
+            fdt_default_settings(&s);
+            s.mode = (fdt_mode)mode;
+            s.n_threads = 3;
+            s.leaf_size = leaf;
+            fdt_context *ctx = NULL;
+            CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+            fdt_result *r = NULL;
+            CHECK_EQ(fdt_triangulate(ctx, p.xyz, p.n, &r), FDT_OK);
+            uint64_t h;
+            CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
+            EXPECTF(h == ref.hash, "leaf size %d, mode %d", leaf, mode);
+            fdt_result_free(&r);
+            fdt_close(&ctx);
+        }
+    free_ref(&ref);
+    free(p.xyz);
+    printf("fdt_parallel_run: bad modes, thread counts and point counts refused; leaf sizes\n");
+}
+
 /* The canonical sort of src/result.c runs on the triangulation's threads
  * (one a core) above 65,536 tets: 15,000 points make about 100,000. With
  * and without neighbours (6- and 4-word records), its order and hash must
@@ -712,6 +765,7 @@ int main(int argc, char **argv)
         return 0;
     }
     test_api();
+    test_run_args();
     test_family(fam_uniform(quick ? 600 : 2000, 1), quick);
     test_family(fam_lattice(quick ? 6 : 9), quick);
     test_family(fam_intsphere(quick ? 325 : 725), quick);
@@ -721,6 +775,5 @@ int main(int argc, char **argv)
     test_tiny(quick ? 2 : 4);
     test_sort_threads();
     test_ghost_rehash();
-    printf("all parallel tests passed\n");
-    return 0;
+    return test_report("parallel");
 }
