@@ -709,11 +709,13 @@ static void test_write_progress(void)
 /* A file that cannot grow past a few hundred bytes (RLIMIT_FSIZE, SIGXFSZ
  * ignored: write(2) fails with EFBIG), in every format: FDT_EIO naming
  * the file, no temporary left, no target made (a TetGen set or an
- * OpenFOAM directory not half written either). 3,000 points, so every
- * format's output is far past the limit and fails in its first loop. */
+ * OpenFOAM directory not half written either). 20,000 points: every
+ * format writes several MB, past the writer's 1 MiB buffer, so the first
+ * flush fails inside a format's loops and the loops after it see the
+ * error (3,000 points fit the buffer: the error came only at close). */
 static void test_write_full(void)
 {
-    enum { N = 3000 };
+    enum { N = 20000 };
     static double pts[3 * N];
     uint64_t seed = 77;
     for (size_t i = 0; i < 3 * N; i++)
