@@ -743,6 +743,27 @@ dt=$(grep '^tets: ' demo.out | awk '{ print $2 }')
 [ "$(wc -l <out/demo.tets)" = "$dt" ] || fail "--demo -o: .tets has not $dt lines"
 run demo_small "$FRONTDT" --demo 3
 expect_rc demo_small 2
+# More points than memory holds: exit 4 (resources), said; past what a
+# size_t of coordinates can count too.
+for big in 100000000000000 1000000000000000000; do
+    run demo_huge "$FRONTDT" --demo "$big" -q
+    expect_rc demo_huge 4 && expect_in demo_huge err "demo: no memory for $big points"
+done
+usage_case u_demo_columns "need an input file, not --demo" --demo 100 --columns 1,2,3
+# --stats-json of a demo: no input (null), the demo's count, the check.
+run demo_json "$FRONTDT" --demo 1000 --check --stats-json out/demo.json -q
+expect_rc demo_json 0
+grep -q '"input": null, "demo": 1000,' out/demo.json || fail "demo_json: $(head -c 200 out/demo.json)"
+grep -q '"check": "passed"' out/demo.json || fail "demo_json: no check passed"
+# --stats says whether the threads were pinned: bound on a synthetic
+# topology hwloc accepts any binding on (refused without hwloc), not asked
+# without --pin.
+run pin_stats env HWLOC_SYNTHETIC="core:2 pu:1" "$FRONTDT" pts.xyz --pin -t 2 --mode shared --stats -q
+expect_rc pin_stats 0
+grep -Eq 'pinned +(yes|refused \(ran unpinned\))$' pin_stats.out pin_stats.err ||
+    fail "pin_stats: no pinned line: $(cat pin_stats.out)"
+run nopin_stats "$FRONTDT" pts.xyz -t 2 --mode shared --stats -q
+grep -Eq 'pinned +no$' nopin_stats.out nopin_stats.err || fail "nopin_stats: $(cat nopin_stats.out)"
 
 # ---------------------------------------------------------------------------
 # Signals: exit 6, no output, no temporary file
