@@ -59,10 +59,21 @@ int fdt_lex_compare(const double *p, const double *q);
 int fdt_compare_dist(const double *q, const double *x, const double *y);
 
 /* The circumcentre of the tetrahedron (a, b, c, d) relative to a, from
- * exact integer arithmetic: x[k] within a relative 2^-51 of the true
- * value for any finite input, however flat the tet. 0 on success, -1 when
- * the four points are coplanar or a component overflows a double. For
- * the ill-conditioned spheres the floating formula cannot bound. */
+ * exact integer arithmetic, for any finite input (subnormal coordinates
+ * included: they are scaled to integers exactly), however flat the tet.
+ * Accuracy of each component x[k] against the true value X:
+ *   |X| >= 2^-1022 (normal): |x[k] - X| <= 2^-51 |X|;
+ *   |X| <  2^-1022 (subnormal range, doubles 2^-1074 apart, so no
+ *   relative bound can hold): |x[k] - X| <= 2^-51 |X| + 2^-1074; a
+ *   component below 2^-1075 may come back 0.
+ * (The quotient is truncated to 53 bits, then ldexp rounds it onto the
+ * subnormal grid.) tests/test_predicates.c (test_circumcenter) checks
+ * these bounds against GMP rationals on random, flat, mixed 2^-1050..
+ * 2^900, subnormal, offset and huge inputs, and prints the largest errors
+ * it saw: 2 x 2^-53 relative and 0.5 x 2^-1074 absolute (seeds 1-3, scale
+ * 4). 0 on success, -1 when the four points are coplanar or a component
+ * overflows a double. For the ill-conditioned spheres the floating
+ * formula cannot bound. */
 int fdt_circumcenter_exact(const double *a, const double *b, const double *c,
                            const double *d, double x[3]);
 

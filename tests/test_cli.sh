@@ -114,6 +114,23 @@ usage_case u_demo_input "--demo takes no input" --demo 1000 pts.xyz
 usage_case u_demo_word "--demo takes no input" --demo abc
 usage_case u_demo_eq "--demo wants a point count" --demo=12x
 usage_case u_pin_arg "option --pin=3" --pin=3 pts.xyz
+usage_case u_long_missing "option --threads needs a value" pts.xyz --threads
+usage_case u_o_nine "-o given more than 8 times" pts.xyz -o a1.tets -o a2.tets -o a3.tets \
+    -o a4.tets -o a5.tets -o a6.tets -o a7.tets -o a8.tets -o a9.tets
+usage_case u_demo_format "need an input file, not --demo" --demo 100 --input-format xyz
+usage_case u_two_stdout "both want standard output" pts.xyz -o - --stats-json -
+usage_case u_stdout_tetgen "cannot go to standard output" pts.xyz -o - --format tetgen
+# --help and --version that cannot be written: exit 5, the reason said.
+run help_full bash -c '"$1" --help >/dev/full' _ "$FRONTDT"
+expect_rc help_full 5 && expect_in help_full err "stdout:"
+run version_full bash -c '"$1" --version >/dev/full' _ "$FRONTDT"
+expect_rc version_full 5
+# An output name too long for the file system's paths: exit 5, nothing made.
+mkdir -p out
+long_name=out/$(printf 'n%.0s' $(seq 1 5000)).tets
+run o_toolong "$FRONTDT" pts.xyz -o "$long_name"
+expect_rc o_toolong 5 && expect_in o_toolong err "File name too long"
+expect_empty_dir o_toolong out
 # A usage error must not create the output.
 mkdir -p out
 run u_nooutput "$FRONTDT" --mode turbo pts.xyz -o out/x.tets
@@ -727,6 +744,27 @@ dt=$(grep '^tets: ' demo.out | awk '{ print $2 }')
 [ "$(wc -l <out/demo.tets)" = "$dt" ] || fail "--demo -o: .tets has not $dt lines"
 run demo_small "$FRONTDT" --demo 3
 expect_rc demo_small 2
+# More points than memory holds: exit 4 (resources), said; past what a
+# size_t of coordinates can count too.
+for big in 100000000000000 1000000000000000000; do
+    run demo_huge "$FRONTDT" --demo "$big" -q
+    expect_rc demo_huge 4 && expect_in demo_huge err "demo: no memory for $big points"
+done
+usage_case u_demo_columns "need an input file, not --demo" --demo 100 --columns 1,2,3
+# --stats-json of a demo: no input (null), the demo's count, the check.
+run demo_json "$FRONTDT" --demo 1000 --check --stats-json out/demo.json -q
+expect_rc demo_json 0
+grep -q '"input": null, "demo": 1000,' out/demo.json || fail "demo_json: $(head -c 200 out/demo.json)"
+grep -q '"check": "passed"' out/demo.json || fail "demo_json: no check passed"
+# --stats says whether the threads were pinned: bound on a synthetic
+# topology hwloc accepts any binding on (refused without hwloc), not asked
+# without --pin.
+run pin_stats env HWLOC_SYNTHETIC="core:2 pu:1" "$FRONTDT" pts.xyz --pin -t 2 --mode shared --stats -q
+expect_rc pin_stats 0
+grep -Eq 'pinned +(yes|refused \(ran unpinned\))$' pin_stats.out pin_stats.err ||
+    fail "pin_stats: no pinned line: $(cat pin_stats.out)"
+run nopin_stats "$FRONTDT" pts.xyz -t 2 --mode shared --stats -q
+grep -Eq 'pinned +no$' nopin_stats.out nopin_stats.err || fail "nopin_stats: $(cat nopin_stats.out)"
 
 # ---------------------------------------------------------------------------
 # Signals: exit 6, no output, no temporary file

@@ -457,9 +457,51 @@ static int sc_stream(void *arg, const char **bad)
 typedef struct post_arg {
     const ptset *ps;
     int neighbors;
-    int what; /* 0: sort, 1: hash, 2: check */
+    int what; /* 0: sort, 1: hash, 2: check, 3: faces, edges and a
+                 vertex's neighbours (src/faces.c) */
     uint64_t want_hash;
 } post_arg;
+
+/* The faces, the edges and vertex 0's neighbours of r (under injection),
+ * each compared with those of a result made without it; a failed call
+ * must leave r able to answer once the memory is back. */
+static int derived(fdt_result *r, const post_arg *a, const char **bad)
+{
+    size_t nf = 0, ne = 0, nv = 0;
+    const fdt_vid *f = NULL, *e = NULL, *v = NULL;
+    const fdt_tid *ft = NULL, *ftr = NULL;
+    int rc = fdt_result_faces(r, &nf, &f, &ft);
+    if (rc == FDT_OK)
+        rc = fdt_result_edges(r, &ne, &e);
+    if (rc == FDT_OK)
+        rc = fdt_result_vertex_neighbors(r, 0, &nv, &v);
+    long at = atomic_load(&fault_at);
+    atomic_store(&fault_at, 0);
+    fdt_result *ref = NULL;
+    size_t rf = 0, re = 0, rv = 0;
+    const fdt_vid *fr = NULL, *er = NULL, *vr = NULL;
+    if (triangulate(a->ps, &serial_cfg, a->neighbors, &ref) != FDT_OK ||
+        fdt_result_faces(ref, &rf, &fr, &ftr) != FDT_OK ||
+        fdt_result_edges(ref, &re, &er) != FDT_OK ||
+        fdt_result_vertex_neighbors(ref, 0, &rv, &vr) != FDT_OK) {
+        *bad = "cannot make the reference faces";
+    } else {
+        if (rc != FDT_OK) {
+            /* the memory is back: r answers now */
+            if (fdt_result_faces(r, &nf, &f, &ft) != FDT_OK ||
+                fdt_result_edges(r, &ne, &e) != FDT_OK ||
+                fdt_result_vertex_neighbors(r, 0, &nv, &v) != FDT_OK)
+                *bad = "no faces after a failed call";
+        }
+        if (!*bad && (nf != rf || ne != re || nv != rv || memcmp(f, fr, 3 * nf * sizeof *f) ||
+                      memcmp(ft, ftr, 2 * nf * sizeof *ft) ||
+                      memcmp(e, er, 2 * ne * sizeof *e) || memcmp(v, vr, nv * sizeof *v)))
+            *bad = "faces, edges or neighbours differ from the reference";
+    }
+    fdt_result_free(&ref);
+    atomic_store(&fault_at, at);
+    return rc;
+}
 
 /* A result made without injection, then sort/hash/check under it. */
 static int sc_post(void *arg, const char **bad)
@@ -481,6 +523,8 @@ static int sc_post(void *arg, const char **bad)
         rc = fdt_result_hash(r, &h);
         if (rc == FDT_OK && h != a->want_hash)
             *bad = "wrong hash";
+    } else if (a->what == 3) {
+        rc = derived(r, a, bad);
     } else {
         char msg[256];
         rc = fdt_check(a->ps->xyz, a->ps->n, fdt_result_tets(r),
@@ -1041,10 +1085,10 @@ int main(int argc, char **argv)
             size_t nt = fdt_result_num_tets(r);
             fdt_result_free(&r);
 
-            static const char *const what[4] = {"triangulate", "result_sort",
-                                                "result_hash", "check"};
-            char nm[4][96];
-            for (int w = 0; w < 4; w++)
+            static const char *const what[5] = {"triangulate", "result_sort",
+                                                "result_hash", "check", "faces"};
+            char nm[5][96];
+            for (int w = 0; w < 5; w++)
                 snprintf(nm[w], sizeof nm[w], "%s %s%s", what[w], ps->name,
                          nb ? " (nbrs)" : "");
             tri_arg ta = {ps, &serial_cfg, nb, h, nt};
@@ -1062,7 +1106,7 @@ int main(int argc, char **argv)
                 scenario ss = {snm, FDT_ENOMEM, sc_stream, &sa};
                 inject_all(&ss);
             }
-            for (int w = 0; w < 3; w++) {
+            for (int w = 0; w < 4; w++) {
                 post_arg pa = {ps, nb, w, h};
                 scenario post = {nm[w + 1], FDT_ENOMEM, sc_post, &pa};
                 inject_all(&post);

@@ -231,6 +231,7 @@ static void test_basic(void)
     CHECK_EQ(fdt_mailbox_post(a, 2, m), FDT_EINVAL);
     CHECK_EQ(fdt_mailbox_post(a, -1, m), FDT_EINVAL);
     CHECK_EQ(fdt_mailbox_post(b, 0, m), FDT_EINVAL); /* not b's message */
+    CHECK_EQ(fdt_mailbox_post(a, 1, NULL), FDT_EINVAL);
     fdt_mailbox_discard(a, m);
 
     /* Send to self: FIFO, was-empty reports, payloads intact. */
@@ -272,6 +273,12 @@ static void test_basic(void)
     CHECK_EQ(fdt_mailbox_send(a, 1, &src), 1);
     src.kind = 0;
     CHECK_EQ(fdt_mailbox_send(a, 1, &src), FDT_EINVAL);
+    src.kind = FDT_MSG_KIND_END;
+    CHECK_EQ(fdt_mailbox_send(a, 1, &src), FDT_EINVAL);
+    src.kind = FDT_MSG_NODERECV;
+    CHECK_EQ(fdt_mailbox_send(a, 2, &src), FDT_EINVAL);
+    CHECK_EQ(fdt_mailbox_send(a, -1, &src), FDT_EINVAL);
+    CHECK_EQ(fdt_mailbox_send(a, 1, NULL), FDT_EINVAL);
     CHECK_EQ(fdt_mailbox_poll(b, &got), 1);
     CHECK_EQ(got.kind, FDT_MSG_NODERECV);
     CHECK_EQ(got.tag, 55);

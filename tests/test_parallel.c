@@ -30,7 +30,9 @@
 #include <unistd.h>
 
 #include "frontdt.h"
+#include "parallel.h"
 #include "partition.h"
+#include "prepare.h"
 #include "result.h"
 
 #include "testutil.h"
@@ -536,13 +538,6 @@ static void test_api(void)
     CHECK_EQ(ts.tets, st.tets);
     CHECK_EQ(fdt_result_thread_stats(r, 1, &ts), FDT_EINVAL);
     fdt_result_free(&r);
-    /* n_threads 0: the core count, any mode. */
-    r = run(&p, FDT_MODE_MESSAGE, 0, 0, FDT_OK);
-    CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
-    CHECK(st.threads >= 1 && st.threads <= 1024);
-    CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
-    CHECK(h == ref.hash);
-    fdt_result_free(&r);
     /* Every point twice: merged before partitioning, same mesh. */
     {
         pts d = pts_alloc("uniform-twice", 2 * p.n);
@@ -561,30 +556,6 @@ static void test_api(void)
     r = run(&p, FDT_MODE_SHARED, 4, 0, FDT_OK);
     CHECK(fdt_result_neighbors(r) == NULL);
     fdt_result_free(&r);
-    /* Pinning: bound (1, each thread on a core) or refused (-1, unpinned);
-     * either way the same mesh. */
-    {
-        fdt_settings s;
-        fdt_default_settings(&s);
-        s.mode = FDT_MODE_SHARED;
-        s.n_threads = 3;
-        s.pin = 1;
-        fdt_context *ctx = NULL;
-        CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
-        CHECK_EQ(fdt_triangulate(ctx, p.xyz, p.n, &r), FDT_OK);
-        CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
-        CHECK(st.pinned == 1 || st.pinned == -1);
-        for (int i = 0; i < 3; i++) {
-            CHECK_EQ(fdt_result_thread_stats(r, i, &ts), FDT_OK);
-            if (st.pinned == 1)
-                CHECK(ts.core >= 0);
-        }
-        CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
-        CHECK(h == ref.hash);
-        printf("pin: %s\n", st.pinned == 1 ? "threads bound to cores" : "binding refused, ran unpinned");
-        fdt_result_free(&r);
-        fdt_close(&ctx);
-    }
     /* The work shift balances tets, not points: on uniform points the
      * first part, owner of every tet across the cuts (§3.2), built 2.3 %
      * more tets than the last of two and 7 % more of eight without it. */
@@ -617,13 +588,55 @@ static void test_api(void)
     printf("api: auto mode, thread count 0, no neighbours, refusals\n");
 }
 
-/* A progress callback that cancels: the run stops with FDT_ECANCELED,
- * without hanging, and leaks nothing (run under a leak checker). */
-static int cancel_cb(void *user, double f)
+/* fdt_parallel_run's refusals: a mode that is not a parallel one, a
+ * thread count outside 1..1024, fewer than four distinct points; each
+ * FDT_EINVAL with an empty output. And the settings' leaf size reaches
+ * the parts' trees: any leaf size, the same mesh. */
+static void test_run_args(void)
 {
-    (void)f;
-    int *calls = user;
-    return ++*calls >= 1;
+    pts p = fam_uniform(400, 41);
+    reference ref = make_ref(&p);
+    fdt_prepared pr;
+    char diag[256] = "";
+    CHECK_EQ(fdt_prepare(p.xyz, p.n, 1, &pr, diag, sizeof diag), FDT_OK);
+    fdt_settings s;
+    fdt_default_settings(&s);
+    fdt_par_out out;
+    const struct { fdt_mode mode; int threads; } bad[] = {
+        {FDT_MODE_SERIAL, 2}, {FDT_MODE_AUTO, 2}, {FDT_MODE_SHARED, 0},
+        {FDT_MODE_MESSAGE, 1025}, {FDT_MODE_SHARED, -3}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        memset(&out, 0x55, sizeof out);
+        EXPECTF(fdt_parallel_run(&pr, &s, bad[i].mode, bad[i].threads, NULL, &out, diag,
+                                 sizeof diag) == FDT_EINVAL,
+                "mode %d, %d threads", (int)bad[i].mode, bad[i].threads);
+        EXPECT(out.mb.tets == NULL && out.tstats == NULL && out.nthreads == 0);
+    }
+    size_t m = pr.m;
+    pr.m = 3;
+    EXPECT(fdt_parallel_run(&pr, &s, FDT_MODE_SHARED, 2, NULL, &out, diag, sizeof diag) ==
+           FDT_EINVAL);
+    pr.m = m;
+    fdt_prepared_free(&pr);
+    for (int leaf = 1; leaf <= 64; leaf *= 64)
+        for (int mode = FDT_MODE_SHARED; mode <= FDT_MODE_MESSAGE; mode++) {
+            fdt_default_settings(&s);
+            s.mode = (fdt_mode)mode;
+            s.n_threads = 3;
+            s.leaf_size = leaf;
+            fdt_context *ctx = NULL;
+            CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+            fdt_result *r = NULL;
+            CHECK_EQ(fdt_triangulate(ctx, p.xyz, p.n, &r), FDT_OK);
+            uint64_t h;
+            CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
+            EXPECTF(h == ref.hash, "leaf size %d, mode %d", leaf, mode);
+            fdt_result_free(&r);
+            fdt_close(&ctx);
+        }
+    free_ref(&ref);
+    free(p.xyz);
+    printf("fdt_parallel_run: bad modes, thread counts and point counts refused; leaf sizes\n");
 }
 
 /* The canonical sort of src/result.c runs on the triangulation's threads
@@ -698,37 +711,6 @@ static void test_sort_threads(void)
     free(p.xyz);
 }
 
-/* Cancellation of a parallel run, in both modes: the first report (after
- * 50 ms, src/parallel.c) cancels. 400,000 points take seconds on every
- * thread count here, so the run cannot finish first: FDT_OK would mean the
- * callback's answer was ignored. */
-static void test_cancel(void)
-{
-    pts p = fam_uniform(400000, 11);
-    for (int m = FDT_MODE_SHARED; m <= FDT_MODE_MESSAGE; m++) {
-        fdt_settings s;
-        fdt_default_settings(&s);
-        s.mode = (fdt_mode)m;
-        s.n_threads = 3;
-        int calls = 0;
-        s.progress = cancel_cb;
-        s.progress_user = &calls;
-        fdt_context *ctx = NULL;
-        CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
-        fdt_result *r = (fdt_result *)ctx; /* must be set to NULL */
-        double t0 = now_s();
-        int err = fdt_triangulate(ctx, p.xyz, p.n, &r);
-        double dt = now_s() - t0;
-        CHECK_EQ(err, FDT_ECANCELED);
-        CHECK(r == NULL);
-        CHECK(calls >= 1); /* reports go on until the workers stop */
-        fdt_close(&ctx);
-        printf("cancel: progress callback stops a %s run after %.2f s\n", mode_name((fdt_mode)m),
-               dt);
-    }
-    free(p.xyz);
-}
-
 /* Message mode caches foreign coordinates in a per-thread ghost map of
  * 1,024 slots at first, doubled at half load (src/parallel.c, ghost_put).
  * The small families never fill it; 40,000 uniform points cut in two or
@@ -783,6 +765,7 @@ int main(int argc, char **argv)
         return 0;
     }
     test_api();
+    test_run_args();
     test_family(fam_uniform(quick ? 600 : 2000, 1), quick);
     test_family(fam_lattice(quick ? 6 : 9), quick);
     test_family(fam_intsphere(quick ? 325 : 725), quick);
@@ -792,8 +775,5 @@ int main(int argc, char **argv)
     test_tiny(quick ? 2 : 4);
     test_sort_threads();
     test_ghost_rehash();
-    if (!quick)
-        test_cancel();
-    printf("all parallel tests passed\n");
-    return 0;
+    return test_report("parallel");
 }

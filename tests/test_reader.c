@@ -1463,6 +1463,36 @@ static void test_open(tctx *t)
                      FDT_IO_EFORMAT &&
                  strstr(big, "bad.xyz:1: expected 3 numbers, found 2") != NULL,
           "full message: %s", big);
+    /* the _with and _mem_with entry points' arguments; formats of names */
+    fdt_rd_opts o;
+    fdt_rd_opts_default(&o);
+    EXPECT(fdt_rd_format_by_name(NULL) == FDT_RD_AUTO);
+    EXPECT(fdt_rd_format_by_name("PLY") == FDT_RD_PLY);
+    EXPECT(fdt_rd_format_of_path(NULL) == FDT_RD_AUTO);
+    EXPECT(fdt_rd_format_of_path("d.xyz/points") == FDT_RD_AUTO); /* the dot is the dir's */
+    EXPECT(fdt_rd_format_of_path("d/p.Node") == FDT_RD_NODE);
+    EXPECTF(fdt_rd_points_with(path, NULL, &xyz, &n, big, sizeof big) == FDT_IO_EOPEN &&
+                strstr(big, "invalid arguments") != NULL,
+            "NULL options: %s", big);
+    EXPECTF(fdt_rd_points_mem_with(NULL, "0 0 0\n", 6, &o, &xyz, &n, big, sizeof big) ==
+                    FDT_IO_EOPEN &&
+                strstr(big, "(null): invalid arguments") != NULL,
+            "NULL name: %s", big);
+    EXPECT(fdt_rd_points_mem_with("m.xyz", NULL, 6, &o, &xyz, &n, big, sizeof big) ==
+           FDT_IO_EOPEN);
+    EXPECT(fdt_rd_points_mem_with("m.xyz", "0 0 0\n", 6, NULL, &xyz, &n, big, sizeof big) ==
+           FDT_IO_EOPEN);
+    EXPECT(fdt_rd_points_mem_with("m.xyz", "0 0 0\n", 6, &o, NULL, &n, big, sizeof big) ==
+           FDT_IO_EOPEN);
+    EXPECTF(fdt_rd_points_mem_with("m.xyz", "0 0 0\n", SIZE_MAX, &o, &xyz, &n, big,
+                                   sizeof big) == FDT_IO_ENOMEM &&
+                strstr(big, "too large") != NULL && xyz == NULL && n == 0,
+            "SIZE_MAX bytes: %s", big);
+    /* an empty buffer with no data pointer is an empty file */
+    EXPECT(fdt_rd_points_mem_with("m.xyz", NULL, 0, &o, &xyz, &n, big, sizeof big) !=
+           FDT_IO_EOPEN);
+    free(xyz);
+    xyz = NULL;
     /* a successful read clears the message */
     write_file(t, "fine.xyz", "0 0 0\n", 6, path, sizeof path);
     EXPECTF(fdt_rd_points(path, &xyz, &n, big, sizeof big) == FDT_IO_OK &&

@@ -401,6 +401,41 @@ static void test_centre(void)
     fdt_result_free(&r);
 }
 
+/* The accessors' refusals and clamps: thread stats of a thread that is
+ * not there, NULL arguments, sizes the library does not know; the hash on
+ * a thread count below 1 or above 64 is the same hash. */
+static void test_refusals(void)
+{
+    double xyz[3 * 60];
+    uint64_t seed = 3;
+    for (int i = 0; i < 3 * 60; i++)
+        xyz[i] = test_unif(&seed);
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = FDT_MODE_SERIAL;
+    fdt_context *ctx = NULL;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    fdt_result *r = NULL;
+    CHECK_EQ(fdt_triangulate(ctx, xyz, 60, &r), FDT_OK);
+    fdt_thread_stats ts;
+    CHECK_EQ(fdt_result_thread_stats(r, 0, &ts), FDT_OK);
+    CHECK_EQ(ts.tets, fdt_result_num_tets(r));
+    CHECK_EQ(fdt_result_thread_stats(NULL, 0, &ts), FDT_EINVAL);
+    CHECK_EQ(fdt_result_thread_stats(r, 0, NULL), FDT_EINVAL);
+    CHECK_EQ(fdt_result_thread_stats(r, -1, &ts), FDT_EINVAL);
+    CHECK_EQ(fdt_result_thread_stats(r, 1, &ts), FDT_EINVAL);
+    CHECK_EQ(fdt_result_thread_stats_sized(r, 0, &ts, 3), FDT_EINVAL);
+    CHECK_EQ(fdt_result_num_tets(NULL), 0);
+    uint64_t h1, h0, h99;
+    CHECK_EQ(fdt_result_hash(r, &h1), FDT_OK);
+    CHECK_EQ(fdt_result_hash_threads(r, 0, &h0), FDT_OK);
+    CHECK_EQ(fdt_result_hash_threads(r, 99, &h99), FDT_OK);
+    CHECK(h0 == h1 && h99 == h1);
+    fdt_result_free(&r);
+    fdt_close(&ctx);
+    printf("refusals: thread stats, NULLs, sizes; hash threads clamped\n");
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 3 && strcmp(argv[1], "--write-centre") == 0) {
@@ -410,6 +445,7 @@ int main(int argc, char **argv)
         }
         return 0;
     }
+    test_refusals();
     test_synthetic();
     test_centre();
     return 0;

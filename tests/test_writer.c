@@ -998,6 +998,62 @@ static void test_cleanup_idle(const char *dir)
     EXPECT(count_entries(dir) == before);
 }
 
+/* The format table's lookups (src/writer.c): by name, by path (a
+ * directory format by its last component, trailing slashes and case
+ * ignored), the list for messages, what each needs, and every layout's
+ * file names (a directory's parts, a family without its extension as
+ * --format gives it, names too long). */
+static void test_format_table(const char *dir)
+{
+    (void)dir;
+    EXPECT(fdt_format_by_name(NULL) == NULL && fdt_format_by_name("nope") == NULL);
+    const fdt_format *msh2 = fdt_format_by_name("msh2"), *foam = fdt_format_by_name("openfoam"),
+                     *tg = fdt_format_by_name("tetgen"), *vtu = fdt_format_by_name("vtu"),
+                     *tets = fdt_format_by_name("tets"), *vtk = fdt_format_by_name("vtk");
+    CHECK(msh2 && foam && tg && vtu && tets && vtk);
+    EXPECT(!strcmp(fdt_format_name(msh2), "msh2") && fdt_format_name(NULL) == NULL);
+    EXPECT(fdt_format_by_path(NULL) == NULL);
+    EXPECT(fdt_format_by_path("case/polyMesh") == foam);
+    EXPECT(fdt_format_by_path("case/polyMesh//") == foam);
+    EXPECT(fdt_format_by_path("case/POLYMESH") == foam);
+    EXPECT(fdt_format_by_path("polyMesh") == foam);
+    EXPECT(fdt_format_by_path("case/xpolyMesh") == NULL);
+    EXPECT(fdt_format_by_path("case/polyMes") == NULL);
+    EXPECT(fdt_format_by_path("m.msh") != msh2); /* msh2 has no extension */
+    EXPECT(fdt_format_is_text(tets) && !fdt_format_is_text(vtu) && !fdt_format_is_text(NULL));
+    /* all_faces adds the faces to TetGen's set alone */
+    EXPECT(fdt_format_needs(NULL, 1) == 0);
+    EXPECT((fdt_format_needs(tg, 1) & FDT_NEED_FACES) && !(fdt_format_needs(tg, 0) & FDT_NEED_FACES));
+    EXPECT(fdt_format_needs(tg, 0) & FDT_NEED_NBRS);
+    EXPECT(fdt_format_needs(vtk, 1) == fdt_format_needs(vtk, 0));
+    const char *list = fdt_format_list();
+    EXPECTF(strstr(list, "tets (.tets)") && strstr(list, "openfoam (polyMesh)") &&
+                strstr(list, ", msh2, ") && strstr(list, "tetgen (.ele)"),
+            "[%s]", list);
+    EXPECT(fdt_format_list() == list); /* built once */
+
+    char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+    /* a directory: its parts inside it, trailing slashes dropped */
+    EXPECT(fdt_output_files_as("case/polyMesh//", NULL, names) == 5);
+    EXPECT(!strcmp(names[0], "case/polyMesh/points") && !strcmp(names[4], "case/polyMesh/boundary"));
+    /* --format openfoam on any directory name */
+    EXPECT(fdt_output_files_as("out", foam, names) == 5 && !strcmp(names[1], "out/faces"));
+    /* --format tetgen on a name without .ele: the base name itself */
+    EXPECT(fdt_output_files_as("d/m", tg, names) == 4);
+    EXPECT(!strcmp(names[0], "d/m.node") && !strcmp(names[1], "d/m.ele"));
+    /* unknown format and no --format: none */
+    EXPECT(fdt_output_files_as("m.xyz", NULL, names) == 0);
+    /* too long for a path, each layout */
+    static char longp[FDT_IO_PATH + 8];
+    memset(longp, 'x', sizeof longp - 1);
+    EXPECT(fdt_output_files_as(longp, tets, names) == -1);
+    EXPECT(fdt_output_files_as(longp, tg, names) == -1);
+    memset(longp, 'x', FDT_IO_PATH - 4);
+    longp[FDT_IO_PATH - 4] = '\0';
+    EXPECT(fdt_output_files_as(longp, foam, names) == -1); /* "/points" does not fit */
+    EXPECT(fdt_output_files_as(longp, tets, names) == 1);
+}
+
 int main(void)
 {
     const char *tmp = getenv("TMPDIR");
@@ -1010,11 +1066,12 @@ int main(void)
     }
     char sub[4096];
     const char *names[] = { "small", "refuse", "ids", "large", "files",
-                            "same" };
+                            "same", "table" };
     void (*fns[])(const char *) = { test_small_mesh, test_refusals,
                                     test_big_ids, test_large,
-                                    test_output_files, test_same_file };
-    for (int i = 0; i < 6; i++) {
+                                    test_output_files, test_same_file,
+                                    test_format_table };
+    for (int i = 0; i < 7; i++) {
         snprintf(sub, sizeof sub, "%s/%s", dir, names[i]);
         mkdir(sub, 0755);
         long before = test_failures();
