@@ -207,9 +207,8 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     if (user)
         popt.sink = &sink;
     if (ctx->s.mode == FDT_MODE_AUTO && mode == FDT_MODE_SHARED &&
-        ctx->s.search == FDT_SEARCH_AUTO &&
-        fdt_oracle_probe(pr.p, (uint32_t)pr.m, ctx->s.leaf_size))
-        popt.global_mesh = 1;
+        ctx->s.search == FDT_SEARCH_AUTO)
+        popt.global_mesh = FDT_PAR_MESH_PROBE; /* beside the partition */
     double t1;
     size_t mem_tree = 0, mem_mesh = 0, mem_sink = 0;
     fdt_front_stats fst;

@@ -287,21 +287,17 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
 #define PROBE_COST 140
 
 /* The kd search's cost a face (as fdt_oracle_tick costs it) over the k
- * points P[first + i * stride], i < k; -1 if it cannot be measured (no
- * memory, a flat sample). */
-static double probe_cost(const double *P, size_t first, uint32_t stride, uint32_t k,
-                         int leaf_size)
+ * points of S (a copy, which the kd build permutes); -1 if it cannot be
+ * measured (no memory, a flat sample). */
+static double probe_cost(double *S, uint32_t k, int leaf_size)
 {
     double cost = -1.0;
-    double *S = malloc(3 * (size_t)k * sizeof *S);
     fdt_vid *orig = malloc((size_t)k * sizeof *orig);
     fdt_kdtree t = {0};
-    if (!S || !orig)
+    if (!orig)
         goto done;
-    for (uint32_t i = 0; i < k; i++) {
-        memcpy(S + 3 * (size_t)i, P + 3 * (first + (size_t)i * stride), 3 * sizeof *S);
+    for (uint32_t i = 0; i < k; i++)
         orig[i] = (fdt_vid)i;
-    }
     char diag[8];
     if (fdt_seed_check_dimension(S, orig, k, diag, sizeof diag) != FDT_OK)
         goto done;
@@ -324,19 +320,51 @@ static double probe_cost(const double *P, size_t first, uint32_t stride, uint32_
     cost = work > budget.cost ? work / PROBE_FACES : work / (double)st.faces_advanced;
 done:
     fdt_kd_free(&t);
-    free(S);
     free(orig);
     return cost;
 }
 
-/* Both samples, the first that is expensive decides (above). */
-int fdt_oracle_probe(const double *P, uint32_t m, int leaf_size)
+/* P[first + i * stride], i < k, copied; NULL without memory. */
+static double *probe_sample(const double *P, size_t first, uint32_t stride, uint32_t k)
+{
+    double *S = malloc(3 * (size_t)k * sizeof *S);
+    if (S)
+        for (uint32_t i = 0; i < k; i++)
+            memcpy(S + 3 * (size_t)i, P + 3 * (first + (size_t)i * stride), 3 * sizeof *S);
+    return S;
+}
+
+/* Both samples, the first that is expensive decides (above); the run
+ * only where thinning dropped points (stride > 1). */
+void fdt_oracle_probe_take(fdt_probe_samples *ps, const double *P, uint32_t m, int leaf_size)
 {
     uint32_t stride = m > PROBE_POINTS ? m / PROBE_POINTS : 1;
     uint32_t k = m / stride;
-    if (k < 4)
-        return 0;
-    if (probe_cost(P, 0, stride, k, leaf_size) > PROBE_COST)
-        return 1;
-    return stride > 1 && probe_cost(P, (size_t)(m - k) / 2, 1, k, leaf_size) > PROBE_COST;
+    ps->S[0] = ps->S[1] = NULL;
+    ps->k = k < 4 ? 0 : k;
+    ps->leaf_size = leaf_size;
+    if (ps->k == 0)
+        return;
+    ps->S[0] = probe_sample(P, 0, stride, k);
+    if (stride > 1)
+        ps->S[1] = probe_sample(P, (size_t)(m - k) / 2, 1, k);
+}
+
+int fdt_oracle_probe_decide(fdt_probe_samples *ps)
+{
+    int expensive = 0;
+    for (int i = 0; i < 2 && !expensive; i++)
+        if (ps->S[i])
+            expensive = probe_cost(ps->S[i], ps->k, ps->leaf_size) > PROBE_COST;
+    free(ps->S[0]);
+    free(ps->S[1]);
+    ps->S[0] = ps->S[1] = NULL;
+    return expensive;
+}
+
+int fdt_oracle_probe(const double *P, uint32_t m, int leaf_size)
+{
+    fdt_probe_samples ps;
+    fdt_oracle_probe_take(&ps, P, m, leaf_size);
+    return fdt_oracle_probe_decide(&ps);
 }

@@ -106,4 +106,19 @@ int fdt_oracle_note(fdt_oracle *o, int64_t tid, uint32_t mtet);
  */
 int fdt_oracle_probe(const double *P, uint32_t m, int leaf_size);
 
+/*
+ * fdt_oracle_probe in two steps, so that the samples can be copied before
+ * src/partition.c permutes P and costed on another thread while the
+ * partition runs (src/parallel.c): take copies the samples (no memory
+ * for one: that sample counts as cheap, as in fdt_oracle_probe), decide
+ * costs them, frees them and returns what fdt_oracle_probe would have.
+ */
+typedef struct fdt_probe_samples {
+    double *S[2]; /* every stride-th point; a run of consecutive points */
+    uint32_t k;   /* points in each (0: too few points, not expensive) */
+    int leaf_size;
+} fdt_probe_samples;
+void fdt_oracle_probe_take(fdt_probe_samples *ps, const double *P, uint32_t m, int leaf_size);
+int fdt_oracle_probe_decide(fdt_probe_samples *ps);
+
 #endif

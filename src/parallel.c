@@ -14,12 +14,14 @@
  */
 #include "parallel.h"
 
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "engine.h"
 #include "gather.h"
+#include "oracle.h"
 #include "seed.h"
 #include "termination.h"
 #include "threads.h"
@@ -133,6 +135,19 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
     return fdt_parallel_run(pr, s, mode, nthreads, NULL, out, diag, dlen);
 }
 
+/* The probe (FDT_PAR_MESH_PROBE) on its own thread. */
+typedef struct probe_job {
+    fdt_probe_samples ps;
+    int expensive;
+} probe_job;
+
+static void *probe_main(void *arg)
+{
+    probe_job *pj = arg;
+    pj->expensive = fdt_oracle_probe_decide(&pj->ps);
+    return NULL;
+}
+
 int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int nthreads,
                      const fdt_par_opts *opt, fdt_par_out *out, char *diag, size_t dlen)
 {
@@ -153,12 +168,35 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * (up to one a part): at 1M points on two cores that took a quarter
      * of a second off a setup of 0.9 s. */
     int cores = fdt_parallel_default_threads();
+    /* The probe only decides the shared mesh's build, after the partition
+     * and the seeds, whose first cut and seed search leave the second
+     * core idle (bench/NOTES.md entry 56): it runs beside them on samples
+     * copied before the partition permutes the points, so its answer is
+     * fdt_oracle_probe's on the caller's order. pthread_join orders its
+     * answer before the read below. */
+    int probe = opt && opt->global_mesh == FDT_PAR_MESH_PROBE && mode == FDT_MODE_SHARED;
+    int probing = 0, expensive = 0;
+    probe_job pj = {{{NULL, NULL}, 0, 0}, 0};
+    pthread_t probe_th;
+    if (probe) {
+        fdt_oracle_probe_take(&pj.ps, pr->p, (uint32_t)pr->m, s->leaf_size);
+        probing = pthread_create(&probe_th, NULL, probe_main, &pj) == 0;
+    }
     int err = fdt_partition_build(&pt, pr->p, pr->orig, (uint32_t)pr->m, nthreads,
                                   s->leaf_size > 0 ? s->leaf_size : FDT_DEFAULT_LEAF,
                                   cores < nthreads ? cores : nthreads);
-    if (err)
-        return err;
-    if ((err = fdt_par_make_seeds(&pt, &seeds, &nseeds, &kq0)) != FDT_OK) {
+    int perr = err;
+    if (perr == FDT_OK)
+        err = fdt_par_make_seeds(&pt, &seeds, &nseeds, &kq0);
+    if (probing) {
+        pthread_join(probe_th, NULL);
+        expensive = pj.expensive;
+    } else if (probe) {
+        expensive = fdt_oracle_probe_decide(&pj.ps); /* no thread: here */
+    }
+    if (perr != FDT_OK)
+        return perr; /* pt is zeroed, no seeds */
+    if (err != FDT_OK) {
         if (err == FDT_EINTERNAL)
             snprintf(diag, dlen, "internal error: no seed tetrahedron found");
         goto fail;
@@ -327,7 +365,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * owned by the parts' fronts. A build that cannot be made (no memory)
      * leaves the parts on their own oracles. */
     double t_gm = 0.0;
-    if (opt && opt->global_mesh && mode == FDT_MODE_SHARED) {
+    if (opt && (opt->global_mesh == 1 || expensive) && mode == FDT_MODE_SHARED) {
         double tg = fdt_now_s();
         int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads,
                                           &kq0.pc);

@@ -45,6 +45,9 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
                              fdt_mode mode, int nthreads, fdt_par_out *out,
                              char *diag, size_t dlen);
 
+/* fdt_par_opts.global_mesh: let the probe decide (src/parallel.c). */
+#define FDT_PAR_MESH_PROBE 2
+
 /* How a run is carried out beyond the settings (tests). */
 typedef struct fdt_par_opts {
     int shuffle;        /* nonzero: the test transport of src/transport.h,
@@ -58,7 +61,11 @@ typedef struct fdt_par_opts {
     size_t fail_after;
     int global_mesh;    /* shared mode: build the DT of every point first
                            (fdt_ins_build_parallel, on nthreads threads)
-                           and let every part read its apexes from it */
+                           and let every part read its apexes from it;
+                           FDT_PAR_MESH_PROBE: only if fdt_oracle_probe
+                           finds the kd search expensive (src/oracle.h),
+                           the probe running on a thread of its own beside
+                           the partition and the seeds */
     struct fdt_tsink *sink; /* where the tets go (src/sink.h); NULL: into
                            out->mb. A sink with a caller's fdt_sink streams:
                            out->mb stays empty, nothing is gathered, and

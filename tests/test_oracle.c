@@ -27,6 +27,8 @@
 #include <unistd.h>
 
 #include "frontdt.h"
+#include "oracle.h"
+#include "prepare.h"
 
 #include "testutil.h"
 
@@ -267,6 +269,43 @@ static void test_family(pts p, int want_auto, int quick)
     printf("ok %s (%zu points)\n", p.name, p.n);
 }
 
+/* fdt_oracle_probe_take copies its samples: src/parallel.c costs them on
+ * another thread while the partition permutes the points, so the answer
+ * must be the one on the points as they were when taken, and the same as
+ * fdt_oracle_probe's. 74,088 points: both samples (every second point,
+ * and a run of consecutive ones). */
+static void test_probe_samples(void)
+{
+    size_t n = 42 * 42 * 42;
+    /* a rotated lattice: its sample costs thousands of points a face
+     * (bench/NOTES.md entry 55), uniform points' ~90 */
+    pts cyl = gen_lattice("rotlattice", 42, 0.3, 0.5, 0.7), uni = gen_uniform(n, 7);
+    fdt_prepared a, b; /* scaled as the engine sees them */
+    char diag[256];
+    CHECK_EQ(fdt_prepare(cyl.xyz, n, 1, &a, diag, sizeof diag), FDT_OK);
+    CHECK_EQ(fdt_prepare(uni.xyz, n, 1, &b, diag, sizeof diag), FDT_OK);
+    CHECK(a.m == n && b.m == n);
+    double *save = malloc(3 * n * sizeof *save);
+    CHECK(save);
+    memcpy(save, a.p, 3 * n * sizeof *save);
+    CHECK_EQ(fdt_oracle_probe(a.p, (uint32_t)n, 0), 1);
+    CHECK_EQ(fdt_oracle_probe(b.p, (uint32_t)n, 0), 0);
+    fdt_probe_samples ps;
+    fdt_oracle_probe_take(&ps, a.p, (uint32_t)n, 0);
+    memcpy(a.p, b.p, 3 * n * sizeof *save); /* changed after the take */
+    CHECK_EQ(fdt_oracle_probe_decide(&ps), 1);
+    fdt_oracle_probe_take(&ps, a.p, (uint32_t)n, 0);
+    memcpy(a.p, save, 3 * n * sizeof *save);
+    CHECK_EQ(fdt_oracle_probe_decide(&ps), 0);
+    CHECK(ps.S[0] == NULL && ps.S[1] == NULL); /* decide frees them */
+    free(save);
+    fdt_prepared_free(&a);
+    fdt_prepared_free(&b);
+    free(cyl.xyz);
+    free(uni.xyz);
+    printf("ok probe samples taken before the points change\n");
+}
+
 /* Two layers, two threads: the bisection cuts z (the widest extent is
  * made z by stretching), so a part within one layer is one plane and
  * cannot build a mesh; the kd search answers there instead, with the same
@@ -313,6 +352,7 @@ int main(int argc, char **argv)
     int quick = argc > 1 && !strcmp(argv[1], "--quick");
     alarm(600);
     test_flat_parts();
+    test_probe_samples();
     test_early_switch();
     test_family(gen_uniform(3000, 1), -1, quick);
     /* 60 rings of 64: the kd search tests hundreds of points a face here,
