@@ -43,6 +43,8 @@ void fdt_mpi_out_free(fdt_mpi_out *out)
 {
     free(out->rank_counts);
     free(out->rank_tets);
+    free(out->rank_times);
+    out->rank_times = NULL;
     free(out->all_tets);
     free(out->all_hull);
     free(out->own_tets);
@@ -173,6 +175,7 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
         e->n = size;
         e->search = o->search;
         e->msg_term = 1;
+        e->park = !o->no_park; /* a round trip crosses processes: park, go on */
         e->fail_part = o->fail_rank;
         e->fail_after = o->fail_after;
         e->w = aligned_alloc(alignof(worker), (size_t)size * sizeof(worker));
@@ -238,7 +241,7 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     /* Every rank's setup succeeded, or no rank runs: a rank whose setup
      * failed could not answer the others' NODESENDs. */
     err = first_error(comm, size, err, "setup", &out->err_rank, diag, dlen);
-    double t1 = fdt_now_s();
+    double t1 = fdt_now_s(), c1 = fdt_thread_cpu_s();
     if (!err) {
         int rc = fdt_eng_worker_loop(w);
         /* ABORT to every other rank, unless an ABORT stopped us */
@@ -248,7 +251,7 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
          * our own (recorded by fdt_eng_set_error) or 0. */
         err = first_error(comm, size, w->err, "run", &out->err_rank, diag, dlen);
     }
-    double t2 = fdt_now_s();
+    double t2 = fdt_now_s(), c2 = fdt_thread_cpu_s();
     if (err) {
         if (tp)
             fdt_transport_mpi_abandon(tp);
@@ -268,8 +271,9 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     if (rank == 0) {
         out->rank_counts = malloc((size_t)size * sizeof both);
         out->rank_tets = malloc((size_t)size * sizeof *out->rank_tets);
+        out->rank_times = malloc((size_t)size * FDT_MPI_NTIMES * sizeof *out->rank_times);
     }
-    int oom = rank == 0 && (!out->rank_counts || !out->rank_tets);
+    int oom = rank == 0 && (!out->rank_counts || !out->rank_tets || !out->rank_times);
     MPI_Bcast(&oom, 1, MPI_INT, 0, comm);
     if (oom) {
         err = FDT_ENOMEM;
@@ -278,6 +282,13 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     }
     MPI_Gather(both, 2 * FDT_MSG_KIND_END, MPI_UINT64_T, out->rank_counts,
                2 * FDT_MSG_KIND_END, MPI_UINT64_T, 0, comm);
+    /* Where each rank's front time went (--stats): the wait timers of
+     * src/protocol.c (t_idle: nothing to do; t_query_wait: blocked on
+     * answers) beside its CPU time. */
+    double tm[FDT_MPI_NTIMES] = {t2 - t1, c2 - c1, w->st.t_idle, w->st.t_query_wait,
+                                 (double)w->st.faces_advanced};
+    MPI_Gather(tm, FDT_MPI_NTIMES, MPI_DOUBLE, out->rank_times, FDT_MPI_NTIMES, MPI_DOUBLE, 0,
+               comm);
     uint64_t nt = w->out.ntets, *rt = NULL;
     if (rank == 0 && !(rt = malloc((size_t)size * sizeof *rt)))
         MPI_Abort(comm, 4);
