@@ -59,6 +59,9 @@ typedef struct fdt_par_opts {
     int global_mesh;    /* shared mode: build the DT of every point first
                            (fdt_ins_build_parallel, on nthreads threads)
                            and let every part read its apexes from it */
+    int park;           /* message mode: park a face that waits for a
+                           NODERECV, as MPI ranks do (src/engine.c), so
+                           the shuffle tests run that loop too */
 } fdt_par_opts;
 
 /* fdt_parallel_triangulate with options (NULL: none, what it does). */
