@@ -53,8 +53,10 @@ typedef struct parked {
     qbuf qb;
     uint32_t mapex, mtet;      /* the own mesh's answer (fdt_front_apex) */
     uint32_t qid;              /* the query out (its tag) */
-    int part;                  /* asked */
+    int part;                  /* asked, or to ask (held) */
     int used;
+    int held;                  /* the query is not sent yet: a face with
+                                  the same lowest vertex is asking */
     int sp;
     int stack[64];
 } parked;
