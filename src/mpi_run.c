@@ -1,10 +1,16 @@
 /*
  * One rank of a distributed run; see mpi_run.h.
  *
- * The run on a rank is the message-mode worker of src/engine.c, unchanged:
- * an engine whose e->n parts are the ranks, of which this rank fills only
- * its own worker (the others stay zero: message mode never reads another
- * part's worker, it asks that part by message). Termination is
+ * The run on a rank is the message-mode worker of src/engine.c: an engine
+ * whose e->n parts are the ranks, of which this rank fills only its own
+ * worker (the others stay zero: message mode never reads another part's
+ * worker, it asks that part by message). One difference (e->park): a face
+ * that asks another rank is parked until the answer comes, and the rank
+ * advances its other faces meanwhile, since a round trip between processes
+ * (the other rank's next poll, or its next time slice when ranks share
+ * cores) is far longer than a face. Parked faces are work, so a rank with
+ * any is never idle in the sense of src/termination.c, and the proof there
+ * is unchanged. Termination is
  * src/termination.c's Dijkstra-Scholten over FACESEND/FACERECV, with IAMDONE
  * epoch 1 (a root's tree finished, to rank 0) and epoch 2 (rank 0: every
  * tree finished, to all); the proof at the top of that file never uses

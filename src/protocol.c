@@ -7,7 +7,8 @@
  * same walk, but for another part it sends NODESEND (face coordinates, best
  * so far) to that part's thread and waits for NODERECV, answering the
  * NODESENDs in its own mailbox meanwhile (so waiting threads cannot
- * deadlock, §4) and deferring FACESENDs until the face is done. Message-mode
+ * deadlock, §4) and deferring FACESENDs until the face is done (MPI
+ * ranks instead park the face and go on: src/engine.c, fdt_eng_resume). Message-mode
  * threads read only their own part's coordinates: a FACESEND carries the
  * coordinates of every id but the lowest (which the receiver owns), and
  * each thread caches the foreign coordinates it has been sent ("ghosts").
