@@ -16,6 +16,7 @@ packages=(
   python3-dev python3-numpy python3-scipy
   locales gcovr
   mpi-default-dev mpi-default-bin
+  libmpich-dev mpich
 )
 
 missing=()

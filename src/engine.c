@@ -214,14 +214,83 @@ static int offer_from_mesh(worker *w, fdt_apex *s, int part)
     return FDT_OK;
 }
 
-static int search_others(worker *w, fdt_apex *s, qbuf *qb)
+/* The walk stopped: a parked face's NODESEND is out (engine.park). */
+enum { WALK_PARKED = 2 };
+
+/* Sends parked face pk's query to pk->part: the slot in the tag's low
+ * bits, a sequence number above them (a stale answer cannot match a
+ * reused slot). WALK_PARKED or an error. */
+static int post_parked(worker *w, parked *pk)
+{
+    uint32_t tag = (++w->qid << 6) | (uint32_t)(pk - w->pk);
+    int rc = fdt_proto_post_query(w, &pk->ap, pk->part, tag);
+    if (rc)
+        return rc;
+    pk->qid = tag;
+    pk->held = 0;
+    return WALK_PARKED;
+}
+
+/*
+ * Whether another parked face with pk's lowest vertex has its query out.
+ * Faces with one lowest vertex come off the queue together (src/faceq.c)
+ * and are often faces of one tet: once a parked face's tet is built, its
+ * siblings are complete and need no query. So a face whose search must ask
+ * another rank while a sibling asks is held, its query not sent, until the
+ * sibling is done (release_held); stage 3's first measurement parked
+ * without this and sent 40 % more NODESENDs than waiting for each answer
+ * (1M uniform points, 2 ranks: 168k against 120k). Invariant: every held
+ * slot has a sibling whose query is out, so a held face is not held for
+ * ever (that sibling's answer comes, and its end releases one).
+ */
+static int sibling_asking(const worker *w, const parked *pk)
+{
+    for (int i = 0; i < FDT_PARK_MAX; i++) {
+        const parked *q = &w->pk[i];
+        if (q != pk && q->used && !q->held && q->f[0] == pk->f[0])
+            return 1;
+    }
+    return 0;
+}
+
+/* A parked face with lowest vertex v ended (finished or dropped): held
+ * siblings that left the front are dropped, and if none of v's faces
+ * asks any more, the first held one sends its query (the invariant
+ * above). FDT_OK or an error. */
+static int release_held(worker *w, uint32_t v)
+{
+    for (int i = 0; i < FDT_PARK_MAX; i++) {
+        const parked *q = &w->pk[i];
+        if (q->used && !q->held && q->f[0] == v)
+            return FDT_OK;
+    }
+    for (int i = 0; i < FDT_PARK_MAX; i++) {
+        parked *q = &w->pk[i];
+        if (!q->used || !q->held || q->f[0] != v)
+            continue;
+        fdt_face *s = fdt_facetab_find(&w->ft, q->f);
+        if (!s || s->v[1] != q->f[1]) {
+            q->used = 0; /* completed meanwhile: see fdt_eng_resume */
+            q->held = 0;
+            w->npk--;
+            continue;
+        }
+        int rc = post_parked(w, q);
+        return rc == WALK_PARKED ? FDT_OK : rc;
+    }
+    return FDT_OK;
+}
+
+/* Walks from stack[0..*sp) (the root alone to start). In park mode a part
+ * to ask gets a NODESEND tagged with slot pk and the walk stops there
+ * (WALK_PARKED), the stack saved in *sp; fdt_eng_resume goes on from it
+ * once the answer has been offered. Otherwise the part is asked and
+ * waited for, as message mode does. */
+static int walk_others(worker *w, fdt_apex *s, qbuf *qb, int *stack, int *sp, parked *pk)
 {
     const fdt_partition *pt = w->e->pt;
-    int stack[64];
-    int sp = 0;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        const fdt_pnode *nd = &pt->nodes[stack[--sp]];
+    while (*sp > 0) {
+        const fdt_pnode *nd = &pt->nodes[stack[--*sp]];
         if (nd->begin == nd->end || nd->part == w->id)
             continue;
         if (!fdt_apex_box_useful(s, nd->lo, nd->hi))
@@ -236,6 +305,13 @@ static int search_others(worker *w, fdt_apex *s, qbuf *qb)
                 } else {
                     fdt_apex_search(s, &pt->trees[nd->part], &w->kq);
                 }
+            } else if (pk) {
+                pk->part = nd->part;
+                if (sibling_asking(w, pk)) {
+                    pk->held = 1;
+                    return WALK_PARKED;
+                }
+                return post_parked(w, pk);
             } else {
                 int rc = fdt_proto_remote_query(w, s, nd->part, qb);
                 if (rc)
@@ -252,22 +328,63 @@ static int search_others(worker *w, fdt_apex *s, qbuf *qb)
         double dl = l->begin < l->end ? fdt_box_dist2_sc(l->lo, l->hi, q, sc) : INFINITY;
         double dr = r->begin < r->end ? fdt_box_dist2_sc(r->lo, r->hi, q, sc) : INFINITY;
         if (dl <= dr) {
-            stack[sp++] = nd->left + 1;
-            stack[sp++] = nd->left;
+            stack[(*sp)++] = nd->left + 1;
+            stack[(*sp)++] = nd->left;
         } else {
-            stack[sp++] = nd->left;
-            stack[sp++] = nd->left + 1;
+            stack[(*sp)++] = nd->left;
+            stack[(*sp)++] = nd->left + 1;
         }
     }
     return FDT_OK;
 }
 
-/* Advances one own front face. Returns 1 if it did, 0 if the queue held
- * no live face, or an error. */
+/* The end of a face's advance once every part that could hold a better
+ * apex was searched: a hull face, a local tet, or a FACESEND to the tet's
+ * owner. s: f's live slot. Returns 1 or an error. */
+static int finish_face(worker *w, const uint32_t f[3], fdt_face *s, fdt_apex *ap,
+                       uint32_t mapex, uint32_t mtet)
+{
+    int err;
+    if (ap->best == FDT_NONE) {
+        /* Nothing on the open side: a hull face, already outward. The
+         * search changed no table (message mode deferred its FACESENDs;
+         * a parked face's slot was looked up again). */
+        if ((err = fdt_emit_hull(&w->em, f)) != FDT_OK)
+            return err;
+        w->st.hull_faces++;
+        fdt_facetab_remove(&w->ft, s);
+        return 1;
+    }
+    uint32_t p = ap->best;
+    uint32_t v[4] = {f[0], f[1], f[2], p};
+    /* f[0] is the face's lowest id, and ours. */
+    int owner = p > f[0] || is_own(w, p) ? w->id : fdt_partition_owner(w->e->pt, p);
+    if (owner == w->id) {
+        if (w->e->mode == FDT_MODE_MESSAGE && !is_own(w, p) &&
+            (err = fdt_ghost_put(&w->ghosts, p, ap->bp)) != FDT_OK)
+            return err;
+        /* The search changed no table (above), so s still holds f. A
+         * local build always adds a tet (fdt_eng_build_tet), the last of out; its
+         * mesh tet is known when the mesh gave its apex. */
+        err = fdt_eng_build_tet(w, v, 0, s);
+        if (!err)
+            err = fdt_oracle_note(&w->orc, (int64_t)w->em.ntets - 1,
+                                  p == mapex ? mtet : FDT_NONE);
+    } else {
+        /* p is the tet's lowest id: the owner reads its coordinates
+         * itself, the message carries f's. */
+        w->st.tet_requests++;
+        err = fdt_proto_send_face(w, owner, f, p, -1);
+    }
+    return err ? err : 1;
+}
+
+/* Advances one own front face. Returns 1 if it did (or parked it), 0 if
+ * the queue held no live face, or an error. In park mode the caller
+ * leaves a slot free. */
 static int advance_one(worker *w)
 {
     fdt_face *s = NULL;
-    uint32_t f[3];
     uint32_t fv[3];
     while (fdt_faceq_pop(&w->fq, fv)) {
         /* the slot of a face that may come up soon, as in src/front.c */
@@ -282,15 +399,28 @@ static int advance_one(worker *w)
     }
     if (!s)
         return 0;
-    memcpy(f, s->v, sizeof f);
+    /* The search state: on the stack, or in a free slot where it can
+     * wait for an answer (park mode). */
+    parked local, *pk = &local;
+    if (w->e->park) {
+        if (!w->pk && !(w->pk = calloc(FDT_PARK_MAX, sizeof *w->pk)))
+            return FDT_ENOMEM;
+        int k = 0;
+        while (k < FDT_PARK_MAX && w->pk[k].used)
+            k++;
+        if (k == FDT_PARK_MAX)
+            return FDT_EINTERNAL; /* the loop leaves a slot free */
+        pk = &w->pk[k];
+    }
+    uint32_t *f = pk->f;
+    memcpy(f, s->v, sizeof pk->f);
     w->st.faces_advanced++;
-    double a[3], b[3], c[3];
     const double *pa = coords(w, f[0]), *pb = coords(w, f[1]), *pc = coords(w, f[2]);
     if (!pa || !pb || !pc)
         return FDT_EINTERNAL;
-    memcpy(a, pa, sizeof a);
-    memcpy(b, pb, sizeof b);
-    memcpy(c, pc, sizeof c);
+    memcpy(pk->a, pa, sizeof pk->a);
+    memcpy(pk->b, pb, sizeof pk->b);
+    memcpy(pk->c, pc, sizeof pk->c);
     fdt_oracle_tick(&w->orc, w->st.faces_advanced - 1, &w->kq);
     if (w->orc.state == 1 && !w->orc.gm && !w->published) {
         /* release: see mesh_pub */
@@ -314,55 +444,66 @@ static int advance_one(worker *w)
     uint32_t copp = FDT_NONE;
     if (s->aux == (uint32_t)w->id)
         fdt_emit_unlink(&w->em, s->tet, &ctid, &copp);
-    uint32_t mapex = FDT_NONE, mtet = FDT_NONE;
+    pk->mapex = FDT_NONE;
+    pk->mtet = FDT_NONE;
     int inside = 0;
-    fdt_apex ap;
-    int err = fdt_front_apex(&w->orc, w->tree, &w->ft, f, a, b, c, ctid, copp, 1, &ap,
-                             &inside, &mapex, &mtet, &w->kq);
+    int err = fdt_front_apex(&w->orc, w->tree, &w->ft, f, pk->a, pk->b, pk->c, ctid, copp, 1,
+                             &pk->ap, &inside, &pk->mapex, &pk->mtet, &w->kq);
     if (err)
         return err;
     /* fdt_front_apex sets mapex to the kd search's answer when the mesh
      * was not asked; the mesh tet (mtet) stays FDT_NONE then. */
-    qbuf qb = {{{0}}, 0};
-    err = inside ? FDT_OK : search_others(w, &ap, &qb);
-    if (err)
-        return err;
-    if (ap.best == FDT_NONE) {
-        /* Nothing on the open side: a hull face, already outward. The
-         * search changed no table (message mode deferred its FACESENDs). */
-        fdt_face *live = fdt_facetab_find(&w->ft, f);
-        if (!live)
-            return FDT_EINTERNAL;
-        if ((err = fdt_emit_hull(&w->em, f)) != FDT_OK)
+    pk->qb.next = 0;
+    if (!inside) {
+        pk->sp = 0;
+        pk->stack[pk->sp++] = 0;
+        err = walk_others(w, &pk->ap, &pk->qb, pk->stack, &pk->sp, w->e->park ? pk : NULL);
+        if (err == WALK_PARKED) {
+            pk->used = 1;
+            w->npk++;
+            return 1;
+        }
+        if (err)
             return err;
-        w->st.hull_faces++;
-        fdt_facetab_remove(&w->ft, live);
-        return 1;
     }
-    uint32_t p = ap.best;
-    uint32_t v[4] = {f[0], f[1], f[2], p};
-    /* f[0] is the face's lowest id, and ours. */
-    int owner = p > f[0] || is_own(w, p) ? w->id : fdt_partition_owner(w->e->pt, p);
-    if (owner == w->id) {
-        if (w->e->mode == FDT_MODE_MESSAGE && !is_own(w, p) &&
-            (err = fdt_ghost_put(&w->ghosts, p, ap.bp)) != FDT_OK)
-            return err;
-        /* The search changed no table (above), so s still holds f. A
-         * local build always adds a tet (fdt_eng_build_tet), the last of out; its
-         * mesh tet is known when the mesh gave its apex. */
-        err = fdt_eng_build_tet(w, v, 0, s);
-        if (!err)
-            err = fdt_oracle_note(&w->orc, w->em.ntets - 1,
-                                  p == mapex ? mtet : FDT_NONE);
-    } else {
-        /* p is the tet's lowest id: the owner reads its coordinates
-         * itself, the message carries f's. */
-        w->st.tet_requests++;
-        err = fdt_proto_send_face(w, owner, f, p, -1);
-    }
-    return err ? err : 1;
+    /* Message mode deferred the FACESENDs that came while it waited, so
+     * s still holds f. */
+    return finish_face(w, f, s, &pk->ap, pk->mapex, pk->mtet);
 }
 
+/*
+ * A parked face's answer (engine.park). While the face waited, this rank
+ * went on with its other faces and its mail, so the face table may have
+ * changed: f is looked up again. If it left the front, a tet on its open
+ * side was built meanwhile (by us, completing f, or by the tet's owner,
+ * who sent us f back); that tet is the one this search would find (the
+ * tet on a face's open side is unique: the same rules decide it whoever
+ * searches), so the face is dropped. A face cannot come back once gone
+ * (a face belongs to two tets at most), nor be queued twice.
+ */
+int fdt_eng_resume(worker *w, const fdt_msg *m)
+{
+    uint32_t k = m->tag & (FDT_PARK_MAX - 1);
+    if (!w->pk || !w->pk[k].used || w->pk[k].held || w->pk[k].qid != m->tag ||
+        w->pk[k].part != m->sender)
+        return FDT_EINTERNAL;
+    parked *pk = &w->pk[k];
+    int err = fdt_proto_take_answer(w, m, &pk->ap, &pk->qb);
+    if (!err)
+        err = walk_others(w, &pk->ap, &pk->qb, pk->stack, &pk->sp, pk);
+    if (err == WALK_PARKED)
+        return RUN_ON; /* asking again, or held behind a sibling that asks */
+    pk->used = 0;
+    w->npk--;
+    if (err)
+        return err;
+    fdt_face *s = fdt_facetab_find(&w->ft, pk->f);
+    if (s && s->v[1] == pk->f[1] && (err = finish_face(w, pk->f, s, &pk->ap, pk->mapex,
+                                                        pk->mtet)) < 0)
+        return err;
+    /* The slot is free but keeps its face: its siblings may go on. */
+    return release_held(w, pk->f[0]);
+}
 
 int fdt_eng_worker_setup(worker *w)
 {
@@ -412,12 +553,21 @@ int fdt_eng_worker_loop(worker *w)
             if (rc != RUN_ON)
                 return rc;
         }
-        if ((rc = advance_one(w)) < 0)
+        /* Park mode: a full table of parked faces waits for answers. */
+        rc = w->npk < FDT_PARK_MAX ? advance_one(w) : 0;
+        if (rc < 0)
             return rc;
         if (w->id == w->e->fail_part && w->st.faces_advanced >= w->e->fail_after)
             return FDT_EINTERNAL; /* a test's injected failure (fdt_par_opts) */
         if (rc == 1 || w->deferred.n > 0)
             continue;
+        if (w->npk > 0) {
+            /* Not idle: parked faces are work (src/termination.c's
+             * detach needs none left); their answers are mail. */
+            if ((rc = fdt_proto_wait_mail(w, 0, &w->st.t_query_wait)) != FDT_OK)
+                return rc;
+            continue;
+        }
         /* Nothing to do: shared mode gives up its unit, message mode
          * may detach (src/termination.c). */
         if ((rc = fdt_term_idle(w)) != RUN_ON)
@@ -440,4 +590,5 @@ void fdt_eng_worker_free(worker *w)
     free(w->ghosts.g);
     free(w->links.r);
     free(w->deferred.q);
+    free(w->pk);
 }

@@ -39,6 +39,29 @@ enum { RUN_ON = 0, RUN_DONE = 1 };
 
 struct engine;
 
+/* How many faces an MPI rank may keep parked (a power of two: the slot is
+ * the low bits of its NODESEND's tag). */
+#define FDT_PARK_MAX 64
+
+/* A face whose apex search waits for another rank's NODERECV (MPI ranks,
+ * engine.park; src/engine.c, advance_one): the search state, in a slot
+ * that does not move (ap points to a, b, c and into qb), and the
+ * bisection walk's stack where it stopped. */
+typedef struct parked {
+    uint32_t f[3];
+    double a[3], b[3], c[3];
+    fdt_apex ap;
+    qbuf qb;
+    uint32_t mapex, mtet;      /* the own mesh's answer (fdt_front_apex) */
+    uint32_t qid;              /* the query out (its tag) */
+    int part;                  /* asked, or to ask (held) */
+    int used;
+    int held;                  /* the query is not sent yet: a face with
+                                  the same lowest vertex is asking */
+    int sp;
+    int stack[64];
+} parked;
+
 typedef struct worker {
     /* Tets built so far, for the calling thread's progress estimate only:
      * written (relaxed) by the owner every few thousand tets, read
@@ -58,6 +81,8 @@ typedef struct worker {
     ghostmap ghosts;           /* message mode: foreign coordinates */
     linklist links;            /* completed faces between two threads */
     pfqueue deferred;          /* message mode: FACESENDs for later */
+    parked *pk;                /* engine.park: FDT_PARK_MAX slots */
+    int npk;                   /* slots in use */
     uint32_t (*seeds)[4];      /* seed tets to build first (borrowed) */
     int nseeds;
     int active;                /* shared mode: holds an activity unit of
@@ -131,6 +156,8 @@ typedef struct engine {
     int msg_term;              /* message mode: termination and abort by
                                   messages alone (src/termination.c) */
     int roots;                 /* message mode: parts holding seeds */
+    int park;                  /* message mode on MPI ranks: a face waiting
+                                  for a NODERECV is parked, not waited on */
     int fail_part;             /* a test's injected failure (-1: none) */
     size_t fail_after;
     int ctl_err;               /* message mode: the calling thread's error
@@ -196,6 +223,9 @@ int fdt_eng_build_tet(worker *w, const uint32_t v[4], int request, fdt_face *adv
 int fdt_eng_worker_setup(worker *w);
 /* The worker's loop: seeds, messages, faces, until IAMDONE or abort. */
 int fdt_eng_worker_loop(worker *w);
+/* Engine.park: NODERECV m resumes the face parked in its slot (the walk
+ * goes on, or the face is finished). RUN_ON or an error. */
+int fdt_eng_resume(worker *w, const fdt_msg *m);
 void fdt_eng_worker_free(worker *w);
 
 #endif

@@ -26,7 +26,7 @@ enum { EX_OK = 0, EX_USAGE = 1, EX_INPUT = 2, EX_RESOURCES = 4, EX_WRITE = 5, EX
 
 typedef struct opts {
     const char *input, *output, *format;
-    int set_hash, stats, quiet, leaf;
+    int set_hash, stats, quiet, leaf, no_park;
     int fail_rank;
     size_t fail_after;
 } opts;
@@ -42,6 +42,8 @@ static const char usage[] =
     "  --set-hash          print the mesh's set hash (equals frontdt's)\n"
     "  --stats             per-rank tets and message counts, and their totals\n"
     "  --leaf N            kd-tree leaf size (default 30)\n"
+    "  --no-park           a face waits for each answer of another rank, as\n"
+    "                      frontdt --mode message does (for comparison)\n"
     "  -q                  print nothing but errors (and what is asked)\n";
 
 /* ---- -o BASE.pvtu: one .vtu piece a rank and an index ------------------- */
@@ -188,6 +190,8 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
             o->stats = 1;
         } else if (!strcmp(a, "-q")) {
             o->quiet = 1;
+        } else if (!strcmp(a, "--no-park")) {
+            o->no_park = 1;
         } else if (!strcmp(a, "--leaf") && v) {
             char *end;
             long x = strtol(v, &end, 10);
@@ -302,6 +306,16 @@ static void print_stats(const fdt_mpi_out *r, int size, double t_read)
                     9, c[FDT_MSG_KIND_END + k]);
         fputc('\n', stderr);
     }
+    fprintf(stderr, "  rank   front s     cpu s    idle s  q-wait s      faces  msgs/face\n");
+    for (int q = 0; q < size; q++) {
+        const double *t = r->rank_times + (size_t)q * FDT_MPI_NTIMES;
+        const uint64_t *c = r->rank_counts + (size_t)q * 2 * FDT_MSG_KIND_END;
+        uint64_t msgs = 0;
+        for (int k = 1; k < FDT_MSG_KIND_END; k++)
+            msgs += c[k];
+        fprintf(stderr, "  %4d %9.3f %9.3f %9.3f %9.3f %10.0f %10.4f\n", q, t[0], t[1], t[2],
+                t[3], t[4], t[4] > 0 ? (double)msgs / t[4] : 0.0);
+    }
     fprintf(stderr, "  messages          sent / received (all ranks)\n");
     for (int k = 1; k < FDT_MSG_KIND_END; k++)
         fprintf(stderr, "    %-15s %" PRIu64 " / %" PRIu64 "\n", fdt_msg_kind_name(k),
@@ -349,7 +363,7 @@ static int run(int argc, char **argv, int rank, int size)
     }
     int pieces = o.output && is_pvtu(o.output);
     fdt_mpi_opts mo = {o.leaf, FDT_SEARCH_AUTO, o.output && !pieces, pieces, o.fail_rank,
-                       o.fail_after};
+                       o.fail_after, o.no_park};
     err = fdt_mpi_run(MPI_COMM_WORLD, &pr, &mo, &r, diag, sizeof diag);
     if (err) {
         if (rank == 0)

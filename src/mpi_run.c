@@ -1,10 +1,16 @@
 /*
  * One rank of a distributed run; see mpi_run.h.
  *
- * The run on a rank is the message-mode worker of src/engine.c, unchanged:
- * an engine whose e->n parts are the ranks, of which this rank fills only
- * its own worker (the others stay zero: message mode never reads another
- * part's worker, it asks that part by message). Termination is
+ * The run on a rank is the message-mode worker of src/engine.c: an engine
+ * whose e->n parts are the ranks, of which this rank fills only its own
+ * worker (the others stay zero: message mode never reads another part's
+ * worker, it asks that part by message). One difference (e->park): a face
+ * that asks another rank is parked until the answer comes, and the rank
+ * advances its other faces meanwhile, since a round trip between processes
+ * (the other rank's next poll, or its next time slice when ranks share
+ * cores) is far longer than a face. Parked faces are work, so a rank with
+ * any is never idle in the sense of src/termination.c, and the proof there
+ * is unchanged. Termination is
  * src/termination.c's Dijkstra-Scholten over FACESEND/FACERECV, with IAMDONE
  * epoch 1 (a root's tree finished, to rank 0) and epoch 2 (rank 0: every
  * tree finished, to all); the proof at the top of that file never uses
@@ -43,6 +49,8 @@ void fdt_mpi_out_free(fdt_mpi_out *out)
 {
     free(out->rank_counts);
     free(out->rank_tets);
+    free(out->rank_times);
+    out->rank_times = NULL;
     free(out->all_tets);
     free(out->all_hull);
     free(out->own_tets);
@@ -141,6 +149,10 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     fdt_kdq kq0;
     memset(&kq0, 0, sizeof kq0);
     fdt_vid *mine = NULL;
+    /* The rank's tets stay in its meshbuf (tree-order ids) for the output
+     * below: the in-memory sink (src/sink.h). */
+    fdt_tsink mem_sink;
+    int mem_sink_ok = 0;
     int err = FDT_OK;
     if (size > FDT_PARTITION_MAX || size > FDT_MAILBOX_MAX_THREADS || pr->m < 4 ||
         pr->m > UINT32_MAX - 1)
@@ -153,6 +165,10 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
                                   o->leaf_size > 0 ? o->leaf_size : FDT_DEFAULT_LEAF, 1);
     if (!err)
         err = fdt_par_make_seeds(&pt, &seeds, &nseeds, &kq0);
+    if (!err) {
+        err = fdt_tsink_init(&mem_sink, pr->orig, NULL);
+        mem_sink_ok = err == FDT_OK;
+    }
     if (!err) {
         e = aligned_alloc(alignof(engine), (sizeof(engine) + alignof(engine) - 1) /
                                                alignof(engine) * alignof(engine));
@@ -169,10 +185,12 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
         e->pt = &pt;
         e->P = pr->p;
         e->orig = pr->orig;
+        e->sink = &mem_sink;
         e->mode = FDT_MODE_MESSAGE;
         e->n = size;
         e->search = o->search;
         e->msg_term = 1;
+        e->park = !o->no_park; /* a round trip crosses processes: park, go on */
         e->fail_part = o->fail_rank;
         e->fail_after = o->fail_after;
         e->w = aligned_alloc(alignof(worker), (size_t)size * sizeof(worker));
@@ -238,7 +256,7 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     /* Every rank's setup succeeded, or no rank runs: a rank whose setup
      * failed could not answer the others' NODESENDs. */
     err = first_error(comm, size, err, "setup", &out->err_rank, diag, dlen);
-    double t1 = fdt_now_s();
+    double t1 = fdt_now_s(), c1 = fdt_thread_cpu_s();
     if (!err) {
         int rc = fdt_eng_worker_loop(w);
         /* ABORT to every other rank, unless an ABORT stopped us */
@@ -248,7 +266,7 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
          * our own (recorded by fdt_eng_set_error) or 0. */
         err = first_error(comm, size, w->err, "run", &out->err_rank, diag, dlen);
     }
-    double t2 = fdt_now_s();
+    double t2 = fdt_now_s(), c2 = fdt_thread_cpu_s();
     if (err) {
         if (tp)
             fdt_transport_mpi_abandon(tp);
@@ -268,8 +286,9 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     if (rank == 0) {
         out->rank_counts = malloc((size_t)size * sizeof both);
         out->rank_tets = malloc((size_t)size * sizeof *out->rank_tets);
+        out->rank_times = malloc((size_t)size * FDT_MPI_NTIMES * sizeof *out->rank_times);
     }
-    int oom = rank == 0 && (!out->rank_counts || !out->rank_tets);
+    int oom = rank == 0 && (!out->rank_counts || !out->rank_tets || !out->rank_times);
     MPI_Bcast(&oom, 1, MPI_INT, 0, comm);
     if (oom) {
         err = FDT_ENOMEM;
@@ -278,6 +297,13 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     }
     MPI_Gather(both, 2 * FDT_MSG_KIND_END, MPI_UINT64_T, out->rank_counts,
                2 * FDT_MSG_KIND_END, MPI_UINT64_T, 0, comm);
+    /* Where each rank's front time went (--stats): the wait timers of
+     * src/protocol.c (t_idle: nothing to do; t_query_wait: blocked on
+     * answers) beside its CPU time. */
+    double tm[FDT_MPI_NTIMES] = {t2 - t1, c2 - c1, w->st.t_idle, w->st.t_query_wait,
+                                 (double)w->st.faces_advanced};
+    MPI_Gather(tm, FDT_MPI_NTIMES, MPI_DOUBLE, out->rank_times, FDT_MPI_NTIMES, MPI_DOUBLE, 0,
+               comm);
     uint64_t nt = w->out.ntets, *rt = NULL;
     if (rank == 0 && !(rt = malloc((size_t)size * sizeof *rt)))
         MPI_Abort(comm, 4);
@@ -343,6 +369,8 @@ done:
         free(e);
     }
     fdt_transport_destroy(&tp);
+    if (mem_sink_ok)
+        fdt_tsink_free(&mem_sink);
     free(seeds);
     fdt_partition_free(&pt);
     if (err)

@@ -35,7 +35,12 @@ typedef struct fdt_mpi_opts {
                             (FDT_EINTERNAL) once it advanced fail_after
                             faces; -1: none */
     size_t fail_after;
+    int no_park;         /* nonzero: a face waits for each NODERECV (the
+                            threaded message mode's loop) instead of
+                            being parked (src/engine.c) */
 } fdt_mpi_opts;
+
+enum { FDT_MPI_NTIMES = 5 };
 
 typedef struct fdt_mpi_out {
     /* On every rank: */
@@ -51,6 +56,10 @@ typedef struct fdt_mpi_out {
     uint64_t *rank_counts; /* size * 2 * FDT_MSG_KIND_END: each rank's sent
                               then received (owned) */
     size_t *rank_tets;     /* size (owned) */
+    double *rank_times;    /* size * FDT_MPI_NTIMES (owned): each rank's
+                              front wall and CPU seconds, seconds blocked
+                              idle and blocked with faces waiting on
+                              answers, faces advanced (owned) */
     fdt_vid *all_tets;     /* gather: 4 per tet, input numbering (owned) */
     size_t ntets;
     fdt_vid *all_hull;     /* gather: 3 per hull face, outward (owned) */

@@ -342,6 +342,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * mode: every part with seeds is a root of Dijkstra-Scholten, engaged
      * with no parent (src/termination.c). */
     e->msg_term = mode == FDT_MODE_MESSAGE;
+    e->park = mode == FDT_MODE_MESSAGE && opt && opt->park;
     e->fail_part = opt && opt->fail ? opt->fail_part : -1;
     e->fail_after = opt ? opt->fail_after : 0;
     for (int i = 0; i < nthreads; i++) {

@@ -70,6 +70,9 @@ typedef struct fdt_par_opts {
                            out->mb. A sink with a caller's fdt_sink streams:
                            out->mb stays empty, nothing is gathered, and
                            each thread flushes its batches itself */
+    int park;           /* message mode: park a face that waits for a
+                           NODERECV, as MPI ranks do (src/engine.c), so
+                           the shuffle tests run that loop too */
 } fdt_par_opts;
 
 /* fdt_parallel_triangulate with options (NULL: none, what it does). */

@@ -7,7 +7,8 @@
  * same walk, but for another part it sends NODESEND (face coordinates, best
  * so far) to that part's thread and waits for NODERECV, answering the
  * NODESENDs in its own mailbox meanwhile (so waiting threads cannot
- * deadlock, §4) and deferring FACESENDs until the face is done. Message-mode
+ * deadlock, §4) and deferring FACESENDs until the face is done (MPI
+ * ranks instead park the face and go on: src/engine.c, fdt_eng_resume). Message-mode
  * threads read only their own part's coordinates: a FACESEND carries the
  * coordinates of every id but the lowest (which the receiver owns), and
  * each thread caches the foreign coordinates it has been sent ("ghosts").
@@ -182,16 +183,15 @@ int fdt_proto_wait_mail(worker *w, int spin, double *acc)
     return rc < 0 ? FDT_EINTERNAL : FDT_OK;
 }
 
-/* Message mode: asks part j whether it holds a better apex than s's. */
-int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
+/* Posts a NODESEND to part j: the face and best point of s, query id tag. */
+int fdt_proto_post_query(worker *w, const fdt_apex *s, int j, uint32_t tag)
 {
     fdt_msg *m;
     int rc = fdt_tp_alloc(w->e->tp, w->id, &m);
     if (rc)
         return rc;
-    uint32_t qid = ++w->qid;
     m->kind = FDT_MSG_NODESEND;
-    m->tag = qid;
+    m->tag = tag;
     fdt_msg_nodesend *q = &m->u.nodesend;
     memcpy(q->xyz[0], s->a, sizeof q->xyz[0]);
     memcpy(q->xyz[1], s->b, sizeof q->xyz[1]);
@@ -205,6 +205,33 @@ int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
     w->st.remote_queries++;
     if (fdt_tp_post(w->e->tp, w->id, j, m) < 0)
         return FDT_EINTERNAL;
+    return FDT_OK;
+}
+
+/* Offers NODERECV m's better point, if any, to s (its coordinates kept in
+ * qb, whose other buffer may hold s's current best). */
+int fdt_proto_take_answer(worker *w, const fdt_msg *m, fdt_apex *s, qbuf *qb)
+{
+    if (m->u.noderecv.best != FDT_MSG_NONE) {
+        double *x = qb->x[qb->next];
+        qb->next ^= 1;
+        memcpy(x, m->u.noderecv.best_xyz, 3 * sizeof *x);
+        fdt_apex_offer(s, m->u.noderecv.best, x, &w->kq);
+        /* The same exact tests accepted it over there. */
+        if (s->best != m->u.noderecv.best)
+            return FDT_EINTERNAL;
+        w->st.remote_improved++;
+    }
+    return FDT_OK;
+}
+
+/* Message mode: asks part j whether it holds a better apex than s's. */
+int fdt_proto_remote_query(worker *w, fdt_apex *s, int j, qbuf *qb)
+{
+    uint32_t qid = ++w->qid;
+    int rc = fdt_proto_post_query(w, s, j, qid);
+    if (rc)
+        return rc;
     double t0 = fdt_now_s(), waited = 0.0;
     pwait pw = {qid, j, s, qb, 0};
     for (;;) {
@@ -246,21 +273,19 @@ static int on_nodesend(worker *w, const fdt_msg *m, pwait *pw)
 }
 
 /* NODERECV: the answer to the query pw waits on (the only one out: a part
- * asks one part at a time); its better point, if any, is offered. */
+ * asks one part at a time); its better point, if any, is offered. In the
+ * main loop (pw NULL) it can only answer a parked face of an MPI rank. */
 static int on_noderecv(worker *w, const fdt_msg *m, pwait *pw)
 {
-    if (!pw || m->tag != pw->qid || m->sender != pw->part)
-        return FDT_EINTERNAL;
-    if (m->u.noderecv.best != FDT_MSG_NONE) {
-        double *x = pw->qb->x[pw->qb->next];
-        pw->qb->next ^= 1;
-        memcpy(x, m->u.noderecv.best_xyz, 3 * sizeof *x);
-        fdt_apex_offer(pw->s, m->u.noderecv.best, x, &w->kq);
-        /* The same exact tests accepted it over there. */
-        if (pw->s->best != m->u.noderecv.best)
-            return FDT_EINTERNAL;
-        w->st.remote_improved++;
+    if (!pw) {
+        /* An MPI rank's parked face (src/engine.c): resumed by its slot. */
+        return w->e->park ? fdt_eng_resume(w, m) : FDT_EINTERNAL;
     }
+    if (m->tag != pw->qid || m->sender != pw->part)
+        return FDT_EINTERNAL;
+    int rc = fdt_proto_take_answer(w, m, pw->s, pw->qb);
+    if (rc)
+        return rc;
     pw->answered = 1;
     return RUN_ON;
 }

@@ -86,7 +86,13 @@ int fdt_proto_answer_query(struct worker *w, const fdt_msg *m);
 /* Blocks until the mailbox holds something (or a kick), after `spin`
  * yields; the seconds blocked are added to *acc. */
 int fdt_proto_wait_mail(struct worker *w, int spin, double *acc);
-/* Message mode: asks part j whether it holds a better apex than s's. */
+/* Posts a NODESEND of s's face and best point to part j, query id tag. */
+int fdt_proto_post_query(struct worker *w, const fdt_apex *s, int j, uint32_t tag);
+/* Offers the better point of NODERECV m, if any, to s (coordinates kept
+ * in qb). FDT_OK or FDT_EINTERNAL. */
+int fdt_proto_take_answer(struct worker *w, const fdt_msg *m, fdt_apex *s, qbuf *qb);
+/* Message mode: asks part j whether it holds a better apex than s's and
+ * waits for the answer. */
 int fdt_proto_remote_query(struct worker *w, fdt_apex *s, int j, qbuf *qb);
 
 #endif
