@@ -524,6 +524,9 @@ int fdt_eng_worker_setup(worker *w)
     /* The part's mesh, if it comes to one, is built by this thread: its
      * pages are first touched here, near the core that reads them. */
     fdt_oracle_init(&w->orc, w->tree, w->e->search);
+    /* every part may switch at once: each gets its share of the memory */
+    if (w->e->search == FDT_SEARCH_AUTO)
+        w->orc.mem_cap = fdt_oracle_mem_share(w->e->n);
     if (w->e->gmesh_ok)
         fdt_oracle_share(&w->orc, &w->e->gmesh);
     w->qcache_part = -1;

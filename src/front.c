@@ -167,6 +167,8 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *
     if (err)
         return err;
     fdt_oracle_init(&orc, t, search);
+    if (search == FDT_SEARCH_AUTO)
+        orc.mem_cap = fdt_oracle_mem_share(1);
     if ((err = fdt_facetab_init(&ft, 4096)) != FDT_OK)
         return err;
     if ((err = fdt_faceq_init(&fq, t->base, t->n)) != FDT_OK) {

@@ -3,6 +3,8 @@
 #include "mem.h"
 
 #include <stdint.h>
+#include <stdio.h>
+#include <unistd.h>
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
@@ -22,4 +24,25 @@ void fdt_mem_advise_huge(void *p, size_t bytes)
     (void)p;
     (void)bytes;
 #endif
+}
+
+size_t fdt_mem_available(void)
+{
+    FILE *f = fopen("/proc/meminfo", "r");
+    if (f) {
+        char line[256];
+        unsigned long long kib;
+        while (fgets(line, sizeof line, f))
+            if (sscanf(line, "MemAvailable: %llu kB", &kib) == 1) {
+                fclose(f);
+                return kib > SIZE_MAX / 1024 ? SIZE_MAX : (size_t)kib * 1024;
+            }
+        fclose(f);
+    }
+#if defined(_SC_AVPHYS_PAGES) && defined(_SC_PAGESIZE)
+    long pages = sysconf(_SC_AVPHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && size > 0 && (unsigned long)pages <= SIZE_MAX / (unsigned long)size)
+        return (size_t)pages * (size_t)size;
+#endif
+    return SIZE_MAX;
 }

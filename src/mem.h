@@ -18,4 +18,11 @@
  * touch already gets a huge page. */
 void fdt_mem_advise_huge(void *p, size_t bytes);
 
+/* The memory the system can still give without swapping, in bytes: the
+ * kernel's MemAvailable (free memory plus the page cache it can drop),
+ * else the free pages, else SIZE_MAX (unknown: no limit). For choices
+ * that may trade memory for speed (src/oracle.c) only, never for
+ * correctness. */
+size_t fdt_mem_available(void);
+
 #endif

@@ -1,5 +1,6 @@
 /* The choice of apex oracle; see oracle.h and bench/NOTES.md, entry 51. */
 #include "oracle.h"
+#include "mem.h"
 #include "clock.h"
 
 #include "front.h"
@@ -129,8 +130,20 @@ void fdt_oracle_free(fdt_oracle *o)
     o->state = -1;
 }
 
+size_t fdt_oracle_mem_share(int parts)
+{
+    size_t avail = fdt_mem_available();
+    return avail == SIZE_MAX ? 0 : avail / (size_t)(parts > 0 ? parts : 1);
+}
+
 static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
 {
+    if (o->policy == FDT_SEARCH_AUTO && o->mem_cap &&
+        FDT_ORACLE_MESH_BYTES * (double)o->t->n > (double)o->mem_cap) {
+        o->state = -1;
+        o->mesh_refused = 1;
+        return;
+    }
     double t0 = fdt_now_s();
     int err = fdt_ins_build(&o->mesh, o->t->P, o->t->base, o->t->n, &kq->pc);
     o->t_mesh += fdt_now_s() - t0;

@@ -55,7 +55,26 @@ typedef struct fdt_oracle {
     size_t star_walks;    /* of those, found by a walk around a vertex */
     size_t switched_at;   /* faces advanced when the mesh was built (0: never) */
     double t_mesh;        /* seconds building the mesh */
+    /* Auto policy: the bytes this part's mesh may take (0: no cap). A
+     * switch whose mesh would not fit is not made (the kd search stays:
+     * always right, only slower); mesh_refused says it happened. */
+    size_t mem_cap;
+    int mesh_refused;
 } fdt_oracle;
+
+/* What an insertion mesh of n points takes at its peak, in bytes: about
+ * 220 kept a point (src/insert.h) plus the build's scratch and the tet
+ * array's growth, and the oracle's table of mesh tets (4 bytes an output
+ * tet). */
+#define FDT_ORACLE_MESH_BYTES 330.0
+
+/* The cap (fdt_oracle.mem_cap) for each of `parts` oracles that may each
+ * build a mesh at once: an equal share of the memory available now
+ * (fdt_mem_available). At 1e8 uniform points on two threads each part's
+ * mesh would have needed 16 GiB with 24 GiB in the machine: the time
+ * rule, whose constants were measured at 1e6 points, switched, and the
+ * run was killed for memory (a streamed run, bench/NOTES.md entry 58). */
+size_t fdt_oracle_mem_share(int parts);
 
 void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy);
 void fdt_oracle_free(fdt_oracle *o);

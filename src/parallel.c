@@ -21,6 +21,7 @@
 
 #include "engine.h"
 #include "gather.h"
+#include "mem.h"
 #include "oracle.h"
 #include "seed.h"
 #include "termination.h"
@@ -366,6 +367,11 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * owned by the parts' fronts. A build that cannot be made (no memory)
      * leaves the parts on their own oracles. */
     double t_gm = 0.0;
+    /* The probe's choice (not an explicit global_mesh == 1) is dropped
+     * when the mesh would not fit the memory available (src/oracle.h,
+     * FDT_ORACLE_MESH_BYTES): the parts' kd searches are always right. */
+    if (expensive && FDT_ORACLE_MESH_BYTES * (double)pr->m > (double)fdt_mem_available())
+        expensive = 0;
     if (opt && (opt->global_mesh == 1 || expensive) && mode == FDT_MODE_SHARED) {
         double tg = fdt_now_s();
         int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads,

@@ -347,10 +347,55 @@ static void test_flat_parts(void)
     printf("ok flat parts\n");
 }
 
+/* A switch whose mesh would not fit the part's share of memory
+ * (fdt_oracle.mem_cap) is not made: the oracle stays on the kd search
+ * and says so; with no cap, or room, the same switch builds the mesh. The
+ * oracle is driven directly: a spent window budget asks for the switch. */
+static void test_mem_cap(void)
+{
+    pts p = gen_cylinder(20, 32);
+    fdt_prepared pr;
+    char diag[256];
+    CHECK_EQ(fdt_prepare(p.xyz, p.n, 1, &pr, diag, sizeof diag), FDT_OK);
+    fdt_kdtree t;
+    memset(&t, 0, sizeof t);
+    CHECK_EQ(fdt_kd_build(&t, pr.p, pr.orig, 0, (uint32_t)pr.m, 18), FDT_OK);
+    const size_t caps[3] = {1, 0, (size_t)(FDT_ORACLE_MESH_BYTES * (double)pr.m) + 1};
+    const int want[3] = {-1, 1, 1};
+    for (int i = 0; i < 3; i++) {
+        fdt_oracle o;
+        fdt_oracle_init(&o, &t, FDT_SEARCH_AUTO);
+        o.mem_cap = caps[i];
+        o.w_budget = 0;
+        fdt_kdq kq;
+        memset(&kq, 0, sizeof kq);
+        kq.points = 1000;
+        fdt_oracle_tick(&o, 10, &kq);
+        EXPECTF(o.state == want[i] && o.mesh_refused == (want[i] < 0), "cap %zu: state %d",
+                caps[i], o.state);
+        fdt_oracle_free(&o);
+    }
+    /* an explicit --search mesh is kept whatever the cap */
+    fdt_oracle o;
+    fdt_oracle_init(&o, &t, FDT_SEARCH_MESH);
+    o.mem_cap = 1;
+    fdt_kdq kq;
+    memset(&kq, 0, sizeof kq);
+    fdt_oracle_tick(&o, 0, &kq);
+    EXPECT(o.state == 1 && !o.mesh_refused);
+    fdt_oracle_free(&o);
+    EXPECT(fdt_oracle_mem_share(2) <= fdt_oracle_mem_share(1));
+    fdt_kd_free(&t);
+    fdt_prepared_free(&pr);
+    free(p.xyz);
+    printf("ok memory cap\n");
+}
+
 int main(int argc, char **argv)
 {
     int quick = argc > 1 && !strcmp(argv[1], "--quick");
     alarm(600);
+    test_mem_cap();
     test_flat_parts();
     test_probe_samples();
     test_early_switch();
@@ -409,5 +454,5 @@ int main(int argc, char **argv)
         free(p.xyz);
         printf("ok uniform stays on the kd search\n");
     }
-    return 0;
+    return test_report("oracle");
 }
