@@ -477,6 +477,10 @@ int fdt_rd_points_mem_with(const char *name, const void *data, size_t len,
     rd_begin(&c, xyz, n);
     if (name == NULL || o == NULL || (data == NULL && len > 0) || xyz == NULL || n == NULL)
         return fdt_rd_fail(&c, FDT_IO_EOPEN, ": invalid arguments");
+    /* No object is larger than PTRDIFF_MAX bytes (C11 6.5.6): a longer
+     * length is a caller's mistake, refused before any byte is read. */
+    if (len > PTRDIFF_MAX)
+        return fdt_rd_fail(&c, FDT_IO_ENOMEM, ": file too large for memory");
     int rc = FDT_IO_OK;
     const rd_format *f = rd_setup(&c, name, o, &rc);
     if (f == NULL)
