@@ -595,3 +595,38 @@ void fdt_eng_worker_free(worker *w)
     free(w->deferred.q);
     free(w->pk);
 }
+
+engine *fdt_eng_new(int n)
+{
+    /* The engine holds atomics and 64-aligned workers: aligned_alloc
+     * wants a size that is a multiple of the alignment. */
+    size_t esz = (sizeof(engine) + alignof(engine) - 1) / alignof(engine) * alignof(engine);
+    engine *e = aligned_alloc(alignof(engine), esz);
+    if (!e)
+        return NULL;
+    memset(e, 0, sizeof *e);
+    atomic_init(&e->work, 0);
+    atomic_init(&e->error, 0);
+    atomic_init(&e->abort, 0);
+    atomic_init(&e->pin_refused, 0);
+    e->n = n;
+    e->w = aligned_alloc(alignof(worker), (size_t)n * sizeof(worker));
+    if (!e->w) {
+        free(e);
+        return NULL;
+    }
+    memset(e->w, 0, (size_t)n * sizeof(worker));
+    for (int i = 0; i < n; i++) {
+        atomic_init(&e->w[i].tets_done, 0);
+        atomic_init(&e->w[i].mesh_pub, 0);
+    }
+    return e;
+}
+
+void fdt_eng_delete(engine *e)
+{
+    if (!e)
+        return;
+    free(e->w);
+    free(e);
+}

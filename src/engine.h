@@ -228,4 +228,11 @@ int fdt_eng_worker_loop(worker *w);
 int fdt_eng_resume(worker *w, const fdt_msg *m);
 void fdt_eng_worker_free(worker *w);
 
+/* A zeroed engine of n workers (n >= 1), its atomics initialized, e->n
+ * set; the threaded run (src/parallel.c) and an MPI rank (src/mpi_run.c)
+ * fill in the rest. NULL when out of memory. Freed by fdt_eng_delete
+ * (the workers' own tables by fdt_eng_worker_free first). */
+engine *fdt_eng_new(int n);
+void fdt_eng_delete(engine *e);
+
 #endif

@@ -169,40 +169,22 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
         err = fdt_tsink_init(&mem_sink, pr->orig, NULL);
         mem_sink_ok = err == FDT_OK;
     }
-    if (!err) {
-        e = aligned_alloc(alignof(engine), (sizeof(engine) + alignof(engine) - 1) /
-                                               alignof(engine) * alignof(engine));
-        if (!e)
-            err = FDT_ENOMEM;
-    }
+    if (!err && !(e = fdt_eng_new(size)))
+        err = FDT_ENOMEM;
     worker *w = NULL;
     if (!err) {
-        memset(e, 0, sizeof *e);
-        atomic_init(&e->work, 0);
-        atomic_init(&e->error, 0);
-        atomic_init(&e->abort, 0);
-        atomic_init(&e->pin_refused, 0);
         e->pt = &pt;
         e->P = pr->p;
         e->orig = pr->orig;
         e->sink = &mem_sink;
         e->mode = FDT_MODE_MESSAGE;
-        e->n = size;
         e->search = o->search;
         e->msg_term = 1;
         e->park = !o->no_park; /* a round trip crosses processes: park, go on */
         e->fail_part = o->fail_rank;
         e->fail_after = o->fail_after;
-        e->w = aligned_alloc(alignof(worker), (size_t)size * sizeof(worker));
-        if (!e->w)
-            err = FDT_ENOMEM;
-    }
-    if (!err) {
-        memset(e->w, 0, (size_t)size * sizeof(worker));
         for (int i = 0; i < size; i++) {
             worker *x = &e->w[i];
-            atomic_init(&x->tets_done, 0);
-            atomic_init(&x->mesh_pub, 0);
             x->e = e;
             x->id = i;
             x->tree = &pt.trees[i];
@@ -365,8 +347,7 @@ done:
             fdt_eng_worker_free(w);
             free(w->seeds);
         }
-        free(e->w);
-        free(e);
+        fdt_eng_delete(e);
     }
     fdt_transport_destroy(&tp);
     if (mem_sink_ok)

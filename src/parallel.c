@@ -202,16 +202,9 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
             snprintf(diag, dlen, "internal error: no seed tetrahedron found");
         goto fail;
     }
-    /* The engine holds atomics and 64-aligned workers. */
     err = FDT_ENOMEM;
-    e = aligned_alloc(alignof(engine), (sizeof(engine) + alignof(engine) - 1) /
-                                           alignof(engine) * alignof(engine));
-    if (!e)
+    if (!(e = fdt_eng_new(nthreads)))
         goto fail;
-    memset(e, 0, sizeof *e);
-    atomic_init(&e->error, 0);
-    atomic_init(&e->abort, 0);
-    atomic_init(&e->pin_refused, 0);
     e->pt = &pt;
     e->P = pr->p;
     e->orig = pr->orig;
@@ -224,16 +217,9 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         e->sink = &mem_sink;
     }
     e->mode = mode;
-    e->n = nthreads;
     e->want_nbrs = s->neighbors != 0;
     e->search = (int)s->search;
     e->pin = s->pin != 0;
-    e->w = aligned_alloc(alignof(worker), (size_t)nthreads * sizeof(worker));
-    if (!e->w)
-        goto fail;
-    memset(e->w, 0, (size_t)nthreads * sizeof(worker));
-    for (int i = 0; i < nthreads; i++)
-        atomic_init(&e->w[i].mesh_pub, 0);
     if (opt && opt->shuffle)
         err = fdt_transport_shuffle(&e->tp, nthreads + 1, opt->seed, opt->delay_pct);
     else
@@ -493,10 +479,8 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     out->t_gather = fdt_now_s() - t2;
 fail:
     if (e) {
-        if (e->w)
-            for (int i = 0; i < nthreads; i++)
-                fdt_eng_worker_free(&e->w[i]);
-        free(e->w);
+        for (int i = 0; i < nthreads; i++)
+            fdt_eng_worker_free(&e->w[i]);
         fdt_ins_free(&e->gmesh);
         fdt_transport_destroy(&e->tp);
         if (sync_ok) {
@@ -510,7 +494,7 @@ fail:
         if (e->topo)
             hwloc_topology_destroy(e->topo);
 #endif
-        free(e);
+        fdt_eng_delete(e);
     }
     free(seeds);
     fdt_partition_free(&pt);
