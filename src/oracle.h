@@ -70,10 +70,10 @@ typedef struct fdt_oracle {
 
 /* The cap (fdt_oracle.mem_cap) for each of `parts` oracles that may each
  * build a mesh at once: an equal share of the memory available now
- * (fdt_mem_available). At 1e8 uniform points on two threads each part's
- * mesh would have needed 16 GiB with 24 GiB in the machine: the time
- * rule, whose constants were measured at 1e6 points, switched, and the
- * run was killed for memory (a streamed run, bench/NOTES.md entry 58). */
+ * (fdt_mem_available). At 1e8 uniform points on two threads auto mode
+ * built an insertion mesh (a part's switch or the probe's mesh of every
+ * point: not measured which) and the run was killed at 24 GiB, where the
+ * kd search alone peaks at 5.8 GiB (bench/NOTES.md entry 58). */
 size_t fdt_oracle_mem_share(int parts);
 
 void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy);
