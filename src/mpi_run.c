@@ -311,8 +311,7 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
         snprintf(diag, dlen, "out of memory renumbering the tets");
         goto done;
     }
-    for (size_t i = 0; i < n4; i++)
-        mine[i] = pr->orig[w->out.tets[i]];
+    fdt_sink_renumber(pr->orig, mine, w->out.tets, n4);
     fdt_sethash h = {0, 0};
     fdt_sethash_add_n(&h, (const uint32_t *)mine, w->out.ntets);
     uint64_t hv[2] = {h.sum, h.count}, hs[2] = {0, 0};
@@ -327,8 +326,7 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     } else if (o->gather) {
         err = gather_ids(comm, rank, size, mine, w->out.ntets, 4, &out->all_tets, &out->ntets);
         if (!err) {
-            for (size_t i = 0; i < n3; i++)
-                mine[i] = pr->orig[w->out.hull[i]];
+            fdt_sink_renumber(pr->orig, mine, w->out.hull, n3);
             err = gather_ids(comm, rank, size, mine, w->out.nhull, 3, &out->all_hull,
                              &out->nhull);
         }
