@@ -1942,9 +1942,10 @@ static void *pipe_writer_run(void *arg)
     return NULL;
 }
 
-/* Reads data through a pipe standing in for standard input ("-"). */
-static int read_stdin(const void *data, size_t len, int format, double **xyz, size_t *n,
-                      char *err, size_t errlen)
+/* Reads data with options o through a pipe standing in for standard
+ * input ("-"), written by a thread of its own. */
+static int read_stdin_with(const void *data, size_t len, const fdt_rd_opts *o, double **xyz,
+                           size_t *n, char *err, size_t errlen)
 {
     int fds[2];
     if (pipe(fds) != 0)
@@ -1957,14 +1958,21 @@ static int read_stdin(const void *data, size_t len, int format, double **xyz, si
     pthread_t tid;
     if (pthread_create(&tid, NULL, pipe_writer_run, &w) != 0)
         exit(1);
-    fdt_rd_opts o;
-    fdt_rd_opts_default(&o);
-    o.format = format;
-    int rc = fdt_rd_points_with("-", &o, xyz, n, err, errlen);
+    int rc = fdt_rd_points_with("-", o, xyz, n, err, errlen);
     pthread_join(tid, NULL);
     dup2(saved, STDIN_FILENO);
     close(saved);
     return rc;
+}
+
+/* The same with the default options and format. */
+static int read_stdin(const void *data, size_t len, int format, double **xyz, size_t *n,
+                      char *err, size_t errlen)
+{
+    fdt_rd_opts o;
+    fdt_rd_opts_default(&o);
+    o.format = format;
+    return read_stdin_with(data, len, &o, xyz, n, err, errlen);
 }
 
 typedef struct prog_log {
@@ -2109,23 +2117,8 @@ static int read_chunked(const char *name, const void *data, size_t len, size_t c
     o.min_slice = 1;
     if (!pipe_in)
         return fdt_rd_points_mem_with(name, data, len, &o, xyz, n, err, errlen);
-    int fds[2];
-    if (pipe(fds) != 0)
-        exit(1);
-    int saved = dup(STDIN_FILENO);
-    if (saved < 0 || dup2(fds[0], STDIN_FILENO) < 0)
-        exit(1);
-    close(fds[0]);
-    pipe_writer w = {NULL, fds[1], data, len};
-    pthread_t tid;
-    if (pthread_create(&tid, NULL, pipe_writer_run, &w) != 0)
-        exit(1);
     o.format = fdt_rd_format_of_path(name);
-    int rc = fdt_rd_points_with("-", &o, xyz, n, err, errlen);
-    pthread_join(tid, NULL);
-    dup2(saved, STDIN_FILENO);
-    close(saved);
-    return rc;
+    return read_stdin_with(data, len, &o, xyz, n, err, errlen);
 }
 
 /*
