@@ -10,8 +10,9 @@
  *    line counts after the parse; only a failing slice is parsed again to
  *    word its error with them (the lowest failing rank's is the file's
  *    first, as a whole read would report). Input ids: an MPI_Exscan of
- *    the slices' point counts. Other formats and standard input: every
- *    rank reads the whole input and keeps slice r of its points.
+ *    the slices' point counts. Other formats: every rank reads the whole
+ *    input and keeps slice r of its points; standard input (which reaches
+ *    rank 0 alone): rank 0 reads it and scatters the slices.
  * 2. Bisection by exchange (§3.1; the cut rule of src/partition.c): a
  *    group of g ranks (all of them at first) splits into k = g / 2 and
  *    g - k; the cut is on the box's widest axis d at the count partition.c
@@ -190,6 +191,43 @@ static int read_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local 
             }
         }
         err = io_err(rc);
+    } else if (strcmp(o->input, "-") == 0) {
+        /* Standard input reaches rank 0 alone (mpirun forwards it there):
+         * rank 0 reads it and scatters slice r to rank r. */
+        double *all_xyz = NULL;
+        size_t all_n = 0;
+        if (rank == 0)
+            err = fdt_read_points(o->input, o->format, &all_xyz, &all_n, diag, dlen);
+        if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+            return err;
+        uint64_t an = all_n;
+        MPI_Bcast(&an, 1, MPI_UINT64_T, 0, comm);
+        size_t a = (size_t)(an * (uint64_t)rank / (uint64_t)size);
+        n = (size_t)(an * (uint64_t)(rank + 1) / (uint64_t)size) - a;
+        first = a;
+        int *cnt = rank == 0 ? malloc(2 * (size_t)size * sizeof *cnt) : NULL;
+        xyz = malloc((3 * n + 1) * sizeof *xyz);
+        err = xyz && (rank != 0 || cnt) ? FDT_OK : FDT_ENOMEM;
+        snprintf(diag, dlen, "out of memory reading standard input");
+        if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
+            free(cnt);
+            free(xyz);
+            fdt_free(all_xyz);
+            return err;
+        }
+        diag[0] = '\0';
+        MPI_Datatype pt3;
+        MPI_Type_contiguous(3, MPI_DOUBLE, &pt3);
+        MPI_Type_commit(&pt3);
+        for (int q = 0; cnt && q < size; q++) {
+            size_t qa = (size_t)(an * (uint64_t)q / (uint64_t)size);
+            cnt[q] = (int)((size_t)(an * (uint64_t)(q + 1) / (uint64_t)size) - qa);
+            cnt[size + q] = (int)qa;
+        }
+        MPI_Scatterv(all_xyz, cnt, cnt ? cnt + size : NULL, pt3, xyz, (int)n, pt3, 0, comm);
+        MPI_Type_free(&pt3);
+        free(cnt);
+        fdt_free(all_xyz);
     } else {
         double *all_xyz = NULL;
         size_t all_n = 0;
@@ -880,13 +918,14 @@ static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const do
 }
 
 /* The dimension check over every rank's affine basis (collective). */
-static int check_dimension(MPI_Comm comm, const fdt_mpi_local *L, char *diag, size_t dlen)
+static int check_dimension(MPI_Comm comm, const fdt_mpi_local *L, const char *path, char *diag,
+                           size_t dlen)
 {
     int size;
     MPI_Comm_size(comm, &size);
     if (L->m < 4) {
-        snprintf(diag, dlen, "only %zu distinct point%s: a tetrahedralization needs at least 4",
-                 L->m, L->m == 1 ? "" : "s");
+        snprintf(diag, dlen, "%s: only %zu distinct point%s: a tetrahedralization needs at least 4",
+                 path, L->m, L->m == 1 ? "" : "s");
         return FDT_EDEGENERATE;
     }
     /* 4 points a rank: coordinates and input id, unused ones with id -1 */
@@ -927,12 +966,13 @@ static int check_dimension(MPI_Comm comm, const fdt_mpi_local *L, char *diag, si
     } else {
         k = affine_basis(P, n, bs);
         if (k == 2) {
-            snprintf(diag, dlen, "all %zu distinct points are collinear (on the line through "
-                     "input points %d and %d)", L->m, (int)id[bs[0]], (int)id[bs[1]]);
+            snprintf(diag, dlen, "%s: all %zu distinct points are collinear (on the line "
+                     "through input points %d and %d)", path, L->m, (int)id[bs[0]],
+                     (int)id[bs[1]]);
             err = FDT_EDEGENERATE;
         } else if (k == 3) {
-            snprintf(diag, dlen, "all %zu distinct points are coplanar (in the plane of input "
-                     "points %d, %d and %d)", L->m, (int)id[bs[0]], (int)id[bs[1]],
+            snprintf(diag, dlen, "%s: all %zu distinct points are coplanar (in the plane of "
+                     "input points %d, %d and %d)", path, L->m, (int)id[bs[0]], (int)id[bs[1]],
                      (int)id[bs[2]]);
             err = FDT_EDEGENERATE;
         }
@@ -1034,7 +1074,7 @@ int fdt_mpi_setup(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, 
     L->t[FDT_MPI_T_MERGE] = t3 - t2;
 
     /* 4. the partition: ranges, nodes, this rank's tree */
-    err = check_dimension(comm, L, diag, dlen);
+    err = check_dimension(comm, L, strcmp(o->input, "-") == 0 ? "stdin" : o->input, diag, dlen);
     if (err)
         goto fail;
     fdt_partition *pt = &L->pt;
