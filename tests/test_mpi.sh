@@ -8,7 +8,11 @@
 # same mesh as the serial run's, byte for byte; a rank that fails (the
 # hidden --inject-failure) ends every rank with the error, no hang, no
 # output; -o BASE.pvtu writes one piece a rank and an index that VTK reads
-# as the serial mesh.
+# as the serial mesh. The distributed setup (each rank its slice of a text
+# file, bisection by exchange, duplicates merged across slices): headers
+# and comments, duplicates spread across slices, the whole-read fallback,
+# standard input, a bad line in a later rank's slice (every rank exits 2
+# with the serial run's message, line number included, and writes nothing).
 # Usage: test_mpi.sh FRONTDT FRONTDT_MPI GEN_POINTS MPIRUN DATA_DIR [PYTHON3]
 set -u
 frontdt=$1 fmpi=$2 gen=$3 mpirun=$4 data=$5 python=${6:-python3}
@@ -95,6 +99,71 @@ extra=()
 # termination as non-roots.
 printf '0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n' >"$work/five.xyz"
 check five "$work/five.xyz" 7
+
+# The distributed setup (§3.1, src/mpi_setup.c): each rank parses its byte
+# slice of a text file, cut at line starts wherever the byte offsets fall
+# (mid-line, as a rule). A header line, comments, blank lines, CRLF and
+# commas, on every rank count; duplicates spread across slices (the file
+# twice over, so each point's duplicate is in another rank's slice), whose
+# gathered .tets must be serial's byte for byte (the first input id of
+# each class survives, as src/prepare.c's merge); the whole-read fallback
+# for other formats (PLY) and standard input (read by rank 0, scattered).
+{
+  printf '\xef\xbb\xbfX,Y,Z\r\n# clusters, as csv\r\n\r\n'
+  awk '{printf "%s,%s,%s%s\r\n", $1, $2, $3, (NR % 97 == 0 ? "  # a comment" : "")}
+       NR % 211 == 0 {printf "\r\n# between\r\n"}' "$work/clusters.xyz"
+} >"$work/header.csv"
+check "header csv" "$work/header.csv" "${nps[@]}"
+cat "$work/clusters.xyz" "$work/clusters.xyz" >"$work/twice.xyz"
+check "duplicates across slices" "$work/twice.xyz" 2 3 7
+# every lattice point five times: the class at a cut is five equal points,
+# which must all go to one side (split, two ranks would each build on
+# the point, and the run fails)
+for i in 1 2 3 4 5; do cat "$work/lattice.xyz"; done >"$work/lattice5.xyz"
+check "lattice, each point five times" "$work/lattice5.xyz" 2 3 7
+"$frontdt" --mode serial -q -o "$work/twice_ref.tets" "$work/twice.xyz" || fail "serial -o twice"
+checks=$((checks + 1))
+mpi 3 120 "$fmpi" -q -o "$work/twice3.tets" "$work/twice.xyz" || fail "-o twice, 3 ranks"
+cmp -s "$work/twice_ref.tets" "$work/twice3.tets" || fail "-o twice, 3 ranks: differs from serial"
+checks=$((checks + 1))
+mpi 3 60 "$fmpi" -q --stats "$work/twice.xyz" 2>"$work/st" >/dev/null
+grep -q "each rank read its slice of the file; 6000 points, 3000 duplicates merged" "$work/st" ||
+  { fail "twice, 3 ranks: --stats does not say slices and 3000 duplicates"; cat "$work/st"; }
+"$gen" uniform 3000 23 "$work/u.ply" >/dev/null || fail "gen_points ply"
+check "ply (whole-read fallback)" "$work/u.ply" 3
+checks=$((checks + 1))
+mpi 2 60 "$fmpi" -q --stats "$work/u.ply" 2>"$work/st" >/dev/null
+grep -q "every rank read the whole input" "$work/st" || fail "ply: --stats does not say whole read"
+checks=$((checks + 1))
+ref=$("$frontdt" --mode serial -q --set-hash "$work/clusters.xyz")
+got=$(mpi 3 60 "$fmpi" -q --set-hash --input-format xyz - <"$work/clusters.xyz")
+[[ -n $ref && $got == "$ref" ]] || fail "standard input, 3 ranks: '$got', serial '$ref'"
+
+# Bad input in a slice: every rank exits 2 with the error of a whole read
+# (the file's first bad line, its number counted over the slices before
+# it), and nothing is written. Lines 2950 (the last rank's slice of 3)
+# and then 1500 as well (rank 1's of 4, reported first).
+rankvar='${OMPI_COMM_WORLD_RANK:-${PMI_RANK:-?}}'
+awk 'NR == 2950 {print "1.0 2.0 oops"; next} {print}' "$work/clusters.xyz" >"$work/bad1.xyz"
+awk 'NR == 2950 {print "1.0 2.0 oops"; next} NR == 1500 {print "1 2"; next} {print}' \
+  "$work/clusters.xyz" >"$work/bad2.xyz"
+printf '0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 2 0\n0 0 0\n' >"$work/flat.xyz"
+for spec in "bad1 3" "bad2 4" "flat 3"; do
+  set -- $spec
+  checks=$((checks + 1))
+  want=$("$frontdt" --mode serial -q "$work/$1.xyz" 2>&1 | sed 's/^frontdt: //')
+  rm -f "$work/bad.tets"
+  out=$(mpi "$2" 60 bash -c "\"\$0\" -q -o \"$work/bad.tets\" \"$work/$1.xyz\"; echo \"rank-exit $rankvar \$?\"" "$fmpi" 2>"$work/ferr")
+  n2=$(grep -c '^rank-exit [0-9?]* 2$' <<<"$out")
+  [[ $n2 -eq $2 ]] || { fail "$1 on $2 ranks: $n2 of $2 ranks ended with exit 2"; echo "$out"; }
+  got=$(grep '^frontdt-mpi: ' "$work/ferr" | sed 's/^frontdt-mpi: //')
+  case $1 in
+    flat) [[ $got == *"flat.xyz: all 5 distinct points are coplanar"* ]] ||
+            fail "flat on $2 ranks: '$got'" ;;
+    *) [[ $got == "$want" ]] || fail "$1 on $2 ranks: '$got', serial says '$want'" ;;
+  esac
+  ls -A "$work" | grep -q 'bad\.tets' && fail "$1 on $2 ranks: output left behind"
+done
 
 if [[ -r $data/bunny_35947.xyz ]]; then
   check bunny "$data/bunny_35947.xyz" "${nps[@]}"
