@@ -22,7 +22,7 @@
  *    straddle a cut. An MPI_Alltoallv then spreads each side's points
  *    evenly over that side's ranks, and MPI_Comm_split makes the two
  *    groups of the next level.
- * 3. Merge: equal points now sit on one rank, which sorts its points and
+ * 3. Merge: equal points now sit on one rank, which hashes its points and
  *    keeps each class's least input id (src/prepare.c's rule, so ids and
  *    hashes equal serial's); the power of two scale is chosen from the
  *    extremes reduced over the ranks, as fdt_prepare chooses it.
@@ -547,13 +547,19 @@ static int bisect(MPI_Comm comm, MPI_Datatype rt, rec **pr, size_t *pn, int dims
 
 /* ---- 3. merge ------------------------------------------------------------ */
 
-static int rec_cmp(const void *x, const void *y)
+/* A hash of a point's coordinates, -0 folded onto +0 (equal points, as
+ * key_cmp compares them, hash alike). */
+static uint64_t point_mix(const double *x)
 {
-    const rec *a = x, *b = y;
-    int c = key_cmp(a->x, b->x, 0);
-    if (c)
-        return c;
-    return a->id < b->id ? -1 : a->id > b->id;
+    uint64_t h = 0x9E3779B97F4A7C15ull;
+    for (int k = 0; k < 3; k++) {
+        double v = x[k] == 0.0 ? 0.0 : x[k];
+        uint64_t u;
+        memcpy(&u, &v, sizeof u);
+        h = (h ^ u) * 0xBF58476D1CE4E5B9ull;
+        h ^= h >> 29;
+    }
+    return h ^ (h >> 32);
 }
 
 /* ---- 4. trees: the bisection's nodes on every rank ------------------------ */
@@ -1015,13 +1021,40 @@ int fdt_mpi_setup(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, 
     if (err)
         goto fail;
 
-    /* 3. merge: sorted, each class's first (least) input id survives */
-    qsort(r, n, sizeof *r, rec_cmp);
+    /* 3. merge: each class's first (least) input id survives. A hash
+     * table of record indices, one pass: slot[h] holds the class's
+     * survivor so far, cls[i] the slot of record i's class (a sort of the
+     * 32-byte records cost 0.37 s a rank at 1M on 2 ranks). */
+    size_t cap = 16;
+    while (cap < 2 * n)
+        cap *= 2;
+    uint32_t *slot = malloc(cap * sizeof *slot), *cls = malloc((n + 1) * sizeof *cls);
+    err = slot && cls && n < UINT32_MAX ? FDT_OK : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory merging the duplicates");
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
+        free(slot);
+        free(cls);
+        goto fail;
+    }
+    memset(slot, 0xff, cap * sizeof *slot);
     size_t m = 0;
     double ext[2] = {0.0, -INFINITY}; /* max |x|, -(min nonzero |x|) */
     for (size_t i = 0; i < n; i++) {
-        if (i == 0 || key_cmp(r[i].x, r[i - 1].x, 0) != 0)
-            m++;
+        size_t h = (size_t)point_mix(r[i].x) & (cap - 1);
+        for (;; h = (h + 1) & (cap - 1)) {
+            uint32_t q = slot[h];
+            if (q == UINT32_MAX) {
+                slot[h] = (uint32_t)i;
+                m++;
+                break;
+            }
+            if (key_cmp(r[q].x, r[i].x, 0) == 0) {
+                if (r[i].id < r[q].id)
+                    slot[h] = (uint32_t)i;
+                break;
+            }
+        }
+        cls[i] = (uint32_t)h;
         for (int k = 0; k < 3; k++) {
             double ax = fabs(r[i].x[k]);
             if (ax > ext[0])
@@ -1043,27 +1076,32 @@ int fdt_mpi_setup(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, 
     err = L->p && L->orig && (!o->keep_input || (L->in_id && L->in_vertex && L->in_xyz))
               ? FDT_OK
               : FDT_ENOMEM;
-    snprintf(diag, dlen, "out of memory merging the duplicates");
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
+        free(slot);
+        free(cls);
         goto fail;
+    }
     diag[0] = '\0';
     {
         size_t j = 0;
         for (size_t i = 0; i < n; i++) {
-            if (i == 0 || key_cmp(r[i].x, r[i - 1].x, 0) != 0) {
+            uint32_t q = slot[cls[i]];
+            if (q == (uint32_t)i) { /* the survivor of its class */
                 for (int k = 0; k < 3; k++)
                     L->p[3 * j + k] = ldexp(r[i].x[k], L->scale_exp); /* exact */
                 L->orig[j++] = (fdt_vid)r[i].id;
             }
             if (o->keep_input) {
                 L->in_id[i] = (fdt_vid)r[i].id;
-                L->in_vertex[i] = L->orig[j - 1];
+                L->in_vertex[i] = (fdt_vid)r[q].id;
                 memcpy(L->in_xyz + 3 * i, r[i].x, sizeof r[i].x);
             }
         }
         L->nloc = m;
         L->nin = o->keep_input ? n : 0;
     }
+    free(slot);
+    free(cls);
     free(r);
     r = NULL;
     uint64_t mm = m, gm = 0;
