@@ -319,8 +319,11 @@ static void setup_stats(const fdt_mpi_local *L, int rank, int size, int print)
                MPI_COMM_WORLD);
     if (rank == 0 && print) {
         fprintf(stderr, "  setup: %s; %zu points, %zu duplicates merged\n",
-                L->sliced ? "each rank read its slice of the file"
-                          : "every rank read the whole input (not a .xyz/.txt/.csv file)",
+                L->sliced == 1   ? "each rank read its slice of the file"
+                : L->sliced == 2 ? "each rank read its vertices of the binary PLY"
+                : L->sliced == 3 ? "rank 0 read standard input and scattered it"
+                                 : "every rank read the whole input (.node, ASCII PLY or PLY "
+                                   "with lists)",
                 L->n, L->ndup);
         fprintf(stderr, "  rank    read s  exchange s   merge s   trees s   seeds s   bytes sent\n");
         for (int q = 0; q < size; q++) {

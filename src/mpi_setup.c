@@ -10,8 +10,12 @@
  *    line counts after the parse; only a failing slice is parsed again to
  *    word its error with them (the lowest failing rank's is the file's
  *    first, as a whole read would report). Input ids: an MPI_Exscan of
- *    the slices' point counts. Other formats: every rank reads the whole
- *    input and keeps slice r of its points; standard input (which reaches
+ *    the slices' point counts. A binary PLY whose elements have fixed
+ *    sizes: the header on every rank, then vertices [N r / p, N (r + 1) /
+ *    p) by pread (a NaN or infinity anywhere: rank 0 reads the file whole
+ *    to word the error as frontdt does). Other formats (.node, ASCII PLY,
+ *    PLY with lists): every rank reads the whole input and keeps slice r
+ *    of its points; standard input (which reaches
  *    rank 0 alone): rank 0 reads it and scatters the slices.
  * 2. Bisection by exchange (§3.1; the cut rule of src/partition.c): a
  *    group of g ranks (all of them at first) splits into k = g / 2 and
@@ -114,14 +118,18 @@ static int io_err(int rc)
 
 /* ---- 1. read ------------------------------------------------------------- */
 
-/* Whether o's input is read by slices: a regular file of a text format. */
+/* How o's input may be read by slices: 1 a regular file of a text point
+ * format, 2 a regular PLY file (binary, if fdt_rd_ply_find_layout agrees), 0
+ * not at all. */
 static int sliceable(const fdt_mpi_setup_opts *o)
 {
     if (strcmp(o->input, "-") == 0)
         return 0;
     int f = o->format ? fdt_rd_format_by_name(o->format) : fdt_rd_format_of_path(o->input);
     struct stat st;
-    return f == FDT_RD_XYZ && stat(o->input, &st) == 0 && S_ISREG(st.st_mode);
+    if (stat(o->input, &st) != 0 || !S_ISREG(st.st_mode))
+        return 0;
+    return f == FDT_RD_XYZ ? 1 : f == FDT_RD_PLY ? 2 : 0;
 }
 
 /* This rank's points as records with input ids, into *out (*nout). */
@@ -135,12 +143,69 @@ static int read_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local 
     size_t n = 0;
     int err = FDT_OK;
     uint64_t first = 0; /* input id of this rank's first point */
-    L->sliced = sliceable(o);
-    /* every rank decides alike unless the file changes under it: agree */
-    int all = L->sliced;
-    MPI_Allreduce(&L->sliced, &all, 1, MPI_INT, MPI_MIN, comm);
-    L->sliced = all;
-    if (L->sliced) {
+    /* Rank 0 decides how the input is read (1: text slices, 2: binary
+     * PLY slices, 0: whole) and tells everyone. */
+    int kind = 0;
+    fdt_rd_ply_layout lay;
+    memset(&lay, 0, sizeof lay);
+    if (rank == 0) {
+        kind = sliceable(o);
+        if (kind == 2) {
+            int lr = fdt_rd_ply_find_layout(o->input, &lay, diag, dlen);
+            kind = lr == 1 ? 2 : 0; /* errors: the whole read words them */
+        }
+    }
+    MPI_Bcast(&kind, 1, MPI_INT, 0, comm);
+    L->sliced = kind; /* 3 below for standard input */
+    if (kind == 2) {
+        unsigned long long lv[8] = {lay.vertex_off, lay.rec, lay.count, lay.off[0], lay.off[1],
+                                    lay.off[2], 0, (unsigned long long)lay.big};
+        int ty[3] = {lay.type[0], lay.type[1], lay.type[2]};
+        MPI_Bcast(lv, 8, MPI_UNSIGNED_LONG_LONG, 0, comm);
+        MPI_Bcast(ty, 3, MPI_INT, 0, comm);
+        lay.vertex_off = (size_t)lv[0];
+        lay.rec = (size_t)lv[1];
+        lay.count = lv[2];
+        for (int k = 0; k < 3; k++) {
+            lay.off[k] = (size_t)lv[3 + k];
+            lay.type[k] = ty[k];
+        }
+        lay.big = (int)lv[7];
+        /* vertices [N r / p, N (r + 1) / p), by pread of their bytes */
+        unsigned long long a = lay.count * (unsigned long long)rank / (unsigned long long)size;
+        unsigned long long b = lay.count * (unsigned long long)(rank + 1) / (unsigned long long)size;
+        n = (size_t)(b - a);
+        int rc = fdt_rd_ply_range(o->input, &lay, a, n, &xyz, diag, dlen);
+        int bad = rc == FDT_IO_EFORMAT, anybad = 0;
+        MPI_Allreduce(&bad, &anybad, 1, MPI_INT, MPI_MAX, comm);
+        if (anybad) {
+            /* a NaN or an infinity: rank 0 reads the file whole, which
+             * words the error exactly as frontdt does (only bad files pay) */
+            free(xyz);
+            xyz = NULL;
+            double *w = NULL;
+            size_t wn = 0;
+            err = FDT_EFORMAT;
+            if (rank == 0) {
+                err = fdt_read_points(o->input, o->format, &w, &wn, diag, dlen);
+                fdt_free(w);
+                if (!err) {
+                    snprintf(diag, dlen, "%s: a slice and the whole read disagree", o->input);
+                    err = FDT_EINTERNAL;
+                }
+            }
+            /* rank 0's message is the one: the others only follow */
+            int e0 = err;
+            MPI_Bcast(&e0, 1, MPI_INT, 0, comm);
+            char m0[512];
+            snprintf(m0, sizeof m0, "%s", diag);
+            MPI_Bcast(m0, (int)sizeof m0, MPI_CHAR, 0, comm);
+            snprintf(diag, dlen, "%s", m0);
+            return e0;
+        }
+        err = io_err(rc);
+        first = a;
+    } else if (kind == 1) {
         fdt_rd_head h;
         memset(&h, 0, sizeof h);
         if (rank == 0)
@@ -192,6 +257,7 @@ static int read_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local 
         }
         err = io_err(rc);
     } else if (strcmp(o->input, "-") == 0) {
+        L->sliced = 3;
         /* Standard input reaches rank 0 alone (mpirun forwards it there):
          * rank 0 reads it and scatters slice r to rank r. */
         double *all_xyz = NULL;
@@ -255,7 +321,7 @@ static int read_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local 
     MPI_Exscan(&mn, &off, 1, MPI_UINT64_T, MPI_SUM, comm);
     if (rank == 0)
         off = 0;
-    if (L->sliced)
+    if (L->sliced == 1)
         first = off;
     if (tot == 0) {
         free(xyz);
@@ -338,29 +404,52 @@ static int prop_cmp(const void *x, const void *y)
     return key_cmp(((const prop *)x)->key, ((const prop *)y)->key, g_dim);
 }
 
+/* Samples a rank sends a round of pick_cut: enough that the two pivots
+ * bracket the cut within a few percent of the undecided points, few
+ * enough that every rank sorts them all in no time. */
+static int samples_per_rank(int gs)
+{
+    int s = 4096 / gs;
+    return s < 16 ? 16 : s > 1024 ? 1024 : s;
+}
+
 /*
  * Rearranges r[0, n) so that r[0, *nleft) go left: over the group, the
  * `target` smallest keys on axis d, give or take the class of points equal
  * to the key at the cut, which goes wholly to the side nearer the target.
- * Each round every rank proposes the middle key of its undecided range,
- * weighted by that range's size; the weighted median proposal is the
- * pivot; each rank splits its range three ways and the counts summed over
- * the group decide which part stays undecided. The pivot is an undecided
- * point, so every round decides at least its class: it ends.
+ * Each round every rank sends samples of its undecided range, each
+ * weighted by the points it stands for; the weighted quantiles a margin
+ * below and above the target are the pivots lo <= hi; each rank splits its
+ * range five ways (< lo, = lo, between, = hi, > hi) and the counts summed
+ * over the group say where the cut falls: at a segment's end (done), in a
+ * class of equal points (wholly to the nearer side: done), or in a range,
+ * which stays undecided. The pivots are undecided points, so every round
+ * decides at least their classes: it ends; with good samples the range
+ * shrinks to a tenth or less a round.
  */
 static void pick_cut(MPI_Comm g, int gs, rec *r, size_t n, uint64_t target, int d, size_t *nleft,
                      prop *props)
 {
     size_t a = 0, b = n; /* [0, a) left, [b, n) right, decided */
     uint64_t below = 0;  /* points decided left over the group */
+    int S = samples_per_rank(gs);
     for (;;) {
-        prop mine = {{0, 0, 0}, (double)(b - a)};
-        if (b > a)
-            memcpy(mine.key, r[a + (b - a) / 2].x, sizeof mine.key);
-        MPI_Allgather(&mine, 4, MPI_DOUBLE, props, 4, MPI_DOUBLE, g);
-        int k = 0;
+        prop *mine = props + (size_t)gs * (size_t)S; /* S more after the gathered */
+        size_t act = b - a;
+        for (int j = 0; j < S; j++) {
+            if (act == 0 || (size_t)j >= act) {
+                mine[j].w = 0;
+                memset(mine[j].key, 0, sizeof mine[j].key);
+                continue;
+            }
+            size_t ns = act < (size_t)S ? act : (size_t)S;
+            memcpy(mine[j].key, r[a + (act * (2 * (size_t)j + 1)) / (2 * ns)].x, sizeof mine[j].key);
+            mine[j].w = (double)act / (double)ns;
+        }
+        MPI_Allgather(mine, 4 * S, MPI_DOUBLE, props, 4 * S, MPI_DOUBLE, g);
+        size_t k = 0;
         double total = 0;
-        for (int i = 0; i < gs; i++)
+        for (size_t i = 0; i < (size_t)gs * (size_t)S; i++)
             if (props[i].w > 0) {
                 props[k++] = props[i];
                 total += props[i].w;
@@ -368,40 +457,69 @@ static void pick_cut(MPI_Comm g, int gs, rec *r, size_t n, uint64_t target, int 
         if (k == 0)
             break;
         g_dim = d;
-        qsort(props, (size_t)k, sizeof *props, prop_cmp);
+        qsort(props, k, sizeof *props, prop_cmp);
+        /* the target among the undecided, and a margin of two standard
+         * deviations of a quantile estimated from k samples */
+        double t = (double)(target - below), margin = 2.0 * total / sqrt((double)k);
+        size_t ilo = 0, ihi = k - 1;
         double acc = 0;
-        int piv = k - 1;
-        for (int i = 0; i < k; i++) {
+        for (size_t i = 0; i < k; i++) {
             acc += props[i].w;
-            if (2 * acc >= total) {
-                piv = i;
+            if (acc < t - margin)
+                ilo = i + 1 < k ? i + 1 : i;
+            if (acc >= t + margin) {
+                ihi = i;
                 break;
             }
         }
-        double pivot[3];
-        memcpy(pivot, props[piv].key, sizeof pivot);
-        size_t l1, l2;
-        split3(r, a, b, pivot, d, &l1, &l2);
-        uint64_t c[2] = {l1 - a, l2 - l1}, s[2];
-        MPI_Allreduce(c, s, 2, MPI_UINT64_T, MPI_SUM, g);
-        uint64_t L = s[0], E = s[1];
-        if (below + L >= target) {
-            b = l1; /* the pivot's class and above go right */
-            if (below + L == target) {
-                a = l1;
-                break;
-            }
-        } else if (below + L + E >= target) {
-            /* the class at the cut: wholly to the nearer side */
-            if (target - (below + L) <= below + L + E - target)
-                a = b = l1;
-            else
-                a = b = l2;
-            break;
+        if (ilo > ihi)
+            ilo = ihi;
+        double lo[3], hi[3];
+        memcpy(lo, props[ilo].key, sizeof lo);
+        memcpy(hi, props[ihi].key, sizeof hi);
+        /* five segments: [a, e1) < lo, [e1, e2) = lo, [e2, e3) between,
+         * [e3, e4) = hi, [e4, b) > hi (the last two empty when lo = hi) */
+        size_t e[6];
+        e[0] = a;
+        split3(r, a, b, lo, d, &e[1], &e[2]);
+        if (key_cmp(lo, hi, d) == 0) {
+            e[3] = e[4] = e[2];
         } else {
-            a = l2;
-            below += L + E;
+            split3(r, e[2], b, hi, d, &e[3], &e[4]);
         }
+        e[5] = b;
+        uint64_t c[5], sum[5];
+        for (int i = 0; i < 5; i++)
+            c[i] = e[i + 1] - e[i];
+        MPI_Allreduce(c, sum, 5, MPI_UINT64_T, MPI_SUM, g);
+        uint64_t want = target - below, C = 0;
+        int done = 0;
+        for (int i = 0; i < 5; i++) {
+            if (want == C) { /* the cut at segment i's start */
+                a = b = e[i];
+                done = 1;
+                break;
+            }
+            if (want < C + sum[i]) {
+                if (i == 1 || i == 3) {
+                    /* a class of equal points: wholly to the nearer side */
+                    a = b = want - C <= C + sum[i] - want ? e[i] : e[i + 1];
+                    done = 1;
+                } else {
+                    a = e[i];
+                    b = e[i + 1];
+                    below += C;
+                }
+                break;
+            }
+            C += sum[i];
+        }
+        if (!done && want == C) { /* the cut after every segment */
+            a = b = e[5];
+            done = 1;
+        }
+        if (done)
+            break;
     }
     *nleft = a;
 }
@@ -437,7 +555,9 @@ static int bisect(MPI_Comm comm, MPI_Datatype rt, rec **pr, size_t *pn, int dims
     int gs, gr, depth = 0;
     MPI_Comm_size(g, &gs);
     int *sc = malloc(4 * ((size_t)gs + 1) * sizeof *sc);
-    prop *props = malloc(((size_t)gs + 1) * sizeof *props);
+    /* pick_cut's samples for any group size g <= gs: (g + 1) S(g) <=
+     * max(4096, 16 g) + 1024 */
+    prop *props = malloc(((size_t)16 * ((size_t)gs + 1) + 8192) * sizeof *props);
     if (!sc || !props)
         err = FDT_ENOMEM;
     snprintf(diag, dlen, "out of memory in the bisection");

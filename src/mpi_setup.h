@@ -55,8 +55,10 @@ typedef struct fdt_mpi_local {
     size_t m;            /* distinct points, all ranks */
     size_t ndup;         /* input points merged into an earlier one */
     int scale_exp;
-    int sliced;          /* 1: each rank read its slice; 0: every rank read
-                            the whole input (other formats, stdin) */
+    int sliced;          /* how the input was read: 1 each rank its byte
+                            range of a text file, 2 its vertices of a
+                            binary PLY, 3 rank 0 standard input (scattered),
+                            0 every rank the whole input (other formats) */
     /* keep_input: every input point this rank held after the exchange,
      * duplicates included: its input id, its vertex (the input id it was
      * merged into, itself if none) and its coordinates as read. */

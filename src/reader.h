@@ -189,4 +189,27 @@ int fdt_rd_text_range(const char *path, const fdt_rd_opts *o, size_t begin, size
                       size_t ncols, size_t line0, double **xyz, size_t *n, size_t *lines,
                       char *err, size_t errlen);
 
+/*
+ * Binary PLY slices (the same use): a file whose elements all have a fixed
+ * size and whose size is what its header says has vertex i at byte
+ * vertex_off + i rec. fdt_rd_ply_find_layout: 1 and *lay for such a file, 0 for
+ * any other (ASCII, lists, a bad header or size: read it whole, which
+ * words what is wrong), or an FDT_IO error opening it.
+ * fdt_rd_ply_range: vertices [first, first + count) into *xyz (3 doubles
+ * each, malloc'd); FDT_IO_EFORMAT if a coordinate is NaN or infinite
+ * (the whole read words that error as a whole read does).
+ */
+typedef struct fdt_rd_ply_layout {
+    size_t vertex_off;  /* byte of vertex 0 */
+    size_t rec;         /* bytes a vertex */
+    unsigned long long count; /* vertices */
+    size_t off[3];      /* bytes of x, y, z into a vertex */
+    int type[3];        /* their types (src/read_ply.c) */
+    int big;            /* big-endian */
+} fdt_rd_ply_layout;
+
+int fdt_rd_ply_find_layout(const char *path, fdt_rd_ply_layout *lay, char *err, size_t errlen);
+int fdt_rd_ply_range(const char *path, const fdt_rd_ply_layout *lay, unsigned long long first,
+                     size_t count, double **xyz, char *err, size_t errlen);
+
 #endif

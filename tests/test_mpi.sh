@@ -133,7 +133,55 @@ grep -q "each rank read its slice of the file; 6000 points, 3000 duplicates merg
 check "ply (whole-read fallback)" "$work/u.ply" 3
 checks=$((checks + 1))
 mpi 2 60 "$fmpi" -q --stats "$work/u.ply" 2>"$work/st" >/dev/null
-grep -q "every rank read the whole input" "$work/st" || fail "ply: --stats does not say whole read"
+grep -q "each rank read its vertices of the binary PLY" "$work/st" ||
+  fail "ply: --stats does not say vertex slices"
+# PLY layouts (written by python3; skipped without it): big-endian floats
+# with a colour, after a fixed-size element (sliced by vertex); a face
+# list after the vertices (read whole); ASCII (read whole); a NaN in the
+# last vertex (every rank exits 2 with frontdt's message).
+if "$python" - "$work" "$work/clusters.xyz" <<'PY'
+import struct, sys
+work, src = sys.argv[1], sys.argv[2]
+pts = [tuple(float(v) for v in l.split()[:3]) for l in open(src) if l.strip()]
+def ply(name, fmt, props, rows, pre=b"", post=b"", tail=b""):
+    with open(f"{work}/{name}.ply", "wb") as f:
+        f.write(b"ply\nformat " + fmt + b" 1.0\n" + pre + b"element vertex %d\n" % len(rows)
+                + props + post + b"end_header\n")
+        for r in rows:
+            f.write(r)
+        f.write(tail)
+be = [struct.pack(">fffB", x, y, z, 7) for x, y, z in pts]
+ply("be", b"binary_big_endian",
+    b"property float x\nproperty float y\nproperty float z\nproperty uchar red\n", be,
+    pre=b"element camera 2\nproperty double fov\nproperty int id\n"
+    + b"", tail=b"")
+# the camera element's 2 x 12 bytes precede the vertices
+data = open(f"{work}/be.ply", "rb").read()
+head, body = data.split(b"end_header\n", 1)
+open(f"{work}/be.ply", "wb").write(head + b"end_header\n" + struct.pack(">di", 1.0, 1) * 2 + body)
+le = [struct.pack("<ddd", x, y, z) for x, y, z in pts]
+ply("faces", b"binary_little_endian",
+    b"property double x\nproperty double y\nproperty double z\n", le,
+    post=b"element face 1\nproperty list uchar int vertex_indices\n",
+    tail=struct.pack("<Biii", 3, 0, 1, 2))
+ply("ascii", b"ascii", b"property double x\nproperty double y\nproperty double z\n",
+    [b"%r %r %r\n" % p for p in pts])
+nan = le[:-1] + [struct.pack("<ddd", 0.5, float("nan"), 0.5)]
+ply("nan", b"binary_little_endian",
+    b"property double x\nproperty double y\nproperty double z\n", nan)
+PY
+then
+  check "ply big-endian floats after a camera element" "$work/be.ply" 2 3
+  check "ply with a face list" "$work/faces.ply" 3
+  check "ply ascii" "$work/ascii.ply" 2
+  checks=$((checks + 1))
+  mpi 3 60 "$fmpi" -q --stats "$work/be.ply" 2>"$work/st" >/dev/null
+  grep -q "each rank read its vertices of the binary PLY" "$work/st" || fail "be.ply: not sliced"
+  mpi 3 60 "$fmpi" -q --stats "$work/faces.ply" 2>"$work/st" >/dev/null
+  grep -q "every rank read the whole input" "$work/st" || fail "faces.ply: not read whole"
+else
+  echo "skip: PLY layouts ($python absent)"
+fi
 checks=$((checks + 1))
 ref=$("$frontdt" --mode serial -q --set-hash "$work/clusters.xyz")
 got=$(mpi 3 60 "$fmpi" -q --set-hash --input-format xyz - <"$work/clusters.xyz")
@@ -148,19 +196,21 @@ awk 'NR == 2950 {print "1.0 2.0 oops"; next} {print}' "$work/clusters.xyz" >"$wo
 awk 'NR == 2950 {print "1.0 2.0 oops"; next} NR == 1500 {print "1 2"; next} {print}' \
   "$work/clusters.xyz" >"$work/bad2.xyz"
 printf '0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 2 0\n0 0 0\n' >"$work/flat.xyz"
-for spec in "bad1 3" "bad2 4" "flat 3"; do
+bads=("bad1.xyz 3" "bad2.xyz 4" "flat.xyz 3")
+[[ -s $work/nan.ply ]] && bads+=("nan.ply 3")
+for spec in "${bads[@]}"; do
   set -- $spec
   checks=$((checks + 1))
-  want=$("$frontdt" --mode serial -q "$work/$1.xyz" 2>&1 | sed 's/^frontdt: //')
+  want=$("$frontdt" --mode serial -q "$work/$1" 2>&1 | sed 's/^frontdt: //')
   rm -f "$work/bad.tets"
-  out=$(mpi "$2" 60 bash -c "\"\$0\" -q -o \"$work/bad.tets\" \"$work/$1.xyz\"; echo \"rank-exit $rankvar \$?\"" "$fmpi" 2>"$work/ferr")
+  out=$(mpi "$2" 60 bash -c "\"\$0\" -q -o \"$work/bad.tets\" \"$work/$1\"; echo \"rank-exit $rankvar \$?\"" "$fmpi" 2>"$work/ferr")
   n2=$(grep -c '^rank-exit [0-9?]* 2$' <<<"$out")
   [[ $n2 -eq $2 ]] || { fail "$1 on $2 ranks: $n2 of $2 ranks ended with exit 2"; echo "$out"; }
   got=$(grep '^frontdt-mpi: ' "$work/ferr" | sed 's/^frontdt-mpi: //')
   case $1 in
-    flat) [[ $got == *"flat.xyz: all 5 distinct points are coplanar"* ]] ||
+    flat.xyz) [[ $got == *"flat.xyz: all 5 distinct points are coplanar"* ]] ||
             fail "flat on $2 ranks: '$got'" ;;
-    *) [[ $got == "$want" ]] || fail "$1 on $2 ranks: '$got', serial says '$want'" ;;
+    *) [[ -n $want && $got == "$want" ]] || fail "$1 on $2 ranks: '$got', serial says '$want'" ;;
   esac
   ls -A "$work" | grep -q 'bad\.tets' && fail "$1 on $2 ranks: output left behind"
 done
