@@ -10,10 +10,12 @@
 #include <inttypes.h>
 #include <limits.h>
 #include <mpi.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #include "frontdt.h"
 #include "mpi_run.h"
@@ -23,7 +25,66 @@
 #include "seed.h"
 #include "writer.h"
 
-enum { EX_OK = 0, EX_USAGE = 1, EX_INPUT = 2, EX_RESOURCES = 4, EX_WRITE = 5, EX_INTERNAL = 7 };
+enum {
+    EX_OK = 0,
+    EX_USAGE = 1,
+    EX_INPUT = 2,
+    EX_RESOURCES = 4,
+    EX_WRITE = 5,
+    EX_SIGNAL = 6,
+    EX_INTERNAL = 7
+};
+
+/* ---- SIGINT / SIGTERM ----------------------------------------------------
+ *
+ * mpirun passes an interrupt on to every rank (Open MPI forwards SIGINT
+ * and SIGTERM, MPICH's hydra SIGINT). Each rank removes what it is
+ * writing, as frontdt does (fdt_write_cleanup: the temporaries of a write
+ * in progress), and its piece of -o BASE.pvtu if it was complete but the
+ * index is not yet, so an interrupted run leaves no output, and leaves
+ * with exit code 6 without waiting for the others (which the same signal
+ * ends). With the piece it removes the index (any rank may: they name the
+ * same file), so an index never outlives a piece it names: rank 0 writes
+ * the index only after every piece is written, and every rank keeps
+ * piece_live until all have passed a barrier after learning that the
+ * index is there (a rank that left early keeps rank 0 in that barrier
+ * until mpirun ends it, with the same cleanup). Only async-signal-safe
+ * calls: unlink, write, _exit. The names are written while piece_live is
+ * 0 and published by the store of 1 after them (volatile accesses keep
+ * their order). */
+static char piece_path[FDT_IO_PATH], index_path[FDT_IO_PATH];
+static volatile sig_atomic_t piece_live;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    fdt_write_cleanup();
+    if (piece_live) {
+        (void)unlink(piece_path);
+        (void)unlink(index_path);
+    }
+    static const char msg[] = "\nfrontdt-mpi: interrupted\n";
+    ssize_t w = write(STDERR_FILENO, msg, sizeof msg - 1);
+    (void)w;
+    _exit(EX_SIGNAL);
+}
+
+static void install_signals(void)
+{
+    static const int sigs[2] = {SIGINT, SIGTERM};
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaddset(&sa.sa_mask, SIGINT);
+    sigaddset(&sa.sa_mask, SIGTERM);
+    for (int i = 0; i < 2; i++) {
+        struct sigaction old;
+        /* a signal ignored at startup stays ignored, as in frontdt */
+        if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler != SIG_IGN)
+            (void)sigaction(sigs[i], &sa, NULL);
+    }
+}
 
 typedef struct opts {
     const char *input, *output, *format;
@@ -456,9 +517,15 @@ static int run(int argc, char **argv, int rank, int size)
          * every piece is removed again: all or nothing. */
         char name[FDT_IO_PATH];
         const char *rel;
-        int perr = piece_name(o.output, rank, name, sizeof name, &rel) != 0 ? FDT_EIO
-                   : write_piece(name, r.own_ids, r.own_xyz, r.own_npts, r.own_tets,
-                                 r.own_ntets, diag, sizeof diag);
+        int perr = piece_name(o.output, rank, name, sizeof name, &rel) != 0 ? FDT_EIO : FDT_OK;
+        if (!perr) {
+            /* from here an interrupt removes the piece (on_signal) */
+            memcpy(piece_path, name, sizeof piece_path);
+            snprintf(index_path, sizeof index_path, "%s", o.output);
+            piece_live = 1;
+            perr = write_piece(name, r.own_ids, r.own_xyz, r.own_npts, r.own_tets, r.own_ntets,
+                               diag, sizeof diag);
+        }
         if (perr)
             fprintf(stderr, "frontdt-mpi: rank %d: %s\n", rank, diag);
         int bad = perr == FDT_ENOMEM ? EX_RESOURCES : perr ? EX_WRITE : 0, worst = 0;
@@ -470,6 +537,10 @@ static int run(int argc, char **argv, int rank, int size)
         MPI_Bcast(&worst, 1, MPI_INT, 0, MPI_COMM_WORLD);
         if (worst && !perr)
             (void)remove(name);
+        /* complete (the index is there) or removed, on every rank: nothing
+         * to undo */
+        MPI_Barrier(MPI_COMM_WORLD);
+        piece_live = 0;
         rc = worst;
     }
 out:
@@ -488,6 +559,7 @@ int main(int argc, char **argv)
     int rank = 0, size = 1;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
+    install_signals();
     int rc = run(argc, argv, rank, size);
     MPI_Finalize();
     return rc;
