@@ -392,16 +392,24 @@ static void split3(rec *r, size_t a, size_t b, const double *pivot, int d, size_
     *l2 = gt;
 }
 
+/* A sample of pick_cut: a key rotated so that the cut's axis comes first
+ * (key[j] = x_(d+j) mod 3: plain lexicographic order is the cut's order,
+ * and qsort needs no axis), and the points it stands for. */
 typedef struct prop {
     double key[3];
     double w;
 } prop;
 
-static int g_dim; /* pick_cut's axis for prop_cmp (qsort has no context) */
-
 static int prop_cmp(const void *x, const void *y)
 {
-    return key_cmp(((const prop *)x)->key, ((const prop *)y)->key, g_dim);
+    return key_cmp(((const prop *)x)->key, ((const prop *)y)->key, 0);
+}
+
+/* x rotated for axis d (into a prop's key), or back (d = 3 - d). */
+static void rotate(double *out, const double *x, int d)
+{
+    for (int j = 0; j < 3; j++)
+        out[j] = x[(d + j) % 3];
 }
 
 /* Samples a rank sends a round of pick_cut: enough that the two pivots
@@ -443,7 +451,7 @@ static void pick_cut(MPI_Comm g, int gs, rec *r, size_t n, uint64_t target, int 
                 continue;
             }
             size_t ns = act < (size_t)S ? act : (size_t)S;
-            memcpy(mine[j].key, r[a + (act * (2 * (size_t)j + 1)) / (2 * ns)].x, sizeof mine[j].key);
+            rotate(mine[j].key, r[a + (act * (2 * (size_t)j + 1)) / (2 * ns)].x, d);
             mine[j].w = (double)act / (double)ns;
         }
         MPI_Allgather(mine, 4 * S, MPI_DOUBLE, props, 4 * S, MPI_DOUBLE, g);
@@ -456,7 +464,6 @@ static void pick_cut(MPI_Comm g, int gs, rec *r, size_t n, uint64_t target, int 
             }
         if (k == 0)
             break;
-        g_dim = d;
         qsort(props, k, sizeof *props, prop_cmp);
         /* the target among the undecided, and a margin of two standard
          * deviations of a quantile estimated from k samples */
@@ -475,8 +482,8 @@ static void pick_cut(MPI_Comm g, int gs, rec *r, size_t n, uint64_t target, int 
         if (ilo > ihi)
             ilo = ihi;
         double lo[3], hi[3];
-        memcpy(lo, props[ilo].key, sizeof lo);
-        memcpy(hi, props[ihi].key, sizeof hi);
+        rotate(lo, props[ilo].key, (3 - d) % 3);
+        rotate(hi, props[ihi].key, (3 - d) % 3);
         /* five segments: [a, e1) < lo, [e1, e2) = lo, [e2, e3) between,
          * [e3, e4) = hi, [e4, b) > hi (the last two empty when lo = hi) */
         size_t e[6];
