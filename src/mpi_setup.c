@@ -971,7 +971,8 @@ static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const do
         size_t at = 0;
         for (int q = 0; q < size; q++) {
             sdisp[q] = (int)at;
-            memcpy(sb + at, bc[q].buf, (size_t)scount[q] * sizeof *sb);
+            if (scount[q] > 0)
+                memcpy(sb + at, bc[q].buf, (size_t)scount[q] * sizeof *sb);
             at += (size_t)scount[q];
             if (q != rank)
                 L->bytes_sent += (uint64_t)scount[q] * sizeof(rec);

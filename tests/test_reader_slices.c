@@ -204,7 +204,10 @@ static void test_ply(const char *dir)
 
 int main(void)
 {
-    char dir[] = "/tmp/fdt-test-slices.XXXXXX";
+    const char *tmp = getenv("TMPDIR");
+    char dir[256];
+    int k = snprintf(dir, sizeof dir, "%s/fdt-test-slices.XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    CHECK(k > 0 && (size_t)k < sizeof dir);
     CHECK(mkdtemp(dir) != NULL);
     test_text(dir);
     test_ply(dir);
