@@ -1,18 +1,21 @@
 /*
  * frontdt-mpi: the distributed run (issue 19) under mpirun, one part per
- * rank (src/mpi_run.h). Every rank reads the whole input (the first stage
- * of the setup, mpi_run.h); rank 0 prints and writes. Exit codes are the
- * CLI's (README, Exit codes), the same on every rank.
+ * rank (src/mpi_run.h). Each rank reads its slice of the input and the
+ * ranks bisect the points by exchanging them (src/mpi_setup.h); rank 0
+ * prints and writes. Exit codes are the CLI's (README, Exit codes), the
+ * same on every rank.
  *
  *   mpirun -np 4 frontdt-mpi [-o OUT] [--set-hash] [--stats] [-q] INPUT
  */
 #include <inttypes.h>
 #include <limits.h>
 #include <mpi.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #include "frontdt.h"
 #include "mpi_run.h"
@@ -22,7 +25,66 @@
 #include "seed.h"
 #include "writer.h"
 
-enum { EX_OK = 0, EX_USAGE = 1, EX_INPUT = 2, EX_RESOURCES = 4, EX_WRITE = 5, EX_INTERNAL = 7 };
+enum {
+    EX_OK = 0,
+    EX_USAGE = 1,
+    EX_INPUT = 2,
+    EX_RESOURCES = 4,
+    EX_WRITE = 5,
+    EX_SIGNAL = 6,
+    EX_INTERNAL = 7
+};
+
+/* ---- SIGINT / SIGTERM ----------------------------------------------------
+ *
+ * mpirun passes an interrupt on to every rank (Open MPI forwards SIGINT
+ * and SIGTERM, MPICH's hydra SIGINT). Each rank removes what it is
+ * writing, as frontdt does (fdt_write_cleanup: the temporaries of a write
+ * in progress), and its piece of -o BASE.pvtu if it was complete but the
+ * index is not yet, so an interrupted run leaves no output, and leaves
+ * with exit code 6 without waiting for the others (which the same signal
+ * ends). With the piece it removes the index (any rank may: they name the
+ * same file), so an index never outlives a piece it names: rank 0 writes
+ * the index only after every piece is written, and every rank keeps
+ * piece_live until all have passed a barrier after learning that the
+ * index is there (a rank that left early keeps rank 0 in that barrier
+ * until mpirun ends it, with the same cleanup). Only async-signal-safe
+ * calls: unlink, write, _exit. The names are written while piece_live is
+ * 0 and published by the store of 1 after them (volatile accesses keep
+ * their order). */
+static char piece_path[FDT_IO_PATH], index_path[FDT_IO_PATH];
+static volatile sig_atomic_t piece_live;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    fdt_write_cleanup();
+    if (piece_live) {
+        (void)unlink(piece_path);
+        (void)unlink(index_path);
+    }
+    static const char msg[] = "\nfrontdt-mpi: interrupted\n";
+    ssize_t w = write(STDERR_FILENO, msg, sizeof msg - 1);
+    (void)w;
+    _exit(EX_SIGNAL);
+}
+
+static void install_signals(void)
+{
+    static const int sigs[2] = {SIGINT, SIGTERM};
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaddset(&sa.sa_mask, SIGINT);
+    sigaddset(&sa.sa_mask, SIGTERM);
+    for (int i = 0; i < 2; i++) {
+        struct sigaction old;
+        /* a signal ignored at startup stays ignored, as in frontdt */
+        if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler != SIG_IGN)
+            (void)sigaction(sigs[i], &sa, NULL);
+    }
+}
 
 typedef struct opts {
     const char *input, *output, *format;
@@ -34,7 +96,9 @@ typedef struct opts {
 static const char usage[] =
     "Usage: mpirun -np N frontdt-mpi [options] INPUT\n"
     "  The Delaunay tetrahedralization of INPUT (.xyz .txt .csv .node .ply),\n"
-    "  one part per MPI rank; every rank reads INPUT.\n"
+    "  one part per MPI rank; each rank reads its slice of a .xyz .txt .csv\n"
+    "  file or a binary .ply (other inputs: every rank reads them whole;\n"
+    "  standard input, -: rank 0 reads it and scatters the slices).\n"
     "  -o FILE             write the mesh, gathered to rank 0 (.tets .vtu .vtk\n"
     "                      .msh .mesh polyMesh; not .ele: no neighbours yet)\n"
     "  -o BASE.pvtu        one piece a rank, BASE_RANK.vtu, and the index BASE.pvtu\n"
@@ -70,35 +134,31 @@ static int is_pvtu(const char *path)
 }
 
 /* Writes this rank's piece: its tets (input numbering) over the points
- * they use, renumbered 0..k-1 in input order. FDT_OK or an error, diag. */
-static int write_piece(const char *name, const double *xyz, size_t n, const fdt_vid *tets,
-                       size_t nt, char *diag, size_t dlen)
+ * they use (ids: their input ids, ascending, xyz their coordinates; npts
+ * of them), renumbered 0..npts-1 in that order. FDT_OK or an error, diag. */
+static int write_piece(const char *name, const fdt_vid *ids, const double *xyz, size_t npts,
+                       const fdt_vid *tets, size_t nt, char *diag, size_t dlen)
 {
-    int32_t *map = malloc((n ? n : 1) * sizeof *map);
     fdt_vid *lt = malloc((4 * nt + 1) * sizeof *lt);
-    double *px = NULL;
     int err = FDT_ENOMEM;
-    if (!map || !lt)
+    if (!lt)
         goto done;
-    for (size_t i = 0; i < n; i++)
-        map[i] = -1;
-    for (size_t i = 0; i < 4 * nt; i++)
-        map[tets[i]] = 0;
-    size_t k = 0;
-    for (size_t i = 0; i < n; i++)
-        if (map[i] == 0)
-            map[i] = (int32_t)k++;
-    if (!(px = malloc((3 * k + 1) * sizeof *px)))
-        goto done;
-    for (size_t i = 0; i < n; i++)
-        if (map[i] >= 0)
-            memcpy(px + 3 * (size_t)map[i], xyz + 3 * i, 3 * sizeof *px);
-    for (size_t i = 0; i < 4 * nt; i++)
-        lt[i] = map[tets[i]];
+    for (size_t i = 0; i < 4 * nt; i++) {
+        /* ids is sorted and holds every id the tets use */
+        size_t lo = 0, hi = npts;
+        while (hi - lo > 1) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (ids[mid] <= tets[i])
+                lo = mid;
+            else
+                hi = mid;
+        }
+        lt[i] = (fdt_vid)lo;
+    }
     fdt_mesh_view v;
     memset(&v, 0, sizeof v);
-    v.xyz = px;
-    v.n_points = k;
+    v.xyz = xyz;
+    v.n_points = npts;
     v.tets = lt;
     v.n_tets = nt;
     err = fdt_wr_mesh_as(name, fdt_format_by_name("vtu"), &v, diag, dlen) == FDT_IO_OK
@@ -107,9 +167,7 @@ static int write_piece(const char *name, const double *xyz, size_t n, const fdt_
 done:
     if (err == FDT_ENOMEM)
         snprintf(diag, dlen, "out of memory writing a piece");
-    free(map);
     free(lt);
-    free(px);
     return err;
 }
 
@@ -292,6 +350,53 @@ static int exit_code(int err)
     }
 }
 
+/* The setup's errors (src/mpi_setup.h): the CLI's codes for the input. */
+static int setup_exit_code(int err)
+{
+    switch (err) {
+    case FDT_EINVAL:
+        return EX_USAGE;
+    case FDT_ENOMEM:
+    case FDT_ETOOBIG:
+        return EX_RESOURCES;
+    case FDT_EINTERNAL:
+        return EX_INTERNAL;
+    default: /* FDT_EIO, FDT_EFORMAT, FDT_EDEGENERATE */
+        return EX_INPUT;
+    }
+}
+
+/* The setup's phases on every rank (rank 0 prints; collective). */
+static void setup_stats(const fdt_mpi_local *L, int rank, int size, int print)
+{
+    double mine[FDT_MPI_T_END + 1];
+    memcpy(mine, L->t, sizeof L->t);
+    mine[FDT_MPI_T_END] = (double)L->bytes_sent;
+    double *all = rank == 0 ? malloc((size_t)size * sizeof mine) : NULL;
+    int ok = rank != 0 || all;
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!ok)
+        return;
+    MPI_Gather(mine, FDT_MPI_T_END + 1, MPI_DOUBLE, all, FDT_MPI_T_END + 1, MPI_DOUBLE, 0,
+               MPI_COMM_WORLD);
+    if (rank == 0 && print) {
+        fprintf(stderr, "  setup: %s; %zu points, %zu duplicates merged\n",
+                L->sliced == 1   ? "each rank read its slice of the file"
+                : L->sliced == 2 ? "each rank read its vertices of the binary PLY"
+                : L->sliced == 3 ? "rank 0 read standard input and scattered it"
+                                 : "every rank read the whole input (.node, ASCII PLY or PLY "
+                                   "with lists)",
+                L->n, L->ndup);
+        fprintf(stderr, "  rank    read s  exchange s   merge s   trees s   seeds s   bytes sent\n");
+        for (int q = 0; q < size; q++) {
+            const double *t = all + (size_t)q * (FDT_MPI_T_END + 1);
+            fprintf(stderr, "  %4d %9.3f %11.3f %9.3f %9.3f %9.3f %12.0f\n", q, t[0], t[1], t[2],
+                    t[3], t[4], t[5]);
+        }
+    }
+    free(all);
+}
+
 static void print_stats(const fdt_mpi_out *r, int size, double t_read)
 {
     fprintf(stderr, "frontdt-mpi: %d ranks\n  rank        tets", size);
@@ -320,7 +425,7 @@ static void print_stats(const fdt_mpi_out *r, int size, double t_read)
     for (int k = 1; k < FDT_MSG_KIND_END; k++)
         fprintf(stderr, "    %-15s %" PRIu64 " / %" PRIu64 "\n", fdt_msg_kind_name(k),
                 r->all_sent[k], r->all_received[k]);
-    fprintf(stderr, "  time (rank 0)     read %.3f s, setup %.3f s, front %.3f s, output %.3f s\n",
+    fprintf(stderr, "  time (rank 0)     setup %.3f s, run's setup %.3f s, front %.3f s, output %.3f s\n",
             t_read, r->t_setup, r->t_front, r->t_out);
 }
 
@@ -333,38 +438,27 @@ static int run(int argc, char **argv, int rank, int size)
         return rc;
     char diag[512] = "";
     double t0 = MPI_Wtime();
-    double *xyz = NULL;
-    size_t n = 0;
-    fdt_prepared pr;
-    memset(&pr, 0, sizeof pr);
+    fdt_mpi_local L;
+    memset(&L, 0, sizeof L);
     fdt_mpi_out r;
     memset(&r, 0, sizeof r);
     fdt_result *res = NULL;
-    /* Every rank reads the same file and prepares the same points; read
-     * and input errors are therefore the same on every rank (mpi_run.h)
-     * but for memory: the ranks agree on the worst exit code. */
-    int fail = 0;
-    int err = fdt_read_points(o.input, o.format, &xyz, &n, diag, sizeof diag);
-    if (err) {
-        fail = err == FDT_ENOMEM ? EX_RESOURCES : err == FDT_EINVAL ? EX_USAGE : EX_INPUT;
-    } else {
-        err = fdt_prepare(xyz, n, 1, &pr, diag, sizeof diag);
-        if (!err)
-            err = fdt_seed_check_dimension(pr.p, pr.orig, (uint32_t)pr.m, diag, sizeof diag);
-        if (err)
-            fail = err == FDT_ENOMEM || err == FDT_ETOOBIG ? EX_RESOURCES : EX_INPUT;
-    }
+    int pieces = o.output && is_pvtu(o.output);
+    /* The setup (src/mpi_setup.h) returns the same code on every rank,
+     * with the lowest failing rank's message. */
+    fdt_mpi_setup_opts so = {o.input, o.format, o.leaf, o.output && !pieces};
+    int err = fdt_mpi_setup(MPI_COMM_WORLD, &so, &L, diag, sizeof diag);
     double t_read = MPI_Wtime() - t0;
-    MPI_Allreduce(&fail, &rc, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-    if (rc) {
+    if (err) {
         if (rank == 0)
-            fprintf(stderr, "frontdt-mpi: %s\n", fail ? diag : "failed on another rank");
+            fprintf(stderr, "frontdt-mpi: %s\n", diag);
+        rc = setup_exit_code(err);
         goto out;
     }
-    int pieces = o.output && is_pvtu(o.output);
+    setup_stats(&L, rank, size, o.stats);
     fdt_mpi_opts mo = {o.leaf, FDT_SEARCH_AUTO, o.output && !pieces, pieces, o.fail_rank,
                        o.fail_after, o.no_park};
-    err = fdt_mpi_run(MPI_COMM_WORLD, &pr, &mo, &r, diag, sizeof diag);
+    err = fdt_mpi_run(MPI_COMM_WORLD, &L, &mo, &r, diag, sizeof diag);
     if (err) {
         if (rank == 0)
             fprintf(stderr, "frontdt-mpi: %s (%s)\n", diag, fdt_strerror(err));
@@ -387,7 +481,7 @@ static int run(int argc, char **argv, int rank, int size)
             print_stats(&r, size, t_read);
         if (!o.quiet)
             fprintf(stderr, "frontdt-mpi: %zu points, %zu vertices, %" PRIu64 " tets on %d ranks\n",
-                    n, pr.m, r.hash.count, size);
+                    L.n, L.m, r.hash.count, size);
         if (o.set_hash)
             printf("set-hash: %016" PRIx64 "\n", fdt_sethash_value(&r.hash));
         if (!rc && o.output && !pieces) {
@@ -401,13 +495,14 @@ static int run(int argc, char **argv, int rank, int size)
                 res->ntets = r.ntets;
                 res->hull = r.all_hull;
                 res->nhull = r.nhull;
-                res->dupmap = pr.dupmap;
-                res->n = n;
-                res->ndup = pr.ndup;
+                res->dupmap = r.all_dupmap;
+                res->n = r.n_input;
+                res->ndup = r.ndup;
                 r.all_tets = NULL;
                 r.all_hull = NULL;
-                pr.dupmap = NULL;
-                err = fdt_write_mesh(res, xyz, n, o.output, NULL, diag, sizeof diag);
+                r.all_dupmap = NULL;
+                err = fdt_write_mesh(res, r.all_xyz, r.n_input, o.output, NULL, diag,
+                                     sizeof diag);
                 if (err) {
                     fprintf(stderr, "frontdt-mpi: %s\n", diag);
                     rc = err == FDT_ENOMEM ? EX_RESOURCES : EX_WRITE;
@@ -423,8 +518,15 @@ static int run(int argc, char **argv, int rank, int size)
          * every piece is removed again: all or nothing. */
         char name[FDT_IO_PATH];
         const char *rel;
-        int perr = piece_name(o.output, rank, name, sizeof name, &rel) != 0 ? FDT_EIO
-                   : write_piece(name, xyz, n, r.own_tets, r.own_ntets, diag, sizeof diag);
+        int perr = piece_name(o.output, rank, name, sizeof name, &rel) != 0 ? FDT_EIO : FDT_OK;
+        if (!perr) {
+            /* from here an interrupt removes the piece (on_signal) */
+            memcpy(piece_path, name, sizeof piece_path);
+            snprintf(index_path, sizeof index_path, "%s", o.output);
+            piece_live = 1;
+            perr = write_piece(name, r.own_ids, r.own_xyz, r.own_npts, r.own_tets, r.own_ntets,
+                               diag, sizeof diag);
+        }
         if (perr)
             fprintf(stderr, "frontdt-mpi: rank %d: %s\n", rank, diag);
         int bad = perr == FDT_ENOMEM ? EX_RESOURCES : perr ? EX_WRITE : 0, worst = 0;
@@ -436,13 +538,16 @@ static int run(int argc, char **argv, int rank, int size)
         MPI_Bcast(&worst, 1, MPI_INT, 0, MPI_COMM_WORLD);
         if (worst && !perr)
             (void)remove(name);
+        /* complete (the index is there) or removed, on every rank: nothing
+         * to undo */
+        MPI_Barrier(MPI_COMM_WORLD);
+        piece_live = 0;
         rc = worst;
     }
 out:
     fdt_result_free(&res);
     fdt_mpi_out_free(&r);
-    fdt_prepared_free(&pr);
-    fdt_free(xyz);
+    fdt_mpi_local_free(&L);
     return rc;
 }
 
@@ -455,6 +560,7 @@ int main(int argc, char **argv)
     int rank = 0, size = 1;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
+    install_signals();
     int rc = run(argc, argv, rank, size);
     MPI_Finalize();
     return rc;

@@ -28,6 +28,7 @@
 #include "mpi_run.h"
 
 #include <limits.h>
+#include <math.h>
 #include <stdalign.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -40,6 +41,12 @@
 #include "termination.h"
 #include "transport_mpi.h"
 
+/* A point in the translation and gathers: coordinates and an id. */
+typedef struct xrec {
+    double x[3];
+    uint64_t id;
+} xrec;
+
 static const char *err_what(int err)
 {
     return err == FDT_ENOMEM ? "out of memory" : "inconsistent front";
@@ -47,6 +54,14 @@ static const char *err_what(int err)
 
 void fdt_mpi_out_free(fdt_mpi_out *out)
 {
+    free(out->own_ids);
+    free(out->own_xyz);
+    free(out->all_xyz);
+    free(out->all_dupmap);
+    out->own_ids = NULL;
+    out->own_xyz = NULL;
+    out->all_xyz = NULL;
+    out->all_dupmap = NULL;
     free(out->rank_counts);
     free(out->rank_tets);
     free(out->rank_times);
@@ -132,7 +147,176 @@ static int first_error(MPI_Comm comm, int size, int myerr, const char *phase, in
     return err;
 }
 
-int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_out *out,
+static int u32_cmp(const void *x, const void *y)
+{
+    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
+    return a < b ? -1 : a > b;
+}
+
+static int xrec_cmp(const void *x, const void *y)
+{
+    const xrec *a = x, *b = y;
+    return a->id < b->id ? -1 : a->id > b->id;
+}
+
+/*
+ * Input numbering for cnt global ids src, into dst (collective). A rank
+ * knows the input ids of its own points only; those of the other ranks'
+ * points its tets use (their vertices across the cuts) it asks their
+ * owners for, one MPI_Alltoallv each way, which also brings their
+ * coordinates as read. used (may be NULL): every distinct point src uses,
+ * by input id ascending, with those coordinates (*nused of them), for a
+ * piece of the output.
+ */
+static int translate(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L, const uint32_t *src,
+                     size_t cnt, fdt_vid *dst, xrec **used, size_t *nused, uint64_t *bytes,
+                     char *diag, size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    uint32_t lo = L->lo, hi = L->lo + (uint32_t)L->nloc;
+    size_t nf = 0;
+    for (size_t i = 0; i < cnt; i++)
+        nf += src[i] < lo || src[i] >= hi;
+    uint32_t *F = malloc((nf + 1) * sizeof *F), *Q = NULL;
+    int *c = malloc(4 * (size_t)size * sizeof *c);
+    xrec *ans = NULL, *got = NULL;
+    unsigned char *mark = used ? calloc(L->nloc + 1, 1) : NULL;
+    int err = F && c && (!used || mark) ? FDT_OK : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory translating ids to input numbering");
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+        goto done;
+    nf = 0;
+    for (size_t i = 0; i < cnt; i++)
+        if (src[i] < lo || src[i] >= hi)
+            F[nf++] = src[i];
+        else if (mark)
+            mark[src[i] - lo] = 1;
+    qsort(F, nf, sizeof *F, u32_cmp);
+    size_t k = 0;
+    for (size_t i = 0; i < nf; i++)
+        if (i == 0 || F[i] != F[k - 1])
+            F[k++] = F[i];
+    nf = k;
+    /* sorted ids group by owner, owners in rank order */
+    int *sc = c, *sd = c + size, *rc = c + 2 * size, *rd = c + 3 * size;
+    for (int q = 0; q < size; q++)
+        sc[q] = 0;
+    for (size_t i = 0; i < nf; i++)
+        sc[fdt_partition_owner(&L->pt, F[i])]++;
+    MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, comm);
+    size_t nq = 0;
+    for (int q = 0, at = 0; q < size; q++) {
+        sd[q] = at;
+        at += sc[q];
+        rd[q] = (int)nq;
+        nq += (size_t)rc[q];
+        if (q != rank)
+            *bytes += (uint64_t)sc[q] * sizeof(uint32_t);
+    }
+    Q = malloc((nq + 1) * sizeof *Q);
+    ans = malloc((nq + 1) * sizeof *ans);
+    got = malloc((nf + 1) * sizeof *got);
+    err = Q && ans && got ? FDT_OK : FDT_ENOMEM;
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+        goto done;
+    MPI_Alltoallv(F, sc, sd, MPI_UINT32_T, Q, rc, rd, MPI_UINT32_T, comm);
+    for (size_t i = 0; i < nq; i++) {
+        uint32_t j = Q[i] - lo; /* ours: every asker asked its owner */
+        for (int d = 0; d < 3; d++)
+            ans[i].x[d] = ldexp(L->p[3 * (size_t)j + d], -L->scale_exp); /* exact */
+        ans[i].id = L->orig[j];
+        *bytes += sizeof(xrec);
+    }
+    MPI_Alltoallv(ans, rc, rd, xt, got, sc, sd, xt, comm);
+    for (size_t i = 0; i < cnt; i++) {
+        uint32_t g = src[i];
+        if (g >= lo && g < hi) {
+            dst[i] = L->orig[g - lo];
+        } else {
+            uint32_t *at = bsearch(&g, F, nf, sizeof *F, u32_cmp);
+            dst[i] = (fdt_vid)got[at - F].id;
+        }
+    }
+    if (used) {
+        size_t nu = nf;
+        for (size_t i = 0; i < L->nloc; i++)
+            nu += mark[i];
+        xrec *u = malloc((nu + 1) * sizeof *u);
+        err = u ? FDT_OK : FDT_ENOMEM;
+        if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+            goto done;
+        size_t j = 0;
+        for (size_t i = 0; i < L->nloc; i++)
+            if (mark[i]) {
+                for (int d = 0; d < 3; d++)
+                    u[j].x[d] = ldexp(L->p[3 * i + d], -L->scale_exp);
+                u[j++].id = L->orig[i];
+            }
+        memcpy(u + j, got, nf * sizeof *u);
+        qsort(u, nu, sizeof *u, xrec_cmp);
+        *used = u;
+        *nused = nu;
+    }
+done:
+    free(F);
+    free(Q);
+    free(c);
+    free(ans);
+    free(got);
+    free(mark);
+    return err;
+}
+
+/* Every input point's coordinates and vertex to rank 0 (collective). */
+static int gather_points(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L, fdt_mpi_out *out,
+                         char *diag, size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    xrec *mine = malloc((L->nin + 1) * sizeof *mine), *all = NULL;
+    int *cnt = rank == 0 ? malloc(2 * (size_t)size * sizeof *cnt) : NULL;
+    if (rank == 0) {
+        all = malloc((L->n + 1) * sizeof *all);
+        out->all_xyz = malloc((3 * L->n + 1) * sizeof *out->all_xyz);
+        out->all_dupmap = malloc((L->n + 1) * sizeof *out->all_dupmap);
+    }
+    int err = mine && (rank != 0 || (cnt && all && out->all_xyz && out->all_dupmap)) ? FDT_OK
+                                                                                   : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory gathering the points to rank 0");
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) == FDT_OK) {
+        for (size_t i = 0; i < L->nin; i++) {
+            memcpy(mine[i].x, L->in_xyz + 3 * i, sizeof mine[i].x);
+            mine[i].id = (uint64_t)(uint32_t)L->in_id[i] | (uint64_t)(uint32_t)L->in_vertex[i] << 32;
+        }
+        int myn = (int)L->nin;
+        MPI_Gather(&myn, 1, MPI_INT, cnt, 1, MPI_INT, 0, comm);
+        if (rank == 0)
+            for (int q = 0, at = 0; q < size; q++) {
+                cnt[size + q] = at;
+                at += cnt[q];
+            }
+        MPI_Gatherv(mine, myn, xt, all, cnt, cnt ? cnt + size : NULL, xt, 0, comm);
+        if (rank == 0) {
+            for (size_t i = 0; i < L->n; i++) {
+                uint32_t id = (uint32_t)all[i].id;
+                memcpy(out->all_xyz + 3 * (size_t)id, all[i].x, sizeof all[i].x);
+                out->all_dupmap[id] = (fdt_vid)(uint32_t)(all[i].id >> 32);
+            }
+            out->n_input = L->n;
+            out->ndup = L->ndup;
+        }
+        diag[0] = '\0';
+    }
+    free(mine);
+    free(all);
+    free(cnt);
+    return err;
+}
+
+int fdt_mpi_run(MPI_Comm comm, fdt_mpi_local *L, const fdt_mpi_opts *o, fdt_mpi_out *out,
                 char *diag, size_t dlen)
 {
     memset(out, 0, sizeof *out);
@@ -141,41 +325,35 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     MPI_Comm_rank(comm, &rank);
     MPI_Comm_size(comm, &size);
     double t0 = fdt_now_s();
-    fdt_partition pt;
-    memset(&pt, 0, sizeof pt);
+    fdt_partition *pt = &L->pt;
     engine *e = NULL;
-    uint32_t(*seeds)[4] = NULL;
-    int nseeds = 0;
-    fdt_kdq kq0;
-    memset(&kq0, 0, sizeof kq0);
     fdt_vid *mine = NULL;
+    MPI_Datatype xt;
+    MPI_Type_contiguous((int)sizeof(xrec), MPI_BYTE, &xt);
+    MPI_Type_commit(&xt);
+    /* This rank's points by global id (mpi_setup.c: it holds ids [lo, lo
+     * + nloc) only, and nothing reads another id of P or orig). */
+    double *P = L->p - 3 * (size_t)L->lo;
+    fdt_vid *orig = L->orig - L->lo;
     /* The rank's tets stay in its meshbuf (tree-order ids) for the output
      * below: the in-memory sink (src/sink.h). */
     fdt_tsink mem_sink;
     int mem_sink_ok = 0;
     int err = FDT_OK;
-    if (size > FDT_PARTITION_MAX || size > FDT_MAILBOX_MAX_THREADS || pr->m < 4 ||
-        pr->m > UINT32_MAX - 1)
+    if (size > FDT_PARTITION_MAX || size > FDT_MAILBOX_MAX_THREADS || L->m < 4 ||
+        L->m > UINT32_MAX - 1)
         err = FDT_EINVAL;
-    /* The setup is deterministic (the same points, the same partition,
-     * trees and seeds on every rank: mpi_run.h), so it fails alike on every
-     * rank but for memory; its errors join the run's below. */
-    if (!err)
-        err = fdt_partition_build(&pt, pr->p, pr->orig, (uint32_t)pr->m, size,
-                                  o->leaf_size > 0 ? o->leaf_size : FDT_DEFAULT_LEAF, 1);
-    if (!err)
-        err = fdt_par_make_seeds(&pt, &seeds, &nseeds, &kq0);
     if (!err) {
-        err = fdt_tsink_init(&mem_sink, pr->orig, NULL);
+        err = fdt_tsink_init(&mem_sink, orig, NULL);
         mem_sink_ok = err == FDT_OK;
     }
     if (!err && !(e = fdt_eng_new(size)))
         err = FDT_ENOMEM;
     worker *w = NULL;
     if (!err) {
-        e->pt = &pt;
-        e->P = pr->p;
-        e->orig = pr->orig;
+        e->pt = pt;
+        e->P = P;
+        e->orig = orig;
         e->sink = &mem_sink;
         e->mode = FDT_MODE_MESSAGE;
         e->search = o->search;
@@ -187,9 +365,9 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
             worker *x = &e->w[i];
             x->e = e;
             x->id = i;
-            x->tree = &pt.trees[i];
-            x->lo = pt.start[i];
-            x->hi = pt.start[i + 1];
+            x->tree = &pt->trees[i];
+            x->lo = pt->start[i];
+            x->hi = pt->start[i + 1];
             x->parent = -1;
             x->aborted_by = -1;
         }
@@ -198,29 +376,31 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
         w->st.core = -1;
         w->report_at = 4096;
         /* Our seeds (owner: the part of the lowest id), their foreign
-         * vertices delivered with them as a FACESEND would carry them. Every
-         * part holding a seed is a root of Dijkstra-Scholten
+         * vertices delivered with them as a FACESEND would carry them
+         * (mpi_setup.c found every seed with its coordinates). Every part
+         * holding a seed is a root of Dijkstra-Scholten
          * (src/termination.c); every rank counts the roots alike. */
-        w->seeds = malloc(((size_t)nseeds + 1) * sizeof *w->seeds);
+        w->seeds = malloc(((size_t)L->nseeds + 1) * sizeof *w->seeds);
         if (!w->seeds)
             err = FDT_ENOMEM;
         int *has = calloc((size_t)size, sizeof *has);
         if (!has)
             err = FDT_ENOMEM;
-        for (int i = 0; !err && i < nseeds; i++) {
-            uint32_t lo = seeds[i][0];
+        for (int i = 0; !err && i < L->nseeds; i++) {
+            const uint32_t *sd = L->seeds[i];
+            uint32_t lo = sd[0];
             for (int k = 1; k < 4; k++)
-                if (seeds[i][k] < lo)
-                    lo = seeds[i][k];
-            int own = fdt_partition_owner(&pt, lo);
+                if (sd[k] < lo)
+                    lo = sd[k];
+            int own = fdt_partition_owner(pt, lo);
             if (!has[own]++)
                 e->roots++;
             if (own != rank)
                 continue;
-            memcpy(w->seeds[w->nseeds++], seeds[i], sizeof seeds[i]);
+            memcpy(w->seeds[w->nseeds++], sd, sizeof w->seeds[0]);
             for (int k = 0; k < 4; k++)
-                if (!is_own(w, seeds[i][k]) &&
-                    fdt_ghost_put(&w->ghosts, seeds[i][k], pr->p + 3 * (size_t)seeds[i][k]))
+                if (!is_own(w, sd[k]) &&
+                    fdt_ghost_put(&w->ghosts, sd[k], L->seed_xyz[i] + 3 * k))
                     err = FDT_ENOMEM;
         }
         free(has);
@@ -279,7 +459,8 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     }
     MPI_Gather(both, 2 * FDT_MSG_KIND_END, MPI_UINT64_T, out->rank_counts,
                2 * FDT_MSG_KIND_END, MPI_UINT64_T, 0, comm);
-    /* Where each rank's front time went (--stats): the wait timers of
+    /* Where each rank's time went (--stats): the setup's phases
+     * (src/mpi_setup.h), then the front: the wait timers of
      * src/protocol.c (t_idle: nothing to do; t_query_wait: blocked on
      * answers) beside its CPU time. */
     double tm[FDT_MPI_NTIMES] = {t2 - t1, c2 - c1, w->st.t_idle, w->st.t_query_wait,
@@ -291,7 +472,7 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
         MPI_Abort(comm, 4);
     MPI_Gather(&nt, 1, MPI_UINT64_T, rt, 1, MPI_UINT64_T, 0, comm);
     if (rank == 0) {
-        for (int r = 0; r < size; r++)
+        for (size_t r = 0; r < (size_t)size; r++)
             out->rank_tets[r] = (size_t)rt[r];
         free(rt);
     }
@@ -299,9 +480,8 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     MPI_Reduce(mc.received, out->all_received, FDT_MSG_KIND_END, MPI_UINT64_T, MPI_SUM, 0,
                comm);
 
-    /* Our tets in input numbering (pr->orig, permuted with the points):
-     * the set hash, whose partial sums add over ranks (src/sethash.h), and
-     * the gather. */
+    /* Our tets in input numbering: the set hash, whose partial sums add
+     * over ranks (src/sethash.h), and the outputs. */
     size_t n4 = 4 * w->out.ntets, n3 = 3 * w->out.nhull;
     mine = malloc((n4 > n3 ? n4 : n3) * sizeof *mine + 1);
     int merr = mine ? FDT_OK : FDT_ENOMEM, any = 0;
@@ -311,7 +491,13 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
         snprintf(diag, dlen, "out of memory renumbering the tets");
         goto done;
     }
-    fdt_sink_renumber(pr->orig, mine, w->out.tets, n4);
+    xrec *used = NULL;
+    size_t nused = 0;
+    int pieces = o->keep_own && !o->gather;
+    err = translate(comm, xt, L, w->out.tets, n4, mine, pieces ? &used : NULL, &nused,
+                    &out->bytes_out, diag, dlen);
+    if (err)
+        goto done;
     fdt_sethash h = {0, 0};
     fdt_sethash_add_n(&h, (const uint32_t *)mine, w->out.ntets);
     uint64_t hv[2] = {h.sum, h.count}, hs[2] = {0, 0};
@@ -319,20 +505,34 @@ int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_
     MPI_Reduce(hv, hs, 2, MPI_UINT64_T, MPI_SUM, 0, comm);
     out->hash.sum = hs[0];
     out->hash.count = hs[1];
-    if (o->keep_own && !o->gather) {
+    if (pieces) {
         out->own_tets = mine;
         out->own_ntets = w->out.ntets;
         mine = NULL;
+        out->own_ids = malloc((nused + 1) * sizeof *out->own_ids);
+        out->own_xyz = malloc((3 * nused + 1) * sizeof *out->own_xyz);
+        err = out->own_ids && out->own_xyz ? FDT_OK : FDT_ENOMEM;
+        for (size_t i = 0; !err && i < nused; i++) {
+            out->own_ids[i] = (fdt_vid)used[i].id;
+            memcpy(out->own_xyz + 3 * i, used[i].x, sizeof used[i].x);
+        }
+        out->own_npts = nused;
+        free(used);
+        snprintf(diag, dlen, "out of memory for this rank's piece");
+        err = fdt_mpi_agree(comm, err, diag, dlen);
     } else if (o->gather) {
         err = gather_ids(comm, rank, size, mine, w->out.ntets, 4, &out->all_tets, &out->ntets);
-        if (!err) {
-            fdt_sink_renumber(pr->orig, mine, w->out.hull, n3);
+        if (!err)
+            err = translate(comm, xt, L, w->out.hull, n3, mine, NULL, NULL, &out->bytes_out,
+                            diag, dlen);
+        if (!err)
             err = gather_ids(comm, rank, size, mine, w->out.nhull, 3, &out->all_hull,
                              &out->nhull);
-        }
         if (err)
             snprintf(diag, dlen, "%s gathering the mesh to rank 0",
                      err == FDT_ETOOBIG ? "too many tets (MPI int counts)" : "out of memory");
+        if (!err)
+            err = gather_points(comm, xt, L, out, diag, dlen);
     }
 done:
     out->t_setup = t1 - t0;
@@ -350,8 +550,7 @@ done:
     fdt_transport_destroy(&tp);
     if (mem_sink_ok)
         fdt_tsink_free(&mem_sink);
-    free(seeds);
-    fdt_partition_free(&pt);
+    MPI_Type_free(&xt);
     if (err)
         fdt_mpi_out_free(out);
     return err;

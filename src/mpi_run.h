@@ -4,15 +4,13 @@
  * other ranks of the communicator, nothing shared but messages (the MPI
  * transport, src/transport_mpi.c). Built only with MPI.
  *
- * Setup, first stage: every rank holds the whole prepared input and
- * computes the same deterministic partition (coordinate bisection, one part
- * per rank), the same kd-trees and the same seeds (src/parallel.c's
- * fdt_par_make_seeds), but triangulates only its own part: its search reads
- * its own points alone, and other parts' points reach it only in
- * NODESEND/NODERECV/FACESEND payloads, exactly as message mode between
- * threads. The setup of §3.1 (each rank reading a slice, bisection by
- * exchanging points between rank pairs, seeds without a global tree) is
- * the next stage; only the setup changes then, not the run.
+ * Setup: src/mpi_setup.c (§3.1): each rank holds its own part alone (its
+ * points, ids [lo, lo + nloc) in partition order, its kd-tree), the
+ * bisection's boxes and every seed, and triangulates only its own part:
+ * other parts' points reach it only in NODESEND/NODERECV/FACESEND
+ * payloads, exactly as message mode between threads. After the run a
+ * rank translates its tets' ids to input numbering by asking the owners
+ * of their foreign vertices (translate() in mpi_run.c).
  */
 #ifndef FDT_MPI_RUN_H
 #define FDT_MPI_RUN_H
@@ -22,7 +20,7 @@
 #include <stdint.h>
 
 #include "frontdt.h"
-#include "prepare.h"
+#include "mpi_setup.h"
 #include "sethash.h"
 
 typedef struct fdt_mpi_opts {
@@ -50,6 +48,12 @@ typedef struct fdt_mpi_out {
     double t_setup, t_front, t_out; /* seconds, this rank */
     fdt_vid *own_tets;     /* keep_own: 4 per tet, input numbering (owned) */
     size_t own_ntets;
+    fdt_vid *own_ids;      /* keep_own: the input ids of the points those
+                              tets use, ascending (owned) */
+    double *own_xyz;       /* keep_own: their coordinates as read, 3 each
+                              (owned) */
+    size_t own_npts;
+    uint64_t bytes_out;    /* bytes this rank sent translating ids */
     /* On rank 0 only (reduced over the ranks): */
     fdt_sethash hash;
     uint64_t all_sent[FDT_MSG_KIND_END], all_received[FDT_MSG_KIND_END];
@@ -64,17 +68,21 @@ typedef struct fdt_mpi_out {
     size_t ntets;
     fdt_vid *all_hull;     /* gather: 3 per hull face, outward (owned) */
     size_t nhull;
+    double *all_xyz;       /* gather: every input point as read, 3 each
+                              (owned) */
+    fdt_vid *all_dupmap;   /* gather: each input point's vertex (owned) */
+    size_t n_input, ndup;
 } fdt_mpi_out;
 
 /*
- * Triangulates pr (the same prepared points on every rank; permuted in
- * place into partition order) with one part per rank of comm. Collective:
- * every rank calls it and every rank returns the same code: FDT_OK, or the
- * failing rank's error (FDT_ENOMEM, FDT_EINTERNAL, FDT_ETOOBIG for a gather
- * beyond MPI's int counts), with diag saying which rank and why. On
- * failure out holds nothing and no rank has output.
+ * Triangulates the points of the ranks of comm, each rank's part being
+ * its L (src/mpi_setup.h; its tree's arrays are read, not changed).
+ * Collective: every rank calls it and every rank returns the same code:
+ * FDT_OK, or the failing rank's error (FDT_ENOMEM, FDT_EINTERNAL,
+ * FDT_ETOOBIG for a gather beyond MPI's int counts), with diag saying
+ * which rank and why. On failure out holds nothing and no rank has output.
  */
-int fdt_mpi_run(MPI_Comm comm, fdt_prepared *pr, const fdt_mpi_opts *o, fdt_mpi_out *out,
+int fdt_mpi_run(MPI_Comm comm, fdt_mpi_local *L, const fdt_mpi_opts *o, fdt_mpi_out *out,
                 char *diag, size_t dlen);
 void fdt_mpi_out_free(fdt_mpi_out *out);
 

@@ -300,3 +300,30 @@ int fdt_partition_global_tree(const fdt_partition *pt, fdt_kdtree *out)
     compose(pt, 0, out, 0);
     return FDT_OK;
 }
+
+/* ---- a distributed partition (src/mpi_setup.c) --------------------------- */
+
+uint32_t fdt_partition_work_shift(const fdt_pnode *nd, uint32_t nleft, uint64_t count, double w,
+                                  int a)
+{
+    return work_shift(nd, nleft, count, w, a);
+}
+
+int fdt_partition_build_own(fdt_partition *pt, double *P, fdt_vid *orig, int part, int leaf_size)
+{
+    double(*region)[2][3] = malloc((size_t)pt->nparts * sizeof *region);
+    if (!region)
+        return FDT_ENOMEM;
+    const double all_lo[3] = {-INFINITY, -INFINITY, -INFINITY};
+    const double all_hi[3] = {INFINITY, INFINITY, INFINITY};
+    regions(pt, 0, all_lo, all_hi, region);
+    int err = FDT_OK;
+    uint32_t n = pt->start[part + 1] - pt->start[part];
+    if (n > 0) {
+        err = fdt_kd_build(&pt->trees[part], P, orig, pt->start[part], n, leaf_size);
+        if (!err)
+            fdt_kd_set_region(&pt->trees[part], region[part][0], region[part][1]);
+    }
+    free(region);
+    return err;
+}

@@ -66,4 +66,21 @@ int fdt_partition_owner(const fdt_partition *pt, uint32_t id);
  */
 int fdt_partition_global_tree(const fdt_partition *pt, fdt_kdtree *out);
 
+/*
+ * For a partition made elsewhere (src/mpi_setup.c: the bisection by
+ * exchange between MPI ranks, each holding one part): the points the
+ * bisection moves from the left side of a cut to the right for the tets
+ * across it (node nd's box, nleft of its count points on the left, w its
+ * extent on the cut's axis, a parts on the left), as fdt_partition_build
+ * does; and, once start, nodes and nnodes are filled as
+ * fdt_partition_build fills them and trees is nparts zeroed trees, the
+ * kd-tree of part `part` alone, with its region, over ids [start[part],
+ * start[part + 1]) of P and orig (indexed by global id). FDT_OK or
+ * FDT_ENOMEM.
+ */
+uint32_t fdt_partition_work_shift(const fdt_pnode *nd, uint32_t nleft, uint64_t count, double w,
+                                  int a);
+int fdt_partition_build_own(fdt_partition *pt, double *P, fdt_vid *orig, int part,
+                            int leaf_size);
+
 #endif

@@ -406,3 +406,8 @@ int fdt_prepare_inplace(double *xyz, size_t n, fdt_prepared *pr, char *diag, siz
 {
     return prepare_any(xyz, xyz, n, 1, pr, diag, dlen);
 }
+
+int fdt_prepare_scale_exp(double maxabs, double minabs)
+{
+    return choose_scale(maxabs, minabs);
+}

@@ -39,5 +39,10 @@ int fdt_prepare(const double *xyz, size_t n, int threads, fdt_prepared *pr, char
  * is unchanged. */
 int fdt_prepare_inplace(double *xyz, size_t n, fdt_prepared *pr, char *diag, size_t dlen);
 void fdt_prepared_free(fdt_prepared *pr);
+/* The scale exponent fdt_prepare chooses for points whose largest |x| is
+ * maxabs and smallest nonzero |x| minabs (INFINITY: none), for callers
+ * that see the points in pieces (src/mpi_setup.c: each MPI rank its own,
+ * the extremes reduced over the ranks). */
+int fdt_prepare_scale_exp(double maxabs, double minabs);
 
 #endif

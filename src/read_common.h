@@ -57,6 +57,9 @@ typedef struct rd_src {
     size_t mem_len;
     size_t pos;        /* bytes delivered so far */
     int eof;           /* a read found the end */
+    int bounded;       /* fd: deliver no more than `left` bytes (a range
+                          of a file, fdt_rd_text_range) */
+    size_t left;
 } rd_src;
 
 typedef struct rd_ctx {
@@ -176,6 +179,14 @@ size_t fdt_rd_count_rest(rd_fields *f);
  * PLY is loaded whole into *owned (freed by the caller, c->buf points to
  * it) and parsed there. */
 int fdt_rd_stream_xyz(rd_ctx *c, rd_points *pb);
+/* A range of a text point file (fdt_rd_text_range): its lines are point
+ * lines of ncols fields, the first numbered line0 + 1; *lines: the line
+ * ends it read (may be NULL). */
+int fdt_rd_stream_xyz_range(rd_ctx *c, rd_points *pb, size_t ncols, size_t line0, size_t *lines);
+/* The head of a text point file in buf[0, len) (eof: the file ends there):
+ * 1 when it is enough to tell fdt_rd_text_head's answers, set in *h; 0
+ * when more bytes are needed. */
+int fdt_rd_xyz_head(const char *buf, size_t len, int eof, fdt_rd_head *h);
 int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned);
 int fdt_rd_read_node(const rd_ctx *c, const char *start, rd_points *pb);
 

@@ -12,11 +12,19 @@
 
 #include "read_common.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#ifndef O_CLOEXEC
+#define O_CLOEXEC 0
+#endif
 
 _Static_assert(sizeof(float) == 4 && sizeof(double) == 8,
                "binary PLY decoding assumes IEEE binary32/binary64");
@@ -1111,4 +1119,164 @@ int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned)
     ply_hdr_free(&h);
     free(hb);
     return rc;
+}
+
+/* ------------------------------------------------------------------ */
+/* Binary PLY slices (src/reader.h; src/mpi_setup.c)                  */
+/* ------------------------------------------------------------------ */
+
+int fdt_rd_ply_find_layout(const char *path, fdt_rd_ply_layout *lay, char *err, size_t errlen)
+{
+    rd_ctx c;
+    memset(&c, 0, sizeof c);
+    c.path = path;
+    c.err = err;
+    c.errlen = errlen;
+    memset(lay, 0, sizeof *lay);
+    int fd;
+    do
+        fd = open(path, O_RDONLY | O_CLOEXEC);
+    while (fd < 0 && errno == EINTR);
+    if (fd < 0)
+        return fdt_rd_fail(&c, FDT_IO_EOPEN, ": cannot open: %s", strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        return 0; /* the whole read says what it is */
+    }
+    uint64_t size = (uint64_t)st.st_size;
+    rd_src src = {fd, NULL, 0, 0, 0, 0, 0};
+    c.src = &src;
+    size_t cap = (size_t)64 << 10, len = 0;
+    char *hb = NULL;
+    ply_hdr h;
+    memset(&h, 0, sizeof h);
+    int rc = 0, parsed = 0;
+    /* the header's complete lines, read until one is end_header (as
+     * fdt_rd_stream_ply); any failure: not sliceable, the whole read
+     * words it */
+    for (;;) {
+        char *nb = realloc(hb, cap + 1);
+        if (nb == NULL) {
+            rc = fdt_rd_fail(&c, FDT_IO_ENOMEM, ": out of memory");
+            break;
+        }
+        hb = nb;
+        ptrdiff_t r = fdt_rd_src_read(&c, hb + len, cap - len);
+        if (r < 0) {
+            rc = FDT_IO_EOPEN;
+            break;
+        }
+        len += (size_t)r;
+        hb[len] = '\0';
+        size_t lines = len;
+        if (!src.eof)
+            while (lines > 0 && hb[lines - 1] != '\n')
+                lines--;
+        rd_ctx hc = c;
+        hc.buf = hb;
+        hc.size = lines;
+        hc.err = NULL;
+        hc.errlen = 0;
+        ply_hdr_free(&h);
+        memset(&h, 0, sizeof h);
+        int pr = len == 0 ? FDT_IO_EFORMAT : ply_parse_header(&hc, &h);
+        if (pr == FDT_IO_OK) {
+            parsed = 1;
+            break;
+        }
+        if (src.eof || !h.no_end || cap > (SIZE_MAX - 1) / 2)
+            break;
+        cap *= 2;
+    }
+    close(fd);
+    if (parsed && (h.format == PLY_LE || h.format == PLY_BE) && h.vertex != SIZE_MAX) {
+        /* every element of fixed size, and the file exactly as long as
+         * the header says: then vertex i is at a known byte */
+        uint64_t at = h.data_off, vat = 0;
+        int ok = 1;
+        for (size_t ei = 0; ei < h.n_elems && ok; ei++) {
+            const ply_elem *el = &h.elems[ei];
+            if (el->has_list || (el->min_bytes && el->count > (UINT64_MAX - at) / el->min_bytes))
+                ok = 0;
+            else {
+                if (ei == h.vertex)
+                    vat = at;
+                at += el->count * el->min_bytes;
+            }
+        }
+        const ply_elem *v = &h.elems[h.vertex];
+        if (ok && at == size && v->count <= RD_MAX_POINTS && v->min_bytes > 0) {
+            lay->vertex_off = (size_t)vat;
+            lay->rec = v->min_bytes;
+            lay->count = v->count;
+            lay->big = h.format == PLY_BE;
+            for (size_t j = 0, o = 0; j < v->n_props; j++) {
+                const ply_prop *p = &h.props[v->first_prop + j];
+                if (p->role) {
+                    lay->type[p->role - 1] = p->type;
+                    lay->off[p->role - 1] = o;
+                }
+                o += ply_size[p->type];
+            }
+            rc = 1;
+        }
+    }
+    ply_hdr_free(&h);
+    free(hb);
+    return rc;
+}
+
+int fdt_rd_ply_range(const char *path, const fdt_rd_ply_layout *lay, unsigned long long first,
+                     size_t count, double **xyz, char *err, size_t errlen)
+{
+    rd_ctx c;
+    memset(&c, 0, sizeof c);
+    c.path = path;
+    c.err = err;
+    c.errlen = errlen;
+    *xyz = NULL;
+    if (first > lay->count || count > lay->count - first)
+        return fdt_rd_fail(&c, FDT_IO_EFORMAT, ": vertices beyond the header's count");
+    int fd;
+    do
+        fd = open(path, O_RDONLY | O_CLOEXEC);
+    while (fd < 0 && errno == EINTR);
+    if (fd < 0)
+        return fdt_rd_fail(&c, FDT_IO_EOPEN, ": cannot open: %s", strerror(errno));
+    double *d = malloc((3 * count + 1) * sizeof *d);
+    size_t per = RD_CHUNK / lay->rec + 1;
+    unsigned char *buf = malloc(per * lay->rec);
+    int rc = d && buf ? FDT_IO_OK : fdt_rd_fail(&c, FDT_IO_ENOMEM, ": out of memory");
+    for (size_t i = 0; rc == FDT_IO_OK && i < count; i += per) {
+        size_t k = count - i < per ? count - i : per, want = k * lay->rec, got = 0;
+        size_t off = lay->vertex_off + (size_t)(first + i) * lay->rec;
+        while (got < want) {
+            ssize_t r = pread(fd, buf + got, want - got, (off_t)(off + got));
+            if (r < 0 && errno == EINTR)
+                continue;
+            if (r <= 0) {
+                rc = fdt_rd_fail(&c, FDT_IO_EOPEN, ": cannot read: %s",
+                                 r < 0 ? strerror(errno) : "the file shrank");
+                break;
+            }
+            got += (size_t)r;
+        }
+        for (size_t j = 0; rc == FDT_IO_OK && j < k; j++)
+            for (int a = 0; a < 3; a++) {
+                double x = ply_get(buf + j * lay->rec + lay->off[a], lay->type[a], lay->big);
+                if (!isfinite(x)) /* the whole read words it */
+                    rc = fdt_rd_fail(&c, FDT_IO_EFORMAT, ": vertex %llu: not finite",
+                                     (unsigned long long)(first + i + j + 1));
+                d[3 * (i + j) + a] = x;
+            }
+    }
+    close(fd);
+    free(buf);
+    if (rc != FDT_IO_OK) {
+        free(d);
+        return rc;
+    }
+    *xyz = d;
+    return FDT_IO_OK;
 }

@@ -344,7 +344,29 @@ static const char *rd_last_newline(const char *s, const char *e)
     return NULL;
 }
 
+/*
+ * The stream of c->src from the state a whole file starts in (whole: look
+ * for a byte order mark and the header, refuse an empty input) or, for a
+ * range of a file (src/reader.c, fdt_rd_text_range), from the middle of
+ * the point lines: no byte order mark, no header, every line with ncols0
+ * fields, the first line numbered first_line + 1. *lines_out (may be NULL):
+ * the line ends read.
+ */
+static int rd_xyz_stream_from(rd_ctx *c, rd_points *pb, int whole, size_t ncols0, size_t line0,
+                              size_t *lines_out);
+
 int fdt_rd_stream_xyz(rd_ctx *c, rd_points *pb)
+{
+    return rd_xyz_stream_from(c, pb, 1, 3, 0, NULL);
+}
+
+int fdt_rd_stream_xyz_range(rd_ctx *c, rd_points *pb, size_t ncols, size_t line0, size_t *lines)
+{
+    return rd_xyz_stream_from(c, pb, 0, ncols, line0, lines);
+}
+
+static int rd_xyz_stream_from(rd_ctx *c, rd_points *pb, int whole, size_t ncols0,
+                              size_t first_line, size_t *lines_out)
 {
     size_t T = c->threads > 1 ? (size_t)c->threads : 1;
     if (T > RD_SLICES_MAX)
@@ -364,12 +386,12 @@ int fdt_rd_stream_xyz(rd_ctx *c, rd_points *pb)
     /* Lines before the first content line are blank or comments; the
      * first content line may be a header (rd_is_header), skipped; the
      * first point line then sets the column count of every line. */
-    enum { FIND_FIRST, FIND_COLUMNS, PARSE } st = FIND_FIRST;
-    size_t ncols = 3;
+    enum { FIND_FIRST, FIND_COLUMNS, PARSE } st = whole ? FIND_FIRST : PARSE;
+    size_t ncols = ncols0;
     size_t len = 0;     /* bytes in buf: a carried partial line, then new ones */
     size_t done = 0;    /* input bytes before buf[0] */
-    size_t lineno = 0;  /* lines before buf[0] */
-    int rc = FDT_IO_OK, first = 1;
+    size_t lineno = first_line; /* lines before buf[0] */
+    int rc = FDT_IO_OK, first = whole;
     size_t bom = 0; /* bytes of a byte order mark at buf[0], until parsed */
     for (;;) {
         ptrdiff_t r = fdt_rd_src_read(c, buf + len, cap - len);
@@ -458,5 +480,41 @@ int fdt_rd_stream_xyz(rd_ctx *c, rd_points *pb)
         bom = 0;
     }
     free(buf);
+    if (lines_out != NULL)
+        *lines_out = lineno - first_line;
     return rc;
+}
+
+int fdt_rd_xyz_head(const char *buf, size_t len, int eof, fdt_rd_head *h)
+{
+    size_t bom = len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0 ? 3 : 0;
+    if (!eof && len < 3 && memcmp(buf, "\xef\xbb\xbf", len) == 0)
+        return 0; /* cannot tell a byte order mark yet */
+    const char *s = buf + bom, *end = buf + len;
+    if (!eof) {
+        /* only complete lines: the last one may go on */
+        const char *nl = rd_last_newline(s, end);
+        end = nl != NULL ? nl + 1 : s;
+    }
+    memset(h, 0, sizeof *h);
+    h->body = bom;
+    const char *fs, *fe;
+    size_t fl;
+    if (!rd_first_content(s, end, &fs, &fe, &fl))
+        return eof; /* no content: no points at all, or more to read */
+    if (!rd_is_header(fs, fe)) {
+        h->ncols = rd_count_fields(fs, fe);
+        return 1;
+    }
+    /* a header: the points start on the line after it, and the next
+     * content line sets the column count (as fdt_rd_stream_xyz) */
+    const char *nl = memchr(fe, '\n', (size_t)(end - fe));
+    const char *after = nl != NULL ? nl + 1 : end;
+    h->body = (size_t)(after - buf);
+    h->body_line = fl;
+    if (rd_first_content(after, end, &fs, &fe, &fl)) {
+        h->ncols = rd_count_fields(fs, fe);
+        return 1;
+    }
+    return eof;
 }

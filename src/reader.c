@@ -133,6 +133,11 @@ ptrdiff_t fdt_rd_src_read(const rd_ctx *c, void *dst, size_t len)
         return (ptrdiff_t)k;
     }
     size_t got = 0;
+    if (s->bounded && len > s->left) {
+        len = s->left; /* the range's end is its end of file */
+        if (len == 0)
+            s->eof = 1;
+    }
     while (got < len && !s->eof) {
         size_t want = len - got < RD_READ_MAX ? len - got : RD_READ_MAX;
         ssize_t r = read(s->fd, (char *)dst + got, want);
@@ -152,6 +157,11 @@ ptrdiff_t fdt_rd_src_read(const rd_ctx *c, void *dst, size_t len)
         }
         got += (size_t)r;
         s->pos += (size_t)r;
+        if (s->bounded) {
+            s->left -= (size_t)r;
+            if (s->left == 0)
+                s->eof = 1;
+        }
     }
     return (ptrdiff_t)got;
 }
@@ -446,7 +456,7 @@ int fdt_rd_points_with(const char *path, const fdt_rd_opts *o, double **xyz, siz
     else if ((f = rd_setup(&c, path, o, &rc)) != NULL && f->stream == NULL)
         rc = rd_slurp(&c, fd, &st, &buf);
     if (rc == FDT_IO_OK && f != NULL && f->stream != NULL) {
-        rd_src src = {fd, NULL, 0, 0, 0};
+        rd_src src = {fd, NULL, 0, 0, 0, 0, 0};
         if (S_ISREG(st.st_mode)) /* a hint for readahead: failure is harmless */
             (void)posix_fadvise(fd, 0, 0, POSIX_FADV_SEQUENTIAL);
         c.size_known = S_ISREG(st.st_mode) && (uintmax_t)st.st_size <= SIZE_MAX;
@@ -488,7 +498,7 @@ int fdt_rd_points_mem_with(const char *name, const void *data, size_t len,
     if (f->stream != NULL) {
         /* the streamed formats copy the bytes chunk by chunk, as they
          * would read them from a file */
-        rd_src src = {-1, data, len, 0, 0};
+        rd_src src = {-1, data, len, 0, 0, 0, 0};
         c.size = len;
         c.size_known = 1;
         return rd_stream(&c, f, &src, xyz, n);
@@ -658,4 +668,179 @@ int fdt_read_points(const char *path, const char *format, double **xyz, size_t *
     fdt_default_read_options(&o);
     o.format = format;
     return fdt_read_points_opts(path, &o, xyz, n, diag, diag_size);
+}
+
+/* ------------------------------------------------------------------ */
+/* Text slices (src/reader.h; src/mpi_setup.c)                        */
+/* ------------------------------------------------------------------ */
+
+/* Opens path for a slice read: the descriptor, or -1 with c's message. */
+static int rd_open_regular(rd_ctx *c, const char *path, struct stat *st)
+{
+    int fd;
+    do
+        fd = open(path, O_RDONLY | O_CLOEXEC);
+    while (fd < 0 && errno == EINTR);
+    if (fd < 0) {
+        fdt_rd_fail(c, FDT_IO_EOPEN, ": cannot open: %s", strerror(errno));
+        return -1;
+    }
+    if (fstat(fd, st) != 0 || !S_ISREG(st->st_mode) || (uintmax_t)st->st_size > SIZE_MAX) {
+        fdt_rd_fail(c, FDT_IO_EOPEN, ": not a regular file");
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+/* pread until len bytes or the end; the bytes read, or -1 (message). */
+static ptrdiff_t rd_pread_all(rd_ctx *c, int fd, char *dst, size_t len, size_t off)
+{
+    size_t got = 0;
+    while (got < len) {
+        size_t want = len - got < RD_READ_MAX ? len - got : RD_READ_MAX;
+        ssize_t r = pread(fd, dst + got, want, (off_t)(off + got));
+        if (r == 0)
+            break;
+        if (r < 0) {
+            if (errno == EINTR)
+                continue;
+            fdt_rd_fail(c, FDT_IO_EOPEN, ": cannot read: %s", strerror(errno));
+            return -1;
+        }
+        got += (size_t)r;
+    }
+    return (ptrdiff_t)got;
+}
+
+int fdt_rd_text_head(const char *path, fdt_rd_head *h, char *err, size_t errlen)
+{
+    rd_ctx c;
+    memset(&c, 0, sizeof c);
+    c.path = path;
+    c.err = err;
+    c.errlen = errlen;
+    rd_begin(&c, NULL, NULL);
+    memset(h, 0, sizeof *h);
+    struct stat st;
+    int fd = rd_open_regular(&c, path, &st);
+    if (fd < 0)
+        return FDT_IO_EOPEN;
+    size_t size = (size_t)st.st_size, cap = RD_FIRST_CHUNK, len = 0;
+    char *buf = NULL;
+    int rc = FDT_IO_OK;
+    /* The head is a few lines: read more only while they are not whole. */
+    for (;;) {
+        char *nb = realloc(buf, cap);
+        if (nb == NULL) {
+            rc = fdt_rd_fail(&c, FDT_IO_ENOMEM, ": out of memory");
+            break;
+        }
+        buf = nb;
+        ptrdiff_t r = rd_pread_all(&c, fd, buf + len, cap - len, len);
+        if (r < 0) {
+            rc = FDT_IO_EOPEN;
+            break;
+        }
+        len += (size_t)r;
+        int eof = len >= size || len < cap;
+        if (fdt_rd_xyz_head(buf, len, eof, h))
+            break;
+        if (cap > SIZE_MAX / 2) {
+            rc = fdt_rd_fail(&c, FDT_IO_ENOMEM, ": out of memory");
+            break;
+        }
+        cap *= 2;
+    }
+    h->size = size;
+    free(buf);
+    close(fd);
+    return rc;
+}
+
+int fdt_rd_text_line_start(const char *path, size_t at, size_t *out, char *err, size_t errlen)
+{
+    rd_ctx c;
+    memset(&c, 0, sizeof c);
+    c.path = path;
+    c.err = err;
+    c.errlen = errlen;
+    rd_begin(&c, NULL, NULL);
+    struct stat st;
+    int fd = rd_open_regular(&c, path, &st);
+    if (fd < 0)
+        return FDT_IO_EOPEN;
+    size_t size = (size_t)st.st_size;
+    int rc = FDT_IO_OK;
+    if (at == 0 || at >= size) {
+        *out = at < size ? at : size;
+        close(fd);
+        return rc;
+    }
+    /* from the byte before at: a '\n' there makes at a line start */
+    char buf[1 << 16];
+    size_t pos = at - 1;
+    *out = size;
+    while (pos < size) {
+        ptrdiff_t r = rd_pread_all(&c, fd, buf, sizeof buf, pos);
+        if (r <= 0) {
+            rc = r < 0 ? FDT_IO_EOPEN : FDT_IO_OK;
+            break;
+        }
+        const char *nl = memchr(buf, '\n', (size_t)r);
+        if (nl != NULL) {
+            *out = pos + (size_t)(nl - buf) + 1;
+            break;
+        }
+        pos += (size_t)r;
+    }
+    close(fd);
+    return rc;
+}
+
+int fdt_rd_text_range(const char *path, const fdt_rd_opts *o, size_t begin, size_t end,
+                      size_t ncols, size_t line0, double **xyz, size_t *n, size_t *lines,
+                      char *err, size_t errlen)
+{
+    rd_ctx c;
+    memset(&c, 0, sizeof c);
+    c.path = path;
+    c.err = err;
+    c.errlen = errlen;
+    rd_begin(&c, xyz, n);
+    *lines = 0;
+    int rc = FDT_IO_OK;
+    const rd_format *f = rd_setup(&c, path, o, &rc);
+    if (f == NULL)
+        return rc;
+    if (f->id != FDT_RD_XYZ)
+        return fdt_rd_fail(&c, FDT_IO_EFORMAT, ": not a text point format");
+    c.progress = NULL;
+    struct stat st;
+    int fd = rd_open_regular(&c, path, &st);
+    if (fd < 0)
+        return FDT_IO_EOPEN;
+    if (end > (size_t)st.st_size)
+        end = (size_t)st.st_size;
+    if (begin > end)
+        begin = end;
+    if (lseek(fd, (off_t)begin, SEEK_SET) < 0) {
+        rc = fdt_rd_fail(&c, FDT_IO_EOPEN, ": cannot seek: %s", strerror(errno));
+        close(fd);
+        return rc;
+    }
+    rd_src src = {fd, NULL, 0, 0, end == begin, 1, end - begin};
+    c.src = &src;
+    c.size = end - begin;
+    c.size_known = 1;
+    rd_points pb = {NULL, 0, 0, 0};
+    rc = fdt_rd_stream_xyz_range(&c, &pb, ncols, line0, lines);
+    close(fd);
+    if (rc != FDT_IO_OK || pb.n == 0) {
+        free(pb.xyz);
+        return rc;
+    }
+    *xyz = pb.xyz;
+    *n = pb.n;
+    return FDT_IO_OK;
 }

@@ -156,4 +156,60 @@ int fdt_rd_points_mem_with(const char *name, const void *data, size_t len,
                              const fdt_rd_opts *o, double **xyz, size_t *n, char *err,
                              size_t errlen);
 
+/*
+ * Text slices, for a read shared by the ranks of a distributed run
+ * (src/mpi_setup.c): each rank parses its own byte range of a .xyz/.txt/
+ * .csv file with the same parser as above, so its points and messages are
+ * those of the whole read (line numbers given the lines before its range).
+ */
+typedef struct fdt_rd_head {
+    size_t body;      /* the first byte that may start a point line: after
+                         a byte order mark and a header line */
+    size_t body_line; /* lines before body (the header's number, or 0) */
+    size_t ncols;     /* fields of the first point line; 0: none (the file
+                         has no points) */
+    size_t size;      /* the file's bytes */
+} fdt_rd_head;
+
+/* What the head of a regular file path says (reads only until it knows). */
+int fdt_rd_text_head(const char *path, fdt_rd_head *h, char *err, size_t errlen);
+/* The first line start at or after byte at (at itself when it is 0, or
+ * follows a '\n'; the file's size when no line starts there). */
+int fdt_rd_text_line_start(const char *path, size_t at, size_t *out, char *err,
+                           size_t errlen);
+/*
+ * Parses bytes [begin, end) of path (begin and end line starts at or
+ * after the head's body, or the file's size) as point lines of ncols
+ * fields whose first line is line line0 + 1; *lines: the line ends in
+ * the range. The format must be a text point format (o->format or the
+ * extension); o->threads parse a block at once as above. A range with no
+ * points gives *n = 0 and FDT_IO_OK; *xyz is then NULL.
+ */
+int fdt_rd_text_range(const char *path, const fdt_rd_opts *o, size_t begin, size_t end,
+                      size_t ncols, size_t line0, double **xyz, size_t *n, size_t *lines,
+                      char *err, size_t errlen);
+
+/*
+ * Binary PLY slices (the same use): a file whose elements all have a fixed
+ * size and whose size is what its header says has vertex i at byte
+ * vertex_off + i rec. fdt_rd_ply_find_layout: 1 and *lay for such a file, 0 for
+ * any other (ASCII, lists, a bad header or size: read it whole, which
+ * words what is wrong), or an FDT_IO error opening it.
+ * fdt_rd_ply_range: vertices [first, first + count) into *xyz (3 doubles
+ * each, malloc'd); FDT_IO_EFORMAT if a coordinate is NaN or infinite
+ * (the whole read words that error as a whole read does).
+ */
+typedef struct fdt_rd_ply_layout {
+    size_t vertex_off;  /* byte of vertex 0 */
+    size_t rec;         /* bytes a vertex */
+    unsigned long long count; /* vertices */
+    size_t off[3];      /* bytes of x, y, z into a vertex */
+    int type[3];        /* their types (src/read_ply.c) */
+    int big;            /* big-endian */
+} fdt_rd_ply_layout;
+
+int fdt_rd_ply_find_layout(const char *path, fdt_rd_ply_layout *lay, char *err, size_t errlen);
+int fdt_rd_ply_range(const char *path, const fdt_rd_ply_layout *lay, unsigned long long first,
+                     size_t count, double **xyz, char *err, size_t errlen);
+
 #endif

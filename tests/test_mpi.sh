@@ -8,7 +8,11 @@
 # same mesh as the serial run's, byte for byte; a rank that fails (the
 # hidden --inject-failure) ends every rank with the error, no hang, no
 # output; -o BASE.pvtu writes one piece a rank and an index that VTK reads
-# as the serial mesh.
+# as the serial mesh. The distributed setup (each rank its slice of a text
+# file, bisection by exchange, duplicates merged across slices): headers
+# and comments, duplicates spread across slices, the whole-read fallback,
+# standard input, a bad line in a later rank's slice (every rank exits 2
+# with the serial run's message, line number included, and writes nothing).
 # Usage: test_mpi.sh FRONTDT FRONTDT_MPI GEN_POINTS MPIRUN DATA_DIR [PYTHON3]
 set -u
 frontdt=$1 fmpi=$2 gen=$3 mpirun=$4 data=$5 python=${6:-python3}
@@ -96,6 +100,135 @@ extra=()
 printf '0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n' >"$work/five.xyz"
 check five "$work/five.xyz" 7
 
+# The distributed setup (§3.1, src/mpi_setup.c): each rank parses its byte
+# slice of a text file, cut at line starts wherever the byte offsets fall
+# (mid-line, as a rule). A header line, comments, blank lines, CRLF and
+# commas, on every rank count; duplicates spread across slices (the file
+# twice over, so each point's duplicate is in another rank's slice), whose
+# gathered .tets must be serial's byte for byte (the first input id of
+# each class survives, as src/prepare.c's merge); the whole-read fallback
+# for other formats (PLY) and standard input (read by rank 0, scattered).
+{
+  printf '\xef\xbb\xbfX,Y,Z\r\n# clusters, as csv\r\n\r\n'
+  awk '{printf "%s,%s,%s%s\r\n", $1, $2, $3, (NR % 97 == 0 ? "  # a comment" : "")}
+       NR % 211 == 0 {printf "\r\n# between\r\n"}' "$work/clusters.xyz"
+} >"$work/header.csv"
+check "header csv" "$work/header.csv" "${nps[@]}"
+cat "$work/clusters.xyz" "$work/clusters.xyz" >"$work/twice.xyz"
+check "duplicates across slices" "$work/twice.xyz" 2 3 7
+# every lattice point five times: the class at a cut is five equal points,
+# which must all go to one side (split, two ranks would each build on
+# the point, and the run fails)
+for i in 1 2 3 4 5; do cat "$work/lattice.xyz"; done >"$work/lattice5.xyz"
+check "lattice, each point five times" "$work/lattice5.xyz" 2 3 7
+"$frontdt" --mode serial -q -o "$work/twice_ref.tets" "$work/twice.xyz" || fail "serial -o twice"
+checks=$((checks + 1))
+mpi 3 120 "$fmpi" -q -o "$work/twice3.tets" "$work/twice.xyz" || fail "-o twice, 3 ranks"
+cmp -s "$work/twice_ref.tets" "$work/twice3.tets" || fail "-o twice, 3 ranks: differs from serial"
+checks=$((checks + 1))
+mpi 3 60 "$fmpi" -q --stats "$work/twice.xyz" 2>"$work/st" >/dev/null
+grep -q "each rank read its slice of the file; 6000 points, 3000 duplicates merged" "$work/st" ||
+  { fail "twice, 3 ranks: --stats does not say slices and 3000 duplicates"; cat "$work/st"; }
+"$gen" uniform 3000 23 "$work/u.ply" >/dev/null || fail "gen_points ply"
+check "ply (whole-read fallback)" "$work/u.ply" 3
+checks=$((checks + 1))
+mpi 2 60 "$fmpi" -q --stats "$work/u.ply" 2>"$work/st" >/dev/null
+grep -q "each rank read its vertices of the binary PLY" "$work/st" ||
+  fail "ply: --stats does not say vertex slices"
+# PLY layouts (written by python3; skipped without it): big-endian floats
+# with a colour, after a fixed-size element (sliced by vertex); a face
+# list after the vertices (read whole); ASCII (read whole); a NaN in the
+# last vertex (every rank exits 2 with frontdt's message).
+if "$python" - "$work" "$work/clusters.xyz" <<'PY'
+import struct, sys
+work, src = sys.argv[1], sys.argv[2]
+pts = [tuple(float(v) for v in l.split()[:3]) for l in open(src) if l.strip()]
+def ply(name, fmt, props, rows, pre=b"", post=b"", tail=b""):
+    with open(f"{work}/{name}.ply", "wb") as f:
+        f.write(b"ply\nformat " + fmt + b" 1.0\n" + pre + b"element vertex %d\n" % len(rows)
+                + props + post + b"end_header\n")
+        for r in rows:
+            f.write(r)
+        f.write(tail)
+be = [struct.pack(">fffB", x, y, z, 7) for x, y, z in pts]
+ply("be", b"binary_big_endian",
+    b"property float x\nproperty float y\nproperty float z\nproperty uchar red\n", be,
+    pre=b"element camera 2\nproperty double fov\nproperty int id\n"
+    + b"", tail=b"")
+# the camera element's 2 x 12 bytes precede the vertices
+data = open(f"{work}/be.ply", "rb").read()
+head, body = data.split(b"end_header\n", 1)
+open(f"{work}/be.ply", "wb").write(head + b"end_header\n" + struct.pack(">di", 1.0, 1) * 2 + body)
+le = [struct.pack("<ddd", x, y, z) for x, y, z in pts]
+ply("faces", b"binary_little_endian",
+    b"property double x\nproperty double y\nproperty double z\n", le,
+    post=b"element face 1\nproperty list uchar int vertex_indices\n",
+    tail=struct.pack("<Biii", 3, 0, 1, 2))
+ply("ascii", b"ascii", b"property double x\nproperty double y\nproperty double z\n",
+    [b"%r %r %r\n" % p for p in pts])
+nan = le[:-1] + [struct.pack("<ddd", 0.5, float("nan"), 0.5)]
+ply("nan", b"binary_little_endian",
+    b"property double x\nproperty double y\nproperty double z\n", nan)
+PY
+then
+  check "ply big-endian floats after a camera element" "$work/be.ply" 2 3
+  check "ply with a face list" "$work/faces.ply" 3
+  check "ply ascii" "$work/ascii.ply" 2
+  checks=$((checks + 1))
+  mpi 3 60 "$fmpi" -q --stats "$work/be.ply" 2>"$work/st" >/dev/null
+  grep -q "each rank read its vertices of the binary PLY" "$work/st" || fail "be.ply: not sliced"
+  mpi 3 60 "$fmpi" -q --stats "$work/faces.ply" 2>"$work/st" >/dev/null
+  grep -q "every rank read the whole input" "$work/st" || fail "faces.ply: not read whole"
+else
+  echo "skip: PLY layouts ($python absent)"
+fi
+if [[ ${#oversub[@]} -gt 0 ]]; then
+  checks=$((checks + 1))
+  ref=$("$frontdt" --mode serial -q --set-hash "$work/clusters.xyz")
+  # Open MPI 4's mpirun itself now and then crashes forwarding standard
+  # input (orte_iof_hnp_read_local_handler, open-mpi/ompi#7483): a crash
+  # of the launcher, named in its message, is tried again (3 times)
+  for try in 1 2 3; do
+    got=$(mpi 3 60 "$fmpi" -q --set-hash --input-format xyz - <"$work/clusters.xyz" 2>"$work/stdin.err")
+    grep -q "orte_iof_hnp_read_local_handler" "$work/stdin.err" || break
+    echo "note: mpirun crashed forwarding standard input (try $try)"
+  done
+  [[ -n $ref && $got == "$ref" ]] || { fail "standard input, 3 ranks: '$got', serial '$ref'"; cat "$work/stdin.err"; }
+else
+  # MPICH's launcher (hydra 4.0) aborts forwarding this 180 kB to any
+  # program ("process reading stdin too slowly; can't keep up"), wc -c
+  # included
+  echo "skip: standard input (not Open MPI's launcher)"
+fi
+
+# Bad input in a slice: every rank exits 2 with the error of a whole read
+# (the file's first bad line, its number counted over the slices before
+# it), and nothing is written. Lines 2950 (the last rank's slice of 3)
+# and then 1500 as well (rank 1's of 4, reported first).
+rankvar='${OMPI_COMM_WORLD_RANK:-${PMI_RANK:-?}}'
+awk 'NR == 2950 {print "1.0 2.0 oops"; next} {print}' "$work/clusters.xyz" >"$work/bad1.xyz"
+awk 'NR == 2950 {print "1.0 2.0 oops"; next} NR == 1500 {print "1 2"; next} {print}' \
+  "$work/clusters.xyz" >"$work/bad2.xyz"
+printf '0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 2 0\n0 0 0\n' >"$work/flat.xyz"
+bads=("bad1.xyz 3" "bad2.xyz 4" "flat.xyz 3")
+[[ -s $work/nan.ply ]] && bads+=("nan.ply 3")
+for spec in "${bads[@]}"; do
+  set -- $spec
+  checks=$((checks + 1))
+  want=$("$frontdt" --mode serial -q "$work/$1" 2>&1 | sed 's/^frontdt: //')
+  rm -f "$work/bad.tets"
+  out=$(mpi "$2" 60 bash -c "\"\$0\" -q -o \"$work/bad.tets\" \"$work/$1\"; echo \"rank-exit $rankvar \$?\"" "$fmpi" 2>"$work/ferr")
+  n2=$(grep -c '^rank-exit [0-9?]* 2$' <<<"$out")
+  [[ $n2 -eq $2 ]] || { fail "$1 on $2 ranks: $n2 of $2 ranks ended with exit 2"; echo "$out"; }
+  got=$(grep '^frontdt-mpi: ' "$work/ferr" | sed 's/^frontdt-mpi: //')
+  case $1 in
+    flat.xyz) [[ $got == *"flat.xyz: all 5 distinct points are coplanar"* ]] ||
+            fail "flat on $2 ranks: '$got'" ;;
+    *) [[ -n $want && $got == "$want" ]] || fail "$1 on $2 ranks: '$got', serial says '$want'" ;;
+  esac
+  ls -A "$work" | grep -q 'bad\.tets' && fail "$1 on $2 ranks: output left behind"
+done
+
 if [[ -r $data/bunny_35947.xyz ]]; then
   check bunny "$data/bunny_35947.xyz" "${nps[@]}"
 else
@@ -164,6 +297,38 @@ for spec in "4 2:50" "7 0:200" "3 1:0" "2 1:400"; do
   grep -q "rank ${inj%%:*} failed" "$work/ferr" || { fail "injected $inj: no message naming the rank"; cat "$work/ferr"; }
   ls -A "$work" | grep -q fail.tets && fail "injected $inj on $np ranks: output left behind"
 done
+
+# SIGINT to mpirun (Open MPI forwards it to every rank): every rank ends
+# (exit 6, "interrupted"), and -o BASE.pvtu leaves either nothing or the
+# complete set (the index and every piece), never a piece or an index
+# alone; signals at a few moments, at least one of them mid-run.
+if [[ ${#oversub[@]} -gt 0 ]]; then
+  "$gen" uniform 100000 31 "$work/u100k.xyz" >/dev/null || fail "gen_points 100k"
+  interrupted=0
+  for delay in 0.6 1.2 2.4; do
+    checks=$((checks + 1))
+    rm -rf "$work/sig"
+    mkdir "$work/sig"
+    "$mpirun" "${oversub[@]}" -np 3 "$fmpi" -q -o "$work/sig/mesh.pvtu" "$work/u100k.xyz" \
+      2>"$work/sigerr" &
+    pid=$!
+    sleep "$delay"
+    kill -INT "$pid" 2>/dev/null
+    for _ in $(seq 60); do kill -0 "$pid" 2>/dev/null || break; sleep 1; done
+    if kill -0 "$pid" 2>/dev/null; then
+      fail "SIGINT after ${delay}s: mpirun still runs 60 s later"
+      kill -KILL "$pid"
+    fi
+    wait "$pid" 2>/dev/null
+    grep -q "frontdt-mpi: interrupted" "$work/sigerr" && interrupted=$((interrupted + 1))
+    left=$(ls -A "$work/sig" | tr '\n' ' ')
+    [[ -z $left || $left == "mesh.pvtu mesh_0.vtu mesh_1.vtu mesh_2.vtu " ]] ||
+      fail "SIGINT after ${delay}s: left '$left'"
+  done
+  [[ $interrupted -gt 0 ]] || fail "SIGINT: no run was interrupted"
+else
+  echo "skip: SIGINT (not Open MPI's launcher)"
+fi
 
 echo "$checks checks, $fails failures"
 [[ $fails -eq 0 ]]
