@@ -222,7 +222,8 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
         if (fdt_format_needs(f, 0) & FDT_NEED_NBRS) {
             if (rank == 0)
                 fprintf(stderr, "frontdt-mpi: %s needs tet neighbours, which the MPI run "
-                                "does not gather yet; use frontdt\n", fdt_format_name(f));
+                                "does not gather yet; use frontdt, or -o BASE.pele for\n"
+                                "TetGen pieces without neighbours\n", fdt_format_name(f));
             return EX_USAGE;
         }
         for (int k = 0; k < nf; k++)
