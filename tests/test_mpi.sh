@@ -363,31 +363,38 @@ for spec in "4 2:50" "7 0:200" "3 1:0" "2 1:400"; do
 done
 
 # SIGINT to mpirun (Open MPI forwards it to every rank): every rank ends
-# (exit 6, "interrupted"), and -o BASE.pvtu leaves either nothing or the
-# complete set (the index and every piece), never a piece or an index
-# alone; signals at a few moments, at least one of them mid-run.
+# (exit 6, "interrupted"), and -o BASE.pvtu / .pfdtb / .pele leaves either
+# nothing or the complete set (the index, every piece, the .node), never a
+# piece or an index alone; signals at a few moments, at least one of them
+# mid-run.
 if [[ ${#oversub[@]} -gt 0 ]]; then
   "$gen" uniform 100000 31 "$work/u100k.xyz" >/dev/null || fail "gen_points 100k"
   interrupted=0
-  for delay in 0.6 1.2 2.4; do
+  complete_pvtu="mesh.pvtu mesh_0.vtu mesh_1.vtu mesh_2.vtu "
+  complete_pfdtb="mesh.pfdtb mesh_0.fdtb mesh_1.fdtb mesh_2.fdtb "
+  complete_pele="mesh.node mesh.pele mesh_0.ele mesh_0.face mesh_1.ele mesh_1.face mesh_2.ele mesh_2.face "
+  for spec in "0.6 pvtu" "1.2 pvtu" "2.4 pvtu" "1.5 pfdtb" "2.0 pele"; do
+    set -- $spec
+    delay=$1 ext=$2
     checks=$((checks + 1))
     rm -rf "$work/sig"
     mkdir "$work/sig"
-    "$mpirun" "${oversub[@]}" -np 3 "$fmpi" -q -o "$work/sig/mesh.pvtu" "$work/u100k.xyz" \
+    "$mpirun" "${oversub[@]}" -np 3 "$fmpi" -q -o "$work/sig/mesh.$ext" "$work/u100k.xyz" \
       2>"$work/sigerr" &
     pid=$!
     sleep "$delay"
     kill -INT "$pid" 2>/dev/null
     for _ in $(seq 60); do kill -0 "$pid" 2>/dev/null || break; sleep 1; done
     if kill -0 "$pid" 2>/dev/null; then
-      fail "SIGINT after ${delay}s: mpirun still runs 60 s later"
+      fail "SIGINT after ${delay}s (.$ext): mpirun still runs 60 s later"
       kill -KILL "$pid"
     fi
     wait "$pid" 2>/dev/null
     grep -q "frontdt-mpi: interrupted" "$work/sigerr" && interrupted=$((interrupted + 1))
-    left=$(ls -A "$work/sig" | tr '\n' ' ')
-    [[ -z $left || $left == "mesh.pvtu mesh_0.vtu mesh_1.vtu mesh_2.vtu " ]] ||
-      fail "SIGINT after ${delay}s: left '$left'"
+    left=$(ls -A "$work/sig" | LC_ALL=C sort | tr '\n' ' ')
+    complete=complete_$ext
+    [[ -z $left || $left == "${!complete}" ]] ||
+      fail "SIGINT after ${delay}s (.$ext): left '$left'"
   done
   [[ $interrupted -gt 0 ]] || fail "SIGINT: no run was interrupted"
 else
