@@ -343,6 +343,17 @@ for ext in pfdtb pele; do
   [[ $rc -eq 5 && ! -e $work/none ]] || fail ".$ext into a missing directory: exit $rc"
 done
 
+# An output file of the set that is the input (here the .node): exit 1,
+# nothing written, the input as it was.
+checks=$((checks + 1))
+mkdir -p "$work/in"
+"$frontdt" --mode serial -q -o "$work/in/m.ele" "$work/clusters.xyz" || fail "serial .ele"
+cp "$work/in/m.node" "$work/in/orig.node"
+mpi 2 60 "$fmpi" -q -o "$work/in/m.pele" "$work/in/m.node" 2>/dev/null
+rc=$?
+[[ $rc -eq 1 && ! -e $work/in/m.pele && ! -e $work/in/m_0.ele ]] &&
+  cmp -s "$work/in/m.node" "$work/in/orig.node" || fail ".pele whose .node is the input: exit $rc"
+
 # A failing rank: every rank ends with the error (exit 7), quickly, and
 # nothing is written. The wrapper reports each rank's exit code and exits
 # 0 itself, so mpirun does not kill the other ranks first: each must end
