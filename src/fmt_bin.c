@@ -5,7 +5,12 @@
  *   bytes  0..7   magic "FDTMESH\0"
  *          8..11  uint32 version, 1
  *         12..15  uint32 flags: 1 ids are int64 (else int32), 2 the points
- *                 follow the header, 4 the hull faces follow the tets
+ *                 follow the header, 4 the hull faces follow the tets,
+ *                 8 a piece: one rank's share of a distributed mesh
+ *                 (frontdt-mpi -o BASE.pfdtb), no points, the ids number
+ *                 the input file's points (in input order, a duplicate's
+ *                 tets name its first occurrence), "points" is how many
+ *                 the input has
  *         16..23  uint64 points
  *         24..31  uint64 tets      (a streamed file: patched at the end)
  *         32..39  uint64 hull faces (the same)
@@ -20,7 +25,7 @@
 
 #define BIN_HEADER 64
 #define BIN_VERSION 1u
-enum { BIN_IDS64 = 1, BIN_POINTS = 2, BIN_HULL = 4 };
+enum { BIN_IDS64 = 1, BIN_POINTS = 2, BIN_HULL = 4, BIN_PIECE = 8 };
 
 static void put_le(unsigned char *p, uint64_t v, int bytes)
 {
@@ -90,6 +95,19 @@ int fdt_put_bin(out_file *o, const fdt_mesh_view *m, const void *prep, char *err
     put_points(o, m->xyz, m->n_points);
     put_ids(o, m->tets, 4 * m->n_tets, 0);
     put_ids(o, m->hull, 3 * m->n_hull, 0);
+    return FDT_IO_OK;
+}
+
+int fdt_put_bin_piece(out_file *o, uint64_t n_input, const fdt_vid *tets, size_t nt,
+                      const fdt_vid *hull, size_t nh)
+{
+    /* int64 ids only when int32 cannot number the input */
+    int ids64 = n_input > (uint64_t)INT32_MAX;
+    unsigned char h[BIN_HEADER];
+    bin_header(h, BIN_PIECE | BIN_HULL | (ids64 ? BIN_IDS64 : 0), n_input, nt, nh);
+    out_bytes(o, h, sizeof h);
+    put_ids(o, tets, 4 * nt, ids64);
+    put_ids(o, hull, 3 * nh, ids64);
     return FDT_IO_OK;
 }
 

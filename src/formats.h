@@ -89,6 +89,10 @@ extern const fdt_format fdt_formats[];
 int fdt_out_open(out_file *o, const char *target);
 void fdt_out_abandon(out_file *o);
 int fdt_out_commit(out_file *files, int k, char *err, size_t errlen);
+/* The temporary's path of a file fdt_out_open opened (NULL if none): for
+ * frontdt-mpi's collective .node, which the other ranks fill with pwrite
+ * before rank 0 commits it (src/mpi_output.c). */
+const char *fdt_out_temp(const out_file *o);
 /* The lock of the public writers (the registry of temporaries is
  * process-wide). */
 void fdt_write_lock(void);
@@ -114,6 +118,11 @@ extern const fdt_stream_fmt fdt_stream_tetgen;
 /* src/fmt_bin.c: the compact binary format (README, "Binary mesh") */
 int fdt_put_bin(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
                 size_t errlen);
+/* One rank's piece of a distributed mesh (src/mpi_output.c): the header
+ * with flag 8 (a piece, no points: ids number the n_input input points),
+ * its nt tets and nh hull faces; int64 ids when n_input needs them. */
+int fdt_put_bin_piece(out_file *o, uint64_t n_input, const fdt_vid *tets, size_t nt,
+                      const fdt_vid *hull, size_t nh);
 extern const fdt_stream_fmt fdt_stream_bin;
 /* src/fmt_gmsh.c */
 int fdt_put_msh41(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,

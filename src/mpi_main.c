@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "frontdt.h"
+#include "mpi_output.h"
 #include "mpi_run.h"
 #include "prepare.h"
 #include "reader.h"
@@ -40,29 +41,18 @@ enum {
  * mpirun passes an interrupt on to every rank (Open MPI forwards SIGINT
  * and SIGTERM, MPICH's hydra SIGINT). Each rank removes what it is
  * writing, as frontdt does (fdt_write_cleanup: the temporaries of a write
- * in progress), and its piece of -o BASE.pvtu if it was complete but the
- * index is not yet, so an interrupted run leaves no output, and leaves
- * with exit code 6 without waiting for the others (which the same signal
- * ends). With the piece it removes the index (any rank may: they name the
- * same file), so an index never outlives a piece it names: rank 0 writes
- * the index only after every piece is written, and every rank keeps
- * piece_live until all have passed a barrier after learning that the
- * index is there (a rank that left early keeps rank 0 in that barrier
- * until mpirun ends it, with the same cleanup). Only async-signal-safe
- * calls: unlink, write, _exit. The names are written while piece_live is
- * 0 and published by the store of 1 after them (volatile accesses keep
- * their order). */
-static char piece_path[FDT_IO_PATH], index_path[FDT_IO_PATH];
-static volatile sig_atomic_t piece_live;
-
+ * in progress), and the files of a distributed output while that output
+ * is not complete on every rank (fdt_mpo_cleanup, src/mpi_output.h), so
+ * an interrupted run leaves no output, and leaves with exit code 6
+ * without waiting for the others (which the same signal ends; a rank
+ * that left early keeps the others in fdt_mpo_write's last barrier until
+ * mpirun ends them, with the same cleanup). Only async-signal-safe calls:
+ * unlink, write, _exit. */
 static void on_signal(int sig)
 {
     (void)sig;
     fdt_write_cleanup();
-    if (piece_live) {
-        (void)unlink(piece_path);
-        (void)unlink(index_path);
-    }
+    fdt_mpo_cleanup();
     static const char msg[] = "\nfrontdt-mpi: interrupted\n";
     ssize_t w = write(STDERR_FILENO, msg, sizeof msg - 1);
     (void)w;
@@ -91,6 +81,8 @@ typedef struct opts {
     int set_hash, stats, quiet, leaf, no_park;
     int fail_rank;
     size_t fail_after;
+    int fail_write;      /* --inject-write-failure RANK, -1: none */
+    int kind;            /* FDT_MPO_* of -o */
 } opts;
 
 static const char usage[] =
@@ -102,6 +94,12 @@ static const char usage[] =
     "  -o FILE             write the mesh, gathered to rank 0 (.tets .vtu .vtk\n"
     "                      .msh .mesh polyMesh; not .ele: no neighbours yet)\n"
     "  -o BASE.pvtu        one piece a rank, BASE_RANK.vtu, and the index BASE.pvtu\n"
+    "  -o BASE.pfdtb       one .fdtb piece a rank, BASE_RANK.fdtb (tets and hull\n"
+    "                      faces, ids numbering the input's points), and the\n"
+    "                      text index BASE.pfdtb\n"
+    "  -o BASE.pele        BASE.node (every rank writes its lines), one TetGen\n"
+    "                      piece a rank, BASE_RANK.ele and .face, and the text\n"
+    "                      index BASE.pele"
     "  --input-format F    xyz, node or ply (default: by extension)\n"
     "  --set-hash          print the mesh's set hash (equals frontdt's)\n"
     "  --stats             per-rank tets and message counts, and their totals\n"
@@ -110,125 +108,12 @@ static const char usage[] =
     "                      frontdt --mode message does (for comparison)\n"
     "  -q                  print nothing but errors (and what is asked)\n";
 
-/* ---- -o BASE.pvtu: one .vtu piece a rank and an index ------------------- */
-
-/* BASE_RANK.vtu beside BASE.pvtu (path), and its name relative to the
- * index's directory (*rel points into out). 0, or -1 if it does not fit. */
-static int piece_name(const char *path, int rank, char *out, size_t len, const char **rel)
-{
-    size_t n = strlen(path);
-    if (n < 5)
-        return -1;
-    int k = snprintf(out, len, "%.*s_%d.vtu", (int)(n - 5), path, rank);
-    if (k < 0 || (size_t)k >= len)
-        return -1;
-    const char *slash = strrchr(out, '/');
-    *rel = slash ? slash + 1 : out;
-    return 0;
-}
-
-static int is_pvtu(const char *path)
-{
-    size_t n = strlen(path);
-    return n > 5 && strcasecmp(path + n - 5, ".pvtu") == 0;
-}
-
-/* Writes this rank's piece: its tets (input numbering) over the points
- * they use (ids: their input ids, ascending, xyz their coordinates; npts
- * of them), renumbered 0..npts-1 in that order. FDT_OK or an error, diag. */
-static int write_piece(const char *name, const fdt_vid *ids, const double *xyz, size_t npts,
-                       const fdt_vid *tets, size_t nt, char *diag, size_t dlen)
-{
-    fdt_vid *lt = malloc((4 * nt + 1) * sizeof *lt);
-    int err = FDT_ENOMEM;
-    if (!lt)
-        goto done;
-    for (size_t i = 0; i < 4 * nt; i++) {
-        /* ids is sorted and holds every id the tets use */
-        size_t lo = 0, hi = npts;
-        while (hi - lo > 1) {
-            size_t mid = lo + (hi - lo) / 2;
-            if (ids[mid] <= tets[i])
-                lo = mid;
-            else
-                hi = mid;
-        }
-        lt[i] = (fdt_vid)lo;
-    }
-    fdt_mesh_view v;
-    memset(&v, 0, sizeof v);
-    v.xyz = xyz;
-    v.n_points = npts;
-    v.tets = lt;
-    v.n_tets = nt;
-    err = fdt_wr_mesh_as(name, fdt_format_by_name("vtu"), &v, diag, dlen) == FDT_IO_OK
-              ? FDT_OK
-              : FDT_EIO;
-done:
-    if (err == FDT_ENOMEM)
-        snprintf(diag, dlen, "out of memory writing a piece");
-    free(lt);
-    return err;
-}
-
-static int little_endian(void)
-{
-    const uint16_t one = 1;
-    unsigned char b;
-    memcpy(&b, &one, 1);
-    return b == 1;
-}
-
-/* s with XML's five special characters escaped, to f. */
-static void put_xml(FILE *f, const char *s)
-{
-    for (; *s; s++)
-        switch (*s) {
-        case '&': fputs("&amp;", f); break;
-        case '<': fputs("&lt;", f); break;
-        case '>': fputs("&gt;", f); break;
-        case '"': fputs("&quot;", f); break;
-        case '\'': fputs("&apos;", f); break;
-        default: fputc(*s, f);
-        }
-}
-
-/* The index: ParaView reads the pieces it names. Rank 0. */
-static int write_index(const char *path, int size, char *diag, size_t dlen)
-{
-    fdt_wr_side *side;
-    FILE *f = fdt_wr_side_open(path, &side, diag, dlen);
-    if (!f)
-        return FDT_EIO;
-    fprintf(f, "<?xml version=\"1.0\"?>\n"
-               "<VTKFile type=\"PUnstructuredGrid\" version=\"0.1\" byte_order=\"%s\" "
-               "header_type=\"UInt64\">\n"
-               "  <PUnstructuredGrid GhostLevel=\"0\">\n"
-               "    <PPoints>\n"
-               "      <PDataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"/>\n"
-               "    </PPoints>\n",
-            little_endian() ? "LittleEndian" : "BigEndian");
-    char name[FDT_IO_PATH];
-    const char *rel;
-    for (int r = 0; r < size; r++) {
-        if (piece_name(path, r, name, sizeof name, &rel) != 0) {
-            fdt_wr_side_abandon(side);
-            snprintf(diag, dlen, "%s: piece name too long", path);
-            return FDT_EIO;
-        }
-        fputs("    <Piece Source=\"", f);
-        put_xml(f, rel);
-        fputs("\"/>\n", f);
-    }
-    fprintf(f, "  </PUnstructuredGrid>\n</VTKFile>\n");
-    return fdt_wr_side_commit(side, diag, dlen) == FDT_IO_OK ? FDT_OK : FDT_EIO;
-}
-
 /* -1: go on; else an exit code. Only rank 0 prints. */
 static int parse(int argc, char **argv, opts *o, int rank, int size)
 {
     memset(o, 0, sizeof *o);
     o->fail_rank = -1;
+    o->fail_write = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -274,6 +159,18 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
             o->fail_rank = (int)r;
             o->fail_after = (size_t)f;
             i++;
+        } else if (!strcmp(a, "--inject-write-failure") && v) {
+            /* Hidden, for tests/test_mpi.sh: rank RANK's piece fails once
+             * written (the others' are then removed). */
+            char *end;
+            long r = strtol(v, &end, 10);
+            if (*end || r < 0 || r > INT_MAX) {
+                if (rank == 0)
+                    fprintf(stderr, "frontdt-mpi: --inject-write-failure wants RANK\n");
+                return EX_USAGE;
+            }
+            o->fail_write = (int)r;
+            i++;
         } else if (a[0] == '-' && a[1]) {
             if (rank == 0)
                 fprintf(stderr, "frontdt-mpi: unknown option or missing value: '%s'\n%s", a,
@@ -292,24 +189,26 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
             fprintf(stderr, "frontdt-mpi: no input file\n%s", usage);
         return EX_USAGE;
     }
-    if (o->output && is_pvtu(o->output)) {
-        /* pieces: none of them (nor the index) may be the input */
+    o->kind = o->output ? fdt_mpo_kind(o->output) : FDT_MPO_GATHER;
+    if (o->kind != FDT_MPO_GATHER) {
+        /* pieces: none of them (nor the .node, nor the index) may be the
+         * input */
         char name[FDT_IO_PATH];
-        const char *rel;
-        for (int r = -1; r < size; r++) {
-            const char *x = name;
-            if (r < 0)
-                x = o->output;
-            else if (piece_name(o->output, r, name, sizeof name, &rel) != 0) {
+        for (size_t k = 0;; k++) {
+            int got = fdt_mpo_file(o->output, size, k, name, sizeof name);
+            if (got < 0) {
                 if (rank == 0)
                     fprintf(stderr, "frontdt-mpi: '%s': piece names too long\n", o->output);
                 return EX_USAGE;
             }
+            const char *x = got ? name : o->output;
             if (fdt_same_file(x, o->input)) {
                 if (rank == 0)
                     fprintf(stderr, "frontdt-mpi: output '%s' is the input '%s'\n", x, o->input);
                 return EX_USAGE;
             }
+            if (!got)
+                break;
         }
     } else if (o->output) {
         const fdt_format *f = fdt_format_by_path(o->output);
@@ -323,7 +222,8 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
         if (fdt_format_needs(f, 0) & FDT_NEED_NBRS) {
             if (rank == 0)
                 fprintf(stderr, "frontdt-mpi: %s needs tet neighbours, which the MPI run "
-                                "does not gather yet; use frontdt\n", fdt_format_name(f));
+                                "does not gather yet; use frontdt, or -o BASE.pele for\n"
+                                "TetGen pieces without neighbours\n", fdt_format_name(f));
             return EX_USAGE;
         }
         for (int k = 0; k < nf; k++)
@@ -443,10 +343,11 @@ static int run(int argc, char **argv, int rank, int size)
     fdt_mpi_out r;
     memset(&r, 0, sizeof r);
     fdt_result *res = NULL;
-    int pieces = o.output && is_pvtu(o.output);
+    int pieces = o.kind != FDT_MPO_GATHER;
     /* The setup (src/mpi_setup.h) returns the same code on every rank,
      * with the lowest failing rank's message. */
-    fdt_mpi_setup_opts so = {o.input, o.format, o.leaf, o.output && !pieces};
+    fdt_mpi_setup_opts so = {o.input, o.format, o.leaf,
+                             (o.output && !pieces) || o.kind == FDT_MPO_ELE};
     int err = fdt_mpi_setup(MPI_COMM_WORLD, &so, &L, diag, sizeof diag);
     double t_read = MPI_Wtime() - t0;
     if (err) {
@@ -456,7 +357,8 @@ static int run(int argc, char **argv, int rank, int size)
         goto out;
     }
     setup_stats(&L, rank, size, o.stats);
-    fdt_mpi_opts mo = {o.leaf, FDT_SEARCH_AUTO, o.output && !pieces, pieces, o.fail_rank,
+    int own = !pieces ? 0 : o.kind == FDT_MPO_VTU ? FDT_MPI_OWN_POINTS : FDT_MPI_OWN_HULL;
+    fdt_mpi_opts mo = {o.leaf, FDT_SEARCH_AUTO, o.output && !pieces, own, o.fail_rank,
                        o.fail_after, o.no_park};
     err = fdt_mpi_run(MPI_COMM_WORLD, &L, &mo, &r, diag, sizeof diag);
     if (err) {
@@ -513,36 +415,29 @@ static int run(int argc, char **argv, int rank, int size)
     }
     MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
     if (!rc && pieces) {
-        /* Each rank its piece (temporary and rename, by the writer), then
-         * rank 0 the index once every piece is there; if any write fails,
-         * every piece is removed again: all or nothing. */
-        char name[FDT_IO_PATH];
-        const char *rel;
-        int perr = piece_name(o.output, rank, name, sizeof name, &rel) != 0 ? FDT_EIO : FDT_OK;
-        if (!perr) {
-            /* from here an interrupt removes the piece (on_signal) */
-            memcpy(piece_path, name, sizeof piece_path);
-            snprintf(index_path, sizeof index_path, "%s", o.output);
-            piece_live = 1;
-            perr = write_piece(name, r.own_ids, r.own_xyz, r.own_npts, r.own_tets, r.own_ntets,
-                               diag, sizeof diag);
-        }
-        if (perr)
+        /* Each rank its piece, rank 0 the index (src/mpi_output.h): all or
+         * nothing, the same code on every rank; the rank that failed says
+         * why. */
+        double tw = MPI_Wtime();
+        fdt_mpo_args oa = {o.output, o.input, o.fail_write};
+        int mine = FDT_OK;
+        uint64_t io[2];
+        err = fdt_mpo_write(MPI_COMM_WORLD, &oa, &L, &r, &mine, io, diag, sizeof diag);
+        if (mine)
             fprintf(stderr, "frontdt-mpi: rank %d: %s\n", rank, diag);
-        int bad = perr == FDT_ENOMEM ? EX_RESOURCES : perr ? EX_WRITE : 0, worst = 0;
-        MPI_Allreduce(&bad, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-        if (!worst && rank == 0 && write_index(o.output, size, diag, sizeof diag) != FDT_OK) {
-            fprintf(stderr, "frontdt-mpi: %s\n", diag);
-            worst = EX_WRITE;
+        rc = err == FDT_OK ? EX_OK : err == FDT_ENOMEM ? EX_RESOURCES : EX_WRITE;
+        if (o.stats) {
+            double t[3] = {MPI_Wtime() - tw, (double)io[0], (double)io[1]};
+            double *all = rank == 0 ? malloc(3 * (size_t)size * sizeof *all) : NULL;
+            MPI_Gather(t, 3, MPI_DOUBLE, all, 3, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+            if (rank == 0 && all) {
+                fprintf(stderr, "  rank  pieces s   bytes written   bytes sent\n");
+                for (int q = 0; q < size; q++)
+                    fprintf(stderr, "  %4d %9.3f %15.0f %12.0f\n", q, all[3 * q],
+                            all[3 * q + 1], all[3 * q + 2]);
+            }
+            free(all);
         }
-        MPI_Bcast(&worst, 1, MPI_INT, 0, MPI_COMM_WORLD);
-        if (worst && !perr)
-            (void)remove(name);
-        /* complete (the index is there) or removed, on every rank: nothing
-         * to undo */
-        MPI_Barrier(MPI_COMM_WORLD);
-        piece_live = 0;
-        rc = worst;
     }
 out:
     fdt_result_free(&res);

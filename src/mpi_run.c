@@ -70,6 +70,8 @@ void fdt_mpi_out_free(fdt_mpi_out *out)
     free(out->all_hull);
     free(out->own_tets);
     out->own_tets = NULL;
+    free(out->own_hull);
+    out->own_hull = NULL;
     out->rank_counts = NULL;
     out->rank_tets = NULL;
     out->all_tets = NULL;
@@ -494,7 +496,8 @@ int fdt_mpi_run(MPI_Comm comm, fdt_mpi_local *L, const fdt_mpi_opts *o, fdt_mpi_
     xrec *used = NULL;
     size_t nused = 0;
     int pieces = o->keep_own && !o->gather;
-    err = translate(comm, xt, L, w->out.tets, n4, mine, pieces ? &used : NULL, &nused,
+    int with_pts = pieces && (o->keep_own & FDT_MPI_OWN_POINTS);
+    err = translate(comm, xt, L, w->out.tets, n4, mine, with_pts ? &used : NULL, &nused,
                     &out->bytes_out, diag, dlen);
     if (err)
         goto done;
@@ -505,7 +508,20 @@ int fdt_mpi_run(MPI_Comm comm, fdt_mpi_local *L, const fdt_mpi_opts *o, fdt_mpi_
     MPI_Reduce(hv, hs, 2, MPI_UINT64_T, MPI_SUM, 0, comm);
     out->hash.sum = hs[0];
     out->hash.count = hs[1];
-    if (pieces) {
+    if (pieces && !with_pts) {
+        /* .fdtb or .ele pieces: the ids alone, hull faces too */
+        out->own_tets = mine;
+        out->own_ntets = w->out.ntets;
+        mine = NULL;
+        out->own_hull = malloc((n3 + 1) * sizeof *out->own_hull);
+        err = out->own_hull ? FDT_OK : FDT_ENOMEM;
+        snprintf(diag, dlen, "out of memory for this rank's piece");
+        err = fdt_mpi_agree(comm, err, diag, dlen);
+        if (!err)
+            err = translate(comm, xt, L, w->out.hull, n3, out->own_hull, NULL, NULL,
+                            &out->bytes_out, diag, dlen);
+        out->own_nhull = w->out.nhull;
+    } else if (pieces) {
         out->own_tets = mine;
         out->own_ntets = w->out.ntets;
         mine = NULL;

@@ -27,8 +27,10 @@ typedef struct fdt_mpi_opts {
     int leaf_size;       /* 0: the default */
     int search;          /* fdt_search */
     int gather;          /* nonzero: every tet and hull face to rank 0 */
-    int keep_own;        /* nonzero (not with gather): this rank's tets in
-                            input numbering stay in out->own_tets */
+    int keep_own;        /* FDT_MPI_OWN_* (not with gather): this rank's
+                            tets in input numbering stay in out->own_tets,
+                            with the points they use (.vtu pieces) or
+                            with its hull faces (.fdtb and .ele pieces) */
     int fail_rank;       /* a test's injected failure: rank fail_rank fails
                             (FDT_EINTERNAL) once it advanced fail_after
                             faces; -1: none */
@@ -39,6 +41,7 @@ typedef struct fdt_mpi_opts {
 } fdt_mpi_opts;
 
 enum { FDT_MPI_NTIMES = 5 };
+enum { FDT_MPI_OWN_POINTS = 1, FDT_MPI_OWN_HULL = 2 };
 
 typedef struct fdt_mpi_out {
     /* On every rank: */
@@ -53,6 +56,10 @@ typedef struct fdt_mpi_out {
     double *own_xyz;       /* keep_own: their coordinates as read, 3 each
                               (owned) */
     size_t own_npts;
+    fdt_vid *own_hull;     /* keep_own & FDT_MPI_OWN_HULL: this rank's hull
+                              faces, 3 each, outward, input numbering
+                              (owned) */
+    size_t own_nhull;
     uint64_t bytes_out;    /* bytes this rank sent translating ids */
     /* On rank 0 only (reduced over the ranks): */
     fdt_sethash hash;

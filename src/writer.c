@@ -293,6 +293,11 @@ int fdt_out_commit(out_file *files, int k, char *err, size_t errlen)
     return commit_all(files, k, err, errlen, 0);
 }
 
+const char *fdt_out_temp(const out_file *o)
+{
+    return o->slot >= 0 ? fdt_io_tmp_path[o->slot] : NULL;
+}
+
 /* ------------------------------------------------------------------------ */
 /* Side files (the CLI's --stats-json)                                       */
 /* ------------------------------------------------------------------------ */

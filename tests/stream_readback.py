@@ -2,6 +2,14 @@
 """Streamed outputs against the in-memory ones, and interrupted streamed writes.
 
 usage: stream_readback.py FRONTDT README
+       stream_readback.py FRONTDT README --pieces INDEX REF
+
+--pieces (tests/test_mpi.sh): the pieces of frontdt-mpi's -o INDEX (.pfdtb,
+read with README.md's read_pieces, or .pele: the .ele/.face pieces beside
+their .node) hold, all together, the tets and hull faces of the serial
+run's REF.ele / REF.face, each the same way round; the index's counts and
+names are those of the files; each .fdtb piece's header says piece (flag 8),
+no points, the input's point count.
 
 1. A random point set (one duplicate point) is written by the CLI twice: in
    memory (--no-stream: .ele with .node/.face/.neigh, .vtu, .fdtb) and
@@ -101,14 +109,15 @@ def read_vtu(path):
     return pts, [conn[4 * i:4 * i + 4] for i in range(nt)]
 
 
-def readme_reader():
+def readme_reader(name="read_fdtb"):
     text = open(README).read()
     m = re.search(r"<!-- fdtb-reader[^>]*-->\n```python\n(.*?)```", text, re.S)
-    if not m:
-        fail("README.md has no fdtb-reader block")
+    mp = re.search(r"<!-- fdtb-pieces-reader[^>]*-->\n```python\n(.*?)```", text, re.S)
+    if not m or not mp:
+        fail("README.md has no fdtb-reader or fdtb-pieces-reader block")
         return None
-    if len(m.group(1).splitlines()) > 20:
-        fail("README.md's fdtb reader is over 20 lines")
+    if len(m.group(1).splitlines()) > 20 or len(mp.group(1).splitlines()) > 20:
+        fail("README.md's fdtb reader or pieces reader is over 20 lines")
     try:
         import numpy  # noqa: F401
     except ImportError:
@@ -116,7 +125,8 @@ def readme_reader():
         return None
     env = {}
     exec(m.group(1), env)
-    return env["read_fdtb"]
+    exec(mp.group(1), env)
+    return env[name]
 
 
 def read_fdtb(path, numpy_reader):
@@ -270,6 +280,89 @@ def refused(tmp):
     if listing(d):
         fail("refused runs left %s" % listing(d))
 
+
+def index_lines(index):
+    """The text index: (fields, [(name, tets, hull)])."""
+    keys, pieces = {}, []
+    lines = open(index).read().splitlines()
+    if not lines or lines[0] != "frontdt-pieces 1":
+        fail("%s: first line %r" % (index, lines[:1]))
+    for line in lines[1:]:
+        key, _, val = line.partition(" ")
+        if key == "piece":
+            name, nt, nh = val.rsplit(" ", 2)
+            pieces.append((name, int(nt), int(nh)))
+        else:
+            keys[key] = val
+    return keys, pieces
+
+
+def pieces(index, ref):
+    """--pieces: the mesh of frontdt-mpi's pieces against the serial run's."""
+    keys, plist = index_lines(index)
+    d = os.path.dirname(index)
+    ref_tets = read_table(ref + ".ele", 4)
+    ref_hull = read_table(ref + ".face", 3)
+    npoints = int(open(ref + ".node").readline().split()[0])
+    if int(keys.get("points", -1)) != npoints or int(keys.get("ranks", 0)) != len(plist):
+        fail("%s: points %s, ranks %s for %d pieces (input %d points)"
+             % (index, keys.get("points"), keys.get("ranks"), len(plist), npoints))
+    tt, th = (int(x) for x in keys.get("total", "-1 -1").split())
+    if (tt, th) != (sum(p[1] for p in plist), sum(p[2] for p in plist)) or tt != len(ref_tets):
+        fail("%s: total %d %d; pieces %d, serial %d tets"
+             % (index, tt, th, sum(p[1] for p in plist), len(ref_tets)))
+    if not re.fullmatch(r"[0-9a-f]{16}", keys.get("set-hash", "")):
+        fail("%s: no set-hash line" % index)
+    tets, hull = [], []
+    if keys.get("format") == "fdtb":
+        for name, nt, nh in plist:
+            head = open(os.path.join(d, name), "rb").read(64)
+            magic, version, flags, n, cnt_t, cnt_h = struct.unpack_from("<8sIIQQQ", head, 0)
+            if magic != b"FDTMESH\0" or version != 1 or flags != 12 or n != npoints \
+                    or (cnt_t, cnt_h) != (nt, nh):
+                fail("%s: header %r %d flags %d points %d counts %d %d" %
+                     (name, magic, version, flags, n, cnt_t, cnt_h))
+        reader = readme_reader("read_pieces")
+        if reader:
+            t, h, rkeys = reader(index)
+            if rkeys.get("set-hash") != keys.get("set-hash"):
+                fail("README's read_pieces: fields %r" % rkeys)
+            tets = [tuple(int(x) for x in r) for r in t]
+            hull = [tuple(int(x) for x in r) for r in h]
+        else:
+            for name, nt, nh in plist:
+                data = open(os.path.join(d, name), "rb").read()
+                ids = struct.unpack_from("<%di" % (4 * nt + 3 * nh), data, 64)
+                if 64 + 4 * len(ids) != len(data):
+                    fail("%s: %d bytes" % (name, len(data)))
+                tets += [ids[4 * i:4 * i + 4] for i in range(nt)]
+                hull += [ids[4 * nt + 3 * i:4 * nt + 3 * i + 3] for i in range(nh)]
+    elif keys.get("format") == "ele":
+        node = os.path.join(d, keys.get("node", ""))
+        if open(node, "rb").read() != open(ref + ".node", "rb").read():
+            fail("%s: not the serial run's .node, byte for byte" % node)
+        for name, nt, nh in plist:
+            t = read_table(os.path.join(d, name), 4)
+            h = read_table(os.path.join(d, name[:-4] + ".face"), 3)
+            if (len(t), len(h)) != (nt, nh):
+                fail("%s: %d tets, %d faces; the index says %d, %d" % (name, len(t), len(h),
+                                                                    nt, nh))
+            tets += t
+            hull += h
+    else:
+        fail("%s: format %r" % (index, keys.get("format")))
+    if sorted(canon_tet(t) for t in tets) != sorted(canon_tet(t) for t in ref_tets):
+        fail("%s: the pieces' tets are not the serial run's (or not the same way round)" % index)
+    if sorted(canon_face(f) for f in hull) != sorted(canon_face(f) for f in ref_hull):
+        fail("%s: the pieces' hull faces are not the serial run's" % index)
+
+
+if len(sys.argv) == 6 and sys.argv[3] == "--pieces":
+    pieces(sys.argv[4], sys.argv[5])
+    if failures:
+        sys.exit(1)
+    print("stream_readback --pieces: all checks passed")
+    sys.exit(0)
 
 with tempfile.TemporaryDirectory() as tmp:
     compare(tmp)

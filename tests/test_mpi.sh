@@ -8,7 +8,9 @@
 # same mesh as the serial run's, byte for byte; a rank that fails (the
 # hidden --inject-failure) ends every rank with the error, no hang, no
 # output; -o BASE.pvtu writes one piece a rank and an index that VTK reads
-# as the serial mesh. The distributed setup (each rank its slice of a text
+# as the serial mesh; -o BASE.pfdtb / BASE.pele write a piece a rank and a
+# text index (the pieces together: the serial tets, the collective .node
+# the serial .node byte for byte; a failed piece leaves nothing). The distributed setup (each rank its slice of a text
 # file, bisection by exchange, duplicates merged across slices): headers
 # and comments, duplicates spread across slices, the whole-read fallback,
 # standard input, a bad line in a later rank's slice (every rank exits 2
@@ -279,6 +281,79 @@ mpi 2 60 "$fmpi" -q -o "$work/none/mesh.pvtu" "$work/clusters.xyz" 2>/dev/null
 rc=$?
 [[ $rc -eq 5 && ! -e $work/none ]] || fail ".pvtu into a missing directory: exit $rc"
 
+# -o BASE.pfdtb and -o BASE.pele: one piece a rank and a text index, no
+# gather. All pieces together hold the serial run's tets and hull faces,
+# each the same way round (stream_readback.py --pieces: the .pfdtb through
+# README.md's read_pieces when numpy is there; the headers, the index's
+# names and counts), and the .node that every rank wrote its lines of is
+# the serial run's byte for byte. Inputs: 1-7 ranks on clusters,
+# duplicates spread across slices, five points on 7 ranks (ranks with no
+# tets: empty pieces).
+readback=$(dirname "$0")/stream_readback.py
+readme=$(dirname "$0")/../README.md
+pieces_check() {
+  local name=$1 f=$2 np=$3 ext=$4 d="$work/pc"
+  checks=$((checks + 1))
+  rm -rf "$d"
+  mkdir "$d"
+  "$frontdt" --mode serial -q -o "$d/ref.ele" "$f" || { fail "$name: serial .ele"; return; }
+  if ! mpi "$np" 120 "$fmpi" -q -o "$d/m.$ext" "$f" 2>"$d/err"; then
+    fail "$name, -o .$ext, $np ranks: exit $?"; sed 's/^/    /' "$d/err" | tail -5; return
+  fi
+  if ! "$python" "$readback" "$frontdt" "$readme" --pieces "$d/m.$ext" "$d/ref" >"$d/log" 2>&1; then
+    fail "$name, -o .$ext, $np ranks: the pieces are not the serial mesh"
+    sed 's/^/    /' "$d/log" | tail -5
+  fi
+  local want=$((np + 5)) # the pieces, the index, ref.{node,ele,face,neigh}
+  [[ $ext == pele ]] && want=$((2 * np + 6)) # .face pieces and the .node
+  [[ $(ls -A "$d" | grep -vcE '^(err|log)$') -eq $want ]] ||
+    fail "$name, -o .$ext, $np ranks: files $(ls -A "$d" | tr '\n' ' ')"
+}
+for np in "${nps[@]}"; do
+  pieces_check clusters "$work/clusters.xyz" "$np" pfdtb
+  pieces_check clusters "$work/clusters.xyz" "$np" pele
+done
+for np in 3 7; do
+  pieces_check "duplicates across slices" "$work/twice.xyz" "$np" pfdtb
+  pieces_check "duplicates across slices" "$work/twice.xyz" "$np" pele
+done
+pieces_check "five points" "$work/five.xyz" 7 pele
+pieces_check "five points" "$work/five.xyz" 7 pfdtb
+grep -q '^piece m_6.fdtb 0 0$' "$work/pc/m.pfdtb" ||
+  fail "five points on 7 ranks: rank 6 holds tets (the check of an empty piece checks nothing)"
+# A rank whose piece fails once written (hidden --inject-write-failure):
+# every rank exits 5 and no piece, .node or index is left (the pieces
+# already renamed are removed again); a missing directory: exit 5 too.
+for spec in "3 pfdtb 1" "3 pele 2" "4 pele 0" "2 pvtu 1"; do
+  set -- $spec
+  checks=$((checks + 1))
+  rm -rf "$work/wf"
+  mkdir "$work/wf"
+  mpi "$1" 60 "$fmpi" -q --inject-write-failure "$3" -o "$work/wf/m.$2" "$work/clusters.xyz" \
+    2>"$work/wferr"
+  rc=$?
+  [[ $rc -eq 5 ]] || fail "write failure on rank $3 of $1, .$2: exit $rc"
+  grep -q "rank $3: .*injected failure" "$work/wferr" || fail "write failure, .$2: no message"
+  [[ -z $(ls -A "$work/wf") ]] || fail "write failure on rank $3 of $1, .$2: left $(ls -A "$work/wf" | tr '\n' ' ')"
+done
+for ext in pfdtb pele; do
+  checks=$((checks + 1))
+  mpi 3 60 "$fmpi" -q -o "$work/none/m.$ext" "$work/clusters.xyz" 2>/dev/null
+  rc=$?
+  [[ $rc -eq 5 && ! -e $work/none ]] || fail ".$ext into a missing directory: exit $rc"
+done
+
+# An output file of the set that is the input (here the .node): exit 1,
+# nothing written, the input as it was.
+checks=$((checks + 1))
+mkdir -p "$work/in"
+"$frontdt" --mode serial -q -o "$work/in/m.ele" "$work/clusters.xyz" || fail "serial .ele"
+cp "$work/in/m.node" "$work/in/orig.node"
+mpi 2 60 "$fmpi" -q -o "$work/in/m.pele" "$work/in/m.node" 2>/dev/null
+rc=$?
+[[ $rc -eq 1 && ! -e $work/in/m.pele && ! -e $work/in/m_0.ele ]] &&
+  cmp -s "$work/in/m.node" "$work/in/orig.node" || fail ".pele whose .node is the input: exit $rc"
+
 # A failing rank: every rank ends with the error (exit 7), quickly, and
 # nothing is written. The wrapper reports each rank's exit code and exits
 # 0 itself, so mpirun does not kill the other ranks first: each must end
@@ -299,31 +374,38 @@ for spec in "4 2:50" "7 0:200" "3 1:0" "2 1:400"; do
 done
 
 # SIGINT to mpirun (Open MPI forwards it to every rank): every rank ends
-# (exit 6, "interrupted"), and -o BASE.pvtu leaves either nothing or the
-# complete set (the index and every piece), never a piece or an index
-# alone; signals at a few moments, at least one of them mid-run.
+# (exit 6, "interrupted"), and -o BASE.pvtu / .pfdtb / .pele leaves either
+# nothing or the complete set (the index, every piece, the .node), never a
+# piece or an index alone; signals at a few moments, at least one of them
+# mid-run.
 if [[ ${#oversub[@]} -gt 0 ]]; then
   "$gen" uniform 100000 31 "$work/u100k.xyz" >/dev/null || fail "gen_points 100k"
   interrupted=0
-  for delay in 0.6 1.2 2.4; do
+  complete_pvtu="mesh.pvtu mesh_0.vtu mesh_1.vtu mesh_2.vtu "
+  complete_pfdtb="mesh.pfdtb mesh_0.fdtb mesh_1.fdtb mesh_2.fdtb "
+  complete_pele="mesh.node mesh.pele mesh_0.ele mesh_0.face mesh_1.ele mesh_1.face mesh_2.ele mesh_2.face "
+  for spec in "0.6 pvtu" "1.2 pvtu" "2.4 pvtu" "1.5 pfdtb" "2.0 pele"; do
+    set -- $spec
+    delay=$1 ext=$2
     checks=$((checks + 1))
     rm -rf "$work/sig"
     mkdir "$work/sig"
-    "$mpirun" "${oversub[@]}" -np 3 "$fmpi" -q -o "$work/sig/mesh.pvtu" "$work/u100k.xyz" \
+    "$mpirun" "${oversub[@]}" -np 3 "$fmpi" -q -o "$work/sig/mesh.$ext" "$work/u100k.xyz" \
       2>"$work/sigerr" &
     pid=$!
     sleep "$delay"
     kill -INT "$pid" 2>/dev/null
     for _ in $(seq 60); do kill -0 "$pid" 2>/dev/null || break; sleep 1; done
     if kill -0 "$pid" 2>/dev/null; then
-      fail "SIGINT after ${delay}s: mpirun still runs 60 s later"
+      fail "SIGINT after ${delay}s (.$ext): mpirun still runs 60 s later"
       kill -KILL "$pid"
     fi
     wait "$pid" 2>/dev/null
     grep -q "frontdt-mpi: interrupted" "$work/sigerr" && interrupted=$((interrupted + 1))
-    left=$(ls -A "$work/sig" | tr '\n' ' ')
-    [[ -z $left || $left == "mesh.pvtu mesh_0.vtu mesh_1.vtu mesh_2.vtu " ]] ||
-      fail "SIGINT after ${delay}s: left '$left'"
+    left=$(ls -A "$work/sig" | LC_ALL=C sort | tr '\n' ' ')
+    complete=complete_$ext
+    [[ -z $left || $left == "${!complete}" ]] ||
+      fail "SIGINT after ${delay}s (.$ext): left '$left'"
   done
   [[ $interrupted -gt 0 ]] || fail "SIGINT: no run was interrupted"
 else
