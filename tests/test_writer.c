@@ -9,6 +9,10 @@
  * and no partial output; the file set of each output family
  * (fdt_output_files) and file identity by any name (fdt_same_file), which
  * the CLI uses to refuse an output that would overwrite its input.
+ * The side files (fdt_wr_side_*), a mesh whose arrays are missing, a
+ * polyMesh over a regular file, and text written to a stream that fails
+ * (/dev/full) or is refused (binary formats): each refused with its code
+ * and a message naming the file, nothing left behind.
  * src/outfile.h's buffer on its own, over pipes, where a seek or a pwrite
  * fails (ESPIPE) and a write fails in stdio's flush or in ours (EPIPE,
  * the reader gone): the first errno is kept, nothing more is written, and
@@ -1061,6 +1065,85 @@ static void test_format_table(const char *dir)
     EXPECT(fdt_output_files_as(longp, tets, names) == 1);
 }
 
+/* Side files, missing arrays, streams. */
+static void test_misc(const char *dir)
+{
+    char p[4096], err[512];
+    fdt_wr_side *side = NULL;
+    /* side files: a name that is a directory, too long, in a missing
+     * directory: NULL, the reason, nothing created */
+    snprintf(p, sizeof p, "%s/", dir);
+    EXPECT(fdt_wr_side_open(p, &side, err, sizeof err) == NULL && side == NULL &&
+           strstr(err, strerror(EISDIR)));
+    static char longp[FDT_IO_PATH + 8];
+    memset(longp, 'x', sizeof longp - 1);
+    static char lerr[FDT_IO_PATH + 256]; /* the message holds the path */
+    EXPECT(fdt_wr_side_open(longp, &side, lerr, sizeof lerr) == NULL &&
+           strstr(lerr, strerror(ENAMETOOLONG)));
+    snprintf(p, sizeof p, "%s/no/side.json", dir);
+    EXPECT(fdt_wr_side_open(p, &side, err, sizeof err) == NULL &&
+           strstr(err, "no/side.json: ") && strstr(err, strerror(ENOENT)));
+    fdt_wr_side_abandon(NULL);
+    snprintf(p, sizeof p, "%s/side.json", dir);
+    FILE *f = fdt_wr_side_open(p, &side, err, sizeof err);
+    CHECK(f && side);
+    fputs("{}\n", f);
+    EXPECT(count_entries(dir) == 1 && count_temps(dir) == 1);
+    fdt_wr_side_abandon(side);
+    EXPECT(count_entries(dir) == 0);
+    f = fdt_wr_side_open(p, &side, err, sizeof err);
+    CHECK(f && side);
+    fputs("{}\n", f);
+    EXPECT(fdt_wr_side_commit(side, err, sizeof err) == FDT_IO_OK);
+    size_t len;
+    char *back = slurp(p, &len);
+    EXPECT(back && strcmp(back, "{}\n") == 0 && count_temps(dir) == 0);
+    free(back);
+    unlink(p);
+
+    /* arrays missing from the view */
+    mesh m;
+    make_mesh(&m);
+    fdt_mesh_view v = view_of(&m);
+    fdt_mesh_view bad = v;
+    bad.tets = NULL;
+    snprintf(p, sizeof p, "%s/m.tets", dir);
+    expect_fail(dir, p, &bad, FDT_IO_EFORMAT, "m.tets: mesh arrays missing");
+    bad = v;
+    bad.hull = NULL;
+    expect_fail(dir, p, &bad, FDT_IO_EFORMAT, "mesh arrays missing");
+    bad = v;
+    bad.faces = m.hull; /* any face list, without its tets */
+    bad.n_faces = 1;
+    expect_fail(dir, p, &bad, FDT_IO_EFORMAT, "face list without its tets");
+    EXPECT(fdt_wr_mesh_ex(NULL, NULL, &v, NULL, NULL, err, sizeof err) == FDT_IO_EFORMAT &&
+           strstr(err, "no path or no mesh"));
+    EXPECT(fdt_wr_mesh(p, NULL, err, sizeof err) == FDT_IO_EFORMAT);
+
+    /* streams: refused without one, or for a binary format; a full
+     * device reports ENOSPC under the name given */
+    const fdt_format *tets = fdt_format_by_name("tets"), *vtu = fdt_format_by_name("vtu");
+    CHECK(tets && vtu);
+    EXPECT(fdt_wr_mesh_stream(NULL, "stdout", tets, &v, err, sizeof err) == FDT_IO_EFORMAT);
+    EXPECT(fdt_wr_mesh_stream(stderr, "stdout", NULL, &v, err, sizeof err) == FDT_IO_EFORMAT);
+    EXPECT(fdt_wr_mesh_stream(stderr, "stdout", vtu, &v, err, sizeof err) == FDT_IO_EEXT &&
+           strstr(err, "single-file text format"));
+    bad = v;
+    bad.tets = NULL;
+    EXPECT(fdt_wr_mesh_stream(stderr, "stdout", tets, &bad, err, sizeof err) ==
+           FDT_IO_EFORMAT && strstr(err, "mesh arrays missing"));
+    FILE *full = fopen("/dev/full", "w");
+    if (full) {
+        EXPECTF(fdt_wr_mesh_stream(full, "stdout", tets, &v, err, sizeof err) ==
+                    FDT_IO_EWRITE && strstr(err, "stdout: ") && strstr(err, strerror(ENOSPC)),
+                "[%s]", err);
+        fclose(full);
+    } else {
+        printf("misc: no /dev/full, its case skipped\n");
+    }
+    EXPECT(count_entries(dir) == 0);
+}
+
 /* ------------------------------------------------------------------------ */
 /* src/outfile.h alone                                                       */
 /* ------------------------------------------------------------------------ */
@@ -1246,12 +1329,12 @@ int main(void)
     }
     char sub[4096];
     const char *names[] = { "small", "refuse", "ids", "large", "files",
-                            "same", "table", "outfile" };
+                            "same", "table", "outfile", "misc" };
     void (*fns[])(const char *) = { test_small_mesh, test_refusals,
                                     test_big_ids, test_large,
                                     test_output_files, test_same_file,
-                                    test_format_table, test_outfile };
-    for (int i = 0; i < 8; i++) {
+                                    test_format_table, test_outfile, test_misc };
+    for (int i = 0; i < 9; i++) {
         snprintf(sub, sizeof sub, "%s/%s", dir, names[i]);
         mkdir(sub, 0755);
         long before = test_failures();
