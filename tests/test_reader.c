@@ -1420,6 +1420,24 @@ static void test_open(tctx *t)
     EXPECT_ERR(t, path, FDT_IO_EOPEN, "sub.xyz/: is a directory");
     EXPECT_ERR(t, t->dir, FDT_IO_EOPEN, ": is a directory");
 
+    /* A file that opens but cannot be read: /proc/self/mem at offset 0
+     * (unmapped) fails read() with EIO, through a link of each format's
+     * name: the streamed readers and the buffered one report it. */
+    if (access("/proc/self/mem", R_OK) == 0) {
+        const char *names[] = {"mem.xyz", "mem.ply", "mem.node"};
+        for (int i = 0; i < 3; i++) {
+            snprintf(path, sizeof path, "%s/%s", t->dir, names[i]);
+            if (symlink("/proc/self/mem", path) != 0) {
+                fail_at(t, __LINE__, "symlink %s: %s", path, strerror(errno));
+                continue;
+            }
+            char want[64];
+            snprintf(want, sizeof want, "%s: cannot read: %s", names[i], strerror(EIO));
+            EXPECT_ERR(t, path, FDT_IO_EOPEN, want);
+            unlink(path);
+        }
+    }
+
     write_file(t, "locked.xyz", "0 0 0\n", 6, path, sizeof path);
     if (geteuid() != 0) { /* root reads anything */
         chmod(path, 0);
@@ -2031,6 +2049,20 @@ static void test_stdin(tctx *t)
     EXPECTF(rc == FDT_IO_OK && n == NP && memcmp(xyz, want, 3 * NP * sizeof *want) == 0,
           "stdin ply: %s, %zu points: %s", code_name(rc), n, err);
     free(xyz);
+
+    /* .node, read whole (not streamed): from a pipe its size is unknown,
+     * the buffer grows from 64 KiB as the bytes come. */
+    bbuf nd = {0};
+    bb_printf(&nd, "%d 3 0 0\n", NP);
+    for (size_t i = 0; i < NP; i++)
+        bb_printf(&nd, "%zu %.17g %.17g %.17g\n", i, want[3 * i], want[3 * i + 1],
+                  want[3 * i + 2]);
+    rc = read_stdin(nd.p, nd.n, FDT_RD_NODE, &xyz, &n, err, sizeof err);
+    EXPECTF(nd.n > 4 * 65536 && rc == FDT_IO_OK && n == NP &&
+                memcmp(xyz, want, 3 * NP * sizeof *want) == 0,
+            "stdin node (%zu bytes): %s, %zu points: %s", nd.n, code_name(rc), n, err);
+    free(xyz);
+    bb_free(&nd);
 
     /* Messages name stdin; without a format it is refused. */
     rc = read_stdin("0 0 0\n1 0 q\n", 12, FDT_RD_XYZ, &xyz, &n, err, sizeof err);
