@@ -252,6 +252,18 @@ static void test_refusals(const double *xyz, size_t n, const fdt_result *mem)
     EXPECT(a == 0 && b == 0);
     EXPECT(entries() == before);
 
+    /* no message buffer at all is fine: the codes alone; the sink and the
+     * counts want somewhere to write */
+    CHECK(fdt_stream_writer_open(&w, path_in("q.fdtb"), NULL, xyz, n, 0, NULL, 0) == FDT_OK);
+    EXPECT(fdt_stream_writer_sink(w, NULL) == FDT_EINVAL);
+    CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+    EXPECT(sink.tets(sink.user, NULL, 0) == FDT_OK);
+    fdt_stream_writer_counts(w, NULL, NULL);
+    fdt_vid neg[4] = {0, 1, 2, -1};
+    EXPECT(sink.tets(sink.user, neg, 1) == FDT_EINVAL);
+    EXPECT(fdt_stream_writer_close(&w, 1, NULL, 0) == FDT_EINVAL && w == NULL);
+    EXPECT(entries() == before);
+
     /* Every temporary slot taken: ten TetGen sets hold 30 of the 32, the
      * eleventh gets its .node and .ele and fails at its .face; its two
      * temporaries go, the others stay until closed. */
