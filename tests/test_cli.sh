@@ -234,7 +234,7 @@ run io_noformat "$FRONTDT" - </dev/null
 expect_rc io_noformat 1 && expect_in io_noformat err "needs --input-format"
 run io_badformat "$FRONTDT" --input-format las io.xyz
 expect_rc io_badformat 1 && expect_in io_badformat err "unknown input format 'las'"
-for bad in 0,1,2 1,2 1,2,3,4 1,1,2 a,b,c 1,,2; do
+for bad in 0,1,2 1,2 1,2,3,4 1,1,2 1,2,1 1,2,2 a,b,c 1,,2 ,1,2 12345678901234567,1,2; do
     run io_badcols "$FRONTDT" --columns "$bad" io.xyz
     expect_rc io_badcols 1 && expect_in io_badcols err "--columns wants three"
 done
@@ -849,6 +849,17 @@ usage_case u_stream_hash "--hash sorts the whole mesh" st.xyz --stream --hash
 usage_case u_memlimit "--memory-limit wants" st.xyz --memory-limit 12X
 usage_case u_memlimit0 "--memory-limit wants" st.xyz --memory-limit 0
 usage_case u_memlimit_big "--memory-limit wants" st.xyz --memory-limit 99999999999999999G
+# no digits, more than 19 digits, a unit after 'i' only with K, M or G
+usage_case u_memlimit_nodigit "--memory-limit wants" st.xyz --memory-limit G
+usage_case u_memlimit_20 "--memory-limit wants" st.xyz --memory-limit 12345678901234567890
+usage_case u_memlimit_ib "--memory-limit wants" st.xyz --memory-limit 5iB
+usage_case u_memlimit_tail "--memory-limit wants" st.xyz --memory-limit 5MBx
+usage_case u_threads_empty "--threads" --threads= st.xyz
+# every spelling of a unit: 1024 KiB, 1 MB and 1mib are all 1 MiB
+for lim in 1024KiB 1MB 1mib 1048576b; do
+    run st_limit_$lim "$FRONTDT" st.xyz --memory-limit $lim
+    expect_rc st_limit_$lim 4 && expect_in st_limit_$lim err "more than --memory-limit 1 MiB"
+done
 run st_limit "$FRONTDT" st.xyz --memory-limit 1M
 expect_rc st_limit 4 && expect_in st_limit err "more than --memory-limit 1 MiB"
 run st_limit_ok "$FRONTDT" st.xyz --memory-limit 2G --stream --stats

@@ -997,6 +997,33 @@ static void test_same_file(const char *dir)
     EXPECT(!fdt_same_file("loop.a", "loop.b"));
     EXPECT(!fdt_same_file("no/such/x.tets", "no/such/../such/x.tets"));
     EXPECT(!fdt_same_file("in.node/x", "in.node"));
+    /* a name with nothing after its slash, not there: unresolvable */
+    EXPECT(!fdt_same_file("gone/", "./gone/"));
+    /* a name in the root directory, however many slashes */
+    EXPECT(fdt_same_file("/fdt_same_file_none", "//fdt_same_file_none"));
+    /* a path longer than any the writer takes */
+    static char longp[FDT_IO_PATH + 8];
+    memset(longp, 'x', sizeof longp - 1);
+    EXPECT(fdt_same_file(longp, longp) && !fdt_same_file(longp, "in.node"));
+    /* a dangling link whose target no longer fits beside its directory */
+    static char target[FDT_IO_PATH];
+    memset(target, 'y', FDT_IO_PATH - 2);
+    target[FDT_IO_PATH - 2] = '\0';
+    if (symlink(target, "sub/far") == 0) {
+        EXPECT(!fdt_same_file("sub/far", "sub/./far"));
+        unlink("sub/far");
+    }
+    /* A path is looked up at most 40 times (FDT_IO_MAX_HOPS, like the
+     * kernel's limit on links): hop0 -> hop1 -> ... -> hop45, not there.
+     * From hop6, 39 links and the missing name: within the limit; from
+     * hop5, 40 links: unresolvable. */
+    for (int i = 0; i < 45; i++) {
+        snprintf(a, sizeof a, "hop%d", i);
+        snprintf(b, sizeof b, "hop%d", i + 1);
+        EXPECT(symlink(b, a) == 0);
+    }
+    EXPECT(fdt_same_file("hop10", "./hop45") && fdt_same_file("hop6", "hop45"));
+    EXPECT(!fdt_same_file("hop5", "hop45") && !fdt_same_file("hop0", "hop45"));
 
     EXPECT(chdir(cwd) == 0);
 }
