@@ -57,6 +57,9 @@ typedef struct rd_src {
     size_t mem_len;
     size_t pos;        /* bytes delivered so far */
     int eof;           /* a read found the end */
+    size_t fail_after; /* mem only, for tests (fdt_rd_opts.fail_after):
+                          a read reaching past this many bytes fails as
+                          read() would; 0: never */
 } rd_src;
 
 typedef struct rd_ctx {

@@ -2194,6 +2194,51 @@ static void chunk_case(tctx *t, int line, const char *name, const void *data, si
         }
     }
 }
+/*
+ * A read() that fails part-way (fdt_rd_opts.fail_after: the memory
+ * source fails with EIO as soon as a read reaches past that byte), at
+ * every byte of the input, in blocks of several sizes, on 1 and 3
+ * threads: always FDT_IO_EOPEN with "NAME: cannot read: ..." and the
+ * outputs cleared, never a partial point set; a limit at or past the end
+ * changes nothing.
+ */
+static void fail_sweep(tctx *t, int line, const char *name, const void *data, size_t len,
+                       const double *want, size_t nw)
+{
+    static const size_t chunks[] = {0, 1, 7, 64};
+    char wmsg[300];
+    snprintf(wmsg, sizeof wmsg, "%s: cannot read: %s", name, strerror(EIO));
+    for (size_t ci = 0; ci < sizeof chunks / sizeof chunks[0]; ci++) {
+        for (int threads = 1; threads <= 3; threads += 2) {
+            for (size_t at = 1; at <= len + 1; at++) {
+                fdt_rd_opts o;
+                fdt_rd_opts_default(&o);
+                o.chunk = chunks[ci];
+                o.threads = threads;
+                o.min_slice = 1;
+                o.fail_after = at;
+                double *xyz = (double *)&xyz;
+                size_t n = 7;
+                char err[512] = "";
+                int rc = fdt_rd_points_mem_with(name, data, len, &o, &xyz, &n, err, sizeof err);
+                test_count_checks(1);
+                if (at < len && (rc != FDT_IO_EOPEN || strcmp(err, wmsg) != 0 || xyz != NULL ||
+                                 n != 0))
+                    fail_at(t, line, "%s, chunk %zu, %d threads, failing after %zu of %zu "
+                                     "bytes: %s '%s'", name, chunks[ci], threads, at, len,
+                            code_name(rc), err);
+                if (at >= len && (rc != FDT_IO_OK || n != nw ||
+                                  memcmp(xyz, want, 3 * nw * sizeof *want) != 0))
+                    fail_at(t, line, "%s, chunk %zu, %d threads, a limit of %zu past %zu "
+                                     "bytes: %s '%s'", name, chunks[ci], threads, at, len,
+                            code_name(rc), err);
+                if (rc == FDT_IO_OK)
+                    free(xyz);
+            }
+        }
+    }
+}
+
 #define CHUNK_OK(t, name, text, want)                                                  \
     chunk_case((t), __LINE__, name, text, strlen(text), FDT_IO_OK, NULL, want,            \
                sizeof(want) / sizeof(want)[0] / 3)
@@ -2227,6 +2272,12 @@ static void test_chunks(tctx *t)
     static const double w9[] = {1, 2, 3, 4.5, 50, -6, 7, 8, 9};
     /* lines, numbers and exponents split at every byte */
     CHUNK_OK(t, "split.xyz", "1 2 3\n4.5 5e1 -6\n7 8 9\n", w9);
+    const char *hdr_csv = "\xef\xbb\xbf# a comment\n\n  X, Y, Z\n1,2,3\n# c\n4.5,5e1,-6\n7,8,9";
+    fail_sweep(t, __LINE__, "fail.csv", hdr_csv, strlen(hdr_csv), w9, 3);
+    const char *ascii_ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\n"
+                            "property double y\nproperty double z\nend_header\n"
+                            "1 2 3\n4.5 5e1 -6\n7 8 9\n";
+    fail_sweep(t, __LINE__, "fail_ascii.ply", ascii_ply, strlen(ascii_ply), w9, 3);
     /* CRLF: a boundary between '\r' and '\n' */
     CHUNK_OK(t, "crlf.xyz", "1 2 3\r\n4.5 5e1 -6\r\n7 8 9\r\n", w9);
     /* the last line without its newline */
@@ -2264,6 +2315,7 @@ static void test_chunks(tctx *t)
     for (size_t i = 0; i < 9; i++)
         put_le(&b, &w9[i], 8);
     chunk_case(t, __LINE__, "le.ply", b.p, b.n, FDT_IO_OK, NULL, w9, 3);
+    fail_sweep(t, __LINE__, "fail_le.ply", b.p, b.n, w9, 3);
     /* a short body: the error names the byte where the data ends */
     size_t hdr = b.n - 72;
     char msg[300];
@@ -2318,6 +2370,7 @@ static void test_chunks(tctx *t)
             put_le(&b, &v, 4);
     }
     chunk_case(t, __LINE__, "mixed.ply", b.p, b.n, FDT_IO_OK, NULL, w9, 3);
+    fail_sweep(t, __LINE__, "fail_mixed.ply", b.p, b.n, w9, 3);
     hdr = b.n - 3 * 13 - 2 * 13;
     snprintf(msg, sizeof msg, "mixedshort.ply: byte %zu: file ends inside element 'face' item "
                               "2 of 2", b.n - 1);
