@@ -498,6 +498,22 @@ run full_json "$FRONTDT" pts.xyz --stats-json out/full.json --quiet
 expect_rc full_json 5 && expect_in full_json err "out/full.json: No space left on device"
 [ -L out/full.json ] || fail "full_json: the symbolic link to /dev/full was removed"
 rm -f out/full.json
+# --stats-json - on a full standard output: exit 5, stdout named.
+run full_json_stdout bash -c '"$1" "$2" --stats-json - --quiet >/dev/full' _ "$FRONTDT" pts.xyz
+expect_rc full_json_stdout 5 && expect_in full_json_stdout err "stdout: No space left on device"
+# --stats-json to a file past the file size limit (1 KiB; the JSON is
+# larger): its commit fails, exit 5, nothing left, an old file kept.
+printf 'old\n' >out/old.json
+(
+    trap - XFSZ
+    ulimit -f 1
+    exec "$FRONTDT" pts.xyz --stats-json out/old.json --quiet
+) >fsize_json.out 2>fsize_json.err
+RC=$?
+expect_rc fsize_json 5 && expect_in fsize_json err "out/old.json: File too large"
+[ "$(cat out/old.json)" = old ] || fail "fsize_json: out/old.json was changed"
+rm -f out/old.json
+expect_empty_dir fsize_json out
 
 # ---------------------------------------------------------------------------
 # Reading from a pipe and a FIFO: not seekable, not mapped; the same mesh
