@@ -15,6 +15,7 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 
+#include "read_common.h"
 #include "reader.h"
 
 #include <dirent.h>
@@ -1519,6 +1520,47 @@ static void test_open(tctx *t)
     free(xyz);
 }
 
+/* The integer parsers of src/read_text.c (.node and .ply headers): the
+ * int64 range exactly, signs, and what is not an integer. */
+static void test_parse_int(tctx *t)
+{
+    (void)t;
+    static const struct {
+        const char *s;
+        int st;
+        int64_t v;
+    } cases[] = {
+        {"0", NUM_OK, 0},
+        {"+17", NUM_OK, 17},
+        {"-17", NUM_OK, -17},
+        {"9223372036854775807", NUM_OK, INT64_MAX},
+        {"-9223372036854775808", NUM_OK, INT64_MIN},
+        {"9223372036854775808", NUM_OVERFLOW, 0},
+        {"-9223372036854775809", NUM_OVERFLOW, 0},
+        {"18446744073709551616", NUM_OVERFLOW, 0}, /* past uint64 too */
+        {"123456789012345678901234567890", NUM_OVERFLOW, 0},
+        {"", NUM_SYNTAX, 0},
+        {"-", NUM_SYNTAX, 0},
+        {"+", NUM_SYNTAX, 0},
+        {"12a", NUM_SYNTAX, 0},
+        {"1.0", NUM_SYNTAX, 0},
+        {"--1", NUM_SYNTAX, 0},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        int64_t v = 42;
+        int st = fdt_rd_parse_int(cases[i].s, strlen(cases[i].s), &v);
+        EXPECTF(st == cases[i].st && (st != NUM_OK || v == cases[i].v), "'%s': %d, %lld",
+                cases[i].s, st, (long long)v);
+    }
+    /* counts: digits only, no sign */
+    uint64_t u = 7;
+    EXPECT(fdt_rd_parse_count("123", 3, &u) == NUM_OK && u == 123);
+    EXPECT(fdt_rd_parse_count("+1", 2, &u) == NUM_SYNTAX);
+    EXPECT(fdt_rd_parse_count("-1", 2, &u) == NUM_SYNTAX);
+    EXPECT(fdt_rd_parse_count("", 0, &u) == NUM_SYNTAX);
+    EXPECT(fdt_rd_parse_count("99999999999999999999", 20, &u) == NUM_OVERFLOW);
+}
+
 /* Numbers do not depend on the locale's decimal point. */
 static void test_locale(tctx *t)
 {
@@ -2440,6 +2482,7 @@ int main(int argc, char **argv)
     test_fuzz(&t);
     test_open(&t);
     test_locale(&t);
+    test_parse_int(&t);
     test_columns(&t);
     test_stdin(&t);
     test_chunks(&t);
