@@ -11,7 +11,8 @@
  *   every temporary and leaves the target as it was; so does close(0);
  * - formats that cannot stream are refused at open, nothing created;
  * - .fdtb's flags: 64-bit ids and no points, the header and arrays read
- *   back; a hull batch larger than the first growth of its buffer;
+ *   back; hull batches larger than the first growth of its buffer and
+ *   than its second;
  * - refusals at open (NULL arguments, unknown format or flags, a path
  *   too long, every temporary slot taken in the middle of a TetGen set)
  *   and bad batches (NULL, a hull face's id out of range): EINVAL or EIO,
@@ -184,25 +185,26 @@ static void test_bin_flags(const double *xyz, size_t n, const fdt_result *mem)
         EXPECT(sink.tets(sink.user, tets, t) == FDT_OK);
         EXPECT(sink.hull(sink.user, hull, hb) == FDT_OK);
         EXPECT(sink.hull(sink.user, NULL, 0) == FDT_OK); /* an empty batch */
+        EXPECT(sink.hull(sink.user, hull, hb) == FDT_OK); /* the buffer doubles */
         EXPECT(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_OK);
         size_t len;
         unsigned char *b = slurp(path_in(name), &len);
         size_t at = 64 + (pts ? 24 * n : 0);
         CHECK(b);
-        EXPECTF(len == at + 32 * t + 24 * hb, "%s: %zu bytes", name, len);
-        if (len != at + 32 * t + 24 * hb) {
+        EXPECTF(len == at + 32 * t + 48 * hb, "%s: %zu bytes", name, len);
+        if (len != at + 32 * t + 48 * hb) {
             free(b);
             continue;
         }
         EXPECT(memcmp(b, "FDTMESH", 8) == 0 && get_u64(b + 8) == (1 | (uint64_t)(1 | 4 | 2 * pts) << 32));
-        EXPECT(get_u64(b + 16) == n && get_u64(b + 24) == t && get_u64(b + 32) == hb);
+        EXPECT(get_u64(b + 16) == n && get_u64(b + 24) == t && get_u64(b + 32) == 2 * hb);
         if (pts)
             EXPECT(memcmp(b + 64, xyz, 24 * n) == 0);
         size_t bad = 0;
         for (size_t i = 0; i < 4 * t; i++)
             bad += get_u64(b + at + 8 * i) != (uint64_t)tets[i];
-        for (size_t i = 0; i < 3 * hb; i++)
-            bad += get_u64(b + at + 32 * t + 8 * i) != (uint64_t)hull[i];
+        for (size_t i = 0; i < 6 * hb; i++)
+            bad += get_u64(b + at + 32 * t + 8 * i) != (uint64_t)hull[i % (3 * hb)];
         EXPECTF(bad == 0, "%s: %zu ids differ", name, bad);
         free(b);
         unlink(path_in(name));
