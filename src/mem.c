@@ -28,7 +28,12 @@ void fdt_mem_advise_huge(void *p, size_t bytes)
 
 size_t fdt_mem_available(void)
 {
-    FILE *f = fopen("/proc/meminfo", "r");
+    return fdt_mem_available_at("/proc/meminfo");
+}
+
+size_t fdt_mem_available_at(const char *meminfo)
+{
+    FILE *f = fopen(meminfo, "r");
     if (f) {
         char line[256];
         unsigned long long kib;

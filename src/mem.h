@@ -24,5 +24,8 @@ void fdt_mem_advise_huge(void *p, size_t bytes);
  * that may trade memory for speed (src/oracle.c) only, never for
  * correctness. */
 size_t fdt_mem_available(void);
+/* The same with the kernel's file at meminfo (fdt_mem_available passes
+ * "/proc/meminfo"): lets tests/test_mem.c feed it a file of its own. */
+size_t fdt_mem_available_at(const char *meminfo);
 
 #endif

@@ -60,6 +60,9 @@ typedef struct rd_src {
     int bounded;       /* fd: deliver no more than `left` bytes (a range
                           of a file, fdt_rd_text_range) */
     size_t left;
+    size_t fail_after; /* mem only, for tests (fdt_rd_opts.fail_after):
+                          a read reaching past this many bytes fails as
+                          read() would; 0: never */
 } rd_src;
 
 typedef struct rd_ctx {

@@ -1145,7 +1145,7 @@ int fdt_rd_ply_find_layout(const char *path, fdt_rd_ply_layout *lay, char *err, 
         return 0; /* the whole read says what it is */
     }
     uint64_t size = (uint64_t)st.st_size;
-    rd_src src = {fd, NULL, 0, 0, 0, 0, 0};
+    rd_src src = {.fd = fd};
     c.src = &src;
     size_t cap = (size_t)64 << 10, len = 0;
     char *hb = NULL;

@@ -125,6 +125,10 @@ ptrdiff_t fdt_rd_src_read(const rd_ctx *c, void *dst, size_t len)
         len = (size_t)PTRDIFF_MAX;
     if (s->fd < 0) {
         size_t k = s->mem_len - s->pos < len ? s->mem_len - s->pos : len;
+        if (s->fail_after != 0 && k > 0 && s->pos + k > s->fail_after) {
+            fdt_rd_fail(c, FDT_IO_EOPEN, ": cannot read: %s", strerror(EIO));
+            return -1;
+        }
         if (k > 0)
             memcpy(dst, s->mem + s->pos, k);
         s->pos += k;
@@ -456,7 +460,7 @@ int fdt_rd_points_with(const char *path, const fdt_rd_opts *o, double **xyz, siz
     else if ((f = rd_setup(&c, path, o, &rc)) != NULL && f->stream == NULL)
         rc = rd_slurp(&c, fd, &st, &buf);
     if (rc == FDT_IO_OK && f != NULL && f->stream != NULL) {
-        rd_src src = {fd, NULL, 0, 0, 0, 0, 0};
+        rd_src src = {.fd = fd};
         if (S_ISREG(st.st_mode)) /* a hint for readahead: failure is harmless */
             (void)posix_fadvise(fd, 0, 0, POSIX_FADV_SEQUENTIAL);
         c.size_known = S_ISREG(st.st_mode) && (uintmax_t)st.st_size <= SIZE_MAX;
@@ -498,7 +502,7 @@ int fdt_rd_points_mem_with(const char *name, const void *data, size_t len,
     if (f->stream != NULL) {
         /* the streamed formats copy the bytes chunk by chunk, as they
          * would read them from a file */
-        rd_src src = {-1, data, len, 0, 0, 0, 0};
+        rd_src src = {.fd = -1, .mem = data, .mem_len = len, .fail_after = o->fail_after};
         c.size = len;
         c.size_known = 1;
         return rd_stream(&c, f, &src, xyz, n);
@@ -829,7 +833,7 @@ int fdt_rd_text_range(const char *path, const fdt_rd_opts *o, size_t begin, size
         close(fd);
         return rc;
     }
-    rd_src src = {fd, NULL, 0, 0, end == begin, 1, end - begin};
+    rd_src src = {.fd = fd, .eof = end == begin, .bounded = 1, .left = end - begin};
     c.src = &src;
     c.size = end - begin;
     c.size_known = 1;

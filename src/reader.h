@@ -134,6 +134,10 @@ typedef struct fdt_rd_opts {
                           lines and items straddle many refills */
     fdt_rd_progress_fn progress; /* may be NULL */
     void *progress_user;
+    size_t fail_after; /* tests only, fdt_rd_points_mem_with's streamed
+                          formats: a read reaching past this many bytes
+                          fails with EIO, as read() can in the middle of
+                          a file; 0 (the default): never */
 } fdt_rd_opts;
 
 /* Defaults: by extension, columns 1, 2, 3, one thread, no progress. */

@@ -234,7 +234,7 @@ run io_noformat "$FRONTDT" - </dev/null
 expect_rc io_noformat 1 && expect_in io_noformat err "needs --input-format"
 run io_badformat "$FRONTDT" --input-format las io.xyz
 expect_rc io_badformat 1 && expect_in io_badformat err "unknown input format 'las'"
-for bad in 0,1,2 1,2 1,2,3,4 1,1,2 a,b,c 1,,2; do
+for bad in 0,1,2 1,2 1,2,3,4 1,1,2 1,2,1 1,2,2 a,b,c 1,,2 ,1,2 12345678901234567,1,2; do
     run io_badcols "$FRONTDT" --columns "$bad" io.xyz
     expect_rc io_badcols 1 && expect_in io_badcols err "--columns wants three"
 done
@@ -498,6 +498,22 @@ run full_json "$FRONTDT" pts.xyz --stats-json out/full.json --quiet
 expect_rc full_json 5 && expect_in full_json err "out/full.json: No space left on device"
 [ -L out/full.json ] || fail "full_json: the symbolic link to /dev/full was removed"
 rm -f out/full.json
+# --stats-json - on a full standard output: exit 5, stdout named.
+run full_json_stdout bash -c '"$1" "$2" --stats-json - --quiet >/dev/full' _ "$FRONTDT" pts.xyz
+expect_rc full_json_stdout 5 && expect_in full_json_stdout err "stdout: No space left on device"
+# --stats-json to a file past the file size limit (1 KiB; the JSON is
+# larger): its commit fails, exit 5, nothing left, an old file kept.
+printf 'old\n' >out/old.json
+(
+    trap - XFSZ
+    ulimit -f 1
+    exec "$FRONTDT" pts.xyz --stats-json out/old.json --quiet
+) >fsize_json.out 2>fsize_json.err
+RC=$?
+expect_rc fsize_json 5 && expect_in fsize_json err "out/old.json: File too large"
+[ "$(cat out/old.json)" = old ] || fail "fsize_json: out/old.json was changed"
+rm -f out/old.json
+expect_empty_dir fsize_json out
 
 # ---------------------------------------------------------------------------
 # Reading from a pipe and a FIFO: not seekable, not mapped; the same mesh
@@ -849,6 +865,17 @@ usage_case u_stream_hash "--hash sorts the whole mesh" st.xyz --stream --hash
 usage_case u_memlimit "--memory-limit wants" st.xyz --memory-limit 12X
 usage_case u_memlimit0 "--memory-limit wants" st.xyz --memory-limit 0
 usage_case u_memlimit_big "--memory-limit wants" st.xyz --memory-limit 99999999999999999G
+# no digits, more than 19 digits, a unit after 'i' only with K, M or G
+usage_case u_memlimit_nodigit "--memory-limit wants" st.xyz --memory-limit G
+usage_case u_memlimit_20 "--memory-limit wants" st.xyz --memory-limit 12345678901234567890
+usage_case u_memlimit_ib "--memory-limit wants" st.xyz --memory-limit 5iB
+usage_case u_memlimit_tail "--memory-limit wants" st.xyz --memory-limit 5MBx
+usage_case u_threads_empty "--threads" --threads= st.xyz
+# every spelling of a unit: 1024 KiB, 1 MB and 1mib are all 1 MiB
+for lim in 1024KiB 1MB 1mib 1048576b; do
+    run st_limit_$lim "$FRONTDT" st.xyz --memory-limit $lim
+    expect_rc st_limit_$lim 4 && expect_in st_limit_$lim err "more than --memory-limit 1 MiB"
+done
 run st_limit "$FRONTDT" st.xyz --memory-limit 1M
 expect_rc st_limit 4 && expect_in st_limit err "more than --memory-limit 1 MiB"
 run st_limit_ok "$FRONTDT" st.xyz --memory-limit 2G --stream --stats

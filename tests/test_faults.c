@@ -8,8 +8,8 @@
  * and GMP are not seen: they cannot be made to fail from here. (GMP aborts
  * on a failed allocation by design; README.md, Limits.)
  *
- * For each scenario (a read, a triangulation, a sort, a hash, a check, a
- * write) and k = 1, 2, ...:
+ * For each scenario (a read, a triangulation, a sort, a hash, a check, a write,
+ * a streamed write through fdt_stream_writer_*) and k = 1, 2, ...:
  *   - "once":  the k-th allocation of the scenario fails, later ones work;
  *   - "from":  the k-th and every later allocation fail (error paths that
  *              allocate while cleaning up fail too);
@@ -817,6 +817,45 @@ static int sc_write(void *arg, const char **bad)
     return rc;
 }
 
+/* The streaming writer (src/writer_stream.c) fed the mesh in two tets
+ * batches and one hull batch, then committed: a failed allocation (the
+ * writer, a file's buffer, .fdtb's hull buffer) ends it with FDT_ENOMEM,
+ * a message naming the file and no file left. */
+static int sc_stream_write(void *arg, const char **bad)
+{
+    write_arg *a = arg;
+    char path[1024], diag[1024] = "";
+    snprintf(path, sizeof path, "%s/mesh%s", a->dir, a->ext);
+    fdt_stream_writer *w = NULL;
+    int rc = fdt_stream_writer_open(&w, path, NULL, a->ps->xyz, a->ps->n, 0, diag,
+                                    sizeof diag);
+    if (rc == FDT_OK) {
+        fdt_sink sink;
+        size_t t = fdt_result_num_tets(a->res);
+        const fdt_vid *tets = fdt_result_tets(a->res);
+        int e = fdt_stream_writer_sink(w, &sink);
+        if (e == FDT_OK)
+            e = sink.tets(sink.user, tets, t / 2);
+        if (e == FDT_OK)
+            e = sink.hull(sink.user, fdt_result_hull_faces(a->res),
+                          fdt_result_num_hull_faces(a->res));
+        if (e == FDT_OK)
+            e = sink.tets(sink.user, tets + 4 * (t / 2), t - t / 2);
+        rc = fdt_stream_writer_close(&w, 1, diag, sizeof diag);
+        if (e != FDT_OK && rc != e)
+            *bad = "the commit forgot a sink's error";
+    }
+    int left = count_entries(a->dir);
+    int want = rc != FDT_OK ? 0 : strcmp(a->ext, ".ele") == 0 ? 3 : 1;
+    if (left != want)
+        *bad = rc != FDT_OK ? "files left after a failed write"
+                            : "wrong number of files after the write";
+    if (rc != FDT_OK && strncmp(diag, a->dir, strlen(a->dir)) != 0)
+        *bad = "failed write without a message naming the file";
+    empty_dir(a->dir);
+    return rc;
+}
+
 /* ------------------------------------------------------------------ */
 /* Inputs on disk                                                     */
 /* ------------------------------------------------------------------ */
@@ -1128,6 +1167,14 @@ int main(int argc, char **argv)
             snprintf(nm, sizeof nm, "write %s", exts[i]);
             write_arg wa = {&sets[0], outdir, exts[i], r};
             scenario sc = {nm, FDT_IO_ENOMEM, sc_write, &wa};
+            inject_all(&sc);
+        }
+        static const char *const sexts[3] = {".fdtb", ".vtu", ".ele"};
+        for (int i = 0; i < 3; i++) {
+            char nm[64];
+            snprintf(nm, sizeof nm, "stream write %s", sexts[i]);
+            write_arg wa = {&sets[0], outdir, sexts[i], r};
+            scenario sc = {nm, FDT_ENOMEM, sc_stream_write, &wa};
             inject_all(&sc);
         }
     }

@@ -608,6 +608,19 @@ static void test_write_errors(void)
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("isdir.tets"), NULL, diag, sizeof diag),
              FDT_EIO);
     CHECK_EQ(count_temps(dir), 0);
+    /* a new polyMesh whose temporary directory's name cannot fit a path
+     * (the target itself still would): ENAMETOOLONG, nothing made */
+    static char longp[4200], ldiag[4400];
+    int w = snprintf(longp, sizeof longp, "%s", dir);
+    while (w < 4080)
+        w += snprintf(longp + w, sizeof longp - (size_t)w, "/%.*s", 4080 - w > 200 ? 200 : 4080 - w,
+                      "dddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddd"
+                      "dddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddd"
+                      "dddddddddddddddddddddddddddddddddddddddddddddddd");
+    snprintf(longp + w, sizeof longp - (size_t)w, "/polyMesh");
+    CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, longp, "openfoam", ldiag, sizeof ldiag), FDT_EIO);
+    CHECK(strstr(ldiag, strerror(ENAMETOOLONG)) != NULL);
+    CHECK_EQ(count_temps(dir), 0);
 
     /* the caller's mistakes: FDT_EINVAL, no file made */
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("m.stl"), NULL, diag, sizeof diag), FDT_EINVAL);

@@ -7,6 +7,11 @@
  * systems, "never", a kernel short of free 2 MB blocks) the test checks
  * only that the hint leaves the memory usable, and says so. Odd
  * alignments and sizes below the threshold must be harmless.
+ *
+ * fdt_mem_available reads MemAvailable from a meminfo file of the test's
+ * own (fdt_mem_available_at): the value in bytes; a count too big for
+ * size_t as SIZE_MAX; a file without the line, or no file, falls back to
+ * the free pages (sysconf), the value the test computes itself.
  */
 #define _DEFAULT_SOURCE
 #include <stdint.h>
@@ -15,6 +20,7 @@
 #include <string.h>
 
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include "mem.h"
 #include "testutil.h"
@@ -56,8 +62,70 @@ static long huge_kb(const void *p, size_t bytes)
     return kb;
 }
 
+/* A meminfo file holding text, in a directory of its own. */
+static char mdir[] = "/tmp/fdt_test_mem_XXXXXX";
+
+static const char *meminfo(const char *text)
+{
+    static char path[64];
+    snprintf(path, sizeof path, "%s/meminfo", mdir);
+    FILE *f = fopen(path, "w");
+    CHECK(f);
+    CHECK(fputs(text, f) >= 0);
+    CHECK(fclose(f) == 0);
+    return path;
+}
+
+/* sysconf's free pages in bytes: the fallback, as mem.c computes it. */
+static size_t free_pages(void)
+{
+    long pages = sysconf(_SC_AVPHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    CHECK(pages > 0 && size > 0);
+    return (size_t)pages * (size_t)size;
+}
+
+/* Within 1/8 of the free pages measured just before and after (they
+ * move while the system runs). */
+static int near_free_pages(size_t got)
+{
+    size_t a = free_pages(), b = free_pages();
+    size_t lo = (a < b ? a : b), hi = (a > b ? a : b);
+    return got >= lo - lo / 8 && got <= hi + hi / 8;
+}
+
+static void test_available(void)
+{
+    CHECK(mkdtemp(mdir));
+    EXPECT(fdt_mem_available_at(meminfo("MemTotal:       16000000 kB\n"
+                                        "MemFree:         1000000 kB\n"
+                                        "MemAvailable:    1234567 kB\n"
+                                        "Buffers:           10000 kB\n")) ==
+           (size_t)1234567 * 1024);
+    /* the first line already */
+    EXPECT(fdt_mem_available_at(meminfo("MemAvailable: 7 kB\n")) == 7 * 1024);
+    /* 2^64 - 1 kB: more than size_t holds in bytes */
+    EXPECT(fdt_mem_available_at(meminfo("MemAvailable: 18446744073709551615 kB\n")) ==
+           SIZE_MAX);
+    /* no MemAvailable line (kernels before 3.14): the free pages */
+    size_t got = fdt_mem_available_at(meminfo("MemTotal: 16000000 kB\nMemFree: 5 kB\n"));
+    EXPECTF(got != 5 * 1024 && near_free_pages(got), "%zu bytes", got);
+    char missing[96];
+    snprintf(missing, sizeof missing, "%s/none", mdir);
+    got = fdt_mem_available_at(missing);
+    EXPECTF(near_free_pages(got), "%zu bytes", got);
+    /* the real one: some memory, and what fdt_mem_available says */
+    size_t real = fdt_mem_available();
+    EXPECT(real > 0 && real != SIZE_MAX);
+    char path[96];
+    snprintf(path, sizeof path, "%s/meminfo", mdir);
+    unlink(path);
+    rmdir(mdir);
+}
+
 int main(void)
 {
+    test_available();
+
     /* Harmless anywhere: NULL, tiny, unaligned. */
     fdt_mem_advise_huge(NULL, 1 << 30);
     char small[100];

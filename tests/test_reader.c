@@ -15,6 +15,7 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 
+#include "read_common.h"
 #include "reader.h"
 
 #include <dirent.h>
@@ -1420,6 +1421,24 @@ static void test_open(tctx *t)
     EXPECT_ERR(t, path, FDT_IO_EOPEN, "sub.xyz/: is a directory");
     EXPECT_ERR(t, t->dir, FDT_IO_EOPEN, ": is a directory");
 
+    /* A file that opens but cannot be read: /proc/self/mem at offset 0
+     * (unmapped) fails read() with EIO, through a link of each format's
+     * name: the streamed readers and the buffered one report it. */
+    if (access("/proc/self/mem", R_OK) == 0) {
+        const char *names[] = {"mem.xyz", "mem.ply", "mem.node"};
+        for (int i = 0; i < 3; i++) {
+            snprintf(path, sizeof path, "%s/%s", t->dir, names[i]);
+            if (symlink("/proc/self/mem", path) != 0) {
+                fail_at(t, __LINE__, "symlink %s: %s", path, strerror(errno));
+                continue;
+            }
+            char want[64];
+            snprintf(want, sizeof want, "%s: cannot read: %s", names[i], strerror(EIO));
+            EXPECT_ERR(t, path, FDT_IO_EOPEN, want);
+            unlink(path);
+        }
+    }
+
     write_file(t, "locked.xyz", "0 0 0\n", 6, path, sizeof path);
     if (geteuid() != 0) { /* root reads anything */
         chmod(path, 0);
@@ -1499,6 +1518,47 @@ static void test_open(tctx *t)
                  n == 1 && big[0] == '\0',
           "successful read");
     free(xyz);
+}
+
+/* The integer parsers of src/read_text.c (.node and .ply headers): the
+ * int64 range exactly, signs, and what is not an integer. */
+static void test_parse_int(tctx *t)
+{
+    (void)t;
+    static const struct {
+        const char *s;
+        int st;
+        int64_t v;
+    } cases[] = {
+        {"0", NUM_OK, 0},
+        {"+17", NUM_OK, 17},
+        {"-17", NUM_OK, -17},
+        {"9223372036854775807", NUM_OK, INT64_MAX},
+        {"-9223372036854775808", NUM_OK, INT64_MIN},
+        {"9223372036854775808", NUM_OVERFLOW, 0},
+        {"-9223372036854775809", NUM_OVERFLOW, 0},
+        {"18446744073709551616", NUM_OVERFLOW, 0}, /* past uint64 too */
+        {"123456789012345678901234567890", NUM_OVERFLOW, 0},
+        {"", NUM_SYNTAX, 0},
+        {"-", NUM_SYNTAX, 0},
+        {"+", NUM_SYNTAX, 0},
+        {"12a", NUM_SYNTAX, 0},
+        {"1.0", NUM_SYNTAX, 0},
+        {"--1", NUM_SYNTAX, 0},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        int64_t v = 42;
+        int st = fdt_rd_parse_int(cases[i].s, strlen(cases[i].s), &v);
+        EXPECTF(st == cases[i].st && (st != NUM_OK || v == cases[i].v), "'%s': %d, %lld",
+                cases[i].s, st, (long long)v);
+    }
+    /* counts: digits only, no sign */
+    uint64_t u = 7;
+    EXPECT(fdt_rd_parse_count("123", 3, &u) == NUM_OK && u == 123);
+    EXPECT(fdt_rd_parse_count("+1", 2, &u) == NUM_SYNTAX);
+    EXPECT(fdt_rd_parse_count("-1", 2, &u) == NUM_SYNTAX);
+    EXPECT(fdt_rd_parse_count("", 0, &u) == NUM_SYNTAX);
+    EXPECT(fdt_rd_parse_count("99999999999999999999", 20, &u) == NUM_OVERFLOW);
 }
 
 /* Numbers do not depend on the locale's decimal point. */
@@ -2032,6 +2092,20 @@ static void test_stdin(tctx *t)
           "stdin ply: %s, %zu points: %s", code_name(rc), n, err);
     free(xyz);
 
+    /* .node, read whole (not streamed): from a pipe its size is unknown,
+     * the buffer grows from 64 KiB as the bytes come. */
+    bbuf nd = {0};
+    bb_printf(&nd, "%d 3 0 0\n", NP);
+    for (size_t i = 0; i < NP; i++)
+        bb_printf(&nd, "%zu %.17g %.17g %.17g\n", i, want[3 * i], want[3 * i + 1],
+                  want[3 * i + 2]);
+    rc = read_stdin(nd.p, nd.n, FDT_RD_NODE, &xyz, &n, err, sizeof err);
+    EXPECTF(nd.n > 4 * 65536 && rc == FDT_IO_OK && n == NP &&
+                memcmp(xyz, want, 3 * NP * sizeof *want) == 0,
+            "stdin node (%zu bytes): %s, %zu points: %s", nd.n, code_name(rc), n, err);
+    free(xyz);
+    bb_free(&nd);
+
     /* Messages name stdin; without a format it is refused. */
     rc = read_stdin("0 0 0\n1 0 q\n", 12, FDT_RD_XYZ, &xyz, &n, err, sizeof err);
     EXPECTF(rc == FDT_IO_EFORMAT && strcmp(err, "stdin:2: not a number: 'q'") == 0,
@@ -2162,6 +2236,51 @@ static void chunk_case(tctx *t, int line, const char *name, const void *data, si
         }
     }
 }
+/*
+ * A read() that fails part-way (fdt_rd_opts.fail_after: the memory
+ * source fails with EIO as soon as a read reaches past that byte), at
+ * every byte of the input, in blocks of several sizes, on 1 and 3
+ * threads: always FDT_IO_EOPEN with "NAME: cannot read: ..." and the
+ * outputs cleared, never a partial point set; a limit at or past the end
+ * changes nothing.
+ */
+static void fail_sweep(tctx *t, int line, const char *name, const void *data, size_t len,
+                       const double *want, size_t nw)
+{
+    static const size_t chunks[] = {0, 1, 7, 64};
+    char wmsg[300];
+    snprintf(wmsg, sizeof wmsg, "%s: cannot read: %s", name, strerror(EIO));
+    for (size_t ci = 0; ci < sizeof chunks / sizeof chunks[0]; ci++) {
+        for (int threads = 1; threads <= 3; threads += 2) {
+            for (size_t at = 1; at <= len + 1; at++) {
+                fdt_rd_opts o;
+                fdt_rd_opts_default(&o);
+                o.chunk = chunks[ci];
+                o.threads = threads;
+                o.min_slice = 1;
+                o.fail_after = at;
+                double *xyz = (double *)&xyz;
+                size_t n = 7;
+                char err[512] = "";
+                int rc = fdt_rd_points_mem_with(name, data, len, &o, &xyz, &n, err, sizeof err);
+                test_count_checks(1);
+                if (at < len && (rc != FDT_IO_EOPEN || strcmp(err, wmsg) != 0 || xyz != NULL ||
+                                 n != 0))
+                    fail_at(t, line, "%s, chunk %zu, %d threads, failing after %zu of %zu "
+                                     "bytes: %s '%s'", name, chunks[ci], threads, at, len,
+                            code_name(rc), err);
+                if (at >= len && (rc != FDT_IO_OK || n != nw ||
+                                  memcmp(xyz, want, 3 * nw * sizeof *want) != 0))
+                    fail_at(t, line, "%s, chunk %zu, %d threads, a limit of %zu past %zu "
+                                     "bytes: %s '%s'", name, chunks[ci], threads, at, len,
+                            code_name(rc), err);
+                if (rc == FDT_IO_OK)
+                    free(xyz);
+            }
+        }
+    }
+}
+
 #define CHUNK_OK(t, name, text, want)                                                  \
     chunk_case((t), __LINE__, name, text, strlen(text), FDT_IO_OK, NULL, want,            \
                sizeof(want) / sizeof(want)[0] / 3)
@@ -2195,6 +2314,12 @@ static void test_chunks(tctx *t)
     static const double w9[] = {1, 2, 3, 4.5, 50, -6, 7, 8, 9};
     /* lines, numbers and exponents split at every byte */
     CHUNK_OK(t, "split.xyz", "1 2 3\n4.5 5e1 -6\n7 8 9\n", w9);
+    const char *hdr_csv = "\xef\xbb\xbf# a comment\n\n  X, Y, Z\n1,2,3\n# c\n4.5,5e1,-6\n7,8,9";
+    fail_sweep(t, __LINE__, "fail.csv", hdr_csv, strlen(hdr_csv), w9, 3);
+    const char *ascii_ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\n"
+                            "property double y\nproperty double z\nend_header\n"
+                            "1 2 3\n4.5 5e1 -6\n7 8 9\n";
+    fail_sweep(t, __LINE__, "fail_ascii.ply", ascii_ply, strlen(ascii_ply), w9, 3);
     /* CRLF: a boundary between '\r' and '\n' */
     CHUNK_OK(t, "crlf.xyz", "1 2 3\r\n4.5 5e1 -6\r\n7 8 9\r\n", w9);
     /* the last line without its newline */
@@ -2232,6 +2357,7 @@ static void test_chunks(tctx *t)
     for (size_t i = 0; i < 9; i++)
         put_le(&b, &w9[i], 8);
     chunk_case(t, __LINE__, "le.ply", b.p, b.n, FDT_IO_OK, NULL, w9, 3);
+    fail_sweep(t, __LINE__, "fail_le.ply", b.p, b.n, w9, 3);
     /* a short body: the error names the byte where the data ends */
     size_t hdr = b.n - 72;
     char msg[300];
@@ -2286,6 +2412,7 @@ static void test_chunks(tctx *t)
             put_le(&b, &v, 4);
     }
     chunk_case(t, __LINE__, "mixed.ply", b.p, b.n, FDT_IO_OK, NULL, w9, 3);
+    fail_sweep(t, __LINE__, "fail_mixed.ply", b.p, b.n, w9, 3);
     hdr = b.n - 3 * 13 - 2 * 13;
     snprintf(msg, sizeof msg, "mixedshort.ply: byte %zu: file ends inside element 'face' item "
                               "2 of 2", b.n - 1);
@@ -2355,6 +2482,7 @@ int main(int argc, char **argv)
     test_fuzz(&t);
     test_open(&t);
     test_locale(&t);
+    test_parse_int(&t);
     test_columns(&t);
     test_stdin(&t);
     test_chunks(&t);

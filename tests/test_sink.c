@@ -1,7 +1,8 @@
 /*
  * The tet sink (src/sink.c): batches of the configured size in input
- * numbering, the set hash of what was handed on, the stop codes and that
- * nothing reaches a sink after it stopped, the face links a front keeps,
+ * numbering, the set hash of what was handed on, the stop codes (of the
+ * tets and of the hull callback) and that nothing reaches a sink after it
+ * stopped, batch sizes below 1 refused, the face links a front keeps,
  * memory and drop modes, calls serialized across threads; and the serial
  * front and the parallel engine streaming through small batches (many
  * calls a run) with the in-memory run's tets, stopped mid-run by the sink
@@ -68,6 +69,24 @@ static int tally_hull(void *u, const fdt_vid *f, size_t count)
     k->nh += count;
     atomic_fetch_sub(&k->inside, 1);
     return 0;
+}
+
+/* Hull callbacks that refuse: a stop (any positive value) and an
+ * FDT_E* code passed on. */
+static int hull_stop(void *u, const fdt_vid *f, size_t count)
+{
+    (void)u;
+    (void)f;
+    (void)count;
+    return 3;
+}
+
+static int hull_enomem(void *u, const fdt_vid *f, size_t count)
+{
+    (void)u;
+    (void)f;
+    (void)count;
+    return FDT_ENOMEM;
 }
 
 static void tally_init(tally *k)
@@ -145,6 +164,31 @@ static void test_emit(void)
         fdt_emit_free(&b);
         fdt_tsink_free(&s);
     }
+
+    /* A hull batch refused: its code, from the hull call as from the
+     * tets'; a batch size below 1 is refused at the emitter's start;
+     * freeing a sink twice is harmless. */
+    for (int c = 0; c < 2; c++) {
+        tally_init(&k);
+        fdt_sink hs = {sizeof hs, tally_tets, c ? hull_enomem : hull_stop, &k};
+        CHECK_EQ(fdt_tsink_init(&s, orig, &us), FDT_OK);
+        s.user = &hs;
+        s.hbatch = 2;
+        CHECK_EQ(fdt_emit_init(&em, &s, NULL), FDT_OK);
+        uint32_t f3[3] = {0, 1, 2};
+        EXPECT(fdt_emit_hull(&em, f3) == FDT_OK);
+        EXPECT(fdt_emit_hull(&em, f3) == (c ? FDT_ENOMEM : FDT_ECANCELED));
+        fdt_emit_free(&em);
+        fdt_tsink_free(&s);
+        fdt_tsink_free(&s);
+    }
+    CHECK_EQ(fdt_tsink_init(&s, orig, &us), FDT_OK);
+    s.batch = 0;
+    EXPECT(fdt_emit_init(&em, &s, NULL) == FDT_EINVAL);
+    s.batch = 3;
+    s.hbatch = 0;
+    EXPECT(fdt_emit_init(&em, &s, NULL) == FDT_EINVAL);
+    fdt_tsink_free(&s);
 
     /* Memory mode keeps tree-order ids; drop mode keeps nothing. */
     fdt_meshbuf mb;

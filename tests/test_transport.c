@@ -1,6 +1,8 @@
 /*
  * Tests of the transport interface (src/transport.c) and of the parallel
  * engine's protocol and termination under adversarial schedules:
+ *   - both transports refuse zero endpoints (the shuffle also a delay
+ *     outside 0..90) and leave *out NULL;
  *   - the shuffle transport delivers every message once, keeps each
  *     sender's order, reorders across senders (it would test nothing if it
  *     did not), and counts what it hands out;
@@ -32,6 +34,15 @@ static void test_shuffle_order(void)
     enum { N = 4, PER = 200 };
     fdt_transport *t;
     CHECK_EQ(fdt_transport_shuffle(&t, N, 7, 95), FDT_EINVAL);
+    CHECK_EQ(fdt_transport_shuffle(&t, N, 7, -1), FDT_EINVAL);
+    /* no endpoints: the mailboxes refuse, and nothing is left */
+    t = (fdt_transport *)&t;
+    CHECK_EQ(fdt_transport_shuffle(&t, 0, 7, 30), FDT_EINVAL);
+    CHECK(t == NULL);
+    t = (fdt_transport *)&t;
+    CHECK_EQ(fdt_transport_mailbox(&t, 0), FDT_EINVAL);
+    CHECK(t == NULL);
+    fdt_transport_destroy(NULL);
     CHECK_EQ(fdt_transport_shuffle(&t, N, 7, 30), FDT_OK);
     /* Senders 1..3 post PER messages each to 0, interleaved round-robin;
      * sender s's k-th message has tag k. */

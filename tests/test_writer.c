@@ -9,12 +9,23 @@
  * and no partial output; the file set of each output family
  * (fdt_output_files) and file identity by any name (fdt_same_file), which
  * the CLI uses to refuse an output that would overwrite its input.
+ * The side files (fdt_wr_side_*), a mesh whose arrays are missing, a
+ * polyMesh over a regular file, and text written to a stream that fails
+ * (/dev/full) or is refused (binary formats): each refused with its code
+ * and a message naming the file, nothing left behind.
+ * src/outfile.h's buffer on its own, over pipes, where a seek or a pwrite
+ * fails (ESPIPE) and a write fails in stdio's flush or in ours (EPIPE,
+ * the reader gone): the first errno is kept, nothing more is written, and
+ * the text items (integers of either sign, doubles, counts padded to a
+ * width) come out as the readers expect them.
  */
+#include "outfile.h"
 #include "reader.h"
 #include "writer.h"
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <inttypes.h>
 #include <signal.h>
 #include <stdint.h>
@@ -986,6 +997,33 @@ static void test_same_file(const char *dir)
     EXPECT(!fdt_same_file("loop.a", "loop.b"));
     EXPECT(!fdt_same_file("no/such/x.tets", "no/such/../such/x.tets"));
     EXPECT(!fdt_same_file("in.node/x", "in.node"));
+    /* a name with nothing after its slash, not there: unresolvable */
+    EXPECT(!fdt_same_file("gone/", "./gone/"));
+    /* a name in the root directory, however many slashes */
+    EXPECT(fdt_same_file("/fdt_same_file_none", "//fdt_same_file_none"));
+    /* a path longer than any the writer takes */
+    static char longp[FDT_IO_PATH + 8];
+    memset(longp, 'x', sizeof longp - 1);
+    EXPECT(fdt_same_file(longp, longp) && !fdt_same_file(longp, "in.node"));
+    /* a dangling link whose target no longer fits beside its directory */
+    static char target[FDT_IO_PATH];
+    memset(target, 'y', FDT_IO_PATH - 2);
+    target[FDT_IO_PATH - 2] = '\0';
+    if (symlink(target, "sub/far") == 0) {
+        EXPECT(!fdt_same_file("sub/far", "sub/./far"));
+        unlink("sub/far");
+    }
+    /* A path is looked up at most 40 times (FDT_IO_MAX_HOPS, like the
+     * kernel's limit on links): hop0 -> hop1 -> ... -> hop45, not there.
+     * From hop6, 39 links and the missing name: within the limit; from
+     * hop5, 40 links: unresolvable. */
+    for (int i = 0; i < 45; i++) {
+        snprintf(a, sizeof a, "hop%d", i);
+        snprintf(b, sizeof b, "hop%d", i + 1);
+        EXPECT(symlink(b, a) == 0);
+    }
+    EXPECT(fdt_same_file("hop10", "./hop45") && fdt_same_file("hop6", "hop45"));
+    EXPECT(!fdt_same_file("hop5", "hop45") && !fdt_same_file("hop0", "hop45"));
 
     EXPECT(chdir(cwd) == 0);
 }
@@ -1054,6 +1092,258 @@ static void test_format_table(const char *dir)
     EXPECT(fdt_output_files_as(longp, tets, names) == 1);
 }
 
+/* Side files, missing arrays, streams. */
+static void test_misc(const char *dir)
+{
+    char p[4096], err[512];
+    fdt_wr_side *side = NULL;
+    /* side files: a name that is a directory, too long, in a missing
+     * directory: NULL, the reason, nothing created */
+    snprintf(p, sizeof p, "%s/", dir);
+    EXPECT(fdt_wr_side_open(p, &side, err, sizeof err) == NULL && side == NULL &&
+           strstr(err, strerror(EISDIR)));
+    static char longp[FDT_IO_PATH + 8];
+    memset(longp, 'x', sizeof longp - 1);
+    static char lerr[FDT_IO_PATH + 256]; /* the message holds the path */
+    EXPECT(fdt_wr_side_open(longp, &side, lerr, sizeof lerr) == NULL &&
+           strstr(lerr, strerror(ENAMETOOLONG)));
+    snprintf(p, sizeof p, "%s/no/side.json", dir);
+    EXPECT(fdt_wr_side_open(p, &side, err, sizeof err) == NULL &&
+           strstr(err, "no/side.json: ") && strstr(err, strerror(ENOENT)));
+    fdt_wr_side_abandon(NULL);
+    snprintf(p, sizeof p, "%s/side.json", dir);
+    FILE *f = fdt_wr_side_open(p, &side, err, sizeof err);
+    CHECK(f && side);
+    fputs("{}\n", f);
+    EXPECT(count_entries(dir) == 1 && count_temps(dir) == 1);
+    fdt_wr_side_abandon(side);
+    EXPECT(count_entries(dir) == 0);
+    f = fdt_wr_side_open(p, &side, err, sizeof err);
+    CHECK(f && side);
+    fputs("{}\n", f);
+    EXPECT(fdt_wr_side_commit(side, err, sizeof err) == FDT_IO_OK);
+    size_t len;
+    char *back = slurp(p, &len);
+    EXPECT(back && strcmp(back, "{}\n") == 0 && count_temps(dir) == 0);
+    free(back);
+    unlink(p);
+
+    /* arrays missing from the view */
+    mesh m;
+    make_mesh(&m);
+    fdt_mesh_view v = view_of(&m);
+    fdt_mesh_view bad = v;
+    bad.tets = NULL;
+    snprintf(p, sizeof p, "%s/m.tets", dir);
+    expect_fail(dir, p, &bad, FDT_IO_EFORMAT, "m.tets: mesh arrays missing");
+    bad = v;
+    bad.hull = NULL;
+    expect_fail(dir, p, &bad, FDT_IO_EFORMAT, "mesh arrays missing");
+    bad = v;
+    bad.faces = m.hull; /* any face list, without its tets */
+    bad.n_faces = 1;
+    expect_fail(dir, p, &bad, FDT_IO_EFORMAT, "face list without its tets");
+    EXPECT(fdt_wr_mesh_ex(NULL, NULL, &v, NULL, NULL, err, sizeof err) == FDT_IO_EFORMAT &&
+           strstr(err, "no path or no mesh"));
+    EXPECT(fdt_wr_mesh(p, NULL, err, sizeof err) == FDT_IO_EFORMAT);
+
+    /* streams: refused without one, or for a binary format; a full
+     * device reports ENOSPC under the name given */
+    const fdt_format *tets = fdt_format_by_name("tets"), *vtu = fdt_format_by_name("vtu");
+    CHECK(tets && vtu);
+    EXPECT(fdt_wr_mesh_stream(NULL, "stdout", tets, &v, err, sizeof err) == FDT_IO_EFORMAT);
+    EXPECT(fdt_wr_mesh_stream(stderr, "stdout", NULL, &v, err, sizeof err) == FDT_IO_EFORMAT);
+    EXPECT(fdt_wr_mesh_stream(stderr, "stdout", vtu, &v, err, sizeof err) == FDT_IO_EEXT &&
+           strstr(err, "single-file text format"));
+    bad = v;
+    bad.tets = NULL;
+    EXPECT(fdt_wr_mesh_stream(stderr, "stdout", tets, &bad, err, sizeof err) ==
+           FDT_IO_EFORMAT && strstr(err, "mesh arrays missing"));
+    FILE *full = fopen("/dev/full", "w");
+    if (full) {
+        EXPECTF(fdt_wr_mesh_stream(full, "stdout", tets, &v, err, sizeof err) ==
+                    FDT_IO_EWRITE && strstr(err, "stdout: ") && strstr(err, strerror(ENOSPC)),
+                "[%s]", err);
+        fclose(full);
+    } else {
+        printf("misc: no /dev/full, its case skipped\n");
+    }
+    EXPECT(count_entries(dir) == 0);
+}
+
+/* ------------------------------------------------------------------------ */
+/* src/outfile.h alone                                                       */
+/* ------------------------------------------------------------------------ */
+
+typedef struct meter_log {
+    int calls;
+    uint64_t done, total;
+} meter_log;
+
+static void meter_fn(void *user, int stage, uint64_t done, uint64_t total)
+{
+    meter_log *l = user;
+    l->calls += stage == FDT_STAGE_WRITE;
+    l->done = done;
+    l->total = total;
+}
+
+/* An out_file over the write end of a new pipe; its read end in *rd. */
+static void pipe_out(out_file *o, int *rd)
+{
+    int fds[2];
+    CHECK(pipe(fds) == 0);
+    memset(o, 0, sizeof *o);
+    o->slot = -1;
+    o->path = "pipe";
+    o->f = fdopen(fds[1], "wb");
+    o->buf = malloc(OUT_BUF_SIZE);
+    CHECK(o->f && o->buf);
+    *rd = fds[0];
+}
+
+static void pipe_close(out_file *o, int rd)
+{
+    fclose(o->f);
+    free(o->buf);
+    if (rd >= 0)
+        close(rd);
+}
+
+/* What the pipe holds now (at most 255 bytes), as a string. */
+static const char *pipe_text(int rd)
+{
+    static char b[256];
+    int fl = fcntl(rd, F_GETFL);
+    fcntl(rd, F_SETFL, fl | O_NONBLOCK);
+    ssize_t k = read(rd, b, sizeof b - 1);
+    fcntl(rd, F_SETFL, fl);
+    b[k > 0 ? k : 0] = '\0';
+    return b;
+}
+
+static void test_outfile(const char *dir)
+{
+    out_file o;
+    int rd;
+    meter_log ml = {0, 0, 0};
+    out_meter mt = {meter_fn, &ml, 0, 5}; /* an estimate below what comes */
+
+    /* Text items, flushed through the meter. */
+    pipe_out(&o, &rd);
+    o.meter = &mt;
+    out_i64(&o, -123);
+    out_char(&o, ' ');
+    out_i64(&o, INT64_MIN);
+    out_char(&o, ' ');
+    out_i64(&o, 0);
+    out_char(&o, ' ');
+    out_double(&o, 0.1);
+    out_char(&o, ' ');
+    char *p = out_room(&o, 6);
+    fmt_u64_width(p, 42, 6);
+    o.len += 6;
+    out_str(&o, "|");
+    out_flush(&o);
+    EXPECT(o.err == 0 && o.len == 0);
+    CHECK(fflush(o.f) == 0);
+    const char *want = "-123 -9223372036854775808 0 0.10000000000000001     42|";
+    const char *got = pipe_text(rd);
+    EXPECTF(strcmp(got, want) == 0, "[%s]", got);
+    /* the meter saw every byte, its total never below them */
+    EXPECTF(ml.calls == 1 && ml.done == strlen(want) && ml.total == ml.done,
+            "%d calls, %" PRIu64 " of %" PRIu64, ml.calls, ml.done, ml.total);
+    out_flush(&o); /* nothing buffered: no call */
+    EXPECT(ml.calls == 1);
+
+    /* A pipe has no offset: out_tell fails with ESPIPE (and returns 0),
+     * and the error is final. */
+    out_str(&o, "abc");
+    EXPECT(out_tell(&o) == 0 && o.err == ESPIPE);
+    out_flush(&o);
+    EXPECT(o.len == 3); /* an output in error is not written */
+    o.err = 0;
+    /* out_patch flushes ours and stdio's, then pwrite fails (ESPIPE):
+     * the bytes before it are out, the patch is not */
+    out_patch(&o, 0, "X", 1);
+    EXPECT(o.err == ESPIPE);
+    got = pipe_text(rd);
+    EXPECTF(strcmp(got, "abc") == 0, "[%s]", got);
+    /* With the error kept, a patch writes nothing at all. */
+    out_str(&o, "def");
+    out_patch(&o, 0, "X", 1);
+    EXPECT(o.err == ESPIPE && o.len == 3 && pipe_text(rd)[0] == '\0');
+    /* out_room into an output in error: the bytes go to the bin, the
+     * buffer never overflows */
+    o.len = OUT_BUF_SIZE - 2;
+    out_i64(&o, 1234567);
+    EXPECT(o.len == 7 && o.err == ESPIPE);
+    pipe_close(&o, rd);
+
+    /* The reader gone (EPIPE; SIGPIPE ignored as the CLI's writes meet
+     * it): a few bytes pass our flush into stdio's buffer and fail in
+     * fflush, inside out_patch. */
+    void (*old)(int) = signal(SIGPIPE, SIG_IGN);
+    pipe_out(&o, &rd);
+    close(rd);
+    out_str(&o, "abc");
+    out_patch(&o, 0, "X", 1);
+    EXPECTF(o.err == EPIPE, "%s", strerror(o.err));
+    pipe_close(&o, -1);
+    /* More than our buffer in one out_bytes: its first flush fails and
+     * the rest is dropped, the error kept. */
+    pipe_out(&o, &rd);
+    close(rd);
+    size_t big = 3 * (size_t)OUT_BUF_SIZE;
+    char *junk = calloc(1, big);
+    CHECK(junk);
+    out_bytes(&o, junk, big);
+    EXPECT(o.err == EPIPE && o.len == 0);
+    free(junk);
+    /* out_fail keeps the first errno, and a failure without one is EIO */
+    out_fail(&o, ENOSPC);
+    EXPECT(o.err == EPIPE);
+    o.err = 0;
+    out_fail(&o, 0);
+    EXPECT(o.err == EIO);
+    pipe_close(&o, -1);
+    signal(SIGPIPE, old);
+
+    /* A patch in a regular file lands in place, the stream's position
+     * left at the end; after an error it writes nothing. */
+    char path[4096];
+    snprintf(path, sizeof path, "%s/patch", dir);
+    memset(&o, 0, sizeof o);
+    o.f = fopen(path, "wb");
+    o.buf = malloc(OUT_BUF_SIZE);
+    CHECK(o.f && o.buf);
+    out_str(&o, "0123456789");
+    EXPECT(out_tell(&o) == 10);
+    out_patch(&o, 2, "ab", 2);
+    out_str(&o, "!");
+    o.err = ENOSPC; /* as a failed write would leave it */
+    out_patch(&o, 5, "Z", 1);
+    o.err = 0;
+    out_flush(&o);
+    fclose(o.f);
+    free(o.buf);
+    size_t len;
+    char *back = slurp(path, &len);
+    EXPECTF(back && strcmp(back, "01ab456789!") == 0, "[%s]", back ? back : "");
+    free(back);
+    unlink(path);
+
+    /* The messages: the path named, ENOMEM not a write failure, no errno
+     * read as EIO, no buffer no message. */
+    char err[128];
+    EXPECT(set_errno_err(err, sizeof err, "a.vtu", ENOSPC) == FDT_IO_EWRITE &&
+           strstr(err, "a.vtu: ") == err && strstr(err, strerror(ENOSPC)));
+    EXPECT(set_errno_err(err, sizeof err, "a.vtu", ENOMEM) == FDT_IO_ENOMEM);
+    EXPECT(set_errno_err(err, sizeof err, NULL, 0) == FDT_IO_EWRITE &&
+           strstr(err, "(null): ") == err && strstr(err, strerror(EIO)));
+    EXPECT(set_err(NULL, 0, FDT_IO_EFORMAT, "x", "y") == FDT_IO_EFORMAT);
+}
+
 int main(void)
 {
     const char *tmp = getenv("TMPDIR");
@@ -1066,12 +1356,12 @@ int main(void)
     }
     char sub[4096];
     const char *names[] = { "small", "refuse", "ids", "large", "files",
-                            "same", "table" };
+                            "same", "table", "outfile", "misc" };
     void (*fns[])(const char *) = { test_small_mesh, test_refusals,
                                     test_big_ids, test_large,
                                     test_output_files, test_same_file,
-                                    test_format_table };
-    for (int i = 0; i < 7; i++) {
+                                    test_format_table, test_outfile, test_misc };
+    for (int i = 0; i < 9; i++) {
         snprintf(sub, sizeof sub, "%s/%s", dir, names[i]);
         mkdir(sub, 0755);
         long before = test_failures();

@@ -9,7 +9,22 @@
  * - a batch naming a point that is not there stops the run (the sink
  *   returns FDT_EINVAL, the run returns it), and the close then removes
  *   every temporary and leaves the target as it was; so does close(0);
- * - formats that cannot stream are refused at open, nothing created.
+ * - formats that cannot stream are refused at open, nothing created;
+ * - .fdtb's flags: 64-bit ids and no points, the header and arrays read
+ *   back; hull batches larger than the first growth of its buffer and
+ *   than its second;
+ * - refusals at open (NULL arguments, unknown format or flags, a path
+ *   too long, every temporary slot taken in the middle of a TetGen set)
+ *   and bad batches (NULL, a hull face's id out of range): EINVAL or EIO,
+ *   nothing left on disk, every later call refused with the first error;
+ * - writes failing part-way (a file size limit, EFBIG, as a full disk's
+ *   ENOSPC): in the header's points at open, in a batch of tets (the sink
+ *   returns FDT_EIO), in the final flush and count patch at the commit;
+ *   a rename that fails at the commit (the target a non-empty
+ *   directory), in the middle of a TetGen set too: FDT_EIO with the file
+ *   and the reason named, no temporary left, the old targets intact
+ *   where the rename never reached them; a stale .neigh removed at the
+ *   commit, and a .neigh that cannot be removed reported.
  * The CLI's streamed files against its in-memory ones, and interrupted
  * streamed writes, are tests/stream_readback.py's.
  */
@@ -18,9 +33,12 @@
 #include "testutil.h"
 
 #include <dirent.h>
+#include <errno.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -132,6 +150,312 @@ static int poison_hull(void *user, const fdt_vid *f, size_t count)
     return p->inner.hull(p->inner.user, f, count);
 }
 
+/* Whether the file at path holds exactly text. */
+static int holds(const char *path, const char *text)
+{
+    size_t len;
+    unsigned char *b = slurp(path, &len);
+    int ok = b && len == strlen(text) && memcmp(b, text, len) == 0;
+    free(b);
+    return ok;
+}
+
+/* .fdtb with FDT_STREAM_IDS64, with and without the points: the flags,
+ * the counts and the arrays in their 64-bit little-endian form; a hull
+ * batch bigger than the buffer's first growth (3 x 4096 ids). */
+static void test_bin_flags(const double *xyz, size_t n, const fdt_result *mem)
+{
+    char diag[1024];
+    const fdt_vid *tets = fdt_result_tets(mem);
+    size_t t = fdt_result_num_tets(mem), h = fdt_result_num_hull_faces(mem);
+    /* the hull faces repeated: 10000 in one batch */
+    size_t hb = 10000;
+    fdt_vid *hull = malloc(3 * hb * sizeof *hull);
+    CHECK(hull);
+    for (size_t i = 0; i < 3 * hb; i++)
+        hull[i] = fdt_result_hull_faces(mem)[i % (3 * h)];
+    for (int pts = 0; pts < 2; pts++) {
+        int flags = FDT_STREAM_IDS64 | (pts ? 0 : FDT_STREAM_NO_POINTS);
+        const char *name = pts ? "w64.fdtb" : "np64.fdtb";
+        fdt_stream_writer *w = NULL;
+        CHECK(fdt_stream_writer_open(&w, path_in(name), NULL, xyz, n, flags, diag,
+                                     sizeof diag) == FDT_OK);
+        fdt_sink sink;
+        CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+        EXPECT(sink.tets(sink.user, tets, t) == FDT_OK);
+        EXPECT(sink.hull(sink.user, hull, hb) == FDT_OK);
+        EXPECT(sink.hull(sink.user, NULL, 0) == FDT_OK); /* an empty batch */
+        EXPECT(sink.hull(sink.user, hull, hb) == FDT_OK); /* the buffer doubles */
+        EXPECT(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_OK);
+        size_t len;
+        unsigned char *b = slurp(path_in(name), &len);
+        size_t at = 64 + (pts ? 24 * n : 0);
+        CHECK(b);
+        EXPECTF(len == at + 32 * t + 48 * hb, "%s: %zu bytes", name, len);
+        if (len != at + 32 * t + 48 * hb) {
+            free(b);
+            continue;
+        }
+        EXPECT(memcmp(b, "FDTMESH", 8) == 0 && get_u64(b + 8) == (1 | (uint64_t)(1 | 4 | 2 * pts) << 32));
+        EXPECT(get_u64(b + 16) == n && get_u64(b + 24) == t && get_u64(b + 32) == 2 * hb);
+        if (pts)
+            EXPECT(memcmp(b + 64, xyz, 24 * n) == 0);
+        size_t bad = 0;
+        for (size_t i = 0; i < 4 * t; i++)
+            bad += get_u64(b + at + 8 * i) != (uint64_t)tets[i];
+        for (size_t i = 0; i < 6 * hb; i++)
+            bad += get_u64(b + at + 32 * t + 8 * i) != (uint64_t)hull[i % (3 * hb)];
+        EXPECTF(bad == 0, "%s: %zu ids differ", name, bad);
+        free(b);
+        unlink(path_in(name));
+    }
+    free(hull);
+}
+
+/* What open refuses, and bad batches: nothing is left behind. */
+static void test_refusals(const double *xyz, size_t n, const fdt_result *mem)
+{
+    char diag[1024];
+    fdt_stream_writer *w = (fdt_stream_writer *)diag; /* set to NULL on failure */
+    int before = entries();
+    EXPECT(fdt_stream_writer_open(NULL, path_in("r.fdtb"), NULL, xyz, n, 0, diag,
+                                  sizeof diag) == FDT_EINVAL && strstr(diag, "NULL"));
+    EXPECT(fdt_stream_writer_open(&w, NULL, NULL, xyz, n, 0, diag, sizeof diag) == FDT_EINVAL);
+    EXPECT(fdt_stream_writer_open(&w, path_in("r.fdtb"), NULL, NULL, n, 0, diag,
+                                  sizeof diag) == FDT_EINVAL);
+    EXPECT(fdt_stream_writer_open(&w, path_in("r.fdtb"), NULL, xyz, n, 0, NULL, 8) ==
+           FDT_EINVAL);
+    w = (fdt_stream_writer *)diag;
+    EXPECT(fdt_stream_writer_open(&w, path_in("r.fdtb"), "nope", xyz, n, 0, diag,
+                                  sizeof diag) == FDT_EINVAL && w == NULL &&
+           strstr(diag, "unknown output format") && strstr(diag, "bin"));
+    EXPECT(fdt_stream_writer_open(&w, path_in("r.fdtb"), NULL, xyz, n, 4, diag,
+                                  sizeof diag) == FDT_EINVAL && strstr(diag, "flags"));
+    /* a path whose temporary name cannot fit */
+    static char longp[5000];
+    memset(longp, 'x', sizeof longp - 6);
+    memcpy(longp + sizeof longp - 6, ".fdtb", 6);
+    static char ldiag[6000]; /* the message holds the path */
+    EXPECT(fdt_stream_writer_open(&w, longp, NULL, xyz, n, 0, ldiag, sizeof ldiag) == FDT_EIO &&
+           strstr(ldiag, strerror(ENAMETOOLONG)));
+    /* a missing directory: the temporary's error, the file named */
+    char p[600];
+    snprintf(p, sizeof p, "%s/no/such.vtu", dir);
+    EXPECT(fdt_stream_writer_open(&w, p, NULL, xyz, n, 0, diag, sizeof diag) == FDT_EIO &&
+           strstr(diag, "no/such.vtu: ") && strstr(diag, strerror(ENOENT)));
+    /* the NULLs of the other calls */
+    fdt_sink sink;
+    EXPECT(fdt_stream_writer_sink(NULL, &sink) == FDT_EINVAL);
+    EXPECT(fdt_stream_writer_close(NULL, 1, diag, sizeof diag) == FDT_EINVAL);
+    w = NULL;
+    EXPECT(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_EINVAL);
+    uint64_t a = 7, b = 7;
+    fdt_stream_writer_counts(NULL, &a, &b);
+    EXPECT(a == 0 && b == 0);
+    EXPECT(entries() == before);
+
+    /* no message buffer at all is fine: the codes alone; the sink and the
+     * counts want somewhere to write */
+    CHECK(fdt_stream_writer_open(&w, path_in("q.fdtb"), NULL, xyz, n, 0, NULL, 0) == FDT_OK);
+    EXPECT(fdt_stream_writer_sink(w, NULL) == FDT_EINVAL);
+    CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+    EXPECT(sink.tets(sink.user, NULL, 0) == FDT_OK);
+    fdt_stream_writer_counts(w, NULL, NULL);
+    fdt_vid neg[4] = {0, 1, 2, -1};
+    EXPECT(sink.tets(sink.user, neg, 1) == FDT_EINVAL);
+    EXPECT(fdt_stream_writer_close(&w, 1, NULL, 0) == FDT_EINVAL && w == NULL);
+    EXPECT(entries() == before);
+
+    /* Every temporary slot taken: ten TetGen sets hold 30 of the 32, the
+     * eleventh gets its .node and .ele and fails at its .face; its two
+     * temporaries go, the others stay until closed. */
+    fdt_stream_writer *ws[10];
+    for (int i = 0; i < 10; i++) {
+        char name[32];
+        snprintf(name, sizeof name, "slot%d.ele", i);
+        CHECK(fdt_stream_writer_open(&ws[i], path_in(name), NULL, xyz, n, 0, diag,
+                                     sizeof diag) == FDT_OK);
+    }
+    EXPECT(entries() == before + 30);
+    EXPECT(fdt_stream_writer_open(&w, path_in("slotx.ele"), NULL, xyz, n, 0, diag,
+                                  sizeof diag) == FDT_EIO && w == NULL &&
+           strstr(diag, "slotx.face: ") && strstr(diag, strerror(EMFILE)));
+    EXPECTF(entries() == before + 30, "%d entries", entries());
+    for (int i = 0; i < 10; i++)
+        EXPECT(fdt_stream_writer_close(&ws[i], 0, diag, sizeof diag) == FDT_OK);
+    EXPECT(entries() == before);
+
+    /* Bad batches: a NULL one, a hull face out of range; the first error
+     * stays, later batches and the commit are refused with it. */
+    const fdt_vid *tets = fdt_result_tets(mem);
+    for (int k = 0; k < 3; k++) {
+        CHECK(fdt_stream_writer_open(&w, path_in("bad.fdtb"), NULL, xyz, n, 0, diag,
+                                     sizeof diag) == FDT_OK);
+        CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+        const char *want;
+        if (k == 0) {
+            EXPECT(sink.tets(sink.user, NULL, 1) == FDT_EINVAL);
+            want = "a batch of tets is NULL";
+        } else if (k == 1) {
+            EXPECT(sink.hull(sink.user, NULL, 2) == FDT_EINVAL);
+            want = "a batch of hull faces is NULL";
+        } else {
+            fdt_vid f[3] = {0, 1, (fdt_vid)n};
+            EXPECT(sink.hull(sink.user, f, 1) == FDT_EINVAL);
+            want = "a hull face uses vertex";
+        }
+        EXPECT(sink.tets(sink.user, tets, 1) == FDT_EINVAL);
+        EXPECT(sink.hull(sink.user, tets, 1) == FDT_EINVAL);
+        uint64_t nt = 9, nh = 9;
+        fdt_stream_writer_counts(w, &nt, &nh);
+        EXPECT(nt == 0 && nh == 0);
+        EXPECTF(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_EINVAL &&
+                    strstr(diag, "bad.fdtb: ") && strstr(diag, want),
+                "%d: [%s]", k, diag);
+        EXPECT(entries() == before);
+    }
+}
+
+/* A non-empty directory at path: no rename can replace it. */
+static void block_with_dir(const char *path)
+{
+    char keep[600];
+    CHECK(mkdir(path, 0755) == 0);
+    snprintf(keep, sizeof keep, "%s/keep", path);
+    CHECK(write_file(keep, "k\n"));
+}
+
+static void unblock(const char *path)
+{
+    char keep[600];
+    snprintf(keep, sizeof keep, "%s/keep", path);
+    unlink(keep);
+    rmdir(path);
+}
+
+/* Writes that fail part-way, renames that fail at the commit. */
+static void test_write_errors(const double *xyz, size_t n, const fdt_result *mem)
+{
+    char diag[1024];
+    const fdt_vid *tets = fdt_result_tets(mem);
+    size_t t = fdt_result_num_tets(mem);
+    fdt_stream_writer *w = NULL;
+    fdt_sink sink;
+    int before = entries();
+    const char *outs[] = {"f.fdtb", "f.vtu", "f.ele"};
+    for (int o = 0; o < 3; o++)
+        CHECK(write_file(path_in(outs[o]), "old\n"));
+    before += 3;
+
+    /* A file size limit of 200 kB (SIGXFSZ ignored, as the CLI does): a
+     * write past it fails with EFBIG. */
+    struct rlimit old_lim, lim;
+    CHECK(getrlimit(RLIMIT_FSIZE, &old_lim) == 0);
+    void (*old_h)(int) = signal(SIGXFSZ, SIG_IGN);
+    lim = old_lim;
+    lim.rlim_cur = 200000;
+    CHECK(setrlimit(RLIMIT_FSIZE, &lim) == 0);
+
+    /* In the header's points at open: 50,000 points are 1.2 MB, more than
+     * the buffer, so begin already writes. */
+    size_t nb = 50000;
+    double *big = calloc(3 * nb, sizeof *big);
+    CHECK(big);
+    EXPECTF(fdt_stream_writer_open(&w, path_in("f.fdtb"), NULL, big, nb, 0, diag,
+                                   sizeof diag) == FDT_EIO && w == NULL &&
+                strstr(diag, "f.fdtb: ") && strstr(diag, strerror(EFBIG)),
+            "[%s]", diag);
+    free(big);
+    EXPECT(entries() == before && holds(path_in("f.fdtb"), "old\n"));
+
+    /* In a batch of tets: the same batch fed until the bytes pass the
+     * buffer (1 MiB) and the limit; the sink says FDT_EIO, and so does
+     * every later call, the commit too. */
+    for (int o = 0; o < 3; o++) {
+        CHECK(fdt_stream_writer_open(&w, path_in(outs[o]), NULL, xyz, n, 0, diag,
+                                     sizeof diag) == FDT_OK);
+        CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+        int rc = FDT_OK, k = 0;
+        while (rc == FDT_OK && k < 100) {
+            rc = sink.tets(sink.user, tets, t);
+            k++;
+        }
+        EXPECTF(rc == FDT_EIO && k > 1, "%s: %d after %d batches", outs[o], rc, k);
+        EXPECT(sink.tets(sink.user, tets, 1) == FDT_EIO);
+        EXPECT(sink.hull(sink.user, tets, 1) == FDT_EIO);
+        /* .ele: the .ele itself is the file that fails (the .node is
+         * still in its buffer) */
+        EXPECTF(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_EIO &&
+                    strstr(diag, outs[o]) && strstr(diag, strerror(EFBIG)),
+                "%s: [%s]", outs[o], diag);
+        EXPECTF(entries() == before && holds(path_in(outs[o]), "old\n"), "%s", outs[o]);
+    }
+
+    /* At the commit: the tets fit the buffer, not the limit; the final
+     * flush before the count patch fails. */
+    for (int o = 0; o < 2; o++) {
+        CHECK(fdt_stream_writer_open(&w, path_in(outs[o]), NULL, xyz, n, 0, diag,
+                                     sizeof diag) == FDT_OK);
+        CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+        EXPECT(sink.tets(sink.user, tets, t) == FDT_OK);
+        EXPECTF(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_EIO &&
+                    strstr(diag, outs[o]) && strstr(diag, strerror(EFBIG)),
+                "%s: [%s]", outs[o], diag);
+        EXPECTF(entries() == before && holds(path_in(outs[o]), "old\n"), "%s", outs[o]);
+    }
+    CHECK(setrlimit(RLIMIT_FSIZE, &old_lim) == 0);
+    signal(SIGXFSZ, old_h);
+
+    /* A rename that fails: the target is a non-empty directory. */
+    block_with_dir(path_in("d.fdtb"));
+    CHECK(fdt_stream_writer_open(&w, path_in("d.fdtb"), NULL, xyz, n, 0, diag, sizeof diag) ==
+          FDT_OK);
+    CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+    EXPECT(sink.tets(sink.user, tets, t) == FDT_OK);
+    EXPECTF(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_EIO &&
+                strstr(diag, "d.fdtb: ") && strstr(diag, strerror(EISDIR)),
+            "[%s]", diag);
+    unblock(path_in("d.fdtb"));
+    EXPECT(entries() == before);
+    /* ... in the middle of a TetGen set: the .node and .ele already
+     * renamed go too (all or none) */
+    block_with_dir(path_in("s.face"));
+    CHECK(fdt_stream_writer_open(&w, path_in("s.ele"), NULL, xyz, n, 0, diag, sizeof diag) ==
+          FDT_OK);
+    CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+    EXPECT(sink.tets(sink.user, tets, t) == FDT_OK);
+    EXPECTF(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_EIO &&
+                strstr(diag, "s.face: "), "[%s]", diag);
+    EXPECT(access(path_in("s.node"), F_OK) != 0 && access(path_in("s.ele"), F_OK) != 0);
+    unblock(path_in("s.face"));
+    EXPECT(entries() == before);
+
+    /* The stale .neigh of an older set is removed at the commit; one
+     * that cannot be (a non-empty directory) is reported, the new set
+     * in place. */
+    CHECK(write_file(path_in("n.neigh"), "old\n"));
+    CHECK(fdt_stream_writer_open(&w, path_in("n.ele"), NULL, xyz, n, 0, diag, sizeof diag) ==
+          FDT_OK);
+    CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+    EXPECT(sink.tets(sink.user, tets, t) == FDT_OK);
+    EXPECT(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_OK);
+    EXPECT(access(path_in("n.neigh"), F_OK) != 0 && access(path_in("n.ele"), F_OK) == 0);
+    block_with_dir(path_in("n.neigh"));
+    CHECK(fdt_stream_writer_open(&w, path_in("n.ele"), NULL, xyz, n, 0, diag, sizeof diag) ==
+          FDT_OK);
+    CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+    EXPECT(sink.tets(sink.user, tets, t) == FDT_OK);
+    EXPECTF(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_EIO &&
+                strstr(diag, "n.neigh: "), "[%s]", diag);
+    EXPECT(access(path_in("n.ele"), F_OK) == 0);
+    unblock(path_in("n.neigh"));
+    const char *ns[] = {"n.node", "n.ele", "n.face"};
+    for (int i = 0; i < 3; i++)
+        unlink(path_in(ns[i]));
+    for (int o = 0; o < 3; o++)
+        unlink(path_in(outs[o]));
+}
+
 int main(void)
 {
     CHECK(mkdtemp(dir));
@@ -236,6 +560,10 @@ int main(void)
     EXPECT(fdt_stream_writer_close(&w, 0, diag, sizeof diag) == FDT_OK);
     EXPECT(entries() == before);
     EXPECT(access(path_in("c.vtu"), F_OK) != 0);
+
+    test_bin_flags(xyz, n, mem);
+    test_refusals(xyz, n, mem);
+    test_write_errors(xyz, n, mem);
 
     fdt_result_free(&mem);
     fdt_close(&ctx);
