@@ -243,6 +243,12 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         pthread_mutex_destroy(&e->lock);
         goto fail;
     }
+    if (pthread_cond_init(&e->gm_cv, NULL) != 0) {
+        pthread_cond_destroy(&e->go);
+        pthread_cond_destroy(&e->cv);
+        pthread_mutex_destroy(&e->lock);
+        goto fail;
+    }
     sync_ok = 1;
 #ifdef FDT_HAVE_HWLOC
     if (e->pin) {
@@ -358,6 +364,12 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * FDT_ORACLE_MESH_BYTES): the parts' kd searches are always right. */
     if (expensive && FDT_ORACLE_MESH_BYTES * (double)pr->m > (double)fdt_mem_available())
         expensive = 0;
+    /* The probe's "not clearly expensive" (src/oracle.c, PROBE_SURE):
+     * the parts start on the kd search and switch together when one of
+     * them measures it expensive at the full density (src/engine.c,
+     * collective_step; bench/NOTES.md entry 59). */
+    e->collective = mode == FDT_MODE_SHARED &&
+                    ((probe && !expensive) || (opt && opt->global_mesh == FDT_PAR_MESH_COLLECTIVE));
     if (opt && (opt->global_mesh == 1 || expensive) && mode == FDT_MODE_SHARED) {
         double tg = fdt_now_s();
         int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads,
@@ -484,6 +496,7 @@ fail:
         fdt_ins_free(&e->gmesh);
         fdt_transport_destroy(&e->tp);
         if (sync_ok) {
+            pthread_cond_destroy(&e->gm_cv);
             pthread_cond_destroy(&e->go);
             pthread_cond_destroy(&e->cv);
             pthread_mutex_destroy(&e->lock);
