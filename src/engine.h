@@ -245,6 +245,10 @@ static inline const double *coords(const worker *w, uint32_t id)
 int fdt_eng_face_arrives(worker *w, const uint32_t v[3], int thread, int64_t link, fdt_face *known);
 /* Builds tet v, which we own; request: asked for by FACESEND. */
 int fdt_eng_build_tet(worker *w, const uint32_t v[4], int request, fdt_face *advanced);
+/* Builds tet v asked for by a FACESEND whose link is mtet: the tet's slot
+ * in the mesh of every point (engine.gmesh) when the sender read its apex
+ * there, -1 otherwise. */
+int fdt_eng_build_requested(worker *w, const uint32_t v[4], int64_t mtet);
 /* The worker's tables (on its own thread, after pinning). */
 int fdt_eng_worker_setup(worker *w);
 /* The worker's loop: seeds, messages, faces, until IAMDONE or abort. */

@@ -12,6 +12,8 @@
  *   requests sent; every FACESEND sent is received;
  * - an injected failure of any part, before or after its first faces,
  *   ends the run with FDT_EINTERNAL naming that part, and no mesh;
+ * - with the mesh of every point built first, the parts own equal shares
+ *   of its tets, and few faces are found by walks;
  * - the collective switch: the mesh of every point is built in the middle
  *   of the run once a majority of the parts votes for it, never on one
  *   part's vote of two, with serial's tets either way.
@@ -291,6 +293,65 @@ static void run_collective(const input *in, const uint32_t *ref, size_t nref, in
     fdt_prepared_free(&pr);
 }
 
+/*
+ * The mesh of every point built before the fronts (global_mesh 1): the
+ * parts' ranges are moved so that each owns as many of its tets and hull
+ * faces (src/parallel.c, recut_by_mesh), where the bisection's halves of
+ * a pipe gave the lower part every tet across the cut; and a tet built on
+ * another part's request has its mesh slot noted (the request carries
+ * it), so its faces are not found by walks around a vertex. Serial's
+ * tets, tets a thread within 10 % (the hull faces count too), and under
+ * 2 % of the faces found by a walk.
+ */
+static void test_recut(void)
+{
+    /* a pipe scan as tests/gen_points cylscan makes it: 71 rings of 71
+     * points at jittered angles, rings 2 pi / 71 apart, radius 1 */
+    const int m = 71;
+    input pipe = {"pipe scan", malloc(3 * (size_t)m * m * sizeof(double)), (size_t)m * m};
+    CHECK(pipe.xyz != NULL);
+    uint64_t seed = 29;
+    for (int j = 0, n = 0; j < m; j++)
+        for (int i = 0; i < m; i++, n++) {
+            double a = 6.283185307179586 * (i + 0.9 * test_unif(&seed) - 0.45) / m;
+            pipe.xyz[3 * n] = cos(a);
+            pipe.xyz[3 * n + 1] = sin(a);
+            pipe.xyz[3 * n + 2] = j * 6.283185307179586 / m;
+        }
+    size_t nref;
+    uint32_t *ref = serial_set(&pipe, &nref);
+    fdt_prepared pr;
+    char diag[256] = "";
+    CHECK_EQ(fdt_prepare(pipe.xyz, pipe.n, 1, &pr, diag, sizeof diag), FDT_OK);
+    fdt_settings s;
+    fdt_default_settings(&s);
+    fdt_par_opts opt;
+    memset(&opt, 0, sizeof opt);
+    opt.global_mesh = 1;
+    fdt_par_out out;
+    CHECK_EQ(fdt_parallel_run(&pr, &s, FDT_MODE_SHARED, 2, &opt, &out, diag, sizeof diag), FDT_OK);
+    EXPECT(out.mb.ntets == nref);
+    EXPECTF(out.pst.load_imbalance < 1.1, "pipe, mesh first: load imbalance %.3f (tets %zu, %zu)",
+            out.pst.load_imbalance, out.tstats[0].tets, out.tstats[1].tets);
+    EXPECTF(out.fst.star_walks * 50 < out.fst.faces_advanced, "pipe: %zu of %zu faces by a walk",
+            out.fst.star_walks, out.fst.faces_advanced);
+    if (out.mb.ntets == nref) {
+        uint32_t *c = malloc(nref * 4 * sizeof *c);
+        CHECK(c != NULL);
+        memcpy(c, out.mb.tets, nref * 4 * sizeof *c);
+        for (size_t i = 0; i < nref; i++)
+            sort4(c + 4 * i);
+        qsort(c, nref, 4 * sizeof *c, cmp4);
+        EXPECT(!memcmp(c, ref, nref * 4 * sizeof *c));
+        free(c);
+    }
+    fdt_par_out_free(&out);
+    fdt_prepared_free(&pr);
+    free(ref);
+    free(pipe.xyz);
+    printf("mesh first: a pipe's tets split evenly, requests carry their mesh slot\n");
+}
+
 static void test_collective(void)
 {
     /* a pipe: every part votes, the mesh is built and read by all */
@@ -353,6 +414,7 @@ int main(void)
         }
     printf("injected failures: every part, both modes, named\n");
     test_collective();
+    test_recut();
     for (int f = 0; f < 2; f++)
         free(ins[f].xyz);
     return test_report("engine");
