@@ -89,17 +89,17 @@
  * by points tested alone, under COLLECTIVE_SURE units a face, needs the
  * window's walk to have visited SLOW_NODES nodes a face too, the time
  * rule's own condition: the first windows of an extruded grid's flat
- * layer or a city's ground cost 330-430 units at 2-15 nodes a face
- * (bench/NOTES.md entry 59). Once another part voted, a part also votes
+ * layers and of the wind-study city cost 280-430 units at 2-15 nodes a
+ * face (bench/NOTES.md entry 59). Once another part voted, a part also votes
  * early, on its thread CPU since COLLECTIVE_TIMED_FROM faces measured over
  * COLLECTIVE_TIMED_MIN more, when the kd search's remaining cost is over
  * COLLECTIVE_CLEAR times the mesh's predicted cost, or over
  * COLLECTIVE_MARGIN times with SLOW_NODES nodes a face: without it the
  * second part of an O-grid or a cubed sphere waited for its first full
  * time check (16,384 or 32,768 faces at 1.7-3 us a face, +0.10 and +0.15
- * s CPU of 0.9 and 0.7); at 4,096 faces the early measure gave 2.2-3.4
- * there, 1.8 on the statue, and 1.0-1.3 on both parts of autzen and on
- * lonestar's part 0 (12-13 nodes a face), which must not vote. The
+ * s CPU of 0.9 and 0.7); at 4,096-8,192 faces the early measure gave
+ * 2.2-3.6 there, 1.8 on the statue, and 1.1-1.3 on autzen's part 1 and on
+ * lonestar's part 0 (12-19 nodes a face), which must not vote. The
  * margins are above the serial TIME_MARGIN because a window this short
  * is noisier and a collective mesh costs every part.
  */
