@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mem.h"
 #include "termination.h"
 
 /*
@@ -153,6 +154,16 @@ int fdt_eng_build_tet(worker *w, const uint32_t v[4], int request, fdt_face *adv
         atomic_store_explicit(&w->tets_done, nt, memory_order_relaxed);
     }
     return FDT_OK;
+}
+
+int fdt_eng_build_requested(worker *w, const uint32_t v[4], int64_t mtet)
+{
+    int64_t before = (int64_t)w->em.ntets;
+    int err = fdt_eng_build_tet(w, v, 1, NULL);
+    /* built (not a duplicate): its mesh slot, when the sender knew it */
+    if (!err && mtet >= 0 && w->orc.gm && (int64_t)w->em.ntets > before)
+        err = fdt_oracle_note(&w->orc, (int64_t)w->em.ntets - 1, (uint32_t)mtet);
+    return err;
 }
 
 /*
@@ -374,9 +385,101 @@ static int finish_face(worker *w, const uint32_t f[3], fdt_face *s, fdt_apex *ap
         /* p is the tet's lowest id: the owner reads its coordinates
          * itself, the message carries f's. */
         w->st.tet_requests++;
-        err = fdt_proto_send_face(w, owner, f, p, -1);
+        /* With the mesh of every point (read by every part) the request
+         * carries the tet's mesh slot in its unused link, so the owner
+         * notes it and later reads the apexes of the tet's faces from the
+         * mesh; without it each was found by a walk around a vertex
+         * (cylscan 100k, two threads: 30k walks on the lower part,
+         * which receives the 54k requests; bench/NOTES.md entry 60). */
+        int64_t mlink = w->orc.gm && p == mapex && mtet != FDT_NONE ? (int64_t)mtet : -1;
+        err = fdt_proto_send_face(w, owner, f, p, mlink);
     }
     return err ? err : 1;
+}
+
+/*
+ * The collective switch (engine.collective, bench/NOTES.md entry 59).
+ * The probe decides the mesh of every point before the fronts start only
+ * where its sample is clearly expensive; elsewhere the parts start on the
+ * kd search and the serial front's rules (src/oracle.c) measure each
+ * part's own faces at the full density; a part whose rule chooses a mesh
+ * votes. Once a majority voted, the part that sees it builds the mesh of
+ * every point on the run's thread count (fdt_ins_build_parallel: it runs
+ * here, the other parts wait, so the cores are not oversubscribed), and
+ * every part reads its later apexes from it, asking no other part (entry
+ * 54). One part's vote is not enough: lonestar's part 1 voted on its
+ * dense first faces, and with its own mesh took 1.56-1.67 s of thread CPU
+ * where the kd search takes 1.14-1.22 s (entry 59). The tets built before are
+ * final (DESIGN.md, Output); their faces still on a front have no noted
+ * mesh tet and are found by a walk around a vertex. The mesh gives the
+ * same apexes as the kd search (the perturbed DT is unique), so only the
+ * time depends on who chose and when.
+ */
+static int collective_build(worker *w)
+{
+    engine *e = w->e;
+    uint32_t n = e->pt->m;
+    double t0 = fdt_now_s();
+    int err = FDT_ENOMEM;
+    /* the mesh must fit (src/oracle.h, FDT_ORACLE_MESH_BYTES) */
+    if (FDT_ORACLE_MESH_BYTES * (double)n <= (double)fdt_mem_available())
+        err = fdt_ins_build_parallel(&e->gmesh, e->P, 0, n, e->n, &w->kq.pc);
+    w->orc.t_mesh += fdt_now_s() - t0;
+    w->orc.switched_at = w->st.faces_advanced;
+    pthread_mutex_lock(&e->lock);
+    e->gmesh_ok = err == FDT_OK;
+    /* release: publishes gmesh (engine.gm_state) */
+    atomic_store_explicit(&e->gm_state, err == FDT_OK ? 2 : 3, memory_order_release);
+    pthread_cond_broadcast(&e->gm_cv);
+    pthread_mutex_unlock(&e->lock);
+    w->orc.collective = 0;
+    if (err == FDT_OK)
+        fdt_oracle_share(&w->orc, &e->gmesh);
+    else
+        w->orc.state = -1;
+    /* No memory, or points that do not span 3-D: the kd search is always
+     * right, only slower. */
+    return err == FDT_ENOMEM || err == FDT_EDEGENERATE ? FDT_OK : err;
+}
+
+/* Called after each tick of a collective part's oracle: builds the mesh
+ * if this part chose first, waits while another builds, and takes the
+ * mesh (or, the build failed, the kd search for good) once it is done. */
+static int collective_step(worker *w)
+{
+    engine *e = w->e;
+    /* acquire: pairs with collective_build's release store */
+    int gs = atomic_load_explicit(&e->gm_state, memory_order_acquire);
+    if (gs == 0) {
+        if (w->orc.state != 2) {
+            /* another part voted: this one's early opinion counts */
+            if (w->orc.collective == 1 && atomic_load_explicit(&e->gm_votes, memory_order_relaxed))
+                w->orc.collective = 2;
+            return FDT_OK;
+        }
+        if (!w->gm_voted) {
+            w->gm_voted = 1;
+            atomic_fetch_add_explicit(&e->gm_votes, 1, memory_order_relaxed);
+        }
+        if (atomic_load_explicit(&e->gm_votes, memory_order_relaxed) < e->n / 2 + 1)
+            return FDT_OK; /* state 2 searches as state 0; others may vote */
+        /* acq_rel: the one builder; a loser reads the winner's state */
+        if (atomic_compare_exchange_strong_explicit(&e->gm_state, &gs, 1, memory_order_acq_rel,
+                                                    memory_order_acquire))
+            return collective_build(w);
+    }
+    if (gs == 1) {
+        pthread_mutex_lock(&e->lock);
+        while ((gs = atomic_load_explicit(&e->gm_state, memory_order_acquire)) == 1)
+            pthread_cond_wait(&e->gm_cv, &e->lock);
+        pthread_mutex_unlock(&e->lock);
+    }
+    w->orc.collective = 0;
+    if (gs == 2)
+        fdt_oracle_share(&w->orc, &e->gmesh);
+    else
+        w->orc.state = -1;
+    return FDT_OK;
 }
 
 /* Advances one own front face. Returns 1 if it did (or parked it), 0 if
@@ -422,6 +525,11 @@ static int advance_one(worker *w)
     memcpy(pk->b, pb, sizeof pk->b);
     memcpy(pk->c, pc, sizeof pk->c);
     fdt_oracle_tick(&w->orc, w->st.faces_advanced - 1, &w->kq);
+    if (w->orc.collective) {
+        int cerr = collective_step(w);
+        if (cerr)
+            return cerr;
+    }
     if (w->orc.state == 1 && !w->orc.gm && !w->published) {
         /* release: see mesh_pub */
         atomic_store_explicit(&w->mesh_pub, 1, memory_order_release);
@@ -529,6 +637,8 @@ int fdt_eng_worker_setup(worker *w)
         w->orc.mem_cap = fdt_oracle_mem_share(w->e->n);
     if (w->e->gmesh_ok)
         fdt_oracle_share(&w->orc, &w->e->gmesh);
+    else if (w->e->collective && w->e->search == FDT_SEARCH_AUTO)
+        w->orc.collective = 1;
     w->qcache_part = -1;
     return FDT_OK;
 }
@@ -620,6 +730,8 @@ engine *fdt_eng_new(int n)
         atomic_init(&e->w[i].tets_done, 0);
         atomic_init(&e->w[i].mesh_pub, 0);
     }
+    atomic_init(&e->gm_state, 0);
+    atomic_init(&e->gm_votes, 0);
     return e;
 }
 

@@ -105,6 +105,7 @@ typedef struct worker {
      * (shared mode, search_others). */
     atomic_int mesh_pub;
     int published;             /* mesh_pub stored (this thread's copy) */
+    int gm_voted;              /* counted in engine.gm_votes */
     fdt_ins_query iq;          /* scratch of the queries of other meshes */
     uint32_t *qhint;           /* per part: where the last walk ended */
     uint32_t qcache_v;         /* iq answers for this vertex in this part */
@@ -149,6 +150,31 @@ typedef struct engine {
                                   built before the threads start, read-only
                                   after (thread creation publishes it) */
     int gmesh_ok;
+    /* The collective switch (bench/NOTES.md entry 59): 1 when the parts
+     * start on the kd search with collective oracles (fdt_oracle.
+     * collective). Once a majority of them voted (gm_votes), the part that
+     * sees it builds gmesh with every part's thread count
+     * (fdt_ins_build_parallel) while the other parts wait, then all read
+     * it. gm_state: 0 none chosen, 1 being built, 2 built (gmesh_ok), 3
+     * failed (no memory, flat points: every part stays on the kd search).
+     * The one 0 -> 1 is a strong CAS (acq_rel): exactly one part builds.
+     * The builder writes gmesh, then stores 2 or 3 with release under
+     * `lock` and broadcasts gm_cv; a part that loads 2 with acquire sees
+     * the whole mesh, which is not written again until every thread is
+     * joined. A part that loads 1 waits on gm_cv under `lock`, re-reading
+     * gm_state there, so the broadcast cannot be missed (the store is
+     * made under the same mutex). */
+    int collective;
+    atomic_int gm_state;
+    /* Parts whose oracle chose the mesh (each counts once; relaxed: only
+     * the count matters, the build's CAS orders the rest, and a voter
+     * re-reads it at every face, so a vote not yet seen is seen later).
+     * The mesh serves every part, so a majority must choose it: one part
+     * of an airborne scan (lonestar, ../shared/data) whose first faces lie
+     * in a dense patch measures the kd search slow there while the whole
+     * part, and the other part, run faster on it (entry 59). */
+    atomic_int gm_votes;
+    pthread_cond_t gm_cv;
     int n;
     int want_nbrs;
     fdt_transport *tp;         /* messages between the parts: endpoints
@@ -219,6 +245,10 @@ static inline const double *coords(const worker *w, uint32_t id)
 int fdt_eng_face_arrives(worker *w, const uint32_t v[3], int thread, int64_t link, fdt_face *known);
 /* Builds tet v, which we own; request: asked for by FACESEND. */
 int fdt_eng_build_tet(worker *w, const uint32_t v[4], int request, fdt_face *advanced);
+/* Builds tet v asked for by a FACESEND whose link is mtet: the tet's slot
+ * in the mesh of every point (engine.gmesh) when the sender read its apex
+ * there, -1 otherwise. */
+int fdt_eng_build_requested(worker *w, const uint32_t v[4], int64_t mtet);
 /* The worker's tables (on its own thread, after pinning). */
 int fdt_eng_worker_setup(worker *w);
 /* The worker's loop: seeds, messages, faces, until IAMDONE or abort. */

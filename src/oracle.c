@@ -82,6 +82,48 @@
 #define TIMED_FROM 4096
 #define TIMED_MIN 8192
 
+/*
+ * A collective part (fdt_oracle.collective: a part of a two-thread auto
+ * run, src/engine.c) votes for the mesh of every point instead of
+ * building its own, and that mesh is built once a majority voted. A vote
+ * by points tested alone, under COLLECTIVE_SURE units a face, needs the
+ * window's walk to have visited SLOW_NODES nodes a face too, the time
+ * rule's own condition: the first windows of an extruded grid's flat
+ * layers and of the wind-study city cost 280-430 units at 2-15 nodes a
+ * face (bench/NOTES.md entry 59). Once another part voted, a part also votes
+ * early, on its thread CPU since COLLECTIVE_TIMED_FROM faces measured over
+ * COLLECTIVE_TIMED_MIN more, when the kd search's remaining cost is over
+ * COLLECTIVE_CLEAR times the mesh's predicted cost, or over
+ * COLLECTIVE_MARGIN times with SLOW_NODES nodes a face: without it the
+ * second part of an O-grid or a cubed sphere waited for its first full
+ * time check (16,384 or 32,768 faces at 1.7-3 us a face, +0.10 and +0.15
+ * s CPU of 0.9 and 0.7); at 4,096-8,192 faces the early measure gave
+ * 2.2-3.6 there, 1.8 on the statue, and 1.1-1.3 on autzen's part 1 and on
+ * lonestar's part 0 (12-19 nodes a face), which must not vote. The
+ * margins are above the serial TIME_MARGIN because a window this short
+ * is noisier and a collective mesh costs every part; the serial margin
+ * holds where the walk visits DENSE_NODES nodes a face, which the airborne
+ * scans' parts never averaged (autzen 12-19, lonestar's part 0 8-16) and
+ * the statue (33) and bunny (24-29) do: the measured times, and so the
+ * ratios, fall on a quieter machine against the fixed MESH_BUILD_US, and
+ * the statue's 1.8 (bunny's 1.3-1.5) should not then drop under
+ * COLLECTIVE_MARGIN to wait for the 16,384-face check. The same margins
+ * hold at a collective part's later time checks (from TIMED_FROM):
+ * autzen's part 1 measured 1.11-1.26 there at 17-19 nodes a face, over
+ * the serial 1.15 in some runs, and the mesh was built (1 run in 6) once
+ * its part 0 had voted on its first faces (67 nodes a face over 189
+ * faces). COLLECTIVE_MARGIN lies between those and citylidar's part 0
+ * (1.5-1.6 at 18-22 nodes): at 1.5 that part stayed on the kd search in 3
+ * runs of 6 (bench/NOTES.md entry 61). All of these were measured on this
+ * loaded 2-core machine: the margins are thin.
+ */
+#define COLLECTIVE_SURE 1000.0
+#define COLLECTIVE_TIMED_FROM 1024
+#define COLLECTIVE_TIMED_MIN 2048
+#define COLLECTIVE_MARGIN 1.35
+#define COLLECTIVE_CLEAR 2.0
+#define DENSE_NODES 25.0
+
 /* The window's work so far is measured in these units. */
 static inline size_t work_units(const fdt_kdq *kq)
 {
@@ -138,6 +180,10 @@ size_t fdt_oracle_mem_share(int parts)
 
 static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
 {
+    if (o->collective) {
+        o->state = 2;
+        return;
+    }
     if (o->policy == FDT_SEARCH_AUTO && o->mem_cap &&
         FDT_ORACLE_MESH_BYTES * (double)o->t->n > (double)o->mem_cap) {
         o->state = -1;
@@ -155,13 +201,39 @@ static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
         o->switched_at = faces ? faces : 1;
 }
 
+/* Whether a switch chosen by points tested (a window's cost a face, the
+ * window since w_faces) stands (see collective, oracle.h). */
+static int count_switch_stands(const fdt_oracle *o, size_t faces, const fdt_kdq *kq, double cost)
+{
+    if (!o->collective || cost >= COLLECTIVE_SURE)
+        return 1;
+    size_t df = faces - o->w_faces;
+    double nodes = df ? (double)(kq->nodes - o->w_nodes) / (double)df : 0.0;
+    return nodes >= SLOW_NODES;
+}
+
+/* A collective part's time rule (above): the kd search's remaining cost
+ * is ratio times the mesh's predicted cost, the walk visits nodes a face. */
+static int collective_time_vote(double ratio, double nodes)
+{
+    return ratio > COLLECTIVE_CLEAR || (nodes >= SLOW_NODES && ratio > COLLECTIVE_MARGIN) ||
+           (nodes >= DENSE_NODES && ratio > TIME_MARGIN);
+}
+
 void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
 {
     if (o->state != 0)
         return;
     if (faces < o->next_check) {
-        if (work_units(kq) > o->w_budget)
-            build_mesh(o, faces, kq);
+        if (work_units(kq) > o->w_budget) {
+            size_t df = faces > o->w_faces ? faces - o->w_faces : 1;
+            double cost = (double)(work_units(kq) - o->w_points - EXACT_WEIGHT * o->w_exact) /
+                          (double)df;
+            if (count_switch_stands(o, faces, kq, cost))
+                build_mesh(o, faces, kq);
+            else
+                o->w_budget = SIZE_MAX; /* the window's end decides */
+        }
         return;
     }
     if (o->policy == FDT_SEARCH_MESH || o->t->n == 0) {
@@ -177,12 +249,29 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
     double cost = df > 0 ? ((double)points + EXACT_WEIGHT * (double)exact) / (double)df : 0.0;
     double total = FACES_PER_POINT * (double)o->t->n;
     double left = total > (double)faces ? total - (double)faces : 0.0;
-    if (df > 0 && (cost - MESH_FACE_COST) * left > (SWITCH_COST - MESH_FACE_COST) * total) {
+    if (df > 0 && (cost - MESH_FACE_COST) * left > (SWITCH_COST - MESH_FACE_COST) * total &&
+        count_switch_stands(o, faces, kq, cost)) {
         build_mesh(o, faces, kq);
         return;
     }
     /* The time rule over everything since TIMED_FROM faces (see above). */
     double now = fdt_thread_cpu_s();
+    /* A collective part's early opinion, once another part voted. */
+    if (o->collective && o->c_faces == 0 && faces >= COLLECTIVE_TIMED_FROM && now > 0.0) {
+        o->c_faces = faces;
+        o->c_cpu = now;
+        o->c_nodes = kq->nodes;
+    } else if (o->collective == 2 && o->c_faces > 0 &&
+               faces >= o->c_faces + COLLECTIVE_TIMED_MIN && now > 0.0) {
+        double nf = (double)(faces - o->c_faces);
+        double us = 1e6 * (now - o->c_cpu) / nf;
+        double nodes = (double)(kq->nodes - o->c_nodes) / nf;
+        double ratio = us * left / (MESH_BUILD_US * (double)o->t->n + MESH_WALK_US * left);
+        if (collective_time_vote(ratio, nodes)) {
+            build_mesh(o, faces, kq);
+            return;
+        }
+    }
     if (o->t_faces == 0 && faces >= TIMED_FROM && now > 0.0) {
         o->t_faces = faces;
         o->t_cpu = now;
@@ -191,8 +280,9 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
         double nf = (double)(faces - o->t_faces);
         double us = 1e6 * (now - o->t_cpu) / nf;
         double nodes = (double)(kq->nodes - o->t_nodes) / nf;
-        if (nodes >= SLOW_NODES &&
-            us * left > TIME_MARGIN * (MESH_BUILD_US * (double)o->t->n + MESH_WALK_US * left)) {
+        double ratio = us * left / (MESH_BUILD_US * (double)o->t->n + MESH_WALK_US * left);
+        if (o->collective ? collective_time_vote(ratio, nodes)
+                          : nodes >= SLOW_NODES && ratio > TIME_MARGIN) {
             build_mesh(o, faces, kq);
             return;
         }
@@ -200,6 +290,7 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
     o->w_faces = faces;
     o->w_points = kq->points;
     o->w_exact = kq->pc.orient_exact + kq->pc.insphere_exact;
+    o->w_nodes = kq->nodes;
     size_t win = faces < FIRST_WINDOW ? FIRST_WINDOW : faces < WINDOW ? faces : WINDOW;
     o->next_check = faces + win;
     o->w_budget = window_budget(o, work_units(kq), o->next_check, win);
@@ -283,21 +374,23 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
  * input points (the local density of files written in scan or grid
  * order: an O-grid's boundary layer, an extruded grid's planes, which
  * thinning hides: 111 and 44 points a face thinned, 198 and 365 in a
- * run). Either above PROBE_COST is expensive. The threshold is lower than
- * the serial switch's (SWITCH_COST) because the other choice costs more:
- * parts with meshes of their own points ask each other across the cuts
- * (entry 52), so two threads on an O-grid took 1.3 s wall against 0.75 s
- * serial. Measured (bench/NOTES.md entry 54), thinned / run: uniform 89
- * / 69, ball 113 / 105, clusters 83 / 86, lidar 124 / 81, lonestar 128 /
- * 124 stay on the kd search; citylidar 147 / 116, ogrid 111 / 198,
- * cubedsphere 184 / 141, extruded 44 / 365, bunny 167 / 167, autzen 180 /
- * 256 and every family that the serial rule switches early share one
- * mesh. The margins are thin (lonestar at 128, citylidar at 147): a wrong
- * choice costs at most the difference between the two parallel paths
- * (lonestar with one mesh: 1.65 s against 1.62 s wall on two threads;
- * autzen 0.32 s against 0.25 s), never correctness.
+ * run). Either above PROBE_SURE is clearly expensive: the threads build
+ * the mesh of every point before the fronts start. Below it the parts
+ * start on the kd search and measure it at the full density, and a
+ * majority of them decides the same mesh (the collective switch,
+ * src/engine.c), because no threshold on these samples separates the
+ * inputs that want the mesh from those that do not. Measured (bench/NOTES.md
+ * entries 54 and 59), thinned / run: uniform 89 / 69, lonestar 128 / 124,
+ * citylidar 147 / 116, ogrid 111 / 198, cubedsphere 184 / 141, bunny 167,
+ * autzen 180 / 256, statue 165 / 301, windcity 316 / 235, extruded 44 /
+ * 365; on two threads autzen and lonestar run faster on the kd search,
+ * the others on the mesh. Centre of a sphere 918 / 1,113, pipes, rotated
+ * lattices and 12-digit spheres above 1,000: for them the first faces
+ * measured would only delay the build. The probe stops once its running
+ * cost passes PROBE_SURE x PROBE_FACES (the average can then only end
+ * above it).
  */
-#define PROBE_COST 140
+#define PROBE_SURE 500
 
 /* The kd search's cost a face (as fdt_oracle_tick costs it) over the k
  * points of S (a copy, which the kd build permutes); -1 if it cannot be
@@ -318,14 +411,14 @@ static double probe_cost(double *S, uint32_t k, int leaf_size)
         goto done;
     fdt_front_stats st;
     memset(&st, 0, sizeof st);
-    /* The decision is "above PROBE_COST a face on average": once the
-     * running cost passes PROBE_COST * PROBE_FACES, the average over
+    /* The decision is "above PROBE_SURE a face on average": once the
+     * running cost passes PROBE_SURE * PROBE_FACES, the average over
      * however many faces the front would still run (at most PROBE_FACES)
      * can only end above it, so the front stops there with the same
      * answer. A rotated lattice's sample costs 12,392 units a face: 3 faces
      * instead of 256, 0.19 s of CPU on one thread saved before the build
      * (bench/NOTES.md entry 55). */
-    const fdt_probe_budget budget = {(double)PROBE_COST * PROBE_FACES, EXACT_WEIGHT};
+    const fdt_probe_budget budget = {(double)PROBE_SURE * PROBE_FACES, EXACT_WEIGHT};
     if (fdt_front_probe(&t, k / 2, PROBE_FACES, &budget, &st) != FDT_OK || st.faces_advanced == 0)
         goto done;
     double work = (double)st.kq.points +
@@ -368,7 +461,7 @@ int fdt_oracle_probe_decide(fdt_probe_samples *ps)
     int expensive = 0;
     for (int i = 0; i < 2 && !expensive; i++)
         if (ps->S[i])
-            expensive = probe_cost(ps->S[i], ps->k, ps->leaf_size) > PROBE_COST;
+            expensive = probe_cost(ps->S[i], ps->k, ps->leaf_size) > PROBE_SURE;
     free(ps->S[0]);
     free(ps->S[1]);
     ps->S[0] = ps->S[1] = NULL;

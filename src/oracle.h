@@ -34,14 +34,28 @@
 typedef struct fdt_oracle {
     const fdt_kdtree *t;  /* borrowed: the part's tree (its points) */
     int policy;           /* FDT_SEARCH_AUTO, _KD or _MESH */
-    int state;            /* 0: kd search; 1: mesh; -1: mesh unavailable */
+    int state;            /* 0: kd search; 1: mesh; -1: mesh unavailable;
+                             2: the rule chose the mesh of every point
+                             (collective, below), kd search until the
+                             engine provides it (fdt_oracle_share) */
     fdt_ins mesh;         /* owned, valid when state == 1 and !gm */
     const fdt_ins *gm;    /* borrowed: a mesh of every point (shared by
                              all parts, fdt_oracle_share), or NULL */
     uint32_t *mt;         /* owned: mesh tet of output tet i, FDT_NONE unknown */
     size_t mtcap;
     /* The switching window: counter values at its start. */
-    size_t next_check, w_faces, w_points, w_exact;
+    size_t next_check, w_faces, w_points, w_exact, w_nodes;
+    /* 1: a part of a threaded run whose switch is collective: the rule's
+     * choice sets state 2 and the engine builds one mesh of every point
+     * for all parts (src/engine.c) instead of this part's own mesh. Such
+     * a mesh costs every part, so a choice by points tested alone must be
+     * clear (COLLECTIVE_SURE in src/oracle.c) or come with the slow walk
+     * the time rule also asks for (SLOW_NODES). */
+    int collective;       /* 2: another part voted (src/engine.c) */
+    /* A collective part's early time measure: from COLLECTIVE_TIMED_FROM
+     * faces (0: not started), thread CPU and kd nodes then. */
+    size_t c_faces, c_nodes;
+    double c_cpu;
     /* Work (points tested + EXACT_WEIGHT x exact tests, since the run's
      * start) past which the window in progress must end in a switch:
      * the switch is made as soon as it is passed (SIZE_MAX: never). */
@@ -114,14 +128,15 @@ void fdt_oracle_share(fdt_oracle *o, const fdt_ins *gm);
 int fdt_oracle_note(fdt_oracle *o, int64_t tid, uint32_t mtet);
 
 /*
- * Whether the kd search is expensive on these points (the m distinct
- * points P, 3 doubles each): the first faces of a serial front over a
- * sample of them, costed as fdt_oracle_tick does. The parallel modes pay
- * for such inputs twice: each part builds its mesh, and a face whose
- * sphere crosses a cut still asks the other parts, where a pipe's or a
- * grid's spheres are as wide as the object (bench/NOTES.md, entry 52);
- * src/api.c then runs FDT_MODE_AUTO serially. 0 on any failure (no
- * memory, a flat sample): the caller's choice stands.
+ * Whether the kd search is clearly expensive on these points (the m
+ * distinct points P, 3 doubles each): the first faces of a serial front
+ * over a sample of them, costed as fdt_oracle_tick does. The parallel
+ * modes pay for such inputs twice: each part builds its mesh, and a face
+ * whose sphere crosses a cut still asks the other parts, where a pipe's or
+ * a grid's spheres are as wide as the object (bench/NOTES.md, entry 52);
+ * src/parallel.c then builds one mesh of every point before the fronts,
+ * and otherwise lets the parts decide it together (entry 59). 0 on any
+ * failure (no memory, a flat sample): the caller's choice stands.
  */
 int fdt_oracle_probe(const double *P, uint32_t m, int leaf_size);
 

@@ -136,6 +136,41 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
     return fdt_parallel_run(pr, s, mode, nthreads, NULL, out, diag, dlen);
 }
 
+/*
+ * With the mesh of every point built before the fronts, the tets each id
+ * will own (§3.2: a tet belongs to its lowest vertex's part) are known,
+ * and the parts' ranges move to split them evenly (fdt_partition_recut):
+ * the bisection cuts the points in half, but a pipe's inner tets span it
+ * and all of those across the cut go to the lower part (cylscan 100k:
+ * 726k tets against 577k, front thread CPU 0.43 s against 0.28 s;
+ * bench/NOTES.md entry 60). Hull faces count as tets do (each is a face
+ * advanced): by tets alone the lower part, with 140k of the pipe's 200k
+ * hull faces, kept 0.33-0.35 s against 0.29-0.31. One pass over the
+ * mesh's slots. FDT_OK or FDT_ENOMEM.
+ */
+static int recut_by_mesh(fdt_partition *pt, const fdt_ins *gm)
+{
+    uint32_t *w = calloc(pt->m ? pt->m : 1, sizeof *w);
+    if (!w)
+        return FDT_ENOMEM;
+    uint64_t total = 0;
+    for (uint32_t t = 0; t < gm->nslots; t++) {
+        const uint32_t *v = fdt_ins_tet(gm, t);
+        if (v[0] == FDT_NONE && v[1] == FDT_NONE)
+            continue; /* a freed slot */
+        /* the lowest id; FDT_NONE (the infinite vertex of a hull face's
+         * tet) is above every id, so a hull face counts for its own
+         * lowest vertex: a face advanced, as a tet is */
+        uint32_t lo = v[0] < v[1] ? v[0] : v[1];
+        uint32_t hi = v[2] < v[3] ? v[2] : v[3];
+        w[lo < hi ? lo : hi]++;
+        total++;
+    }
+    fdt_partition_recut(pt, w, total);
+    free(w);
+    return FDT_OK;
+}
+
 /* The probe (FDT_PAR_MESH_PROBE) on its own thread. */
 typedef struct probe_job {
     fdt_probe_samples ps;
@@ -220,6 +255,42 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     e->want_nbrs = s->neighbors != 0;
     e->search = (int)s->search;
     e->pin = s->pin != 0;
+    /* The DT of every point, for inputs where the kd search degenerates
+     * (src/api.c decides, by fdt_oracle_probe): built here on the run's
+     * threads, then every part reads its faces' apexes from it and asks
+     * no other part (bench/NOTES.md entry 54). Tets are still made and
+     * owned by the parts' fronts. A build that cannot be made (no memory)
+     * leaves the parts on their own oracles. Built before the seeds go to
+     * their owners and the workers take their ranges: recut_by_mesh moves
+     * those ranges. */
+    double t_gm = 0.0;
+    /* The probe's choice (not an explicit global_mesh == 1) is dropped
+     * when the mesh would not fit the memory available (src/oracle.h,
+     * FDT_ORACLE_MESH_BYTES): the parts' kd searches are always right. */
+    if (expensive && FDT_ORACLE_MESH_BYTES * (double)pr->m > (double)fdt_mem_available())
+        expensive = 0;
+    /* The probe's "not clearly expensive" (src/oracle.c, PROBE_SURE):
+     * the parts start on the kd search and switch together when one of
+     * them measures it expensive at the full density (src/engine.c,
+     * collective_step; bench/NOTES.md entry 59). */
+    e->collective = mode == FDT_MODE_SHARED &&
+                    ((probe && !expensive) || (opt && opt->global_mesh == FDT_PAR_MESH_COLLECTIVE));
+    if (opt && (opt->global_mesh == 1 || expensive) && mode == FDT_MODE_SHARED) {
+        double tg = fdt_now_s();
+        int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads,
+                                          &kq0.pc);
+        t_gm = fdt_now_s() - tg;
+        if (gerr == FDT_OK) {
+            e->gmesh_ok = 1;
+            if (nthreads > 1 && (err = recut_by_mesh(&pt, &e->gmesh)) != FDT_OK)
+                goto fail;
+        } else if (gerr != FDT_ENOMEM && gerr != FDT_EDEGENERATE) {
+            err = gerr;
+            if (gerr == FDT_EINTERNAL)
+                snprintf(diag, dlen, "internal error: the parallel insertion mesh failed");
+            goto fail;
+        }
+    }
     if (opt && opt->shuffle)
         err = fdt_transport_shuffle(&e->tp, nthreads + 1, opt->seed, opt->delay_pct);
     else
@@ -239,6 +310,12 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         goto fail;
     }
     if (pthread_cond_init(&e->go, NULL) != 0) {
+        pthread_cond_destroy(&e->cv);
+        pthread_mutex_destroy(&e->lock);
+        goto fail;
+    }
+    if (pthread_cond_init(&e->gm_cv, NULL) != 0) {
+        pthread_cond_destroy(&e->go);
         pthread_cond_destroy(&e->cv);
         pthread_mutex_destroy(&e->lock);
         goto fail;
@@ -344,32 +421,6 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         } else {
             w->active = 1;
             active++;
-        }
-    }
-    /* The DT of every point, for inputs where the kd search degenerates
-     * (src/api.c decides, by fdt_oracle_probe): built here on the run's
-     * threads, then every part reads its faces' apexes from it and asks
-     * no other part (bench/NOTES.md entry 54). Tets are still made and
-     * owned by the parts' fronts. A build that cannot be made (no memory)
-     * leaves the parts on their own oracles. */
-    double t_gm = 0.0;
-    /* The probe's choice (not an explicit global_mesh == 1) is dropped
-     * when the mesh would not fit the memory available (src/oracle.h,
-     * FDT_ORACLE_MESH_BYTES): the parts' kd searches are always right. */
-    if (expensive && FDT_ORACLE_MESH_BYTES * (double)pr->m > (double)fdt_mem_available())
-        expensive = 0;
-    if (opt && (opt->global_mesh == 1 || expensive) && mode == FDT_MODE_SHARED) {
-        double tg = fdt_now_s();
-        int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads,
-                                          &kq0.pc);
-        t_gm = fdt_now_s() - tg;
-        if (gerr == FDT_OK)
-            e->gmesh_ok = 1;
-        else if (gerr != FDT_ENOMEM && gerr != FDT_EDEGENERATE) {
-            err = gerr;
-            if (gerr == FDT_EINTERNAL)
-                snprintf(diag, dlen, "internal error: the parallel insertion mesh failed");
-            goto fail;
         }
     }
     /* Every thread with seeds starts holding its activity unit. Thread
@@ -484,6 +535,7 @@ fail:
         fdt_ins_free(&e->gmesh);
         fdt_transport_destroy(&e->tp);
         if (sync_ok) {
+            pthread_cond_destroy(&e->gm_cv);
             pthread_cond_destroy(&e->go);
             pthread_cond_destroy(&e->cv);
             pthread_mutex_destroy(&e->lock);

@@ -45,8 +45,12 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
                              fdt_mode mode, int nthreads, fdt_par_out *out,
                              char *diag, size_t dlen);
 
-/* fdt_par_opts.global_mesh: let the probe decide (src/parallel.c). */
+/* fdt_par_opts.global_mesh: let the probe decide (src/parallel.c):
+ * where it is not sure, the parts decide together (src/engine.c,
+ * collective_step). */
 #define FDT_PAR_MESH_PROBE 2
+/* fdt_par_opts.global_mesh: no probe, the parts decide together (tests). */
+#define FDT_PAR_MESH_COLLECTIVE 3
 
 /* How a run is carried out beyond the settings (tests). */
 typedef struct fdt_par_opts {

@@ -218,6 +218,20 @@ int fdt_partition_build(fdt_partition *pt, double *P, fdt_vid *orig,
     return FDT_OK;
 }
 
+void fdt_partition_recut(fdt_partition *pt, const uint32_t *w, uint64_t total)
+{
+    uint64_t sum = 0;
+    uint32_t id = 0;
+    for (int p = 1; p < pt->nparts; p++) {
+        /* total * p / nparts without overflow: total < 2^32 * 2^32 */
+        uint64_t goal = total / (uint64_t)pt->nparts * (uint64_t)p +
+                        total % (uint64_t)pt->nparts * (uint64_t)p / (uint64_t)pt->nparts;
+        while (id < pt->m && sum < goal)
+            sum += w[id++];
+        pt->start[p] = id;
+    }
+}
+
 int fdt_partition_owner(const fdt_partition *pt, uint32_t id)
 {
     /* The last p with start[p] <= id: its range [start[p], start[p + 1])

@@ -59,6 +59,18 @@ void fdt_partition_free(fdt_partition *pt);
 int fdt_partition_owner(const fdt_partition *pt, uint32_t id);
 
 /*
+ * Moves the parts' id ranges (start) so that each owns an equal share of
+ * the weight w (m entries, w[id] the work that id's part will do for it;
+ * total their sum): start[p] becomes the first id whose prefix sum reaches
+ * p * total / nparts. Only ownership moves (fdt_partition_owner, the
+ * workers' ranges): the kd-trees and the bisection's nodes keep theirs, so
+ * a part's tree may then hold ids it does not own and miss ids it does.
+ * For runs where every apex comes from one mesh of every point
+ * (src/parallel.c), whose parts never search their own trees alone.
+ */
+void fdt_partition_recut(fdt_partition *pt, const uint32_t *w, uint64_t total);
+
+/*
  * One kd-tree over all m points: the bisection tree on top (empty parts
  * left out), each part's tree below it, nodes copied (out owns them; free
  * with fdt_kd_free). It reads every part's points, so only the setup phase

@@ -112,7 +112,7 @@ int fdt_proto_handle_face(worker *w, const pface *pf)
         err = fdt_eng_face_arrives(w, f->v, pf->sender, f->tet, NULL);
     } else {
         uint32_t v[4] = {f->v[0], f->v[1], f->v[2], f->apex};
-        err = fdt_eng_build_tet(w, v, 1, NULL);
+        err = fdt_eng_build_requested(w, v, f->tet);
     }
     if (err)
         return err;

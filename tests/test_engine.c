@@ -11,8 +11,14 @@
  *   tet request per face it advances; duplicate requests are among the
  *   requests sent; every FACESEND sent is received;
  * - an injected failure of any part, before or after its first faces,
- *   ends the run with FDT_EINTERNAL naming that part, and no mesh.
+ *   ends the run with FDT_EINTERNAL naming that part, and no mesh;
+ * - with the mesh of every point built first, the parts own equal shares
+ *   of its tets, and few faces are found by walks;
+ * - the collective switch: the mesh of every point is built in the middle
+ *   of the run once a majority of the parts votes for it, never on one
+ *   part's vote of two, with serial's tets either way.
  */
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -220,6 +226,171 @@ static void run_failing(const input *in, fdt_mode mode, int nthreads, int part, 
     fdt_prepared_free(&pr);
 }
 
+/* An exact pipe: rings of per_ring points about the x axis from x = x0,
+ * radius 0.5 about (y, z) = (0.5, 0.5), rings 1/40 apart; the kd search
+ * tests hundreds of points a face there (src/oracle.c). Appended at in's
+ * point `at`. */
+static void put_pipe(input *in, size_t at, int rings, int per_ring, double x0)
+{
+    size_t n = at;
+    for (int k = 0; k < rings; k++)
+        for (int j = 0; j < per_ring; j++, n++) {
+            double t = 6.283185307179586 * j / per_ring;
+            in->xyz[3 * n] = x0 + 0.025 * k;
+            in->xyz[3 * n + 1] = 0.5 + 0.5 * cos(t);
+            in->xyz[3 * n + 2] = 0.5 + 0.5 * sin(t);
+        }
+}
+
+/*
+ * The collective switch (src/engine.c, collective_step; bench/NOTES.md
+ * entry 59), forced by FDT_PAR_MESH_COLLECTIVE: the parts start on the kd
+ * search and, once a majority of them votes, one builds the mesh of every
+ * point while the others wait, and all read it. The tets are serial's
+ * either way. want: the parts that read the mesh (stats mesh_parts), 0
+ * where it must not be built.
+ */
+static void run_collective(const input *in, const uint32_t *ref, size_t nref, int nthreads,
+                           int want)
+{
+    fdt_prepared pr;
+    char diag[256] = "";
+    CHECK_EQ(fdt_prepare(in->xyz, in->n, 1, &pr, diag, sizeof diag), FDT_OK);
+    fdt_settings s;
+    fdt_default_settings(&s);
+    fdt_par_opts opt;
+    memset(&opt, 0, sizeof opt);
+    opt.global_mesh = FDT_PAR_MESH_COLLECTIVE;
+    fdt_par_out out;
+    int err = fdt_parallel_run(&pr, &s, FDT_MODE_SHARED, nthreads, &opt, &out, diag, sizeof diag);
+    EXPECTF(err == FDT_OK, "%s, collective, %d threads: %d %s", in->name, nthreads, err, diag);
+    if (err) {
+        fdt_prepared_free(&pr);
+        return;
+    }
+    EXPECTF((int)out.fst.mesh_parts == want, "%s, collective, %d threads: %zu parts read a mesh, want %d",
+            in->name, nthreads, out.fst.mesh_parts, want);
+    /* built in the middle of the run: faces before it from the kd search */
+    if (want)
+        EXPECTF(out.fst.mesh_faces > 0 && out.fst.mesh_faces < out.fst.faces_advanced,
+                "%s: %zu of %zu faces from the mesh", in->name, out.fst.mesh_faces,
+                out.fst.faces_advanced);
+    else
+        EXPECT(out.fst.mesh_faces == 0);
+    EXPECT(out.mb.ntets == nref);
+    if (out.mb.ntets == nref) {
+        uint32_t *c = malloc(nref * 4 * sizeof *c);
+        CHECK(c != NULL);
+        memcpy(c, out.mb.tets, nref * 4 * sizeof *c);
+        for (size_t i = 0; i < nref; i++)
+            sort4(c + 4 * i);
+        qsort(c, nref, 4 * sizeof *c, cmp4);
+        EXPECTF(!memcmp(c, ref, nref * 4 * sizeof *c), "%s, collective, %d threads: serial's tets",
+                in->name, nthreads);
+        free(c);
+    }
+    fdt_par_out_free(&out);
+    fdt_prepared_free(&pr);
+}
+
+/*
+ * The mesh of every point built before the fronts (global_mesh 1): the
+ * parts' ranges are moved so that each owns as many of its tets and hull
+ * faces (src/parallel.c, recut_by_mesh), where the bisection's halves of
+ * a pipe gave the lower part every tet across the cut; and a tet built on
+ * another part's request has its mesh slot noted (the request carries
+ * it), so its faces are not found by walks around a vertex. Serial's
+ * tets, tets a thread within 10 % (the hull faces count too), and under
+ * 2 % of the faces found by a walk.
+ */
+static void test_recut(void)
+{
+    /* a pipe scan as tests/gen_points cylscan makes it: 71 rings of 71
+     * points at jittered angles, rings 2 pi / 71 apart, radius 1 */
+    const int m = 71;
+    input pipe = {"pipe scan", malloc(3 * (size_t)m * m * sizeof(double)), (size_t)m * m};
+    CHECK(pipe.xyz != NULL);
+    uint64_t seed = 29;
+    for (int j = 0, n = 0; j < m; j++)
+        for (int i = 0; i < m; i++, n++) {
+            double a = 6.283185307179586 * (i + 0.9 * test_unif(&seed) - 0.45) / m;
+            pipe.xyz[3 * n] = cos(a);
+            pipe.xyz[3 * n + 1] = sin(a);
+            pipe.xyz[3 * n + 2] = j * 6.283185307179586 / m;
+        }
+    size_t nref;
+    uint32_t *ref = serial_set(&pipe, &nref);
+    fdt_prepared pr;
+    char diag[256] = "";
+    CHECK_EQ(fdt_prepare(pipe.xyz, pipe.n, 1, &pr, diag, sizeof diag), FDT_OK);
+    fdt_settings s;
+    fdt_default_settings(&s);
+    fdt_par_opts opt;
+    memset(&opt, 0, sizeof opt);
+    opt.global_mesh = 1;
+    fdt_par_out out;
+    CHECK_EQ(fdt_parallel_run(&pr, &s, FDT_MODE_SHARED, 2, &opt, &out, diag, sizeof diag), FDT_OK);
+    EXPECT(out.mb.ntets == nref);
+    EXPECTF(out.pst.load_imbalance < 1.1, "pipe, mesh first: load imbalance %.3f (tets %zu, %zu)",
+            out.pst.load_imbalance, out.tstats[0].tets, out.tstats[1].tets);
+    EXPECTF(out.fst.star_walks * 50 < out.fst.faces_advanced, "pipe: %zu of %zu faces by a walk",
+            out.fst.star_walks, out.fst.faces_advanced);
+    if (out.mb.ntets == nref) {
+        uint32_t *c = malloc(nref * 4 * sizeof *c);
+        CHECK(c != NULL);
+        memcpy(c, out.mb.tets, nref * 4 * sizeof *c);
+        for (size_t i = 0; i < nref; i++)
+            sort4(c + 4 * i);
+        qsort(c, nref, 4 * sizeof *c, cmp4);
+        EXPECT(!memcmp(c, ref, nref * 4 * sizeof *c));
+        free(c);
+    }
+    fdt_par_out_free(&out);
+    fdt_prepared_free(&pr);
+    free(ref);
+    free(pipe.xyz);
+    printf("mesh first: a pipe's tets split evenly, requests carry their mesh slot\n");
+}
+
+static void test_collective(void)
+{
+    /* a pipe: every part votes, the mesh is built and read by all */
+    input pipe = {"pipe", malloc(3 * 40 * 64 * sizeof(double)), 40 * 64};
+    CHECK(pipe.xyz != NULL);
+    put_pipe(&pipe, 0, 40, 64, 0.0);
+    size_t nref;
+    uint32_t *ref = serial_set(&pipe, &nref);
+    run_collective(&pipe, ref, nref, 2, 2);
+    run_collective(&pipe, ref, nref, 3, 3);
+    free(ref);
+    /* four parts: uniform points in the unit cube (two parts) beside a
+     * short pipe from x = 1.05 (two parts); the pipe's parts vote, the
+     * uniform parts do not (their faces are cheap, and too few, about
+     * 3,300 a part, to reach the time measure), and two votes of four are
+     * not a majority: no mesh (lonestar's case, where one part's dense
+     * first faces voted alone) */
+    size_t nu = 16 * 64;
+    input half = {"uniform+pipe", malloc(3 * 2 * nu * sizeof(double)), 2 * nu};
+    CHECK(half.xyz != NULL);
+    uint64_t seed = 17;
+    for (size_t i = 0; i < 3 * nu; i++)
+        half.xyz[i] = test_unif(&seed);
+    put_pipe(&half, nu, 16, 64, 1.05);
+    ref = serial_set(&half, &nref);
+    run_collective(&half, ref, nref, 4, 0);
+    free(ref);
+    /* uniform points: nobody votes */
+    input uni = uniform(3000, 23);
+    ref = serial_set(&uni, &nref);
+    run_collective(&uni, ref, nref, 2, 0);
+    free(ref);
+    free(pipe.xyz);
+    free(half.xyz);
+    free(uni.xyz);
+    printf("collective switch: a pipe builds one mesh on 2 and 3 threads, one part's vote "
+           "builds none, serial's tets\n");
+}
+
 int main(void)
 {
     setvbuf(stdout, NULL, _IOLBF, 0);
@@ -242,6 +413,8 @@ int main(void)
             run_failing(&ins[0], (fdt_mode)m, 3, part, 25);
         }
     printf("injected failures: every part, both modes, named\n");
+    test_collective();
+    test_recut();
     for (int f = 0; f < 2; f++)
         free(ins[f].xyz);
     return test_report("engine");

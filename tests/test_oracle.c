@@ -13,7 +13,8 @@
  *   - a part whose points are coplanar cannot build a mesh and falls back
  *     to the kd search with the same result;
  *   - FDT_MODE_AUTO with threads builds one mesh of every point for the
- *     cylinder (the probe) and its parts read it,
+ *     cylinder (the probe) and its parts read it; a part of such a run
+ *     votes for that mesh rather than building its own (collective),
  *     uniform points on two parts;
  *   - in shared mode other parts' meshes answer the faces whose sphere
  *     crosses a cut (thread stats mesh_queries).
@@ -391,10 +392,71 @@ static void test_mem_cap(void)
     printf("ok memory cap\n");
 }
 
+/* A collective oracle (fdt_oracle.collective: a part of a two-thread
+ * auto run) votes (state 2) instead of building a mesh of its own; a vote
+ * by points tested under COLLECTIVE_SURE (1,000 units a face) stands only
+ * with 18 kd nodes a face or more (bench/NOTES.md entry 59), where a
+ * serial oracle switches on the points alone. Driven directly, as
+ * test_mem_cap: 10 faces into the first window, whose budget is spent. */
+static void test_collective_vote(void)
+{
+    pts p = gen_cylinder(20, 32);
+    fdt_prepared pr;
+    char diag[256];
+    CHECK_EQ(fdt_prepare(p.xyz, p.n, 1, &pr, diag, sizeof diag), FDT_OK);
+    fdt_kdtree t;
+    memset(&t, 0, sizeof t);
+    CHECK_EQ(fdt_kd_build(&t, pr.p, pr.orig, 0, (uint32_t)pr.m, 18), FDT_OK);
+    /* collective, points a face, nodes a face -> state, window budget left */
+    static const struct {
+        int collective;
+        size_t points, nodes;
+        int state;
+    } c[] = {
+        {1, 20000, 5, 2},  /* 2,000 units a face: a vote, whatever the walk */
+        {1, 400, 5, 0},    /* 400 units at 5 nodes a face: no vote yet */
+        {1, 400, 30, 2},   /* the same at 30 nodes: a vote */
+        {0, 400, 5, 1},    /* serial: the points alone decide, the mesh is built */
+    };
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        fdt_oracle o;
+        fdt_oracle_init(&o, &t, FDT_SEARCH_AUTO);
+        o.collective = c[i].collective;
+        o.w_budget = 0;
+        fdt_kdq kq;
+        memset(&kq, 0, sizeof kq);
+        kq.points = 10 * c[i].points;
+        kq.nodes = 10 * c[i].nodes;
+        fdt_oracle_tick(&o, 10, &kq);
+        EXPECTF(o.state == c[i].state, "case %zu: state %d, want %d", i, o.state, c[i].state);
+        /* a vote builds nothing here: the engine builds the mesh of every point */
+        if (c[i].state == 2)
+            EXPECT(o.switched_at == 0 && o.t_mesh == 0.0);
+        /* a refused vote waits for the window's end instead of asking at every face */
+        if (c[i].state == 0) {
+            EXPECT(o.w_budget == SIZE_MAX);
+            kq.points += 10;
+            fdt_oracle_tick(&o, 11, &kq);
+            EXPECT(o.state == 0);
+        }
+        /* state 2 searches with the kd tree until the engine shares a mesh */
+        uint32_t apex, mtet;
+        const uint32_t f[3] = {0, 1, 2};
+        if (o.state == 2)
+            EXPECT(fdt_oracle_apex(&o, f, -1, FDT_NONE, &apex, &mtet) == 0);
+        fdt_oracle_free(&o);
+    }
+    fdt_kd_free(&t);
+    fdt_prepared_free(&pr);
+    free(p.xyz);
+    printf("ok collective votes\n");
+}
+
 int main(int argc, char **argv)
 {
     int quick = argc > 1 && !strcmp(argv[1], "--quick");
     alarm(600);
+    test_collective_vote();
     test_mem_cap();
     test_flat_parts();
     test_probe_samples();

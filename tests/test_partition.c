@@ -2,7 +2,8 @@
  * The partition module (src/partition.c): proportional part sizes for any
  * N (less the work shift), contiguous ranges, owner lookup (empty parts
  * skipped), the permutation kept, bisection boxes holding their points,
- * the composite tree's nearest point against brute force, and refusals.
+ * the composite tree's nearest point against brute force, refusals, and
+ * the ranges moved by weights (fdt_partition_recut).
  */
 #include <math.h>
 #include <stdint.h>
@@ -133,8 +134,55 @@ static void test_partition(void)
     printf("partition: proportional parts, owners, boxes, composite tree\n");
 }
 
+/* fdt_partition_recut: each part's range holds an equal share of the
+ * weights (the first id whose prefix sum reaches p * total / nparts
+ * starts part p); heavy low ids move the cut down, an empty weight range
+ * leaves a part empty, and the owners follow the new ranges. The trees
+ * are not touched. */
+static void test_recut(void)
+{
+    double *P = malloc(3 * 100 * sizeof *P);
+    fdt_vid *orig = malloc(100 * sizeof *orig);
+    CHECK(P && orig);
+    uint64_t seed = 11;
+    for (size_t i = 0; i < 300; i++)
+        P[i] = test_unif(&seed);
+    for (size_t i = 0; i < 100; i++)
+        orig[i] = (fdt_vid)i;
+    fdt_partition pt;
+    CHECK_EQ(fdt_partition_build(&pt, P, orig, 100, 2, 18, 1), FDT_OK);
+    uint32_t tree0 = pt.trees[0].n;
+    uint32_t w[100];
+    for (int i = 0; i < 100; i++)
+        w[i] = i < 20 ? 4 : 1; /* 80 + 80: half the weight in ids 0..19 */
+    fdt_partition_recut(&pt, w, 160);
+    EXPECTF(pt.start[0] == 0 && pt.start[1] == 20 && pt.start[2] == 100, "cut at %u", pt.start[1]);
+    EXPECT(fdt_partition_owner(&pt, 19) == 0 && fdt_partition_owner(&pt, 20) == 1);
+    EXPECT(pt.trees[0].n == tree0); /* only ownership moved */
+    fdt_partition_free(&pt);
+    CHECK_EQ(fdt_partition_build(&pt, P, orig, 100, 3, 18, 1), FDT_OK);
+    for (int i = 0; i < 100; i++)
+        w[i] = i < 50 ? 0 : 1; /* nothing owned below 50 */
+    fdt_partition_recut(&pt, w, 50);
+    /* goals 16 and 33 of 50: ids 50..65 reach 16, 50..82 reach 33 */
+    EXPECTF(pt.start[1] == 66 && pt.start[2] == 83 && pt.start[3] == 100, "cuts at %u, %u",
+            pt.start[1], pt.start[2]);
+    EXPECT(fdt_partition_owner(&pt, 0) == 0 && fdt_partition_owner(&pt, 66) == 1 &&
+           fdt_partition_owner(&pt, 99) == 2);
+    for (int i = 0; i < 100; i++)
+        w[i] = i == 99 ? 5 : 0; /* all on the last id: two empty parts */
+    fdt_partition_recut(&pt, w, 5);
+    EXPECT(pt.start[1] == 100 && pt.start[2] == 100);
+    EXPECT(fdt_partition_owner(&pt, 99) == 0);
+    fdt_partition_free(&pt);
+    free(P);
+    free(orig);
+    printf("partition: recut by weights\n");
+}
+
 int main(void)
 {
     test_partition();
+    test_recut();
     return test_report("test_partition");
 }
