@@ -142,6 +142,8 @@ static void bin_tets(fdt_stream_out *s, const fdt_vid *t, size_t count)
 
 static void bin_hull(fdt_stream_out *s, const fdt_vid *f, size_t count)
 {
+    if (count == 0)
+        return; /* an empty batch may come with no array (memcpy's NULL) */
     size_t need = 3 * (size_t)s->n_hull + 3 * count;
     if (need > s->hull_cap) {
         size_t cap = s->hull_cap ? 2 * s->hull_cap : 3 * 4096;

@@ -1015,14 +1015,18 @@ int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned)
     memset(&h, 0, sizeof h);
     int rc;
     for (;;) {
+        /* h holds the previous pass's parse (a header cut short) from the
+         * second pass on: every exit frees it */
         char *nb = realloc(hb, cap + 1);
         if (nb == NULL) {
+            ply_hdr_free(&h);
             free(hb);
             return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
         }
         hb = nb;
         ptrdiff_t r = fdt_rd_src_read(c, hb + len, cap - len);
         if (r < 0) {
+            ply_hdr_free(&h);
             free(hb);
             return FDT_IO_EOPEN;
         }
