@@ -733,24 +733,6 @@ static void make_nodes(node_ctx *c, int id, int p0, int k, int depth)
 
 /* ---- 5. seeds ------------------------------------------------------------ */
 
-/* Exactly: are a, b, t collinear? (src/seed.c's test: each projection on a
- * coordinate plane is degenerate, by an exact orient3d with the axis's
- * unit point.) */
-static int collinear(const double *a, const double *b, const double *t)
-{
-    for (int k = 0; k < 3; k++) {
-        double pa[3], pb[3], pt[3], e[3] = {0.0, 0.0, 0.0};
-        memcpy(pa, a, sizeof pa);
-        memcpy(pb, b, sizeof pb);
-        memcpy(pt, t, sizeof pt);
-        pa[k] = pb[k] = pt[k] = 0.0;
-        e[k] = 1.0;
-        if (fdt_orient3d(pa, pb, pt, e, NULL) != 0)
-            return 0;
-    }
-    return 1;
-}
-
 /* A greedy affine basis of the n points P (distinct): indices into out
  * (at most 4), their count. */
 static int affine_basis(const double *P, size_t n, size_t out[4])
@@ -761,7 +743,7 @@ static int affine_basis(const double *P, size_t n, size_t out[4])
         int take = k == 0 ? 1
                    : k == 1 ? !(q[0] == P[3 * out[0]] && q[1] == P[3 * out[0] + 1] &&
                                 q[2] == P[3 * out[0] + 2])
-                   : k == 2 ? !collinear(P + 3 * out[0], P + 3 * out[1], q)
+                   : k == 2 ? !fdt_seed_collinear(P + 3 * out[0], P + 3 * out[1], q)
                             : fdt_orient3d(P + 3 * out[0], P + 3 * out[1], P + 3 * out[2], q,
                                            NULL) != 0;
         if (take)

@@ -57,7 +57,7 @@ static double norm_robust(const double *v)
  * products do not, since they underflow or cancel when the input mixes
  * magnitudes.
  */
-static int collinear_exact(const double *a, const double *b, const double *t)
+int fdt_seed_collinear(const double *a, const double *b, const double *t)
 {
     for (int k = 0; k < 3; k++) {
         double pa[3], pb[3], pt[3], e[3] = {0.0, 0.0, 0.0};
@@ -85,7 +85,7 @@ int fdt_seed_check_dimension(const double *P, const fdt_vid *orig, uint32_t m,
      * (the two below took 20 ms of the setup at 1M). */
     uint32_t few = m < 64 ? m : 64, qc = FDT_NONE;
     for (uint32_t i = 2; i < few && qc == FDT_NONE; i++)
-        if (!collinear_exact(P, P + 3, P + 3 * (size_t)i))
+        if (!fdt_seed_collinear(P, P + 3, P + 3 * (size_t)i))
             qc = i;
     for (uint32_t i = 2; i < few && qc != FDT_NONE; i++)
         if (i != qc && fdt_orient3d(P, P + 3, P + 3 * (size_t)qc, P + 3 * (size_t)i, NULL) != 0)
@@ -125,10 +125,10 @@ int fdt_seed_check_dimension(const double *P, const fdt_vid *orig, uint32_t m,
      * cross product nonzero), or every floating cross product may have
      * vanished for points that are not collinear: look for an exactly
      * non-collinear third point. */
-    if (ic == FDT_NONE || collinear_exact(a, b, P + 3 * (size_t)ic)) {
+    if (ic == FDT_NONE || fdt_seed_collinear(a, b, P + 3 * (size_t)ic)) {
         ic = FDT_NONE;
         for (uint32_t i = 1; i < m && ic == FDT_NONE; i++)
-            if (i != ib && !collinear_exact(a, b, P + 3 * (size_t)i))
+            if (i != ib && !fdt_seed_collinear(a, b, P + 3 * (size_t)i))
                 ic = i;
     }
     if (ic == FDT_NONE) {

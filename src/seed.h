@@ -9,6 +9,10 @@
 #include <stdint.h>
 #include "kdtree.h"
 
+/* Exactly: are the points a, b and t collinear? (Each projection onto a
+ * coordinate plane degenerate, by exact orient3d; src/seed.c says why.) */
+int fdt_seed_collinear(const double *a, const double *b, const double *t);
+
 /* FDT_OK if the m points (3 doubles each) span 3-D space; otherwise
  * FDT_EDEGENERATE with the reason in diag (fewer than 4 points, all
  * collinear, all coplanar). orig maps ids to input indices for messages. */
