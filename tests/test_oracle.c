@@ -16,6 +16,8 @@
  *     cylinder (the probe) and its parts read it; a part of such a run
  *     votes for that mesh rather than building its own (collective),
  *     uniform points on two parts;
+ *   - the time rules, driven with a window start's CPU that gives a known
+ *     ratio: a collective part's early vote and later rule, the serial rule;
  *   - in shared mode other parts' meshes answer the faces whose sphere
  *     crosses a cut (thread stats mesh_queries).
  * Usage: test_oracle [--quick]   (--quick: fewer thread counts)
@@ -27,6 +29,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "clock.h"
 #include "frontdt.h"
 #include "oracle.h"
 #include "prepare.h"
@@ -452,11 +455,117 @@ static void test_collective_vote(void)
     printf("ok collective votes\n");
 }
 
+/* The thread CPU a window start must have had for the time rules to see
+ * `us` microseconds a face over nf faces (t: the tree of n points; the
+ * rule's ratio is us * left / (3 n + 0.2 left), MESH_BUILD_US and
+ * MESH_WALK_US in src/oracle.c), read just before the tick: the
+ * microseconds between the two reads move a ratio by under 1e-3 here. */
+static double cpu_for_ratio(const fdt_kdtree *t, size_t faces, size_t nf, double ratio)
+{
+    double left = 6.5 * (double)t->n - (double)faces;
+    double us = ratio * (3.0 * (double)t->n + 0.2 * left) / left;
+    return fdt_thread_cpu_s() - us * (double)nf / 1e6;
+}
+
+/* The time rules, driven directly with the window start's CPU set so that
+ * the measured ratio is known: a collective part's early vote (past 2.0,
+ * past 1.35 with 18 kd nodes a face, past 1.15 with 25), the serial rule
+ * (past 1.15 with 18 nodes), a collective part's later rule (the
+ * collective margins), and the window's edges (a budget spent before any
+ * face, a window past the last face). */
+static void test_time_votes(void)
+{
+    pts p = gen_cylinder(60, 64);
+    fdt_prepared pr;
+    char diag[256];
+    CHECK_EQ(fdt_prepare(p.xyz, p.n, 1, &pr, diag, sizeof diag), FDT_OK);
+    fdt_kdtree t;
+    memset(&t, 0, sizeof t);
+    CHECK_EQ(fdt_kd_build(&t, pr.p, pr.orig, 0, (uint32_t)pr.m, 18), FDT_OK);
+    CHECK(6.5 * (double)t.n > 13000.0); /* room for the serial rule's faces */
+    /* rule: 0 a collective part's early vote (2), 1 the serial rule, 2 a
+     * collective part's later rule */
+    static const struct {
+        int rule;
+        double ratio, nodes;
+        int state;
+    } c[] = {
+        {0, 3.0, 5, 2},    {0, 1.7, 20, 2},  {0, 1.7, 5, 0},   {0, 1.25, 30, 2},
+        {0, 1.25, 20, 0},  {0, 1.0, 30, 0},  {0, -1.0, 30, 0}, {1, 1.5, 20, 1},
+        {1, 1.5, 10, 0},   {1, 1.0, 20, 0},  {2, 1.7, 20, 2},  {2, 1.7, 5, 0},
+        {2, 3.0, 1, 2},
+    };
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        fdt_oracle o;
+        fdt_oracle_init(&o, &t, FDT_SEARCH_AUTO);
+        fdt_kdq kq;
+        memset(&kq, 0, sizeof kq); /* no points tested: the cost rule never switches */
+        size_t faces, nf;
+        if (c[i].rule == 0) {
+            o.collective = 2;
+            o.c_faces = 1000;
+            faces = 4000; /* before the serial rule's start (4,096) */
+            nf = faces - o.c_faces;
+            kq.nodes = (size_t)(c[i].nodes * (double)nf);
+            o.c_cpu = cpu_for_ratio(&t, faces, nf, c[i].ratio);
+        } else {
+            o.collective = c[i].rule == 2;
+            o.c_faces = 1; /* the early measure started, never voted */
+            o.t_faces = 4096;
+            faces = 4096 + 8192;
+            nf = faces - o.t_faces;
+            kq.nodes = (size_t)(c[i].nodes * (double)nf);
+            o.t_cpu = cpu_for_ratio(&t, faces, nf, c[i].ratio);
+        }
+        fdt_oracle_tick(&o, faces, &kq);
+        EXPECTF(o.state == c[i].state, "case %zu (rule %d, ratio %.2f, %.0f nodes): state %d",
+                i, c[i].rule, c[i].ratio, c[i].nodes, o.state);
+        if (o.state == 0) /* a window goes on */
+            EXPECT(o.next_check > faces && o.w_faces == faces);
+        fdt_oracle_free(&o);
+    }
+
+    /* a collective part's budget spent at face 0 by points alone, under
+     * COLLECTIVE_SURE: no walk seen yet, no vote; the window's end decides */
+    fdt_oracle o;
+    fdt_oracle_init(&o, &t, FDT_SEARCH_AUTO);
+    o.collective = 1;
+    o.w_budget = 0;
+    fdt_kdq kq;
+    memset(&kq, 0, sizeof kq);
+    kq.points = 500;
+    fdt_oracle_tick(&o, 0, &kq);
+    EXPECT(o.state == 0 && o.w_budget == SIZE_MAX);
+    fdt_oracle_free(&o);
+    /* a window starting past the faces the run is expected to have: the
+     * serial rule starts there, the next window has no budget */
+    fdt_oracle_init(&o, &t, FDT_SEARCH_AUTO);
+    memset(&kq, 0, sizeof kq);
+    size_t late = (size_t)(7.0 * (double)t.n);
+    fdt_oracle_tick(&o, late, &kq);
+    EXPECT(o.state == 0 && o.t_faces == late && o.w_budget == SIZE_MAX &&
+           o.next_check == late + 16384);
+    fdt_oracle_free(&o);
+    fdt_kd_free(&t);
+
+    /* --search mesh over a part of 3 points: no mesh, the kd search */
+    CHECK_EQ(fdt_kd_build(&t, pr.p, pr.orig, 0, 3, 18), FDT_OK);
+    fdt_oracle_init(&o, &t, FDT_SEARCH_MESH);
+    fdt_oracle_tick(&o, 0, &kq);
+    EXPECT(o.state == -1);
+    fdt_oracle_free(&o);
+    fdt_kd_free(&t);
+    fdt_prepared_free(&pr);
+    free(p.xyz);
+    printf("ok time votes\n");
+}
+
 int main(int argc, char **argv)
 {
     int quick = argc > 1 && !strcmp(argv[1], "--quick");
     alarm(600);
     test_collective_vote();
+    test_time_votes();
     test_mem_cap();
     test_flat_parts();
     test_probe_samples();

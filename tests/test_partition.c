@@ -3,7 +3,9 @@
  * N (less the work shift), contiguous ranges, owner lookup (empty parts
  * skipped), the permutation kept, bisection boxes holding their points,
  * the composite tree's nearest point against brute force, refusals, and
- * the ranges moved by weights (fdt_partition_recut).
+ * the ranges moved by weights (fdt_partition_recut), a part's own tree
+ * built from a partition made elsewhere (fdt_partition_build_own) and the
+ * work shift (fdt_partition_work_shift), for src/mpi_setup.c.
  */
 #include <math.h>
 #include <stdint.h>
@@ -180,9 +182,103 @@ static void test_recut(void)
     printf("partition: recut by weights\n");
 }
 
+/*
+ * A partition made elsewhere (src/mpi_setup.c): start and nodes as
+ * fdt_partition_build fills them, zeroed trees, then each part's tree by
+ * fdt_partition_build_own must be the tree fdt_partition_build built
+ * (same nodes, boxes and ranges; the same region, hence the same cells),
+ * an empty part's tree left empty.
+ */
+static void test_build_own(void)
+{
+    const struct {
+        uint32_t m;
+        int np;
+    } cases[] = {{600, 1}, {600, 2}, {600, 5}, {5, 8}};
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+        uint32_t m = cases[c].m;
+        int np = cases[c].np;
+        double *P = malloc(3 * (size_t)m * sizeof *P);
+        fdt_vid *orig = malloc(m * sizeof *orig);
+        CHECK(P && orig);
+        uint64_t seed = 13 + c;
+        for (size_t i = 0; i < 3 * (size_t)m; i++)
+            P[i] = test_unif(&seed);
+        for (uint32_t i = 0; i < m; i++)
+            orig[i] = (fdt_vid)i;
+        fdt_partition pt;
+        CHECK_EQ(fdt_partition_build(&pt, P, orig, m, np, 10, 1), FDT_OK);
+        /* the other copy: the points as the bisection left them */
+        double *P2 = malloc(3 * (size_t)m * sizeof *P2);
+        fdt_vid *orig2 = malloc(m * sizeof *orig2);
+        CHECK(P2 && orig2);
+        memcpy(P2, P, 3 * (size_t)m * sizeof *P2);
+        memcpy(orig2, orig, m * sizeof *orig2);
+        fdt_partition own = {.nparts = np, .m = m, .nnodes = pt.nnodes};
+        own.start = malloc(((size_t)np + 1) * sizeof *own.start);
+        own.nodes = malloc((size_t)pt.nnodes * sizeof *own.nodes);
+        own.trees = calloc((size_t)np, sizeof *own.trees);
+        CHECK(own.start && own.nodes && own.trees);
+        memcpy(own.start, pt.start, ((size_t)np + 1) * sizeof *own.start);
+        memcpy(own.nodes, pt.nodes, (size_t)pt.nnodes * sizeof *own.nodes);
+        for (int p = 0; p < np; p++) {
+            EXPECT(fdt_partition_build_own(&own, P2, orig2, p, 10) == FDT_OK);
+            const fdt_kdtree *a = &pt.trees[p], *b = &own.trees[p];
+            int same = a->n == b->n && a->base == b->base && a->nnodes == b->nnodes;
+            for (uint32_t j = 0; same && j < a->nnodes; j++) {
+                const fdt_kdnode *x = &a->nodes[j], *y = &b->nodes[j];
+                same = x->begin == y->begin && x->end == y->end && x->left == y->left &&
+                       memcmp(x->lo, y->lo, sizeof x->lo) == 0 &&
+                       memcmp(x->hi, y->hi, sizeof x->hi) == 0;
+                if (same && a->cell && b->cell)
+                    same = memcmp(a->cell[j], b->cell[j], sizeof a->cell[j]) == 0;
+                else if (same)
+                    same = !a->cell && !b->cell;
+            }
+            EXPECTF(same, "m %u, %d parts: part %d's tree (%u nodes, %u points) differs",
+                    m, np, p, b->nnodes, b->n);
+            if (m < (uint32_t)np)
+                EXPECT((a->n == 0) == (pt.start[p] == pt.start[p + 1]));
+        }
+        fdt_partition_free(&own);
+        fdt_partition_free(&pt);
+        free(P);
+        free(orig);
+        free(P2);
+        free(orig2);
+    }
+    printf("partition: parts' own trees as the whole build\n");
+}
+
+/* The points the cut moves left for the tets across it: 0.578 count^(2/3)
+ * V^(1/3) / w, at most a sixteenth of the left side, nothing for a flat box
+ * or parts under 64 points. */
+static void test_work_shift(void)
+{
+    fdt_pnode nd = {.lo = {0, 0, 0}, .hi = {1, 1, 1}};
+    uint32_t want = (uint32_t)(0.578 * cbrt(1e6 * 1e6) / 1.0);
+    EXPECTF(fdt_partition_work_shift(&nd, 500000, 1000000, 1.0, 1) == want, "%u",
+            fdt_partition_work_shift(&nd, 500000, 1000000, 1.0, 1));
+    EXPECT(want > 5700 && want < 5800);
+    /* a narrow extent: capped at nleft / 16 */
+    EXPECT(fdt_partition_work_shift(&nd, 500000, 1000000, 1e-6, 1) == 500000 / 16);
+    EXPECT(fdt_partition_work_shift(&nd, 64 * 3 - 1, 1000, 1.0, 3) == 0); /* 63 a part */
+    /* 64 a part: 0.578 * 100 = 57.8 capped at 192 / 16 */
+    EXPECT(fdt_partition_work_shift(&nd, 64 * 3, 1000, 1.0, 3) == 12);
+    EXPECT(fdt_partition_work_shift(&nd, 64 * 3, 1000, 10.0, 3) == 5); /* 5.78 */
+    EXPECT(fdt_partition_work_shift(&nd, 500000, 1000000, 0.0, 1) == 0);
+    nd.hi[2] = 0; /* flat */
+    EXPECT(fdt_partition_work_shift(&nd, 500000, 1000000, 1.0, 1) == 0);
+    nd.hi[2] = NAN;
+    EXPECT(fdt_partition_work_shift(&nd, 500000, 1000000, 1.0, 1) == 0);
+    printf("partition: work shift\n");
+}
+
 int main(void)
 {
     test_partition();
     test_recut();
+    test_build_own();
+    test_work_shift();
     return test_report("test_partition");
 }

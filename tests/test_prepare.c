@@ -136,9 +136,52 @@ static void test_prepare_inplace(void)
     free(xyz);
 }
 
+/* fdt_prepare_scale_exp (the exponent each MPI rank applies, from the
+ * extremes reduced over the ranks): the one fdt_prepare picks for the same
+ * points, the largest |x| brought into [1/2, 1), the smallest nonzero |x|
+ * kept at or above 2^-1021 (the clamp wins over the first), 0 for all
+ * zeros. */
+static void test_scale_exp(void)
+{
+    EXPECT(fdt_prepare_scale_exp(0.0, INFINITY) == 0);
+    EXPECT(fdt_prepare_scale_exp(1.0, 1.0) == -1);
+    EXPECT(fdt_prepare_scale_exp(0.75, 0.75) == 0);
+    EXPECT(fdt_prepare_scale_exp(1e-10, 1e-10) == 33); /* 2^-34 <= 1e-10 < 2^-33 */
+    /* 1e300 alone: into [1/2, 1); with 1e-300 the clamp keeps it normal */
+    int k = fdt_prepare_scale_exp(1e300, 1e300);
+    EXPECTF(ldexp(1e300, k) < 1.0 && ldexp(1e300, k) >= 0.5, "1e300: 2^%d", k);
+    k = fdt_prepare_scale_exp(1e300, 1e-300);
+    EXPECTF(ldexp(1e-300, k) >= ldexp(1.0, -1021) && ldexp(1e-300, k - 1) < ldexp(1.0, -1021),
+            "1e300 and 1e-300: 2^%d", k);
+    /* random magnitudes: the same exponent as fdt_prepare on the points */
+    uint64_t seed = 5;
+    char diag[256];
+    for (int t = 0; t < 200; t++) {
+        double xyz[12];
+        double maxabs = 0.0, minabs = INFINITY;
+        for (int i = 0; i < 12; i++) {
+            double e = (test_unif(&seed) - 0.5) * 1600.0 * (t % 4 == 0 ? 1.0 : 0.1);
+            xyz[i] = (i % 5 == 0 && t % 3 == 0) ? 0.0 : ldexp(test_unif(&seed) + 0.01, (int)e);
+            if (i % 2)
+                xyz[i] = -xyz[i];
+            double a = fabs(xyz[i]);
+            if (a > maxabs)
+                maxabs = a;
+            if (a > 0.0 && a < minabs)
+                minabs = a;
+        }
+        fdt_prepared pr;
+        CHECK(fdt_prepare(xyz, 4, 1, &pr, diag, sizeof diag) == FDT_OK);
+        k = fdt_prepare_scale_exp(maxabs, minabs);
+        EXPECTF(k == pr.scale_exp, "trial %d: 2^%d, fdt_prepare 2^%d", t, k, pr.scale_exp);
+        fdt_prepared_free(&pr);
+    }
+}
+
 int main(void)
 {
     test_prepare();
+    test_scale_exp();
     test_prepare_threads();
     test_prepare_inplace();
     return test_report("test_prepare");
