@@ -12,14 +12,8 @@ command -v gcovr >/dev/null || { echo "coverage: gcovr missing (scripts/bootstra
 # Without MPI: the MPI modules (src/mpi_run.c, src/transport_mpi.c,
 # src/mpi_main.c) are tested by suite mpi (.ci/run), not by the default
 # suite measured here, and would count as unexecuted lines.
-# Atomic counters: the threaded tests run the same code on several
-# threads, and gcov's plain counters then lose increments; the counts it
-# derives from them can come out negative ("branch 2 taken -5" in
-# src/oracle.c on 2026-11-26), which gcovr refuses to parse, failing the
-# gate whatever the coverage.
 if [[ ! -f build-cov/build.ninja ]]; then
-    meson setup build-cov -Db_coverage=true --buildtype=debug -Denable_bench=false -Dmpi=disabled \
-        -Dc_args=-fprofile-update=atomic -Dcpp_args=-fprofile-update=atomic >/dev/null
+    meson setup build-cov -Db_coverage=true --buildtype=debug -Denable_bench=false -Dmpi=disabled >/dev/null
 fi
 ninja -C build-cov
 # Counts from an earlier run would add up: start from zero.
