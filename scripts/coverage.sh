@@ -30,5 +30,11 @@ FDT_E2E_TIMEOUT_SCALE=6 meson test -C build-cov --print-errorlogs --timeout-mult
 # gate for a local look, never in CI.
 lines=${FDT_COV_LINES:-95}
 branches=${FDT_COV_BRANCHES:-90}
+# --gcov-ignore-parse-errors: likely a test process that exits while worker
+# threads are still inside the library (the CLI's signal tests) leaves
+# counts dumped mid-flight, and gcov then derives a negative branch count
+# ("branch 2 taken -1" in src/oracle.c on 2026-11-26, every test passing;
+# atomic counters did not help), which gcovr 5 refuses to parse; skipping
+# that line drops its record instead of failing the gate.
 gcovr -r . --filter 'src/' --exclude-unreachable-branches --exclude-throw-branches \
-    --print-summary --fail-under-line "$lines" --fail-under-branch "$branches" build-cov
+    --gcov-ignore-parse-errors --print-summary --fail-under-line "$lines" --fail-under-branch "$branches" build-cov
