@@ -12,14 +12,8 @@ command -v gcovr >/dev/null || { echo "coverage: gcovr missing (scripts/bootstra
 # Without MPI: the MPI modules (src/mpi_run.c, src/transport_mpi.c,
 # src/mpi_main.c) are tested by suite mpi (.ci/run), not by the default
 # suite measured here, and would count as unexecuted lines.
-# Atomic counters: the threaded tests run the same code on several
-# threads, and gcov's plain counters then lose increments; the counts it
-# derives from them can come out negative ("branch 2 taken -5" in
-# src/oracle.c on 2026-11-26), which gcovr refuses to parse, failing the
-# gate whatever the coverage.
 if [[ ! -f build-cov/build.ninja ]]; then
-    meson setup build-cov -Db_coverage=true --buildtype=debug -Denable_bench=false -Dmpi=disabled \
-        -Dc_args=-fprofile-update=atomic -Dcpp_args=-fprofile-update=atomic >/dev/null
+    meson setup build-cov -Db_coverage=true --buildtype=debug -Denable_bench=false -Dmpi=disabled >/dev/null
 fi
 ninja -C build-cov
 # Counts from an earlier run would add up: start from zero.
@@ -36,5 +30,11 @@ FDT_E2E_TIMEOUT_SCALE=6 meson test -C build-cov --print-errorlogs --timeout-mult
 # gate for a local look, never in CI.
 lines=${FDT_COV_LINES:-95}
 branches=${FDT_COV_BRANCHES:-90}
+# --gcov-ignore-parse-errors: likely a test process that exits while worker
+# threads are still inside the library (the CLI's signal tests) leaves
+# counts dumped mid-flight, and gcov then derives a negative branch count
+# ("branch 2 taken -1" in src/oracle.c on 2026-11-26, every test passing;
+# atomic counters did not help), which gcovr 5 refuses to parse; skipping
+# that line drops its record instead of failing the gate.
 gcovr -r . --filter 'src/' --exclude-unreachable-branches --exclude-throw-branches \
-    --print-summary --fail-under-line "$lines" --fail-under-branch "$branches" build-cov
+    --gcov-ignore-parse-errors --print-summary --fail-under-line "$lines" --fail-under-branch "$branches" build-cov
