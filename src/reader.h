@@ -184,8 +184,9 @@ int fdt_rd_text_line_start(const char *path, size_t at, size_t *out, char *err,
 /*
  * Parses bytes [begin, end) of path (begin and end line starts at or
  * after the head's body, or the file's size) as point lines of ncols
- * fields whose first line is line line0 + 1; *lines: the line ends in
- * the range. The format must be a text point format (o->format or the
+ * fields whose first line is line line0 + 1; *lines: the lines in the
+ * range (a last line with no line end, which only the file's last range
+ * can hold, counts too, so the next range's line0 is never off). The format must be a text point format (o->format or the
  * extension); o->threads parse a block at once as above. A range with no
  * points gives *n = 0 and FDT_IO_OK; *xyz is then NULL.
  */
