@@ -86,6 +86,16 @@ typedef struct rd_ctx {
     size_t progress_scale; /* parsed bytes are reported times this */
 } rd_ctx;
 
+/* A context for reading `path` (named so in messages), its errors worded
+ * into err[errlen]; every other field zero. */
+static inline void rd_ctx_start(rd_ctx *c, const char *path, char *err, size_t errlen)
+{
+    memset(c, 0, sizeof *c);
+    c->path = path;
+    c->err = err;
+    c->errlen = errlen;
+}
+
 /* The buffer to start a streamed read of c with: the chunk, or less when
  * the input is known to be smaller or its size is not known. */
 static inline size_t fdt_rd_first_cap(const rd_ctx *c, size_t chunk, size_t left)

@@ -1132,10 +1132,7 @@ int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned)
 int fdt_rd_ply_find_layout(const char *path, fdt_rd_ply_layout *lay, char *err, size_t errlen)
 {
     rd_ctx c;
-    memset(&c, 0, sizeof c);
-    c.path = path;
-    c.err = err;
-    c.errlen = errlen;
+    rd_ctx_start(&c, path, err, errlen);
     memset(lay, 0, sizeof *lay);
     int fd;
     do
@@ -1235,10 +1232,7 @@ int fdt_rd_ply_range(const char *path, const fdt_rd_ply_layout *lay, unsigned lo
                      size_t count, double **xyz, char *err, size_t errlen)
 {
     rd_ctx c;
-    memset(&c, 0, sizeof c);
-    c.path = path;
-    c.err = err;
-    c.errlen = errlen;
+    rd_ctx_start(&c, path, err, errlen);
     *xyz = NULL;
     if (first > lay->count || count > lay->count - first)
         return fdt_rd_fail(&c, FDT_IO_EFORMAT, ": vertices beyond the header's count");

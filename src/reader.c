@@ -433,10 +433,7 @@ int fdt_rd_points_with(const char *path, const fdt_rd_opts *o, double **xyz, siz
 {
     int is_stdin = path != NULL && strcmp(path, "-") == 0;
     rd_ctx c;
-    memset(&c, 0, sizeof c);
-    c.path = path == NULL ? "(null)" : is_stdin ? "stdin" : path;
-    c.err = err;
-    c.errlen = errlen;
+    rd_ctx_start(&c, path == NULL ? "(null)" : is_stdin ? "stdin" : path, err, errlen);
     rd_begin(&c, xyz, n);
     if (path == NULL || o == NULL || xyz == NULL || n == NULL)
         return fdt_rd_fail(&c, FDT_IO_EOPEN, ": invalid arguments");
@@ -484,10 +481,7 @@ int fdt_rd_points_mem_with(const char *name, const void *data, size_t len,
                              size_t errlen)
 {
     rd_ctx c;
-    memset(&c, 0, sizeof c);
-    c.path = name != NULL ? name : "(null)";
-    c.err = err;
-    c.errlen = errlen;
+    rd_ctx_start(&c, name != NULL ? name : "(null)", err, errlen);
     rd_begin(&c, xyz, n);
     if (name == NULL || o == NULL || (data == NULL && len > 0) || xyz == NULL || n == NULL)
         return fdt_rd_fail(&c, FDT_IO_EOPEN, ": invalid arguments");
@@ -720,10 +714,7 @@ static ptrdiff_t rd_pread_all(rd_ctx *c, int fd, char *dst, size_t len, size_t o
 int fdt_rd_text_head(const char *path, fdt_rd_head *h, char *err, size_t errlen)
 {
     rd_ctx c;
-    memset(&c, 0, sizeof c);
-    c.path = path;
-    c.err = err;
-    c.errlen = errlen;
+    rd_ctx_start(&c, path, err, errlen);
     rd_begin(&c, NULL, NULL);
     memset(h, 0, sizeof *h);
     struct stat st;
@@ -765,10 +756,7 @@ int fdt_rd_text_head(const char *path, fdt_rd_head *h, char *err, size_t errlen)
 int fdt_rd_text_line_start(const char *path, size_t at, size_t *out, char *err, size_t errlen)
 {
     rd_ctx c;
-    memset(&c, 0, sizeof c);
-    c.path = path;
-    c.err = err;
-    c.errlen = errlen;
+    rd_ctx_start(&c, path, err, errlen);
     rd_begin(&c, NULL, NULL);
     struct stat st;
     int fd = rd_open_regular(&c, path, &st);
@@ -807,10 +795,7 @@ int fdt_rd_text_range(const char *path, const fdt_rd_opts *o, size_t begin, size
                       char *err, size_t errlen)
 {
     rd_ctx c;
-    memset(&c, 0, sizeof c);
-    c.path = path;
-    c.err = err;
-    c.errlen = errlen;
+    rd_ctx_start(&c, path, err, errlen);
     rd_begin(&c, xyz, n);
     *lines = 0;
     int rc = FDT_IO_OK;
