@@ -195,19 +195,25 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     if ((err = fdt_seed_check_dimension(pr.p, pr.orig, (uint32_t)pr.m, ctx->diag,
                                         sizeof ctx->diag)) != FDT_OK)
         goto fail;
-    /* AUTO with threads, and inputs where the kd search degenerates
-     * (src/oracle.h, fdt_oracle_probe): parts with meshes of their own
-     * points ask each other about every face whose sphere crosses a cut,
-     * and there the spheres are as wide as the object, so the threads
-     * first build the DT of every point together (fdt_ins_build_parallel)
-     * and every part reads its apexes from it (bench/NOTES.md entries 52,
-     * 54). An explicit mode is kept as asked. */
+    /* Inputs where the kd search degenerates (src/oracle.h,
+     * fdt_oracle_probe): parts with meshes of their own points ask each
+     * other about every face whose sphere crosses a cut, and there the
+     * spheres are as wide as the object, so the threads first build the
+     * DT of every point together (fdt_ins_build_parallel) and every part
+     * reads its apexes from it (bench/NOTES.md entries 52, 54). That is a
+     * choice of the apex search (--search auto), not of the mode: the
+     * parts, their fronts and their messages stay, and --search kd or
+     * mesh keeps one structure a part. So an explicit --mode shared gets
+     * it as AUTO does, and message mode too, where the one immutable mesh
+     * stands for the replica each rank of an MPI run builds
+     * (src/mpi_run.c, replica_mesh); before, both kept one mesh a part and
+     * took 30-40x serial's time on a cone (entry 63). The parts' joint
+     * vote when the probe is unsure (entry 59) stays shared mode's. */
     fdt_par_opts popt;
     memset(&popt, 0, sizeof popt);
     if (user)
         popt.sink = &sink;
-    if (ctx->s.mode == FDT_MODE_AUTO && mode == FDT_MODE_SHARED &&
-        ctx->s.search == FDT_SEARCH_AUTO)
+    if (mode != FDT_MODE_SERIAL && ctx->s.search == FDT_SEARCH_AUTO)
         popt.global_mesh = FDT_PAR_MESH_PROBE; /* beside the partition */
     double t1;
     size_t mem_tree = 0, mem_mesh = 0, mem_sink = 0;

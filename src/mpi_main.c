@@ -79,6 +79,7 @@ static void install_signals(void)
 typedef struct opts {
     const char *input, *output, *format;
     int set_hash, stats, quiet, leaf, no_park;
+    int search;          /* fdt_search: --search */
     int fail_rank;
     size_t fail_after;
     int fail_write;      /* --inject-write-failure RANK, -1: none */
@@ -104,6 +105,9 @@ static const char usage[] =
     "  --set-hash          print the mesh's set hash (equals frontdt's)\n"
     "  --stats             per-rank tets and message counts, and their totals\n"
     "  --leaf N            kd-tree leaf size (default 30)\n"
+    "  --search HOW        auto (default: the kd search; where it degenerates,\n"
+    "                      every rank reads a replica of the DT of every point),\n"
+    "                      kd or mesh (each rank a mesh of its own points)\n"
     "  --no-park           a face waits for each answer of another rank, as\n"
     "                      frontdt --mode message does (for comparison)\n"
     "  -q                  print nothing but errors (and what is asked)\n";
@@ -135,6 +139,20 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
             o->quiet = 1;
         } else if (!strcmp(a, "--no-park")) {
             o->no_park = 1;
+        } else if (!strcmp(a, "--search") && v) {
+            if (!strcmp(v, "auto"))
+                o->search = FDT_SEARCH_AUTO;
+            else if (!strcmp(v, "kd"))
+                o->search = FDT_SEARCH_KD;
+            else if (!strcmp(v, "mesh"))
+                o->search = FDT_SEARCH_MESH;
+            else {
+                if (rank == 0)
+                    fprintf(stderr, "frontdt-mpi: --search wants auto, kd or mesh, not '%s'\n",
+                            v);
+                return EX_USAGE;
+            }
+            i++;
         } else if (!strcmp(a, "--leaf") && v) {
             char *end;
             long x = strtol(v, &end, 10);
@@ -327,6 +345,9 @@ static void print_stats(const fdt_mpi_out *r, int size, double t_read)
                 r->all_sent[k], r->all_received[k]);
     fprintf(stderr, "  time (rank 0)     setup %.3f s, run's setup %.3f s, front %.3f s, output %.3f s\n",
             t_read, r->t_setup, r->t_front, r->t_out);
+    if (r->t_replica > 0.0)
+        fprintf(stderr, "  replica mesh      the DT of every point on every rank, rank 0's built "
+                        "in %.3f s (src/mpi_run.c)\n", r->t_replica);
 }
 
 /* The run after MPI_Init; every rank returns the same code. */
@@ -358,7 +379,7 @@ static int run(int argc, char **argv, int rank, int size)
     }
     setup_stats(&L, rank, size, o.stats);
     int own = !pieces ? 0 : o.kind == FDT_MPO_VTU ? FDT_MPI_OWN_POINTS : FDT_MPI_OWN_HULL;
-    fdt_mpi_opts mo = {o.leaf, FDT_SEARCH_AUTO, o.output && !pieces, own, o.fail_rank,
+    fdt_mpi_opts mo = {o.leaf, o.search, o.output && !pieces, own, o.fail_rank,
                        o.fail_after, o.no_park};
     err = fdt_mpi_run(MPI_COMM_WORLD, &L, &mo, &r, diag, sizeof diag);
     if (err) {

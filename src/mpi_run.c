@@ -36,6 +36,10 @@
 
 #include "clock.h"
 #include "engine.h"
+#include "insert.h"
+#include "kdtree.h"
+#include "mem.h"
+#include "oracle.h"
 #include "parallel.h"
 #include "partition.h"
 #include "termination.h"
@@ -318,6 +322,98 @@ static int gather_points(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L,
     return err;
 }
 
+/*
+ * The replica mesh (bench/NOTES.md entry 63): on inputs where the kd
+ * search degenerates (pipes, cones, spheres: the empty spheres are as
+ * wide as the object), nearly every face's sphere crosses a cut, and the
+ * rank that owns it asks the others, who answer with their own degenerate
+ * kd searches: a cone of 20,000 points took 20 s on 2 ranks against 0.3 s
+ * serial. There every rank builds the DT of every point from an
+ * all-gather of the coordinates and reads its faces' apexes from it, as
+ * the threads of shared mode read the one mesh they built together
+ * (src/parallel.c): the ranks still own their points, faces and tets, and
+ * still send FACESENDs; no NODESEND is needed. Chosen when a majority of
+ * the ranks' probes (fdt_oracle_probe over each rank's own points) find
+ * the kd search clearly expensive and the replica fits the memory of every
+ * node (its ranks counted by MPI_Comm_split_type); --search kd or mesh
+ * never builds one. A rank that cannot build it (no memory) goes on with
+ * its kd search and asks the others: the answers are the same either way
+ * (the perturbed DT is unique), so the ranks need not agree after the
+ * vote. Collective over comm up to the build: a rank that failed before
+ * (e NULL) takes part, voting no and refusing the gather. *P_all gets the gathered
+ * coordinates (which e->gmesh borrows) or NULL; *built 1 when e->gmesh
+ * holds the mesh. Returns FDT_OK (no replica is not an error).
+ */
+static int replica_mesh(MPI_Comm comm, const fdt_mpi_local *L, const fdt_mpi_opts *o, engine *e,
+                        double **P_all, int *built, double *t_build)
+{
+    *P_all = NULL;
+    *built = 0;
+    *t_build = 0.0;
+    int size;
+    MPI_Comm_size(comm, &size);
+    if (o->search != FDT_SEARCH_AUTO || size < 2 || 3 * L->m > (size_t)INT_MAX)
+        return FDT_OK;
+    int vote = 0, votes = 0;
+    if (e) {
+        fdt_probe_samples ps;
+        fdt_oracle_probe_take(&ps, L->p, (uint32_t)L->nloc,
+                              o->leaf_size > 0 ? o->leaf_size : FDT_DEFAULT_LEAF);
+        vote = fdt_oracle_probe_decide(&ps);
+    }
+    MPI_Allreduce(&vote, &votes, 1, MPI_INT, MPI_SUM, comm);
+    if (2 * votes <= size)
+        return FDT_OK;
+    /* Every rank of a node holds a replica: the node's MemAvailable
+     * shared among them must hold the coordinates and the mesh. */
+    MPI_Comm node;
+    int on_node = 1;
+    if (MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node) ==
+        MPI_SUCCESS) {
+        MPI_Comm_size(node, &on_node);
+        MPI_Comm_free(&node);
+    }
+    size_t avail = fdt_mem_available();
+    double need = (24.0 + FDT_ORACLE_MESH_BYTES) * (double)L->m * (double)on_node;
+    double *all = NULL;
+    int ok = e && (avail == SIZE_MAX || need <= (double)avail);
+    if (ok && !(all = malloc(3 * L->m * sizeof *all)))
+        ok = 0;
+    int *cnt = ok ? malloc(2 * (size_t)size * sizeof *cnt) : NULL;
+    if (ok && !cnt)
+        ok = 0;
+    int all_ok = 0;
+    MPI_Allreduce(&ok, &all_ok, 1, MPI_INT, MPI_MIN, comm);
+    if (!all_ok) {
+        free(all);
+        free(cnt);
+        return FDT_OK;
+    }
+    /* Ids are contiguous by rank (src/mpi_setup.h: rank q holds [start[q],
+     * start[q + 1])), so the gather in rank order is the global array. */
+    for (int q = 0; q < size; q++) {
+        cnt[q] = (int)(3 * (size_t)(L->pt.start[q + 1] - L->pt.start[q]));
+        cnt[size + q] = (int)(3 * (size_t)L->pt.start[q]);
+    }
+    MPI_Allgatherv(L->p, (int)(3 * L->nloc), MPI_DOUBLE, all, cnt, cnt + size, MPI_DOUBLE,
+                   comm);
+    free(cnt);
+    double t0 = fdt_now_s();
+    fdt_pred_counts pc;
+    memset(&pc, 0, sizeof pc);
+    int err = fdt_ins_build(&e->gmesh, all, 0, (uint32_t)L->m, &pc);
+    *t_build = fdt_now_s() - t0;
+    if (err == FDT_OK) {
+        *P_all = all;
+        *built = 1;
+        return FDT_OK;
+    }
+    free(all);
+    /* no memory, or (a bug) an inconsistent build: this rank asks the
+     * others as before; FDT_EINTERNAL is still an error */
+    return err == FDT_EINTERNAL ? err : FDT_OK;
+}
+
 int fdt_mpi_run(MPI_Comm comm, fdt_mpi_local *L, const fdt_mpi_opts *o, fdt_mpi_out *out,
                 char *diag, size_t dlen)
 {
@@ -330,6 +426,7 @@ int fdt_mpi_run(MPI_Comm comm, fdt_mpi_local *L, const fdt_mpi_opts *o, fdt_mpi_
     fdt_partition *pt = &L->pt;
     engine *e = NULL;
     fdt_vid *mine = NULL;
+    double *P_all = NULL; /* the replica mesh's coordinates (replica_mesh) */
     MPI_Datatype xt;
     MPI_Type_contiguous((int)sizeof(xrec), MPI_BYTE, &xt);
     MPI_Type_commit(&xt);
@@ -415,6 +512,13 @@ int fdt_mpi_run(MPI_Comm comm, fdt_mpi_local *L, const fdt_mpi_opts *o, fdt_mpi_
         e->tp = tp;
     if (!err && terr)
         err = terr;
+    /* Collective: every rank takes part (one that failed votes no). */
+    int replica = 0;
+    int rerr = replica_mesh(comm, L, o, err ? NULL : e, &P_all, &replica, &out->t_replica);
+    if (!err)
+        err = rerr;
+    if (!err && replica)
+        e->gmesh_ok = 1;
     if (!err)
         err = fdt_eng_worker_setup(w);
     /* Every rank's setup succeeded, or no rank runs: a rank whose setup
@@ -561,8 +665,10 @@ done:
             fdt_eng_worker_free(w);
             free(w->seeds);
         }
+        fdt_ins_free(&e->gmesh);
         fdt_eng_delete(e);
     }
+    free(P_all);
     fdt_transport_destroy(&tp);
     if (mem_sink_ok)
         fdt_tsink_free(&mem_sink);

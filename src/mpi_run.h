@@ -49,6 +49,8 @@ typedef struct fdt_mpi_out {
     size_t tets;         /* this rank's tets */
     uint64_t sent[FDT_MSG_KIND_END], received[FDT_MSG_KIND_END]; /* this rank */
     double t_setup, t_front, t_out; /* seconds, this rank */
+    double t_replica;    /* seconds building the replica mesh (0: none;
+                            src/mpi_run.c, replica_mesh) */
     fdt_vid *own_tets;     /* keep_own: 4 per tet, input numbering (owned) */
     size_t own_ntets;
     fdt_vid *own_ids;      /* keep_own: the input ids of the points those

@@ -210,7 +210,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * copied before the partition permutes the points, so its answer is
      * fdt_oracle_probe's on the caller's order. pthread_join orders its
      * answer before the read below. */
-    int probe = opt && opt->global_mesh == FDT_PAR_MESH_PROBE && mode == FDT_MODE_SHARED;
+    int probe = opt && opt->global_mesh == FDT_PAR_MESH_PROBE;
     int probing = 0, expensive = 0;
     probe_job pj = {{{NULL, NULL}, 0, 0}, 0};
     pthread_t probe_th;
@@ -258,7 +258,10 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     /* The DT of every point, for inputs where the kd search degenerates
      * (src/api.c decides, by fdt_oracle_probe): built here on the run's
      * threads, then every part reads its faces' apexes from it and asks
-     * no other part (bench/NOTES.md entry 54). Tets are still made and
+     * no other part (bench/NOTES.md entry 54). In message mode it stands
+     * for the replica each MPI rank builds for itself (src/mpi_run.c):
+     * immutable once built, so one copy serves every part, and the parts
+     * still exchange their faces by FACESEND. Tets are still made and
      * owned by the parts' fronts. A build that cannot be made (no memory)
      * leaves the parts on their own oracles. Built before the seeds go to
      * their owners and the workers take their ranges: recut_by_mesh moves
@@ -275,7 +278,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * collective_step; bench/NOTES.md entry 59). */
     e->collective = mode == FDT_MODE_SHARED &&
                     ((probe && !expensive) || (opt && opt->global_mesh == FDT_PAR_MESH_COLLECTIVE));
-    if (opt && (opt->global_mesh == 1 || expensive) && mode == FDT_MODE_SHARED) {
+    if (opt && (opt->global_mesh == 1 || expensive)) {
         double tg = fdt_now_s();
         int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads,
                                           &kq0.pc);

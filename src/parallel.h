@@ -46,8 +46,8 @@ int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
                              char *diag, size_t dlen);
 
 /* fdt_par_opts.global_mesh: let the probe decide (src/parallel.c):
- * where it is not sure, the parts decide together (src/engine.c,
- * collective_step). */
+ * where it is not sure, shared mode's parts decide together
+ * (src/engine.c, collective_step); message mode's keep their own. */
 #define FDT_PAR_MESH_PROBE 2
 /* fdt_par_opts.global_mesh: no probe, the parts decide together (tests). */
 #define FDT_PAR_MESH_COLLECTIVE 3
@@ -63,9 +63,10 @@ typedef struct fdt_par_opts {
                            once it has advanced fail_after faces */
     int fail_part;
     size_t fail_after;
-    int global_mesh;    /* shared mode: build the DT of every point first
+    int global_mesh;    /* build the DT of every point first
                            (fdt_ins_build_parallel, on nthreads threads)
-                           and let every part read its apexes from it;
+                           and let every part read its apexes from it
+                           (in message mode as a replica, src/parallel.c);
                            FDT_PAR_MESH_PROBE: only if fdt_oracle_probe
                            finds the kd search expensive (src/oracle.h),
                            the probe running on a thread of its own beside

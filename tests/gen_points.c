@@ -1197,6 +1197,137 @@ static int fam_centre(pts *p, size_t n, rng *r)
     return 0;
 }
 
+/* ~N: a terrestrial scan's lines: L = sqrt(N/2) parallel lines 0.5 m
+ * apart, points every 5 cm along each, on a gently curved ground, with
+ * 0.1 mm of noise in height. Nearly collinear runs of thousands of points
+ * and long thin triangles between the lines. */
+static int fam_scanlines(pts *p, size_t n, rng *r)
+{
+    size_t lines = (size_t)llround(sqrt((double)n / 2.0));
+    if (lines < 2)
+        lines = 2;
+    size_t k = n / lines < 2 ? 2 : n / lines;
+    for (size_t i = 0; i < lines; i++)
+        for (size_t j = 0; j < k; j++) {
+            double x = 0.05 * (double)j;
+            double y = 0.5 * (double)i + 0.01 * sin(0.1 * (double)j);
+            if (pts_add(p, x, y, 0.002 * x * x + 1e-4 * rng_u01(r)))
+                return -1;
+        }
+    return 0;
+}
+
+/* ~N: a boundary-layer block: an m x m grid of spacing 1, eight layers
+ * whose heights grow tenfold from 1e-6 (cells of aspect ratio up to 1e6,
+ * as a CFD mesh near a wall). Exact cospherical cells at every scale. */
+static int fam_blayer(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    size_t m = (size_t)llround(sqrt((double)n / 8.0));
+    if (m < 2)
+        m = 2;
+    double z[8] = {0.0};
+    for (int k = 1; k < 8; k++)
+        z[k] = z[k - 1] + pow(10.0, (double)(k - 7));
+    for (size_t i = 0; i < m; i++)
+        for (size_t j = 0; j < m; j++)
+            for (int k = 0; k < 8; k++)
+                if (pts_add(p, (double)i, (double)j, z[k]))
+                    return -1;
+    return 0;
+}
+
+/* ~N: a torus (R 3, r 1) sampled on its parameter grid: rings of equally
+ * spaced points, every ring's points cospherical within rounding. */
+static int fam_torus(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    size_t nu = (size_t)llround(sqrt(1.15 * (double)n));
+    if (nu < 3)
+        nu = 3;
+    size_t nv = n / nu < 3 ? 3 : n / nu;
+    for (size_t i = 0; i < nu; i++)
+        for (size_t j = 0; j < nv; j++) {
+            double u = two_pi * (double)i / (double)nu, v = two_pi * (double)j / (double)nv;
+            double w = 3.0 + cos(v);
+            if (pts_add(p, w * cos(u), w * sin(u), sin(v)))
+                return -1;
+        }
+    return 0;
+}
+
+/* ~N: a cone, as the vertices of an axisymmetric CAD part: rings of 2m
+ * equally spaced points at m heights, the radius growing with the height.
+ * Every ring is cocircular, and the empty spheres of the inside are as
+ * large as the part. */
+static int fam_cone(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    size_t m = (size_t)llround(sqrt((double)n / 2.0));
+    if (m < 2)
+        m = 2;
+    for (size_t i = 1; i <= m; i++)
+        for (size_t j = 0; j < 2 * m; j++) {
+            double a = two_pi * (double)j / (double)(2 * m), rr = 0.01 * (double)i;
+            if (pts_add(p, rr * cos(a), rr * sin(a), 0.02 * (double)i))
+                return -1;
+        }
+    return 0;
+}
+
+/* N points along a helix (a curve: a fibre, a wire, a drill path). Its
+ * Delaunay tetrahedralization has about 150 tets a point. */
+static int fam_helix(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    for (size_t i = 0; i < n; i++) {
+        double t = 0.05 * (double)i;
+        if (pts_add(p, cos(t), sin(t), 0.02 * t))
+            return -1;
+    }
+    return 0;
+}
+
+/* N points on two concentric spheres of radii 1 and 50 (Fibonacci
+ * spirals), half on each: a body and its far field, nothing between. */
+static int fam_twoshells(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    size_t h = n / 2 < 2 ? 2 : n / 2;
+    const double golden = 0.5 * two_pi * (3.0 - sqrt(5.0));
+    for (int s = 0; s < 2; s++) {
+        double rad = s ? 50.0 : 1.0;
+        size_t cnt = s ? (n > h ? n - h : h) : h;
+        for (size_t k = 0; k < cnt; k++) {
+            double z = 1.0 - 2.0 * ((double)k + 0.5) / (double)cnt;
+            double rr = sqrt(1.0 - z * z), ph = (double)k * golden;
+            if (pts_add(p, rad * rr * cos(ph), rad * rr * sin(ph), rad * z))
+                return -1;
+        }
+    }
+    return 0;
+}
+
+/* ~N: the surface of an integer box m^3, every lattice point of its six
+ * faces (a CAD solid's surface mesh): exactly coplanar and cospherical
+ * everywhere, empty inside. */
+static int fam_boxsurf(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    size_t m = (size_t)llround(sqrt((double)n / 6.0));
+    if (m < 1)
+        m = 1;
+    for (size_t a = 0; a <= m; a++)
+        for (size_t b = 0; b <= m; b++)
+            for (size_t c = 0; c <= m; c++) {
+                if (a != 0 && a != m && b != 0 && b != m && c != 0 && c != m)
+                    continue;
+                if (pts_add(p, (double)a, (double)b, (double)c))
+                    return -1;
+            }
+    return 0;
+}
+
 /* How a family's coordinates are printed: most as %.17g, which round-trips
  * every double; a few the way their real files are written. */
 enum { FMT_17G, FMT_12G, FMT_2F, FMT_6F };
@@ -1246,6 +1377,13 @@ static const struct family {
      "bumpy scanned surface, ~5% exact duplicates, %.6f"},
     {"centre", fam_centre, FMT_17G,
      "N - 1 on a sphere (radial jitter 1e-7) + its centre"},
+    {"scanlines", fam_scanlines, FMT_17G, "~N: scan lines 0.5 m apart, 5 cm steps, curved ground"},
+    {"blayer", fam_blayer, FMT_17G, "~N: boundary-layer block, 8 layers from 1e-6 growing 10x"},
+    {"torus", fam_torus, FMT_17G, "~N: torus surface on its parameter grid"},
+    {"cone", fam_cone, FMT_17G, "~N: cone of cocircular rings (axisymmetric CAD part)"},
+    {"helix", fam_helix, FMT_17G, "points along a helix (a curve in 3-D)"},
+    {"twoshells", fam_twoshells, FMT_17G, "two Fibonacci spheres, radii 1 and 50"},
+    {"boxsurf", fam_boxsurf, FMT_17G, "~N: every integer point of a box's surface"},
 };
 #define N_FAMILIES (sizeof families / sizeof families[0])
 

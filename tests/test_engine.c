@@ -346,6 +346,32 @@ static void test_recut(void)
         free(c);
     }
     fdt_par_out_free(&out);
+    /* Message mode reads the same mesh as a replica (src/api.c; an MPI
+     * rank builds its own, src/mpi_run.c): no part asks another, and the
+     * tets are serial's. Before, each part kept a mesh of its own points
+     * and asked the others, whose kd searches degenerate on a pipe. */
+    fdt_prepared_free(&pr);
+    for (int t = 2; t <= 3; t++) {
+        CHECK_EQ(fdt_prepare(pipe.xyz, pipe.n, 1, &pr, diag, sizeof diag), FDT_OK);
+        CHECK_EQ(fdt_parallel_run(&pr, &s, FDT_MODE_MESSAGE, t, &opt, &out, diag, sizeof diag),
+                 FDT_OK);
+        EXPECTF(out.pst.remote_queries == 0 && out.pst.sent[FDT_MSG_NODESEND] == 0,
+                "pipe, message mode, %d threads: %zu remote queries", t, out.pst.remote_queries);
+        EXPECT(out.pst.sent[FDT_MSG_FACESEND] > 0);
+        EXPECT(out.mb.ntets == nref);
+        if (out.mb.ntets == nref) {
+            uint32_t *c = malloc(nref * 4 * sizeof *c);
+            CHECK(c != NULL);
+            memcpy(c, out.mb.tets, nref * 4 * sizeof *c);
+            for (size_t i = 0; i < nref; i++)
+                sort4(c + 4 * i);
+            qsort(c, nref, 4 * sizeof *c, cmp4);
+            EXPECTF(!memcmp(c, ref, nref * 4 * sizeof *c), "pipe, message mode, %d threads", t);
+            free(c);
+        }
+        fdt_par_out_free(&out);
+        fdt_prepared_free(&pr);
+    }
     fdt_prepared_free(&pr);
     free(ref);
     free(pipe.xyz);

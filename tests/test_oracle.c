@@ -582,7 +582,8 @@ int main(int argc, char **argv)
     /* FDT_MODE_AUTO with threads: the probe (fdt_oracle_probe) makes the
      * threads build one mesh of every point for the cylinder, which every
      * part reads; uniform points run on two parts with the kd search; an
-     * explicit mode is kept. Same hashes as the kd search in serial. */
+     * explicit shared mode does the same. Same hashes as the kd search in
+     * serial. */
     {
         pts p = gen_cylinder(60, 64);
         fdt_stats st;
@@ -602,8 +603,26 @@ int main(int argc, char **argv)
             CHECK_EQ(hash_of(r), hash_of(ref));
             fdt_result_free(&r);
         }
-        r = run(&p, FDT_MODE_SHARED, 2, FDT_SEARCH_AUTO, &st);
-        CHECK_EQ(st.mode, FDT_MODE_SHARED);
+        /* an explicit shared mode reads the same mesh of every point
+         * (src/api.c): the search is --search auto's choice, not the
+         * mode's; message mode reads it as a replica (an MPI rank's own
+         * copy, src/mpi_run.c), and --search kd keeps the queries */
+        for (int t = 1; t <= 3; t++) {
+            r = run(&p, FDT_MODE_SHARED, t, FDT_SEARCH_AUTO, &st);
+            CHECK_EQ(st.mode, FDT_MODE_SHARED);
+            CHECK_EQ(st.mesh_parts, (size_t)t);
+            CHECK_EQ(st.remote_queries, 0);
+            CHECK_EQ(hash_of(r), hash_of(ref));
+            fdt_result_free(&r);
+        }
+        r = run(&p, FDT_MODE_MESSAGE, 2, FDT_SEARCH_AUTO, &st);
+        CHECK_EQ(st.mode, FDT_MODE_MESSAGE);
+        CHECK_EQ(st.mesh_parts, 2);
+        CHECK_EQ(st.remote_queries, 0);
+        CHECK_EQ(hash_of(r), hash_of(ref));
+        fdt_result_free(&r);
+        r = run(&p, FDT_MODE_MESSAGE, 2, FDT_SEARCH_KD, &st);
+        CHECK(st.remote_queries > 0);
         CHECK_EQ(hash_of(r), hash_of(ref));
         fdt_result_free(&r);
         fdt_result_free(&ref);
