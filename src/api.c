@@ -207,7 +207,7 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
      * it as AUTO does, and message mode too, where the one immutable mesh
      * stands for the replica each rank of an MPI run builds
      * (src/mpi_run.c, replica_mesh); before, both kept one mesh a part and
-     * took 30-40x serial's time on a cone (entry 63). The parts' joint
+     * took 40-50x serial's CPU on a cone (entry 63). The parts' joint
      * vote when the probe is unsure (entry 59) stays shared mode's. */
     fdt_par_opts popt;
     memset(&popt, 0, sizeof popt);

@@ -340,9 +340,10 @@ static int gather_points(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L,
  * its kd search and asks the others: the answers are the same either way
  * (the perturbed DT is unique), so the ranks need not agree after the
  * vote. Collective over comm up to the build: a rank that failed before
- * (e NULL) takes part, voting no and refusing the gather. *P_all gets the gathered
- * coordinates (which e->gmesh borrows) or NULL; *built 1 when e->gmesh
- * holds the mesh. Returns FDT_OK (no replica is not an error).
+ * (e NULL) takes part, voting no and refusing the gather. *P_all gets
+ * the gathered coordinates (which e->gmesh borrows) or NULL; *built 1
+ * when e->gmesh holds the mesh. Returns FDT_OK (no replica is not an
+ * error) or FDT_EINTERNAL (an inconsistent build: a bug).
  */
 static int replica_mesh(MPI_Comm comm, const fdt_mpi_local *L, const fdt_mpi_opts *o, engine *e,
                         double **P_all, int *built, double *t_build)
