@@ -36,6 +36,7 @@
 #include <limits.h>
 #include <gmp.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
@@ -850,29 +851,78 @@ static int orient_stage_b(const double *u, const double *v, const double *w)
     return expansion_sign(det, n);
 }
 
+/* Stage C's integers, one set a thread (orient_stage_c, insphere_stage_c):
+ * made on the thread's first call and kept, so that a call allocates
+ * nothing once they have grown to its inputs' width. Made and cleared a
+ * call, they cost a run on a stretched grid (gen_points blayer, 1.9 M
+ * exact calls at 100k points) a tenth of its time in malloc, free and
+ * realloc (bench/NOTES.md entry 65). A thread's set is cleared when the
+ * thread exits, by the destructor of a pthread key made once
+ * (pthread_once, which also makes scratch_key_ok visible to every thread
+ * that returns from it); the main thread's stays until the process ends.
+ * Without a key (its creation failed) an exiting thread leaves its set,
+ * a few hundred bytes. */
+typedef struct gmp_scratch {
+    mpz_t q[5][3], m3, lift, det, t;
+    int ready;
+} gmp_scratch;
+
+static _Thread_local gmp_scratch scratch_tls;
+static pthread_key_t scratch_key;
+static int scratch_key_ok;
+static pthread_once_t scratch_once = PTHREAD_ONCE_INIT;
+
+static void scratch_clear(void *p)
+{
+    gmp_scratch *s = p;
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            mpz_clear(s->q[i][k]);
+    mpz_clears(s->m3, s->lift, s->det, s->t, NULL);
+    s->ready = 0;
+}
+
+static void scratch_key_make(void)
+{
+    scratch_key_ok = pthread_key_create(&scratch_key, scratch_clear) == 0;
+}
+
+static gmp_scratch *scratch(void)
+{
+    gmp_scratch *s = &scratch_tls;
+    if (!s->ready) {
+        /* Sized for the usual spread of exponents (GMP would otherwise
+         * grow each from nothing: 12 % of a run on points normalised onto
+         * a sphere); wider inputs still grow them, once. */
+        for (int i = 0; i < 5; i++)
+            for (int k = 0; k < 3; k++)
+                mpz_init2(s->q[i][k], 128);
+        mpz_init2(s->m3, 512);
+        mpz_init2(s->lift, 512);
+        mpz_init2(s->det, 512);
+        mpz_init2(s->t, 512);
+        s->ready = 1;
+        pthread_once(&scratch_once, scratch_key_make);
+        if (scratch_key_ok)
+            pthread_setspecific(scratch_key, s);
+    }
+    return s;
+}
+
 static int orient_stage_c(const double *a, const double *b, const double *c, const double *d)
 {
     const double *const pts[4] = {a, b, c, d};
     int kmin = min_int_exponent(pts, 4);
-    mpz_t q[4][3], r, t;
+    gmp_scratch *z = scratch();
+    mpz_t *q[4] = {z->q[0], z->q[1], z->q[2], z->q[3]};
     for (int i = 0; i < 4; i++)
-        for (int k = 0; k < 3; k++) {
-            mpz_init(q[i][k]);
+        for (int k = 0; k < 3; k++)
             mpz_set_scaled(q[i][k], pts[i][k], kmin);
-        }
-    mpz_init(r);
-    mpz_init(t);
     for (int i = 1; i < 4; i++)
         for (int k = 0; k < 3; k++)
             mpz_sub(q[i][k], q[i][k], q[0][k]);
-    mpz_det3(r, q[1], q[2], q[3], t);
-    int s = mpz_sgn(r);
-    mpz_clear(t);
-    mpz_clear(r);
-    for (int i = 0; i < 4; i++)
-        for (int k = 0; k < 3; k++)
-            mpz_clear(q[i][k]);
-    return s;
+    mpz_det3(z->det, q[1], q[2], q[3], z->t);
+    return mpz_sgn(z->det);
 }
 
 /* Whether the n points all have the same value in one coordinate: then
@@ -1125,45 +1175,31 @@ static int insphere_stage_c(const double *a, const double *b, const double *c,
 {
     const double *const pts[5] = {a, b, c, d, e};
     int kmin = min_int_exponent(pts, 5);
-    mpz_t q[5][3], m3, lift, det, t;
-    /* Sized at creation for the usual spread of exponents (GMP would
-     * otherwise grow each from nothing: 12 % of a run on points
-     * normalised onto a sphere); wider inputs still grow them. */
+    gmp_scratch *z = scratch();
     for (int i = 0; i < 5; i++)
-        for (int k = 0; k < 3; k++) {
-            mpz_init2(q[i][k], 128);
-            mpz_set_scaled(q[i][k], pts[i][k], kmin);
-        }
-    mpz_init2(m3, 512);
-    mpz_init2(lift, 512);
-    mpz_init2(det, 512);
-    mpz_init2(t, 512);
+        for (int k = 0; k < 3; k++)
+            mpz_set_scaled(z->q[i][k], pts[i][k], kmin);
     for (int i = 0; i < 4; i++)
         for (int k = 0; k < 3; k++)
-            mpz_sub(q[i][k], q[i][k], q[4][k]);
+            mpz_sub(z->q[i][k], z->q[i][k], z->q[4][k]);
     /* det4 = sum over rows i of (-1)^(i+1) |P_i|^2 det3(other rows), the
      * expansion along the lift column (rows A, B, C, D = 0..3). */
-    mpz_set_ui(det, 0);
+    mpz_set_ui(z->det, 0);
     for (int i = 0; i < 4; i++) {
         mpz_t *rows[3];
         for (int j = 0, r = 0; j < 4; j++)
             if (j != i)
-                rows[r++] = q[j];
-        mpz_det3(m3, rows[0], rows[1], rows[2], t);
-        mpz_mul(lift, q[i][0], q[i][0]);
-        mpz_addmul(lift, q[i][1], q[i][1]);
-        mpz_addmul(lift, q[i][2], q[i][2]);
+                rows[r++] = z->q[j];
+        mpz_det3(z->m3, rows[0], rows[1], rows[2], z->t);
+        mpz_mul(z->lift, z->q[i][0], z->q[i][0]);
+        mpz_addmul(z->lift, z->q[i][1], z->q[i][1]);
+        mpz_addmul(z->lift, z->q[i][2], z->q[i][2]);
         if (i % 2 == 0)
-            mpz_submul(det, lift, m3);
+            mpz_submul(z->det, z->lift, z->m3);
         else
-            mpz_addmul(det, lift, m3);
+            mpz_addmul(z->det, z->lift, z->m3);
     }
-    int s = -mpz_sgn(det);
-    mpz_clears(m3, lift, det, t, NULL);
-    for (int i = 0; i < 5; i++)
-        for (int k = 0; k < 3; k++)
-            mpz_clear(q[i][k]);
-    return s;
+    return -mpz_sgn(z->det);
 }
 
 int fdt_insphere_exact(const double *a, const double *b, const double *c,
