@@ -94,9 +94,12 @@ typedef enum fdt_mode {
  * perturbed Delaunay tetrahedralization is unique); they differ in cost.
  */
 typedef enum fdt_search {
-    FDT_SEARCH_AUTO = 0,  /* the kd search (§2.2, §4), switching a part to
-                             its insertion mesh where searches get
-                             expensive (scans, CFD grids, cospherical sets) */
+    FDT_SEARCH_AUTO = 0,  /* the kd search (§2.2, §4), switching to an
+                             insertion mesh where searches get expensive
+                             (scans, CFD grids, cospherical sets): serial,
+                             the mesh of the points; with threads, in any
+                             mode, one mesh of every point that all parts
+                             read */
     FDT_SEARCH_KD = 1,    /* the kd search only */
     FDT_SEARCH_MESH = 2   /* each part's insertion mesh from the start */
 } fdt_search;

@@ -109,6 +109,14 @@ done
 extra=(--search kd)
 check "cone --search kd" "$work/cone.xyz" 2
 extra=()
+checks=$((checks + 1))
+if mpi 2 300 "$fmpi" -q --stats --search kd "$work/cone.xyz" >/dev/null 2>"$work/cone.err"; then
+  q=$(awk '$1 == "NODESEND" && $3 == "/" {print $2}' "$work/cone.err")
+  [[ $q -gt 0 ]] || fail "cone --search kd, 2 ranks: no NODESEND (q='$q')"
+  ! grep -q '^  replica mesh ' "$work/cone.err" || fail "cone --search kd: a replica mesh"
+else
+  fail "cone --search kd, 2 ranks: exit $?"
+fi
 # A face waiting for each answer (--no-park, message mode's loop) gives the
 # same mesh as parked faces.
 extra=(--no-park)
