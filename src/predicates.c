@@ -887,6 +887,16 @@ static void scratch_key_make(void)
     scratch_key_ok = pthread_key_create(&scratch_key, scratch_clear) == 0;
 }
 
+/* The library unloaded (dlclose) while threads that used it live on must
+ * not leave them a key whose destructor is unmapped code: the key goes
+ * with the library, and those threads' sets are left, a few hundred
+ * bytes each. Runs at exit too, after every worker has been joined. */
+__attribute__((destructor)) static void scratch_key_drop(void)
+{
+    if (scratch_key_ok)
+        pthread_key_delete(scratch_key);
+}
+
 static gmp_scratch *scratch(void)
 {
     gmp_scratch *s = &scratch_tls;
