@@ -76,6 +76,27 @@ static void sort4(uint32_t *v)
         }
 }
 
+/* The canonical set of n tets in place: each sorted, then the list. */
+static void canon_set(uint32_t *c, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        sort4(c + 4 * i);
+    qsort(c, n, 4 * sizeof *c, cmp4);
+}
+
+/* Whether the n tets are the canonical set ref (serial_set), in any
+ * order of tets and of each tet's vertices. */
+static int same_set(const uint32_t *tets, const uint32_t *ref, size_t n)
+{
+    uint32_t *c = malloc(n * 4 * sizeof *c + 1);
+    CHECK(c != NULL);
+    memcpy(c, tets, n * 4 * sizeof *c);
+    canon_set(c, n);
+    int same = !memcmp(c, ref, n * 4 * sizeof *c);
+    free(c);
+    return same;
+}
+
 /* Tets of the serial run (input numbering), each sorted, then sorted:
  * the canonical set. */
 static uint32_t *serial_set(const input *in, size_t *nt)
@@ -93,9 +114,7 @@ static uint32_t *serial_set(const input *in, size_t *nt)
     const fdt_vid *t = fdt_result_tets(r);
     for (size_t i = 0; i < 4 * *nt; i++)
         c[i] = (uint32_t)t[i];
-    for (size_t i = 0; i < *nt; i++)
-        sort4(c + 4 * i);
-    qsort(c, *nt, 4 * sizeof *c, cmp4);
+    canon_set(c, *nt);
     fdt_result_free(&r);
     fdt_close(&ctx);
     return c;
@@ -166,17 +185,9 @@ static void run_checked(const input *in, const uint32_t *ref, size_t nref, fdt_m
         EXPECT(fsent == 0);
     /* the serial engine's tets */
     EXPECT(out.mb.ntets == nref);
-    if (out.mb.ntets == nref) {
-        uint32_t *c = malloc(nref * 4 * sizeof *c);
-        CHECK(c != NULL);
-        memcpy(c, out.mb.tets, nref * 4 * sizeof *c);
-        for (size_t i = 0; i < nref; i++)
-            sort4(c + 4 * i);
-        qsort(c, nref, 4 * sizeof *c, cmp4);
-        EXPECTF(!memcmp(c, ref, nref * 4 * sizeof *c), "%s, mode %d, %d threads: serial's tets",
+    if (out.mb.ntets == nref)
+        EXPECTF(same_set(out.mb.tets, ref, nref), "%s, mode %d, %d threads: serial's tets",
                 in->name, mode, nthreads);
-        free(c);
-    }
     /* neighbours: symmetric, -1 exactly on the hull */
     if (nbrs) {
         size_t open = 0, asym = 0;
@@ -278,17 +289,9 @@ static void run_collective(const input *in, const uint32_t *ref, size_t nref, in
     else
         EXPECT(out.fst.mesh_faces == 0);
     EXPECT(out.mb.ntets == nref);
-    if (out.mb.ntets == nref) {
-        uint32_t *c = malloc(nref * 4 * sizeof *c);
-        CHECK(c != NULL);
-        memcpy(c, out.mb.tets, nref * 4 * sizeof *c);
-        for (size_t i = 0; i < nref; i++)
-            sort4(c + 4 * i);
-        qsort(c, nref, 4 * sizeof *c, cmp4);
-        EXPECTF(!memcmp(c, ref, nref * 4 * sizeof *c), "%s, collective, %d threads: serial's tets",
+    if (out.mb.ntets == nref)
+        EXPECTF(same_set(out.mb.tets, ref, nref), "%s, collective, %d threads: serial's tets",
                 in->name, nthreads);
-        free(c);
-    }
     fdt_par_out_free(&out);
     fdt_prepared_free(&pr);
 }
@@ -335,16 +338,8 @@ static void test_recut(void)
             out.pst.load_imbalance, out.tstats[0].tets, out.tstats[1].tets);
     EXPECTF(out.fst.star_walks * 50 < out.fst.faces_advanced, "pipe: %zu of %zu faces by a walk",
             out.fst.star_walks, out.fst.faces_advanced);
-    if (out.mb.ntets == nref) {
-        uint32_t *c = malloc(nref * 4 * sizeof *c);
-        CHECK(c != NULL);
-        memcpy(c, out.mb.tets, nref * 4 * sizeof *c);
-        for (size_t i = 0; i < nref; i++)
-            sort4(c + 4 * i);
-        qsort(c, nref, 4 * sizeof *c, cmp4);
-        EXPECT(!memcmp(c, ref, nref * 4 * sizeof *c));
-        free(c);
-    }
+    if (out.mb.ntets == nref)
+        EXPECT(same_set(out.mb.tets, ref, nref));
     fdt_par_out_free(&out);
     /* Message mode reads the same mesh as a replica (src/api.c; an MPI
      * rank builds its own, src/mpi_run.c): no part asks another, and the
@@ -359,16 +354,8 @@ static void test_recut(void)
                 "pipe, message mode, %d threads: %zu remote queries", t, out.pst.remote_queries);
         EXPECT(out.pst.sent[FDT_MSG_FACESEND] > 0);
         EXPECT(out.mb.ntets == nref);
-        if (out.mb.ntets == nref) {
-            uint32_t *c = malloc(nref * 4 * sizeof *c);
-            CHECK(c != NULL);
-            memcpy(c, out.mb.tets, nref * 4 * sizeof *c);
-            for (size_t i = 0; i < nref; i++)
-                sort4(c + 4 * i);
-            qsort(c, nref, 4 * sizeof *c, cmp4);
-            EXPECTF(!memcmp(c, ref, nref * 4 * sizeof *c), "pipe, message mode, %d threads", t);
-            free(c);
-        }
+        if (out.mb.ntets == nref)
+            EXPECTF(same_set(out.mb.tets, ref, nref), "pipe, message mode, %d threads", t);
         fdt_par_out_free(&out);
         fdt_prepared_free(&pr);
     }
