@@ -92,12 +92,12 @@ int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
  * concurrently, each from its own region of the id (kd) order, under
  * per-tet try-locks; points whose cavities keep meeting another thread's
  * are inserted at the end on the calling thread. nthreads < 1 counts as
- * 1, over 255 as 255; the caller's thread is one of them. Same arguments,
+ * 1, over 63 as 63; the caller's thread is one of them. Same arguments,
  * results and errors as fdt_ins_build; on any error m holds nothing.
  * Memory: the slots are reserved up front from the serial rounds' slots
  * a point (x1.35, so about 300 bytes a point kept on uniform points,
  * against fdt_ins_build's 220), plus during the build 1 byte a slot
- * (locks) and 4 bytes a point (start hints).
+ * (its lock and conflict mark) and 4 bytes a point (start hints).
  */
 int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                            int nthreads, fdt_pred_counts *cnt);

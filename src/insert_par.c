@@ -21,7 +21,13 @@
  * The perturbed DT is unique, so the insertion order (and which thread
  * inserted what) cannot change the result: only the slot numbering.
  *
- * Locks. Every slot has an owner byte (0: free; i + 1: held by worker i).
+ * Locks. Every slot has a state byte: its owner in the low six bits (0:
+ * free; i + 1: held by worker i) and, above them, the conflict mark of
+ * the insertion that holds it (MARK_*, written only by the holder). One
+ * byte for both, because the cavity search reads both for every tet it
+ * meets, and a second array cost a second cache line a tet: a worker
+ * alone took 13-23 % more time than the serial build with the two
+ * (bench/NOTES.md entry 66).
  * An insertion holds a lock on every tet it reads: the walk goes hand over
  * hand (it locks the next tet before letting the current one go, so the
  * neighbour reference it follows stays valid: whoever destroys or rewires
@@ -46,10 +52,13 @@
  * worker's own list. A worker that finds the capacity spent stops every
  * worker cleanly (before writing anything); phase 3 grows the arrays.
  *
- * Data-race freedom (the TSan suite runs the tests): the tets (m->T) and
- * the conflict marks are plain memory, each slot's touched only by the
- * holder of its lock; the lock's acquire on taking it and release on
- * letting it go order every access of one holder before the next holder's.
+ * Data-race freedom (the TSan suite runs the tests): the tets (m->T) are
+ * plain memory, each slot's touched only by the holder of its lock; the
+ * lock's acquire on taking it and release on letting it go order every
+ * access of one holder before the next holder's. The state bytes are
+ * atomics: the holder changes its mark with relaxed stores (it alone
+ * writes a held byte; another thread's compare-and-swap expects 0 and
+ * fails on any held byte, marked or not).
  * The per-point start hints are relaxed atomics, validated by locking.
  */
 #include "insert.h"
@@ -66,7 +75,9 @@
 
 enum {
     CHUNK = 256,       /* fresh slots a worker takes at a time */
-    MAX_WORKERS = 255, /* owner ids are bytes, 0 meaning free */
+    MAX_WORKERS = 63,  /* owner ids are six bits, 0 meaning free */
+    OWNER = 63,        /* the owner's bits of a state byte */
+    MARK_SHIFT = 6,    /* the mark's */
     RECENT = 8,        /* recent new tets kept as walk starts */
     HINT_REACH = 16,   /* ids tried each side for a neighbour's hint */
 };
@@ -78,8 +89,7 @@ enum { BUSY = 1, FULL = 2 };
 
 typedef struct shared {
     fdt_ins *m;
-    atomic_uchar *lock;        /* cap entries: owner, 0 free */
-    uint8_t *mark;             /* cap entries: MARK_*, only the lock holder's */
+    atomic_uchar *lock;        /* cap entries: owner | mark << MARK_SHIFT, 0 free */
     atomic_uint_fast64_t next; /* the next fresh slot */
     _Atomic uint32_t *hint;    /* n entries: a tet that held point base + i */
     int single;                /* phase 3: one thread, the arrays may grow */
@@ -163,7 +173,7 @@ static inline int lock_live(worker *w, uint32_t t)
      * fails still takes the cache line. */
     unsigned char exp = atomic_load_explicit(&w->sh->lock[t], memory_order_relaxed);
     if (exp != 0)
-        return exp == w->me;
+        return (exp & OWNER) == w->me;
     if (atomic_compare_exchange_strong_explicit(&w->sh->lock[t], &exp, w->me,
                                                 memory_order_acquire, memory_order_relaxed)) {
         if (push_held(w, t) != FDT_OK) {
@@ -172,11 +182,24 @@ static inline int lock_live(worker *w, uint32_t t)
         }
         return 1;
     }
-    return exp == w->me;
+    return (exp & OWNER) == w->me;
+}
+
+/* The mark of a slot w holds, and a new one (relaxed: see Data-race
+ * freedom). */
+static inline int get_mark(const worker *w, uint32_t t)
+{
+    return atomic_load_explicit(&w->sh->lock[t], memory_order_relaxed) >> MARK_SHIFT;
+}
+
+static inline void set_mark(worker *w, uint32_t t, int mark)
+{
+    atomic_store_explicit(&w->sh->lock[t], (unsigned char)(w->me | mark << MARK_SHIFT),
+                          memory_order_relaxed);
 }
 
 /* Lets go of everything this insertion holds but the slots it freed,
- * which stay locked on its free list; clears their marks first. */
+ * which stay locked on its free list (unlocking clears the mark too). */
 static void release_all(worker *w)
 {
     shared *sh = w->sh;
@@ -186,7 +209,6 @@ static void release_all(worker *w)
         const uint32_t *v = T + 8 * (size_t)t;
         if (v[0] == INF && v[1] == INF)
             continue;
-        sh->mark[t] = MARK_NONE;
         unlock_slot(sh, t);
     }
     w->nheld = 0;
@@ -203,7 +225,7 @@ static inline void free_slot(worker *w, uint32_t t)
     v[4] = w->free_head;
     w->free_head = t;
     w->nfree++;
-    w->sh->mark[t] = MARK_NONE;
+    set_mark(w, t, MARK_NONE);
 }
 
 /* Phase 3 only (one thread): more capacity. */
@@ -221,11 +243,6 @@ static int grow_arrays(shared *sh, uint64_t need)
     if (!t)
         return FDT_ENOMEM;
     m->T = t;
-    uint8_t *mk = realloc(sh->mark, (size_t)nc);
-    if (!mk)
-        return FDT_ENOMEM;
-    memset(mk + m->cap, 0, (size_t)(nc - m->cap));
-    sh->mark = mk;
     atomic_uchar *lk = malloc((size_t)nc * sizeof *lk);
     if (!lk)
         return FDT_ENOMEM;
@@ -457,9 +474,8 @@ static int insert_point(worker *w, uint32_t pid)
             return FDT_EINVAL;
         }
     }
-    uint8_t *mark = sh->mark;
     w->ncav = w->nbnd = 0;
-    mark[t0] = MARK_IN;
+    set_mark(w, t0, MARK_IN);
     w->cav[w->ncav++] = t0;
     for (int j = 0; j < 4; j++)
         fdt_prefetch(m->T + 8 * (size_t)(v0[4 + j] >> 2));
@@ -472,9 +488,10 @@ static int insert_point(worker *w, uint32_t pid)
                 err = r == 0 ? BUSY : r;
                 goto abort;
             }
-            if (mark[o] == MARK_IN)
+            int mk = get_mark(w, o);
+            if (mk == MARK_IN)
                 continue;
-            if (mark[o] == MARK_NONE) {
+            if (mk == MARK_NONE) {
                 int cf = conflict(w, o, p);
                 if (cf < 0) {
                     err = cf == -BUSY ? BUSY : cf;
@@ -484,7 +501,7 @@ static int insert_point(worker *w, uint32_t pid)
                     if (w->ncav == w->cavcap &&
                         (err = ins_grow_u32(&w->cav, &w->cavcap, w->ncav + 1)) != FDT_OK)
                         goto abort;
-                    mark[o] = MARK_IN;
+                    set_mark(w, o, MARK_IN);
                     w->cav[w->ncav++] = o;
                     /* its neighbours are tested next: ask for them now */
                     const uint32_t *on = m->T + 8 * (size_t)o + 4;
@@ -494,7 +511,7 @@ static int insert_point(worker *w, uint32_t pid)
                     }
                     continue;
                 }
-                mark[o] = MARK_OUT;
+                set_mark(w, o, MARK_OUT);
             }
             if (w->nbnd == w->bndcap &&
                 (err = ins_grow_u32(&w->bnd, &w->bndcap, w->nbnd + 1)) != FDT_OK)
@@ -508,7 +525,6 @@ static int insert_point(worker *w, uint32_t pid)
         (err = ins_grow_u32(&w->held, &w->heldcap, w->nheld + w->nbnd)) != FDT_OK ||
         (err = ins_edges_begin(&w->edges, 3 * w->nbnd / 2)) != FDT_OK)
         goto abort;
-    mark = sh->mark;
 
     /* The new tets (ins_star_tet), as in src/insert.c. */
     uint32_t *T = m->T;
@@ -752,9 +768,8 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
         }
     }
     sh.lock = malloc((size_t)m->cap * sizeof *sh.lock);
-    sh.mark = calloc((size_t)m->cap, 1);
     sh.hint = malloc((size_t)n * sizeof *sh.hint);
-    if (!sh.lock || !sh.mark || !sh.hint)
+    if (!sh.lock || !sh.hint)
         goto fail;
     for (uint32_t i = 0; i < m->cap; i++)
         atomic_init(&sh.lock[i], 0);
@@ -959,7 +974,6 @@ out:
     for (int i = 0; i < nw; i++)
         worker_free(&ws[i]);
     free(sh.lock);
-    free(sh.mark);
     free(sh.hint);
     free(order);
     free(pts);
