@@ -104,20 +104,23 @@ static inline int fdt_front_apex(fdt_oracle *orc, const fdt_kdtree *t, fdt_facet
                                  fdt_apex *ap, int *inside, uint32_t *apex, uint32_t *mtet,
                                  fdt_kdq *kq)
 {
+    int from_mesh = fdt_oracle_apex(orc, f, ctid, copp, apex, mtet);
+    if (from_mesh && keep && orc->gm) {
+        /* A mesh of every point (fdt_oracle_share) gives the apex itself:
+         * nothing to search or offer (its sphere is not even needed: on a
+         * pipe, offering it cost a circumcentre, often in GMP, a face),
+         * and the search state needs only its answer (the caller reads
+         * best and bp; fdt_apex_init's normal was 3 % of a two-thread
+         * front on the mesh, bench/NOTES.md entry 67). */
+        ap->best = *apex;
+        ap->bp = *apex != FDT_NONE ? t->P + 3 * (size_t)*apex : NULL;
+        fdt_facetab_prefetch_tet(ft, f, *apex);
+        *inside = 1;
+        return FDT_OK;
+    }
     if (keep)
         fdt_apex_init(ap, a, b, c, f[0], f[1], f[2]);
-    if (fdt_oracle_apex(orc, f, ctid, copp, apex, mtet)) {
-        if (keep && orc->gm) {
-            /* A mesh of every point (fdt_oracle_share) gives the apex
-             * itself: nothing to search or offer (its sphere is not even
-             * needed: on a pipe, offering it cost a circumcentre, often
-             * in GMP, a face). */
-            ap->best = *apex;
-            ap->bp = *apex != FDT_NONE ? t->P + 3 * (size_t)*apex : NULL;
-            fdt_facetab_prefetch_tet(ft, f, *apex);
-            *inside = 1;
-            return FDT_OK;
-        }
+    if (from_mesh) {
         /* The mesh's answer is the first of t's points in the pencil of
          * spheres through f's circle: with keep it is offered to the
          * search state, where only another part's point can beat it. */
