@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "engine.h"
 #include "gather.h"
@@ -200,10 +201,14 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     int mem_sink_ok = 0;
     fdt_kdq kq0;
     memset(&kq0, 0, sizeof kq0);
-    /* The parts' trees are built on as many threads as there are cores
+    /* The parts' trees are built on as many threads as there are CPUs
      * (up to one a part): at 1M points on two cores that took a quarter
-     * of a second off a setup of 0.9 s. */
-    int cores = fdt_parallel_default_threads();
+     * of a second off a setup of 0.9 s. Online CPUs, not hwloc's cores:
+     * the topology's load took 3.9 ms, inside the timed run of every
+     * `--threads N` (bench/NOTES.md entry 68), and a builder on a second
+     * hardware thread of a core costs nothing here. */
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    int cores = ncpu < 1 ? 1 : ncpu > FDT_PARTITION_MAX ? FDT_PARTITION_MAX : (int)ncpu;
     /* The probe only decides the shared mesh's build, after the partition
      * and the seeds, whose first cut and seed search leave the second
      * core idle (bench/NOTES.md entry 56): it runs beside them on samples
