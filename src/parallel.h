@@ -29,7 +29,7 @@ typedef struct fdt_par_out {
 } fdt_par_out;
 
 /* The default thread count: physical cores (hwloc), else online CPUs,
- * clamped to [1, 1024]; counted on the first call of the process. */
+ * clamped to [1, 1024]. */
 int fdt_parallel_default_threads(void);
 
 /*

@@ -85,16 +85,7 @@ static void *worker_main(void *arg)
     return NULL;
 }
 
-/*
- * The core count is read once a process: hwloc's topology load reads
- * sysfs and took 3.9 ms a call here, and src/api.c asks for it when the
- * thread count is left to us (bench/NOTES.md entry 68). The cores do not
- * change under a run.
- */
-static pthread_once_t cores_once = PTHREAD_ONCE_INIT;
-static int cores_count;
-
-static void count_cores(void)
+int fdt_parallel_default_threads(void)
 {
     long n = 0;
 #ifdef FDT_HAVE_HWLOC
@@ -111,15 +102,7 @@ static void count_cores(void)
         n = 1;
     if (n > FDT_PARTITION_MAX)
         n = FDT_PARTITION_MAX;
-    cores_count = (int)n;
-}
-
-int fdt_parallel_default_threads(void)
-{
-    /* pthread_once orders count_cores's write before every return (it
-     * cannot fail on a statically initialized control). */
-    (void)pthread_once(&cores_once, count_cores);
-    return cores_count;
+    return (int)n;
 }
 
 /* Runs the workers and waits for their loops, then has them gather the
