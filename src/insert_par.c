@@ -64,6 +64,7 @@
 #include "insert.h"
 #include "insert_impl.h"
 #include "clock.h"
+#include "mem.h"
 
 #include <pthread.h>
 #include <sched.h>
@@ -761,6 +762,10 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
             uint32_t *t = malloc((size_t)want * 8 * sizeof *t);
             if (!t)
                 goto fail;
+            /* Huge pages, as src/insert.c's first block has: without
+             * them each worker took a fault a 4 KB page it first wrote
+             * (bench/NOTES.md entry 69). */
+            fdt_mem_advise_huge(t, (size_t)want * 8 * sizeof *t);
             memcpy(t, m->T, (size_t)m->nslots * 8 * sizeof *t);
             free(m->T);
             m->T = t;
