@@ -1,6 +1,5 @@
 /* The serial advancing front; see front.h. */
 #include "front.h"
-#include "mem.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -22,12 +21,7 @@ int fdt_meshbuf_init(fdt_meshbuf *mb, size_t expected_tets, int want_nbrs)
     mb->tets = malloc(mb->tcap * 4 * sizeof *mb->tets);
     if (want_nbrs)
         mb->nbrs = malloc(mb->tcap * 4 * sizeof *mb->nbrs);
-    /* Written once, in order: huge pages take a fault every 2 MB
-     * instead of every 4 KB (bench/NOTES.md entry 69). */
-    if (mb->tets)
-        fdt_mem_advise_huge(mb->tets, mb->tcap * 4 * sizeof *mb->tets);
-    if (mb->nbrs)
-        fdt_mem_advise_huge(mb->nbrs, mb->tcap * 4 * sizeof *mb->nbrs);
+
     mb->hcap = 1024;
     mb->hull = malloc(mb->hcap * 3 * sizeof *mb->hull);
     if (!mb->tets || !mb->hull || (want_nbrs && !mb->nbrs)) {
