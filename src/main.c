@@ -21,6 +21,7 @@
  * "--stats-json -" claims stdout for the JSON object alone).
  */
 #include "frontdt.h"
+#include "cli_signals.h"
 #include "clock.h"
 #include "progress.h"
 #include "reader.h"
@@ -31,7 +32,6 @@
 #include <inttypes.h>
 #include <limits.h>
 #include <math.h>
-#include <signal.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -173,56 +173,9 @@ static int usage_error(const char *fmt, ...)
 /* Signals                                                                   */
 /* ------------------------------------------------------------------------ */
 
-/*
- * SIGINT/SIGTERM: remove the temporary (or just renamed, if its file set
- * is incomplete) output files and leave with exit code 6. Only
- * async-signal-safe calls here: unlink() inside fdt_write_cleanup(),
- * write() and _exit().
- */
-static void on_signal(int sig)
-{
-    (void)sig;
-    fdt_write_cleanup();
-    static const char msg[] = "\nfrontdt: interrupted\n";
-    ssize_t w = write(STDERR_FILENO, msg, sizeof msg - 1);
-    (void)w;
-    _exit(CLI_SIGNAL);
-}
-
-static int install_signals(void)
-{
-    static const int sigs[2] = { SIGINT, SIGTERM };
-    /* A write beyond RLIMIT_FSIZE (ulimit -f) raises SIGXFSZ, whose default
-     * action kills the process and leaves the temporary output behind.
-     * Ignored, the write fails with EFBIG instead, which the writer reports
-     * like a full disk (exit 5, temporaries removed). */
-    struct sigaction ign;
-    memset(&ign, 0, sizeof ign);
-    ign.sa_handler = SIG_IGN;
-    sigemptyset(&ign.sa_mask);
-    if (sigaction(SIGXFSZ, &ign, NULL) != 0)
-        return -1;
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    /* One handler at a time: a SIGTERM during SIGINT's cleanup waits. */
-    sigaddset(&sa.sa_mask, SIGINT);
-    sigaddset(&sa.sa_mask, SIGTERM);
-    for (int i = 0; i < 2; i++) {
-        struct sigaction old;
-        if (sigaction(sigs[i], NULL, &old) != 0)
-            return -1;
-        /* A signal ignored at startup stays ignored (the Unix convention:
-         * the shell ignores SIGINT for background jobs, nohup and friends
-         * mean it). */
-        if (old.sa_handler == SIG_IGN)
-            continue;
-        if (sigaction(sigs[i], &sa, NULL) != 0)
-            return -1;
-    }
-    return 0;
-}
+/* SIGINT/SIGTERM remove the temporary (or just renamed, if its file set
+ * is incomplete) output files (fdt_write_cleanup) and leave with exit
+ * code 6; SIGXFSZ is ignored (src/cli_signals.h). */
 
 /* ------------------------------------------------------------------------ */
 /* Argument parsing                                                          */
@@ -1522,7 +1475,7 @@ done:
 
 int main(int argc, char **argv)
 {
-    if (install_signals() != 0) {
+    if (fdt_cli_signals("frontdt", fdt_write_cleanup, CLI_SIGNAL) != 0) {
         say("cannot install signal handlers: %s", strerror(errno));
         return CLI_INTERNAL;
     }

@@ -10,13 +10,13 @@
 #include <inttypes.h>
 #include <limits.h>
 #include <mpi.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 #include <unistd.h>
 
+#include "cli_signals.h"
 #include "frontdt.h"
 #include "mpi_output.h"
 #include "mpi_run.h"
@@ -36,7 +36,7 @@ enum {
     EX_INTERNAL = 7
 };
 
-/* ---- SIGINT / SIGTERM ----------------------------------------------------
+/* ---- SIGINT / SIGTERM / SIGXFSZ ------------------------------------------
  *
  * mpirun passes an interrupt on to every rank (Open MPI forwards SIGINT
  * and SIGTERM, MPICH's hydra SIGINT). Each rank removes what it is
@@ -46,34 +46,13 @@ enum {
  * an interrupted run leaves no output, and leaves with exit code 6
  * without waiting for the others (which the same signal ends; a rank
  * that left early keeps the others in fdt_mpo_write's last barrier until
- * mpirun ends them, with the same cleanup). Only async-signal-safe calls:
- * unlink, write, _exit. */
-static void on_signal(int sig)
+ * mpirun ends them, with the same cleanup). SIGXFSZ is ignored, as in
+ * frontdt: a write beyond ulimit -f fails with EFBIG (exit 5, temporaries
+ * removed) instead of killing the rank (src/cli_signals.h). */
+static void cleanup_outputs(void)
 {
-    (void)sig;
-    fdt_write_cleanup();
+    fdt_write_cleanup(); /* both async-signal-safe: unlink only */
     fdt_mpo_cleanup();
-    static const char msg[] = "\nfrontdt-mpi: interrupted\n";
-    ssize_t w = write(STDERR_FILENO, msg, sizeof msg - 1);
-    (void)w;
-    _exit(EX_SIGNAL);
-}
-
-static void install_signals(void)
-{
-    static const int sigs[2] = {SIGINT, SIGTERM};
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaddset(&sa.sa_mask, SIGINT);
-    sigaddset(&sa.sa_mask, SIGTERM);
-    for (int i = 0; i < 2; i++) {
-        struct sigaction old;
-        /* a signal ignored at startup stays ignored, as in frontdt */
-        if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler != SIG_IGN)
-            (void)sigaction(sigs[i], &sa, NULL);
-    }
 }
 
 typedef struct opts {
@@ -476,7 +455,8 @@ int main(int argc, char **argv)
     int rank = 0, size = 1;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
-    install_signals();
+    if (fdt_cli_signals("frontdt-mpi", cleanup_outputs, EX_SIGNAL) != 0)
+        fprintf(stderr, "frontdt-mpi: cannot install signal handlers\n"); /* runs on */
     int rc = run(argc, argv, rank, size);
     MPI_Finalize();
     return rc;

@@ -1,0 +1,22 @@
+/*
+ * Signals of the command-line programs (frontdt, src/main.c; frontdt-mpi,
+ * src/mpi_main.c): one handling for both, so they cannot drift apart.
+ * Not part of the library, which never installs handlers.
+ */
+#ifndef FDT_CLI_SIGNALS_H
+#define FDT_CLI_SIGNALS_H
+
+/*
+ * SIGINT and SIGTERM call cleanup (not NULL; async-signal-safe: it
+ * removes the temporaries of the outputs in progress), print "\nPROG: interrupted\n"
+ * on standard error and leave with exit_code. A signal ignored at startup
+ * stays ignored (the Unix convention: the shell ignores SIGINT for
+ * background jobs, and nohup and friends mean it). SIGXFSZ is ignored, so
+ * a write beyond RLIMIT_FSIZE (ulimit -f) fails with EFBIG and reaches the
+ * writer, which reports it like a full disk and removes its temporaries,
+ * instead of killing the process with them left behind. Call once, before
+ * any thread starts. 0, or -1 with errno set.
+ */
+int fdt_cli_signals(const char *prog, void (*cleanup)(void), int exit_code);
+
+#endif
