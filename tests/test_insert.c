@@ -900,9 +900,38 @@ static void test_parallel_refusals(const char *gen)
     free(u.xyz);
 }
 
+/* More threads than a lock byte can name (63, src/insert_par.c): the
+ * build runs on 63 workers and gives the same tets. */
+static void test_parallel_many_threads(const char *gen)
+{
+    pts p = gen_family(gen, "clusters", 3000, 7);
+    prepped pp;
+    prep(&p, &pp);
+    fdt_ins m;
+    CHECK_EQ(fdt_ins_build(&m, pp.pr.p, 0, pp.m, NULL), FDT_OK);
+    meshset ref = kernel_mesh(&m, NULL);
+    fdt_ins_free(&m);
+    static const int many[] = {63, 64, 100};
+    for (size_t i = 0; i < sizeof many / sizeof many[0]; i++) {
+        CHECK_EQ(fdt_ins_build_parallel(&m, pp.pr.p, 0, pp.m, many[i], NULL), FDT_OK);
+        char nm[64];
+        snprintf(nm, sizeof nm, "clusters-3000 parallel t%d", many[i]);
+        meshset got = kernel_mesh(&m, NULL);
+        same_mesh(&got, &ref, nm);
+        check_structure(&m, nm);
+        meshset_free(&got);
+        fdt_ins_free(&m);
+    }
+    printf("parallel clusters-3000: same as serial for 63, 64 and 100 threads\n");
+    meshset_free(&ref);
+    prep_free(&pp);
+    free(p.xyz);
+}
+
 static void run_parallel(const char *gen)
 {
     test_parallel_refusals(gen);
+    test_parallel_many_threads(gen);
     static const struct {
         const char *fam;
         size_t n;
