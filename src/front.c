@@ -21,7 +21,6 @@ int fdt_meshbuf_init(fdt_meshbuf *mb, size_t expected_tets, int want_nbrs)
     mb->tets = malloc(mb->tcap * 4 * sizeof *mb->tets);
     if (want_nbrs)
         mb->nbrs = malloc(mb->tcap * 4 * sizeof *mb->nbrs);
-
     mb->hcap = 1024;
     mb->hull = malloc(mb->hcap * 3 * sizeof *mb->hull);
     if (!mb->tets || !mb->hull || (want_nbrs && !mb->nbrs)) {

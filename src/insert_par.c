@@ -25,9 +25,9 @@
  * free; i + 1: held by worker i) and, above them, the conflict mark of
  * the insertion that holds it (MARK_*, written only by the holder). One
  * byte for both, because the cavity search reads both for every tet it
- * meets, and a second array cost a second cache line a tet: a worker
- * alone took 13-23 % more time than the serial build with the two
- * (bench/NOTES.md entry 66).
+ * meets, and a second array cost a second cache line a tet: the
+ * two-thread build took 2-5 % longer with the two (bench/NOTES.md
+ * entry 66).
  * An insertion holds a lock on every tet it reads: the walk goes hand over
  * hand (it locks the next tet before letting the current one go, so the
  * neighbour reference it follows stays valid: whoever destroys or rewires
