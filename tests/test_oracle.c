@@ -351,24 +351,43 @@ static void test_flat_parts(void)
     printf("ok flat parts\n");
 }
 
+/* A cylinder's points as the engine sees them and their kd-tree: what
+ * the tests that drive an oracle directly start from. */
+typedef struct cyl_tree {
+    pts p;
+    fdt_prepared pr;
+    fdt_kdtree t;
+} cyl_tree;
+
+static void cyl_tree_make(cyl_tree *c, int rings, int per_ring)
+{
+    char diag[256];
+    c->p = gen_cylinder(rings, per_ring);
+    CHECK_EQ(fdt_prepare(c->p.xyz, c->p.n, 1, &c->pr, diag, sizeof diag), FDT_OK);
+    memset(&c->t, 0, sizeof c->t);
+    CHECK_EQ(fdt_kd_build(&c->t, c->pr.p, c->pr.orig, 0, (uint32_t)c->pr.m, 18), FDT_OK);
+}
+
+static void cyl_tree_free(cyl_tree *c)
+{
+    fdt_kd_free(&c->t);
+    fdt_prepared_free(&c->pr);
+    free(c->p.xyz);
+}
+
 /* A switch whose mesh would not fit the part's share of memory
  * (fdt_oracle.mem_cap) is not made: the oracle stays on the kd search
  * and says so; with no cap, or room, the same switch builds the mesh. The
  * oracle is driven directly: a spent window budget asks for the switch. */
 static void test_mem_cap(void)
 {
-    pts p = gen_cylinder(20, 32);
-    fdt_prepared pr;
-    char diag[256];
-    CHECK_EQ(fdt_prepare(p.xyz, p.n, 1, &pr, diag, sizeof diag), FDT_OK);
-    fdt_kdtree t;
-    memset(&t, 0, sizeof t);
-    CHECK_EQ(fdt_kd_build(&t, pr.p, pr.orig, 0, (uint32_t)pr.m, 18), FDT_OK);
-    const size_t caps[3] = {1, 0, (size_t)(FDT_ORACLE_MESH_BYTES * (double)pr.m) + 1};
+    cyl_tree cy;
+    cyl_tree_make(&cy, 20, 32);
+    const size_t caps[3] = {1, 0, (size_t)(FDT_ORACLE_MESH_BYTES * (double)cy.pr.m) + 1};
     const int want[3] = {-1, 1, 1};
     for (int i = 0; i < 3; i++) {
         fdt_oracle o;
-        fdt_oracle_init(&o, &t, FDT_SEARCH_AUTO);
+        fdt_oracle_init(&o, &cy.t, FDT_SEARCH_AUTO);
         o.mem_cap = caps[i];
         o.w_budget = 0;
         fdt_kdq kq;
@@ -381,7 +400,7 @@ static void test_mem_cap(void)
     }
     /* an explicit --search mesh is kept whatever the cap */
     fdt_oracle o;
-    fdt_oracle_init(&o, &t, FDT_SEARCH_MESH);
+    fdt_oracle_init(&o, &cy.t, FDT_SEARCH_MESH);
     o.mem_cap = 1;
     fdt_kdq kq;
     memset(&kq, 0, sizeof kq);
@@ -389,9 +408,7 @@ static void test_mem_cap(void)
     EXPECT(o.state == 1 && !o.mesh_refused);
     fdt_oracle_free(&o);
     EXPECT(fdt_oracle_mem_share(2) <= fdt_oracle_mem_share(1));
-    fdt_kd_free(&t);
-    fdt_prepared_free(&pr);
-    free(p.xyz);
+    cyl_tree_free(&cy);
     printf("ok memory cap\n");
 }
 
@@ -403,13 +420,8 @@ static void test_mem_cap(void)
  * test_mem_cap: 10 faces into the first window, whose budget is spent. */
 static void test_collective_vote(void)
 {
-    pts p = gen_cylinder(20, 32);
-    fdt_prepared pr;
-    char diag[256];
-    CHECK_EQ(fdt_prepare(p.xyz, p.n, 1, &pr, diag, sizeof diag), FDT_OK);
-    fdt_kdtree t;
-    memset(&t, 0, sizeof t);
-    CHECK_EQ(fdt_kd_build(&t, pr.p, pr.orig, 0, (uint32_t)pr.m, 18), FDT_OK);
+    cyl_tree cy;
+    cyl_tree_make(&cy, 20, 32);
     /* collective, points a face, nodes a face -> state, window budget left */
     static const struct {
         int collective;
@@ -423,7 +435,7 @@ static void test_collective_vote(void)
     };
     for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
         fdt_oracle o;
-        fdt_oracle_init(&o, &t, FDT_SEARCH_AUTO);
+        fdt_oracle_init(&o, &cy.t, FDT_SEARCH_AUTO);
         o.collective = c[i].collective;
         o.w_budget = 0;
         fdt_kdq kq;
@@ -449,9 +461,7 @@ static void test_collective_vote(void)
             EXPECT(fdt_oracle_apex(&o, f, -1, FDT_NONE, &apex, &mtet) == 0);
         fdt_oracle_free(&o);
     }
-    fdt_kd_free(&t);
-    fdt_prepared_free(&pr);
-    free(p.xyz);
+    cyl_tree_free(&cy);
     printf("ok collective votes\n");
 }
 
@@ -475,14 +485,9 @@ static double cpu_for_ratio(const fdt_kdtree *t, size_t faces, size_t nf, double
  * face, a window past the last face). */
 static void test_time_votes(void)
 {
-    pts p = gen_cylinder(60, 64);
-    fdt_prepared pr;
-    char diag[256];
-    CHECK_EQ(fdt_prepare(p.xyz, p.n, 1, &pr, diag, sizeof diag), FDT_OK);
-    fdt_kdtree t;
-    memset(&t, 0, sizeof t);
-    CHECK_EQ(fdt_kd_build(&t, pr.p, pr.orig, 0, (uint32_t)pr.m, 18), FDT_OK);
-    CHECK(6.5 * (double)t.n > 13000.0); /* room for the serial rule's faces */
+    cyl_tree cy;
+    cyl_tree_make(&cy, 60, 64);
+    CHECK(6.5 * (double)cy.t.n > 13000.0); /* room for the serial rule's faces */
     /* rule: 0 a collective part's early vote (2), 1 the serial rule, 2 a
      * collective part's later rule */
     static const struct {
@@ -497,7 +502,7 @@ static void test_time_votes(void)
     };
     for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
         fdt_oracle o;
-        fdt_oracle_init(&o, &t, FDT_SEARCH_AUTO);
+        fdt_oracle_init(&o, &cy.t, FDT_SEARCH_AUTO);
         fdt_kdq kq;
         memset(&kq, 0, sizeof kq); /* no points tested: the cost rule never switches */
         size_t faces, nf;
@@ -507,7 +512,7 @@ static void test_time_votes(void)
             faces = 4000; /* before the serial rule's start (4,096) */
             nf = faces - o.c_faces;
             kq.nodes = (size_t)(c[i].nodes * (double)nf);
-            o.c_cpu = cpu_for_ratio(&t, faces, nf, c[i].ratio);
+            o.c_cpu = cpu_for_ratio(&cy.t, faces, nf, c[i].ratio);
         } else {
             o.collective = c[i].rule == 2;
             o.c_faces = 1; /* the early measure started, never voted */
@@ -515,7 +520,7 @@ static void test_time_votes(void)
             faces = 4096 + 8192;
             nf = faces - o.t_faces;
             kq.nodes = (size_t)(c[i].nodes * (double)nf);
-            o.t_cpu = cpu_for_ratio(&t, faces, nf, c[i].ratio);
+            o.t_cpu = cpu_for_ratio(&cy.t, faces, nf, c[i].ratio);
         }
         fdt_oracle_tick(&o, faces, &kq);
         EXPECTF(o.state == c[i].state, "case %zu (rule %d, ratio %.2f, %.0f nodes): state %d",
@@ -528,7 +533,7 @@ static void test_time_votes(void)
     /* a collective part's budget spent at face 0 by points alone, under
      * COLLECTIVE_SURE: no walk seen yet, no vote; the window's end decides */
     fdt_oracle o;
-    fdt_oracle_init(&o, &t, FDT_SEARCH_AUTO);
+    fdt_oracle_init(&o, &cy.t, FDT_SEARCH_AUTO);
     o.collective = 1;
     o.w_budget = 0;
     fdt_kdq kq;
@@ -539,24 +544,22 @@ static void test_time_votes(void)
     fdt_oracle_free(&o);
     /* a window starting past the faces the run is expected to have: the
      * serial rule starts there, the next window has no budget */
-    fdt_oracle_init(&o, &t, FDT_SEARCH_AUTO);
+    fdt_oracle_init(&o, &cy.t, FDT_SEARCH_AUTO);
     memset(&kq, 0, sizeof kq);
-    size_t late = (size_t)(7.0 * (double)t.n);
+    size_t late = (size_t)(7.0 * (double)cy.t.n);
     fdt_oracle_tick(&o, late, &kq);
     EXPECT(o.state == 0 && o.t_faces == late && o.w_budget == SIZE_MAX &&
            o.next_check == late + 16384);
     fdt_oracle_free(&o);
-    fdt_kd_free(&t);
+    fdt_kd_free(&cy.t);
 
     /* --search mesh over a part of 3 points: no mesh, the kd search */
-    CHECK_EQ(fdt_kd_build(&t, pr.p, pr.orig, 0, 3, 18), FDT_OK);
-    fdt_oracle_init(&o, &t, FDT_SEARCH_MESH);
+    CHECK_EQ(fdt_kd_build(&cy.t, cy.pr.p, cy.pr.orig, 0, 3, 18), FDT_OK);
+    fdt_oracle_init(&o, &cy.t, FDT_SEARCH_MESH);
     fdt_oracle_tick(&o, 0, &kq);
     EXPECT(o.state == -1);
     fdt_oracle_free(&o);
-    fdt_kd_free(&t);
-    fdt_prepared_free(&pr);
-    free(p.xyz);
+    cyl_tree_free(&cy);
     printf("ok time votes\n");
 }
 
