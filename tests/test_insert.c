@@ -798,14 +798,22 @@ static void test_refusals(void)
  * first run of each count. */
 static size_t serial_finished; /* points of the parallel builds' serial ends */
 
+/* The serial build's tets of pp: what every parallel build must give. */
+static meshset serial_reference(const prepped *pp)
+{
+    fdt_ins m;
+    CHECK_EQ(fdt_ins_build(&m, pp->pr.p, 0, pp->m, NULL), FDT_OK);
+    meshset ref = kernel_mesh(&m, NULL);
+    fdt_ins_free(&m);
+    return ref;
+}
+
 static void test_parallel_set(pts p, int reps)
 {
     prepped pp;
     prep(&p, &pp);
     fdt_ins m;
-    CHECK_EQ(fdt_ins_build(&m, pp.pr.p, 0, pp.m, NULL), FDT_OK);
-    meshset ref = kernel_mesh(&m, NULL);
-    fdt_ins_free(&m);
+    meshset ref = serial_reference(&pp);
     static const int threads[] = {1, 2, 3, 5, 8};
     for (size_t ti = 0; ti < sizeof threads / sizeof threads[0]; ti++) {
         for (int r = 0; r < reps; r++) {
@@ -908,9 +916,7 @@ static void test_parallel_many_threads(const char *gen)
     prepped pp;
     prep(&p, &pp);
     fdt_ins m;
-    CHECK_EQ(fdt_ins_build(&m, pp.pr.p, 0, pp.m, NULL), FDT_OK);
-    meshset ref = kernel_mesh(&m, NULL);
-    fdt_ins_free(&m);
+    meshset ref = serial_reference(&pp);
     static const int many[] = {63, 64, 100};
     for (size_t i = 0; i < sizeof many / sizeof many[0]; i++) {
         CHECK_EQ(fdt_ins_build_parallel(&m, pp.pr.p, 0, pp.m, many[i], NULL), FDT_OK);
