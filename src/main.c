@@ -21,7 +21,7 @@
  * "--stats-json -" claims stdout for the JSON object alone).
  */
 #include "frontdt.h"
-#include "cli_signals.h"
+#include "cli.h"
 #include "clock.h"
 #include "progress.h"
 #include "reader.h"
@@ -175,7 +175,7 @@ static int usage_error(const char *fmt, ...)
 
 /* SIGINT/SIGTERM remove the temporary (or just renamed, if its file set
  * is incomplete) output files (fdt_write_cleanup) and leave with exit
- * code 6; SIGXFSZ is ignored (src/cli_signals.h). */
+ * code 6; SIGXFSZ is ignored (src/cli.h). */
 
 /* ------------------------------------------------------------------------ */
 /* Argument parsing                                                          */
@@ -410,13 +410,7 @@ static int parse_args(int argc, char **argv, cli *c)
                                    "message or auto)", optarg);
             break;
         case OPT_SEARCH:
-            if (!strcmp(optarg, "auto"))
-                c->search = FDT_SEARCH_AUTO;
-            else if (!strcmp(optarg, "kd"))
-                c->search = FDT_SEARCH_KD;
-            else if (!strcmp(optarg, "mesh"))
-                c->search = FDT_SEARCH_MESH;
-            else
+            if (fdt_cli_search(optarg, &c->search) != 0)
                 return usage_error("unknown search '%s' (auto, kd or mesh)", optarg);
             break;
         case 't':

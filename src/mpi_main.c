@@ -16,7 +16,7 @@
 #include <strings.h>
 #include <unistd.h>
 
-#include "cli_signals.h"
+#include "cli.h"
 #include "frontdt.h"
 #include "mpi_output.h"
 #include "mpi_run.h"
@@ -48,7 +48,7 @@ enum {
  * that left early keeps the others in fdt_mpo_write's last barrier until
  * mpirun ends them, with the same cleanup). SIGXFSZ is ignored, as in
  * frontdt: a write beyond ulimit -f fails with EFBIG (exit 5, temporaries
- * removed) instead of killing the rank (src/cli_signals.h). */
+ * removed) instead of killing the rank (src/cli.h). */
 static void cleanup_outputs(void)
 {
     fdt_write_cleanup(); /* both async-signal-safe: unlink only */
@@ -119,13 +119,10 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
         } else if (!strcmp(a, "--no-park")) {
             o->no_park = 1;
         } else if (!strcmp(a, "--search") && v) {
-            if (!strcmp(v, "auto"))
-                o->search = FDT_SEARCH_AUTO;
-            else if (!strcmp(v, "kd"))
-                o->search = FDT_SEARCH_KD;
-            else if (!strcmp(v, "mesh"))
-                o->search = FDT_SEARCH_MESH;
-            else {
+            fdt_search sv;
+            if (fdt_cli_search(v, &sv) == 0) {
+                o->search = (int)sv;
+            } else {
                 if (rank == 0)
                     fprintf(stderr, "frontdt-mpi: --search wants auto, kd or mesh, not '%s'\n",
                             v);

@@ -1,10 +1,13 @@
 /*
- * Signals of the command-line programs (frontdt, src/main.c; frontdt-mpi,
- * src/mpi_main.c): one handling for both, so they cannot drift apart.
- * Not part of the library, which never installs handlers.
+ * What the two command-line programs (frontdt, src/main.c; frontdt-mpi,
+ * src/mpi_main.c) share, so they cannot drift apart: their signal
+ * handling and the names of their options' values. Not part of the
+ * library, which never installs handlers or reads option text.
  */
-#ifndef FDT_CLI_SIGNALS_H
-#define FDT_CLI_SIGNALS_H
+#ifndef FDT_CLI_H
+#define FDT_CLI_H
+
+#include "frontdt.h"
 
 /*
  * SIGINT and SIGTERM call cleanup (not NULL; async-signal-safe: it
@@ -18,5 +21,9 @@
  * any thread starts. 0, or -1 with errno set.
  */
 int fdt_cli_signals(const char *prog, void (*cleanup)(void), int exit_code);
+
+/* --search NAME: auto, kd or mesh into *out (0), or -1 (unknown; *out
+ * untouched). The caller words the error. */
+int fdt_cli_search(const char *name, fdt_search *out);
 
 #endif

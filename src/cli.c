@@ -1,5 +1,5 @@
-/* Signals of the command-line programs; see cli_signals.h. */
-#include "cli_signals.h"
+/* What the command-line programs share; see cli.h. */
+#include "cli.h"
 
 #include <errno.h>
 #include <signal.h>
@@ -62,4 +62,18 @@ int fdt_cli_signals(const char *prog, void (*cleanup)(void), int exit_code)
             return -1;
     }
     return 0;
+}
+
+int fdt_cli_search(const char *name, fdt_search *out)
+{
+    static const struct {
+        const char *name;
+        fdt_search search;
+    } names[] = {{"auto", FDT_SEARCH_AUTO}, {"kd", FDT_SEARCH_KD}, {"mesh", FDT_SEARCH_MESH}};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (!strcmp(name, names[i].name)) {
+            *out = names[i].search;
+            return 0;
+        }
+    return -1;
 }
