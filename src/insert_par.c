@@ -6,8 +6,11 @@
  *
  * Phases.
  *   1. Serial start (src/insert.c): the first BRIO rounds, until about
- *      n/32 points are in (at least the first round), so the mesh is fine
- *      enough that concurrent cavities are small and rarely meet.
+ *      n/128 points are in (at least the first round), so the mesh is
+ *      fine enough that concurrent cavities are small and rarely meet.
+ *      It was n/32 until bench/NOTES.md entry 72: on two threads the
+ *      deferrals stayed at tens a 100k run, and the serial start fell
+ *      from 3-8 % of the build's wall time to under 2 %.
  *   2. Concurrent insertion: the points of the later rounds are split by
  *      id range, and ids are kd-tree order, so each thread gets one
  *      spatial region (a bisection of the kd order). Each thread inserts
@@ -724,9 +727,9 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
     uint32_t round_end[32], first[4];
     int nrounds;
     fdt_ins_brio(P, base, n, order, round_end, &nrounds);
-    /* Phase 1: the first rounds up to n/32 points (at least one round). */
+    /* Phase 1: the first rounds up to n/128 points (at least one round). */
     int r0 = 1;
-    while (r0 < nrounds && round_end[r0 - 1] < n / 32)
+    while (r0 < nrounds && round_end[r0 - 1] < n / 128)
         r0++;
     uint32_t prefix = round_end[r0 - 1];
     uint64_t slots = slots_a_point > 0.0 ? (uint64_t)(slots_a_point * n) + 64

@@ -37,6 +37,34 @@ static int key_cmp(const void *x, const void *y)
     return 0;
 }
 
+/* Sorts the ns tets of key (each a pair: its sorted ids, then the tet)
+ * by their ids and writes the distinct tets to sd, their count to *nout. */
+static void seeds_distinct(uint32_t (*key)[4], int ns, uint32_t (*sd)[4], int *nout)
+{
+    qsort(key, (size_t)ns, 2 * sizeof *key, key_cmp);
+    int nd = 0;
+    for (int i = 0; i < ns; i++) {
+        if (nd > 0 && key_cmp(key[2 * i], key[2 * (i - 1)]) == 0)
+            continue;
+        memcpy(sd[nd++], key[2 * i + 1], sizeof sd[0]);
+    }
+    *nout = nd;
+}
+
+/* key[2 * i]: tet v's ids sorted; key[2 * i + 1]: v itself. */
+static void seed_key(uint32_t (*key)[4], int i, const uint32_t v[4])
+{
+    uint32_t *kk = key[2 * i];
+    memcpy(kk, v, 4 * sizeof *v);
+    for (int a = 1; a < 4; a++)
+        for (int b = a; b > 0 && kk[b - 1] > kk[b]; b--) {
+            uint32_t x = kk[b];
+            kk[b] = kk[b - 1];
+            kk[b - 1] = x;
+        }
+    memcpy(key[2 * i + 1], v, 4 * sizeof *v);
+}
+
 /* Seeds: one per nonempty part, the Delaunay tet (src/seed.c) at the part's
  * point nearest its box centre, found in a tree over all points (the setup
  * may read every part); identical seeds are dropped. *out gets *nout
@@ -67,34 +95,61 @@ int fdt_par_make_seeds(const fdt_partition *pt, uint32_t (**out)[4], int *nout,
         uint32_t v[4];
         if ((err = fdt_seed_tet(&all, a, v, kq)) != FDT_OK)
             goto done;
-        /* key: sorted ids, then the oriented ids (to recover them). */
-        uint32_t *kk = key[2 * ns];
-        memcpy(kk, v, sizeof v);
-        for (int i = 1; i < 4; i++)
-            for (int j = i; j > 0 && kk[j - 1] > kk[j]; j--) {
-                uint32_t x = kk[j];
-                kk[j] = kk[j - 1];
-                kk[j - 1] = x;
-            }
-        memcpy(key[2 * ns + 1], v, sizeof v);
-        ns++;
+        seed_key(key, ns++, v);
     }
-    /* Sort pairs (key, tet) by key: qsort on 32-byte records. */
-    qsort(key, (size_t)ns, 2 * sizeof *key, key_cmp);
-    int nd = 0;
-    for (int i = 0; i < ns; i++) {
-        if (nd > 0 && key_cmp(key[2 * i], key[2 * (i - 1)]) == 0)
-            continue;
-        memcpy(sd[nd++], key[2 * i + 1], sizeof sd[0]);
-    }
+    seeds_distinct(key, ns, sd, nout);
     *out = sd;
-    *nout = nd;
     sd = NULL;
 done:
     free(sd);
     free(key);
     fdt_kd_free(&all);
     return err;
+}
+
+/*
+ * The seeds where the mesh of every point is built before the fronts
+ * start: one finite tet of it at the middle id of each nonempty part (ids
+ * are kd order, so that point is inside the part), its tets being the
+ * Delaunay tets, positively oriented as the kd seeds are. fdt_seed_tet's
+ * search costs nothing like this where that mesh was wanted: at the
+ * centre of a sphere its candidate window holds the whole shell, and the
+ * two seeds of a two-thread run took 0.006 s (bench/NOTES.md entry 72).
+ * FDT_OK or FDT_ENOMEM.
+ */
+static int seeds_from_mesh(const fdt_partition *pt, const fdt_ins *gm, uint32_t (**out)[4],
+                           int *nout)
+{
+    uint32_t(*sd)[4] = malloc((size_t)pt->nparts * sizeof *sd);
+    uint32_t(*key)[4] = malloc((size_t)pt->nparts * 2 * sizeof *key);
+    if (!sd || !key) {
+        free(sd);
+        free(key);
+        return FDT_ENOMEM;
+    }
+    int ns = 0;
+    for (int p = 0; p < pt->nparts; p++) {
+        if (pt->start[p] == pt->start[p + 1])
+            continue;
+        uint32_t a = pt->start[p] + (pt->start[p + 1] - pt->start[p]) / 2;
+        uint32_t t = gm->vtet[a - gm->base];
+        const uint32_t *v = fdt_ins_tet(gm, t);
+        /* an infinite tet: the finite one across its hull face holds a
+         * too (a is a vertex of that face) */
+        for (int k = 0; k < 4; k++)
+            if (v[k] == FDT_NONE) {
+                uint32_t nt;
+                int nk;
+                fdt_ins_across(gm, t, k, &nt, &nk);
+                v = fdt_ins_tet(gm, nt);
+                break;
+            }
+        seed_key(key, ns++, v);
+    }
+    seeds_distinct(key, ns, sd, nout);
+    free(key);
+    *out = sd;
+    return FDT_OK;
 }
 
 /* c[k] += k_[k] for every kind k. */
@@ -209,12 +264,14 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * hardware thread of a core costs nothing here. */
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     int cores = ncpu < 1 ? 1 : ncpu > FDT_PARTITION_MAX ? FDT_PARTITION_MAX : (int)ncpu;
-    /* The probe only decides the shared mesh's build, after the partition
-     * and the seeds, whose first cut and seed search leave the second
-     * core idle (bench/NOTES.md entry 56): it runs beside them on samples
-     * copied before the partition permutes the points, so its answer is
-     * fdt_oracle_probe's on the caller's order. pthread_join orders its
-     * answer before the read below. */
+    /* The probe only decides the shared mesh's build, after the
+     * partition, whose first cut leaves the second core idle (bench/NOTES.md
+     * entry 56): it runs beside it on samples copied before the partition
+     * permutes the points, so its answer is fdt_oracle_probe's on the
+     * caller's order. pthread_join orders its answer before the read
+     * below. The seeds come after it: from the mesh where it is built
+     * (entry 72), else by the kd search, which then no longer overlaps
+     * the probe (0.1-0.3 ms a run where the mesh is not built). */
     int probe = opt && opt->global_mesh == FDT_PAR_MESH_PROBE;
     int probing = 0, expensive = 0;
     probe_job pj = {{{NULL, NULL}, 0, 0}, 0};
@@ -226,22 +283,14 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     int err = fdt_partition_build(&pt, pr->p, pr->orig, (uint32_t)pr->m, nthreads,
                                   s->leaf_size > 0 ? s->leaf_size : FDT_DEFAULT_LEAF,
                                   cores < nthreads ? cores : nthreads);
-    int perr = err;
-    if (perr == FDT_OK)
-        err = fdt_par_make_seeds(&pt, &seeds, &nseeds, &kq0);
     if (probing) {
         pthread_join(probe_th, NULL);
         expensive = pj.expensive;
     } else if (probe) {
         expensive = fdt_oracle_probe_decide(&pj.ps); /* no thread: here */
     }
-    if (perr != FDT_OK)
-        return perr; /* pt is zeroed, no seeds */
-    if (err != FDT_OK) {
-        if (err == FDT_EINTERNAL)
-            snprintf(diag, dlen, "internal error: no seed tetrahedron found");
-        goto fail;
-    }
+    if (err != FDT_OK)
+        return err; /* pt is zeroed */
     err = FDT_ENOMEM;
     if (!(e = fdt_eng_new(nthreads)))
         goto fail;
@@ -298,6 +347,15 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
                 snprintf(diag, dlen, "internal error: the parallel insertion mesh failed");
             goto fail;
         }
+    }
+    /* The seeds, after the mesh of every point where it was built: its
+     * tets are Delaunay tets already (seeds_from_mesh). */
+    err = e->gmesh_ok ? seeds_from_mesh(&pt, &e->gmesh, &seeds, &nseeds)
+                      : fdt_par_make_seeds(&pt, &seeds, &nseeds, &kq0);
+    if (err != FDT_OK) {
+        if (err == FDT_EINTERNAL)
+            snprintf(diag, dlen, "internal error: no seed tetrahedron found");
+        goto fail;
     }
     if (opt && opt->shuffle)
         err = fdt_transport_shuffle(&e->tp, nthreads + 1, opt->seed, opt->delay_pct);
