@@ -43,9 +43,9 @@ static void pin_thread(worker *w)
 #endif
 }
 
-static void *worker_main(void *arg)
+/* A worker's run: its setup and loop, then its count in `finished`. */
+static void worker_run(worker *w)
 {
-    worker *w = arg;
     engine *e = w->e;
     double cpu0 = fdt_thread_cpu_s();
     if (e->pin)
@@ -71,6 +71,14 @@ static void *worker_main(void *arg)
     pthread_mutex_lock(&e->lock);
     e->finished++;
     pthread_cond_signal(&e->cv);
+    pthread_mutex_unlock(&e->lock);
+}
+
+/* Its part of the gather, once fdt_threads_run said whether there is one. */
+static void worker_gather(worker *w)
+{
+    engine *e = w->e;
+    pthread_mutex_lock(&e->lock);
     while (e->gather == 0)
         pthread_cond_wait(&e->go, &e->lock);
     int copy = e->gather > 0;
@@ -82,6 +90,12 @@ static void *worker_main(void *arg)
         pthread_cond_signal(&e->cv);
         pthread_mutex_unlock(&e->lock);
     }
+}
+
+static void *worker_main(void *arg)
+{
+    worker_run(arg);
+    worker_gather(arg);
     return NULL;
 }
 
@@ -107,8 +121,14 @@ int fdt_parallel_default_threads(void)
 
 /* Runs the workers and waits for their loops, then has them gather the
  * mesh (fdt_gather_prepare, fdt_gather_copy) and joins them; *t_loops: when the
- * last loop ended. The calling thread reports progress meanwhile (and
- * cancels through the abort path). */
+ * last loop ended. Where progress is reported (and a cancel taken through
+ * the abort path) or threads are pinned, the calling thread does that
+ * meanwhile and every worker has a thread of its own; otherwise the
+ * calling thread is worker 0. With a new thread for every worker, one of
+ * two started 2-5 ms after the other in about half the runs on this
+ * two-core machine, while the insertion build's second thread, whose
+ * caller is its worker 0, started within 0.1 ms (bench/NOTES.md entry 73).
+ * A pinned worker 0 would leave the caller's thread pinned. */
 int fdt_threads_run(engine *e, const fdt_settings *s, double *t_loops)
 {
     pthread_attr_t attr;
@@ -117,7 +137,8 @@ int fdt_threads_run(engine *e, const fdt_settings *s, double *t_loops)
     /* 1024 threads at the default 8 MiB would reserve 8 GiB of address
      * space; a worker's deepest stack is a few KiB of walk stacks. */
     (void)pthread_attr_setstacksize(&attr, (size_t)1 << 20);
-    int created = 0, err = FDT_OK;
+    int inline0 = !s->progress && !e->pin;
+    int created = inline0, err = FDT_OK;
     for (; created < e->n; created++)
         if (pthread_create(&e->w[created].th, &attr, worker_main, &e->w[created]) != 0) {
             err = FDT_ETHREAD;
@@ -125,6 +146,11 @@ int fdt_threads_run(engine *e, const fdt_settings *s, double *t_loops)
             break;
         }
     pthread_attr_destroy(&attr);
+    /* created counts worker 0 when it runs here: every one of them
+     * finishes its loop (a thread that could not be made stopped the
+     * others through the error). */
+    if (inline0)
+        worker_run(&e->w[0]);
     double expect = 6.5 * (double)e->pt->m + 1.0;
     pthread_mutex_lock(&e->lock);
     while (e->finished < created) {
@@ -169,10 +195,14 @@ int fdt_threads_run(engine *e, const fdt_settings *s, double *t_loops)
     }
     e->gather = go;
     pthread_cond_broadcast(&e->go);
+    pthread_mutex_unlock(&e->lock);
+    if (inline0)
+        worker_gather(&e->w[0]);
+    pthread_mutex_lock(&e->lock);
     while (go > 0 && e->copied < e->n)
         pthread_cond_wait(&e->cv, &e->lock);
     pthread_mutex_unlock(&e->lock);
-    for (int i = 0; i < created; i++)
+    for (int i = inline0; i < created; i++)
         pthread_join(e->w[i].th, NULL);
     return err;
 }
