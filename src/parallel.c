@@ -68,10 +68,9 @@ static void seed_key(uint32_t (*key)[4], int i, const uint32_t v[4])
 /* Seeds: one per nonempty part, the Delaunay tet (src/seed.c) at the part's
  * point nearest its box centre, found in a tree over all points (the setup
  * may read every part); identical seeds are dropped. *out gets *nout
- * positively oriented tets (owned by the caller). Also every rank of an
- * MPI run (src/mpi_run.c), which computes the same seeds. */
-int fdt_par_make_seeds(const fdt_partition *pt, uint32_t (**out)[4], int *nout,
-                       fdt_kdq *kq)
+ * positively oriented tets (owned by the caller). An MPI run finds its
+ * ranks' seeds in src/mpi_setup.c, from the points each rank is sent. */
+static int seeds_by_kd(const fdt_partition *pt, uint32_t (**out)[4], int *nout, fdt_kdq *kq)
 {
     fdt_kdtree all;
     int err = fdt_partition_global_tree(pt, &all);
@@ -351,7 +350,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     /* The seeds, after the mesh of every point where it was built: its
      * tets are Delaunay tets already (seeds_from_mesh). */
     err = e->gmesh_ok ? seeds_from_mesh(&pt, &e->gmesh, &seeds, &nseeds)
-                      : fdt_par_make_seeds(&pt, &seeds, &nseeds, &kq0);
+                      : seeds_by_kd(&pt, &seeds, &nseeds, &kq0);
     if (err != FDT_OK) {
         if (err == FDT_EINTERNAL)
             snprintf(diag, dlen, "internal error: no seed tetrahedron found");

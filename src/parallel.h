@@ -88,12 +88,6 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
 void fdt_parallel_fill_stats(const fdt_par_out *o, fdt_mode mode,
                              fdt_stats *st);
 
-/* The seed tets of the parts of pt (src/parallel.c): *out gets *nout
- * positively oriented tets (owned by the caller), the same for the same
- * partition wherever it is computed. */
-int fdt_par_make_seeds(const fdt_partition *pt, uint32_t (**out)[4], int *nout,
-                       fdt_kdq *kq);
-
 /* Frees what out still owns (mb, tstats). */
 void fdt_par_out_free(fdt_par_out *out);
 
