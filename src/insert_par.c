@@ -99,11 +99,18 @@ typedef struct shared {
     int single;                /* phase 3: one thread, the arrays may grow */
     atomic_int stop;           /* an error or spent slots: every worker stops */
     atomic_int err;            /* the first error (0: none) */
+    /* Phase 2's points, which each worker picks from (pick_points): the
+     * BRIO order, its rounds r0 .. nrounds - 1, the start's four points. */
+    const uint32_t *order;
+    const uint32_t *round_end;
+    int r0, nrounds;
+    uint32_t first[4];
 } shared;
 
 typedef struct worker {
     shared *sh;
     unsigned char me;          /* owner id */
+    uint32_t own_lo, own_span; /* its region: ids own_lo .. own_lo + own_span - 1 */
     uint32_t *held;            /* slots locked by this insertion */
     size_t nheld, heldcap;
     uint32_t *cav;             /* the cavity's tets */
@@ -117,10 +124,12 @@ typedef struct worker {
     uint32_t recent[RECENT];   /* more starts, when last is held elsewhere */
     unsigned nrecent;
     uint64_t rng;              /* the walk's choices */
-    const uint32_t *pts;       /* its points in insertion order (borrowed) */
+    const uint32_t *pts;       /* its points in insertion order */
     size_t npts;
-    const size_t *round_end;   /* ends of its rounds in pts (borrowed) */
+    size_t *round_end;         /* ends of its rounds in pts (borrowed) */
     int nrounds;
+    uint32_t *mine;            /* owned: phase 2's points, pick_points */
+    int picked;                /* pick_points ran */
     uint32_t *def;             /* deferred points */
     size_t ndef, defcap;
     uint32_t *todo;            /* owned: a later pass's points (pts) */
@@ -609,11 +618,39 @@ static int retry_deferred(worker *w, size_t *done)
     return FDT_OK;
 }
 
+/*
+ * Phase 2's points of w's region, by round in BRIO order (ids ascending
+ * within a round), from the shared order: each worker picks its own, at
+ * the same time (one pass over the order each, two compares a point; on
+ * the calling thread the split took 2 ms at 440k points, a division a
+ * point, bench/NOTES.md entry 76).
+ */
+static void pick_points(worker *w)
+{
+    const shared *sh = w->sh;
+    size_t k = 0;
+    for (int r = sh->r0; r < sh->nrounds; r++) {
+        for (uint32_t j = sh->round_end[r - 1]; j < sh->round_end[r]; j++) {
+            uint32_t id = sh->order[j];
+            if (id - w->own_lo < w->own_span && id != sh->first[0] && id != sh->first[1] &&
+                id != sh->first[2] && id != sh->first[3])
+                w->mine[k++] = id;
+        }
+        w->round_end[r - sh->r0] = k;
+    }
+    w->pts = w->mine;
+    w->npts = k;
+    w->picked = 1;
+    w->nrounds = sh->nrounds - sh->r0;
+}
+
 static void *worker_main(void *arg)
 {
     worker *w = arg;
     shared *sh = w->sh;
     double c0 = fdt_thread_cpu_s();
+    if (!w->picked)
+        pick_points(w);
     size_t i = 0;
     int err = FDT_OK;
     for (int r = 0; r < w->nrounds && !err; r++) {
@@ -669,13 +706,23 @@ static void worker_free(worker *w)
     free(w->edges.eh);
     free(w->def);
     free(w->todo);
+    free(w->mine);
 }
 
-static int worker_init(worker *w, shared *sh, int id)
+static int worker_init(worker *w, shared *sh, int id, int nw, uint32_t base, uint32_t n,
+                       size_t *round_end)
 {
     memset(w, 0, sizeof *w);
     w->sh = sh;
     w->me = (unsigned char)(id + 1);
+    /* Its region: the ids i with (i - base) * nw / n == id. */
+    uint64_t lo = ((uint64_t)id * n + (uint64_t)nw - 1) / (uint64_t)nw;
+    uint64_t hi = ((uint64_t)(id + 1) * n + (uint64_t)nw - 1) / (uint64_t)nw;
+    w->own_lo = base + (uint32_t)lo;
+    w->own_span = (uint32_t)(hi - lo);
+    w->round_end = round_end;
+    if (!(w->mine = malloc(((size_t)w->own_span + 1) * sizeof *w->mine)))
+        return FDT_ENOMEM;
     w->free_head = FDT_NONE;
     w->rng = UINT64_C(0x853c49e6748fea9b) ^ ((uint64_t)id * UINT64_C(0x9E3779B97F4A7C15));
     if (ins_grow_u32(&w->held, &w->heldcap, 256) != FDT_OK ||
@@ -708,19 +755,15 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
     }
     int nw = nthreads;
     uint32_t *order = malloc((size_t)n * sizeof *order);
-    uint32_t *pts = malloc((size_t)n * sizeof *pts);
     size_t *rend = malloc((size_t)nw * 32 * sizeof *rend);
-    size_t *wcount = calloc((size_t)nw, sizeof *wcount);
     worker *ws = calloc((size_t)nw, sizeof *ws);
     shared sh;
     memset(&sh, 0, sizeof sh);
     sh.m = m;
     int err = FDT_ENOMEM;
-    if (!order || !pts || !rend || !wcount || !ws) {
+    if (!order || !rend || !ws) {
         free(order);
-        free(pts);
         free(rend);
-        free(wcount);
         free(ws);
         return FDT_ENOMEM;
     }
@@ -775,19 +818,21 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
             m->cap = (uint32_t)want;
         }
     }
-    sh.lock = malloc((size_t)m->cap * sizeof *sh.lock);
+    /* All bytes zero: every lock free (an atomic_uchar's 0 is all zero
+     * bits). calloc leaves the zeroing to the pages' first touch, in the
+     * workers, where atomic_init a byte took 2.9 ms at 440k points on
+     * this thread (bench/NOTES.md entry 76). */
+    sh.lock = calloc((size_t)m->cap, sizeof *sh.lock);
     sh.hint = malloc((size_t)n * sizeof *sh.hint);
     if (!sh.lock || !sh.hint)
         goto fail;
-    for (uint32_t i = 0; i < m->cap; i++)
-        atomic_init(&sh.lock[i], 0);
     for (uint32_t i = 0; i < n; i++)
         atomic_init(&sh.hint[i], FDT_NONE);
     atomic_init(&sh.next, m->nslots);
     atomic_init(&sh.stop, 0);
     atomic_init(&sh.err, 0);
     for (int i = 0; i < nw; i++)
-        if ((err = worker_init(&ws[i], &sh, i)) != FDT_OK)
+        if ((err = worker_init(&ws[i], &sh, i, nw, base, n, rend + 32 * (size_t)i)) != FDT_OK)
             goto fail;
     err = FDT_ENOMEM;
 
@@ -822,36 +867,12 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
         if (ws[i].last == FDT_NONE)
             ws[i].last = anylive;
 
-    /* Phase 2's points by region (id range), keeping the BRIO order. */
-    for (uint32_t j = prefix; j < n; j++) {
-        uint32_t id = order[j];
-        if (id == first[0] || id == first[1] || id == first[2] || id == first[3])
-            continue;
-        wcount[(uint64_t)(id - base) * (uint64_t)nw / n]++;
-    }
-    size_t acc = 0;
-    for (int i = 0; i < nw; i++) {
-        ws[i].pts = pts + acc;
-        ws[i].round_end = rend + 32 * (size_t)i;
-        ws[i].nrounds = nrounds - r0;
-        acc += wcount[i];
-        wcount[i] = 0;
-    }
-    for (int r = r0; r < nrounds; r++) {
-        for (uint32_t j = round_end[r - 1]; j < round_end[r]; j++) {
-            uint32_t id = order[j];
-            if (id == first[0] || id == first[1] || id == first[2] || id == first[3])
-                continue;
-            int reg = (int)((uint64_t)(id - base) * (uint64_t)nw / n);
-            ((uint32_t *)ws[reg].pts)[wcount[reg]++] = id;
-        }
-        for (int i = 0; i < nw; i++)
-            rend[32 * (size_t)i + (size_t)(r - r0)] = wcount[i];
-    }
-    for (int i = 0; i < nw; i++)
-        ws[i].npts = wcount[i];
-    free(order);
-    order = NULL;
+    /* Phase 2's points: each worker picks its region's (pick_points). */
+    sh.order = order;
+    sh.round_end = round_end;
+    sh.r0 = r0;
+    sh.nrounds = nrounds;
+    memcpy(sh.first, first, sizeof sh.first);
 
     /* Phase 2. pthread_create orders everything above before the
      * workers; a worker that cannot start leaves its points to phase 3.
@@ -864,7 +885,11 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
         for (int i = 1; i < nw; i++)
             if (ws[i].started)
                 pthread_join(ws[i].th, NULL);
-        /* The joins order the workers' writes before what follows. */
+        /* The joins order the workers' writes before what follows. A
+         * worker that did not start leaves its points to phase 3. */
+        for (int i = 1; i < nw; i++)
+            if (!ws[i].picked)
+                pick_points(&ws[i]);
         if ((err = atomic_load_explicit(&sh.err, memory_order_relaxed)) != 0)
             goto fail;
         uint64_t next = atomic_load_explicit(&sh.next, memory_order_relaxed);
@@ -984,9 +1009,7 @@ out:
     free(sh.lock);
     free(sh.hint);
     free(order);
-    free(pts);
     free(rend);
-    free(wcount);
     free(ws);
     return err;
 }

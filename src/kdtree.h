@@ -67,6 +67,31 @@ typedef struct fdt_kdq {
  */
 int fdt_kd_build(fdt_kdtree *t, double *P, fdt_vid *orig, uint32_t base,
                  uint32_t n, int leaf_size);
+
+/*
+ * fdt_kd_build in jobs, for several threads (src/partition.c): the same
+ * tree, node for node. fdt_kd_begin allocates the nodes and gives the
+ * root's job; fdt_kd_run builds a job's subtree whole when it holds at
+ * most `grain` points (returns 0), else only its node, and returns its
+ * two children's jobs in kids (returns 2). Jobs of one tree may run on
+ * different threads at once (they touch disjoint nodes and ids); once
+ * every job has run, fdt_kd_end builds the climb tables and the float
+ * blocks. Each job's node ids were given before it runs, so the
+ * numbering is fdt_kd_build's whatever the order.
+ */
+typedef struct fdt_kd_job {
+    fdt_kdtree *t;
+    double *P;                 /* the tree's points, permuted by the build */
+    fdt_vid *orig;
+    uint32_t leaf;
+    uint32_t node, begin, end; /* the subtree's root and its ids */
+    uint32_t next;             /* the first id of its descendants' block */
+} fdt_kd_job;
+
+int fdt_kd_begin(fdt_kdtree *t, double *P, fdt_vid *orig, uint32_t base, uint32_t n,
+                 int leaf_size, fdt_kd_job *root);
+int fdt_kd_run(const fdt_kd_job *job, uint32_t grain, fdt_kd_job kids[2]);
+int fdt_kd_end(fdt_kdtree *t);
 void fdt_kd_free(fdt_kdtree *t);
 /* The bytes t owns (nodes, climb tables, float blocks): fdt_stats.mem_tree. */
 size_t fdt_kd_bytes(const fdt_kdtree *t);

@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <sched.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -133,36 +134,94 @@ static void regions(const fdt_partition *pt, int id, const double lo[3], const d
     regions(pt, nd->left + 1, rlo, rhi, out);
 }
 
-/* The parts' trees are independent (each permutes only its own id range
- * of P and orig), so a few threads build them, taking parts in turn. */
+/*
+ * The parts' trees are independent (each permutes only its own id range
+ * of P and orig), and each is built in jobs (fdt_kd_run): a job over more
+ * than `grain` points builds its node and leaves its two halves as jobs,
+ * a smaller one builds its whole subtree. So the builders share every
+ * tree's work, not only whole trees: with one tree a builder, the second
+ * of two builders started 4 ms late (the probe's thread, src/parallel.c,
+ * held the other core) and its tree ended 4 ms after the first
+ * (bench/NOTES.md entry 76). The jobs wait on a stack under a mutex:
+ * about 2 n / grain of them, each a few hundred microseconds of work.
+ */
 typedef struct tree_jobs {
     fdt_partition *pt;
-    double *P;
-    fdt_vid *orig;
-    int leaf_size;
     double (*region)[2][3]; /* each part's (regions()) */
-    /* The next part to build. Relaxed: the counter only hands out each
-     * index once (fetch_add is atomic whatever the order); what a builder
-     * wrote is published to the caller by pthread_join. */
-    atomic_int next;
+    uint32_t grain;
+    pthread_mutex_t mu;     /* guards stack, nstack, cap, busy */
+    fdt_kd_job *stack;
+    size_t nstack, cap;
+    size_t busy;            /* jobs taken and not yet done */
+    /* The next part to end (fdt_kd_end). Relaxed: the counter only hands
+     * out each index once; what a builder wrote is published to the
+     * caller by pthread_join. */
+    atomic_int next_end;
     /* Set (relaxed) by a builder that ran out of memory; read after the
      * joins, which order it. */
     atomic_int failed;
 } tree_jobs;
 
+/* Takes a job (1), or 0 once every job is done. Waits while the stack is
+ * empty and others still run jobs that may leave more. */
+static int take_job(tree_jobs *j, fdt_kd_job *job)
+{
+    pthread_mutex_lock(&j->mu);
+    while (j->nstack == 0 && j->busy > 0) {
+        pthread_mutex_unlock(&j->mu);
+        sched_yield();
+        pthread_mutex_lock(&j->mu);
+    }
+    int got = j->nstack > 0;
+    if (got) {
+        *job = j->stack[--j->nstack];
+        j->busy++;
+    }
+    pthread_mutex_unlock(&j->mu);
+    return got;
+}
+
+/* A job is done, leaving nk more (kids). */
+static void done_job(tree_jobs *j, const fdt_kd_job *kids, int nk)
+{
+    pthread_mutex_lock(&j->mu);
+    for (int i = 0; i < nk; i++) {
+        if (j->nstack == j->cap) {
+            size_t nc = j->cap * 2;
+            fdt_kd_job *ns = realloc(j->stack, nc * sizeof *ns);
+            if (!ns) {
+                /* no room: build that half whole, here */
+                pthread_mutex_unlock(&j->mu);
+                fdt_kd_job sub[2];
+                fdt_kd_run(&kids[i], UINT32_MAX, sub);
+                pthread_mutex_lock(&j->mu);
+                continue;
+            }
+            j->stack = ns;
+            j->cap = nc;
+        }
+        j->stack[j->nstack++] = kids[i];
+    }
+    j->busy--;
+    pthread_mutex_unlock(&j->mu);
+}
+
 static void *build_trees(void *arg)
 {
     tree_jobs *j = arg;
     fdt_partition *pt = j->pt;
+    fdt_kd_job job, kids[2];
+    while (take_job(j, &job))
+        done_job(j, kids, fdt_kd_run(&job, j->grain, kids));
     for (;;) {
-        int p = atomic_fetch_add_explicit(&j->next, 1, memory_order_relaxed);
+        int p = atomic_fetch_add_explicit(&j->next_end, 1, memory_order_relaxed);
         if (p >= pt->nparts)
             return NULL;
-        uint32_t n = pt->start[p + 1] - pt->start[p];
-        if (n > 0 && fdt_kd_build(&pt->trees[p], j->P, j->orig, pt->start[p], n,
-                                  j->leaf_size) != FDT_OK)
+        if (pt->start[p + 1] == pt->start[p] || !pt->trees[p].nodes)
+            continue; /* empty, or its fdt_kd_begin failed (failed is set) */
+        if (fdt_kd_end(&pt->trees[p]) != FDT_OK)
             atomic_store_explicit(&j->failed, 1, memory_order_relaxed);
-        else if (n > 0)
+        else
             fdt_kd_set_region(&pt->trees[p], j->region[p][0], j->region[p][1]);
     }
 }
@@ -194,11 +253,37 @@ int fdt_partition_build(fdt_partition *pt, double *P, fdt_vid *orig,
     const double all_lo[3] = {-INFINITY, -INFINITY, -INFINITY};
     const double all_hi[3] = {INFINITY, INFINITY, INFINITY};
     regions(pt, 0, all_lo, all_hi, region);
-    tree_jobs j = {pt, P, orig, leaf_size, region, 0, 0};
-    atomic_init(&j.next, 0);
+    tree_jobs j;
+    memset(&j, 0, sizeof j);
+    j.pt = pt;
+    j.region = region;
+    /* Jobs of 4,096 points at least (a few hundred microseconds), and
+     * some 16 a builder where the points allow. */
+    j.grain = m / (16 * (uint32_t)(nworkers > 0 ? nworkers : 1));
+    if (j.grain < 4096)
+        j.grain = 4096;
+    j.cap = 64 + 4 * (size_t)nparts;
+    j.stack = malloc(j.cap * sizeof *j.stack);
+    if (!j.stack || pthread_mutex_init(&j.mu, NULL) != 0) {
+        free(j.stack);
+        free(region);
+        fdt_partition_free(pt);
+        return FDT_ENOMEM;
+    }
+    atomic_init(&j.next_end, 0);
     atomic_init(&j.failed, 0);
-    if (nworkers > nparts)
-        nworkers = nparts;
+    /* The roots, the last part's first (the stack is taken from the top). */
+    for (int p = nparts - 1; p >= 0; p--) {
+        uint32_t n = pt->start[p + 1] - pt->start[p];
+        if (n == 0)
+            continue;
+        if (fdt_kd_begin(&pt->trees[p], P, orig, pt->start[p], n, leaf_size,
+                         &j.stack[j.nstack]) != FDT_OK) {
+            atomic_store_explicit(&j.failed, 1, memory_order_relaxed);
+            continue;
+        }
+        j.nstack++;
+    }
     if (nworkers > FDT_BUILDERS_MAX)
         nworkers = FDT_BUILDERS_MAX;
     pthread_t th[FDT_BUILDERS_MAX];
@@ -210,6 +295,8 @@ int fdt_partition_build(fdt_partition *pt, double *P, fdt_vid *orig,
     build_trees(&j);
     for (int i = 0; i < started; i++)
         pthread_join(th[i], NULL);
+    pthread_mutex_destroy(&j.mu);
+    free(j.stack);
     free(region);
     if (atomic_load_explicit(&j.failed, memory_order_relaxed)) {
         fdt_partition_free(pt);

@@ -539,8 +539,67 @@ static void test_apex_ulpgrid(void)
     }
 }
 
+/*
+ * fdt_kd_begin / fdt_kd_run / fdt_kd_end (the partition's builders share
+ * a tree's jobs) give fdt_kd_build's tree node for node, and the same
+ * permutation of the points, whatever order the jobs run in: here the
+ * pending jobs are taken from the bottom of the list (breadth first)
+ * with a small grain, so the right halves of the top run before the left
+ * subtrees are done, and nodes are numbered out of build order.
+ */
+static void test_jobs(int fam, size_t want, int leaf, uint32_t grain)
+{
+    double *xyz = malloc(want * 3 * sizeof *xyz);
+    size_t n = make_points(fam, want, xyz);
+    fdt_prepared a, b;
+    char diag[256];
+    EXPECTF(fdt_prepare(xyz, n, 1, &a, diag, sizeof diag) == FDT_OK, "prepare");
+    EXPECTF(fdt_prepare(xyz, n, 1, &b, diag, sizeof diag) == FDT_OK, "prepare");
+    uint32_t m = (uint32_t)a.m;
+    fdt_kdtree ta, tb;
+    CHECK_EQ(fdt_kd_build(&ta, a.p, a.orig, 0, m, leaf), FDT_OK);
+    fdt_kd_job *jobs = malloc((4 * (size_t)m + 8) * sizeof *jobs);
+    size_t head = 0, tail = 0, ran = 0;
+    CHECK_EQ(fdt_kd_begin(&tb, b.p, b.orig, 0, m, leaf, &jobs[tail++]), FDT_OK);
+    while (head < tail) {
+        fdt_kd_job kids[2];
+        int k = fdt_kd_run(&jobs[head++], grain, kids);
+        ran++;
+        for (int i = 0; i < k; i++)
+            jobs[tail++] = kids[i];
+    }
+    CHECK_EQ(fdt_kd_end(&tb), FDT_OK);
+    EXPECTF(ran > 3 || m <= grain, "%s: %zu jobs", family_name[fam], ran);
+    CHECK_EQ(ta.nnodes, tb.nnodes);
+    int same = 1;
+    for (uint32_t i = 0; i < ta.nnodes && same; i++) {
+        const fdt_kdnode *x = &ta.nodes[i], *y = &tb.nodes[i];
+        same = x->begin == y->begin && x->end == y->end && x->left == y->left &&
+               x->dim == y->dim && memcmp(x->lo, y->lo, sizeof x->lo) == 0 &&
+               memcmp(x->hi, y->hi, sizeof x->hi) == 0;
+    }
+    EXPECTF(same, "%s: the jobs' nodes differ from fdt_kd_build's", family_name[fam]);
+    EXPECTF(memcmp(a.p, b.p, 3 * (size_t)m * sizeof *a.p) == 0 &&
+                memcmp(a.orig, b.orig, (size_t)m * sizeof *a.orig) == 0,
+            "%s: the jobs permuted the points otherwise", family_name[fam]);
+    EXPECTF(memcmp(ta.leafof, tb.leafof, (size_t)m * sizeof *ta.leafof) == 0 &&
+                memcmp(ta.parent, tb.parent, ta.nnodes * sizeof *ta.parent) == 0,
+            "%s: climb tables differ", family_name[fam]);
+    free(jobs);
+    fdt_kd_free(&ta);
+    fdt_kd_free(&tb);
+    fdt_prepared_free(&a);
+    fdt_prepared_free(&b);
+    free(xyz);
+}
+
 int main(void)
 {
+    for (int fam = 0; fam < NFAMILIES; fam++) {
+        test_jobs(fam, 5000, 18, 200);
+        test_jobs(fam, 3000, 30, 31);
+        test_jobs(fam, 700, 3, 4);
+    }
     test_nearest_ties();
     test_apex_ulpgrid();
     for (g_sse_only = 0; g_sse_only <= 1; g_sse_only++)
