@@ -91,6 +91,9 @@ enum {
  * (phase 2). Either way nothing was written and nothing is held. */
 enum { BUSY = 1, FULL = 2 };
 
+/* lock_live's answers besides 0 (another worker holds the tet). */
+enum { MINE = 1, TAKEN = 2 };
+
 typedef struct shared {
     fdt_ins *m;
     atomic_uchar *lock;        /* cap entries: owner | mark << MARK_SHIFT, 0 free */
@@ -111,10 +114,18 @@ typedef struct worker {
     shared *sh;
     unsigned char me;          /* owner id */
     uint32_t own_lo, own_span; /* its region: ids own_lo .. own_lo + own_span - 1 */
-    uint32_t *held;            /* slots locked by this insertion */
-    size_t nheld, heldcap;
+    /* What an insertion locks is on one of these lists (see insert_point):
+     * the cavity (MARK_IN), the tets outside it met by the search
+     * (MARK_OUT), the tets under hull faces the coplanar rule read
+     * (unmarked unless met again), the new tets. */
     uint32_t *cav;             /* the cavity's tets */
     size_t ncav, cavcap;
+    uint32_t *outl;            /* the tets marked MARK_OUT */
+    size_t nout, outcap;
+    uint32_t *under;           /* the coplanar rule's tets, locked by it */
+    size_t nunder, undercap;
+    uint32_t *newt;            /* the new tets */
+    size_t newcap;
     uint32_t *bnd;             /* its boundary faces, packed (tet, k) */
     size_t nbnd, bndcap;
     ins_edges edges;
@@ -163,68 +174,70 @@ static inline void unlock_slot(shared *sh, uint32_t t)
     atomic_store_explicit(&sh->lock[t], 0, memory_order_release);
 }
 
-static inline int push_held(worker *w, uint32_t t)
-{
-    if (w->nheld == w->heldcap && ins_grow_u32(&w->held, &w->heldcap, w->nheld + 1) != FDT_OK)
-        return FDT_ENOMEM;
-    w->held[w->nheld++] = t;
-    return FDT_OK;
-}
-
 /*
- * Makes sure w holds live slot t: 1 if it does (taken now, or already
- * held by this insertion), 0 if another worker holds it, FDT_ENOMEM.
- * "Already held" can be read from a failed CAS: only w writes its own id,
- * and its own earlier write is what the relaxed load then returns. (A
- * slot this worker freed is locked by it too, but a live tet's neighbour
- * is never a freed slot, and only neighbours reach here.)
+ * Makes sure w holds live slot t: TAKEN if it took it now (its mark is
+ * then MARK_NONE), MINE if this insertion held it already (*mark: its
+ * mark), 0 if another worker holds it. "Already held" can be read from a
+ * failed CAS: only w writes its own id, and its own earlier write is what
+ * the relaxed load then returns. (A slot this worker freed is locked by
+ * it too, but a live tet's neighbour is never a freed slot, and only
+ * neighbours reach here.)
  */
-static inline int lock_live(worker *w, uint32_t t)
+static inline int lock_live(worker *w, uint32_t t, int *mark)
 {
     /* A plain look first (relaxed: the CAS below is what acquires): most
      * neighbours met are this insertion's own cavity tets, and a CAS that
-     * fails still takes the cache line. */
+     * fails still takes the cache line. The look gives the mark too. */
     unsigned char exp = atomic_load_explicit(&w->sh->lock[t], memory_order_relaxed);
-    if (exp != 0)
-        return (exp & OWNER) == w->me;
-    if (atomic_compare_exchange_strong_explicit(&w->sh->lock[t], &exp, w->me,
-                                                memory_order_acquire, memory_order_relaxed)) {
-        if (push_held(w, t) != FDT_OK) {
-            unlock_slot(w->sh, t);
-            return FDT_ENOMEM;
-        }
-        return 1;
+    if (exp == 0 && atomic_compare_exchange_strong_explicit(&w->sh->lock[t], &exp, w->me,
+                                                            memory_order_acquire,
+                                                            memory_order_relaxed)) {
+        *mark = MARK_NONE;
+        return TAKEN;
     }
-    return (exp & OWNER) == w->me;
+    *mark = exp >> MARK_SHIFT;
+    return (exp & OWNER) == w->me ? MINE : 0;
 }
 
-/* The mark of a slot w holds, and a new one (relaxed: see Data-race
- * freedom). */
-static inline int get_mark(const worker *w, uint32_t t)
-{
-    return atomic_load_explicit(&w->sh->lock[t], memory_order_relaxed) >> MARK_SHIFT;
-}
-
+/* A new mark for a slot w holds (relaxed: see Data-race freedom). */
 static inline void set_mark(worker *w, uint32_t t, int mark)
 {
     atomic_store_explicit(&w->sh->lock[t], (unsigned char)(w->me | mark << MARK_SHIFT),
                           memory_order_relaxed);
 }
 
-/* Lets go of everything this insertion holds but the slots it freed,
- * which stay locked on its free list (unlocking clears the mark too). */
-static void release_all(worker *w)
+static void unlock_list(shared *sh, const uint32_t *list, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        unlock_slot(sh, list[i]);
+}
+
+/* Lets go of the coplanar rule's tets that no list below has: still
+ * unmarked, live (a freed cavity slot is unmarked too, but stays w's) and
+ * still w's (a list let go of it before, and another worker may hold it
+ * since). */
+static void unlock_under(worker *w)
 {
     shared *sh = w->sh;
     const uint32_t *T = sh->m->T;
-    for (size_t i = 0; i < w->nheld; i++) {
-        uint32_t t = w->held[i];
+    for (size_t i = 0; i < w->nunder; i++) {
+        uint32_t t = w->under[i];
         const uint32_t *v = T + 8 * (size_t)t;
-        if (v[0] == INF && v[1] == INF)
-            continue;
-        unlock_slot(sh, t);
+        if (atomic_load_explicit(&sh->lock[t], memory_order_relaxed) == w->me &&
+            !(v[0] == INF && v[1] == INF))
+            unlock_slot(sh, t);
     }
-    w->nheld = 0;
+    w->nunder = 0;
+}
+
+/* An insertion gives up before writing anything: lets go of every tet it
+ * locked (the cavity's too; unlocking clears the marks). */
+static void abort_insertion(worker *w)
+{
+    unlock_list(w->sh, w->cav, w->ncav);
+    unlock_list(w->sh, w->outl, w->nout);
+    w->ncav = w->nout = 0;
+    unlock_under(w);
 }
 
 /* ------------------------------------------------------------------ */
@@ -308,8 +321,7 @@ static int reserve(worker *w, size_t need)
     return FDT_OK;
 }
 
-/* A slot for a new tet, locked by w and held by this insertion (reserve
- * first; push_held cannot fail: the caller made room). */
+/* A slot for a new tet, locked by w (reserve first). */
 static inline uint32_t alloc_slot(worker *w)
 {
     uint32_t t;
@@ -322,7 +334,6 @@ static inline uint32_t alloc_slot(worker *w)
         /* Never seen by another thread: see reserve. */
         atomic_store_explicit(&w->sh->lock[t], w->me, memory_order_relaxed);
     }
-    w->held[w->nheld++] = t;
     return t;
 }
 
@@ -331,8 +342,8 @@ static inline uint32_t alloc_slot(worker *w)
 
 /*
  * Hand-over-hand visibility walk (src/insert.c's walk) from `start`,
- * which this worker has just locked (not yet in held). On 0 (located)
- * *out is locked and pushed on held; on BUSY nothing is held.
+ * which this worker has just locked. On 0 (located) *out is locked (the
+ * caller's to let go); on BUSY nothing is held.
  */
 static int walk_locked(worker *w, const double *p, uint32_t start, uint32_t *out)
 {
@@ -391,11 +402,6 @@ static int walk_locked(worker *w, const double *p, uint32_t start, uint32_t *out
         from = (int)(nb & 3);
     }
     w->st.walk_steps += steps;
-    int err = push_held(w, t);
-    if (err) {
-        unlock_slot(sh, t);
-        return err;
-    }
     *out = t;
     return FDT_OK;
 }
@@ -458,16 +464,32 @@ static inline int conflict(worker *w, uint32_t t, const double *p)
     if (o != 0)
         return o > 0;
     uint32_t u = v[4 + inf] >> 2;
-    int r = lock_live(w, u);
-    if (r <= 0)
-        return r == 0 ? -BUSY : r;
+    int umark, r = lock_live(w, u, &umark);
+    if (r == 0)
+        return -BUSY;
+    if (r == TAKEN) {
+        if (w->nunder == w->undercap &&
+            ins_grow_u32(&w->under, &w->undercap, w->nunder + 1) != FDT_OK) {
+            unlock_slot(w->sh, u);
+            return FDT_ENOMEM;
+        }
+        w->under[w->nunder++] = u;
+    }
     const uint32_t *x = m->T + 8 * (size_t)u;
     return ins_insphere(ins_pt(m, x[0]), ins_pt(m, x[1]), ins_pt(m, x[2]), ins_pt(m, x[3]), p,
                         &w->cnt) > 0;
 }
 
-/* Inserts point pid: FDT_OK, BUSY (nothing changed, nothing held), or an
- * error (nothing held). */
+/*
+ * Inserts point pid: FDT_OK, BUSY (nothing changed, nothing held), or an
+ * error (nothing held). Every tet it locks is on one of w's lists from
+ * the moment it is locked to its release: the walk's last tet and the
+ * cavity on cav, the tets outside met by the search on outl, the tets the
+ * coplanar rule locked on under, the new tets on newt. So releasing is a
+ * pass over the lists (the cavity's slots, freed, stay locked), as the
+ * serial build clears its marks, instead of a list of every lock taken:
+ * bench/NOTES.md entry 78.
+ */
 static int insert_point(worker *w, uint32_t pid)
 {
     shared *sh = w->sh;
@@ -483,11 +505,11 @@ static int insert_point(worker *w, uint32_t pid)
             continue;
         const double *q = ins_pt(m, v0[i]);
         if (q[0] == p[0] && q[1] == p[1] && q[2] == p[2]) {
-            release_all(w);
+            unlock_slot(sh, t0);
             return FDT_EINVAL;
         }
     }
-    w->ncav = w->nbnd = 0;
+    w->ncav = w->nbnd = w->nout = w->nunder = 0;
     set_mark(w, t0, MARK_IN);
     w->cav[w->ncav++] = t0;
     for (int j = 0; j < 4; j++)
@@ -496,24 +518,33 @@ static int insert_point(worker *w, uint32_t pid)
         uint32_t c = w->cav[ci];
         for (int k = 0; k < 4; k++) {
             uint32_t o = m->T[8 * (size_t)c + 4 + k] >> 2;
-            int r = lock_live(w, o);
-            if (r <= 0) {
-                err = r == 0 ? BUSY : r;
+            int mk, r = lock_live(w, o, &mk);
+            if (r == 0) {
+                err = BUSY;
                 goto abort;
             }
-            int mk = get_mark(w, o);
             if (mk == MARK_IN)
                 continue;
             if (mk == MARK_NONE) {
+                /* Room on both lists first, so o is on one before
+                 * anything else can fail; until then a failure lets go
+                 * of o here if it was taken now (else it is on under). */
+                if ((w->ncav == w->cavcap &&
+                     (err = ins_grow_u32(&w->cav, &w->cavcap, w->ncav + 1)) != FDT_OK) ||
+                    (w->nout == w->outcap &&
+                     (err = ins_grow_u32(&w->outl, &w->outcap, w->nout + 1)) != FDT_OK)) {
+                    if (r == TAKEN)
+                        unlock_slot(sh, o);
+                    goto abort;
+                }
                 int cf = conflict(w, o, p);
                 if (cf < 0) {
+                    if (r == TAKEN)
+                        unlock_slot(sh, o);
                     err = cf == -BUSY ? BUSY : cf;
                     goto abort;
                 }
                 if (cf) {
-                    if (w->ncav == w->cavcap &&
-                        (err = ins_grow_u32(&w->cav, &w->cavcap, w->ncav + 1)) != FDT_OK)
-                        goto abort;
                     set_mark(w, o, MARK_IN);
                     w->cav[w->ncav++] = o;
                     /* its neighbours are tested next: ask for them now */
@@ -525,6 +556,7 @@ static int insert_point(worker *w, uint32_t pid)
                     continue;
                 }
                 set_mark(w, o, MARK_OUT);
+                w->outl[w->nout++] = o;
             }
             if (w->nbnd == w->bndcap &&
                 (err = ins_grow_u32(&w->bnd, &w->bndcap, w->nbnd + 1)) != FDT_OK)
@@ -535,7 +567,7 @@ static int insert_point(worker *w, uint32_t pid)
     /* Everything read is held: from here on the insertion cannot fail
      * for another thread's sake, only for want of slots or memory. */
     if ((err = reserve(w, w->nbnd)) != FDT_OK ||
-        (err = ins_grow_u32(&w->held, &w->heldcap, w->nheld + w->nbnd)) != FDT_OK ||
+        (err = ins_grow_u32(&w->newt, &w->newcap, w->nbnd)) != FDT_OK ||
         (err = ins_edges_begin(&w->edges, 3 * w->nbnd / 2)) != FDT_OK)
         goto abort;
 
@@ -545,26 +577,30 @@ static int insert_point(worker *w, uint32_t pid)
     uint32_t s = FDT_NONE;
     for (size_t i = 0; i < w->nbnd; i++) {
         s = alloc_slot(w);
+        w->newt[i] = s;
         linked += ins_star_tet(T, &w->edges, w->bnd[i], pid, s);
     }
-    if (2 * linked != 3 * w->nbnd) {
-        release_all(w);
-        return FDT_EINTERNAL;
-    }
+    if (2 * linked != 3 * w->nbnd)
+        return FDT_EINTERNAL; /* the build fails: what stays locked does not matter */
     for (size_t i = 0; i < w->ncav; i++)
         free_slot(w, w->cav[i]);
     w->st.cavity_tets += w->ncav;
     w->st.created_tets += w->nbnd;
     if (w->ncav > w->st.max_cavity)
         w->st.max_cavity = w->ncav;
-    release_all(w);
+    /* Release: every write above happens before the next holder's
+     * acquire. The coplanar rule's tets first: a freed cavity slot is
+     * told from them by its tet (unlock_under). */
+    unlock_under(w);
+    unlock_list(sh, w->outl, w->nout);
+    unlock_list(sh, w->newt, w->nbnd);
     w->last = s;
     w->recent[w->nrecent++ % RECENT] = s;
     /* Relaxed: a hint only, validated by locking (see locate). */
     atomic_store_explicit(&sh->hint[pid - m->base], s, memory_order_relaxed);
     return FDT_OK;
 abort:
-    release_all(w);
+    abort_insertion(w);
     return err;
 }
 
@@ -700,7 +736,9 @@ static void *worker_main(void *arg)
 
 static void worker_free(worker *w)
 {
-    free(w->held);
+    free(w->outl);
+    free(w->under);
+    free(w->newt);
     free(w->cav);
     free(w->bnd);
     free(w->edges.eh);
@@ -725,7 +763,8 @@ static int worker_init(worker *w, shared *sh, int id, int nw, uint32_t base, uin
         return FDT_ENOMEM;
     w->free_head = FDT_NONE;
     w->rng = UINT64_C(0x853c49e6748fea9b) ^ ((uint64_t)id * UINT64_C(0x9E3779B97F4A7C15));
-    if (ins_grow_u32(&w->held, &w->heldcap, 256) != FDT_OK ||
+    if (ins_grow_u32(&w->outl, &w->outcap, 256) != FDT_OK ||
+        ins_grow_u32(&w->newt, &w->newcap, 256) != FDT_OK ||
         ins_grow_u32(&w->cav, &w->cavcap, 64) != FDT_OK ||
         ins_grow_u32(&w->bnd, &w->bndcap, 256) != FDT_OK)
         return FDT_ENOMEM;
