@@ -149,9 +149,9 @@ typedef struct tree_jobs {
     fdt_partition *pt;
     double (*region)[2][3]; /* each part's (regions()) */
     uint32_t grain;
-    pthread_mutex_t mu;     /* guards stack, nstack, cap, busy */
+    pthread_mutex_t mu;     /* guards stack, nstack, busy */
     fdt_kd_job *stack;
-    size_t nstack, cap;
+    size_t nstack;
     size_t busy;            /* jobs taken and not yet done */
     /* The next part to end (fdt_kd_end). Relaxed: the counter only hands
      * out each index once; what a builder wrote is published to the
@@ -181,27 +181,13 @@ static int take_job(tree_jobs *j, fdt_kd_job *job)
     return got;
 }
 
-/* A job is done, leaving nk more (kids). */
+/* A job is done, leaving nk more (kids); the stack has room for every
+ * job there will ever be (fdt_partition_build). */
 static void done_job(tree_jobs *j, const fdt_kd_job *kids, int nk)
 {
     pthread_mutex_lock(&j->mu);
-    for (int i = 0; i < nk; i++) {
-        if (j->nstack == j->cap) {
-            size_t nc = j->cap * 2;
-            fdt_kd_job *ns = realloc(j->stack, nc * sizeof *ns);
-            if (!ns) {
-                /* no room: build that half whole, here */
-                pthread_mutex_unlock(&j->mu);
-                fdt_kd_job sub[2];
-                fdt_kd_run(&kids[i], UINT32_MAX, sub);
-                pthread_mutex_lock(&j->mu);
-                continue;
-            }
-            j->stack = ns;
-            j->cap = nc;
-        }
+    for (int i = 0; i < nk; i++)
         j->stack[j->nstack++] = kids[i];
-    }
     j->busy--;
     pthread_mutex_unlock(&j->mu);
 }
@@ -262,8 +248,14 @@ int fdt_partition_build(fdt_partition *pt, double *P, fdt_vid *orig,
     j.grain = m / (16 * (uint32_t)(nworkers > 0 ? nworkers : 1));
     if (j.grain < 4096)
         j.grain = 4096;
-    j.cap = 64 + 4 * (size_t)nparts;
-    j.stack = malloc(j.cap * sizeof *j.stack);
+    /* Room for every job: the roots and two a split. A split job holds
+     * more than grain points, those of one depth are disjoint, so at most
+     * m / grain of them a depth (and m / grain <= 16 nworkers); a split
+     * leaves its larger half at most 2/3 of its points (left_count in
+     * src/kdtree.c), so the splits go at most log_{3/2}(m / grain) + 1 deep,
+     * under 20 for 64 builders: 64 depths is room to spare. */
+    size_t cap = (size_t)nparts + 2 * 64 * ((size_t)m / j.grain + 1);
+    j.stack = malloc(cap * sizeof *j.stack);
     if (!j.stack || pthread_mutex_init(&j.mu, NULL) != 0) {
         free(j.stack);
         free(region);
