@@ -1,7 +1,8 @@
 /* Small helpers shared by modules: bit scans (src/kdtree.c, src/faceq.c,
  * src/result.c), powers of two from a double's bits (src/kdtree.c,
- * src/prepare.c) and a prefetch hint (src/facetab.h, src/prepare.c,
- * src/check.c). */
+ * src/prepare.c), a prefetch hint (src/facetab.h, src/prepare.c,
+ * src/check.c) and four ids in ascending order (src/engine.c,
+ * src/parallel.c). */
 #ifndef FDT_BITS_H
 #define FDT_BITS_H
 
@@ -25,6 +26,18 @@ static inline int fdt_exp2_normal(double x)
     uint64_t b;
     memcpy(&b, &x, sizeof b);
     return (int)((b >> 52) & 0x7ff) - 1022;
+}
+
+/* s[0..3] in ascending order (a 5-comparator sorting network, as
+ * src/fmt_tets.c's sort4 for its signed ids). */
+static inline void fdt_sort4_u32(uint32_t s[4])
+{
+    static const int ij[5][2] = {{0, 1}, {2, 3}, {0, 2}, {1, 3}, {1, 2}};
+    for (int c = 0; c < 5; c++) {
+        uint32_t x = s[ij[c][0]], y = s[ij[c][1]];
+        s[ij[c][0]] = x < y ? x : y;
+        s[ij[c][1]] = x < y ? y : x;
+    }
 }
 
 /* Index of the lowest set bit of m != 0. */

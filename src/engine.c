@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bits.h"
 #include "mem.h"
 #include "termination.h"
 
@@ -97,12 +98,7 @@ int fdt_eng_build_tet(worker *w, const uint32_t v[4], int request, fdt_face *adv
     if (far_owner != w->id) {
         uint32_t k[4];
         memcpy(k, v, sizeof k);
-        for (int i = 1; i < 4; i++)
-            for (int j = i; j > 0 && k[j - 1] > k[j]; j--) {
-                uint32_t x = k[j];
-                k[j] = k[j - 1];
-                k[j - 1] = x;
-            }
+        fdt_sort4_u32(k);
         int rc = fdt_tetset_insert(&w->built, k);
         if (rc < 0)
             return rc;

@@ -20,6 +20,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "bits.h"
 #include "engine.h"
 #include "gather.h"
 #include "mem.h"
@@ -54,14 +55,8 @@ static void seeds_distinct(uint32_t (*key)[4], int ns, uint32_t (*sd)[4], int *n
 /* key[2 * i]: tet v's ids sorted; key[2 * i + 1]: v itself. */
 static void seed_key(uint32_t (*key)[4], int i, const uint32_t v[4])
 {
-    uint32_t *kk = key[2 * i];
-    memcpy(kk, v, 4 * sizeof *v);
-    for (int a = 1; a < 4; a++)
-        for (int b = a; b > 0 && kk[b - 1] > kk[b]; b--) {
-            uint32_t x = kk[b];
-            kk[b] = kk[b - 1];
-            kk[b - 1] = x;
-        }
+    memcpy(key[2 * i], v, 4 * sizeof *v);
+    fdt_sort4_u32(key[2 * i]);
     memcpy(key[2 * i + 1], v, 4 * sizeof *v);
 }
 
