@@ -49,6 +49,8 @@ typedef struct fdt_ins_stats {
     size_t deferred;      /* fdt_ins_build_parallel: insertions put off (a tet held
                            * by another thread, or the slots spent) */
     size_t serial_finish; /* fdt_ins_build_parallel: points left to its serial end */
+    size_t stolen;        /* fdt_ins_build_parallel: points a worker took from the
+                           * end of another's last round */
     /* fdt_ins_build_parallel: thread CPU seconds of its serial start, of
      * its workers (the busiest one, and all together) and of its serial
      * end (finish included). start + workers_max + finish is the wall

@@ -17,7 +17,8 @@
  *      its points round by round, in id order within a round (BRIO kept
  *      per region). Both threads sweep their region in the same direction,
  *      so when thread i is at the cut with thread i + 1, thread i + 1 is at
- *      its far end.
+ *      its far end. A thread done with its own points takes points from
+ *      the end of another's last round (struct span).
  *   3. Serial finish: points left deferred (their cavity met another
  *      thread's too often) or left undone (slots ran out) are inserted on
  *      the calling thread, where the arrays may grow.
@@ -71,6 +72,7 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <stdalign.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -94,8 +96,30 @@ enum { BUSY = 1, FULL = 2 };
 /* lock_live's answers besides 0 (another worker holds the tet). */
 enum { MINE = 1, TAKEN = 2 };
 
+/*
+ * A worker's last round is shared once it reaches it: the points it has
+ * not taken yet are the range [front, back) of its list, one 64-bit
+ * atomic (front in the high half), on a cache line of its own. The owner
+ * takes CLAIM points at a time from the front, in its BRIO order; a
+ * worker done with its own points takes CLAIM from the back of the
+ * fullest other range (steal). Before, the thread that finished first
+ * waited at the join: one region ended 10-30 ms after the other in the
+ * collective builds of citylidar 200k and statue 440k (bench/NOTES.md
+ * entry 81). The back of a range is the far end of the owner's sweep,
+ * beside the start of the next region, which its worker left long ago,
+ * so owner and thief rarely meet until the range is nearly spent.
+ */
+typedef struct span {
+    alignas(64) _Atomic uint64_t fb; /* front << 32 | back, indices into pts */
+} span;
+
+enum { CLAIM = 16 };
+
 typedef struct shared {
     fdt_ins *m;
+    span *spans;               /* nw: the workers' last rounds */
+    struct worker *all;        /* the workers, for stealing */
+    int nw;
     atomic_uchar *lock;        /* cap entries: owner | mark << MARK_SHIFT, 0 free */
     atomic_uint_fast64_t next; /* the next fresh slot */
     _Atomic uint32_t *hint;    /* n entries: a tet that held point base + i */
@@ -680,6 +704,91 @@ static void pick_points(worker *w)
     w->nrounds = sh->nrounds - sh->r0;
 }
 
+/* Inserts pts[a .. b) in order, deferring what meets another worker's
+ * tets; once the workers are stopped (slots spent, an error) the rest is
+ * deferred to phase 3 unread. */
+static int insert_range(worker *w, const uint32_t *pts, size_t a, size_t b)
+{
+    for (size_t j = a; j < b; j++) {
+        /* Relaxed: a flag polled to stop early; what it reports is read
+         * after the join. */
+        if (atomic_load_explicit(&w->sh->stop, memory_order_relaxed)) {
+            for (; j < b; j++)
+                if (defer(w, pts[j]) != FDT_OK)
+                    return FDT_ENOMEM;
+            return FDT_OK;
+        }
+        int rc = insert_point(w, pts[j]);
+        if (rc == FULL) /* stop everyone; phase 3 grows the arrays */
+            atomic_store_explicit(&w->sh->stop, 1, memory_order_relaxed);
+        if (rc == BUSY || rc == FULL)
+            rc = defer(w, pts[j]);
+        if (rc != FDT_OK)
+            return rc;
+    }
+    return FDT_OK;
+}
+
+/* The owner's next CLAIM points of its last round (span, above): 0 when
+ * none is left. Relaxed: the owner wrote its own list; the thieves' CAS
+ * only moves back. */
+static int claim_own(worker *w, size_t *a, size_t *b)
+{
+    _Atomic uint64_t *fb = &w->sh->spans[w->me - 1].fb;
+    uint64_t cur = atomic_load_explicit(fb, memory_order_relaxed);
+    for (;;) {
+        uint32_t f = (uint32_t)(cur >> 32), k = (uint32_t)cur;
+        if (f >= k)
+            return 0;
+        uint32_t nf = k - f > CLAIM ? f + CLAIM : k;
+        if (atomic_compare_exchange_weak_explicit(fb, &cur, (uint64_t)nf << 32 | k,
+                                                  memory_order_relaxed, memory_order_relaxed)) {
+            *a = f;
+            *b = nf;
+            return 1;
+        }
+    }
+}
+
+/* CLAIM points from the back of the fullest other last round with more
+ * than CLAIM left (the owner keeps its last few): *v's pts[*a .. *b).
+ * Acquire, on the load and the exchange: pairs with the owner's release
+ * store that published the range (worker_main), so its list, written
+ * before, is read here; the owner's claims are read-modify-writes and
+ * continue that release sequence. */
+static int steal(worker *w, worker **v, size_t *a, size_t *b)
+{
+    shared *sh = w->sh;
+    while (!atomic_load_explicit(&sh->stop, memory_order_relaxed)) {
+        int best = -1;
+        uint32_t most = CLAIM;
+        uint64_t bcur = 0;
+        for (int i = 0; i < sh->nw; i++) {
+            if (i == w->me - 1)
+                continue;
+            uint64_t cur = atomic_load_explicit(&sh->spans[i].fb, memory_order_acquire);
+            uint32_t f = (uint32_t)(cur >> 32), k = (uint32_t)cur;
+            if (k > f && k - f > most) {
+                most = k - f;
+                best = i;
+                bcur = cur;
+            }
+        }
+        if (best < 0)
+            return 0;
+        uint32_t f = (uint32_t)(bcur >> 32), k = (uint32_t)bcur;
+        if (atomic_compare_exchange_strong_explicit(&sh->spans[best].fb, &bcur,
+                                                    (uint64_t)f << 32 | (k - CLAIM),
+                                                    memory_order_acquire, memory_order_relaxed)) {
+            *v = &sh->all[best];
+            *a = k - CLAIM;
+            *b = k;
+            return 1;
+        }
+    }
+    return 0;
+}
+
 static void *worker_main(void *arg)
 {
     worker *w = arg;
@@ -687,37 +796,31 @@ static void *worker_main(void *arg)
     double c0 = fdt_thread_cpu_s();
     if (!w->picked)
         pick_points(w);
-    size_t i = 0;
+    size_t i = 0, done, a, b;
     int err = FDT_OK;
-    for (int r = 0; r < w->nrounds && !err; r++) {
-        for (; i < w->round_end[r]; i++) {
-            /* Relaxed: a flag polled to stop early; what it reports is
-             * read after the join. */
-            if (atomic_load_explicit(&sh->stop, memory_order_relaxed))
-                break;
-            int rc = insert_point(w, w->pts[i]);
-            if (rc == FULL) /* stop everyone; phase 3 grows the arrays */
-                atomic_store_explicit(&sh->stop, 1, memory_order_relaxed);
-            if (rc == BUSY || rc == FULL)
-                rc = defer(w, w->pts[i]);
-            if (rc != FDT_OK) {
-                err = rc;
-                break;
-            }
-        }
-        if (i < w->round_end[r])
-            break;
-        size_t done;
+    for (int r = 0; r + 1 < w->nrounds && !err; r++) {
+        err = insert_range(w, w->pts, i, w->round_end[r]);
+        i = w->round_end[r];
         if (!err)
             err = retry_deferred(w, &done);
     }
-    /* The points not reached (stopped) go to phase 3 with the deferred. */
-    for (; i < w->npts && !err; i++)
-        err = defer(w, w->pts[i]);
+    /* release: publishes the list to thieves (steal). Only now: a
+     * thief's points inserted before the owner's earlier rounds there
+     * would break the BRIO order (larger cavities, longer walks). */
+    atomic_store_explicit(&sh->spans[w->me - 1].fb, (uint64_t)i << 32 | w->npts,
+                          memory_order_release);
+    while (!err && claim_own(w, &a, &b))
+        err = insert_range(w, w->pts, a, b);
+    if (!err)
+        err = retry_deferred(w, &done);
+    worker *v;
+    while (!err && steal(w, &v, &a, &b)) {
+        w->st.stolen += b - a;
+        err = insert_range(w, v->pts, a, b);
+    }
     /* The last deferred points, while others still work: back off when a
      * pass makes no progress; phase 3 takes what is left. */
     for (int idle = 0; !err && w->ndef && idle < 8;) {
-        size_t done;
         err = retry_deferred(w, &done);
         if (done == 0) {
             idle++;
@@ -863,8 +966,11 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
      * this thread (bench/NOTES.md entry 76). */
     sh.lock = calloc((size_t)m->cap, sizeof *sh.lock);
     sh.hint = malloc((size_t)n * sizeof *sh.hint);
-    if (!sh.lock || !sh.hint)
+    sh.spans = aligned_alloc(alignof(span), (size_t)nw * sizeof *sh.spans);
+    if (!sh.lock || !sh.hint || !sh.spans)
         goto fail;
+    sh.all = ws;
+    sh.nw = nw;
     for (uint32_t i = 0; i < n; i++)
         atomic_init(&sh.hint[i], FDT_NONE);
     atomic_init(&sh.next, m->nslots);
@@ -918,6 +1024,10 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
      * When the slots run out, the workers stop, the arrays grow here
      * (no thread runs) and the workers go on with what they left. */
     for (int pass = 0;; pass++) {
+        /* Every last round empty until its owner publishes it: a worker
+         * that does not start is never stolen from. */
+        for (int i = 0; i < nw; i++)
+            atomic_init(&sh.spans[i].fb, 0);
         for (int i = 1; i < nw; i++)
             ws[i].started = pthread_create(&ws[i].th, NULL, worker_main, &ws[i]) == 0;
         worker_main(&ws[0]);
@@ -1020,6 +1130,7 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
         m->stats.created_tets += s->created_tets;
         m->stats.conflict_tests += s->conflict_tests;
         m->stats.deferred += s->deferred;
+        m->stats.stolen += s->stolen;
         if (s->max_cavity > m->stats.max_cavity)
             m->stats.max_cavity = s->max_cavity;
         if (cnt) {
@@ -1047,6 +1158,7 @@ out:
         worker_free(&ws[i]);
     free(sh.lock);
     free(sh.hint);
+    free(sh.spans);
     free(order);
     free(rend);
     free(ws);

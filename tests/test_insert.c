@@ -797,6 +797,7 @@ static void test_refusals(void)
  * are deferred, differs from run to run); full structure checks on the
  * first run of each count. */
 static size_t serial_finished; /* points of the parallel builds' serial ends */
+static size_t stolen_points;   /* points taken from another worker's last round */
 
 /* The serial build's tets of pp: what every parallel build must give. */
 static meshset serial_reference(const prepped *pp)
@@ -828,6 +829,7 @@ static void test_parallel_set(pts p, int reps)
             if (spp > 0.0)
                 CHECK(m.stats.deferred > 0); /* the slots did run out */
             serial_finished += m.stats.serial_finish;
+            stolen_points += m.stats.stolen;
             t_kernel += now_s() - t0;
             char nm[96];
             snprintf(nm, sizeof nm, "%s parallel t%d run %d", p.name, threads[ti], r);
@@ -956,8 +958,11 @@ static void run_parallel(const char *gen)
     test_parallel_set(two_planes(40), 2);
     /* the serial finish (and its growing arrays) was reached */
     CHECK(serial_finished > 0);
+    /* and workers took points from others' last rounds (8 threads on
+     * fewer cores finish their regions far apart) */
+    CHECK(stolen_points > 0);
     printf("test_insert --parallel: all checks passed (parallel kernel %.3f s, %zu points "
-           "by the serial finishes)\n", t_kernel, serial_finished);
+           "by the serial finishes, %zu stolen)\n", t_kernel, serial_finished, stolen_points);
 }
 
 /* ---- timing driver ----------------------------------------------------- */
@@ -1021,11 +1026,11 @@ static int time_file(const char *path, int reps, int threads)
     qsort(cs, (size_t)reps, sizeof *cs, cmp_double);
     printf("SUMMARY code=insert threads=%d file=%s points=%u tets=%zu hull=%zu build_s=%.4f min_s=%.4f "
            "max_s=%.4f cpu_s=%.4f reps=%d prep_kd_s=%.4f walk_steps=%zu cavity_tets=%zu max_cavity=%zu "
-           "conflict_tests=%zu deferred=%zu serial_finish=%zu cpu_start=%.3f cpu_workers_max=%.3f cpu_workers_sum=%.3f cpu_finish=%.3f exact_orient=%zu exact_insphere=%zu slots=%u bytes_per_point=%.1f\n",
+           "conflict_tests=%zu deferred=%zu stolen=%zu serial_finish=%zu cpu_start=%.3f cpu_workers_max=%.3f cpu_workers_sum=%.3f cpu_finish=%.3f exact_orient=%zu exact_insphere=%zu slots=%u bytes_per_point=%.1f\n",
            threads, path, pp.m, m.nfinite, m.ninfinite, med, sorted[0], sorted[reps - 1], cs[reps / 2],
            reps, t_prep,
            m.stats.walk_steps, m.stats.cavity_tets, m.stats.max_cavity, m.stats.conflict_tests,
-           m.stats.deferred, m.stats.serial_finish, m.stats.cpu_start_s, m.stats.cpu_workers_max_s,
+           m.stats.deferred, m.stats.stolen, m.stats.serial_finish, m.stats.cpu_start_s, m.stats.cpu_workers_max_s,
            m.stats.cpu_workers_sum_s, m.stats.cpu_finish_s, cnt.orient_exact, cnt.insphere_exact, m.nslots,
            ((double)m.cap * 32.0 + (double)m.n * 4.0) / (double)m.n);
     fdt_ins_free(&m);
