@@ -68,6 +68,29 @@ static void test_dimension(void)
           FDT_EDEGENERATE && strstr(diag, "collinear"), "collinear: %s", diag);
     EXPECTF(fdt_seed_check_dimension(line, (const fdt_vid[]){0, 1, 2}, 3, diag, sizeof diag) ==
           FDT_EDEGENERATE && strstr(diag, "only 3"), "three points: %s", diag);
+    /* Larger sets: a line, then a plane, then one point off it, at an
+     * index among the first 64, among the 64 spread ones (m (2k + 1) /
+     * 128), between them, or last; each found, whichever way. */
+    enum { BIG = 5000 };
+    double *big = malloc(3 * BIG * sizeof *big);
+    fdt_vid *ids = malloc(BIG * sizeof *ids);
+    CHECK(big && ids);
+    const uint32_t off[] = {BIG, 3, 63, 64, 39, BIG / 2 - 1, BIG / 2 + 7, BIG - 1};
+    for (size_t c = 0; c < sizeof off / sizeof off[0]; c++) {
+        for (uint32_t i = 0; i < BIG; i++) {
+            ids[i] = (fdt_vid)i;
+            big[3 * i] = (double)(i % 97);
+            big[3 * i + 1] = (double)(i / 97); /* the first 97 on a line */
+            big[3 * i + 2] = i == off[c] ? 0.5 : 0.0;
+        }
+        int rc = fdt_seed_check_dimension(big, ids, BIG, diag, sizeof diag);
+        if (off[c] == BIG)
+            EXPECTF(rc == FDT_EDEGENERATE && strstr(diag, "coplanar"), "big plane: %s", diag);
+        else
+            EXPECTF(rc == FDT_OK, "plane with point %u off it refused: %s", off[c], diag);
+    }
+    free(big);
+    free(ids);
 }
 
 int main(void)
