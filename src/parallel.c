@@ -590,14 +590,10 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     out->t_gather = fdt_now_s() - t2;
 fail:
     if (e) {
-        double F0 = fdt_now_s();
         for (int i = 0; i < nthreads; i++)
             fdt_eng_worker_free(&e->w[i]);
-        double F1 = fdt_now_s();
         fdt_ins_free(&e->gmesh);
-        double F2 = fdt_now_s();
         fdt_transport_destroy(&e->tp);
-        if (getenv("FDT_PH")) fprintf(stderr, "FIN gather %.4f wfree %.4f gmfree %.4f\n", F0 - t2, F1 - F0, F2 - F1);
         if (sync_ok) {
             pthread_cond_destroy(&e->gm_cv);
             pthread_cond_destroy(&e->go);
@@ -612,10 +608,8 @@ fail:
 #endif
         fdt_eng_delete(e);
     }
-    double F3 = fdt_now_s();
     free(seeds);
     fdt_partition_free(&pt);
-    if (getenv("FDT_PH")) fprintf(stderr, "FIN ptfree %.4f\n", fdt_now_s() - F3);
     if (mem_sink_ok)
         fdt_tsink_free(&mem_sink);
     if (err)
