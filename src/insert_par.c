@@ -69,6 +69,7 @@
 #include "insert_impl.h"
 #include "clock.h"
 #include "mem.h"
+#include "spawn.h"
 
 #include <pthread.h>
 #include <sched.h>
@@ -1029,7 +1030,7 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
         for (int i = 0; i < nw; i++)
             atomic_init(&sh.spans[i].fb, 0);
         for (int i = 1; i < nw; i++)
-            ws[i].started = pthread_create(&ws[i].th, NULL, worker_main, &ws[i]) == 0;
+            ws[i].started = fdt_spawn(&ws[i].th, 0, worker_main, &ws[i]) == 0;
         worker_main(&ws[0]);
         for (int i = 1; i < nw; i++)
             if (ws[i].started)

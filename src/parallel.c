@@ -26,6 +26,7 @@
 #include "mem.h"
 #include "oracle.h"
 #include "seed.h"
+#include "spawn.h"
 #include "termination.h"
 #include "threads.h"
 
@@ -272,7 +273,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     pthread_t probe_th;
     if (probe) {
         fdt_oracle_probe_take(&pj.ps, pr->p, (uint32_t)pr->m, s->leaf_size);
-        probing = pthread_create(&probe_th, NULL, probe_main, &pj) == 0;
+        probing = fdt_spawn(&probe_th, 0, probe_main, &pj) == 0;
     }
     int err = fdt_partition_build(&pt, pr->p, pr->orig, (uint32_t)pr->m, nthreads,
                                   s->leaf_size > 0 ? s->leaf_size : FDT_DEFAULT_LEAF,

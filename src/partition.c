@@ -1,5 +1,6 @@
 /* Recursive coordinate bisection into N parts; see partition.h. */
 #include "partition.h"
+#include "spawn.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -282,7 +283,7 @@ int fdt_partition_build(fdt_partition *pt, double *P, fdt_vid *orig,
     int started = 0;
     /* Helpers that cannot be started are not an error: the calling thread
      * builds whatever is left. */
-    while (started < nworkers - 1 && pthread_create(&th[started], NULL, build_trees, &j) == 0)
+    while (started < nworkers - 1 && fdt_spawn(&th[started], 0, build_trees, &j) == 0)
         started++;
     build_trees(&j);
     for (int i = 0; i < started; i++)

@@ -2,6 +2,7 @@
 #include "prepare.h"
 
 #include "mem.h"
+#include "spawn.h"
 
 #include <float.h>
 #include <math.h>
@@ -207,7 +208,7 @@ static void prep_phase(prep_job *j, int phase, prep_arg *args)
     int made[PREP_SLICES_MAX];
     j->phase = phase;
     for (int t = 1; t < j->T; t++)
-        made[t] = pthread_create(&tid[t], NULL, prep_worker, &args[t]) == 0;
+        made[t] = fdt_spawn(&tid[t], 0, prep_worker, &args[t]) == 0;
     prep_worker(&args[0]);
     for (int t = 1; t < j->T; t++) {
         if (made[t])

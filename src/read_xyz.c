@@ -10,6 +10,7 @@
 #endif
 
 #include "read_common.h"
+#include "spawn.h"
 
 #include <pthread.h>
 #include <stdint.h>
@@ -253,7 +254,7 @@ static void rd_slices_pass(rd_slice *sl, size_t T, int pass)
     for (size_t t = 0; t < T; t++)
         sl[t].pass = pass;
     for (size_t t = 1; t < T; t++)
-        made[t] = pthread_create(&tid[t], NULL, rd_slice_run, &sl[t]) == 0;
+        made[t] = fdt_spawn(&tid[t], 0, rd_slice_run, &sl[t]) == 0;
     rd_slice_run(&sl[0]);
     for (size_t t = 1; t < T; t++) {
         if (made[t])

@@ -11,6 +11,7 @@
 
 #include "bits.h"
 #include "sethash.h"
+#include "spawn.h"
 
 void fdt_result_free(fdt_result **r)
 {
@@ -592,7 +593,7 @@ static void run_phase(sort_job *j, int phase, sort_arg *args, pthread_t *tid, in
 {
     j->phase = phase;
     for (int t = 1; t < j->T; t++)
-        made[t] = pthread_create(&tid[t], NULL, sort_worker, &args[t]) == 0;
+        made[t] = fdt_spawn(&tid[t], 0, sort_worker, &args[t]) == 0;
     sort_worker(&args[0]);
     for (int t = 1; t < j->T; t++)
         if (made[t])

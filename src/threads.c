@@ -8,6 +8,7 @@
 
 #include "gather.h"
 #include "parallel.h"
+#include "spawn.h"
 #include "termination.h"
 
 static void pin_thread(worker *w)
@@ -131,21 +132,16 @@ int fdt_parallel_default_threads(void)
  * A pinned worker 0 would leave the caller's thread pinned. */
 int fdt_threads_run(engine *e, const fdt_settings *s, double *t_loops)
 {
-    pthread_attr_t attr;
-    if (pthread_attr_init(&attr) != 0)
-        return FDT_ETHREAD;
-    /* 1024 threads at the default 8 MiB would reserve 8 GiB of address
-     * space; a worker's deepest stack is a few KiB of walk stacks. */
-    (void)pthread_attr_setstacksize(&attr, (size_t)1 << 20);
     int inline0 = !s->progress && !e->pin;
     int created = inline0, err = FDT_OK;
+    /* 1024 threads at the default 8 MiB would reserve 8 GiB of address
+     * space; a worker's deepest stack is a few KiB of walk stacks. */
     for (; created < e->n; created++)
-        if (pthread_create(&e->w[created].th, &attr, worker_main, &e->w[created]) != 0) {
+        if (fdt_spawn(&e->w[created].th, (size_t)1 << 20, worker_main, &e->w[created]) != 0) {
             err = FDT_ETHREAD;
             fdt_term_ctl_fail(e, FDT_ETHREAD, created, "could not create a thread");
             break;
         }
-    pthread_attr_destroy(&attr);
     /* created counts worker 0 when it runs here: every one of them
      * finishes its loop (a thread that could not be made stopped the
      * others through the error). */
