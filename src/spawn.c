@@ -41,10 +41,9 @@ int fdt_spawn(pthread_t *th, size_t stack_bytes, void *(*fn)(void *), void *arg)
         return rc;
     if (stack_bytes)
         (void)pthread_attr_setstacksize(&attr, stack_bytes);
-    start *s = NULL;
 #ifdef FDT_SPAWN_AFFINITY
     int cpu = sched_getcpu();
-    s = malloc(sizeof *s);
+    start *s = malloc(sizeof *s);
     if (s && cpu >= 0 && cpu < CPU_SETSIZE &&
         pthread_getaffinity_np(pthread_self(), sizeof s->all, &s->all) == 0 &&
         CPU_ISSET(cpu, &s->all) && CPU_COUNT(&s->all) > 1) {
