@@ -479,9 +479,9 @@ static double cpu_for_ratio(const fdt_kdtree *t, size_t faces, size_t nf, double
 
 /* The time rules, driven directly with the window start's CPU set so that
  * the measured ratio is known: a collective part's early vote (past 2.0,
- * past 1.35 with 18 kd nodes a face, past 1.15 with 25), the serial rule
- * (past 1.15 with 18 nodes), a collective part's later rule (the
- * collective margins), and the window's edges (a budget spent before any
+ * past 1.30 with 18 kd nodes a face, past 1.15 with 25), the serial rule
+ * (past 1.05 with 18 nodes), a collective part's later rule (the
+ * collective margins: a dense walk's 1.10 is not enough there), and the window's edges (a budget spent before any
  * face, a window past the last face). */
 static void test_time_votes(void)
 {
@@ -497,8 +497,9 @@ static void test_time_votes(void)
     } c[] = {
         {0, 3.0, 5, 2},    {0, 1.7, 20, 2},  {0, 1.7, 5, 0},   {0, 1.25, 30, 2},
         {0, 1.25, 20, 0},  {0, 1.0, 30, 0},  {0, -1.0, 30, 0}, {1, 1.5, 20, 1},
-        {1, 1.5, 10, 0},   {1, 1.0, 20, 0},  {2, 1.7, 20, 2},  {2, 1.7, 5, 0},
-        {2, 3.0, 1, 2},
+        {1, 1.5, 10, 0},   {1, 1.0, 20, 0},  {1, 1.10, 20, 1}, {1, 1.10, 17, 0},
+        {2, 1.7, 20, 2},   {2, 1.7, 5, 0},   {2, 3.0, 1, 2},   {2, 1.10, 30, 0},
+        {2, 1.20, 30, 2},
     };
     for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
         fdt_oracle o;
