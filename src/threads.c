@@ -128,8 +128,10 @@ int fdt_parallel_default_threads(void)
  * calling thread is worker 0. With a new thread for every worker, one of
  * two started 2-5 ms after the other in about half the runs on this
  * two-core machine, while the insertion build's second thread, whose
- * caller is its worker 0, started within 0.1 ms (bench/NOTES.md entry 73).
- * A pinned worker 0 would leave the caller's thread pinned. */
+ * caller is its worker 0, started within 0.1 ms (bench/NOTES.md entry 73;
+ * entry 85 found why a new thread sometimes starts late: the kernel put it
+ * on its creator's core, which fdt_spawn now avoids). A pinned worker 0
+ * would leave the caller's thread pinned. */
 int fdt_threads_run(engine *e, const fdt_settings *s, double *t_loops)
 {
     int inline0 = !s->progress && !e->pin;
