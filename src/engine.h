@@ -46,8 +46,7 @@ struct engine;
 /* A face whose apex search waits for another rank's NODERECV (MPI ranks,
  * engine.park; src/engine.c, advance_one): the search state, in a slot
  * that does not move (ap points to a, b, c, copied in message mode, and
- * into qb), and the
- * bisection walk's stack where it stopped. */
+ * into qb), and the bisection walk's stack where it stopped. */
 typedef struct parked {
     uint32_t f[3];
     double a[3], b[3], c[3];
