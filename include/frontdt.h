@@ -244,7 +244,7 @@ FDT_API int fdt_result_sort(fdt_result *r);
  * content of a .tets file). Sorts r first (fdt_result_sort). */
 FDT_API int fdt_result_hash(fdt_result *r, uint64_t *hash);
 
-/* The set hash of r's tets (src/sethash.h): an order-independent 64-bit
+/* The set hash of r's tets (src/base/sethash.h): an order-independent 64-bit
  * hash of the tet set, the same for every mode, thread count and order of
  * emission, with no sort (r is not changed). It differs from
  * fdt_result_hash's value. A streamed result (fdt_triangulate_stream),
@@ -297,7 +297,7 @@ typedef enum fdt_msg_kind {
     FDT_MSG_NODERECV = 3, /* their answers */
     FDT_MSG_FACESEND = 4, /* faces, and found apexes, for their owner */
     FDT_MSG_FACERECV = 5, /* acknowledgements of FACESEND (message mode;
-                             shared mode needs none: 0, src/termination.c) */
+                             shared mode needs none: 0, src/par/termination.c) */
     FDT_MSG_ABORT = 6,    /* a part failed: stop (message mode) */
     FDT_MSG_KIND_END = 7  /* arrays indexed by kind have this many slots */
 } fdt_msg_kind;

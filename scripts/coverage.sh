@@ -9,8 +9,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v gcovr >/dev/null || { echo "coverage: gcovr missing (scripts/bootstrap.sh installs it)" >&2; exit 1; }
-# Without MPI: the MPI modules (src/mpi_run.c, src/transport_mpi.c,
-# src/mpi_main.c) are tested by suite mpi (.ci/run), not by the default
+# Without MPI: the MPI modules (src/mpi/mpi_run.c, src/mpi/transport_mpi.c,
+# src/cli/mpi_main.c) are tested by suite mpi (.ci/run), not by the default
 # suite measured here, and would count as unexecuted lines.
 if [[ ! -f build-cov/build.ninja ]]; then
     meson setup build-cov -Db_coverage=true --buildtype=debug -Denable_bench=false -Dmpi=disabled >/dev/null
@@ -25,7 +25,7 @@ FDT_E2E_TIMEOUT_SCALE=6 meson test -C build-cov --print-errorlogs --timeout-mult
 # Issue 20's gate: 95 % of lines and 90 % of branches of src/ as a whole.
 # Measured 96.0 % of lines (10852 of 11303) and 90.3 % of branches (7092 of
 # 7856) on 2026-11-26, once tests reached the error paths of the
-# streaming writers, the readers and src/outfile.h; thread scheduling
+# streaming writers, the readers and src/io/write/outfile.h; thread scheduling
 # moves a few branches between runs. FDT_COV_LINES / FDT_COV_BRANCHES override the
 # gate for a local look, never in CI.
 lines=${FDT_COV_LINES:-95}
@@ -33,7 +33,7 @@ branches=${FDT_COV_BRANCHES:-90}
 # --gcov-ignore-parse-errors: likely a test process that exits while worker
 # threads are still inside the library (the CLI's signal tests) leaves
 # counts dumped mid-flight, and gcov then derives a negative branch count
-# ("branch 2 taken -1" in src/oracle.c on 2026-11-26, every test passing;
+# ("branch 2 taken -1" in src/front/oracle.c on 2026-11-26, every test passing;
 # atomic counters did not help), which gcovr 5 refuses to parse; skipping
 # that line drops its record instead of failing the gate.
 gcovr -r . --filter 'src/' --exclude-unreachable-branches --exclude-throw-branches \

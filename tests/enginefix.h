@@ -12,9 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "engine.h"
+#include "par/engine.h"
 #include "testutil.h"
-#include "transport.h"
+#include "par/transport.h"
 
 /* mode: FDT_MODE_SHARED or FDT_MODE_MESSAGE (then termination by
  * messages, msg_term); parts own consecutive ranges of `per` ids of P. */

@@ -1,5 +1,5 @@
 /*
- * The public API's contract (include/frontdt.h, src/api.c, src/result.c)
+ * The public API's contract (include/frontdt.h, src/api/api.c, src/mesh/result.c)
  * through the public header alone: settings and their defaults, refused
  * arguments, every error code's text and the diagnostics that name the
  * point, the result getters (NULL-safe), the duplicate map, and the

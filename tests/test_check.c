@@ -1,5 +1,5 @@
 /*
- * Tests for src/check.c (fdt_check).
+ * Tests for src/mesh/check.c (fdt_check).
  *
  * Correct meshes come from a brute-force generator that needs nothing but
  * the predicates: for n <= 40 points, every positively oriented 4-subset
@@ -21,7 +21,7 @@
  * its axis), two disjoint tets, two tets sharing only an edge or a vertex.
  */
 #include "frontdt.h"
-#include "predicates.h"
+#include "geom/predicates.h"
 
 #include <math.h>
 #include <stdint.h>

@@ -1,5 +1,5 @@
 #!/bin/bash
-# End-to-end tests of the frontdt command-line tool (src/main.c).
+# End-to-end tests of the frontdt command-line tool (src/cli/main.c).
 #
 # usage: test_cli.sh FRONTDT BAD_DIR
 #   FRONTDT  the built frontdt executable

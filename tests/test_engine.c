@@ -1,5 +1,5 @@
 /*
- * The per-part step of the parallel engine (src/engine.c) through
+ * The per-part step of the parallel engine (src/par/engine.c) through
  * fdt_parallel_run on the mailbox transport, its contract read off the
  * gathered mesh and the per-thread stats:
  * - ownership (§3.2): every tet and hull face a thread output has its
@@ -26,8 +26,8 @@
 #include <unistd.h>
 
 #include "frontdt.h"
-#include "parallel.h"
-#include "prepare.h"
+#include "par/parallel.h"
+#include "geom/prepare.h"
 #include "testutil.h"
 
 typedef struct input {
@@ -239,7 +239,7 @@ static void run_failing(const input *in, fdt_mode mode, int nthreads, int part, 
 
 /* An exact pipe: rings of per_ring points about the x axis from x = x0,
  * radius 0.5 about (y, z) = (0.5, 0.5), rings 1/40 apart; the kd search
- * tests hundreds of points a face there (src/oracle.c). Appended at in's
+ * tests hundreds of points a face there (src/front/oracle.c). Appended at in's
  * point `at`. */
 static void put_pipe(input *in, size_t at, int rings, int per_ring, double x0)
 {
@@ -254,7 +254,7 @@ static void put_pipe(input *in, size_t at, int rings, int per_ring, double x0)
 }
 
 /*
- * The collective switch (src/engine.c, collective_step; bench/NOTES.md
+ * The collective switch (src/par/engine.c, collective_step; bench/NOTES.md
  * entry 59), forced by FDT_PAR_MESH_COLLECTIVE: the parts start on the kd
  * search and, once a majority of them votes, one builds the mesh of every
  * point while the others wait, and all read it. The tets are serial's
@@ -299,7 +299,7 @@ static void run_collective(const input *in, const uint32_t *ref, size_t nref, in
 /*
  * The mesh of every point built before the fronts (global_mesh 1): the
  * parts' ranges are moved so that each owns as many of its tets and hull
- * faces (src/parallel.c, recut_by_mesh), where the bisection's halves of
+ * faces (src/par/parallel.c, recut_by_mesh), where the bisection's halves of
  * a pipe gave the lower part every tet across the cut; and a tet built on
  * another part's request has its mesh slot noted (the request carries
  * it), so its faces are not found by walks around a vertex. Serial's
@@ -341,8 +341,8 @@ static void test_recut(void)
     if (out.mb.ntets == nref)
         EXPECT(same_set(out.mb.tets, ref, nref));
     fdt_par_out_free(&out);
-    /* Message mode reads the same mesh as a replica (src/api.c; an MPI
-     * rank builds its own, src/mpi_run.c): no part asks another, and the
+    /* Message mode reads the same mesh as a replica (src/api/api.c; an MPI
+     * rank builds its own, src/mpi/mpi_run.c): no part asks another, and the
      * tets are serial's. Before, each part kept a mesh of its own points
      * and asked the others, whose kd searches degenerate on a pipe. */
     fdt_prepared_free(&pr);

@@ -1,5 +1,5 @@
 /*
- * The front's face queue (src/faceq.c) against a plain model: random
+ * The front's face queue (src/front/faceq.c) against a plain model: random
  * pushes and pops over id ranges of several sizes and bases, checking
  * that every pop returns a face of the lowest nonempty bucket, the last
  * one pushed into it, that nothing is lost or duplicated, that the
@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "faceq.h"
+#include "front/faceq.h"
 #include "frontdt.h"
 #include "testutil.h"
 

@@ -1,11 +1,11 @@
 /*
- * Tests for src/faces.c: fdt_result_faces, fdt_result_edges and
+ * Tests for src/mesh/faces.c: fdt_result_faces, fdt_result_edges and
  * fdt_result_vertex_neighbors, on uniform points in a ball, a cospherical
  * lattice (degenerate: the perturbation decides) with duplicates, and the
  * same input on two threads.
  *
  * Checked against the tets and the exact predicates, independently of how
- * src/faces.c builds the lists: each face's orientation (tets[2i]'s fourth
+ * src/mesh/faces.c builds the lists: each face's orientation (tets[2i]'s fourth
  * vertex strictly on the positive side, tets[2i+1]'s on the negative
  * side), each tet's four faces listed exactly once, the neighbours of the
  * result agreeing with the face's two tets, the hull faces equal to
@@ -14,8 +14,8 @@
  * neighbours ascending and the edges seen from both ends, and the face
  * list rebuilt after fdt_result_sort and identical for two threads.
  */
-#include "predicates.h"
-#include "result.h"
+#include "geom/predicates.h"
+#include "mesh/result.h"
 #include "testutil.h"
 
 #include <string.h>

@@ -1,5 +1,5 @@
 /*
- * The face table (src/facetab.c): canonical rotation keeps the
+ * The face table (src/front/facetab.c): canonical rotation keeps the
  * orientation, a face is found from its reverse, and backward-shift
  * deletion in random order keeps every other face findable.
  */
@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "facetab.h"
+#include "front/facetab.h"
 #include "frontdt.h"
 #include "testutil.h"
 

@@ -36,9 +36,9 @@
 #endif
 
 #include "frontdt.h"
-#include "insert.h"
-#include "reader.h"
-#include "writer.h"
+#include "mesh/insert.h"
+#include "io/read/reader.h"
+#include "io/write/writer.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -458,7 +458,7 @@ typedef struct post_arg {
     const ptset *ps;
     int neighbors;
     int what; /* 0: sort, 1: hash, 2: check, 3: faces, edges and a
-                 vertex's neighbours (src/faces.c) */
+                 vertex's neighbours (src/mesh/faces.c) */
     uint64_t want_hash;
 } post_arg;
 
@@ -549,7 +549,7 @@ static int sc_post(void *arg, const char **bad)
 }
 
 /* ------------------------------------------------------------------ */
-/* Scenarios: the insertion kernel (src/insert.c)                     */
+/* Scenarios: the insertion kernel (src/mesh/insert.c)                     */
 /* ------------------------------------------------------------------ */
 
 typedef struct ins_arg {
@@ -817,7 +817,7 @@ static int sc_write(void *arg, const char **bad)
     return rc;
 }
 
-/* The streaming writer (src/writer_stream.c) fed the mesh in two tets
+/* The streaming writer (src/io/write/writer_stream.c) fed the mesh in two tets
  * batches and one hull batch, then committed: a failed allocation (the
  * writer, a file's buffer, .fdtb's hull buffer) ends it with FDT_ENOMEM,
  * a message naming the file and no file left. */

@@ -1,5 +1,5 @@
 /*
- * The serial advancing front (src/front.c) on its own, below the public
+ * The serial advancing front (src/front/front.c) on its own, below the public
  * API: over a kd tree of prepared points it must build a mesh that
  * fdt_check accepts (orientation, shared faces, neighbour links both ways,
  * closed convex hull, perturbed empty spheres), the same tets with the kd
@@ -13,10 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "front.h"
-#include "kdtree.h"
-#include "predicates.h"
-#include "prepare.h"
+#include "front/front.h"
+#include "geom/kdtree.h"
+#include "geom/predicates.h"
+#include "geom/prepare.h"
 #include "testutil.h"
 #include "testpoints.h"
 

@@ -1,5 +1,5 @@
 /*
- * The gather of a parallel run (src/gather.c) on a hand-built run of
+ * The gather of a parallel run (src/par/gather.c) on a hand-built run of
  * three parts (tests/enginefix.h): part 0 with a few tets, part 1 with
  * more than part 0's buffers hold (so they grow), part 2 empty. Checked:
  * - the tets and hull faces come out in part order, renumbered into input
@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "enginefix.h"
-#include "gather.h"
+#include "par/gather.h"
 
 enum { K0 = 3, K1 = 100, NT = K0 + K1, NP = 4 * NT, NH = 2 * NT + 2 };
 
@@ -67,7 +67,7 @@ static engine *make_run(int want_nbrs, int linker)
     return e;
 }
 
-/* The gather as src/threads.c runs it: prepare, each worker's copy (in
+/* The gather as src/par/threads.c runs it: prepare, each worker's copy (in
  * reverse here: the slices do not depend on the order), finish. */
 static int gather(engine *e, fdt_meshbuf *mb)
 {

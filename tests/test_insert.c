@@ -1,5 +1,5 @@
 /*
- * Tests of the incremental-insertion kernel (src/insert.c).
+ * Tests of the incremental-insertion kernel (src/mesh/insert.c).
  *
  * For every family of tests/gen_points at a small size and for hand-built
  * nasty sets (integer lattice, rotated lattice, exact cylinder, cube
@@ -44,13 +44,13 @@
 #include <unistd.h>
 
 #include "frontdt.h"
-#include "front.h"
-#include "insert.h"
-#include "insert_impl.h"
-#include "kdtree.h"
-#include "predicates.h"
-#include "prepare.h"
-#include "seed.h"
+#include "front/front.h"
+#include "mesh/insert.h"
+#include "mesh/insert_impl.h"
+#include "geom/kdtree.h"
+#include "geom/predicates.h"
+#include "geom/prepare.h"
+#include "front/seed.h"
 
 #include "testutil.h"
 
@@ -422,7 +422,7 @@ static const double *P_(const fdt_ins *m, uint32_t v)
 }
 
 /* Whether tet t, finite or infinite, is in conflict with point q (the
- * kernel's rule, restated independently of src/insert.c). */
+ * kernel's rule, restated independently of src/mesh/insert.c). */
 static int in_conflict(const fdt_ins *m, uint32_t t, uint32_t q)
 {
     const uint32_t *v = fdt_ins_tet(m, t);
@@ -702,7 +702,7 @@ static void expect_refusal(const double *xyz, uint32_t n, int want, const char *
 
 /* fdt_ins_brio: a permutation of the ids by round, with the point nearest
  * the centre of the bounding box first wherever its id falls (a hub inside
- * a shell inserted late makes every cavity span the shell: src/insert.c,
+ * a shell inserted late makes every cavity span the shell: src/mesh/insert.c,
  * centre_first). */
 static void test_brio_order(void)
 {
@@ -910,7 +910,7 @@ static void test_parallel_refusals(const char *gen)
     free(u.xyz);
 }
 
-/* More threads than a lock byte can name (63, src/insert_par.c): the
+/* More threads than a lock byte can name (63, src/mesh/insert_par.c): the
  * build runs on 63 workers and gives the same tets. */
 static void test_parallel_many_threads(const char *gen)
 {

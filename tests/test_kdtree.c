@@ -1,5 +1,5 @@
 /*
- * kd-tree and apex-search tests against brute force (src/kdtree.c) on the
+ * kd-tree and apex-search tests against brute force (src/geom/kdtree.c) on the
  * point families of tests/testpoints.h (the seed, the face table and the
  * input preparation have their own files: tests/test_seed.c,
  * tests/test_facetab.c, tests/test_prepare.c); the
@@ -13,9 +13,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "kdtree.h"
-#include "predicates.h"
-#include "prepare.h"
+#include "geom/kdtree.h"
+#include "geom/predicates.h"
+#include "geom/prepare.h"
 #include "testutil.h"
 #include "testpoints.h"
 
@@ -63,7 +63,7 @@ static void test_family(int fam, size_t want, int leaf)
     fdt_kdq kq;
     memset(&kq, 0, sizeof kq);
 
-    /* The float blocks (src/kdtree.c): each leaf's block holds its points
+    /* The float blocks (src/geom/kdtree.c): each leaf's block holds its points
      * as (x - lo) 2^-e, e the exponent of the box's largest extent, each
      * within 2^-23 of that value, in rows of a multiple of 8 floats, 32-byte
      * aligned (AVX loads); padding lanes are 0. */
@@ -462,7 +462,7 @@ static void test_nearest_ties(void)
  * (tests/gen_points.c's ulpgrid family), scaled by fdt_prepare like real
  * input. The search ball's centre a + x is rounded at the magnitude of a,
  * an error of the order of the grid step, which only the absolute term of
- * the ball's tolerance (update_ball in src/kdtree.c) covers; without it the
+ * the ball's tolerance (update_ball in src/geom/kdtree.c) covers; without it the
  * ball can leave out a point of the true sphere. Both searches against
  * brute force, on local and random faces.
  */

@@ -1,5 +1,5 @@
 /*
- * Tests of src/mailbox.c: API contract on one thread, then threaded
+ * Tests of src/par/mailbox.c: API contract on one thread, then threaded
  * torture tests in the manner of ck's regressions and liburcu's tests:
  *   - many producers, one consumer: order per producer, exact counts per
  *     kind, no loss, no duplication, bounded pools (recycling);
@@ -16,7 +16,7 @@
  * Usage: test_mailbox [messages_per_torture_run [ring_hops_per_token
  *                      [pingpong_rounds]]]
  */
-#include "mailbox.h"
+#include "par/mailbox.h"
 
 #include <errno.h>
 #include <inttypes.h>

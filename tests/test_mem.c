@@ -1,5 +1,5 @@
 /*
- * src/mem.c: the huge-page hint. Where the kernel grants transparent huge
+ * src/base/mem.c: the huge-page hint. Where the kernel grants transparent huge
  * pages on request (the "madvise" or "always" setting), memory advised
  * and then written must show up as AnonHugePages in /proc/self/smaps for
  * its range whenever a control range the test advises itself (madvise on
@@ -22,7 +22,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
-#include "mem.h"
+#include "base/mem.h"
 #include "testutil.h"
 
 /* The kernel's setting: 1 if it grants huge pages on request. */

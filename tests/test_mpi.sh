@@ -92,7 +92,7 @@ for fam in "lattice 3000" "clusters 3000" "grid2d 3000" "dup 4000" "uniform 4000
   check "$1" "$work/$1.xyz" "${nps[@]}"
 done
 # A cone (rings of cocircular points, empty spheres as wide as the part):
-# the ranks' probes vote for the replica mesh (src/mpi_run.c), every rank
+# the ranks' probes vote for the replica mesh (src/mpi/mpi_run.c), every rank
 # reads its apexes from its own copy, and no rank asks another (before it,
 # 20,000 such points took 20 s on 2 ranks against serial's 0.3 s). The
 # same mesh as serial's; --search kd keeps the queries.
@@ -128,13 +128,13 @@ extra=()
 printf '0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n' >"$work/five.xyz"
 check five "$work/five.xyz" 7
 
-# The distributed setup (§3.1, src/mpi_setup.c): each rank parses its byte
+# The distributed setup (§3.1, src/mpi/mpi_setup.c): each rank parses its byte
 # slice of a text file, cut at line starts wherever the byte offsets fall
 # (mid-line, as a rule). A header line, comments, blank lines, CRLF and
 # commas, on every rank count; duplicates spread across slices (the file
 # twice over, so each point's duplicate is in another rank's slice), whose
 # gathered .tets must be serial's byte for byte (the first input id of
-# each class survives, as src/prepare.c's merge); the whole-read fallback
+# each class survives, as src/geom/prepare.c's merge); the whole-read fallback
 # for other formats (PLY) and standard input (read by rank 0, scattered).
 {
   printf '\xef\xbb\xbfX,Y,Z\r\n# clusters, as csv\r\n\r\n'

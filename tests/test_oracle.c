@@ -1,5 +1,5 @@
 /*
- * Tests of the apex oracle (src/oracle.c) through the library: the kd
+ * Tests of the apex oracle (src/front/oracle.c) through the library: the kd
  * search, the insertion mesh from the start, and the automatic switch must
  * give the same mesh -- the same canonical hash, tet for tet -- in serial,
  * shared and message modes, for any thread count, on the families where the
@@ -29,10 +29,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "clock.h"
+#include "base/clock.h"
 #include "frontdt.h"
-#include "oracle.h"
-#include "prepare.h"
+#include "front/oracle.h"
+#include "geom/prepare.h"
 
 #include "testutil.h"
 
@@ -252,7 +252,7 @@ static void test_family(pts p, int want_auto, int quick)
                 if (s == FDT_SEARCH_MESH)
                     CHECK(st.mesh_faces > 0 || strcmp(p.name, "layers") == 0);
                 /* Shared mode asks the other parts' meshes for the faces
-                 * whose sphere crosses a cut (src/parallel.c,
+                 * whose sphere crosses a cut (src/par/parallel.c,
                  * offer_from_mesh): on uniform points every part has a
                  * mesh and small conflict regions, so some must be. */
                 if (s == FDT_SEARCH_MESH && mode == FDT_MODE_SHARED &&
@@ -273,7 +273,7 @@ static void test_family(pts p, int want_auto, int quick)
     printf("ok %s (%zu points)\n", p.name, p.n);
 }
 
-/* fdt_oracle_probe_take copies its samples: src/parallel.c costs them on
+/* fdt_oracle_probe_take copies its samples: src/par/parallel.c costs them on
  * another thread while the partition permutes the points, so the answer
  * must be the one on the points as they were when taken, and the same as
  * fdt_oracle_probe's. 74,088 points: both samples (every second point,
@@ -315,7 +315,7 @@ static void test_probe_samples(void)
  * cannot build a mesh; the kd search answers there instead, with the same
  * result. */
 /* The switch comes as soon as the window in progress has spent enough to
- * decide it (src/oracle.c, window_budget), not at the window's end: on a
+ * decide it (src/front/oracle.c, window_budget), not at the window's end: on a
  * cylinder, whose first faces test hundreds of points each, before the
  * first window's 256 faces are done. Work counts, not times: deterministic. */
 static void test_early_switch(void)
@@ -342,7 +342,7 @@ static void test_flat_parts(void)
     fdt_result *r = run(&p, FDT_MODE_SHARED, 2, FDT_SEARCH_MESH, &st);
     CHECK_EQ(hash_of(r), hash_of(ref));
     /* The first cut is moved off the median by the work its lower side
-     * owns (src/partition.c), so the lower part holds part of the z = 0
+     * owns (src/geom/partition.c), so the lower part holds part of the z = 0
      * layer only: flat, no mesh; the upper part has both layers. */
     CHECK(st.mesh_parts < 2);
     fdt_result_free(&r);
@@ -468,7 +468,7 @@ static void test_collective_vote(void)
 /* The thread CPU a window start must have had for the time rules to see
  * `us` microseconds a face over nf faces (t: the tree of n points; the
  * rule's ratio is us * left / (3 n + 0.2 left), MESH_BUILD_US and
- * MESH_WALK_US in src/oracle.c), read just before the tick: the
+ * MESH_WALK_US in src/front/oracle.c), read just before the tick: the
  * microseconds between the two reads move a ratio by under 1e-3 here. */
 static double cpu_for_ratio(const fdt_kdtree *t, size_t faces, size_t nf, double ratio)
 {
@@ -608,9 +608,9 @@ int main(int argc, char **argv)
             fdt_result_free(&r);
         }
         /* an explicit shared mode reads the same mesh of every point
-         * (src/api.c): the search is --search auto's choice, not the
+         * (src/api/api.c): the search is --search auto's choice, not the
          * mode's; message mode reads it as a replica (an MPI rank's own
-         * copy, src/mpi_run.c), and --search kd keeps the queries */
+         * copy, src/mpi/mpi_run.c), and --search kd keeps the queries */
         for (int t = 1; t <= 3; t++) {
             r = run(&p, FDT_MODE_SHARED, t, FDT_SEARCH_AUTO, &st);
             CHECK_EQ(st.mode, FDT_MODE_SHARED);

@@ -1,5 +1,5 @@
 /*
- * Tests of the parallel engine (src/parallel.c; the partition has
+ * Tests of the parallel engine (src/par/parallel.c; the partition has
  * tests/test_partition.c): shared
  * and message modes must give the serial tetrahedralization exactly, for
  * any thread count, on the named hard families (uniform, lattice, integer
@@ -30,10 +30,10 @@
 #include <unistd.h>
 
 #include "frontdt.h"
-#include "parallel.h"
-#include "partition.h"
-#include "prepare.h"
-#include "result.h"
+#include "par/parallel.h"
+#include "geom/partition.h"
+#include "geom/prepare.h"
+#include "mesh/result.h"
 
 #include "testutil.h"
 
@@ -639,7 +639,7 @@ static void test_run_args(void)
     printf("fdt_parallel_run: bad modes, thread counts and point counts refused; leaf sizes\n");
 }
 
-/* The canonical sort of src/result.c runs on the triangulation's threads
+/* The canonical sort of src/mesh/result.c runs on the triangulation's threads
  * (one a core) above 65,536 tets: 15,000 points make about 100,000. With
  * and without neighbours (6- and 4-word records), its order and hash must
  * be serial mode's, and the tets strictly increasing in canonical key. */
@@ -691,7 +691,7 @@ static void test_sort_threads(void)
         fdt_result_free(&ref);
     }
     free(p.xyz);
-    /* The hash while sorting (src/result.c, phase D): worker 0 chains the
+    /* The hash while sorting (src/mesh/result.c, phase D): worker 0 chains the
      * texts the other sort threads wrote ahead of it, on more threads than
      * cores too. Buckets of a few hundred tets, so that worker 0 is still
      * hashing when the sorting runs out and the writers start. */
@@ -712,7 +712,7 @@ static void test_sort_threads(void)
 }
 
 /* Message mode caches foreign coordinates in a per-thread ghost map of
- * 1,024 slots at first, doubled at half load (src/parallel.c, ghost_put).
+ * 1,024 slots at first, doubled at half load (src/par/parallel.c, ghost_put).
  * The small families never fill it; 40,000 uniform points cut in two or
  * four give each part a layer of thousands of foreign points, so the map
  * is rehashed several times during the run: the mesh must still be

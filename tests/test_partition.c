@@ -1,11 +1,11 @@
 /*
- * The partition module (src/partition.c): proportional part sizes for any
+ * The partition module (src/geom/partition.c): proportional part sizes for any
  * N (less the work shift), contiguous ranges, owner lookup (empty parts
  * skipped), the permutation kept, bisection boxes holding their points,
  * the composite tree's nearest point against brute force, refusals, and
  * the ranges moved by weights (fdt_partition_recut), a part's own tree
  * built from a partition made elsewhere (fdt_partition_build_own) and the
- * work shift (fdt_partition_work_shift), for src/mpi_setup.c.
+ * work shift (fdt_partition_work_shift), for src/mpi/mpi_setup.c.
  */
 #include <math.h>
 #include <stdint.h>
@@ -14,7 +14,7 @@
 #include <string.h>
 
 #include "frontdt.h"
-#include "partition.h"
+#include "geom/partition.h"
 #include "testutil.h"
 
 static void test_partition(void)
@@ -56,7 +56,7 @@ static void test_partition(void)
             if (sz)
                 CHECK_EQ(pt.trees[i].base, pt.start[i]);
         }
-        /* Proportional splits, less the work shift (src/partition.c,
+        /* Proportional splits, less the work shift (src/geom/partition.c,
          * work_shift: at most a sixteenth of a left side a level, and none
          * below 16 points): sizes near m / N, nobody empty while m >= N. */
         double mean = (double)p.n / np;
@@ -183,7 +183,7 @@ static void test_recut(void)
 }
 
 /*
- * A partition made elsewhere (src/mpi_setup.c): start and nodes as
+ * A partition made elsewhere (src/mpi/mpi_setup.c): start and nodes as
  * fdt_partition_build fills them, zeroed trees, then each part's tree by
  * fdt_partition_build_own must be the tree fdt_partition_build built
  * (same nodes, boxes and ranges; the same region, hence the same cells),

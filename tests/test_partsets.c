@@ -1,5 +1,5 @@
 /*
- * The parallel engine's per-part containers (src/partsets.c): the set of
+ * The parallel engine's per-part containers (src/par/partsets.c): the set of
  * boundary tets (duplicate requests answer 0, growth keeps every key),
  * the ghost map of foreign coordinates (first coordinates kept, found
  * across several rehashes, NULL for ids never put, colliding ids on one
@@ -11,7 +11,7 @@
 #include <string.h>
 
 #include "frontdt.h"
-#include "partsets.h"
+#include "par/partsets.h"
 #include "testutil.h"
 
 /* Tets keyed on sorted ids; the set grows from empty (1,024 slots,

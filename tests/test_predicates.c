@@ -1,7 +1,7 @@
 /*
- * Tests for src/predicates.c.
+ * Tests for src/geom/predicates.c.
  *
- * The reference here shares no code with src/predicates.c and uses a
+ * The reference here shares no code with src/geom/predicates.c and uses a
  * different method: every input double is taken exactly as a GMP rational,
  * the lifted determinants
  *   orient:   det[p 1]           (4x4, rows a..d)
@@ -54,7 +54,7 @@
  * Usage: test_predicates [seed [scale [verbose]]]; scale multiplies the
  * case counts (e.g. 0.05 under valgrind, 10 for a long run).
  */
-#include "predicates.h"
+#include "geom/predicates.h"
 
 #include <gmp.h>
 #include <inttypes.h>
@@ -67,7 +67,7 @@
 
 #include "testutil.h"
 
-/* The filters' error-bound constants from their derivations (src/predicates.h:
+/* The filters' error-bound constants from their derivations (src/geom/predicates.h:
  * C eps, eps = 2^-53, with a 2^-12 margin for the filters; C eps^2 for the
  * adaptive stage), not from the header's macros: a wrong constant there
  * must fail test_conventions, not move the bound windows along with it. */
@@ -928,7 +928,7 @@ static void report_section(const tctx *T, const char *name, long failures_before
 }
 
 /* A filter's arithmetic, replicated operation for operation from
- * src/predicates.h (the build contracts nothing, -ffp-contract=off, so the
+ * src/geom/predicates.h (the build contracts nothing, -ffp-contract=off, so the
  * doubles are the filter's own), with the outer terms of its permanent
  * kept apart: a bound that lost one of them is what the windows look for. */
 typedef struct filt_eval {
@@ -1068,7 +1068,7 @@ static int ref_of(tctx *T, int insphere, double (*p)[3])
  * |det| / bound falls in (3/4, 1]. On each: the filter defers (it must:
  * |det| is within its bound), fdt_orient3d / fdt_insphere leave the
  * filters, also on copies scaled by 2^-+400 / 2^-+300 that only the
- * rescaled second filter (src/predicates.c) can see, and return the
+ * rescaled second filter (src/geom/predicates.c) can see, and return the
  * rational sign. Every try, in the window or not, checks that the filter
  * answers what the replica says, so the replica is the filter's. A bound
  * short by one outer term of the permanent answers on every window input
@@ -1164,7 +1164,7 @@ static int diff_exact(double p, double q)
 
 /*
  * Whether the exact stage takes stage B (expansions) on these points,
- * by the admission rule of src/predicates.c: every coordinate 0 or of
+ * by the admission rule of src/geom/predicates.c: every coordinate 0 or of
  * magnitude within [2^-lim, 2^lim] (lim = 300 for orient3d, 150 for
  * insphere) and every difference to the last point (orient3d: to the
  * first) exact. The tests require both classes to occur; that each class
@@ -1490,7 +1490,7 @@ static void test_degenerate_magnitudes(tctx *T, double scale, int verbose)
 /* The circumcentre of (a, b, c, d) relative to a, in rationals, by
  * Gaussian elimination on 2 [u; v; w] x = (|u|^2, |v|^2, |w|^2) with
  * u = b - a, v = c - a, w = d - a (a different route from the cofactor
- * formula of src/predicates.c). Returns 0 if the system is singular (the
+ * formula of src/geom/predicates.c). Returns 0 if the system is singular (the
  * points coplanar). */
 static int ref_circumcenter(const double *a, const double *b, const double *c, const double *d,
                             mpq_t x[3])
@@ -1557,7 +1557,7 @@ typedef struct cc_tally {
  * are coplanar or a component is at least 2^1024 in magnitude; 0 when
  * every component is below 2^1023 (in between either answer is allowed:
  * the last bits decide), and then each component within a relative
- * 2^-51 of the true one, as src/predicates.h promises, plus 2^-1074 for
+ * 2^-51 of the true one, as src/geom/predicates.h promises, plus 2^-1074 for
  * a component below 2^-1022, in the subnormal range, where a double has
  * fewer bits (a component of 2^-1022 or more gets no absolute slack).
  */
@@ -1683,7 +1683,7 @@ static void test_circumcenter(tctx *T, double scale, int verbose)
         printf("  circumcenter: %ld centres (%ld with a subnormal component), %ld coplanar, "
                "%ld overflowing\n",
                C.ok, C.subnormal_part, C.coplanar, C.overflow);
-    /* the figures src/predicates.h quotes */
+    /* the figures src/geom/predicates.h quotes */
     printf("  circumcenter: largest error %.3g x 2^-53 relative (components >= 2^-1022), "
            "%.3g x 2^-1074 absolute (components below)\n",
            C.max_rel_ulp, C.max_sub_abs);
@@ -1906,7 +1906,7 @@ static void bench(tctx *T)
 }
 
 /* ------------------------------------------------------------------ */
-/* The adaptive stage (src/predicates.c, between the filters and the
+/* The adaptive stage (src/geom/predicates.c, between the filters and the
  * exact stages B/C). */
 
 /* Rotation by (0.3, 0.5, 0.7) rad about x, then y, then z, in doubles. */
@@ -2051,7 +2051,7 @@ static void test_adapt_families(tctx *T, double scale, int verbose)
     }
 }
 
-/* The permanents the adaptive stage compares with (src/predicates.h: the
+/* The permanents the adaptive stage compares with (src/geom/predicates.h: the
  * filters' perm of the rounded differences), recomputed here. */
 static double adapt_perm_orient(const double *a, const double *b, const double *c,
                                 const double *d)
@@ -2328,7 +2328,7 @@ static void bench_adapt(tctx *T)
 
 /* ------------------------------------------------------------------ */
 /*
- * Stage G (src/predicates.c): points on a binary grid 2^k evaluated in
+ * Stage G (src/geom/predicates.c): points on a binary grid 2^k evaluated in
  * plain doubles. Integer points scaled by 2^k, with spreads on both sides
  * of the stage's bounds (differences up to 2^9 units for insphere, 2^16
  * for orient3d) and k at and beyond both ends of its ranges (insphere

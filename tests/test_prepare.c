@@ -1,5 +1,5 @@
 /*
- * Input preparation (src/prepare.c): duplicate merge into the first index
+ * Input preparation (src/geom/prepare.c): duplicate merge into the first index
  * (-0 == +0), power-of-two scaling (exact, mixed magnitudes kept normal),
  * NaN and Inf refused with the point named, the merge on several
  * threads equal to one thread's bit for bit, and the merge in the
@@ -11,11 +11,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "prepare.h"
+#include "geom/prepare.h"
 #include "testutil.h"
 #include "testpoints.h"
 
-/* The merge on several threads (src/prepare.c, prepare_threads) gives
+/* The merge on several threads (src/geom/prepare.c, prepare_threads) gives
  * the one-thread result bit for bit, duplicates and scaling included, and
  * names the same first non-finite point. */
 static void test_prepare_threads(void)

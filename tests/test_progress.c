@@ -1,5 +1,5 @@
 /*
- * The CLI's progress line (src/progress.c), drawn into a temporary file
+ * The CLI's progress line (src/cli/progress.c), drawn into a temporary file
  * instead of stderr and read back:
  * - nothing at all when disabled;
  * - the width: $COLUMNS (stderr is no terminal here), 80 when unset or
@@ -28,7 +28,7 @@
 #include <unistd.h>
 
 #include "frontdt.h"
-#include "progress.h"
+#include "cli/progress.h"
 #include "testutil.h"
 
 static int g_fd = -1;

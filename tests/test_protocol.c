@@ -1,5 +1,5 @@
 /*
- * The messages of the parallel engine (src/protocol.c), driven by one
+ * The messages of the parallel engine (src/par/protocol.c), driven by one
  * thread over a hand-built engine (tests/enginefix.h):
  * - each kind's payload size and name, and the refusal of kinds that are
  *   none;
@@ -21,7 +21,7 @@
 #include <string.h>
 
 #include "enginefix.h"
-#include "protocol.h"
+#include "par/protocol.h"
 
 /* Eight points: part 0 owns ids 0..3, part 1 ids 4..7; each coordinate
  * tells its id (x = id, y = 10 id, z = 100 id + 1). */

@@ -1,5 +1,5 @@
 /*
- * Tests for the point readers (src/reader.c).
+ * Tests for the point readers (src/io/read/reader.c).
  *
  *   test_reader BAD_DIR GOOD_DIR   unit tests, then replays the tables
  *                                  tests/bad/EXPECTED.txt and
@@ -15,8 +15,8 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 
-#include "read_common.h"
-#include "reader.h"
+#include "io/read/read_common.h"
+#include "io/read/reader.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -203,7 +203,7 @@ static void check_read_ok(tctx *t, int line, const char *path,
             }
         }
     }
-    /* Sliced reads (src/reader.c, rd_read_xyz): slices of a byte and up,
+    /* Sliced reads (src/io/read/reader.c, rd_read_xyz): slices of a byte and up,
      * so that even these small files are cut, give the same points. */
     static const int threads[] = {2, 3, 7};
     for (size_t k = 0; k < sizeof threads / sizeof *threads && got == n; k++) {
@@ -380,7 +380,7 @@ static void random_literal(tctx *t, char *out, size_t cap)
             snprintf(out + o, cap - o, "%.*g", 1 + (int)rnd_below(t, 17),
                      fabs(v));
         } else if (shape == 4) {
-            /* the 128-bit path of src/reader.c (rd_exact_small): 16..19
+            /* the 128-bit path of src/io/read/reader.c (rd_exact_small): 16..19
              * significant digits, a decimal point anywhere, |e10| <= 19
              * and a little beyond, digits often ending in 5 (near ties) */
             int nd = 16 + (int)rnd_below(t, 4), point = (int)rnd_below(t, (uint64_t)nd + 1);
@@ -462,7 +462,7 @@ static void test_xyz_random(tctx *t, const char *tag, size_t npts,
 }
 
 /* A text of several megabytes read in slices at the default slice size
- * (src/reader.c, rd_read_xyz): the same points for every thread count,
+ * (src/io/read/reader.c, rd_read_xyz): the same points for every thread count,
  * and for errors anywhere (first line, slice ends, last line, two at
  * once) the one-thread message with the file's own line number. */
 static void test_xyz_sliced(tctx *t)
@@ -1520,7 +1520,7 @@ static void test_open(tctx *t)
     free(xyz);
 }
 
-/* The integer parsers of src/read_text.c (.node and .ply headers): the
+/* The integer parsers of src/io/read/read_text.c (.node and .ply headers): the
  * int64 range exactly, signs, and what is not an integer. */
 static void test_parse_int(tctx *t)
 {

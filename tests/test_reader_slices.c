@@ -1,6 +1,6 @@
 /*
- * The readers' slice entry points (src/reader.h, "Text slices" and
- * "Binary PLY slices"), which the distributed setup (src/mpi_setup.c)
+ * The readers' slice entry points (src/io/read/reader.h, "Text slices" and
+ * "Binary PLY slices"), which the distributed setup (src/mpi/mpi_setup.c)
  * gives each MPI rank: a file cut into slices at every byte offset (two
  * slices) and into 3 and 7 slices must give, joined in order, exactly the
  * points of the whole read; a bad line must be worded by the slice that
@@ -19,7 +19,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "reader.h"
+#include "io/read/reader.h"
 #include "testutil.h"
 
 static void write_file(const char *path, const char *data, size_t len)
@@ -418,7 +418,7 @@ static void test_text_range(const char *dir)
 }
 
 /* A PLY scalar of type t (char uchar short ushort int uint float double,
- * as src/read_ply.c's order) at p. */
+ * as src/io/read/read_ply.c's order) at p. */
 static const char *const ply_tname[8] = {"char", "uchar", "short", "ushort",
                                          "int",  "uint",  "float", "double"};
 static const size_t ply_tsize[8] = {1, 1, 2, 2, 4, 4, 4, 8};

@@ -1,5 +1,5 @@
 /*
- * Tests for src/result.c: the canonical sort and hash against a reference
+ * Tests for src/mesh/result.c: the canonical sort and hash against a reference
  * computed here (qsort, snprintf, FNV-1a), on one to four threads, with and
  * without neighbours.
  *
@@ -20,8 +20,8 @@
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L /* mkdtemp */
 #endif
-#include "reader.h"
-#include "result.h"
+#include "io/read/reader.h"
+#include "mesh/result.h"
 #include "testutil.h"
 
 #include <math.h>
@@ -49,7 +49,7 @@ static double rnd_sym(void) { return 2.0 * ((double)(rnd() >> 11) * 0x1p-53) - 1
 
 /* ---- the reference ------------------------------------------------------- */
 
-/* A tet as the sort must leave it, computed independently of src/result.c:
+/* A tet as the sort must leave it, computed independently of src/mesh/result.c:
  * ids ascending, then the last two swapped if that took an odd number of
  * transpositions (so the orientation is kept); key: the ids ascending. */
 typedef struct ref_tet {

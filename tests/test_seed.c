@@ -1,5 +1,5 @@
 /*
- * The seed tetrahedron (src/seed.c): from several starting points of every
+ * The seed tetrahedron (src/front/seed.c): from several starting points of every
  * family of tests/testpoints.h the seed is positively oriented and empty
  * of every other point under the perturbed insphere test (brute force);
  * the dimension check names coplanar, collinear and too-small inputs.
@@ -10,10 +10,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "kdtree.h"
-#include "predicates.h"
-#include "prepare.h"
-#include "seed.h"
+#include "geom/kdtree.h"
+#include "geom/predicates.h"
+#include "geom/prepare.h"
+#include "front/seed.h"
 #include "testutil.h"
 #include "testpoints.h"
 

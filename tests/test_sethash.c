@@ -1,5 +1,5 @@
 /*
- * The set hash (src/sethash.h, fdt_result_set_hash) and the streamed run
+ * The set hash (src/base/sethash.h, fdt_result_set_hash) and the streamed run
  * (fdt_triangulate_stream): the mix's values against an independent
  * implementation of the rule (Python, values pinned below: a change of
  * the rule breaks every hash users and ranks compare), its independence
@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "frontdt.h"
-#include "sethash.h"
+#include "base/sethash.h"
 #include "testutil.h"
 
 static uint64_t value_of(const uint32_t *tets, size_t n)
@@ -29,7 +29,7 @@ static uint64_t value_of(const uint32_t *tets, size_t n)
 static void test_rule(void)
 {
     /* Computed by a separate Python implementation of the rule in
-     * src/sethash.h (sorted ids, two pairs mixed with SplitMix64's
+     * src/base/sethash.h (sorted ids, two pairs mixed with SplitMix64's
      * finaliser, sum, count folded in). */
     const uint32_t one[4] = {0, 1, 2, 3};
     const uint32_t two[8] = {3, 1, 2, 0, 4, 1, 2, 3};

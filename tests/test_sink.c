@@ -1,5 +1,5 @@
 /*
- * The tet sink (src/sink.c): batches of the configured size in input
+ * The tet sink (src/front/sink.c): batches of the configured size in input
  * numbering, the set hash of what was handed on, the stop codes (of the
  * tets and of the hull callback) and that nothing reaches a sink after it
  * stopped, batch sizes below 1 refused, the face links a front keeps,
@@ -19,11 +19,11 @@
 #include <string.h>
 
 #include "frontdt.h"
-#include "kdtree.h"
-#include "parallel.h"
-#include "prepare.h"
-#include "sethash.h"
-#include "sink.h"
+#include "geom/kdtree.h"
+#include "par/parallel.h"
+#include "geom/prepare.h"
+#include "base/sethash.h"
+#include "front/sink.h"
 #include "testutil.h"
 
 /* A sink that counts and hashes what it gets, checks that no two calls

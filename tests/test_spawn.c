@@ -1,5 +1,5 @@
 /*
- * src/spawn.c: a helper thread started off the caller's core.
+ * src/base/spawn.c: a helper thread started off the caller's core.
  * - The thread runs fn(arg), and pthread_join returns fn's result.
  * - Once fn runs, the thread's CPU set is the caller's whole set again:
  *   the placement is for its start only, never a pin. Checked with the
@@ -19,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "spawn.h"
+#include "base/spawn.h"
 #include "testutil.h"
 
 typedef struct seen {

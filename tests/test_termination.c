@@ -1,5 +1,5 @@
 /*
- * Termination and errors of the parallel engine (src/termination.c), each
+ * Termination and errors of the parallel engine (src/par/termination.c), each
  * rule on a scripted sequence played by one thread over a hand-built
  * engine (tests/enginefix.h):
  * - shared mode: the unit counter (R1-R3): the last release sends IAMDONE
@@ -21,7 +21,7 @@
 #include <string.h>
 
 #include "enginefix.h"
-#include "termination.h"
+#include "par/termination.h"
 
 static long long work(engine *e)
 {

@@ -1,5 +1,5 @@
 /*
- * Hardware and threads of the parallel engine (src/threads.c), through the
+ * Hardware and threads of the parallel engine (src/par/threads.c), through the
  * public API:
  * - the default thread count: hwloc's cores (a synthetic topology set by
  *   HWLOC_SYNTHETIC stands in for the machine: 3 cores, and 2,000 cores
@@ -25,7 +25,7 @@
 #include <unistd.h>
 
 #include "frontdt.h"
-#include "parallel.h"
+#include "par/parallel.h"
 #include "testutil.h"
 
 static double *uniform(size_t n, uint64_t seed)

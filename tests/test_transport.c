@@ -1,12 +1,12 @@
 /*
- * Tests of the transport interface (src/transport.c) and of the parallel
+ * Tests of the transport interface (src/par/transport.c) and of the parallel
  * engine's protocol and termination under adversarial schedules:
  *   - both transports refuse zero endpoints (the shuffle also a delay
  *     outside 0..90) and leave *out NULL;
  *   - the shuffle transport delivers every message once, keeps each
  *     sender's order, reorders across senders (it would test nothing if it
  *     did not), and counts what it hands out;
- *   - the engine (src/parallel.c and the modules it is split into) run over
+ *   - the engine (src/par/parallel.c and the modules it is split into) run over
  *     the shuffle transport, a few hundred times (seeds x thread counts
  *     2, 3, 5, 7 x shared and message modes x small hard inputs: uniform,
  *     a cubic lattice, an extruded 2-D grid, clusters, duplicates): the
@@ -21,9 +21,9 @@
 #include <unistd.h>
 
 #include "frontdt.h"
-#include "parallel.h"
-#include "prepare.h"
-#include "transport.h"
+#include "par/parallel.h"
+#include "geom/prepare.h"
+#include "par/transport.h"
 
 #include "testutil.h"
 
@@ -245,7 +245,7 @@ static void run_shuffled(const input *in, const fdt_vid *ref, size_t nref, uint6
         CHECK_EQ(sent[FDT_MSG_NODESEND], 0);
         CHECK_EQ(sent[FDT_MSG_FACERECV], 0);
     } else {
-        /* FACERECV acknowledges every FACESEND (src/termination.c) */
+        /* FACERECV acknowledges every FACESEND (src/par/termination.c) */
         CHECK_EQ(sent[FDT_MSG_FACERECV], sent[FDT_MSG_FACESEND]);
         /* the final IAMDONE reached every other part */
         for (int i = 1; i < out.nthreads; i++)

@@ -1,5 +1,5 @@
 /*
- * Tests for src/writer.c: a hand-made mesh (a cube cut into 5 tets, plus
+ * Tests for src/io/write/writer.c: a hand-made mesh (a cube cut into 5 tets, plus
  * an unused duplicate point) written in every format and parsed back here;
  * a large synthetic mesh that crosses the writer's buffer many times;
  * decimal formatting of large ids; refusal of non-canonical .tets; write
@@ -13,15 +13,15 @@
  * polyMesh over a regular file, and text written to a stream that fails
  * (/dev/full) or is refused (binary formats): each refused with its code
  * and a message naming the file, nothing left behind.
- * src/outfile.h's buffer on its own, over pipes, where a seek or a pwrite
+ * src/io/write/outfile.h's buffer on its own, over pipes, where a seek or a pwrite
  * fails (ESPIPE) and a write fails in stdio's flush or in ours (EPIPE,
  * the reader gone): the first errno is kept, nothing more is written, and
  * the text items (integers of either sign, doubles, counts padded to a
  * width) come out as the readers expect them.
  */
-#include "outfile.h"
-#include "reader.h"
-#include "writer.h"
+#include "io/write/outfile.h"
+#include "io/read/reader.h"
+#include "io/write/writer.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -1036,7 +1036,7 @@ static void test_cleanup_idle(const char *dir)
     EXPECT(count_entries(dir) == before);
 }
 
-/* The format table's lookups (src/writer.c): by name, by path (a
+/* The format table's lookups (src/io/write/writer.c): by name, by path (a
  * directory format by its last component, trailing slashes and case
  * ignored), the list for messages, what each needs, and every layout's
  * file names (a directory's parts, a family without its extension as
@@ -1172,7 +1172,7 @@ static void test_misc(const char *dir)
 }
 
 /* ------------------------------------------------------------------------ */
-/* src/outfile.h alone                                                       */
+/* src/io/write/outfile.h alone                                                       */
 /* ------------------------------------------------------------------------ */
 
 typedef struct meter_log {

@@ -1,9 +1,9 @@
 /*
- * The streaming writers (src/writer_stream.c, include/frontdt.h's
+ * The streaming writers (src/io/write/writer_stream.c, include/frontdt.h's
  * fdt_stream_writer_*), through the public API:
  * - each streaming format, fed by fdt_triangulate_stream, commits a file
  *   whose tets are the in-memory run's set (the .fdtb parsed back here and
- *   set-hashed with src/sethash.h's rule, as fdt_result_set_hash);
+ *   set-hashed with src/base/sethash.h's rule, as fdt_result_set_hash);
  * - a writer fed in batches in any order (hull first, tets split) gives
  *   the same .fdtb as fdt_write_mesh for the same tets;
  * - a batch naming a point that is not there stops the run (the sink
@@ -29,7 +29,7 @@
  * streamed writes, are tests/stream_readback.py's.
  */
 #include "frontdt.h"
-#include "sethash.h"
+#include "base/sethash.h"
 #include "testutil.h"
 
 #include <dirent.h>

@@ -140,7 +140,7 @@ def bad():
 
 def degenerate():
     """Files every reader accepts and the library refuses (exit 2 from the
-    CLI): their EXPECTED.txt messages come from src/seed.c and name
+    CLI): their EXPECTED.txt messages come from src/front/seed.c and name
     'distinct point'."""
     put(BAD, 'three_points.xyz', '0 0 0\n1 0 0\n0 1 0\n')
     put(BAD, 'repeated_point.xyz', '1.5 -2 3\n' * 4000)

@@ -20,7 +20,7 @@
  * point's power of two).
  */
 #include "frontdt.h"
-#include "predicates.h"
+#include "geom/predicates.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -72,7 +72,7 @@ static size_t fm_decode(const uint8_t *data, size_t size, double *xyz)
     return n;
 }
 
-/* Lexicographic order of points i and j (src/predicates.c; -0 equals
+/* Lexicographic order of points i and j (src/geom/predicates.c; -0 equals
  * +0 there, as in the duplicate merge). */
 static int fm_cmp_pt(const double *xyz, int i, int j)
 {
@@ -216,7 +216,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* Three threads in shared mode advance the faces in another order
      * (three fronts, faces handed between them): a search that depends on
      * the order showed up only that way (the underflowed norm in
-     * update_ball, src/kdtree.c). Same input order, so same hash. */
+     * update_ball, src/geom/kdtree.c). Same input order, so same hash. */
     char d3[512];
     fdt_result *r3 = NULL;
     int rc3 = fm_run(xyz, n, 0, FDT_MODE_SHARED, 3, &r3, d3, sizeof d3);

@@ -1,12 +1,12 @@
 /*
- * libFuzzer target for the point readers (src/reader.c), one build per
+ * libFuzzer target for the point readers (src/io/read/reader.c), one build per
  * format: FDT_FUZZ_FORMAT is 1 (.xyz), 2 (.node) or 3 (.ply). The input
  * bytes are the file; fdt_rd_points_mem() parses them exactly as
  * fdt_rd_points() would parse a file holding them.
  *
  * Beyond "no crash, no leak, no undefined behaviour" (the sanitizers'
  * part), every outcome is checked against the reader's contract
- * (src/reader.h) and a violation aborts, which libFuzzer reports as a
+ * (src/io/read/reader.h) and a violation aborts, which libFuzzer reports as a
  * crash with the input saved:
  *  - success: points returned, 1 <= n, at least 3 bytes per point (a
  *    binary PLY of int8 coordinates is the densest encoding), every
@@ -20,7 +20,7 @@
  * option -Dfuzzing=true) and, always, with tests/fuzz/replay_main.c as a
  * plain program that replays the corpus in the default test suite.
  */
-#include "reader.h"
+#include "io/read/reader.h"
 
 #include <math.h>
 #include <stdint.h>

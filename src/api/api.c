@@ -1,0 +1,368 @@
+/* The public entry points: settings, context, the triangulation pipeline
+ * (DESIGN.md, Data flow). */
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "frontdt.h"
+#include "base/clock.h"
+#include "front/front.h"
+#include "geom/kdtree.h"
+#include "front/oracle.h"
+#include "par/parallel.h"
+#include "geom/prepare.h"
+#include "mesh/result.h"
+#include "front/seed.h"
+#include "base/sethash.h"
+#include "front/sink.h"
+
+struct fdt_context {
+    fdt_settings s;
+    char diag[512];
+};
+
+const char *fdt_strerror(int err)
+{
+    switch (err) {
+    case FDT_OK: return "success";
+    case FDT_EINVAL: return "invalid argument";
+    case FDT_ENOMEM: return "out of memory";
+    case FDT_EDEGENERATE: return "degenerate input (fewer than 4 distinct points, or all coplanar)";
+    case FDT_ERANGE: return "a coordinate is NaN or infinite";
+    case FDT_ETOOBIG: return "too many points or tetrahedra for the index types";
+    case FDT_ECHECK: return "the mesh failed verification";
+    case FDT_ECANCELED: return "canceled";
+    case FDT_EINTERNAL: return "internal error (a bug: please report it)";
+    case FDT_ETHREAD: return "could not create a thread";
+    case FDT_EIO: return "a file could not be opened, read, written or renamed";
+    case FDT_EFORMAT: return "malformed input file";
+    default: return "unknown error";
+    }
+}
+
+const char *fdt_version(void) { return FDT_VERSION_STRING; }
+
+/* What the library allocates for the caller (fdt_read_points) comes from
+ * malloc; freeing it here keeps a caller with another allocator, or a
+ * Windows-style split C runtime, from freeing it with the wrong one. */
+void fdt_free(void *p) { free(p); }
+
+/*
+ * The fdt_settings sizes this library accepts (include/frontdt.h, ABI):
+ * this release's, and, once a field is added, each earlier release's
+ * (offsetof the first field it lacks), whose missing fields then take
+ * their defaults in fdt_open.
+ */
+/* permute_input took what was padding after search: the struct kept its
+ * size, so every caller's struct_size is still this one. */
+_Static_assert(sizeof(fdt_settings) ==
+                   (offsetof(fdt_settings, search) + sizeof(fdt_search) +
+                    _Alignof(fdt_settings) - 1) / _Alignof(fdt_settings) * _Alignof(fdt_settings),
+               "permute_input inside the first release's size");
+
+static int settings_size_known(size_t size)
+{
+    return size == sizeof(fdt_settings);
+}
+
+int fdt_default_settings_sized(fdt_settings *s, size_t struct_size)
+{
+    if (!s)
+        return FDT_EINVAL;
+    if (!settings_size_known(struct_size)) {
+        /* A caller built against a later header: leave it a size fdt_open
+         * refuses, rather than defaults it would take for its own. */
+        if (struct_size >= sizeof s->struct_size)
+            s->struct_size = 0;
+        return FDT_EINVAL;
+    }
+    fdt_settings d;
+    memset(&d, 0, sizeof d);
+    d.struct_size = struct_size;
+    d.mode = FDT_MODE_AUTO;
+    d.n_threads = 0;
+    d.leaf_size = FDT_DEFAULT_LEAF;
+    memcpy(s, &d, struct_size);
+    return FDT_OK;
+}
+
+int fdt_open(fdt_context **ctx, const fdt_settings *s)
+{
+    if (!ctx)
+        return FDT_EINVAL;
+    *ctx = NULL;
+    if (!s || !settings_size_known(s->struct_size))
+        return FDT_EINVAL;
+    /* The caller's bytes over the defaults: fields of a later release than
+     * the caller's keep their defaults. */
+    fdt_settings all;
+    fdt_default_settings_sized(&all, sizeof all);
+    memcpy(&all, s, s->struct_size);
+    if (all.n_threads < 0 || all.n_threads > 1024 || all.leaf_size < 0 ||
+        all.mode < FDT_MODE_AUTO || all.mode > FDT_MODE_MESSAGE)
+        return FDT_EINVAL;
+    fdt_context *c = calloc(1, sizeof *c);
+    if (!c)
+        return FDT_ENOMEM;
+    c->s = all;
+    c->s.struct_size = sizeof c->s;
+    if (c->s.leaf_size == 0)
+        c->s.leaf_size = FDT_DEFAULT_LEAF;
+    *ctx = c;
+    return FDT_OK;
+}
+
+void fdt_close(fdt_context **ctx)
+{
+    if (!ctx)
+        return;
+    free(*ctx);
+    *ctx = NULL;
+}
+
+const char *fdt_context_diagnostic(const fdt_context *ctx)
+{
+    return ctx ? ctx->diag : "";
+}
+
+/* The point whose coordinates are nearest the centre of the root box
+ * (§2.1: "a node near the center of the cloud"). */
+static uint32_t central_point(const fdt_kdtree *t)
+{
+    const fdt_kdnode *r = &t->nodes[0];
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = r->lo[k] * 0.5 + r->hi[k] * 0.5;
+    return fdt_kd_nearest(t, c, FDT_NONE, NULL);
+}
+
+/*
+ * The pipeline of fdt_triangulate and fdt_triangulate_stream: user NULL
+ * keeps the mesh (the in-memory sink: each thread's meshbuf, gathered and
+ * renumbered at the end), else every tet and hull face leaves through the
+ * caller's sink as it is built (src/front/sink.h) and the result keeps none.
+ */
+static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *user,
+               fdt_result **out)
+{
+    if (!ctx || !out || (!xyz && n))
+        return FDT_EINVAL;
+    *out = NULL;
+    ctx->diag[0] = '\0';
+    /* AUTO: serial for one thread, shared otherwise; 0 threads: one per
+     * physical core. Shared and message run src/par/parallel.c, which fills
+     * the same meshbuf (global tree-order ids) and counters. */
+    fdt_mode mode = ctx->s.mode;
+    int nthreads = ctx->s.n_threads;
+    if (mode != FDT_MODE_SERIAL && nthreads == 0)
+        nthreads = fdt_parallel_default_threads();
+    if (mode == FDT_MODE_AUTO)
+        mode = nthreads == 1 ? FDT_MODE_SERIAL : FDT_MODE_SHARED;
+    double t0 = fdt_now_s();
+    fdt_prepared pr;
+    fdt_kdtree tree = {0};
+    fdt_meshbuf mb = {0};
+    fdt_par_out par;
+    memset(&par, 0, sizeof par);
+    fdt_result *r = NULL;
+    fdt_tsink sink;
+    fdt_emit em;
+    memset(&em, 0, sizeof em);
+    if (fdt_tsink_init(&sink, NULL, user) != FDT_OK)
+        return FDT_ENOMEM;
+    /* The merge runs on the engine's threads in parallel modes; serial
+     * mode stays sequential from end to end. */
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    /* permute_input: the caller's array becomes the point store (the
+     * const was the caller's to give up, include/frontdt.h). */
+    int err = ctx->s.permute_input
+                  ? fdt_prepare_inplace((double *)(uintptr_t)xyz, n, &pr, ctx->diag,
+                                        sizeof ctx->diag)
+                  : fdt_prepare(xyz, n,
+                                mode == FDT_MODE_SERIAL          ? 1
+                                : cpus >= 1 && nthreads > cpus ? (int)cpus
+                                                               : nthreads,
+                                &pr, ctx->diag, sizeof ctx->diag);
+    if (err) {
+        fdt_tsink_free(&sink);
+        return err;
+    }
+    sink.orig = pr.orig;
+    if ((err = fdt_seed_check_dimension(pr.p, pr.orig, (uint32_t)pr.m, ctx->diag,
+                                        sizeof ctx->diag)) != FDT_OK)
+        goto fail;
+    /* Inputs where the kd search degenerates (src/front/oracle.h,
+     * fdt_oracle_probe): parts with meshes of their own points ask each
+     * other about every face whose sphere crosses a cut, and there the
+     * spheres are as wide as the object, so the threads first build the
+     * DT of every point together (fdt_ins_build_parallel) and every part
+     * reads its apexes from it (bench/NOTES.md entries 52, 54). That is a
+     * choice of the apex search (--search auto), not of the mode: the
+     * parts, their fronts and their messages stay, and --search kd or
+     * mesh keeps one structure a part. So an explicit --mode shared gets
+     * it as AUTO does, and message mode too, where the one immutable mesh
+     * stands for the replica each rank of an MPI run builds
+     * (src/mpi/mpi_run.c, replica_mesh); before, both kept one mesh a part and
+     * took 40-50x serial's CPU on a cone (entry 63). The parts' joint
+     * vote when the probe is unsure (entry 59) stays shared mode's. */
+    fdt_par_opts popt;
+    memset(&popt, 0, sizeof popt);
+    if (user)
+        popt.sink = &sink;
+    if (mode != FDT_MODE_SERIAL && ctx->s.search == FDT_SEARCH_AUTO)
+        popt.global_mesh = FDT_PAR_MESH_PROBE; /* beside the partition */
+    double t1;
+    size_t mem_tree = 0, mem_mesh = 0, mem_sink = 0;
+    fdt_front_stats fst;
+    memset(&fst, 0, sizeof fst);
+    if (mode != FDT_MODE_SERIAL) {
+        double tp = fdt_now_s();
+        err = fdt_parallel_run(&pr, &ctx->s, mode, nthreads, &popt, &par, ctx->diag,
+                               sizeof ctx->diag);
+        if (err)
+            goto fail;
+        mb = par.mb;
+        memset(&par.mb, 0, sizeof par.mb);
+        fst = par.fst;
+        t1 = tp + par.t_setup; /* partition, trees and seeds count as preparation */
+    } else {
+        err = FDT_ENOMEM;
+        if (fdt_kd_build(&tree, pr.p, pr.orig, 0, (uint32_t)pr.m, ctx->s.leaf_size) != FDT_OK)
+            goto fail;
+        mem_tree = fdt_kd_bytes(&tree);
+        if (!user &&
+            fdt_meshbuf_init(&mb, (size_t)(6.9 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
+            goto fail;
+        if (fdt_emit_init(&em, &sink, &mb) != FDT_OK)
+            goto fail;
+        t1 = fdt_now_s();
+        err = fdt_front_emit(&tree, central_point(&tree), (int)ctx->s.search, &em,
+                             ctx->s.progress, ctx->s.progress_user, &fst);
+        if (!err)
+            err = fdt_emit_flush(&em);
+        mem_mesh = fdt_meshbuf_bytes(&mb);
+        mem_sink = fdt_emit_bytes(&em);
+    }
+    if (err) {
+        if (err == FDT_ENOMEM)
+            snprintf(ctx->diag, sizeof ctx->diag, "out of memory after %lld tetrahedra",
+                     (long long)em.ntets);
+        else if (err == FDT_EINTERNAL)
+            snprintf(ctx->diag, sizeof ctx->diag,
+                     "internal error: the front became inconsistent after %lld tetrahedra",
+                     (long long)em.ntets);
+        goto fail;
+    }
+    double t2 = fdt_now_s();
+    err = FDT_ENOMEM;
+    r = calloc(1, sizeof *r);
+    if (!r)
+        goto fail;
+    /* Renumber into the caller's numbering in place (the sink's one rule,
+     * fdt_sink_renumber; same width, so the buffers are reused). The
+     * parallel engine's threads did that as they gathered the mesh; a
+     * streamed run's tets were renumbered as they left. */
+    fdt_vid *tets = (fdt_vid *)mb.tets;
+    fdt_vid *hull = (fdt_vid *)mb.hull;
+    if (mode == FDT_MODE_SERIAL && !user) {
+        fdt_sink_renumber(pr.orig, tets, mb.tets, 4 * mb.ntets);
+        fdt_sink_renumber(pr.orig, hull, mb.hull, 3 * mb.nhull);
+    }
+    if (user) {
+        r->streamed = 1;
+        r->set_hash = fdt_sethash_value(&sink.hash);
+    }
+    r->tets = tets;
+    r->ntets = mb.ntets;
+    r->nbrs = mb.nbrs;
+    r->hull = hull;
+    r->nhull = mb.nhull;
+    r->dupmap = pr.dupmap;
+    pr.dupmap = NULL;
+    r->n = n;
+    r->ndup = pr.ndup;
+    memset(&mb, 0, sizeof mb);
+    fdt_stats *st = &r->stats;
+    st->points = n;
+    st->vertices = pr.m;
+    st->tets = user ? sink.ntets : r->ntets;
+    st->hull_faces = user ? sink.nhull : r->nhull;
+    st->faces_advanced = fst.faces_advanced;
+    st->kd_nodes_visited = fst.kq.nodes;
+    st->points_tested = fst.kq.points;
+    st->exact_orient = fst.kq.pc.orient_exact;
+    st->exact_insphere = fst.kq.pc.insphere_exact;
+    st->adapt_orient = fst.kq.pc.orient_adapt;
+    st->adapt_insphere = fst.kq.pc.insphere_adapt;
+    st->max_front = fst.max_front;
+    st->mesh_faces = fst.mesh_faces;
+    st->mesh_parts = fst.mesh_parts;
+    st->t_mesh = fst.t_mesh;
+    st->threads = 1;
+    st->mode = FDT_MODE_SERIAL;
+    /* Memory (include/frontdt.h): the points' three arrays, then each
+     * structure at its largest. */
+    st->mem_points = pr.m * (3 * sizeof *pr.p + sizeof *pr.orig) + n * sizeof *pr.dupmap;
+    st->mem_merge = pr.merge_bytes;
+    st->mem_tree = mem_tree;
+    st->mem_front = fst.mem_front;
+    st->mem_mesh = mem_mesh;
+    st->mem_sink = mem_sink;
+    st->t_prepare = t1 - t0;
+    st->t_front = t2 - t1;
+    st->t_finish = fdt_now_s() - t2;
+    if (mode != FDT_MODE_SERIAL) {
+        fdt_parallel_fill_stats(&par, mode, st);
+        st->t_front = par.t_front;
+        st->t_finish += par.t_gather;
+        r->tstats = par.tstats;
+        par.tstats = NULL;
+        st->mem_tree = par.pst.mem_tree;
+        st->mem_front = par.pst.mem_front;
+        st->mem_mesh = par.pst.mem_mesh;
+        st->mem_sink = par.pst.mem_sink;
+    }
+    fdt_emit_free(&em);
+    fdt_tsink_free(&sink);
+    fdt_kd_free(&tree);
+    fdt_prepared_free(&pr);
+    if (ctx->s.progress)
+        ctx->s.progress(ctx->s.progress_user, 1.0);
+    *out = r;
+    return FDT_OK;
+fail:
+    if (err == FDT_ENOMEM && !ctx->diag[0])
+        snprintf(ctx->diag, sizeof ctx->diag, "out of memory triangulating %zu points", n);
+    if (err == FDT_ECANCELED && !ctx->diag[0])
+        snprintf(ctx->diag, sizeof ctx->diag, "canceled");
+    fdt_emit_free(&em);
+    fdt_tsink_free(&sink);
+    fdt_meshbuf_free(&mb);
+    fdt_par_out_free(&par);
+    fdt_kd_free(&tree);
+    fdt_prepared_free(&pr);
+    fdt_result_free(&r);
+    return err;
+}
+
+int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n, fdt_result **out)
+{
+    return run(ctx, xyz, n, NULL, out);
+}
+
+int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
+                           const fdt_sink *sink, fdt_result **out)
+{
+    if (!ctx || !out || !sink || sink->struct_size < sizeof(fdt_sink) || !sink->tets)
+        return FDT_EINVAL;
+    *out = NULL;
+    if (ctx->s.neighbors) {
+        snprintf(ctx->diag, sizeof ctx->diag, "a streamed run has no neighbours");
+        return FDT_EINVAL;
+    }
+    return run(ctx, xyz, n, sink, out);
+}

@@ -1,0 +1,53 @@
+/* Huge-page hints; see mem.h. */
+#define _DEFAULT_SOURCE /* madvise and MADV_HUGEPAGE are not POSIX */
+#include "base/mem.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <unistd.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+#define HUGE_PAGE ((uintptr_t)2 << 20)
+
+void fdt_mem_advise_huge(void *p, size_t bytes)
+{
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    if (!p || bytes < 2 * HUGE_PAGE)
+        return;
+    uintptr_t lo = ((uintptr_t)p + HUGE_PAGE - 1) & ~(HUGE_PAGE - 1);
+    uintptr_t hi = ((uintptr_t)p + bytes) & ~(HUGE_PAGE - 1);
+    if (hi > lo)
+        (void)madvise((void *)lo, hi - lo, MADV_HUGEPAGE);
+#else
+    (void)p;
+    (void)bytes;
+#endif
+}
+
+size_t fdt_mem_available(void)
+{
+    return fdt_mem_available_at("/proc/meminfo");
+}
+
+size_t fdt_mem_available_at(const char *meminfo)
+{
+    FILE *f = fopen(meminfo, "r");
+    if (f) {
+        char line[256];
+        unsigned long long kib;
+        while (fgets(line, sizeof line, f))
+            if (sscanf(line, "MemAvailable: %llu kB", &kib) == 1) {
+                fclose(f);
+                return kib > SIZE_MAX / 1024 ? SIZE_MAX : (size_t)kib * 1024;
+            }
+        fclose(f);
+    }
+#if defined(_SC_AVPHYS_PAGES) && defined(_SC_PAGESIZE)
+    long pages = sysconf(_SC_AVPHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && size > 0 && (unsigned long)pages <= SIZE_MAX / (unsigned long)size)
+        return (size_t)pages * (size_t)size;
+#endif
+    return SIZE_MAX;
+}

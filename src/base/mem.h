@@ -1,0 +1,31 @@
+/*
+ * Large allocations and the kernel's huge pages. The apex search reads
+ * the coordinates, the kd-tree and the float blocks all over tens of MB
+ * (1M points: 24 MB of coordinates alone), and with 4 KB pages nearly
+ * every node or leaf it visits is on a page the TLB does not hold; 2 MB
+ * pages cover the same data with a few dozen entries. Linux gives them to
+ * anonymous memory marked MADV_HUGEPAGE where transparent huge pages are
+ * set to "madvise" (Debian's default) or "always".
+ */
+#ifndef FDT_MEM_H
+#define FDT_MEM_H
+
+#include <stddef.h>
+
+/* Asks for huge pages over the 2 MB-aligned part of [p, p + bytes) when
+ * it spans at least 4 MB; a hint only (no error, no effect elsewhere).
+ * Best called before the memory is first written, so that the first
+ * touch already gets a huge page. */
+void fdt_mem_advise_huge(void *p, size_t bytes);
+
+/* The memory the system can still give without swapping, in bytes: the
+ * kernel's MemAvailable (free memory plus the page cache it can drop),
+ * else the free pages, else SIZE_MAX (unknown: no limit). For choices
+ * that may trade memory for speed (src/front/oracle.c) only, never for
+ * correctness. */
+size_t fdt_mem_available(void);
+/* The same with the kernel's file at meminfo (fdt_mem_available passes
+ * "/proc/meminfo"): lets tests/test_mem.c feed it a file of its own. */
+size_t fdt_mem_available_at(const char *meminfo);
+
+#endif

@@ -1,0 +1,29 @@
+/*
+ * What the two command-line programs (frontdt, src/cli/main.c; frontdt-mpi,
+ * src/cli/mpi_main.c) share, so they cannot drift apart: their signal
+ * handling and the names of their options' values. Not part of the
+ * library, which never installs handlers or reads option text.
+ */
+#ifndef FDT_CLI_H
+#define FDT_CLI_H
+
+#include "frontdt.h"
+
+/*
+ * SIGINT and SIGTERM call cleanup (not NULL; async-signal-safe: it
+ * removes the temporaries of the outputs in progress), print "\nPROG: interrupted\n"
+ * on standard error and leave with exit_code. A signal ignored at startup
+ * stays ignored (the Unix convention: the shell ignores SIGINT for
+ * background jobs, and nohup and friends mean it). SIGXFSZ is ignored, so
+ * a write beyond RLIMIT_FSIZE (ulimit -f) fails with EFBIG and reaches the
+ * writer, which reports it like a full disk and removes its temporaries,
+ * instead of killing the process with them left behind. Call once, before
+ * any thread starts. 0, or -1 with errno set.
+ */
+int fdt_cli_signals(const char *prog, void (*cleanup)(void), int exit_code);
+
+/* --search NAME: auto, kd or mesh into *out (0), or -1 (unknown; *out
+ * untouched). The caller words the error. */
+int fdt_cli_search(const char *name, fdt_search *out);
+
+#endif

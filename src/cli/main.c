@@ -1,0 +1,1492 @@
+/*
+ * frontdt: the command-line tool. Reads a point cloud (src/io/read/reader.h),
+ * triangulates it with the library (include/frontdt.h), optionally checks
+ * the result and writes it (src/io/write/writer.h).
+ *
+ * Exit codes (also listed by --help; scripts and tests rely on them):
+ *   0  success
+ *   1  usage error (bad option or value, missing input, a setting the
+ *      library refuses, unknown output extension, an output that would
+ *      overwrite the input)
+ *   2  bad input: unreadable or malformed file, unknown input extension,
+ *      NaN/Inf, fewer than 4 distinct points, all points coplanar
+ *   3  --check found the mesh is not the Delaunay tetrahedralization
+ *   4  out of resources: memory, index range, threads
+ *   5  cannot write the output
+ *   6  interrupted by SIGINT or SIGTERM (no output, no temporary file left)
+ *   7  internal error (a bug: please report it)
+ *
+ * Everything the tool says goes to stderr with a "frontdt: " prefix, except
+ * the summary and the --hash line, which go to stdout (to stderr when
+ * "--stats-json -" claims stdout for the JSON object alone).
+ */
+#include "frontdt.h"
+#include "cli/cli.h"
+#include "base/clock.h"
+#include "cli/progress.h"
+#include "io/read/reader.h"
+#include "io/write/writer.h"
+
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+enum {
+    CLI_OK = 0,
+    CLI_USAGE = 1,
+    CLI_INPUT = 2,
+    CLI_CHECK = 3,
+    CLI_RESOURCES = 4,
+    CLI_WRITE = 5,
+    CLI_SIGNAL = 6,
+    CLI_INTERNAL = 7
+};
+
+#define DEMO_DEFAULT_N 1000000u
+/* -o given more often than this is a usage error */
+#define MAX_OUTPUTS 8
+/* Fixed so that "--demo N" is the same point set on every run and host. */
+#define DEMO_SEED UINT64_C(0x5eed0f0f1992)
+
+typedef struct cli {
+    const char *input;      /* NULL with --demo; "-": standard input */
+    int input_format;       /* FDT_RD_AUTO: by the input's extension */
+    const char *input_format_name; /* --input-format as given, or NULL */
+    int columns[3];         /* --columns, from 1; {0, 0, 0}: 1, 2, 3 */
+    int progress;           /* --progress: draw even when not a terminal */
+    const char *output;     /* the first -o; NULL: triangulate and report only */
+    const char *outputs[MAX_OUTPUTS]; /* every -o, in order ("-": stdout) */
+    const char *out_format[MAX_OUTPUTS]; /* its --format, NULL: by extension */
+    int n_outputs;
+    const char *format;     /* a --format not yet taken by an -o */
+    int all_faces;          /* --all-faces: TetGen .face with every face */
+    const char *stats_json; /* NULL, a path, or "-" for stdout */
+    fdt_mode mode;
+    fdt_search search;
+    int threads;            /* -1: the library's default */
+    int pin, check, stats, hash, set_hash, quiet;
+    int stream;             /* --stream 1, --no-stream -1, else 0: when
+                               every output can (stream_refusal) */
+    unsigned long long memory_limit; /* --memory-limit bytes; 0: none */
+    int demo;
+    size_t demo_n;
+} cli;
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+        "Usage: frontdt [options] INPUT [-o OUTPUT]\n"
+        "       frontdt --demo [N] [options] [-o OUTPUT]\n"
+        "Exact 3D Delaunay tetrahedralization by the advancing front.\n"
+        "\n"
+        "INPUT:  .xyz/.txt/.csv (x y z per line; more columns skipped; a first\n"
+        "        line of words is a header), .node (TetGen), .ply; '-' is standard\n"
+        "        input (needs --input-format)\n"
+        "OUTPUT: .tets (canonical sorted text), .ele (TetGen .node/.ele/\n"
+        "        .face/.neigh), .vtu (VTK XML, ParaView), .vtk (VTK legacy),\n"
+        "        .msh (gmsh 4.1), .mesh (Medit), DIR/polyMesh (OpenFOAM),\n"
+        "        .fdtb (frontdt binary)\n"
+        "\n"
+        "Options:\n"
+        "  -o, --output FILE      write the mesh (format by extension); may be\n"
+        "                         given up to %d times; '-': standard output\n"
+        "      --format NAME      format of the next -o (of the last -o when\n"
+        "                         none follows): tets, tetgen, vtu, bin, vtk, msh,\n"
+        "                         msh2, medit, openfoam; or, named xyz, txt,\n"
+        "                         csv, node or ply, the input's (--input-format)\n"
+        "      --all-faces        TetGen .face lists every face (TetGen -f)\n"
+        "      --input-format FMT xyz (also txt, csv), node or ply: the input's\n"
+        "                         format whatever its name (needed for '-')\n"
+        "      --columns X,Y,Z    the columns of x, y and z in .xyz/.txt/.csv,\n"
+        "                         counted from 1 as cut -f and awk do (1,2,3)\n"
+        "      --mode MODE        serial, shared, message or auto (default)\n"
+        "      --search HOW       how apexes are found: auto (default: the kd\n"
+        "                         search, an insertion mesh where it gets\n"
+        "                         expensive), kd or mesh\n"
+        "  -t, --threads N        worker threads (0: one per core)\n"
+        "      --pin              bind thread i to core i\n"
+        "      --check            verify the result exactly (exit 3 if not Delaunay)\n"
+        "      --stats            print statistics to stderr\n"
+        "      --stats-json FILE  write statistics as JSON ('-': stdout)\n"
+        "      --hash             print the canonical hash of the tet set\n"
+        "      --set-hash         print the set hash (order-independent, no sort)\n"
+        "      --stream           write the tets as they are built, never holding\n"
+        "                         the mesh (.ele without .neigh, .vtu, .fdtb; no\n"
+        "                         -o: count them); the points are stored once\n"
+        "                         (about 60 bytes a point); refuses an output or\n"
+        "                         option that needs the mesh\n"
+        "      --no-stream        keep the whole mesh (default streams when every\n"
+        "                         -o is .vtu or .fdtb and nothing needs the mesh)\n"
+        "      --memory-limit B   refuse (exit 4) a run whose estimated memory\n"
+        "                         exceeds B bytes (suffixes K, M, G: 2^10..2^30)\n"
+        "  -q, --quiet            no summary, no progress, no notes\n"
+        "      --progress         draw the progress line on stderr even when it\n"
+        "                         is not a terminal (it is drawn on terminals)\n"
+        "      --demo [N]         triangulate N random points in the unit cube\n"
+        "                         (fixed seed; default %u)\n"
+        "  -h, --help             this help\n"
+        "  -V, --version          version\n"
+        "\n"
+        "Exit codes:\n"
+        "  0 success             1 usage error (also '-' without --input-format,\n"
+        "                          --columns for .node/.ply)   2 bad input\n"
+        "  3 --check failed      4 out of resources (also over --memory-limit)\n"
+        "  5 cannot write output\n"
+        "  6 interrupted         7 internal error\n",
+        MAX_OUTPUTS, DEMO_DEFAULT_N);
+}
+
+static void say(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("frontdt: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+static int usage_error(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("frontdt: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+    fputs("Try 'frontdt --help' for more information.\n", stderr);
+    return CLI_USAGE;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Signals                                                                   */
+/* ------------------------------------------------------------------------ */
+
+/* SIGINT/SIGTERM remove the temporary (or just renamed, if its file set
+ * is incomplete) output files (fdt_write_cleanup) and leave with exit
+ * code 6; SIGXFSZ is ignored (src/cli/cli.h). */
+
+/* ------------------------------------------------------------------------ */
+/* Argument parsing                                                          */
+/* ------------------------------------------------------------------------ */
+
+static int all_digits(const char *s)
+{
+    if (!*s)
+        return 0;
+    for (; *s; s++)
+        if (*s < '0' || *s > '9')
+            return 0;
+    return 1;
+}
+
+/* A decimal count: digits only, no sign, no overflow. */
+static int parse_count(const char *s, unsigned long long max,
+                       unsigned long long *v)
+{
+    if (!all_digits(s))
+        return -1;
+    errno = 0;
+    char *end;
+    unsigned long long x = strtoull(s, &end, 10);
+    if (errno || *end || x > max)
+        return -1;
+    *v = x;
+    return 0;
+}
+
+/* A byte count for --memory-limit: digits, then K, M or G (binary:
+ * 2^10, 2^20, 2^30; any case, an optional trailing B or iB). 0 refused. */
+static int parse_bytes(const char *s, unsigned long long *v)
+{
+    size_t d = 0;
+    while (s[d] >= '0' && s[d] <= '9')
+        d++;
+    if (d == 0 || d > 19)
+        return -1;
+    errno = 0;
+    char *end;
+    unsigned long long x = strtoull(s, &end, 10);
+    if (errno || x == 0)
+        return -1;
+    unsigned shift = 0;
+    switch (*end) {
+    case 'k': case 'K': shift = 10; end++; break;
+    case 'm': case 'M': shift = 20; end++; break;
+    case 'g': case 'G': shift = 30; end++; break;
+    default: break;
+    }
+    if (shift && *end == 'i')
+        end++;
+    if (*end == 'b' || *end == 'B')
+        end++;
+    if (*end || (shift && x > (ULLONG_MAX >> shift)))
+        return -1;
+    *v = x << shift;
+    return 0;
+}
+
+enum {
+    OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH, OPT_SET_HASH,
+    OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
+    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT
+};
+
+static const struct option long_opts[] = {
+    { "output", required_argument, NULL, 'o' },
+    { "format", required_argument, NULL, OPT_FORMAT },
+    { "all-faces", no_argument, NULL, OPT_ALL_FACES },
+    { "mode", required_argument, NULL, OPT_MODE },
+    { "search", required_argument, NULL, OPT_SEARCH },
+    { "threads", required_argument, NULL, 't' },
+    { "pin", no_argument, NULL, OPT_PIN },
+    { "check", no_argument, NULL, OPT_CHECK },
+    { "stats", no_argument, NULL, OPT_STATS },
+    { "stats-json", required_argument, NULL, OPT_STATS_JSON },
+    { "hash", no_argument, NULL, OPT_HASH },
+    { "set-hash", no_argument, NULL, OPT_SET_HASH },
+    { "quiet", no_argument, NULL, 'q' },
+    { "demo", optional_argument, NULL, OPT_DEMO },
+    { "input-format", required_argument, NULL, OPT_INPUT_FORMAT },
+    { "columns", required_argument, NULL, OPT_COLUMNS },
+    { "progress", no_argument, NULL, OPT_PROGRESS },
+    { "stream", no_argument, NULL, OPT_STREAM },
+    { "no-stream", no_argument, NULL, OPT_NO_STREAM },
+    { "memory-limit", required_argument, NULL, OPT_MEMORY_LIMIT },
+    { "help", no_argument, NULL, 'h' },
+    { "version", no_argument, NULL, 'V' },
+    { NULL, 0, NULL, 0 },
+};
+
+/*
+ * getopt_long's optional_argument only takes "--demo=N"; "--demo N" with a
+ * separate numeric word is rewritten to "--demo=N" before parsing (an
+ * input file named by digits alone cannot be meant with --demo, which
+ * takes no input). Returns a new argv (strings borrowed or owned by
+ * *owned) or NULL when out of memory.
+ */
+static char **rewrite_demo(int argc, char **argv, int *new_argc,
+                           char ***owned, int *n_owned)
+{
+    char **out = calloc((size_t)argc + 1, sizeof *out);
+    char **own = calloc((size_t)argc + 1, sizeof *own);
+    if (!out || !own) {
+        free(out);
+        free(own);
+        return NULL;
+    }
+    int k = 0, no = 0, options_done = 0;
+    for (int i = 0; i < argc; i++) {
+        if (i > 0 && !options_done && strcmp(argv[i], "--") == 0)
+            options_done = 1;
+        if (i > 0 && !options_done && strcmp(argv[i], "--demo") == 0 &&
+            i + 1 < argc && all_digits(argv[i + 1])) {
+            size_t len = strlen(argv[i + 1]) + sizeof "--demo=";
+            char *s = malloc(len);
+            if (!s) {
+                for (int j = 0; j < no; j++)
+                    free(own[j]);
+                free(own);
+                free(out);
+                return NULL;
+            }
+            snprintf(s, len, "--demo=%s", argv[i + 1]);
+            own[no++] = s;
+            out[k++] = s;
+            i++;
+            continue;
+        }
+        out[k++] = argv[i];
+    }
+    out[k] = NULL;
+    *new_argc = k;
+    *owned = own;
+    *n_owned = no;
+    return out;
+}
+
+/* Was the option getopt_long just refused a short one ("-x")? Then
+ * optopt names it; for long ones we quote the word instead. */
+static int short_opt(char **argv, int ind)
+{
+    return optopt > 0 && optopt < 128 && ind > 0 && argv[ind - 1] &&
+           strncmp(argv[ind - 1], "--", 2) != 0;
+}
+
+/* "3,4,5": three distinct columns counted from 1 (cut -f, awk, gnuplot's
+ * "using 3:4:5"). 0 or -1 on anything else. */
+static int parse_columns(const char *s, int cols[3])
+{
+    for (int k = 0; k < 3; k++) {
+        const char *end = strchr(s, ',');
+        size_t len = end ? (size_t)(end - s) : strlen(s);
+        char word[16];
+        unsigned long long v;
+        if ((k < 2) != (end != NULL) || len == 0 || len >= sizeof word)
+            return -1;
+        memcpy(word, s, len);
+        word[len] = '\0';
+        if (parse_count(word, 1000000, &v) != 0 || v == 0)
+            return -1;
+        cols[k] = (int)v;
+        s = end ? end + 1 : s + len;
+    }
+    if (cols[0] == cols[1] || cols[0] == cols[2] || cols[1] == cols[2])
+        return -1;
+    return 0;
+}
+
+/* Returns -1 to go on, or an exit code (0 after --help/--version). */
+static int parse_args(int argc, char **argv, cli *c)
+{
+    memset(c, 0, sizeof *c);
+    c->mode = FDT_MODE_AUTO;
+    c->threads = -1;
+    c->demo_n = DEMO_DEFAULT_N;
+    opterr = 0; /* we print our own messages */
+    optind = 1;
+    int ch;
+    unsigned long long v;
+    int format_last = 0; /* the last --format came after every -o */
+    while ((ch = getopt_long(argc, argv, ":o:t:qhV", long_opts, NULL)) != -1) {
+        switch (ch) {
+        case 'o':
+            if (c->n_outputs == MAX_OUTPUTS)
+                return usage_error("-o given more than %d times", MAX_OUTPUTS);
+            if (!*optarg)
+                return usage_error("empty output file name");
+            for (int i = 0; i < c->n_outputs; i++)
+                if (!strcmp(c->outputs[i], optarg))
+                    return usage_error("-o %s given twice", optarg);
+            if (!c->output)
+                c->output = optarg;
+            c->out_format[c->n_outputs] = c->format;
+            c->outputs[c->n_outputs++] = optarg;
+            c->format = NULL; /* --format is one -o's */
+            format_last = 0;
+            break;
+        case OPT_FORMAT:
+            /* One option names both, as issue 17 asks (--format xyz for
+             * standard input, --format msh2 for an output): the input
+             * formats' names (xyz, txt, csv, node, ply) and the output
+             * formats' never meet, so the name says which is meant. */
+            if (!fdt_format_by_name(optarg) &&
+                fdt_rd_format_by_name(optarg) != FDT_RD_AUTO) {
+                c->input_format = fdt_rd_format_by_name(optarg);
+                c->input_format_name = optarg;
+                break;
+            }
+            if (!fdt_format_by_name(optarg))
+                return usage_error("unknown format '%s' (input: xyz, txt, csv, node, ply; "
+                                   "output: %s)", optarg, fdt_format_list());
+            c->format = optarg;
+            format_last = 1;
+            break;
+        case OPT_ALL_FACES:
+            c->all_faces = 1;
+            break;
+        case OPT_MODE:
+            if (!strcmp(optarg, "serial"))
+                c->mode = FDT_MODE_SERIAL;
+            else if (!strcmp(optarg, "shared"))
+                c->mode = FDT_MODE_SHARED;
+            else if (!strcmp(optarg, "message"))
+                c->mode = FDT_MODE_MESSAGE;
+            else if (!strcmp(optarg, "auto"))
+                c->mode = FDT_MODE_AUTO;
+            else
+                return usage_error("unknown mode '%s' (serial, shared, "
+                                   "message or auto)", optarg);
+            break;
+        case OPT_SEARCH:
+            if (fdt_cli_search(optarg, &c->search) != 0)
+                return usage_error("unknown search '%s' (auto, kd or mesh)", optarg);
+            break;
+        case 't':
+            if (parse_count(optarg, INT_MAX, &v) != 0)
+                return usage_error("--threads wants a count, not '%s'",
+                                   optarg);
+            c->threads = (int)v;
+            break;
+        case OPT_PIN:
+            c->pin = 1;
+            break;
+        case OPT_CHECK:
+            c->check = 1;
+            break;
+        case OPT_STATS:
+            c->stats = 1;
+            break;
+        case OPT_STATS_JSON:
+            if (!*optarg)
+                return usage_error("empty --stats-json file name");
+            c->stats_json = optarg;
+            break;
+        case OPT_HASH:
+            c->hash = 1;
+            break;
+        case OPT_SET_HASH:
+            c->set_hash = 1;
+            break;
+        case OPT_STREAM:
+        case OPT_NO_STREAM:
+            if (c->stream != 0 && c->stream != (ch == OPT_STREAM ? 1 : -1))
+                return usage_error("--stream and --no-stream together");
+            c->stream = ch == OPT_STREAM ? 1 : -1;
+            break;
+        case 'q':
+            c->quiet = 1;
+            break;
+        case OPT_INPUT_FORMAT:
+            c->input_format = fdt_rd_format_by_name(optarg);
+            c->input_format_name = optarg;
+            if (c->input_format == FDT_RD_AUTO)
+                return usage_error("unknown input format '%s' (xyz, txt, csv, node or "
+                                   "ply)", optarg);
+            break;
+        case OPT_COLUMNS:
+            if (parse_columns(optarg, c->columns) != 0)
+                return usage_error("--columns wants three different column numbers "
+                                   "from 1, as 3,4,5, not '%s'", optarg);
+            break;
+        case OPT_PROGRESS:
+            c->progress = 1;
+            break;
+        case OPT_MEMORY_LIMIT:
+            if (parse_bytes(optarg, &c->memory_limit) != 0)
+                return usage_error("--memory-limit wants a byte count > 0 (suffix K, M or G), "
+                                   "not '%s'", optarg);
+            break;
+        case OPT_DEMO:
+            c->demo = 1;
+            if (optarg) {
+                if (parse_count(optarg, SIZE_MAX, &v) != 0)
+                    return usage_error("--demo wants a point count, not '%s'",
+                                       optarg);
+                c->demo_n = (size_t)v;
+            }
+            break;
+        case 'h':
+        case 'V':
+            if (ch == 'h')
+                usage(stdout);
+            else
+                printf("frontdt %s (library %s)\n", FDT_VERSION_STRING,
+                       fdt_version());
+            if (fflush(stdout) != 0) {
+                say("stdout: %s", strerror(errno));
+                return CLI_WRITE;
+            }
+            return CLI_OK;
+        case ':':
+            if (short_opt(argv, optind))
+                return usage_error("option -%c needs a value", optopt);
+            return usage_error("option %s needs a value", argv[optind - 1]);
+        case '?':
+        default:
+            if (short_opt(argv, optind))
+                return usage_error("unknown option -%c", optopt);
+            return usage_error("unknown, ambiguous or misused option %s",
+                               argv[optind - 1]);
+        }
+    }
+    /* "-o m.msh --format msh2": a --format after the last -o is that
+     * -o's (the others keep their extensions) */
+    if (format_last && c->n_outputs > 0 && !c->out_format[c->n_outputs - 1])
+        c->out_format[c->n_outputs - 1] = c->format;
+    int npos = argc - optind;
+    if (c->demo) {
+        if (npos > 0)
+            return usage_error("--demo takes no input file (got '%s')",
+                               argv[optind]);
+    } else {
+        if (npos == 0)
+            return usage_error("no input file");
+        if (npos > 1)
+            return usage_error("one input file only (got '%s' and '%s')",
+                               argv[optind], argv[optind + 1]);
+        c->input = argv[optind];
+        /* "-" has no extension to go by; a format without columns cannot
+         * take --columns. Both refused before anything is read. */
+        int fmt = c->input_format != FDT_RD_AUTO ? c->input_format
+                                                 : fdt_rd_format_of_path(c->input);
+        if (!strcmp(c->input, "-") && c->input_format == FDT_RD_AUTO)
+            return usage_error("reading standard input ('-') needs --input-format "
+                               "xyz, node or ply");
+        if (c->columns[0] && fmt != FDT_RD_XYZ && fmt != FDT_RD_AUTO)
+            return usage_error("--columns applies to .xyz, .txt and .csv input only");
+    }
+    if (c->demo && (c->input_format != FDT_RD_AUTO || c->columns[0]))
+        return usage_error("--input-format and --columns need an input file, not --demo");
+    return -1;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Output pre-checks (before the long computation)                          */
+/* ------------------------------------------------------------------------ */
+
+/*
+ * Refuses, before anything is read, a run that would replace a file it
+ * reads: any file of the output's set (names[0..k), from
+ * fdt_output_files(), so "-o m.ele" covers m.node too) that is the input,
+ * and the --stats-json file, written after the mesh, where it is the
+ * input or one of the mesh's files. "Is" means the same file by any name
+ * (fdt_same_file: "./x", "d/../x", absolute, symbolic or hard links).
+ * Without this "frontdt m.node -o m.ele" rewrote m.node, its attributes,
+ * markers, comments and 1-based numbering lost. Returns -1 to go on, or
+ * CLI_USAGE after naming both files.
+ */
+static int refuse_overwrites(const cli *c, const char *output, char names[][FDT_IO_PATH],
+                             int k)
+{
+    const char *json = c->stats_json && strcmp(c->stats_json, "-") != 0
+                           ? c->stats_json
+                           : NULL;
+    /* Standard input is no file of ours to overwrite. */
+    const char *in = c->input && strcmp(c->input, "-") != 0 ? c->input : NULL;
+    for (int i = 0; i < k; i++) {
+        /* The set's other files are named with their -o: the user typed
+         * m.ele and should hear why m.node is at stake. */
+        char via[FDT_IO_PATH + 32] = "";
+        if (strcmp(names[i], output) != 0)
+            snprintf(via, sizeof via, " (written with -o %s)", output);
+        if (in && fdt_same_file(names[i], in)) {
+            say("output %s%s would overwrite the input %s", names[i], via, in);
+            return CLI_USAGE;
+        }
+        if (json && fdt_same_file(names[i], json)) {
+            say("--stats-json file %s would overwrite the output %s%s", json,
+                names[i], via);
+            return CLI_USAGE;
+        }
+    }
+    if (json && in && fdt_same_file(json, in)) {
+        say("--stats-json file %s would overwrite the input %s", json, in);
+        return CLI_USAGE;
+    }
+    return -1;
+}
+
+/*
+ * Can a file be created at path? Its directory must exist, be a directory
+ * and be writable; path itself must not be a directory. A cheap early
+ * answer so a doomed run fails in milliseconds rather than after the
+ * triangulation; the writer still checks every step for real.
+ */
+static int output_dir_ok(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    char dir[4096];
+    if (!slash) {
+        strcpy(dir, ".");
+    } else {
+        size_t len = (size_t)(slash - path);
+        if (len == 0)
+            len = 1; /* "/name": the root directory */
+        if (len >= sizeof dir) {
+            say("%s: %s", path, strerror(ENAMETOOLONG));
+            return 0;
+        }
+        memcpy(dir, path, len);
+        dir[len] = '\0';
+    }
+    struct stat st;
+    if (stat(dir, &st) != 0) {
+        say("%s: %s", path, strerror(errno));
+        return 0;
+    }
+    if (!S_ISDIR(st.st_mode)) {
+        say("%s: %s", path, strerror(ENOTDIR));
+        return 0;
+    }
+    if (access(dir, W_OK | X_OK) != 0) {
+        say("%s: %s", path, strerror(errno));
+        return 0;
+    }
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        say("%s: %s", path, strerror(EISDIR));
+        return 0;
+    }
+    return 1;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Demo points                                                               */
+/* ------------------------------------------------------------------------ */
+
+/* splitmix64 (Steele, Lea, Flood 2014): expands the seed into the
+ * xoshiro256** state (Blackman and Vigna 2018), which draws the points. */
+static uint64_t splitmix64(uint64_t *s)
+{
+    uint64_t z = (*s += UINT64_C(0x9e3779b97f4a7c15));
+    z = (z ^ (z >> 30)) * UINT64_C(0xbf58476d1ce4e5b9);
+    z = (z ^ (z >> 27)) * UINT64_C(0x94d049bb133111eb);
+    return z ^ (z >> 31);
+}
+
+static inline uint64_t rotl64(uint64_t x, int k)
+{
+    return (x << k) | (x >> (64 - k));
+}
+
+static inline uint64_t xoshiro_next(uint64_t s[4])
+{
+    uint64_t r = rotl64(s[1] * 5, 7) * 9;
+    uint64_t t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = rotl64(s[3], 45);
+    return r;
+}
+
+/* n points uniform in [0, 1)^3, 53 random bits per coordinate. */
+static double *demo_points(size_t n)
+{
+    if (n > SIZE_MAX / (3 * sizeof(double)))
+        return NULL;
+    double *xyz = malloc(n > 0 ? 3 * n * sizeof *xyz : 1);
+    if (!xyz)
+        return NULL;
+    uint64_t seed = DEMO_SEED, s[4];
+    for (int i = 0; i < 4; i++)
+        s[i] = splitmix64(&seed);
+    for (size_t i = 0; i < 3 * n; i++)
+        xyz[i] = (double)(xoshiro_next(s) >> 11) * 0x1.0p-53;
+    return xyz;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Error mapping                                                             */
+/* ------------------------------------------------------------------------ */
+
+static int exit_for_engine(int err)
+{
+    switch (err) {
+    case FDT_OK:
+        return CLI_OK;
+    case FDT_EINVAL:
+        return CLI_USAGE;
+    case FDT_EDEGENERATE:
+    case FDT_ERANGE:
+        return CLI_INPUT;
+    case FDT_ENOMEM:
+    case FDT_ETOOBIG:
+    case FDT_ETHREAD:
+        return CLI_RESOURCES;
+    case FDT_ECHECK:
+        return CLI_CHECK;
+    default: /* FDT_EINTERNAL, and FDT_ECANCELED which we never ask for */
+        return CLI_INTERNAL;
+    }
+}
+
+/* Threads for reading a text file: those of the triangulation, at most
+ * one an online CPU (more only take turns); one in serial mode, so that
+ * mode stays sequential from end to end. */
+static int reader_threads(const cli *c)
+{
+    if (c->mode == FDT_MODE_SERIAL || c->threads == 1)
+        return 1;
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    if (cpus < 1)
+        return 1;
+    return c->threads > 1 && c->threads < cpus ? c->threads : (int)(cpus > 64 ? 64 : cpus);
+}
+
+/* fdt_read_points_opts: everything but memory is the input's fault (the
+ * CLI refuses a bad --input-format, "-" without it and misplaced
+ * --columns up front, as usage errors). */
+static int exit_for_reader(int err)
+{
+    return err == FDT_ENOMEM ? CLI_RESOURCES : CLI_INPUT;
+}
+
+/* fdt_write_mesh_opts: formats, standard output and neighbours were
+ * settled before the run, so FDT_EINVAL here is ours, as FDT_EINTERNAL. */
+static int exit_for_writer(int err)
+{
+    switch (err) {
+    case FDT_EIO:
+        return CLI_WRITE;
+    case FDT_ENOMEM:
+        return CLI_RESOURCES;
+    default:
+        return CLI_INTERNAL;
+    }
+}
+
+static const char *mode_name(fdt_mode m)
+{
+    switch (m) {
+    case FDT_MODE_SERIAL:
+        return "serial";
+    case FDT_MODE_SHARED:
+        return "shared";
+    case FDT_MODE_MESSAGE:
+        return "message";
+    default:
+        return "auto";
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* Statistics                                                                */
+/* ------------------------------------------------------------------------ */
+
+typedef struct timings {
+    double read, triangulate, check, canon, write;
+} timings;
+
+/* Per-thread and per-kind figures of a parallel run (§4-§5): what the
+ * bench harness and the issue notes report. */
+static void print_parallel_stats(const fdt_result *res, const fdt_stats *st)
+{
+    fprintf(stderr, "  messages          sent / received\n");
+    for (int k = 1; k < FDT_MSG_KIND_END; k++)
+        fprintf(stderr, "    %-15s %zu / %zu\n", fdt_msg_kind_name(k), st->sent[k],
+                st->received[k]);
+    fprintf(stderr,
+        "  remote queries    %zu made, %zu answered, %zu improved the apex\n"
+        "  tet requests      %zu (%zu for tets already built)\n"
+        "  idle time         %.3f s (sum over threads), query wait %.3f s\n"
+        "  load imbalance    %.3f (max / mean tets per thread)\n"
+        "  pinned            %s\n",
+        st->remote_queries, st->remote_answered, st->remote_improved,
+        st->tet_requests, st->duplicate_requests, st->t_idle, st->t_query_wait,
+        st->load_imbalance,
+        st->pinned > 0 ? "yes" : st->pinned < 0 ? "refused (ran unpinned)" : "no");
+    fprintf(stderr, "  thread  points      tets  faces adv  rem.q made/ans  FACESEND s/r  idle s  core\n");
+    for (int i = 0; i < st->threads; i++) {
+        fdt_thread_stats ts;
+        if (fdt_result_thread_stats(res, i, &ts) != FDT_OK)
+            break;
+        fprintf(stderr, "  %6d %7zu %9zu %10zu %8zu/%-6zu %7zu/%-6zu %7.3f %5d\n", i, ts.points,
+                ts.tets, ts.faces_advanced, ts.remote_queries, ts.remote_answered,
+                ts.sent[FDT_MSG_FACESEND], ts.received[FDT_MSG_FACESEND], ts.t_idle, ts.core);
+    }
+}
+
+static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
+                        const timings *tm)
+{
+    fprintf(stderr,
+        "frontdt: statistics\n"
+        "  points            %zu\n"
+        "  vertices          %zu (%zu duplicates merged)\n"
+        "  tets              %zu\n"
+        "  hull faces        %zu\n"
+        "  faces advanced    %zu\n"
+        "  kd nodes visited  %zu\n"
+        "  points tested     %zu\n"
+        "  exact orient3d    %zu\n"
+        "  exact insphere    %zu\n"
+        "  adaptive orient3d %zu\n"
+        "  adaptive insphere %zu\n"
+        "  largest front     %zu\n"
+        "  mesh faces        %zu (%zu parts built a mesh in %.3f s)\n"
+        "  threads           %d\n"
+        "  mode              %s\n"
+        "  time prepare      %.3f s\n"
+        "  time front        %.3f s\n"
+        "  time finish       %.3f s\n"
+        "  time read         %.3f s\n"
+        "  time triangulate  %.3f s\n"
+        "  time check        %.3f s\n"
+        "  time canon+hash   %.3f s\n"
+        "  time write        %.3f s\n",
+        st->points, st->vertices, dups, st->tets, st->hull_faces,
+        st->faces_advanced, st->kd_nodes_visited, st->points_tested,
+        st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
+        st->max_front, st->mesh_faces, st->mesh_parts, st->t_mesh, st->threads,
+        mode_name(st->mode), st->t_prepare, st->t_front, st->t_finish,
+        tm->read, tm->triangulate, tm->check, tm->canon, tm->write);
+    if (st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE)
+        print_parallel_stats(res, st);
+}
+
+/* --stats, memory: each structure's bytes, a point and in all, the
+ * estimate (--memory-limit's) and the measured peak. */
+static void print_memory(const fdt_stats *st, size_t n, unsigned long long estimate,
+                         unsigned long long peak)
+{
+    double pn = n ? (double)n : 1.0;
+    const struct {
+        const char *name;
+        size_t bytes;
+    } m[] = {{"points", st->mem_points}, {"merge table", st->mem_merge},
+             {"kd-trees", st->mem_tree},  {"front", st->mem_front},
+             {"mesh", st->mem_mesh},      {"sink buffers", st->mem_sink}};
+    for (size_t i = 0; i < sizeof m / sizeof *m; i++)
+        fprintf(stderr, "  memory %-12s %8.1f MiB %6.1f B/point\n", m[i].name,
+                (double)m[i].bytes / 1048576.0, (double)m[i].bytes / pn);
+    if (st->max_front)
+        fprintf(stderr, "  memory a front face %.1f B (largest front %zu faces)\n",
+                (double)st->mem_front / (double)st->max_front, st->max_front);
+    fprintf(stderr, "  memory estimate     %8.1f MiB %6.1f B/point\n",
+            (double)estimate / 1048576.0, (double)estimate / pn);
+    if (peak)
+        fprintf(stderr, "  memory peak RSS     %8.1f MiB %6.1f B/point (%+.0f%% of the estimate)\n",
+                (double)peak / 1048576.0, (double)peak / pn,
+                100.0 * ((double)peak - (double)estimate) / (double)estimate);
+}
+
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\')
+            fprintf(f, "\\%c", *p);
+        else if (*p < 0x20)
+            fprintf(f, "\\u%04x", *p);
+        else
+            fputc(*p, f);
+    }
+    fputc('"', f);
+}
+
+/* JSON numbers cannot be NaN or infinite; times never are, but be safe. */
+static double finite_or_zero(double x)
+{
+    return (x == x && x - x == 0) ? x : 0;
+}
+
+/* The counts by kind as {"iamdone": n, ...}: each kind's name in lower
+ * case. */
+static void json_msgs(FILE *f, const char *key, const size_t *m)
+{
+    fprintf(f, ", \"%s\": {", key);
+    for (int k = 1; k < FDT_MSG_KIND_END; k++) {
+        fprintf(f, "%s\"", k > 1 ? ", " : "");
+        for (const char *c = fdt_msg_kind_name(k); *c; c++)
+            fputc(*c >= 'A' && *c <= 'Z' ? *c - 'A' + 'a' : *c, f);
+        fprintf(f, "\": %zu", m[k]);
+    }
+    fputc('}', f);
+}
+
+static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
+                             const fdt_stats *st, size_t dups, const timings *tm,
+                             int have_hash, uint64_t hash)
+{
+    fputs("{\"input\": ", f);
+    if (c->input)
+        json_string(f, c->input);
+    else
+        fputs("null", f);
+    if (c->demo)
+        fprintf(f, ", \"demo\": %zu", c->demo_n);
+    fprintf(f,
+        ", \"points\": %zu, \"vertices\": %zu, \"duplicates\": %zu"
+        ", \"tets\": %zu, \"hull_faces\": %zu, \"faces_advanced\": %zu"
+        ", \"kd_nodes_visited\": %zu, \"points_tested\": %zu"
+        ", \"exact_orient\": %zu, \"exact_insphere\": %zu"
+        ", \"adapt_orient\": %zu, \"adapt_insphere\": %zu"
+        ", \"max_front\": %zu, \"mesh_faces\": %zu, \"mesh_parts\": %zu"
+        ", \"t_mesh\": %.9g, \"threads\": %d, \"mode\": \"%s\""
+        ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
+        ", \"t_read\": %.9g, \"t_triangulate\": %.9g, \"t_check\": %.9g"
+        ", \"t_canon\": %.9g, \"t_write\": %.9g",
+        st->points, st->vertices, dups, st->tets, st->hull_faces,
+        st->faces_advanced, st->kd_nodes_visited, st->points_tested,
+        st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
+        st->max_front, st->mesh_faces, st->mesh_parts, finite_or_zero(st->t_mesh),
+        st->threads, mode_name(st->mode), finite_or_zero(st->t_prepare),
+        finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
+        finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
+        finite_or_zero(tm->check), finite_or_zero(tm->canon), finite_or_zero(tm->write));
+    json_msgs(f, "sent", st->sent);
+    json_msgs(f, "received", st->received);
+    fprintf(f,
+        ", \"remote_queries\": %zu, \"remote_answered\": %zu, \"remote_improved\": %zu"
+        ", \"tet_requests\": %zu, \"duplicate_requests\": %zu, \"t_idle\": %.9g"
+        ", \"t_query_wait\": %.9g, \"load_imbalance\": %.9g, \"pinned\": %d",
+        st->remote_queries, st->remote_answered, st->remote_improved, st->tet_requests,
+        st->duplicate_requests, finite_or_zero(st->t_idle), finite_or_zero(st->t_query_wait),
+        finite_or_zero(st->load_imbalance), st->pinned);
+    fputs(", \"per_thread\": [", f);
+    for (int i = 0; i < st->threads; i++) {
+        fdt_thread_stats ts;
+        if (fdt_result_thread_stats(res, i, &ts) != FDT_OK)
+            break;
+        fprintf(f, "%s{\"points\": %zu, \"tets\": %zu, \"faces_advanced\": %zu"
+                   ", \"remote_queries\": %zu, \"remote_answered\": %zu"
+                   ", \"t_idle\": %.9g, \"t_cpu\": %.9g, \"core\": %d",
+                i ? ", " : "", ts.points, ts.tets, ts.faces_advanced, ts.remote_queries,
+                ts.remote_answered, finite_or_zero(ts.t_idle), finite_or_zero(ts.t_cpu), ts.core);
+        json_msgs(f, "sent", ts.sent);
+        json_msgs(f, "received", ts.received);
+        fputc('}', f);
+    }
+    fputc(']', f);
+    if (c->check)
+        fputs(", \"check\": \"passed\"", f);
+    if (have_hash)
+        fprintf(f, ", \"hash\": \"%016" PRIx64 "\"", hash);
+    fputs("}\n", f);
+}
+
+/* ------------------------------------------------------------------------ */
+/* The run                                                                   */
+/* ------------------------------------------------------------------------ */
+
+/* ------------------------------------------------------------------------ */
+/* Streaming (issue 18)                                                      */
+/* ------------------------------------------------------------------------ */
+
+/* Why this command cannot stream, or NULL: every -o a file in a format
+ * with a streaming writer, and nothing that needs the whole mesh. In the
+ * default mode a TetGen output is not streamed either: its .neigh needs
+ * the neighbours, so only --stream (which drops .neigh) streams it. */
+static const char *stream_refusal(const cli *c, const fdt_format *const *fmts, int forced,
+                                  char *why, size_t len)
+{
+    if (c->check)
+        return "--check needs the whole mesh";
+    if (c->hash)
+        return "--hash sorts the whole mesh (--set-hash needs no sort)";
+    if (c->all_faces)
+        return "--all-faces needs the face list of the whole mesh";
+    for (int o = 0; o < c->n_outputs; o++) {
+        if (!strcmp(c->outputs[o], "-"))
+            return "-o - (standard output) cannot stream";
+        const char *name = fdt_format_name(fmts[o]);
+        if (fdt_stream_format_ok(c->outputs[o], name) != 1 ||
+            (!forced && !strcmp(name, "tetgen"))) {
+            snprintf(why, len, "-o %s: format %s needs the whole mesh (tetgen, vtu and bin "
+                     "stream)", c->outputs[o], name);
+            return why;
+        }
+    }
+    return NULL;
+}
+
+/* The sink of a streamed run: each batch to every -o's writer in turn;
+ * counts what went by (the summary's tets and hull faces). */
+typedef struct fanout {
+    fdt_stream_writer *w[MAX_OUTPUTS];
+    fdt_sink sink[MAX_OUTPUTS];
+    int n;
+    int failed;      /* the writer that refused a batch, -1: none */
+    uint64_t tets, hull;
+} fanout;
+
+static int fanout_tets(void *user, const fdt_vid *t, size_t count)
+{
+    fanout *fo = user;
+    for (int i = 0; i < fo->n; i++) {
+        int r = fo->sink[i].tets(fo->sink[i].user, t, count);
+        if (r) {
+            fo->failed = i;
+            return r;
+        }
+    }
+    fo->tets += count;
+    return 0;
+}
+
+static int fanout_hull(void *user, const fdt_vid *f, size_t count)
+{
+    fanout *fo = user;
+    for (int i = 0; i < fo->n; i++) {
+        int r = fo->sink[i].hull(fo->sink[i].user, f, count);
+        if (r) {
+            fo->failed = i;
+            return r;
+        }
+    }
+    fo->hull += count;
+    return 0;
+}
+
+/* Closes every writer: commits them all when commit is set and each
+ * commit succeeds, else removes what is left. Returns the exit code. */
+static int fanout_close(fanout *fo, int commit)
+{
+    int code = CLI_OK;
+    for (int i = 0; i < fo->n; i++) {
+        char err[1024];
+        int r = fdt_stream_writer_close(&fo->w[i], commit && code == CLI_OK, err, sizeof err);
+        if (r != FDT_OK && code == CLI_OK && (commit || i == fo->failed)) {
+            say("%s", err);
+            code = exit_for_writer(r);
+        }
+    }
+    return code;
+}
+
+/*
+ * The bytes a run on n points is expected to need at its peak (for
+ * --memory-limit, and printed by --stats beside the measured peak): the
+ * points as read (24 a point, the CLI's array; a streamed run prepares
+ * them in it, fdt_settings.permute_input), the library's own copy (24
+ * otherwise), input indices and duplicate map (8), the merge's table
+ * (4 bytes a slot, slots the power of two >= 2n, freed before the
+ * trees), the kd-trees (about 26 a point with leaves of 30: 24.5
+ * measured on 1M uniform points), the front (the queue's buckets, 1 a
+ * point, and 110 bytes a front face, for 8 n^(2/3) faces: a front is a
+ * surface; 1M uniform points measured 34k faces serial, 50k on two
+ * threads, 3.6 bytes a point in all) and, in memory, the tets: 6.5 a
+ * point, 16 bytes each and 32 more with neighbours, twice over in the
+ * parallel gather's worst case (thread 0's buffer grown to the whole mesh
+ * while the others still hold theirs), plus the writers' and the face
+ * list's needs, which this does not count. Streamed: a 1 MiB batch a
+ * thread. Plus 16 MiB for the program, its libraries and stacks.
+ */
+static unsigned long long memory_estimate(size_t n, int stream, int threads, int nbrs)
+{
+    double pts = 24.0 * (double)n;
+    double own = stream ? 0.0 : 24.0 * (double)n;
+    double idx = 8.0 * (double)n;
+    double merge = 16.0;
+    while (merge < 2.0 * (double)n)
+        merge *= 2.0;
+    merge *= 4.0;
+    double tree = 26.0 * (double)n;
+    double front = 1.0 * (double)n + 110.0 * 8.0 * cbrt((double)n) * cbrt((double)n);
+    double mesh = 0.0;
+    if (!stream) {
+        mesh = 6.5 * (double)n * (16.0 + (nbrs ? 32.0 : 0.0));
+        if (threads > 1)
+            mesh *= 2.0;
+    }
+    double sinks = stream ? (double)(threads > 1 ? threads : 1) * 1.2 * 1048576.0 : 0.0;
+    double during_merge = pts + own + idx + merge;
+    double during_front = pts + own + idx + tree + front + mesh + sinks;
+    double peak = during_merge > during_front ? during_merge : during_front;
+    return (unsigned long long)(peak + 16.0 * 1048576.0);
+}
+
+/* The process's peak resident set in bytes (0 if unknown). */
+static unsigned long long peak_rss_bytes(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0)
+        return 0;
+    return (unsigned long long)ru.ru_maxrss * 1024ull; /* Linux: KiB */
+}
+
+static int run(const cli *c)
+{
+    int code = CLI_OK;
+    double *xyz = NULL;
+    size_t n = 0;
+    fdt_context *ctx = NULL;
+    fdt_result *res = NULL;
+    timings tm = { 0 };
+    const char *name = !c->input ? "demo" : strcmp(c->input, "-") ? c->input : "stdin";
+    /* The progress line (src/cli/progress.h): on a terminal, or asked for. */
+    progress prog;
+    progress_init(&prog, !c->quiet && (c->progress || isatty(STDERR_FILENO)));
+    int json_stdout = c->stats_json && !strcmp(c->stats_json, "-");
+    /* stdout carries the JSON object alone when asked to. */
+    FILE *info = json_stdout ? stderr : stdout;
+
+    /* Refuse doomed or destructive outputs before reading or computing
+     * anything: each -o's format, its files against the input, the
+     * --stats-json file and every other -o's files. */
+    const fdt_format *fmts[MAX_OUTPUTS];
+    int need = 0, to_stdout = 0;
+    for (int o = 0; o < c->n_outputs; o++) {
+        const char *out = c->outputs[o];
+        if (!strcmp(out, "-")) {
+            /* standard output: text only, the canonical .tets by default */
+            fmts[o] = fdt_format_by_name(c->out_format[o] ? c->out_format[o] : "tets");
+            if (!fdt_format_is_text(fmts[o]) || !strcmp(fdt_format_name(fmts[o]), "tetgen") ||
+                !strcmp(fdt_format_name(fmts[o]), "openfoam"))
+                return usage_error("-o -: format %s cannot go to standard output "
+                                   "(one text file only: tets, vtk, msh, msh2, medit)",
+                                   fdt_format_name(fmts[o]));
+            if (json_stdout)
+                return usage_error("-o - and --stats-json - both want standard output");
+            to_stdout = 1;
+            need |= fdt_format_needs(fmts[o], c->all_faces);
+            continue;
+        }
+        fmts[o] = c->out_format[o] ? fdt_format_by_name(c->out_format[o])
+                                   : fdt_format_by_path(out);
+        if (!fmts[o])
+            return usage_error("%s: unknown output format (use %s, or --format)", out,
+                               fdt_format_list());
+        need |= fdt_format_needs(fmts[o], c->all_faces);
+        char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+        int n_names = fdt_output_files_as(out, fmts[o], names);
+        if (n_names <= 0) {
+            say("%s: %s", out, strerror(ENAMETOOLONG));
+            return CLI_WRITE;
+        }
+        code = refuse_overwrites(c, out, names, n_names);
+        if (code >= 0)
+            return code;
+        for (int p = 0; p < o; p++) {
+            if (!strcmp(c->outputs[p], "-"))
+                continue;
+            char other[FDT_IO_MAX_FILES][FDT_IO_PATH];
+            int k = fdt_output_files_as(c->outputs[p], fmts[p], other);
+            for (int i = 0; i < n_names; i++)
+                for (int j = 0; j < k; j++)
+                    if (fdt_same_file(names[i], other[j])) {
+                        say("output %s (-o %s) is also written by -o %s", names[i], out,
+                            c->outputs[p]);
+                        return CLI_USAGE;
+                    }
+        }
+        /* a directory format's path may be an existing directory: then
+         * its files are what must be creatable */
+        struct stat dst;
+        const char *probe = fmts[o] == fdt_format_by_name("openfoam") &&
+                                    stat(out, &dst) == 0 && S_ISDIR(dst.st_mode)
+                                ? names[0]
+                                : out;
+        if (!output_dir_ok(probe))
+            return CLI_WRITE;
+    }
+    {
+        char none[1][FDT_IO_PATH];
+        code = refuse_overwrites(c, "", none, 0); /* --stats-json vs the input */
+        if (code >= 0)
+            return code;
+    }
+    /* Stream (the tets go to the files as they are built) when asked, or
+     * when every output can and nothing needs the mesh. */
+    char why[FDT_IO_PATH + 200];
+    const char *refusal = stream_refusal(c, fmts, c->stream > 0, why, sizeof why);
+    if (c->stream > 0 && refusal)
+        return usage_error("--stream: %s", refusal);
+    int streaming = c->stream > 0 || (c->stream == 0 && !refusal && c->n_outputs > 0);
+    code = CLI_OK;
+    if (c->stats_json && !json_stdout && !output_dir_ok(c->stats_json))
+        return CLI_WRITE;
+    /* the summary goes to stderr when the mesh goes to stdout */
+    if (to_stdout)
+        info = stderr;
+
+    /* Points. */
+    double t0 = fdt_now_s();
+    if (c->demo) {
+        n = c->demo_n;
+        xyz = demo_points(n);
+        if (!xyz) {
+            say("demo: no memory for %zu points", n);
+            return CLI_RESOURCES;
+        }
+    } else {
+        char err[1024];
+        fdt_read_options ro;
+        fdt_default_read_options(&ro);
+        ro.format = c->input_format_name;
+        memcpy(ro.columns, c->columns, sizeof ro.columns);
+        ro.n_threads = reader_threads(c);
+        if (prog.enabled) {
+            ro.progress = progress_io;
+            ro.progress_user = &prog;
+        }
+        progress_phase(&prog, "read");
+        int r = fdt_read_points_opts(c->input, &ro, &xyz, &n, err, sizeof err);
+        progress_clear(&prog);
+        if (r != FDT_OK) {
+            say("%s", err);
+            return exit_for_reader(r);
+        }
+    }
+    tm.read = fdt_now_s() - t0;
+
+    /* Triangulation. */
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = c->mode;
+    s.search = c->search;
+    if (c->threads >= 0)
+        s.n_threads = c->threads;
+    s.pin = c->pin;
+    s.neighbors = !streaming && (c->check || (need & FDT_NEED_NBRS));
+    if (prog.enabled) {
+        s.progress = progress_engine;
+        s.progress_user = &prog;
+    }
+    /* A streamed run prepares the points in the array we read them into
+     * (the writers took what they need of it when they were opened,
+     * below, before the run): the points are stored once. */
+    s.permute_input = streaming;
+    int run_threads = c->mode == FDT_MODE_SERIAL ? 1
+                      : c->threads > 0           ? c->threads
+                                                 : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    unsigned long long estimate = memory_estimate(n, streaming, run_threads, s.neighbors);
+    if (c->memory_limit && estimate > c->memory_limit) {
+        say("%s: %zu points need about %llu MiB (%s%s), more than --memory-limit %llu MiB",
+            name, n, estimate >> 20, streaming ? "streamed" : "in memory",
+            s.neighbors ? ", with neighbours" : "", c->memory_limit >> 20);
+        code = CLI_RESOURCES;
+        goto done;
+    }
+    int r = fdt_open(&ctx, &s);
+    if (r != FDT_OK) {
+        say("cannot use these settings: %s", fdt_strerror(r));
+        code = exit_for_engine(r);
+        goto done;
+    }
+    fanout fo;
+    memset(&fo, 0, sizeof fo);
+    fo.failed = -1;
+    if (streaming) {
+        for (int o = 0; o < c->n_outputs; o++) {
+            char err[1024];
+            r = fdt_stream_writer_open(&fo.w[o], c->outputs[o], fdt_format_name(fmts[o]), xyz,
+                                       n, 0, err, sizeof err);
+            if (r != FDT_OK) {
+                say("%s", err);
+                (void)fanout_close(&fo, 0);
+                code = exit_for_writer(r);
+                goto done;
+            }
+            fo.n = o + 1;
+            (void)fdt_stream_writer_sink(fo.w[o], &fo.sink[o]);
+        }
+    }
+    t0 = fdt_now_s();
+    progress_phase(&prog, "merge"); /* "triangulate" at the library's first report */
+    if (streaming) {
+        fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &fo};
+        r = fdt_triangulate_stream(ctx, xyz, n, &sink, &res);
+    } else {
+        r = fdt_triangulate(ctx, xyz, n, &res);
+    }
+    tm.triangulate = fdt_now_s() - t0;
+    progress_clear(&prog);
+    if (streaming) {
+        /* the writers end with the run: committed (counts patched, all
+         * renamed) after a whole run, removed after a failed one */
+        t0 = fdt_now_s();
+        int wcode = fanout_close(&fo, r == FDT_OK);
+        tm.write = fdt_now_s() - t0;
+        if (fo.failed >= 0) {
+            code = wcode; /* the run stopped for the writer's error */
+            goto done;
+        }
+        if (r == FDT_OK && wcode != CLI_OK) {
+            code = wcode;
+            goto done;
+        }
+    }
+    if (r != FDT_OK) {
+        const char *diag = fdt_context_diagnostic(ctx);
+        say("%s: %s", name, diag && *diag ? diag : fdt_strerror(r));
+        code = exit_for_engine(r);
+        goto done;
+    }
+    /* No engine threads may outlive this point: the signal handler then
+     * runs on the thread that is writing, never beside it. */
+    fdt_close(&ctx);
+
+    size_t dups = fdt_result_num_duplicates(res);
+    if (dups > 0 && !c->quiet)
+        say("%s: merged %zu duplicate points", name, dups);
+    /* --pin where the system refuses a binding (or hwloc is missing): the
+     * run went on unpinned, which the user who asked should hear once. */
+    fdt_stats pst;
+    if (c->pin && !c->quiet && fdt_result_stats(res, &pst) == FDT_OK && pst.pinned < 0)
+        say("--pin: a thread could not be bound to its core; ran unpinned");
+
+    size_t nt = streaming ? (size_t)fo.tets : fdt_result_num_tets(res);
+    if (c->check) {
+        char msg[1024];
+        t0 = fdt_now_s();
+        progress_phase(&prog, "check");
+        r = fdt_check(xyz, n, fdt_result_tets(res), nt,
+                      fdt_result_neighbors(res), msg, sizeof msg);
+        progress_clear(&prog);
+        tm.check = fdt_now_s() - t0;
+        if (r != FDT_OK) {
+            if (r == FDT_ECHECK)
+                say("%s: check failed: %s", name, msg);
+            else
+                say("%s: check could not run: %s", name, fdt_strerror(r));
+            code = exit_for_engine(r);
+            goto done;
+        }
+    }
+
+    /* The canonical order makes .tets and the hash independent of thread
+     * count and mode; the other formats do not need it. */
+    t0 = fdt_now_s();
+    uint64_t hash = 0, set_hash = 0;
+    if (c->set_hash)
+        (void)fdt_result_set_hash(res, &set_hash); /* res is not NULL: cannot fail */
+    if (c->hash || (need & FDT_NEED_SORTED))
+        progress_phase(&prog, "sort");
+    if (c->hash) {
+        /* sorts too, hashing each part of the sort while it is in cache */
+        r = fdt_result_hash(res, &hash);
+        progress_clear(&prog);
+        if (r != FDT_OK) {
+            say("%s: sorting and hashing the tets failed: %s", name, fdt_strerror(r));
+            code = exit_for_engine(r);
+            goto done;
+        }
+    } else if (need & FDT_NEED_SORTED) {
+        r = fdt_result_sort(res);
+        progress_clear(&prog);
+        if (r != FDT_OK) {
+            say("%s: sorting the tets failed: %s", name, fdt_strerror(r));
+            code = exit_for_engine(r);
+            goto done;
+        }
+    }
+    progress_clear(&prog);
+    tm.canon = fdt_now_s() - t0;
+
+    if (c->n_outputs > 0 && !streaming) {
+        t0 = fdt_now_s();
+        char err[1024];
+        /* The public writer computes the face list where a format needs
+         * it (after the sort above: it names tets by their numbers) and
+         * reports its bytes (progress_io: the write phase moves). */
+        fdt_write_options wo;
+        fdt_default_write_options(&wo);
+        wo.all_faces = c->all_faces;
+        if (prog.enabled) {
+            wo.progress = progress_io;
+            wo.progress_user = &prog;
+        }
+        progress_phase(&prog, "write");
+        for (int o = 0; o < c->n_outputs; o++) {
+            wo.format = fdt_format_name(fmts[o]);
+            r = fdt_write_mesh_opts(res, xyz, n, c->outputs[o], &wo, err, sizeof err);
+            if (r != FDT_OK) {
+                progress_clear(&prog);
+                say("%s", err);
+                code = exit_for_writer(r);
+                tm.write = fdt_now_s() - t0;
+                goto done;
+            }
+        }
+        progress_clear(&prog);
+        tm.write = fdt_now_s() - t0;
+    }
+
+    fdt_stats st;
+    memset(&st, 0, sizeof st);
+    r = fdt_result_stats(res, &st);
+    if (r != FDT_OK && (c->stats || c->stats_json)) {
+        say("%s: no statistics: %s", name, fdt_strerror(r));
+        code = exit_for_engine(r);
+        goto done;
+    }
+    if (c->stats) {
+        print_stats(res, &st, dups, &tm);
+        print_memory(&st, n, estimate, peak_rss_bytes());
+    }
+    if (c->stats_json) {
+        /* A file goes through a temporary renamed at the end, as the
+         * mesh does: a failed or interrupted write leaves what was there.
+         * A device or a pipe (named, or reached through a link) is
+         * written in place: renaming over it would replace a /dev node
+         * or a FIFO someone reads with a plain file. */
+        char jerr[1024];
+        fdt_wr_side *side = NULL;
+        struct stat jst;
+        int in_place = json_stdout || (stat(c->stats_json, &jst) == 0 && !S_ISREG(jst.st_mode));
+        FILE *f = json_stdout ? stdout
+                  : in_place  ? fopen(c->stats_json, "w")
+                              : fdt_wr_side_open(c->stats_json, &side, jerr, sizeof jerr);
+        if (!f) {
+            if (in_place)
+                say("%s: %s", c->stats_json, strerror(errno));
+            else
+                say("%s", jerr);
+            code = CLI_WRITE;
+            goto done;
+        }
+        errno = 0;
+        write_stats_json(f, c, res, &st, dups, &tm, c->hash, hash);
+        int e = ferror(f) ? (errno ? errno : EIO) : 0;
+        if (in_place) {
+            if ((json_stdout ? fflush(f) : fclose(f)) != 0 && !e)
+                e = errno ? errno : EIO;
+            if (e) {
+                say("%s: %s", json_stdout ? "stdout" : c->stats_json, strerror(e));
+                code = CLI_WRITE;
+                goto done;
+            }
+        } else if (e) {
+            fdt_wr_side_abandon(side);
+            say("%s: %s", c->stats_json, strerror(e));
+            code = CLI_WRITE;
+            goto done;
+        } else if (fdt_wr_side_commit(side, jerr, sizeof jerr) != FDT_IO_OK) {
+            say("%s", jerr);
+            code = CLI_WRITE;
+            goto done;
+        }
+    }
+
+    if (c->hash)
+        fprintf(info, "hash: %016" PRIx64 "\n", hash);
+    if (c->set_hash)
+        fprintf(info, "set-hash: %016" PRIx64 "\n", set_hash);
+    if (!c->quiet) {
+        size_t nh = streaming ? (size_t)fo.hull : fdt_result_num_hull_faces(res);
+        if (c->demo)
+            fprintf(info, "demo: %zu random points in the unit cube\n", n);
+        else
+            fprintf(info, "input: %s\n", c->input);
+        fprintf(info, "points: %zu", n);
+        if (dups)
+            fprintf(info, " (%zu duplicates merged)", dups);
+        fprintf(info, "\ntets: %zu\nhull faces: %zu\n", nt, nh);
+        fprintf(info, "time: %.3f s\n", tm.triangulate);
+        fprintf(info, "tets/s: %.0f\n",
+                tm.triangulate > 0 ? (double)nt / tm.triangulate : 0.0);
+        if (c->check)
+            fprintf(info, "check: passed\n");
+        if (c->output)
+            fprintf(info, "output: %s\n", c->output);
+    }
+    if (fflush(stdout) != 0) {
+        say("stdout: %s", strerror(errno));
+        code = CLI_WRITE;
+    }
+
+done:
+    fdt_result_free(&res);
+    fdt_close(&ctx);
+    free(xyz);
+    return code;
+}
+
+int main(int argc, char **argv)
+{
+    if (fdt_cli_signals("frontdt", fdt_write_cleanup, CLI_SIGNAL) != 0) {
+        say("cannot install signal handlers: %s", strerror(errno));
+        return CLI_INTERNAL;
+    }
+    int nargc = 0, n_owned = 0;
+    char **owned = NULL;
+    char **nargv = rewrite_demo(argc, argv, &nargc, &owned, &n_owned);
+    if (!nargv) {
+        say("out of memory");
+        return CLI_RESOURCES;
+    }
+    cli c;
+    int code = parse_args(nargc, nargv, &c);
+    if (code < 0)
+        code = run(&c);
+    for (int i = 0; i < n_owned; i++)
+        free(owned[i]);
+    free(owned);
+    free(nargv);
+    return code;
+}

@@ -1,0 +1,158 @@
+/*
+ * Which apex oracle a front uses (bench/NOTES.md, entry 51).
+ *
+ * The apex of a front face is the first open-side point of the pencil of
+ * spheres through the face's circle (§2.2). Two exact ways find it:
+ *   - the kd search (src/geom/kdtree.c): certifies the sphere empty by testing
+ *     every point the tree cannot exclude; ~90 points a face on uniform
+ *     clouds, but thousands where many points lie near the sphere
+ *     (cylinders, rotated lattices, near-cospherical sets, flat scans);
+ *   - the insertion mesh (src/mesh/insert.c): the part's own points
+ *     triangulated once by Bowyer-Watson insertion; the apex is the vertex
+ *     across the face, one array read when the face came from a tet the
+ *     mesh gave.
+ * The perturbed Delaunay tetrahedralization is unique, so both give the
+ * same apex and may be mixed face by face: a front starts on the kd
+ * search and switches to the mesh when a window of faces shows the
+ * searches are expensive. The mesh is a read-only certificate; tets are
+ * still emitted one by one by the front, final when built.
+ *
+ * In a part of the parallel engine the mesh holds only the part's points:
+ * its answer is the first of the part's points in the pencil, and the
+ * caller still asks the other parts (their points may come earlier), as
+ * after its own kd search.
+ */
+#ifndef FDT_ORACLE_H
+#define FDT_ORACLE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "frontdt.h"
+#include "mesh/insert.h"
+#include "geom/kdtree.h"
+
+typedef struct fdt_oracle {
+    const fdt_kdtree *t;  /* borrowed: the part's tree (its points) */
+    int policy;           /* FDT_SEARCH_AUTO, _KD or _MESH */
+    int state;            /* 0: kd search; 1: mesh; -1: mesh unavailable;
+                             2: the rule chose the mesh of every point
+                             (collective, below), kd search until the
+                             engine provides it (fdt_oracle_share) */
+    fdt_ins mesh;         /* owned, valid when state == 1 and !gm */
+    const fdt_ins *gm;    /* borrowed: a mesh of every point (shared by
+                             all parts, fdt_oracle_share), or NULL */
+    uint32_t *mt;         /* owned: mesh tet of output tet i, FDT_NONE unknown */
+    size_t mtcap;
+    /* The switching window: counter values at its start. */
+    size_t next_check, w_faces, w_points, w_exact, w_nodes;
+    /* 1: a part of a threaded run whose switch is collective: the rule's
+     * choice sets state 2 and the engine builds one mesh of every point
+     * for all parts (src/par/engine.c) instead of this part's own mesh. Such
+     * a mesh costs every part, so a choice by points tested alone must be
+     * clear (COLLECTIVE_SURE in src/front/oracle.c) or come with the slow walk
+     * the time rule also asks for (SLOW_NODES). */
+    int collective;       /* 2: another part voted (src/par/engine.c) */
+    /* A collective part's early time measure: from COLLECTIVE_TIMED_FROM
+     * faces (0: not started), thread CPU and kd nodes then. */
+    size_t c_faces, c_nodes;
+    double c_cpu;
+    /* Work (points tested + EXACT_WEIGHT x exact tests, since the run's
+     * start) past which the window in progress must end in a switch:
+     * the switch is made as soon as it is passed (SIZE_MAX: never). */
+    size_t w_budget;
+    /* The time rule's start: faces advanced (0: not started), thread CPU
+     * (s) and kd nodes visited then. */
+    size_t t_faces, t_nodes;
+    double t_cpu;
+    /* Statistics. */
+    size_t mesh_faces;    /* faces whose apex the mesh gave */
+    size_t star_walks;    /* of those, found by a walk around a vertex */
+    size_t switched_at;   /* faces advanced when the mesh was built (0: never) */
+    double t_mesh;        /* seconds building the mesh */
+    /* Auto policy: the bytes this part's mesh may take (0: no cap). A
+     * switch whose mesh would not fit is not made (the kd search stays:
+     * always right, only slower); mesh_refused says it happened. */
+    size_t mem_cap;
+    int mesh_refused;
+} fdt_oracle;
+
+/* What an insertion mesh of n points takes at its peak, in bytes: about
+ * 220 kept a point (src/mesh/insert.h) plus the build's scratch and the tet
+ * array's growth, and the oracle's table of mesh tets (4 bytes an output
+ * tet). */
+#define FDT_ORACLE_MESH_BYTES 330.0
+
+/* The cap (fdt_oracle.mem_cap) for each of `parts` oracles that may each
+ * build a mesh at once: an equal share of the memory available now
+ * (fdt_mem_available). At 1e8 uniform points on two threads auto mode
+ * built an insertion mesh (a part's switch or the probe's mesh of every
+ * point: not measured which) and the run was killed at 24 GiB, where the
+ * kd search alone peaks at 5.8 GiB (bench/NOTES.md entry 58). */
+size_t fdt_oracle_mem_share(int parts);
+
+void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy);
+void fdt_oracle_free(fdt_oracle *o);
+
+/*
+ * Called before each face is advanced, with the front's running counters
+ * (faces advanced so far, and the kd work in kq). Decides at the end of
+ * each window whether the kd search has become expensive and, if so,
+ * builds the mesh (counting its exact tests in kq). A part whose points do
+ * not span 3-D, or a build that runs out of memory, stays on the kd
+ * search: never an error. Cheap between windows.
+ */
+void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq);
+
+/*
+ * The mesh's answer for front face f (open side orient3d(f0,f1,f2,x) > 0),
+ * whose closed-side tet is output tet ctid (-1: none known) with vertex
+ * copp opposite f. Returns 1 when the mesh holds f: *apex is the first of
+ * the part's points in the pencil (FDT_NONE: no point of the part on the
+ * open side) and *mtet the mesh tet of (f, apex) to note for the new tet.
+ * Returns 0 when the mesh is not in use or f is not one of its faces (a
+ * vertex of another part): the caller runs the kd search.
+ */
+int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t copp,
+                    uint32_t *apex, uint32_t *mtet);
+
+/*
+ * Makes o answer from gm, the DT of every point of the run (built once by
+ * fdt_ins_build_parallel and read by every part): then each answer is the
+ * apex itself, not just the first of the part's points, and no other part
+ * need be asked. gm is borrowed and must outlive o; o never switches.
+ */
+void fdt_oracle_share(fdt_oracle *o, const fdt_ins *gm);
+
+/* Notes that output tet tid is mesh tet mtet (FDT_NONE: not known). Only
+ * stores while the mesh is in use. FDT_OK or FDT_ENOMEM. */
+int fdt_oracle_note(fdt_oracle *o, int64_t tid, uint32_t mtet);
+
+/*
+ * Whether the kd search is clearly expensive on these points (the m
+ * distinct points P, 3 doubles each): the first faces of a serial front
+ * over a sample of them, costed as fdt_oracle_tick does. The parallel
+ * modes pay for such inputs twice: each part builds its mesh, and a face
+ * whose sphere crosses a cut still asks the other parts, where a pipe's or
+ * a grid's spheres are as wide as the object (bench/NOTES.md, entry 52);
+ * src/par/parallel.c then builds one mesh of every point before the fronts,
+ * and otherwise lets the parts decide it together (entry 59). 0 on any
+ * failure (no memory, a flat sample): the caller's choice stands.
+ */
+int fdt_oracle_probe(const double *P, uint32_t m, int leaf_size);
+
+/*
+ * fdt_oracle_probe in two steps, so that the samples can be copied before
+ * src/geom/partition.c permutes P and costed on another thread while the
+ * partition runs (src/par/parallel.c): take copies the samples (no memory
+ * for one: that sample counts as cheap, as in fdt_oracle_probe), decide
+ * costs them, frees them and returns what fdt_oracle_probe would have.
+ */
+typedef struct fdt_probe_samples {
+    double *S[2]; /* every stride-th point; a run of consecutive points */
+    uint32_t k;   /* points in each (0: too few points, not expensive) */
+    int leaf_size;
+} fdt_probe_samples;
+void fdt_oracle_probe_take(fdt_probe_samples *ps, const double *P, uint32_t m, int leaf_size);
+int fdt_oracle_probe_decide(fdt_probe_samples *ps);
+
+#endif

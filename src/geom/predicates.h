@@ -1,0 +1,314 @@
+/*
+ * Exact geometric predicates on double coordinates, and the symbolic
+ * perturbation that makes the Delaunay tetrahedralization unique.
+ *
+ * Sign conventions are CGAL's, so that our mesh equals CGAL's
+ * Delaunay_triangulation_3 tet for tet:
+ *   fdt_orient3d(a,b,c,d)  = sign det[b-a; c-a; d-a]
+ *       > 0: (a,b,c,d) positively oriented (d on the positive side of abc)
+ *   fdt_insphere(a,b,c,d,e) for positively oriented (a,b,c,d)
+ *       > 0: e strictly inside the circumsphere, < 0 outside, 0 on it
+ *       (CGAL side_of_oriented_sphere: ON_POSITIVE_SIDE is +1).
+ *
+ * Every function is exact for all finite doubles: a floating-point filter
+ * with a proven error bound decides most calls; an adaptive stage with a
+ * bound of order eps^2 most of the rest (near-degenerate inputs); the
+ * remainder, exact zeros among them, are evaluated exactly (expansion
+ * arithmetic when no intermediate can underflow, GMP integers otherwise).
+ * No global mutable state; thread-safe.
+ *
+ * The filters are static inline below (the hot path, called tens of
+ * millions of times); the exact stages are out of line in
+ * src/geom/predicates.c. The filters' error analysis holds whether or not the
+ * compiler contracts a*b+c into a fused multiply-add (contraction only
+ * removes roundings), but not under -ffast-math (reassociation) or with
+ * x87 extended-precision evaluation (src/geom/predicates.c refuses to compile
+ * unless FLT_EVAL_METHOD is 0). IEEE round-to-nearest-even is assumed.
+ */
+#ifndef FDT_PREDICATES_H
+#define FDT_PREDICATES_H
+
+#include <float.h>
+#include <math.h>
+#include <stddef.h>
+
+/* Counters of calls that left the filter; per thread, owned by the caller.
+ * May be NULL everywhere below. *_exact: calls that reached an exact
+ * stage (B or C); *_adapt: calls the adaptive stage decided, which then
+ * need no exact arithmetic (the two are disjoint). */
+typedef struct fdt_pred_counts {
+    size_t orient_exact;
+    size_t insphere_exact;
+    size_t orient_adapt;
+    size_t insphere_adapt;
+} fdt_pred_counts;
+
+int fdt_orient3d(const double *a, const double *b, const double *c,
+                 const double *d, fdt_pred_counts *cnt);
+int fdt_insphere(const double *a, const double *b, const double *c,
+                 const double *d, const double *e, fdt_pred_counts *cnt);
+
+/* Lexicographic (x, then y, then z) comparison: -1, 0, +1. */
+int fdt_lex_compare(const double *p, const double *q);
+
+/* Exact sign of |x - q|^2 - |y - q|^2 for any finite doubles: -1 when x
+ * is strictly nearer to q than y, 0 on a tie, +1 otherwise. Floating
+ * squared distances can tie (or invert) when the points mix magnitudes
+ * (1e-149 next to 1), which made the seed's "nearest neighbour" edge
+ * non-Delaunay; callers use this only on floating near-ties. */
+int fdt_compare_dist(const double *q, const double *x, const double *y);
+
+/* The circumcentre of the tetrahedron (a, b, c, d) relative to a, from
+ * exact integer arithmetic, for any finite input (subnormal coordinates
+ * included: they are scaled to integers exactly), however flat the tet.
+ * Accuracy of each component x[k] against the true value X:
+ *   |X| >= 2^-1022 (normal): |x[k] - X| <= 2^-51 |X|;
+ *   |X| <  2^-1022 (subnormal range, doubles 2^-1074 apart, so no
+ *   relative bound can hold): |x[k] - X| <= 2^-51 |X| + 2^-1074; a
+ *   component below 2^-1075 may come back 0.
+ * (The quotient is truncated to 53 bits, then ldexp rounds it onto the
+ * subnormal grid.) tests/test_predicates.c (test_circumcenter) checks
+ * these bounds against GMP rationals on random, flat, mixed 2^-1050..
+ * 2^900, subnormal, offset and huge inputs, and prints the largest errors
+ * it saw: 2 x 2^-53 relative and 0.5 x 2^-1074 absolute (seeds 1-3, scale
+ * 4). 0 on success, -1 when the four points are coplanar or a component
+ * overflows a double. For the ill-conditioned spheres the floating
+ * formula cannot bound. */
+int fdt_circumcenter_exact(const double *a, const double *b, const double *c,
+                           const double *d, double x[3]);
+
+/*
+ * Perturbed insphere (Devillers & Teillaud 2011, as in CGAL's
+ * Delaunay_triangulation_3::side_of_oriented_sphere with perturb=true).
+ * Precondition: (a,b,c,d) positively oriented, the five points pairwise
+ * distinct. Never returns 0: +1 inside, -1 outside.
+ */
+int fdt_insphere_perturbed(const double *a, const double *b, const double *c,
+                           const double *d, const double *e,
+                           fdt_pred_counts *cnt);
+
+/* ------------------------------------------------------------------ */
+/* Filters and exact stages, for callers that want to inline the filter. */
+
+/* What a filter returns when it cannot decide the sign. */
+#define FDT_PRED_UNSURE 2
+
+/*
+ * The exact stages alone (no filter): same results and sign conventions as
+ * fdt_orient3d / fdt_insphere; they count the call in cnt (may be NULL).
+ */
+int fdt_orient3d_exact(const double *a, const double *b, const double *c,
+                       const double *d, fdt_pred_counts *cnt);
+int fdt_insphere_exact(const double *a, const double *b, const double *c,
+                       const double *d, const double *e, fdt_pred_counts *cnt);
+
+/*
+ * The adaptive stage alone (src/geom/predicates.c, between the filters and the
+ * exact stages): +1 / -1 when it can prove the sign (same conventions as
+ * fdt_orient3d / fdt_insphere), FDT_PRED_UNSURE otherwise, and always
+ * FDT_PRED_UNSURE for coordinates outside its range (stage B's) or when a
+ * point shares a coordinate with a (orient3d) or e (insphere). It never
+ * returns 0 and counts nothing. Exposed for tests.
+ */
+int fdt_orient3d_adapt(const double *a, const double *b, const double *c,
+                       const double *d);
+int fdt_insphere_adapt(const double *a, const double *b, const double *c,
+                       const double *d, const double *e);
+
+/*
+ * Error-bound constants of the filters (derivations at the filters).
+ * eps = 2^-53 is the unit roundoff.
+ *   FDT_O3D_ERRBOUND = 8 eps (1 + 2^-12)
+ *   FDT_ISP_ERRBOUND = 16 eps (1 + 2^-12)
+ * And of the adaptive stage (derivation in src/geom/predicates.c): it decides
+ * when |estimate| > bound = fl(C perm), perm the filter's permanent of the
+ * rounded differences, computed as in the filters below.
+ *   FDT_O3D_ADAPT_ERRBOUND = 41 eps^2
+ *   FDT_ISP_ADAPT_ERRBOUND = 109 eps^2
+ */
+#define FDT_O3D_ERRBOUND 0x1.001p-50
+#define FDT_ISP_ERRBOUND 0x1.001p-49
+#define FDT_O3D_ADAPT_ERRBOUND 0x1.48p-101
+#define FDT_ISP_ADAPT_ERRBOUND 0x1.b4p-100
+
+/*
+ * Floating-point filter for orient3d: +1 or -1 when that is certainly the
+ * sign of det[b-a; c-a; d-a], FDT_PRED_UNSURE otherwise (never 0).
+ *
+ * Error bound. Write eps = 2^-53, eta = 2^-1075 (half the smallest
+ * subnormal). Every operation obeys fl(x op y) = (x op y)(1 + delta) + mu,
+ * |delta| <= eps, |mu| <= eta, and mu = 0 for + and - (a sum that lands in
+ * the subnormal range is exact) -- provided nothing overflows.
+ *
+ * No overflow: perm is computed with the same association as det from the
+ * same products, with |.| everywhere; rounding is monotone and
+ * |fl(x - y)| <= fl(|x| + |y|), so every intermediate of det is at most
+ * the matching intermediate of perm in magnitude. perm <= DBL_MAX therefore
+ * means nothing overflowed (an overflowed difference gives perm = inf or
+ * NaN, and both fail the test).
+ *
+ * Rounding without underflow. det is a sum of six monomials t_k = +-u_i
+ * v_j w_l of the exact differences. Each reaches det_computed multiplied
+ * by at most 8 factors (1 + delta): three differences, the inner product,
+ * the inner difference, the outer product and at most two outer sums. So
+ * |det_computed - det| <= gamma8 P, gamma8 = 8eps/(1 - 8eps), with
+ * P = sum |t_k| the exact permanent; and perm >= (1 - eps)^8 P because
+ * perm's terms go through the same number of roundings, all on
+ * non-negative values.
+ *
+ * Underflow. A product's mu in one of the six inner products (v_j w_l) is
+ * then multiplied by the computed |u_i| and rounded at most 3 more times;
+ * an outer product's mu at most twice. The absolute perturbation of det
+ * (and, likewise, the amount by which perm may fall short) is at most
+ *   U = 2 eta (1+eps)^4 su' + 3 eta (1+eps)^2,  su' = |ux|+|uy|+|uz|
+ * (exact sum of the computed magnitudes; su' <= (1+3eps) su). We require
+ * perm >= 2^-800 and fl(su 2^-980) <= perm. Scaling by 2^-980 is exact
+ * unless su < 2^-42 (and then U < 2^-1070 anyway); otherwise
+ * su <= 2^980 perm and U <= 2^-93 perm + 2^-1071 <= 2^-92 perm.
+ *
+ * Together: |det_computed - det| <= gamma8 P + U and
+ * P <= (perm + U) / (1-eps)^8, so the error is at most
+ * gamma8 (1-eps)^-8 perm + 2U <= (8eps + 200 eps^2 + 2^-91) perm.
+ * The computed bound fl(B perm), B = FDT_O3D_ERRBOUND, is at least
+ * B perm (1 - eps) (no underflow: B perm >= 2^-851) = (8eps + 2^-62 - ...)
+ * perm, which exceeds the error by ~2^-62 perm. Hence det_computed > bound
+ * implies det > 0, and det_computed < -bound implies det < 0.
+ */
+static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
+                                           const double w[3])
+{
+    const double ux = u[0], uy = u[1], uz = u[2];
+    const double vx = v[0], vy = v[1], vz = v[2];
+    const double wx = w[0], wy = w[1], wz = w[2];
+    const double vywz = vy * wz, vzwy = vz * wy;
+    const double vzwx = vz * wx, vxwz = vx * wz;
+    const double vxwy = vx * wy, vywx = vy * wx;
+    const double det = ux * (vywz - vzwy) + uy * (vzwx - vxwz) + uz * (vxwy - vywx);
+    const double aux = fabs(ux), auy = fabs(uy), auz = fabs(uz);
+    const double perm = aux * (fabs(vywz) + fabs(vzwy)) + auy * (fabs(vzwx) + fabs(vxwz)) +
+                        auz * (fabs(vxwy) + fabs(vywx));
+    const double su = aux + auy + auz;
+    if (perm >= 0x1p-800 && perm <= DBL_MAX && su * 0x1p-980 <= perm) {
+        const double bound = FDT_O3D_ERRBOUND * perm;
+        /* Branch-free: the sign itself is a coin flip on typical input,
+         * whether it is certain is nearly always yes. */
+        const int s = (det > bound) - (det < -bound);
+        if (s != 0)
+            return s;
+    }
+    return FDT_PRED_UNSURE;
+}
+
+/* The filter proper works on the rounded differences u = b - a, v = c - a,
+ * w = d - a; fdt_orient3d() also calls it on differences rescaled by a
+ * power of two when they lie outside the range the bound covers. */
+static inline int fdt_orient3d_filter(const double *a, const double *b,
+                                      const double *c, const double *d)
+{
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    return fdt_orient3d_filter_diff(u, v, w);
+}
+
+/*
+ * Floating-point filter for insphere: +1 / -1 when that is certainly the
+ * CGAL insphere sign (see the top of this file), FDT_PRED_UNSURE otherwise.
+ *
+ * With A = a-e, B = b-e, C = c-e, D = d-e (rows) and |A|^2 etc.,
+ *   det4 = det[A |A|^2; B |B|^2; C |C|^2; D |D|^2]
+ *        = (|D|^2 abc - |C|^2 dab) + (|B|^2 cda - |A|^2 bcd),
+ * where abc = det[A; B; C] etc. (expanded along the z column from the xy
+ * minors ab = Ax By - Bx Ay, ...). det4 equals the lifted 5x5 determinant
+ * det[p |p|^2 1] (rows a..e), which is positive exactly when e is outside
+ * the sphere of a CGAL-positively oriented (a,b,c,d); so the CGAL sign is
+ * -sign(det4).
+ *
+ * Error bound, in the model of fdt_orient3d_filter. No overflow: perm
+ * mirrors det4's evaluation with |.| (same argument). Rounding: each of
+ * the monomials (a lift square times a z difference times an xy product:
+ * five differences) meets at most 16 roundings: 5 differences, inner
+ * product and difference (2), z product (1), two sums of the 3x3 minor
+ * (2), the square and two sums of the lift (3), the outer product (1) and
+ * two outer sums (2). So |det4_computed - det4| <= gamma16 P and
+ * perm >= (1-eps)^16 P.
+ * Underflow: with M the largest computed |difference| (so each lift <= 4M^2,
+ * each xy minor <= 3M^2, each 3x3 minor <= 10M^3, all up to negligible mu
+ * terms), a product's mu is amplified by at most: 24 inner-product paths
+ * times M (z) times 4M^2 (lift); 12 z-products times 4M^2; 12 squares times
+ * 10M^3 (their 3x3 minor); 4 outer products times 1; with (1+eps)^8 of
+ * rounding: U <= 1.01 eta (216 M^3 + 48 M^2 + 4) <= 2^-1066 (M^4 + 1).
+ * L = sum of the four computed lifts has M^2 <= 1.01 L + 2^-1070, and we
+ * require perm >= 2^-800 and fl(L fl(L 2^-960)) <= perm: an overflow gives
+ * inf and fails; if L < 2^-31 then M < 1 and U <= 2^-1065; otherwise
+ * L 2^-960 is exact, the product is not subnormal, and
+ * L^2 <= (1+eps) 2^960 perm. So U <= 2^-1066 (1.03 * 2^960 perm + 2)
+ * <= 2^-104 perm.
+ * Total error <= (gamma16 (1-eps)^-16 + 2^-102) perm
+ * <= (16 eps + 600 eps^2 + 2^-102) perm, while fl(B perm) with
+ * B = FDT_ISP_ERRBOUND is >= (16eps + 2^-61 - 17 eps^2) perm.
+ */
+static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
+                                           const double C[3], const double D[3])
+{
+    const double aex = A[0], aey = A[1], aez = A[2];
+    const double bex = B[0], bey = B[1], bez = B[2];
+    const double cex = C[0], cey = C[1], cez = C[2];
+    const double dex = D[0], dey = D[1], dez = D[2];
+
+    const double aexbey = aex * bey, bexaey = bex * aey;
+    const double bexcey = bex * cey, cexbey = cex * bey;
+    const double cexdey = cex * dey, dexcey = dex * cey;
+    const double dexaey = dex * aey, aexdey = aex * dey;
+    const double aexcey = aex * cey, cexaey = cex * aey;
+    const double bexdey = bex * dey, dexbey = dex * bey;
+    const double ab = aexbey - bexaey, bc = bexcey - cexbey;
+    const double cd = cexdey - dexcey, da = dexaey - aexdey;
+    const double ac = aexcey - cexaey, bd = bexdey - dexbey;
+
+    const double abc = aez * bc - bez * ac + cez * ab;
+    const double bcd = bez * cd - cez * bd + dez * bc;
+    const double cda = cez * da + dez * ac + aez * cd;
+    const double dab = dez * ab + aez * bd + bez * da;
+
+    const double alift = aex * aex + aey * aey + aez * aez;
+    const double blift = bex * bex + bey * bey + bez * bez;
+    const double clift = cex * cex + cey * cey + cez * cez;
+    const double dlift = dex * dex + dey * dey + dez * dez;
+
+    const double det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+
+    const double abP = fabs(aexbey) + fabs(bexaey), bcP = fabs(bexcey) + fabs(cexbey);
+    const double cdP = fabs(cexdey) + fabs(dexcey), daP = fabs(dexaey) + fabs(aexdey);
+    const double acP = fabs(aexcey) + fabs(cexaey), bdP = fabs(bexdey) + fabs(dexbey);
+    const double aezP = fabs(aez), bezP = fabs(bez), cezP = fabs(cez), dezP = fabs(dez);
+    const double abcP = aezP * bcP + bezP * acP + cezP * abP;
+    const double bcdP = bezP * cdP + cezP * bdP + dezP * bcP;
+    const double cdaP = cezP * daP + dezP * acP + aezP * cdP;
+    const double dabP = dezP * abP + aezP * bdP + bezP * daP;
+    const double perm = (dlift * abcP + clift * dabP) + (blift * cdaP + alift * bcdP);
+
+    const double lsum = (alift + blift) + (clift + dlift);
+    if (perm >= 0x1p-800 && perm <= DBL_MAX && lsum * (lsum * 0x1p-960) <= perm) {
+        const double bound = FDT_ISP_ERRBOUND * perm;
+        const int s = (det < -bound) - (det > bound);
+        if (s != 0)
+            return s;
+    }
+    return FDT_PRED_UNSURE;
+}
+
+/* As for orient3d: the proper filter takes the rounded differences
+ * A = a - e, ..., D = d - e. */
+static inline int fdt_insphere_filter(const double *a, const double *b,
+                                      const double *c, const double *d,
+                                      const double *e)
+{
+    const double A[3] = {a[0] - e[0], a[1] - e[1], a[2] - e[2]};
+    const double B[3] = {b[0] - e[0], b[1] - e[1], b[2] - e[2]};
+    const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
+    const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
+    return fdt_insphere_filter_diff(A, B, C, D);
+}
+
+#endif

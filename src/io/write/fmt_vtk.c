@@ -1,0 +1,247 @@
+/* VTK: XML .vtu (appended raw, ParaView) and legacy ASCII .vtk
+ * (src/io/write/formats.h). */
+#include "io/write/formats.h"
+
+static int host_is_little_endian(void)
+{
+    const uint16_t one = 1;
+    unsigned char b;
+    memcpy(&b, &one, 1);
+    return b == 1;
+}
+
+#define VTK_TETRA 10
+
+int fdt_put_vtu(out_file *o, const fdt_mesh_view *m, const void *prep, char *err, size_t errlen)
+{
+    (void)prep;
+    const char *path = o->path;
+
+    /* Appended raw data: each array is a UInt64 byte count followed by the
+     * bytes, in host order (byte_order says which); the offset attributes
+     * count from the first byte after '_'. */
+    uint64_t n = m->n_points, nt = m->n_tets;
+    uint64_t sz_pts = 3 * n * sizeof(double);
+    uint64_t sz_conn = 4 * nt * sizeof(int64_t);
+    uint64_t sz_off = nt * sizeof(int64_t);
+    uint64_t sz_typ = nt;
+    uint64_t off_pts = 0;
+    uint64_t off_conn = off_pts + 8 + sz_pts;
+    uint64_t off_off = off_conn + 8 + sz_conn;
+    uint64_t off_typ = off_off + 8 + sz_off;
+
+    char head[2048];
+    int k = snprintf(head, sizeof head,
+        "<?xml version=\"1.0\"?>\n"
+        "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+        "byte_order=\"%s\" header_type=\"UInt64\">\n"
+        "  <UnstructuredGrid>\n"
+        "    <Piece NumberOfPoints=\"%llu\" NumberOfCells=\"%llu\">\n"
+        "      <Points>\n"
+        "        <DataArray type=\"Float64\" Name=\"Points\" "
+        "NumberOfComponents=\"3\" format=\"appended\" offset=\"%llu\"/>\n"
+        "      </Points>\n"
+        "      <Cells>\n"
+        "        <DataArray type=\"Int64\" Name=\"connectivity\" "
+        "format=\"appended\" offset=\"%llu\"/>\n"
+        "        <DataArray type=\"Int64\" Name=\"offsets\" "
+        "format=\"appended\" offset=\"%llu\"/>\n"
+        "        <DataArray type=\"UInt8\" Name=\"types\" "
+        "format=\"appended\" offset=\"%llu\"/>\n"
+        "      </Cells>\n"
+        "    </Piece>\n"
+        "  </UnstructuredGrid>\n"
+        "  <AppendedData encoding=\"raw\">\n"
+        "   _",
+        host_is_little_endian() ? "LittleEndian" : "BigEndian",
+        (unsigned long long)n, (unsigned long long)nt,
+        (unsigned long long)off_pts, (unsigned long long)off_conn,
+        (unsigned long long)off_off, (unsigned long long)off_typ);
+    if (k < 0 || (size_t)k >= sizeof head) {
+        return set_errno_err(err, errlen, path, EOVERFLOW);
+    }
+    out_bytes(o, head, (size_t)k);
+
+    out_bytes(o, &sz_pts, 8);
+    out_bytes(o, m->xyz, (size_t)sz_pts);
+
+    out_bytes(o, &sz_conn, 8);
+    for (size_t i = 0; i < 4 * m->n_tets && !o->err; i++) {
+        int64_t v = m->tets[i];
+        char *p = out_room(o, 8);
+        memcpy(p, &v, 8);
+        o->len += 8;
+    }
+    out_bytes(o, &sz_off, 8);
+    for (size_t t = 0; t < m->n_tets && !o->err; t++) {
+        int64_t v = 4 * (int64_t)(t + 1);
+        char *p = out_room(o, 8);
+        memcpy(p, &v, 8);
+        o->len += 8;
+    }
+    out_bytes(o, &sz_typ, 8);
+    for (size_t t = 0; t < m->n_tets && !o->err; t++)
+        out_char(o, VTK_TETRA);
+    out_str(o, "\n  </AppendedData>\n</VTKFile>\n");
+    return FDT_IO_OK;
+}
+
+int fdt_put_vtk(out_file *o, const fdt_mesh_view *m, const void *prep, char *err, size_t errlen)
+{
+    (void)prep;
+    (void)err;
+    (void)errlen;
+
+    out_str(o, "# vtk DataFile Version 3.0\n"
+                "frontdt Delaunay tetrahedralization\n"
+                "ASCII\n"
+                "DATASET UNSTRUCTURED_GRID\n"
+                "POINTS ");
+    out_i64(o, (int64_t)m->n_points);
+    out_str(o, " double\n");
+    for (size_t i = 0; i < m->n_points && !o->err; i++) {
+        out_double(o, m->xyz[3 * i]);
+        out_char(o, ' ');
+        out_double(o, m->xyz[3 * i + 1]);
+        out_char(o, ' ');
+        out_double(o, m->xyz[3 * i + 2]);
+        out_char(o, '\n');
+    }
+    /* CELLS <cells> <list size>: each cell is its count then its ids. */
+    out_str(o, "CELLS ");
+    out_i64(o, (int64_t)m->n_tets);
+    out_char(o, ' ');
+    out_i64(o, 5 * (int64_t)m->n_tets);
+    out_char(o, '\n');
+    for (size_t t = 0; t < m->n_tets && !o->err; t++) {
+        out_char(o, '4');
+        for (int c = 0; c < 4; c++) {
+            out_char(o, ' ');
+            out_i64(o, m->tets[4 * t + (size_t)c]);
+        }
+        out_char(o, '\n');
+    }
+    out_str(o, "CELL_TYPES ");
+    out_i64(o, (int64_t)m->n_tets);
+    out_char(o, '\n');
+    for (size_t t = 0; t < m->n_tets && !o->err; t++)
+        out_str(o, "10\n");
+    return FDT_IO_OK;
+}
+
+
+/* ------------------------------------------------------------------------ */
+/* Streaming .vtu (src/io/write/formats.h)                                           */
+/* ------------------------------------------------------------------------ */
+
+/*
+ * The same file as fdt_put_vtu, laid out for a tet count known only at
+ * the end: the points (known) first, then the connectivity as the tets
+ * come, then the offsets and types (arithmetic: 4(t+1) and 10, written at
+ * the end from the count). What depends on the count (NumberOfCells, the
+ * offset attributes of the last two arrays, the connectivity's byte
+ * count) is written as a fixed-width placeholder and patched: the numbers
+ * as 20 zero-padded digits (VTK and meshio parse them as decimal), the
+ * byte count as its 8 raw bytes.
+ */
+#define VTU_NUM_WIDTH 20
+
+/* Puts "<prefix><20-digit placeholder>" and remembers where the digits are. */
+static void vtu_placeholder(out_file *o, const char *prefix, uint64_t *mark)
+{
+    out_str(o, prefix);
+    *mark = out_tell(o);
+    out_str(o, "00000000000000000000");
+}
+
+static void vtu_patch_num(out_file *o, uint64_t mark, uint64_t v)
+{
+    char p[VTU_NUM_WIDTH + 1];
+    snprintf(p, sizeof p, "%020llu", (unsigned long long)v);
+    out_patch(o, mark, p, VTU_NUM_WIDTH);
+}
+
+static int vtu_begin(fdt_stream_out *s, char *err, size_t errlen)
+{
+    out_file *o = &s->files[0];
+    uint64_t n = s->n_points;
+    uint64_t sz_pts = 3 * n * sizeof(double);
+    char line[512];
+    int k = snprintf(line, sizeof line,
+        "<?xml version=\"1.0\"?>\n"
+        "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+        "byte_order=\"%s\" header_type=\"UInt64\">\n"
+        "  <UnstructuredGrid>\n"
+        "    <Piece NumberOfPoints=\"%llu\" NumberOfCells=\"",
+        host_is_little_endian() ? "LittleEndian" : "BigEndian", (unsigned long long)n);
+    if (k < 0 || (size_t)k >= sizeof line)
+        return set_errno_err(err, errlen, o->path, EOVERFLOW);
+    out_bytes(o, line, (size_t)k);
+    s->mark[0] = out_tell(o);
+    out_str(o, "00000000000000000000\">\n"
+               "      <Points>\n"
+               "        <DataArray type=\"Float64\" Name=\"Points\" "
+               "NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/>\n"
+               "      </Points>\n"
+               "      <Cells>\n"
+               "        <DataArray type=\"Int64\" Name=\"connectivity\" "
+               "format=\"appended\" offset=\"");
+    out_i64(o, (int64_t)(8 + sz_pts));
+    vtu_placeholder(o, "\"/>\n        <DataArray type=\"Int64\" Name=\"offsets\" "
+                       "format=\"appended\" offset=\"", &s->mark[1]);
+    vtu_placeholder(o, "\"/>\n        <DataArray type=\"UInt8\" Name=\"types\" "
+                       "format=\"appended\" offset=\"", &s->mark[2]);
+    out_str(o, "\"/>\n"
+               "      </Cells>\n"
+               "    </Piece>\n"
+               "  </UnstructuredGrid>\n"
+               "  <AppendedData encoding=\"raw\">\n"
+               "   _");
+    /* the appended offsets count from the byte after '_' */
+    s->mark[3] = out_tell(o);
+    out_bytes(o, &sz_pts, 8);
+    out_bytes(o, s->xyz, (size_t)sz_pts);
+    uint64_t zero = 0; /* the connectivity's byte count, patched */
+    out_bytes(o, &zero, 8);
+    return FDT_IO_OK;
+}
+
+static void vtu_tets(fdt_stream_out *s, const fdt_vid *t, size_t count)
+{
+    out_file *o = &s->files[0];
+    for (size_t i = 0; i < 4 * count && !o->err; i++) {
+        int64_t v = t[i];
+        char *p = out_room(o, 8);
+        memcpy(p, &v, 8);
+        o->len += 8;
+    }
+}
+
+static int vtu_finish(fdt_stream_out *s, char *err, size_t errlen)
+{
+    (void)err;
+    (void)errlen;
+    out_file *o = &s->files[0];
+    uint64_t nt = s->n_tets, n = s->n_points;
+    uint64_t sz_pts = 3 * n * sizeof(double);
+    uint64_t sz_conn = 4 * nt * sizeof(int64_t), sz_off = nt * sizeof(int64_t);
+    uint64_t off_off = 8 + sz_pts + 8 + sz_conn, off_typ = off_off + 8 + sz_off;
+    out_bytes(o, &sz_off, 8);
+    for (uint64_t t = 0; t < nt && !o->err; t++) {
+        int64_t v = 4 * (int64_t)(t + 1);
+        char *p = out_room(o, 8);
+        memcpy(p, &v, 8);
+        o->len += 8;
+    }
+    out_bytes(o, &nt, 8); /* the types' byte count: one a cell */
+    for (uint64_t t = 0; t < nt && !o->err; t++)
+        out_char(o, VTK_TETRA);
+    out_str(o, "\n  </AppendedData>\n</VTKFile>\n");
+    vtu_patch_num(o, s->mark[0], nt);
+    vtu_patch_num(o, s->mark[1], off_off);
+    vtu_patch_num(o, s->mark[2], off_typ);
+    out_patch(o, s->mark[3] + 8 + sz_pts, &sz_conn, 8);
+    return FDT_IO_OK;
+}
+
+const fdt_stream_fmt fdt_stream_vtu = {1, vtu_begin, vtu_tets, NULL, vtu_finish};

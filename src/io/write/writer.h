@@ -1,0 +1,147 @@
+/*
+ * Mesh writers: the internal entry points behind the public fdt_write_mesh
+ * (include/frontdt.h; its adaptor is at the end of src/io/write/writer.c), used
+ * directly by the CLI and the tests.
+ * Every file is written to a temporary file in the same directory and
+ * renamed over the target only when complete: an interrupted or failed run
+ * leaves no partial output. fdt_io_cleanup_temps() is async-signal-safe and
+ * removes every temporary file still open (for SIGINT/SIGTERM handlers).
+ */
+#ifndef FDT_WRITER_H
+#define FDT_WRITER_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include "frontdt.h"
+
+typedef struct fdt_mesh_view {
+    const double *xyz;       /* 3 * n_points input coordinates (borrowed) */
+    size_t n_points;         /* input points, duplicates included */
+    const fdt_vid *tets;     /* 4 per tet, input numbering, positive */
+    size_t n_tets;
+    const fdt_tid *nbrs;     /* 4 per tet or NULL (required for .ele) */
+    const fdt_vid *hull;     /* 3 per hull face, outward */
+    size_t n_hull;
+    /* The face list of fdt_result_faces, or NULL (required by the formats
+     * whose row needs FDT_NEED_FACES, and by all_faces). */
+    const fdt_vid *faces;    /* 3 per face, tets[2i] on the positive side */
+    const fdt_tid *face_tets;/* 2 per face, -1 on the hull */
+    size_t n_faces;
+    int all_faces;           /* TetGen .face: every face (TetGen -f) */
+} fdt_mesh_view;
+
+typedef struct fdt_format fdt_format; /* a row of src/io/write/formats.h's table */
+
+/* What a row needs in the fdt_mesh_view beyond points and tets. */
+enum {
+    FDT_NEED_NBRS = 1,  /* tet neighbours */
+    FDT_NEED_FACES = 2, /* the face list (fdt_result_faces) */
+    FDT_NEED_SORTED = 4 /* canonical tet order (fdt_result_sort) */
+};
+
+
+/* The row named name (--format), or NULL. */
+const fdt_format *fdt_format_by_name(const char *name);
+/* The row path's extension chooses (a directory format: its last
+ * component, "polyMesh"), or NULL. */
+const fdt_format *fdt_format_by_path(const char *path);
+/* The row's name and whether it is text (may go to standard output). */
+const char *fdt_format_name(const fdt_format *f);
+int fdt_format_is_text(const fdt_format *f);
+/* Whether writing with f needs tet neighbours, the face list, canonical
+ * order (FDT_NEED_* of src/io/write/formats.h, or'ed). */
+int fdt_format_needs(const fdt_format *f, int all_faces);
+/* "name (.ext, .ext)" of every row, comma separated, for messages. */
+const char *fdt_format_list(void);
+
+/*
+ * Writes the mesh in the format given by path's extension:
+ *   .tets  canonical text: one tet per line, its 4 ids ascending, lines in
+ *          ascending order. The tets must already be in canonical order
+ *          (fdt_result_sort); this is verified, not assumed.
+ *   .ele   TetGen: BASE.node, BASE.ele, BASE.face, BASE.neigh, 0-based.
+ *   .vtu   VTK XML UnstructuredGrid (ParaView), every input point.
+ *   .vtk   VTK legacy unstructured grid.
+ * Returns FDT_IO_OK or an FDT_IO_* code with a message in err.
+ */
+int fdt_wr_mesh(const char *path, const fdt_mesh_view *m, char *err,
+                   size_t errlen);
+/* The same in format f (NULL: by path's extension). A directory format
+ * (OpenFOAM polyMesh) is written to a temporary directory beside path and
+ * renamed to path at the end when path does not exist yet; when path is an
+ * existing directory, each of its files is replaced by its own
+ * temporary-and-rename, all or none (other files there are left alone). */
+int fdt_wr_mesh_as(const char *path, const fdt_format *f, const fdt_mesh_view *m,
+                      char *err, size_t errlen);
+/* fdt_wr_mesh_as reporting the bytes written through progress (NULL:
+ * none), stage FDT_STAGE_WRITE, done of an estimated total
+ * (fdt_wr_estimate) summed over the output's files. */
+int fdt_wr_mesh_ex(const char *path, const fdt_format *f, const fdt_mesh_view *m,
+                   fdt_io_progress_fn progress, void *progress_user, char *err, size_t errlen);
+/* An estimate of the bytes format f writes for m, all files together:
+ * the progress total. Within a few tens of percent for the text formats
+ * (coordinates taken as 20 characters each). */
+uint64_t fdt_wr_estimate(const fdt_format *f, const fdt_mesh_view *m);
+/* A text format written to an open stream (standard output: no temporary,
+ * nothing renamed). Only single-file text formats. */
+int fdt_wr_mesh_stream(FILE *stream, const char *name, const fdt_format *f,
+                          const fdt_mesh_view *m, char *err, size_t errlen);
+int fdt_wr_mesh_stream_ex(FILE *stream, const char *name, const fdt_format *f,
+                          const fdt_mesh_view *m, fdt_io_progress_fn progress,
+                          void *progress_user, char *err, size_t errlen);
+
+/* The longest path the writer takes (its temporary names live in fixed
+ * buffers a signal handler can read), and the most files one output
+ * family writes (an OpenFOAM polyMesh: five). */
+#define FDT_IO_PATH 4096
+#define FDT_IO_MAX_FILES 5
+
+/*
+ * The files fdt_wr_mesh(path, ...) writes, in the order it writes them,
+ * into names[0..count): path alone for .tets, .vtu and .vtk; for .ele,
+ * BASE.node, path itself, BASE.face and BASE.neigh (BASE is path without
+ * ".ele"; the siblings' extensions are lowercase whatever the case of
+ * ".ele"). The writer builds its file set from this list, so a check made
+ * on it covers every file a run will replace. Returns the count, 0 for an
+ * unknown extension, -1 when a name would not fit FDT_IO_PATH.
+ */
+int fdt_output_files(const char *path,
+                     char names[FDT_IO_MAX_FILES][FDT_IO_PATH]);
+/* The same for format f (NULL: by extension); a directory format lists
+ * the files in the directory path. */
+int fdt_output_files_as(const char *path, const fdt_format *f,
+                        char names[FDT_IO_MAX_FILES][FDT_IO_PATH]);
+
+/*
+ * Do paths a and b reach the same file? 1 if so, else 0. Each path stands
+ * for the file that opening it would read or create, symbolic links
+ * followed (a dangling link stands for the file it would create):
+ *   - an existing file is known by (st_dev, st_ino), so "./x", "d/../x",
+ *     an absolute path, a symbolic link and a hard link all match it;
+ *   - a name not there yet is known by its directory's (st_dev, st_ino)
+ *     and its last component, compared byte for byte (a case-insensitive
+ *     file system's "A" and "a" are not matched while neither exists).
+ * Equal strings always match. A path that cannot be resolved (a missing
+ * directory, no permission, a loop of links) matches only its own string:
+ * whatever then tries to use it fails on its own.
+ */
+int fdt_same_file(const char *a, const char *b);
+
+/*
+ * A small file written with stdio through the same temporary-and-rename
+ * (and signal cleanup) as the mesh: the CLI's --stats-json. open returns
+ * the stream of the temporary (NULL and a message in err on failure);
+ * commit closes it and renames it over target (FDT_IO_OK or a writer
+ * code, the message in err, the temporary removed); abandon removes it.
+ * Either frees side.
+ */
+typedef struct fdt_wr_side fdt_wr_side;
+FILE *fdt_wr_side_open(const char *target, fdt_wr_side **side, char *err, size_t errlen);
+int fdt_wr_side_commit(fdt_wr_side *side, char *err, size_t errlen);
+void fdt_wr_side_abandon(fdt_wr_side *side);
+
+/* Removes every temporary output file not yet renamed. Async-signal-safe. */
+void fdt_io_cleanup_temps(void);
+
+#endif

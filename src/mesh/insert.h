@@ -1,0 +1,195 @@
+/*
+ * The perturbed Delaunay tetrahedralization of one partition's points by
+ * incremental (Bowyer-Watson) insertion: the second apex oracle of the
+ * front. Where the kd search must test thousands of points to certify a
+ * face's apex (scans, CFD grids, cylinders, near-cospherical sets), the
+ * front reads the apex from this DT's adjacency instead. The perturbed DT
+ * is unique (src/geom/predicates.h), so this kernel and the kd search give the
+ * same apex for every face and the two can be mixed face by face.
+ *
+ * Representation (CGAL's Triangulation_data_structure_3, in flat arrays):
+ *   - tet slot t holds T[8t .. 8t+3], its four vertices (global point ids;
+ *     FDT_NONE is the infinite vertex), and T[8t+4 .. 8t+7], its four
+ *     neighbours: entry 4+k is the neighbour across the face opposite
+ *     vertex k, packed as 4 * neighbour + (index of that face in the
+ *     neighbour);
+ *   - finite tets are positively oriented (fdt_orient3d > 0); an infinite
+ *     tet lies over one hull face, and is "positive" in the sense that
+ *     putting any point strictly outside that hull face in place of the
+ *     infinite vertex gives a positively oriented tet;
+ *   - freed slots are recycled (a free list through them): a freed slot
+ *     has FDT_NONE as vertex 0 and vertex 1 (a live tet has at most one).
+ * Memory: 32 bytes a slot and about 6.7 slots a point (6.5 finite tets a
+ * point on uniform points, plus the hull's infinite tets and growth
+ * slack), plus 4 bytes a point for the incident-tet table: about 220
+ * bytes a point kept. During the build also 1 byte a slot (conflict
+ * marks) and 4 bytes a point (insertion order), and the cavity scratch.
+ *
+ * Threads: fdt_ins_build runs on one thread, fdt_ins_build_parallel on
+ * several; afterwards the structure is immutable and any thread may query
+ * it.
+ */
+#ifndef FDT_INSERT_H
+#define FDT_INSERT_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "frontdt.h"
+#include "geom/kdtree.h"
+#include "geom/predicates.h"
+
+/* Work counters of one build (fdt_ins.stats). */
+typedef struct fdt_ins_stats {
+    size_t inserted;      /* points inserted (n) */
+    size_t walk_steps;    /* tets visited by point location */
+    size_t cavity_tets;   /* tets destroyed (sum of the cavity sizes) */
+    size_t created_tets;  /* tets created */
+    size_t max_cavity;    /* largest cavity */
+    size_t conflict_tests;/* conflict (insphere / hull side) tests */
+    size_t deferred;      /* fdt_ins_build_parallel: insertions put off (a tet held
+                           * by another thread, or the slots spent) */
+    size_t serial_finish; /* fdt_ins_build_parallel: points left to its serial end */
+    size_t stolen;        /* fdt_ins_build_parallel: points a worker took from the
+                           * end of another's last round */
+    /* fdt_ins_build_parallel: thread CPU seconds of its serial start, of
+     * its workers (the busiest one, and all together) and of its serial
+     * end (finish included). start + workers_max + finish is the wall
+     * time with a free core a worker. */
+    double cpu_start_s, cpu_workers_max_s, cpu_workers_sum_s, cpu_finish_s;
+} fdt_ins_stats;
+
+typedef struct fdt_ins {
+    const double *P;      /* borrowed: global coordinates, 3 per id */
+    uint32_t base, n;     /* the points: global ids [base, base + n) */
+    uint32_t *T;          /* owned: 8 per slot, see above */
+    uint32_t nslots;      /* slots in use or freed ([0, nslots) are valid) */
+    uint32_t cap;         /* slots allocated */
+    uint32_t free_head;   /* first freed slot, FDT_NONE if none */
+    uint32_t *vtet;       /* owned: n entries, a live tet holding id base + i */
+    size_t nfinite;       /* finite tets */
+    size_t ninfinite;     /* infinite tets = hull faces */
+    fdt_ins_stats stats;
+} fdt_ins;
+
+/*
+ * Builds the perturbed DT of the points with global ids [base, base + n)
+ * of P (3 doubles per id; borrowed, and it must outlive m). The points must
+ * be pairwise distinct; they should be in a spatially coherent order (the
+ * kd-tree's), which the insertion order (BRIO) keeps within its rounds.
+ * cnt (may be NULL) counts the predicate calls that needed exact
+ * arithmetic.
+ * Returns FDT_OK; FDT_EDEGENERATE when the points do not span 3-D space
+ * (n < 4, all collinear or all coplanar): a clean refusal, the caller keeps
+ * its kd search; FDT_EINVAL when two points coincide (found when the second
+ * is inserted); FDT_ETOOBIG when the tets would not fit the packed 30-bit
+ * neighbour references; FDT_ENOMEM; FDT_EINTERNAL if an invariant failed
+ * (a bug). On any error m holds nothing (fdt_ins_free is still allowed).
+ */
+int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                  fdt_pred_counts *cnt);
+/*
+ * The same DT as fdt_ins_build (the same set of tets and hull faces; the
+ * slot numbering differs), built by nthreads threads (src/mesh/insert_par.c):
+ * the first BRIO rounds serially, then the threads insert the rest
+ * concurrently, each from its own region of the id (kd) order, under
+ * per-tet try-locks; points whose cavities keep meeting another thread's
+ * are inserted at the end on the calling thread. nthreads < 1 counts as
+ * 1, over 63 as 63; the caller's thread is one of them. Same arguments,
+ * results and errors as fdt_ins_build; on any error m holds nothing.
+ * Memory: the slots are reserved up front from the serial rounds' slots
+ * a point (x1.35, so about 300 bytes a point kept on uniform points,
+ * against fdt_ins_build's 220), plus during the build 1 byte a slot
+ * (its lock and conflict mark) and 4 bytes a point (start hints).
+ */
+int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                           int nthreads, fdt_pred_counts *cnt);
+/* Frees what m owns and zeroes it; m may be zeroed or freed already. */
+void fdt_ins_free(fdt_ins *m);
+
+/* The four vertices of live slot t (FDT_NONE: the infinite vertex). */
+static inline const uint32_t *fdt_ins_tet(const fdt_ins *m, uint32_t t)
+{
+    return m->T + 8 * (size_t)t;
+}
+
+/* Whether slot t holds a finite tet (not infinite, not freed). */
+static inline int fdt_ins_is_finite(const fdt_ins *m, uint32_t t)
+{
+    const uint32_t *v = m->T + 8 * (size_t)t;
+    return v[0] != FDT_NONE && v[1] != FDT_NONE && v[2] != FDT_NONE && v[3] != FDT_NONE;
+}
+
+/* The first finite tet in a slot >= t, FDT_NONE if none: iterate with
+ * for (t = fdt_ins_next_finite(m, 0); t != FDT_NONE;
+ *      t = fdt_ins_next_finite(m, t + 1)). */
+uint32_t fdt_ins_next_finite(const fdt_ins *m, uint32_t t);
+
+/*
+ * The neighbour of tet `tet` across its face k (the face opposite vertex
+ * k): *ntet gets the neighbour's slot, *nk the index of the shared face in
+ * it. Returns the neighbour's vertex nk, the apex of that face seen from
+ * tet: a point id, or FDT_NONE when the neighbour is the infinite tet over
+ * a hull face (for a finite face). O(1).
+ */
+static inline uint32_t fdt_ins_across(const fdt_ins *m, uint32_t tet, int k,
+                                      uint32_t *ntet, int *nk)
+{
+    uint32_t r = m->T[8 * (size_t)tet + 4 + (unsigned)k];
+    *ntet = r >> 2;
+    *nk = (int)(r & 3);
+    return m->T[8 * (size_t)(r >> 2) + (r & 3)];
+}
+
+/*
+ * For the oriented face (a, b, c), whose open side is where
+ * fdt_orient3d(a, b, c, x) > 0, finds the tet of the DT on the open side
+ * that has abc as a face: *tet gets its slot and *k the index of face abc
+ * in it, so that vertex k of *tet is the apex (FDT_NONE when abc is a hull
+ * face whose open side is the outside). Returns 1 if found; 0 if abc is
+ * not a face of this DT, or a vertex lies outside [base, base + n) (the
+ * front also holds faces with vertices of other partitions).
+ * Cost: a breadth-first search of a's star (the tets incident to a) until
+ * it meets a tet with face abc: O(degree of a), about 25 tets on uniform
+ * points, but up to O(n) for a vertex joined to most points (cospherical
+ * sets: the perturbation makes one vertex's star hold most tets). Stars
+ * over 512 tets take a heap buffer; if that allocation fails the search
+ * falls back to a scan of all slots, so the answer is always right. Where
+ * the caller already holds a neighbouring tet, fdt_ins_across is O(1).
+ */
+int fdt_ins_find_face(const fdt_ins *m, uint32_t a, uint32_t b, uint32_t c,
+                      uint32_t *tet, int *k);
+
+/*
+ * Scratch of fdt_ins_conflict_vertices, owned by the querying thread:
+ * zero it to start, free it with fdt_ins_query_free.
+ */
+typedef struct fdt_ins_query {
+    uint32_t *tq, *tset;  /* the conflict region's tets, and their set */
+    size_t ntq, tcap;
+    uint32_t *vs, *vset;  /* the answer: its distinct finite vertices */
+    size_t nvs, vcap;
+    uint64_t rng;         /* the walk's choices */
+} fdt_ins_query;
+
+/*
+ * The vertices of the tets of m in conflict with the point q, which is not
+ * one of m's points: with m the DT of a point set S, they are the
+ * neighbours q would have in the DT of S + {q} (the cavity is star-shaped
+ * from q, so every vertex of a cavity tet is on its boundary). Adding more
+ * points never gives q a neighbour in S it did not have, so for a face
+ * (q, b, c) of the DT of any superset, the first point of S in the pencil
+ * of spheres through the face's circle is among them (src/par/parallel.c asks
+ * another part's mesh this way). Read-only on m: any number of threads may
+ * query one mesh at once, each with its own qs and hint (a slot to start
+ * the walk from, updated to where it ended; any value to start).
+ * On FDT_OK qs->vs[0 .. qs->nvs) holds the vertices; 1 when the region
+ * holds more than max_tets tets (no answer: a point just outside a large
+ * flat hull facet of m sees all of it); FDT_ENOMEM; FDT_EINTERNAL (a walk
+ * cycle, impossible in a regular triangulation). Cost: the walk plus the
+ * conflict region, a few dozen tets on well-spread points.
+ */
+int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
+                              size_t max_tets, fdt_ins_query *qs, fdt_pred_counts *cnt);
+void fdt_ins_query_free(fdt_ins_query *qs);
+
+#endif

@@ -1,0 +1,206 @@
+/*
+ * What src/mesh/insert.c (the serial build) and src/mesh/insert_par.c (the parallel
+ * build) share: the predicates' inline filters, the edge table that links
+ * a cavity's new tets, and the serial phases the parallel build starts and
+ * ends with. Internal to the insertion kernel; src/mesh/insert.h is its API.
+ */
+#ifndef FDT_INSERT_IMPL_H
+#define FDT_INSERT_IMPL_H
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include "mesh/insert.h"
+
+/* Neighbour references are 4 * slot + face in 32 bits. */
+#define INS_MAX_SLOTS (UINT32_C(1) << 30)
+#define PACK(t, k) (((uint32_t)(t) << 2) | (uint32_t)(k))
+#define INF FDT_NONE
+
+/* Conflict marks of a build, per slot. */
+enum { MARK_NONE = 0, MARK_IN = 1, MARK_OUT = 2 };
+
+static inline const double *ins_pt(const fdt_ins *m, uint32_t v)
+{
+    return m->P + 3 * (size_t)v;
+}
+
+/* The filters inline, the exact stages (and the rescaled filters) out of
+ * line: most calls end in the filter. */
+static inline int ins_orient(const double *a, const double *b, const double *c, const double *d,
+                             fdt_pred_counts *cnt)
+{
+    int s = fdt_orient3d_filter(a, b, c, d);
+    if (s != FDT_PRED_UNSURE)
+        return s;
+    return fdt_orient3d(a, b, c, d, cnt);
+}
+
+static inline int ins_insphere(const double *a, const double *b, const double *c,
+                               const double *d, const double *e, fdt_pred_counts *cnt)
+{
+    int s = fdt_insphere_filter(a, b, c, d, e);
+    if (s != FDT_PRED_UNSURE)
+        return s;
+    return fdt_insphere_perturbed(a, b, c, d, e, cnt);
+}
+
+/* For a face opposite vertex k, the edge of that face opposite its vertex
+ * i (i != k) has the vertices at the two other indices. */
+static const uint8_t ins_other2[4][4][2] = {
+    {{0, 0}, {2, 3}, {1, 3}, {1, 2}},
+    {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
+    {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
+    {{1, 2}, {0, 2}, {0, 1}, {0, 0}},
+};
+
+static inline int ins_grow_u32(uint32_t **a, size_t *cap, size_t need)
+{
+    if (need <= *cap)
+        return FDT_OK;
+    size_t nc = *cap ? *cap : 64;
+    while (nc < need)
+        nc += nc / 2 + 1;
+    uint32_t *p = realloc(*a, nc * sizeof *p);
+    if (!p)
+        return FDT_ENOMEM;
+    *a = p;
+    *cap = nc;
+    return FDT_OK;
+}
+
+/* The new tets' edges of one insertion: the two new faces through an edge
+ * of the cavity's boundary (besides the new point) are neighbours. */
+typedef struct ins_edge_slot {
+    uint64_t key;     /* the two vertex ids, smaller first */
+    uint32_t val;     /* packed face (new tet, index) waiting for its twin */
+    uint32_t stamp;   /* valid when equal to the table's current stamp */
+} ins_edge_slot;
+
+typedef struct ins_edges {
+    ins_edge_slot *eh;
+    uint32_t bits;    /* 2^bits slots (0: none yet) */
+    uint32_t stamp;
+} ins_edges;
+
+/* A table with room for `edges` keys at most half full, emptied: a new
+ * stamp invalidates every slot at once. */
+static inline int ins_edges_begin(ins_edges *e, size_t edges)
+{
+    uint32_t bits = e->bits ? e->bits : 6;
+    while (((size_t)1 << bits) < 2 * edges)
+        bits++;
+    if (bits != e->bits) {
+        ins_edge_slot *s = calloc((size_t)1 << bits, sizeof *s);
+        if (!s)
+            return FDT_ENOMEM;
+        free(e->eh);
+        e->eh = s;
+        e->bits = bits;
+        e->stamp = 0;
+    }
+    if (++e->stamp == 0) { /* wrapped: old stamps would read as valid */
+        memset(e->eh, 0, ((size_t)1 << e->bits) * sizeof *e->eh);
+        e->stamp = 1;
+    }
+    return FDT_OK;
+}
+
+/*
+ * Face `f` (packed) of a new tet contains the edge xy besides the new
+ * point: the other new tet through xy is its neighbour there. The first of
+ * the two to arrive waits in the table, the second links both. Returns 1
+ * when it linked.
+ */
+static inline int ins_link_edge(ins_edges *e, uint32_t *T, uint32_t x, uint32_t y, uint32_t f)
+{
+    uint64_t key = x < y ? ((uint64_t)x << 32) | y : ((uint64_t)y << 32) | x;
+    uint32_t mask = (UINT32_C(1) << e->bits) - 1;
+    uint32_t h = (uint32_t)((key * UINT64_C(0x9E3779B97F4A7C15)) >> (64 - e->bits));
+    for (;; h = (h + 1) & mask) {
+        ins_edge_slot *s = &e->eh[h];
+        if (s->stamp != e->stamp) {
+            s->stamp = e->stamp;
+            s->key = key;
+            s->val = f;
+            return 0;
+        }
+        if (s->key == key) {
+            uint32_t g = s->val;
+            T[8 * (size_t)(g >> 2) + 4 + (g & 3)] = f;
+            T[8 * (size_t)(f >> 2) + 4 + (f & 3)] = g;
+            s->key = UINT64_MAX; /* each edge is shared by exactly two faces */
+            return 1;
+        }
+    }
+}
+
+/*
+ * One tet of an insertion's star, in slot s: the cavity's boundary face
+ * bnd (packed: cavity tet c, face opposite its vertex k) with pid in place
+ * of vertex k, on the same side of the face as c's vertex k was (the
+ * cavity is star-shaped), so positively oriented. It takes over c's
+ * neighbour across the face and links its three other faces through the
+ * edge table (ins_link_edge). c must still be readable (its slot is freed
+ * after the star is built). Returns the number of faces it linked.
+ */
+static inline size_t ins_star_tet(uint32_t *T, ins_edges *e, uint32_t bnd, uint32_t pid,
+                                  uint32_t s)
+{
+    uint32_t c = bnd >> 2;
+    int k = (int)(bnd & 3);
+    uint32_t *nw = T + 8 * (size_t)s;
+    const uint32_t *cv = T + 8 * (size_t)c;
+    memcpy(nw, cv, 4 * sizeof *nw);
+    nw[k] = pid;
+    uint32_t o = cv[4 + k];
+    nw[4 + k] = o;
+    T[8 * (size_t)(o >> 2) + 4 + (o & 3)] = PACK(s, k);
+    size_t linked = 0;
+    for (int j = 0; j < 4; j++) {
+        if (j == k)
+            continue;
+        linked += (size_t)ins_link_edge(e, T, nw[ins_other2[k][j][0]], nw[ins_other2[k][j][1]],
+                                        PACK(s, j));
+    }
+    return linked;
+}
+
+/*
+ * order[] = the ids [base, base + n) of P's points by BRIO round
+ * (src/mesh/insert.c), the first round first, the point nearest the centre of
+ * their bounding box at order[0]; round_end[r] (r = 0 .. *nrounds - 1) is
+ * the end of round r in order[]. round_end has room for 32 entries.
+ */
+void fdt_ins_brio(const double *P, uint32_t base, uint32_t n, uint32_t *order,
+                  uint32_t *round_end, int *nrounds);
+
+/*
+ * The serial start of a build: m is set up for the points [base, base +
+ * n) of P with room for `slots` tets (more if the serial phase needs it),
+ * the first tetrahedron is found in order[0 .. n) (first[] gets its four
+ * ids) and order[0 .. prefix) is inserted, first[] skipped. On error m
+ * holds nothing.
+ */
+int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                         const uint32_t *order, uint32_t prefix, uint64_t slots,
+                         uint32_t first[4], fdt_pred_counts *cnt);
+
+/*
+ * The end of a build, once every point is in: the incident-tet table, the
+ * finite and infinite counts, and the free list rebuilt through every
+ * freed slot of [0, nslots). FDT_EINTERNAL if a point is in no tet,
+ * FDT_ENOMEM; on error m holds nothing.
+ */
+int fdt_ins_finish(fdt_ins *m);
+
+/*
+ * fdt_ins_build_parallel with the slots' first capacity forced to
+ * slots_a_point a point (0: its own estimate): the tests make it small,
+ * so the workers run out of slots and the arrays grow between passes,
+ * then in the serial finish.
+ */
+int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                                 int nthreads, double slots_a_point, fdt_pred_counts *cnt);
+
+#endif

@@ -1,0 +1,539 @@
+/*
+ * The distributed output of frontdt-mpi (src/mpi/mpi_output.h; issue 19): one
+ * piece a rank, in input numbering, and an index by rank 0; the .node of
+ * a .pele written by every rank into one file. No rank ever holds more
+ * than its own tets and a 1/p share of the points.
+ */
+#include "mpi/mpi_output.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <inttypes.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "io/write/formats.h"
+#include "io/write/outfile.h"
+#include "base/sethash.h"
+#include "io/write/writer.h"
+
+/* ---- names ---------------------------------------------------------------- */
+
+static const char *const index_ext[] = {NULL, ".pvtu", ".pfdtb", ".pele"};
+static const char *const piece_ext[] = {NULL, ".vtu", ".fdtb", ".ele"};
+static const char *const format_word[] = {NULL, "vtu", "fdtb", "ele"};
+
+int fdt_mpo_kind(const char *path)
+{
+    size_t n = strlen(path);
+    for (int k = FDT_MPO_VTU; k <= FDT_MPO_ELE; k++) {
+        size_t e = strlen(index_ext[k]);
+        if (n > e && strcasecmp(path + n - e, index_ext[k]) == 0)
+            return k;
+    }
+    return FDT_MPO_GATHER;
+}
+
+/* BASE + mid + ext beside the index path (BASE: path less its extension).
+ * 0, or -1 if it does not fit. */
+static int sibling(const char *path, int kind, const char *mid, const char *ext, char *out,
+                   size_t len)
+{
+    size_t n = strlen(path) - strlen(index_ext[kind]);
+    int k = snprintf(out, len, "%.*s%s%s", (int)n, path, mid, ext);
+    return k < 0 || (size_t)k >= len ? -1 : 0;
+}
+
+/* A rank's piece: .vtu, .fdtb or .ele (face: its .face beside it). */
+static int piece_name(const char *path, int kind, int rank, int face, char *out, size_t len)
+{
+    char mid[24];
+    snprintf(mid, sizeof mid, "_%d", rank);
+    return sibling(path, kind, mid, face ? ".face" : piece_ext[kind], out, len);
+}
+
+int fdt_mpo_file(const char *path, int size, size_t k, char *out, size_t len)
+{
+    int kind = fdt_mpo_kind(path);
+    if (kind == FDT_MPO_GATHER)
+        return 0;
+    int rc;
+    if (k < (size_t)size)
+        rc = piece_name(path, kind, (int)k, 0, out, len);
+    else if (kind != FDT_MPO_ELE)
+        return 0;
+    else if (k < 2 * (size_t)size)
+        rc = piece_name(path, kind, (int)(k - (size_t)size), 1, out, len);
+    else if (k == 2 * (size_t)size)
+        rc = sibling(path, kind, "", ".node", out, len);
+    else
+        return 0;
+    return rc ? -1 : 1;
+}
+
+/* The name relative to the index's directory. */
+static const char *rel_name(const char *name)
+{
+    const char *slash = strrchr(name, '/');
+    return slash ? slash + 1 : name;
+}
+
+/* ---- signal cleanup --------------------------------------------------------
+ *
+ * From the moment a rank starts its piece until every rank has passed the
+ * barrier after the index (complete) or after the removals (failed), an
+ * interrupt removes this rank's pieces, the .node and the index (any rank
+ * may: they name the same files), so an index never outlives a file it
+ * names and nothing partial is left. The names are written while live is
+ * 0 and published by the store of 1 after them (volatile accesses keep
+ * their order; the handler runs on this thread). */
+enum { LIVE_MAX = 4 };
+static char live_path[LIVE_MAX][FDT_IO_PATH];
+static volatile sig_atomic_t live_n;
+
+void fdt_mpo_cleanup(void)
+{
+    for (int i = 0; i < live_n; i++)
+        (void)unlink(live_path[i]);
+}
+
+/* ---- pieces ---------------------------------------------------------------- */
+
+static int io_code(int io)
+{
+    return io == FDT_IO_OK ? FDT_OK : io == FDT_IO_ENOMEM ? FDT_ENOMEM : FDT_EIO;
+}
+
+/* .vtu: the rank's tets over the points they use (ids: their input ids,
+ * ascending; xyz their coordinates), renumbered 0..npts-1 in that order. */
+static int write_vtu(const char *name, const fdt_mpi_out *r, char *diag, size_t dlen)
+{
+    size_t nt = r->own_ntets, npts = r->own_npts;
+    const fdt_vid *ids = r->own_ids, *tets = r->own_tets;
+    fdt_vid *lt = malloc((4 * nt + 1) * sizeof *lt);
+    if (!lt) {
+        snprintf(diag, dlen, "out of memory writing a piece");
+        return FDT_ENOMEM;
+    }
+    for (size_t i = 0; i < 4 * nt; i++) {
+        /* ids is sorted and holds every id the tets use */
+        size_t lo = 0, hi = npts;
+        while (hi - lo > 1) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (ids[mid] <= tets[i])
+                lo = mid;
+            else
+                hi = mid;
+        }
+        lt[i] = (fdt_vid)lo;
+    }
+    fdt_mesh_view v;
+    memset(&v, 0, sizeof v);
+    v.xyz = r->own_xyz;
+    v.n_points = npts;
+    v.tets = lt;
+    v.n_tets = nt;
+    int err = io_code(fdt_wr_mesh_as(name, fdt_format_by_name("vtu"), &v, diag, dlen));
+    free(lt);
+    return err;
+}
+
+/* Opens k temporaries, puts the piece, commits all or none (src/io/write/writer.c). */
+static int write_files(char (*names)[FDT_IO_PATH], int k, int kind, uint64_t n_input,
+                       const fdt_mpi_out *r, char *diag, size_t dlen)
+{
+    out_file f[2];
+    int nopen = 0, e = 0;
+    fdt_write_lock();
+    for (; nopen < k && !e; nopen++)
+        if ((e = fdt_out_open(&f[nopen], names[nopen])) != 0)
+            break;
+    fdt_write_unlock();
+    if (e) {
+        int code = io_code(set_errno_err(diag, dlen, names[nopen], e));
+        fdt_write_lock();
+        for (int i = 0; i < nopen; i++)
+            fdt_out_abandon(&f[i]);
+        fdt_write_unlock();
+        return code;
+    }
+    if (kind == FDT_MPO_BIN) {
+        fdt_put_bin_piece(&f[0], n_input, r->own_tets, r->own_ntets, r->own_hull, r->own_nhull);
+    } else {
+        fdt_mesh_view v;
+        memset(&v, 0, sizeof v);
+        v.n_points = n_input;
+        v.tets = r->own_tets;
+        v.n_tets = r->own_ntets;
+        v.hull = r->own_hull;
+        v.n_hull = r->own_nhull;
+        fdt_put_tetgen_ele(&f[0], &v, NULL, diag, dlen);
+        fdt_put_tetgen_face(&f[1], &v, NULL, diag, dlen);
+    }
+    fdt_write_lock();
+    int rc = io_code(fdt_out_commit(f, k, diag, dlen));
+    fdt_write_unlock();
+    return rc;
+}
+
+/* ---- the collective .node -------------------------------------------------
+ *
+ * The serial .node is "N 3 0 0" and then a line "ID X Y Z" an input point
+ * in input order, the coordinates as read in %.17g (src/io/write/fmt_tetgen.c).
+ * Rank q takes the input ids [N q/p, N (q+1)/p): every rank sends each of
+ * its points (the setup's in_id/in_xyz, duplicates included) to the rank
+ * of its id (one MPI_Alltoallv of 32 bytes a point), formats its lines
+ * exactly as the serial writer does, and an MPI_Exscan of the byte counts
+ * gives each rank its offset. Rank 0 creates the temporary (src/io/write/writer.c,
+ * so the rename and the signal cleanup are the usual ones) and writes the
+ * header and its lines through it; the others pwrite theirs into the same
+ * file, close it, and only after all have (an MPI_Allreduce) does rank 0
+ * commit: the renamed file is complete, or nothing is renamed. */
+typedef struct nrec {
+    double x[3];
+    uint64_t id;
+} nrec;
+
+static size_t block_start(uint64_t n, int size, int q)
+{
+    return (size_t)(n * (uint64_t)q / (uint64_t)size);
+}
+
+static int block_owner(uint64_t n, int size, uint64_t id)
+{
+    int q = (int)(id * (uint64_t)size / n);
+    while (q + 1 < size && block_start(n, size, q + 1) <= id)
+        q++;
+    while (q > 0 && block_start(n, size, q) > id)
+        q--;
+    return q;
+}
+
+static int pwrite_all(int fd, const char *p, size_t n, uint64_t at)
+{
+    while (n > 0) {
+        ssize_t k = pwrite(fd, p, n, (off_t)at);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0)
+            return k < 0 ? errno : EIO;
+        p += k;
+        n -= (size_t)k;
+        at += (uint64_t)k;
+    }
+    return 0;
+}
+
+static int write_node(MPI_Comm comm, const char *name, const fdt_mpi_local *L, uint64_t *io,
+                      char *diag, size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    uint64_t n = L->n;
+    size_t lo = block_start(n, size, rank), nmine = block_start(n, size, rank + 1) - lo;
+    int *c = malloc(4 * (size_t)size * sizeof *c);
+    nrec *sb = malloc((L->nin + 1) * sizeof *sb), *rb = malloc((nmine + 1) * sizeof *rb);
+    char *text = malloc(nmine * 100 + 64);
+    int err = c && sb && rb && text ? FDT_OK : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory writing %s", name);
+    out_file of;
+    int of_open = 0;
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+        goto done;
+    int *sc = c, *sd = c + size, *rc = c + 2 * size, *rd = c + 3 * size;
+    memset(sc, 0, (size_t)size * sizeof *sc);
+    for (size_t i = 0; i < L->nin; i++)
+        sc[block_owner(n, size, (uint64_t)(uint32_t)L->in_id[i])]++;
+    MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, comm);
+    size_t nr = 0;
+    for (int q = 0, at = 0; q < size; q++) {
+        sd[q] = at;
+        at += sc[q];
+        rd[q] = (int)nr;
+        nr += (size_t)rc[q];
+        if (q != rank)
+            io[1] += (uint64_t)sc[q] * sizeof(nrec);
+    }
+    /* counting sort by destination (sd[] moves on; put back below) */
+    for (size_t i = 0; i < L->nin; i++) {
+        int q = block_owner(n, size, (uint64_t)(uint32_t)L->in_id[i]);
+        nrec *p = &sb[sd[q]++];
+        memcpy(p->x, L->in_xyz + 3 * i, sizeof p->x);
+        p->id = (uint64_t)(uint32_t)L->in_id[i];
+    }
+    for (int q = 0; q < size; q++)
+        sd[q] -= sc[q];
+    MPI_Datatype nt;
+    MPI_Type_contiguous((int)sizeof(nrec), MPI_BYTE, &nt);
+    MPI_Type_commit(&nt);
+    nrec *tmp = malloc((nr + 1) * sizeof *tmp);
+    err = tmp && nr == nmine ? FDT_OK : tmp ? FDT_EINTERNAL : FDT_ENOMEM;
+    snprintf(diag, dlen, "%s writing %s", err == FDT_ENOMEM ? "out of memory" : "points lost",
+             name);
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) == FDT_OK)
+        MPI_Alltoallv(sb, sc, sd, nt, tmp, rc, rd, nt, comm);
+    MPI_Type_free(&nt);
+    /* each id of the block exactly once (the setup's in_id partition the
+     * input), placed by id */
+    unsigned char *seen = err ? NULL : calloc(nmine + 1, 1);
+    if (!err && !seen)
+        err = FDT_ENOMEM;
+    for (size_t i = 0; !err && i < nr; i++) {
+        size_t j = (size_t)tmp[i].id - lo;
+        if (tmp[i].id < lo || j >= nmine || seen[j]) {
+            err = FDT_EINTERNAL;
+            snprintf(diag, dlen, "input id %" PRIu64 " twice or outside its block writing %s",
+                     tmp[i].id, name);
+            break;
+        }
+        seen[j] = 1;
+        rb[j] = tmp[i];
+    }
+    free(tmp);
+    free(seen);
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+        goto done;
+    /* the lines, as src/io/write/fmt_tetgen.c's fdt_put_tetgen_node writes them */
+    size_t len = 0;
+    if (rank == 0) {
+        len += fmt_u64(text, n);
+        memcpy(text + len, " 3 0 0\n", 7);
+        len += 7;
+    }
+    for (size_t i = 0; i < nmine && !err; i++) {
+        len += fmt_u64(text + len, lo + i);
+        for (int d = 0; d < 3; d++) {
+            text[len++] = ' ';
+            int k = snprintf(text + len, OUT_MAX_ITEM, "%.17g", rb[i].x[d]);
+            if (k < 0 || k >= OUT_MAX_ITEM) {
+                err = FDT_EINTERNAL;
+                snprintf(diag, dlen, "%s: a coordinate does not format", name);
+                break;
+            }
+            len += (size_t)k;
+        }
+        text[len++] = '\n';
+    }
+    uint64_t mylen = len, off = 0;
+    MPI_Exscan(&mylen, &off, 1, MPI_UINT64_T, MPI_SUM, comm);
+    if (rank == 0)
+        off = 0; /* MPI_Exscan leaves rank 0's undefined */
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+        goto done;
+    /* rank 0's temporary, its path to every rank */
+    char tpath[FDT_IO_PATH] = "";
+    if (rank == 0) {
+        fdt_write_lock();
+        int e = fdt_out_open(&of, name);
+        fdt_write_unlock();
+        if (e)
+            err = io_code(set_errno_err(diag, dlen, name, e));
+        else {
+            of_open = 1;
+            snprintf(tpath, sizeof tpath, "%s", fdt_out_temp(&of));
+        }
+    }
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+        goto done;
+    MPI_Bcast(tpath, (int)sizeof tpath, MPI_CHAR, 0, comm);
+    if (rank == 0) {
+        out_bytes(&of, text, len);
+        io[0] += len;
+    } else {
+        /* no O_CREAT: if rank 0's temporary is gone (an interrupt), fail */
+        int fd = open(tpath, O_WRONLY | O_CLOEXEC);
+        int e = fd < 0 ? errno : pwrite_all(fd, text, len, off);
+        if (fd >= 0 && close(fd) != 0 && !e)
+            e = errno;
+        if (e)
+            err = io_code(set_errno_err(diag, dlen, name, e));
+        io[0] += len;
+    }
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) == FDT_OK && rank == 0) {
+        fdt_write_lock();
+        err = io_code(fdt_out_commit(&of, 1, diag, dlen));
+        fdt_write_unlock();
+        of_open = 0;
+    }
+    err = fdt_mpi_agree(comm, err, diag, dlen);
+done:
+    if (of_open) {
+        fdt_write_lock();
+        fdt_out_abandon(&of);
+        fdt_write_unlock();
+    }
+    free(c);
+    free(sb);
+    free(rb);
+    free(text);
+    return err;
+}
+
+/* ---- indexes --------------------------------------------------------------- */
+
+static int little_endian(void)
+{
+    const uint16_t one = 1;
+    unsigned char b;
+    memcpy(&b, &one, 1);
+    return b == 1;
+}
+
+/* s with XML's five special characters escaped, to f. */
+static void put_xml(FILE *f, const char *s)
+{
+    for (; *s; s++)
+        switch (*s) {
+        case '&': fputs("&amp;", f); break;
+        case '<': fputs("&lt;", f); break;
+        case '>': fputs("&gt;", f); break;
+        case '"': fputs("&quot;", f); break;
+        case '\'': fputs("&apos;", f); break;
+        default: fputc(*s, f);
+        }
+}
+
+/* The ParaView index: it reads the pieces it names. */
+static void put_pvtu(FILE *f, const char *path, int size)
+{
+    fprintf(f, "<?xml version=\"1.0\"?>\n"
+               "<VTKFile type=\"PUnstructuredGrid\" version=\"0.1\" byte_order=\"%s\" "
+               "header_type=\"UInt64\">\n"
+               "  <PUnstructuredGrid GhostLevel=\"0\">\n"
+               "    <PPoints>\n"
+               "      <PDataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"/>\n"
+               "    </PPoints>\n",
+            little_endian() ? "LittleEndian" : "BigEndian");
+    char name[FDT_IO_PATH];
+    for (int q = 0; q < size; q++) {
+        piece_name(path, FDT_MPO_VTU, q, 0, name, sizeof name); /* checked by the caller */
+        fputs("    <Piece Source=\"", f);
+        put_xml(f, rel_name(name));
+        fputs("\"/>\n", f);
+    }
+    fprintf(f, "  </PUnstructuredGrid>\n</VTKFile>\n");
+}
+
+/* The text index of .pfdtb and .pele (src/mpi/mpi_output.h, README). A control
+ * character in the input's name would break its line: written as '?'. */
+static void put_text_index(FILE *f, const fdt_mpo_args *a, int kind, const fdt_mpi_local *L,
+                           const fdt_mpi_out *r, int size, const uint64_t *counts)
+{
+    fprintf(f, "frontdt-pieces 1\nformat %s\ninput ", format_word[kind]);
+    for (const char *s = a->input; *s; s++)
+        fputc((unsigned char)*s < 32 || *s == 127 ? '?' : *s, f);
+    fprintf(f, "\npoints %zu\nduplicates %zu\nranks %d\n", L->n, L->ndup, size);
+    char name[FDT_IO_PATH];
+    if (kind == FDT_MPO_ELE) {
+        sibling(a->path, kind, "", ".node", name, sizeof name);
+        fprintf(f, "node %s\n", rel_name(name));
+    }
+    uint64_t tt = 0, th = 0;
+    for (int q = 0; q < size; q++) {
+        piece_name(a->path, kind, q, 0, name, sizeof name);
+        fprintf(f, "piece %s %" PRIu64 " %" PRIu64 "\n", rel_name(name), counts[2 * q],
+                counts[2 * q + 1]);
+        tt += counts[2 * q];
+        th += counts[2 * q + 1];
+    }
+    fprintf(f, "total %" PRIu64 " %" PRIu64 "\nset-hash %016" PRIx64 "\n", tt, th,
+            fdt_sethash_value(&r->hash));
+}
+
+/* ---- the whole output ------------------------------------------------------ */
+
+int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
+                  const fdt_mpi_out *r, int *mine, uint64_t io[2], char *diag, size_t dlen)
+{
+    io[0] = io[1] = 0;
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    int kind = fdt_mpo_kind(a->path);
+    *mine = FDT_OK;
+    diag[0] = '\0';
+    /* The names: this rank's piece (and .face), the .node, the index. The
+     * CLI checked every name fits (fdt_mpo_file). */
+    char names[2][FDT_IO_PATH], node[FDT_IO_PATH] = "";
+    int k = kind == FDT_MPO_ELE ? 2 : 1;
+    for (int i = 0; i < k; i++)
+        piece_name(a->path, kind, rank, i, names[i], sizeof names[i]);
+    if (kind == FDT_MPO_ELE)
+        sibling(a->path, kind, "", ".node", node, sizeof node);
+    int nl = 0;
+    for (int i = 0; i < k; i++)
+        memcpy(live_path[nl++], names[i], FDT_IO_PATH);
+    if (node[0])
+        memcpy(live_path[nl++], node, FDT_IO_PATH);
+    snprintf(live_path[nl++], FDT_IO_PATH, "%s", a->path);
+    live_n = nl; /* from here an interrupt removes them (fdt_mpo_cleanup) */
+
+    int err = FDT_OK;
+    if (kind == FDT_MPO_ELE) {
+        err = write_node(comm, node, L, io, diag, dlen);
+        if (err && rank == 0)
+            *mine = err; /* the agreed message: rank 0 says it */
+    }
+    int wrote = 0;
+    if (!err) {
+        int e = kind == FDT_MPO_VTU ? write_vtu(names[0], r, diag, dlen)
+                                    : write_files(names, k, kind, L->n, r, diag, dlen);
+        wrote = e == FDT_OK;
+        struct stat st;
+        for (int i = 0; wrote && i < k; i++)
+            if (stat(names[i], &st) == 0)
+                io[0] += (uint64_t)st.st_size;
+        if (!e && rank == a->fail_rank) {
+            e = FDT_EIO;
+            snprintf(diag, dlen, "%s: injected failure after the piece was written", names[0]);
+        }
+        *mine = e;
+    }
+    /* 2: a write failed, 1: out of memory, 0: all is well (MPI_MAX) */
+    int bad = *mine == FDT_OK ? 0 : *mine == FDT_ENOMEM ? 1 : 2, worst = 0;
+    if (err)
+        bad = err == FDT_ENOMEM ? 1 : 2;
+    MPI_Allreduce(&bad, &worst, 1, MPI_INT, MPI_MAX, comm);
+    uint64_t cnt[2] = {r->own_ntets, r->own_nhull}, *all = NULL;
+    if (rank == 0 && !(all = malloc(2 * (size_t)size * sizeof *all)))
+        worst = worst ? worst : 1;
+    MPI_Gather(cnt, 2, MPI_UINT64_T, all, 2, MPI_UINT64_T, 0, comm);
+    if (rank == 0 && !worst) {
+        /* the index, last: every piece is there */
+        fdt_wr_side *side;
+        FILE *f = fdt_wr_side_open(a->path, &side, diag, dlen);
+        if (!f) {
+            worst = 2;
+        } else {
+            if (kind == FDT_MPO_VTU)
+                put_pvtu(f, a->path, size);
+            else
+                put_text_index(f, a, kind, L, r, size, all);
+            if (fdt_wr_side_commit(side, diag, dlen) != FDT_IO_OK)
+                worst = 2;
+        }
+        if (worst)
+            *mine = FDT_EIO;
+    }
+    free(all);
+    MPI_Bcast(&worst, 1, MPI_INT, 0, comm);
+    if (worst) {
+        /* all or nothing: this rank's pieces, and (rank 0, which renamed
+         * it) the .node */
+        for (int i = 0; wrote && i < k; i++)
+            (void)remove(names[i]);
+        if (rank == 0 && node[0] && !err)
+            (void)remove(node);
+    }
+    /* complete (the index is there) or removed, on every rank: nothing to
+     * undo */
+    MPI_Barrier(comm);
+    live_n = 0;
+    return worst == 0 ? FDT_OK : worst == 1 ? FDT_ENOMEM : FDT_EIO;
+}

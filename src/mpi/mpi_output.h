@@ -1,0 +1,79 @@
+/*
+ * The distributed output of frontdt-mpi (issue 19): each rank writes its
+ * own piece of the mesh, in input numbering, and rank 0 a small index,
+ * with no gather of the mesh to one rank. Built only with MPI.
+ *
+ *   -o BASE.pvtu   BASE_RANK.vtu (the rank's tets over the points they
+ *                  use) and the ParaView index BASE.pvtu
+ *   -o BASE.pfdtb  BASE_RANK.fdtb (.fdtb with flag 8: the rank's tets and
+ *                  hull faces, no points, ids numbering the input's
+ *                  points) and the text index BASE.pfdtb
+ *   -o BASE.pele   BASE.node written by every rank at once (each its
+ *                  range of input ids, at its byte offset: the serial
+ *                  run's .node, byte for byte), BASE_RANK.ele and
+ *                  BASE_RANK.face (TetGen rows numbering that .node) and
+ *                  the text index BASE.pele
+ *
+ * The text index (README, "Distributed runs"): a line "frontdt-pieces 1",
+ * then "KEY VALUE" lines: format, input, points, duplicates, ranks, node
+ * (.pele only), one "piece NAME TETS HULL" a rank in rank order, "total
+ * TETS HULL", "set-hash HEX". Names are relative to the index's directory.
+ *
+ * All or nothing: every file goes through a temporary renamed at its end
+ * (src/io/write/writer.c); the index is written last, once every piece is there,
+ * and if any rank fails every piece (and the .node) is removed again on
+ * every rank. fdt_mpo_cleanup is the signal handler's part.
+ */
+#ifndef FDT_MPI_OUTPUT_H
+#define FDT_MPI_OUTPUT_H
+
+#include <mpi.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "mpi/mpi_run.h"
+#include "mpi/mpi_setup.h"
+
+enum {
+    FDT_MPO_GATHER = 0, /* any other -o: gathered to rank 0 */
+    FDT_MPO_VTU,        /* .pvtu */
+    FDT_MPO_BIN,        /* .pfdtb */
+    FDT_MPO_ELE         /* .pele */
+};
+
+/* The kind of output path names, by its extension (case-insensitive). */
+int fdt_mpo_kind(const char *path);
+
+/* The k-th file (0..2) a run with size ranks writes for the index path
+ * other than the index itself, into out: the pieces in rank order, then
+ * (.pele) the .node. 1, 0 when there is no k-th file, or -1 when a name
+ * does not fit len. For the CLI's check that none is the input. */
+int fdt_mpo_file(const char *path, int size, size_t k, char *out, size_t len);
+
+typedef struct fdt_mpo_args {
+    const char *path;       /* the index */
+    const char *input;      /* the input as named on the command line */
+    int fail_rank;          /* a test's injected failure: this rank's
+                               piece write fails after its temporary is
+                               written; -1: none */
+} fdt_mpo_args;
+
+/*
+ * Writes the pieces and the index (collective). r: the run's output with
+ * keep_own (FDT_MPI_OWN_POINTS for .pvtu, FDT_MPI_OWN_HULL otherwise) and,
+ * on rank 0, the reduced set hash; L: the setup's (keep_input for .pele).
+ * Returns the same code on every rank: FDT_OK, FDT_ENOMEM or FDT_EIO;
+ * *mine is this rank's own error (its message in diag) or FDT_OK when
+ * another rank failed. On failure nothing of the output is left. io: the
+ * bytes this rank wrote to files, and sent to other ranks (the .node's
+ * exchange), for --stats.
+ */
+int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
+                  const fdt_mpi_out *r, int *mine, uint64_t io[2], char *diag, size_t dlen);
+
+/* Removes this rank's pieces, the .node and the index while a write is
+ * between its first piece and the end of fdt_mpo_write. Async-signal-safe
+ * (unlink only). */
+void fdt_mpo_cleanup(void);
+
+#endif

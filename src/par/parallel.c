@@ -1,0 +1,619 @@
+/*
+ * The parallel engine's entry point; see parallel.h. The engine is split
+ * by concern: src/par/engine.c (the per-part step, ownership), src/par/protocol.c
+ * (the messages and their handlers), src/par/termination.c (when a run ends,
+ * errors), src/par/threads.c (hardware and threads), src/par/gather.c (output),
+ * src/par/partsets.c (per-part containers).
+ *
+ * Setup (the calling thread): recursive coordinate bisection into N parts
+ * and one kd-tree per part (src/geom/partition.c), one seed tet per part near
+ * its centre (src/front/seed.c over a tree of all points), each seed delivered
+ * to its owner. Then one thread per part, and at the end a gather of the
+ * threads' tets into one mesh in input numbering, each thread copying its
+ * own share (fdt_gather_prepare, fdt_gather_copy, fdt_gather_finish).
+ */
+#include "par/parallel.h"
+
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "base/bits.h"
+#include "par/engine.h"
+#include "par/gather.h"
+#include "base/mem.h"
+#include "front/oracle.h"
+#include "front/seed.h"
+#include "base/spawn.h"
+#include "par/termination.h"
+#include "par/threads.h"
+
+static int key_cmp(const void *x, const void *y)
+{
+    const uint32_t *a = x, *b = y;
+    for (int i = 0; i < 4; i++)
+        if (a[i] != b[i])
+            return a[i] < b[i] ? -1 : 1;
+    return 0;
+}
+
+/* Sorts the ns tets of key (each a pair: its sorted ids, then the tet)
+ * by their ids and writes the distinct tets to sd, their count to *nout. */
+static void seeds_distinct(uint32_t (*key)[4], int ns, uint32_t (*sd)[4], int *nout)
+{
+    qsort(key, (size_t)ns, 2 * sizeof *key, key_cmp);
+    int nd = 0;
+    for (int i = 0; i < ns; i++) {
+        if (nd > 0 && key_cmp(key[2 * i], key[2 * (i - 1)]) == 0)
+            continue;
+        memcpy(sd[nd++], key[2 * i + 1], sizeof sd[0]);
+    }
+    *nout = nd;
+}
+
+/* key[2 * i]: tet v's ids sorted; key[2 * i + 1]: v itself. */
+static void seed_key(uint32_t (*key)[4], int i, const uint32_t v[4])
+{
+    memcpy(key[2 * i], v, 4 * sizeof *v);
+    fdt_sort4_u32(key[2 * i]);
+    memcpy(key[2 * i + 1], v, 4 * sizeof *v);
+}
+
+/* Seeds: one per nonempty part, the Delaunay tet (src/front/seed.c) at the part's
+ * point nearest its box centre, found in a tree over all points (the setup
+ * may read every part); identical seeds are dropped. *out gets *nout
+ * positively oriented tets (owned by the caller). An MPI run finds its
+ * ranks' seeds in src/mpi/mpi_setup.c, from the points each rank is sent. */
+static int seeds_by_kd(const fdt_partition *pt, uint32_t (**out)[4], int *nout, fdt_kdq *kq)
+{
+    fdt_kdtree all;
+    int err = fdt_partition_global_tree(pt, &all);
+    if (err)
+        return err;
+    uint32_t(*sd)[4] = malloc((size_t)pt->nparts * sizeof *sd);
+    uint32_t(*key)[4] = malloc((size_t)pt->nparts * 2 * sizeof *key);
+    if (!sd || !key) {
+        err = FDT_ENOMEM;
+        goto done;
+    }
+    int ns = 0;
+    for (int p = 0; p < pt->nparts; p++) {
+        const fdt_kdtree *t = &pt->trees[p];
+        if (!t->n)
+            continue;
+        double c[3];
+        for (int k = 0; k < 3; k++)
+            c[k] = t->nodes[0].lo[k] * 0.5 + t->nodes[0].hi[k] * 0.5;
+        uint32_t a = fdt_kd_nearest(t, c, FDT_NONE, kq);
+        uint32_t v[4];
+        if ((err = fdt_seed_tet(&all, a, v, kq)) != FDT_OK)
+            goto done;
+        seed_key(key, ns++, v);
+    }
+    seeds_distinct(key, ns, sd, nout);
+    *out = sd;
+    sd = NULL;
+done:
+    free(sd);
+    free(key);
+    fdt_kd_free(&all);
+    return err;
+}
+
+/*
+ * The seeds where the mesh of every point is built before the fronts
+ * start: one finite tet of it at the middle id of each nonempty part (ids
+ * are kd order, so that point is inside the part), its tets being the
+ * Delaunay tets, positively oriented as the kd seeds are. fdt_seed_tet's
+ * search costs nothing like this where that mesh was wanted: at the
+ * centre of a sphere its candidate window holds the whole shell, and the
+ * two seeds of a two-thread run took 0.006 s (bench/NOTES.md entry 72).
+ * FDT_OK or FDT_ENOMEM.
+ */
+static int seeds_from_mesh(const fdt_partition *pt, const fdt_ins *gm, uint32_t (**out)[4],
+                           int *nout)
+{
+    uint32_t(*sd)[4] = malloc((size_t)pt->nparts * sizeof *sd);
+    uint32_t(*key)[4] = malloc((size_t)pt->nparts * 2 * sizeof *key);
+    if (!sd || !key) {
+        free(sd);
+        free(key);
+        return FDT_ENOMEM;
+    }
+    int ns = 0;
+    for (int p = 0; p < pt->nparts; p++) {
+        if (pt->start[p] == pt->start[p + 1])
+            continue;
+        uint32_t a = pt->start[p] + (pt->start[p + 1] - pt->start[p]) / 2;
+        uint32_t t = gm->vtet[a - gm->base];
+        const uint32_t *v = fdt_ins_tet(gm, t);
+        /* an infinite tet: the finite one across its hull face holds a
+         * too (a is a vertex of that face) */
+        for (int k = 0; k < 4; k++)
+            if (v[k] == FDT_NONE) {
+                uint32_t nt;
+                int nk;
+                fdt_ins_across(gm, t, k, &nt, &nk);
+                v = fdt_ins_tet(gm, nt);
+                break;
+            }
+        seed_key(key, ns++, v);
+    }
+    seeds_distinct(key, ns, sd, nout);
+    free(key);
+    *out = sd;
+    return FDT_OK;
+}
+
+/* c[k] += k_[k] for every kind k. */
+static void msg_counts_add(size_t *c, const uint64_t *k)
+{
+    for (int i = 0; i < FDT_MSG_KIND_END; i++)
+        c[i] += (size_t)k[i];
+}
+
+void fdt_par_out_free(fdt_par_out *out)
+{
+    fdt_meshbuf_free(&out->mb);
+    free(out->tstats);
+    out->tstats = NULL;
+}
+
+void fdt_parallel_fill_stats(const fdt_par_out *o, fdt_mode mode,
+                             fdt_stats *st)
+{
+    const fdt_stats *p = &o->pst;
+    memcpy(st->sent, p->sent, sizeof st->sent);
+    memcpy(st->received, p->received, sizeof st->received);
+    st->remote_queries = p->remote_queries;
+    st->remote_answered = p->remote_answered;
+    st->remote_improved = p->remote_improved;
+    st->tet_requests = p->tet_requests;
+    st->duplicate_requests = p->duplicate_requests;
+    st->t_idle = p->t_idle;
+    st->t_query_wait = p->t_query_wait;
+    st->load_imbalance = p->load_imbalance;
+    st->pinned = p->pinned;
+    st->threads = o->nthreads;
+    st->mode = mode;
+}
+
+int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
+                             fdt_mode mode, int nthreads, fdt_par_out *out,
+                             char *diag, size_t dlen)
+{
+    return fdt_parallel_run(pr, s, mode, nthreads, NULL, out, diag, dlen);
+}
+
+/*
+ * With the mesh of every point built before the fronts, the tets each id
+ * will own (§3.2: a tet belongs to its lowest vertex's part) are known,
+ * and the parts' ranges move to split them evenly (fdt_partition_recut):
+ * the bisection cuts the points in half, but a pipe's inner tets span it
+ * and all of those across the cut go to the lower part (cylscan 100k:
+ * 726k tets against 577k, front thread CPU 0.43 s against 0.28 s;
+ * bench/NOTES.md entry 60). Hull faces count as tets do (each is a face
+ * advanced): by tets alone the lower part, with 140k of the pipe's 200k
+ * hull faces, kept 0.33-0.35 s against 0.29-0.31. One pass over the
+ * mesh's slots. FDT_OK or FDT_ENOMEM.
+ */
+static int recut_by_mesh(fdt_partition *pt, const fdt_ins *gm)
+{
+    uint32_t *w = calloc(pt->m ? pt->m : 1, sizeof *w);
+    if (!w)
+        return FDT_ENOMEM;
+    uint64_t total = 0;
+    for (uint32_t t = 0; t < gm->nslots; t++) {
+        const uint32_t *v = fdt_ins_tet(gm, t);
+        if (v[0] == FDT_NONE && v[1] == FDT_NONE)
+            continue; /* a freed slot */
+        /* the lowest id; FDT_NONE (the infinite vertex of a hull face's
+         * tet) is above every id, so a hull face counts for its own
+         * lowest vertex: a face advanced, as a tet is */
+        uint32_t lo = v[0] < v[1] ? v[0] : v[1];
+        uint32_t hi = v[2] < v[3] ? v[2] : v[3];
+        w[lo < hi ? lo : hi]++;
+        total++;
+    }
+    fdt_partition_recut(pt, w, total);
+    free(w);
+    return FDT_OK;
+}
+
+/* The probe (FDT_PAR_MESH_PROBE) on its own thread. */
+typedef struct probe_job {
+    fdt_probe_samples ps;
+    int expensive;
+} probe_job;
+
+static void *probe_main(void *arg)
+{
+    probe_job *pj = arg;
+    pj->expensive = fdt_oracle_probe_decide(&pj->ps);
+    return NULL;
+}
+
+int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int nthreads,
+                     const fdt_par_opts *opt, fdt_par_out *out, char *diag, size_t dlen)
+{
+    memset(out, 0, sizeof *out);
+    if ((mode != FDT_MODE_SHARED && mode != FDT_MODE_MESSAGE) || nthreads < 1 ||
+        nthreads > FDT_PARTITION_MAX || pr->m < 4 || pr->m > UINT32_MAX - 1)
+        return FDT_EINVAL;
+    double t0 = fdt_now_s();
+    fdt_partition pt;
+    engine *e = NULL;
+    uint32_t(*seeds)[4] = NULL;
+    int nseeds = 0, sync_ok = 0;
+    fdt_tsink mem_sink;
+    int mem_sink_ok = 0;
+    fdt_kdq kq0;
+    memset(&kq0, 0, sizeof kq0);
+    /* The parts' trees are built on as many threads as there are CPUs
+     * (up to one a part): at 1M points on two cores that took a quarter
+     * of a second off a setup of 0.9 s. Online CPUs, not hwloc's cores:
+     * the topology's load took 3.9 ms, inside the timed run of every
+     * `--threads N` (bench/NOTES.md entry 68), and a builder on a second
+     * hardware thread of a core costs nothing here. */
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    int cores = ncpu < 1 ? 1 : ncpu > FDT_PARTITION_MAX ? FDT_PARTITION_MAX : (int)ncpu;
+    /* The probe only decides the shared mesh's build, after the
+     * partition, whose first cut leaves the second core idle (bench/NOTES.md
+     * entry 56): it runs beside it on samples copied before the partition
+     * permutes the points, so its answer is fdt_oracle_probe's on the
+     * caller's order. pthread_join orders its answer before the read
+     * below. The seeds come after it: from the mesh where it is built
+     * (entry 72), else by the kd search, which then no longer overlaps
+     * the probe (0.1-0.3 ms a run where the mesh is not built). */
+    int probe = opt && opt->global_mesh == FDT_PAR_MESH_PROBE;
+    int probing = 0, expensive = 0;
+    probe_job pj = {{{NULL, NULL}, 0, 0}, 0};
+    pthread_t probe_th;
+    if (probe) {
+        fdt_oracle_probe_take(&pj.ps, pr->p, (uint32_t)pr->m, s->leaf_size);
+        probing = fdt_spawn(&probe_th, 0, probe_main, &pj) == 0;
+    }
+    int err = fdt_partition_build(&pt, pr->p, pr->orig, (uint32_t)pr->m, nthreads,
+                                  s->leaf_size > 0 ? s->leaf_size : FDT_DEFAULT_LEAF,
+                                  cores < nthreads ? cores : nthreads);
+    if (probing) {
+        pthread_join(probe_th, NULL);
+        expensive = pj.expensive;
+    } else if (probe) {
+        expensive = fdt_oracle_probe_decide(&pj.ps); /* no thread: here */
+    }
+    if (err != FDT_OK)
+        return err; /* pt is zeroed */
+    err = FDT_ENOMEM;
+    if (!(e = fdt_eng_new(nthreads)))
+        goto fail;
+    e->pt = &pt;
+    e->P = pr->p;
+    e->orig = pr->orig;
+    if (opt && opt->sink) {
+        e->sink = opt->sink;
+    } else {
+        if (fdt_tsink_init(&mem_sink, pr->orig, NULL) != FDT_OK)
+            goto fail;
+        mem_sink_ok = 1;
+        e->sink = &mem_sink;
+    }
+    e->mode = mode;
+    e->want_nbrs = s->neighbors != 0;
+    e->search = (int)s->search;
+    e->pin = s->pin != 0;
+    /* The DT of every point, for inputs where the kd search degenerates
+     * (src/api/api.c decides, by fdt_oracle_probe): built here on the run's
+     * threads, then every part reads its faces' apexes from it and asks
+     * no other part (bench/NOTES.md entry 54). In message mode it stands
+     * for the replica each MPI rank builds for itself (src/mpi/mpi_run.c):
+     * immutable once built, so one copy serves every part, and the parts
+     * still exchange their faces by FACESEND. Tets are still made and
+     * owned by the parts' fronts. A build that cannot be made (no memory)
+     * leaves the parts on their own oracles. Built before the seeds go to
+     * their owners and the workers take their ranges: recut_by_mesh moves
+     * those ranges. */
+    double t_gm = 0.0;
+    /* The probe's choice (not an explicit global_mesh == 1) is dropped
+     * when the mesh would not fit the memory available (src/front/oracle.h,
+     * FDT_ORACLE_MESH_BYTES): the parts' kd searches are always right. */
+    if (expensive && FDT_ORACLE_MESH_BYTES * (double)pr->m > (double)fdt_mem_available())
+        expensive = 0;
+    /* The probe's "not clearly expensive" (src/front/oracle.c, PROBE_SURE):
+     * the parts start on the kd search and switch together when one of
+     * them measures it expensive at the full density (src/par/engine.c,
+     * collective_step; bench/NOTES.md entry 59). */
+    e->collective = mode == FDT_MODE_SHARED &&
+                    ((probe && !expensive) || (opt && opt->global_mesh == FDT_PAR_MESH_COLLECTIVE));
+    if (opt && (opt->global_mesh == 1 || expensive)) {
+        double tg = fdt_now_s();
+        int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads,
+                                          &kq0.pc);
+        t_gm = fdt_now_s() - tg;
+        if (gerr == FDT_OK) {
+            e->gmesh_ok = 1;
+            if (nthreads > 1 && (err = recut_by_mesh(&pt, &e->gmesh)) != FDT_OK)
+                goto fail;
+        } else if (gerr != FDT_ENOMEM && gerr != FDT_EDEGENERATE) {
+            err = gerr;
+            if (gerr == FDT_EINTERNAL)
+                snprintf(diag, dlen, "internal error: the parallel insertion mesh failed");
+            goto fail;
+        }
+    }
+    /* The seeds, after the mesh of every point where it was built: its
+     * tets are Delaunay tets already (seeds_from_mesh). */
+    err = e->gmesh_ok ? seeds_from_mesh(&pt, &e->gmesh, &seeds, &nseeds)
+                      : seeds_by_kd(&pt, &seeds, &nseeds, &kq0);
+    if (err != FDT_OK) {
+        if (err == FDT_EINTERNAL)
+            snprintf(diag, dlen, "internal error: no seed tetrahedron found");
+        goto fail;
+    }
+    if (opt && opt->shuffle)
+        err = fdt_transport_shuffle(&e->tp, nthreads + 1, opt->seed, opt->delay_pct);
+    else
+        err = fdt_transport_mailbox(&e->tp, nthreads + 1);
+    if (err) {
+        /* FDT_EINVAL: a bad test option; otherwise out of memory (a mutex
+         * that cannot be made counts as that, as before) */
+        if (err != FDT_EINVAL)
+            err = FDT_ENOMEM;
+        goto fail;
+    }
+    err = FDT_ENOMEM;
+    if (pthread_mutex_init(&e->lock, NULL) != 0)
+        goto fail;
+    if (pthread_cond_init(&e->cv, NULL) != 0) {
+        pthread_mutex_destroy(&e->lock);
+        goto fail;
+    }
+    if (pthread_cond_init(&e->go, NULL) != 0) {
+        pthread_cond_destroy(&e->cv);
+        pthread_mutex_destroy(&e->lock);
+        goto fail;
+    }
+    if (pthread_cond_init(&e->gm_cv, NULL) != 0) {
+        pthread_cond_destroy(&e->go);
+        pthread_cond_destroy(&e->cv);
+        pthread_mutex_destroy(&e->lock);
+        goto fail;
+    }
+    sync_ok = 1;
+#ifdef FDT_HAVE_HWLOC
+    if (e->pin) {
+        if (hwloc_topology_init(&e->topo) == 0 && hwloc_topology_load(e->topo) == 0) {
+            e->ncores = hwloc_get_nbobjs_by_type(e->topo, HWLOC_OBJ_CORE);
+            e->numa_nodes = hwloc_get_nbobjs_by_type(e->topo, HWLOC_OBJ_NUMANODE);
+        }
+        if (e->ncores <= 0) {
+            if (e->topo)
+                hwloc_topology_destroy(e->topo);
+            e->topo = NULL;
+            atomic_store_explicit(&e->pin_refused, 1, memory_order_relaxed);
+        }
+    }
+#else
+    if (e->pin)
+        atomic_store_explicit(&e->pin_refused, 1, memory_order_relaxed);
+#endif
+    /* Seeds to their owners: sorted by key, so each owner's are adjacent
+     * in owner order once grouped; nseeds <= nthreads, a scan is fine. */
+    long long active = 0;
+    for (int i = 0; i < nthreads; i++) {
+        worker *w = &e->w[i];
+        atomic_init(&w->tets_done, 0);
+        w->e = e;
+        w->id = i;
+        w->tree = &pt.trees[i];
+        w->lo = pt.start[i];
+        w->hi = pt.start[i + 1];
+        w->st.points = w->hi - w->lo;
+        w->st.core = -1;
+        w->report_at = 4096;
+    }
+    /* Regroup seeds by owner in place: counting sort. */
+    {
+        uint32_t(*by)[4] = malloc(((size_t)nseeds + 1) * sizeof *by);
+        int *cnt = calloc((size_t)nthreads + 1, sizeof *cnt);
+        if (!by || !cnt) {
+            free(by);
+            free(cnt);
+            goto fail;
+        }
+        int *own = malloc(((size_t)nseeds + 1) * sizeof *own);
+        if (!own) {
+            free(by);
+            free(cnt);
+            goto fail;
+        }
+        for (int i = 0; i < nseeds; i++) {
+            uint32_t lo = seeds[i][0];
+            for (int k = 1; k < 4; k++)
+                if (seeds[i][k] < lo)
+                    lo = seeds[i][k];
+            own[i] = fdt_partition_owner(&pt, lo);
+            cnt[own[i] + 1]++;
+        }
+        for (int i = 0; i < nthreads; i++)
+            cnt[i + 1] += cnt[i];
+        for (int i = 0; i < nthreads; i++) {
+            e->w[i].seeds = by + cnt[i];
+            e->w[i].nseeds = cnt[i + 1] - cnt[i];
+        }
+        for (int i = 0; i < nseeds; i++)
+            memcpy(by[cnt[own[i]]++], seeds[i], sizeof by[0]);
+        free(own);
+        free(cnt);
+        free(seeds);
+        seeds = by;
+    }
+    /* Message mode: a seed's foreign vertices are delivered with it, as a
+     * FACESEND would carry them (the setup may read every part). */
+    if (mode == FDT_MODE_MESSAGE)
+        for (int i = 0; i < nthreads; i++) {
+            worker *w = &e->w[i];
+            for (int j = 0; j < w->nseeds; j++)
+                for (int k = 0; k < 4; k++) {
+                    uint32_t id = w->seeds[j][k];
+                    if (!is_own(w, id) &&
+                        fdt_ghost_put(&w->ghosts, id, pr->p + 3 * (size_t)id) != FDT_OK)
+                        goto fail;
+                }
+        }
+    /* Shared mode: every part with seeds holds an activity unit. Message
+     * mode: every part with seeds is a root of Dijkstra-Scholten, engaged
+     * with no parent (src/par/termination.c). */
+    e->msg_term = mode == FDT_MODE_MESSAGE;
+    e->park = mode == FDT_MODE_MESSAGE && opt && opt->park;
+    e->fail_part = opt && opt->fail ? opt->fail_part : -1;
+    e->fail_after = opt ? opt->fail_after : 0;
+    for (int i = 0; i < nthreads; i++) {
+        worker *w = &e->w[i];
+        w->parent = -1;
+        w->aborted_by = -1;
+        if (w->nseeds == 0)
+            continue;
+        if (e->msg_term) {
+            w->engaged = 1;
+            e->roots++;
+        } else {
+            w->active = 1;
+            active++;
+        }
+    }
+    /* Every thread with seeds starts holding its activity unit. Thread
+     * creation orders this before everything the workers do. */
+    atomic_init(&e->work, active);
+    double t1 = fdt_now_s();
+    double t2 = t1;
+    err = fdt_threads_run(e, s, &t2);
+    /* After pthread_join: any order would do; acquire documents that the
+     * recorded err_thread/err_what are read after the CAS that chose them. */
+    int werr = e->msg_term ? fdt_term_error(e, &e->err_thread, &e->err_what)
+                           : atomic_load_explicit(&e->error, memory_order_acquire);
+    if (werr) {
+        err = werr;
+        if (werr == FDT_ENOMEM)
+            snprintf(diag, dlen, "out of memory in worker thread %d", e->err_thread);
+        else if (werr == FDT_EINTERNAL)
+            snprintf(diag, dlen, "internal error in worker thread %d: %s", e->err_thread,
+                     e->err_what ? e->err_what : "?");
+        else if (werr == FDT_ETHREAD)
+            snprintf(diag, dlen, "could not create thread %d of %d", e->err_thread, nthreads);
+        goto fail;
+    }
+    if (err)
+        goto fail;
+
+    /* Statistics, and the message balance: every message sent was
+     * received, kind by kind. */
+    out->tstats = calloc((size_t)nthreads, sizeof *out->tstats);
+    err = FDT_ENOMEM;
+    if (!out->tstats)
+        goto fail;
+    fdt_stats *ps = &out->pst;
+    size_t maxt = 0, sumt = 0;
+    for (int i = 0; i < nthreads; i++) {
+        worker *w = &e->w[i];
+        fdt_thread_stats *ts = &out->tstats[i];
+        fdt_mailbox_counts mc;
+        fdt_tp_counts(e->tp, i, &mc);
+        *ts = w->st;
+        ts->tets = (size_t)w->em.ntets;
+        ps->mem_tree += fdt_kd_bytes(&pt.trees[i]);
+        ps->mem_front += fdt_front_bytes(&w->ft, &w->fq);
+        ps->mem_mesh += fdt_meshbuf_bytes(&w->out);
+        ps->mem_sink += fdt_emit_bytes(&w->em);
+        msg_counts_add(ts->sent, mc.sent);
+        msg_counts_add(ts->received, mc.received);
+        msg_counts_add(ps->sent, mc.sent);
+        msg_counts_add(ps->received, mc.received);
+        ps->remote_queries += ts->remote_queries;
+        ps->remote_answered += ts->remote_answered;
+        ps->remote_improved += ts->remote_improved;
+        ps->tet_requests += ts->tet_requests;
+        ps->duplicate_requests += ts->duplicate_requests;
+        ps->t_idle += ts->t_idle;
+        ps->t_query_wait += ts->t_query_wait;
+        out->fst.faces_advanced += ts->faces_advanced;
+        /* The sum of the threads' largest fronts: an upper bound on the
+         * largest total front, which no thread observes. */
+        out->fst.max_front += ts->max_front;
+        out->fst.kq.nodes += w->kq.nodes;
+        out->fst.kq.points += w->kq.points;
+        out->fst.kq.pc.orient_exact += w->kq.pc.orient_exact;
+        out->fst.kq.pc.insphere_exact += w->kq.pc.insphere_exact;
+        out->fst.mesh_faces += w->orc.mesh_faces;
+        out->fst.star_walks += w->orc.star_walks;
+        out->fst.mesh_parts += w->orc.switched_at != 0 || w->orc.gm;
+        out->fst.t_mesh += w->orc.t_mesh;
+        out->fst.kq.pc.orient_adapt += w->kq.pc.orient_adapt;
+        out->fst.kq.pc.insphere_adapt += w->kq.pc.insphere_adapt;
+        if (ts->tets > maxt)
+            maxt = ts->tets;
+        sumt += ts->tets;
+    }
+    out->fst.t_mesh += t_gm;
+    out->fst.kq.nodes += kq0.nodes;
+    out->fst.kq.points += kq0.points;
+    out->fst.kq.pc.orient_exact += kq0.pc.orient_exact;
+    out->fst.kq.pc.insphere_exact += kq0.pc.insphere_exact;
+    out->fst.kq.pc.orient_adapt += kq0.pc.orient_adapt;
+    out->fst.kq.pc.insphere_adapt += kq0.pc.insphere_adapt;
+    ps->load_imbalance = sumt ? (double)maxt * nthreads / (double)sumt : 1.0;
+    ps->pinned = e->pin ? (atomic_load_explicit(&e->pin_refused, memory_order_relaxed) ? -1 : 1) : 0;
+    /* IAMDONE: shared mode, one to every other part; message mode also
+     * one from each root but part 0 to part 0 (its tree finished). FACERECV:
+     * one for each FACESEND in message mode, none in shared mode. */
+    size_t iamdones = (size_t)nthreads - 1 +
+                      (e->msg_term ? (size_t)e->roots - (e->w[0].nseeds > 0) : 0);
+    if (memcmp(ps->sent, ps->received, sizeof ps->sent) != 0 ||
+        ps->remote_queries != ps->remote_answered ||
+        ps->sent[FDT_MSG_NODESEND] != ps->remote_queries ||
+        ps->sent[FDT_MSG_IAMDONE] != iamdones || ps->sent[FDT_MSG_ABORT] != 0 ||
+        ps->sent[FDT_MSG_FACERECV] != (e->msg_term ? ps->sent[FDT_MSG_FACESEND] : 0)) {
+        snprintf(diag, dlen, "internal error: messages sent and received differ");
+        err = FDT_EINTERNAL;
+        goto fail;
+    }
+    err = e->sink->user ? FDT_OK : fdt_gather_finish(e, &out->mb);
+    if (err) {
+        if (err == FDT_EINTERNAL)
+            snprintf(diag, dlen, "internal error: a face between threads was not linked");
+        goto fail;
+    }
+    out->nthreads = nthreads;
+    out->t_setup = t1 - t0;
+    out->t_front = t2 - t1;
+    out->t_gather = fdt_now_s() - t2;
+fail:
+    if (e) {
+        for (int i = 0; i < nthreads; i++)
+            fdt_eng_worker_free(&e->w[i]);
+        fdt_ins_free(&e->gmesh);
+        fdt_transport_destroy(&e->tp);
+        if (sync_ok) {
+            pthread_cond_destroy(&e->gm_cv);
+            pthread_cond_destroy(&e->go);
+            pthread_cond_destroy(&e->cv);
+            pthread_mutex_destroy(&e->lock);
+        }
+        free(e->toff);
+        free(e->hoff);
+#ifdef FDT_HAVE_HWLOC
+        if (e->topo)
+            hwloc_topology_destroy(e->topo);
+#endif
+        fdt_eng_delete(e);
+    }
+    free(seeds);
+    fdt_partition_free(&pt);
+    if (mem_sink_ok)
+        fdt_tsink_free(&mem_sink);
+    if (err)
+        fdt_par_out_free(out);
+    return err;
+}

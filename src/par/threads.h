@@ -1,0 +1,14 @@
+/*
+ * Hardware and threads of the parallel engine: hwloc, pinning, starting
+ * the workers, progress while they run, joining them (src/par/threads.c).
+ */
+#ifndef FDT_THREADS_H
+#define FDT_THREADS_H
+
+#include "par/engine.h"
+
+/* Runs the workers and waits for their loops, then has them gather the
+ * mesh and joins them; *t_loops: when the last loop ended. */
+int fdt_threads_run(engine *e, const fdt_settings *s, double *t_loops);
+
+#endif
