@@ -94,6 +94,26 @@ static void test_ghosts(void)
         EXPECTF(r && r[0] == i + 0.25, "id %u after the rehash", i);
     }
     free(g2.g);
+
+    /* Coordinates read from the map itself and put under another id at the
+     * very put that grows the table (issue 34: the apex of a message-mode
+     * face is a ghost, its coordinates point into the map): the new entry
+     * gets them, not the freed table's bytes (ASan: heap-use-after-free
+     * before the put copied them first). A put of an id already there
+     * leaves the table as it is, even at the growth threshold. */
+    ghostmap g3 = {0};
+    for (uint32_t i = 0; i < 512; i++) {
+        double p3[3] = {i + 0.5, 1, 2};
+        CHECK_EQ(fdt_ghost_put(&g3, i, p3), FDT_OK);
+    }
+    const ghost *before = g3.g;
+    CHECK_EQ(fdt_ghost_put(&g3, 7, fdt_ghost_find(&g3, 7)), FDT_OK);
+    EXPECT(g3.g == before && g3.cap == 1024 && g3.count == 512);
+    CHECK_EQ(fdt_ghost_put(&g3, 9999, fdt_ghost_find(&g3, 300)), FDT_OK);
+    EXPECT(g3.cap == 2048 && g3.count == 513);
+    const double *m = fdt_ghost_find(&g3, 9999);
+    EXPECT(m && m[0] == 300.5 && m[1] == 1 && m[2] == 2);
+    free(g3.g);
 }
 
 static void test_links(void)

@@ -111,9 +111,12 @@ static inline int fdt_front_apex(fdt_oracle *orc, const fdt_kdtree *t, fdt_facet
          * pipe, offering it cost a circumcentre, often in GMP, a face),
          * and the search state needs only its answer (the caller reads
          * best and bp; fdt_apex_init's normal was 3 % of a two-thread
-         * front on the mesh, bench/NOTES.md entry 67). */
+         * front on the mesh, bench/NOTES.md entry 67). The coordinates
+         * come from the mesh's own array: t holds only this part's points
+         * where a rank of frontdt-mpi reads the replica mesh (t->P + 3 *
+         * apex was past the rank's points for a foreign apex). */
         ap->best = *apex;
-        ap->bp = *apex != FDT_NONE ? t->P + 3 * (size_t)*apex : NULL;
+        ap->bp = *apex != FDT_NONE ? orc->gm->P + 3 * (size_t)*apex : NULL;
         fdt_facetab_prefetch_tet(ft, f, *apex);
         *inside = 1;
         return FDT_OK;

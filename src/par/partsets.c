@@ -83,6 +83,14 @@ const double *fdt_ghost_find(const ghostmap *gm, uint32_t id)
 
 int fdt_ghost_put(ghostmap *gm, uint32_t id, const double *x)
 {
+    /* x may point into gm itself (an apex search reads a ghost's
+     * coordinates from the table, finish_face puts them back): look the id
+     * up before anything moves, and copy x before the table can grow and
+     * free the slot it points at. */
+    if (fdt_ghost_find(gm, id))
+        return FDT_OK; /* coordinates never change */
+    double xc[3];
+    memcpy(xc, x, sizeof xc);
     if (2 * (gm->count + 1) > gm->cap) {
         size_t ncap = gm->cap ? gm->cap * 2 : 1024;
         ghost *ng = malloc(ncap * sizeof *ng);
@@ -105,11 +113,9 @@ int fdt_ghost_put(ghostmap *gm, uint32_t id, const double *x)
     size_t mask = gm->cap - 1, h = id_hash(id) & mask;
     for (;;) {
         ghost *e = &gm->g[h];
-        if (e->id == id)
-            return FDT_OK; /* coordinates never change */
         if (e->id == UINT32_MAX) {
             e->id = id;
-            memcpy(e->x, x, sizeof e->x);
+            memcpy(e->x, xc, sizeof e->x);
             gm->count++;
             return FDT_OK;
         }
