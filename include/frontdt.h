@@ -457,6 +457,13 @@ typedef struct fdt_read_options {
                              calling thread only */
     fdt_io_progress_fn progress; /* may be NULL; stages LOAD and PARSE */
     void *progress_user;  /* borrowed, passed back to progress */
+    /* Added in 0.2 (a 0.1 struct_size, without them, reads as 0 and 0): */
+    char delimiter;       /* xyz/txt/csv: the field separator besides
+                             blanks, ',' or ';'; ' ' for blanks only; 0:
+                             ',', refusing a line that mixes blank and
+                             tight-comma separators ("0,5 1,25 2", FDT_EFORMAT) */
+    int decimal_comma;    /* xyz/txt/csv: ',' is the decimal mark; the
+                             delimiter must then not be ',' (0: blanks) */
 } fdt_read_options;
 
 /* Fills the first struct_size bytes of *o with the defaults (format by

@@ -251,6 +251,24 @@ expect_rc io_stdinbad 2 && expect_in io_stdinbad err "stdin:2: not a number: 'x'
 awk 'BEGIN { print "id,name,X,Y,Z,R,G,B" } { printf "%d,p%d,%s,%s,%s,255,0,0\n", NR, NR, $1, $2, $3 }' io.xyz >io_lidar.csv
 run io_csv "$FRONTDT" --hash --columns 3,4,5 io_lidar.csv
 expect_rc io_csv 0 && expect_in io_csv out "$io_hash"
+# A European export (issue 34): decimal commas between blanks are refused,
+# naming the line (they read as other numbers before), and read with
+# --decimal-comma as the same mesh; ';' fields likewise with --delimiter.
+awk '{ gsub(/\./, ",") } 1' io.xyz >io_eu.xyz
+run io_eu "$FRONTDT" --hash io_eu.xyz
+expect_rc io_eu 2 && expect_in io_eu err "io_eu.xyz:1: commas between digits and blanks between fields: pass --decimal-comma"
+run io_eu_dc "$FRONTDT" --hash --decimal-comma io_eu.xyz
+expect_rc io_eu_dc 0 && expect_in io_eu_dc out "$io_hash"
+awk 'BEGIN { print "X;Y;Z" } { gsub(/\./, ","); print $1 ";" $2 ";" $3 }' io.xyz >io_eu.csv
+run io_eu_semi "$FRONTDT" --hash io_eu.csv
+expect_rc io_eu_semi 2 && expect_in io_eu_semi err "io_eu.csv:2: fields separated by ';'" &&
+  expect_in io_eu_semi err "--delimiter ';' --decimal-comma"
+run io_eu_semi_ok "$FRONTDT" --hash --delimiter ';' --decimal-comma io_eu.csv
+expect_rc io_eu_semi_ok 0 && expect_in io_eu_semi_ok out "$io_hash"
+run io_eu_both "$FRONTDT" --decimal-comma --delimiter , io_eu.xyz
+expect_rc io_eu_both 1 && expect_in io_eu_both err "a comma cannot be both"
+run io_eu_node "$FRONTDT" --decimal-comma io.node
+expect_rc io_eu_node 1 && expect_in io_eu_node err "--delimiter and --decimal-comma apply to .xyz"
 awk '{ print $0, 17, 200, 100, 50 }' io.xyz >io_extra.txt
 run io_extra "$FRONTDT" --hash io_extra.txt
 expect_rc io_extra 0 && expect_in io_extra out "$io_hash"

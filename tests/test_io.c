@@ -254,6 +254,31 @@ static void test_read(void)
              FDT_EINVAL);
     CHECK(strstr(diag, "size") != NULL);
     CHECK_EQ(fdt_default_read_options_sized(NULL, sizeof o), FDT_EINVAL);
+    /* 0.1's size, which ended before delimiter, is still read (with the
+     * default separators); this release's reads a decimal comma. */
+    put_file(at("eu.xyz"), "0,5 0 0\n1 0 0\n0 1 0\n0 0 1\n");
+    fdt_read_options old;
+    memset(&old, 0x5a, sizeof old); /* the bytes a 0.1 caller does not have */
+    CHECK_EQ(fdt_default_read_options_sized(&old, offsetof(fdt_read_options, delimiter)),
+             FDT_OK);
+    CHECK_EQ(fdt_read_points_opts(at("a.csv"), &old, &xyz, &n, diag, sizeof diag), FDT_OK);
+    CHECK_EQ(n, 3);
+    fdt_free(xyz);
+    CHECK_EQ(fdt_read_points_opts(at("eu.xyz"), &old, &xyz, &n, diag, sizeof diag),
+             FDT_EFORMAT);
+    CHECK(strstr(diag, "eu.xyz:1:") != NULL && strstr(diag, "--decimal-comma") != NULL);
+    fdt_default_read_options(&o);
+    o.decimal_comma = 1;
+    CHECK_EQ(fdt_read_points_opts(at("eu.xyz"), &o, &xyz, &n, diag, sizeof diag), FDT_OK);
+    CHECK(n == 4 && xyz[0] == 0.5);
+    fdt_free(xyz);
+    o.delimiter = ',';
+    CHECK_EQ(fdt_read_points_opts(at("eu.xyz"), &o, &xyz, &n, diag, sizeof diag), FDT_EINVAL);
+    CHECK(strstr(diag, "decimal comma cannot also separate") != NULL);
+    o.decimal_comma = 0;
+    o.delimiter = '|';
+    CHECK_EQ(fdt_read_points_opts(at("eu.xyz"), &o, &xyz, &n, diag, sizeof diag), FDT_EINVAL);
+    CHECK(strstr(diag, "the delimiter is") != NULL);
     /* NULL options: the defaults */
     CHECK_EQ(fdt_read_points_opts(at("a.csv"), NULL, &xyz, &n, diag, sizeof diag), FDT_OK);
     CHECK_EQ(n, 3);

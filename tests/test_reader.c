@@ -447,7 +447,7 @@ static void test_xyz_random(tctx *t, const char *tag, size_t npts,
     for (size_t i = 0; i < 3 * npts; i++) {
         random_literal(t, lit, sizeof lit);
         want[i] = strtod(lit, NULL);
-        bb_printf(&b, "%s%s", lit, i % 3 == 2 ? "\n" : (i & 1 ? "," : " "));
+        bb_printf(&b, "%s%s", lit, i % 3 == 2 ? "\n" : (i & 1 ? ", " : " "));
     }
     char path[1024], name[64];
     snprintf(name, sizeof name, "random_%s.xyz", tag);
@@ -585,7 +585,7 @@ static void test_xyz_bad(tctx *t)
         {"1,2,3,", ":3: empty field (stray comma)"},
         {"1, ,2,3", ":3: empty field (stray comma)"},
         {",", ":3: empty field (stray comma)"},
-        {"1;2;3", ":3: not a number: '1;2;3'"},
+        {"1;2;3", ":3: fields separated by ';' in '1;2;3': read the file with --delimiter ';'"},
         {"1 2 3\r4", ":3: expected 3 numbers, found 4"},
         {"1 2 33333333333333333333333333333333333333333333333333x",
          ":3: not a number: '333333333333333333333333...'"},
@@ -1854,14 +1854,18 @@ static int run_data(const char *dir)
 /* Columns, headers, standard input, pipes and progress (issue 17)    */
 /* ------------------------------------------------------------------ */
 
-/* Reads text named name through fdt_rd_points_mem_with with columns
- * cols (NULL: the defaults) on `threads` threads (slices of a byte);
- * returns the code, the points in *xyz (caller frees) and the message. */
-static int read_cols(const char *name, const char *text, const int *cols, int threads,
-                     double **xyz, size_t *n, char *err, size_t errlen)
+/* Reads text named name through fdt_rd_points_mem_with with the options
+ * base (NULL: the defaults) and columns cols (NULL: base's) on `threads`
+ * threads (slices of a byte); returns the code, the points in *xyz
+ * (caller frees) and the message. */
+static int read_cols(const char *name, const char *text, const fdt_rd_opts *base,
+                     const int *cols, int threads, double **xyz, size_t *n, char *err,
+                     size_t errlen)
 {
     fdt_rd_opts o;
     fdt_rd_opts_default(&o);
+    if (base != NULL)
+        o = *base;
     if (cols != NULL)
         memcpy(o.columns, cols, sizeof o.columns);
     o.threads = threads;
@@ -1870,15 +1874,16 @@ static int read_cols(const char *name, const char *text, const int *cols, int th
 }
 
 /* The text must read as want[0..3n) on 1 and 3 threads. */
-#define COLS_OK(t, name, text, cols, want, nw) cols_ok((t), __LINE__, name, text, cols, want, nw)
-static void cols_ok(tctx *t, int line, const char *name, const char *text, const int *cols,
-                    const double *want, size_t nw)
+#define COLS_OK(t, name, text, cols, want, nw) \
+    cols_ok((t), __LINE__, name, text, NULL, cols, want, nw)
+static void cols_ok(tctx *t, int line, const char *name, const char *text,
+                    const fdt_rd_opts *base, const int *cols, const double *want, size_t nw)
 {
     for (int T = 1; T <= 3; T += 2) {
         double *xyz = NULL;
         size_t n = 0;
         char err[256];
-        int rc = read_cols(name, text, cols, T, &xyz, &n, err, sizeof err);
+        int rc = read_cols(name, text, base, cols, T, &xyz, &n, err, sizeof err);
         test_count_checks(1);
         if (rc != FDT_IO_OK || n != nw || memcmp(xyz, want, 3 * nw * sizeof *want) != 0)
             fail_at(t, line, "%s (%d threads): %s, %zu points: %s", name, T, code_name(rc), n,
@@ -1888,21 +1893,88 @@ static void cols_ok(tctx *t, int line, const char *name, const char *text, const
 }
 
 /* The text must be refused with a message holding sub, on 1 and 3 threads. */
-#define COLS_ERR(t, name, text, cols, sub) cols_err((t), __LINE__, name, text, cols, sub)
-static void cols_err(tctx *t, int line, const char *name, const char *text, const int *cols,
-                     const char *sub)
+#define COLS_ERR(t, name, text, cols, sub) cols_err((t), __LINE__, name, text, NULL, cols, sub)
+static void cols_err(tctx *t, int line, const char *name, const char *text,
+                     const fdt_rd_opts *base, const int *cols, const char *sub)
 {
     for (int T = 1; T <= 3; T += 2) {
         double *xyz = NULL;
         size_t n = 0;
         char err[256];
-        int rc = read_cols(name, text, cols, T, &xyz, &n, err, sizeof err);
+        int rc = read_cols(name, text, base, cols, T, &xyz, &n, err, sizeof err);
         test_count_checks(1);
         if (rc == FDT_IO_OK || strstr(err, sub) == NULL)
             fail_at(t, line, "%s (%d threads): want an error with \"%s\", got %s: %s", name, T,
                     sub, code_name(rc), err);
         free(xyz);
     }
+}
+
+/* Decimal commas and semicolons (issue 34): a European export is read
+ * as written when its separator and decimal mark are named, and refused,
+ * naming its line and what to pass, when they are not; never read as
+ * other numbers. On 1 and 3 threads (the slices' refusals are worded by
+ * the one-thread read). */
+#define SEP_OK(t, name, text, delim, dc, want, nw) \
+    cols_ok((t), __LINE__, name, text, sep_opts(&o, delim, dc), NULL, want, nw)
+#define SEP_ERR(t, name, text, delim, dc, sub) \
+    cols_err((t), __LINE__, name, text, sep_opts(&o, delim, dc), NULL, sub)
+static const fdt_rd_opts *sep_opts(fdt_rd_opts *o, char delim, int dc)
+{
+    fdt_rd_opts_default(o);
+    o->delimiter = delim;
+    o->decimal_comma = dc;
+    return o;
+}
+
+static void test_separators(tctx *t)
+{
+    fdt_rd_opts o;
+    static const double eu[] = {64.4067, 58.7253, 78.2371, 0.5, 0.25, 2, 1, 0, 0, 0, 1, 0};
+    static const double half[] = {0.5, 0.1, 0.2, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const double sq[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const char *eu_blank = "64,4067 58,7253 78,2371\n0,5 0,25 2\n1 0 0\n0 1 0\n";
+    /* A decimal comma and blanks: refused by default (it read as x=64,
+     * y=4067, z=58), read with --decimal-comma. */
+    SEP_ERR(t, "eu.xyz", eu_blank, 0, 0,
+            "eu.xyz:1: commas between digits and blanks between fields: pass --decimal-comma");
+    SEP_OK(t, "eu.xyz", eu_blank, 0, 1, eu, 4);
+    SEP_OK(t, "eu.xyz", "x y z\n64,4067 58,7253 78,2371\n0,5\t0,25\t2\n1 0 0\n0 1 0\n", 0, 1, eu,
+           4);
+    /* Every point on one line before ("0,5 0,1 0,2": 0 5 0): refused on
+     * the line that first mixes them. */
+    SEP_ERR(t, "half.xyz", "1 0 0\n0,5 0,1 0,2\n", 0, 0, "half.xyz:2: commas between digits");
+    SEP_ERR(t, "late.xyz", "1 0 0\n0 1 0\n0 0 1\n7 8,5 9\n", 0, 0, "late.xyz:4:");
+    /* Semicolons: refused, naming the line (not taken as a header), with
+     * the option to pass, and --decimal-comma when the line has commas. */
+    SEP_ERR(t, "semi.csv", "0;0;0\n1;0;0\n0;1;0\n0;0;1\n", 0, 0,
+            "semi.csv:1: fields separated by ';' in '0;0;0': read the file with --delimiter ';'");
+    SEP_ERR(t, "semih.csv", "x;y;z\n0;0;0\n1;0;0\n0;1;0\n0;0;1\n", 0, 0,
+            "semih.csv:2: fields separated by ';'");
+    SEP_ERR(t, "semid.csv", "0,5;0,1;0,2\n", 0, 0, "--delimiter ';' --decimal-comma");
+    SEP_OK(t, "semi.csv", "x;y;z\n0;0;0\n1;0;0\n0 ;1; 0\n0;0;1\n", ';', 0, sq, 4);
+    SEP_OK(t, "semid.csv", "0,5;0,1;0,2\n1;0;0\n0;1;0\n0;0;1\n", ';', 1, half, 4);
+    SEP_ERR(t, "semid.csv", "0,5;0,1;0,2\n", ';', 0,
+            "semid.csv:1: a comma inside the number '0,5': pass --decimal-comma");
+    SEP_ERR(t, "semie.csv", "0;;0\n", ';', 0, "semie.csv:1: empty field (stray semicolon)");
+    /* What stays as it was: commas alone, commas with blanks around them,
+     * blanks alone; a named ',' delimiter reads mixed lines as before. */
+    SEP_OK(t, "c.csv", "0,0,0\n1,0,0\n0,1,0\n0,0,1\n", 0, 0, sq, 4);
+    SEP_OK(t, "cs.csv", "0, 0, 0\n1 ,0 ,0\n0 , 1 , 0\n0,0,1\n", 0, 0, sq, 4);
+    SEP_OK(t, "b.xyz", "0 0 0\n1 0 0\n0 1 0\n0 0 1\n", 0, 0, sq, 4);
+    static const double mixed[] = {0, 5, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    SEP_OK(t, "m.xyz", "0,5 0,1 0,2\n1 0 0 0 0 0\n0 1 0 0 0 0\n0 0 1 0 0 0\n", ',', 0, mixed, 4);
+    /* Blanks only: a comma is then inside a field. */
+    SEP_ERR(t, "bc.xyz", "0,0,0\n", ' ', 0, "bc.xyz:1: a comma inside the number '0,0,0'");
+    /* A decimal comma with a thousands separator or two commas: refused. */
+    SEP_ERR(t, "k.xyz", "1.000,5 0 0\n", 0, 1, "k.xyz:1: not a number: '1.000,5'");
+    SEP_ERR(t, "cc.xyz", "1,0,5 0 0\n", 0, 1, "cc.xyz:1: not a number: '1,0,5'");
+    /* Refused options: a comma both ways; another character; a format
+     * without fields. */
+    SEP_ERR(t, "both.xyz", "0 0 0\n", ',', 1, "a decimal comma cannot also separate fields");
+    SEP_ERR(t, "x.xyz", "0 0 0\n", 'x', 0, "the delimiter is ',', ';' or ' '");
+    SEP_ERR(t, "p.node", "1 3 0 0\n0 0 0 0\n", ';', 0,
+            "a delimiter or decimal comma applies to .xyz, .txt and .csv only");
 }
 
 static void test_columns(tctx *t)
@@ -2484,6 +2556,7 @@ int main(int argc, char **argv)
     test_locale(&t);
     test_parse_int(&t);
     test_columns(&t);
+    test_separators(&t);
     test_stdin(&t);
     test_chunks(&t);
     replay_bad(&t, argv[1]);

@@ -64,6 +64,8 @@ typedef struct cli {
     int input_format;       /* FDT_RD_AUTO: by the input's extension */
     const char *input_format_name; /* --input-format as given, or NULL */
     int columns[3];         /* --columns, from 1; {0, 0, 0}: 1, 2, 3 */
+    char delimiter;         /* --delimiter: ',', ';', ' '; 0: not given */
+    int decimal_comma;      /* --decimal-comma */
     int progress;           /* --progress: draw even when not a terminal */
     const char *output;     /* the first -o; NULL: triangulate and report only */
     const char *outputs[MAX_OUTPUTS]; /* every -o, in order ("-": stdout) */
@@ -110,6 +112,10 @@ static void usage(FILE *f)
         "                         format whatever its name (needed for '-')\n"
         "      --columns X,Y,Z    the columns of x, y and z in .xyz/.txt/.csv,\n"
         "                         counted from 1 as cut -f and awk do (1,2,3)\n"
+        "      --delimiter C      the field separator of .xyz/.txt/.csv besides\n"
+        "                         blanks: ',' (default) or ';'; ' ': blanks only\n"
+        "      --decimal-comma    numbers are written 0,5 (then the delimiter\n"
+        "                         is ';' or blanks: blanks unless given)\n"
         "      --mode MODE        serial, shared, message or auto (default)\n"
         "      --search HOW       how apexes are found: auto (default: the kd\n"
         "                         search, an insertion mesh where it gets\n"
@@ -240,6 +246,7 @@ static int parse_bytes(const char *s, unsigned long long *v)
 enum {
     OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH, OPT_SET_HASH,
     OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
+    OPT_DELIMITER, OPT_DECIMAL_COMMA,
     OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT
 };
 
@@ -260,6 +267,8 @@ static const struct option long_opts[] = {
     { "demo", optional_argument, NULL, OPT_DEMO },
     { "input-format", required_argument, NULL, OPT_INPUT_FORMAT },
     { "columns", required_argument, NULL, OPT_COLUMNS },
+    { "delimiter", required_argument, NULL, OPT_DELIMITER },
+    { "decimal-comma", no_argument, NULL, OPT_DECIMAL_COMMA },
     { "progress", no_argument, NULL, OPT_PROGRESS },
     { "stream", no_argument, NULL, OPT_STREAM },
     { "no-stream", no_argument, NULL, OPT_NO_STREAM },
@@ -460,6 +469,15 @@ static int parse_args(int argc, char **argv, cli *c)
                 return usage_error("--columns wants three different column numbers "
                                    "from 1, as 3,4,5, not '%s'", optarg);
             break;
+        case OPT_DELIMITER:
+            if (strlen(optarg) != 1 || !strchr(",; ", optarg[0]))
+                return usage_error("--delimiter is ',', ';' or ' ' (blanks only), not '%s'",
+                                   optarg);
+            c->delimiter = optarg[0];
+            break;
+        case OPT_DECIMAL_COMMA:
+            c->decimal_comma = 1;
+            break;
         case OPT_PROGRESS:
             c->progress = 1;
             break;
@@ -526,9 +544,17 @@ static int parse_args(int argc, char **argv, cli *c)
                                "xyz, node or ply");
         if (c->columns[0] && fmt != FDT_RD_XYZ && fmt != FDT_RD_AUTO)
             return usage_error("--columns applies to .xyz, .txt and .csv input only");
+        if ((c->delimiter || c->decimal_comma) && fmt != FDT_RD_XYZ && fmt != FDT_RD_AUTO)
+            return usage_error("--delimiter and --decimal-comma apply to .xyz, .txt and .csv "
+                               "input only");
     }
-    if (c->demo && (c->input_format != FDT_RD_AUTO || c->columns[0]))
-        return usage_error("--input-format and --columns need an input file, not --demo");
+    if (c->decimal_comma && c->delimiter == ',')
+        return usage_error("--decimal-comma with --delimiter ',': a comma cannot be both; "
+                           "the fields of such a file are separated by ';' or blanks");
+    if (c->demo && (c->input_format != FDT_RD_AUTO || c->columns[0] || c->delimiter ||
+                    c->decimal_comma))
+        return usage_error("--input-format, --columns, --delimiter and --decimal-comma need "
+                           "an input file, not --demo");
     return -1;
 }
 
@@ -1189,6 +1215,8 @@ static int run(const cli *c)
         fdt_default_read_options(&ro);
         ro.format = c->input_format_name;
         memcpy(ro.columns, c->columns, sizeof ro.columns);
+        ro.delimiter = c->delimiter;
+        ro.decimal_comma = c->decimal_comma;
         ro.n_threads = reader_threads(c);
         if (prog.enabled) {
             ro.progress = progress_io;

@@ -81,6 +81,11 @@ typedef struct rd_ctx {
     size_t min_slice; /* least bytes a slice; 0: RD_MIN_SLICE */
     int col[3];       /* .xyz: 0-based columns of x, y, z */
     int custom_cols;  /* col[] is not 0, 1, 2 (the messages say so) */
+    char sep;         /* .xyz: the separator besides blanks (',', ';' or
+                         0: blanks only); rd_ctx_start: ',' */
+    int sep_guard;    /* .xyz: refuse a line that mixes blank and tight
+                         comma separators (the delimiter was not named) */
+    int decimal_comma; /* .xyz: ',' is the decimal mark */
     fdt_rd_progress_fn progress; /* NULL on threads other than the caller's */
     void *progress_user;
     size_t progress_scale; /* parsed bytes are reported times this */
@@ -94,6 +99,8 @@ static inline void rd_ctx_start(rd_ctx *c, const char *path, char *err, size_t e
     c->path = path;
     c->err = err;
     c->errlen = errlen;
+    c->sep = ',';
+    c->sep_guard = 1;
 }
 
 /* The buffer to start a streamed read of c with: the chunk, or less when
@@ -179,7 +186,8 @@ int fdt_rd_blank(const char *s, const char *e);
 
 typedef struct rd_fields {
     const char *p, *e;
-    int commas; /* ',' separates fields (text point formats) */
+    char sep;   /* separates fields besides blanks (',' in the text point
+                   formats by default; ';'); 0: blanks only */
     size_t n;   /* fields returned so far */
 } rd_fields;
 
@@ -199,7 +207,7 @@ int fdt_rd_stream_xyz_range(rd_ctx *c, rd_points *pb, size_t ncols, size_t line0
 /* The head of a text point file in buf[0, len) (eof: the file ends there):
  * 1 when it is enough to tell fdt_rd_text_head's answers, set in *h; 0
  * when more bytes are needed. */
-int fdt_rd_xyz_head(const char *buf, size_t len, int eof, fdt_rd_head *h);
+int fdt_rd_xyz_head(const char *buf, size_t len, int eof, char sep, fdt_rd_head *h);
 int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned);
 int fdt_rd_read_node(const rd_ctx *c, const char *start, rd_points *pb);
 
@@ -241,9 +249,9 @@ static inline int rd_tok_is(const char *s, size_t len, const char *w)
 
 /*
  * Next field of a line: 1 and the field, 0 at the end of the line, -1 on an
- * empty field (a comma at the start or end of the line, or two commas with
- * nothing between). Fields are separated by whitespace and, when commas is
- * set, by at most one comma.
+ * empty field (a separator at the start or end of the line, or two with
+ * nothing between). Fields are separated by whitespace and, when sep is
+ * set, by at most one sep.
  */
 /* Moves f->p to the start of the next field; same results as below. */
 static inline int fdt_rd_skip_sep(rd_fields *f)
@@ -251,7 +259,7 @@ static inline int fdt_rd_skip_sep(rd_fields *f)
     const char *p = f->p, *e = f->e;
     while (p < e && rd_is_space(*p))
         p++;
-    if (f->commas && p < e && *p == ',') {
+    if (f->sep && p < e && *p == f->sep) {
         if (f->n == 0) {
             f->p = p;
             return -1;
@@ -259,7 +267,7 @@ static inline int fdt_rd_skip_sep(rd_fields *f)
         p++;
         while (p < e && rd_is_space(*p))
             p++;
-        if (p == e || *p == ',') {
+        if (p == e || *p == f->sep) {
             f->p = p;
             return -1;
         }
@@ -270,7 +278,7 @@ static inline int fdt_rd_skip_sep(rd_fields *f)
 
 static inline int fdt_rd_is_sep(const rd_fields *f, const char *p)
 {
-    return p == f->e || rd_is_space(*p) || (f->commas && *p == ',');
+    return p == f->e || rd_is_space(*p) || (f->sep && *p == f->sep);
 }
 
 static inline int fdt_rd_next_field(rd_fields *f, const char **ts, size_t *tl)

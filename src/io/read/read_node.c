@@ -27,7 +27,7 @@ int fdt_rd_read_node(const rd_ctx *c, const char *start, rd_points *pb)
     uint64_t hv[4] = {0, 3, 0, 0};
     size_t hline = 0;
     while (hline == 0 && fdt_rd_next_line(&L, &s, &e)) {
-        rd_fields f = {s, fdt_rd_cut_comment(s, e), 1, 0};
+        rd_fields f = {s, fdt_rd_cut_comment(s, e), ',', 0};
         size_t k = 0;
         while ((r = fdt_rd_next_field(&f, &ts, &tl)) != 0) {
             if (r < 0)
@@ -98,7 +98,7 @@ int fdt_rd_read_node(const rd_ctx *c, const char *start, rd_points *pb)
     while (fdt_rd_next_line(&L, &s, &e)) {
         if ((L.lineno & (RD_PROGRESS_EVERY - 1)) == 0)
             fdt_rd_progress(c, (size_t)(L.p - c->buf));
-        rd_fields f = {s, fdt_rd_cut_comment(s, e), 1, 0};
+        rd_fields f = {s, fdt_rd_cut_comment(s, e), ',', 0};
         if (fdt_rd_blank(f.p, f.e))
             continue;
         if (pb->n == npts)

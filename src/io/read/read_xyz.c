@@ -22,10 +22,12 @@
 /* ------------------------------------------------------------------ */
 
 /* Whether the first content line s..e is a header: printable ASCII and
- * no field (between blanks and commas) that reads as a number, finite or
- * not, so that a first line of data, or of binary garbage, is never
- * skipped unseen. */
-static int rd_is_header(const char *s, const char *e)
+ * no field (between blanks and sep, and between ';' too: a line of
+ * semicolon-separated numbers is data whose separator is refused, not a
+ * header) that reads as a number, finite or not, or starts as one (a
+ * digit, after a sign or a point), so that a first line of
+ * data, or of binary garbage, is never skipped unseen. */
+static int rd_is_header(const char *s, const char *e, char sep, int decimal_comma)
 {
     for (const char *p = s; p < e; p++) {
         unsigned char ch = (unsigned char)*p;
@@ -34,14 +36,21 @@ static int rd_is_header(const char *s, const char *e)
     }
     const char *p = s;
     while (p < e) {
-        while (p < e && (rd_is_space(*p) || *p == ','))
+        while (p < e && (rd_is_space(*p) || (sep && *p == sep) || *p == ';'))
             p++;
         const char *t = p;
-        while (p < e && !rd_is_space(*p) && *p != ',')
+        while (p < e && !rd_is_space(*p) && !(sep && *p == sep) && *p != ';')
             p++;
         if (p > t) {
             double v;
-            if (fdt_rd_parse_real(t, (size_t)(p - t), &v, 0) != NUM_SYNTAX)
+            /* a number, or a field that starts as one ("0,5" or "1.000,5"
+             * where ',' is not the separator): data, whose error the
+             * parse words */
+            size_t tl = (size_t)(p - t);
+            const char *d = t + (*t == '+' || *t == '-');
+            d += d < p && *d == '.';
+            if ((d < p && rd_is_digit(*d)) ||
+                (!decimal_comma && fdt_rd_parse_real(t, tl, &v, 0) != NUM_SYNTAX))
                 return 0;
         }
     }
@@ -66,9 +75,9 @@ static int rd_first_content(const char *start, const char *end, const char **s,
 
 /* Fields of the line s..e (a stray comma's empty field not counted: the
  * parse reports it). */
-static size_t rd_count_fields(const char *s, const char *e)
+static size_t rd_count_fields(const char *s, const char *e, char sep)
 {
-    rd_fields f = {s, e, 1, 0};
+    rd_fields f = {s, e, sep, 0};
     size_t k = 0;
     const char *ts;
     size_t tl;
@@ -79,6 +88,66 @@ static size_t rd_count_fields(const char *s, const char *e)
         else
             f.p++;
     return k;
+}
+
+/* The separators seen on a line, for the guard against decimal commas
+ * (rd_ctx.sep_guard): a blank-only separator between two fields, and a
+ * comma with a digit right before and after it ("0,5"). */
+enum { RD_SEEN_BLANK = 1, RD_SEEN_TIGHT_COMMA = 2 };
+
+/* What the separator [p0, p) between two fields was: its RD_SEEN_* bit. */
+static inline int rd_sep_kind(const char *p0, const char *p)
+{
+    if (p - p0 == 1) /* the common case: one blank or one comma */
+        return *p0 != ',' ? RD_SEEN_BLANK
+                          : rd_is_digit(p0[-1]) && rd_is_digit(*p) ? RD_SEEN_TIGHT_COMMA : 0;
+    for (; p0 < p; p0++)
+        if (*p0 == ',')
+            return 0;
+    return RD_SEEN_BLANK;
+}
+
+/* The refusal of a field that is no number because of its separators or
+ * decimal mark: a ';' (no ';' delimiter named), or a ',' inside a field
+ * (',' is not the delimiter and no decimal comma was named). s..e: the
+ * field's line. 0 when the field has neither, and the caller words the
+ * usual error. */
+static int rd_sep_fail(const rd_ctx *c, size_t line, const char *ts, size_t tl,
+                       const char *s, const char *e)
+{
+    char q[RD_QUOTE_CAP];
+    int semi = c->sep != ';' && memchr(ts, ';', tl) != NULL;
+    int comma = !c->decimal_comma && c->sep != ',' && memchr(ts, ',', tl) != NULL;
+    if (semi)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: fields separated by ';' in %s: read the file with "
+                           "--delimiter ';'%s",
+                           line, fdt_rd_quote(q, ts, tl),
+                           memchr(s, ',', (size_t)(e - s)) != NULL ? " --decimal-comma (',' is then "
+                                                         "the decimal mark)" : "");
+    if (comma)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: a comma inside the number %s: pass --decimal-comma if ',' "
+                           "is its decimal mark",
+                           line, fdt_rd_quote(q, ts, tl));
+    return 0;
+}
+
+/* A decimal-comma field ts[0, tl) as a number: the one ',' read as '.'
+ * (a '.' in it is refused: 1.000,5 has a thousands separator). */
+static int rd_parse_decimal_comma(const char *ts, size_t tl, double *v)
+{
+    char b[128];
+    if (tl >= sizeof b || memchr(ts, '.', tl) != NULL)
+        return NUM_SYNTAX;
+    memcpy(b, ts, tl);
+    char *comma = memchr(b, ',', tl);
+    if (comma != NULL) {
+        *comma = '.';
+        if (memchr(comma + 1, ',', tl - (size_t)(comma + 1 - b)) != NULL)
+            return NUM_SYNTAX;
+    }
+    return fdt_rd_parse_real(b, tl, v, 1);
 }
 
 /* The lines in [start, end) (end: the input's end or just after a '\n')
@@ -104,20 +173,42 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
     while (fdt_rd_next_line(&L, &s, &e)) {
         if ((L.lineno & (RD_PROGRESS_EVERY - 1)) == 0)
             fdt_rd_progress(c, (size_t)(L.p - start));
-        rd_fields f = {s, fdt_rd_cut_comment(s, e), 1, 0};
+        rd_fields f = {s, fdt_rd_cut_comment(s, e), c->sep, 0};
         double v[3];
         size_t k = 0;
-        const char *ts;
-        size_t tl = 0; /* set by fdt_rd_next_field before any use */
-        int r;
-        while ((r = fdt_rd_skip_sep(&f)) != 0) {
+        const char *ts = NULL;
+        size_t tl = 0; /* both set by fdt_rd_next_field before any use */
+        int r, seen = 0;
+        for (;;) {
+            const char *p0 = f.p;
+            if ((r = fdt_rd_skip_sep(&f)) == 0)
+                break;
             if (r < 0)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT, ":%zu: empty field (stray %s)", L.lineno,
+                                   c->sep == ';' ? "semicolon" : "comma");
+            /* A line of "0,5 1,25 2" read with ',' as the separator would
+             * be other numbers: refused unless a delimiter was named. */
+            if (c->sep_guard && k > 0 &&
+                (seen |= rd_sep_kind(p0, f.p)) == (RD_SEEN_BLANK | RD_SEEN_TIGHT_COMMA))
                 return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: empty field (stray comma)", L.lineno);
+                                   ":%zu: commas between digits and blanks between fields: "
+                                   "pass --decimal-comma if ',' is the decimal mark, "
+                                   "--delimiter ',' if commas separate fields",
+                                   L.lineno);
             int which = k == c0 ? 0 : k == c1 ? 1 : k == c2 ? 2 : -1;
             if (which < 0) {
                 /* not a coordinate: skipped, only counted */
                 fdt_rd_next_field(&f, &ts, &tl);
+                k++;
+                continue;
+            }
+            if (c->decimal_comma) {
+                fdt_rd_next_field(&f, &ts, &tl);
+                int st = rd_parse_decimal_comma(ts, tl, &v[which]);
+                if (st != NUM_OK) {
+                    int rs = st == NUM_SYNTAX ? rd_sep_fail(c, L.lineno, ts, tl, s, e) : 0;
+                    return rs ? rs : fdt_rd_num_fail(c, L.lineno, "", st, ts, tl);
+                }
                 k++;
                 continue;
             }
@@ -131,7 +222,8 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
                 st = fdt_rd_parse_real(ts, tl, &v[which], 1);
                 if (st == NUM_OK) /* cannot happen: the scan stopped early */
                     st = NUM_SYNTAX;
-                return fdt_rd_num_fail(c, L.lineno, "", st, ts, tl);
+                int rs = st == NUM_SYNTAX ? rd_sep_fail(c, L.lineno, ts, tl, s, e) : 0;
+                return rs ? rs : fdt_rd_num_fail(c, L.lineno, "", st, ts, tl);
             }
             if (st != NUM_OK)
                 return fdt_rd_num_fail(c, L.lineno, "", st, ts, used);
@@ -444,18 +536,18 @@ static int rd_xyz_stream_from(rd_ctx *c, rd_points *pb, int whole, size_t ncols0
         const char *fs, *fe;
         size_t fl;
         if (st == FIND_FIRST && rd_first_content(s, end, &fs, &fe, &fl)) {
-            if (rd_is_header(fs, fe)) {
+            if (rd_is_header(fs, fe, c->sep, c->decimal_comma)) {
                 const char *nl = memchr(fe, '\n', (size_t)(end - fe));
                 line0 += fl;
                 s = nl != NULL ? nl + 1 : end;
                 st = FIND_COLUMNS;
             } else {
-                ncols = rd_count_fields(fs, fe);
+                ncols = rd_count_fields(fs, fe, c->sep);
                 st = PARSE;
             }
         }
         if (st == FIND_COLUMNS && rd_first_content(s, end, &fs, &fe, &fl)) {
-            ncols = rd_count_fields(fs, fe);
+            ncols = rd_count_fields(fs, fe, c->sep);
             st = PARSE;
         }
         size_t lines = 0;
@@ -486,7 +578,7 @@ static int rd_xyz_stream_from(rd_ctx *c, rd_points *pb, int whole, size_t ncols0
     return rc;
 }
 
-int fdt_rd_xyz_head(const char *buf, size_t len, int eof, fdt_rd_head *h)
+int fdt_rd_xyz_head(const char *buf, size_t len, int eof, char sep, fdt_rd_head *h)
 {
     size_t bom = len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0 ? 3 : 0;
     if (!eof && len < 3 && memcmp(buf, "\xef\xbb\xbf", len) == 0)
@@ -503,8 +595,8 @@ int fdt_rd_xyz_head(const char *buf, size_t len, int eof, fdt_rd_head *h)
     size_t fl;
     if (!rd_first_content(s, end, &fs, &fe, &fl))
         return eof; /* no content: no points at all, or more to read */
-    if (!rd_is_header(fs, fe)) {
-        h->ncols = rd_count_fields(fs, fe);
+    if (!rd_is_header(fs, fe, sep, 0)) {
+        h->ncols = rd_count_fields(fs, fe, sep);
         return 1;
     }
     /* a header: the points start on the line after it, and the next
@@ -514,7 +606,7 @@ int fdt_rd_xyz_head(const char *buf, size_t len, int eof, fdt_rd_head *h)
     h->body = (size_t)(after - buf);
     h->body_line = fl;
     if (rd_first_content(after, end, &fs, &fe, &fl)) {
-        h->ncols = rd_count_fields(fs, fe);
+        h->ncols = rd_count_fields(fs, fe, sep);
         return 1;
     }
     return eof;

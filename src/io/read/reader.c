@@ -383,6 +383,16 @@ static int rd_stream(rd_ctx *c, const rd_format *f, rd_src *src, double **xyz, s
     return rd_finish(c, rc, &pb, xyz, n);
 }
 
+/* Why a delimiter and decimal mark cannot be read together, or NULL. */
+static const char *rd_sep_refusal(char delimiter, int decimal_comma)
+{
+    if (delimiter != 0 && delimiter != ',' && delimiter != ';' && delimiter != ' ')
+        return "the delimiter is ',', ';' or ' ' (blanks only)";
+    if (decimal_comma && delimiter == ',')
+        return "a decimal comma cannot also separate fields (delimiter ';' or ' ')";
+    return NULL;
+}
+
 /*
  * Sets up c from the options and picks the format: the one the options
  * name, else the name's extension's. NULL after wording the refusal (an
@@ -406,6 +416,15 @@ static const rd_format *rd_setup(rd_ctx *c, const char *name, const fdt_rd_opts 
         c->col[k] = custom ? o->columns[k] - 1 : k;
     }
     c->custom_cols = custom && !(c->col[0] == 0 && c->col[1] == 1 && c->col[2] == 2);
+    /* The separator and the decimal mark (README, "Separators"). */
+    const char *why = rd_sep_refusal(o->delimiter, o->decimal_comma);
+    if (why != NULL) {
+        *rc = fdt_rd_fail(c, FDT_IO_EFORMAT, ": %s", why);
+        return NULL;
+    }
+    c->decimal_comma = o->decimal_comma != 0;
+    c->sep_guard = o->delimiter == 0 && !o->decimal_comma;
+    c->sep = o->delimiter == ' ' ? 0 : o->delimiter != 0 ? o->delimiter : o->decimal_comma ? 0 : ',';
     int id = o->format != FDT_RD_AUTO ? o->format : fdt_rd_format_of_path(name);
     const rd_format *f = rd_format_row(id);
     if (f == NULL) {
@@ -423,6 +442,11 @@ static const rd_format *rd_setup(rd_ctx *c, const char *name, const fdt_rd_opts 
     }
     if (c->custom_cols && !f->has_columns) {
         *rc = fdt_rd_fail(c, FDT_IO_EFORMAT, ": columns apply to .xyz, .txt and .csv only");
+        return NULL;
+    }
+    if ((o->delimiter != 0 || o->decimal_comma) && !f->has_columns) {
+        *rc = fdt_rd_fail(c, FDT_IO_EFORMAT,
+                          ": a delimiter or decimal comma applies to .xyz, .txt and .csv only");
         return NULL;
     }
     return f;
@@ -558,10 +582,11 @@ int fdt_rd_points_mem_threads(const char *name, const void *data, size_t len, in
 /* ------------------------------------------------------------------ */
 
 /* The fdt_read_options sizes this library accepts (include/frontdt.h,
- * ABI): this release's only, so far. */
+ * ABI): this release's, and 0.1's, which ended before delimiter. */
+#define READ_OPTIONS_0_1_SIZE offsetof(fdt_read_options, delimiter)
 static int read_options_size_known(size_t size)
 {
-    return size == sizeof(fdt_read_options);
+    return size == sizeof(fdt_read_options) || size == READ_OPTIONS_0_1_SIZE;
 }
 
 int fdt_default_read_options_sized(fdt_read_options *o, size_t struct_size)
@@ -638,6 +663,13 @@ int fdt_read_points_opts(const char *path, const fdt_read_options *o, double **x
         return rd_refuse(diag, diag_size, path,
                          "columns apply to .xyz, .txt and .csv only%s", NULL);
     memcpy(ro.columns, o->columns, sizeof ro.columns);
+    if (o->struct_size > READ_OPTIONS_0_1_SIZE) {
+        ro.delimiter = o->delimiter;
+        ro.decimal_comma = o->decimal_comma;
+        const char *why = rd_sep_refusal(ro.delimiter, ro.decimal_comma);
+        if (why != NULL)
+            return rd_refuse(diag, diag_size, path, why, NULL); /* no % in why */
+    }
     ro.threads = o->n_threads > 1 ? o->n_threads : 1;
     rd_public_progress pp = {o->progress, o->progress_user};
     if (o->progress != NULL) {
@@ -739,7 +771,7 @@ int fdt_rd_text_head(const char *path, fdt_rd_head *h, char *err, size_t errlen)
         }
         len += (size_t)r;
         int eof = len >= size || len < cap;
-        if (fdt_rd_xyz_head(buf, len, eof, h))
+        if (fdt_rd_xyz_head(buf, len, eof, c.sep, h))
             break;
         if (cap > SIZE_MAX / 2) {
             rc = fdt_rd_fail(&c, FDT_IO_ENOMEM, ": out of memory");

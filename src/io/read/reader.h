@@ -132,6 +132,14 @@ typedef struct fdt_rd_opts {
                           .csv, binary .ply); 0: 8 MiB. Results do not
                           depend on it: the tests make it tiny so that
                           lines and items straddle many refills */
+    char delimiter;    /* text point formats: the character that separates
+                          fields besides blanks: ',' or ';'; ' ': blanks
+                          only; 0 (the default): ',', and a line that
+                          mixes blank and comma separators, as decimal
+                          commas do ("0,5 1,25 2"), is refused */
+    int decimal_comma; /* text point formats: ',' is the decimal mark
+                          ("0,5"); needs a delimiter other than ',' (its
+                          default then: blanks only) */
     fdt_rd_progress_fn progress; /* may be NULL */
     void *progress_user;
     size_t fail_after; /* tests only, fdt_rd_points_mem_with's streamed
