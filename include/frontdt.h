@@ -24,8 +24,10 @@
  *   - an fdt_settings must come from fdt_default_settings() (which sets
  *     struct_size); one zeroed by hand is refused by fdt_open().
  * Today every struct has one size (the first release's), except
- * fdt_stats, which has two: the first release's (ending at t_mesh) and
- * this one's, with the memory fields (mem_points ..).
+ * fdt_stats, which has three: the first release's (ending at t_mesh),
+ * 0.1's with the memory fields (mem_points ..), and this one's with the
+ * one-part engine's (final_tets ..); and fdt_read_options, which has two
+ * (0.1's ended before delimiter).
  * fdt_read_options and fdt_write_options (file formats, at the end) follow
  * the same rule.
  */
@@ -364,6 +366,14 @@ typedef struct fdt_stats {
     size_t mem_mesh;          /* tets and hull faces kept in memory (0
                                  when streamed), neighbours included */
     size_t mem_sink;          /* the stream's batches (one per thread) */
+    /* The one-part engine (issue 31). Added in 0.2: a 0.1 caller passes
+     * a shorter size and gets the fields above. */
+    size_t final_tets;        /* tets that went to the sink straight from a
+                                 part's certified insertion mesh, with no
+                                 front (serial, --search auto or mesh) */
+    size_t certified_tets;    /* finite tets the mesh certificates checked
+                                 before any was trusted */
+    double t_certify;         /* seconds certifying meshes */
 } fdt_stats;
 
 /* Fills the first struct_size bytes of *st (its struct_size included).

@@ -194,6 +194,41 @@ static fdt_result *run(const pts *p, fdt_mode mode, int threads, fdt_search sear
     return r;
 }
 
+static int drop_tets(void *user, const fdt_vid *t, size_t count)
+{
+    (void)user;
+    (void)t;
+    (void)count;
+    return 0;
+}
+
+/* A streamed serial run (the tets dropped): the paper's front, whose
+ * oracle still switches by its rules (src/front/oracle.c). */
+static fdt_result *run_stream(const pts *p, fdt_stats *st)
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = FDT_MODE_SERIAL;
+    fdt_context *ctx = NULL;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    fdt_sink sink = {sizeof sink, drop_tets, NULL, NULL};
+    fdt_result *r = NULL;
+    int err = fdt_triangulate_stream(ctx, p->xyz, p->n, &sink, &r);
+    if (err != FDT_OK)
+        fprintf(stderr, "%s (streamed): %s\n", p->name, fdt_context_diagnostic(ctx));
+    CHECK_EQ(err, FDT_OK);
+    fdt_close(&ctx);
+    CHECK_EQ(fdt_result_stats(r, st), FDT_OK);
+    return r;
+}
+
+static uint64_t set_hash_of(const fdt_result *r)
+{
+    uint64_t h;
+    CHECK_EQ(fdt_result_set_hash(r, &h), FDT_OK);
+    return h;
+}
+
 static uint64_t hash_of(fdt_result *r)
 {
     uint64_t h;
@@ -202,8 +237,10 @@ static uint64_t hash_of(fdt_result *r)
 }
 
 /* Every search, mode and thread count against the kd search in serial
- * mode. want_auto: 1 the automatic rule must switch in serial mode, 0 it
- * must not, -1 either. */
+ * mode. In memory, serial --search mesh and auto are the one-part engine
+ * (src/front/partmesh.h): every tet from the certified mesh, no front.
+ * want_auto: 1 the automatic rule of a streamed serial run (the front)
+ * must switch, 0 it must not, -1 either. */
 static void test_family(pts p, int want_auto, int quick)
 {
     fdt_stats st;
@@ -212,11 +249,14 @@ static void test_family(pts p, int want_auto, int quick)
     CHECK_EQ(st.mesh_faces, 0);
     CHECK_EQ(st.mesh_parts, 0);
 
+    uint64_t sref = set_hash_of(ref);
     fdt_result *r = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_MESH, &st);
-    /* The whole mesh came from the insertion mesh (all faces but the
-     * seed's own search), and it is the Delaunay tetrahedralization. */
+    /* The whole mesh came from the certified insertion mesh, no face was
+     * advanced, and it is the Delaunay tetrahedralization. */
     CHECK_EQ(st.mesh_parts, 1);
-    CHECK(st.mesh_faces + 1 >= st.faces_advanced);
+    CHECK_EQ(st.faces_advanced, 0);
+    CHECK_EQ(st.final_tets, st.tets);
+    CHECK_EQ(st.certified_tets, st.tets);
     char msg[256];
     int rc = fdt_check(p.xyz, p.n, fdt_result_tets(r), fdt_result_num_tets(r), NULL, msg,
                        sizeof msg);
@@ -228,6 +268,11 @@ static void test_family(pts p, int want_auto, int quick)
 
     r = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_AUTO, &st);
     CHECK_EQ(hash_of(r), href);
+    CHECK_EQ(st.final_tets, st.tets);
+    fdt_result_free(&r);
+    r = run_stream(&p, &st);
+    CHECK(set_hash_of(r) == sref);
+    CHECK_EQ(st.final_tets, 0);
     if (want_auto >= 0)
         CHECK_EQ(st.mesh_parts, (size_t)want_auto);
     if (st.mesh_parts)
@@ -638,11 +683,12 @@ int main(int argc, char **argv)
         free(p.xyz);
         printf("ok auto mode's probe\n");
     }
-    /* Uniform points must never pay for a mesh. */
+    /* Uniform points must never pay for a mesh in the front (a streamed
+     * serial run; in memory the serial run is the one-part engine). */
     {
         pts p = gen_uniform(40000, 11);
         fdt_stats st;
-        fdt_result *r = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_AUTO, &st);
+        fdt_result *r = run_stream(&p, &st);
         CHECK_EQ(st.mesh_parts, 0);
         fdt_result_free(&r);
         free(p.xyz);

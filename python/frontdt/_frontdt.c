@@ -367,6 +367,8 @@ static PyObject *tri_stats(TriObject *self, void *closure)
         PUT_DBL(d, st, t_query_wait) || PUT_DBL(d, st, load_imbalance) ||
         put(d, "pinned", PyLong_FromLong(st.pinned)) || PUT_SIZE(d, st, mesh_faces) ||
         PUT_SIZE(d, st, mesh_parts) || PUT_DBL(d, st, t_mesh) ||
+        PUT_SIZE(d, st, final_tets) || PUT_SIZE(d, st, certified_tets) ||
+        PUT_DBL(d, st, t_certify) ||
         put(d, "duplicates", PyLong_FromSize_t(fdt_result_num_duplicates(self->r)))) {
         Py_DECREF(d);
         return NULL;

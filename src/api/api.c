@@ -13,6 +13,7 @@
 #include "front/front.h"
 #include "geom/kdtree.h"
 #include "front/oracle.h"
+#include "front/partmesh.h"
 #include "par/parallel.h"
 #include "geom/prepare.h"
 #include "mesh/result.h"
@@ -219,6 +220,8 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     size_t mem_tree = 0, mem_mesh = 0, mem_sink = 0;
     fdt_front_stats fst;
     memset(&fst, 0, sizeof fst);
+    fdt_partmesh_stats pms;
+    memset(&pms, 0, sizeof pms);
     if (mode != FDT_MODE_SERIAL) {
         double tp = fdt_now_s();
         err = fdt_parallel_run(&pr, &ctx->s, mode, nthreads, &popt, &par, ctx->diag,
@@ -240,8 +243,18 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
         if (fdt_emit_init(&em, &sink, &mb) != FDT_OK)
             goto fail;
         t1 = fdt_now_s();
-        err = fdt_front_emit(&tree, central_point(&tree), (int)ctx->s.search, &em,
-                             ctx->s.progress, ctx->s.progress_user, &fst);
+        /* The path is a function of the settings alone (issue 31): in
+         * memory, --search auto and mesh run the one-part engine (the
+         * insertion mesh, certified, is the answer); --search kd, and a
+         * streamed run, whose memory must stay bounded, run the paper's
+         * front. */
+        if (ctx->s.search != FDT_SEARCH_KD && !user)
+            err = fdt_partmesh_emit_all(pr.p, (uint32_t)pr.m, &em, ctx->s.progress,
+                                        ctx->s.progress_user, &pms, ctx->diag,
+                                        sizeof ctx->diag);
+        else
+            err = fdt_front_emit(&tree, central_point(&tree), (int)ctx->s.search, &em,
+                                 ctx->s.progress, ctx->s.progress_user, &fst);
         if (!err)
             err = fdt_emit_flush(&em);
         mem_mesh = fdt_meshbuf_bytes(&mb);
@@ -251,7 +264,10 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
         if (err == FDT_ENOMEM)
             snprintf(ctx->diag, sizeof ctx->diag, "out of memory after %lld tetrahedra",
                      (long long)em.ntets);
-        else if (err == FDT_EINTERNAL)
+        else if (err == FDT_ECHECK && !ctx->diag[0])
+            snprintf(ctx->diag, sizeof ctx->diag, "mesh certificate failed: %s",
+                     fst.cert_what ? fst.cert_what : "?");
+        else if (err == FDT_EINTERNAL && !ctx->diag[0])
             snprintf(ctx->diag, sizeof ctx->diag,
                      "internal error: the front became inconsistent after %lld tetrahedra",
                      (long long)em.ntets);
@@ -300,8 +316,15 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     st->adapt_insphere = fst.kq.pc.insphere_adapt;
     st->max_front = fst.max_front;
     st->mesh_faces = fst.mesh_faces;
-    st->mesh_parts = fst.mesh_parts;
-    st->t_mesh = fst.t_mesh;
+    st->mesh_parts = fst.mesh_parts + (pms.final_tets > 0);
+    st->t_mesh = fst.t_mesh + pms.t_mesh;
+    st->final_tets = pms.final_tets;
+    st->certified_tets = pms.certified_tets;
+    st->t_certify = pms.t_certify;
+    st->exact_orient += pms.pc.orient_exact;
+    st->exact_insphere += pms.pc.insphere_exact;
+    st->adapt_orient += pms.pc.orient_adapt;
+    st->adapt_insphere += pms.pc.insphere_adapt;
     st->threads = 1;
     st->mode = FDT_MODE_SERIAL;
     /* Memory (include/frontdt.h): the points' three arrays, then each

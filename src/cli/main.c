@@ -824,6 +824,7 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  adaptive insphere %zu\n"
         "  largest front     %zu\n"
         "  mesh faces        %zu (%zu parts built a mesh in %.3f s)\n"
+        "  final from mesh   %zu tets (certified %zu in %.3f s)\n"
         "  threads           %d\n"
         "  mode              %s\n"
         "  time prepare      %.3f s\n"
@@ -837,8 +838,8 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         st->points, st->vertices, dups, st->tets, st->hull_faces,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
-        st->max_front, st->mesh_faces, st->mesh_parts, st->t_mesh, st->threads,
-        mode_name(st->mode), st->t_prepare, st->t_front, st->t_finish,
+        st->max_front, st->mesh_faces, st->mesh_parts, st->t_mesh, st->final_tets,
+        st->certified_tets, st->t_certify, st->threads, mode_name(st->mode), st->t_prepare, st->t_front, st->t_finish,
         tm->read, tm->triangulate, tm->check, tm->canon, tm->write);
     if (st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE)
         print_parallel_stats(res, st);
@@ -922,7 +923,8 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         ", \"exact_orient\": %zu, \"exact_insphere\": %zu"
         ", \"adapt_orient\": %zu, \"adapt_insphere\": %zu"
         ", \"max_front\": %zu, \"mesh_faces\": %zu, \"mesh_parts\": %zu"
-        ", \"t_mesh\": %.9g, \"threads\": %d, \"mode\": \"%s\""
+        ", \"t_mesh\": %.9g, \"final_tets\": %zu, \"certified_tets\": %zu"
+        ", \"t_certify\": %.9g, \"threads\": %d, \"mode\": \"%s\""
         ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
         ", \"t_read\": %.9g, \"t_triangulate\": %.9g, \"t_check\": %.9g"
         ", \"t_canon\": %.9g, \"t_write\": %.9g",
@@ -930,6 +932,7 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
         st->max_front, st->mesh_faces, st->mesh_parts, finite_or_zero(st->t_mesh),
+        st->final_tets, st->certified_tets, finite_or_zero(st->t_certify),
         st->threads, mode_name(st->mode), finite_or_zero(st->t_prepare),
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),

@@ -212,6 +212,11 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *
             st->max_front = ft.count;
         uint32_t f[3] = {s->v[0], s->v[1], s->v[2]};
         fdt_oracle_tick(&orc, st->faces_advanced, &st->kq);
+        if (orc.err) {
+            err = orc.err;
+            st->cert_what = orc.err_what;
+            goto done;
+        }
         st->faces_advanced++;
         /* The insertion mesh first, where the oracle switched to it: it
          * holds every point, so its answer is the apex (or, FDT_NONE, a

@@ -5,6 +5,7 @@
 
 #include "front/front.h"
 #include "front/seed.h"
+#include "mesh/certify.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -208,6 +209,19 @@ static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
     }
     double t0 = fdt_now_s();
     int err = fdt_ins_build(&o->mesh, o->t->P, o->t->base, o->t->n, &kq->pc);
+    if (err == FDT_OK || err == FDT_EINTERNAL) {
+        /* No answer is read before the mesh is proved (issue 31 item 6);
+         * an insertion whose own checks broke is a wrong mesh too. */
+        fdt_certify_fail why = {0, -1, "the insertion's own consistency checks failed"};
+        if (err == FDT_OK)
+            err = fdt_certify(&o->mesh, &kq->pc, &why);
+        if (err) {
+            fdt_ins_free(&o->mesh);
+            o->err = FDT_ECHECK;
+            o->err_what = why.what;
+            err = FDT_ECHECK;
+        }
+    }
     o->t_mesh += fdt_now_s() - t0;
     /* FDT_EDEGENERATE (a part whose points are coplanar: one layer of an
      * extruded grid) or FDT_ENOMEM: the kd search is always right, only

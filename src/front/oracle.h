@@ -74,6 +74,10 @@ typedef struct fdt_oracle {
      * always right, only slower); mesh_refused says it happened. */
     size_t mem_cap;
     int mesh_refused;
+    /* FDT_ECHECK once a mesh it built failed its certificate (src/mesh/
+     * certify.h; err_what says which check): the caller stops the run. */
+    int err;
+    const char *err_what;
 } fdt_oracle;
 
 /* What an insertion mesh of n points takes at its peak, in bytes: about
@@ -97,9 +101,10 @@ void fdt_oracle_free(fdt_oracle *o);
  * Called before each face is advanced, with the front's running counters
  * (faces advanced so far, and the kd work in kq). Decides at the end of
  * each window whether the kd search has become expensive and, if so,
- * builds the mesh (counting its exact tests in kq). A part whose points do
- * not span 3-D, or a build that runs out of memory, stays on the kd
- * search: never an error. Cheap between windows.
+ * builds the mesh (counting its exact tests in kq) and certifies it. A
+ * part whose points do not span 3-D, or a build that runs out of memory,
+ * stays on the kd search; a mesh that fails its certificate sets o->err
+ * (FDT_ECHECK), which the caller must check. Cheap between windows.
  */
 void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq);
 

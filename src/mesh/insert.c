@@ -497,7 +497,8 @@ static void build_free(build *b)
 
 int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                          const uint32_t *order, uint32_t prefix, uint64_t slots,
-                         uint32_t first[4], fdt_pred_counts *cnt)
+                         uint32_t first[4], fdt_pred_counts *cnt, fdt_progress_fn progress,
+                         void *puser)
 {
     memset(m, 0, sizeof *m);
     m->P = P;
@@ -535,6 +536,11 @@ int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
             continue;
         if ((err = insert_point(&b, id, &last)) != FDT_OK)
             goto fail;
+        if (progress && (i & 0xffff) == 0xffff &&
+            progress(puser, (double)i / (double)prefix) != 0) {
+            err = FDT_ECANCELED;
+            goto fail;
+        }
     }
     build_free(&b);
     return FDT_OK;
@@ -589,6 +595,12 @@ int fdt_ins_finish(fdt_ins *m)
 int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                   fdt_pred_counts *cnt)
 {
+    return fdt_ins_build_progress(m, P, base, n, cnt, NULL, NULL);
+}
+
+int fdt_ins_build_progress(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                           fdt_pred_counts *cnt, fdt_progress_fn progress, void *puser)
+{
     memset(m, 0, sizeof *m);
     if (n < 4) {
         m->P = P;
@@ -606,7 +618,7 @@ int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
     /* About 6.5 tets a point on uniform points, plus the hull: growing by
      * realloc stays possible for inputs with more. */
     int err = fdt_ins_build_prefix(m, P, base, n, order, n, (uint64_t)n * 27 / 4 + 64, first,
-                                   cnt);
+                                   cnt, progress, puser);
     free(order);
     if (err)
         return err;

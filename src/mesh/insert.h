@@ -87,6 +87,11 @@ typedef struct fdt_ins {
  */
 int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                   fdt_pred_counts *cnt);
+/* The same, calling progress (may be NULL) every 64k insertions with the
+ * fraction inserted; a nonzero return cancels the build (FDT_ECANCELED,
+ * m holds nothing). */
+int fdt_ins_build_progress(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                           fdt_pred_counts *cnt, fdt_progress_fn progress, void *puser);
 /*
  * The same DT as fdt_ins_build (the same set of tets and hull faces; the
  * slot numbering differs), built by nthreads threads (src/mesh/insert_par.c):

@@ -42,7 +42,16 @@ static inline int ins_insphere(const double *a, const double *b, const double *c
     int s = fdt_insphere_filter(a, b, c, d, e);
     if (s != FDT_PRED_UNSURE)
         return s;
+#ifdef FDT_PLANT_INSPHERE
+    /* The planted bug of -Dplant=insphere (tests/test_plant.sh; the
+     * certificate of src/mesh/certify.h must stop the run): no exact stage
+     * and no perturbation, a filter that cannot decide reads as a point on
+     * the sphere (not in conflict). */
+    (void)cnt;
+    return 0;
+#else
     return fdt_insphere_perturbed(a, b, c, d, e, cnt);
+#endif
 }
 
 /* For a face opposite vertex k, the edge of that face opposite its vertex
@@ -179,12 +188,14 @@ void fdt_ins_brio(const double *P, uint32_t base, uint32_t n, uint32_t *order,
  * The serial start of a build: m is set up for the points [base, base +
  * n) of P with room for `slots` tets (more if the serial phase needs it),
  * the first tetrahedron is found in order[0 .. n) (first[] gets its four
- * ids) and order[0 .. prefix) is inserted, first[] skipped. On error m
- * holds nothing.
+ * ids) and order[0 .. prefix) is inserted, first[] skipped. progress
+ * (may be NULL) is called every 64k insertions with the fraction done;
+ * nonzero cancels (FDT_ECANCELED). On error m holds nothing.
  */
 int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                          const uint32_t *order, uint32_t prefix, uint64_t slots,
-                         uint32_t first[4], fdt_pred_counts *cnt);
+                         uint32_t first[4], fdt_pred_counts *cnt, fdt_progress_fn progress,
+                         void *puser);
 
 /*
  * The end of a build, once every point is in: the incident-tet table, the

@@ -921,7 +921,7 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
     uint64_t slots = slots_a_point > 0.0 ? (uint64_t)(slots_a_point * n) + 64
                                          : (uint64_t)n * 8 + (uint64_t)nw * 2 * CHUNK + 1024;
     double c0 = fdt_thread_cpu_s();
-    err = fdt_ins_build_prefix(m, P, base, n, order, prefix, slots, first, cnt);
+    err = fdt_ins_build_prefix(m, P, base, n, order, prefix, slots, first, cnt, NULL, NULL);
     if (err)
         goto out;
     double c1 = fdt_thread_cpu_s();

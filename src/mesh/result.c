@@ -38,11 +38,13 @@ size_t fdt_result_num_duplicates(const fdt_result *r) { return r ? r->ndup : 0; 
 /* The sizes of fdt_stats and fdt_thread_stats this library fills
  * (include/frontdt.h, ABI): this release's; earlier releases' join here
  * when a field is added. */
-/* This release's fdt_stats and the first release's, which ended before
- * the memory fields (include/frontdt.h, ABI). */
+/* This release's fdt_stats, 0.1's (which ended before final_tets) and the
+ * first release's, which ended before the memory fields (include/frontdt.h,
+ * ABI). */
 static int stats_size_known(size_t size)
 {
-    return size == sizeof(fdt_stats) || size == offsetof(fdt_stats, mem_points);
+    return size == sizeof(fdt_stats) || size == offsetof(fdt_stats, mem_points) ||
+           size == offsetof(fdt_stats, final_tets);
 }
 
 static int thread_stats_size_known(size_t size)

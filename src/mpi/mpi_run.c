@@ -36,6 +36,7 @@
 
 #include "base/clock.h"
 #include "par/engine.h"
+#include "mesh/certify.h"
 #include "mesh/insert.h"
 #include "geom/kdtree.h"
 #include "base/mem.h"
@@ -53,7 +54,9 @@ typedef struct xrec {
 
 static const char *err_what(int err)
 {
-    return err == FDT_ENOMEM ? "out of memory" : "inconsistent front";
+    return err == FDT_ENOMEM   ? "out of memory"
+           : err == FDT_ECHECK ? "a mesh failed its certificate (src/mesh/certify.h)"
+                               : "inconsistent front";
 }
 
 void fdt_mpi_out_free(fdt_mpi_out *out)
@@ -403,6 +406,16 @@ static int replica_mesh(MPI_Comm comm, const fdt_mpi_local *L, const fdt_mpi_opt
     fdt_pred_counts pc;
     memset(&pc, 0, sizeof pc);
     int err = fdt_ins_build(&e->gmesh, all, 0, (uint32_t)L->m, &pc);
+    if (err == FDT_OK) {
+        /* proved before this rank reads it (issue 31 item 6) */
+        fdt_certify_fail why;
+        if ((err = fdt_certify(&e->gmesh, &pc, &why)) != FDT_OK) {
+            fdt_ins_free(&e->gmesh);
+            *t_build = fdt_now_s() - t0;
+            free(all);
+            return err;
+        }
+    }
     *t_build = fdt_now_s() - t0;
     if (err == FDT_OK) {
         *P_all = all;

@@ -26,6 +26,7 @@
 #include "base/bits.h"
 #include "base/mem.h"
 #include "par/termination.h"
+#include "mesh/certify.h"
 
 /*
  * A face of tet link (thread, (tid << 2) | i) arrives at its owner (us):
@@ -420,6 +421,16 @@ static int collective_build(worker *w)
     /* the mesh must fit (src/front/oracle.h, FDT_ORACLE_MESH_BYTES) */
     if (FDT_ORACLE_MESH_BYTES * (double)n <= (double)fdt_mem_available())
         err = fdt_ins_build_parallel(&e->gmesh, e->P, 0, n, e->n, &w->kq.pc);
+    if (err == FDT_OK) {
+        /* proved before any part reads it (issue 31 item 6), on the
+         * threads the build used: the others wait for it as for the build */
+        fdt_certify_fail why;
+        if ((err = fdt_certify_parallel(&e->gmesh, e->n, &w->kq.pc, &why)) == FDT_ECHECK) {
+            w->orc.err = FDT_ECHECK;
+            w->orc.err_what = why.what;
+            fdt_ins_free(&e->gmesh);
+        }
+    }
     w->orc.t_mesh += fdt_now_s() - t0;
     w->orc.switched_at = w->st.faces_advanced;
     pthread_mutex_lock(&e->lock);
@@ -533,6 +544,8 @@ static int advance_one(worker *w)
         pc = pk->c;
     }
     fdt_oracle_tick(&w->orc, w->st.faces_advanced - 1, &w->kq);
+    if (w->orc.err)
+        return w->orc.err; /* its mesh failed the certificate */
     if (w->orc.collective) {
         int cerr = collective_step(w);
         if (cerr)

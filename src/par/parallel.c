@@ -29,6 +29,7 @@
 #include "base/spawn.h"
 #include "par/termination.h"
 #include "par/threads.h"
+#include "mesh/certify.h"
 
 static int key_cmp(const void *x, const void *y)
 {
@@ -333,13 +334,25 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
                                           &kq0.pc);
         t_gm = fdt_now_s() - tg;
         if (gerr == FDT_OK) {
+            /* proved before any part reads it (issue 31 item 6) */
+            fdt_certify_fail why;
+            if ((err = fdt_certify_parallel(&e->gmesh, nthreads, &kq0.pc, &why)) != FDT_OK) {
+                if (err == FDT_ECHECK)
+                    fdt_certify_describe(&why, diag, dlen);
+                goto fail;
+            }
             e->gmesh_ok = 1;
             if (nthreads > 1 && (err = recut_by_mesh(&pt, &e->gmesh)) != FDT_OK)
                 goto fail;
         } else if (gerr != FDT_ENOMEM && gerr != FDT_EDEGENERATE) {
             err = gerr;
-            if (gerr == FDT_EINTERNAL)
-                snprintf(diag, dlen, "internal error: the parallel insertion mesh failed");
+            if (gerr == FDT_EINTERNAL) {
+                /* the insertion's own checks of its mesh broke: a wrong
+                 * mesh, as the certificate would say (src/front/partmesh.c) */
+                err = FDT_ECHECK;
+                snprintf(diag, dlen, "mesh certificate failed: the parallel insertion's own "
+                                     "consistency checks failed");
+            }
             goto fail;
         }
     }
@@ -503,6 +516,9 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
                      e->err_what ? e->err_what : "?");
         else if (werr == FDT_ETHREAD)
             snprintf(diag, dlen, "could not create thread %d of %d", e->err_thread, nthreads);
+        else if (werr == FDT_ECHECK)
+            snprintf(diag, dlen, "mesh certificate failed in worker thread %d: %s",
+                     e->err_thread, e->err_what ? e->err_what : "?");
         goto fail;
     }
     if (err)

@@ -65,6 +65,7 @@ static void worker_run(worker *w)
         fdt_eng_set_error(e, rc, w->id,
                           rc == FDT_ENOMEM      ? "out of memory"
                           : rc == FDT_EINTERNAL ? "inconsistent front"
+                          : rc == FDT_ECHECK    ? (w->orc.err_what ? w->orc.err_what : "?")
                                                 : "the sink stopped the run");
     /* relaxed: a progress estimate only. */
     atomic_store_explicit(&w->tets_done, (size_t)w->em.ntets, memory_order_relaxed);

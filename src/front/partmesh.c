@@ -1,0 +1,136 @@
+/* A part's own mesh, built, certified and handed to the sink:
+ * src/front/partmesh.h. */
+#include "front/partmesh.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "base/clock.h"
+#include "mesh/certify.h"
+
+#define INF FDT_NONE
+
+/* The face of a tet opposite its vertex k, ordered so that vertex k lies
+ * on its positive side (orient3d(face, v[k]) > 0 for a positive tet): the
+ * even permutations (face, k) of (0, 1, 2, 3). For an infinite tet (k its
+ * infinite vertex) that is its hull face, outward (src/mesh/insert.h). */
+static const uint8_t face_toward[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
+
+static int report(fdt_progress_fn progress, void *puser, double fraction)
+{
+    return progress && progress(puser, fraction) ? FDT_ECANCELED : FDT_OK;
+}
+
+/* The insertion's progress as the first half of the run's. */
+typedef struct half_progress {
+    fdt_progress_fn fn;
+    void *user;
+} half_progress;
+
+static int build_progress(void *user, double fraction)
+{
+    const half_progress *h = user;
+    return h->fn(h->user, 0.5 * fraction);
+}
+
+/* Every finite tet of mesh to em, in slot order; with neighbours, the
+ * links from the mesh's own adjacency (tid[slot]: its tet id). Then every
+ * hull face. */
+static int emit_mesh(const fdt_ins *mesh, fdt_emit *em, fdt_progress_fn progress,
+                     void *puser, size_t *emitted)
+{
+    fdt_meshbuf *mb = em->mb;
+    int64_t *nbrs = mb ? mb->nbrs : NULL;
+    uint32_t *tid = NULL;
+    if (nbrs && !(tid = malloc((size_t)mesh->nslots * sizeof *tid)))
+        return FDT_ENOMEM;
+    int err = FDT_OK;
+    int64_t first = em->ntets;
+    size_t next_report = 1u << 16;
+    for (uint32_t s = 0; s < mesh->nslots; s++) {
+        if (!fdt_ins_is_finite(mesh, s))
+            continue;
+        int64_t id = fdt_emit_tet(em, fdt_ins_tet(mesh, s));
+        if (id < 0) {
+            err = (int)id;
+            goto done;
+        }
+        if (tid)
+            tid[s] = (uint32_t)(id - first);
+        if ((size_t)(id - first) >= next_report) {
+            next_report += 1u << 16;
+            double fr = 0.6 + 0.35 * (double)(id - first) / (double)(mesh->nfinite + 1);
+            if ((err = report(progress, puser, fr)) != FDT_OK)
+                goto done;
+        }
+    }
+    *emitted = (size_t)(em->ntets - first);
+    if (tid) {
+        /* The meshbuf may have moved while it grew: read it again. Entry k
+         * of a tet is its neighbour across the face opposite vertex k, -1
+         * on the hull (src/front/front.h). */
+        nbrs = em->mb->nbrs;
+        for (uint32_t s = 0; s < mesh->nslots; s++) {
+            if (!fdt_ins_is_finite(mesh, s))
+                continue;
+            int64_t *o = nbrs + 4 * (size_t)(first + tid[s]);
+            for (int k = 0; k < 4; k++) {
+                uint32_t nt;
+                int nk;
+                uint32_t apex = fdt_ins_across(mesh, s, k, &nt, &nk);
+                o[k] = apex == INF ? -1 : first + (int64_t)tid[nt];
+            }
+        }
+    }
+    for (uint32_t s = 0; s < mesh->nslots; s++) {
+        const uint32_t *v = fdt_ins_tet(mesh, s);
+        int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
+        if (inf < 0 || (v[0] == INF && v[1] == INF)) /* finite, or a freed slot */
+            continue;
+        const uint8_t *f = face_toward[inf];
+        uint32_t h[3] = {v[f[0]], v[f[1]], v[f[2]]};
+        if ((err = fdt_emit_hull(em, h)) != FDT_OK)
+            goto done;
+    }
+done:
+    free(tid);
+    return err;
+}
+
+int fdt_partmesh_emit_all(const double *P, uint32_t m, fdt_emit *em, fdt_progress_fn progress,
+                          void *puser, fdt_partmesh_stats *st, char *diag, size_t dlen)
+{
+    fdt_ins mesh;
+    double t0 = fdt_now_s();
+    half_progress hp = {progress, puser};
+    int err = fdt_ins_build_progress(&mesh, P, 0, m, &st->pc, progress ? build_progress : NULL,
+                                     &hp);
+    st->t_mesh = fdt_now_s() - t0;
+    if (err == FDT_EDEGENERATE || err == FDT_EINVAL || err == FDT_EINTERNAL) {
+        /* The caller merged duplicates and checked the dimension, so each
+         * is the insertion's own check of its mesh failing (a walk that
+         * cycles, a cavity that is not a ball): the mesh is wrong, which
+         * the certificate reports too. */
+        snprintf(diag, dlen, "mesh certificate failed: the insertion's own consistency "
+                             "checks failed (%s)", fdt_strerror(err));
+        err = FDT_ECHECK;
+    }
+    if (!err)
+        err = report(progress, puser, 0.5);
+    if (!err) {
+        /* No tet leaves before the whole mesh is proved (certify.h). */
+        double t1 = fdt_now_s();
+        fdt_certify_fail why;
+        err = fdt_certify(&mesh, &st->pc, &why);
+        st->t_certify = fdt_now_s() - t1;
+        st->certified_tets = mesh.nfinite;
+        if (err == FDT_ECHECK)
+            fdt_certify_describe(&why, diag, dlen);
+    }
+    if (!err)
+        err = report(progress, puser, 0.6);
+    if (!err)
+        err = emit_mesh(&mesh, em, progress, puser, &st->final_tets);
+    fdt_ins_free(&mesh);
+    return err;
+}

@@ -1,0 +1,54 @@
+/*
+ * A part's own mesh, built, certified and handed to the sink (issue 31,
+ * "one engine"; bench/NOTES.md entry 87).
+ *
+ * The part triangulates its points by incremental insertion
+ * (src/mesh/insert.c), proves the result is their perturbed Delaunay
+ * tetrahedralization (src/mesh/certify.h), and emits its tets at once:
+ * a tet is final when no point outside the part can lie in or on its
+ * circumsphere. With one part (a serial run of --search auto or mesh)
+ * that is every tet: the mesh is the answer, and no front re-derives it.
+ * The hull faces are the faces of the infinite tets, outward.
+ *
+ * Parts of a threaded run, whose walls the front stitches, are the next
+ * step of the issue (bench/NOTES.md entry 87); today the threaded engine
+ * still reads its apexes from meshes (src/front/oracle.h), each certified
+ * before it is trusted.
+ */
+#ifndef FDT_PARTMESH_H
+#define FDT_PARTMESH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "front/sink.h"
+#include "mesh/insert.h"
+
+/* Bytes a point the one-part engine holds at its peak besides the points
+ * and the output tets: the insertion mesh (about 220 kept, src/mesh/
+ * insert.h) and its build's scratch, the tet-id map with neighbours.
+ * 1M uniform points: the CLI's --memory-limit estimate uses it. */
+#define FDT_PARTMESH_BYTES 300.0
+
+/* What the one-part engine did, for fdt_stats. */
+typedef struct fdt_partmesh_stats {
+    size_t final_tets;     /* tets emitted straight from the mesh */
+    size_t certified_tets; /* finite tets the certificate checked */
+    double t_mesh;         /* seconds building the mesh */
+    double t_certify;      /* seconds certifying it */
+    fdt_pred_counts pc;    /* exact predicate calls of both */
+} fdt_partmesh_stats;
+
+/*
+ * The whole run as one part: the DT of the points [0, m) of P (tree order,
+ * distinct, spanning 3-D: the caller checked), certified, every tet and
+ * hull face emitted to em (neighbours too when em's meshbuf keeps them).
+ * progress (may be NULL) is called between the phases and every 64k tets
+ * emitted with an estimated fraction; nonzero cancels (FDT_ECANCELED).
+ * Returns FDT_OK, FDT_ECHECK (the certificate failed: diag says where),
+ * FDT_ENOMEM, FDT_ETOOBIG, FDT_EINTERNAL, or the sink's stop code.
+ */
+int fdt_partmesh_emit_all(const double *P, uint32_t m, fdt_emit *em, fdt_progress_fn progress,
+                          void *puser, fdt_partmesh_stats *st, char *diag, size_t dlen);
+
+#endif

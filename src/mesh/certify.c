@@ -1,0 +1,273 @@
+/* The certificate of an insertion mesh: src/mesh/certify.h says what is
+ * checked and why it proves the mesh is the perturbed DT. */
+#include "mesh/certify.h"
+
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "base/spawn.h"
+
+#define INF FDT_NONE
+
+static inline const double *pt(const fdt_ins *m, uint32_t v)
+{
+    return m->P + 3 * (size_t)v;
+}
+
+static inline int is_freed(const uint32_t *v)
+{
+    return v[0] == INF && v[1] == INF;
+}
+
+/* The exact signs, filter first (most calls end there). */
+static inline int orient(const double *a, const double *b, const double *c, const double *d,
+                         fdt_pred_counts *cnt)
+{
+    int s = fdt_orient3d_filter(a, b, c, d);
+    return s != FDT_PRED_UNSURE ? s : fdt_orient3d(a, b, c, d, cnt);
+}
+
+static inline int insphere(const double *a, const double *b, const double *c, const double *d,
+                           const double *e, fdt_pred_counts *cnt)
+{
+    int s = fdt_insphere_filter(a, b, c, d, e);
+    return s != FDT_PRED_UNSURE ? s : fdt_insphere_perturbed(a, b, c, d, e, cnt);
+}
+
+static int fail(fdt_certify_fail *why, uint32_t slot, int face, const char *what)
+{
+    if (why) {
+        why->slot = slot;
+        why->face = face;
+        why->what = what;
+    }
+    return FDT_ECHECK;
+}
+
+/* orient3d of tet v with its vertex k replaced by point q. */
+static int orient_with(const fdt_ins *m, const uint32_t *v, int k, const double *q,
+                       fdt_pred_counts *cnt)
+{
+    const double *p[4];
+    for (int i = 0; i < 4; i++)
+        p[i] = i == k ? q : pt(m, v[i]);
+    return orient(p[0], p[1], p[2], p[3], cnt);
+}
+
+/* Whether point q is in conflict with infinite tet v (infinite vertex at
+ * index inf): the insertion's rule (src/mesh/insert.c, "Hull"), strictly
+ * outside the hull face's plane, or on it and inside the sphere of the
+ * finite tet under the face. */
+static int conflicts_infinite(const fdt_ins *m, const uint32_t *v, int inf, const double *q,
+                              fdt_pred_counts *cnt)
+{
+    int o = orient_with(m, v, inf, q, cnt);
+    if (o != 0)
+        return o > 0;
+    const uint32_t *w = m->T + 8 * (size_t)(v[4 + inf] >> 2);
+    return insphere(pt(m, w[0]), pt(m, w[1]), pt(m, w[2]), pt(m, w[3]), q, cnt) > 0;
+}
+
+/* Whether tets v (face k) and w (face nk) share the face's three vertices. */
+static int same_face(const uint32_t *v, int k, const uint32_t *w, int nk)
+{
+    for (int i = 0; i < 4; i++) {
+        if (i == k)
+            continue;
+        int found = 0;
+        for (int j = 0; j < 4; j++)
+            found |= j != nk && w[j] == v[i];
+        if (!found)
+            return 0;
+    }
+    return 1;
+}
+
+/* The pair checks of face k of tet v (slot t, infinite vertex at inf, -1
+ * if none) and face nk of its neighbour w: the geometric half of checks
+ * 2-3 that involve both. NULL if they pass, else what failed. */
+static const char *check_pair(const fdt_ins *m, const uint32_t *v, int k, int inf,
+                              const uint32_t *w, int nk, fdt_pred_counts *cnt)
+{
+    uint32_t p = v[k], q = w[nk];
+    int winf = w[0] == INF ? 0 : w[1] == INF ? 1 : w[2] == INF ? 2 : w[3] == INF ? 3 : -1;
+    if (p == INF || q == INF) {
+        /* A hull face (the finite face of an infinite tet) over its
+         * finite tet: that tet's vertex on the inner side. */
+        const uint32_t *h = p == INF ? v : w, *in = p == INF ? w : v;
+        int hinf = p == INF ? k : nk, ik = p == INF ? nk : k;
+        return orient_with(m, h, hinf, pt(m, in[ik]), cnt) >= 0
+                   ? "a hull face with its tet outside"
+                   : NULL;
+    }
+    if (inf < 0 && winf < 0) {
+        /* Two finite tets: q on the other side of the face (no fold), and
+         * outside the sphere of v (which, for a pair, is p outside w's). */
+        if (orient_with(m, v, k, pt(m, q), cnt) >= 0)
+            return "two tets on the same side of their face";
+        if (insphere(pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), pt(m, q), cnt) > 0)
+            return "a face is not locally Delaunay";
+        return NULL;
+    }
+    if (inf < 0 || winf < 0)
+        return "a finite face between a finite and an infinite tet";
+    /* Two hull faces through an edge: convex, or coplanar and locally
+     * Delaunay in their plane; both sides checked. */
+    if (conflicts_infinite(m, v, inf, pt(m, q), cnt) ||
+        conflicts_infinite(m, w, winf, pt(m, p), cnt))
+        return "the hull is not convex (or not Delaunay in a plane)";
+    return NULL;
+}
+
+/* How many tets ahead the loop prefetches its neighbours: the neighbour
+ * slots are where the time goes (perf: more than half of it in the load
+ * of a neighbour's first vertex, a cache miss). */
+#define AHEAD 8
+
+int fdt_certify_slots(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_counts *cnt,
+                      fdt_certify_fail *why)
+{
+    if (hi > m->nslots)
+        hi = m->nslots;
+    /* Each face is checked once, from its lower slot, which also checks
+     * the higher slot's reference back. The higher slot's own references
+     * are only counted (skipped); every one of them must be the back half
+     * of a pair checked from below: skipped == pairs. A reference with no
+     * way back breaks the equality even when its target is consistent
+     * with someone else. Counted over [lo, hi) only when the range is the
+     * whole mesh; a partial range checks both halves itself. */
+    int whole = lo == 0 && hi == m->nslots;
+    size_t skipped = 0, pairs = 0;
+    for (uint32_t t = lo; t < hi; t++) {
+        if (t + AHEAD < hi) {
+            const uint32_t *a = m->T + 8 * (size_t)(t + AHEAD);
+            for (int k = 0; k < 4; k++)
+                if ((a[4 + k] >> 2) < m->nslots)
+                    __builtin_prefetch(m->T + 8 * (size_t)(a[4 + k] >> 2));
+        }
+        const uint32_t *v = m->T + 8 * (size_t)t;
+        if (is_freed(v))
+            continue;
+        int inf = -1, ninf = 0;
+        for (int i = 0; i < 4; i++)
+            if (v[i] == INF) {
+                inf = i;
+                ninf++;
+            }
+        if (ninf > 1)
+            return fail(why, t, -1, "more than one infinite vertex");
+        if (inf < 0 && orient(pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), cnt) <= 0)
+            return fail(why, t, -1, "a finite tet is not positively oriented");
+        for (int k = 0; k < 4; k++) {
+            uint32_t r = v[4 + k], nt = r >> 2;
+            int nk = (int)(r & 3);
+            if (nt >= m->nslots || nt == t)
+                return fail(why, t, k, "a neighbour reference past the slots, or to itself");
+            if (nt < t && whole) {
+                skipped++;
+                continue;
+            }
+            const uint32_t *w = m->T + 8 * (size_t)nt;
+            if (is_freed(w))
+                return fail(why, t, k, "a neighbour is a freed slot");
+            if (w[4 + nk] != ((t << 2) | (uint32_t)k))
+                return fail(why, t, k, "the neighbour does not refer back");
+            if (!same_face(v, k, w, nk))
+                return fail(why, t, k, "the neighbours do not share the face");
+            pairs++;
+            if (nt < t)
+                continue; /* a partial range: its geometry is checked from nt */
+            const char *bad = check_pair(m, v, k, inf, w, nk, cnt);
+            if (bad)
+                return fail(why, t, k, bad);
+        }
+    }
+    if (whole && skipped != pairs)
+        return fail(why, hi, -1, "a neighbour reference with no way back");
+    return FDT_OK;
+}
+
+int fdt_certify_vertices(const fdt_ins *m, fdt_certify_fail *why)
+{
+    for (uint32_t i = 0; i < m->n; i++) {
+        uint32_t s = m->vtet[i], id = m->base + i;
+        if (s >= m->nslots)
+            return fail(why, s, -1, "a point is in no tet");
+        const uint32_t *v = m->T + 8 * (size_t)s;
+        if (is_freed(v) || (v[0] != id && v[1] != id && v[2] != id && v[3] != id))
+            return fail(why, s, -1, "a point is not a vertex of its tet");
+    }
+    return FDT_OK;
+}
+
+int fdt_certify(const fdt_ins *m, fdt_pred_counts *cnt, fdt_certify_fail *why)
+{
+    int err = fdt_certify_slots(m, 0, m->nslots, cnt, why);
+    return err ? err : fdt_certify_vertices(m, why);
+}
+
+typedef struct cert_job {
+    const fdt_ins *m;
+    uint32_t lo, hi;
+    fdt_pred_counts pc;
+    fdt_certify_fail why;
+    int rc;
+    pthread_t th;
+    int started;
+} cert_job;
+
+static void *cert_run(void *arg)
+{
+    cert_job *j = arg;
+    j->rc = fdt_certify_slots(j->m, j->lo, j->hi, &j->pc, &j->why);
+    return NULL;
+}
+
+int fdt_certify_parallel(const fdt_ins *m, int nthreads, fdt_pred_counts *cnt,
+                         fdt_certify_fail *why)
+{
+    if (nthreads <= 1 || m->nslots < 4096)
+        return fdt_certify(m, cnt, why);
+    cert_job *j = calloc((size_t)nthreads, sizeof *j);
+    if (!j)
+        return FDT_ENOMEM;
+    for (int i = 0; i < nthreads; i++) {
+        j[i].m = m;
+        j[i].lo = (uint32_t)((uint64_t)m->nslots * (uint64_t)i / (uint64_t)nthreads);
+        j[i].hi = (uint32_t)((uint64_t)m->nslots * (uint64_t)(i + 1) / (uint64_t)nthreads);
+    }
+    int err = FDT_OK;
+    for (int i = 1; i < nthreads; i++)
+        if (!(j[i].started = fdt_spawn(&j[i].th, 0, cert_run, &j[i]) == 0))
+            err = FDT_ETHREAD;
+    cert_run(&j[0]);
+    for (int i = 1; i < nthreads; i++)
+        if (j[i].started)
+            pthread_join(j[i].th, NULL);
+    /* The joins publish each job's fields to this thread. */
+    for (int i = 0; i < nthreads && !err; i++)
+        if (j[i].rc) {
+            err = j[i].rc;
+            if (why)
+                *why = j[i].why;
+        }
+    if (cnt)
+        for (int i = 0; i < nthreads; i++) {
+            cnt->orient_exact += j[i].pc.orient_exact;
+            cnt->insphere_exact += j[i].pc.insphere_exact;
+            cnt->orient_adapt += j[i].pc.orient_adapt;
+            cnt->insphere_adapt += j[i].pc.insphere_adapt;
+        }
+    free(j);
+    return err ? err : fdt_certify_vertices(m, why);
+}
+
+void fdt_certify_describe(const fdt_certify_fail *why, char *buf, size_t len)
+{
+    if (why->face >= 0)
+        snprintf(buf, len, "mesh certificate failed: tet slot %u face %d: %s", why->slot,
+                 why->face, why->what);
+    else
+        snprintf(buf, len, "mesh certificate failed: tet slot %u: %s", why->slot, why->what);
+}
