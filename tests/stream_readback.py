@@ -1,11 +1,11 @@
 #!/usr/bin/python3
 """Streamed outputs against the in-memory ones, and interrupted streamed writes.
 
-usage: stream_readback.py FRONTDT README
-       stream_readback.py FRONTDT README --pieces INDEX REF
+usage: stream_readback.py FRONTDT REFERENCE_MD
+       stream_readback.py FRONTDT REFERENCE_MD --pieces INDEX REF
 
 --pieces (tests/test_mpi.sh): the pieces of frontdt-mpi's -o INDEX (.pfdtb,
-read with README.md's read_pieces, or .pele: the .ele/.face pieces beside
+read with doc/reference.md's read_pieces, or .pele: the .ele/.face pieces beside
 their .node) hold, all together, the tets and hull faces of the serial
 run's REF.ele / REF.face, each the same way round; the index's counts and
 names are those of the files; each .fdtb piece's header says piece (flag 8),
@@ -14,7 +14,7 @@ no points, the input's point count.
 1. A random point set (one duplicate point) is written by the CLI twice: in
    memory (--no-stream: .ele with .node/.face/.neigh, .vtu, .fdtb) and
    streamed (--stream, two threads: .ele with .node/.face, .vtu, .fdtb).
-   Each file is parsed back (the .fdtb with the numpy reader of README.md,
+   Each file is parsed back (the .fdtb with the numpy reader of doc/reference.md,
    "Binary mesh", when numpy is installed, else with struct): every file
    holds the same set of tets, each the same way round (the same even
    permutation), the same hull faces, the same points (.node byte for byte,
@@ -114,10 +114,10 @@ def readme_reader(name="read_fdtb"):
     m = re.search(r"<!-- fdtb-reader[^>]*-->\n```python\n(.*?)```", text, re.S)
     mp = re.search(r"<!-- fdtb-pieces-reader[^>]*-->\n```python\n(.*?)```", text, re.S)
     if not m or not mp:
-        fail("README.md has no fdtb-reader or fdtb-pieces-reader block")
+        fail(README + " has no fdtb-reader or fdtb-pieces-reader block")
         return None
     if len(m.group(1).splitlines()) > 20 or len(mp.group(1).splitlines()) > 20:
-        fail("README.md's fdtb reader or pieces reader is over 20 lines")
+        fail(README + ": the fdtb reader or pieces reader is over 20 lines")
     try:
         import numpy  # noqa: F401
     except ImportError:
@@ -326,7 +326,7 @@ def pieces(index, ref):
         if reader:
             t, h, rkeys = reader(index)
             if rkeys.get("set-hash") != keys.get("set-hash"):
-                fail("README's read_pieces: fields %r" % rkeys)
+                fail("the documented read_pieces: fields %r" % rkeys)
             tets = [tuple(int(x) for x in r) for r in t]
             hull = [tuple(int(x) for x in r) for r in h]
         else:

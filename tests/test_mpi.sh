@@ -319,13 +319,13 @@ rc=$?
 # -o BASE.pfdtb and -o BASE.pele: one piece a rank and a text index, no
 # gather. All pieces together hold the serial run's tets and hull faces,
 # each the same way round (stream_readback.py --pieces: the .pfdtb through
-# README.md's read_pieces when numpy is there; the headers, the index's
+# doc/reference.md's read_pieces when numpy is there; the headers, the index's
 # names and counts), and the .node that every rank wrote its lines of is
 # the serial run's byte for byte. Inputs: 1-7 ranks on clusters,
 # duplicates spread across slices, five points on 7 ranks (ranks with no
 # tets: empty pieces).
 readback=$(dirname "$0")/stream_readback.py
-readme=$(dirname "$0")/../README.md
+readme=$(dirname "$0")/../doc/reference.md
 pieces_check() {
   local name=$1 f=$2 np=$3 ext=$4 d="$work/pc"
   checks=$((checks + 1))
