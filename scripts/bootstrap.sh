@@ -13,7 +13,7 @@ packages=(
   libtbb-dev libqhull-dev
   python3 python3-vtk9 python3-meshio gmsh openfoam
   gnuplot-nox valgrind clang libclang-rt-14-dev
-  python3-dev python3-numpy python3-scipy
+  python3-dev python3-numpy python3-scipy python3-mesonpy python3-venv
   locales gcovr
   mpi-default-dev mpi-default-bin
   libmpich-dev mpich

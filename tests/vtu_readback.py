@@ -1,18 +1,31 @@
 #!/usr/bin/python3
-"""Reads frontdt's .vtu and .vtk output back with VTK itself.
+"""Reads every output format back with the readers users have: VTK and meshio.
 
 usage: vtu_readback.py FRONTDT
 
-Writes a random point set (with one duplicate point) as .xyz, runs
-`frontdt IN -o OUT` for .tets, .vtu and .vtk, and reads the VTK files with
-vtkXMLUnstructuredGridReader and vtkUnstructuredGridReader (the readers
-ParaView uses). Checks: VTK reports no error; every input point is there,
-bit-exact, the duplicate included; the cells are exactly the .tets set;
-every cell is a VTK_TETRA with positive volume (exact rational arithmetic).
-Exit 77 (meson's "skipped") when the vtk module is not installed.
+Writes a random point set (with one duplicate point) as .xyz and runs the
+CLI on it three times:
+  - in memory (--no-stream): .tets, .vtu, .vtk, .msh (gmsh 4.1), .msh
+    (--format msh2: gmsh 2.2), .mesh (Medit), .ele (TetGen, with .node);
+  - streamed (--stream, two threads): .vtu and .ele;
+  - with no option: `-o d.vtu`, which streams by default (the case of
+    issue 34 item 4); its header must have the streamed layout.
+Each file is read by every reader that knows its format:
+  - VTK (python3-vtk9): .vtu with vtkXMLUnstructuredGridReader, .vtk with
+    vtkUnstructuredGridReader (the readers ParaView uses), no error or
+    warning event;
+  - meshio (python3-meshio, meshio 5): .vtu, .vtk, both .msh, .mesh, .ele.
+Checks on each: every input point is there, in order, bit-exact, the
+duplicate included; the tets are exactly the .tets set, none twice; every
+tet is positively oriented (exact integer arithmetic); VTK's cells are all
+VTK_TETRA. (.fdtb has no outside reader: tests/stream_readback.py reads it
+with README.md's reader; the OpenFOAM polyMesh: tests/formats_readback.sh.)
+Each reader missing is said and skipped; exit 77 (meson's "skipped") when
+neither is installed.
 """
 import os
 import random
+import re
 import subprocess
 import sys
 import tempfile
@@ -23,8 +36,11 @@ SKIP = 77
 try:
     import vtk
 except ImportError:
-    print("vtk python module not installed: skipped")
-    sys.exit(SKIP)
+    vtk = None
+try:
+    import meshio
+except ImportError:
+    meshio = None
 
 
 class ErrorCatcher:
@@ -42,59 +58,114 @@ def read_tets(path):
         return [tuple(int(x) for x in line.split()) for line in f]
 
 
-def det_positive(p, q):
-    """Exact sign of det(b-a, c-a, d-a) for the tet q over points p."""
-    a, b, c, d = (tuple(Fraction(x) for x in p[i]) for i in q)
-    u = [b[k] - a[k] for k in range(3)]
-    v = [c[k] - a[k] for k in range(3)]
-    w = [d[k] - a[k] for k in range(3)]
-    det = (u[0] * (v[1] * w[2] - v[2] * w[1])
-           - u[1] * (v[0] * w[2] - v[2] * w[0])
-           + u[2] * (v[0] * w[1] - v[1] * w[0]))
-    return det > 0
+class Orienter:
+    """Exact orientation of tets over the points, by integer arithmetic.
+
+    Every double is an integer times 2^-1074, so the coordinates scaled by
+    2^1074 are integers and the determinant's sign is exact. A sorted tet's
+    sign is computed once; a tet in another order is that sign times the
+    parity of the permutation.
+    """
+
+    def __init__(self, pts):
+        self.q = [tuple(int(Fraction(x) * 2 ** 1074) for x in p) for p in pts]
+        self.sorted_sign = {}
+
+    def _sign(self, t):
+        a, b, c, d = (self.q[i] for i in t)
+        u = [b[k] - a[k] for k in range(3)]
+        v = [c[k] - a[k] for k in range(3)]
+        w = [d[k] - a[k] for k in range(3)]
+        det = (u[0] * (v[1] * w[2] - v[2] * w[1])
+               - u[1] * (v[0] * w[2] - v[2] * w[0])
+               + u[2] * (v[0] * w[1] - v[1] * w[0]))
+        return (det > 0) - (det < 0)
+
+    def positive(self, t):
+        key = tuple(sorted(t))
+        s = self.sorted_sign.get(key)
+        if s is None:
+            s = self.sorted_sign[key] = self._sign(key)
+        parity = sum(1 for i in range(4) for j in range(i + 1, 4) if t[i] > t[j]) & 1
+        return s * (-1 if parity else 1) > 0
 
 
-def check_grid(kind, grid, pts, tets_set, errors):
+def check_mesh(what, points, tets, ref):
+    """points: a list of 3-tuples; tets: a list of 4-tuples; ref: (pts,
+    tets_set, orienter). Returns the failures."""
+    pts, tets_set, orient = ref
     fails = []
-    if errors.messages:
-        fails.append("%s: VTK said %s" % (kind, "; ".join(errors.messages)))
-    n = grid.GetNumberOfPoints()
-    if n != len(pts):
-        fails.append("%s: %d points, want %d" % (kind, n, len(pts)))
-        return fails
-    for i in range(n):
-        if tuple(grid.GetPoint(i)) != pts[i]:
-            fails.append("%s: point %d is %r, want %r" % (kind, i, grid.GetPoint(i), pts[i]))
+    if len(points) != len(pts):
+        return ["%s: %d points, want %d" % (what, len(points), len(pts))]
+    for i, p in enumerate(points):
+        if tuple(p) != pts[i]:
+            fails.append("%s: point %d is %r, want %r" % (what, i, tuple(p), pts[i]))
             break
-    nc = grid.GetNumberOfCells()
-    if nc != len(tets_set):
-        fails.append("%s: %d cells, want %d (.tets lines)" % (kind, nc, len(tets_set)))
     seen = set()
-    ids = vtk.vtkIdList()
-    for c in range(nc):
-        if grid.GetCellType(c) != vtk.VTK_TETRA:
-            fails.append("%s: cell %d has type %d, want VTK_TETRA (10)"
-                         % (kind, c, grid.GetCellType(c)))
-            break
-        grid.GetCellPoints(c, ids)
-        q = tuple(ids.GetId(k) for k in range(ids.GetNumberOfIds()))
+    for c, q in enumerate(tets):
         if len(q) != 4:
-            fails.append("%s: cell %d has %d points" % (kind, c, len(q)))
+            fails.append("%s: cell %d has %d points" % (what, c, len(q)))
             break
-        if not det_positive(pts, q):
-            fails.append("%s: cell %d %r is not positively oriented" % (kind, c, q))
+        if min(q) < 0 or max(q) >= len(pts):
+            fails.append("%s: cell %d %r names a point out of range" % (what, c, q))
+            break
+        if not orient.positive(q):
+            fails.append("%s: cell %d %r is not positively oriented" % (what, c, q))
             break
         seen.add(tuple(sorted(q)))
+    if len(tets) != len(tets_set):
+        fails.append("%s: %d tets, want %d (.tets lines)" % (what, len(tets), len(tets_set)))
     if seen != tets_set:
-        fails.append("%s: cell set differs from the .tets set (%d vs %d distinct)"
-                     % (kind, len(seen), len(tets_set)))
+        fails.append("%s: tet set differs from the .tets set (%d distinct, %d in common, want %d)"
+                     % (what, len(seen), len(seen & tets_set), len(tets_set)))
     return fails
+
+
+def read_vtk(path):
+    """(points, tets, failures) by VTK's own reader for .vtu or .vtk."""
+    reader = (vtk.vtkXMLUnstructuredGridReader() if path.endswith(".vtu")
+              else vtk.vtkUnstructuredGridReader())
+    errors = ErrorCatcher()
+    reader.AddObserver("ErrorEvent", errors)
+    reader.AddObserver("WarningEvent", errors)
+    reader.SetFileName(path)
+    reader.Update()
+    grid = reader.GetOutput()
+    fails = ["VTK said " + m for m in errors.messages]
+    points = [grid.GetPoint(i) for i in range(grid.GetNumberOfPoints())]
+    tets = []
+    ids = vtk.vtkIdList()
+    for c in range(grid.GetNumberOfCells()):
+        if grid.GetCellType(c) != vtk.VTK_TETRA:
+            fails.append("cell %d has type %d, want VTK_TETRA (10)" % (c, grid.GetCellType(c)))
+            break
+        grid.GetCellPoints(c, ids)
+        tets.append(tuple(ids.GetId(k) for k in range(ids.GetNumberOfIds())))
+    return points, tets, fails
+
+
+def read_meshio(path):
+    """(points, tets, failures) by meshio.read; cells other than tetra (a
+    format's boundary faces) are not tets and are left aside."""
+    try:
+        m = meshio.read(path)
+    except Exception as e:  # meshio raises anything from ReadError to KeyError
+        return [], [], ["meshio.read raised %s: %s" % (type(e).__name__, e)]
+    points = [tuple(p) for p in m.points.tolist()]
+    tets = []
+    for block in m.cells:
+        if block.type == "tetra":
+            tets += [tuple(q) for q in block.data.tolist()]
+    return points, tets, []
 
 
 def main():
     if len(sys.argv) != 2:
         print(__doc__)
         return 2
+    if vtk is None and meshio is None:
+        print("neither the vtk nor the meshio python module is installed: skipped")
+        return SKIP
     frontdt = os.path.abspath(sys.argv[1])
     rnd = random.Random(20240501)
     pts = [(rnd.uniform(-1, 1), rnd.uniform(-1, 1), rnd.uniform(-1, 1))
@@ -106,36 +177,66 @@ def main():
         with open(inp, "w") as f:
             for p in pts:
                 f.write("%r %r %r\n" % p)
-        outs = {}
-        for ext in ("tets", "vtu", "vtk"):
-            out = os.path.join(d, "mesh." + ext)
-            r = subprocess.run([frontdt, inp, "-o", out, "--quiet"],
+
+        def out(name):
+            return os.path.join(d, name)
+
+        runs = [
+            ["--no-stream", "-o", out("m.tets"), "-o", out("m.vtu"), "-o", out("m.vtk"),
+             "-o", out("m.msh"), "--format", "msh2", "-o", out("m2.msh"),
+             "-o", out("m.mesh"), "-o", out("m.ele")],
+            ["--stream", "--threads", "2", "-o", out("s.vtu"), "-o", out("s.ele")],
+            ["-o", out("d.vtu")],
+        ]
+        for args in runs:
+            r = subprocess.run([frontdt, inp, "--quiet"] + args,
                                capture_output=True, text=True, timeout=300)
             if r.returncode != 0:
-                print("frontdt -o %s: exit %d: %s" % (out, r.returncode, r.stderr))
+                print("FAIL: frontdt %s: exit %d: %s" % (" ".join(args), r.returncode, r.stderr))
                 return 1
-            outs[ext] = out
-        tets = read_tets(outs["tets"])
+        tets = read_tets(out("m.tets"))
         tets_set = set(tets)
         if len(tets_set) != len(tets) or not tets:
-            print(".tets has repeated lines or none")
+            print("FAIL: .tets has repeated lines or none")
             return 1
+        ref = (pts, tets_set, Orienter(pts))
 
-        for kind, reader in (("vtu", vtk.vtkXMLUnstructuredGridReader()),
-                             ("vtk", vtk.vtkUnstructuredGridReader())):
-            errors = ErrorCatcher()
-            reader.AddObserver("ErrorEvent", errors)
-            reader.AddObserver("WarningEvent", errors)
-            reader.SetFileName(outs[kind])
-            reader.Update()
-            grid = reader.GetOutput()
-            fails += check_grid(kind, grid, pts, tets_set, errors)
+        # The streamed layout: each number the end decides (the cell count
+        # first) in a fixed field of 21 bytes (src/io/write/fmt_vtk.c).
+        for name in ("s.vtu", "d.vtu"):
+            with open(out(name), "rb") as f:
+                head = f.read(4096)
+            if not re.search(rb'NumberOfCells="[0-9" ]{21}>', head):
+                fails.append("%s: not the streamed .vtu layout (the default -o .vtu "
+                             "should stream)" % name)
+
+        files = {
+            "vtk": ["m.vtu", "s.vtu", "d.vtu", "m.vtk"],
+            "meshio": ["m.vtu", "s.vtu", "d.vtu", "m.vtk", "m.msh", "m2.msh",
+                       "m.mesh", "m.ele", "s.ele"],
+        }
+        readers = {"vtk": read_vtk if vtk else None, "meshio": read_meshio if meshio else None}
+        checked = []
+        for who, names in files.items():
+            if readers[who] is None:
+                print("%s python module not installed: its reads skipped (%s)"
+                      % (who, " ".join(names)))
+                continue
+            for name in names:
+                what = "%s reading %s" % (who, name)
+                points, cells, errs = readers[who](out(name))
+                new = ["%s: %s" % (what, e) for e in errs]
+                if not errs:
+                    new += check_mesh(what, points, cells, ref)
+                fails += new
+                print("%s: %s" % (what, "FAIL" if new else "ok"))
+                checked.append(what)
 
     for f in fails:
         print("FAIL:", f)
     if fails:
         return 1
-    print("vtu/vtk readback ok: %d points, %d tets" % (len(pts), len(tets_set)))
+    print("readback ok: %d points, %d tets, %d reads" % (len(pts), len(tets_set), len(checked)))
     return 0
 
 

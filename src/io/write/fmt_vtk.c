@@ -140,25 +140,44 @@ int fdt_put_vtk(out_file *o, const fdt_mesh_view *m, const void *prep, char *err
  * come, then the offsets and types (arithmetic: 4(t+1) and 10, written at
  * the end from the count). What depends on the count (NumberOfCells, the
  * offset attributes of the last two arrays, the connectivity's byte
- * count) is written as a fixed-width placeholder and patched: the numbers
- * as 20 zero-padded digits (VTK and meshio parse them as decimal), the
+ * count) is written as a fixed-width placeholder and patched: each number
+ * in a field of VTU_NUM_FIELD bytes that holds its decimal digits, the
+ * attribute's closing quote, then blanks (offset="4750800"      />); the
  * byte count as its 8 raw bytes.
+ *
+ * The blanks lie between the attribute and what follows, where XML allows
+ * any whitespace, so the attribute's value is the bare number both readers
+ * expect: VTK parses it as a number, but meshio 5 finds each appended
+ * array by comparing offset="..." as a string with the decimal offset it
+ * has counted to, so a value padded with zeros or blanks inside the
+ * quotes ("00000000000000000200", "200 ") is not found (issue 34 item 4;
+ * tests/vtu_readback.py reads the streamed file with both).
  */
-#define VTU_NUM_WIDTH 20
+#define VTU_NUM_FIELD 21 /* UINT64_MAX's 20 digits and the closing quote */
 
-/* Puts "<prefix><20-digit placeholder>" and remembers where the digits are. */
+/* Fills field[0..VTU_NUM_FIELD) with v's digits, '"' and blanks. */
+static void vtu_num_field(char field[VTU_NUM_FIELD + 1], uint64_t v)
+{
+    int k = snprintf(field, VTU_NUM_FIELD + 1, "%llu\"", (unsigned long long)v);
+    memset(field + k, ' ', (size_t)(VTU_NUM_FIELD - k));
+    field[VTU_NUM_FIELD] = '\0';
+}
+
+/* Puts "<prefix>" then the field of 0, and remembers where the field is. */
 static void vtu_placeholder(out_file *o, const char *prefix, uint64_t *mark)
 {
+    char field[VTU_NUM_FIELD + 1];
     out_str(o, prefix);
     *mark = out_tell(o);
-    out_str(o, "00000000000000000000");
+    vtu_num_field(field, 0);
+    out_bytes(o, field, VTU_NUM_FIELD);
 }
 
 static void vtu_patch_num(out_file *o, uint64_t mark, uint64_t v)
 {
-    char p[VTU_NUM_WIDTH + 1];
-    snprintf(p, sizeof p, "%020llu", (unsigned long long)v);
-    out_patch(o, mark, p, VTU_NUM_WIDTH);
+    char field[VTU_NUM_FIELD + 1];
+    vtu_num_field(field, v);
+    out_patch(o, mark, field, VTU_NUM_FIELD);
 }
 
 static int vtu_begin(fdt_stream_out *s, char *err, size_t errlen)
@@ -172,13 +191,13 @@ static int vtu_begin(fdt_stream_out *s, char *err, size_t errlen)
         "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
         "byte_order=\"%s\" header_type=\"UInt64\">\n"
         "  <UnstructuredGrid>\n"
-        "    <Piece NumberOfPoints=\"%llu\" NumberOfCells=\"",
+        "    <Piece NumberOfPoints=\"%llu\"",
         host_is_little_endian() ? "LittleEndian" : "BigEndian", (unsigned long long)n);
     if (k < 0 || (size_t)k >= sizeof line)
         return set_errno_err(err, errlen, o->path, EOVERFLOW);
     out_bytes(o, line, (size_t)k);
-    s->mark[0] = out_tell(o);
-    out_str(o, "00000000000000000000\">\n"
+    vtu_placeholder(o, " NumberOfCells=\"", &s->mark[0]);
+    out_str(o, ">\n"
                "      <Points>\n"
                "        <DataArray type=\"Float64\" Name=\"Points\" "
                "NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/>\n"
@@ -189,9 +208,9 @@ static int vtu_begin(fdt_stream_out *s, char *err, size_t errlen)
     out_i64(o, (int64_t)(8 + sz_pts));
     vtu_placeholder(o, "\"/>\n        <DataArray type=\"Int64\" Name=\"offsets\" "
                        "format=\"appended\" offset=\"", &s->mark[1]);
-    vtu_placeholder(o, "\"/>\n        <DataArray type=\"UInt8\" Name=\"types\" "
+    vtu_placeholder(o, "/>\n        <DataArray type=\"UInt8\" Name=\"types\" "
                        "format=\"appended\" offset=\"", &s->mark[2]);
-    out_str(o, "\"/>\n"
+    out_str(o, "/>\n"
                "      </Cells>\n"
                "    </Piece>\n"
                "  </UnstructuredGrid>\n"
