@@ -9,10 +9,6 @@
 #include "front/seed.h"
 #include "front/sink.h"
 
-/* For a positively oriented (v0,v1,v2,v3), (v1,v2,v3,v0) is an odd
- * permutation, so v0 is on the negative side of (v1,v2,v3): that face is
- * already outward; the others follow the same parity count. */
-const int fdt_tet_face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
 int fdt_meshbuf_init(fdt_meshbuf *mb, size_t expected_tets, int want_nbrs)
 {

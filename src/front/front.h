@@ -76,9 +76,6 @@ typedef struct fdt_probe_budget {
 int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces,
                     const fdt_probe_budget *budget, fdt_front_stats *st);
 
-/* The outward faces of a positively oriented tet: face i is opposite
- * vertex i and has that vertex on its negative side. */
-extern const int fdt_tet_face[4][3];
 
 /*
  * The apex of front face f (§2.2), the step the serial front and a part of

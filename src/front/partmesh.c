@@ -10,11 +10,6 @@
 
 #define INF FDT_NONE
 
-/* The face of a tet opposite its vertex k, ordered so that vertex k lies
- * on its positive side (orient3d(face, v[k]) > 0 for a positive tet): the
- * even permutations (face, k) of (0, 1, 2, 3). For an infinite tet (k its
- * infinite vertex) that is its hull face, outward (src/mesh/insert.h). */
-static const uint8_t face_toward[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
 
 static int report(fdt_progress_fn progress, void *puser, double fraction)
 {
@@ -87,8 +82,12 @@ static int emit_mesh(const fdt_ins *mesh, fdt_emit *em, fdt_progress_fn progress
         int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
         if (inf < 0 || (v[0] == INF && v[1] == INF)) /* finite, or a freed slot */
             continue;
-        const uint8_t *f = face_toward[inf];
-        uint32_t h[3] = {v[f[0]], v[f[1]], v[f[2]]};
+        /* An infinite tet is positive with any point outside its hull
+         * face in place of the infinite vertex (src/mesh/insert.h), so
+         * that point is on the negative side of the tet's outward face
+         * there: the hull face, outward, is that face reversed. */
+        const int *f = fdt_tet_face[inf];
+        uint32_t h[3] = {v[f[0]], v[f[2]], v[f[1]]};
         if ((err = fdt_emit_hull(em, h)) != FDT_OK)
             goto done;
     }

@@ -41,6 +41,11 @@
 #include <stdint.h>
 #include <string.h>
 
+/* For a positively oriented (v0,v1,v2,v3), (v1,v2,v3,v0) is an odd
+ * permutation, so v0 is on the negative side of (v1,v2,v3): that face is
+ * already outward; the others follow the same parity count. */
+const int fdt_tet_face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
 /* Expansion arithmetic needs each operation rounded once to double. */
 #if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
 #error "src/geom/predicates.c needs FLT_EVAL_METHOD == 0 (SSE2 doubles, no x87)"

@@ -43,6 +43,11 @@ typedef struct fdt_pred_counts {
     size_t insphere_adapt;
 } fdt_pred_counts;
 
+/* The outward faces of a positively oriented tet: face i is opposite
+ * vertex i and has that vertex on its negative side (orient3d of the face
+ * and v[i] < 0). */
+extern const int fdt_tet_face[4][3];
+
 int fdt_orient3d(const double *a, const double *b, const double *c,
                  const double *d, fdt_pred_counts *cnt);
 int fdt_insphere(const double *a, const double *b, const double *c,

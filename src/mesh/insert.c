@@ -62,7 +62,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/bits.h"
-#include "front/front.h"
 #include "base/mem.h"
 
 /* State of one build that the result does not keep. */
