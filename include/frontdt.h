@@ -96,12 +96,16 @@ typedef enum fdt_mode {
  * perturbed Delaunay tetrahedralization is unique); they differ in cost.
  */
 typedef enum fdt_search {
-    FDT_SEARCH_AUTO = 0,  /* the kd search (§2.2, §4), switching to an
+    FDT_SEARCH_AUTO = 0,  /* serial in memory: the one-part engine, the
+                             certified insertion mesh of every point is the
+                             answer (no front); streamed or with threads:
+                             the kd search (§2.2, §4), switching to an
                              insertion mesh where searches get expensive
                              (scans, CFD grids, cospherical sets): serial,
                              the mesh of the points; with threads, in any
                              mode, one mesh of every point that all parts
-                             read */
+                             read. Every mesh is certified first
+                             (FDT_ECHECK when it fails) */
     FDT_SEARCH_KD = 1,    /* the kd search only */
     FDT_SEARCH_MESH = 2   /* each part's insertion mesh from the start */
 } fdt_search;
