@@ -4,6 +4,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "base/clock.h"
 #include "mesh/certify.h"
@@ -94,6 +95,34 @@ static int emit_mesh(const fdt_ins *mesh, fdt_emit *em, fdt_progress_fn progress
 done:
     free(tid);
     return err;
+}
+
+size_t fdt_partmesh_final(const fdt_ins *m, const fdt_kdtree *t, uint8_t *final)
+{
+    size_t count = 0;
+    int everything = t->cell == NULL;
+    fdt_kdq kq;
+    memset(&kq, 0, sizeof kq);
+    for (uint32_t s = 0; s < m->nslots; s++) {
+        final[s] = 0;
+        if (!fdt_ins_is_finite(m, s))
+            continue;
+        if (!everything) {
+            /* The ball of the tet as the apex search keeps it: face
+             * (v0, v1, v2) with v3 on its open side (a positive tet). */
+            const uint32_t *v = fdt_ins_tet(m, s);
+            const double *P = m->P;
+            fdt_apex ap;
+            fdt_apex_init(&ap, P + 3 * (size_t)v[0], P + 3 * (size_t)v[1],
+                          P + 3 * (size_t)v[2], v[0], v[1], v[2]);
+            fdt_apex_offer(&ap, v[3], P + 3 * (size_t)v[3], &kq);
+            if (ap.best != v[3] || !fdt_apex_inside_region(&ap, t))
+                continue;
+        }
+        final[s] = 1;
+        count++;
+    }
+    return count;
 }
 
 int fdt_partmesh_emit_all(const double *P, uint32_t m, fdt_emit *em, fdt_progress_fn progress,

@@ -22,6 +22,7 @@
 #include <stdint.h>
 
 #include "front/sink.h"
+#include "geom/kdtree.h"
 #include "mesh/insert.h"
 
 /* Bytes a point the one-part engine holds at its peak besides the points
@@ -38,6 +39,20 @@ typedef struct fdt_partmesh_stats {
     double t_certify;      /* seconds certifying it */
     fdt_pred_counts pc;    /* exact predicate calls of both */
 } fdt_partmesh_stats;
+
+/*
+ * Marks the final tets of a part's certified mesh m: the finite tets whose
+ * circumsphere (a conservative ball, src/geom/kdtree.c) lies strictly
+ * inside the region of the part's tree t, the part's bisection cell
+ * (fdt_kd_set_region; infinite on the hull's sides). No point of another
+ * part lies in such a cell's interior, so none lies in or on the sphere:
+ * the tet is a tet of the perturbed DT of all the points, final before
+ * any other part is looked at. final[s] = 1 for such a slot s, else 0
+ * (m->nslots bytes, the caller's). Returns how many. A tree without a
+ * region (no climb tables) has all of space as its region: every finite
+ * tet is final, as for a run of one part.
+ */
+size_t fdt_partmesh_final(const fdt_ins *m, const fdt_kdtree *t, uint8_t *final);
 
 /*
  * The whole run as one part: the DT of the points [0, m) of P (tree order,
