@@ -248,11 +248,14 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
          * insertion mesh, certified, is the answer); --search kd, and a
          * streamed run, whose memory must stay bounded, run the paper's
          * front. */
-        if (ctx->s.search != FDT_SEARCH_KD && !user)
+        if (ctx->s.search != FDT_SEARCH_KD && !user) {
+            /* the tree only put the points in its (spatially coherent)
+             * order, which the insertion's BRIO rounds keep */
+            fdt_kd_free(&tree);
             err = fdt_partmesh_emit_all(pr.p, (uint32_t)pr.m, &em, ctx->s.progress,
                                         ctx->s.progress_user, &pms, ctx->diag,
                                         sizeof ctx->diag);
-        else
+        } else
             err = fdt_front_emit(&tree, central_point(&tree), (int)ctx->s.search, &em,
                                  ctx->s.progress, ctx->s.progress_user, &fst);
         if (!err)

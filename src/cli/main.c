@@ -24,6 +24,7 @@
 #include "cli/cli.h"
 #include "base/clock.h"
 #include "cli/progress.h"
+#include "front/partmesh.h"
 #include "io/read/reader.h"
 #include "io/write/writer.h"
 
@@ -1076,7 +1077,8 @@ static int fanout_close(fanout *fo, int commit)
  * list's needs, which this does not count. Streamed: a 1 MiB batch a
  * thread. Plus 16 MiB for the program, its libraries and stacks.
  */
-static unsigned long long memory_estimate(size_t n, int stream, int threads, int nbrs)
+static unsigned long long memory_estimate(size_t n, int stream, int threads, int nbrs,
+                                          int one_part)
 {
     double pts = 24.0 * (double)n;
     double own = stream ? 0.0 : 24.0 * (double)n;
@@ -1096,6 +1098,15 @@ static unsigned long long memory_estimate(size_t n, int stream, int threads, int
     double sinks = stream ? (double)(threads > 1 ? threads : 1) * 1.2 * 1048576.0 : 0.0;
     double during_merge = pts + own + idx + merge;
     double during_front = pts + own + idx + tree + front + mesh + sinks;
+    if (one_part) {
+        /* The one-part engine (serial in memory, --search auto or mesh):
+         * the insertion mesh instead of the tree and the front, whose tet
+         * array becomes the output's (src/front/partmesh.h); neighbours
+         * are written beside it. 1M uniform points: 289 bytes a point
+         * measured at the peak. */
+        during_front = pts + own + idx + FDT_PARTMESH_BYTES * (double)n +
+                       (nbrs ? 6.5 * 32.0 * (double)n : 0.0);
+    }
     double peak = during_merge > during_front ? during_merge : during_front;
     return (unsigned long long)(peak + 16.0 * 1048576.0);
 }
@@ -1256,7 +1267,9 @@ static int run(const cli *c)
     int run_threads = c->mode == FDT_MODE_SERIAL ? 1
                       : c->threads > 0           ? c->threads
                                                  : (int)sysconf(_SC_NPROCESSORS_ONLN);
-    unsigned long long estimate = memory_estimate(n, streaming, run_threads, s.neighbors);
+    unsigned long long estimate =
+        memory_estimate(n, streaming, run_threads, s.neighbors,
+                        !streaming && run_threads == 1 && c->search != FDT_SEARCH_KD);
     if (c->memory_limit && estimate > c->memory_limit) {
         say("%s: %zu points need about %llu MiB (%s%s), more than --memory-limit %llu MiB",
             name, n, estimate >> 20, streaming ? "streamed" : "in memory",

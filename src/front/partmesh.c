@@ -29,16 +29,111 @@ static int build_progress(void *user, double fraction)
     return h->fn(h->user, 0.5 * fraction);
 }
 
-/* Every finite tet of mesh to em, in slot order; with neighbours, the
- * links from the mesh's own adjacency (tid[slot]: its tet id). Then every
- * hull face. */
-static int emit_mesh(const fdt_ins *mesh, fdt_emit *em, fdt_progress_fn progress,
-                     void *puser, size_t *emitted)
+/* Tet ids in slot order (tid[s] for each finite slot s), then the
+ * neighbours of each finite tet from the mesh's adjacency into nbrs (4 a
+ * tet from index `first`; entry k across the face opposite vertex k, -1 on
+ * the hull, as src/front/front.h's meshbuf keeps them). */
+static void link_neighbours(const fdt_ins *mesh, const uint32_t *tid, int64_t first,
+                            int64_t *nbrs)
+{
+    for (uint32_t s = 0; s < mesh->nslots; s++) {
+        if (!fdt_ins_is_finite(mesh, s))
+            continue;
+        int64_t *o = nbrs + 4 * (size_t)(first + tid[s]);
+        for (int k = 0; k < 4; k++) {
+            uint32_t nt;
+            int nk;
+            uint32_t apex = fdt_ins_across(mesh, s, k, &nt, &nk);
+            o[k] = apex == INF ? -1 : first + (int64_t)tid[nt];
+        }
+    }
+}
+
+/* Every hull face: the infinite tets' finite faces, outward. */
+static int emit_hull(const fdt_ins *mesh, fdt_emit *em)
+{
+    for (uint32_t s = 0; s < mesh->nslots; s++) {
+        const uint32_t *v = fdt_ins_tet(mesh, s);
+        int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
+        if (inf < 0 || (v[0] == INF && v[1] == INF)) /* finite, or a freed slot */
+            continue;
+        /* An infinite tet is positive with any point outside its hull
+         * face in place of the infinite vertex (src/mesh/insert.h), so
+         * that point is on the negative side of the tet's outward face
+         * there: the hull face, outward, is that face reversed. */
+        const int *f = fdt_tet_face[inf];
+        uint32_t h[3] = {v[f[0]], v[f[2]], v[f[1]]};
+        int err = fdt_emit_hull(em, h);
+        if (err)
+            return err;
+    }
+    return FDT_OK;
+}
+
+/*
+ * In memory, with an empty meshbuf: the mesh's own tet array becomes the
+ * meshbuf's, each finite slot's four vertices moved down to its tet id's
+ * place (tid <= slot, and a slot's 8 words hold a tet's 4, so a vertex is
+ * read before its words are written over). The output then costs no copy:
+ * without this the mesh (32 bytes a slot) and the output (16 a tet) were
+ * held together, 419 bytes a point at the peak on 1M uniform points
+ * against the kd front's 200 (bench/NOTES.md entry 87).
+ */
+static int hand_over(fdt_ins *mesh, fdt_emit *em, size_t *emitted)
 {
     fdt_meshbuf *mb = em->mb;
-    int64_t *nbrs = mb ? mb->nbrs : NULL;
     uint32_t *tid = NULL;
-    if (nbrs && !(tid = malloc((size_t)mesh->nslots * sizeof *tid)))
+    if (mb->nbrs) {
+        if (!(tid = malloc((size_t)mesh->nslots * sizeof *tid)))
+            return FDT_ENOMEM;
+        uint32_t k = 0;
+        for (uint32_t s = 0; s < mesh->nslots; s++)
+            if (fdt_ins_is_finite(mesh, s))
+                tid[s] = k++;
+        size_t need = mesh->nfinite + 1;
+        if (need > mb->tcap) {
+            int64_t *nn = realloc(mb->nbrs, need * 4 * sizeof *nn);
+            if (!nn) {
+                free(tid);
+                return FDT_ENOMEM;
+            }
+            mb->nbrs = nn;
+        }
+        link_neighbours(mesh, tid, 0, mb->nbrs);
+        free(tid);
+    }
+    int err = emit_hull(mesh, em);
+    if (err)
+        return err;
+    uint32_t *T = mesh->T;
+    size_t k = 0;
+    for (uint32_t s = 0; s < mesh->nslots; s++)
+        if (fdt_ins_is_finite(mesh, s)) {
+            memmove(T + 4 * k, T + 8 * (size_t)s, 4 * sizeof *T);
+            k++;
+        }
+    uint32_t *shrunk = realloc(T, (k + 1) * 4 * sizeof *T);
+    mesh->T = NULL; /* the meshbuf owns it now; fdt_ins_free leaves it */
+    free(mb->tets);
+    mb->tets = shrunk ? shrunk : T;
+    mb->ntets = k;
+    mb->tcap = k + 1;
+    em->ntets = (int64_t)k;
+    *emitted = k;
+    return FDT_OK;
+}
+
+/* Every finite tet of mesh to em, in slot order (a stream, or a meshbuf
+ * that already holds tets); with neighbours, the links from the mesh's
+ * own adjacency. Then every hull face. */
+static int emit_mesh(fdt_ins *mesh, fdt_emit *em, fdt_progress_fn progress, void *puser,
+                     size_t *emitted)
+{
+    fdt_meshbuf *mb = em->mb;
+    if (mb && mb->ntets == 0)
+        return hand_over(mesh, em, emitted);
+    uint32_t *tid = NULL;
+    if (mb && mb->nbrs && !(tid = malloc((size_t)mesh->nslots * sizeof *tid)))
         return FDT_ENOMEM;
     int err = FDT_OK;
     int64_t first = em->ntets;
@@ -61,37 +156,9 @@ static int emit_mesh(const fdt_ins *mesh, fdt_emit *em, fdt_progress_fn progress
         }
     }
     *emitted = (size_t)(em->ntets - first);
-    if (tid) {
-        /* The meshbuf may have moved while it grew: read it again. Entry k
-         * of a tet is its neighbour across the face opposite vertex k, -1
-         * on the hull (src/front/front.h). */
-        nbrs = em->mb->nbrs;
-        for (uint32_t s = 0; s < mesh->nslots; s++) {
-            if (!fdt_ins_is_finite(mesh, s))
-                continue;
-            int64_t *o = nbrs + 4 * (size_t)(first + tid[s]);
-            for (int k = 0; k < 4; k++) {
-                uint32_t nt;
-                int nk;
-                uint32_t apex = fdt_ins_across(mesh, s, k, &nt, &nk);
-                o[k] = apex == INF ? -1 : first + (int64_t)tid[nt];
-            }
-        }
-    }
-    for (uint32_t s = 0; s < mesh->nslots; s++) {
-        const uint32_t *v = fdt_ins_tet(mesh, s);
-        int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
-        if (inf < 0 || (v[0] == INF && v[1] == INF)) /* finite, or a freed slot */
-            continue;
-        /* An infinite tet is positive with any point outside its hull
-         * face in place of the infinite vertex (src/mesh/insert.h), so
-         * that point is on the negative side of the tet's outward face
-         * there: the hull face, outward, is that face reversed. */
-        const int *f = fdt_tet_face[inf];
-        uint32_t h[3] = {v[f[0]], v[f[2]], v[f[1]]};
-        if ((err = fdt_emit_hull(em, h)) != FDT_OK)
-            goto done;
-    }
+    if (tid) /* the meshbuf may have moved while it grew: read it again */
+        link_neighbours(mesh, tid, first, em->mb->nbrs);
+    err = emit_hull(mesh, em);
 done:
     free(tid);
     return err;

@@ -25,11 +25,11 @@
 #include "geom/kdtree.h"
 #include "mesh/insert.h"
 
-/* Bytes a point the one-part engine holds at its peak besides the points
- * and the output tets: the insertion mesh (about 220 kept, src/mesh/
- * insert.h) and its build's scratch, the tet-id map with neighbours.
- * 1M uniform points: the CLI's --memory-limit estimate uses it. */
-#define FDT_PARTMESH_BYTES 300.0
+/* Bytes a point the one-part engine holds at its peak besides the points:
+ * the insertion mesh (32 bytes a slot, about 6.7 slots a point, and its
+ * incident-tet table) with the build's scratch; the output tets reuse the
+ * mesh's array. The CLI's --memory-limit estimate uses it. */
+#define FDT_PARTMESH_BYTES 235.0
 
 /* What the one-part engine did, for fdt_stats. */
 typedef struct fdt_partmesh_stats {
