@@ -15,7 +15,9 @@
 # output directory that does not exist (exit 5, nothing left), write errors part-
 # way (file size limit, in the middle of a TetGen set too, /dev/full: exit
 # 5, nothing left), SIGTERM and SIGINT
-# during a long run and during the write (exit 6, nothing left), --demo,
+# during a long run and during the write (exit 6, nothing left), several
+# outputs all or none (SIGINT during the second; a failure or signal at
+# every step of the final commit: all old or all new), --demo,
 # repeatability (byte-identical .tets, identical --hash), independence of
 # input order (shuffled copy mapped back), --check, --stats/--stats-json,
 # duplicate reporting, --pin refused (said once), every output format;
@@ -853,7 +855,108 @@ for target in big.ele big.vtk; do
     fi
     expect_empty_dir "SIGTERM while writing $target" out
 done
+
+# All-or-none outputs (issue 34 item 3). SIGINT while the second of four
+# outputs is written: every old output must still be there, unchanged
+# (the first one was already replaced before).
+rm -rf out && mkdir out
+"$FRONTDT" --demo 3000 -q -o out/x.msh -o out/x.vtk -o out/x.mesh -o out/x.ele ||
+    fail "all-or-none: the old outputs were not written"
+mkdir -p aon_old && cp -p out/x.* aon_old/
+"$FRONTDT" --demo 200000 --quiet -o out/x.msh -o out/x.vtk -o out/x.mesh -o out/x.ele \
+    >sig.out 2>sig.err &
+pid=$!
+seen=0
+while kill -0 "$pid" 2>/dev/null; do
+    if compgen -G "out/.x.vtk.tmp.*" >/dev/null; then
+        seen=1
+        kill -INT "$pid"
+        break
+    fi
+    sleep 0.01
+done
+wait "$pid"
+RC=$?
+if [ "$seen" = 1 ]; then
+    [ "$RC" = 6 ] || fail "SIGINT while writing the second output: exit $RC, want 6"
+    for f in aon_old/x.*; do
+        cmp -s "$f" "out/${f#aon_old/}" ||
+            fail "SIGINT while writing the second output: out/${f#aon_old/} was replaced"
+    done
+    left=$(cd out && ls -A | tr '\n' ' ')
+    [ "$left" = "x.ele x.face x.mesh x.msh x.neigh x.node x.vtk " ] ||
+        fail "SIGINT while writing the second output left: $left"
+else
+    fail "all-or-none: the write (exit $RC) finished before the second output began"
+fi
+rm -rf aon_old out
 set +m
+
+# Every step of the final commit (FDT_TEST_COMMIT_FAULT=K:fail|signal,
+# src/io/write/writer.c: each backup link, the journal, each rename, the
+# commit point and the step after it) fails or is interrupted in turn;
+# afterwards every output is either the old one or the new one, all
+# alike (byte for byte against a run without a fault), and the folders
+# hold nothing else: no temporary, backup or journal.
+# aon_check NAME ARGS...: old outputs in aon_seed (made by the caller),
+# the new ones by ARGS in aon_new; each fault in a copy of aon_seed.
+aon_list() { (cd "$1" && find . -mindepth 1 | LC_ALL=C sort | tr '\n' ' '); }
+aon_same() { # DIR_A DIR_B: same names, same bytes (stats.json: names only)
+    [ "$(aon_list "$1")" = "$(aon_list "$2")" ] || return 1
+    local f
+    while read -r f; do
+        case $f in *stats.json) continue ;; esac
+        [ -d "$1/$f" ] || cmp -s "$1/$f" "$2/$f" || return 1
+    done < <(cd "$1" && find . -mindepth 1 -type f)
+    return 0
+}
+aon_check() {
+    local name=$1 how k word reached=0
+    shift
+    rm -rf aon_new && cp -a aon_seed aon_new
+    (cd aon_new && "$FRONTDT" "$@" >/dev/null 2>&1) || fail "$name: the run without a fault failed"
+    for how in fail signal; do
+        for k in $(seq 1 80); do
+            rm -rf aon_run && cp -a aon_seed aon_run
+            (cd aon_run && FDT_TEST_COMMIT_FAULT=$k:$how "$FRONTDT" "$@" >../aon.out 2>../aon.err)
+            RC=$?
+            word=$(sed -n 's/^frontdt: test fault ([a-z]*) at commit step [0-9]*: //p' aon.err)
+            if [ -z "$word" ]; then
+                [ "$RC" = 0 ] || fail "$name: no fault at step $k, yet exit $RC: $(head -c 300 aon.err)"
+                aon_same aon_run aon_new || fail "$name: a run past every step did not write the new outputs"
+                break
+            fi
+            reached=$((reached + 1))
+            if [ "$word" = committed ]; then
+                # after the commit point: all new (a signal still exits 6)
+                [ "$RC" = "$([ $how = fail ] && echo 0 || echo 6)" ] ||
+                    fail "$name: $how after the commit point: exit $RC"
+                aon_same aon_run aon_new ||
+                    fail "$name: $how after the commit point: not every output is new: $(aon_list aon_run)"
+            else
+                [ "$RC" = "$([ $how = fail ] && echo 5 || echo 6)" ] ||
+                    fail "$name: $how at commit step $k ($word): exit $RC: $(head -c 300 aon.err)"
+                aon_same aon_run aon_seed ||
+                    fail "$name: $how at commit step $k ($word): not every output is the old one: $(aon_list aon_run)"
+            fi
+        done
+    done
+    # each mode reaches the backups, the journal, the renames and the commit
+    [ "$reached" -ge 10 ] || fail "$name: only $reached commit steps were reached"
+    rm -rf aon_run aon_new aon.out aon.err
+}
+rm -rf aon_seed && mkdir -p aon_seed/p aon_seed/q
+(cd aon_seed && "$FRONTDT" --demo 1500 -q --mode serial -o x.msh -o x.vtk -o x.mesh -o x.ele \
+    -o q/polyMesh --stats-json stats.json) || fail "all-or-none: the old outputs were not written"
+aon_check aon_memory --demo 1600 -q --mode serial -o x.msh -o x.vtk -o x.mesh -o x.ele \
+    -o p/polyMesh -o q/polyMesh --stats-json stats.json
+# streamed outputs go through the same commit; the stale .neigh beside a
+# streamed TetGen set is removed with it
+rm -rf aon_seed && mkdir aon_seed
+(cd aon_seed && "$FRONTDT" --demo 1500 -q --mode serial -o y.vtu -o y.ele) ||
+    fail "all-or-none: the old streamed outputs were not written"
+aon_check aon_stream --demo 1600 -q --mode serial --stream -o y.vtu -o y.ele -o y.fdtb
+rm -rf aon_seed
 
 # --stream (issue 18): the streamed mesh's set hash equals the in-memory
 # run's in every mode; what a stream cannot do is refused; --memory-limit

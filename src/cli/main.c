@@ -13,7 +13,9 @@
  *   3  --check found the mesh is not the Delaunay tetrahedralization
  *   4  out of resources: memory, index range, threads
  *   5  cannot write the output
- *   6  interrupted by SIGINT or SIGTERM (no output, no temporary file left)
+ *   6  interrupted by SIGINT or SIGTERM (no temporary file left, every
+ *      output as before the run: the outputs are renamed all together at
+ *      the end, fdt_wr_set_commit)
  *   7  internal error (a bug: please report it)
  *
  * Everything the tool says goes to stderr with a "frontdt: " prefix, except
@@ -149,7 +151,10 @@ static void usage(FILE *f)
         "                          --columns for .node/.ply)   2 bad input\n"
         "  3 --check failed      4 out of resources (also over --memory-limit)\n"
         "  5 cannot write output\n"
-        "  6 interrupted         7 internal error\n",
+        "  6 interrupted (every output left as it was)\n"
+        "  7 internal error\n"
+        "Outputs are all or none: each is written to a temporary file, and only\n"
+        "when all are complete are they renamed over their names.\n",
         MAX_OUTPUTS, DEMO_DEFAULT_N);
 }
 
@@ -179,9 +184,9 @@ static int usage_error(const char *fmt, ...)
 /* Signals                                                                   */
 /* ------------------------------------------------------------------------ */
 
-/* SIGINT/SIGTERM remove the temporary (or just renamed, if its file set
- * is incomplete) output files (fdt_write_cleanup) and leave with exit
- * code 6; SIGXFSZ is ignored (src/cli/cli.h). */
+/* SIGINT/SIGTERM remove the temporary output files and put back any
+ * output the final commit already replaced (fdt_write_cleanup) and leave
+ * with exit code 6; SIGXFSZ is ignored (src/cli/cli.h). */
 
 /* ------------------------------------------------------------------------ */
 /* Argument parsing                                                          */
@@ -1199,6 +1204,14 @@ static int run(const cli *c)
     /* the summary goes to stderr when the mesh goes to stdout */
     if (to_stdout)
         info = stderr;
+    /* Every file output of the run (the meshes, streamed or not, and the
+     * --stats-json file) waits complete in its temporary until all are,
+     * then all are renamed together (fdt_wr_set_commit, below): all new,
+     * or, after any failure or signal, all as they were. */
+    if (fdt_wr_set_begin(0) != 0) {
+        say("internal error: a commit set is already open");
+        return CLI_INTERNAL;
+    }
 
     /* Points. */
     double t0 = fdt_now_s();
@@ -1207,7 +1220,8 @@ static int run(const cli *c)
         xyz = demo_points(n);
         if (!xyz) {
             say("demo: no memory for %zu points", n);
-            return CLI_RESOURCES;
+            code = CLI_RESOURCES;
+            goto done;
         }
     } else {
         char err[1024];
@@ -1227,7 +1241,8 @@ static int run(const cli *c)
         progress_clear(&prog);
         if (r != FDT_OK) {
             say("%s", err);
-            return exit_for_reader(r);
+            code = exit_for_reader(r);
+            goto done;
         }
     }
     tm.read = fdt_now_s() - t0;
@@ -1461,6 +1476,15 @@ static int run(const cli *c)
         }
     }
 
+    {
+        char cerr[FDT_IO_PATH + 300];
+        if (fdt_wr_set_commit(cerr, sizeof cerr) != FDT_IO_OK) {
+            say("%s", cerr);
+            code = CLI_WRITE;
+            goto done;
+        }
+    }
+
     if (c->hash)
         fprintf(info, "hash: %016" PRIx64 "\n", hash);
     if (c->set_hash)
@@ -1489,6 +1513,7 @@ static int run(const cli *c)
     }
 
 done:
+    fdt_wr_set_abandon(); /* after a failure: every temporary goes */
     fdt_result_free(&res);
     fdt_close(&ctx);
     free(xyz);

@@ -141,7 +141,29 @@ FILE *fdt_wr_side_open(const char *target, fdt_wr_side **side, char *err, size_t
 int fdt_wr_side_commit(fdt_wr_side *side, char *err, size_t errlen);
 void fdt_wr_side_abandon(fdt_wr_side *side);
 
-/* Removes every temporary output file not yet renamed. Async-signal-safe. */
+/*
+ * Commit sets (issue 34 item 3): the outputs of one run, all new or all
+ * as they were. After fdt_wr_set_begin() every commit of this module
+ * (fdt_wr_mesh*, the streaming writers' close, fdt_wr_side_commit) only
+ * closes its complete temporaries and adds them to the set;
+ * fdt_wr_set_commit() then renames them all, in the order they came,
+ * backing up the targets it replaces and keeping a journal
+ * ".frontdt-commit-PID" in the first target's folder while it renames
+ * (src/io/write/writer.c, "Commit sets", says how). Any failure, or
+ * SIGINT/SIGTERM (fdt_io_cleanup_temps), before its end puts every
+ * output back as it was and removes every temporary; FDT_IO_OK or
+ * FDT_IO_EWRITE with the file named in err. no_clobber: the commit
+ * refuses (and changes nothing) when a target exists. fdt_wr_set_abandon()
+ * removes the set's temporaries. One set at a time, from one thread:
+ * begin returns -1 while one is open. fdt_wr_set_active(): is one open?
+ */
+int fdt_wr_set_begin(int no_clobber);
+int fdt_wr_set_commit(char *err, size_t errlen);
+void fdt_wr_set_abandon(void);
+int fdt_wr_set_active(void);
+
+/* Removes every temporary output file not yet renamed (and rolls back a
+ * commit set not yet committed). Async-signal-safe. */
 void fdt_io_cleanup_temps(void);
 
 #endif
