@@ -122,6 +122,22 @@ usage_case u_o_nine "-o given more than 8 times" pts.xyz -o a1.tets -o a2.tets -
 usage_case u_demo_format "need an input file, not --demo" --demo 100 --input-format xyz
 usage_case u_two_stdout "both want standard output" pts.xyz -o - --stats-json -
 usage_case u_stdout_tetgen "cannot go to standard output" pts.xyz -o - --format tetgen
+# --format against the output's extension (issue 34 item 5): refused when
+# it names another format, before anything is written; fine when they
+# agree (msh2 and msh share .msh) or the name has no known extension
+usage_case u_format_ext "--format msh2 contradicts the extension of m.vtu (vtu)" pts.xyz \
+    -o m.msh -o m22.msh --format msh2 -o m.vtu
+[ ! -e m.msh ] && [ ! -e m22.msh ] && [ ! -e m.vtu ] || fail "u_format_ext wrote an output"
+usage_case u_format_ext2 "--format vtk contradicts the extension of m.ele (tetgen)" pts.xyz \
+    -o m.ele --format vtk
+for ok in "-o f22.msh --format msh2" "-o f.ele --format tetgen" "-o f.dat --format vtk" \
+    "-o f.vtk --format vtk"; do
+    # shellcheck disable=SC2086 # the words of each case
+    run format_ok "$FRONTDT" pts.xyz -q $ok
+    expect_rc format_ok 0
+done
+[ -s f22.msh ] && [ -s f.ele ] && [ -s f.dat ] && [ -s f.vtk ] || fail "format_ok: an output is missing"
+rm -f f22.msh f.node f.ele f.face f.neigh f.dat f.vtk
 # --help and --version that cannot be written: exit 5, the reason said.
 run help_full bash -c '"$1" --help >/dev/full' _ "$FRONTDT"
 expect_rc help_full 5 && expect_in help_full err "stdout:"

@@ -1057,7 +1057,19 @@ static void test_format_table(const char *dir)
     EXPECT(fdt_format_by_path("polyMesh") == foam);
     EXPECT(fdt_format_by_path("case/xpolyMesh") == NULL);
     EXPECT(fdt_format_by_path("case/polyMes") == NULL);
-    EXPECT(fdt_format_by_path("m.msh") != msh2); /* msh2 has no extension */
+    EXPECT(fdt_format_by_path("m.msh") != msh2); /* .msh chooses msh, the first row */
+    /* --format against the extension (issue 34 item 5): the row the
+     * extension names when it is another; NULL when it agrees or names
+     * none */
+    EXPECT(fdt_format_contradicted("m.vtu", msh2) == vtu);
+    EXPECT(fdt_format_contradicted("m.msh", msh2) == NULL);
+    EXPECT(fdt_format_contradicted("m.MSH", msh2) == NULL);
+    EXPECT(fdt_format_contradicted("m.ele", tg) == NULL);
+    EXPECT(fdt_format_contradicted("m.dat", vtu) == NULL);
+    EXPECT(fdt_format_contradicted("m", foam) == NULL);
+    EXPECT(fdt_format_contradicted("case/polyMesh", vtu) == foam);
+    EXPECT(fdt_format_contradicted("m.ele", vtk) == tg);
+    EXPECT(fdt_format_contradicted("m.vtu", NULL) == NULL);
     EXPECT(fdt_format_is_text(tets) && !fdt_format_is_text(vtu) && !fdt_format_is_text(NULL));
     /* all_faces adds the faces to TetGen's set alone */
     EXPECT(fdt_format_needs(NULL, 1) == 0);
@@ -1066,7 +1078,7 @@ static void test_format_table(const char *dir)
     EXPECT(fdt_format_needs(vtk, 1) == fdt_format_needs(vtk, 0));
     const char *list = fdt_format_list();
     EXPECTF(strstr(list, "tets (.tets)") && strstr(list, "openfoam (polyMesh)") &&
-                strstr(list, ", msh2, ") && strstr(list, "tetgen (.ele)"),
+                strstr(list, ", msh2 (.msh), ") && strstr(list, "tetgen (.ele)"),
             "[%s]", list);
     EXPECT(fdt_format_list() == list); /* built once */
 

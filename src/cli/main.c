@@ -107,8 +107,9 @@ static void usage(FILE *f)
         "                         given up to %d times; '-': standard output\n"
         "      --format NAME      format of the next -o (of the last -o when\n"
         "                         none follows): tets, tetgen, vtu, bin, vtk, msh,\n"
-        "                         msh2, medit, openfoam; or, named xyz, txt,\n"
-        "                         csv, node or ply, the input's (--input-format)\n"
+        "                         msh2, medit, openfoam; an -o whose extension\n"
+        "                         names another format is refused; or, named xyz,\n"
+        "                         txt, csv, node or ply, the input's (--input-format)\n"
         "      --all-faces        TetGen .face lists every face (TetGen -f)\n"
         "      --input-format FMT xyz (also txt, csv), node or ply: the input's\n"
         "                         format whatever its name (needed for '-')\n"
@@ -1152,6 +1153,11 @@ static int run(const cli *c)
         if (!fmts[o])
             return usage_error("%s: unknown output format (use %s, or --format)", out,
                                fdt_format_list());
+        /* "-o m.vtu --format msh2" would write gmsh into m.vtu */
+        const fdt_format *by_ext = fdt_format_contradicted(out, fmts[o]);
+        if (by_ext)
+            return usage_error("--format %s contradicts the extension of %s (%s)",
+                               fdt_format_name(fmts[o]), out, fdt_format_name(by_ext));
         need |= fdt_format_needs(fmts[o], c->all_faces);
         char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
         int n_names = fdt_output_files_as(out, fmts[o], names);

@@ -63,7 +63,10 @@ typedef struct fdt_stream_fmt {
 typedef struct fdt_format {
     const char *name;                  /* --format NAME */
     const char *exts[3];               /* lowercase, with the dot; for a
-                                          directory its last component */
+                                          directory its last component.
+                                          Rows may share one: the first
+                                          row with it is the one a path
+                                          chooses (msh before msh2) */
     const char *what;                  /* one line for --help */
     int binary;                        /* 0: text, may go to stdout */
     fdt_layout layout;

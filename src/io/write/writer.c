@@ -958,6 +958,14 @@ const fdt_format *fdt_format_by_path(const char *path)
     return NULL;
 }
 
+const fdt_format *fdt_format_contradicted(const char *path, const fdt_format *f)
+{
+    const fdt_format *by = fdt_format_by_path(path);
+    if (!f || !by || by == f || matching_ext(path, f))
+        return NULL;
+    return by;
+}
+
 const char *fdt_format_name(const fdt_format *f) { return f ? f->name : NULL; }
 int fdt_format_is_text(const fdt_format *f) { return f && !f->binary; }
 
@@ -1154,7 +1162,7 @@ const fdt_format fdt_formats[] = {
      {NULL}, {fdt_put_vtk}, NULL, NULL},
     {"msh", {".msh"}, "gmsh MSH 4.1 ASCII: tets and hull triangles", 0, FDT_LAYOUT_FILE, 0,
      1, {NULL}, {fdt_put_msh41}, NULL, NULL},
-    {"msh2", {NULL}, "gmsh MSH 2.2 ASCII (--format msh2)", 0, FDT_LAYOUT_FILE, 0, 1,
+    {"msh2", {".msh"}, "gmsh MSH 2.2 ASCII (--format msh2)", 0, FDT_LAYOUT_FILE, 0, 1,
      {NULL}, {fdt_put_msh22}, NULL, NULL},
     {"medit", {".mesh"}, "Medit .mesh (MMG, meshio): tets and hull triangles", 0,
      FDT_LAYOUT_FILE, 0, 1, {NULL}, {fdt_put_medit}, NULL, NULL},

@@ -46,6 +46,10 @@ const fdt_format *fdt_format_by_name(const char *name);
 /* The row path's extension chooses (a directory format: its last
  * component, "polyMesh"), or NULL. */
 const fdt_format *fdt_format_by_path(const char *path);
+/* When a path's extension names another format than f (--format msh2
+ * with m.vtu): the row the extension chooses; NULL when it agrees (one
+ * of f's extensions: msh2 shares .msh with msh) or names no format. */
+const fdt_format *fdt_format_contradicted(const char *path, const fdt_format *f);
 /* The row's name and whether it is text (may go to standard output). */
 const char *fdt_format_name(const fdt_format *f);
 int fdt_format_is_text(const fdt_format *f);
