@@ -330,29 +330,39 @@ expect_empty_dir ext out
 start=$(date +%s%N)
 run nodir "$FRONTDT" --demo 3000000 -o out/no/such/dir/mesh.tets
 end=$(date +%s%N)
-expect_rc nodir 5 && expect_in nodir err "out/no/such/dir/mesh.tets: "
+expect_rc nodir 5 &&
+    expect_in nodir err "cannot create output out/no/such/dir/mesh.tets: folder out/no/such/dir does not exist"
 ms=$(((end - start) / 1000000))
 [ "$ms" -lt 2000 ] || fail "missing output directory took ${ms} ms: not refused up front"
 expect_empty_dir nodir out
 # ... also for a normal input file, and a TetGen set.
 run nodir2 "$FRONTDT" pts.xyz -o out/nodir/mesh.ele
-expect_rc nodir2 5
+expect_rc nodir2 5 && expect_in nodir2 err "cannot create output out/nodir/mesh.ele: folder out/nodir does not exist"
 expect_empty_dir nodir2 out
+# ... and a polyMesh whose case has no constant/ (issue 34 item 8: the
+# message names the output's role and the missing folder)
+mkdir out/case
+run nodir3 "$FRONTDT" pts.xyz -o out/case/constant/polyMesh
+expect_rc nodir3 5 &&
+    expect_in nodir3 err "cannot create output out/case/constant/polyMesh: folder out/case/constant does not exist"
+rmdir out/case
+expect_empty_dir nodir3 out
 # A regular file in place of the directory.
 touch out/plain
 run notdir "$FRONTDT" pts.xyz -o out/plain/mesh.vtu
-expect_rc notdir 5 && expect_in notdir err "out/plain/mesh.vtu: "
+expect_rc notdir 5 && expect_in notdir err "cannot create output out/plain/mesh.vtu: out/plain is not a folder"
 rm -f out/plain
 expect_empty_dir notdir out
 # The output is a directory.
 mkdir out/isdir.tets
 run isdir "$FRONTDT" pts.xyz -o out/isdir.tets
-expect_rc isdir 5
+expect_rc isdir 5 && expect_in isdir err "cannot create output out/isdir.tets: a folder has that name"
 rmdir out/isdir.tets
 expect_empty_dir isdir out
 # --stats-json into a missing directory is refused up front as well.
 run jsondir "$FRONTDT" pts.xyz --stats-json out/no/stats.json
-expect_rc jsondir 5
+expect_rc jsondir 5 &&
+    expect_in jsondir err "cannot create --stats-json file out/no/stats.json: folder out/no does not exist"
 expect_empty_dir jsondir out
 
 # ---------------------------------------------------------------------------

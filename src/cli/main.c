@@ -610,47 +610,14 @@ static int refuse_overwrites(const cli *c, const char *output, char names[][FDT_
     return -1;
 }
 
-/*
- * Can a file be created at path? Its directory must exist, be a directory
- * and be writable; path itself must not be a directory. A cheap early
- * answer so a doomed run fails in milliseconds rather than after the
- * triangulation; the writer still checks every step for real.
- */
-static int output_dir_ok(const char *path)
+/* Can a file be created at path (fdt_output_dir_check)? Says why not. */
+static int output_dir_ok(const char *role, const char *path)
 {
-    const char *slash = strrchr(path, '/');
-    char dir[4096];
-    if (!slash) {
-        strcpy(dir, ".");
-    } else {
-        size_t len = (size_t)(slash - path);
-        if (len == 0)
-            len = 1; /* "/name": the root directory */
-        if (len >= sizeof dir) {
-            say("%s: %s", path, strerror(ENAMETOOLONG));
-            return 0;
-        }
-        memcpy(dir, path, len);
-        dir[len] = '\0';
-    }
-    struct stat st;
-    if (stat(dir, &st) != 0) {
-        say("%s: %s", path, strerror(errno));
-        return 0;
-    }
-    if (!S_ISDIR(st.st_mode)) {
-        say("%s: %s", path, strerror(ENOTDIR));
-        return 0;
-    }
-    if (access(dir, W_OK | X_OK) != 0) {
-        say("%s: %s", path, strerror(errno));
-        return 0;
-    }
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
-        say("%s: %s", path, strerror(EISDIR));
-        return 0;
-    }
-    return 1;
+    char err[2 * FDT_IO_PATH + 100];
+    if (fdt_output_dir_check(role, path, err, sizeof err) == 0)
+        return 1;
+    say("%s", err);
+    return 0;
 }
 
 /* ------------------------------------------------------------------------ */
@@ -1188,7 +1155,7 @@ static int run(const cli *c)
                                     stat(out, &dst) == 0 && S_ISDIR(dst.st_mode)
                                 ? names[0]
                                 : out;
-        if (!output_dir_ok(probe))
+        if (!output_dir_ok("output", probe))
             return CLI_WRITE;
     }
     {
@@ -1205,7 +1172,7 @@ static int run(const cli *c)
         return usage_error("--stream: %s", refusal);
     int streaming = c->stream > 0 || (c->stream == 0 && !refusal && c->n_outputs > 0);
     code = CLI_OK;
-    if (c->stats_json && !json_stdout && !output_dir_ok(c->stats_json))
+    if (c->stats_json && !json_stdout && !output_dir_ok("--stats-json file", c->stats_json))
         return CLI_WRITE;
     /* the summary goes to stderr when the mesh goes to stdout */
     if (to_stdout)

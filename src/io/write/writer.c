@@ -218,6 +218,74 @@ static void out_abandon(out_file *o)
 }
 
 /* ------------------------------------------------------------------------ */
+/* Why a file cannot be created (issue 34 item 8)                            */
+/* ------------------------------------------------------------------------ */
+
+/* path's folder ("." when it names none, "/" for "/name") into dir. */
+static void folder_of(const char *path, char *dir, size_t len)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(dir, len, ".");
+    else if (slash == path)
+        snprintf(dir, len, "/");
+    else
+        snprintf(dir, len, "%.*s", (int)(slash - path), path);
+}
+
+int fdt_create_err(char *err, size_t errlen, const char *role, const char *path, int e)
+{
+    char dir[FDT_IO_PATH];
+    folder_of(path, dir, sizeof dir);
+    int code = e == ENOMEM ? FDT_IO_ENOMEM : FDT_IO_EWRITE;
+    if (!err || errlen == 0)
+        return code;
+    switch (e) {
+    case ENOENT:
+        snprintf(err, errlen, "cannot create %s %s: folder %s does not exist", role, path, dir);
+        break;
+    case ENOTDIR:
+        snprintf(err, errlen, "cannot create %s %s: %s is not a folder", role, path, dir);
+        break;
+    case EACCES:
+    case EPERM:
+    case EROFS:
+        snprintf(err, errlen, "cannot create %s %s: folder %s is not writable (%s)", role, path,
+                 dir, strerror(e));
+        break;
+    case EISDIR:
+        snprintf(err, errlen, "cannot create %s %s: a folder has that name", role, path);
+        break;
+    default: /* not the folder's fault (no memory, no space): as every write error */
+        return set_errno_err(err, errlen, path, e);
+    }
+    return code;
+}
+
+int fdt_output_dir_check(const char *role, const char *path, char *err, size_t errlen)
+{
+    char dir[FDT_IO_PATH];
+    if (strlen(path) + 1 > sizeof dir) {
+        fdt_create_err(err, errlen, role, path, ENAMETOOLONG);
+        return ENAMETOOLONG;
+    }
+    folder_of(path, dir, sizeof dir);
+    struct stat st;
+    int e = 0;
+    if (stat(dir, &st) != 0)
+        e = errno;
+    else if (!S_ISDIR(st.st_mode))
+        e = ENOTDIR;
+    else if (access(dir, W_OK | X_OK) != 0)
+        e = errno;
+    else if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        e = EISDIR;
+    if (e)
+        fdt_create_err(err, errlen, role, path, e);
+    return e;
+}
+
+/* ------------------------------------------------------------------------ */
 /* Commit sets: the outputs of one run renamed together (issue 34 item 3)   */
 /* ------------------------------------------------------------------------ */
 
@@ -811,7 +879,7 @@ FILE *fdt_wr_side_open(const char *target, fdt_wr_side **side, char *err, size_t
     if (e) {
         free(*side);
         *side = NULL;
-        set_errno_err(err, errlen, target, e);
+        fdt_create_err(err, errlen, "output", target, e);
         return NULL;
     }
     /* The caller writes with stdio: the buffer of out_file is not used. */
@@ -1202,7 +1270,7 @@ static int write_parts(const fdt_format *f, char names[FDT_IO_MAX_FILES][FDT_IO_
         if (e) {
             for (int j = 0; j < i; j++)
                 out_abandon(&files[j]);
-            return set_errno_err(err, errlen, names[i], e);
+            return fdt_create_err(err, errlen, "output", names[i], e);
         }
         files[i].meter = meter;
         int r = f->put[i](&files[i], m, prep, err, errlen);
@@ -1241,7 +1309,7 @@ static int write_new_dir(const fdt_format *f, const char *path, const fdt_mesh_v
     memcpy(fdt_io_tmpdir + dirlen + 1, target + dirlen, len - dirlen);
     memcpy(fdt_io_tmpdir + len + 1, suffix, sizeof suffix);
     if (!mkdtemp(fdt_io_tmpdir))
-        return set_errno_err(err, errlen, path, errno);
+        return fdt_create_err(err, errlen, "output", path, errno);
     fdt_io_tmpdir_live = 1;
     int r = FDT_IO_OK;
     /* mkdtemp makes mode 0700: give it a plain mkdir's mode */

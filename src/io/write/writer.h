@@ -118,6 +118,23 @@ int fdt_output_files_as(const char *path, const fdt_format *f,
                         char names[FDT_IO_MAX_FILES][FDT_IO_PATH]);
 
 /*
+ * Creating a file at path (issue 34 item 8): its folder must exist, be a
+ * folder and be writable, and path must not be a folder. Returns 0, or
+ * an errno with "cannot create ROLE PATH: folder DIR does not exist" (or
+ * "...: DIR is not a folder", "folder DIR is not writable (...)", "a
+ * folder has that name") in err: a cheap early answer, so a doomed run
+ * fails in milliseconds rather than after the triangulation; the writer
+ * still checks every step for real. role names what the file is for
+ * ("output", "--stats-json file").
+ */
+int fdt_output_dir_check(const char *role, const char *path, char *err, size_t errlen);
+/* The same message for errno e met creating path, when the folder is
+ * why (ENOENT, ENOTDIR, EACCES, EPERM, EROFS, EISDIR); else "PATH:
+ * strerror" as every write error. Returns FDT_IO_EWRITE (FDT_IO_ENOMEM
+ * for ENOMEM). */
+int fdt_create_err(char *err, size_t errlen, const char *role, const char *path, int e);
+
+/*
  * Do paths a and b reach the same file? 1 if so, else 0. Each path stands
  * for the file that opening it would read or create, symbolic links
  * followed (a dangling link stands for the file it would create):

@@ -114,7 +114,7 @@ int fdt_stream_writer_open(fdt_stream_writer **wp, const char *path, const char 
         int e = fdt_out_open(&w->s.files[i], names[i]);
         if (e) {
             abandon_all(w);
-            rc = set_errno_err(diag, diag_size, names[i], e);
+            rc = fdt_create_err(diag, diag_size, "output", names[i], e);
             break;
         }
         w->s.nfiles = i + 1;
