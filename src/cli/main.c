@@ -508,8 +508,11 @@ static int parse_args(int argc, char **argv, cli *c)
             else
                 printf("frontdt %s (library %s)\n", FDT_VERSION_STRING,
                        fdt_version());
-            if (fflush(stdout) != 0) {
-                say("stdout: %s", strerror(errno));
+            /* a help longer than stdio's buffer meets the error in
+             * fprintf already: the stream's error flag keeps it (and
+             * errno its reason) */
+            if (fflush(stdout) != 0 || ferror(stdout)) {
+                say("stdout: %s", strerror(errno ? errno : EIO));
                 return CLI_WRITE;
             }
             return CLI_OK;
