@@ -9,7 +9,8 @@
 #
 # Covers: --help/--version, reading from a pipe and a FIFO, usage errors (exit 1), every hostile input
 # (its exit code and message, and no output or temporary file left), an
-# unknown output extension refused before any computation (exit 1), an
+# unknown output extension refused before any computation (exit 1),
+# --format against the extension (exit 1), --no-clobber (exit 5), an
 # output that would overwrite the input refused (exit 1, every output family
 # against every way of naming the input, the input's bytes unchanged), an
 # output directory that does not exist (exit 5, nothing left), write errors part-
@@ -359,6 +360,38 @@ run isdir "$FRONTDT" pts.xyz -o out/isdir.tets
 expect_rc isdir 5 && expect_in isdir err "cannot create output out/isdir.tets: a folder has that name"
 rmdir out/isdir.tets
 expect_empty_dir isdir out
+# Replacing an existing output (issue 34 item 6): allowed by default,
+# refused by --no-clobber before any work (exit 5, the file named, every
+# file as it was), for any file of a set and for --stats-json; a run
+# whose outputs are all new is not refused.
+printf 'old\n' >out/c.vtk
+run clob_default "$FRONTDT" pts.xyz -q -o out/c.vtk
+expect_rc clob_default 0
+grep -q '^old$' out/c.vtk && fail "clob_default: the existing out/c.vtk was not replaced"
+printf 'old\n' >out/c.vtk
+start=$(date +%s%N)
+run clob "$FRONTDT" --demo 3000000 --no-clobber -o out/new.vtu -o out/c.vtk
+end=$(date +%s%N)
+expect_rc clob 5 && expect_in clob err "output out/c.vtk exists; --no-clobber keeps it"
+ms=$(((end - start) / 1000000))
+[ "$ms" -lt 2000 ] || fail "--no-clobber took ${ms} ms: not refused up front"
+[ "$(cat out/c.vtk)" = old ] || fail "clob: out/c.vtk changed"
+[ ! -e out/new.vtu ] || fail "clob: out/new.vtu written"
+rm -f out/c.vtk
+printf 'old\n' >out/c.neigh
+run clob_set "$FRONTDT" pts.xyz --no-clobber -o out/c.ele
+expect_rc clob_set 5 && expect_in clob_set err "output out/c.neigh (written with -o out/c.ele) exists"
+[ "$(cat out/c.neigh)" = old ] || fail "clob_set: out/c.neigh changed"
+rm -f out/c.neigh
+printf '{}\n' >out/c.json
+run clob_json "$FRONTDT" pts.xyz --no-clobber --stats-json out/c.json
+expect_rc clob_json 5 && expect_in clob_json err "--stats-json file out/c.json exists"
+rm -f out/c.json
+run clob_new "$FRONTDT" pts.xyz -q --no-clobber -o out/c.ele --stats-json out/c.json
+expect_rc clob_new 0
+[ -s out/c.node ] && [ -s out/c.neigh ] && [ -s out/c.json ] || fail "clob_new: outputs missing"
+rm -f out/c.*
+expect_empty_dir clob out
 # --stats-json into a missing directory is refused up front as well.
 run jsondir "$FRONTDT" pts.xyz --stats-json out/no/stats.json
 expect_rc jsondir 5 &&

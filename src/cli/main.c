@@ -12,7 +12,8 @@
  *      NaN/Inf, fewer than 4 distinct points, all points coplanar
  *   3  --check found the mesh is not the Delaunay tetrahedralization
  *   4  out of resources: memory, index range, threads
- *   5  cannot write the output
+ *   5  cannot write the output (also an output that exists, with
+ *      --no-clobber)
  *   6  interrupted by SIGINT or SIGTERM (no temporary file left, every
  *      output as before the run: the outputs are renamed all together at
  *      the end, fdt_wr_set_commit)
@@ -80,6 +81,7 @@ typedef struct cli {
     fdt_search search;
     int threads;            /* -1: the library's default */
     int pin, check, stats, hash, set_hash, quiet;
+    int no_clobber;         /* --no-clobber: refuse to replace any output */
     int stream;             /* --stream 1, --no-stream -1, else 0: when
                                every output can (stream_refusal) */
     unsigned long long memory_limit; /* --memory-limit bytes; 0: none */
@@ -104,7 +106,11 @@ static void usage(FILE *f)
         "\n"
         "Options:\n"
         "  -o, --output FILE      write the mesh (format by extension); may be\n"
-        "                         given up to %d times; '-': standard output\n"
+        "                         given up to %d times; '-': standard output.\n"
+        "                         An existing output is replaced (as TetGen and\n"
+        "                         gmsh do); an input never is (exit 1)\n"
+        "      --no-clobber       refuse (exit 5, before any work) when any\n"
+        "                         output file exists (.node of -o m.ele too)\n"
         "      --format NAME      format of the next -o (of the last -o when\n"
         "                         none follows): tets, tetgen, vtu, bin, vtk, msh,\n"
         "                         msh2, medit, openfoam; an -o whose extension\n"
@@ -151,7 +157,7 @@ static void usage(FILE *f)
         "  0 success             1 usage error (also '-' without --input-format,\n"
         "                          --columns for .node/.ply)   2 bad input\n"
         "  3 --check failed      4 out of resources (also over --memory-limit)\n"
-        "  5 cannot write output\n"
+        "  5 cannot write output (also --no-clobber)\n"
         "  6 interrupted (every output left as it was)\n"
         "  7 internal error\n"
         "Outputs are all or none: each is written to a temporary file, and only\n"
@@ -253,7 +259,7 @@ enum {
     OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH, OPT_SET_HASH,
     OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
     OPT_DELIMITER, OPT_DECIMAL_COMMA,
-    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT
+    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT, OPT_NO_CLOBBER
 };
 
 static const struct option long_opts[] = {
@@ -279,6 +285,7 @@ static const struct option long_opts[] = {
     { "stream", no_argument, NULL, OPT_STREAM },
     { "no-stream", no_argument, NULL, OPT_NO_STREAM },
     { "memory-limit", required_argument, NULL, OPT_MEMORY_LIMIT },
+    { "no-clobber", no_argument, NULL, OPT_NO_CLOBBER },
     { "help", no_argument, NULL, 'h' },
     { "version", no_argument, NULL, 'V' },
     { NULL, 0, NULL, 0 },
@@ -487,6 +494,9 @@ static int parse_args(int argc, char **argv, cli *c)
         case OPT_PROGRESS:
             c->progress = 1;
             break;
+        case OPT_NO_CLOBBER:
+            c->no_clobber = 1;
+            break;
         case OPT_MEMORY_LIMIT:
             if (parse_bytes(optarg, &c->memory_limit) != 0)
                 return usage_error("--memory-limit wants a byte count > 0 (suffix K, M or G), "
@@ -609,6 +619,31 @@ static int refuse_overwrites(const cli *c, const char *output, char names[][FDT_
     if (json && in && fdt_same_file(json, in)) {
         say("--stats-json file %s would overwrite the input %s", json, in);
         return CLI_USAGE;
+    }
+    return -1;
+}
+
+/*
+ * --no-clobber: refuses, before anything is read, an output any of whose
+ * files (names[0..k), so "-o m.ele" covers m.node too) exists, a
+ * dangling symbolic link included (the rename would replace the link).
+ * Returns -1 to go on, or CLI_WRITE after naming the file. The commit
+ * checks again before it renames (fdt_wr_set_begin).
+ */
+static int refuse_clobber(const cli *c, const char *output, char names[][FDT_IO_PATH], int k)
+{
+    if (!c->no_clobber)
+        return -1;
+    for (int i = 0; i < k; i++) {
+        struct stat st;
+        if (lstat(names[i], &st) != 0)
+            continue;
+        if (strcmp(names[i], output) != 0)
+            say("output %s (written with -o %s) exists; --no-clobber keeps it", names[i],
+                output);
+        else
+            say("output %s exists; --no-clobber keeps it", names[i]);
+        return CLI_WRITE;
     }
     return -1;
 }
@@ -1138,6 +1173,9 @@ static int run(const cli *c)
         code = refuse_overwrites(c, out, names, n_names);
         if (code >= 0)
             return code;
+        code = refuse_clobber(c, out, names, n_names);
+        if (code >= 0)
+            return code;
         for (int p = 0; p < o; p++) {
             if (!strcmp(c->outputs[p], "-"))
                 continue;
@@ -1177,6 +1215,13 @@ static int run(const cli *c)
     code = CLI_OK;
     if (c->stats_json && !json_stdout && !output_dir_ok("--stats-json file", c->stats_json))
         return CLI_WRITE;
+    /* a device or a pipe is written in place, not replaced (below) */
+    struct stat jst0;
+    if (c->no_clobber && c->stats_json && !json_stdout && lstat(c->stats_json, &jst0) == 0 &&
+        (stat(c->stats_json, &jst0) != 0 || S_ISREG(jst0.st_mode))) {
+        say("--stats-json file %s exists; --no-clobber keeps it", c->stats_json);
+        return CLI_WRITE;
+    }
     /* the summary goes to stderr when the mesh goes to stdout */
     if (to_stdout)
         info = stderr;
@@ -1184,7 +1229,7 @@ static int run(const cli *c)
      * --stats-json file) waits complete in its temporary until all are,
      * then all are renamed together (fdt_wr_set_commit, below): all new,
      * or, after any failure or signal, all as they were. */
-    if (fdt_wr_set_begin(0) != 0) {
+    if (fdt_wr_set_begin(c->no_clobber) != 0) {
         say("internal error: a commit set is already open");
         return CLI_INTERNAL;
     }
