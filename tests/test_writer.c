@@ -12,7 +12,8 @@
  * The side files (fdt_wr_side_*), a mesh whose arrays are missing, a
  * polyMesh over a regular file, and text written to a stream that fails
  * (/dev/full) or is refused (binary formats): each refused with its code
- * and a message naming the file, nothing left behind.
+ * and a message naming the file, nothing left behind. Commit sets: the
+ * outputs of one run renamed together or not at all.
  * src/io/write/outfile.h's buffer on its own, over pipes, where a seek or a pwrite
  * fails (ESPIPE) and a write fails in stdio's flush or in ours (EPIPE,
  * the reader gone): the first errno is kept, nothing more is written, and
@@ -1358,6 +1359,103 @@ static void test_outfile(const char *dir)
     EXPECT(set_err(NULL, 0, FDT_IO_EFORMAT, "x", "y") == FDT_IO_EFORMAT);
 }
 
+/* Commit sets (issue 34 item 3): outputs written in a set stay in their
+ * temporaries until fdt_wr_set_commit renames them all; abandoned, a
+ * --no-clobber refusal, or a failure at any step of the commit
+ * (FDT_TEST_COMMIT_FAULT) leaves every old file as it was, and nothing
+ * else in the folder. */
+static int same_bytes(const char *path, const char *want, size_t wlen)
+{
+    size_t len;
+    char *got = slurp(path, &len);
+    int same = got && len == wlen && memcmp(got, want, len) == 0;
+    free(got);
+    return same;
+}
+
+static void test_commit_set(const char *dir)
+{
+    mesh m;
+    make_mesh(&m);
+    fdt_mesh_view v = view_of(&m), old = v;
+    old.n_tets = NT - 1; /* the previous run's mesh: other bytes */
+    old.nbrs = NULL;     /* (they would name the tet left out) */
+    char a[4096], b[4096], err[8192];
+    snprintf(a, sizeof a, "%s/a.vtk", dir);
+    snprintf(b, sizeof b, "%s/a.msh", dir);
+    size_t la = 0, lb = 0, na = 0, nb = 0;
+    char *olda, *oldb, *newa, *newb;
+    /* the new and the old bytes */
+    EXPECT(fdt_wr_mesh(a, &v, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_mesh(b, &v, err, sizeof err) == FDT_IO_OK);
+    newa = slurp(a, &na);
+    newb = slurp(b, &nb);
+    EXPECT(fdt_wr_mesh(a, &old, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_mesh(b, &old, err, sizeof err) == FDT_IO_OK);
+    olda = slurp(a, &la);
+    oldb = slurp(b, &lb);
+    CHECK(newa && newb && olda && oldb);
+    EXPECT(la != na || memcmp(olda, newa, la) != 0);
+
+    /* committed: nothing changes before the commit, all after it */
+    EXPECT(fdt_wr_set_begin(0) == 0 && fdt_wr_set_active());
+    EXPECT(fdt_wr_set_begin(0) == -1); /* one at a time */
+    EXPECT(fdt_wr_mesh(a, &v, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_mesh(b, &v, err, sizeof err) == FDT_IO_OK);
+    EXPECT(same_bytes(a, olda, la) && same_bytes(b, oldb, lb));
+    EXPECT(count_temps(dir) == 2);
+    EXPECT(fdt_wr_set_commit(err, sizeof err) == FDT_IO_OK && !fdt_wr_set_active());
+    EXPECT(same_bytes(a, newa, na) && same_bytes(b, newb, nb));
+    EXPECT(count_entries(dir) == 2); /* no temporary, backup or journal */
+
+    /* abandoned: the old files stay, the temporaries go */
+    EXPECT(fdt_wr_mesh(a, &old, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_mesh(b, &old, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_set_begin(0) == 0);
+    EXPECT(fdt_wr_mesh(a, &v, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_mesh(b, &v, err, sizeof err) == FDT_IO_OK);
+    fdt_wr_set_abandon();
+    EXPECT(!fdt_wr_set_active());
+    EXPECT(same_bytes(a, olda, la) && same_bytes(b, oldb, lb) && count_entries(dir) == 2);
+
+    /* --no-clobber: the commit refuses an existing target, changes nothing */
+    EXPECT(fdt_wr_set_begin(1) == 0);
+    EXPECT(fdt_wr_mesh(a, &v, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_set_commit(err, sizeof err) == FDT_IO_EWRITE);
+    EXPECTF(strstr(err, "a.vtk: exists (--no-clobber)") != NULL, "[%s]", err);
+    EXPECT(same_bytes(a, olda, la) && count_entries(dir) == 2);
+
+    /* a failure at every step: two backups, the journal, two renames, the
+     * commit point; after it (step 7) the commit is done */
+    for (int k = 1; k <= 8; k++) {
+        char fault[32];
+        snprintf(fault, sizeof fault, "%d:fail", k);
+        EXPECT(fdt_wr_set_begin(0) == 0);
+        EXPECT(fdt_wr_mesh(a, &v, err, sizeof err) == FDT_IO_OK);
+        EXPECT(fdt_wr_mesh(b, &v, err, sizeof err) == FDT_IO_OK);
+        setenv("FDT_TEST_COMMIT_FAULT", fault, 1);
+        int r = fdt_wr_set_commit(err, sizeof err);
+        unsetenv("FDT_TEST_COMMIT_FAULT");
+        if (k <= 6) {
+            EXPECTF(r == FDT_IO_EWRITE && strstr(err, "every output left as it was"),
+                    "step %d: %d [%s]", k, r, err);
+            EXPECTF(same_bytes(a, olda, la) && same_bytes(b, oldb, lb), "step %d", k);
+        } else {
+            EXPECTF(r == FDT_IO_OK, "step %d: %d [%s]", k, r, err);
+            EXPECTF(same_bytes(a, newa, na) && same_bytes(b, newb, nb), "step %d", k);
+            EXPECT(fdt_wr_mesh(a, &old, err, sizeof err) == FDT_IO_OK);
+            EXPECT(fdt_wr_mesh(b, &old, err, sizeof err) == FDT_IO_OK);
+        }
+        EXPECTF(count_entries(dir) == 2, "step %d: %d entries", k, count_entries(dir));
+    }
+    unlink(a);
+    unlink(b);
+    free(olda);
+    free(oldb);
+    free(newa);
+    free(newb);
+}
+
 int main(void)
 {
     const char *tmp = getenv("TMPDIR");
@@ -1370,12 +1468,13 @@ int main(void)
     }
     char sub[4096];
     const char *names[] = { "small", "refuse", "ids", "large", "files",
-                            "same", "table", "outfile", "misc" };
+                            "same", "table", "outfile", "misc", "commit" };
     void (*fns[])(const char *) = { test_small_mesh, test_refusals,
                                     test_big_ids, test_large,
                                     test_output_files, test_same_file,
-                                    test_format_table, test_outfile, test_misc };
-    for (int i = 0; i < 9; i++) {
+                                    test_format_table, test_outfile, test_misc,
+                                    test_commit_set };
+    for (int i = 0; i < 10; i++) {
         snprintf(sub, sizeof sub, "%s/%s", dir, names[i]);
         mkdir(sub, 0755);
         long before = test_failures();
