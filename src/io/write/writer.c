@@ -6,9 +6,10 @@
  *
  * Every file goes to a temporary ".NAME.tmp.XXXXXX" beside its target and
  * is renamed over the target only once every byte of it (and, for TetGen,
- * of all four files) has been written and closed without error. So a
- * failed, full-disk or interrupted run never leaves a truncated mesh that
- * a later stage could mistake for a complete one.
+ * of all four files; in a commit set, of every output of the run) has
+ * been written and closed without error. So a failed, full-disk or
+ * interrupted run never leaves a truncated mesh that a later stage could
+ * mistake for a complete one, nor (in a set) a mix of new and old outputs.
  *
  * Output goes through our own large buffer (src/io/write/outfile.h) and is handed
  * to stdio in big chunks. Every fwrite/fflush/fclose result is checked and
