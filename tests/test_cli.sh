@@ -9,13 +9,16 @@
 #
 # Covers: --help/--version, reading from a pipe and a FIFO, usage errors (exit 1), every hostile input
 # (its exit code and message, and no output or temporary file left), an
-# unknown output extension refused before any computation (exit 1), an
+# unknown output extension refused before any computation (exit 1),
+# --format against the extension (exit 1), --no-clobber (exit 5), an
 # output that would overwrite the input refused (exit 1, every output family
 # against every way of naming the input, the input's bytes unchanged), an
 # output directory that does not exist (exit 5, nothing left), write errors part-
 # way (file size limit, in the middle of a TetGen set too, /dev/full: exit
 # 5, nothing left), SIGTERM and SIGINT
-# during a long run and during the write (exit 6, nothing left), --demo,
+# during a long run and during the write (exit 6, nothing left), several
+# outputs all or none (SIGINT during the second; a failure or signal at
+# every step of the final commit: all old or all new), --demo,
 # repeatability (byte-identical .tets, identical --hash), independence of
 # input order (shuffled copy mapped back), --check, --stats/--stats-json,
 # duplicate reporting, --pin refused (said once), every output format;
@@ -120,6 +123,22 @@ usage_case u_o_nine "-o given more than 8 times" pts.xyz -o a1.tets -o a2.tets -
 usage_case u_demo_format "need an input file, not --demo" --demo 100 --input-format xyz
 usage_case u_two_stdout "both want standard output" pts.xyz -o - --stats-json -
 usage_case u_stdout_tetgen "cannot go to standard output" pts.xyz -o - --format tetgen
+# --format against the output's extension (issue 34 item 5): refused when
+# it names another format, before anything is written; fine when they
+# agree (msh2 and msh share .msh) or the name has no known extension
+usage_case u_format_ext "--format msh2 contradicts the extension of m.vtu (vtu)" pts.xyz \
+    -o m.msh -o m22.msh --format msh2 -o m.vtu
+[ ! -e m.msh ] && [ ! -e m22.msh ] && [ ! -e m.vtu ] || fail "u_format_ext wrote an output"
+usage_case u_format_ext2 "--format vtk contradicts the extension of m.ele (tetgen)" pts.xyz \
+    -o m.ele --format vtk
+for ok in "-o f22.msh --format msh2" "-o f.ele --format tetgen" "-o f.dat --format vtk" \
+    "-o f.vtk --format vtk"; do
+    # shellcheck disable=SC2086 # the words of each case
+    run format_ok "$FRONTDT" pts.xyz -q $ok
+    expect_rc format_ok 0
+done
+[ -s f22.msh ] && [ -s f.ele ] && [ -s f.dat ] && [ -s f.vtk ] || fail "format_ok: an output is missing"
+rm -f f22.msh f.node f.ele f.face f.neigh f.dat f.vtk
 # --help and --version that cannot be written: exit 5, the reason said.
 run help_full bash -c '"$1" --help >/dev/full' _ "$FRONTDT"
 expect_rc help_full 5 && expect_in help_full err "stdout:"
@@ -312,29 +331,71 @@ expect_empty_dir ext out
 start=$(date +%s%N)
 run nodir "$FRONTDT" --demo 3000000 -o out/no/such/dir/mesh.tets
 end=$(date +%s%N)
-expect_rc nodir 5 && expect_in nodir err "out/no/such/dir/mesh.tets: "
+expect_rc nodir 5 &&
+    expect_in nodir err "cannot create output out/no/such/dir/mesh.tets: folder out/no/such/dir does not exist"
 ms=$(((end - start) / 1000000))
 [ "$ms" -lt 2000 ] || fail "missing output directory took ${ms} ms: not refused up front"
 expect_empty_dir nodir out
 # ... also for a normal input file, and a TetGen set.
 run nodir2 "$FRONTDT" pts.xyz -o out/nodir/mesh.ele
-expect_rc nodir2 5
+expect_rc nodir2 5 && expect_in nodir2 err "cannot create output out/nodir/mesh.ele: folder out/nodir does not exist"
 expect_empty_dir nodir2 out
+# ... and a polyMesh whose case has no constant/ (issue 34 item 8: the
+# message names the output's role and the missing folder)
+mkdir out/case
+run nodir3 "$FRONTDT" pts.xyz -o out/case/constant/polyMesh
+expect_rc nodir3 5 &&
+    expect_in nodir3 err "cannot create output out/case/constant/polyMesh: folder out/case/constant does not exist"
+rmdir out/case
+expect_empty_dir nodir3 out
 # A regular file in place of the directory.
 touch out/plain
 run notdir "$FRONTDT" pts.xyz -o out/plain/mesh.vtu
-expect_rc notdir 5 && expect_in notdir err "out/plain/mesh.vtu: "
+expect_rc notdir 5 && expect_in notdir err "cannot create output out/plain/mesh.vtu: out/plain is not a folder"
 rm -f out/plain
 expect_empty_dir notdir out
 # The output is a directory.
 mkdir out/isdir.tets
 run isdir "$FRONTDT" pts.xyz -o out/isdir.tets
-expect_rc isdir 5
+expect_rc isdir 5 && expect_in isdir err "cannot create output out/isdir.tets: a folder has that name"
 rmdir out/isdir.tets
 expect_empty_dir isdir out
+# Replacing an existing output (issue 34 item 6): allowed by default,
+# refused by --no-clobber before any work (exit 5, the file named, every
+# file as it was), for any file of a set and for --stats-json; a run
+# whose outputs are all new is not refused.
+printf 'old\n' >out/c.vtk
+run clob_default "$FRONTDT" pts.xyz -q -o out/c.vtk
+expect_rc clob_default 0
+grep -q '^old$' out/c.vtk && fail "clob_default: the existing out/c.vtk was not replaced"
+printf 'old\n' >out/c.vtk
+start=$(date +%s%N)
+run clob "$FRONTDT" --demo 3000000 --no-clobber -o out/new.vtu -o out/c.vtk
+end=$(date +%s%N)
+expect_rc clob 5 && expect_in clob err "output out/c.vtk exists; --no-clobber keeps it"
+ms=$(((end - start) / 1000000))
+[ "$ms" -lt 2000 ] || fail "--no-clobber took ${ms} ms: not refused up front"
+[ "$(cat out/c.vtk)" = old ] || fail "clob: out/c.vtk changed"
+[ ! -e out/new.vtu ] || fail "clob: out/new.vtu written"
+rm -f out/c.vtk
+printf 'old\n' >out/c.neigh
+run clob_set "$FRONTDT" pts.xyz --no-clobber -o out/c.ele
+expect_rc clob_set 5 && expect_in clob_set err "output out/c.neigh (written with -o out/c.ele) exists"
+[ "$(cat out/c.neigh)" = old ] || fail "clob_set: out/c.neigh changed"
+rm -f out/c.neigh
+printf '{}\n' >out/c.json
+run clob_json "$FRONTDT" pts.xyz --no-clobber --stats-json out/c.json
+expect_rc clob_json 5 && expect_in clob_json err "--stats-json file out/c.json exists"
+rm -f out/c.json
+run clob_new "$FRONTDT" pts.xyz -q --no-clobber -o out/c.ele --stats-json out/c.json
+expect_rc clob_new 0
+[ -s out/c.node ] && [ -s out/c.neigh ] && [ -s out/c.json ] || fail "clob_new: outputs missing"
+rm -f out/c.*
+expect_empty_dir clob out
 # --stats-json into a missing directory is refused up front as well.
 run jsondir "$FRONTDT" pts.xyz --stats-json out/no/stats.json
-expect_rc jsondir 5
+expect_rc jsondir 5 &&
+    expect_in jsondir err "cannot create --stats-json file out/no/stats.json: folder out/no does not exist"
 expect_empty_dir jsondir out
 
 # ---------------------------------------------------------------------------
@@ -853,7 +914,108 @@ for target in big.ele big.vtk; do
     fi
     expect_empty_dir "SIGTERM while writing $target" out
 done
+
+# All-or-none outputs (issue 34 item 3). SIGINT while the second of four
+# outputs is written: every old output must still be there, unchanged
+# (the first one was already replaced before).
+rm -rf out && mkdir out
+"$FRONTDT" --demo 3000 -q -o out/x.msh -o out/x.vtk -o out/x.mesh -o out/x.ele ||
+    fail "all-or-none: the old outputs were not written"
+mkdir -p aon_old && cp -p out/x.* aon_old/
+"$FRONTDT" --demo 200000 --quiet -o out/x.msh -o out/x.vtk -o out/x.mesh -o out/x.ele \
+    >sig.out 2>sig.err &
+pid=$!
+seen=0
+while kill -0 "$pid" 2>/dev/null; do
+    if compgen -G "out/.x.vtk.tmp.*" >/dev/null; then
+        seen=1
+        kill -INT "$pid"
+        break
+    fi
+    sleep 0.01
+done
+wait "$pid"
+RC=$?
+if [ "$seen" = 1 ]; then
+    [ "$RC" = 6 ] || fail "SIGINT while writing the second output: exit $RC, want 6"
+    for f in aon_old/x.*; do
+        cmp -s "$f" "out/${f#aon_old/}" ||
+            fail "SIGINT while writing the second output: out/${f#aon_old/} was replaced"
+    done
+    left=$(cd out && ls -A | tr '\n' ' ')
+    [ "$left" = "x.ele x.face x.mesh x.msh x.neigh x.node x.vtk " ] ||
+        fail "SIGINT while writing the second output left: $left"
+else
+    fail "all-or-none: the write (exit $RC) finished before the second output began"
+fi
+rm -rf aon_old out
 set +m
+
+# Every step of the final commit (FDT_TEST_COMMIT_FAULT=K:fail|signal,
+# src/io/write/writer.c: each backup link, the journal, each rename, the
+# commit point and the step after it) fails or is interrupted in turn;
+# afterwards every output is either the old one or the new one, all
+# alike (byte for byte against a run without a fault), and the folders
+# hold nothing else: no temporary, backup or journal.
+# aon_check NAME ARGS...: old outputs in aon_seed (made by the caller),
+# the new ones by ARGS in aon_new; each fault in a copy of aon_seed.
+aon_list() { (cd "$1" && find . -mindepth 1 | LC_ALL=C sort | tr '\n' ' '); }
+aon_same() { # DIR_A DIR_B: same names, same bytes (stats.json: names only)
+    [ "$(aon_list "$1")" = "$(aon_list "$2")" ] || return 1
+    local f
+    while read -r f; do
+        case $f in *stats.json) continue ;; esac
+        [ -d "$1/$f" ] || cmp -s "$1/$f" "$2/$f" || return 1
+    done < <(cd "$1" && find . -mindepth 1 -type f)
+    return 0
+}
+aon_check() {
+    local name=$1 how k word reached=0
+    shift
+    rm -rf aon_new && cp -a aon_seed aon_new
+    (cd aon_new && "$FRONTDT" "$@" >/dev/null 2>&1) || fail "$name: the run without a fault failed"
+    for how in fail signal; do
+        for k in $(seq 1 80); do
+            rm -rf aon_run && cp -a aon_seed aon_run
+            (cd aon_run && FDT_TEST_COMMIT_FAULT=$k:$how "$FRONTDT" "$@" >../aon.out 2>../aon.err)
+            RC=$?
+            word=$(sed -n 's/^frontdt: test fault ([a-z]*) at commit step [0-9]*: //p' aon.err)
+            if [ -z "$word" ]; then
+                [ "$RC" = 0 ] || fail "$name: no fault at step $k, yet exit $RC: $(head -c 300 aon.err)"
+                aon_same aon_run aon_new || fail "$name: a run past every step did not write the new outputs"
+                break
+            fi
+            reached=$((reached + 1))
+            if [ "$word" = committed ]; then
+                # after the commit point: all new (a signal still exits 6)
+                [ "$RC" = "$([ $how = fail ] && echo 0 || echo 6)" ] ||
+                    fail "$name: $how after the commit point: exit $RC"
+                aon_same aon_run aon_new ||
+                    fail "$name: $how after the commit point: not every output is new: $(aon_list aon_run)"
+            else
+                [ "$RC" = "$([ $how = fail ] && echo 5 || echo 6)" ] ||
+                    fail "$name: $how at commit step $k ($word): exit $RC: $(head -c 300 aon.err)"
+                aon_same aon_run aon_seed ||
+                    fail "$name: $how at commit step $k ($word): not every output is the old one: $(aon_list aon_run)"
+            fi
+        done
+    done
+    # each mode reaches the backups, the journal, the renames and the commit
+    [ "$reached" -ge 10 ] || fail "$name: only $reached commit steps were reached"
+    rm -rf aon_run aon_new aon.out aon.err
+}
+rm -rf aon_seed && mkdir -p aon_seed/p aon_seed/q
+(cd aon_seed && "$FRONTDT" --demo 1500 -q --mode serial -o x.msh -o x.vtk -o x.mesh -o x.ele \
+    -o q/polyMesh --stats-json stats.json) || fail "all-or-none: the old outputs were not written"
+aon_check aon_memory --demo 1600 -q --mode serial -o x.msh -o x.vtk -o x.mesh -o x.ele \
+    -o p/polyMesh -o q/polyMesh --stats-json stats.json
+# streamed outputs go through the same commit; the stale .neigh beside a
+# streamed TetGen set is removed with it
+rm -rf aon_seed && mkdir aon_seed
+(cd aon_seed && "$FRONTDT" --demo 1500 -q --mode serial -o y.vtu -o y.ele) ||
+    fail "all-or-none: the old streamed outputs were not written"
+aon_check aon_stream --demo 1600 -q --mode serial --stream -o y.vtu -o y.ele -o y.fdtb
+rm -rf aon_seed
 
 # --stream (issue 18): the streamed mesh's set hash equals the in-memory
 # run's in every mode; what a stream cannot do is refused; --memory-limit

@@ -612,6 +612,9 @@ static void test_write_errors(void)
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("nodir/m.vtu"), NULL, diag, sizeof diag),
              FDT_EIO);
     CHECK(strstr(diag, "nodir/m.vtu") != NULL);
+    /* the message says what is missing (issue 34 item 8) */
+    CHECK(strstr(diag, "cannot create output ") != NULL &&
+          strstr(diag, "nodir does not exist") != NULL);
     /* a regular file where a directory should be */
     put_file(at("plain"), "x");
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("plain/m.msh"), NULL, diag, sizeof diag),

@@ -12,7 +12,8 @@
  * The side files (fdt_wr_side_*), a mesh whose arrays are missing, a
  * polyMesh over a regular file, and text written to a stream that fails
  * (/dev/full) or is refused (binary formats): each refused with its code
- * and a message naming the file, nothing left behind.
+ * and a message naming the file, nothing left behind. Commit sets: the
+ * outputs of one run renamed together or not at all.
  * src/io/write/outfile.h's buffer on its own, over pipes, where a seek or a pwrite
  * fails (ESPIPE) and a write fails in stdio's flush or in ours (EPIPE,
  * the reader gone): the first errno is kept, nothing more is written, and
@@ -731,12 +732,14 @@ static void test_refusals(const char *dir)
     snprintf(p, sizeof p, "%s/.tets", dir);
     expect_fail(dir, p, &v, FDT_IO_EEXT, "unknown output format");
 
-    /* Missing directory. */
+    /* Missing directory: the message says which folder is missing (issue
+     * 34 item 8). */
     snprintf(p, sizeof p, "%s/no/such/dir/out.tets", dir);
-    snprintf(q, sizeof q, "%s: %s", p, strerror(ENOENT));
+    snprintf(q, sizeof q, "cannot create output %s: folder %s/no/such/dir does not exist", p,
+             dir);
     expect_fail(dir, p, &v, FDT_IO_EWRITE, q);
     snprintf(p, sizeof p, "%s/no/such/dir/out.ele", dir);
-    expect_fail(dir, p, &v, FDT_IO_EWRITE, strerror(ENOENT));
+    expect_fail(dir, p, &v, FDT_IO_EWRITE, "/no/such/dir does not exist");
 
     /* A regular file where the directory should be (fails even as root). */
     snprintf(q, sizeof q, "%s/plain", dir);
@@ -744,7 +747,7 @@ static void test_refusals(const char *dir)
     fputs("x\n", f);
     fclose(f);
     snprintf(p, sizeof p, "%s/plain/out.vtu", dir);
-    expect_fail(dir, p, &v, FDT_IO_EWRITE, strerror(ENOTDIR));
+    expect_fail(dir, p, &v, FDT_IO_EWRITE, "/plain is not a folder");
 
     /* The target is a directory. */
     snprintf(p, sizeof p, "%s/isdir.vtk", dir);
@@ -1057,7 +1060,19 @@ static void test_format_table(const char *dir)
     EXPECT(fdt_format_by_path("polyMesh") == foam);
     EXPECT(fdt_format_by_path("case/xpolyMesh") == NULL);
     EXPECT(fdt_format_by_path("case/polyMes") == NULL);
-    EXPECT(fdt_format_by_path("m.msh") != msh2); /* msh2 has no extension */
+    EXPECT(fdt_format_by_path("m.msh") != msh2); /* .msh chooses msh, the first row */
+    /* --format against the extension (issue 34 item 5): the row the
+     * extension names when it is another; NULL when it agrees or names
+     * none */
+    EXPECT(fdt_format_contradicted("m.vtu", msh2) == vtu);
+    EXPECT(fdt_format_contradicted("m.msh", msh2) == NULL);
+    EXPECT(fdt_format_contradicted("m.MSH", msh2) == NULL);
+    EXPECT(fdt_format_contradicted("m.ele", tg) == NULL);
+    EXPECT(fdt_format_contradicted("m.dat", vtu) == NULL);
+    EXPECT(fdt_format_contradicted("m", foam) == NULL);
+    EXPECT(fdt_format_contradicted("case/polyMesh", vtu) == foam);
+    EXPECT(fdt_format_contradicted("m.ele", vtk) == tg);
+    EXPECT(fdt_format_contradicted("m.vtu", NULL) == NULL);
     EXPECT(fdt_format_is_text(tets) && !fdt_format_is_text(vtu) && !fdt_format_is_text(NULL));
     /* all_faces adds the faces to TetGen's set alone */
     EXPECT(fdt_format_needs(NULL, 1) == 0);
@@ -1066,7 +1081,7 @@ static void test_format_table(const char *dir)
     EXPECT(fdt_format_needs(vtk, 1) == fdt_format_needs(vtk, 0));
     const char *list = fdt_format_list();
     EXPECTF(strstr(list, "tets (.tets)") && strstr(list, "openfoam (polyMesh)") &&
-                strstr(list, ", msh2, ") && strstr(list, "tetgen (.ele)"),
+                strstr(list, ", msh2 (.msh), ") && strstr(list, "tetgen (.ele)"),
             "[%s]", list);
     EXPECT(fdt_format_list() == list); /* built once */
 
@@ -1101,7 +1116,7 @@ static void test_misc(const char *dir)
      * directory: NULL, the reason, nothing created */
     snprintf(p, sizeof p, "%s/", dir);
     EXPECT(fdt_wr_side_open(p, &side, err, sizeof err) == NULL && side == NULL &&
-           strstr(err, strerror(EISDIR)));
+           strstr(err, "a folder has that name"));
     static char longp[FDT_IO_PATH + 8];
     memset(longp, 'x', sizeof longp - 1);
     static char lerr[FDT_IO_PATH + 256]; /* the message holds the path */
@@ -1109,7 +1124,7 @@ static void test_misc(const char *dir)
            strstr(lerr, strerror(ENAMETOOLONG)));
     snprintf(p, sizeof p, "%s/no/side.json", dir);
     EXPECT(fdt_wr_side_open(p, &side, err, sizeof err) == NULL &&
-           strstr(err, "no/side.json: ") && strstr(err, strerror(ENOENT)));
+           strstr(err, "no/side.json: folder ") && strstr(err, "/no does not exist"));
     fdt_wr_side_abandon(NULL);
     snprintf(p, sizeof p, "%s/side.json", dir);
     FILE *f = fdt_wr_side_open(p, &side, err, sizeof err);
@@ -1344,6 +1359,103 @@ static void test_outfile(const char *dir)
     EXPECT(set_err(NULL, 0, FDT_IO_EFORMAT, "x", "y") == FDT_IO_EFORMAT);
 }
 
+/* Commit sets (issue 34 item 3): outputs written in a set stay in their
+ * temporaries until fdt_wr_set_commit renames them all; abandoned, a
+ * --no-clobber refusal, or a failure at any step of the commit
+ * (FDT_TEST_COMMIT_FAULT) leaves every old file as it was, and nothing
+ * else in the folder. */
+static int same_bytes(const char *path, const char *want, size_t wlen)
+{
+    size_t len;
+    char *got = slurp(path, &len);
+    int same = got && len == wlen && memcmp(got, want, len) == 0;
+    free(got);
+    return same;
+}
+
+static void test_commit_set(const char *dir)
+{
+    mesh m;
+    make_mesh(&m);
+    fdt_mesh_view v = view_of(&m), old = v;
+    old.n_tets = NT - 1; /* the previous run's mesh: other bytes */
+    old.nbrs = NULL;     /* (they would name the tet left out) */
+    char a[4096], b[4096], err[8192];
+    snprintf(a, sizeof a, "%s/a.vtk", dir);
+    snprintf(b, sizeof b, "%s/a.msh", dir);
+    size_t la = 0, lb = 0, na = 0, nb = 0;
+    char *olda, *oldb, *newa, *newb;
+    /* the new and the old bytes */
+    EXPECT(fdt_wr_mesh(a, &v, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_mesh(b, &v, err, sizeof err) == FDT_IO_OK);
+    newa = slurp(a, &na);
+    newb = slurp(b, &nb);
+    EXPECT(fdt_wr_mesh(a, &old, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_mesh(b, &old, err, sizeof err) == FDT_IO_OK);
+    olda = slurp(a, &la);
+    oldb = slurp(b, &lb);
+    CHECK(newa && newb && olda && oldb);
+    EXPECT(la != na || memcmp(olda, newa, la) != 0);
+
+    /* committed: nothing changes before the commit, all after it */
+    EXPECT(fdt_wr_set_begin(0) == 0 && fdt_wr_set_active());
+    EXPECT(fdt_wr_set_begin(0) == -1); /* one at a time */
+    EXPECT(fdt_wr_mesh(a, &v, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_mesh(b, &v, err, sizeof err) == FDT_IO_OK);
+    EXPECT(same_bytes(a, olda, la) && same_bytes(b, oldb, lb));
+    EXPECT(count_temps(dir) == 2);
+    EXPECT(fdt_wr_set_commit(err, sizeof err) == FDT_IO_OK && !fdt_wr_set_active());
+    EXPECT(same_bytes(a, newa, na) && same_bytes(b, newb, nb));
+    EXPECT(count_entries(dir) == 2); /* no temporary, backup or journal */
+
+    /* abandoned: the old files stay, the temporaries go */
+    EXPECT(fdt_wr_mesh(a, &old, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_mesh(b, &old, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_set_begin(0) == 0);
+    EXPECT(fdt_wr_mesh(a, &v, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_mesh(b, &v, err, sizeof err) == FDT_IO_OK);
+    fdt_wr_set_abandon();
+    EXPECT(!fdt_wr_set_active());
+    EXPECT(same_bytes(a, olda, la) && same_bytes(b, oldb, lb) && count_entries(dir) == 2);
+
+    /* --no-clobber: the commit refuses an existing target, changes nothing */
+    EXPECT(fdt_wr_set_begin(1) == 0);
+    EXPECT(fdt_wr_mesh(a, &v, err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_set_commit(err, sizeof err) == FDT_IO_EWRITE);
+    EXPECTF(strstr(err, "a.vtk: exists (--no-clobber)") != NULL, "[%s]", err);
+    EXPECT(same_bytes(a, olda, la) && count_entries(dir) == 2);
+
+    /* a failure at every step: two backups, the journal, two renames, the
+     * commit point; after it (step 7) the commit is done */
+    for (int k = 1; k <= 8; k++) {
+        char fault[32];
+        snprintf(fault, sizeof fault, "%d:fail", k);
+        EXPECT(fdt_wr_set_begin(0) == 0);
+        EXPECT(fdt_wr_mesh(a, &v, err, sizeof err) == FDT_IO_OK);
+        EXPECT(fdt_wr_mesh(b, &v, err, sizeof err) == FDT_IO_OK);
+        setenv("FDT_TEST_COMMIT_FAULT", fault, 1);
+        int r = fdt_wr_set_commit(err, sizeof err);
+        unsetenv("FDT_TEST_COMMIT_FAULT");
+        if (k <= 6) {
+            EXPECTF(r == FDT_IO_EWRITE && strstr(err, "every output left as it was"),
+                    "step %d: %d [%s]", k, r, err);
+            EXPECTF(same_bytes(a, olda, la) && same_bytes(b, oldb, lb), "step %d", k);
+        } else {
+            EXPECTF(r == FDT_IO_OK, "step %d: %d [%s]", k, r, err);
+            EXPECTF(same_bytes(a, newa, na) && same_bytes(b, newb, nb), "step %d", k);
+            EXPECT(fdt_wr_mesh(a, &old, err, sizeof err) == FDT_IO_OK);
+            EXPECT(fdt_wr_mesh(b, &old, err, sizeof err) == FDT_IO_OK);
+        }
+        EXPECTF(count_entries(dir) == 2, "step %d: %d entries", k, count_entries(dir));
+    }
+    unlink(a);
+    unlink(b);
+    free(olda);
+    free(oldb);
+    free(newa);
+    free(newb);
+}
+
 int main(void)
 {
     const char *tmp = getenv("TMPDIR");
@@ -1356,12 +1468,13 @@ int main(void)
     }
     char sub[4096];
     const char *names[] = { "small", "refuse", "ids", "large", "files",
-                            "same", "table", "outfile", "misc" };
+                            "same", "table", "outfile", "misc", "commit" };
     void (*fns[])(const char *) = { test_small_mesh, test_refusals,
                                     test_big_ids, test_large,
                                     test_output_files, test_same_file,
-                                    test_format_table, test_outfile, test_misc };
-    for (int i = 0; i < 9; i++) {
+                                    test_format_table, test_outfile, test_misc,
+                                    test_commit_set };
+    for (int i = 0; i < 10; i++) {
         snprintf(sub, sizeof sub, "%s/%s", dir, names[i]);
         mkdir(sub, 0755);
         long before = test_failures();

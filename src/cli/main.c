@@ -12,8 +12,11 @@
  *      NaN/Inf, fewer than 4 distinct points, all points coplanar
  *   3  --check found the mesh is not the Delaunay tetrahedralization
  *   4  out of resources: memory, index range, threads
- *   5  cannot write the output
- *   6  interrupted by SIGINT or SIGTERM (no output, no temporary file left)
+ *   5  cannot write the output (also an output that exists, with
+ *      --no-clobber)
+ *   6  interrupted by SIGINT or SIGTERM (no temporary file left, every
+ *      output as before the run: the outputs are renamed all together at
+ *      the end, fdt_wr_set_commit)
  *   7  internal error (a bug: please report it)
  *
  * Everything the tool says goes to stderr with a "frontdt: " prefix, except
@@ -79,6 +82,7 @@ typedef struct cli {
     fdt_search search;
     int threads;            /* -1: the library's default */
     int pin, check, stats, hash, set_hash, quiet;
+    int no_clobber;         /* --no-clobber: refuse to replace any output */
     int stream;             /* --stream 1, --no-stream -1, else 0: when
                                every output can (stream_refusal) */
     unsigned long long memory_limit; /* --memory-limit bytes; 0: none */
@@ -103,11 +107,16 @@ static void usage(FILE *f)
         "\n"
         "Options:\n"
         "  -o, --output FILE      write the mesh (format by extension); may be\n"
-        "                         given up to %d times; '-': standard output\n"
+        "                         given up to %d times; '-': standard output.\n"
+        "                         An existing output is replaced (as TetGen and\n"
+        "                         gmsh do); an input never is (exit 1)\n"
+        "      --no-clobber       refuse (exit 5, before any work) when any\n"
+        "                         output file exists (.node of -o m.ele too)\n"
         "      --format NAME      format of the next -o (of the last -o when\n"
         "                         none follows): tets, tetgen, vtu, bin, vtk, msh,\n"
-        "                         msh2, medit, openfoam; or, named xyz, txt,\n"
-        "                         csv, node or ply, the input's (--input-format)\n"
+        "                         msh2, medit, openfoam; an -o whose extension\n"
+        "                         names another format is refused; or, named xyz,\n"
+        "                         txt, csv, node or ply, the input's (--input-format)\n"
         "      --all-faces        TetGen .face lists every face (TetGen -f)\n"
         "      --input-format FMT xyz (also txt, csv), node or ply: the input's\n"
         "                         format whatever its name (needed for '-')\n"
@@ -150,8 +159,11 @@ static void usage(FILE *f)
         "  0 success             1 usage error (also '-' without --input-format,\n"
         "                          --columns for .node/.ply)   2 bad input\n"
         "  3 --check failed      4 out of resources (also over --memory-limit)\n"
-        "  5 cannot write output\n"
-        "  6 interrupted         7 internal error\n",
+        "  5 cannot write output (also --no-clobber)\n"
+        "  6 interrupted (every output left as it was)\n"
+        "  7 internal error\n"
+        "Outputs are all or none: each is written to a temporary file, and only\n"
+        "when all are complete are they renamed over their names.\n",
         MAX_OUTPUTS, DEMO_DEFAULT_N);
 }
 
@@ -181,9 +193,9 @@ static int usage_error(const char *fmt, ...)
 /* Signals                                                                   */
 /* ------------------------------------------------------------------------ */
 
-/* SIGINT/SIGTERM remove the temporary (or just renamed, if its file set
- * is incomplete) output files (fdt_write_cleanup) and leave with exit
- * code 6; SIGXFSZ is ignored (src/cli/cli.h). */
+/* SIGINT/SIGTERM remove the temporary output files and put back any
+ * output the final commit already replaced (fdt_write_cleanup) and leave
+ * with exit code 6; SIGXFSZ is ignored (src/cli/cli.h). */
 
 /* ------------------------------------------------------------------------ */
 /* Argument parsing                                                          */
@@ -249,7 +261,7 @@ enum {
     OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH, OPT_SET_HASH,
     OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
     OPT_DELIMITER, OPT_DECIMAL_COMMA,
-    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT
+    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT, OPT_NO_CLOBBER
 };
 
 static const struct option long_opts[] = {
@@ -275,6 +287,7 @@ static const struct option long_opts[] = {
     { "stream", no_argument, NULL, OPT_STREAM },
     { "no-stream", no_argument, NULL, OPT_NO_STREAM },
     { "memory-limit", required_argument, NULL, OPT_MEMORY_LIMIT },
+    { "no-clobber", no_argument, NULL, OPT_NO_CLOBBER },
     { "help", no_argument, NULL, 'h' },
     { "version", no_argument, NULL, 'V' },
     { NULL, 0, NULL, 0 },
@@ -483,6 +496,9 @@ static int parse_args(int argc, char **argv, cli *c)
         case OPT_PROGRESS:
             c->progress = 1;
             break;
+        case OPT_NO_CLOBBER:
+            c->no_clobber = 1;
+            break;
         case OPT_MEMORY_LIMIT:
             if (parse_bytes(optarg, &c->memory_limit) != 0)
                 return usage_error("--memory-limit wants a byte count > 0 (suffix K, M or G), "
@@ -504,8 +520,11 @@ static int parse_args(int argc, char **argv, cli *c)
             else
                 printf("frontdt %s (library %s)\n", FDT_VERSION_STRING,
                        fdt_version());
-            if (fflush(stdout) != 0) {
-                say("stdout: %s", strerror(errno));
+            /* a help longer than stdio's buffer meets the error in
+             * fprintf already: the stream's error flag keeps it (and
+             * errno its reason) */
+            if (fflush(stdout) != 0 || ferror(stdout)) {
+                say("stdout: %s", strerror(errno ? errno : EIO));
                 return CLI_WRITE;
             }
             return CLI_OK;
@@ -607,46 +626,38 @@ static int refuse_overwrites(const cli *c, const char *output, char names[][FDT_
 }
 
 /*
- * Can a file be created at path? Its directory must exist, be a directory
- * and be writable; path itself must not be a directory. A cheap early
- * answer so a doomed run fails in milliseconds rather than after the
- * triangulation; the writer still checks every step for real.
+ * --no-clobber: refuses, before anything is read, an output any of whose
+ * files (names[0..k), so "-o m.ele" covers m.node too) exists, a
+ * dangling symbolic link included (the rename would replace the link).
+ * Returns -1 to go on, or CLI_WRITE after naming the file. The commit
+ * checks again before it renames (fdt_wr_set_begin).
  */
-static int output_dir_ok(const char *path)
+static int refuse_clobber(const cli *c, const char *output, char names[][FDT_IO_PATH], int k)
 {
-    const char *slash = strrchr(path, '/');
-    char dir[4096];
-    if (!slash) {
-        strcpy(dir, ".");
-    } else {
-        size_t len = (size_t)(slash - path);
-        if (len == 0)
-            len = 1; /* "/name": the root directory */
-        if (len >= sizeof dir) {
-            say("%s: %s", path, strerror(ENAMETOOLONG));
-            return 0;
-        }
-        memcpy(dir, path, len);
-        dir[len] = '\0';
+    if (!c->no_clobber)
+        return -1;
+    for (int i = 0; i < k; i++) {
+        struct stat st;
+        if (lstat(names[i], &st) != 0)
+            continue;
+        if (strcmp(names[i], output) != 0)
+            say("output %s (written with -o %s) exists; --no-clobber keeps it", names[i],
+                output);
+        else
+            say("output %s exists; --no-clobber keeps it", names[i]);
+        return CLI_WRITE;
     }
-    struct stat st;
-    if (stat(dir, &st) != 0) {
-        say("%s: %s", path, strerror(errno));
-        return 0;
-    }
-    if (!S_ISDIR(st.st_mode)) {
-        say("%s: %s", path, strerror(ENOTDIR));
-        return 0;
-    }
-    if (access(dir, W_OK | X_OK) != 0) {
-        say("%s: %s", path, strerror(errno));
-        return 0;
-    }
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
-        say("%s: %s", path, strerror(EISDIR));
-        return 0;
-    }
-    return 1;
+    return -1;
+}
+
+/* Can a file be created at path (fdt_output_dir_check)? Says why not. */
+static int output_dir_ok(const char *role, const char *path)
+{
+    char err[2 * FDT_IO_PATH + 100];
+    if (fdt_output_dir_check(role, path, err, sizeof err) == 0)
+        return 1;
+    say("%s", err);
+    return 0;
 }
 
 /* ------------------------------------------------------------------------ */
@@ -1162,6 +1173,11 @@ static int run(const cli *c)
         if (!fmts[o])
             return usage_error("%s: unknown output format (use %s, or --format)", out,
                                fdt_format_list());
+        /* "-o m.vtu --format msh2" would write gmsh into m.vtu */
+        const fdt_format *by_ext = fdt_format_contradicted(out, fmts[o]);
+        if (by_ext)
+            return usage_error("--format %s contradicts the extension of %s (%s)",
+                               fdt_format_name(fmts[o]), out, fdt_format_name(by_ext));
         need |= fdt_format_needs(fmts[o], c->all_faces);
         char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
         int n_names = fdt_output_files_as(out, fmts[o], names);
@@ -1170,6 +1186,9 @@ static int run(const cli *c)
             return CLI_WRITE;
         }
         code = refuse_overwrites(c, out, names, n_names);
+        if (code >= 0)
+            return code;
+        code = refuse_clobber(c, out, names, n_names);
         if (code >= 0)
             return code;
         for (int p = 0; p < o; p++) {
@@ -1192,7 +1211,7 @@ static int run(const cli *c)
                                     stat(out, &dst) == 0 && S_ISDIR(dst.st_mode)
                                 ? names[0]
                                 : out;
-        if (!output_dir_ok(probe))
+        if (!output_dir_ok("output", probe))
             return CLI_WRITE;
     }
     {
@@ -1209,11 +1228,26 @@ static int run(const cli *c)
         return usage_error("--stream: %s", refusal);
     int streaming = c->stream > 0 || (c->stream == 0 && !refusal && c->n_outputs > 0);
     code = CLI_OK;
-    if (c->stats_json && !json_stdout && !output_dir_ok(c->stats_json))
+    if (c->stats_json && !json_stdout && !output_dir_ok("--stats-json file", c->stats_json))
         return CLI_WRITE;
+    /* a device or a pipe is written in place, not replaced (below) */
+    struct stat jst0;
+    if (c->no_clobber && c->stats_json && !json_stdout && lstat(c->stats_json, &jst0) == 0 &&
+        (stat(c->stats_json, &jst0) != 0 || S_ISREG(jst0.st_mode))) {
+        say("--stats-json file %s exists; --no-clobber keeps it", c->stats_json);
+        return CLI_WRITE;
+    }
     /* the summary goes to stderr when the mesh goes to stdout */
     if (to_stdout)
         info = stderr;
+    /* Every file output of the run (the meshes, streamed or not, and the
+     * --stats-json file) waits complete in its temporary until all are,
+     * then all are renamed together (fdt_wr_set_commit, below): all new,
+     * or, after any failure or signal, all as they were. */
+    if (fdt_wr_set_begin(c->no_clobber) != 0) {
+        say("internal error: a commit set is already open");
+        return CLI_INTERNAL;
+    }
 
     /* Points. */
     double t0 = fdt_now_s();
@@ -1222,7 +1256,8 @@ static int run(const cli *c)
         xyz = demo_points(n);
         if (!xyz) {
             say("demo: no memory for %zu points", n);
-            return CLI_RESOURCES;
+            code = CLI_RESOURCES;
+            goto done;
         }
     } else {
         char err[1024];
@@ -1242,7 +1277,8 @@ static int run(const cli *c)
         progress_clear(&prog);
         if (r != FDT_OK) {
             say("%s", err);
-            return exit_for_reader(r);
+            code = exit_for_reader(r);
+            goto done;
         }
     }
     tm.read = fdt_now_s() - t0;
@@ -1478,6 +1514,15 @@ static int run(const cli *c)
         }
     }
 
+    {
+        char cerr[FDT_IO_PATH + 300];
+        if (fdt_wr_set_commit(cerr, sizeof cerr) != FDT_IO_OK) {
+            say("%s", cerr);
+            code = CLI_WRITE;
+            goto done;
+        }
+    }
+
     if (c->hash)
         fprintf(info, "hash: %016" PRIx64 "\n", hash);
     if (c->set_hash)
@@ -1506,6 +1551,7 @@ static int run(const cli *c)
     }
 
 done:
+    fdt_wr_set_abandon(); /* after a failure: every temporary goes */
     fdt_result_free(&res);
     fdt_close(&ctx);
     free(xyz);

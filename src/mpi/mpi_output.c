@@ -155,7 +155,7 @@ static int write_files(char (*names)[FDT_IO_PATH], int k, int kind, uint64_t n_i
             break;
     fdt_write_unlock();
     if (e) {
-        int code = io_code(set_errno_err(diag, dlen, names[nopen], e));
+        int code = io_code(fdt_create_err(diag, dlen, "output", names[nopen], e));
         fdt_write_lock();
         for (int i = 0; i < nopen; i++)
             fdt_out_abandon(&f[i]);
@@ -333,7 +333,7 @@ static int write_node(MPI_Comm comm, const char *name, const fdt_mpi_local *L, u
         int e = fdt_out_open(&of, name);
         fdt_write_unlock();
         if (e)
-            err = io_code(set_errno_err(diag, dlen, name, e));
+            err = io_code(fdt_create_err(diag, dlen, "output", name, e));
         else {
             of_open = 1;
             snprintf(tpath, sizeof tpath, "%s", fdt_out_temp(&of));

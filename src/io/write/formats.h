@@ -63,7 +63,10 @@ typedef struct fdt_stream_fmt {
 typedef struct fdt_format {
     const char *name;                  /* --format NAME */
     const char *exts[3];               /* lowercase, with the dot; for a
-                                          directory its last component */
+                                          directory its last component.
+                                          Rows may share one: the first
+                                          row with it is the one a path
+                                          chooses (msh before msh2) */
     const char *what;                  /* one line for --help */
     int binary;                        /* 0: text, may go to stdout */
     fdt_layout layout;
@@ -89,6 +92,10 @@ extern const fdt_format fdt_formats[];
 int fdt_out_open(out_file *o, const char *target);
 void fdt_out_abandon(out_file *o);
 int fdt_out_commit(out_file *files, int k, char *err, size_t errlen);
+/* Removes target (a file the set no longer has: a streamed TetGen set's
+ * old .neigh), with the commit when a commit set is open (writer.h),
+ * else now. FDT_IO_OK (also when there is none) or a code with err. */
+int fdt_out_remove_at_commit(const char *target, char *err, size_t errlen);
 /* The temporary's path of a file fdt_out_open opened (NULL if none): for
  * frontdt-mpi's collective .node, which the other ranks fill with pwrite
  * before rank 0 commits it (src/mpi/mpi_output.c). */

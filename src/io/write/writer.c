@@ -6,9 +6,10 @@
  *
  * Every file goes to a temporary ".NAME.tmp.XXXXXX" beside its target and
  * is renamed over the target only once every byte of it (and, for TetGen,
- * of all four files) has been written and closed without error. So a
- * failed, full-disk or interrupted run never leaves a truncated mesh that
- * a later stage could mistake for a complete one.
+ * of all four files; in a commit set, of every output of the run) has
+ * been written and closed without error. So a failed, full-disk or
+ * interrupted run never leaves a truncated mesh that a later stage could
+ * mistake for a complete one, nor (in a set) a mix of new and old outputs.
  *
  * Output goes through our own large buffer (src/io/write/outfile.h) and is handed
  * to stdio in big chunks. Every fwrite/fflush/fclose result is checked and
@@ -72,8 +73,11 @@ static volatile sig_atomic_t fdt_io_state[FDT_IO_SLOTS];
 static char fdt_io_tmpdir[FDT_IO_PATH];
 static volatile sig_atomic_t fdt_io_tmpdir_live;
 
+static void set_cleanup(void);
+
 void fdt_io_cleanup_temps(void)
 {
+    set_cleanup(); /* first: it may rename a temporary the slots name */
     for (int i = 0; i < FDT_IO_SLOTS; i++) {
         sig_atomic_t st = fdt_io_state[i];
         if (st == SLOT_TEMP || st == SLOT_RENAMING)
@@ -214,6 +218,528 @@ static void out_abandon(out_file *o)
     }
 }
 
+/* ------------------------------------------------------------------------ */
+/* Why a file cannot be created (issue 34 item 8)                            */
+/* ------------------------------------------------------------------------ */
+
+/* path's folder ("." when it names none, "/" for "/name") into dir. */
+static void folder_of(const char *path, char *dir, size_t len)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(dir, len, ".");
+    else if (slash == path)
+        snprintf(dir, len, "/");
+    else
+        snprintf(dir, len, "%.*s", (int)(slash - path), path);
+}
+
+int fdt_create_err(char *err, size_t errlen, const char *role, const char *path, int e)
+{
+    char dir[FDT_IO_PATH];
+    folder_of(path, dir, sizeof dir);
+    int code = e == ENOMEM ? FDT_IO_ENOMEM : FDT_IO_EWRITE;
+    if (!err || errlen == 0)
+        return code;
+    switch (e) {
+    case ENOENT:
+        snprintf(err, errlen, "cannot create %s %s: folder %s does not exist", role, path, dir);
+        break;
+    case ENOTDIR:
+        snprintf(err, errlen, "cannot create %s %s: %s is not a folder", role, path, dir);
+        break;
+    case EACCES:
+    case EPERM:
+    case EROFS:
+        snprintf(err, errlen, "cannot create %s %s: folder %s is not writable (%s)", role, path,
+                 dir, strerror(e));
+        break;
+    case EISDIR:
+        snprintf(err, errlen, "cannot create %s %s: a folder has that name", role, path);
+        break;
+    default: /* not the folder's fault (no memory, no space): as every write error */
+        return set_errno_err(err, errlen, path, e);
+    }
+    return code;
+}
+
+int fdt_output_dir_check(const char *role, const char *path, char *err, size_t errlen)
+{
+    char dir[FDT_IO_PATH];
+    if (strlen(path) + 1 > sizeof dir) {
+        fdt_create_err(err, errlen, role, path, ENAMETOOLONG);
+        return ENAMETOOLONG;
+    }
+    folder_of(path, dir, sizeof dir);
+    struct stat st;
+    int e = 0;
+    if (stat(dir, &st) != 0)
+        e = errno;
+    else if (!S_ISDIR(st.st_mode))
+        e = ENOTDIR;
+    else if (access(dir, W_OK | X_OK) != 0)
+        e = errno;
+    else if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        e = EISDIR;
+    if (e)
+        fdt_create_err(err, errlen, role, path, e);
+    return e;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Commit sets: the outputs of one run renamed together (issue 34 item 3)   */
+/* ------------------------------------------------------------------------ */
+
+/*
+ * Between fdt_wr_set_begin() and fdt_wr_set_commit() a commit renames
+ * nothing: the closed, complete temporaries join the set, in the order
+ * they were committed (the CLI's -o order, each output's files in its
+ * format's order), and fdt_wr_set_commit() renames them all at the end:
+ *
+ *   1. backups: each target that exists gets a hard link beside it,
+ *      ".NAME.old.PID.I" (where the file system has no links, the old
+ *      target is renamed to that name at its turn, just before the new
+ *      file takes its place);
+ *   2. the journal ".frontdt-commit-PID" in the first target's folder,
+ *      listing every TEMP -> FINAL pair and its backup, written and
+ *      fsync'd (with its folder) before the first rename;
+ *   3. the renames, in the set's order;
+ *   4. the commit point: the journal is removed; then the backups.
+ *
+ * A failure or SIGINT/SIGTERM anywhere before the commit point rolls the
+ * set back: every backup is renamed over its target, a new target that
+ * had none is removed, the temporaries and the journal are removed, so
+ * every output is as it was before the run. After the commit point every
+ * output is new (a signal then only removes the backups). A crash or
+ * SIGKILL between 2 and 4 leaves the journal, which says how to undo the
+ * renames by hand.
+ *
+ * Each step (its system call and the recorded state) runs with SIGINT
+ * and SIGTERM blocked, so the handler (fdt_io_cleanup_temps) always finds
+ * a state that says what is on disk; it rolls back with rename(),
+ * unlink() and rmdir() alone, all async-signal-safe, on these fixed
+ * buffers (written only while their entry is not yet counted in set_n).
+ */
+/* Eight polyMesh outputs (five files and their directory each) and a
+ * --stats-json. */
+#define FDT_SET_MAX 64
+
+enum {
+    ENT_FILE = 1,   /* a temporary renamed over its target (a polyMesh's
+                       files: to their names in the temporary directory) */
+    ENT_DIR = 2,    /* a temporary directory renamed to its target, after
+                       its files */
+    ENT_REMOVE = 3  /* a target the run removes (a streamed TetGen set's
+                       stale .neigh) */
+};
+enum { STEP_WAIT = 0, STEP_LINKED, STEP_MOVED, STEP_PLACED };
+enum { BAK_NONE = 0, BAK_LINK, BAK_MOVE };
+enum { PHASE_OFF = 0, PHASE_OPEN, PHASE_COMMITTED };
+
+static char set_tmp[FDT_SET_MAX][FDT_IO_PATH];
+static char set_dst[FDT_SET_MAX][FDT_IO_PATH];
+static char set_bak[FDT_SET_MAX][FDT_IO_PATH];
+static volatile sig_atomic_t set_kind[FDT_SET_MAX];
+static volatile sig_atomic_t set_step[FDT_SET_MAX];
+static volatile sig_atomic_t set_bakmode[FDT_SET_MAX];
+static volatile sig_atomic_t set_n;
+static volatile sig_atomic_t set_phase;
+static char set_journal[FDT_IO_PATH];
+static volatile sig_atomic_t set_journal_live;
+static int set_no_clobber;
+
+/* Undoes whatever the entries' steps say was done, newest first, then
+ * removes the temporaries and the journal. Async-signal-safe. */
+static void set_rollback(void)
+{
+    int n = (int)set_n;
+    for (int i = n - 1; i >= 0; i--) {
+        sig_atomic_t k = set_kind[i], st = set_step[i];
+        if (k == ENT_DIR && st == STEP_PLACED)
+            rename(set_dst[i], set_tmp[i]);
+        else if (st == STEP_PLACED || st == STEP_MOVED) {
+            if (set_bakmode[i] != BAK_NONE)
+                rename(set_bak[i], set_dst[i]);
+            else
+                unlink(set_dst[i]);
+        } else if (st == STEP_LINKED)
+            unlink(set_bak[i]);
+        set_step[i] = STEP_WAIT;
+    }
+    for (int i = 0; i < n; i++)
+        if (set_kind[i] == ENT_FILE)
+            unlink(set_tmp[i]);
+    for (int i = 0; i < n; i++)
+        if (set_kind[i] == ENT_DIR)
+            rmdir(set_tmp[i]);
+    if (set_journal_live) {
+        unlink(set_journal);
+        set_journal_live = 0;
+    }
+}
+
+/* After the commit point: the backups go. Async-signal-safe. */
+static void set_finish(void)
+{
+    for (int i = 0; i < (int)set_n; i++)
+        if (set_bakmode[i] != BAK_NONE)
+            unlink(set_bak[i]);
+    if (set_journal_live) {
+        unlink(set_journal);
+        set_journal_live = 0;
+    }
+}
+
+static void set_clear(void)
+{
+    int n = (int)set_n;
+    set_n = 0;
+    for (int i = 0; i < n; i++) {
+        set_kind[i] = 0;
+        set_step[i] = STEP_WAIT;
+        set_bakmode[i] = BAK_NONE;
+    }
+    set_phase = PHASE_OFF;
+}
+
+/* The signal handler's part (fdt_io_cleanup_temps). */
+static void set_cleanup(void)
+{
+    if (set_phase == PHASE_COMMITTED)
+        set_finish();
+    else if (set_phase == PHASE_OPEN)
+        set_rollback();
+    else
+        return;
+    set_clear();
+}
+
+static void block_signals(sigset_t *old)
+{
+    sigset_t s;
+    sigemptyset(&s);
+    sigaddset(&s, SIGINT);
+    sigaddset(&s, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &s, old);
+}
+
+static void restore_signals(const sigset_t *old)
+{
+    pthread_sigmask(SIG_SETMASK, old, NULL);
+}
+
+/* Adds an entry (its buffers first, then the count). 0 or an errno. */
+static int set_add(int kind, const char *tmp, const char *dst)
+{
+    int i = (int)set_n;
+    if (i >= FDT_SET_MAX)
+        return EMFILE;
+    size_t lt = tmp ? strlen(tmp) : 0, ld = strlen(dst);
+    if (lt + 1 > FDT_IO_PATH || ld + 1 > FDT_IO_PATH)
+        return ENAMETOOLONG;
+    memcpy(set_tmp[i], tmp ? tmp : "", lt + 1);
+    memcpy(set_dst[i], dst, ld + 1);
+    set_bak[i][0] = '\0';
+    set_step[i] = STEP_WAIT;
+    set_bakmode[i] = BAK_NONE;
+    set_kind[i] = kind;
+    set_n = i + 1;
+    return 0;
+}
+
+int fdt_wr_set_begin(int no_clobber)
+{
+    if (set_phase != PHASE_OFF)
+        return -1;
+    set_no_clobber = no_clobber;
+    set_phase = PHASE_OPEN;
+    return 0;
+}
+
+int fdt_wr_set_active(void)
+{
+    return set_phase == PHASE_OPEN;
+}
+
+void fdt_wr_set_abandon(void)
+{
+    if (set_phase == PHASE_OFF)
+        return;
+    sigset_t old;
+    block_signals(&old);
+    set_cleanup();
+    restore_signals(&old);
+}
+
+/*
+ * The test hook (tests/test_cli.sh): FDT_TEST_COMMIT_FAULT=K:fail makes
+ * step K of the commit (counted from 1: each backup, the journal, each
+ * rename, the commit point, the step after it) fail as with EIO;
+ * K:signal raises SIGTERM just before it. Each step it reaches is named on
+ * stderr so the test knows which state to expect.
+ */
+typedef struct set_fault {
+    long at;     /* 0: none */
+    int signal;  /* else fail */
+    long step;
+} set_fault;
+
+static void fault_init(set_fault *f)
+{
+    memset(f, 0, sizeof *f);
+    const char *e = getenv("FDT_TEST_COMMIT_FAULT");
+    char *end;
+    if (!e)
+        return;
+    long k = strtol(e, &end, 10);
+    if (k > 0 && *end == ':') {
+        f->at = k;
+        f->signal = strcmp(end + 1, "signal") == 0;
+    }
+}
+
+/* 1 when this step is to fail (a signal does not come back). */
+static int fault_here(set_fault *f, const char *what)
+{
+    f->step++;
+    if (f->at == 0 || f->step != f->at)
+        return 0;
+    fprintf(stderr, "frontdt: test fault (%s) at commit step %ld: %s\n",
+            f->signal ? "signal" : "fail", f->step, what);
+    fflush(stderr);
+    if (f->signal) {
+        raise(SIGTERM);
+        return 0; /* a caller that handles SIGTERM goes on */
+    }
+    return 1;
+}
+
+/* ".NAME.old.PID.I" beside path. 0 or an errno. */
+static int backup_name(char *out, const char *path, int i)
+{
+    const char *slash = strrchr(path, '/');
+    int dirlen = slash ? (int)(slash + 1 - path) : 0;
+    int w = snprintf(out, FDT_IO_PATH, "%.*s.%s.old.%ld.%d", dirlen, path, path + dirlen,
+                     (long)getpid(), i);
+    return w < 0 || w >= FDT_IO_PATH ? ENAMETOOLONG : 0;
+}
+
+/* fsync of a folder (the entries made in it); errors other than the
+ * folder refusing fsync count. */
+static int sync_dir(const char *dir)
+{
+    int fd = open(dir, O_RDONLY);
+    if (fd < 0)
+        return errno;
+    int e = fsync(fd) != 0 && errno != EINVAL && errno != EROFS ? errno : 0;
+    close(fd);
+    return e;
+}
+
+static const char *kind_word(int k)
+{
+    return k == ENT_FILE ? "file" : k == ENT_DIR ? "dir" : "remove";
+}
+
+/* Is entry i a file inside a directory of the set still to be renamed
+ * (a new polyMesh's)? */
+static int in_set_dir(int i)
+{
+    for (int j = 0; j < (int)set_n; j++) {
+        size_t l = strlen(set_tmp[j]);
+        if (set_kind[j] == ENT_DIR && strncmp(set_dst[i], set_tmp[j], l) == 0 &&
+            set_dst[i][l] == '/')
+            return 1;
+    }
+    return 0;
+}
+
+/* Step 2: the journal, in the first target's folder (a new directory's
+ * files are not there yet: its own folder). 0 or an errno. */
+static int write_journal(void)
+{
+    int i0 = 0;
+    while (i0 + 1 < (int)set_n && in_set_dir(i0))
+        i0++;
+    const char *first = set_dst[i0];
+    const char *slash = strrchr(first, '/');
+    int dirlen = slash ? (int)(slash - first) : 0;
+    char dir[FDT_IO_PATH];
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else if (dirlen == 0)
+        snprintf(dir, sizeof dir, "/");
+    else
+        snprintf(dir, sizeof dir, "%.*s", dirlen, first);
+    char path[FDT_IO_PATH];
+    int w = snprintf(path, sizeof path, "%s/.frontdt-commit-%ld", dir, (long)getpid());
+    if (w < 0 || w >= (int)sizeof path)
+        return ENAMETOOLONG;
+    memcpy(set_journal, path, (size_t)w + 1);
+    set_journal_live = 1; /* before it exists: the handler may remove it */
+    int fd = open(path, O_WRONLY | O_CREAT | O_EXCL, 0644);
+    if (fd < 0) {
+        int e = errno;
+        set_journal_live = 0; /* never ours: not to be removed */
+        return e;
+    }
+    FILE *f = fdopen(fd, "w");
+    if (!f) {
+        int e = errno;
+        close(fd);
+        return e;
+    }
+    char cwd[FDT_IO_PATH];
+    fprintf(f,
+            "# frontdt commit journal (process %ld): the outputs of one run, renamed\n"
+            "# together. While this file exists the renames may be partly done. To undo\n"
+            "# them: rename each BACKUP to its FINAL ('-': remove FINAL if TEMP is gone);\n"
+            "# for a dir line rename FINAL back to TEMP; then remove every TEMP. Fields are\n"
+            "# tab-separated: KIND TEMP FINAL BACKUP, paths relative to the cwd line.\n",
+            (long)getpid());
+    fprintf(f, "cwd\t%s\n", getcwd(cwd, sizeof cwd) ? cwd : "?");
+    for (int i = 0; i < (int)set_n; i++)
+        fprintf(f, "%s\t%s\t%s\t%s\n", kind_word((int)set_kind[i]),
+                set_tmp[i][0] ? set_tmp[i] : "-", set_dst[i],
+                set_bakmode[i] != BAK_NONE ? set_bak[i] : "-");
+    int e = 0;
+    if (fflush(f) != 0 || ferror(f))
+        e = errno ? errno : EIO;
+    if (!e && fsync(fd) != 0 && errno != EINVAL)
+        e = errno;
+    if (fclose(f) != 0 && !e)
+        e = errno ? errno : EIO;
+    if (!e)
+        e = sync_dir(dir);
+    return e;
+}
+
+int fdt_wr_set_commit(char *err, size_t errlen)
+{
+    if (set_phase != PHASE_OPEN)
+        return FDT_IO_OK;
+    set_fault fault;
+    fault_init(&fault);
+    sigset_t old;
+    int n = (int)set_n, e = 0, at = -1;
+    const char *what = "";
+    if (n == 0) {
+        set_clear();
+        return FDT_IO_OK;
+    }
+    /* 1. backups (and the checks that need no change on disk) */
+    for (int i = 0; i < n && !e; i++) {
+        struct stat st;
+        if (lstat(set_dst[i], &st) != 0) {
+            if (errno != ENOENT) {
+                e = errno, at = i, what = "cannot check";
+            }
+            continue;
+        }
+        if (set_kind[i] == ENT_DIR) {
+            e = EEXIST, at = i, what = "appeared while the mesh was computed";
+            break;
+        }
+        if (S_ISDIR(st.st_mode)) {
+            e = EISDIR, at = i, what = "cannot replace";
+            break;
+        }
+        if (set_no_clobber) {
+            e = EEXIST, at = i, what = "--no-clobber";
+            break;
+        }
+        if ((e = backup_name(set_bak[i], set_dst[i], i)) != 0) {
+            at = i, what = "cannot back up";
+            break;
+        }
+        if (lstat(set_bak[i], &st) == 0) {
+            e = EEXIST, at = i, what = "cannot back up";
+            break;
+        }
+        if (set_kind[i] == ENT_REMOVE) {
+            set_bakmode[i] = BAK_MOVE; /* the removal is the move */
+            continue;
+        }
+        if (fault_here(&fault, "backup")) {
+            e = EIO, at = i, what = "cannot back up";
+            break;
+        }
+        block_signals(&old);
+        if (link(set_dst[i], set_bak[i]) == 0) {
+            set_bakmode[i] = BAK_LINK;
+            set_step[i] = STEP_LINKED;
+        } else if (errno == EEXIST) {
+            e = EEXIST, at = i, what = "cannot back up";
+        } else {
+            set_bakmode[i] = BAK_MOVE; /* no links here: moved at its turn */
+        }
+        restore_signals(&old);
+    }
+    /* 2. the journal */
+    if (!e && fault_here(&fault, "journal"))
+        e = EIO, at = -1, what = "cannot write the commit journal";
+    if (!e && (e = write_journal()) != 0)
+        at = -1, what = "cannot write the commit journal";
+    /* 3. the renames */
+    for (int i = 0; i < n && !e; i++) {
+        int k = (int)set_kind[i];
+        if (k == ENT_REMOVE && set_bakmode[i] == BAK_NONE)
+            continue;
+        if (set_bakmode[i] == BAK_MOVE) {
+            if (fault_here(&fault, "rename")) {
+                e = EIO, at = i, what = "cannot move aside";
+                break;
+            }
+            block_signals(&old);
+            if (rename(set_dst[i], set_bak[i]) == 0)
+                set_step[i] = STEP_MOVED;
+            else
+                e = errno, at = i, what = "cannot move aside";
+            restore_signals(&old);
+            if (e || k == ENT_REMOVE)
+                continue;
+        }
+        if (fault_here(&fault, "rename")) {
+            e = EIO, at = i, what = "cannot rename into place";
+            break;
+        }
+        block_signals(&old);
+        if (rename(set_tmp[i], set_dst[i]) == 0)
+            set_step[i] = STEP_PLACED;
+        else
+            e = errno, at = i, what = "cannot rename into place";
+        restore_signals(&old);
+    }
+    /* 4. the commit point */
+    if (!e && fault_here(&fault, "commit"))
+        e = EIO, at = -1, what = "cannot commit";
+    if (e) {
+        block_signals(&old);
+        set_rollback();
+        set_clear();
+        restore_signals(&old);
+        char msg[FDT_IO_PATH + 200];
+        if (e == EEXIST && !strcmp(what, "--no-clobber"))
+            snprintf(msg, sizeof msg, "exists (--no-clobber); no output written");
+        else
+            snprintf(msg, sizeof msg, "%s (%s); every output left as it was", what,
+                     strerror(e));
+        return set_err(err, errlen, e == ENOMEM ? FDT_IO_ENOMEM : FDT_IO_EWRITE,
+                       at >= 0 ? set_dst[at] : set_journal, msg);
+    }
+    block_signals(&old);
+    set_phase = PHASE_COMMITTED;
+    unlink(set_journal);
+    set_journal_live = 0;
+    restore_signals(&old);
+    (void)fault_here(&fault, "committed");
+    block_signals(&old);
+    set_finish();
+    set_clear();
+    restore_signals(&old);
+    return FDT_IO_OK;
+}
+
 /*
  * Closes files[0..k) and renames them over their targets, all or none:
  * if any close or rename fails, every temporary and every target already
@@ -234,6 +760,30 @@ static void out_abandon(out_file *o)
  * (fdt_same_file): whoever names it expects the write to go through, and
  * would instead find the link silently turned into a plain file.
  */
+/* What commit_all does with the slots once renamed: KEEP_NONE frees them;
+ * KEEP_RENAMED leaves them live (SLOT_RENAMED) for a directory still to
+ * be renamed. With a commit set open nothing is renamed: the files join
+ * the set and their slots are freed. */
+enum { KEEP_NONE = 0, KEEP_RENAMED = 1 };
+
+/* The closed files[0..k) join the open commit set; their slots are freed
+ * (the set removes the temporaries from now on). */
+static int defer_all(out_file *files, int k, char *err, size_t errlen)
+{
+    for (int i = 0; i < k; i++) {
+        int slot = files[i].slot;
+        int e = set_add(ENT_FILE, fdt_io_tmp_path[slot], fdt_io_dst_path[slot]);
+        if (e) {
+            for (int j = i; j < k; j++)
+                out_abandon(&files[j]);
+            return set_errno_err(err, errlen, files[i].path, e);
+        }
+        fdt_io_state[slot] = SLOT_FREE;
+        files[i].slot = -1;
+    }
+    return FDT_IO_OK;
+}
+
 static int commit_all(out_file *files, int k, char *err, size_t errlen, int keep)
 {
     for (int i = 0; i < k; i++) {
@@ -244,6 +794,8 @@ static int commit_all(out_file *files, int k, char *err, size_t errlen, int keep
             return set_errno_err(err, errlen, files[i].path, e);
         }
     }
+    if (set_phase == PHASE_OPEN)
+        return defer_all(files, k, err, errlen);
     for (int i = 0; i < k; i++) {
         int slot = files[i].slot;
         fdt_io_state[slot] = SLOT_RENAMING;
@@ -293,6 +845,17 @@ int fdt_out_commit(out_file *files, int k, char *err, size_t errlen)
     return commit_all(files, k, err, errlen, 0);
 }
 
+int fdt_out_remove_at_commit(const char *target, char *err, size_t errlen)
+{
+    if (set_phase == PHASE_OPEN) {
+        int e = set_add(ENT_REMOVE, NULL, target);
+        return e ? set_errno_err(err, errlen, target, e) : FDT_IO_OK;
+    }
+    if (unlink(target) != 0 && errno != ENOENT)
+        return set_errno_err(err, errlen, target, errno);
+    return FDT_IO_OK;
+}
+
 const char *fdt_out_temp(const out_file *o)
 {
     return o->slot >= 0 ? fdt_io_tmp_path[o->slot] : NULL;
@@ -317,7 +880,7 @@ FILE *fdt_wr_side_open(const char *target, fdt_wr_side **side, char *err, size_t
     if (e) {
         free(*side);
         *side = NULL;
-        set_errno_err(err, errlen, target, e);
+        fdt_create_err(err, errlen, "output", target, e);
         return NULL;
     }
     /* The caller writes with stdio: the buffer of out_file is not used. */
@@ -462,6 +1025,14 @@ const fdt_format *fdt_format_by_path(const char *path)
         if (matching_ext(path, f))
             return f;
     return NULL;
+}
+
+const fdt_format *fdt_format_contradicted(const char *path, const fdt_format *f)
+{
+    const fdt_format *by = fdt_format_by_path(path);
+    if (!f || !by || by == f || matching_ext(path, f))
+        return NULL;
+    return by;
 }
 
 const char *fdt_format_name(const fdt_format *f) { return f ? f->name : NULL; }
@@ -660,7 +1231,7 @@ const fdt_format fdt_formats[] = {
      {NULL}, {fdt_put_vtk}, NULL, NULL},
     {"msh", {".msh"}, "gmsh MSH 4.1 ASCII: tets and hull triangles", 0, FDT_LAYOUT_FILE, 0,
      1, {NULL}, {fdt_put_msh41}, NULL, NULL},
-    {"msh2", {NULL}, "gmsh MSH 2.2 ASCII (--format msh2)", 0, FDT_LAYOUT_FILE, 0, 1,
+    {"msh2", {".msh"}, "gmsh MSH 2.2 ASCII (--format msh2)", 0, FDT_LAYOUT_FILE, 0, 1,
      {NULL}, {fdt_put_msh22}, NULL, NULL},
     {"medit", {".mesh"}, "Medit .mesh (MMG, meshio): tets and hull triangles", 0,
      FDT_LAYOUT_FILE, 0, 1, {NULL}, {fdt_put_medit}, NULL, NULL},
@@ -689,8 +1260,7 @@ static const char *missing(const fdt_format *f, const fdt_mesh_view *m)
 }
 
 /* Opens names[0..k) as temporaries, writes part i with put[i] and commits
- * them all or none; keep: leave the slots live (SLOT_RENAMED) for a
- * directory still to be renamed. */
+ * them all or none; keep: KEEP_* of commit_all. */
 static int write_parts(const fdt_format *f, char names[FDT_IO_MAX_FILES][FDT_IO_PATH],
                        int k, const fdt_mesh_view *m, const void *prep, out_file *files,
                        out_meter *meter, char *err, size_t errlen, int keep)
@@ -701,7 +1271,7 @@ static int write_parts(const fdt_format *f, char names[FDT_IO_MAX_FILES][FDT_IO_
         if (e) {
             for (int j = 0; j < i; j++)
                 out_abandon(&files[j]);
-            return set_errno_err(err, errlen, names[i], e);
+            return fdt_create_err(err, errlen, "output", names[i], e);
         }
         files[i].meter = meter;
         int r = f->put[i](&files[i], m, prep, err, errlen);
@@ -740,7 +1310,7 @@ static int write_new_dir(const fdt_format *f, const char *path, const fdt_mesh_v
     memcpy(fdt_io_tmpdir + dirlen + 1, target + dirlen, len - dirlen);
     memcpy(fdt_io_tmpdir + len + 1, suffix, sizeof suffix);
     if (!mkdtemp(fdt_io_tmpdir))
-        return set_errno_err(err, errlen, path, errno);
+        return fdt_create_err(err, errlen, "output", path, errno);
     fdt_io_tmpdir_live = 1;
     int r = FDT_IO_OK;
     /* mkdtemp makes mode 0700: give it a plain mkdir's mode */
@@ -755,9 +1325,25 @@ static int write_new_dir(const fdt_format *f, const char *path, const fdt_mesh_v
         goto out;
     }
     out_file files[FDT_IO_MAX_FILES];
-    r = write_parts(f, names, k, m, prep, files, meter, err, errlen, 1);
-    if (r != FDT_IO_OK)
+    int deferred = set_phase == PHASE_OPEN;
+    r = write_parts(f, names, k, m, prep, files, meter, err, errlen, KEEP_RENAMED);
+    if (r != FDT_IO_OK) {
+        if (deferred)
+            fdt_wr_set_abandon(); /* the parts already in the set go too */
         goto out;
+    }
+    if (deferred) {
+        /* the files are in the set: the directory joins it after them,
+         * and the set removes it from now on */
+        int e = set_add(ENT_DIR, fdt_io_tmpdir, target);
+        if (e) {
+            fdt_wr_set_abandon();
+            r = set_errno_err(err, errlen, path, e);
+            goto out;
+        }
+        fdt_io_tmpdir_live = 0;
+        return FDT_IO_OK;
+    }
     if (rename(fdt_io_tmpdir, target) != 0) {
         r = set_errno_err(err, errlen, path, errno);
         for (int i = 0; i < k; i++)
@@ -821,7 +1407,7 @@ int fdt_wr_mesh_ex(const char *path, const fdt_format *f, const fdt_mesh_view *m
         if (k != f->nparts)
             r = set_errno_err(err, errlen, path, ENAMETOOLONG);
         else
-            r = write_parts(f, names, k, m, prep, files, mt, err, errlen, 0);
+            r = write_parts(f, names, k, m, prep, files, mt, err, errlen, KEEP_NONE);
     }
     free(prep);
     return r;

@@ -46,6 +46,10 @@ const fdt_format *fdt_format_by_name(const char *name);
 /* The row path's extension chooses (a directory format: its last
  * component, "polyMesh"), or NULL. */
 const fdt_format *fdt_format_by_path(const char *path);
+/* When a path's extension names another format than f (--format msh2
+ * with m.vtu): the row the extension chooses; NULL when it agrees (one
+ * of f's extensions: msh2 shares .msh with msh) or names no format. */
+const fdt_format *fdt_format_contradicted(const char *path, const fdt_format *f);
 /* The row's name and whether it is text (may go to standard output). */
 const char *fdt_format_name(const fdt_format *f);
 int fdt_format_is_text(const fdt_format *f);
@@ -114,6 +118,23 @@ int fdt_output_files_as(const char *path, const fdt_format *f,
                         char names[FDT_IO_MAX_FILES][FDT_IO_PATH]);
 
 /*
+ * Creating a file at path (issue 34 item 8): its folder must exist, be a
+ * folder and be writable, and path must not be a folder. Returns 0, or
+ * an errno with "cannot create ROLE PATH: folder DIR does not exist" (or
+ * "...: DIR is not a folder", "folder DIR is not writable (...)", "a
+ * folder has that name") in err: a cheap early answer, so a doomed run
+ * fails in milliseconds rather than after the triangulation; the writer
+ * still checks every step for real. role names what the file is for
+ * ("output", "--stats-json file").
+ */
+int fdt_output_dir_check(const char *role, const char *path, char *err, size_t errlen);
+/* The same message for errno e met creating path, when the folder is
+ * why (ENOENT, ENOTDIR, EACCES, EPERM, EROFS, EISDIR); else "PATH:
+ * strerror" as every write error. Returns FDT_IO_EWRITE (FDT_IO_ENOMEM
+ * for ENOMEM). */
+int fdt_create_err(char *err, size_t errlen, const char *role, const char *path, int e);
+
+/*
  * Do paths a and b reach the same file? 1 if so, else 0. Each path stands
  * for the file that opening it would read or create, symbolic links
  * followed (a dangling link stands for the file it would create):
@@ -141,7 +162,29 @@ FILE *fdt_wr_side_open(const char *target, fdt_wr_side **side, char *err, size_t
 int fdt_wr_side_commit(fdt_wr_side *side, char *err, size_t errlen);
 void fdt_wr_side_abandon(fdt_wr_side *side);
 
-/* Removes every temporary output file not yet renamed. Async-signal-safe. */
+/*
+ * Commit sets (issue 34 item 3): the outputs of one run, all new or all
+ * as they were. After fdt_wr_set_begin() every commit of this module
+ * (fdt_wr_mesh*, the streaming writers' close, fdt_wr_side_commit) only
+ * closes its complete temporaries and adds them to the set;
+ * fdt_wr_set_commit() then renames them all, in the order they came,
+ * backing up the targets it replaces and keeping a journal
+ * ".frontdt-commit-PID" in the first target's folder while it renames
+ * (src/io/write/writer.c, "Commit sets", says how). Any failure, or
+ * SIGINT/SIGTERM (fdt_io_cleanup_temps), before its end puts every
+ * output back as it was and removes every temporary; FDT_IO_OK or
+ * FDT_IO_EWRITE with the file named in err. no_clobber: the commit
+ * refuses (and changes nothing) when a target exists. fdt_wr_set_abandon()
+ * removes the set's temporaries. One set at a time, from one thread:
+ * begin returns -1 while one is open. fdt_wr_set_active(): is one open?
+ */
+int fdt_wr_set_begin(int no_clobber);
+int fdt_wr_set_commit(char *err, size_t errlen);
+void fdt_wr_set_abandon(void);
+int fdt_wr_set_active(void);
+
+/* Removes every temporary output file not yet renamed (and rolls back a
+ * commit set not yet committed). Async-signal-safe. */
 void fdt_io_cleanup_temps(void);
 
 #endif

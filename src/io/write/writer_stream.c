@@ -114,7 +114,7 @@ int fdt_stream_writer_open(fdt_stream_writer **wp, const char *path, const char 
         int e = fdt_out_open(&w->s.files[i], names[i]);
         if (e) {
             abandon_all(w);
-            rc = set_errno_err(diag, diag_size, names[i], e);
+            rc = fdt_create_err(diag, diag_size, "output", names[i], e);
             break;
         }
         w->s.nfiles = i + 1;
@@ -268,11 +268,13 @@ int fdt_stream_writer_close(fdt_stream_writer **wp, int commit, char *diag, size
             rc = public_code(r);
             if (diag && diag_size > 0)
                 snprintf(diag, diag_size, "%s", err);
-        } else if (w->stale[0] && unlink(w->stale) != 0 && errno != ENOENT) {
+        } else if (w->stale[0] &&
+                   fdt_out_remove_at_commit(w->stale, err, sizeof err) != FDT_IO_OK) {
             /* the new .ele stands beside an old .neigh: say so, as a
              * failed write (the mesh files themselves are complete) */
             rc = FDT_EIO;
-            set_err(diag, diag_size, 0, w->stale, strerror(errno));
+            if (diag && diag_size > 0)
+                snprintf(diag, diag_size, "%s", err);
         }
     } else {
         abandon_all(w);
