@@ -351,7 +351,9 @@ typedef struct fdt_stats {
                                  -1: asked but refused or unavailable */
     /* The insertion mesh (fdt_search). */
     size_t mesh_faces;        /* faces whose apex the mesh gave */
-    size_t mesh_parts;        /* parts (fronts) that built a mesh */
+    size_t mesh_parts;        /* parts that read an insertion mesh: their
+                                 own, or the one of every point (one mesh
+                                 read by two parts counts two) */
     double t_mesh;            /* seconds building meshes (summed over threads) */
     /* Memory (issue 18): the bytes each structure held at its largest
      * (all threads together). Added after the first release: a caller

@@ -100,6 +100,20 @@ done
 # from the rank's own points, past their end); every rank count 1-8.
 "$gen" skewlattice 64000 1 "$work/skewlattice.xyz" >/dev/null || fail "gen_points skewlattice"
 check skewlattice "$work/skewlattice.xyz" 1 2 3 4 5 6 7 8
+# The options frontdt-mpi shares with frontdt (issue 35): --quiet and
+# --hash (gathered to rank 0) print what frontdt prints; --hash with a
+# piece output is refused.
+want=$("$frontdt" -q --hash "$work/skewlattice.xyz")
+for np in 1 2 3; do
+  checks=$((checks + 1))
+  got=$(mpi "$np" 300 "$fmpi" --quiet --hash "$work/skewlattice.xyz" 2>"$work/q.err")
+  [[ $got == "$want" && ! -s $work/q.err ]] ||
+    fail "--quiet --hash, $np ranks: '$got' (frontdt: '$want'), stderr $(head -c 200 "$work/q.err")"
+done
+checks=$((checks + 1))
+mpi 2 300 "$fmpi" -q --hash -o "$work/h.pvtu" "$work/skewlattice.xyz" >/dev/null 2>"$work/q.err" &&
+  fail "--hash with a piece output was accepted"
+grep -q -- "--hash gathers the mesh to rank 0" "$work/q.err" || fail "--hash with pieces: no message"
 # A cone (rings of cocircular points, empty spheres as wide as the part):
 # the ranks' probes vote for the replica mesh (src/mpi/mpi_run.c), every rank
 # reads its apexes from its own copy, and no rank asks another (before it,

@@ -322,8 +322,8 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     st->mesh_parts = fst.mesh_parts + (pms.final_tets > 0);
     st->t_mesh = fst.t_mesh + pms.t_mesh;
     st->final_tets = pms.final_tets;
-    st->certified_tets = pms.certified_tets;
-    st->t_certify = pms.t_certify;
+    st->certified_tets = pms.certified_tets + fst.certified_tets;
+    st->t_certify = pms.t_certify + fst.t_certify;
     st->exact_orient += pms.pc.orient_exact;
     st->exact_insphere += pms.pc.insphere_exact;
     st->adapt_orient += pms.pc.orient_adapt;

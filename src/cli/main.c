@@ -836,7 +836,7 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  adaptive orient3d %zu\n"
         "  adaptive insphere %zu\n"
         "  largest front     %zu\n"
-        "  mesh faces        %zu (%zu parts built a mesh in %.3f s)\n"
+        "  mesh faces        %zu (%zu parts read a mesh; %.3f s building meshes)\n"
         "  final from mesh   %zu tets (certified %zu in %.3f s)\n"
         "  threads           %d\n"
         "  mode              %s\n"

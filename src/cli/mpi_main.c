@@ -57,7 +57,7 @@ static void cleanup_outputs(void)
 
 typedef struct opts {
     const char *input, *output, *format;
-    int set_hash, stats, quiet, leaf, no_park;
+    int set_hash, hash, stats, quiet, leaf, no_park;
     int search;          /* fdt_search: --search */
     int fail_rank;
     size_t fail_after;
@@ -82,6 +82,8 @@ static const char usage[] =
     "                      index BASE.pele"
     "  --input-format F    xyz, node or ply (default: by extension)\n"
     "  --set-hash          print the mesh's set hash (equals frontdt's)\n"
+    "  --hash              print the canonical hash of the tet set (equals\n"
+    "                      frontdt's --hash; the mesh is gathered to rank 0)\n"
     "  --stats             per-rank tets and message counts, and their totals\n"
     "  --leaf N            kd-tree leaf size (default 30)\n"
     "  --search HOW        auto (default: the kd search; where it degenerates,\n"
@@ -89,7 +91,7 @@ static const char usage[] =
     "                      kd or mesh (each rank a mesh of its own points)\n"
     "  --no-park           a face waits for each answer of another rank, as\n"
     "                      frontdt --mode message does (for comparison)\n"
-    "  -q                  print nothing but errors (and what is asked)\n";
+    "  -q, --quiet         print nothing but errors (and what is asked)\n";
 
 /* -1: go on; else an exit code. Only rank 0 prints. */
 static int parse(int argc, char **argv, opts *o, int rank, int size)
@@ -112,9 +114,11 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
             i++;
         } else if (!strcmp(a, "--set-hash")) {
             o->set_hash = 1;
+        } else if (!strcmp(a, "--hash")) {
+            o->hash = 1;
         } else if (!strcmp(a, "--stats")) {
             o->stats = 1;
-        } else if (!strcmp(a, "-q")) {
+        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             o->quiet = 1;
         } else if (!strcmp(a, "--no-park")) {
             o->no_park = 1;
@@ -184,6 +188,13 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
         return EX_USAGE;
     }
     o->kind = o->output ? fdt_mpo_kind(o->output) : FDT_MPO_GATHER;
+    if (o->kind != FDT_MPO_GATHER && o->hash) {
+        if (rank == 0)
+            fprintf(stderr, "frontdt-mpi: --hash gathers the mesh to rank 0, which a piece "
+                            "output ('%s') does not: use --set-hash\n",
+                    o->output);
+        return EX_USAGE;
+    }
     if (o->kind != FDT_MPO_GATHER) {
         /* pieces: none of them (nor the .node, nor the index) may be the
          * input */
@@ -343,8 +354,9 @@ static int run(int argc, char **argv, int rank, int size)
     int pieces = o.kind != FDT_MPO_GATHER;
     /* The setup (src/mpi/mpi_setup.h) returns the same code on every rank,
      * with the lowest failing rank's message. */
+    /* the gather (-o to rank 0, --hash) takes the points along */
     fdt_mpi_setup_opts so = {o.input, o.format, o.leaf,
-                             (o.output && !pieces) || o.kind == FDT_MPO_ELE};
+                             (o.output && !pieces) || o.hash || o.kind == FDT_MPO_ELE};
     int err = fdt_mpi_setup(MPI_COMM_WORLD, &so, &L, diag, sizeof diag);
     double t_read = MPI_Wtime() - t0;
     if (err) {
@@ -355,8 +367,8 @@ static int run(int argc, char **argv, int rank, int size)
     }
     setup_stats(&L, rank, size, o.stats);
     int own = !pieces ? 0 : o.kind == FDT_MPO_VTU ? FDT_MPI_OWN_POINTS : FDT_MPI_OWN_HULL;
-    fdt_mpi_opts mo = {o.leaf, o.search, o.output && !pieces, own, o.fail_rank,
-                       o.fail_after, o.no_park};
+    int gather = (o.output && !pieces) || o.hash;
+    fdt_mpi_opts mo = {o.leaf, o.search, gather, own, o.fail_rank, o.fail_after, o.no_park};
     err = fdt_mpi_run(MPI_COMM_WORLD, &L, &mo, &r, diag, sizeof diag);
     if (err) {
         if (rank == 0)
@@ -383,9 +395,10 @@ static int run(int argc, char **argv, int rank, int size)
                     L.n, L.m, r.hash.count, size);
         if (o.set_hash)
             printf("set-hash: %016" PRIx64 "\n", fdt_sethash_value(&r.hash));
-        if (!rc && o.output && !pieces) {
-            /* Gathered to rank 0 in input numbering: one result, written
-             * by the CLI's writers (temporary file, renamed at the end). */
+        if (!rc && gather) {
+            /* Gathered to rank 0 in input numbering: one result, hashed
+             * as frontdt hashes its own, and written by the CLI's writers
+             * (temporary file, renamed at the end). */
             res = calloc(1, sizeof *res);
             if (!res) {
                 rc = EX_RESOURCES;
@@ -400,8 +413,16 @@ static int run(int argc, char **argv, int rank, int size)
                 r.all_tets = NULL;
                 r.all_hull = NULL;
                 r.all_dupmap = NULL;
-                err = fdt_write_mesh(res, r.all_xyz, r.n_input, o.output, NULL, diag,
-                                     sizeof diag);
+                uint64_t h;
+                if (o.hash) {
+                    if (fdt_result_hash(res, &h) == FDT_OK)
+                        printf("hash: %016" PRIx64 "\n", h);
+                    else
+                        rc = EX_RESOURCES;
+                }
+                err = rc || !o.output ? FDT_OK
+                                      : fdt_write_mesh(res, r.all_xyz, r.n_input, o.output,
+                                                       NULL, diag, sizeof diag);
                 if (err) {
                     fprintf(stderr, "frontdt-mpi: %s\n", diag);
                     rc = err == FDT_ENOMEM ? EX_RESOURCES : EX_WRITE;

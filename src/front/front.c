@@ -267,6 +267,8 @@ done:
     st->star_walks = orc.star_walks;
     st->mesh_parts = orc.switched_at != 0;
     st->t_mesh = orc.t_mesh;
+    st->certified_tets = orc.certified;
+    st->t_certify = orc.t_certify;
     fdt_oracle_free(&orc);
     fdt_facetab_free(&ft);
     fdt_faceq_free(&fq);

@@ -40,6 +40,8 @@ typedef struct fdt_front_stats {
     size_t mesh_faces, star_walks, mesh_parts;
     double t_mesh;
     const char *cert_what; /* a mesh failed its certificate: which check */
+    size_t certified_tets; /* finite tets of the meshes certified */
+    double t_certify;      /* seconds certifying them */
     size_t mem_front;   /* bytes of the face table (its largest capacity)
                            and of the face queue (at the end) */
 } fdt_front_stats;

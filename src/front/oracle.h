@@ -78,6 +78,8 @@ typedef struct fdt_oracle {
      * certify.h; err_what says which check): the caller stops the run. */
     int err;
     const char *err_what;
+    size_t certified;     /* finite tets of the meshes it certified */
+    double t_certify;     /* seconds certifying them */
 } fdt_oracle;
 
 /* What an insertion mesh of n points takes at its peak, in bytes: about

@@ -317,6 +317,8 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * their owners and the workers take their ranges: recut_by_mesh moves
      * those ranges. */
     double t_gm = 0.0;
+    size_t certified_gm = 0; /* finite tets of the mesh of every point, certified */
+    double t_cert_gm = 0.0;  /* and the seconds that took */
     /* The probe's choice (not an explicit global_mesh == 1) is dropped
      * when the mesh would not fit the memory available (src/front/oracle.h,
      * FDT_ORACLE_MESH_BYTES): the parts' kd searches are always right. */
@@ -336,11 +338,15 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         if (gerr == FDT_OK) {
             /* proved before any part reads it (issue 31 item 6) */
             fdt_certify_fail why;
-            if ((err = fdt_certify_parallel(&e->gmesh, nthreads, &kq0.pc, &why)) != FDT_OK) {
+            double tc = fdt_now_s();
+            err = fdt_certify_parallel(&e->gmesh, nthreads, &kq0.pc, &why);
+            t_cert_gm = fdt_now_s() - tc;
+            if (err != FDT_OK) {
                 if (err == FDT_ECHECK)
                     fdt_certify_describe(&why, diag, dlen);
                 goto fail;
             }
+            certified_gm = e->gmesh.nfinite;
             e->gmesh_ok = 1;
             if (nthreads > 1 && (err = recut_by_mesh(&pt, &e->gmesh)) != FDT_OK)
                 goto fail;
@@ -566,6 +572,8 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         out->fst.star_walks += w->orc.star_walks;
         out->fst.mesh_parts += w->orc.switched_at != 0 || w->orc.gm;
         out->fst.t_mesh += w->orc.t_mesh;
+        out->fst.certified_tets += w->orc.certified;
+        out->fst.t_certify += w->orc.t_certify;
         out->fst.kq.pc.orient_adapt += w->kq.pc.orient_adapt;
         out->fst.kq.pc.insphere_adapt += w->kq.pc.insphere_adapt;
         if (ts->tets > maxt)
@@ -573,6 +581,8 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         sumt += ts->tets;
     }
     out->fst.t_mesh += t_gm;
+    out->fst.certified_tets += certified_gm;
+    out->fst.t_certify += t_cert_gm;
     out->fst.kq.nodes += kq0.nodes;
     out->fst.kq.points += kq0.points;
     out->fst.kq.pc.orient_exact += kq0.pc.orient_exact;
