@@ -181,13 +181,6 @@ void fdt_parallel_fill_stats(const fdt_par_out *o, fdt_mode mode,
     st->mode = mode;
 }
 
-int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
-                             fdt_mode mode, int nthreads, fdt_par_out *out,
-                             char *diag, size_t dlen)
-{
-    return fdt_parallel_run(pr, s, mode, nthreads, NULL, out, diag, dlen);
-}
-
 /*
  * With the mesh of every point built before the fronts, the tets each id
  * will own (§3.2: a tet belongs to its lowest vertex's part) are known,
