@@ -250,16 +250,7 @@ static int write_node(MPI_Comm comm, const char *name, const fdt_mpi_local *L, u
     memset(sc, 0, (size_t)size * sizeof *sc);
     for (size_t i = 0; i < L->nin; i++)
         sc[block_owner(n, size, (uint64_t)(uint32_t)L->in_id[i])]++;
-    MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, comm);
-    size_t nr = 0;
-    for (int q = 0, at = 0; q < size; q++) {
-        sd[q] = at;
-        at += sc[q];
-        rd[q] = (int)nr;
-        nr += (size_t)rc[q];
-        if (q != rank)
-            io[1] += (uint64_t)sc[q] * sizeof(nrec);
-    }
+    size_t nr = fdt_mpi_counts(comm, sc, sd, rc, rd, sizeof(nrec), &io[1]);
     /* counting sort by destination (sd[] moves on; put back below) */
     for (size_t i = 0; i < L->nin; i++) {
         int q = block_owner(n, size, (uint64_t)(uint32_t)L->in_id[i]);

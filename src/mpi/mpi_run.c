@@ -214,16 +214,7 @@ static int translate(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L, con
         sc[q] = 0;
     for (size_t i = 0; i < nf; i++)
         sc[fdt_partition_owner(&L->pt, F[i])]++;
-    MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, comm);
-    size_t nq = 0;
-    for (int q = 0, at = 0; q < size; q++) {
-        sd[q] = at;
-        at += sc[q];
-        rd[q] = (int)nq;
-        nq += (size_t)rc[q];
-        if (q != rank)
-            *bytes += (uint64_t)sc[q] * sizeof(uint32_t);
-    }
+    size_t nq = fdt_mpi_counts(comm, sc, sd, rc, rd, sizeof(uint32_t), bytes);
     Q = malloc((nq + 1) * sizeof *Q);
     ans = malloc((nq + 1) * sizeof *ans);
     got = malloc((nf + 1) * sizeof *got);
