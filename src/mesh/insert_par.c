@@ -283,17 +283,10 @@ static inline void free_slot(worker *w, uint32_t t)
 static int grow_arrays(shared *sh, uint64_t need)
 {
     fdt_ins *m = sh->m;
-    if (need > INS_MAX_SLOTS)
-        return FDT_ETOOBIG;
-    uint64_t nc = (uint64_t)m->cap + m->cap / 2 + 64;
-    if (nc < need)
-        nc = need;
-    if (nc > INS_MAX_SLOTS)
-        nc = INS_MAX_SLOTS;
-    uint32_t *t = realloc(m->T, (size_t)nc * 8 * sizeof *t);
-    if (!t)
-        return FDT_ENOMEM;
-    m->T = t;
+    uint64_t nc;
+    int err = ins_grow_tets(m, need, &nc);
+    if (err)
+        return err;
     atomic_uchar *lk = malloc((size_t)nc * sizeof *lk);
     if (!lk)
         return FDT_ENOMEM;
@@ -397,22 +390,7 @@ static int walk_locked(worker *w, const double *p, uint32_t start, uint32_t *out
         const uint32_t *v = T + 8 * (size_t)t;
         if (v[0] == INF || v[1] == INF || v[2] == INF || v[3] == INF)
             break;
-        const double *q[4] = {ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]),
-                              ins_pt(m, v[3])};
-        w->rng = w->rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
-        uint32_t r = (uint32_t)(w->rng >> 61);
-        int exit = -1;
-        for (uint32_t j = 0; j < 4; j++) {
-            int k = (int)((r + j) & 3);
-            if (k == from)
-                continue;
-            const double *s[4] = {q[0], q[1], q[2], q[3]};
-            s[k] = p;
-            if (ins_orient(s[0], s[1], s[2], s[3], &w->cnt) < 0) {
-                exit = k;
-                break;
-            }
-        }
+        int exit = ins_walk_exit(m, v, p, from, &w->rng, &w->cnt);
         if (exit < 0)
             break;
         uint32_t nb = v[4 + exit];
@@ -478,16 +456,9 @@ static inline int conflict(worker *w, uint32_t t, const double *p)
     const fdt_ins *m = w->sh->m;
     const uint32_t *v = m->T + 8 * (size_t)t;
     w->st.conflict_tests++;
-    int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
-    if (inf < 0)
-        return ins_insphere(ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3]),
-                            p, &w->cnt) > 0;
-    const double *q[4];
-    for (int i = 0; i < 4; i++)
-        q[i] = i == inf ? p : ins_pt(m, v[i]);
-    int o = ins_orient(q[0], q[1], q[2], q[3], &w->cnt);
-    if (o != 0)
-        return o > 0;
+    int inf = -1, c = ins_conflict_local(m, v, p, &w->cnt, &inf);
+    if (c != INS_CONFLICT_UNDER)
+        return c;
     uint32_t u = v[4 + inf] >> 2;
     int umark, r = lock_live(w, u, &umark);
     if (r == 0)
@@ -500,9 +471,7 @@ static inline int conflict(worker *w, uint32_t t, const double *p)
         }
         w->under[w->nunder++] = u;
     }
-    const uint32_t *x = m->T + 8 * (size_t)u;
-    return ins_insphere(ins_pt(m, x[0]), ins_pt(m, x[1]), ins_pt(m, x[2]), ins_pt(m, x[3]), p,
-                        &w->cnt) > 0;
+    return ins_conflict_finite(m, m->T + 8 * (size_t)u, p, &w->cnt);
 }
 
 /*
@@ -525,20 +494,14 @@ static int insert_point(worker *w, uint32_t pid)
     if (err)
         return err;
     const uint32_t *v0 = m->T + 8 * (size_t)t0;
-    for (int i = 0; i < 4; i++) { /* see src/mesh/insert.c: a duplicate */
-        if (v0[i] == INF)
-            continue;
-        const double *q = ins_pt(m, v0[i]);
-        if (q[0] == p[0] && q[1] == p[1] && q[2] == p[2]) {
-            unlock_slot(sh, t0);
-            return FDT_EINVAL;
-        }
+    if (ins_is_vertex(m, v0, p)) { /* see src/mesh/insert.c: a duplicate */
+        unlock_slot(sh, t0);
+        return FDT_EINVAL;
     }
     w->ncav = w->nbnd = w->nout = w->nunder = 0;
     set_mark(w, t0, MARK_IN);
     w->cav[w->ncav++] = t0;
-    for (int j = 0; j < 4; j++)
-        fdt_prefetch(m->T + 8 * (size_t)(v0[4 + j] >> 2));
+    ins_prefetch_nbrs(m->T, t0);
     for (size_t ci = 0; ci < w->ncav; ci++) {
         uint32_t c = w->cav[ci];
         for (int k = 0; k < 4; k++) {
@@ -609,10 +572,7 @@ static int insert_point(worker *w, uint32_t pid)
         return FDT_EINTERNAL; /* the build fails: what stays locked does not matter */
     for (size_t i = 0; i < w->ncav; i++)
         free_slot(w, w->cav[i]);
-    w->st.cavity_tets += w->ncav;
-    w->st.created_tets += w->nbnd;
-    if (w->ncav > w->st.max_cavity)
-        w->st.max_cavity = w->ncav;
+    ins_count_cavity(&w->st, w->ncav, w->nbnd);
     /* Release: every write above happens before the next holder's
      * acquire. The coplanar rule's tets first: a freed cavity slot is
      * told from them by its tet (unlock_under). */
