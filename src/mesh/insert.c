@@ -554,14 +554,8 @@ int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
 int fdt_ins_build_progress(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                            fdt_pred_counts *cnt, fdt_progress_fn progress, void *puser)
 {
-    memset(m, 0, sizeof *m);
-    if (n < 4) {
-        m->P = P;
-        m->base = base;
-        m->n = n;
-        m->free_head = FDT_NONE;
+    if (ins_begin(m, P, base, n) != FDT_OK)
         return FDT_EDEGENERATE;
-    }
     uint32_t *order = malloc((size_t)n * sizeof *order);
     if (!order)
         return FDT_ENOMEM;

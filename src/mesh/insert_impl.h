@@ -179,6 +179,21 @@ static inline void ins_prefetch_nbrs(const uint32_t *T, uint32_t t)
         fdt_prefetch(T + 8 * (size_t)(nb[j] >> 2));
 }
 
+/* A build's start: m emptied for the points [base, base + n) of P.
+ * FDT_EDEGENERATE when n < 4 (m then names the points and holds no tet),
+ * else FDT_OK. */
+static inline int ins_begin(fdt_ins *m, const double *P, uint32_t base, uint32_t n)
+{
+    memset(m, 0, sizeof *m);
+    if (n >= 4)
+        return FDT_OK;
+    m->P = P;
+    m->base = base;
+    m->n = n;
+    m->free_head = FDT_NONE;
+    return FDT_EDEGENERATE;
+}
+
 /* An insertion's counts: its cavity of ncav tets and its nnew new ones. */
 static inline void ins_count_cavity(fdt_ins_stats *st, size_t ncav, size_t nnew)
 {

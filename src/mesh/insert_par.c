@@ -1091,14 +1091,8 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
         nthreads = 1;
     if (nthreads > MAX_WORKERS)
         nthreads = MAX_WORKERS;
-    memset(m, 0, sizeof *m);
-    if (n < 4) {
-        m->P = P;
-        m->base = base;
-        m->n = n;
-        m->free_head = FDT_NONE;
+    if (ins_begin(m, P, base, n) != FDT_OK)
         return FDT_EDEGENERATE;
-    }
     int nw = nthreads;
     uint32_t *order = malloc((size_t)n * sizeof *order);
     size_t *rend = malloc((size_t)nw * 32 * sizeof *rend);
