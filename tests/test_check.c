@@ -20,6 +20,7 @@
  * the hull: a double (and triple) cover (a star bipyramid winding around
  * its axis), two disjoint tets, two tets sharing only an edge or a vertex.
  */
+#include "base/hash.h"
 #include "frontdt.h"
 #include "geom/predicates.h"
 
@@ -283,11 +284,7 @@ static uint64_t rng_state;
 
 static uint64_t rng_next(void)
 {
-    /* splitmix64 */
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
+    return fdt_splitmix64(&rng_state);
 }
 
 static double rng_unit(void)

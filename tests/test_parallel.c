@@ -29,6 +29,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base/hash.h"
 #include "frontdt.h"
 #include "par/parallel.h"
 #include "geom/partition.h"
@@ -46,10 +47,7 @@ typedef struct rng {
 /* splitmix64: plenty for test inputs, identical everywhere. */
 static uint64_t rnext(rng *r)
 {
-    uint64_t z = (r->s += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
+    return fdt_splitmix64(&r->s);
 }
 
 static double runif(rng *r)

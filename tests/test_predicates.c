@@ -54,6 +54,7 @@
  * Usage: test_predicates [seed [scale [verbose]]]; scale multiplies the
  * case counts (e.g. 0.05 under valgrind, 10 for a long run).
  */
+#include "base/hash.h"
 #include "geom/predicates.h"
 
 #include <gmp.h>
@@ -91,10 +92,7 @@ typedef struct tctx {
 
 static uint64_t next_u64(tctx *T)
 {
-    uint64_t z = (T->rng += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
+    return fdt_splitmix64(&T->rng);
 }
 
 /* Uniform in [0, 1). */

@@ -15,6 +15,7 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 
+#include "base/hash.h"
 #include "io/read/read_common.h"
 #include "io/read/reader.h"
 
@@ -60,10 +61,7 @@ static void fail_at(tctx *t, int line, const char *fmt, ...)
 
 static uint64_t rnd(tctx *t)
 {
-    uint64_t z = (t->rng += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
+    return fdt_splitmix64(&t->rng);
 }
 
 static uint64_t rnd_below(tctx *t, uint64_t n)

@@ -20,6 +20,7 @@
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L /* mkdtemp */
 #endif
+#include "base/hash.h"
 #include "io/read/reader.h"
 #include "mesh/result.h"
 #include "testutil.h"
@@ -35,10 +36,7 @@ static uint64_t rng_state = 0x16u;
 
 static uint64_t rnd(void)
 {
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
+    return fdt_splitmix64(&rng_state);
 }
 
 /* uniform in [0, m) (the modulo bias is irrelevant here) */

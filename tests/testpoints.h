@@ -12,13 +12,12 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "base/hash.h"
+
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 static inline uint64_t rnd(void)
 {
-    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
+    return fdt_splitmix64(&rng_state);
 }
 static inline double urand(void) { return (double)(rnd() >> 11) * 0x1p-53; }
 

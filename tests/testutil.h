@@ -22,6 +22,8 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "base/hash.h"
+
 #define CHECK(cond)                                                          \
     do {                                                                     \
         if (!(cond)) {                                                       \
@@ -130,10 +132,7 @@ static inline int test_report(const char *name)
  * state *s, any start value. */
 static inline uint64_t test_rand64(uint64_t *s)
 {
-    uint64_t z = (*s += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
+    return fdt_splitmix64(s);
 }
 
 /* Uniform in [0, 1), 53 bits. */

@@ -147,55 +147,57 @@ static uint32_t central_point(const fdt_kdtree *t)
  * renumbered at the end), else every tet and hull face leaves through the
  * caller's sink as it is built (src/front/sink.h) and the result keeps none.
  */
-static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *user,
-               fdt_result **out)
-{
-    if (!ctx || !out || (!xyz && n))
-        return FDT_EINVAL;
-    *out = NULL;
-    ctx->diag[0] = '\0';
-    /* AUTO: serial for one thread, shared otherwise; 0 threads: one per
-     * physical core. Shared and message run src/par/parallel.c, which fills
-     * the same meshbuf (global tree-order ids) and counters. */
-    fdt_mode mode = ctx->s.mode;
-    int nthreads = ctx->s.n_threads;
-    if (mode != FDT_MODE_SERIAL && nthreads == 0)
-        nthreads = fdt_parallel_default_threads();
-    if (mode == FDT_MODE_AUTO)
-        mode = nthreads == 1 ? FDT_MODE_SERIAL : FDT_MODE_SHARED;
-    double t0 = fdt_now_s();
+/* One run's state, from the prepared points to the result (run's steps). */
+typedef struct run_state {
     fdt_prepared pr;
-    fdt_kdtree tree = {0};
-    fdt_meshbuf mb = {0};
-    fdt_par_out par;
-    memset(&par, 0, sizeof par);
-    fdt_result *r = NULL;
+    fdt_kdtree tree;          /* serial: the one kd-tree */
+    fdt_meshbuf mb;           /* the mesh, until the result takes it */
+    fdt_par_out par;          /* parallel: the engine's output */
     fdt_tsink sink;
-    fdt_emit em;
-    memset(&em, 0, sizeof em);
-    if (fdt_tsink_init(&sink, NULL, user) != FDT_OK)
-        return FDT_ENOMEM;
+    fdt_emit em;              /* serial: the front's emitter */
+    fdt_front_stats fst;
+    fdt_partmesh_stats pms;   /* serial: the one-part engine's counters */
+    size_t mem_tree, mem_mesh, mem_sink;
+} run_state;
+
+/* The mode and thread count the settings ask for. AUTO: serial for one
+ * thread, shared otherwise; 0 threads: one per physical core. Shared and
+ * message run src/par/parallel.c, which fills the same meshbuf (global
+ * tree-order ids) and counters. */
+static void run_mode(const fdt_context *ctx, fdt_mode *mode, int *nthreads)
+{
+    *mode = ctx->s.mode;
+    *nthreads = ctx->s.n_threads;
+    if (*mode != FDT_MODE_SERIAL && *nthreads == 0)
+        *nthreads = fdt_parallel_default_threads();
+    if (*mode == FDT_MODE_AUTO)
+        *mode = *nthreads == 1 ? FDT_MODE_SERIAL : FDT_MODE_SHARED;
+}
+
+/* The points checked, merged and scaled into pr (src/geom/prepare.h). */
+static int run_prepare(fdt_context *ctx, const double *xyz, size_t n, fdt_mode mode,
+                       int nthreads, fdt_prepared *pr)
+{
     /* The merge runs on the engine's threads in parallel modes; serial
      * mode stays sequential from end to end. */
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
     /* permute_input: the caller's array becomes the point store (the
      * const was the caller's to give up, include/frontdt.h). */
-    int err = ctx->s.permute_input
-                  ? fdt_prepare_inplace((double *)(uintptr_t)xyz, n, &pr, ctx->diag,
-                                        sizeof ctx->diag)
-                  : fdt_prepare(xyz, n,
-                                mode == FDT_MODE_SERIAL          ? 1
-                                : cpus >= 1 && nthreads > cpus ? (int)cpus
-                                                               : nthreads,
-                                &pr, ctx->diag, sizeof ctx->diag);
-    if (err) {
-        fdt_tsink_free(&sink);
-        return err;
-    }
-    sink.orig = pr.orig;
-    if ((err = fdt_seed_check_dimension(pr.p, pr.orig, (uint32_t)pr.m, ctx->diag,
-                                        sizeof ctx->diag)) != FDT_OK)
-        goto fail;
+    return ctx->s.permute_input
+               ? fdt_prepare_inplace((double *)(uintptr_t)xyz, n, pr, ctx->diag,
+                                     sizeof ctx->diag)
+               : fdt_prepare(xyz, n,
+                             mode == FDT_MODE_SERIAL          ? 1
+                             : cpus >= 1 && nthreads > cpus ? (int)cpus
+                                                            : nthreads,
+                             pr, ctx->diag, sizeof ctx->diag);
+}
+
+/* The parallel engine (src/par/parallel.c); *t1: when the preparation
+ * ended (partition, trees and seeds count as preparation). */
+static int run_parallel(fdt_context *ctx, fdt_mode mode, int nthreads, const fdt_sink *user,
+                        run_state *rs, double *t1)
+{
     /* Inputs where the kd search degenerates (src/front/oracle.h,
      * fdt_oracle_probe): parts with meshes of their own points ask each
      * other about every face whose sphere crosses a cut, and there the
@@ -213,149 +215,196 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     fdt_par_opts popt;
     memset(&popt, 0, sizeof popt);
     if (user)
-        popt.sink = &sink;
-    if (mode != FDT_MODE_SERIAL && ctx->s.search == FDT_SEARCH_AUTO)
+        popt.sink = &rs->sink;
+    if (ctx->s.search == FDT_SEARCH_AUTO)
         popt.global_mesh = FDT_PAR_MESH_PROBE; /* beside the partition */
-    double t1;
-    size_t mem_tree = 0, mem_mesh = 0, mem_sink = 0;
-    fdt_front_stats fst;
-    memset(&fst, 0, sizeof fst);
-    fdt_partmesh_stats pms;
-    memset(&pms, 0, sizeof pms);
-    if (mode != FDT_MODE_SERIAL) {
-        double tp = fdt_now_s();
-        err = fdt_parallel_run(&pr, &ctx->s, mode, nthreads, &popt, &par, ctx->diag,
+    double tp = fdt_now_s();
+    int err = fdt_parallel_run(&rs->pr, &ctx->s, mode, nthreads, &popt, &rs->par, ctx->diag,
                                sizeof ctx->diag);
-        if (err)
-            goto fail;
-        mb = par.mb;
-        memset(&par.mb, 0, sizeof par.mb);
-        fst = par.fst;
-        t1 = tp + par.t_setup; /* partition, trees and seeds count as preparation */
-    } else {
-        err = FDT_ENOMEM;
-        if (fdt_kd_build(&tree, pr.p, pr.orig, 0, (uint32_t)pr.m, ctx->s.leaf_size) != FDT_OK)
-            goto fail;
-        mem_tree = fdt_kd_bytes(&tree);
-        if (!user &&
-            fdt_meshbuf_init(&mb, (size_t)(6.9 * (double)pr.m) + 64, ctx->s.neighbors) != FDT_OK)
-            goto fail;
-        if (fdt_emit_init(&em, &sink, &mb) != FDT_OK)
-            goto fail;
-        t1 = fdt_now_s();
-        /* The path is a function of the settings alone (issue 31): in
-         * memory, --search auto and mesh run the one-part engine (the
-         * insertion mesh, certified, is the answer); --search kd, and a
-         * streamed run, whose memory must stay bounded, run the paper's
-         * front. */
-        if (ctx->s.search != FDT_SEARCH_KD && !user) {
-            /* the tree only put the points in its (spatially coherent)
-             * order, which the insertion's BRIO rounds keep */
-            fdt_kd_free(&tree);
-            err = fdt_partmesh_emit_all(pr.p, (uint32_t)pr.m, &em, ctx->s.progress,
-                                        ctx->s.progress_user, &pms, ctx->diag,
-                                        sizeof ctx->diag);
-        } else
-            err = fdt_front_emit(&tree, central_point(&tree), (int)ctx->s.search, &em,
-                                 ctx->s.progress, ctx->s.progress_user, &fst);
-        if (!err)
-            err = fdt_emit_flush(&em);
-        mem_mesh = fdt_meshbuf_bytes(&mb);
-        mem_sink = fdt_emit_bytes(&em);
+    if (err)
+        return err;
+    rs->mb = rs->par.mb;
+    memset(&rs->par.mb, 0, sizeof rs->par.mb);
+    rs->fst = rs->par.fst;
+    *t1 = tp + rs->par.t_setup;
+    return FDT_OK;
+}
+
+/* The serial engine: one kd-tree, then the one-part engine or the front;
+ * *t1: when the preparation ended. */
+static int run_serial(fdt_context *ctx, const fdt_sink *user, run_state *rs, double *t1)
+{
+    fdt_prepared *pr = &rs->pr;
+    if (fdt_kd_build(&rs->tree, pr->p, pr->orig, 0, (uint32_t)pr->m, ctx->s.leaf_size) != FDT_OK)
+        return FDT_ENOMEM;
+    rs->mem_tree = fdt_kd_bytes(&rs->tree);
+    if (!user &&
+        fdt_meshbuf_init(&rs->mb, (size_t)(6.9 * (double)pr->m) + 64, ctx->s.neighbors) != FDT_OK)
+        return FDT_ENOMEM;
+    if (fdt_emit_init(&rs->em, &rs->sink, &rs->mb) != FDT_OK)
+        return FDT_ENOMEM;
+    *t1 = fdt_now_s();
+    /* The path is a function of the settings alone (issue 31): in
+     * memory, --search auto and mesh run the one-part engine (the
+     * insertion mesh, certified, is the answer); --search kd, and a
+     * streamed run, whose memory must stay bounded, run the paper's
+     * front. */
+    int err;
+    if (ctx->s.search != FDT_SEARCH_KD && !user) {
+        /* the tree only put the points in its (spatially coherent) order,
+         * which the insertion's BRIO rounds keep */
+        fdt_kd_free(&rs->tree);
+        err = fdt_partmesh_emit_all(pr->p, (uint32_t)pr->m, &rs->em, ctx->s.progress,
+                                    ctx->s.progress_user, &rs->pms, ctx->diag, sizeof ctx->diag);
+    } else
+        err = fdt_front_emit(&rs->tree, central_point(&rs->tree), (int)ctx->s.search, &rs->em,
+                             ctx->s.progress, ctx->s.progress_user, &rs->fst);
+    if (!err)
+        err = fdt_emit_flush(&rs->em);
+    rs->mem_mesh = fdt_meshbuf_bytes(&rs->mb);
+    rs->mem_sink = fdt_emit_bytes(&rs->em);
+    if (err == FDT_ENOMEM)
+        snprintf(ctx->diag, sizeof ctx->diag, "out of memory after %lld tetrahedra",
+                 (long long)rs->em.ntets);
+    else if (err == FDT_ECHECK && !ctx->diag[0])
+        snprintf(ctx->diag, sizeof ctx->diag, "mesh certificate failed: %s",
+                 rs->fst.cert_what ? rs->fst.cert_what : "?");
+    else if (err == FDT_EINTERNAL && !ctx->diag[0])
+        snprintf(ctx->diag, sizeof ctx->diag,
+                 "internal error: the front became inconsistent after %lld tetrahedra",
+                 (long long)rs->em.ntets);
+    return err;
+}
+
+/* The mesh into r, in the caller's numbering (the sink's one rule,
+ * fdt_sink_renumber; same width, so the buffers are reused). The parallel
+ * engine's threads did that as they gathered the mesh; a streamed run's
+ * tets were renumbered as they left. r takes the buffers and the
+ * duplicate map. */
+static void result_take(fdt_result *r, run_state *rs, fdt_mode mode, const fdt_sink *user,
+                        size_t n)
+{
+    fdt_meshbuf *mb = &rs->mb;
+    fdt_vid *tets = (fdt_vid *)mb->tets;
+    fdt_vid *hull = (fdt_vid *)mb->hull;
+    if (mode == FDT_MODE_SERIAL && !user) {
+        fdt_sink_renumber(rs->pr.orig, tets, mb->tets, 4 * mb->ntets);
+        fdt_sink_renumber(rs->pr.orig, hull, mb->hull, 3 * mb->nhull);
     }
+    if (user) {
+        r->streamed = 1;
+        r->set_hash = fdt_sethash_value(&rs->sink.hash);
+    }
+    r->tets = tets;
+    r->ntets = mb->ntets;
+    r->nbrs = mb->nbrs;
+    r->hull = hull;
+    r->nhull = mb->nhull;
+    r->dupmap = rs->pr.dupmap;
+    rs->pr.dupmap = NULL;
+    r->n = n;
+    r->ndup = rs->pr.ndup;
+    memset(mb, 0, sizeof *mb);
+}
+
+/* The run's statistics into r->stats (r->tstats takes the threads'):
+ * t0, t1, t2 the start, the end of the preparation and of the front. */
+static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, const fdt_sink *user,
+                         size_t n, double t0, double t1, double t2)
+{
+    const fdt_prepared *pr = &rs->pr;
+    const fdt_front_stats *fst = &rs->fst;
+    const fdt_partmesh_stats *pms = &rs->pms;
+    fdt_stats *st = &r->stats;
+    st->points = n;
+    st->vertices = pr->m;
+    st->tets = user ? rs->sink.ntets : r->ntets;
+    st->hull_faces = user ? rs->sink.nhull : r->nhull;
+    st->faces_advanced = fst->faces_advanced;
+    st->kd_nodes_visited = fst->kq.nodes;
+    st->points_tested = fst->kq.points;
+    st->exact_orient = fst->kq.pc.orient_exact;
+    st->exact_insphere = fst->kq.pc.insphere_exact;
+    st->adapt_orient = fst->kq.pc.orient_adapt;
+    st->adapt_insphere = fst->kq.pc.insphere_adapt;
+    st->max_front = fst->max_front;
+    st->mesh_faces = fst->mesh_faces;
+    st->mesh_parts = fst->mesh_parts + (pms->final_tets > 0);
+    st->t_mesh = fst->t_mesh + pms->t_mesh;
+    st->final_tets = pms->final_tets;
+    st->certified_tets = pms->certified_tets + fst->certified_tets;
+    st->t_certify = pms->t_certify + fst->t_certify;
+    st->exact_orient += pms->pc.orient_exact;
+    st->exact_insphere += pms->pc.insphere_exact;
+    st->adapt_orient += pms->pc.orient_adapt;
+    st->adapt_insphere += pms->pc.insphere_adapt;
+    st->threads = 1;
+    st->mode = FDT_MODE_SERIAL;
+    /* Memory (include/frontdt.h): the points' three arrays, then each
+     * structure at its largest. */
+    st->mem_points = pr->m * (3 * sizeof *pr->p + sizeof *pr->orig) + n * sizeof *pr->dupmap;
+    st->mem_merge = pr->merge_bytes;
+    st->mem_tree = rs->mem_tree;
+    st->mem_front = fst->mem_front;
+    st->mem_mesh = rs->mem_mesh;
+    st->mem_sink = rs->mem_sink;
+    st->t_prepare = t1 - t0;
+    st->t_front = t2 - t1;
+    st->t_finish = fdt_now_s() - t2;
+    if (mode != FDT_MODE_SERIAL) {
+        fdt_parallel_fill_stats(&rs->par, mode, st);
+        st->t_front = rs->par.t_front;
+        st->t_finish += rs->par.t_gather;
+        r->tstats = rs->par.tstats;
+        rs->par.tstats = NULL;
+        st->mem_tree = rs->par.pst.mem_tree;
+        st->mem_front = rs->par.pst.mem_front;
+        st->mem_mesh = rs->par.pst.mem_mesh;
+        st->mem_sink = rs->par.pst.mem_sink;
+    }
+}
+
+static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *user,
+               fdt_result **out)
+{
+    if (!ctx || !out || (!xyz && n))
+        return FDT_EINVAL;
+    *out = NULL;
+    ctx->diag[0] = '\0';
+    fdt_mode mode;
+    int nthreads;
+    run_mode(ctx, &mode, &nthreads);
+    double t0 = fdt_now_s();
+    run_state rs;
+    memset(&rs, 0, sizeof rs);
+    fdt_result *r = NULL;
+    if (fdt_tsink_init(&rs.sink, NULL, user) != FDT_OK)
+        return FDT_ENOMEM;
+    int err = run_prepare(ctx, xyz, n, mode, nthreads, &rs.pr);
     if (err) {
-        if (err == FDT_ENOMEM)
-            snprintf(ctx->diag, sizeof ctx->diag, "out of memory after %lld tetrahedra",
-                     (long long)em.ntets);
-        else if (err == FDT_ECHECK && !ctx->diag[0])
-            snprintf(ctx->diag, sizeof ctx->diag, "mesh certificate failed: %s",
-                     fst.cert_what ? fst.cert_what : "?");
-        else if (err == FDT_EINTERNAL && !ctx->diag[0])
-            snprintf(ctx->diag, sizeof ctx->diag,
-                     "internal error: the front became inconsistent after %lld tetrahedra",
-                     (long long)em.ntets);
-        goto fail;
+        fdt_tsink_free(&rs.sink);
+        return err;
     }
+    rs.sink.orig = rs.pr.orig;
+    if ((err = fdt_seed_check_dimension(rs.pr.p, rs.pr.orig, (uint32_t)rs.pr.m, ctx->diag,
+                                        sizeof ctx->diag)) != FDT_OK)
+        goto fail;
+    double t1;
+    err = mode != FDT_MODE_SERIAL ? run_parallel(ctx, mode, nthreads, user, &rs, &t1)
+                                  : run_serial(ctx, user, &rs, &t1);
+    if (err)
+        goto fail;
     double t2 = fdt_now_s();
     err = FDT_ENOMEM;
     r = calloc(1, sizeof *r);
     if (!r)
         goto fail;
-    /* Renumber into the caller's numbering in place (the sink's one rule,
-     * fdt_sink_renumber; same width, so the buffers are reused). The
-     * parallel engine's threads did that as they gathered the mesh; a
-     * streamed run's tets were renumbered as they left. */
-    fdt_vid *tets = (fdt_vid *)mb.tets;
-    fdt_vid *hull = (fdt_vid *)mb.hull;
-    if (mode == FDT_MODE_SERIAL && !user) {
-        fdt_sink_renumber(pr.orig, tets, mb.tets, 4 * mb.ntets);
-        fdt_sink_renumber(pr.orig, hull, mb.hull, 3 * mb.nhull);
-    }
-    if (user) {
-        r->streamed = 1;
-        r->set_hash = fdt_sethash_value(&sink.hash);
-    }
-    r->tets = tets;
-    r->ntets = mb.ntets;
-    r->nbrs = mb.nbrs;
-    r->hull = hull;
-    r->nhull = mb.nhull;
-    r->dupmap = pr.dupmap;
-    pr.dupmap = NULL;
-    r->n = n;
-    r->ndup = pr.ndup;
-    memset(&mb, 0, sizeof mb);
-    fdt_stats *st = &r->stats;
-    st->points = n;
-    st->vertices = pr.m;
-    st->tets = user ? sink.ntets : r->ntets;
-    st->hull_faces = user ? sink.nhull : r->nhull;
-    st->faces_advanced = fst.faces_advanced;
-    st->kd_nodes_visited = fst.kq.nodes;
-    st->points_tested = fst.kq.points;
-    st->exact_orient = fst.kq.pc.orient_exact;
-    st->exact_insphere = fst.kq.pc.insphere_exact;
-    st->adapt_orient = fst.kq.pc.orient_adapt;
-    st->adapt_insphere = fst.kq.pc.insphere_adapt;
-    st->max_front = fst.max_front;
-    st->mesh_faces = fst.mesh_faces;
-    st->mesh_parts = fst.mesh_parts + (pms.final_tets > 0);
-    st->t_mesh = fst.t_mesh + pms.t_mesh;
-    st->final_tets = pms.final_tets;
-    st->certified_tets = pms.certified_tets + fst.certified_tets;
-    st->t_certify = pms.t_certify + fst.t_certify;
-    st->exact_orient += pms.pc.orient_exact;
-    st->exact_insphere += pms.pc.insphere_exact;
-    st->adapt_orient += pms.pc.orient_adapt;
-    st->adapt_insphere += pms.pc.insphere_adapt;
-    st->threads = 1;
-    st->mode = FDT_MODE_SERIAL;
-    /* Memory (include/frontdt.h): the points' three arrays, then each
-     * structure at its largest. */
-    st->mem_points = pr.m * (3 * sizeof *pr.p + sizeof *pr.orig) + n * sizeof *pr.dupmap;
-    st->mem_merge = pr.merge_bytes;
-    st->mem_tree = mem_tree;
-    st->mem_front = fst.mem_front;
-    st->mem_mesh = mem_mesh;
-    st->mem_sink = mem_sink;
-    st->t_prepare = t1 - t0;
-    st->t_front = t2 - t1;
-    st->t_finish = fdt_now_s() - t2;
-    if (mode != FDT_MODE_SERIAL) {
-        fdt_parallel_fill_stats(&par, mode, st);
-        st->t_front = par.t_front;
-        st->t_finish += par.t_gather;
-        r->tstats = par.tstats;
-        par.tstats = NULL;
-        st->mem_tree = par.pst.mem_tree;
-        st->mem_front = par.pst.mem_front;
-        st->mem_mesh = par.pst.mem_mesh;
-        st->mem_sink = par.pst.mem_sink;
-    }
-    fdt_emit_free(&em);
-    fdt_tsink_free(&sink);
-    fdt_kd_free(&tree);
-    fdt_prepared_free(&pr);
+    result_take(r, &rs, mode, user, n);
+    result_stats(r, &rs, mode, user, n, t0, t1, t2);
+    fdt_emit_free(&rs.em);
+    fdt_tsink_free(&rs.sink);
+    fdt_kd_free(&rs.tree);
+    fdt_prepared_free(&rs.pr);
     if (ctx->s.progress)
         ctx->s.progress(ctx->s.progress_user, 1.0);
     *out = r;
@@ -365,12 +414,12 @@ fail:
         snprintf(ctx->diag, sizeof ctx->diag, "out of memory triangulating %zu points", n);
     if (err == FDT_ECANCELED && !ctx->diag[0])
         snprintf(ctx->diag, sizeof ctx->diag, "canceled");
-    fdt_emit_free(&em);
-    fdt_tsink_free(&sink);
-    fdt_meshbuf_free(&mb);
-    fdt_par_out_free(&par);
-    fdt_kd_free(&tree);
-    fdt_prepared_free(&pr);
+    fdt_emit_free(&rs.em);
+    fdt_tsink_free(&rs.sink);
+    fdt_meshbuf_free(&rs.mb);
+    fdt_par_out_free(&rs.par);
+    fdt_kd_free(&rs.tree);
+    fdt_prepared_free(&rs.pr);
     fdt_result_free(&r);
     return err;
 }

@@ -17,28 +17,19 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "base/hash.h"
+
 /* An accumulator: partial sums of disjoint sets add (fdt_sethash_merge). */
 typedef struct fdt_sethash {
     uint64_t sum;
     uint64_t count;
 } fdt_sethash;
 
-/* The finaliser of SplitMix64 (Steele, Lea, Flood, OOPSLA 2014): every
- * input bit flips each output bit with probability close to 1/2, so sums
- * of mixes of distinct tets do not cancel by structure. */
-static inline uint64_t fdt_mix64(uint64_t z)
-{
-    z ^= z >> 30;
-    z *= 0xBF58476D1CE4E5B9ull;
-    z ^= z >> 27;
-    z *= 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return z;
-}
-
 /* The mix of one tet, ids in any order (sorted here by a network of five
- * compare-exchanges). Two 32-bit pairs, each mixed, chained so (a,b,c,d)
- * and (c,d,a,b) differ. */
+ * compare-exchanges). Two 32-bit pairs, each mixed with SplitMix64's
+ * finaliser (src/base/hash.h: every input bit flips each output bit with
+ * probability close to 1/2, so sums of mixes of distinct tets do not
+ * cancel by structure), chained so (a,b,c,d) and (c,d,a,b) differ. */
 static inline uint64_t fdt_sethash_tet(const uint32_t t[4])
 {
     uint32_t a = t[0], b = t[1], c = t[2], d = t[3], x;

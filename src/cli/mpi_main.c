@@ -41,8 +41,8 @@ enum {
  * mpirun passes an interrupt on to every rank (Open MPI forwards SIGINT
  * and SIGTERM, MPICH's hydra SIGINT). Each rank removes what it is
  * writing, as frontdt does (fdt_write_cleanup: the temporaries of a write
- * in progress), and the files of a distributed output while that output
- * is not complete on every rank (fdt_mpo_cleanup, src/mpi/mpi_output.h), so
+ * in progress, and the files of a distributed output while that output
+ * is not complete on every rank, src/mpi/mpi_output.h), so
  * an interrupted run leaves no output, and leaves with exit code 6
  * without waiting for the others (which the same signal ends; a rank
  * that left early keeps the others in fdt_mpo_write's last barrier until
@@ -51,8 +51,7 @@ enum {
  * removed) instead of killing the rank (src/cli/cli.h). */
 static void cleanup_outputs(void)
 {
-    fdt_write_cleanup(); /* both async-signal-safe: unlink only */
-    fdt_mpo_cleanup();
+    fdt_write_cleanup(); /* async-signal-safe: unlink only */
 }
 
 typedef struct opts {

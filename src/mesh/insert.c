@@ -89,18 +89,10 @@ static int reserve_slots(build *b, uint32_t extra)
     fdt_ins *m = b->m;
     if ((uint64_t)b->nfree + (m->cap - m->nslots) >= extra)
         return FDT_OK;
-    uint64_t need = (uint64_t)m->nslots + extra - b->nfree;
-    if (need > INS_MAX_SLOTS)
-        return FDT_ETOOBIG;
-    uint64_t nc = (uint64_t)m->cap + m->cap / 2 + 64;
-    if (nc < need)
-        nc = need;
-    if (nc > INS_MAX_SLOTS)
-        nc = INS_MAX_SLOTS;
-    uint32_t *t = realloc(m->T, (size_t)nc * 8 * sizeof *t);
-    if (!t)
-        return FDT_ENOMEM;
-    m->T = t;
+    uint64_t need = (uint64_t)m->nslots + extra - b->nfree, nc;
+    int err = ins_grow_tets(m, need, &nc);
+    if (err)
+        return err;
     uint8_t *mk = realloc(b->mark, (size_t)nc);
     if (!mk)
         return FDT_ENOMEM;
@@ -159,21 +151,7 @@ static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng
         const uint32_t *v = T + 8 * (size_t)t;
         if (v[0] == INF || v[1] == INF || v[2] == INF || v[3] == INF)
             break;
-        const double *q[4] = {ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3])};
-        *rng = *rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
-        uint32_t r = (uint32_t)(*rng >> 61);
-        int exit = -1;
-        for (uint32_t j = 0; j < 4; j++) {
-            int k = (int)((r + j) & 3);
-            if (k == from)
-                continue;
-            const double *s[4] = {q[0], q[1], q[2], q[3]};
-            s[k] = p;
-            if (ins_orient(s[0], s[1], s[2], s[3], cnt) < 0) {
-                exit = k;
-                break;
-            }
-        }
+        int exit = ins_walk_exit(m, v, p, from, rng, cnt);
         if (exit < 0)
             break;
         uint32_t nb = v[4 + exit];
@@ -195,20 +173,8 @@ static int locate(build *b, const double *p, uint32_t start, uint32_t *out)
 /* Whether tet t is in conflict with p (see the top for infinite tets). */
 static inline int conflict(build *b, uint32_t t, const double *p)
 {
-    const fdt_ins *m = b->m;
-    const uint32_t *v = m->T + 8 * (size_t)t;
     b->m->stats.conflict_tests++;
-    int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
-    if (inf < 0)
-        return ins_insphere(ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3]), p, b->cnt) > 0;
-    const double *q[4];
-    for (int i = 0; i < 4; i++)
-        q[i] = i == inf ? p : ins_pt(m, v[i]);
-    int o = ins_orient(q[0], q[1], q[2], q[3], b->cnt);
-    if (o != 0)
-        return o > 0;
-    const uint32_t *w = m->T + 8 * (size_t)(v[4 + inf] >> 2);
-    return ins_insphere(ins_pt(m, w[0]), ins_pt(m, w[1]), ins_pt(m, w[2]), ins_pt(m, w[3]), p, b->cnt) > 0;
+    return ins_conflict(b->m, t, p, b->cnt);
 }
 
 static int insert_point(build *b, uint32_t pid, uint32_t *last)
@@ -223,13 +189,8 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
     /* A point equal to a vertex lies in the closed tet of that vertex only,
      * so the walk ends in a tet that has it: refuse rather than break the
      * perturbation's precondition (pairwise distinct points). */
-    for (int i = 0; i < 4; i++) {
-        if (v0[i] == INF)
-            continue;
-        const double *q = ins_pt(m, v0[i]);
-        if (q[0] == p[0] && q[1] == p[1] && q[2] == p[2])
-            return FDT_EINVAL;
-    }
+    if (ins_is_vertex(m, v0, p))
+        return FDT_EINVAL;
 
     /* The cavity, breadth-first. The walk's tet holds p (closed), and a
      * point of a closed tet other than its vertices is strictly inside its
@@ -239,8 +200,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
     uint8_t *mark = b->mark;
     mark[t0] = MARK_IN;
     b->cav[b->ncav++] = t0;
-    for (int j = 0; j < 4; j++)
-        fdt_prefetch(m->T + 8 * (size_t)(v0[4 + j] >> 2));
+    ins_prefetch_nbrs(m->T, t0);
     for (size_t ci = 0; ci < b->ncav; ci++) {
         uint32_t c = b->cav[ci];
         for (int k = 0; k < 4; k++) {
@@ -254,10 +214,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
                         return err;
                     mark[o] = MARK_IN;
                     b->cav[b->ncav++] = o;
-                    /* its neighbours are tested next: ask for them now */
-                    const uint32_t *on = m->T + 8 * (size_t)o + 4;
-                    for (int j = 0; j < 4; j++)
-                        fdt_prefetch(m->T + 8 * (size_t)(on[j] >> 2));
+                    ins_prefetch_nbrs(m->T, o); /* tested next */
                     continue;
                 }
                 if (b->nout == b->outcap &&
@@ -298,10 +255,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
     }
     for (size_t i = 0; i < b->nout; i++)
         mark[b->outl[i]] = MARK_NONE;
-    m->stats.cavity_tets += b->ncav;
-    m->stats.created_tets += b->nbnd;
-    if (b->ncav > m->stats.max_cavity)
-        m->stats.max_cavity = b->ncav;
+    ins_count_cavity(&m->stats, b->ncav, b->nbnd);
     *last = s;
     return FDT_OK;
 }
@@ -600,14 +554,8 @@ int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
 int fdt_ins_build_progress(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                            fdt_pred_counts *cnt, fdt_progress_fn progress, void *puser)
 {
-    memset(m, 0, sizeof *m);
-    if (n < 4) {
-        m->P = P;
-        m->base = base;
-        m->n = n;
-        m->free_head = FDT_NONE;
+    if (ins_begin(m, P, base, n) != FDT_OK)
         return FDT_EDEGENERATE;
-    }
     uint32_t *order = malloc((size_t)n * sizeof *order);
     if (!order)
         return FDT_ENOMEM;
@@ -844,24 +792,6 @@ void fdt_ins_query_free(fdt_ins_query *qs)
     memset(qs, 0, sizeof *qs);
 }
 
-/* The conflict test of the build (conflict above), without its counters:
- * the mesh is shared read-only by the querying threads. */
-static int conflict_ro(const fdt_ins *m, uint32_t t, const double *p, fdt_pred_counts *cnt)
-{
-    const uint32_t *v = m->T + 8 * (size_t)t;
-    int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
-    if (inf < 0)
-        return ins_insphere(ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3]), p, cnt) > 0;
-    const double *q[4];
-    for (int i = 0; i < 4; i++)
-        q[i] = i == inf ? p : ins_pt(m, v[i]);
-    int o = ins_orient(q[0], q[1], q[2], q[3], cnt);
-    if (o != 0)
-        return o > 0;
-    const uint32_t *w = m->T + 8 * (size_t)(v[4 + inf] >> 2);
-    return ins_insphere(ins_pt(m, w[0]), ins_pt(m, w[1]), ins_pt(m, w[2]), ins_pt(m, w[3]), p, cnt) > 0;
-}
-
 int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
                               size_t max_tets, fdt_ins_query *qs, fdt_pred_counts *cnt)
 {
@@ -899,7 +829,7 @@ int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
              * not keeping a second set. */
             if (qset_has(qs->tset, qs->tcap, o))
                 continue;
-            if (conflict_ro(m, o, q, cnt) && (rc = qset_add(&qs->tq, &qs->tset, &qs->ntq,
+            if (ins_conflict(m, o, q, cnt) && (rc = qset_add(&qs->tq, &qs->tset, &qs->ntq,
                                                            &qs->tcap, o)) < 0)
                 return rc;
         }

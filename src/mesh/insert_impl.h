@@ -1,8 +1,11 @@
 /*
  * What src/mesh/insert.c (the serial build) and src/mesh/insert_par.c (the parallel
- * build) share: the predicates' inline filters, the edge table that links
- * a cavity's new tets, and the serial phases the parallel build starts and
- * ends with. Internal to the insertion kernel; src/mesh/insert.h is its API.
+ * build) share: the predicates' inline filters, the growth of the tets
+ * array, the walk's step, the conflict rule, the duplicate check, the
+ * counters, the edge table that links a cavity's new tets, and the serial
+ * phases the parallel build starts and ends with. Each lives here once;
+ * what differs (the parallel build's locks) stays in its file. Internal
+ * to the insertion kernel; src/mesh/insert.h is its API.
  */
 #ifndef FDT_INSERT_IMPL_H
 #define FDT_INSERT_IMPL_H
@@ -10,6 +13,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include "base/bits.h"
 #include "mesh/insert.h"
 
 /* Neighbour references are 4 * slot + face in 32 bits. */
@@ -52,6 +56,151 @@ static inline int ins_insphere(const double *a, const double *b, const double *c
 #else
     return fdt_insphere_perturbed(a, b, c, d, e, cnt);
 #endif
+}
+
+/*
+ * The tets array grown for `need` slots (a build's reserve): the capacity
+ * half as much again plus 64, at least need, at most INS_MAX_SLOTS; m->T
+ * is reallocated to *nc slots, and the caller grows its own per-slot array
+ * to match and then sets m->cap. FDT_ETOOBIG beyond INS_MAX_SLOTS,
+ * FDT_ENOMEM (m->T unchanged).
+ */
+static inline int ins_grow_tets(fdt_ins *m, uint64_t need, uint64_t *nc_out)
+{
+    if (need > INS_MAX_SLOTS)
+        return FDT_ETOOBIG;
+    uint64_t nc = (uint64_t)m->cap + m->cap / 2 + 64;
+    if (nc < need)
+        nc = need;
+    if (nc > INS_MAX_SLOTS)
+        nc = INS_MAX_SLOTS;
+    uint32_t *t = realloc(m->T, (size_t)nc * 8 * sizeof *t);
+    if (!t)
+        return FDT_ENOMEM;
+    m->T = t;
+    *nc_out = nc;
+    return FDT_OK;
+}
+
+/*
+ * One step of the visibility walk (src/mesh/insert.c's walk) in the finite
+ * tet v (its four vertex ids): the faces are tried from a pseudo-random
+ * one on (*rng, a 64-bit LCG, advances once), skipping `from`, the face
+ * the walk came in by (-1: none). Returns the first face whose plane has p
+ * strictly on its far side, or -1 when p is in the closed tet.
+ */
+static inline int ins_walk_exit(const fdt_ins *m, const uint32_t *v, const double *p, int from,
+                                uint64_t *rng, fdt_pred_counts *cnt)
+{
+    const double *q[4] = {ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3])};
+    *rng = *rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
+    uint32_t r = (uint32_t)(*rng >> 61);
+    for (uint32_t j = 0; j < 4; j++) {
+        int k = (int)((r + j) & 3);
+        if (k == from)
+            continue;
+        const double *s[4] = {q[0], q[1], q[2], q[3]};
+        s[k] = p;
+        if (ins_orient(s[0], s[1], s[2], s[3], cnt) < 0)
+            return k;
+    }
+    return -1;
+}
+
+/* Whether p equals one of the finite vertices of tet v (the walk ends in
+ * a tet of that vertex): the insertion refuses it (FDT_EINVAL) rather
+ * than break the perturbation's precondition, pairwise distinct points. */
+static inline int ins_is_vertex(const fdt_ins *m, const uint32_t *v, const double *p)
+{
+    for (int i = 0; i < 4; i++) {
+        if (v[i] == INF)
+            continue;
+        const double *q = ins_pt(m, v[i]);
+        if (q[0] == p[0] && q[1] == p[1] && q[2] == p[2])
+            return 1;
+    }
+    return 0;
+}
+
+/* Conflict of p with the finite tet v: strictly inside its circumsphere. */
+static inline int ins_conflict_finite(const fdt_ins *m, const uint32_t *v, const double *p,
+                                      fdt_pred_counts *cnt)
+{
+    return ins_insphere(ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3]), p,
+                        cnt) > 0;
+}
+
+/* The return of ins_conflict_local when only the finite tet under the hull
+ * face can decide. */
+#define INS_CONFLICT_UNDER (-1)
+
+/*
+ * Whether tet v (its row of T: ids, then neighbours) is in conflict with
+ * p (src/mesh/insert.c's top: a finite tet when p is strictly inside its
+ * circumsphere, an infinite one when p is strictly outside its hull
+ * face), as far as v alone decides: 1 or 0, or INS_CONFLICT_UNDER when p
+ * is on the hull face's plane, where the finite tet under the face, slot
+ * v[4 + *inf] >> 2, decides (ins_conflict_finite).
+ */
+static inline int ins_conflict_local(const fdt_ins *m, const uint32_t *v, const double *p,
+                                     fdt_pred_counts *cnt, int *inf_out)
+{
+    int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
+    if (inf < 0)
+        return ins_conflict_finite(m, v, p, cnt);
+    const double *q[4];
+    for (int i = 0; i < 4; i++)
+        q[i] = i == inf ? p : ins_pt(m, v[i]);
+    int o = ins_orient(q[0], q[1], q[2], q[3], cnt);
+    if (o != 0)
+        return o > 0;
+    *inf_out = inf;
+    return INS_CONFLICT_UNDER;
+}
+
+/* Whether tet t is in conflict with p, in a mesh nobody else changes
+ * meanwhile (the serial build, and queries of a built mesh). */
+static inline int ins_conflict(const fdt_ins *m, uint32_t t, const double *p,
+                               fdt_pred_counts *cnt)
+{
+    const uint32_t *v = m->T + 8 * (size_t)t;
+    int inf = -1, c = ins_conflict_local(m, v, p, cnt, &inf);
+    if (c != INS_CONFLICT_UNDER)
+        return c;
+    return ins_conflict_finite(m, m->T + 8 * (size_t)(v[4 + inf] >> 2), p, cnt);
+}
+
+/* Asks for the four neighbours of tet t: the cavity search tests them
+ * next. */
+static inline void ins_prefetch_nbrs(const uint32_t *T, uint32_t t)
+{
+    const uint32_t *nb = T + 8 * (size_t)t + 4;
+    for (int j = 0; j < 4; j++)
+        fdt_prefetch(T + 8 * (size_t)(nb[j] >> 2));
+}
+
+/* A build's start: m emptied for the points [base, base + n) of P.
+ * FDT_EDEGENERATE when n < 4 (m then names the points and holds no tet),
+ * else FDT_OK. */
+static inline int ins_begin(fdt_ins *m, const double *P, uint32_t base, uint32_t n)
+{
+    memset(m, 0, sizeof *m);
+    if (n >= 4)
+        return FDT_OK;
+    m->P = P;
+    m->base = base;
+    m->n = n;
+    m->free_head = FDT_NONE;
+    return FDT_EDEGENERATE;
+}
+
+/* An insertion's counts: its cavity of ncav tets and its nnew new ones. */
+static inline void ins_count_cavity(fdt_ins_stats *st, size_t ncav, size_t nnew)
+{
+    st->cavity_tets += ncav;
+    st->created_tets += nnew;
+    if (ncav > st->max_cavity)
+        st->max_cavity = ncav;
 }
 
 /* For a face opposite vertex k, the edge of that face opposite its vertex

@@ -283,17 +283,10 @@ static inline void free_slot(worker *w, uint32_t t)
 static int grow_arrays(shared *sh, uint64_t need)
 {
     fdt_ins *m = sh->m;
-    if (need > INS_MAX_SLOTS)
-        return FDT_ETOOBIG;
-    uint64_t nc = (uint64_t)m->cap + m->cap / 2 + 64;
-    if (nc < need)
-        nc = need;
-    if (nc > INS_MAX_SLOTS)
-        nc = INS_MAX_SLOTS;
-    uint32_t *t = realloc(m->T, (size_t)nc * 8 * sizeof *t);
-    if (!t)
-        return FDT_ENOMEM;
-    m->T = t;
+    uint64_t nc;
+    int err = ins_grow_tets(m, need, &nc);
+    if (err)
+        return err;
     atomic_uchar *lk = malloc((size_t)nc * sizeof *lk);
     if (!lk)
         return FDT_ENOMEM;
@@ -397,22 +390,7 @@ static int walk_locked(worker *w, const double *p, uint32_t start, uint32_t *out
         const uint32_t *v = T + 8 * (size_t)t;
         if (v[0] == INF || v[1] == INF || v[2] == INF || v[3] == INF)
             break;
-        const double *q[4] = {ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]),
-                              ins_pt(m, v[3])};
-        w->rng = w->rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
-        uint32_t r = (uint32_t)(w->rng >> 61);
-        int exit = -1;
-        for (uint32_t j = 0; j < 4; j++) {
-            int k = (int)((r + j) & 3);
-            if (k == from)
-                continue;
-            const double *s[4] = {q[0], q[1], q[2], q[3]};
-            s[k] = p;
-            if (ins_orient(s[0], s[1], s[2], s[3], &w->cnt) < 0) {
-                exit = k;
-                break;
-            }
-        }
+        int exit = ins_walk_exit(m, v, p, from, &w->rng, &w->cnt);
         if (exit < 0)
             break;
         uint32_t nb = v[4 + exit];
@@ -478,16 +456,9 @@ static inline int conflict(worker *w, uint32_t t, const double *p)
     const fdt_ins *m = w->sh->m;
     const uint32_t *v = m->T + 8 * (size_t)t;
     w->st.conflict_tests++;
-    int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
-    if (inf < 0)
-        return ins_insphere(ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3]),
-                            p, &w->cnt) > 0;
-    const double *q[4];
-    for (int i = 0; i < 4; i++)
-        q[i] = i == inf ? p : ins_pt(m, v[i]);
-    int o = ins_orient(q[0], q[1], q[2], q[3], &w->cnt);
-    if (o != 0)
-        return o > 0;
+    int inf = -1, c = ins_conflict_local(m, v, p, &w->cnt, &inf);
+    if (c != INS_CONFLICT_UNDER)
+        return c;
     uint32_t u = v[4 + inf] >> 2;
     int umark, r = lock_live(w, u, &umark);
     if (r == 0)
@@ -500,9 +471,7 @@ static inline int conflict(worker *w, uint32_t t, const double *p)
         }
         w->under[w->nunder++] = u;
     }
-    const uint32_t *x = m->T + 8 * (size_t)u;
-    return ins_insphere(ins_pt(m, x[0]), ins_pt(m, x[1]), ins_pt(m, x[2]), ins_pt(m, x[3]), p,
-                        &w->cnt) > 0;
+    return ins_conflict_finite(m, m->T + 8 * (size_t)u, p, &w->cnt);
 }
 
 /*
@@ -525,20 +494,14 @@ static int insert_point(worker *w, uint32_t pid)
     if (err)
         return err;
     const uint32_t *v0 = m->T + 8 * (size_t)t0;
-    for (int i = 0; i < 4; i++) { /* see src/mesh/insert.c: a duplicate */
-        if (v0[i] == INF)
-            continue;
-        const double *q = ins_pt(m, v0[i]);
-        if (q[0] == p[0] && q[1] == p[1] && q[2] == p[2]) {
-            unlock_slot(sh, t0);
-            return FDT_EINVAL;
-        }
+    if (ins_is_vertex(m, v0, p)) { /* see src/mesh/insert.c: a duplicate */
+        unlock_slot(sh, t0);
+        return FDT_EINVAL;
     }
     w->ncav = w->nbnd = w->nout = w->nunder = 0;
     set_mark(w, t0, MARK_IN);
     w->cav[w->ncav++] = t0;
-    for (int j = 0; j < 4; j++)
-        fdt_prefetch(m->T + 8 * (size_t)(v0[4 + j] >> 2));
+    ins_prefetch_nbrs(m->T, t0);
     for (size_t ci = 0; ci < w->ncav; ci++) {
         uint32_t c = w->cav[ci];
         for (int k = 0; k < 4; k++) {
@@ -609,10 +572,7 @@ static int insert_point(worker *w, uint32_t pid)
         return FDT_EINTERNAL; /* the build fails: what stays locked does not matter */
     for (size_t i = 0; i < w->ncav; i++)
         free_slot(w, w->cav[i]);
-    w->st.cavity_tets += w->ncav;
-    w->st.created_tets += w->nbnd;
-    if (w->ncav > w->st.max_cavity)
-        w->st.max_cavity = w->ncav;
+    ins_count_cavity(&w->st, w->ncav, w->nbnd);
     /* Release: every write above happens before the next holder's
      * acquire. The coplanar rule's tets first: a freed cavity slot is
      * told from them by its tet (unlock_under). */
@@ -881,6 +841,249 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
     return fdt_ins_build_parallel_slots(m, P, base, n, nthreads, 0.0, cnt);
 }
 
+/* ---- the build's steps (fdt_ins_build_parallel_slots) --------------------- */
+
+/*
+ * After phase 1 (prefix points in): the tets array grown for the workers
+ * to the slots a point the serial rounds used, with a third more (later
+ * rounds are denser; the chunks): a family with more tets a point than
+ * uniform points' 6.5 (a pipe scan: 13) then rarely stops the workers for
+ * more. Not when the tests force the capacity (slots_a_point > 0).
+ */
+static int grow_for_workers(fdt_ins *m, uint32_t prefix, uint32_t n, int nw,
+                            double slots_a_point)
+{
+    uint32_t nfree = 0;
+    for (uint32_t t = m->free_head; t != FDT_NONE; t = m->T[8 * (size_t)t + 4])
+        nfree++;
+    uint64_t want = (uint64_t)((double)(m->nslots - nfree) / (double)prefix * 1.35 * n) +
+                    (uint64_t)nw * 2 * CHUNK + 1024;
+    if (want > INS_MAX_SLOTS)
+        want = INS_MAX_SLOTS;
+    if (want > m->cap && slots_a_point <= 0.0) {
+        /* A new block with only the slots in use copied, not a
+         * realloc: the prefix used ~2.5 % of its capacity (statue
+         * 100k: 19,921 of 762,224 slots), and realloc (a copy inside
+         * glibc's heap by then, not an mremap) read all of it and
+         * faulted in the whole new block on this one thread while
+         * the other waited: 0.009-0.012 s at statue, cylscan and
+         * autzen 100k. Now the workers fault in the pages they use,
+         * both at once (bench/NOTES.md entry 56). Every slot the
+         * prefix used, its free list included, is below nslots. */
+        uint32_t *t = malloc((size_t)want * 8 * sizeof *t);
+        if (!t)
+            return FDT_ENOMEM;
+        /* Huge pages, as src/mesh/insert.c's first block has: without
+         * them each worker took a fault a 4 KB page it first wrote
+         * (bench/NOTES.md entry 69). */
+        fdt_mem_advise_huge(t, (size_t)want * 8 * sizeof *t);
+        memcpy(t, m->T, (size_t)m->nslots * 8 * sizeof *t);
+        free(m->T);
+        m->T = t;
+        m->cap = (uint32_t)want;
+    }
+    return FDT_OK;
+}
+
+/* The shared state of phase 2 (locks, hints, spans) and the nw workers
+ * ws, rend their rounds' ends (32 a worker). */
+static int shared_init(shared *sh, worker *ws, int nw, uint32_t base, uint32_t n, size_t *rend)
+{
+    fdt_ins *m = sh->m;
+    /* All bytes zero: every lock free (an atomic_uchar's 0 is all zero
+     * bits). calloc leaves the zeroing to the pages' first touch, in the
+     * workers, where atomic_init a byte took 2.9 ms at 440k points on
+     * this thread (bench/NOTES.md entry 76). */
+    sh->lock = calloc((size_t)m->cap, sizeof *sh->lock);
+    sh->hint = malloc((size_t)n * sizeof *sh->hint);
+    sh->spans = aligned_alloc(alignof(span), (size_t)nw * sizeof *sh->spans);
+    if (!sh->lock || !sh->hint || !sh->spans)
+        return FDT_ENOMEM;
+    sh->all = ws;
+    sh->nw = nw;
+    for (uint32_t i = 0; i < n; i++)
+        atomic_init(&sh->hint[i], FDT_NONE);
+    atomic_init(&sh->next, m->nslots);
+    atomic_init(&sh->stop, 0);
+    atomic_init(&sh->err, 0);
+    for (int i = 0; i < nw; i++) {
+        int err = worker_init(&ws[i], sh, i, nw, base, n, rend + 32 * (size_t)i);
+        if (err != FDT_OK)
+            return err;
+    }
+    return FDT_OK;
+}
+
+/* Starts: the hints of the points in, and each worker's first walk from a
+ * tet of a point of its own region; phase 1's free list becomes worker
+ * 0's. */
+static void hand_out_starts(shared *sh, worker *ws, int nw, uint32_t base, uint32_t n)
+{
+    fdt_ins *m = sh->m;
+    for (int i = 0; i < nw; i++)
+        ws[i].last = FDT_NONE;
+    uint32_t anylive = FDT_NONE;
+    for (uint32_t t = 0; t < m->nslots; t++) {
+        const uint32_t *v = m->T + 8 * (size_t)t;
+        if (v[0] == INF && v[1] == INF) {
+            /* phase 1's free list becomes worker 0's, locked by it */
+            atomic_init(&sh->lock[t], ws[0].me);
+            continue;
+        }
+        anylive = t;
+        for (int k = 0; k < 4; k++) {
+            if (v[k] == INF)
+                continue;
+            uint32_t i = v[k] - base;
+            atomic_init(&sh->hint[i], t);
+            int reg = (int)((uint64_t)i * (uint64_t)nw / n);
+            if (ws[reg].last == FDT_NONE)
+                ws[reg].last = t;
+        }
+    }
+    ws[0].free_head = m->free_head;
+    for (uint32_t t = m->free_head; t != FDT_NONE; t = m->T[8 * (size_t)t + 4])
+        ws[0].nfree++;
+    m->free_head = FDT_NONE;
+    for (int i = 0; i < nw; i++)
+        if (ws[i].last == FDT_NONE)
+            ws[i].last = anylive;
+}
+
+/* Phase 2. pthread_create orders everything before it before the
+ * workers; a worker that cannot start leaves its points to phase 3.
+ * When the slots run out, the workers stop, the arrays grow here (no
+ * thread runs) and the workers go on with what they left. */
+static int phase2(shared *sh, worker *ws, int nw, size_t *rend)
+{
+    fdt_ins *m = sh->m;
+    int err;
+    for (int pass = 0;; pass++) {
+        /* Every last round empty until its owner publishes it: a worker
+         * that does not start is never stolen from. */
+        for (int i = 0; i < nw; i++)
+            atomic_init(&sh->spans[i].fb, 0);
+        for (int i = 1; i < nw; i++)
+            ws[i].started = fdt_spawn(&ws[i].th, 0, worker_main, &ws[i]) == 0;
+        worker_main(&ws[0]);
+        for (int i = 1; i < nw; i++)
+            if (ws[i].started)
+                pthread_join(ws[i].th, NULL);
+        /* The joins order the workers' writes before what follows. A
+         * worker that did not start leaves its points to phase 3. */
+        for (int i = 1; i < nw; i++)
+            if (!ws[i].picked)
+                pick_points(&ws[i]);
+        if ((err = atomic_load_explicit(&sh->err, memory_order_relaxed)) != 0)
+            return err;
+        uint64_t next = atomic_load_explicit(&sh->next, memory_order_relaxed);
+        int started = 1;
+        for (int i = 1; i < nw; i++)
+            started &= ws[i].started;
+        if (next < m->cap || !started || pass >= 8)
+            return FDT_OK; /* not stopped for slots (or give up: phase 3 grows) */
+        /* Every slot below the capacity was handed out: go on above it. */
+        atomic_store_explicit(&sh->next, m->cap, memory_order_relaxed);
+        if ((err = grow_arrays(sh, (uint64_t)m->cap + m->cap / 2)) != FDT_OK)
+            return err;
+        atomic_store_explicit(&sh->stop, 0, memory_order_relaxed);
+        for (int i = 0; i < nw; i++) { /* the deferred points are the new list */
+            worker *w = &ws[i];
+            uint32_t *t = w->todo;
+            size_t c = w->todocap;
+            w->todo = w->def;
+            w->todocap = w->defcap;
+            w->pts = w->todo;
+            w->npts = w->ndef;
+            w->def = t;
+            w->defcap = c;
+            w->ndef = 0;
+            rend[32 * (size_t)i] = w->npts;
+            w->nrounds = 1;
+        }
+    }
+}
+
+/* Phase 3 on this thread, as worker 0 (sh->single set): every freed or
+ * unused slot becomes its own (locked by it), every other lock is free,
+ * and it inserts every point left. */
+static int phase3(shared *sh, worker *ws, int nw)
+{
+    fdt_ins *m = sh->m;
+    worker *w0 = &ws[0];
+    for (int i = 0; i < nw; i++) {
+        worker *w = &ws[i];
+        if (i > 0) {
+            while (w->free_head != FDT_NONE) {
+                uint32_t t = w->free_head;
+                w->free_head = m->T[8 * (size_t)t + 4];
+                atomic_store_explicit(&sh->lock[t], w0->me, memory_order_relaxed);
+                free_slot(w0, t);
+            }
+        }
+        for (; w->fresh < w->fresh_end; w->fresh++) {
+            atomic_store_explicit(&sh->lock[w->fresh], w0->me, memory_order_relaxed);
+            free_slot(w0, w->fresh);
+        }
+        if (!w->started && i > 0) {
+            for (size_t j = 0; j < w->npts; j++)
+                if (defer(w0, w->pts[j]) != FDT_OK)
+                    return FDT_ENOMEM;
+        } else if (i > 0) {
+            for (size_t j = 0; j < w->ndef; j++)
+                if (defer(w0, w->def[j]) != FDT_OK)
+                    return FDT_ENOMEM;
+        }
+    }
+    {
+        /* The counter may have run past the capacity (a worker found it
+         * spent): the slots handed out end at the capacity then. */
+        uint64_t next = atomic_load_explicit(&sh->next, memory_order_relaxed);
+        m->nslots = next < m->cap ? (uint32_t)next : m->cap;
+        atomic_store_explicit(&sh->next, m->nslots, memory_order_relaxed);
+    }
+    m->stats.serial_finish = w0->ndef;
+    for (size_t j = 0; j < w0->ndef; j++) {
+        int rc = insert_point(w0, w0->def[j]);
+        if (rc != FDT_OK) {
+            /* nothing else holds a lock now, and the capacity grows */
+            return rc == BUSY || rc == FULL ? FDT_EINTERNAL : rc;
+        }
+    }
+    {
+        uint64_t next = atomic_load_explicit(&sh->next, memory_order_relaxed);
+        m->nslots = next < m->cap ? (uint32_t)next : m->cap;
+    }
+    /* A chunk's unused rest: freed slots, found by fdt_ins_finish. */
+    for (; w0->fresh < w0->fresh_end; w0->fresh++) {
+        uint32_t *v = m->T + 8 * (size_t)w0->fresh;
+        v[0] = v[1] = INF;
+    }
+    return FDT_OK;
+}
+
+/* The workers' counters into m->stats and cnt (may be NULL). */
+static void sum_worker_stats(fdt_ins *m, const worker *ws, int nw, fdt_pred_counts *cnt)
+{
+    for (int i = 0; i < nw; i++) {
+        const fdt_ins_stats *s = &ws[i].st;
+        m->stats.walk_steps += s->walk_steps;
+        m->stats.cavity_tets += s->cavity_tets;
+        m->stats.created_tets += s->created_tets;
+        m->stats.conflict_tests += s->conflict_tests;
+        m->stats.deferred += s->deferred;
+        m->stats.stolen += s->stolen;
+        if (s->max_cavity > m->stats.max_cavity)
+            m->stats.max_cavity = s->max_cavity;
+        if (cnt) {
+            cnt->orient_exact += ws[i].cnt.orient_exact;
+            cnt->insphere_exact += ws[i].cnt.insphere_exact;
+            cnt->orient_adapt += ws[i].cnt.orient_adapt;
+            cnt->insphere_adapt += ws[i].cnt.insphere_adapt;
+        }
+    }
+}
+
 int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                                  int nthreads, double slots_a_point, fdt_pred_counts *cnt)
 {
@@ -888,14 +1091,8 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
         nthreads = 1;
     if (nthreads > MAX_WORKERS)
         nthreads = MAX_WORKERS;
-    memset(m, 0, sizeof *m);
-    if (n < 4) {
-        m->P = P;
-        m->base = base;
-        m->n = n;
-        m->free_head = FDT_NONE;
+    if (ins_begin(m, P, base, n) != FDT_OK)
         return FDT_EDEGENERATE;
-    }
     int nw = nthreads;
     uint32_t *order = malloc((size_t)n * sizeof *order);
     size_t *rend = malloc((size_t)nw * 32 * sizeof *rend);
@@ -925,222 +1122,23 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
     if (err)
         goto out;
     double c1 = fdt_thread_cpu_s();
-    err = FDT_ENOMEM;
-    {
-        /* The slots a point the serial rounds used, with a third more
-         * (later rounds are denser; the chunks): a family with more
-         * tets a point than uniform points' 6.5 (a pipe scan: 13) then
-         * rarely stops the workers for more. */
-        uint32_t nfree = 0;
-        for (uint32_t t = m->free_head; t != FDT_NONE; t = m->T[8 * (size_t)t + 4])
-            nfree++;
-        uint64_t want = (uint64_t)((double)(m->nslots - nfree) / (double)prefix * 1.35 * n) +
-                        (uint64_t)nw * 2 * CHUNK + 1024;
-        if (want > INS_MAX_SLOTS)
-            want = INS_MAX_SLOTS;
-        if (want > m->cap && slots_a_point <= 0.0) {
-            /* A new block with only the slots in use copied, not a
-             * realloc: the prefix used ~2.5 % of its capacity (statue
-             * 100k: 19,921 of 762,224 slots), and realloc (a copy inside
-             * glibc's heap by then, not an mremap) read all of it and
-             * faulted in the whole new block on this one thread while
-             * the other waited: 0.009-0.012 s at statue, cylscan and
-             * autzen 100k. Now the workers fault in the pages they use,
-             * both at once (bench/NOTES.md entry 56). Every slot the
-             * prefix used, its free list included, is below nslots. */
-            uint32_t *t = malloc((size_t)want * 8 * sizeof *t);
-            if (!t)
-                goto fail;
-            /* Huge pages, as src/mesh/insert.c's first block has: without
-             * them each worker took a fault a 4 KB page it first wrote
-             * (bench/NOTES.md entry 69). */
-            fdt_mem_advise_huge(t, (size_t)want * 8 * sizeof *t);
-            memcpy(t, m->T, (size_t)m->nslots * 8 * sizeof *t);
-            free(m->T);
-            m->T = t;
-            m->cap = (uint32_t)want;
-        }
-    }
-    /* All bytes zero: every lock free (an atomic_uchar's 0 is all zero
-     * bits). calloc leaves the zeroing to the pages' first touch, in the
-     * workers, where atomic_init a byte took 2.9 ms at 440k points on
-     * this thread (bench/NOTES.md entry 76). */
-    sh.lock = calloc((size_t)m->cap, sizeof *sh.lock);
-    sh.hint = malloc((size_t)n * sizeof *sh.hint);
-    sh.spans = aligned_alloc(alignof(span), (size_t)nw * sizeof *sh.spans);
-    if (!sh.lock || !sh.hint || !sh.spans)
+    if ((err = grow_for_workers(m, prefix, n, nw, slots_a_point)) != FDT_OK ||
+        (err = shared_init(&sh, ws, nw, base, n, rend)) != FDT_OK)
         goto fail;
-    sh.all = ws;
-    sh.nw = nw;
-    for (uint32_t i = 0; i < n; i++)
-        atomic_init(&sh.hint[i], FDT_NONE);
-    atomic_init(&sh.next, m->nslots);
-    atomic_init(&sh.stop, 0);
-    atomic_init(&sh.err, 0);
-    for (int i = 0; i < nw; i++)
-        if ((err = worker_init(&ws[i], &sh, i, nw, base, n, rend + 32 * (size_t)i)) != FDT_OK)
-            goto fail;
-    err = FDT_ENOMEM;
-
-    /* Starts: the hints of the points in, and each worker's first walk
-     * from a tet of a point of its own region. */
-    for (int i = 0; i < nw; i++)
-        ws[i].last = FDT_NONE;
-    uint32_t anylive = FDT_NONE;
-    for (uint32_t t = 0; t < m->nslots; t++) {
-        const uint32_t *v = m->T + 8 * (size_t)t;
-        if (v[0] == INF && v[1] == INF) {
-            /* phase 1's free list becomes worker 0's, locked by it */
-            atomic_init(&sh.lock[t], ws[0].me);
-            continue;
-        }
-        anylive = t;
-        for (int k = 0; k < 4; k++) {
-            if (v[k] == INF)
-                continue;
-            uint32_t i = v[k] - base;
-            atomic_init(&sh.hint[i], t);
-            int reg = (int)((uint64_t)i * (uint64_t)nw / n);
-            if (ws[reg].last == FDT_NONE)
-                ws[reg].last = t;
-        }
-    }
-    ws[0].free_head = m->free_head;
-    for (uint32_t t = m->free_head; t != FDT_NONE; t = m->T[8 * (size_t)t + 4])
-        ws[0].nfree++;
-    m->free_head = FDT_NONE;
-    for (int i = 0; i < nw; i++)
-        if (ws[i].last == FDT_NONE)
-            ws[i].last = anylive;
-
+    hand_out_starts(&sh, ws, nw, base, n);
     /* Phase 2's points: each worker picks its region's (pick_points). */
     sh.order = order;
     sh.round_end = round_end;
     sh.r0 = r0;
     sh.nrounds = nrounds;
     memcpy(sh.first, first, sizeof sh.first);
-
-    /* Phase 2. pthread_create orders everything above before the
-     * workers; a worker that cannot start leaves its points to phase 3.
-     * When the slots run out, the workers stop, the arrays grow here
-     * (no thread runs) and the workers go on with what they left. */
-    for (int pass = 0;; pass++) {
-        /* Every last round empty until its owner publishes it: a worker
-         * that does not start is never stolen from. */
-        for (int i = 0; i < nw; i++)
-            atomic_init(&sh.spans[i].fb, 0);
-        for (int i = 1; i < nw; i++)
-            ws[i].started = fdt_spawn(&ws[i].th, 0, worker_main, &ws[i]) == 0;
-        worker_main(&ws[0]);
-        for (int i = 1; i < nw; i++)
-            if (ws[i].started)
-                pthread_join(ws[i].th, NULL);
-        /* The joins order the workers' writes before what follows. A
-         * worker that did not start leaves its points to phase 3. */
-        for (int i = 1; i < nw; i++)
-            if (!ws[i].picked)
-                pick_points(&ws[i]);
-        if ((err = atomic_load_explicit(&sh.err, memory_order_relaxed)) != 0)
-            goto fail;
-        uint64_t next = atomic_load_explicit(&sh.next, memory_order_relaxed);
-        int started = 1;
-        for (int i = 1; i < nw; i++)
-            started &= ws[i].started;
-        if (next < m->cap || !started || pass >= 8)
-            break; /* not stopped for slots (or give up: phase 3 grows) */
-        /* Every slot below the capacity was handed out: go on above it. */
-        atomic_store_explicit(&sh.next, m->cap, memory_order_relaxed);
-        if ((err = grow_arrays(&sh, (uint64_t)m->cap + m->cap / 2)) != FDT_OK)
-            goto fail;
-        atomic_store_explicit(&sh.stop, 0, memory_order_relaxed);
-        for (int i = 0; i < nw; i++) { /* the deferred points are the new list */
-            worker *w = &ws[i];
-            uint32_t *t = w->todo;
-            size_t c = w->todocap;
-            w->todo = w->def;
-            w->todocap = w->defcap;
-            w->pts = w->todo;
-            w->npts = w->ndef;
-            w->def = t;
-            w->defcap = c;
-            w->ndef = 0;
-            rend[32 * (size_t)i] = w->npts;
-            w->nrounds = 1;
-        }
-    }
-
-    /* Phase 3 on this thread, as worker 0: every freed or unused slot
-     * becomes its own (locked by it), every other lock is free. */
-    worker *w0 = &ws[0];
+    if ((err = phase2(&sh, ws, nw, rend)) != FDT_OK)
+        goto fail;
     double c2 = fdt_thread_cpu_s();
     sh.single = 1;
-    err = FDT_ENOMEM;
-    for (int i = 0; i < nw; i++) {
-        worker *w = &ws[i];
-        if (i > 0) {
-            while (w->free_head != FDT_NONE) {
-                uint32_t t = w->free_head;
-                w->free_head = m->T[8 * (size_t)t + 4];
-                atomic_store_explicit(&sh.lock[t], w0->me, memory_order_relaxed);
-                free_slot(w0, t);
-            }
-        }
-        for (; w->fresh < w->fresh_end; w->fresh++) {
-            atomic_store_explicit(&sh.lock[w->fresh], w0->me, memory_order_relaxed);
-            free_slot(w0, w->fresh);
-        }
-        if (!w->started && i > 0) {
-            for (size_t j = 0; j < w->npts; j++)
-                if (defer(w0, w->pts[j]) != FDT_OK)
-                    goto fail;
-        } else if (i > 0) {
-            for (size_t j = 0; j < w->ndef; j++)
-                if (defer(w0, w->def[j]) != FDT_OK)
-                    goto fail;
-        }
-    }
-    {
-        /* The counter may have run past the capacity (a worker found it
-         * spent): the slots handed out end at the capacity then. */
-        uint64_t next = atomic_load_explicit(&sh.next, memory_order_relaxed);
-        m->nslots = next < m->cap ? (uint32_t)next : m->cap;
-        atomic_store_explicit(&sh.next, m->nslots, memory_order_relaxed);
-    }
-    m->stats.serial_finish = w0->ndef;
-    for (size_t j = 0; j < w0->ndef; j++) {
-        int rc = insert_point(w0, w0->def[j]);
-        if (rc != FDT_OK) {
-            /* nothing else holds a lock now, and the capacity grows */
-            err = rc == BUSY || rc == FULL ? FDT_EINTERNAL : rc;
-            goto fail;
-        }
-    }
-    {
-        uint64_t next = atomic_load_explicit(&sh.next, memory_order_relaxed);
-        m->nslots = next < m->cap ? (uint32_t)next : m->cap;
-    }
-    /* A chunk's unused rest: freed slots, found by fdt_ins_finish. */
-    for (; w0->fresh < w0->fresh_end; w0->fresh++) {
-        uint32_t *v = m->T + 8 * (size_t)w0->fresh;
-        v[0] = v[1] = INF;
-    }
-    for (int i = 0; i < nw; i++) {
-        fdt_ins_stats *s = &ws[i].st;
-        m->stats.walk_steps += s->walk_steps;
-        m->stats.cavity_tets += s->cavity_tets;
-        m->stats.created_tets += s->created_tets;
-        m->stats.conflict_tests += s->conflict_tests;
-        m->stats.deferred += s->deferred;
-        m->stats.stolen += s->stolen;
-        if (s->max_cavity > m->stats.max_cavity)
-            m->stats.max_cavity = s->max_cavity;
-        if (cnt) {
-            cnt->orient_exact += ws[i].cnt.orient_exact;
-            cnt->insphere_exact += ws[i].cnt.insphere_exact;
-            cnt->orient_adapt += ws[i].cnt.orient_adapt;
-            cnt->insphere_adapt += ws[i].cnt.insphere_adapt;
-        }
-    }
+    if ((err = phase3(&sh, ws, nw)) != FDT_OK)
+        goto fail;
+    sum_worker_stats(m, ws, nw, cnt);
     err = fdt_ins_finish(m);
     if (err == FDT_OK) {
         m->stats.cpu_start_s = c1 - c0;

@@ -9,7 +9,6 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <inttypes.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -89,17 +88,27 @@ static const char *rel_name(const char *name)
  * barrier after the index (complete) or after the removals (failed), an
  * interrupt removes this rank's pieces, the .node and the index (any rank
  * may: they name the same files), so an index never outlives a file it
- * names and nothing partial is left. The names are written while live is
- * 0 and published by the store of 1 after them (volatile accesses keep
- * their order; the handler runs on this thread). */
-enum { LIVE_MAX = 4 };
-static char live_path[LIVE_MAX][FDT_IO_PATH];
-static volatile sig_atomic_t live_n;
+ * names and nothing partial is left: the writer's registry of temporaries
+ * guards them (fdt_io_guard, src/io/write/writer.h), and its signal
+ * cleanup (fdt_write_cleanup) removes them. At most four names, beside the
+ * writer's own temporaries of this rank (three at a time): the registry's
+ * 32 slots always have room. */
+enum { GUARD_MAX = 4 };
 
-void fdt_mpo_cleanup(void)
+static void guard_all(char (*names)[FDT_IO_PATH], int n, int *slot)
 {
-    for (int i = 0; i < live_n; i++)
-        (void)unlink(live_path[i]);
+    fdt_write_lock();
+    for (int i = 0; i < n; i++)
+        slot[i] = fdt_io_guard(names[i]);
+    fdt_write_unlock();
+}
+
+static void unguard_all(const int *slot, int n)
+{
+    fdt_write_lock();
+    for (int i = 0; i < n; i++)
+        fdt_io_unguard(slot[i]);
+    fdt_write_unlock();
 }
 
 /* ---- pieces ---------------------------------------------------------------- */
@@ -250,16 +259,7 @@ static int write_node(MPI_Comm comm, const char *name, const fdt_mpi_local *L, u
     memset(sc, 0, (size_t)size * sizeof *sc);
     for (size_t i = 0; i < L->nin; i++)
         sc[block_owner(n, size, (uint64_t)(uint32_t)L->in_id[i])]++;
-    MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, comm);
-    size_t nr = 0;
-    for (int q = 0, at = 0; q < size; q++) {
-        sd[q] = at;
-        at += sc[q];
-        rd[q] = (int)nr;
-        nr += (size_t)rc[q];
-        if (q != rank)
-            io[1] += (uint64_t)sc[q] * sizeof(nrec);
-    }
+    size_t nr = fdt_mpi_counts(comm, sc, sd, rc, rd, sizeof(nrec), &io[1]);
     /* counting sort by destination (sd[] moves on; put back below) */
     for (size_t i = 0; i < L->nin; i++) {
         int q = block_owner(n, size, (uint64_t)(uint32_t)L->in_id[i]);
@@ -466,13 +466,14 @@ int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
         piece_name(a->path, kind, rank, i, names[i], sizeof names[i]);
     if (kind == FDT_MPO_ELE)
         sibling(a->path, kind, "", ".node", node, sizeof node);
-    int nl = 0;
+    char guarded[GUARD_MAX][FDT_IO_PATH];
+    int nl = 0, slot[GUARD_MAX];
     for (int i = 0; i < k; i++)
-        memcpy(live_path[nl++], names[i], FDT_IO_PATH);
+        memcpy(guarded[nl++], names[i], FDT_IO_PATH);
     if (node[0])
-        memcpy(live_path[nl++], node, FDT_IO_PATH);
-    snprintf(live_path[nl++], FDT_IO_PATH, "%s", a->path);
-    live_n = nl; /* from here an interrupt removes them (fdt_mpo_cleanup) */
+        memcpy(guarded[nl++], node, FDT_IO_PATH);
+    snprintf(guarded[nl++], FDT_IO_PATH, "%s", a->path);
+    guard_all(guarded, nl, slot); /* from here an interrupt removes them */
 
     int err = FDT_OK;
     if (kind == FDT_MPO_ELE) {
@@ -534,6 +535,6 @@ int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
     /* complete (the index is there) or removed, on every rank: nothing to
      * undo */
     MPI_Barrier(comm);
-    live_n = 0;
+    unguard_all(slot, nl);
     return worst == 0 ? FDT_OK : worst == 1 ? FDT_ENOMEM : FDT_EIO;
 }

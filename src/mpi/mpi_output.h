@@ -22,7 +22,8 @@
  * All or nothing: every file goes through a temporary renamed at its end
  * (src/io/write/writer.c); the index is written last, once every piece is there,
  * and if any rank fails every piece (and the .node) is removed again on
- * every rank. fdt_mpo_cleanup is the signal handler's part.
+ * every rank. Until then an interrupt removes them: the writer's signal
+ * cleanup (fdt_write_cleanup) does, as for its own temporaries.
  */
 #ifndef FDT_MPI_OUTPUT_H
 #define FDT_MPI_OUTPUT_H
@@ -70,10 +71,5 @@ typedef struct fdt_mpo_args {
  */
 int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
                   const fdt_mpi_out *r, int *mine, uint64_t io[2], char *diag, size_t dlen);
-
-/* Removes this rank's pieces, the .node and the index while a write is
- * between its first piece and the end of fdt_mpo_write. Async-signal-safe
- * (unlink only). */
-void fdt_mpo_cleanup(void);
 
 #endif

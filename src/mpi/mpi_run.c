@@ -214,16 +214,7 @@ static int translate(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L, con
         sc[q] = 0;
     for (size_t i = 0; i < nf; i++)
         sc[fdt_partition_owner(&L->pt, F[i])]++;
-    MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, comm);
-    size_t nq = 0;
-    for (int q = 0, at = 0; q < size; q++) {
-        sd[q] = at;
-        at += sc[q];
-        rd[q] = (int)nq;
-        nq += (size_t)rc[q];
-        if (q != rank)
-            *bytes += (uint64_t)sc[q] * sizeof(uint32_t);
-    }
+    size_t nq = fdt_mpi_counts(comm, sc, sd, rc, rd, sizeof(uint32_t), bytes);
     Q = malloc((nq + 1) * sizeof *Q);
     ans = malloc((nq + 1) * sizeof *ans);
     got = malloc((nf + 1) * sizeof *got);
@@ -428,6 +419,198 @@ static int replica_mesh(MPI_Comm comm, const fdt_mpi_local *L, const fdt_mpi_opt
     return err == FDT_EINTERNAL ? err : FDT_OK;
 }
 
+/* This rank's engine e (fdt_eng_new'd, every rank's part known, only
+ * this rank's worker *w set up): the message mode of src/par, its tets
+ * into sink, its seeds. */
+static int rank_engine(engine *e, fdt_mpi_local *L, const fdt_mpi_opts *o, int rank, int size,
+                       double *P, fdt_vid *orig, fdt_tsink *sink, worker **wp)
+{
+    fdt_partition *pt = &L->pt;
+    int err = FDT_OK;
+    e->pt = pt;
+    e->P = P;
+    e->orig = orig;
+    e->sink = sink;
+    e->mode = FDT_MODE_MESSAGE;
+    e->search = o->search;
+    e->msg_term = 1;
+    e->park = !o->no_park; /* a round trip crosses processes: park, go on */
+    e->fail_part = o->fail_rank;
+    e->fail_after = o->fail_after;
+    for (int i = 0; i < size; i++) {
+        worker *x = &e->w[i];
+        x->e = e;
+        x->id = i;
+        x->tree = &pt->trees[i];
+        x->lo = pt->start[i];
+        x->hi = pt->start[i + 1];
+        x->parent = -1;
+        x->aborted_by = -1;
+    }
+    worker *w = &e->w[rank];
+    *wp = w;
+    w->st.points = w->hi - w->lo;
+    w->st.core = -1;
+    w->report_at = 4096;
+    /* Our seeds (owner: the part of the lowest id), their foreign
+     * vertices delivered with them as a FACESEND would carry them
+     * (mpi_setup.c found every seed with its coordinates). Every part
+     * holding a seed is a root of Dijkstra-Scholten
+     * (src/par/termination.c); every rank counts the roots alike. */
+    w->seeds = malloc(((size_t)L->nseeds + 1) * sizeof *w->seeds);
+    if (!w->seeds)
+        err = FDT_ENOMEM;
+    int *has = calloc((size_t)size, sizeof *has);
+    if (!has)
+        err = FDT_ENOMEM;
+    for (int i = 0; !err && i < L->nseeds; i++) {
+        const uint32_t *sd = L->seeds[i];
+        uint32_t lo = sd[0];
+        for (int k = 1; k < 4; k++)
+            if (sd[k] < lo)
+                lo = sd[k];
+        int own = fdt_partition_owner(pt, lo);
+        if (!has[own]++)
+            e->roots++;
+        if (own != rank)
+            continue;
+        memcpy(w->seeds[w->nseeds++], sd, sizeof w->seeds[0]);
+        for (int k = 0; k < 4; k++)
+            if (!is_own(w, sd[k]) && fdt_ghost_put(&w->ghosts, sd[k], L->seed_xyz[i] + 3 * k))
+                err = FDT_ENOMEM;
+    }
+    free(has);
+    w->engaged = w->nseeds > 0;
+    return err;
+}
+
+/* The run's statistics (collective): this rank's counts and tets into
+ * out; their sums and every rank's, with its front's wall and CPU times,
+ * to rank 0, which checks the balance (every kind sent was received). */
+static int rank_stats(MPI_Comm comm, int rank, int size, engine *e, worker *w, double wall,
+                      double cpu, fdt_mpi_out *out, char *diag, size_t dlen)
+{
+    fdt_mailbox_counts mc;
+    fdt_tp_counts(e->tp, rank, &mc);
+    memcpy(out->sent, mc.sent, sizeof out->sent);
+    memcpy(out->received, mc.received, sizeof out->received);
+    out->tets = w->out.ntets;
+    uint64_t both[2 * FDT_MSG_KIND_END];
+    memcpy(both, mc.sent, sizeof mc.sent);
+    memcpy(both + FDT_MSG_KIND_END, mc.received, sizeof mc.received);
+    if (rank == 0) {
+        out->rank_counts = malloc((size_t)size * sizeof both);
+        out->rank_tets = malloc((size_t)size * sizeof *out->rank_tets);
+        out->rank_times = malloc((size_t)size * FDT_MPI_NTIMES * sizeof *out->rank_times);
+    }
+    int oom = rank == 0 && (!out->rank_counts || !out->rank_tets || !out->rank_times);
+    MPI_Bcast(&oom, 1, MPI_INT, 0, comm);
+    if (oom) {
+        snprintf(diag, dlen, "rank 0: out of memory for the statistics");
+        return FDT_ENOMEM;
+    }
+    MPI_Gather(both, 2 * FDT_MSG_KIND_END, MPI_UINT64_T, out->rank_counts,
+               2 * FDT_MSG_KIND_END, MPI_UINT64_T, 0, comm);
+    /* Where each rank's time went (--stats): the setup's phases
+     * (src/mpi/mpi_setup.h), then the front: the wait timers of
+     * src/par/protocol.c (t_idle: nothing to do; t_query_wait: blocked on
+     * answers) beside its CPU time. */
+    double tm[FDT_MPI_NTIMES] = {wall, cpu, w->st.t_idle, w->st.t_query_wait,
+                                 (double)w->st.faces_advanced};
+    MPI_Gather(tm, FDT_MPI_NTIMES, MPI_DOUBLE, out->rank_times, FDT_MPI_NTIMES, MPI_DOUBLE, 0,
+               comm);
+    uint64_t nt = w->out.ntets, *rt = NULL;
+    if (rank == 0 && !(rt = malloc((size_t)size * sizeof *rt)))
+        MPI_Abort(comm, 4);
+    MPI_Gather(&nt, 1, MPI_UINT64_T, rt, 1, MPI_UINT64_T, 0, comm);
+    if (rank == 0) {
+        for (size_t r = 0; r < (size_t)size; r++)
+            out->rank_tets[r] = (size_t)rt[r];
+        free(rt);
+    }
+    MPI_Reduce(mc.sent, out->all_sent, FDT_MSG_KIND_END, MPI_UINT64_T, MPI_SUM, 0, comm);
+    MPI_Reduce(mc.received, out->all_received, FDT_MSG_KIND_END, MPI_UINT64_T, MPI_SUM, 0,
+               comm);
+    return FDT_OK;
+}
+
+/* This rank's tets in input numbering (collective): the set hash, whose
+ * partial sums add over ranks (src/base/sethash.h), and the outputs: the
+ * rank's own piece (o->keep_own) or the mesh gathered to rank 0
+ * (o->gather). *minep: the renumbered tets, the caller's to free unless
+ * a piece took them (then NULL). */
+static int rank_output(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L,
+                       const fdt_mpi_opts *o, worker *w, int rank, int size, fdt_vid **minep,
+                       fdt_mpi_out *out, char *diag, size_t dlen)
+{
+    size_t n4 = 4 * w->out.ntets, n3 = 3 * w->out.nhull;
+    fdt_vid *mine = *minep = malloc((n4 > n3 ? n4 : n3) * sizeof *mine + 1);
+    int merr = mine ? FDT_OK : FDT_ENOMEM, any = 0;
+    MPI_Allreduce(&merr, &any, 1, MPI_INT, MPI_MIN, comm);
+    if (any) {
+        snprintf(diag, dlen, "out of memory renumbering the tets");
+        return FDT_ENOMEM;
+    }
+    xrec *used = NULL;
+    size_t nused = 0;
+    int pieces = o->keep_own && !o->gather;
+    int with_pts = pieces && (o->keep_own & FDT_MPI_OWN_POINTS);
+    int err = translate(comm, xt, L, w->out.tets, n4, mine, with_pts ? &used : NULL, &nused,
+                        &out->bytes_out, diag, dlen);
+    if (err)
+        return err;
+    fdt_sethash h = {0, 0};
+    fdt_sethash_add_n(&h, (const uint32_t *)mine, w->out.ntets);
+    uint64_t hv[2] = {h.sum, h.count}, hs[2] = {0, 0};
+    /* Sums mod 2^64: MPI_SUM on unsigned integers wraps as C's does. */
+    MPI_Reduce(hv, hs, 2, MPI_UINT64_T, MPI_SUM, 0, comm);
+    out->hash.sum = hs[0];
+    out->hash.count = hs[1];
+    if (pieces && !with_pts) {
+        /* .fdtb or .ele pieces: the ids alone, hull faces too */
+        out->own_tets = mine;
+        out->own_ntets = w->out.ntets;
+        *minep = NULL;
+        out->own_hull = malloc((n3 + 1) * sizeof *out->own_hull);
+        err = out->own_hull ? FDT_OK : FDT_ENOMEM;
+        snprintf(diag, dlen, "out of memory for this rank's piece");
+        err = fdt_mpi_agree(comm, err, diag, dlen);
+        if (!err)
+            err = translate(comm, xt, L, w->out.hull, n3, out->own_hull, NULL, NULL,
+                            &out->bytes_out, diag, dlen);
+        out->own_nhull = w->out.nhull;
+    } else if (pieces) {
+        out->own_tets = mine;
+        out->own_ntets = w->out.ntets;
+        *minep = NULL;
+        out->own_ids = malloc((nused + 1) * sizeof *out->own_ids);
+        out->own_xyz = malloc((3 * nused + 1) * sizeof *out->own_xyz);
+        err = out->own_ids && out->own_xyz ? FDT_OK : FDT_ENOMEM;
+        for (size_t i = 0; !err && i < nused; i++) {
+            out->own_ids[i] = (fdt_vid)used[i].id;
+            memcpy(out->own_xyz + 3 * i, used[i].x, sizeof used[i].x);
+        }
+        out->own_npts = nused;
+        free(used);
+        snprintf(diag, dlen, "out of memory for this rank's piece");
+        err = fdt_mpi_agree(comm, err, diag, dlen);
+    } else if (o->gather) {
+        err = gather_ids(comm, rank, size, mine, w->out.ntets, 4, &out->all_tets, &out->ntets);
+        if (!err)
+            err = translate(comm, xt, L, w->out.hull, n3, mine, NULL, NULL, &out->bytes_out,
+                            diag, dlen);
+        if (!err)
+            err = gather_ids(comm, rank, size, mine, w->out.nhull, 3, &out->all_hull,
+                             &out->nhull);
+        if (err)
+            snprintf(diag, dlen, "%s gathering the mesh to rank 0",
+                     err == FDT_ETOOBIG ? "too many tets (MPI int counts)" : "out of memory");
+        if (!err)
+            err = gather_points(comm, xt, L, out, diag, dlen);
+    }
+    return err;
+}
+
 int fdt_mpi_run(MPI_Comm comm, fdt_mpi_local *L, const fdt_mpi_opts *o, fdt_mpi_out *out,
                 char *diag, size_t dlen)
 {
@@ -437,7 +620,6 @@ int fdt_mpi_run(MPI_Comm comm, fdt_mpi_local *L, const fdt_mpi_opts *o, fdt_mpi_
     MPI_Comm_rank(comm, &rank);
     MPI_Comm_size(comm, &size);
     double t0 = fdt_now_s();
-    fdt_partition *pt = &L->pt;
     engine *e = NULL;
     fdt_vid *mine = NULL;
     double *P_all = NULL; /* the replica mesh's coordinates (replica_mesh) */
@@ -463,62 +645,8 @@ int fdt_mpi_run(MPI_Comm comm, fdt_mpi_local *L, const fdt_mpi_opts *o, fdt_mpi_
     if (!err && !(e = fdt_eng_new(size)))
         err = FDT_ENOMEM;
     worker *w = NULL;
-    if (!err) {
-        e->pt = pt;
-        e->P = P;
-        e->orig = orig;
-        e->sink = &mem_sink;
-        e->mode = FDT_MODE_MESSAGE;
-        e->search = o->search;
-        e->msg_term = 1;
-        e->park = !o->no_park; /* a round trip crosses processes: park, go on */
-        e->fail_part = o->fail_rank;
-        e->fail_after = o->fail_after;
-        for (int i = 0; i < size; i++) {
-            worker *x = &e->w[i];
-            x->e = e;
-            x->id = i;
-            x->tree = &pt->trees[i];
-            x->lo = pt->start[i];
-            x->hi = pt->start[i + 1];
-            x->parent = -1;
-            x->aborted_by = -1;
-        }
-        w = &e->w[rank];
-        w->st.points = w->hi - w->lo;
-        w->st.core = -1;
-        w->report_at = 4096;
-        /* Our seeds (owner: the part of the lowest id), their foreign
-         * vertices delivered with them as a FACESEND would carry them
-         * (mpi_setup.c found every seed with its coordinates). Every part
-         * holding a seed is a root of Dijkstra-Scholten
-         * (src/par/termination.c); every rank counts the roots alike. */
-        w->seeds = malloc(((size_t)L->nseeds + 1) * sizeof *w->seeds);
-        if (!w->seeds)
-            err = FDT_ENOMEM;
-        int *has = calloc((size_t)size, sizeof *has);
-        if (!has)
-            err = FDT_ENOMEM;
-        for (int i = 0; !err && i < L->nseeds; i++) {
-            const uint32_t *sd = L->seeds[i];
-            uint32_t lo = sd[0];
-            for (int k = 1; k < 4; k++)
-                if (sd[k] < lo)
-                    lo = sd[k];
-            int own = fdt_partition_owner(pt, lo);
-            if (!has[own]++)
-                e->roots++;
-            if (own != rank)
-                continue;
-            memcpy(w->seeds[w->nseeds++], sd, sizeof w->seeds[0]);
-            for (int k = 0; k < 4; k++)
-                if (!is_own(w, sd[k]) &&
-                    fdt_ghost_put(&w->ghosts, sd[k], L->seed_xyz[i] + 3 * k))
-                    err = FDT_ENOMEM;
-        }
-        free(has);
-        w->engaged = w->nseeds > 0;
-    }
+    if (!err)
+        err = rank_engine(e, L, o, rank, size, P, orig, &mem_sink, &w);
     /* The transport is made by every rank (MPI_Comm_dup is collective). */
     fdt_transport *tp = NULL;
     int terr = fdt_transport_mpi(&tp, comm);
@@ -554,120 +682,9 @@ int fdt_mpi_run(MPI_Comm comm, fdt_mpi_local *L, const fdt_mpi_opts *o, fdt_mpi_
             fdt_transport_mpi_abandon(tp);
         goto done;
     }
-
-    /* Statistics: this rank's counts; their sums and every rank's to rank
-     * 0, which checks the balance (every kind sent was received). */
-    fdt_mailbox_counts mc;
-    fdt_tp_counts(e->tp, rank, &mc);
-    memcpy(out->sent, mc.sent, sizeof out->sent);
-    memcpy(out->received, mc.received, sizeof out->received);
-    out->tets = w->out.ntets;
-    uint64_t both[2 * FDT_MSG_KIND_END];
-    memcpy(both, mc.sent, sizeof mc.sent);
-    memcpy(both + FDT_MSG_KIND_END, mc.received, sizeof mc.received);
-    if (rank == 0) {
-        out->rank_counts = malloc((size_t)size * sizeof both);
-        out->rank_tets = malloc((size_t)size * sizeof *out->rank_tets);
-        out->rank_times = malloc((size_t)size * FDT_MPI_NTIMES * sizeof *out->rank_times);
-    }
-    int oom = rank == 0 && (!out->rank_counts || !out->rank_tets || !out->rank_times);
-    MPI_Bcast(&oom, 1, MPI_INT, 0, comm);
-    if (oom) {
-        err = FDT_ENOMEM;
-        snprintf(diag, dlen, "rank 0: out of memory for the statistics");
+    if ((err = rank_stats(comm, rank, size, e, w, t2 - t1, c2 - c1, out, diag, dlen)) != FDT_OK)
         goto done;
-    }
-    MPI_Gather(both, 2 * FDT_MSG_KIND_END, MPI_UINT64_T, out->rank_counts,
-               2 * FDT_MSG_KIND_END, MPI_UINT64_T, 0, comm);
-    /* Where each rank's time went (--stats): the setup's phases
-     * (src/mpi/mpi_setup.h), then the front: the wait timers of
-     * src/par/protocol.c (t_idle: nothing to do; t_query_wait: blocked on
-     * answers) beside its CPU time. */
-    double tm[FDT_MPI_NTIMES] = {t2 - t1, c2 - c1, w->st.t_idle, w->st.t_query_wait,
-                                 (double)w->st.faces_advanced};
-    MPI_Gather(tm, FDT_MPI_NTIMES, MPI_DOUBLE, out->rank_times, FDT_MPI_NTIMES, MPI_DOUBLE, 0,
-               comm);
-    uint64_t nt = w->out.ntets, *rt = NULL;
-    if (rank == 0 && !(rt = malloc((size_t)size * sizeof *rt)))
-        MPI_Abort(comm, 4);
-    MPI_Gather(&nt, 1, MPI_UINT64_T, rt, 1, MPI_UINT64_T, 0, comm);
-    if (rank == 0) {
-        for (size_t r = 0; r < (size_t)size; r++)
-            out->rank_tets[r] = (size_t)rt[r];
-        free(rt);
-    }
-    MPI_Reduce(mc.sent, out->all_sent, FDT_MSG_KIND_END, MPI_UINT64_T, MPI_SUM, 0, comm);
-    MPI_Reduce(mc.received, out->all_received, FDT_MSG_KIND_END, MPI_UINT64_T, MPI_SUM, 0,
-               comm);
-
-    /* Our tets in input numbering: the set hash, whose partial sums add
-     * over ranks (src/base/sethash.h), and the outputs. */
-    size_t n4 = 4 * w->out.ntets, n3 = 3 * w->out.nhull;
-    mine = malloc((n4 > n3 ? n4 : n3) * sizeof *mine + 1);
-    int merr = mine ? FDT_OK : FDT_ENOMEM, any = 0;
-    MPI_Allreduce(&merr, &any, 1, MPI_INT, MPI_MIN, comm);
-    if (any) {
-        err = FDT_ENOMEM;
-        snprintf(diag, dlen, "out of memory renumbering the tets");
-        goto done;
-    }
-    xrec *used = NULL;
-    size_t nused = 0;
-    int pieces = o->keep_own && !o->gather;
-    int with_pts = pieces && (o->keep_own & FDT_MPI_OWN_POINTS);
-    err = translate(comm, xt, L, w->out.tets, n4, mine, with_pts ? &used : NULL, &nused,
-                    &out->bytes_out, diag, dlen);
-    if (err)
-        goto done;
-    fdt_sethash h = {0, 0};
-    fdt_sethash_add_n(&h, (const uint32_t *)mine, w->out.ntets);
-    uint64_t hv[2] = {h.sum, h.count}, hs[2] = {0, 0};
-    /* Sums mod 2^64: MPI_SUM on unsigned integers wraps as C's does. */
-    MPI_Reduce(hv, hs, 2, MPI_UINT64_T, MPI_SUM, 0, comm);
-    out->hash.sum = hs[0];
-    out->hash.count = hs[1];
-    if (pieces && !with_pts) {
-        /* .fdtb or .ele pieces: the ids alone, hull faces too */
-        out->own_tets = mine;
-        out->own_ntets = w->out.ntets;
-        mine = NULL;
-        out->own_hull = malloc((n3 + 1) * sizeof *out->own_hull);
-        err = out->own_hull ? FDT_OK : FDT_ENOMEM;
-        snprintf(diag, dlen, "out of memory for this rank's piece");
-        err = fdt_mpi_agree(comm, err, diag, dlen);
-        if (!err)
-            err = translate(comm, xt, L, w->out.hull, n3, out->own_hull, NULL, NULL,
-                            &out->bytes_out, diag, dlen);
-        out->own_nhull = w->out.nhull;
-    } else if (pieces) {
-        out->own_tets = mine;
-        out->own_ntets = w->out.ntets;
-        mine = NULL;
-        out->own_ids = malloc((nused + 1) * sizeof *out->own_ids);
-        out->own_xyz = malloc((3 * nused + 1) * sizeof *out->own_xyz);
-        err = out->own_ids && out->own_xyz ? FDT_OK : FDT_ENOMEM;
-        for (size_t i = 0; !err && i < nused; i++) {
-            out->own_ids[i] = (fdt_vid)used[i].id;
-            memcpy(out->own_xyz + 3 * i, used[i].x, sizeof used[i].x);
-        }
-        out->own_npts = nused;
-        free(used);
-        snprintf(diag, dlen, "out of memory for this rank's piece");
-        err = fdt_mpi_agree(comm, err, diag, dlen);
-    } else if (o->gather) {
-        err = gather_ids(comm, rank, size, mine, w->out.ntets, 4, &out->all_tets, &out->ntets);
-        if (!err)
-            err = translate(comm, xt, L, w->out.hull, n3, mine, NULL, NULL, &out->bytes_out,
-                            diag, dlen);
-        if (!err)
-            err = gather_ids(comm, rank, size, mine, w->out.nhull, 3, &out->all_hull,
-                             &out->nhull);
-        if (err)
-            snprintf(diag, dlen, "%s gathering the mesh to rank 0",
-                     err == FDT_ETOOBIG ? "too many tets (MPI int counts)" : "out of memory");
-        if (!err)
-            err = gather_points(comm, xt, L, out, diag, dlen);
-    }
+    err = rank_output(comm, xt, L, o, w, rank, size, &mine, out, diag, dlen);
 done:
     out->t_setup = t1 - t0;
     out->t_front = t2 - t1;

@@ -105,6 +105,25 @@ int fdt_mpi_agree(MPI_Comm comm, int err, char *diag, size_t dlen)
     return e;
 }
 
+size_t fdt_mpi_counts(MPI_Comm comm, const int *sc, int *sd, int *rc, int *rd, size_t rec_size,
+                      uint64_t *bytes)
+{
+    int size, rank;
+    MPI_Comm_size(comm, &size);
+    MPI_Comm_rank(comm, &rank);
+    MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, comm);
+    size_t nr = 0;
+    for (int q = 0, at = 0; q < size; q++) {
+        sd[q] = at;
+        at += sc[q];
+        rd[q] = (int)nr;
+        nr += (size_t)rc[q];
+        if (q != rank)
+            *bytes += (uint64_t)sc[q] * rec_size;
+    }
+    return nr;
+}
+
 static int io_err(int rc)
 {
     switch (rc) {
@@ -632,19 +651,7 @@ static int bisect(MPI_Comm comm, MPI_Datatype rt, rec **pr, size_t *pn, int dims
             }
         }
         /* record counts fit an int: a side's share is under 2^31 points */
-        int disp = 0;
-        for (int q = 0; q < gs; q++) {
-            sdisp[q] = disp;
-            disp += scount[q];
-            if (q != gr)
-                *bytes += (uint64_t)scount[q] * sizeof(rec);
-        }
-        MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, g);
-        size_t nr = 0;
-        for (int q = 0; q < gs; q++) {
-            rdisp[q] = (int)nr;
-            nr += (size_t)rcount[q];
-        }
+        size_t nr = fdt_mpi_counts(g, scount, sdisp, rcount, rdisp, sizeof(rec), bytes);
         rec *nrec = malloc((nr + 1) * sizeof *nrec);
         int e = nrec ? FDT_OK : FDT_ENOMEM;
         snprintf(diag, dlen, "out of memory in the bisection's exchange");
@@ -932,13 +939,9 @@ static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const do
         int *scount = cnt, *sdisp = cnt + size, *rcount = cnt + 2 * size, *rdisp = cnt + 3 * size;
         for (int q = 0; q < size; q++)
             scount[q] = bc[q].n > (size_t)INT_MAX / 2 ? 0 : (int)bc[q].n;
-        MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, comm);
-        size_t nr = 0, ns = 0;
-        for (int q = 0; q < size; q++) {
-            rdisp[q] = (int)nr;
-            nr += (size_t)rcount[q];
-            ns += (size_t)scount[q];
-        }
+        size_t nr = fdt_mpi_counts(comm, scount, sdisp, rcount, rdisp, sizeof(rec),
+                                   &L->bytes_sent);
+        size_t ns = (size_t)sdisp[size - 1] + (size_t)scount[size - 1];
         /* one send buffer: the balls in rank order */
         rec *sb = malloc((ns + 1) * sizeof *sb);
         free(got);
@@ -950,15 +953,9 @@ static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const do
             free(sb);
             break;
         }
-        size_t at = 0;
-        for (int q = 0; q < size; q++) {
-            sdisp[q] = (int)at;
+        for (int q = 0; q < size; q++)
             if (scount[q] > 0)
-                memcpy(sb + at, bc[q].buf, (size_t)scount[q] * sizeof *sb);
-            at += (size_t)scount[q];
-            if (q != rank)
-                L->bytes_sent += (uint64_t)scount[q] * sizeof(rec);
-        }
+                memcpy(sb + sdisp[q], bc[q].buf, (size_t)scount[q] * sizeof *sb);
         MPI_Alltoallv(sb, scount, sdisp, rt, got, rcount, rdisp, rt, comm);
         free(sb);
         if (me.active != 0) {

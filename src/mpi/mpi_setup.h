@@ -86,4 +86,13 @@ void fdt_mpi_local_free(fdt_mpi_local *L);
  * (collective). */
 int fdt_mpi_agree(MPI_Comm comm, int err, char *diag, size_t dlen);
 
+/* The counts of an MPI_Alltoallv over comm (collective): from the send
+ * counts sc (records to each rank), the send displacements sd and, through
+ * an MPI_Alltoall, the receive counts rc and displacements rd, each
+ * displacement the prefix sum in rank order. Adds to *bytes the bytes
+ * sent to the other ranks, rec_size a record. Returns the records
+ * received (the sum of rc). */
+size_t fdt_mpi_counts(MPI_Comm comm, const int *sc, int *sd, int *rc, int *rd, size_t rec_size,
+                      uint64_t *bytes);
+
 #endif

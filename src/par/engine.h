@@ -150,6 +150,8 @@ typedef struct engine {
                                   built before the threads start, read-only
                                   after (thread creation publishes it) */
     int gmesh_ok;
+    size_t gm_certified;       /* the setup's mesh of every point: finite */
+    double gm_t_certify;       /* tets certified, and the seconds it took */
     /* The collective switch (bench/NOTES.md entry 59): 1 when the parts
      * start on the kd search with collective oracles (fdt_oracle.
      * collective). Once a majority of them voted (gm_votes), the part that

@@ -181,13 +181,6 @@ void fdt_parallel_fill_stats(const fdt_par_out *o, fdt_mode mode,
     st->mode = mode;
 }
 
-int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
-                             fdt_mode mode, int nthreads, fdt_par_out *out,
-                             char *diag, size_t dlen)
-{
-    return fdt_parallel_run(pr, s, mode, nthreads, NULL, out, diag, dlen);
-}
-
 /*
  * With the mesh of every point built before the fronts, the tets each id
  * will own (§3.2: a tet belongs to its lowest vertex's part) are known,
@@ -236,22 +229,14 @@ static void *probe_main(void *arg)
     return NULL;
 }
 
-int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int nthreads,
-                     const fdt_par_opts *opt, fdt_par_out *out, char *diag, size_t dlen)
+/* ---- the run's steps (fdt_parallel_run) ----------------------------------- */
+
+/* Partitions the points into nthreads parts, one kd-tree each, with the
+ * probe beside it when probe is set: *expensive gets its answer (0 when
+ * there is no probe). On failure pt is zeroed. */
+static int partition_with_probe(fdt_prepared *pr, const fdt_settings *s, int nthreads,
+                                int probe, fdt_partition *pt, int *expensive)
 {
-    memset(out, 0, sizeof *out);
-    if ((mode != FDT_MODE_SHARED && mode != FDT_MODE_MESSAGE) || nthreads < 1 ||
-        nthreads > FDT_PARTITION_MAX || pr->m < 4 || pr->m > UINT32_MAX - 1)
-        return FDT_EINVAL;
-    double t0 = fdt_now_s();
-    fdt_partition pt;
-    engine *e = NULL;
-    uint32_t(*seeds)[4] = NULL;
-    int nseeds = 0, sync_ok = 0;
-    fdt_tsink mem_sink;
-    int mem_sink_ok = 0;
-    fdt_kdq kq0;
-    memset(&kq0, 0, sizeof kq0);
     /* The parts' trees are built on as many threads as there are CPUs
      * (up to one a part): at 1M points on two cores that took a quarter
      * of a second off a setup of 0.9 s. Online CPUs, not hwloc's cores:
@@ -268,57 +253,72 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * below. The seeds come after it: from the mesh where it is built
      * (entry 72), else by the kd search, which then no longer overlaps
      * the probe (0.1-0.3 ms a run where the mesh is not built). */
-    int probe = opt && opt->global_mesh == FDT_PAR_MESH_PROBE;
-    int probing = 0, expensive = 0;
+    int probing = 0;
     probe_job pj = {{{NULL, NULL}, 0, 0}, 0};
     pthread_t probe_th;
+    *expensive = 0;
     if (probe) {
         fdt_oracle_probe_take(&pj.ps, pr->p, (uint32_t)pr->m, s->leaf_size);
         probing = fdt_spawn(&probe_th, 0, probe_main, &pj) == 0;
     }
-    int err = fdt_partition_build(&pt, pr->p, pr->orig, (uint32_t)pr->m, nthreads,
+    int err = fdt_partition_build(pt, pr->p, pr->orig, (uint32_t)pr->m, nthreads,
                                   s->leaf_size > 0 ? s->leaf_size : FDT_DEFAULT_LEAF,
                                   cores < nthreads ? cores : nthreads);
     if (probing) {
         pthread_join(probe_th, NULL);
-        expensive = pj.expensive;
+        *expensive = pj.expensive;
     } else if (probe) {
-        expensive = fdt_oracle_probe_decide(&pj.ps); /* no thread: here */
+        *expensive = fdt_oracle_probe_decide(&pj.ps); /* no thread: here */
     }
-    if (err != FDT_OK)
-        return err; /* pt is zeroed */
-    err = FDT_ENOMEM;
-    if (!(e = fdt_eng_new(nthreads)))
-        goto fail;
-    e->pt = &pt;
+    return err;
+}
+
+/* The engine over the partition pt, its tets going to opt's sink or, when
+ * there is none, to mem_sink (set up here, *mem_sink_ok). *ep is set
+ * whenever it was allocated, failure or not: engine_free frees it. */
+static int engine_start(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode,
+                        const fdt_par_opts *opt, fdt_partition *pt, int nthreads,
+                        fdt_tsink *mem_sink, int *mem_sink_ok, engine **ep)
+{
+    engine *e = fdt_eng_new(nthreads);
+    *ep = e;
+    if (!e)
+        return FDT_ENOMEM;
+    e->pt = pt;
     e->P = pr->p;
     e->orig = pr->orig;
     if (opt && opt->sink) {
         e->sink = opt->sink;
     } else {
-        if (fdt_tsink_init(&mem_sink, pr->orig, NULL) != FDT_OK)
-            goto fail;
-        mem_sink_ok = 1;
-        e->sink = &mem_sink;
+        if (fdt_tsink_init(mem_sink, pr->orig, NULL) != FDT_OK)
+            return FDT_ENOMEM;
+        *mem_sink_ok = 1;
+        e->sink = mem_sink;
     }
     e->mode = mode;
     e->want_nbrs = s->neighbors != 0;
     e->search = (int)s->search;
     e->pin = s->pin != 0;
-    /* The DT of every point, for inputs where the kd search degenerates
-     * (src/api/api.c decides, by fdt_oracle_probe): built here on the run's
-     * threads, then every part reads its faces' apexes from it and asks
-     * no other part (bench/NOTES.md entry 54). In message mode it stands
-     * for the replica each MPI rank builds for itself (src/mpi/mpi_run.c):
-     * immutable once built, so one copy serves every part, and the parts
-     * still exchange their faces by FACESEND. Tets are still made and
-     * owned by the parts' fronts. A build that cannot be made (no memory)
-     * leaves the parts on their own oracles. Built before the seeds go to
-     * their owners and the workers take their ranges: recut_by_mesh moves
-     * those ranges. */
-    double t_gm = 0.0;
-    size_t certified_gm = 0; /* finite tets of the mesh of every point, certified */
-    double t_cert_gm = 0.0;  /* and the seconds that took */
+    return FDT_OK;
+}
+
+/*
+ * The DT of every point, for inputs where the kd search degenerates
+ * (src/api/api.c decides, by fdt_oracle_probe): built here on the run's
+ * threads, then every part reads its faces' apexes from it and asks
+ * no other part (bench/NOTES.md entry 54). In message mode it stands
+ * for the replica each MPI rank builds for itself (src/mpi/mpi_run.c):
+ * immutable once built, so one copy serves every part, and the parts
+ * still exchange their faces by FACESEND. Tets are still made and
+ * owned by the parts' fronts. A build that cannot be made (no memory)
+ * leaves the parts on their own oracles. Built before the seeds go to
+ * their owners and the workers take their ranges: recut_by_mesh moves
+ * those ranges. Also decides e->collective. *t_gm: the build's time.
+ */
+static int global_mesh(engine *e, fdt_prepared *pr, const fdt_par_opts *opt, int probe,
+                       int expensive, int nthreads, fdt_partition *pt, fdt_kdq *kq0,
+                       double *t_gm, char *diag, size_t dlen)
+{
     /* The probe's choice (not an explicit global_mesh == 1) is dropped
      * when the mesh would not fit the memory available (src/front/oracle.h,
      * FDT_ORACLE_MESH_BYTES): the parts' kd searches are always right. */
@@ -328,49 +328,46 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * the parts start on the kd search and switch together when one of
      * them measures it expensive at the full density (src/par/engine.c,
      * collective_step; bench/NOTES.md entry 59). */
-    e->collective = mode == FDT_MODE_SHARED &&
+    e->collective = e->mode == FDT_MODE_SHARED &&
                     ((probe && !expensive) || (opt && opt->global_mesh == FDT_PAR_MESH_COLLECTIVE));
-    if (opt && (opt->global_mesh == 1 || expensive)) {
-        double tg = fdt_now_s();
-        int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads,
-                                          &kq0.pc);
-        t_gm = fdt_now_s() - tg;
-        if (gerr == FDT_OK) {
-            /* proved before any part reads it (issue 31 item 6) */
-            fdt_certify_fail why;
-            double tc = fdt_now_s();
-            err = fdt_certify_parallel(&e->gmesh, nthreads, &kq0.pc, &why);
-            t_cert_gm = fdt_now_s() - tc;
-            if (err != FDT_OK) {
-                if (err == FDT_ECHECK)
-                    fdt_certify_describe(&why, diag, dlen);
-                goto fail;
-            }
-            certified_gm = e->gmesh.nfinite;
-            e->gmesh_ok = 1;
-            if (nthreads > 1 && (err = recut_by_mesh(&pt, &e->gmesh)) != FDT_OK)
-                goto fail;
-        } else if (gerr != FDT_ENOMEM && gerr != FDT_EDEGENERATE) {
-            err = gerr;
-            if (gerr == FDT_EINTERNAL) {
-                /* the insertion's own checks of its mesh broke: a wrong
-                 * mesh, as the certificate would say (src/front/partmesh.c) */
-                err = FDT_ECHECK;
-                snprintf(diag, dlen, "mesh certificate failed: the parallel insertion's own "
-                                     "consistency checks failed");
-            }
-            goto fail;
+    if (!(opt && (opt->global_mesh == 1 || expensive)))
+        return FDT_OK;
+    double tg = fdt_now_s();
+    int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads, &kq0->pc);
+    *t_gm = fdt_now_s() - tg;
+    if (gerr == FDT_OK) {
+        /* proved before any part reads it (issue 31 item 6) */
+        fdt_certify_fail why;
+        double tc = fdt_now_s();
+        int err = fdt_certify_parallel(&e->gmesh, nthreads, &kq0->pc, &why);
+        e->gm_t_certify = fdt_now_s() - tc;
+        if (err == FDT_OK)
+            e->gm_certified = e->gmesh.nfinite;
+        if (err != FDT_OK) {
+            if (err == FDT_ECHECK)
+                fdt_certify_describe(&why, diag, dlen);
+            return err;
         }
+        e->gmesh_ok = 1;
+        return nthreads > 1 ? recut_by_mesh(pt, &e->gmesh) : FDT_OK;
     }
-    /* The seeds, after the mesh of every point where it was built: its
-     * tets are Delaunay tets already (seeds_from_mesh). */
-    err = e->gmesh_ok ? seeds_from_mesh(&pt, &e->gmesh, &seeds, &nseeds)
-                      : seeds_by_kd(&pt, &seeds, &nseeds, &kq0);
-    if (err != FDT_OK) {
-        if (err == FDT_EINTERNAL)
-            snprintf(diag, dlen, "internal error: no seed tetrahedron found");
-        goto fail;
+    if (gerr == FDT_ENOMEM || gerr == FDT_EDEGENERATE)
+        return FDT_OK;
+    if (gerr == FDT_EINTERNAL) {
+        /* the insertion's own checks of its mesh broke: a wrong
+         * mesh, as the certificate would say (src/front/partmesh.c) */
+        snprintf(diag, dlen, "mesh certificate failed: the parallel insertion's own "
+                             "consistency checks failed");
+        return FDT_ECHECK;
     }
+    return gerr;
+}
+
+/* The transport between the parts and the engine's lock and conditions
+ * (*sync_ok once they all exist). */
+static int engine_sync_init(engine *e, const fdt_par_opts *opt, int nthreads, int *sync_ok)
+{
+    int err;
     if (opt && opt->shuffle)
         err = fdt_transport_shuffle(&e->tp, nthreads + 1, opt->seed, opt->delay_pct);
     else
@@ -378,29 +375,33 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     if (err) {
         /* FDT_EINVAL: a bad test option; otherwise out of memory (a mutex
          * that cannot be made counts as that, as before) */
-        if (err != FDT_EINVAL)
-            err = FDT_ENOMEM;
-        goto fail;
+        return err != FDT_EINVAL ? FDT_ENOMEM : err;
     }
-    err = FDT_ENOMEM;
     if (pthread_mutex_init(&e->lock, NULL) != 0)
-        goto fail;
+        return FDT_ENOMEM;
     if (pthread_cond_init(&e->cv, NULL) != 0) {
         pthread_mutex_destroy(&e->lock);
-        goto fail;
+        return FDT_ENOMEM;
     }
     if (pthread_cond_init(&e->go, NULL) != 0) {
         pthread_cond_destroy(&e->cv);
         pthread_mutex_destroy(&e->lock);
-        goto fail;
+        return FDT_ENOMEM;
     }
     if (pthread_cond_init(&e->gm_cv, NULL) != 0) {
         pthread_cond_destroy(&e->go);
         pthread_cond_destroy(&e->cv);
         pthread_mutex_destroy(&e->lock);
-        goto fail;
+        return FDT_ENOMEM;
     }
-    sync_ok = 1;
+    *sync_ok = 1;
+    return FDT_OK;
+}
+
+/* With pinning: the machine's cores and NUMA nodes (hwloc), or pinning
+ * refused where they cannot be read. */
+static void engine_topology(engine *e)
+{
 #ifdef FDT_HAVE_HWLOC
     if (e->pin) {
         if (hwloc_topology_init(&e->topo) == 0 && hwloc_topology_load(e->topo) == 0) {
@@ -418,73 +419,92 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     if (e->pin)
         atomic_store_explicit(&e->pin_refused, 1, memory_order_relaxed);
 #endif
-    /* Seeds to their owners: sorted by key, so each owner's are adjacent
-     * in owner order once grouped; nseeds <= nthreads, a scan is fine. */
-    long long active = 0;
+}
+
+/* Each worker's part: its tree and its range of ids. */
+static void workers_init(engine *e, fdt_partition *pt, int nthreads)
+{
     for (int i = 0; i < nthreads; i++) {
         worker *w = &e->w[i];
         atomic_init(&w->tets_done, 0);
         w->e = e;
         w->id = i;
-        w->tree = &pt.trees[i];
-        w->lo = pt.start[i];
-        w->hi = pt.start[i + 1];
+        w->tree = &pt->trees[i];
+        w->lo = pt->start[i];
+        w->hi = pt->start[i + 1];
         w->st.points = w->hi - w->lo;
         w->st.core = -1;
         w->report_at = 4096;
     }
-    /* Regroup seeds by owner in place: counting sort. */
-    {
-        uint32_t(*by)[4] = malloc(((size_t)nseeds + 1) * sizeof *by);
-        int *cnt = calloc((size_t)nthreads + 1, sizeof *cnt);
-        if (!by || !cnt) {
-            free(by);
-            free(cnt);
-            goto fail;
-        }
-        int *own = malloc(((size_t)nseeds + 1) * sizeof *own);
-        if (!own) {
-            free(by);
-            free(cnt);
-            goto fail;
-        }
-        for (int i = 0; i < nseeds; i++) {
-            uint32_t lo = seeds[i][0];
-            for (int k = 1; k < 4; k++)
-                if (seeds[i][k] < lo)
-                    lo = seeds[i][k];
-            own[i] = fdt_partition_owner(&pt, lo);
-            cnt[own[i] + 1]++;
-        }
-        for (int i = 0; i < nthreads; i++)
-            cnt[i + 1] += cnt[i];
-        for (int i = 0; i < nthreads; i++) {
-            e->w[i].seeds = by + cnt[i];
-            e->w[i].nseeds = cnt[i + 1] - cnt[i];
-        }
-        for (int i = 0; i < nseeds; i++)
-            memcpy(by[cnt[own[i]]++], seeds[i], sizeof by[0]);
-        free(own);
+}
+
+/* Seeds to their owners: *seeds regrouped by owner (a counting sort, the
+ * owners' in owner order; nseeds <= nthreads, a scan is fine), each
+ * worker's seeds pointing into the new array, which replaces *seeds. */
+static int seeds_to_owners(engine *e, const fdt_partition *pt, uint32_t (**seeds)[4],
+                           int nseeds, int nthreads)
+{
+    uint32_t(*by)[4] = malloc(((size_t)nseeds + 1) * sizeof *by);
+    int *cnt = calloc((size_t)nthreads + 1, sizeof *cnt);
+    if (!by || !cnt) {
+        free(by);
         free(cnt);
-        free(seeds);
-        seeds = by;
+        return FDT_ENOMEM;
     }
-    /* Message mode: a seed's foreign vertices are delivered with it, as a
-     * FACESEND would carry them (the setup may read every part). */
-    if (mode == FDT_MODE_MESSAGE)
-        for (int i = 0; i < nthreads; i++) {
-            worker *w = &e->w[i];
-            for (int j = 0; j < w->nseeds; j++)
-                for (int k = 0; k < 4; k++) {
-                    uint32_t id = w->seeds[j][k];
-                    if (!is_own(w, id) &&
-                        fdt_ghost_put(&w->ghosts, id, pr->p + 3 * (size_t)id) != FDT_OK)
-                        goto fail;
-                }
-        }
-    /* Shared mode: every part with seeds holds an activity unit. Message
-     * mode: every part with seeds is a root of Dijkstra-Scholten, engaged
-     * with no parent (src/par/termination.c). */
+    int *own = malloc(((size_t)nseeds + 1) * sizeof *own);
+    if (!own) {
+        free(by);
+        free(cnt);
+        return FDT_ENOMEM;
+    }
+    uint32_t(*sd)[4] = *seeds;
+    for (int i = 0; i < nseeds; i++) {
+        uint32_t lo = sd[i][0];
+        for (int k = 1; k < 4; k++)
+            if (sd[i][k] < lo)
+                lo = sd[i][k];
+        own[i] = fdt_partition_owner(pt, lo);
+        cnt[own[i] + 1]++;
+    }
+    for (int i = 0; i < nthreads; i++)
+        cnt[i + 1] += cnt[i];
+    for (int i = 0; i < nthreads; i++) {
+        e->w[i].seeds = by + cnt[i];
+        e->w[i].nseeds = cnt[i + 1] - cnt[i];
+    }
+    for (int i = 0; i < nseeds; i++)
+        memcpy(by[cnt[own[i]]++], sd[i], sizeof by[0]);
+    free(own);
+    free(cnt);
+    free(sd);
+    *seeds = by;
+    return FDT_OK;
+}
+
+/* Message mode: a seed's foreign vertices are delivered with it, as a
+ * FACESEND would carry them (the setup may read every part). */
+static int seed_ghosts(engine *e, const fdt_prepared *pr, int nthreads)
+{
+    for (int i = 0; i < nthreads; i++) {
+        worker *w = &e->w[i];
+        for (int j = 0; j < w->nseeds; j++)
+            for (int k = 0; k < 4; k++) {
+                uint32_t id = w->seeds[j][k];
+                if (!is_own(w, id) &&
+                    fdt_ghost_put(&w->ghosts, id, pr->p + 3 * (size_t)id) != FDT_OK)
+                    return FDT_ENOMEM;
+            }
+    }
+    return FDT_OK;
+}
+
+/* Termination's starting state. Shared mode: every part with seeds holds
+ * an activity unit. Message mode: every part with seeds is a root of
+ * Dijkstra-Scholten, engaged with no parent (src/par/termination.c).
+ * Returns the activity units held (shared mode). */
+static long long engine_roles(engine *e, fdt_mode mode, const fdt_par_opts *opt, int nthreads)
+{
+    long long active = 0;
     e->msg_term = mode == FDT_MODE_MESSAGE;
     e->park = mode == FDT_MODE_MESSAGE && opt && opt->park;
     e->fail_part = opt && opt->fail ? opt->fail_part : -1;
@@ -503,39 +523,37 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
             active++;
         }
     }
-    /* Every thread with seeds starts holding its activity unit. Thread
-     * creation orders this before everything the workers do. */
-    atomic_init(&e->work, active);
-    double t1 = fdt_now_s();
-    double t2 = t1;
-    err = fdt_threads_run(e, s, &t2);
+    return active;
+}
+
+/* The workers' first error, after they are joined, its message in diag. */
+static int workers_error(engine *e, int nthreads, char *diag, size_t dlen)
+{
     /* After pthread_join: any order would do; acquire documents that the
      * recorded err_thread/err_what are read after the CAS that chose them. */
     int werr = e->msg_term ? fdt_term_error(e, &e->err_thread, &e->err_what)
                            : atomic_load_explicit(&e->error, memory_order_acquire);
-    if (werr) {
-        err = werr;
-        if (werr == FDT_ENOMEM)
-            snprintf(diag, dlen, "out of memory in worker thread %d", e->err_thread);
-        else if (werr == FDT_EINTERNAL)
-            snprintf(diag, dlen, "internal error in worker thread %d: %s", e->err_thread,
-                     e->err_what ? e->err_what : "?");
-        else if (werr == FDT_ETHREAD)
-            snprintf(diag, dlen, "could not create thread %d of %d", e->err_thread, nthreads);
-        else if (werr == FDT_ECHECK)
-            snprintf(diag, dlen, "mesh certificate failed in worker thread %d: %s",
-                     e->err_thread, e->err_what ? e->err_what : "?");
-        goto fail;
-    }
-    if (err)
-        goto fail;
+    if (werr == FDT_ENOMEM)
+        snprintf(diag, dlen, "out of memory in worker thread %d", e->err_thread);
+    else if (werr == FDT_EINTERNAL)
+        snprintf(diag, dlen, "internal error in worker thread %d: %s", e->err_thread,
+                 e->err_what ? e->err_what : "?");
+    else if (werr == FDT_ETHREAD)
+        snprintf(diag, dlen, "could not create thread %d of %d", e->err_thread, nthreads);
+    else if (werr == FDT_ECHECK)
+        snprintf(diag, dlen, "mesh certificate failed in worker thread %d: %s", e->err_thread,
+                 e->err_what ? e->err_what : "?");
+    return werr;
+}
 
-    /* Statistics, and the message balance: every message sent was
-     * received, kind by kind. */
+/* The threads' statistics into out (tstats, pst, fst), with the setup's
+ * kd queries kq0 and the global mesh's build time t_gm. */
+static int collect_stats(engine *e, const fdt_partition *pt, int nthreads, const fdt_kdq *kq0,
+                         double t_gm, fdt_par_out *out)
+{
     out->tstats = calloc((size_t)nthreads, sizeof *out->tstats);
-    err = FDT_ENOMEM;
     if (!out->tstats)
-        goto fail;
+        return FDT_ENOMEM;
     fdt_stats *ps = &out->pst;
     size_t maxt = 0, sumt = 0;
     for (int i = 0; i < nthreads; i++) {
@@ -545,7 +563,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         fdt_tp_counts(e->tp, i, &mc);
         *ts = w->st;
         ts->tets = (size_t)w->em.ntets;
-        ps->mem_tree += fdt_kd_bytes(&pt.trees[i]);
+        ps->mem_tree += fdt_kd_bytes(&pt->trees[i]);
         ps->mem_front += fdt_front_bytes(&w->ft, &w->fq);
         ps->mem_mesh += fdt_meshbuf_bytes(&w->out);
         ps->mem_sink += fdt_emit_bytes(&w->em);
@@ -581,19 +599,26 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         sumt += ts->tets;
     }
     out->fst.t_mesh += t_gm;
-    out->fst.certified_tets += certified_gm;
-    out->fst.t_certify += t_cert_gm;
-    out->fst.kq.nodes += kq0.nodes;
-    out->fst.kq.points += kq0.points;
-    out->fst.kq.pc.orient_exact += kq0.pc.orient_exact;
-    out->fst.kq.pc.insphere_exact += kq0.pc.insphere_exact;
-    out->fst.kq.pc.orient_adapt += kq0.pc.orient_adapt;
-    out->fst.kq.pc.insphere_adapt += kq0.pc.insphere_adapt;
+    out->fst.certified_tets += e->gm_certified;
+    out->fst.t_certify += e->gm_t_certify;
+    out->fst.kq.nodes += kq0->nodes;
+    out->fst.kq.points += kq0->points;
+    out->fst.kq.pc.orient_exact += kq0->pc.orient_exact;
+    out->fst.kq.pc.insphere_exact += kq0->pc.insphere_exact;
+    out->fst.kq.pc.orient_adapt += kq0->pc.orient_adapt;
+    out->fst.kq.pc.insphere_adapt += kq0->pc.insphere_adapt;
     ps->load_imbalance = sumt ? (double)maxt * nthreads / (double)sumt : 1.0;
     ps->pinned = e->pin ? (atomic_load_explicit(&e->pin_refused, memory_order_relaxed) ? -1 : 1) : 0;
-    /* IAMDONE: shared mode, one to every other part; message mode also
-     * one from each root but part 0 to part 0 (its tree finished). FACERECV:
-     * one for each FACESEND in message mode, none in shared mode. */
+    return FDT_OK;
+}
+
+/* The message balance: every message sent was received, kind by kind.
+ * IAMDONE: shared mode, one to every other part; message mode also one
+ * from each root but part 0 to part 0 (its tree finished). FACERECV: one
+ * for each FACESEND in message mode, none in shared mode. */
+static int check_balance(const engine *e, const fdt_stats *ps, int nthreads, char *diag,
+                         size_t dlen)
+{
     size_t iamdones = (size_t)nthreads - 1 +
                       (e->msg_term ? (size_t)e->roots - (e->w[0].nseeds > 0) : 0);
     if (memcmp(ps->sent, ps->received, sizeof ps->sent) != 0 ||
@@ -602,9 +627,90 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         ps->sent[FDT_MSG_IAMDONE] != iamdones || ps->sent[FDT_MSG_ABORT] != 0 ||
         ps->sent[FDT_MSG_FACERECV] != (e->msg_term ? ps->sent[FDT_MSG_FACESEND] : 0)) {
         snprintf(diag, dlen, "internal error: messages sent and received differ");
-        err = FDT_EINTERNAL;
+        return FDT_EINTERNAL;
+    }
+    return FDT_OK;
+}
+
+/* Frees the engine (NULL: nothing) and what it holds; sync_ok: its lock
+ * and conditions exist. */
+static void engine_free(engine *e, int nthreads, int sync_ok)
+{
+    if (!e)
+        return;
+    for (int i = 0; i < nthreads; i++)
+        fdt_eng_worker_free(&e->w[i]);
+    fdt_ins_free(&e->gmesh);
+    fdt_transport_destroy(&e->tp);
+    if (sync_ok) {
+        pthread_cond_destroy(&e->gm_cv);
+        pthread_cond_destroy(&e->go);
+        pthread_cond_destroy(&e->cv);
+        pthread_mutex_destroy(&e->lock);
+    }
+    free(e->toff);
+    free(e->hoff);
+#ifdef FDT_HAVE_HWLOC
+    if (e->topo)
+        hwloc_topology_destroy(e->topo);
+#endif
+    fdt_eng_delete(e);
+}
+
+int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int nthreads,
+                     const fdt_par_opts *opt, fdt_par_out *out, char *diag, size_t dlen)
+{
+    memset(out, 0, sizeof *out);
+    if ((mode != FDT_MODE_SHARED && mode != FDT_MODE_MESSAGE) || nthreads < 1 ||
+        nthreads > FDT_PARTITION_MAX || pr->m < 4 || pr->m > UINT32_MAX - 1)
+        return FDT_EINVAL;
+    double t0 = fdt_now_s();
+    fdt_partition pt;
+    engine *e = NULL;
+    uint32_t(*seeds)[4] = NULL;
+    int nseeds = 0, sync_ok = 0;
+    fdt_tsink mem_sink;
+    int mem_sink_ok = 0;
+    fdt_kdq kq0;
+    memset(&kq0, 0, sizeof kq0);
+    double t_gm = 0.0;
+    int probe = opt && opt->global_mesh == FDT_PAR_MESH_PROBE, expensive;
+    int err = partition_with_probe(pr, s, nthreads, probe, &pt, &expensive);
+    if (err != FDT_OK)
+        return err; /* pt is zeroed */
+    if ((err = engine_start(pr, s, mode, opt, &pt, nthreads, &mem_sink, &mem_sink_ok, &e)) !=
+            FDT_OK ||
+        (err = global_mesh(e, pr, opt, probe, expensive, nthreads, &pt, &kq0, &t_gm, diag,
+                           dlen)) != FDT_OK)
+        goto fail;
+    /* The seeds, after the mesh of every point where it was built: its
+     * tets are Delaunay tets already (seeds_from_mesh). */
+    err = e->gmesh_ok ? seeds_from_mesh(&pt, &e->gmesh, &seeds, &nseeds)
+                      : seeds_by_kd(&pt, &seeds, &nseeds, &kq0);
+    if (err != FDT_OK) {
+        if (err == FDT_EINTERNAL)
+            snprintf(diag, dlen, "internal error: no seed tetrahedron found");
         goto fail;
     }
+    if ((err = engine_sync_init(e, opt, nthreads, &sync_ok)) != FDT_OK)
+        goto fail;
+    engine_topology(e);
+    workers_init(e, &pt, nthreads);
+    if ((err = seeds_to_owners(e, &pt, &seeds, nseeds, nthreads)) != FDT_OK ||
+        (mode == FDT_MODE_MESSAGE && (err = seed_ghosts(e, pr, nthreads)) != FDT_OK))
+        goto fail;
+    /* Every thread with seeds starts holding its activity unit. Thread
+     * creation orders this before everything the workers do. */
+    atomic_init(&e->work, engine_roles(e, mode, opt, nthreads));
+    double t1 = fdt_now_s();
+    double t2 = t1;
+    err = fdt_threads_run(e, s, &t2);
+    int werr = workers_error(e, nthreads, diag, dlen);
+    if (werr)
+        err = werr;
+    if (err || (err = collect_stats(e, &pt, nthreads, &kq0, t_gm, out)) != FDT_OK ||
+        (err = check_balance(e, &out->pst, nthreads, diag, dlen)) != FDT_OK)
+        goto fail;
     err = e->sink->user ? FDT_OK : fdt_gather_finish(e, &out->mb);
     if (err) {
         if (err == FDT_EINTERNAL)
@@ -616,25 +722,7 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     out->t_front = t2 - t1;
     out->t_gather = fdt_now_s() - t2;
 fail:
-    if (e) {
-        for (int i = 0; i < nthreads; i++)
-            fdt_eng_worker_free(&e->w[i]);
-        fdt_ins_free(&e->gmesh);
-        fdt_transport_destroy(&e->tp);
-        if (sync_ok) {
-            pthread_cond_destroy(&e->gm_cv);
-            pthread_cond_destroy(&e->go);
-            pthread_cond_destroy(&e->cv);
-            pthread_mutex_destroy(&e->lock);
-        }
-        free(e->toff);
-        free(e->hoff);
-#ifdef FDT_HAVE_HWLOC
-        if (e->topo)
-            hwloc_topology_destroy(e->topo);
-#endif
-        fdt_eng_delete(e);
-    }
+    engine_free(e, nthreads, sync_ok);
     free(seeds);
     fdt_partition_free(&pt);
     if (mem_sink_ok)

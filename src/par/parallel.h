@@ -32,19 +32,6 @@ typedef struct fdt_par_out {
  * clamped to [1, 1024]. */
 int fdt_parallel_default_threads(void);
 
-/*
- * Triangulates the prepared points (pr->p and pr->orig are permuted into
- * partition and tree order, as fdt_kd_build does for the serial engine)
- * with nthreads threads (1..1024) in mode FDT_MODE_SHARED or
- * FDT_MODE_MESSAGE, using s's leaf_size, neighbors, pin and progress.
- * Precondition: the points span 3-D space. On success out holds the mesh;
- * on failure out is empty and diag says why. Returns FDT_OK, FDT_EINVAL,
- * FDT_ENOMEM, FDT_ETHREAD, FDT_ECANCELED or FDT_EINTERNAL.
- */
-int fdt_parallel_triangulate(fdt_prepared *pr, const fdt_settings *s,
-                             fdt_mode mode, int nthreads, fdt_par_out *out,
-                             char *diag, size_t dlen);
-
 /* fdt_par_opts.global_mesh: let the probe decide (src/par/parallel.c):
  * where it is not sure, shared mode's parts decide together
  * (src/par/engine.c, collective_step); message mode's keep their own. */
@@ -80,7 +67,16 @@ typedef struct fdt_par_opts {
                            the shuffle tests run that loop too */
 } fdt_par_opts;
 
-/* fdt_parallel_triangulate with options (NULL: none, what it does). */
+/*
+ * Triangulates the prepared points (pr->p and pr->orig are permuted into
+ * partition and tree order, as fdt_kd_build does for the serial engine)
+ * with nthreads threads (1..1024) in mode FDT_MODE_SHARED or
+ * FDT_MODE_MESSAGE, using s's leaf_size, neighbors, pin and progress, and opt
+ * (NULL: none, what it does).
+ * Precondition: the points span 3-D space. On success out holds the mesh;
+ * on failure out is empty and diag says why. Returns FDT_OK, FDT_EINVAL,
+ * FDT_ENOMEM, FDT_ETHREAD, FDT_ECANCELED or FDT_EINTERNAL.
+ */
 int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int nthreads,
                      const fdt_par_opts *opt, fdt_par_out *out, char *diag, size_t dlen);
 

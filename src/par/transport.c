@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/hash.h"
 #include "frontdt.h"
 
 /* ---- mailbox: the in-process mailboxes as they are ------------------------ */
@@ -109,15 +110,6 @@ typedef struct shuf {
     int delay_pct;
 } shuf;
 
-static uint64_t shuf_next(uint64_t *s)
-{
-    /* splitmix64 */
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
 /* Moves everything in self's mailbox to its buffer. FDT_ENOMEM leaves the
  * message in the mailbox (it is polled again later). */
 static int shuf_drain(fdt_transport *t, int self, shuf_ep *e)
@@ -149,9 +141,9 @@ static int sh_poll(fdt_transport *t, int self, fdt_msg *out)
     int err = shuf_drain(t, self, e);
     if (err && !e->n)
         return 0;
-    if (!e->n || (int)(shuf_next(&e->rng) % 100) < s->delay_pct)
+    if (!e->n || (int)(fdt_splitmix64(&e->rng) % 100) < s->delay_pct)
         return 0;
-    size_t pick = (size_t)(shuf_next(&e->rng) % e->n), i = 0;
+    size_t pick = (size_t)(fdt_splitmix64(&e->rng) % e->n), i = 0;
     while (e->buf[i].sender != e->buf[pick].sender)
         i++;
     *out = e->buf[i];

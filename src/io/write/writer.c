@@ -56,13 +56,16 @@
  *                  unlink both, so an interrupted run leaves no output.
  *   SLOT_RENAMED   the target is complete, but the rest of its file set
  *                  (TetGen writes four) is not yet: unlink the target.
+ *   SLOT_GUARDED   a file of a set written outside this writer (a rank's
+ *                  piece of an MPI output, src/mpi/mpi_output.c) that is
+ *                  not complete yet: unlink the target (fdt_io_guard).
  * The writer frees every slot before fdt_wr_mesh() returns.
  */
 /* 32: eight -o outputs streamed at once, three files each, and a
  * --stats-json beside them. */
 #define FDT_IO_SLOTS 32
 
-enum { SLOT_FREE = 0, SLOT_TEMP = 1, SLOT_RENAMING = 2, SLOT_RENAMED = 3 };
+enum { SLOT_FREE = 0, SLOT_TEMP = 1, SLOT_RENAMING = 2, SLOT_RENAMED = 3, SLOT_GUARDED = 4 };
 
 static char fdt_io_tmp_path[FDT_IO_SLOTS][FDT_IO_PATH];
 static char fdt_io_dst_path[FDT_IO_SLOTS][FDT_IO_PATH];
@@ -82,7 +85,7 @@ void fdt_io_cleanup_temps(void)
         sig_atomic_t st = fdt_io_state[i];
         if (st == SLOT_TEMP || st == SLOT_RENAMING)
             unlink(fdt_io_tmp_path[i]);
-        if (st == SLOT_RENAMING || st == SLOT_RENAMED)
+        if (st == SLOT_RENAMING || st == SLOT_RENAMED || st == SLOT_GUARDED)
             unlink(fdt_io_dst_path[i]);
         fdt_io_state[i] = SLOT_FREE;
     }
@@ -102,6 +105,25 @@ static int slot_acquire(void)
         if (fdt_io_state[i] == SLOT_FREE)
             return i;
     return -1;
+}
+
+int fdt_io_guard(const char *target)
+{
+    if (strlen(target) + 1 > FDT_IO_PATH)
+        return -1;
+    int slot = slot_acquire();
+    if (slot < 0)
+        return -1;
+    /* the name first, then the state that publishes it to the handler */
+    memcpy(fdt_io_dst_path[slot], target, strlen(target) + 1);
+    fdt_io_state[slot] = SLOT_GUARDED;
+    return slot;
+}
+
+void fdt_io_unguard(int slot)
+{
+    if (slot >= 0 && fdt_io_state[slot] == SLOT_GUARDED)
+        fdt_io_state[slot] = SLOT_FREE;
 }
 
 /*

@@ -184,7 +184,18 @@ void fdt_wr_set_abandon(void);
 int fdt_wr_set_active(void);
 
 /* Removes every temporary output file not yet renamed (and rolls back a
- * commit set not yet committed). Async-signal-safe. */
+ * commit set not yet committed), and every guarded target (fdt_io_guard).
+ * Async-signal-safe. */
 void fdt_io_cleanup_temps(void);
+
+/* Guards target, a file of an output written outside this writer's
+ * temporaries (the pieces, .node and index of an MPI output): until
+ * fdt_io_unguard, an interrupt (fdt_io_cleanup_temps) removes it, whether
+ * it exists yet or not. The caller holds fdt_write_lock (the registry's
+ * slots are process-wide). Returns the slot, or -1 when the name is too
+ * long or every slot is taken (then nothing guards it). */
+int fdt_io_guard(const char *target);
+/* Ends the guard of slot (-1: none); the file stays. */
+void fdt_io_unguard(int slot);
 
 #endif
