@@ -26,6 +26,7 @@
 #include "frontdt.h"
 #include "cli/cli.h"
 #include "base/clock.h"
+#include "base/hash.h"
 #include "cli/progress.h"
 #include "front/partmesh.h"
 #include "io/read/reader.h"
@@ -664,15 +665,8 @@ static int output_dir_ok(const char *role, const char *path)
 /* Demo points                                                               */
 /* ------------------------------------------------------------------------ */
 
-/* splitmix64 (Steele, Lea, Flood 2014): expands the seed into the
- * xoshiro256** state (Blackman and Vigna 2018), which draws the points. */
-static uint64_t splitmix64(uint64_t *s)
-{
-    uint64_t z = (*s += UINT64_C(0x9e3779b97f4a7c15));
-    z = (z ^ (z >> 30)) * UINT64_C(0xbf58476d1ce4e5b9);
-    z = (z ^ (z >> 27)) * UINT64_C(0x94d049bb133111eb);
-    return z ^ (z >> 31);
-}
+/* splitmix64 (src/base/hash.h) expands the seed into the xoshiro256**
+ * state (Blackman and Vigna 2018), which draws the points. */
 
 static inline uint64_t rotl64(uint64_t x, int k)
 {
@@ -702,7 +696,7 @@ static double *demo_points(size_t n)
         return NULL;
     uint64_t seed = DEMO_SEED, s[4];
     for (int i = 0; i < 4; i++)
-        s[i] = splitmix64(&seed);
+        s[i] = fdt_splitmix64(&seed);
     for (size_t i = 0; i < 3 * n; i++)
         xyz[i] = (double)(xoshiro_next(s) >> 11) * 0x1.0p-53;
     return xyz;
