@@ -143,12 +143,60 @@ static void test_corruptions(void)
     }
     m.vtet[5] = kv;
     EXPECT(fdt_certify(&m, NULL, &why) == FDT_OK);
+    /* a reference to the slot itself, and past the slots */
+    v[4] = (s << 2) | 0;
+    EXPECT(fdt_certify(&m, NULL, &why) == FDT_ECHECK && strstr(why.what, "itself"));
+    v[4] = (m.nslots + 5) << 2;
+    EXPECT(fdt_certify(&m, NULL, &why) == FDT_ECHECK);
+    memcpy(v, keep, sizeof keep);
+    /* a second infinite vertex */
+    v[1] = FDT_NONE;
+    EXPECT(fdt_certify(&m, NULL, &why) == FDT_ECHECK);
+    memcpy(v, keep, sizeof keep);
+    /* a neighbour that is a freed slot (marked so in place) */
+    uint32_t nt = v[4] >> 2, *wn = m.T + 8 * (size_t)nt, wkeep[8];
+    memcpy(wkeep, wn, sizeof wkeep);
+    wn[0] = wn[1] = FDT_NONE;
+    EXPECT(fdt_certify(&m, NULL, &why) == FDT_ECHECK);
+    memcpy(wn, wkeep, sizeof wkeep);
+    /* a vertex replaced by another point: the faces no longer match, or
+     * the geometry fails; every such change is refused, and by the
+     * parallel certificate too (its slot ranges check both halves of a
+     * reference) */
+    for (int k = 0; k < 4; k++) {
+        v[k] = keep[k] == 0 ? 1 : 0;
+        EXPECT(fdt_certify(&m, NULL, &why) == FDT_ECHECK);
+        EXPECT(fdt_certify_parallel(&m, 3, NULL, &why) == FDT_ECHECK);
+        memcpy(v, keep, sizeof keep);
+    }
+    /* an infinite tet's hull face turned inside out */
+    for (uint32_t t = 0; t < m.nslots; t++) {
+        uint32_t *h = m.T + 8 * (size_t)t;
+        if ((h[0] == FDT_NONE) + (h[1] == FDT_NONE) + (h[2] == FDT_NONE) + (h[3] == FDT_NONE) != 1)
+            continue;
+        int i = h[0] == FDT_NONE ? 1 : 0, j = i + 1 + (h[i + 1] == FDT_NONE);
+        uint32_t hk[8];
+        memcpy(hk, h, sizeof hk);
+        uint32_t x = h[i];
+        h[i] = h[j];
+        h[j] = x;
+        EXPECT(fdt_certify(&m, NULL, &why) == FDT_ECHECK);
+        memcpy(h, hk, sizeof hk);
+        break;
+    }
+    /* the whole mesh, on one and on three threads, passes again */
+    EXPECT(fdt_certify(&m, NULL, &why) == FDT_OK);
+    fdt_pred_counts pc = {0, 0, 0, 0};
+    EXPECT(fdt_certify_parallel(&m, 3, &pc, &why) == FDT_OK);
     char buf[160];
     why.slot = 7;
     why.face = 2;
     why.what = "x";
     fdt_certify_describe(&why, buf, sizeof buf);
     EXPECT(strcmp(buf, "mesh certificate failed: tet slot 7 face 2: x") == 0);
+    why.face = -1;
+    fdt_certify_describe(&why, buf, sizeof buf);
+    EXPECT(strcmp(buf, "mesh certificate failed: tet slot 7: x") == 0);
     fdt_ins_free(&m);
     free(p);
 }

@@ -71,7 +71,8 @@ static int emit_hull(const fdt_ins *mesh, fdt_emit *em)
 }
 
 /*
- * In memory, with an empty meshbuf: the mesh's own tet array becomes the
+ * The one-part engine runs in memory only (a streamed run keeps the
+ * front), into an empty meshbuf: the mesh's own tet array becomes the
  * meshbuf's, each finite slot's four vertices moved down to its tet id's
  * place (tid <= slot, and a slot's 8 words hold a tet's 4, so a vertex is
  * read before its words are written over). The output then costs no copy:
@@ -82,6 +83,8 @@ static int emit_hull(const fdt_ins *mesh, fdt_emit *em)
 static int hand_over(fdt_ins *mesh, fdt_emit *em, size_t *emitted)
 {
     fdt_meshbuf *mb = em->mb;
+    if (!mb || mb->ntets != 0)
+        return FDT_EINTERNAL; /* a caller's mistake, src/api/api.c calls it so */
     uint32_t *tid = NULL;
     if (mb->nbrs) {
         if (!(tid = malloc((size_t)mesh->nslots * sizeof *tid)))
@@ -121,47 +124,6 @@ static int hand_over(fdt_ins *mesh, fdt_emit *em, size_t *emitted)
     em->ntets = (int64_t)k;
     *emitted = k;
     return FDT_OK;
-}
-
-/* Every finite tet of mesh to em, in slot order (a stream, or a meshbuf
- * that already holds tets); with neighbours, the links from the mesh's
- * own adjacency. Then every hull face. */
-static int emit_mesh(fdt_ins *mesh, fdt_emit *em, fdt_progress_fn progress, void *puser,
-                     size_t *emitted)
-{
-    fdt_meshbuf *mb = em->mb;
-    if (mb && mb->ntets == 0)
-        return hand_over(mesh, em, emitted);
-    uint32_t *tid = NULL;
-    if (mb && mb->nbrs && !(tid = malloc((size_t)mesh->nslots * sizeof *tid)))
-        return FDT_ENOMEM;
-    int err = FDT_OK;
-    int64_t first = em->ntets;
-    size_t next_report = 1u << 16;
-    for (uint32_t s = 0; s < mesh->nslots; s++) {
-        if (!fdt_ins_is_finite(mesh, s))
-            continue;
-        int64_t id = fdt_emit_tet(em, fdt_ins_tet(mesh, s));
-        if (id < 0) {
-            err = (int)id;
-            goto done;
-        }
-        if (tid)
-            tid[s] = (uint32_t)(id - first);
-        if ((size_t)(id - first) >= next_report) {
-            next_report += 1u << 16;
-            double fr = 0.6 + 0.35 * (double)(id - first) / (double)(mesh->nfinite + 1);
-            if ((err = report(progress, puser, fr)) != FDT_OK)
-                goto done;
-        }
-    }
-    *emitted = (size_t)(em->ntets - first);
-    if (tid) /* the meshbuf may have moved while it grew: read it again */
-        link_neighbours(mesh, tid, first, em->mb->nbrs);
-    err = emit_hull(mesh, em);
-done:
-    free(tid);
-    return err;
 }
 
 size_t fdt_partmesh_final(const fdt_ins *m, const fdt_kdtree *t, uint8_t *final)
@@ -225,7 +187,7 @@ int fdt_partmesh_emit_all(const double *P, uint32_t m, fdt_emit *em, fdt_progres
     if (!err)
         err = report(progress, puser, 0.6);
     if (!err)
-        err = emit_mesh(&mesh, em, progress, puser, &st->final_tets);
+        err = hand_over(&mesh, em, &st->final_tets);
     fdt_ins_free(&mesh);
     return err;
 }

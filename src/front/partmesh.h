@@ -57,9 +57,11 @@ size_t fdt_partmesh_final(const fdt_ins *m, const fdt_kdtree *t, uint8_t *final)
 /*
  * The whole run as one part: the DT of the points [0, m) of P (tree order,
  * distinct, spanning 3-D: the caller checked), certified, every tet and
- * hull face emitted to em (neighbours too when em's meshbuf keeps them).
- * progress (may be NULL) is called between the phases and every 64k tets
- * emitted with an estimated fraction; nonzero cancels (FDT_ECANCELED).
+ * hull face handed to em, whose meshbuf must be empty (in memory only: the
+ * mesh's own array becomes the meshbuf's; neighbours too when it keeps
+ * them).
+ * progress (may be NULL) is called every 64k points inserted and between
+ * the phases with an estimated fraction; nonzero cancels (FDT_ECANCELED).
  * Returns FDT_OK, FDT_ECHECK (the certificate failed: diag says where),
  * FDT_ENOMEM, FDT_ETOOBIG, FDT_EINTERNAL, or the sink's stop code.
  */
