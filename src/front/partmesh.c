@@ -11,7 +11,6 @@
 
 #define INF FDT_NONE
 
-
 static int report(fdt_progress_fn progress, void *puser, double fraction)
 {
     return progress && progress(puser, fraction) ? FDT_ECANCELED : FDT_OK;
