@@ -1967,6 +1967,17 @@ static void test_separators(tctx *t)
     /* A decimal comma with a thousands separator or two commas: refused. */
     SEP_ERR(t, "k.xyz", "1.000,5 0 0\n", 0, 1, "k.xyz:1: not a number: '1.000,5'");
     SEP_ERR(t, "cc.xyz", "1,0,5 0 0\n", 0, 1, "cc.xyz:1: not a number: '1,0,5'");
+    /* a decimal-comma field too long for any double's digits, and one
+     * that overflows */
+    char longf[200];
+    memset(longf, '1', 150);
+    memcpy(longf + 150, ",5 0 0\n", 8);
+    SEP_ERR(t, "long.xyz", longf, 0, 1, "long.xyz:1: not a number");
+    SEP_ERR(t, "big.xyz", "1e999,5 0 0\n", 0, 1, "big.xyz:1: not a number");
+    SEP_ERR(t, "ovf.xyz", "0 1,5e999 0\n", 0, 1, "ovf.xyz:1: '1,5e999' overflows a double");
+    /* separators of several characters between fields: a comma among
+     * blanks is no tight comma, blanks alone are */
+    SEP_OK(t, "wide.xyz", "0  ,  0 ,\t0\n1\t\t0  0\n0 1 0\n0 0 1\n", 0, 0, sq, 4);
     /* Refused options: a comma both ways; another character; a format
      * without fields. */
     SEP_ERR(t, "both.xyz", "0 0 0\n", ',', 1, "a decimal comma cannot also separate fields");
