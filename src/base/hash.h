@@ -27,4 +27,20 @@ static inline uint64_t fdt_splitmix64(uint64_t *state)
     return fdt_mix64(*state += 0x9E3779B97F4A7C15ull);
 }
 
+/* xoshiro256** (Blackman and Vigna 2018): the next draw of state s (seed
+ * it with fdt_splitmix64). The CLI's demo points and tests/gen_points. */
+static inline uint64_t fdt_xoshiro256ss(uint64_t s[4])
+{
+    uint64_t x = s[1] * 5;
+    uint64_t r = ((x << 7) | (x >> 57)) * 9;
+    uint64_t t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = (s[3] << 45) | (s[3] >> 19);
+    return r;
+}
+
 #endif

@@ -668,24 +668,6 @@ static int output_dir_ok(const char *role, const char *path)
 /* splitmix64 (src/base/hash.h) expands the seed into the xoshiro256**
  * state (Blackman and Vigna 2018), which draws the points. */
 
-static inline uint64_t rotl64(uint64_t x, int k)
-{
-    return (x << k) | (x >> (64 - k));
-}
-
-static inline uint64_t xoshiro_next(uint64_t s[4])
-{
-    uint64_t r = rotl64(s[1] * 5, 7) * 9;
-    uint64_t t = s[1] << 17;
-    s[2] ^= s[0];
-    s[3] ^= s[1];
-    s[1] ^= s[2];
-    s[0] ^= s[3];
-    s[2] ^= t;
-    s[3] = rotl64(s[3], 45);
-    return r;
-}
-
 /* n points uniform in [0, 1)^3, 53 random bits per coordinate. */
 static double *demo_points(size_t n)
 {
@@ -698,7 +680,7 @@ static double *demo_points(size_t n)
     for (int i = 0; i < 4; i++)
         s[i] = fdt_splitmix64(&seed);
     for (size_t i = 0; i < 3 * n; i++)
-        xyz[i] = (double)(xoshiro_next(s) >> 11) * 0x1.0p-53;
+        xyz[i] = (double)(fdt_xoshiro256ss(s) >> 11) * 0x1.0p-53;
     return xyz;
 }
 
