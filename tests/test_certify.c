@@ -186,7 +186,7 @@ static void test_corruptions(void)
     }
     /* the whole mesh, on one and on three threads, passes again */
     EXPECT(fdt_certify(&m, NULL, &why) == FDT_OK);
-    fdt_pred_counts pc = {0, 0, 0, 0};
+    fdt_pred_counts pc = {0};
     EXPECT(fdt_certify_parallel(&m, 3, &pc, &why) == FDT_OK);
     char buf[160];
     why.slot = 7;

@@ -41,6 +41,9 @@ typedef struct fdt_pred_counts {
     size_t insphere_exact;
     size_t orient_adapt;
     size_t insphere_adapt;
+    /* Inline insphere filters that could not decide (src/mesh/
+     * insert_impl.h's ins_insphere): the insertion checks its star then. */
+    size_t insphere_unsure;
 } fdt_pred_counts;
 
 /* The outward faces of a positively oriented tet: face i is opposite

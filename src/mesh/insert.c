@@ -149,7 +149,7 @@ static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng
         if (steps > m->nslots)
             return FDT_EINTERNAL; /* a cycle: impossible in a regular triangulation */
         const uint32_t *v = T + 8 * (size_t)t;
-        if (v[0] == INF || v[1] == INF || v[2] == INF || v[3] == INF)
+        if (ins_is_infinite(v))
             break;
         int exit = ins_walk_exit(m, v, p, from, rng, cnt);
         if (exit < 0)
@@ -197,6 +197,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
      * circumsphere; an infinite tet where the walk stops has p strictly
      * outside its hull face. Either way it is in conflict. */
     b->ncav = b->nbnd = b->nout = 0;
+    size_t unsure0 = b->cnt->insphere_unsure; /* see ins_star_face_ok */
     uint8_t *mark = b->mark;
     mark[t0] = MARK_IN;
     b->cav[b->ncav++] = t0;
@@ -208,7 +209,10 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
             if (mark[o] == MARK_IN)
                 continue;
             if (mark[o] == MARK_NONE) {
-                if (conflict(b, o, p)) {
+                int cf = conflict(b, o, p);
+                if (cf < 0)
+                    return cf;
+                if (cf) {
                     if (b->ncav == b->cavcap &&
                         (err = ins_grow_u32(&b->cav, &b->cavcap, b->ncav + 1)) != FDT_OK)
                         return err;
@@ -231,6 +235,9 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
     }
     if (b->nbnd > UINT32_MAX / 2)
         return FDT_ETOOBIG;
+    for (size_t i = 0; b->cnt->insphere_unsure != unsure0 && i < b->nbnd; i++)
+        if (!ins_star_face_ok(m, m->T, b->bnd[i], p, b->cnt))
+            return FDT_EINTERNAL;
     if ((err = reserve_slots(b, (uint32_t)b->nbnd)) != FDT_OK)
         return err;
     if ((err = ins_edges_begin(&b->edges, 3 * b->nbnd / 2)) != FDT_OK)
@@ -463,7 +470,8 @@ int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
     build b;
     memset(&b, 0, sizeof b);
     b.m = m;
-    b.cnt = cnt;
+    fdt_pred_counts own = {0}; /* the insertion reads its counts (ins_star_face_ok) */
+    b.cnt = cnt ? cnt : &own;
     b.rng = UINT64_C(0x853c49e6748fea9b);
     int err = FDT_ENOMEM;
     if (slots > INS_MAX_SLOTS)
@@ -829,8 +837,10 @@ int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
              * not keeping a second set. */
             if (qset_has(qs->tset, qs->tcap, o))
                 continue;
-            if (ins_conflict(m, o, q, cnt) && (rc = qset_add(&qs->tq, &qs->tset, &qs->ntq,
-                                                           &qs->tcap, o)) < 0)
+            int cf = ins_conflict(m, o, q, cnt);
+            if (cf < 0)
+                return cf;
+            if (cf && (rc = qset_add(&qs->tq, &qs->tset, &qs->ntq, &qs->tcap, o)) < 0)
                 return rc;
         }
     }

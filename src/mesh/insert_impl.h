@@ -46,12 +46,13 @@ static inline int ins_insphere(const double *a, const double *b, const double *c
     int s = fdt_insphere_filter(a, b, c, d, e);
     if (s != FDT_PRED_UNSURE)
         return s;
+    if (cnt)
+        cnt->insphere_unsure++;
 #ifdef FDT_PLANT_INSPHERE
     /* The planted bug of -Dplant=insphere (tests/test_plant.sh; the
      * certificate of src/mesh/certify.h must stop the run): no exact stage
      * and no perturbation, a filter that cannot decide reads as a point on
      * the sphere (not in conflict). */
-    (void)cnt;
     return 0;
 #else
     return fdt_insphere_perturbed(a, b, c, d, e, cnt);
@@ -158,8 +159,30 @@ static inline int ins_conflict_local(const fdt_ins *m, const uint32_t *v, const 
     return INS_CONFLICT_UNDER;
 }
 
+/* Whether tet v has the infinite vertex. */
+static inline int ins_is_infinite(const uint32_t *v)
+{
+    return v[0] == INF || v[1] == INF || v[2] == INF || v[3] == INF;
+}
+
+/*
+ * The coplanar rule's second half: the tet u under a hull face decides
+ * (ins_conflict_finite). u is finite in a valid mesh; one that is not
+ * says the mesh is already broken (a wrong predicate, tests/test_plant.sh),
+ * and reading its infinite vertex as a point would read past the points:
+ * FDT_EINTERNAL then.
+ */
+static inline int ins_conflict_under(const fdt_ins *m, const uint32_t *u, const double *p,
+                                     fdt_pred_counts *cnt)
+{
+    if (ins_is_infinite(u))
+        return FDT_EINTERNAL;
+    return ins_conflict_finite(m, u, p, cnt);
+}
+
 /* Whether tet t is in conflict with p, in a mesh nobody else changes
- * meanwhile (the serial build, and queries of a built mesh). */
+ * meanwhile (the serial build, and queries of a built mesh): 1, 0, or
+ * FDT_EINTERNAL (ins_conflict_under). */
 static inline int ins_conflict(const fdt_ins *m, uint32_t t, const double *p,
                                fdt_pred_counts *cnt)
 {
@@ -167,7 +190,44 @@ static inline int ins_conflict(const fdt_ins *m, uint32_t t, const double *p,
     int inf = -1, c = ins_conflict_local(m, v, p, cnt, &inf);
     if (c != INS_CONFLICT_UNDER)
         return c;
-    return ins_conflict_finite(m, m->T + 8 * (size_t)(v[4 + inf] >> 2), p, cnt);
+    return ins_conflict_under(m, m->T + 8 * (size_t)(v[4 + inf] >> 2), p, cnt);
+}
+
+/*
+ * Whether the new tet on boundary face bnd (packed: cavity tet c, face
+ * opposite its vertex k) with p in place of vertex k is positively
+ * oriented, when it is finite. Delaunay's cavity is star-shaped from p, so
+ * with exact predicates this always holds (the certificate of
+ * src/mesh/certify.c asks the same of every finite tet); a cavity that is
+ * not (a wrong insphere: tests/test_plant.sh) would link a star that is no
+ * triangulation, and later walks and cavities would then read anything.
+ * A region whose boundary faces all face away from p is star-shaped from
+ * it (a ray from p crosses that boundary once), so the test on each face
+ * stops such a star before it is written. The insertion asks only when
+ * one of its insphere filters could not decide (cnt->insphere_unsure
+ * moved): what the filters decide is the exact sign, so a cavity found by
+ * them alone is Delaunay's, and most insertions skip the test (bench/
+ * NOTES.md entry 89: all of them cost 9 % of a serial build). An
+ * infinite new tet is not
+ * tested (no point of the mesh stands for its infinite vertex); the
+ * certificate checks the hull at the end.
+ */
+static inline int ins_star_face_ok(const fdt_ins *m, const uint32_t *T, uint32_t bnd,
+                                   const double *p, fdt_pred_counts *cnt)
+{
+    const uint32_t *cv = T + 8 * (size_t)(bnd >> 2);
+    int k = (int)(bnd & 3);
+    const double *q[4];
+    for (int i = 0; i < 4; i++) {
+        if (i == k) {
+            q[i] = p;
+            continue;
+        }
+        if (cv[i] == INF)
+            return 1;
+        q[i] = ins_pt(m, cv[i]);
+    }
+    return ins_orient(q[0], q[1], q[2], q[3], cnt) > 0;
 }
 
 /* Asks for the four neighbours of tet t: the cavity search tests them

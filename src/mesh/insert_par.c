@@ -388,7 +388,7 @@ static int walk_locked(worker *w, const double *p, uint32_t start, uint32_t *out
             return sh->single ? FDT_EINTERNAL : BUSY;
         }
         const uint32_t *v = T + 8 * (size_t)t;
-        if (v[0] == INF || v[1] == INF || v[2] == INF || v[3] == INF)
+        if (ins_is_infinite(v))
             break;
         int exit = ins_walk_exit(m, v, p, from, &w->rng, &w->cnt);
         if (exit < 0)
@@ -471,7 +471,7 @@ static inline int conflict(worker *w, uint32_t t, const double *p)
         }
         w->under[w->nunder++] = u;
     }
-    return ins_conflict_finite(m, m->T + 8 * (size_t)u, p, &w->cnt);
+    return ins_conflict_under(m, m->T + 8 * (size_t)u, p, &w->cnt);
 }
 
 /*
@@ -499,6 +499,7 @@ static int insert_point(worker *w, uint32_t pid)
         return FDT_EINVAL;
     }
     w->ncav = w->nbnd = w->nout = w->nunder = 0;
+    size_t unsure0 = w->cnt.insphere_unsure; /* see ins_star_face_ok */
     set_mark(w, t0, MARK_IN);
     w->cav[w->ncav++] = t0;
     ins_prefetch_nbrs(m->T, t0);
@@ -553,7 +554,14 @@ static int insert_point(worker *w, uint32_t pid)
         }
     }
     /* Everything read is held: from here on the insertion cannot fail
-     * for another thread's sake, only for want of slots or memory. */
+     * for another thread's sake, only for want of slots or memory, or
+     * when the star would not be a triangulation (ins_star_face_ok:
+     * nothing is written then). */
+    for (size_t i = 0; w->cnt.insphere_unsure != unsure0 && i < w->nbnd; i++)
+        if (!ins_star_face_ok(m, m->T, w->bnd[i], p, &w->cnt)) {
+            err = FDT_EINTERNAL;
+            goto abort;
+        }
     if ((err = reserve(w, w->nbnd)) != FDT_OK ||
         (err = ins_grow_u32(&w->newt, &w->newcap, w->nbnd)) != FDT_OK ||
         (err = ins_edges_begin(&w->edges, 3 * w->nbnd / 2)) != FDT_OK)
