@@ -406,6 +406,12 @@ typedef struct fdt_thread_stats {
     int core;                 /* core it was bound to, -1 if not pinned */
     size_t mesh_queries;      /* faces another part's insertion mesh
                                  answered for it (shared mode) */
+    /* The wall engine (issue 31), added after the fields above: a caller
+     * compiled without them passes the shorter size and gets the rest. */
+    size_t final_tets;        /* tets of its part's own mesh emitted at
+                                 once (circumsphere inside its cell) */
+    size_t wall_faces;        /* faces between those and the rest: its
+                                 first front */
 } fdt_thread_stats;
 
 /* Fills *ts for worker thread 0 <= thread < stats.threads. A serial run

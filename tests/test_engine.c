@@ -254,43 +254,46 @@ static void put_pipe(input *in, size_t at, int rings, int per_ring, double x0)
 }
 
 /*
- * The collective switch (src/par/engine.c, collective_step; bench/NOTES.md
- * entry 59), forced by FDT_PAR_MESH_COLLECTIVE: the parts start on the kd
- * search and, once a majority of them votes, one builds the mesh of every
- * point while the others wait, and all read it. The tets are serial's
- * either way. want: the parts that read the mesh (stats mesh_parts), 0
- * where it must not be built.
+ * The wall engine (src/par/engine.c, walls_start; bench/NOTES.md entry 90),
+ * what a threaded run with --search mesh does (and auto where the mesh of
+ * every point does not fit): each part's own mesh, its final tets emitted at
+ * once, the fronts from the walls. Serial's tets in both modes; every
+ * part built a mesh (mesh_parts), final_tets says how many came straight
+ * from them (want_final: some, or none), and each part's wall faces and
+ * final tets are in its thread statistics.
  */
-static void run_collective(const input *in, const uint32_t *ref, size_t nref, int nthreads,
-                           int want)
+static void run_walls(const input *in, const uint32_t *ref, size_t nref, int nthreads,
+                      fdt_mode mode, int want_final)
 {
     fdt_prepared pr;
     char diag[256] = "";
     CHECK_EQ(fdt_prepare(in->xyz, in->n, 1, &pr, diag, sizeof diag), FDT_OK);
     fdt_settings s;
     fdt_default_settings(&s);
-    fdt_par_opts opt;
-    memset(&opt, 0, sizeof opt);
-    opt.global_mesh = FDT_PAR_MESH_COLLECTIVE;
+    s.search = FDT_SEARCH_MESH;
     fdt_par_out out;
-    int err = fdt_parallel_run(&pr, &s, FDT_MODE_SHARED, nthreads, &opt, &out, diag, sizeof diag);
-    EXPECTF(err == FDT_OK, "%s, collective, %d threads: %d %s", in->name, nthreads, err, diag);
+    int err = fdt_parallel_run(&pr, &s, mode, nthreads, NULL, &out, diag, sizeof diag);
+    EXPECTF(err == FDT_OK, "%s, walls, %d threads: %d %s", in->name, nthreads, err, diag);
     if (err) {
         fdt_prepared_free(&pr);
         return;
     }
-    EXPECTF((int)out.fst.mesh_parts == want, "%s, collective, %d threads: %zu parts read a mesh, want %d",
-            in->name, nthreads, out.fst.mesh_parts, want);
-    /* built in the middle of the run: faces before it from the kd search */
-    if (want)
-        EXPECTF(out.fst.mesh_faces > 0 && out.fst.mesh_faces < out.fst.faces_advanced,
-                "%s: %zu of %zu faces from the mesh", in->name, out.fst.mesh_faces,
-                out.fst.faces_advanced);
-    else
-        EXPECT(out.fst.mesh_faces == 0);
+    EXPECTF((int)out.fst.mesh_parts == nthreads, "%s, walls, %d threads: %zu parts built a mesh",
+            in->name, nthreads, out.fst.mesh_parts);
+    size_t fin = 0, walls = 0;
+    for (int i = 0; i < nthreads; i++) {
+        fin += out.tstats[i].final_tets;
+        walls += out.tstats[i].wall_faces;
+    }
+    EXPECT(fin == out.fst.final_tets);
+    EXPECTF(want_final ? fin > 0 && fin < nref && walls > 0 : fin == 0,
+            "%s, walls, %d threads: %zu final of %zu, %zu wall faces", in->name, nthreads, fin,
+            nref, walls);
+    /* the fronts built the rest */
+    EXPECT(out.fst.faces_advanced > 0);
     EXPECT(out.mb.ntets == nref);
     if (out.mb.ntets == nref)
-        EXPECTF(same_set(out.mb.tets, ref, nref), "%s, collective, %d threads: serial's tets",
+        EXPECTF(same_set(out.mb.tets, ref, nref), "%s, walls, %d threads: serial's tets",
                 in->name, nthreads);
     fdt_par_out_free(&out);
     fdt_prepared_free(&pr);
@@ -365,43 +368,30 @@ static void test_recut(void)
     printf("mesh first: a pipe's tets split evenly, requests carry their mesh slot\n");
 }
 
-static void test_collective(void)
+static void test_walls(void)
 {
-    /* a pipe: every part votes, the mesh is built and read by all */
+    /* uniform points: most tets final at once, in both modes */
+    input uni = uniform(3000, 23);
+    size_t nref;
+    uint32_t *ref = serial_set(&uni, &nref);
+    for (int t = 2; t <= 5; t += 3) {
+        run_walls(&uni, ref, nref, t, FDT_MODE_SHARED, 1);
+        run_walls(&uni, ref, nref, t, FDT_MODE_MESSAGE, 1);
+    }
+    free(ref);
+    /* a pipe on 3 parts: its tets span the parts (circumspheres as wide
+     * as the pipe), so no tet is final; the seeds start the fronts */
     input pipe = {"pipe", malloc(3 * 40 * 64 * sizeof(double)), 40 * 64};
     CHECK(pipe.xyz != NULL);
     put_pipe(&pipe, 0, 40, 64, 0.0);
-    size_t nref;
-    uint32_t *ref = serial_set(&pipe, &nref);
-    run_collective(&pipe, ref, nref, 2, 2);
-    run_collective(&pipe, ref, nref, 3, 3);
-    free(ref);
-    /* four parts: uniform points in the unit cube (two parts) beside a
-     * short pipe from x = 1.05 (two parts); the pipe's parts vote, the
-     * uniform parts do not (their faces are cheap, and too few, about
-     * 3,300 a part, to reach the time measure), and two votes of four are
-     * not a majority: no mesh (lonestar's case, where one part's dense
-     * first faces voted alone) */
-    size_t nu = 16 * 64;
-    input half = {"uniform+pipe", malloc(3 * 2 * nu * sizeof(double)), 2 * nu};
-    CHECK(half.xyz != NULL);
-    uint64_t seed = 17;
-    for (size_t i = 0; i < 3 * nu; i++)
-        half.xyz[i] = test_unif(&seed);
-    put_pipe(&half, nu, 16, 64, 1.05);
-    ref = serial_set(&half, &nref);
-    run_collective(&half, ref, nref, 4, 0);
-    free(ref);
-    /* uniform points: nobody votes */
-    input uni = uniform(3000, 23);
-    ref = serial_set(&uni, &nref);
-    run_collective(&uni, ref, nref, 2, 0);
+    ref = serial_set(&pipe, &nref);
+    run_walls(&pipe, ref, nref, 2, FDT_MODE_SHARED, 0);
+    run_walls(&pipe, ref, nref, 3, FDT_MODE_MESSAGE, 0);
     free(ref);
     free(pipe.xyz);
-    free(half.xyz);
     free(uni.xyz);
-    printf("collective switch: a pipe builds one mesh on 2 and 3 threads, one part's vote "
-           "builds none, serial's tets\n");
+    printf("walls: uniform points final at once on 2 and 5 parts, a pipe from its seeds, "
+           "serial's tets\n");
 }
 
 int main(void)
@@ -426,7 +416,7 @@ int main(void)
             run_failing(&ins[0], (fdt_mode)m, 3, part, 25);
         }
     printf("injected failures: every part, both modes, named\n");
-    test_collective();
+    test_walls();
     test_recut();
     for (int f = 0; f < 2; f++)
         free(ins[f].xyz);

@@ -534,6 +534,44 @@ static void check_structure(const fdt_ins *m, const char *what)
 
 /* fdt_ins_find_face against fdt_ins_across, both orientations of every
  * finite face; and its refusals. */
+/* fdt_ins_star_vertices: for a spread of vertices, exactly the vertices
+ * that share a live tet with it (a brute-force scan of every slot), each
+ * once; a vertex outside the mesh and a cap too small give 1. */
+static void check_star_vertices(const fdt_ins *m)
+{
+    fdt_ins_query qs;
+    memset(&qs, 0, sizeof qs);
+    uint8_t *want = calloc((size_t)m->n, 1);
+    CHECK(want != NULL);
+    uint32_t step = m->n / 7 + 1;
+    for (uint32_t i = 0; i < m->n; i += step) {
+        uint32_t a = m->base + i;
+        size_t nwant = 0;
+        memset(want, 0, m->n);
+        for (uint32_t s = 0; s < m->nslots; s++) {
+            const uint32_t *w = fdt_ins_tet(m, s);
+            if ((w[0] == FDT_NONE && w[1] == FDT_NONE) || !has_vertex(w, a))
+                continue;
+            for (int k = 0; k < 4; k++)
+                if (w[k] != FDT_NONE && w[k] != a && !want[w[k] - m->base]) {
+                    want[w[k] - m->base] = 1;
+                    nwant++;
+                }
+        }
+        CHECK_EQ(fdt_ins_star_vertices(m, a, SIZE_MAX, &qs), FDT_OK);
+        CHECK_EQ(qs.nvs, nwant);
+        for (size_t j = 0; j < qs.nvs; j++) {
+            uint32_t v = qs.vs[j];
+            CHECK(v - m->base < m->n && want[v - m->base] == 1);
+            want[v - m->base] = 2; /* each once */
+        }
+        CHECK_EQ(fdt_ins_star_vertices(m, a, 1, &qs), 1);
+    }
+    CHECK_EQ(fdt_ins_star_vertices(m, m->base + m->n, SIZE_MAX, &qs), 1);
+    free(want);
+    fdt_ins_query_free(&qs);
+}
+
 static void check_find_face(const fdt_ins *m)
 {
     for (uint32_t t = fdt_ins_next_finite(m, 0); t != FDT_NONE; t = fdt_ins_next_finite(m, t + 1)) {
@@ -628,6 +666,7 @@ static void test_set(pts p, int extra)
     same_mesh(&got, &ref, p.name);
     check_structure(&m, p.name);
     check_find_face(&m);
+    check_star_vertices(&m);
     check_independent(&m, p.name);
     printf("%-22s %6u points %7zu tets %5zu hull  star max %zu  cavity avg %.1f max %zu  "
            "walk %.1f  exact o/i %zu/%zu\n",

@@ -198,26 +198,15 @@ static int run_prepare(fdt_context *ctx, const double *xyz, size_t n, fdt_mode m
 static int run_parallel(fdt_context *ctx, fdt_mode mode, int nthreads, const fdt_sink *user,
                         run_state *rs, double *t1)
 {
-    /* Inputs where the kd search degenerates (src/front/oracle.h,
-     * fdt_oracle_probe): parts with meshes of their own points ask each
-     * other about every face whose sphere crosses a cut, and there the
-     * spheres are as wide as the object, so the threads first build the
-     * DT of every point together (fdt_ins_build_parallel) and every part
-     * reads its apexes from it (bench/NOTES.md entries 52, 54). That is a
-     * choice of the apex search (--search auto), not of the mode: the
-     * parts, their fronts and their messages stay, and --search kd or
-     * mesh keeps one structure a part. So an explicit --mode shared gets
-     * it as AUTO does, and message mode too, where the one immutable mesh
-     * stands for the replica each rank of an MPI run builds
-     * (src/mpi/mpi_run.c, replica_mesh); before, both kept one mesh a part and
-     * took 40-50x serial's CPU on a cone (entry 63). The parts' joint
-     * vote when the probe is unsure (entry 59) stays shared mode's. */
+    /* --search auto builds the DT of every point on the run's threads
+     * and every part reads its apexes from it; --search mesh runs the
+     * wall engine (each part's own mesh); --search kd the paper's fronts.
+     * Either way the parts, their fronts and their messages stay
+     * (src/par/parallel.c, bench/NOTES.md entry 90). */
     fdt_par_opts popt;
     memset(&popt, 0, sizeof popt);
     if (user)
         popt.sink = &rs->sink;
-    if (ctx->s.search == FDT_SEARCH_AUTO)
-        popt.global_mesh = FDT_PAR_MESH_PROBE; /* beside the partition */
     double tp = fdt_now_s();
     int err = fdt_parallel_run(&rs->pr, &ctx->s, mode, nthreads, &popt, &rs->par, ctx->diag,
                                sizeof ctx->diag);
@@ -331,7 +320,7 @@ static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, const fdt_
     st->mesh_faces = fst->mesh_faces;
     st->mesh_parts = fst->mesh_parts + (pms->final_tets > 0);
     st->t_mesh = fst->t_mesh + pms->t_mesh;
-    st->final_tets = pms->final_tets;
+    st->final_tets = pms->final_tets + fst->final_tets;
     st->certified_tets = pms->certified_tets + fst->certified_tets;
     st->t_certify = pms->t_certify + fst->t_certify;
     st->exact_orient += pms->pc.orient_exact;

@@ -130,8 +130,10 @@ static void usage(FILE *f)
         "      --mode MODE        serial, shared, message or auto (default)\n"
         "      --search HOW       how apexes are found: auto (default: serial in\n"
         "                         memory, the certified insertion mesh is the\n"
-        "                         answer; else the kd search, an insertion mesh\n"
-        "                         where it gets expensive), kd or mesh\n"
+        "                         answer; threads: the mesh of every point where\n"
+        "                         a probe finds the kd search costly, else the kd\n"
+        "                         search), kd, or mesh (threads: each part's own\n"
+        "                         mesh, its inner tets final, fronts at the walls)\n"
         "  -t, --threads N        worker threads (0: one per core)\n"
         "      --pin              bind thread i to core i\n"
         "      --check            verify the result exactly (exit 3 if not Delaunay)\n"
@@ -784,14 +786,16 @@ static void print_parallel_stats(const fdt_result *res, const fdt_stats *st)
         st->tet_requests, st->duplicate_requests, st->t_idle, st->t_query_wait,
         st->load_imbalance,
         st->pinned > 0 ? "yes" : st->pinned < 0 ? "refused (ran unpinned)" : "no");
-    fprintf(stderr, "  thread  points      tets  faces adv  rem.q made/ans  FACESEND s/r  idle s  core\n");
+    fprintf(stderr, "  thread  points      tets     final  walls  faces adv  rem.q made/ans"
+                    "  FACESEND s/r  idle s  core\n");
     for (int i = 0; i < st->threads; i++) {
         fdt_thread_stats ts;
         if (fdt_result_thread_stats(res, i, &ts) != FDT_OK)
             break;
-        fprintf(stderr, "  %6d %7zu %9zu %10zu %8zu/%-6zu %7zu/%-6zu %7.3f %5d\n", i, ts.points,
-                ts.tets, ts.faces_advanced, ts.remote_queries, ts.remote_answered,
-                ts.sent[FDT_MSG_FACESEND], ts.received[FDT_MSG_FACESEND], ts.t_idle, ts.core);
+        fprintf(stderr, "  %6d %7zu %9zu %9zu %6zu %10zu %8zu/%-6zu %7zu/%-6zu %7.3f %5d\n", i,
+                ts.points, ts.tets, ts.final_tets, ts.wall_faces, ts.faces_advanced,
+                ts.remote_queries, ts.remote_answered, ts.sent[FDT_MSG_FACESEND],
+                ts.received[FDT_MSG_FACESEND], ts.t_idle, ts.core);
     }
 }
 
@@ -940,11 +944,13 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         fdt_thread_stats ts;
         if (fdt_result_thread_stats(res, i, &ts) != FDT_OK)
             break;
-        fprintf(f, "%s{\"points\": %zu, \"tets\": %zu, \"faces_advanced\": %zu"
+        fprintf(f, "%s{\"points\": %zu, \"tets\": %zu, \"final_tets\": %zu"
+                   ", \"wall_faces\": %zu, \"faces_advanced\": %zu"
                    ", \"remote_queries\": %zu, \"remote_answered\": %zu"
                    ", \"t_idle\": %.9g, \"t_cpu\": %.9g, \"core\": %d",
-                i ? ", " : "", ts.points, ts.tets, ts.faces_advanced, ts.remote_queries,
-                ts.remote_answered, finite_or_zero(ts.t_idle), finite_or_zero(ts.t_cpu), ts.core);
+                i ? ", " : "", ts.points, ts.tets, ts.final_tets, ts.wall_faces,
+                ts.faces_advanced, ts.remote_queries, ts.remote_answered,
+                finite_or_zero(ts.t_idle), finite_or_zero(ts.t_cpu), ts.core);
         json_msgs(f, "sent", ts.sent);
         json_msgs(f, "received", ts.received);
         fputc('}', f);

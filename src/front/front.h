@@ -41,6 +41,8 @@ typedef struct fdt_front_stats {
     double t_mesh;
     const char *cert_what; /* a mesh failed its certificate: which check */
     size_t certified_tets; /* finite tets of the meshes certified */
+    size_t final_tets;     /* tets emitted straight from a part's mesh
+                              (the wall engine, src/par/engine.c) */
     double t_certify;      /* seconds certifying them */
     size_t mem_front;   /* bytes of the face table (its largest capacity)
                            and of the face queue (at the end) */
@@ -140,6 +142,17 @@ static inline int fdt_front_apex(fdt_oracle *orc, const fdt_kdtree *t, fdt_facet
     }
     if (!keep)
         fdt_apex_init(ap, a, b, c, f[0], f[1], f[2]);
+    /* A face with another part's vertex: the mesh's neighbours of f0 hold
+     * the first of t's points (fdt_oracle_offer_star). */
+    int star = keep ? fdt_oracle_offer_star(orc, f, ap, kq) : 0;
+    if (star < 0)
+        return star;
+    if (star) {
+        *apex = ap->best;
+        fdt_facetab_prefetch_tet(ft, f, ap->best);
+        *inside = fdt_apex_inside_region(ap, t);
+        return FDT_OK;
+    }
     /* Start in f0's leaf and climb (src/geom/kdtree.c): the apex is near, and
      * the guess is the apex for most faces. */
     fdt_apex_guess(ap, t, f[0], kq);

@@ -1,7 +1,7 @@
 /* The choice of apex oracle; see oracle.h and bench/NOTES.md, entry 51. */
 #include "front/oracle.h"
 #include "base/mem.h"
-#include "base/clock.h"
+#include "base/clock.h" /* fdt_now_s: the mesh build's time, for --stats */
 
 #include "front/front.h"
 #include "front/seed.h"
@@ -46,100 +46,12 @@
 #define WINDOW 16384
 
 /*
- * The second rule measures time, because points tested do not say what a
- * point costs: a city model's flat roofs and walls make the walk open
- * more nodes for its points, 0.9-1.05 us a face (thread CPU, this loaded
- * 2-core machine) at ~130 points and ~22 kd nodes a face, where airborne
- * lidar (autzen, lonestar in ../shared/data) takes 0.6-0.8 us at ~120
- * points and ~15 nodes, and uniform clouds 0.55 us at 95 points and 10
- * nodes (bench/NOTES.md entry 53). The mesh costs about MESH_BUILD_US a
- * point to build (uniform 1M: 3.1 s) and MESH_WALK_US a face to read, so
- * the kd search's remaining cost, c a face for `left` faces, pays for it
- * when c * left > MESH_BUILD_US * n + MESH_WALK_US * left. The rule takes
- * c and the nodes a face over all faces since the first TIMED_FROM (cold
- * caches: uniform's first 256 faces take twice its later ones), once
- * TIMED_MIN more have passed, and switches when c exceeds TIME_MARGIN
- * times that and the walk visited SLOW_NODES nodes a face or more. A time
- * alone is noisy on a shared machine, the node count alone does not
- * separate the city from the lidar (1.2x), and single windows do not
- * either: lonestar has a dense region of windows at 220 points, 27 nodes
- * and 1 us a face, after which the mesh cost it 3.2-3.5 s against the kd
- * search's 2.3 s. The rule only moves the switch; the mesh and the kd
- * search give the same apex, so the output never depends on timing. On a
- * faster machine the kd search looks cheaper against these constants and
- * the switch comes later: the safe direction. TIME_MARGIN was 1.25; city
- * lidar at 25k points (seed 1) stayed on the kd search with its checks at
- * 1.18-1.23 times the mesh's predicted cost and took 0.16 s CPU where the
- * mesh takes 0.12-0.13 s (CGAL 0.11 s). At 1.15 no other switch moves
- * over 15 gen_points families at 25k and 100k and ../shared/data (lonestar
- * and autzen stay below SLOW_NODES), and the constants hold: the mesh
- * reads a face in 0.18-0.23 us and builds in 2.9-3.5 us a point on the
- * city, uniform and bunny (bench/NOTES.md entry 55). The machine got
- * faster, and the same city measured 1.14-1.16 at its one check (16,384
- * faces, 20 nodes a face), so it stayed on the kd search in most runs:
- * 0.154 s against 0.10-0.11 s with the mesh (1.74x CGAL's CPU in one
- * bench run). The prediction is the kd search's side that is low: its
- * later faces cost more than the measured ones (statue 25k: 0.96 predicted
- * where the kd search took 1.2 times the mesh's time). 1.05 since; over
- * every family at 5k-440k and ../shared/data, only checks of the city had
- * 17 nodes a face or more and a ratio above 0.9, so no other switch moves
- * (bench/NOTES.md entry 86). The collective parts' dense-walk margin stays
- * 1.15 (DENSE_MARGIN, below).
+ * No rule here reads a clock: the switch is a function of the input and
+ * the settings (issue 31). The time rule (TIME_MARGIN over thread CPU)
+ * and the threaded runs' collective vote that stood here until session 20
+ * picked the same meshes from timings on a loaded machine and switched
+ * the wrong way in some runs (bench/NOTES.md entries 53-61, 79, 86, 90).
  */
-#define MESH_BUILD_US 3.0
-#define MESH_WALK_US 0.2
-#define TIME_MARGIN 1.05
-#define SLOW_NODES 18.0
-#define TIMED_FROM 4096
-#define TIMED_MIN 8192
-
-/*
- * A collective part (fdt_oracle.collective: a part of a two-thread auto
- * run, src/par/engine.c) votes for the mesh of every point instead of
- * building its own, and that mesh is built once a majority voted. A vote
- * by points tested alone, under COLLECTIVE_SURE units a face, needs the
- * window's walk to have visited SLOW_NODES nodes a face too, the time
- * rule's own condition: the first windows of an extruded grid's flat
- * layers and of the wind-study city cost 280-430 units at 2-15 nodes a
- * face (bench/NOTES.md entry 59). Once another part voted, a part also votes
- * early, on its thread CPU since COLLECTIVE_TIMED_FROM faces measured over
- * COLLECTIVE_TIMED_MIN more, when the kd search's remaining cost is over
- * COLLECTIVE_CLEAR times the mesh's predicted cost, or over
- * COLLECTIVE_MARGIN times with SLOW_NODES nodes a face: without it the
- * second part of an O-grid or a cubed sphere waited for its first full
- * time check (16,384 or 32,768 faces at 1.7-3 us a face, +0.10 and +0.15
- * s CPU of 0.9 and 0.7); at 4,096-8,192 faces the early measure gave
- * 2.2-3.6 there, 1.8 on the statue, and 1.1-1.3 on autzen's part 1 and on
- * lonestar's part 0 (12-19 nodes a face), which must not vote. The
- * margins are above the serial TIME_MARGIN because a window this short
- * is noisier and a collective mesh costs every part; DENSE_MARGIN (the
- * serial margin until entry 86) holds where the walk visits DENSE_NODES
- * nodes a face, which the airborne
- * scans' parts never averaged (autzen 12-19, lonestar's part 0 8-16) and
- * the statue (33) and bunny (24-29) do: the measured times, and so the
- * ratios, fall on a quieter machine against the fixed MESH_BUILD_US, and
- * the statue's 1.8 (bunny's 1.3-1.5) should not then drop under
- * COLLECTIVE_MARGIN to wait for the 16,384-face check. The same margins
- * hold at a collective part's later time checks (from TIMED_FROM):
- * autzen's part 1 measured 1.11-1.26 there at 17-19 nodes a face, over
- * the serial 1.15 in some runs, and the mesh was built (1 run in 6) once
- * its part 0 had voted on its first faces (67 nodes a face over 189
- * faces). COLLECTIVE_MARGIN lies between those and citylidar's part 0
- * (1.5-1.6 at 18-22 nodes): at 1.5 that part stayed on the kd search in 3
- * runs of 6 (bench/NOTES.md entry 61). All of these were measured on this
- * loaded 2-core machine: the margins are thin. On a quieter machine the
- * same part measured 1.35-1.46 (its first check at 17.6 nodes a face, its
- * second at 21), and at 1.35 half the runs of one quiet hour stayed on the
- * kd search (0.64 s where the mesh takes 0.24 s): the margin is 1.30 since,
- * under citylidar's quiet values and over autzen's loaded ones (entry 79).
- */
-#define DENSE_MARGIN 1.15
-#define COLLECTIVE_SURE 1000.0
-#define COLLECTIVE_TIMED_FROM 1024
-#define COLLECTIVE_TIMED_MIN 2048
-#define COLLECTIVE_MARGIN 1.30
-#define COLLECTIVE_CLEAR 2.0
-#define DENSE_NODES 25.0
 
 /* The window's work so far is measured in these units. */
 static inline size_t work_units(const fdt_kdq *kq)
@@ -182,6 +94,7 @@ void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy)
 
 void fdt_oracle_free(fdt_oracle *o)
 {
+    fdt_ins_query_free(&o->sq);
     if (o->state == 1 && !o->gm)
         fdt_ins_free(&o->mesh);
     free(o->mt);
@@ -197,10 +110,6 @@ size_t fdt_oracle_mem_share(int parts)
 
 static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
 {
-    if (o->collective) {
-        o->state = 2;
-        return;
-    }
     if (o->policy == FDT_SEARCH_AUTO && o->mem_cap &&
         FDT_ORACLE_MESH_BYTES * (double)o->t->n > (double)o->mem_cap) {
         o->state = -1;
@@ -235,23 +144,14 @@ static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
         o->switched_at = faces ? faces : 1;
 }
 
-/* Whether a switch chosen by points tested (a window's cost a face, the
- * window since w_faces) stands (see collective, oracle.h). */
-static int count_switch_stands(const fdt_oracle *o, size_t faces, const fdt_kdq *kq, double cost)
+int fdt_oracle_build(fdt_oracle *o, fdt_kdq *kq)
 {
-    if (!o->collective || cost >= COLLECTIVE_SURE)
-        return 1;
-    size_t df = faces - o->w_faces;
-    double nodes = df ? (double)(kq->nodes - o->w_nodes) / (double)df : 0.0;
-    return nodes >= SLOW_NODES;
-}
-
-/* A collective part's time rule (above): the kd search's remaining cost
- * is ratio times the mesh's predicted cost, the walk visits nodes a face. */
-static int collective_time_vote(double ratio, double nodes)
-{
-    return ratio > COLLECTIVE_CLEAR || (nodes >= SLOW_NODES && ratio > COLLECTIVE_MARGIN) ||
-           (nodes >= DENSE_NODES && ratio > DENSE_MARGIN);
+    if (o->t->n < 4) {
+        o->state = -1;
+        return FDT_OK;
+    }
+    build_mesh(o, 1, kq);
+    return o->err;
 }
 
 void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
@@ -259,15 +159,8 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
     if (o->state != 0)
         return;
     if (faces < o->next_check) {
-        if (work_units(kq) > o->w_budget) {
-            size_t df = faces > o->w_faces ? faces - o->w_faces : 1;
-            double cost = (double)(work_units(kq) - o->w_points - EXACT_WEIGHT * o->w_exact) /
-                          (double)df;
-            if (count_switch_stands(o, faces, kq, cost))
-                build_mesh(o, faces, kq);
-            else
-                o->w_budget = SIZE_MAX; /* the window's end decides */
-        }
+        if (work_units(kq) > o->w_budget)
+            build_mesh(o, faces, kq);
         return;
     }
     if (o->policy == FDT_SEARCH_MESH || o->t->n == 0) {
@@ -283,48 +176,13 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
     double cost = df > 0 ? ((double)points + EXACT_WEIGHT * (double)exact) / (double)df : 0.0;
     double total = FACES_PER_POINT * (double)o->t->n;
     double left = total > (double)faces ? total - (double)faces : 0.0;
-    if (df > 0 && (cost - MESH_FACE_COST) * left > (SWITCH_COST - MESH_FACE_COST) * total &&
-        count_switch_stands(o, faces, kq, cost)) {
+    if (df > 0 && (cost - MESH_FACE_COST) * left > (SWITCH_COST - MESH_FACE_COST) * total) {
         build_mesh(o, faces, kq);
         return;
-    }
-    /* The time rule over everything since TIMED_FROM faces (see above). */
-    double now = fdt_thread_cpu_s();
-    /* A collective part's early opinion, once another part voted. */
-    if (o->collective && o->c_faces == 0 && faces >= COLLECTIVE_TIMED_FROM && now > 0.0) {
-        o->c_faces = faces;
-        o->c_cpu = now;
-        o->c_nodes = kq->nodes;
-    } else if (o->collective == 2 && o->c_faces > 0 &&
-               faces >= o->c_faces + COLLECTIVE_TIMED_MIN && now > 0.0) {
-        double nf = (double)(faces - o->c_faces);
-        double us = 1e6 * (now - o->c_cpu) / nf;
-        double nodes = (double)(kq->nodes - o->c_nodes) / nf;
-        double ratio = us * left / (MESH_BUILD_US * (double)o->t->n + MESH_WALK_US * left);
-        if (collective_time_vote(ratio, nodes)) {
-            build_mesh(o, faces, kq);
-            return;
-        }
-    }
-    if (o->t_faces == 0 && faces >= TIMED_FROM && now > 0.0) {
-        o->t_faces = faces;
-        o->t_cpu = now;
-        o->t_nodes = kq->nodes;
-    } else if (o->t_faces > 0 && faces >= o->t_faces + TIMED_MIN && now > 0.0) {
-        double nf = (double)(faces - o->t_faces);
-        double us = 1e6 * (now - o->t_cpu) / nf;
-        double nodes = (double)(kq->nodes - o->t_nodes) / nf;
-        double ratio = us * left / (MESH_BUILD_US * (double)o->t->n + MESH_WALK_US * left);
-        if (o->collective ? collective_time_vote(ratio, nodes)
-                          : nodes >= SLOW_NODES && ratio > TIME_MARGIN) {
-            build_mesh(o, faces, kq);
-            return;
-        }
     }
     o->w_faces = faces;
     o->w_points = kq->points;
     o->w_exact = kq->pc.orient_exact + kq->pc.insphere_exact;
-    o->w_nodes = kq->nodes;
     size_t win = faces < FIRST_WINDOW ? FIRST_WINDOW : faces < WINDOW ? faces : WINDOW;
     o->next_check = faces + win;
     o->w_budget = window_budget(o, work_units(kq), o->next_check, win);
@@ -390,6 +248,28 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
     return 1;
 }
 
+/* A star this large is left to the kd search: a vertex joined to most
+ * points of a cospherical set (the perturbation's doing) would offer
+ * them all for every face. */
+#define STAR_MAX_TETS 512
+
+int fdt_oracle_offer_star(fdt_oracle *o, const uint32_t f[3], fdt_apex *ap, fdt_kdq *kq)
+{
+    if (o->state != 1 || o->gm)
+        return 0;
+    int rc = fdt_ins_star_vertices(&o->mesh, f[0], STAR_MAX_TETS, &o->sq);
+    if (rc)
+        return rc == 1 ? 0 : rc;
+    const double *P = o->mesh.P;
+    for (size_t i = 0; i < o->sq.nvs; i++) {
+        uint32_t v = o->sq.vs[i];
+        if (v != f[1] && v != f[2])
+            fdt_apex_offer(ap, v, P + 3 * (size_t)v, kq);
+    }
+    o->star_offers++;
+    return 1;
+}
+
 /*
  * The probe (oracle.h). A sample, not all points: its tree costs a few
  * milliseconds where the whole input's would cost a tenth of a second at
@@ -408,12 +288,8 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
  * input points (the local density of files written in scan or grid
  * order: an O-grid's boundary layer, an extruded grid's planes, which
  * thinning hides: 111 and 44 points a face thinned, 198 and 365 in a
- * run). Either above PROBE_SURE is clearly expensive: the threads build
- * the mesh of every point before the fronts start. Below it the parts
- * start on the kd search and measure it at the full density, and a
- * majority of them decides the same mesh (the collective switch,
- * src/par/engine.c), because no threshold on these samples separates the
- * inputs that want the mesh from those that do not. Measured (bench/NOTES.md
+ * run). Either above PROBE_SURE is clearly expensive: the ranks of an MPI
+ * run build the replica mesh (src/mpi/mpi_run.c). Measured (bench/NOTES.md
  * entries 54 and 59), thinned / run: uniform 89 / 69, lonestar 128 / 124,
  * citylidar 147 / 116, ogrid 111 / 198, cubedsphere 184 / 141, bunny 167,
  * autzen 180 / 256, statue 165 / 301, windcity 316 / 235, extruded 44 /
@@ -424,7 +300,7 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
  * cost passes PROBE_SURE x PROBE_FACES (the average can then only end
  * above it).
  */
-#define PROBE_SURE 500
+#define PROBE_SURE FDT_PROBE_REPLICA
 
 /* The kd search's cost a face (as fdt_oracle_tick costs it) over the k
  * points of S (a copy, which the kd build permutes); -1 if it cannot be
@@ -490,21 +366,18 @@ void fdt_oracle_probe_take(fdt_probe_samples *ps, const double *P, uint32_t m, i
         ps->S[1] = probe_sample(P, (size_t)(m - k) / 2, 1, k);
 }
 
-int fdt_oracle_probe_decide(fdt_probe_samples *ps)
+double fdt_oracle_probe_cost(fdt_probe_samples *ps)
 {
-    int expensive = 0;
-    for (int i = 0; i < 2 && !expensive; i++)
-        if (ps->S[i])
-            expensive = probe_cost(ps->S[i], ps->k, ps->leaf_size) > PROBE_SURE;
+    double cost = 0.0;
+    for (int i = 0; i < 2 && cost <= PROBE_SURE; i++) {
+        if (!ps->S[i])
+            continue;
+        double c = probe_cost(ps->S[i], ps->k, ps->leaf_size);
+        if (c > cost)
+            cost = c;
+    }
     free(ps->S[0]);
     free(ps->S[1]);
     ps->S[0] = ps->S[1] = NULL;
-    return expensive;
-}
-
-int fdt_oracle_probe(const double *P, uint32_t m, int leaf_size)
-{
-    fdt_probe_samples ps;
-    fdt_oracle_probe_take(&ps, P, m, leaf_size);
-    return fdt_oracle_probe_decide(&ps);
+    return cost;
 }

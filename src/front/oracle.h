@@ -34,39 +34,24 @@
 typedef struct fdt_oracle {
     const fdt_kdtree *t;  /* borrowed: the part's tree (its points) */
     int policy;           /* FDT_SEARCH_AUTO, _KD or _MESH */
-    int state;            /* 0: kd search; 1: mesh; -1: mesh unavailable;
-                             2: the rule chose the mesh of every point
-                             (collective, below), kd search until the
-                             engine provides it (fdt_oracle_share) */
+    int state;            /* 0: kd search; 1: mesh; -1: mesh unavailable */
     fdt_ins mesh;         /* owned, valid when state == 1 and !gm */
     const fdt_ins *gm;    /* borrowed: a mesh of every point (shared by
                              all parts, fdt_oracle_share), or NULL */
     uint32_t *mt;         /* owned: mesh tet of output tet i, FDT_NONE unknown */
+    fdt_ins_query sq;     /* scratch of fdt_oracle_offer_star */
     size_t mtcap;
     /* The switching window: counter values at its start. */
-    size_t next_check, w_faces, w_points, w_exact, w_nodes;
-    /* 1: a part of a threaded run whose switch is collective: the rule's
-     * choice sets state 2 and the engine builds one mesh of every point
-     * for all parts (src/par/engine.c) instead of this part's own mesh. Such
-     * a mesh costs every part, so a choice by points tested alone must be
-     * clear (COLLECTIVE_SURE in src/front/oracle.c) or come with the slow walk
-     * the time rule also asks for (SLOW_NODES). */
-    int collective;       /* 2: another part voted (src/par/engine.c) */
-    /* A collective part's early time measure: from COLLECTIVE_TIMED_FROM
-     * faces (0: not started), thread CPU and kd nodes then. */
-    size_t c_faces, c_nodes;
-    double c_cpu;
+    size_t next_check, w_faces, w_points, w_exact;
     /* Work (points tested + EXACT_WEIGHT x exact tests, since the run's
      * start) past which the window in progress must end in a switch:
      * the switch is made as soon as it is passed (SIZE_MAX: never). */
     size_t w_budget;
-    /* The time rule's start: faces advanced (0: not started), thread CPU
-     * (s) and kd nodes visited then. */
-    size_t t_faces, t_nodes;
-    double t_cpu;
     /* Statistics. */
     size_t mesh_faces;    /* faces whose apex the mesh gave */
     size_t star_walks;    /* of those, found by a walk around a vertex */
+    size_t star_offers;   /* faces with another part's vertex answered by
+                             fdt_oracle_offer_star */
     size_t switched_at;   /* faces advanced when the mesh was built (0: never) */
     double t_mesh;        /* seconds building the mesh */
     /* Auto policy: the bytes this part's mesh may take (0: no cap). A
@@ -130,29 +115,43 @@ int fdt_oracle_apex(fdt_oracle *o, const uint32_t f[3], int64_t ctid, uint32_t c
  */
 void fdt_oracle_share(fdt_oracle *o, const fdt_ins *gm);
 
+/*
+ * Builds the part's mesh now, whatever the policy (the wall engine of
+ * src/par/engine.c builds every part's mesh before its front): state 1 and
+ * a certified mesh, or state -1 (fewer than 4 points, points that do not
+ * span 3-D, no memory: the kd search answers). Returns FDT_ECHECK when the
+ * mesh failed its certificate (o->err, o->err_what), else FDT_OK.
+ */
+int fdt_oracle_build(fdt_oracle *o, fdt_kdq *kq);
+
+/*
+ * For a face f with a vertex of another part (fdt_oracle_apex cannot find
+ * it in the part's mesh) whose lowest vertex f[0] is the part's: offers
+ * every mesh neighbour of f[0] to the search state ap (fdt_ins_star_vertices:
+ * the first of the part's points in the pencil is among them), so that
+ * ap->best is the first of the part's points, as the kd search of the
+ * part would leave it. Returns 1 when it did; 0 when it cannot (no mesh, a
+ * shared mesh, f[0] not in it, a star too large): the caller searches the
+ * part's tree; FDT_ENOMEM.
+ */
+int fdt_oracle_offer_star(fdt_oracle *o, const uint32_t f[3], fdt_apex *ap, fdt_kdq *kq);
+
 /* Notes that output tet tid is mesh tet mtet (FDT_NONE: not known). Only
  * stores while the mesh is in use. FDT_OK or FDT_ENOMEM. */
 int fdt_oracle_note(fdt_oracle *o, int64_t tid, uint32_t mtet);
 
 /*
- * Whether the kd search is clearly expensive on these points (the m
+ * Whether the kd search is clearly expensive on these points (a rank's m
  * distinct points P, 3 doubles each): the first faces of a serial front
- * over a sample of them, costed as fdt_oracle_tick does. The parallel
- * modes pay for such inputs twice: each part builds its mesh, and a face
- * whose sphere crosses a cut still asks the other parts, where a pipe's or
- * a grid's spheres are as wide as the object (bench/NOTES.md, entry 52);
- * src/par/parallel.c then builds one mesh of every point before the fronts,
- * and otherwise lets the parts decide it together (entry 59). 0 on any
- * failure (no memory, a flat sample): the caller's choice stands.
- */
-int fdt_oracle_probe(const double *P, uint32_t m, int leaf_size);
-
-/*
- * fdt_oracle_probe in two steps, so that the samples can be copied before
- * src/geom/partition.c permutes P and costed on another thread while the
- * partition runs (src/par/parallel.c): take copies the samples (no memory
- * for one: that sample counts as cheap, as in fdt_oracle_probe), decide
- * costs them, frees them and returns what fdt_oracle_probe would have.
+ * over samples of them, costed as fdt_oracle_tick does, by points tested,
+ * never by time. An MPI run's ranks vote with it for the replica mesh
+ * (src/mpi/mpi_run.c, replica_mesh): there a face whose sphere crosses a
+ * cut asks the other ranks, and a pipe's or a grid's spheres are as wide
+ * as the object (bench/NOTES.md, entry 52). take copies the samples (no
+ * memory for one: that sample counts as cheap); cost costs them, frees
+ * them and returns the larger of their costs a face (0 for a sample that
+ * cannot be costed: no memory, a flat sample), stopping once one passes
+ * FDT_PROBE_REPLICA.
  */
 typedef struct fdt_probe_samples {
     double *S[2]; /* every stride-th point; a run of consecutive points */
@@ -160,6 +159,12 @@ typedef struct fdt_probe_samples {
     int leaf_size;
 } fdt_probe_samples;
 void fdt_oracle_probe_take(fdt_probe_samples *ps, const double *P, uint32_t m, int leaf_size);
-int fdt_oracle_probe_decide(fdt_probe_samples *ps);
+double fdt_oracle_probe_cost(fdt_probe_samples *ps);
+
+/* The probe's cost past which the ranks of an MPI run build the replica
+ * mesh, and the threads of a run the mesh of every point
+ * (src/par/parallel.c). */
+#define FDT_PROBE_REPLICA 500.0
+#define FDT_PROBE_SHARED_MESH 135.0
 
 #endif

@@ -846,3 +846,34 @@ int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
     }
     return FDT_OK;
 }
+
+int fdt_ins_star_vertices(const fdt_ins *m, uint32_t a, size_t max_tets, fdt_ins_query *qs)
+{
+    if (!m->vtet || a - m->base >= m->n)
+        return 1;
+    const uint32_t *T = m->T;
+    if (qs->tset)
+        qset_clear(qs->tq, qs->tset, &qs->ntq, qs->tcap);
+    if (qs->vset)
+        qset_clear(qs->vs, qs->vset, &qs->nvs, qs->vcap);
+    /* a's star, breadth-first from its incident tet through the faces
+     * that hold a (as fdt_ins_find_face walks it) */
+    int rc = qset_add(&qs->tq, &qs->tset, &qs->ntq, &qs->tcap, m->vtet[a - m->base]);
+    if (rc < 0)
+        return rc;
+    for (size_t i = 0; i < qs->ntq; i++) {
+        if (i >= max_tets)
+            return 1;
+        const uint32_t *v = T + 8 * (size_t)qs->tq[i];
+        for (int k = 0; k < 4; k++) {
+            if (v[k] == a)
+                continue; /* the face opposite a leaves the star */
+            if (v[k] != INF &&
+                (rc = qset_add(&qs->vs, &qs->vset, &qs->nvs, &qs->vcap, v[k])) < 0)
+                return rc;
+            if ((rc = qset_add(&qs->tq, &qs->tset, &qs->ntq, &qs->tcap, v[4 + k] >> 2)) < 0)
+                return rc;
+        }
+    }
+    return FDT_OK;
+}

@@ -197,4 +197,18 @@ int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
                               size_t max_tets, fdt_ins_query *qs, fdt_pred_counts *cnt);
 void fdt_ins_query_free(fdt_ins_query *qs);
 
+/*
+ * The vertices joined to vertex a of m (the finite vertices of its star)
+ * into qs->vs[0 .. qs->nvs). With m the DT of a point set S that holds a,
+ * for a face (a, b, c) of the DT of any superset of S, the first point of
+ * S in the pencil of spheres through the face's circle is among them: its
+ * sphere with the face is empty, so it is joined to a in the DT of S and
+ * the face's vertices, and points added to S only take edges away (the
+ * argument of fdt_ins_conflict_vertices). The wall engine asks its own
+ * mesh this way for faces with another part's vertices (src/front/
+ * front.h). Read-only on m. FDT_OK; 1 when a is not a vertex of m or its
+ * star holds more than max_tets tets (no answer); FDT_ENOMEM.
+ */
+int fdt_ins_star_vertices(const fdt_ins *m, uint32_t a, size_t max_tets, fdt_ins_query *qs);
+
 #endif

@@ -49,7 +49,7 @@ static int stats_size_known(size_t size)
 
 static int thread_stats_size_known(size_t size)
 {
-    return size == sizeof(fdt_thread_stats);
+    return size == sizeof(fdt_thread_stats) || size == offsetof(fdt_thread_stats, final_tets);
 }
 
 int fdt_result_stats_sized(const fdt_result *r, fdt_stats *st, size_t struct_size)

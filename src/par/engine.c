@@ -20,12 +20,14 @@
 #include "par/engine.h"
 
 #include <math.h>
+#include <sched.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/bits.h"
 #include "base/mem.h"
 #include "par/termination.h"
+#include "front/partmesh.h"
 #include "mesh/certify.h"
 
 /*
@@ -192,7 +194,7 @@ int fdt_eng_build_requested(worker *w, const uint32_t v[4], int64_t mtet)
  * CPU with the kd search of the other part, 15.5 s with whole regions). */
 #define MESH_QUERY_MAX_TETS 256
 
-static int offer_from_mesh(worker *w, fdt_apex *s, int part)
+int fdt_eng_offer_from_mesh(worker *w, fdt_apex *s, int part)
 {
     const fdt_ins *m = &w->e->w[part].orc.mesh;
     if (w->qcache_part != part || w->qcache_v != s->ia) {
@@ -306,8 +308,18 @@ static int walk_others(worker *w, fdt_apex *s, qbuf *qb, int *stack, int *sp, pa
         if (nd->left < 0) {
             if (w->e->mode == FDT_MODE_SHARED) {
                 /* acquire: pairs with the owner's release (mesh_pub) */
-                if (atomic_load_explicit(&w->e->w[nd->part].mesh_pub, memory_order_acquire)) {
-                    int rc = offer_from_mesh(w, s, nd->part);
+                int pub = atomic_load_explicit(&w->e->w[nd->part].mesh_pub, memory_order_acquire);
+                /* The wall engine: every part publishes, soon (walls_start
+                 * waits on nobody), so wait and read the same answer every
+                 * run. An abort (its part failed) ends the wait. */
+                while (w->e->walls && pub == 0) {
+                    if (aborted(w->e))
+                        return FDT_ECANCELED;
+                    sched_yield();
+                    pub = atomic_load_explicit(&w->e->w[nd->part].mesh_pub, memory_order_acquire);
+                }
+                if (pub == 1) {
+                    int rc = fdt_eng_offer_from_mesh(w, s, nd->part);
                     if (rc)
                         return rc;
                 } else {
@@ -394,106 +406,6 @@ static int finish_face(worker *w, const uint32_t f[3], fdt_face *s, fdt_apex *ap
     return err ? err : 1;
 }
 
-/*
- * The collective switch (engine.collective, bench/NOTES.md entry 59).
- * The probe decides the mesh of every point before the fronts start only
- * where its sample is clearly expensive; elsewhere the parts start on the
- * kd search and the serial front's rules (src/front/oracle.c) measure each
- * part's own faces at the full density; a part whose rule chooses a mesh
- * votes. Once a majority voted, the part that sees it builds the mesh of
- * every point on the run's thread count (fdt_ins_build_parallel: it runs
- * here, the other parts wait, so the cores are not oversubscribed), and
- * every part reads its later apexes from it, asking no other part (entry
- * 54). One part's vote is not enough: lonestar's part 1 voted on its
- * dense first faces, and with its own mesh took 1.56-1.67 s of thread CPU
- * where the kd search takes 1.14-1.22 s (entry 59). The tets built before are
- * final (DESIGN.md, Output); their faces still on a front have no noted
- * mesh tet and are found by a walk around a vertex. The mesh gives the
- * same apexes as the kd search (the perturbed DT is unique), so only the
- * time depends on who chose and when.
- */
-static int collective_build(worker *w)
-{
-    engine *e = w->e;
-    uint32_t n = e->pt->m;
-    double t0 = fdt_now_s();
-    int err = FDT_ENOMEM;
-    /* the mesh must fit (src/front/oracle.h, FDT_ORACLE_MESH_BYTES) */
-    if (FDT_ORACLE_MESH_BYTES * (double)n <= (double)fdt_mem_available())
-        err = fdt_ins_build_parallel(&e->gmesh, e->P, 0, n, e->n, &w->kq.pc);
-    if (err == FDT_OK) {
-        /* proved before any part reads it (issue 31 item 6), on the
-         * threads the build used: the others wait for it as for the build */
-        fdt_certify_fail why;
-        double tc = fdt_now_s();
-        err = fdt_certify_parallel(&e->gmesh, e->n, &w->kq.pc, &why);
-        w->orc.t_certify += fdt_now_s() - tc;
-        if (err == FDT_ECHECK) {
-            w->orc.err = FDT_ECHECK;
-            w->orc.err_what = why.what;
-            fdt_ins_free(&e->gmesh);
-        } else if (err == FDT_OK) {
-            w->orc.certified += e->gmesh.nfinite;
-        }
-    }
-    w->orc.t_mesh += fdt_now_s() - t0;
-    w->orc.switched_at = w->st.faces_advanced;
-    pthread_mutex_lock(&e->lock);
-    e->gmesh_ok = err == FDT_OK;
-    /* release: publishes gmesh (engine.gm_state) */
-    atomic_store_explicit(&e->gm_state, err == FDT_OK ? 2 : 3, memory_order_release);
-    pthread_cond_broadcast(&e->gm_cv);
-    pthread_mutex_unlock(&e->lock);
-    w->orc.collective = 0;
-    if (err == FDT_OK)
-        fdt_oracle_share(&w->orc, &e->gmesh);
-    else
-        w->orc.state = -1;
-    /* No memory, or points that do not span 3-D: the kd search is always
-     * right, only slower. */
-    return err == FDT_ENOMEM || err == FDT_EDEGENERATE ? FDT_OK : err;
-}
-
-/* Called after each tick of a collective part's oracle: builds the mesh
- * if this part chose first, waits while another builds, and takes the
- * mesh (or, the build failed, the kd search for good) once it is done. */
-static int collective_step(worker *w)
-{
-    engine *e = w->e;
-    /* acquire: pairs with collective_build's release store */
-    int gs = atomic_load_explicit(&e->gm_state, memory_order_acquire);
-    if (gs == 0) {
-        if (w->orc.state != 2) {
-            /* another part voted: this one's early opinion counts */
-            if (w->orc.collective == 1 && atomic_load_explicit(&e->gm_votes, memory_order_relaxed))
-                w->orc.collective = 2;
-            return FDT_OK;
-        }
-        if (!w->gm_voted) {
-            w->gm_voted = 1;
-            atomic_fetch_add_explicit(&e->gm_votes, 1, memory_order_relaxed);
-        }
-        if (atomic_load_explicit(&e->gm_votes, memory_order_relaxed) < e->n / 2 + 1)
-            return FDT_OK; /* state 2 searches as state 0; others may vote */
-        /* acq_rel: the one builder; a loser reads the winner's state */
-        if (atomic_compare_exchange_strong_explicit(&e->gm_state, &gs, 1, memory_order_acq_rel,
-                                                    memory_order_acquire))
-            return collective_build(w);
-    }
-    if (gs == 1) {
-        pthread_mutex_lock(&e->lock);
-        while ((gs = atomic_load_explicit(&e->gm_state, memory_order_acquire)) == 1)
-            pthread_cond_wait(&e->gm_cv, &e->lock);
-        pthread_mutex_unlock(&e->lock);
-    }
-    w->orc.collective = 0;
-    if (gs == 2)
-        fdt_oracle_share(&w->orc, &e->gmesh);
-    else
-        w->orc.state = -1;
-    return FDT_OK;
-}
-
 /* Advances one own front face. Returns 1 if it did (or parked it), 0 if
  * the queue held no live face, or an error. In park mode the caller
  * leaves a slot free. */
@@ -551,11 +463,6 @@ static int advance_one(worker *w)
     fdt_oracle_tick(&w->orc, w->st.faces_advanced - 1, &w->kq);
     if (w->orc.err)
         return w->orc.err; /* its mesh failed the certificate */
-    if (w->orc.collective) {
-        int cerr = collective_step(w);
-        if (cerr)
-            return cerr;
-    }
     if (w->orc.state == 1 && !w->orc.gm && !w->published) {
         /* release: see mesh_pub */
         atomic_store_explicit(&w->mesh_pub, 1, memory_order_release);
@@ -657,24 +564,137 @@ int fdt_eng_worker_setup(worker *w)
         return FDT_ENOMEM;
     /* The part's mesh, if it comes to one, is built by this thread: its
      * pages are first touched here, near the core that reads them. */
-    fdt_oracle_init(&w->orc, w->tree, w->e->search);
-    /* every part may switch at once: each gets its share of the memory */
-    if (w->e->search == FDT_SEARCH_AUTO)
-        w->orc.mem_cap = fdt_oracle_mem_share(w->e->n);
+    /* --search auto reads the mesh of every point or, where the probe
+     * found the kd search cheap (src/par/parallel.c), keeps it: a part
+     * that switched to its own mesh alone still asked the other part's
+     * tree about every face near the cut (37M points tested on citylidar
+     * 100k where the kd search tests 1.4M; bench/NOTES.md entry 90). */
+    fdt_oracle_init(&w->orc, w->tree,
+                    w->e->search == FDT_SEARCH_AUTO ? FDT_SEARCH_KD : w->e->search);
     if (w->e->gmesh_ok)
         fdt_oracle_share(&w->orc, &w->e->gmesh);
-    else if (w->e->collective && w->e->search == FDT_SEARCH_AUTO)
-        w->orc.collective = 1;
     w->qcache_part = -1;
     return FDT_OK;
+}
+
+/* Whether seed tet v (positive, global ids) is final slot of our mesh:
+ * all its vertices ours and its slot marked (final). */
+static int seed_is_final(const worker *w, const uint32_t v[4], const uint8_t *final)
+{
+    for (int i = 0; i < 4; i++)
+        if (!is_own(w, v[i]))
+            return 0;
+    uint32_t nt;
+    int nk;
+    /* v3 is on the open side of face (v0, v1, v2) of a positive tet. */
+    return fdt_ins_find_face(&w->orc.mesh, v[0], v[1], v[2], &nt, &nk) &&
+           fdt_ins_tet(&w->orc.mesh, nt)[nk] == v[3] && final[nt];
+}
+
+/*
+ * The final tets of our certified mesh (final[], src/front/partmesh.h) to
+ * the sink, in slot order; then each one's faces: toward another final
+ * tet, the two are neighbours (linked here when neighbours are kept);
+ * toward anything else (a tet that is not final, the part's hull), a face
+ * of the DT of every point whose other side is not known yet: a wall
+ * face, our first front. Every vertex is ours, so we own every such face.
+ */
+static int emit_final(worker *w, const uint8_t *final)
+{
+    const fdt_ins *m = &w->orc.mesh;
+    uint32_t *tid = malloc((size_t)m->nslots * sizeof *tid);
+    if (!tid)
+        return FDT_ENOMEM;
+    int err = FDT_OK;
+    int64_t first = w->em.ntets;
+    for (uint32_t t = 0; t < m->nslots && !err; t++) {
+        if (!final[t])
+            continue;
+        int64_t id = fdt_emit_tet(&w->em, fdt_ins_tet(m, t));
+        if (id < 0)
+            err = (int)id;
+        else if ((err = fdt_oracle_note(&w->orc, id, t)) == FDT_OK)
+            tid[t] = (uint32_t)(id - first);
+    }
+    int64_t *nbrs = w->e->want_nbrs ? w->out.nbrs : NULL;
+    for (uint32_t t = 0; t < m->nslots && !err; t++) {
+        if (!final[t])
+            continue;
+        const uint32_t *v = fdt_ins_tet(m, t);
+        int64_t id = first + tid[t];
+        for (int i = 0; i < 4 && !err; i++) {
+            uint32_t nt;
+            int nk;
+            fdt_ins_across(m, t, i, &nt, &nk);
+            if (final[nt]) {
+                if (nbrs)
+                    nbrs[4 * id + i] = first + tid[nt];
+                continue;
+            }
+            uint32_t fc[3];
+            fdt_face_canon(v[fdt_tet_face[i][0]], v[fdt_tet_face[i][1]], v[fdt_tet_face[i][2]],
+                           fc);
+            w->st.wall_faces++;
+            err = fdt_eng_face_arrives(w, fc, w->id, (int64_t)fdt_emit_link(&w->em, id, i, v[i]),
+                                       NULL);
+        }
+    }
+    w->st.final_tets += (size_t)(w->em.ntets - first);
+    free(tid);
+    return err;
+}
+
+/*
+ * The wall engine's start (issue 31; bench/NOTES.md entry 90). Our points
+ * are triangulated privately, no lock and no other part involved (the
+ * oracle's mesh, certified before it is read), and published for the
+ * other parts' queries. Its tets whose circumsphere lies inside our cell
+ * are final at once (emit_final); the rest of the DT near our cell is
+ * what the fronts build from the walls, asking our mesh for our points
+ * and the other parts for theirs, exactly as the paper's front does from
+ * a seed. The seeds stay: a part without final tets (a surface's points,
+ * thin parts) starts from its seed, and a seed that is a final tet is
+ * skipped (it was emitted). A part whose points do not span 3-D, or whose
+ * mesh does not fit, keeps the kd search and its seed.
+ */
+static int walls_start(worker *w)
+{
+    int rc = fdt_oracle_build(&w->orc, &w->kq);
+    if (rc)
+        return rc; /* the certificate failed: the run stops */
+    /* release: everything the build wrote happens before a reader's
+     * acquire of mesh_pub (walk_others); 2: no mesh, the kd search */
+    atomic_store_explicit(&w->mesh_pub, w->orc.state == 1 ? 1 : 2, memory_order_release);
+    w->published = 1;
+    uint8_t *final = NULL;
+    if (w->orc.state == 1) {
+        final = malloc(w->orc.mesh.nslots ? w->orc.mesh.nslots : 1);
+        if (!final)
+            return FDT_ENOMEM;
+        fdt_partmesh_final(&w->orc.mesh, w->tree, final);
+        if ((rc = emit_final(w, final)) != FDT_OK) {
+            free(final);
+            return rc;
+        }
+    }
+    for (int i = 0; i < w->nseeds && !rc; i++)
+        if (!final || !seed_is_final(w, w->seeds[i], final))
+            rc = fdt_eng_build_tet(w, w->seeds[i], 0, NULL);
+    free(final);
+    return rc;
 }
 
 int fdt_eng_worker_loop(worker *w)
 {
     int rc;
-    for (int i = 0; i < w->nseeds; i++)
-        if ((rc = fdt_eng_build_tet(w, w->seeds[i], 0, NULL)) != FDT_OK)
+    if (w->e->walls) {
+        if ((rc = walls_start(w)) != FDT_OK)
             return rc;
+    } else {
+        for (int i = 0; i < w->nseeds; i++)
+            if ((rc = fdt_eng_build_tet(w, w->seeds[i], 0, NULL)) != FDT_OK)
+                return rc;
+    }
     for (;;) {
         if (aborted(w->e))
             return FDT_OK;
@@ -756,8 +776,6 @@ engine *fdt_eng_new(int n)
         atomic_init(&e->w[i].tets_done, 0);
         atomic_init(&e->w[i].mesh_pub, 0);
     }
-    atomic_init(&e->gm_state, 0);
-    atomic_init(&e->gm_votes, 0);
     return e;
 }
 

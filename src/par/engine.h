@@ -85,6 +85,8 @@ typedef struct worker {
     int npk;                   /* slots in use */
     uint32_t (*seeds)[4];      /* seed tets to build first (borrowed) */
     int nseeds;
+    int root;                  /* starts with work: seeds, or (walls) a
+                                  nonempty part */
     int active;                /* shared mode: holds an activity unit of
                                   e->work */
     /* Message mode (src/par/termination.c): Dijkstra-Scholten over FACESEND
@@ -102,10 +104,11 @@ typedef struct worker {
      * fdt_ins_build wrote the mesh, which is not written again before
      * fdt_eng_worker_free (after every thread is joined). Another thread that loads
      * 1 with acquire sees the whole mesh and may read it with no lock
-     * (shared mode, search_others). */
+     * (shared mode, walk_others). The wall engine stores 2 when the part
+     * has no mesh (too few points, flat, no memory): its readers wait
+     * for 1 or 2, so what answers a query never depends on timing. */
     atomic_int mesh_pub;
     int published;             /* mesh_pub stored (this thread's copy) */
-    int gm_voted;              /* counted in engine.gm_votes */
     fdt_ins_query iq;          /* scratch of the queries of other meshes */
     uint32_t *qhint;           /* per part: where the last walk ended */
     uint32_t qcache_v;         /* iq answers for this vertex in this part */
@@ -146,37 +149,16 @@ typedef struct engine {
     fdt_tsink *sink;           /* the run's sink (src/front/sink.h) */
     fdt_mode mode;
     int search;                /* fdt_search, for every part's oracle */
+    int walls;                 /* the wall engine: each part's own mesh
+                                  first, its final tets at once, the
+                                  fronts from the walls (engine.c,
+                                  walls_start) */
     fdt_ins gmesh;             /* the DT of every point, when gmesh_ok:
                                   built before the threads start, read-only
                                   after (thread creation publishes it) */
     int gmesh_ok;
     size_t gm_certified;       /* the setup's mesh of every point: finite */
     double gm_t_certify;       /* tets certified, and the seconds it took */
-    /* The collective switch (bench/NOTES.md entry 59): 1 when the parts
-     * start on the kd search with collective oracles (fdt_oracle.
-     * collective). Once a majority of them voted (gm_votes), the part that
-     * sees it builds gmesh with every part's thread count
-     * (fdt_ins_build_parallel) while the other parts wait, then all read
-     * it. gm_state: 0 none chosen, 1 being built, 2 built (gmesh_ok), 3
-     * failed (no memory, flat points: every part stays on the kd search).
-     * The one 0 -> 1 is a strong CAS (acq_rel): exactly one part builds.
-     * The builder writes gmesh, then stores 2 or 3 with release under
-     * `lock` and broadcasts gm_cv; a part that loads 2 with acquire sees
-     * the whole mesh, which is not written again until every thread is
-     * joined. A part that loads 1 waits on gm_cv under `lock`, re-reading
-     * gm_state there, so the broadcast cannot be missed (the store is
-     * made under the same mutex). */
-    int collective;
-    atomic_int gm_state;
-    /* Parts whose oracle chose the mesh (each counts once; relaxed: only
-     * the count matters, the build's CAS orders the rest, and a voter
-     * re-reads it at every face, so a vote not yet seen is seen later).
-     * The mesh serves every part, so a majority must choose it: one part
-     * of an airborne scan (lonestar, ../shared/data) whose first faces lie
-     * in a dense patch measures the kd search slow there while the whole
-     * part, and the other part, run faster on it (entry 59). */
-    atomic_int gm_votes;
-    pthread_cond_t gm_cv;
     int n;
     int want_nbrs;
     fdt_transport *tp;         /* messages between the parts: endpoints
@@ -251,6 +233,11 @@ int fdt_eng_build_tet(worker *w, const uint32_t v[4], int request, fdt_face *adv
  * in the mesh of every point (engine.gmesh) when the sender read its apex
  * there, -1 otherwise. */
 int fdt_eng_build_requested(worker *w, const uint32_t v[4], int64_t mtet);
+/* Offers to s the first of part's points in its pencil from part's
+ * published mesh (fdt_ins_conflict_vertices; part's kd search where the
+ * conflict region is too large): other parts' meshes in shared mode,
+ * the part's own when it answers a NODESEND in the wall engine. */
+int fdt_eng_offer_from_mesh(worker *w, fdt_apex *s, int part);
 /* The worker's tables (on its own thread, after pinning). */
 int fdt_eng_worker_setup(worker *w);
 /* The worker's loop: seeds, messages, faces, until IAMDONE or abort. */

@@ -216,26 +216,11 @@ static int recut_by_mesh(fdt_partition *pt, const fdt_ins *gm)
     return FDT_OK;
 }
 
-/* The probe (FDT_PAR_MESH_PROBE) on its own thread. */
-typedef struct probe_job {
-    fdt_probe_samples ps;
-    int expensive;
-} probe_job;
-
-static void *probe_main(void *arg)
-{
-    probe_job *pj = arg;
-    pj->expensive = fdt_oracle_probe_decide(&pj->ps);
-    return NULL;
-}
-
 /* ---- the run's steps (fdt_parallel_run) ----------------------------------- */
 
-/* Partitions the points into nthreads parts, one kd-tree each, with the
- * probe beside it when probe is set: *expensive gets its answer (0 when
- * there is no probe). On failure pt is zeroed. */
-static int partition_with_probe(fdt_prepared *pr, const fdt_settings *s, int nthreads,
-                                int probe, fdt_partition *pt, int *expensive)
+/* Partitions the points into nthreads parts, one kd-tree each. On
+ * failure pt is zeroed. */
+static int partition(fdt_prepared *pr, const fdt_settings *s, int nthreads, fdt_partition *pt)
 {
     /* The parts' trees are built on as many threads as there are CPUs
      * (up to one a part): at 1M points on two cores that took a quarter
@@ -245,32 +230,9 @@ static int partition_with_probe(fdt_prepared *pr, const fdt_settings *s, int nth
      * hardware thread of a core costs nothing here. */
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     int cores = ncpu < 1 ? 1 : ncpu > FDT_PARTITION_MAX ? FDT_PARTITION_MAX : (int)ncpu;
-    /* The probe only decides the shared mesh's build, after the
-     * partition, whose first cut leaves the second core idle (bench/NOTES.md
-     * entry 56): it runs beside it on samples copied before the partition
-     * permutes the points, so its answer is fdt_oracle_probe's on the
-     * caller's order. pthread_join orders its answer before the read
-     * below. The seeds come after it: from the mesh where it is built
-     * (entry 72), else by the kd search, which then no longer overlaps
-     * the probe (0.1-0.3 ms a run where the mesh is not built). */
-    int probing = 0;
-    probe_job pj = {{{NULL, NULL}, 0, 0}, 0};
-    pthread_t probe_th;
-    *expensive = 0;
-    if (probe) {
-        fdt_oracle_probe_take(&pj.ps, pr->p, (uint32_t)pr->m, s->leaf_size);
-        probing = fdt_spawn(&probe_th, 0, probe_main, &pj) == 0;
-    }
-    int err = fdt_partition_build(pt, pr->p, pr->orig, (uint32_t)pr->m, nthreads,
-                                  s->leaf_size > 0 ? s->leaf_size : FDT_DEFAULT_LEAF,
-                                  cores < nthreads ? cores : nthreads);
-    if (probing) {
-        pthread_join(probe_th, NULL);
-        *expensive = pj.expensive;
-    } else if (probe) {
-        *expensive = fdt_oracle_probe_decide(&pj.ps); /* no thread: here */
-    }
-    return err;
+    return fdt_partition_build(pt, pr->p, pr->orig, (uint32_t)pr->m, nthreads,
+                               s->leaf_size > 0 ? s->leaf_size : FDT_DEFAULT_LEAF,
+                               cores < nthreads ? cores : nthreads);
 }
 
 /* The engine over the partition pt, its tets going to opt's sink or, when
@@ -303,34 +265,26 @@ static int engine_start(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode,
 }
 
 /*
- * The DT of every point, for inputs where the kd search degenerates
- * (src/api/api.c decides, by fdt_oracle_probe): built here on the run's
- * threads, then every part reads its faces' apexes from it and asks
- * no other part (bench/NOTES.md entry 54). In message mode it stands
- * for the replica each MPI rank builds for itself (src/mpi/mpi_run.c):
- * immutable once built, so one copy serves every part, and the parts
- * still exchange their faces by FACESEND. Tets are still made and
- * owned by the parts' fronts. A build that cannot be made (no memory)
- * leaves the parts on their own oracles. Built before the seeds go to
+ * The DT of every point, built here on the run's threads with
+ * --search auto (or when a test asks, opt->global_mesh), if it fits the
+ * memory available (src/front/oracle.h, FDT_ORACLE_MESH_BYTES); then
+ * every part reads its faces' apexes from it and asks no other part
+ * (bench/NOTES.md entries 54, 90). In message mode it stands for the
+ * replica each MPI rank builds for itself (src/mpi/mpi_run.c): immutable
+ * once built, so one copy serves every part, and the parts still exchange
+ * their faces by FACESEND. Tets are still made and owned by the parts'
+ * fronts. Where it is not built the wall engine runs (src/par/engine.c),
+ * or with --search kd the paper's fronts. Built before the seeds go to
  * their owners and the workers take their ranges: recut_by_mesh moves
- * those ranges. Also decides e->collective. *t_gm: the build's time.
+ * those ranges. *t_gm: the build's time.
  */
-static int global_mesh(engine *e, fdt_prepared *pr, const fdt_par_opts *opt, int probe,
-                       int expensive, int nthreads, fdt_partition *pt, fdt_kdq *kq0,
-                       double *t_gm, char *diag, size_t dlen)
+static int global_mesh(engine *e, fdt_prepared *pr, const fdt_settings *s,
+                       const fdt_par_opts *opt, double probe, int nthreads, fdt_partition *pt,
+                       fdt_kdq *kq0, double *t_gm, char *diag, size_t dlen)
 {
-    /* The probe's choice (not an explicit global_mesh == 1) is dropped
-     * when the mesh would not fit the memory available (src/front/oracle.h,
-     * FDT_ORACLE_MESH_BYTES): the parts' kd searches are always right. */
-    if (expensive && FDT_ORACLE_MESH_BYTES * (double)pr->m > (double)fdt_mem_available())
-        expensive = 0;
-    /* The probe's "not clearly expensive" (src/front/oracle.c, PROBE_SURE):
-     * the parts start on the kd search and switch together when one of
-     * them measures it expensive at the full density (src/par/engine.c,
-     * collective_step; bench/NOTES.md entry 59). */
-    e->collective = e->mode == FDT_MODE_SHARED &&
-                    ((probe && !expensive) || (opt && opt->global_mesh == FDT_PAR_MESH_COLLECTIVE));
-    if (!(opt && (opt->global_mesh == 1 || expensive)))
+    int want = s->search == FDT_SEARCH_AUTO && probe > FDT_PROBE_SHARED_MESH &&
+               FDT_ORACLE_MESH_BYTES * (double)pr->m <= (double)fdt_mem_available();
+    if (!want && !(opt && opt->global_mesh))
         return FDT_OK;
     double tg = fdt_now_s();
     int gerr = fdt_ins_build_parallel(&e->gmesh, pr->p, 0, (uint32_t)pr->m, nthreads, &kq0->pc);
@@ -384,12 +338,6 @@ static int engine_sync_init(engine *e, const fdt_par_opts *opt, int nthreads, in
         return FDT_ENOMEM;
     }
     if (pthread_cond_init(&e->go, NULL) != 0) {
-        pthread_cond_destroy(&e->cv);
-        pthread_mutex_destroy(&e->lock);
-        return FDT_ENOMEM;
-    }
-    if (pthread_cond_init(&e->gm_cv, NULL) != 0) {
-        pthread_cond_destroy(&e->go);
         pthread_cond_destroy(&e->cv);
         pthread_mutex_destroy(&e->lock);
         return FDT_ENOMEM;
@@ -513,7 +461,8 @@ static long long engine_roles(engine *e, fdt_mode mode, const fdt_par_opts *opt,
         worker *w = &e->w[i];
         w->parent = -1;
         w->aborted_by = -1;
-        if (w->nseeds == 0)
+        w->root = w->nseeds > 0 || (e->walls && w->hi > w->lo);
+        if (!w->root)
             continue;
         if (e->msg_term) {
             w->engaged = 1;
@@ -591,6 +540,7 @@ static int collect_stats(engine *e, const fdt_partition *pt, int nthreads, const
         out->fst.mesh_parts += w->orc.switched_at != 0 || w->orc.gm;
         out->fst.t_mesh += w->orc.t_mesh;
         out->fst.certified_tets += w->orc.certified;
+        out->fst.final_tets += w->st.final_tets;
         out->fst.t_certify += w->orc.t_certify;
         out->fst.kq.pc.orient_adapt += w->kq.pc.orient_adapt;
         out->fst.kq.pc.insphere_adapt += w->kq.pc.insphere_adapt;
@@ -620,7 +570,7 @@ static int check_balance(const engine *e, const fdt_stats *ps, int nthreads, cha
                          size_t dlen)
 {
     size_t iamdones = (size_t)nthreads - 1 +
-                      (e->msg_term ? (size_t)e->roots - (e->w[0].nseeds > 0) : 0);
+                      (e->msg_term ? (size_t)e->roots - (e->w[0].root != 0) : 0);
     if (memcmp(ps->sent, ps->received, sizeof ps->sent) != 0 ||
         ps->remote_queries != ps->remote_answered ||
         ps->sent[FDT_MSG_NODESEND] != ps->remote_queries ||
@@ -643,7 +593,6 @@ static void engine_free(engine *e, int nthreads, int sync_ok)
     fdt_ins_free(&e->gmesh);
     fdt_transport_destroy(&e->tp);
     if (sync_ok) {
-        pthread_cond_destroy(&e->gm_cv);
         pthread_cond_destroy(&e->go);
         pthread_cond_destroy(&e->cv);
         pthread_mutex_destroy(&e->lock);
@@ -674,15 +623,28 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     fdt_kdq kq0;
     memset(&kq0, 0, sizeof kq0);
     double t_gm = 0.0;
-    int probe = opt && opt->global_mesh == FDT_PAR_MESH_PROBE, expensive;
-    int err = partition_with_probe(pr, s, nthreads, probe, &pt, &expensive);
+    /* --search auto: the probe's count of points tested a face on samples
+     * of the points (src/front/oracle.h), taken before the partition
+     * permutes them, chooses the mesh of every point (global_mesh). */
+    double probe = 0.0;
+    if (s->search == FDT_SEARCH_AUTO) {
+        fdt_probe_samples ps;
+        fdt_oracle_probe_take(&ps, pr->p, (uint32_t)pr->m, s->leaf_size);
+        probe = fdt_oracle_probe_cost(&ps);
+    }
+    int err = partition(pr, s, nthreads, &pt);
     if (err != FDT_OK)
         return err; /* pt is zeroed */
     if ((err = engine_start(pr, s, mode, opt, &pt, nthreads, &mem_sink, &mem_sink_ok, &e)) !=
             FDT_OK ||
-        (err = global_mesh(e, pr, opt, probe, expensive, nthreads, &pt, &kq0, &t_gm, diag,
-                           dlen)) != FDT_OK)
+        (err = global_mesh(e, pr, s, opt, probe, nthreads, &pt, &kq0, &t_gm, diag, dlen)) !=
+            FDT_OK)
         goto fail;
+    /* --search mesh: the wall engine (src/par/engine.c, walls_start).
+     * --search auto: the mesh of every point, or the kd search where the
+     * probe found it cheap; the input, the settings and the memory
+     * decide, never a clock (bench/NOTES.md entry 90). */
+    e->walls = s->search == FDT_SEARCH_MESH && !e->gmesh_ok;
     /* The seeds, after the mesh of every point where it was built: its
      * tets are Delaunay tets already (seeds_from_mesh). */
     err = e->gmesh_ok ? seeds_from_mesh(&pt, &e->gmesh, &seeds, &nseeds)

@@ -32,13 +32,6 @@ typedef struct fdt_par_out {
  * clamped to [1, 1024]. */
 int fdt_parallel_default_threads(void);
 
-/* fdt_par_opts.global_mesh: let the probe decide (src/par/parallel.c):
- * where it is not sure, shared mode's parts decide together
- * (src/par/engine.c, collective_step); message mode's keep their own. */
-#define FDT_PAR_MESH_PROBE 2
-/* fdt_par_opts.global_mesh: no probe, the parts decide together (tests). */
-#define FDT_PAR_MESH_COLLECTIVE 3
-
 /* How a run is carried out beyond the settings (tests). */
 typedef struct fdt_par_opts {
     int shuffle;        /* nonzero: the test transport of src/par/transport.h,
@@ -50,14 +43,12 @@ typedef struct fdt_par_opts {
                            once it has advanced fail_after faces */
     int fail_part;
     size_t fail_after;
-    int global_mesh;    /* build the DT of every point first
+    int global_mesh;    /* nonzero: build the DT of every point first
                            (fdt_ins_build_parallel, on nthreads threads)
                            and let every part read its apexes from it
-                           (in message mode as a replica, src/par/parallel.c);
-                           FDT_PAR_MESH_PROBE: only if fdt_oracle_probe
-                           finds the kd search expensive (src/front/oracle.h),
-                           the probe running on a thread of its own beside
-                           the partition and the seeds */
+                           (in message mode as a replica), whatever the
+                           search; --search auto does it by itself where
+                           it fits (src/par/parallel.c, global_mesh) */
     struct fdt_tsink *sink; /* where the tets go (src/front/sink.h); NULL: into
                            out->mb. A sink with a caller's fdt_sink streams:
                            out->mb stays empty, nothing is gathered, and

@@ -147,10 +147,17 @@ int fdt_proto_answer_query(worker *w, const fdt_msg *m)
             return FDT_EINTERNAL;
     }
     size_t tested = w->kq.points;
-    if (w->tree->n)
+    int rc;
+    if (w->e->walls && w->orc.state == 1) {
+        /* The wall engine: the part's own mesh answers (its walls_start
+         * ran before any mail is read, so always). */
+        if ((rc = fdt_eng_offer_from_mesh(w, &s, w->id)) != FDT_OK)
+            return rc;
+    } else if (w->tree->n) {
         fdt_apex_search(&s, w->tree, &w->kq);
+    }
     fdt_msg *r;
-    int rc = fdt_tp_alloc(w->e->tp, w->id, &r);
+    rc = fdt_tp_alloc(w->e->tp, w->id, &r);
     if (rc)
         return rc;
     r->kind = FDT_MSG_NODERECV;
