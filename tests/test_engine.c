@@ -289,6 +289,16 @@ static void run_walls(const input *in, const uint32_t *ref, size_t nref, int nth
     EXPECTF(want_final ? fin > 0 && fin < nref && walls > 0 : fin == 0,
             "%s, walls, %d threads: %zu final of %zu, %zu wall faces", in->name, nthreads, fin,
             nref, walls);
+    /* the same path again: each part's final tets and wall faces are a
+     * function of its points, never of timing */
+    fdt_par_out again;
+    CHECK_EQ(fdt_parallel_run(&pr, &s, mode, nthreads, NULL, &again, diag, sizeof diag), FDT_OK);
+    for (int i = 0; i < nthreads; i++)
+        EXPECTF(again.tstats[i].final_tets == out.tstats[i].final_tets &&
+                    again.tstats[i].wall_faces == out.tstats[i].wall_faces,
+                "%s, walls, %d threads: part %d's final tets or walls changed", in->name,
+                nthreads, i);
+    fdt_par_out_free(&again);
     /* the fronts built the rest */
     EXPECT(out.fst.faces_advanced > 0);
     EXPECT(out.mb.ntets == nref);
