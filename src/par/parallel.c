@@ -26,7 +26,6 @@
 #include "base/mem.h"
 #include "front/oracle.h"
 #include "front/seed.h"
-#include "base/spawn.h"
 #include "par/termination.h"
 #include "par/threads.h"
 #include "mesh/certify.h"
