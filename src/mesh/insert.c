@@ -197,7 +197,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
      * circumsphere; an infinite tet where the walk stops has p strictly
      * outside its hull face. Either way it is in conflict. */
     b->ncav = b->nbnd = b->nout = 0;
-    size_t unsure0 = b->cnt->insphere_unsure; /* see ins_star_face_ok */
+    size_t unsure0 = b->cnt->insphere_unsure; /* see ins_star_ok */
     uint8_t *mark = b->mark;
     mark[t0] = MARK_IN;
     b->cav[b->ncav++] = t0;
@@ -235,9 +235,8 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
     }
     if (b->nbnd > UINT32_MAX / 2)
         return FDT_ETOOBIG;
-    for (size_t i = 0; b->cnt->insphere_unsure != unsure0 && i < b->nbnd; i++)
-        if (!ins_star_face_ok(m, m->T, b->bnd[i], p, b->cnt))
-            return FDT_EINTERNAL;
+    if (!ins_star_ok(m, b->bnd, b->nbnd, p, b->cnt, unsure0))
+        return FDT_EINTERNAL;
     if ((err = reserve_slots(b, (uint32_t)b->nbnd)) != FDT_OK)
         return err;
     if ((err = ins_edges_begin(&b->edges, 3 * b->nbnd / 2)) != FDT_OK)
@@ -470,7 +469,7 @@ int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
     build b;
     memset(&b, 0, sizeof b);
     b.m = m;
-    fdt_pred_counts own = {0}; /* the insertion reads its counts (ins_star_face_ok) */
+    fdt_pred_counts own = {0}; /* the insertion reads its counts (ins_star_ok) */
     b.cnt = cnt ? cnt : &own;
     b.rng = UINT64_C(0x853c49e6748fea9b);
     int err = FDT_ENOMEM;

@@ -194,40 +194,42 @@ static inline int ins_conflict(const fdt_ins *m, uint32_t t, const double *p,
 }
 
 /*
- * Whether the new tet on boundary face bnd (packed: cavity tet c, face
- * opposite its vertex k) with p in place of vertex k is positively
- * oriented, when it is finite. Delaunay's cavity is star-shaped from p, so
+ * Whether the star of p over the cavity's boundary faces bnd[0 .. nbnd)
+ * (packed: cavity tet c, face opposite its vertex k; each new tet is the
+ * face with p in place of vertex k) is a triangulation: every new finite
+ * tet positively oriented. Delaunay's cavity is star-shaped from p, so
  * with exact predicates this always holds (the certificate of
  * src/mesh/certify.c asks the same of every finite tet); a cavity that is
  * not (a wrong insphere: tests/test_plant.sh) would link a star that is no
  * triangulation, and later walks and cavities would then read anything.
  * A region whose boundary faces all face away from p is star-shaped from
  * it (a ray from p crosses that boundary once), so the test on each face
- * stops such a star before it is written. The insertion asks only when
- * one of its insphere filters could not decide (cnt->insphere_unsure
- * moved): what the filters decide is the exact sign, so a cavity found by
- * them alone is Delaunay's, and most insertions skip the test (bench/
- * NOTES.md entry 89: all of them cost 9 % of a serial build). An
- * infinite new tet is not
+ * stops such a star before it is written. It runs only when one of the
+ * insertion's insphere filters could not decide (cnt->insphere_unsure
+ * moved past unsure0, its value when the insertion began): what the
+ * filters decide is the exact sign, so a cavity found by them alone is
+ * Delaunay's, and most insertions skip the test (bench/NOTES.md entry 89:
+ * all of them cost 9 % of a serial build). An infinite new tet is not
  * tested (no point of the mesh stands for its infinite vertex); the
  * certificate checks the hull at the end.
  */
-static inline int ins_star_face_ok(const fdt_ins *m, const uint32_t *T, uint32_t bnd,
-                                   const double *p, fdt_pred_counts *cnt)
+static inline int ins_star_ok(const fdt_ins *m, const uint32_t *bnd, size_t nbnd,
+                              const double *p, fdt_pred_counts *cnt, size_t unsure0)
 {
-    const uint32_t *cv = T + 8 * (size_t)(bnd >> 2);
-    int k = (int)(bnd & 3);
-    const double *q[4];
-    for (int i = 0; i < 4; i++) {
-        if (i == k) {
-            q[i] = p;
-            continue;
+    if (cnt->insphere_unsure == unsure0)
+        return 1;
+    for (size_t j = 0; j < nbnd; j++) {
+        const uint32_t *cv = m->T + 8 * (size_t)(bnd[j] >> 2);
+        int k = (int)(bnd[j] & 3), inf = 0;
+        const double *q[4];
+        for (int i = 0; i < 4; i++) {
+            inf |= i != k && cv[i] == INF;
+            q[i] = i == k ? p : cv[i] == INF ? p : ins_pt(m, cv[i]);
         }
-        if (cv[i] == INF)
-            return 1;
-        q[i] = ins_pt(m, cv[i]);
+        if (!inf && ins_orient(q[0], q[1], q[2], q[3], cnt) <= 0)
+            return 0;
     }
-    return ins_orient(q[0], q[1], q[2], q[3], cnt) > 0;
+    return 1;
 }
 
 /* Asks for the four neighbours of tet t: the cavity search tests them

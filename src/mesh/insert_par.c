@@ -499,7 +499,7 @@ static int insert_point(worker *w, uint32_t pid)
         return FDT_EINVAL;
     }
     w->ncav = w->nbnd = w->nout = w->nunder = 0;
-    size_t unsure0 = w->cnt.insphere_unsure; /* see ins_star_face_ok */
+    size_t unsure0 = w->cnt.insphere_unsure; /* see ins_star_ok */
     set_mark(w, t0, MARK_IN);
     w->cav[w->ncav++] = t0;
     ins_prefetch_nbrs(m->T, t0);
@@ -555,13 +555,12 @@ static int insert_point(worker *w, uint32_t pid)
     }
     /* Everything read is held: from here on the insertion cannot fail
      * for another thread's sake, only for want of slots or memory, or
-     * when the star would not be a triangulation (ins_star_face_ok:
-     * nothing is written then). */
-    for (size_t i = 0; w->cnt.insphere_unsure != unsure0 && i < w->nbnd; i++)
-        if (!ins_star_face_ok(m, m->T, w->bnd[i], p, &w->cnt)) {
-            err = FDT_EINTERNAL;
-            goto abort;
-        }
+     * when the star would not be a triangulation (ins_star_ok: nothing
+     * is written then). */
+    if (!ins_star_ok(m, w->bnd, w->nbnd, p, &w->cnt, unsure0)) {
+        err = FDT_EINTERNAL;
+        goto abort;
+    }
     if ((err = reserve(w, w->nbnd)) != FDT_OK ||
         (err = ins_grow_u32(&w->newt, &w->newcap, w->nbnd)) != FDT_OK ||
         (err = ins_edges_begin(&w->edges, 3 * w->nbnd / 2)) != FDT_OK)
