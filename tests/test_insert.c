@@ -1078,6 +1078,21 @@ static int time_file(const char *path, int reps, int threads)
     return 0;
 }
 
+/* ins_star_edge (src/mesh/insert_impl.h) is fdt_tet_face read as the
+ * star's directed outer edges: for the centre at k and j = 0..2, the tail
+ * and head are the outward face's vertices after f[j], the face index
+ * f[j] itself. */
+static void test_star_edges(void)
+{
+    for (int k = 0; k < 4; k++)
+        for (int j = 0; j < 3; j++) {
+            const int *f = fdt_tet_face[k];
+            CHECK(ins_star_edge[k][j][0] == f[(j + 1) % 3]);
+            CHECK(ins_star_edge[k][j][1] == f[(j + 2) % 3]);
+            CHECK(ins_star_edge[k][j][2] == f[j]);
+        }
+}
+
 int main(int argc, char **argv)
 {
     if (argc >= 3 && strcmp(argv[1], "--time") == 0)
@@ -1094,6 +1109,7 @@ int main(int argc, char **argv)
     const char *gen = argv[1];
     test_refusals();
     test_brio_order();
+    test_star_edges();
 
     /* Every family of gen_points; sizes keep the reference (the front,
      * quadratic on cospherical sets) within a few seconds. */

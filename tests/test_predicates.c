@@ -1136,6 +1136,79 @@ static void test_bound_windows(tctx *T, double scale, int verbose)
 }
 
 
+
+/*
+ * The semi-static stage (fdt_pred_static, fdt_orient3d_static,
+ * fdt_insphere_static): on the tightest box of the points (the largest
+ * permanent next to the box's bound), whenever it decides, its sign is
+ * the rational one and the dynamic filter decides the same (it may only
+ * return what the filter would). Inputs: well spread, nearly coplanar and
+ * nearly cospherical, scaled by 2^e, e in [-130, 130], so boxes outside
+ * [2^-100, 2^100] (where it must never decide) are met too. It must decide
+ * most well-spread inputs (else it would be dead code), never one in a
+ * zeroed fdt_pred_static.
+ */
+static void test_static_filter(tctx *T, double scale)
+{
+    const long failures_before = test_failures();
+    const long n = (long)fmax(20000 * scale, 500);
+    const fdt_pred_static zero = {0, 0};
+    long spread = 0, spread_decided = 0, near_decided = 0, out_decided = 0;
+    for (long it = 0; it < n; it++) {
+        double p[5][3];
+        int kind = (int)(it % 3);
+        if (kind == 0)
+            for (int i = 0; i < 5; i++)
+                for (int k = 0; k < 3; k++)
+                    p[i][k] = sunif(T);
+        else if (kind == 1)
+            gen_near_coplanar(T, p);
+        else
+            gen_near_cospherical(T, p, 0.0);
+        int e = (int)irand(T, -130, 130);
+        for (int i = 0; i < 5; i++)
+            for (int k = 0; k < 3; k++)
+                p[i][k] = ldexp(p[i][k], e);
+        for (int insphere = 0; insphere <= 1; insphere++) {
+            int np = insphere ? 5 : 4;
+            double lo[3], hi[3];
+            for (int k = 0; k < 3; k++) {
+                lo[k] = hi[k] = p[0][k];
+                for (int i = 1; i < np; i++) {
+                    lo[k] = fmin(lo[k], p[i][k]);
+                    hi[k] = fmax(hi[k], p[i][k]);
+                }
+            }
+            fdt_pred_static sf;
+            fdt_pred_static_init(&sf, lo, hi);
+            int st = insphere ? fdt_insphere_static(p[0], p[1], p[2], p[3], p[4], &sf)
+                              : fdt_orient3d_static(p[0], p[1], p[2], p[3], &sf);
+            int z = insphere ? fdt_insphere_static(p[0], p[1], p[2], p[3], p[4], &zero)
+                             : fdt_orient3d_static(p[0], p[1], p[2], p[3], &zero);
+            EXPECT(z == FDT_PRED_UNSURE);
+            double M = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+            int in_range = M >= 0x1p-100 && M <= 0x1p100;
+            if (kind == 0 && in_range) {
+                spread++;
+                spread_decided += st != FDT_PRED_UNSURE;
+            }
+            if (st == FDT_PRED_UNSURE)
+                continue;
+            out_decided += !in_range;
+            near_decided += kind != 0;
+            int ref = ref_of(T, insphere, p), filt = filter_of(insphere, p);
+            if (st != ref || filt != st)
+                print_pts((const double(*)[3])p, np);
+            EXPECT(st == ref);
+            EXPECT(filt == st);
+        }
+    }
+    EXPECT(out_decided == 0);
+    EXPECT(spread > 0 && spread_decided > spread * 9 / 10);
+    EXPECT(near_decided > 0);
+    report_section(T, __func__, failures_before);
+}
+
 /* A random integer below 2^L in magnitude, L uniform in [0, maxbits], so
  * that magnitudes spread over the whole range; negative half the time if
  * sgn. */
@@ -2405,6 +2478,7 @@ int main(int argc, char **argv)
     test_circumcenter(&T, scale, verbose);
     test_compare_dist(&T, scale, verbose);
     test_lex_compare(&T, scale);
+    test_static_filter(&T, scale);
     double t3 = now_s();
     bench(&T);
     bench_adapt(&T);

@@ -685,6 +685,35 @@ static inline void cross3(const double *x, const double *y, double *z)
     z[2] = x[0] * y[1] - x[1] * y[0];
 }
 
+
+void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double hi[3])
+{
+    sf->o3d_inv = sf->isp_inv = 0;
+    double M = 0;
+    for (int k = 0; k < 3; k++) {
+        double d = hi[k] - lo[k];
+        if (!(d >= 0 && d <= DBL_MAX))
+            return;
+        M = d > M ? d : M;
+    }
+    if (!(M >= 0x1p-100 && M <= 0x1p100))
+        return;
+    /* See predicates.h: the permanents' bounds 6 M^3 and 72 M^5, with
+     * room for their own roundings. */
+    const double safe = 1 + 0x1p-20, M3 = M * M * M;
+    double o3d = FDT_O3D_ERRBOUND * (6 * M3 * safe);
+    double isp = FDT_ISP_ERRBOUND * (72 * M3 * M * M * safe);
+    /* The dynamic filters' guards, for any permanent above these bounds
+     * (they hold with a wide margin for M in range; checked all the same). */
+    double su = 4 * M, L = 16 * M * M;
+    if (o3d < 0x1p-790 || su * 0x1p-980 > 0.5 * o3d || isp < 0x1p-790 ||
+        L * (L * 0x1p-960) > 0.5 * isp)
+        return;
+    /* Rounded down: (1 - 2^-50) fl(1/x) <= 1/x. */
+    sf->o3d_inv = (1 / o3d) * (1 - 0x1p-50);
+    sf->isp_inv = (1 / isp) * (1 - 0x1p-50);
+}
+
 /* +1 / -1 when |z| > bound proves the sign of F, FDT_PRED_UNSURE else. */
 static inline int adapt_sign(dword f, double t1, double bound)
 {

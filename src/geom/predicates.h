@@ -319,4 +319,100 @@ static inline int fdt_insphere_filter(const double *a, const double *b,
     return fdt_insphere_filter_diff(A, B, C, D);
 }
 
+/* ------------------------------------------------------------------ */
+/*
+ * Semi-static filters (the first stage of the insertion kernel's tests,
+ * src/mesh/insert_impl.h): for points whose coordinates all lie in one
+ * box, a bound on the filters' permanent holds for every call, so the
+ * filter need not compute it. The insertion makes about 43 conflict tests
+ * and 20 orientation tests a point; this stage decides nearly all of them
+ * on well-spread points at about 60 % of the filter's flops
+ * (bench/NOTES.md entry 91).
+ *
+ * Why it is exact. Let M be the largest extent hi[k] - lo[k] of the box
+ * (rounded up: fl(hi - lo) is monotone, so every computed difference of
+ * two coordinates in the box is at most M in magnitude). Every computed
+ * permanent of fdt_orient3d_filter_diff and fdt_insphere_filter_diff is a
+ * sum of products of such magnitudes, monotone in each, so at most the
+ * same expression with every magnitude M: 6 M^3 and 72 M^5 exactly, up to
+ * its own roundings, which the factor 1 + 2^-20 below covers (so also
+ * under any contraction into fused multiply-adds). With bound = fl(B P),
+ * P that bound on the permanent and B the filter's constant, a computed
+ * |det| > bound then means:
+ *   - the permanent is above the filters' underflow guards: |det| is at
+ *     most the permanent (the same association with |.|, see the filters)
+ *     up to a factor 1 + 2^-40, and fdt_pred_static_init keeps bound
+ *     above 2^-790 and far above the guards' other terms (su 2^-980 and
+ *     L (L 2^-960), with su <= 4M and L <= 16 M^2);
+ *   - the dynamic filter would decide it, with the same sign: its bound
+ *     fl(B perm) is at most fl(B P) (monotone) < |det|.
+ * So this stage only ever returns what the filter would. The bounds are
+ * kept as reciprocals rounded down, tested as fl(|det| inv) > 1 (which
+ * implies |det| > 1 / inv >= bound), so that a zeroed fdt_pred_static,
+ * like the one of a box whose extent is 0, not finite, or outside
+ * [2^-100, 2^100], never decides: the filters and exact stages handle
+ * those calls.
+ */
+typedef struct fdt_pred_static {
+    double o3d_inv; /* decide orient3d when fl(|det| o3d_inv) > 1 */
+    double isp_inv; /* decide insphere when fl(|det4| isp_inv) > 1 */
+} fdt_pred_static;
+
+/* The bounds for points in the box [lo, hi] (componentwise). */
+void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double hi[3]);
+
+/* orient3d's determinant, in fdt_orient3d_filter_diff's association. */
+static inline double fdt_orient3d_det(const double *a, const double *b, const double *c,
+                                      const double *d)
+{
+    const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+    const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
+    const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
+    return ux * (vy * wz - vz * wy) + uy * (vz * wx - vx * wz) + uz * (vx * wy - vy * wx);
+}
+
+/* The sign of orient3d for four points of sf's box, or FDT_PRED_UNSURE. */
+static inline int fdt_orient3d_static(const double *a, const double *b, const double *c,
+                                      const double *d, const fdt_pred_static *sf)
+{
+    const double det = fdt_orient3d_det(a, b, c, d);
+    if (fabs(det) * sf->o3d_inv > 1)
+        return (det > 0) - (det < 0);
+    return FDT_PRED_UNSURE;
+}
+
+/* insphere's det4, in fdt_insphere_filter_diff's association. */
+static inline double fdt_insphere_det(const double *a, const double *b, const double *c,
+                                      const double *d, const double *e)
+{
+    const double aex = a[0] - e[0], aey = a[1] - e[1], aez = a[2] - e[2];
+    const double bex = b[0] - e[0], bey = b[1] - e[1], bez = b[2] - e[2];
+    const double cex = c[0] - e[0], cey = c[1] - e[1], cez = c[2] - e[2];
+    const double dex = d[0] - e[0], dey = d[1] - e[1], dez = d[2] - e[2];
+    const double ab = aex * bey - bex * aey, bc = bex * cey - cex * bey;
+    const double cd = cex * dey - dex * cey, da = dex * aey - aex * dey;
+    const double ac = aex * cey - cex * aey, bd = bex * dey - dex * bey;
+    const double abc = aez * bc - bez * ac + cez * ab;
+    const double bcd = bez * cd - cez * bd + dez * bc;
+    const double cda = cez * da + dez * ac + aez * cd;
+    const double dab = dez * ab + aez * bd + bez * da;
+    const double alift = aex * aex + aey * aey + aez * aez;
+    const double blift = bex * bex + bey * bey + bez * bez;
+    const double clift = cex * cex + cey * cey + cez * cez;
+    const double dlift = dex * dex + dey * dey + dez * dez;
+    return (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+}
+
+/* The CGAL sign of insphere for five points of sf's box (-sign(det4), see
+ * fdt_insphere_filter_diff), or FDT_PRED_UNSURE. */
+static inline int fdt_insphere_static(const double *a, const double *b, const double *c,
+                                      const double *d, const double *e,
+                                      const fdt_pred_static *sf)
+{
+    const double det = fdt_insphere_det(a, b, c, d, e);
+    if (fabs(det) * sf->isp_inv > 1)
+        return (det < 0) - (det > 0);
+    return FDT_PRED_UNSURE;
+}
+
 #endif

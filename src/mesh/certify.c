@@ -20,18 +20,23 @@ static inline int is_freed(const uint32_t *v)
     return v[0] == INF && v[1] == INF;
 }
 
-/* The exact signs, filter first (most calls end there). */
-static inline int orient(const double *a, const double *b, const double *c, const double *d,
-                         fdt_pred_counts *cnt)
+/* The exact signs, filters first (most calls end there); every point is
+ * one of the mesh's, in its box (fdt_ins.sf). */
+static inline int orient(const fdt_ins *m, const double *a, const double *b, const double *c,
+                         const double *d, fdt_pred_counts *cnt)
 {
-    int s = fdt_orient3d_filter(a, b, c, d);
+    int s = fdt_orient3d_static(a, b, c, d, &m->sf);
+    if (s == FDT_PRED_UNSURE)
+        s = fdt_orient3d_filter(a, b, c, d);
     return s != FDT_PRED_UNSURE ? s : fdt_orient3d(a, b, c, d, cnt);
 }
 
-static inline int insphere(const double *a, const double *b, const double *c, const double *d,
-                           const double *e, fdt_pred_counts *cnt)
+static inline int insphere(const fdt_ins *m, const double *a, const double *b, const double *c,
+                           const double *d, const double *e, fdt_pred_counts *cnt)
 {
-    int s = fdt_insphere_filter(a, b, c, d, e);
+    int s = fdt_insphere_static(a, b, c, d, e, &m->sf);
+    if (s == FDT_PRED_UNSURE)
+        s = fdt_insphere_filter(a, b, c, d, e);
     return s != FDT_PRED_UNSURE ? s : fdt_insphere_perturbed(a, b, c, d, e, cnt);
 }
 
@@ -52,7 +57,7 @@ static int orient_with(const fdt_ins *m, const uint32_t *v, int k, const double 
     const double *p[4];
     for (int i = 0; i < 4; i++)
         p[i] = i == k ? q : pt(m, v[i]);
-    return orient(p[0], p[1], p[2], p[3], cnt);
+    return orient(m, p[0], p[1], p[2], p[3], cnt);
 }
 
 /* Whether point q is in conflict with infinite tet v (infinite vertex at
@@ -66,22 +71,40 @@ static int conflicts_infinite(const fdt_ins *m, const uint32_t *v, int inf, cons
     if (o != 0)
         return o > 0;
     const uint32_t *w = m->T + 8 * (size_t)(v[4 + inf] >> 2);
-    return insphere(pt(m, w[0]), pt(m, w[1]), pt(m, w[2]), pt(m, w[3]), q, cnt) > 0;
+    return insphere(m, pt(m, w[0]), pt(m, w[1]), pt(m, w[2]), pt(m, w[3]), q, cnt) > 0;
 }
 
-/* Whether tets v (face k) and w (face nk) share the face's three vertices. */
-static int same_face(const uint32_t *v, int k, const uint32_t *w, int nk)
+/*
+ * How tets v (face k) and w (face nk) are glued: 0 when they do not share
+ * the face's three vertices; else the parity of the permutation taking v,
+ * with its vertex k replaced by w's vertex nk, to w: 1 (odd) when the two
+ * list the face in opposite orders, -1 (even) when in the same order.
+ * With both tets positive (check 2; an infinite one in the sense of
+ * src/mesh/insert.h), orient3d of v with w's apex in place of v[k] is that
+ * parity times orient3d of w: odd means w's apex lies on the far side of
+ * the face from v[k], so the two tets do not fold over each other. That
+ * is a geometric fact read off the ids, no predicate needed.
+ */
+static int glued(const uint32_t *v, int k, const uint32_t *w, int nk)
 {
+    int pos[4];
     for (int i = 0; i < 4; i++) {
-        if (i == k)
+        if (i == k) {
+            pos[i] = nk;
             continue;
-        int found = 0;
+        }
+        pos[i] = -1;
         for (int j = 0; j < 4; j++)
-            found |= j != nk && w[j] == v[i];
-        if (!found)
+            if (j != nk && w[j] == v[i])
+                pos[i] = j;
+        if (pos[i] < 0)
             return 0;
     }
-    return 1;
+    int inv = 0;
+    for (int i = 0; i < 4; i++)
+        for (int j = i + 1; j < 4; j++)
+            inv += pos[i] > pos[j];
+    return inv & 1 ? 1 : -1;
 }
 
 /* The pair checks of face k of tet v (slot t, infinite vertex at inf, -1
@@ -92,21 +115,15 @@ static const char *check_pair(const fdt_ins *m, const uint32_t *v, int k, int in
 {
     uint32_t p = v[k], q = w[nk];
     int winf = w[0] == INF ? 0 : w[1] == INF ? 1 : w[2] == INF ? 2 : w[3] == INF ? 3 : -1;
-    if (p == INF || q == INF) {
-        /* A hull face (the finite face of an infinite tet) over its
-         * finite tet: that tet's vertex on the inner side. */
-        const uint32_t *h = p == INF ? v : w, *in = p == INF ? w : v;
-        int hinf = p == INF ? k : nk, ik = p == INF ? nk : k;
-        return orient_with(m, h, hinf, pt(m, in[ik]), cnt) >= 0
-                   ? "a hull face with its tet outside"
-                   : NULL;
-    }
+    /* A hull face (the finite face of an infinite tet) over its finite tet:
+     * that tet's apex is on the inner side, since the two are glued in
+     * opposite orders (glued). */
+    if (p == INF || q == INF)
+        return NULL;
     if (inf < 0 && winf < 0) {
-        /* Two finite tets: q on the other side of the face (no fold), and
+        /* Two finite tets, on opposite sides of their face (glued): q
          * outside the sphere of v (which, for a pair, is p outside w's). */
-        if (orient_with(m, v, k, pt(m, q), cnt) >= 0)
-            return "two tets on the same side of their face";
-        if (insphere(pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), pt(m, q), cnt) > 0)
+        if (insphere(m, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), pt(m, q), cnt) > 0)
             return "a face is not locally Delaunay";
         return NULL;
     }
@@ -157,7 +174,7 @@ int fdt_certify_slots(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_count
             }
         if (ninf > 1)
             return fail(why, t, -1, "more than one infinite vertex");
-        if (inf < 0 && orient(pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), cnt) <= 0)
+        if (inf < 0 && orient(m, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), cnt) <= 0)
             return fail(why, t, -1, "a finite tet is not positively oriented");
         for (int k = 0; k < 4; k++) {
             uint32_t r = v[4 + k], nt = r >> 2;
@@ -173,8 +190,11 @@ int fdt_certify_slots(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_count
                 return fail(why, t, k, "a neighbour is a freed slot");
             if (w[4 + nk] != ((t << 2) | (uint32_t)k))
                 return fail(why, t, k, "the neighbour does not refer back");
-            if (!same_face(v, k, w, nk))
+            int g = glued(v, k, w, nk);
+            if (g == 0)
                 return fail(why, t, k, "the neighbours do not share the face");
+            if (g < 0)
+                return fail(why, t, k, "two tets on the same side of their face");
             pairs++;
             if (nt < t)
                 continue; /* a partial range: its geometry is checked from nt */

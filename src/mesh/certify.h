@@ -10,7 +10,9 @@
  * What is checked, every slot once, with exact predicates only:
  *  1. structure: each live slot has at most one infinite vertex; each
  *     neighbour reference is a live slot that refers back through the
- *     same face, and the two tets share that face's three vertices;
+ *     same face, and the two tets share that face's three vertices, listed
+ *     in opposite orders (with check 2 that puts the two tets on opposite
+ *     sides of the face, hull faces included);
  *  2. orientation: every finite tet is positively oriented (orient3d > 0);
  *  3. local Delaunay: across every face, the vertex of the neighbour is
  *     not in conflict with the tet, under the rule of the insertion itself

@@ -76,6 +76,8 @@ typedef struct build {
     size_t nbnd, bndcap;
     uint32_t *outl;                /* tets tested and found not in conflict */
     size_t nout, outcap;
+    uint32_t *newt;                /* the new tets' slots */
+    size_t newcap;
     ins_edges edges;               /* the new tets' edges (linking them) */
     uint64_t rng;                  /* the walk's choices */
 } build;
@@ -134,7 +136,8 @@ static inline void free_slot(build *b, uint32_t t)
  * pseudo-random choices (the caller's); steps counts the tets crossed
  * (may be NULL). Reads m only, so other threads may walk a built mesh. */
 static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng,
-                fdt_pred_counts *cnt, size_t *steps_out, uint32_t *out)
+                const fdt_pred_static *sf, fdt_pred_counts *cnt, size_t *steps_out,
+                uint32_t *out)
 {
     const uint32_t *T = m->T;
     uint32_t t = start;
@@ -151,7 +154,7 @@ static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng
         const uint32_t *v = T + 8 * (size_t)t;
         if (ins_is_infinite(v))
             break;
-        int exit = ins_walk_exit(m, v, p, from, rng, cnt);
+        int exit = ins_walk_exit(m, v, p, from, rng, sf, cnt);
         if (exit < 0)
             break;
         uint32_t nb = v[4 + exit];
@@ -167,14 +170,14 @@ static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng
 /* The tet where the build's walk for p from `start` ends. */
 static int locate(build *b, const double *p, uint32_t start, uint32_t *out)
 {
-    return walk(b->m, p, start, &b->rng, b->cnt, &b->m->stats.walk_steps, out);
+    return walk(b->m, p, start, &b->rng, &b->m->sf, b->cnt, &b->m->stats.walk_steps, out);
 }
 
 /* Whether tet t is in conflict with p (see the top for infinite tets). */
 static inline int conflict(build *b, uint32_t t, const double *p)
 {
     b->m->stats.conflict_tests++;
-    return ins_conflict(b->m, t, p, b->cnt);
+    return ins_conflict(b->m, t, p, &b->m->sf, b->cnt);
 }
 
 static int insert_point(build *b, uint32_t pid, uint32_t *last)
@@ -239,22 +242,20 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
         return FDT_EINTERNAL;
     if ((err = reserve_slots(b, (uint32_t)b->nbnd)) != FDT_OK)
         return err;
-    if ((err = ins_edges_begin(&b->edges, 3 * b->nbnd / 2)) != FDT_OK)
+    if ((err = ins_edges_begin(&b->edges, 3 * b->nbnd)) != FDT_OK ||
+        (err = ins_grow_u32(&b->newt, &b->newcap, b->nbnd)) != FDT_OK)
         return err;
     mark = b->mark; /* reserve_slots may have moved it */
 
     /* The new tets (ins_star_tet), allocated before the cavity is freed,
      * so reading it is safe; the cavity's slots serve the next insertion. */
     uint32_t *T = m->T;
-    size_t linked = 0;
-    uint32_t s = FDT_NONE;
     for (size_t i = 0; i < b->nbnd; i++) {
-        s = alloc_slot(b);
-        linked += ins_star_tet(T, &b->edges, b->bnd[i], pid, s);
+        b->newt[i] = alloc_slot(b);
+        ins_star_tet(T, b->bnd[i], pid, b->newt[i]);
     }
-    /* The boundary is a closed surface: every edge met exactly twice. */
-    if (2 * linked != 3 * b->nbnd)
-        return FDT_EINTERNAL;
+    if ((err = ins_link_star(&b->edges, T, b->newt, b->bnd, b->nbnd)) != FDT_OK)
+        return err;
     for (size_t i = 0; i < b->ncav; i++) {
         mark[b->cav[i]] = MARK_NONE;
         free_slot(b, b->cav[i]);
@@ -262,7 +263,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
     for (size_t i = 0; i < b->nout; i++)
         mark[b->outl[i]] = MARK_NONE;
     ins_count_cavity(&m->stats, b->ncav, b->nbnd);
-    *last = s;
+    *last = b->newt[b->nbnd - 1];
     return FDT_OK;
 }
 
@@ -412,7 +413,7 @@ static int start_simplex(build *b, const uint32_t *order, uint32_t n, uint32_t f
     int err = reserve_slots(b, 5);
     if (err)
         return err;
-    if ((err = ins_edges_begin(&b->edges, 6)) != FDT_OK)
+    if ((err = ins_edges_begin(&b->edges, 12)) != FDT_OK)
         return err;
     uint32_t *T = m->T;
     uint32_t t0 = alloc_slot(b);
@@ -420,18 +421,34 @@ static int start_simplex(build *b, const uint32_t *order, uint32_t n, uint32_t f
     /* Over face k (outward order fdt_tet_face[k]: v[k] on its negative
      * side, the outside on its positive side) the infinite tet
      * (face, INF), positive in the sense of src/mesh/insert.h. */
+    uint32_t hull[4], centre[4] = {3, 3, 3, 3};
     for (int k = 0; k < 4; k++) {
-        uint32_t s = alloc_slot(b);
+        uint32_t s = hull[k] = alloc_slot(b);
         uint32_t *w = T + 8 * (size_t)s;
         for (int j = 0; j < 3; j++)
             w[j] = v[fdt_tet_face[k][j]];
         w[3] = INF;
         w[7] = PACK(t0, k);
         T[8 * (size_t)t0 + 4 + k] = PACK(s, 3);
-        for (int j = 0; j < 3; j++)
-            ins_link_edge(&b->edges, T, w[ins_other2[3][j][0]], w[ins_other2[3][j][1]], PACK(s, j));
     }
-    return FDT_OK;
+    /* The four are the star of the infinite vertex over t0's faces. */
+    return ins_link_star(&b->edges, T, hull, centre, 4);
+}
+
+/* The points' bounding box and its semi-static filter bounds. */
+static void ins_bounds(fdt_ins *m)
+{
+    const double *p0 = ins_pt(m, m->base);
+    for (int k = 0; k < 3; k++)
+        m->lo[k] = m->hi[k] = p0[k];
+    for (uint32_t i = 1; i < m->n; i++) {
+        const double *p = ins_pt(m, m->base + i);
+        for (int k = 0; k < 3; k++) {
+            m->lo[k] = p[k] < m->lo[k] ? p[k] : m->lo[k];
+            m->hi[k] = p[k] > m->hi[k] ? p[k] : m->hi[k];
+        }
+    }
+    fdt_pred_static_init(&m->sf, m->lo, m->hi);
 }
 
 /* ------------------------------------------------------------------ */
@@ -451,6 +468,7 @@ static void build_free(build *b)
     free(b->cav);
     free(b->bnd);
     free(b->outl);
+    free(b->newt);
     free(b->edges.eh);
 }
 
@@ -466,6 +484,7 @@ int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
     m->free_head = FDT_NONE;
     if (n < 4)
         return FDT_EDEGENERATE;
+    ins_bounds(m);
     build b;
     memset(&b, 0, sizeof b);
     b.m = m;
@@ -811,7 +830,16 @@ int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
     uint32_t t = *hint;
     if (t >= m->nslots || (T[8 * (size_t)t] == INF && T[8 * (size_t)t + 1] == INF))
         t = m->vtet[0];
-    int err = walk(m, q, t, &qs->rng, cnt, NULL, &t);
+    /* q is not one of the mesh's points: the semi-static bounds of the box
+     * that holds both. */
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; k++) {
+        lo[k] = q[k] < m->lo[k] ? q[k] : m->lo[k];
+        hi[k] = q[k] > m->hi[k] ? q[k] : m->hi[k];
+    }
+    fdt_pred_static sf;
+    fdt_pred_static_init(&sf, lo, hi);
+    int err = walk(m, q, t, &qs->rng, &sf, cnt, NULL, &t);
     if (err)
         return err;
     *hint = t;
@@ -836,7 +864,7 @@ int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
              * not keeping a second set. */
             if (qset_has(qs->tset, qs->tcap, o))
                 continue;
-            int cf = ins_conflict(m, o, q, cnt);
+            int cf = ins_conflict(m, o, q, &sf, cnt);
             if (cf < 0)
                 return cf;
             if (cf && (rc = qset_add(&qs->tq, &qs->tset, &qs->ntq, &qs->tcap, o)) < 0)

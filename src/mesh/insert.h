@@ -66,6 +66,8 @@ typedef struct fdt_ins {
     uint32_t cap;         /* slots allocated */
     uint32_t free_head;   /* first freed slot, FDT_NONE if none */
     uint32_t *vtet;       /* owned: n entries, a live tet holding id base + i */
+    double lo[3], hi[3];  /* the points' bounding box */
+    fdt_pred_static sf;   /* its semi-static filter bounds (src/geom/predicates.h) */
     size_t nfinite;       /* finite tets */
     size_t ninfinite;     /* infinite tets = hull faces */
     fdt_ins_stats stats;

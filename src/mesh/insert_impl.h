@@ -29,21 +29,30 @@ static inline const double *ins_pt(const fdt_ins *m, uint32_t v)
     return m->P + 3 * (size_t)v;
 }
 
-/* The filters inline, the exact stages (and the rescaled filters) out of
- * line: most calls end in the filter. */
+/* The semi-static and the dynamic filters inline, the exact stages (and
+ * the rescaled filters) out of line: most calls end in the first stage.
+ * sf: the semi-static bounds of a box that holds every point the test
+ * reads (fdt_ins.sf for the mesh's own points). */
 static inline int ins_orient(const double *a, const double *b, const double *c, const double *d,
-                             fdt_pred_counts *cnt)
+                             const fdt_pred_static *sf, fdt_pred_counts *cnt)
 {
-    int s = fdt_orient3d_filter(a, b, c, d);
+    int s = fdt_orient3d_static(a, b, c, d, sf);
+    if (s != FDT_PRED_UNSURE)
+        return s;
+    s = fdt_orient3d_filter(a, b, c, d);
     if (s != FDT_PRED_UNSURE)
         return s;
     return fdt_orient3d(a, b, c, d, cnt);
 }
 
 static inline int ins_insphere(const double *a, const double *b, const double *c,
-                               const double *d, const double *e, fdt_pred_counts *cnt)
+                               const double *d, const double *e, const fdt_pred_static *sf,
+                               fdt_pred_counts *cnt)
 {
-    int s = fdt_insphere_filter(a, b, c, d, e);
+    int s = fdt_insphere_static(a, b, c, d, e, sf);
+    if (s != FDT_PRED_UNSURE)
+        return s;
+    s = fdt_insphere_filter(a, b, c, d, e);
     if (s != FDT_PRED_UNSURE)
         return s;
     if (cnt)
@@ -91,7 +100,7 @@ static inline int ins_grow_tets(fdt_ins *m, uint64_t need, uint64_t *nc_out)
  * strictly on its far side, or -1 when p is in the closed tet.
  */
 static inline int ins_walk_exit(const fdt_ins *m, const uint32_t *v, const double *p, int from,
-                                uint64_t *rng, fdt_pred_counts *cnt)
+                                uint64_t *rng, const fdt_pred_static *sf, fdt_pred_counts *cnt)
 {
     const double *q[4] = {ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3])};
     *rng = *rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
@@ -102,7 +111,7 @@ static inline int ins_walk_exit(const fdt_ins *m, const uint32_t *v, const doubl
             continue;
         const double *s[4] = {q[0], q[1], q[2], q[3]};
         s[k] = p;
-        if (ins_orient(s[0], s[1], s[2], s[3], cnt) < 0)
+        if (ins_orient(s[0], s[1], s[2], s[3], sf, cnt) < 0)
             return k;
     }
     return -1;
@@ -125,10 +134,10 @@ static inline int ins_is_vertex(const fdt_ins *m, const uint32_t *v, const doubl
 
 /* Conflict of p with the finite tet v: strictly inside its circumsphere. */
 static inline int ins_conflict_finite(const fdt_ins *m, const uint32_t *v, const double *p,
-                                      fdt_pred_counts *cnt)
+                                      const fdt_pred_static *sf, fdt_pred_counts *cnt)
 {
     return ins_insphere(ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3]), p,
-                        cnt) > 0;
+                        sf, cnt) > 0;
 }
 
 /* The return of ins_conflict_local when only the finite tet under the hull
@@ -144,15 +153,16 @@ static inline int ins_conflict_finite(const fdt_ins *m, const uint32_t *v, const
  * v[4 + *inf] >> 2, decides (ins_conflict_finite).
  */
 static inline int ins_conflict_local(const fdt_ins *m, const uint32_t *v, const double *p,
-                                     fdt_pred_counts *cnt, int *inf_out)
+                                     const fdt_pred_static *sf, fdt_pred_counts *cnt,
+                                     int *inf_out)
 {
     int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
     if (inf < 0)
-        return ins_conflict_finite(m, v, p, cnt);
+        return ins_conflict_finite(m, v, p, sf, cnt);
     const double *q[4];
     for (int i = 0; i < 4; i++)
         q[i] = i == inf ? p : ins_pt(m, v[i]);
-    int o = ins_orient(q[0], q[1], q[2], q[3], cnt);
+    int o = ins_orient(q[0], q[1], q[2], q[3], sf, cnt);
     if (o != 0)
         return o > 0;
     *inf_out = inf;
@@ -173,24 +183,24 @@ static inline int ins_is_infinite(const uint32_t *v)
  * FDT_EINTERNAL then.
  */
 static inline int ins_conflict_under(const fdt_ins *m, const uint32_t *u, const double *p,
-                                     fdt_pred_counts *cnt)
+                                     const fdt_pred_static *sf, fdt_pred_counts *cnt)
 {
     if (ins_is_infinite(u))
         return FDT_EINTERNAL;
-    return ins_conflict_finite(m, u, p, cnt);
+    return ins_conflict_finite(m, u, p, sf, cnt);
 }
 
 /* Whether tet t is in conflict with p, in a mesh nobody else changes
  * meanwhile (the serial build, and queries of a built mesh): 1, 0, or
  * FDT_EINTERNAL (ins_conflict_under). */
 static inline int ins_conflict(const fdt_ins *m, uint32_t t, const double *p,
-                               fdt_pred_counts *cnt)
+                               const fdt_pred_static *sf, fdt_pred_counts *cnt)
 {
     const uint32_t *v = m->T + 8 * (size_t)t;
-    int inf = -1, c = ins_conflict_local(m, v, p, cnt, &inf);
+    int inf = -1, c = ins_conflict_local(m, v, p, sf, cnt, &inf);
     if (c != INS_CONFLICT_UNDER)
         return c;
-    return ins_conflict_under(m, m->T + 8 * (size_t)(v[4 + inf] >> 2), p, cnt);
+    return ins_conflict_under(m, m->T + 8 * (size_t)(v[4 + inf] >> 2), p, sf, cnt);
 }
 
 /*
@@ -226,7 +236,7 @@ static inline int ins_star_ok(const fdt_ins *m, const uint32_t *bnd, size_t nbnd
             inf |= i != k && cv[i] == INF;
             q[i] = i == k ? p : cv[i] == INF ? p : ins_pt(m, cv[i]);
         }
-        if (!inf && ins_orient(q[0], q[1], q[2], q[3], cnt) <= 0)
+        if (!inf && ins_orient(q[0], q[1], q[2], q[3], &m->sf, cnt) <= 0)
             return 0;
     }
     return 1;
@@ -265,15 +275,6 @@ static inline void ins_count_cavity(fdt_ins_stats *st, size_t ncav, size_t nnew)
         st->max_cavity = ncav;
 }
 
-/* For a face opposite vertex k, the edge of that face opposite its vertex
- * i (i != k) has the vertices at the two other indices. */
-static const uint8_t ins_other2[4][4][2] = {
-    {{0, 0}, {2, 3}, {1, 3}, {1, 2}},
-    {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
-    {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
-    {{1, 2}, {0, 2}, {0, 1}, {0, 0}},
-};
-
 static inline int ins_grow_u32(uint32_t **a, size_t *cap, size_t need)
 {
     if (need <= *cap)
@@ -289,11 +290,23 @@ static inline int ins_grow_u32(uint32_t **a, size_t *cap, size_t need)
     return FDT_OK;
 }
 
-/* The new tets' edges of one insertion: the two new faces through an edge
- * of the cavity's boundary (besides the new point) are neighbours. */
+/*
+ * The directed edges of a star's outer surface, which link its tets.
+ * Every tet of a star has the centre (the new point, or the infinite
+ * vertex around the first tetrahedron) and is positively oriented, so the
+ * faces opposite c, each in its tet's outward order (fdt_tet_face), form
+ * a consistently oriented closed surface: each of its edges is walked once
+ * in each direction, by the two faces through it. The face of tet s
+ * through the centre and the directed edge xy is the one opposite s's third outer
+ * vertex; its neighbour is the face through the centre and yx. So one pass puts
+ * every directed edge in the table and a second looks up each edge's
+ * reverse: no branch on which of two faces comes first, no ordering of the
+ * two ids (bench/NOTES.md entry 91: the one-pass table that did both cost
+ * two mispredicted branches a face).
+ */
 typedef struct ins_edge_slot {
-    uint64_t key;     /* the two vertex ids, smaller first */
-    uint32_t val;     /* packed face (new tet, index) waiting for its twin */
+    uint64_t key;     /* the directed edge: tail id << 32 | head id */
+    uint32_t val;     /* packed face (tet, index) through it and the centre */
     uint32_t stamp;   /* valid when equal to the table's current stamp */
 } ins_edge_slot;
 
@@ -326,33 +339,67 @@ static inline int ins_edges_begin(ins_edges *e, size_t edges)
     return FDT_OK;
 }
 
-/*
- * Face `f` (packed) of a new tet contains the edge xy besides the new
- * point: the other new tet through xy is its neighbour there. The first of
- * the two to arrive waits in the table, the second links both. Returns 1
- * when it linked.
- */
-static inline int ins_link_edge(ins_edges *e, uint32_t *T, uint32_t x, uint32_t y, uint32_t f)
+static inline uint32_t ins_edge_hash(const ins_edges *e, uint64_t key)
 {
-    uint64_t key = x < y ? ((uint64_t)x << 32) | y : ((uint64_t)y << 32) | x;
-    uint32_t mask = (UINT32_C(1) << e->bits) - 1;
-    uint32_t h = (uint32_t)((key * UINT64_C(0x9E3779B97F4A7C15)) >> (64 - e->bits));
-    for (;; h = (h + 1) & mask) {
-        ins_edge_slot *s = &e->eh[h];
-        if (s->stamp != e->stamp) {
-            s->stamp = e->stamp;
-            s->key = key;
-            s->val = f;
-            return 0;
-        }
-        if (s->key == key) {
-            uint32_t g = s->val;
-            T[8 * (size_t)(g >> 2) + 4 + (g & 3)] = f;
-            T[8 * (size_t)(f >> 2) + 4 + (f & 3)] = g;
-            s->key = UINT64_MAX; /* each edge is shared by exactly two faces */
-            return 1;
+    return (uint32_t)((key * UINT64_C(0x9E3779B97F4A7C15)) >> (64 - e->bits));
+}
+
+/* For a star tet with its centre at index k, the faces through the
+ * centre: j = 0, 1, 2 gives {tail, head, face}, the directed outer edge
+ * (tail -> head, in the outward order fdt_tet_face[k] of the face opposite
+ * the centre) and the index of the face through the centre and that edge
+ * (the outer face's third vertex). tests/test_insert.c derives it from
+ * fdt_tet_face. */
+static const uint8_t ins_star_edge[4][3][3] = {
+    {{2, 3, 1}, {3, 1, 2}, {1, 2, 3}},
+    {{3, 2, 0}, {2, 0, 3}, {0, 3, 2}},
+    {{1, 3, 0}, {3, 0, 1}, {0, 1, 3}},
+    {{2, 1, 0}, {1, 0, 2}, {0, 2, 1}},
+};
+
+/*
+ * Links the tets slots[0 .. n) of a star (see ins_edges), tet i with its
+ * centre at index ks[i] & 3 (the packed boundary faces serve), the table
+ * emptied for 3n keys by ins_edges_begin: every face through the centre
+ * gets its neighbour. FDT_EINTERNAL, with some links written, when the
+ * outer faces are not a closed surface walked once each way (a directed
+ * edge twice, or one whose reverse is missing): a cavity that is no ball,
+ * which a wrong predicate can make (tests/test_plant.sh).
+ */
+static inline int ins_link_star(ins_edges *e, uint32_t *T, const uint32_t *slots,
+                                const uint32_t *ks, size_t n)
+{
+    uint32_t mask = (UINT32_C(1) << e->bits) - 1, stamp = e->stamp;
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t *v = T + 8 * (size_t)slots[i];
+        const uint8_t(*se)[3] = ins_star_edge[ks[i] & 3];
+        for (int j = 0; j < 3; j++) {
+            uint64_t key = ((uint64_t)v[se[j][0]] << 32) | v[se[j][1]];
+            uint32_t h = ins_edge_hash(e, key);
+            while (e->eh[h].stamp == stamp) {
+                if (e->eh[h].key == key)
+                    return FDT_EINTERNAL;
+                h = (h + 1) & mask;
+            }
+            e->eh[h] = (ins_edge_slot){key, PACK(slots[i], se[j][2]), stamp};
         }
     }
+    for (size_t i = 0; i < n; i++) {
+        uint32_t *v = T + 8 * (size_t)slots[i];
+        const uint8_t(*se)[3] = ins_star_edge[ks[i] & 3];
+        for (int j = 0; j < 3; j++) {
+            uint64_t key = ((uint64_t)v[se[j][1]] << 32) | v[se[j][0]];
+            uint32_t h = ins_edge_hash(e, key);
+            for (;; h = (h + 1) & mask) {
+                if (e->eh[h].stamp != stamp)
+                    return FDT_EINTERNAL;
+                if (e->eh[h].key == key)
+                    break;
+            }
+            v[4 + se[j][2]] = e->eh[h].val;
+        }
+    }
+    return FDT_OK;
 }
 
 /*
@@ -360,12 +407,10 @@ static inline int ins_link_edge(ins_edges *e, uint32_t *T, uint32_t x, uint32_t 
  * bnd (packed: cavity tet c, face opposite its vertex k) with pid in place
  * of vertex k, on the same side of the face as c's vertex k was (the
  * cavity is star-shaped), so positively oriented. It takes over c's
- * neighbour across the face and links its three other faces through the
- * edge table (ins_link_edge). c must still be readable (its slot is freed
- * after the star is built). Returns the number of faces it linked.
+ * neighbour across the face; ins_link_star links its three other faces.
+ * c must still be readable (its slot is freed after the star is built).
  */
-static inline size_t ins_star_tet(uint32_t *T, ins_edges *e, uint32_t bnd, uint32_t pid,
-                                  uint32_t s)
+static inline void ins_star_tet(uint32_t *T, uint32_t bnd, uint32_t pid, uint32_t s)
 {
     uint32_t c = bnd >> 2;
     int k = (int)(bnd & 3);
@@ -376,14 +421,6 @@ static inline size_t ins_star_tet(uint32_t *T, ins_edges *e, uint32_t bnd, uint3
     uint32_t o = cv[4 + k];
     nw[4 + k] = o;
     T[8 * (size_t)(o >> 2) + 4 + (o & 3)] = PACK(s, k);
-    size_t linked = 0;
-    for (int j = 0; j < 4; j++) {
-        if (j == k)
-            continue;
-        linked += (size_t)ins_link_edge(e, T, nw[ins_other2[k][j][0]], nw[ins_other2[k][j][1]],
-                                        PACK(s, j));
-    }
-    return linked;
 }
 
 /*

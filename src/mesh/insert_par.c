@@ -390,7 +390,7 @@ static int walk_locked(worker *w, const double *p, uint32_t start, uint32_t *out
         const uint32_t *v = T + 8 * (size_t)t;
         if (ins_is_infinite(v))
             break;
-        int exit = ins_walk_exit(m, v, p, from, &w->rng, &w->cnt);
+        int exit = ins_walk_exit(m, v, p, from, &w->rng, &m->sf, &w->cnt);
         if (exit < 0)
             break;
         uint32_t nb = v[4 + exit];
@@ -456,7 +456,7 @@ static inline int conflict(worker *w, uint32_t t, const double *p)
     const fdt_ins *m = w->sh->m;
     const uint32_t *v = m->T + 8 * (size_t)t;
     w->st.conflict_tests++;
-    int inf = -1, c = ins_conflict_local(m, v, p, &w->cnt, &inf);
+    int inf = -1, c = ins_conflict_local(m, v, p, &m->sf, &w->cnt, &inf);
     if (c != INS_CONFLICT_UNDER)
         return c;
     uint32_t u = v[4 + inf] >> 2;
@@ -471,7 +471,7 @@ static inline int conflict(worker *w, uint32_t t, const double *p)
         }
         w->under[w->nunder++] = u;
     }
-    return ins_conflict_under(m, m->T + 8 * (size_t)u, p, &w->cnt);
+    return ins_conflict_under(m, m->T + 8 * (size_t)u, p, &m->sf, &w->cnt);
 }
 
 /*
@@ -563,19 +563,16 @@ static int insert_point(worker *w, uint32_t pid)
     }
     if ((err = reserve(w, w->nbnd)) != FDT_OK ||
         (err = ins_grow_u32(&w->newt, &w->newcap, w->nbnd)) != FDT_OK ||
-        (err = ins_edges_begin(&w->edges, 3 * w->nbnd / 2)) != FDT_OK)
+        (err = ins_edges_begin(&w->edges, 3 * w->nbnd)) != FDT_OK)
         goto abort;
 
-    /* The new tets (ins_star_tet), as in src/mesh/insert.c. */
+    /* The new tets (ins_star_tet, ins_link_star), as in src/mesh/insert.c. */
     uint32_t *T = m->T;
-    size_t linked = 0;
-    uint32_t s = FDT_NONE;
     for (size_t i = 0; i < w->nbnd; i++) {
-        s = alloc_slot(w);
-        w->newt[i] = s;
-        linked += ins_star_tet(T, &w->edges, w->bnd[i], pid, s);
+        w->newt[i] = alloc_slot(w);
+        ins_star_tet(T, w->bnd[i], pid, w->newt[i]);
     }
-    if (2 * linked != 3 * w->nbnd)
+    if (ins_link_star(&w->edges, T, w->newt, w->bnd, w->nbnd) != FDT_OK)
         return FDT_EINTERNAL; /* the build fails: what stays locked does not matter */
     for (size_t i = 0; i < w->ncav; i++)
         free_slot(w, w->cav[i]);
@@ -586,6 +583,7 @@ static int insert_point(worker *w, uint32_t pid)
     unlock_under(w);
     unlock_list(sh, w->outl, w->nout);
     unlock_list(sh, w->newt, w->nbnd);
+    uint32_t s = w->newt[w->nbnd - 1];
     w->last = s;
     w->recent[w->nrecent++ % RECENT] = s;
     /* Relaxed: a hint only, validated by locking (see locate). */
