@@ -96,16 +96,17 @@ typedef enum fdt_mode {
  * perturbed Delaunay tetrahedralization is unique); they differ in cost.
  */
 typedef enum fdt_search {
-    FDT_SEARCH_AUTO = 0,  /* serial in memory: the one-part engine, the
-                             certified insertion mesh of every point is the
-                             answer (no front); streamed or with threads:
-                             the kd search (§2.2, §4), switching to an
-                             insertion mesh where searches get expensive
-                             (scans, CFD grids, cospherical sets): serial,
-                             the mesh of the points; with threads, in any
-                             mode, one mesh of every point that all parts
-                             read. Every mesh is certified first
-                             (FDT_ECHECK when it fails) */
+    FDT_SEARCH_AUTO = 0,  /* in memory, serial or with FDT_MODE_AUTO: the
+                             one-part engine, the certified insertion mesh
+                             of every point (built on the run's threads) is
+                             the answer (no front); streamed, or with an
+                             explicit parallel mode: the kd search (§2.2,
+                             §4), switching to an insertion mesh where
+                             searches get expensive (scans, CFD grids,
+                             cospherical sets): serial, the mesh of the
+                             points; with threads, one mesh of every point
+                             that all parts read. Every mesh is certified
+                             first (FDT_ECHECK when it fails) */
     FDT_SEARCH_KD = 1,    /* the kd search only */
     FDT_SEARCH_MESH = 2   /* each part's insertion mesh from the start */
 } fdt_search;
@@ -122,7 +123,10 @@ typedef struct fdt_settings {
                                 set by fdt_default_settings (ABI, above) */
     fdt_mode mode;
     int n_threads;           /* 0: one per physical core (hwloc) */
-    int pin;                 /* nonzero: bind thread i to core i */
+    int pin;                 /* nonzero: bind thread i to core i (the
+                                parts' threads: a threaded run with it
+                                runs the parts, never the one-part
+                                engine) */
     int leaf_size;           /* kd-tree points per leaf, default 30 (the paper's 18, §4, tuned again) */
     int neighbors;           /* nonzero: compute tet neighbours */
     fdt_progress_fn progress;/* may be NULL */

@@ -537,29 +537,29 @@ int main(int argc, char **argv)
     test_family(gen_intsphere(25), -1, quick);
     test_family(gen_layers(25, 3), -1, quick);
     test_family(gen_mixed(600, 5), -1, quick);
-    /* FDT_MODE_AUTO with threads and --search auto: the threads build one
-     * mesh of every point, which every part reads (src/par/parallel.c); an
-     * explicit shared or message mode does the same, --search kd keeps
-     * the queries. Same hashes as the kd search in serial. */
+    /* FDT_MODE_AUTO with threads and --search auto: the one-part engine
+     * (src/api/api.c, one_part), the mesh of every point built on the
+     * threads is the answer, no front, no part, no message; an explicit
+     * shared or message mode runs the parts, which read one mesh of every
+     * point, and --search kd keeps the queries. Same hashes as the kd
+     * search in serial. */
     {
         pts p = gen_cylinder(60, 64);
         fdt_stats st;
         fdt_result *ref = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_KD, &st);
-        fdt_result *r = run(&p, FDT_MODE_AUTO, 2, FDT_SEARCH_AUTO, &st);
-        /* two parts reading one mesh of every point: no part asks another */
-        CHECK_EQ(st.mode, FDT_MODE_SHARED);
-        CHECK_EQ(st.mesh_parts, 2);
-        CHECK_EQ(st.remote_queries, 0);
-        CHECK(st.mesh_faces > 0);
-        CHECK_EQ(hash_of(r), hash_of(ref));
-        fdt_result_free(&r);
-        for (int t = 3; t <= 7; t += 2) {
-            r = run(&p, FDT_MODE_AUTO, t, FDT_SEARCH_AUTO, &st);
+        for (int t = 2; t <= 7; t++) {
+            fdt_result *r = run(&p, FDT_MODE_AUTO, t, FDT_SEARCH_AUTO, &st);
             CHECK_EQ(st.mode, FDT_MODE_SHARED);
+            CHECK_EQ(st.threads, t);
+            CHECK_EQ(st.mesh_parts, 1);
+            CHECK_EQ(st.faces_advanced, 0);
+            CHECK_EQ(st.final_tets, st.tets);
+            CHECK_EQ(st.certified_tets, st.tets);
             CHECK_EQ(st.remote_queries, 0);
             CHECK_EQ(hash_of(r), hash_of(ref));
             fdt_result_free(&r);
         }
+        fdt_result *r;
         /* an explicit shared mode reads the same mesh of every point
          * (src/api/api.c): the search is --search auto's choice, not the
          * mode's; message mode reads it as a replica (an MPI rank's own
@@ -587,9 +587,10 @@ int main(int argc, char **argv)
         p = gen_uniform(20000, 13);
         r = run(&p, FDT_MODE_AUTO, 2, FDT_SEARCH_AUTO, &st);
         CHECK_EQ(st.mode, FDT_MODE_SHARED);
+        CHECK_EQ(st.final_tets, st.tets);
         fdt_result_free(&r);
         free(p.xyz);
-        printf("ok auto mode: the mesh of every point\n");
+        printf("ok auto mode: the one-part engine on threads; explicit modes: the parts\n");
     }
     /* Uniform points must never pay for a mesh in the front (a streamed
      * serial run; in memory the serial run is the one-part engine). */

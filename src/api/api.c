@@ -156,7 +156,8 @@ typedef struct run_state {
     fdt_tsink sink;
     fdt_emit em;              /* serial: the front's emitter */
     fdt_front_stats fst;
-    fdt_partmesh_stats pms;   /* serial: the one-part engine's counters */
+    fdt_partmesh_stats pms;   /* the one-part engine's counters */
+    int parts;                /* nonzero: the parts' engine ran (src/par) */
     size_t mem_tree, mem_mesh, mem_sink;
 } run_state;
 
@@ -198,11 +199,12 @@ static int run_prepare(fdt_context *ctx, const double *xyz, size_t n, fdt_mode m
 static int run_parallel(fdt_context *ctx, fdt_mode mode, int nthreads, const fdt_sink *user,
                         run_state *rs, double *t1)
 {
-    /* --search auto builds the DT of every point on the run's threads
-     * and every part reads its apexes from it; --search mesh runs the
-     * wall engine (each part's own mesh); --search kd the paper's fronts.
-     * Either way the parts, their fronts and their messages stay
-     * (src/par/parallel.c, bench/NOTES.md entry 90). */
+    /* With an explicit mode or a stream: --search auto lets the probe
+     * choose between the DT of every point, which every part reads its
+     * apexes from, and the kd search; --search mesh runs the wall engine
+     * (each part's own mesh); --search kd the paper's fronts. Either way
+     * the parts, their fronts and their messages stay (src/par/
+     * parallel.c, bench/NOTES.md entry 90). */
     fdt_par_opts popt;
     memset(&popt, 0, sizeof popt);
     if (user)
@@ -215,13 +217,34 @@ static int run_parallel(fdt_context *ctx, fdt_mode mode, int nthreads, const fdt
     rs->mb = rs->par.mb;
     memset(&rs->par.mb, 0, sizeof rs->par.mb);
     rs->fst = rs->par.fst;
+    rs->parts = 1;
     *t1 = tp + rs->par.t_setup;
     return FDT_OK;
 }
 
-/* The serial engine: one kd-tree, then the one-part engine or the front;
- * *t1: when the preparation ended. */
-static int run_serial(fdt_context *ctx, const fdt_sink *user, run_state *rs, double *t1)
+/*
+ * Which engine a run takes (issue 31), a function of the settings alone:
+ * in memory, with --search auto or mesh on one thread, and with --search
+ * auto and the default mode on several, the one-part engine (the
+ * insertion mesh of every point, built on the run's threads and
+ * certified, is the answer: no front re-derives it, bench/NOTES.md entry
+ * 91); --search kd, a stream (whose memory must stay bounded), an explicit
+ * --mode shared or message, --pin (which binds the parts' threads) and
+ * --search mesh on several threads run the fronts: serial, or the parts'
+ * engine (src/par/parallel.c).
+ */
+static int one_part(const fdt_context *ctx, fdt_mode mode, const fdt_sink *user)
+{
+    if (user || ctx->s.search == FDT_SEARCH_KD)
+        return 0;
+    return mode == FDT_MODE_SERIAL ||
+           (ctx->s.mode == FDT_MODE_AUTO && ctx->s.search == FDT_SEARCH_AUTO && !ctx->s.pin);
+}
+
+/* One kd-tree, then the one-part engine on nthreads threads or (nthreads
+ * 1) the serial front; *t1: when the preparation ended. */
+static int run_single(fdt_context *ctx, const fdt_sink *user, int one, int nthreads,
+                      run_state *rs, double *t1)
 {
     fdt_prepared *pr = &rs->pr;
     if (fdt_kd_build(&rs->tree, pr->p, pr->orig, 0, (uint32_t)pr->m, ctx->s.leaf_size) != FDT_OK)
@@ -233,18 +256,14 @@ static int run_serial(fdt_context *ctx, const fdt_sink *user, run_state *rs, dou
     if (fdt_emit_init(&rs->em, &rs->sink, &rs->mb) != FDT_OK)
         return FDT_ENOMEM;
     *t1 = fdt_now_s();
-    /* The path is a function of the settings alone (issue 31): in
-     * memory, --search auto and mesh run the one-part engine (the
-     * insertion mesh, certified, is the answer); --search kd, and a
-     * streamed run, whose memory must stay bounded, run the paper's
-     * front. */
     int err;
-    if (ctx->s.search != FDT_SEARCH_KD && !user) {
+    if (one) {
         /* the tree only put the points in its (spatially coherent) order,
          * which the insertion's BRIO rounds keep */
         fdt_kd_free(&rs->tree);
-        err = fdt_partmesh_emit_all(pr->p, (uint32_t)pr->m, &rs->em, ctx->s.progress,
-                                    ctx->s.progress_user, &rs->pms, ctx->diag, sizeof ctx->diag);
+        err = fdt_partmesh_emit_all(pr->p, (uint32_t)pr->m, nthreads, &rs->em,
+                                    ctx->s.progress, ctx->s.progress_user, &rs->pms, ctx->diag,
+                                    sizeof ctx->diag);
     } else
         err = fdt_front_emit(&rs->tree, central_point(&rs->tree), (int)ctx->s.search, &rs->em,
                              ctx->s.progress, ctx->s.progress_user, &rs->fst);
@@ -270,13 +289,12 @@ static int run_serial(fdt_context *ctx, const fdt_sink *user, run_state *rs, dou
  * engine's threads did that as they gathered the mesh; a streamed run's
  * tets were renumbered as they left. r takes the buffers and the
  * duplicate map. */
-static void result_take(fdt_result *r, run_state *rs, fdt_mode mode, const fdt_sink *user,
-                        size_t n)
+static void result_take(fdt_result *r, run_state *rs, const fdt_sink *user, size_t n)
 {
     fdt_meshbuf *mb = &rs->mb;
     fdt_vid *tets = (fdt_vid *)mb->tets;
     fdt_vid *hull = (fdt_vid *)mb->hull;
-    if (mode == FDT_MODE_SERIAL && !user) {
+    if (!rs->parts && !user) {
         fdt_sink_renumber(rs->pr.orig, tets, mb->tets, 4 * mb->ntets);
         fdt_sink_renumber(rs->pr.orig, hull, mb->hull, 3 * mb->nhull);
     }
@@ -298,8 +316,8 @@ static void result_take(fdt_result *r, run_state *rs, fdt_mode mode, const fdt_s
 
 /* The run's statistics into r->stats (r->tstats takes the threads'):
  * t0, t1, t2 the start, the end of the preparation and of the front. */
-static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, const fdt_sink *user,
-                         size_t n, double t0, double t1, double t2)
+static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, int nthreads,
+                         const fdt_sink *user, size_t n, double t0, double t1, double t2)
 {
     const fdt_prepared *pr = &rs->pr;
     const fdt_front_stats *fst = &rs->fst;
@@ -327,8 +345,8 @@ static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, const fdt_
     st->exact_insphere += pms->pc.insphere_exact;
     st->adapt_orient += pms->pc.orient_adapt;
     st->adapt_insphere += pms->pc.insphere_adapt;
-    st->threads = 1;
-    st->mode = FDT_MODE_SERIAL;
+    st->threads = nthreads;
+    st->mode = mode;
     /* Memory (include/frontdt.h): the points' three arrays, then each
      * structure at its largest. */
     st->mem_points = pr->m * (3 * sizeof *pr->p + sizeof *pr->orig) + n * sizeof *pr->dupmap;
@@ -340,7 +358,7 @@ static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, const fdt_
     st->t_prepare = t1 - t0;
     st->t_front = t2 - t1;
     st->t_finish = fdt_now_s() - t2;
-    if (mode != FDT_MODE_SERIAL) {
+    if (rs->parts) {
         fdt_parallel_fill_stats(&rs->par, mode, st);
         st->t_front = rs->par.t_front;
         st->t_finish += rs->par.t_gather;
@@ -379,8 +397,11 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
                                         sizeof ctx->diag)) != FDT_OK)
         goto fail;
     double t1;
-    err = mode != FDT_MODE_SERIAL ? run_parallel(ctx, mode, nthreads, user, &rs, &t1)
-                                  : run_serial(ctx, user, &rs, &t1);
+    int one = one_part(ctx, mode, user);
+    if (mode == FDT_MODE_SERIAL)
+        nthreads = 1;
+    err = one || mode == FDT_MODE_SERIAL ? run_single(ctx, user, one, nthreads, &rs, &t1)
+                                         : run_parallel(ctx, mode, nthreads, user, &rs, &t1);
     if (err)
         goto fail;
     double t2 = fdt_now_s();
@@ -388,8 +409,8 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     r = calloc(1, sizeof *r);
     if (!r)
         goto fail;
-    result_take(r, &rs, mode, user, n);
-    result_stats(r, &rs, mode, user, n, t0, t1, t2);
+    result_take(r, &rs, user, n);
+    result_stats(r, &rs, mode, nthreads, user, n, t0, t1, t2);
     fdt_emit_free(&rs.em);
     fdt_tsink_free(&rs.sink);
     fdt_kd_free(&rs.tree);

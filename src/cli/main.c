@@ -128,12 +128,14 @@ static void usage(FILE *f)
         "      --decimal-comma    numbers are written 0,5 (then the delimiter\n"
         "                         is ';' or blanks: blanks unless given)\n"
         "      --mode MODE        serial, shared, message or auto (default)\n"
-        "      --search HOW       how apexes are found: auto (default: serial in\n"
-        "                         memory, the certified insertion mesh is the\n"
-        "                         answer; threads: the mesh of every point where\n"
-        "                         a probe finds the kd search costly, else the kd\n"
-        "                         search), kd, or mesh (threads: each part's own\n"
-        "                         mesh, its inner tets final, fronts at the walls)\n"
+        "      --search HOW       how apexes are found: auto (default: in memory\n"
+        "                         without --mode, the certified insertion mesh\n"
+        "                         built on the threads is the answer; with\n"
+        "                         --mode, the parts read the mesh of every point\n"
+        "                         where a probe finds the kd search costly, else\n"
+        "                         the kd search), kd, or mesh (threads: each\n"
+        "                         part's own mesh, its inner tets final, fronts\n"
+        "                         at the walls)\n"
         "  -t, --threads N        worker threads (0: one per core)\n"
         "      --pin              bind thread i to core i\n"
         "      --check            verify the result exactly (exit 3 if not Delaunay)\n"
@@ -768,6 +770,22 @@ typedef struct timings {
     double read, triangulate, check, canon, write;
 } timings;
 
+/* Which engine ran, read off the counters (src/api/api.c, one_part):
+ * the one-part engine's mesh is the whole answer, with no face advanced. */
+static int ran_one_part(const fdt_stats *st)
+{
+    return st->faces_advanced == 0 && st->final_tets == st->tets;
+}
+
+static const char *engine_name(const fdt_stats *st)
+{
+    if (ran_one_part(st))
+        return "one part: the insertion mesh of every point is the answer";
+    if (st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE)
+        return "parts with fronts and messages";
+    return "the front";
+}
+
 /* Per-thread and per-kind figures of a parallel run (§4-§5): what the
  * bench harness and the issue notes report. */
 static void print_parallel_stats(const fdt_result *res, const fdt_stats *st)
@@ -820,6 +838,7 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  final from mesh   %zu tets (certified %zu in %.3f s)\n"
         "  threads           %d\n"
         "  mode              %s\n"
+        "  engine            %s\n"
         "  time prepare      %.3f s\n"
         "  time front        %.3f s\n"
         "  time finish       %.3f s\n"
@@ -832,9 +851,10 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
         st->max_front, st->mesh_faces, st->mesh_parts, st->t_mesh, st->final_tets,
-        st->certified_tets, st->t_certify, st->threads, mode_name(st->mode), st->t_prepare, st->t_front, st->t_finish,
+        st->certified_tets, st->t_certify, st->threads, mode_name(st->mode),
+        engine_name(st), st->t_prepare, st->t_front, st->t_finish,
         tm->read, tm->triangulate, tm->check, tm->canon, tm->write);
-    if (st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE)
+    if ((st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE) && !ran_one_part(st))
         print_parallel_stats(res, st);
 }
 
@@ -1092,12 +1112,13 @@ static unsigned long long memory_estimate(size_t n, int stream, int threads, int
     double during_merge = pts + own + idx + merge;
     double during_front = pts + own + idx + tree + front + mesh + sinks;
     if (one_part) {
-        /* The one-part engine (serial in memory, --search auto or mesh):
+        /* The one-part engine (src/api/api.c's one_part):
          * the insertion mesh instead of the tree and the front, whose tet
          * array becomes the output's (src/front/partmesh.h); neighbours
          * are written beside it. 1M uniform points: 289 bytes a point
          * measured at the peak. */
-        during_front = pts + own + idx + FDT_PARTMESH_BYTES * (double)n +
+        during_front = pts + own + idx +
+                       FDT_PARTMESH_BYTES * (threads > 1 ? FDT_PARTMESH_PAR : 1.0) * (double)n +
                        (nbrs ? 6.5 * 32.0 * (double)n : 0.0);
     }
     double peak = during_merge > during_front ? during_merge : during_front;
@@ -1285,9 +1306,12 @@ static int run(const cli *c)
     int run_threads = c->mode == FDT_MODE_SERIAL ? 1
                       : c->threads > 0           ? c->threads
                                                  : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    /* The one-part engine: src/api/api.c's rule (one_part). */
+    int one_part = !streaming && c->search != FDT_SEARCH_KD &&
+                   (run_threads == 1 ||
+                    (c->mode == FDT_MODE_AUTO && c->search == FDT_SEARCH_AUTO && !s.pin));
     unsigned long long estimate =
-        memory_estimate(n, streaming, run_threads, s.neighbors,
-                        !streaming && run_threads == 1 && c->search != FDT_SEARCH_KD);
+        memory_estimate(n, streaming, run_threads, s.neighbors, one_part);
     if (c->memory_limit && estimate > c->memory_limit) {
         say("%s: %zu points need about %llu MiB (%s%s), more than --memory-limit %llu MiB",
             name, n, estimate >> 20, streaming ? "streamed" : "in memory",

@@ -153,14 +153,17 @@ size_t fdt_partmesh_final(const fdt_ins *m, const fdt_kdtree *t, uint8_t *final)
     return count;
 }
 
-int fdt_partmesh_emit_all(const double *P, uint32_t m, fdt_emit *em, fdt_progress_fn progress,
-                          void *puser, fdt_partmesh_stats *st, char *diag, size_t dlen)
+int fdt_partmesh_emit_all(const double *P, uint32_t m, int nthreads, fdt_emit *em,
+                          fdt_progress_fn progress, void *puser, fdt_partmesh_stats *st,
+                          char *diag, size_t dlen)
 {
     fdt_ins mesh;
     double t0 = fdt_now_s();
     half_progress hp = {progress, puser};
-    int err = fdt_ins_build_progress(&mesh, P, 0, m, &st->pc, progress ? build_progress : NULL,
-                                     &hp);
+    int err = nthreads > 1
+                  ? fdt_ins_build_parallel(&mesh, P, 0, m, nthreads, &st->pc)
+                  : fdt_ins_build_progress(&mesh, P, 0, m, &st->pc,
+                                           progress ? build_progress : NULL, &hp);
     st->t_mesh = fdt_now_s() - t0;
     if (err == FDT_EDEGENERATE || err == FDT_EINVAL || err == FDT_EINTERNAL) {
         /* The caller merged duplicates and checked the dimension, so each
@@ -177,7 +180,8 @@ int fdt_partmesh_emit_all(const double *P, uint32_t m, fdt_emit *em, fdt_progres
         /* No tet leaves before the whole mesh is proved (certify.h). */
         double t1 = fdt_now_s();
         fdt_certify_fail why;
-        err = fdt_certify(&mesh, &st->pc, &why);
+        err = nthreads > 1 ? fdt_certify_parallel(&mesh, nthreads, &st->pc, &why)
+                           : fdt_certify(&mesh, &st->pc, &why);
         st->t_certify = fdt_now_s() - t1;
         st->certified_tets = mesh.nfinite;
         if (err == FDT_ECHECK)

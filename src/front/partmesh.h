@@ -30,6 +30,10 @@
  * incident-tet table) with the build's scratch; the output tets reuse the
  * mesh's array. The CLI's --memory-limit estimate uses it. */
 #define FDT_PARTMESH_BYTES 235.0
+/* The factor on it when the mesh is built on several threads: their slots
+ * are reserved up front (src/mesh/insert.h), though not all touched; 1M
+ * uniform points at two threads peaked at 1.05 times the serial run. */
+#define FDT_PARTMESH_PAR 1.1
 
 /* What the one-part engine did, for fdt_stats. */
 typedef struct fdt_partmesh_stats {
@@ -56,16 +60,19 @@ size_t fdt_partmesh_final(const fdt_ins *m, const fdt_kdtree *t, uint8_t *final)
 
 /*
  * The whole run as one part: the DT of the points [0, m) of P (tree order,
- * distinct, spanning 3-D: the caller checked), certified, every tet and
- * hull face handed to em, whose meshbuf must be empty (in memory only: the
- * mesh's own array becomes the meshbuf's; neighbours too when it keeps
- * them).
- * progress (may be NULL) is called every 64k points inserted and between
- * the phases with an estimated fraction; nonzero cancels (FDT_ECANCELED).
+ * distinct, spanning 3-D: the caller checked), built and certified on
+ * nthreads threads (above one fdt_ins_build_parallel and
+ * fdt_certify_parallel: the same DT), every tet and hull face handed to
+ * em, whose meshbuf must be empty (in memory only: the mesh's own array
+ * becomes the meshbuf's; neighbours too when it keeps them).
+ * progress (may be NULL) is called between the phases with an estimated
+ * fraction, and on one thread also every 64k points inserted; nonzero
+ * cancels (FDT_ECANCELED).
  * Returns FDT_OK, FDT_ECHECK (the certificate failed: diag says where),
  * FDT_ENOMEM, FDT_ETOOBIG, FDT_EINTERNAL, or the sink's stop code.
  */
-int fdt_partmesh_emit_all(const double *P, uint32_t m, fdt_emit *em, fdt_progress_fn progress,
-                          void *puser, fdt_partmesh_stats *st, char *diag, size_t dlen);
+int fdt_partmesh_emit_all(const double *P, uint32_t m, int nthreads, fdt_emit *em,
+                          fdt_progress_fn progress, void *puser, fdt_partmesh_stats *st,
+                          char *diag, size_t dlen);
 
 #endif

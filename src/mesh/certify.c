@@ -142,26 +142,47 @@ static const char *check_pair(const fdt_ins *m, const uint32_t *v, int k, int in
  * of a neighbour's first vertex, a cache miss). */
 #define AHEAD 8
 
-int fdt_certify_slots(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_counts *cnt,
-                      fdt_certify_fail *why)
+/*
+ * Whether slot t checks its face with slot nt (checks_here of one end and
+ * not the other, for every face): the lower slot when both lie in the
+ * range [lo, hi), which the sweep then reads again soon, still in cache
+ * (the parity rule below for every face cost 25 % more on one thread);
+ * between two ranges of fdt_certify_parallel, the lower slot when their
+ * xor is odd and the higher when it is even: either end is as likely, so
+ * the ranges get equal shares of those faces, which "always the lower
+ * slot" did not (0.87 s against 0.53 s for the two halves of 1M uniform
+ * points).
+ */
+static inline int checks_here(uint32_t t, uint32_t nt, uint32_t lo, uint32_t hi)
 {
-    if (hi > m->nslots)
-        hi = m->nslots;
-    /* Each face is checked once, from its lower slot, which also checks
-     * the higher slot's reference back. The higher slot's own references
-     * are only counted (skipped); every one of them must be the back half
-     * of a pair checked from below: skipped == pairs. A reference with no
-     * way back breaks the equality even when its target is consistent
-     * with someone else. Counted over [lo, hi) only when the range is the
-     * whole mesh; a partial range checks both halves itself. */
-    int whole = lo == 0 && hi == m->nslots;
-    size_t skipped = 0, pairs = 0;
+    if (nt >= lo && nt < hi)
+        return t < nt;
+    return ((t ^ nt) & 1) ? t < nt : t > nt;
+}
+
+/*
+ * Checks 1-3 for the slots [lo, hi) of m. Each face is checked once, from
+ * one of its two slots (checks_here). That end checks the geometry and
+ * the other end's reference back; the other end only counts its reference
+ * (*skipped) and the checking end counts the pair (*pairs). Over the
+ * whole mesh every skipped reference must be the back half of a checked
+ * pair, so the two sums must be equal (the caller compares them): a
+ * reference with no way back breaks the equality even when its target is
+ * consistent with someone else. Each neighbour slot is read once a face,
+ * where the neighbour reads are most of the time.
+ */
+static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_counts *cnt,
+                         fdt_certify_fail *why, size_t *skipped, size_t *pairs)
+{
     for (uint32_t t = lo; t < hi; t++) {
-        if (t + AHEAD < hi) {
-            const uint32_t *a = m->T + 8 * (size_t)(t + AHEAD);
-            for (int k = 0; k < 4; k++)
-                if ((a[4 + k] >> 2) < m->nslots)
-                    __builtin_prefetch(m->T + 8 * (size_t)(a[4 + k] >> 2));
+        if (t + AHEAD < hi) { /* the neighbours this range will read */
+            uint32_t u = t + AHEAD;
+            const uint32_t *a = m->T + 8 * (size_t)u;
+            for (int k = 0; k < 4; k++) {
+                uint32_t nu = a[4 + k] >> 2;
+                if (nu < m->nslots && checks_here(u, nu, lo, hi))
+                    __builtin_prefetch(m->T + 8 * (size_t)nu);
+            }
         }
         const uint32_t *v = m->T + 8 * (size_t)t;
         if (is_freed(v))
@@ -181,8 +202,8 @@ int fdt_certify_slots(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_count
             int nk = (int)(r & 3);
             if (nt >= m->nslots || nt == t)
                 return fail(why, t, k, "a neighbour reference past the slots, or to itself");
-            if (nt < t && whole) {
-                skipped++;
+            if (!checks_here(t, nt, lo, hi)) {
+                (*skipped)++;
                 continue;
             }
             const uint32_t *w = m->T + 8 * (size_t)nt;
@@ -195,17 +216,21 @@ int fdt_certify_slots(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_count
                 return fail(why, t, k, "the neighbours do not share the face");
             if (g < 0)
                 return fail(why, t, k, "two tets on the same side of their face");
-            pairs++;
-            if (nt < t)
-                continue; /* a partial range: its geometry is checked from nt */
+            (*pairs)++;
             const char *bad = check_pair(m, v, k, inf, w, nk, cnt);
             if (bad)
                 return fail(why, t, k, bad);
         }
     }
-    if (whole && skipped != pairs)
-        return fail(why, hi, -1, "a neighbour reference with no way back");
     return FDT_OK;
+}
+
+/* The end of checks 1-3: every reference skipped was a checked pair's. */
+static int certify_balance(const fdt_ins *m, size_t skipped, size_t pairs,
+                           fdt_certify_fail *why)
+{
+    return skipped == pairs ? FDT_OK
+                            : fail(why, m->nslots, -1, "a neighbour reference with no way back");
 }
 
 int fdt_certify_vertices(const fdt_ins *m, fdt_certify_fail *why)
@@ -223,7 +248,10 @@ int fdt_certify_vertices(const fdt_ins *m, fdt_certify_fail *why)
 
 int fdt_certify(const fdt_ins *m, fdt_pred_counts *cnt, fdt_certify_fail *why)
 {
-    int err = fdt_certify_slots(m, 0, m->nslots, cnt, why);
+    size_t skipped = 0, pairs = 0;
+    int err = certify_range(m, 0, m->nslots, cnt, why, &skipped, &pairs);
+    if (!err)
+        err = certify_balance(m, skipped, pairs, why);
     return err ? err : fdt_certify_vertices(m, why);
 }
 
@@ -232,6 +260,7 @@ typedef struct cert_job {
     uint32_t lo, hi;
     fdt_pred_counts pc;
     fdt_certify_fail why;
+    size_t skipped, pairs;
     int rc;
     pthread_t th;
     int started;
@@ -240,7 +269,7 @@ typedef struct cert_job {
 static void *cert_run(void *arg)
 {
     cert_job *j = arg;
-    j->rc = fdt_certify_slots(j->m, j->lo, j->hi, &j->pc, &j->why);
+    j->rc = certify_range(j->m, j->lo, j->hi, &j->pc, &j->why, &j->skipped, &j->pairs);
     return NULL;
 }
 
@@ -266,12 +295,18 @@ int fdt_certify_parallel(const fdt_ins *m, int nthreads, fdt_pred_counts *cnt,
         if (j[i].started)
             pthread_join(j[i].th, NULL);
     /* The joins publish each job's fields to this thread. */
-    for (int i = 0; i < nthreads && !err; i++)
+    size_t skipped = 0, pairs = 0;
+    for (int i = 0; i < nthreads && !err; i++) {
         if (j[i].rc) {
             err = j[i].rc;
             if (why)
                 *why = j[i].why;
         }
+        skipped += j[i].skipped;
+        pairs += j[i].pairs;
+    }
+    if (!err)
+        err = certify_balance(m, skipped, pairs, why);
     if (cnt)
         for (int i = 0; i < nthreads; i++) {
             cnt->orient_exact += j[i].pc.orient_exact;

@@ -52,20 +52,16 @@ typedef struct fdt_certify_fail {
     const char *what;  /* a static string */
 } fdt_certify_fail;
 
-/* Checks 1-3 for the slots [lo, hi) of m (hi clipped to m->nslots).
- * FDT_OK, or FDT_ECHECK with *why filled (why may be NULL). cnt (may be
- * NULL) counts the exact predicate calls. */
-int fdt_certify_slots(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_counts *cnt,
-                      fdt_certify_fail *why);
-
 /* Check 4: each of m's points is a vertex of its vtet slot. */
 int fdt_certify_vertices(const fdt_ins *m, fdt_certify_fail *why);
 
-/* The whole certificate on the calling thread: checks 1-4. */
+/* The whole certificate on the calling thread: checks 1-4. FDT_OK, or
+ * FDT_ECHECK with *why filled (why may be NULL). cnt (may be NULL) counts
+ * the exact predicate calls. */
 int fdt_certify(const fdt_ins *m, fdt_pred_counts *cnt, fdt_certify_fail *why);
 
 /* The same on nthreads threads (the caller's one of them; slot ranges of
- * equal size, each checking both halves of its references): FDT_OK,
+ * equal size, each face checked in the range of one of its slots): FDT_OK,
  * FDT_ECHECK (*why: the failure of the lowest range that failed), or
  * FDT_ETHREAD / FDT_ENOMEM when the helpers could not start. cnt gets the
  * sum of the threads' counts. */
