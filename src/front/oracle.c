@@ -121,7 +121,8 @@ static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
     if (err == FDT_OK || err == FDT_EINTERNAL) {
         /* No answer is read before the mesh is proved (issue 31 item 6);
          * an insertion whose own checks broke is a wrong mesh too. */
-        fdt_certify_fail why = {0, -1, "the insertion's own consistency checks failed"};
+        fdt_certify_fail why;
+        fdt_certify_build_failed(&why);
         double tc = fdt_now_s();
         if (err == FDT_OK)
             err = fdt_certify(&o->mesh, &kq->pc, &why);

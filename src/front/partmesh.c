@@ -165,13 +165,12 @@ int fdt_partmesh_emit_all(const double *P, uint32_t m, int nthreads, fdt_emit *e
                   : fdt_ins_build_progress(&mesh, P, 0, m, &st->pc,
                                            progress ? build_progress : NULL, &hp);
     st->t_mesh = fdt_now_s() - t0;
+    fdt_certify_fail why;
     if (err == FDT_EDEGENERATE || err == FDT_EINVAL || err == FDT_EINTERNAL) {
         /* The caller merged duplicates and checked the dimension, so each
-         * is the insertion's own check of its mesh failing (a walk that
-         * cycles, a cavity that is not a ball): the mesh is wrong, which
-         * the certificate reports too. */
-        snprintf(diag, dlen, "mesh certificate failed: the insertion's own consistency "
-                             "checks failed (%s)", fdt_strerror(err));
+         * is the insertion's own check of its mesh failing. */
+        fdt_certify_build_failed(&why);
+        fdt_certify_describe(&why, diag, dlen);
         err = FDT_ECHECK;
     }
     if (!err)
@@ -179,7 +178,6 @@ int fdt_partmesh_emit_all(const double *P, uint32_t m, int nthreads, fdt_emit *e
     if (!err) {
         /* No tet leaves before the whole mesh is proved (certify.h). */
         double t1 = fdt_now_s();
-        fdt_certify_fail why;
         err = nthreads > 1 ? fdt_certify_parallel(&mesh, nthreads, &st->pc, &why)
                            : fdt_certify(&mesh, &st->pc, &why);
         st->t_certify = fdt_now_s() - t1;

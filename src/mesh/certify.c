@@ -318,9 +318,18 @@ int fdt_certify_parallel(const fdt_ins *m, int nthreads, fdt_pred_counts *cnt,
     return err ? err : fdt_certify_vertices(m, why);
 }
 
+void fdt_certify_build_failed(fdt_certify_fail *why)
+{
+    why->slot = FDT_NONE;
+    why->face = -1;
+    why->what = "the insertion's own consistency checks failed";
+}
+
 void fdt_certify_describe(const fdt_certify_fail *why, char *buf, size_t len)
 {
-    if (why->face >= 0)
+    if (why->slot == FDT_NONE)
+        snprintf(buf, len, "mesh certificate failed: %s", why->what);
+    else if (why->face >= 0)
         snprintf(buf, len, "mesh certificate failed: tet slot %u face %d: %s", why->slot,
                  why->face, why->what);
     else

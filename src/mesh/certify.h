@@ -68,7 +68,14 @@ int fdt_certify(const fdt_ins *m, fdt_pred_counts *cnt, fdt_certify_fail *why);
 int fdt_certify_parallel(const fdt_ins *m, int nthreads, fdt_pred_counts *cnt,
                          fdt_certify_fail *why);
 
-/* "mesh certificate failed: tet slot S face F: WHAT" into buf. */
+/* "mesh certificate failed: tet slot S face F: WHAT" into buf (without
+ * the slot when it is FDT_NONE). */
 void fdt_certify_describe(const fdt_certify_fail *why, char *buf, size_t len);
+
+/* A failure with no slot: a build's own checks of its mesh failed (a walk
+ * that cycles, a cavity that is not a ball: FDT_EINTERNAL from
+ * src/mesh/insert.h's builds), so the mesh is wrong, and a run reports
+ * it as the certificate's failure (FDT_ECHECK). */
+void fdt_certify_build_failed(fdt_certify_fail *why);
 
 #endif

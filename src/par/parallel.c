@@ -307,10 +307,9 @@ static int global_mesh(engine *e, fdt_prepared *pr, const fdt_settings *s,
     if (gerr == FDT_ENOMEM || gerr == FDT_EDEGENERATE)
         return FDT_OK;
     if (gerr == FDT_EINTERNAL) {
-        /* the insertion's own checks of its mesh broke: a wrong
-         * mesh, as the certificate would say (src/front/partmesh.c) */
-        snprintf(diag, dlen, "mesh certificate failed: the parallel insertion's own "
-                             "consistency checks failed");
+        fdt_certify_fail why;
+        fdt_certify_build_failed(&why);
+        fdt_certify_describe(&why, diag, dlen);
         return FDT_ECHECK;
     }
     return gerr;
