@@ -816,6 +816,15 @@ run pin_quiet env HWLOC_SYNTHETIC="core:2 pu:1(indexes=1000,1001)" HWLOC_THISSYS
     "$FRONTDT" pts.xyz -t 2 --pin --quiet
 expect_rc pin_quiet 0
 [ -s pin_quiet.err ] && fail "pin --quiet still said: $(cat pin_quiet.err)"
+# Which engine ran, in --stats (src/api/api.c, one_part): threads in the
+# default mode build the mesh of every point and it is the answer; an
+# explicit mode runs the parts. The same mesh either way.
+run eng_one "$FRONTDT" pts.xyz -t 2 --stats -o out/eng1.tets
+expect_rc eng_one 0 && expect_in eng_one err "engine            one part"
+run eng_parts "$FRONTDT" pts.xyz -t 2 --mode shared --stats -o out/eng2.tets
+expect_rc eng_parts 0 && expect_in eng_parts err "engine            parts with fronts"
+cmp -s out/eng1.tets out/a.tets || fail "eng_one: another mesh"
+cmp -s out/eng2.tets out/a.tets || fail "eng_parts: another mesh"
 run dup_vtu "$FRONTDT" dup.xyz -o out/dup.ele
 expect_rc dup_vtu 0
 [ "$(head -n1 out/dup.node)" = "304 3 0 0" ] || fail "dup .node must hold all 304 input points"
