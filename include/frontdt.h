@@ -380,7 +380,8 @@ typedef struct fdt_stats {
      * a shorter size and gets the fields above. */
     size_t final_tets;        /* tets that went to the sink straight from a
                                  part's certified insertion mesh, with no
-                                 front (serial, --search auto or mesh) */
+                                 front (the one-part engine: all of them;
+                                 the wall engine: those inside a part) */
     size_t certified_tets;    /* finite tets the mesh certificates checked
                                  before any was trusted */
     double t_certify;         /* seconds certifying meshes */

@@ -247,9 +247,17 @@ static int run_single(fdt_context *ctx, const fdt_sink *user, int one, int nthre
                       run_state *rs, double *t1)
 {
     fdt_prepared *pr = &rs->pr;
-    if (fdt_kd_build(&rs->tree, pr->p, pr->orig, 0, (uint32_t)pr->m, ctx->s.leaf_size) != FDT_OK)
-        return FDT_ENOMEM;
-    rs->mem_tree = fdt_kd_bytes(&rs->tree);
+    if (one && nthreads > 1) {
+        /* the parts' trees, built on the threads, only order the points */
+        int err = fdt_parallel_order(pr, &ctx->s, nthreads, &rs->mem_tree);
+        if (err)
+            return err;
+    } else {
+        if (fdt_kd_build(&rs->tree, pr->p, pr->orig, 0, (uint32_t)pr->m, ctx->s.leaf_size) !=
+            FDT_OK)
+            return FDT_ENOMEM;
+        rs->mem_tree = fdt_kd_bytes(&rs->tree);
+    }
     if (!user &&
         fdt_meshbuf_init(&rs->mb, (size_t)(6.9 * (double)pr->m) + 64, ctx->s.neighbors) != FDT_OK)
         return FDT_ENOMEM;

@@ -6,14 +6,15 @@
  * (src/mesh/insert.c), proves the result is their perturbed Delaunay
  * tetrahedralization (src/mesh/certify.h), and emits its tets at once:
  * a tet is final when no point outside the part can lie in or on its
- * circumsphere. With one part (a serial run of --search auto or mesh)
- * that is every tet: the mesh is the answer, and no front re-derives it.
- * The hull faces are the faces of the infinite tets, outward.
+ * circumsphere. With one part (src/api/api.c's one_part: a serial run of
+ * --search auto or mesh, or a threaded one of --search auto in the
+ * default mode, whose threads build the mesh together) that is every tet:
+ * the mesh is the answer, and no front re-derives it. The hull faces are
+ * the faces of the infinite tets, outward.
  *
- * Parts of a threaded run, whose walls the front stitches, are the next
- * step of the issue (bench/NOTES.md entry 87); today the threaded engine
- * still reads its apexes from meshes (src/front/oracle.h), each certified
- * before it is trusted.
+ * With several parts (the wall engine, --search mesh on threads:
+ * src/par/engine.c) the tets whose circumsphere stays in the part go out
+ * at once and the fronts stitch the walls between parts.
  */
 #ifndef FDT_PARTMESH_H
 #define FDT_PARTMESH_H
