@@ -168,6 +168,13 @@ FDT_API int fdt_open(fdt_context **ctx, const fdt_settings *s);
 /* Frees the context and sets *ctx to NULL; NULL is fine. */
 FDT_API void fdt_close(fdt_context **ctx);
 
+/* Whether a run with settings s takes the one-part engine (fdt_search's
+ * FDT_SEARCH_AUTO: the insertion mesh of every point, built on the run's
+ * threads, is the answer), rather than fronts: in memory (streamed 0,
+ * fdt_triangulate) or streamed (nonzero, fdt_triangulate_stream: never).
+ * A function of the settings alone; for a caller's memory estimate. */
+FDT_API int fdt_engine_one_part(const fdt_settings *s, int streamed);
+
 /*
  * Triangulates n points. xyz holds 3n doubles (x0 y0 z0 x1 ...), borrowed:
  * it is read during the call only. Duplicate points (bit-identical

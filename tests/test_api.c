@@ -421,6 +421,40 @@ static void test_abi_stats(void)
     fdt_close(&ctx);
 }
 
+/* fdt_engine_one_part: the one-part engine in memory with --search auto
+ * (serial, or threads in the default mode without pinning) and mesh
+ * (serial only); never streamed, with kd, an explicit parallel mode or
+ * pinning. The runs of test_search and tests/test_oracle.c check that the
+ * engine that ran is the one it names. */
+static void test_engine_rule(void)
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    EXPECT(fdt_engine_one_part(&s, 0) == 1);
+    EXPECT(fdt_engine_one_part(&s, 1) == 0);
+    EXPECT(fdt_engine_one_part(NULL, 0) == 0);
+    s.n_threads = 4;
+    EXPECT(fdt_engine_one_part(&s, 0) == 1);
+    s.pin = 1;
+    EXPECT(fdt_engine_one_part(&s, 0) == 0);
+    s.pin = 0;
+    s.mode = FDT_MODE_SHARED;
+    EXPECT(fdt_engine_one_part(&s, 0) == 0);
+    s.mode = FDT_MODE_MESSAGE;
+    EXPECT(fdt_engine_one_part(&s, 0) == 0);
+    s.mode = FDT_MODE_SERIAL;
+    EXPECT(fdt_engine_one_part(&s, 0) == 1);
+    s.search = FDT_SEARCH_MESH;
+    EXPECT(fdt_engine_one_part(&s, 0) == 1);
+    s.search = FDT_SEARCH_KD;
+    EXPECT(fdt_engine_one_part(&s, 0) == 0);
+    s.mode = FDT_MODE_AUTO;
+    s.search = FDT_SEARCH_MESH;
+    EXPECT(fdt_engine_one_part(&s, 0) == 0);
+    s.n_threads = 1;
+    EXPECT(fdt_engine_one_part(&s, 0) == 1);
+}
+
 int main(void)
 {
     test_abi_settings();
@@ -430,5 +464,6 @@ int main(void)
     test_result();
     test_progress();
     test_search();
+    test_engine_rule();
     return test_report("test_api");
 }

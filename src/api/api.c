@@ -165,10 +165,10 @@ typedef struct run_state {
  * thread, shared otherwise; 0 threads: one per physical core. Shared and
  * message run src/par/parallel.c, which fills the same meshbuf (global
  * tree-order ids) and counters. */
-static void run_mode(const fdt_context *ctx, fdt_mode *mode, int *nthreads)
+static void run_mode(const fdt_settings *s, fdt_mode *mode, int *nthreads)
 {
-    *mode = ctx->s.mode;
-    *nthreads = ctx->s.n_threads;
+    *mode = s->mode;
+    *nthreads = s->n_threads;
     if (*mode != FDT_MODE_SERIAL && *nthreads == 0)
         *nthreads = fdt_parallel_default_threads();
     if (*mode == FDT_MODE_AUTO)
@@ -233,12 +233,22 @@ static int run_parallel(fdt_context *ctx, fdt_mode mode, int nthreads, const fdt
  * --search mesh on several threads run the fronts: serial, or the parts'
  * engine (src/par/parallel.c).
  */
-static int one_part(const fdt_context *ctx, fdt_mode mode, const fdt_sink *user)
+static int one_part(const fdt_settings *s, fdt_mode mode, int streamed)
 {
-    if (user || ctx->s.search == FDT_SEARCH_KD)
+    if (streamed || s->search == FDT_SEARCH_KD)
         return 0;
     return mode == FDT_MODE_SERIAL ||
-           (ctx->s.mode == FDT_MODE_AUTO && ctx->s.search == FDT_SEARCH_AUTO && !ctx->s.pin);
+           (s->mode == FDT_MODE_AUTO && s->search == FDT_SEARCH_AUTO && !s->pin);
+}
+
+int fdt_engine_one_part(const fdt_settings *s, int streamed)
+{
+    if (!s)
+        return 0;
+    fdt_mode mode;
+    int nthreads;
+    run_mode(s, &mode, &nthreads);
+    return one_part(s, mode, streamed);
 }
 
 /* One kd-tree, then the one-part engine on nthreads threads or (nthreads
@@ -388,7 +398,7 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     ctx->diag[0] = '\0';
     fdt_mode mode;
     int nthreads;
-    run_mode(ctx, &mode, &nthreads);
+    run_mode(&ctx->s, &mode, &nthreads);
     double t0 = fdt_now_s();
     run_state rs;
     memset(&rs, 0, sizeof rs);
@@ -405,7 +415,7 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
                                         sizeof ctx->diag)) != FDT_OK)
         goto fail;
     double t1;
-    int one = one_part(ctx, mode, user);
+    int one = one_part(&ctx->s, mode, user != NULL);
     if (mode == FDT_MODE_SERIAL)
         nthreads = 1;
     err = one || mode == FDT_MODE_SERIAL ? run_single(ctx, user, one, nthreads, &rs, &t1)

@@ -1306,12 +1306,8 @@ static int run(const cli *c)
     int run_threads = c->mode == FDT_MODE_SERIAL ? 1
                       : c->threads > 0           ? c->threads
                                                  : (int)sysconf(_SC_NPROCESSORS_ONLN);
-    /* The one-part engine: src/api/api.c's rule (one_part). */
-    int one_part = !streaming && c->search != FDT_SEARCH_KD &&
-                   (run_threads == 1 ||
-                    (c->mode == FDT_MODE_AUTO && c->search == FDT_SEARCH_AUTO && !s.pin));
-    unsigned long long estimate =
-        memory_estimate(n, streaming, run_threads, s.neighbors, one_part);
+    unsigned long long estimate = memory_estimate(n, streaming, run_threads, s.neighbors,
+                                                  fdt_engine_one_part(&s, streaming));
     if (c->memory_limit && estimate > c->memory_limit) {
         say("%s: %zu points need about %llu MiB (%s%s), more than --memory-limit %llu MiB",
             name, n, estimate >> 20, streaming ? "streamed" : "in memory",
