@@ -1138,14 +1138,16 @@ static void test_bound_windows(tctx *T, double scale, int verbose)
 
 
 /*
- * The semi-static stage (fdt_pred_static, fdt_orient3d_static,
- * fdt_insphere_static): on the tightest box of the points (the largest
- * permanent next to the box's bound), whenever it decides, its sign is
- * the rational one and the dynamic filter decides the same (it may only
- * return what the filter would). Inputs: well spread, nearly coplanar and
- * nearly cospherical, scaled by 2^e, e in [-130, 130], so boxes outside
- * [2^-100, 2^100] (where it must never decide) are met too. It must decide
- * most well-spread inputs (else it would be dead code), never one in a
+ * The semi-static stage (fdt_pred_static, the filters' sinv, the *_sf
+ * filters): on the tightest box of the points (the largest permanent next
+ * to the box's bound), whenever it decides (the replica's determinant
+ * clears the bound), the staged filter answers the rational sign and the
+ * dynamic filter answers the same (the stage may only return what the
+ * filter would); otherwise the staged filter answers what the plain one
+ * does. Inputs: well spread, nearly coplanar and nearly cospherical,
+ * scaled by 2^e, e in [-130, 130], so boxes outside [2^-100, 2^100]
+ * (where it must never decide) are met too. It must decide most
+ * well-spread inputs (else it would be dead code), never one with a
  * zeroed fdt_pred_static.
  */
 static void test_static_filter(tctx *T, double scale)
@@ -1181,22 +1183,28 @@ static void test_static_filter(tctx *T, double scale)
             }
             fdt_pred_static sf;
             fdt_pred_static_init(&sf, lo, hi);
-            int st = insphere ? fdt_insphere_static(p[0], p[1], p[2], p[3], p[4], &sf)
-                              : fdt_orient3d_static(p[0], p[1], p[2], p[3], &sf);
-            int z = insphere ? fdt_insphere_static(p[0], p[1], p[2], p[3], p[4], &zero)
-                             : fdt_orient3d_static(p[0], p[1], p[2], p[3], &zero);
-            EXPECT(z == FDT_PRED_UNSURE);
+            int st = insphere ? fdt_insphere_filter_sf(p[0], p[1], p[2], p[3], p[4], &sf)
+                              : fdt_orient3d_filter_sf(p[0], p[1], p[2], p[3], &sf);
+            int z = insphere ? fdt_insphere_filter_sf(p[0], p[1], p[2], p[3], p[4], &zero)
+                             : fdt_orient3d_filter_sf(p[0], p[1], p[2], p[3], &zero);
+            int filt = filter_of(insphere, p);
+            EXPECT(z == filt);
+            filt_eval ev;
+            eval_replica(insphere, p, &ev);
+            int decided = fabs(ev.det) * (insphere ? sf.isp_inv : sf.o3d_inv) > 1;
             double M = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
             int in_range = M >= 0x1p-100 && M <= 0x1p100;
             if (kind == 0 && in_range) {
                 spread++;
-                spread_decided += st != FDT_PRED_UNSURE;
+                spread_decided += decided;
             }
-            if (st == FDT_PRED_UNSURE)
+            if (!decided) {
+                EXPECT(st == filt);
                 continue;
+            }
             out_decided += !in_range;
             near_decided += kind != 0;
-            int ref = ref_of(T, insphere, p), filt = filter_of(insphere, p);
+            int ref = ref_of(T, insphere, p);
             if (st != ref || filt != st)
                 print_pts((const double(*)[3])p, np);
             EXPECT(st == ref);

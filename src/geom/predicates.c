@@ -1061,7 +1061,7 @@ static int orient3d_filter_rescaled(const double *a, const double *b,
         any |= rescale_diffs(&r[i], 1);
     if (!any)
         return FDT_PRED_UNSURE;
-    return fdt_orient3d_filter_diff(r[0], r[1], r[2]);
+    return fdt_orient3d_filter_diff(r[0], r[1], r[2], 0);
 }
 
 static int insphere_filter_rescaled(const double *a, const double *b,
@@ -1077,7 +1077,7 @@ static int insphere_filter_rescaled(const double *a, const double *b,
     }
     if (!rescale_diffs(r, 4))
         return FDT_PRED_UNSURE;
-    return fdt_insphere_filter_diff(r[0], r[1], r[2], r[3]);
+    return fdt_insphere_filter_diff(r[0], r[1], r[2], r[3], 0);
 }
 
 int fdt_orient3d(const double *a, const double *b, const double *c,

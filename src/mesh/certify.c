@@ -25,18 +25,14 @@ static inline int is_freed(const uint32_t *v)
 static inline int orient(const fdt_ins *m, const double *a, const double *b, const double *c,
                          const double *d, fdt_pred_counts *cnt)
 {
-    int s = fdt_orient3d_static(a, b, c, d, &m->sf);
-    if (s == FDT_PRED_UNSURE)
-        s = fdt_orient3d_filter(a, b, c, d);
+    int s = fdt_orient3d_filter_sf(a, b, c, d, &m->sf);
     return s != FDT_PRED_UNSURE ? s : fdt_orient3d(a, b, c, d, cnt);
 }
 
 static inline int insphere(const fdt_ins *m, const double *a, const double *b, const double *c,
                            const double *d, const double *e, fdt_pred_counts *cnt)
 {
-    int s = fdt_insphere_static(a, b, c, d, e, &m->sf);
-    if (s == FDT_PRED_UNSURE)
-        s = fdt_insphere_filter(a, b, c, d, e);
+    int s = fdt_insphere_filter_sf(a, b, c, d, e, &m->sf);
     return s != FDT_PRED_UNSURE ? s : fdt_insphere_perturbed(a, b, c, d, e, cnt);
 }
 

@@ -36,10 +36,7 @@ static inline const double *ins_pt(const fdt_ins *m, uint32_t v)
 static inline int ins_orient(const double *a, const double *b, const double *c, const double *d,
                              const fdt_pred_static *sf, fdt_pred_counts *cnt)
 {
-    int s = fdt_orient3d_static(a, b, c, d, sf);
-    if (s != FDT_PRED_UNSURE)
-        return s;
-    s = fdt_orient3d_filter(a, b, c, d);
+    int s = fdt_orient3d_filter_sf(a, b, c, d, sf);
     if (s != FDT_PRED_UNSURE)
         return s;
     return fdt_orient3d(a, b, c, d, cnt);
@@ -49,10 +46,7 @@ static inline int ins_insphere(const double *a, const double *b, const double *c
                                const double *d, const double *e, const fdt_pred_static *sf,
                                fdt_pred_counts *cnt)
 {
-    int s = fdt_insphere_static(a, b, c, d, e, sf);
-    if (s != FDT_PRED_UNSURE)
-        return s;
-    s = fdt_insphere_filter(a, b, c, d, e);
+    int s = fdt_insphere_filter_sf(a, b, c, d, e, sf);
     if (s != FDT_PRED_UNSURE)
         return s;
     if (cnt)
