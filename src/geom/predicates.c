@@ -685,7 +685,7 @@ static inline void cross3(const double *x, const double *y, double *z)
     z[2] = x[0] * y[1] - x[1] * y[0];
 }
 
-
+/* The semi-static bounds (predicates.h, fdt_pred_static). */
 void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double hi[3])
 {
     sf->o3d_inv = sf->isp_inv = 0;
