@@ -29,8 +29,8 @@ static inline const double *ins_pt(const fdt_ins *m, uint32_t v)
     return m->P + 3 * (size_t)v;
 }
 
-/* The semi-static and the dynamic filters inline, the exact stages (and
- * the rescaled filters) out of line: most calls end in the first stage.
+/* The filters (semi-static stage, then dynamic) inline, the exact stages
+ * (and the rescaled filters) out of line: most calls end in the filters.
  * sf: the semi-static bounds of a box that holds every point the test
  * reads (fdt_ins.sf for the mesh's own points). */
 static inline int ins_orient(const double *a, const double *b, const double *c, const double *d,
