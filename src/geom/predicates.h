@@ -140,10 +140,53 @@ int fdt_insphere_adapt(const double *a, const double *b, const double *c,
 #define FDT_ISP_ADAPT_ERRBOUND 0x1.b4p-100
 
 /*
+ * Semi-static filters (the insertion kernel's and the certificate's
+ * tests, src/mesh/insert_impl.h, src/mesh/certify.c): for points whose
+ * coordinates all lie in one box, a bound on the filters' permanent holds
+ * for every call, so a call whose determinant clears it needs no
+ * permanent. The filters test it (their sinv argument) right after the
+ * determinant: the insertion makes about 43 conflict tests and 20
+ * orientation tests a point, and on well-spread points this stage decides
+ * 98 % of them without the permanent's flops (bench/NOTES.md entry 91).
+ *
+ * Why it is exact. Let M be the largest extent hi[k] - lo[k] of the box
+ * (rounded up: fl(hi - lo) is monotone, so every computed difference of
+ * two coordinates in the box is at most M in magnitude). Every computed
+ * permanent of fdt_orient3d_filter_diff and fdt_insphere_filter_diff is a
+ * sum of products of such magnitudes, monotone in each, so at most the
+ * same expression with every magnitude M: 6 M^3 and 72 M^5 exactly, up to
+ * its own roundings, which the factor 1 + 2^-20 below covers (so also
+ * under any contraction into fused multiply-adds). With bound = fl(B P),
+ * P that bound on the permanent and B the filter's constant, a computed
+ * |det| > bound then means:
+ *   - the permanent is above the filters' underflow guards: |det| is at
+ *     most the permanent (the same association with |.|, see the filters)
+ *     up to a factor 1 + 2^-40, and fdt_pred_static_init keeps bound
+ *     above 2^-790 and far above the guards' other terms (su 2^-980 and
+ *     L (L 2^-960), with su <= 4M and L <= 16 M^2);
+ *   - the dynamic filter would decide it, with the same sign: its bound
+ *     fl(B perm) is at most fl(B P) (monotone) < |det|, the same computed
+ *     determinant.
+ * So this stage only ever returns what the filter would. The bounds are
+ * kept as reciprocals rounded down, tested as fl(|det| inv) > 1 (which
+ * implies |det| > 1 / inv >= bound), so that a zeroed fdt_pred_static,
+ * like the one of a box whose extent is 0, not finite, or outside
+ * [2^-100, 2^100], never decides: the filters and exact stages handle
+ * those calls.
+ */
+typedef struct fdt_pred_static {
+    double o3d_inv; /* decide orient3d when fl(|det| o3d_inv) > 1 */
+    double isp_inv; /* decide insphere when fl(|det4| isp_inv) > 1 */
+} fdt_pred_static;
+
+/* The bounds for points in the box [lo, hi] (componentwise). */
+void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double hi[3]);
+
+/*
  * Floating-point filter for orient3d: +1 or -1 when that is certainly the
  * sign of det[b-a; c-a; d-a], FDT_PRED_UNSURE otherwise (never 0). sinv:
- * the semi-static stage's reciprocal bound (fdt_pred_static, at the end of
- * this file), tested on the determinant before the permanent; 0: none.
+ * the semi-static stage's reciprocal bound (fdt_pred_static, above),
+ * tested on the determinant before the permanent; 0: none.
  *
  * Error bound. Write eps = 2^-53, eta = 2^-1075 (half the smallest
  * subnormal). Every operation obeys fl(x op y) = (x op y)(1 + delta) + mu,
@@ -213,14 +256,24 @@ static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
 
 /* The filter proper works on the rounded differences u = b - a, v = c - a,
  * w = d - a; fdt_orient3d() also calls it on differences rescaled by a
- * power of two when they lie outside the range the bound covers. */
-static inline int fdt_orient3d_filter(const double *a, const double *b,
-                                      const double *c, const double *d)
+ * power of two when they lie outside the range the bound covers. The _sf
+ * form tests the semi-static stage of sf first: the same determinant
+ * serves both, so a call the stage cannot decide costs only the
+ * comparison more (on scans, whose box is wide next to their tets, it
+ * decides 13-25 % of the certificate's tests, on uniform points 98 %). */
+static inline int fdt_orient3d_filter_sf(const double *a, const double *b, const double *c,
+                                         const double *d, const fdt_pred_static *sf)
 {
     const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    return fdt_orient3d_filter_diff(u, v, w, 0);
+    return fdt_orient3d_filter_diff(u, v, w, sf->o3d_inv);
+}
+
+static inline int fdt_orient3d_filter(const double *a, const double *b,
+                                      const double *c, const double *d)
+{
+    return fdt_orient3d_filter_sf(a, b, c, d, &(const fdt_pred_static){0, 0});
 }
 
 /*
@@ -315,76 +368,7 @@ static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
 }
 
 /* As for orient3d: the proper filter takes the rounded differences
- * A = a - e, ..., D = d - e. */
-static inline int fdt_insphere_filter(const double *a, const double *b,
-                                      const double *c, const double *d,
-                                      const double *e)
-{
-    const double A[3] = {a[0] - e[0], a[1] - e[1], a[2] - e[2]};
-    const double B[3] = {b[0] - e[0], b[1] - e[1], b[2] - e[2]};
-    const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
-    const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
-    return fdt_insphere_filter_diff(A, B, C, D, 0);
-}
-
-/* ------------------------------------------------------------------ */
-/*
- * Semi-static filters (the insertion kernel's and the certificate's
- * tests, src/mesh/insert_impl.h, src/mesh/certify.c): for points whose
- * coordinates all lie in one box, a bound on the filters' permanent holds
- * for every call, so a call whose determinant clears it needs no
- * permanent. The filters test it (their sinv argument) right after the
- * determinant: the insertion makes about 43 conflict tests and 20
- * orientation tests a point, and on well-spread points this stage decides
- * 98 % of them without the permanent's flops (bench/NOTES.md entry 91).
- *
- * Why it is exact. Let M be the largest extent hi[k] - lo[k] of the box
- * (rounded up: fl(hi - lo) is monotone, so every computed difference of
- * two coordinates in the box is at most M in magnitude). Every computed
- * permanent of fdt_orient3d_filter_diff and fdt_insphere_filter_diff is a
- * sum of products of such magnitudes, monotone in each, so at most the
- * same expression with every magnitude M: 6 M^3 and 72 M^5 exactly, up to
- * its own roundings, which the factor 1 + 2^-20 below covers (so also
- * under any contraction into fused multiply-adds). With bound = fl(B P),
- * P that bound on the permanent and B the filter's constant, a computed
- * |det| > bound then means:
- *   - the permanent is above the filters' underflow guards: |det| is at
- *     most the permanent (the same association with |.|, see the filters)
- *     up to a factor 1 + 2^-40, and fdt_pred_static_init keeps bound
- *     above 2^-790 and far above the guards' other terms (su 2^-980 and
- *     L (L 2^-960), with su <= 4M and L <= 16 M^2);
- *   - the dynamic filter would decide it, with the same sign: its bound
- *     fl(B perm) is at most fl(B P) (monotone) < |det|, the same computed
- *     determinant.
- * So this stage only ever returns what the filter would. The bounds are
- * kept as reciprocals rounded down, tested as fl(|det| inv) > 1 (which
- * implies |det| > 1 / inv >= bound), so that a zeroed fdt_pred_static,
- * like the one of a box whose extent is 0, not finite, or outside
- * [2^-100, 2^100], never decides: the filters and exact stages handle
- * those calls.
- */
-typedef struct fdt_pred_static {
-    double o3d_inv; /* decide orient3d when fl(|det| o3d_inv) > 1 */
-    double isp_inv; /* decide insphere when fl(|det4| isp_inv) > 1 */
-} fdt_pred_static;
-
-/* The bounds for points in the box [lo, hi] (componentwise). */
-void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double hi[3]);
-
-/* fdt_orient3d_filter with the semi-static stage of sf first: the same
- * determinant serves both, so a call the stage cannot decide costs only
- * the comparison more (on scans, whose box is wide next to their tets, it
- * decides 13-25 % of the certificate's tests, on uniform points 98 %). */
-static inline int fdt_orient3d_filter_sf(const double *a, const double *b, const double *c,
-                                         const double *d, const fdt_pred_static *sf)
-{
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    return fdt_orient3d_filter_diff(u, v, w, sf->o3d_inv);
-}
-
-/* fdt_insphere_filter with the semi-static stage of sf first (as above). */
+ * A = a - e, ..., D = d - e; the _sf form tests sf's stage first. */
 static inline int fdt_insphere_filter_sf(const double *a, const double *b, const double *c,
                                          const double *d, const double *e,
                                          const fdt_pred_static *sf)
@@ -394,6 +378,13 @@ static inline int fdt_insphere_filter_sf(const double *a, const double *b, const
     const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
     const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
     return fdt_insphere_filter_diff(A, B, C, D, sf->isp_inv);
+}
+
+static inline int fdt_insphere_filter(const double *a, const double *b,
+                                      const double *c, const double *d,
+                                      const double *e)
+{
+    return fdt_insphere_filter_sf(a, b, c, d, e, &(const fdt_pred_static){0, 0});
 }
 
 #endif
