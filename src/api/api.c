@@ -251,8 +251,9 @@ int fdt_engine_one_part(const fdt_settings *s, int streamed)
     return one_part(s, mode, streamed);
 }
 
-/* One kd-tree, then the one-part engine on nthreads threads or (nthreads
- * 1) the serial front; *t1: when the preparation ended. */
+/* The points put in order (one kd-tree; on threads, the parts' trees),
+ * then the one-part engine on nthreads threads or (not one) the serial
+ * front on the tree; *t1: when the preparation ended. */
 static int run_single(fdt_context *ctx, const fdt_sink *user, int one, int nthreads,
                       run_state *rs, double *t1)
 {

@@ -288,15 +288,16 @@ static inline int ins_grow_u32(uint32_t **a, size_t *cap, size_t need)
  * The directed edges of a star's outer surface, which link its tets.
  * Every tet of a star has the centre (the new point, or the infinite
  * vertex around the first tetrahedron) and is positively oriented, so the
- * faces opposite c, each in its tet's outward order (fdt_tet_face), form
- * a consistently oriented closed surface: each of its edges is walked once
- * in each direction, by the two faces through it. The face of tet s
- * through the centre and the directed edge xy is the one opposite s's third outer
- * vertex; its neighbour is the face through the centre and yx. So one pass puts
- * every directed edge in the table and a second looks up each edge's
- * reverse: no branch on which of two faces comes first, no ordering of the
- * two ids (bench/NOTES.md entry 91: the one-pass table that did both cost
- * two mispredicted branches a face).
+ * faces opposite the centre, each in its tet's outward order
+ * (fdt_tet_face), form a consistently oriented closed surface: each of
+ * its edges is walked once in each direction, by the two faces through
+ * it. The face of tet s through the centre and the directed edge xy is
+ * the one opposite s's third outer vertex; its neighbour is the face
+ * through the centre and yx. So one pass puts every directed edge in the
+ * table and a second looks up each edge's reverse: no branch on which of
+ * two faces comes first, no ordering of the two ids (bench/NOTES.md entry
+ * 91: the one-pass table that did both cost two mispredicted branches a
+ * face).
  */
 typedef struct ins_edge_slot {
     uint64_t key;     /* the directed edge: tail id << 32 | head id */

@@ -277,7 +277,9 @@ static int engine_start(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode,
 
 /*
  * The DT of every point, built here on the run's threads with
- * --search auto (or when a test asks, opt->global_mesh), if it fits the
+ * --search auto where the parts run (an explicit mode, a stream or --pin:
+ * in the default mode the one-part engine runs instead, src/api/api.c),
+ * or when a test asks (opt->global_mesh), if it fits the
  * memory available (src/front/oracle.h, FDT_ORACLE_MESH_BYTES); then
  * every part reads its faces' apexes from it and asks no other part
  * (bench/NOTES.md entries 54, 90). In message mode it stands for the
