@@ -658,6 +658,83 @@ FDT_API int fdt_stream_writer_close(fdt_stream_writer **w, int commit, char *dia
 FDT_API void fdt_stream_writer_counts(const fdt_stream_writer *w, uint64_t *tets,
                                       uint64_t *hull);
 
+/*
+ * Voronoi cells (issue 32): each point's cell in the Voronoi diagram of
+ * the points, clipped by a box, with the quantities voro++ reports (its
+ * %v %F %s %n %f and %C), and the DTFE density. Computed from a result's
+ * tets (fdt_triangulate), so the cells are the duals of the exact Delaunay
+ * mesh: the same for every thread count, mode and input order.
+ *
+ * Every cell is clipped by the box (default: the points' bounding box; a
+ * given box must hold every point): a cell that lies inside it is summed
+ * from its tets, one that leaves it (a hull point's cell is unbounded) is
+ * cut from the box by its neighbours' bisector planes, as voro++ cuts
+ * every cell. The volumes of a box's cells add up to the box's volume.
+ * Sums are exact-order-independent (src/base/fixsum.h): the same bits for
+ * every order of the tets.
+ */
+typedef struct fdt_voronoi fdt_voronoi;
+
+typedef struct fdt_voronoi_options {
+    size_t struct_size; /* sizeof(fdt_voronoi_options) as compiled by the caller */
+    int box_given;      /* nonzero: clip by box, not the points' bounding box */
+    double box[6];      /* xmin, ymin, zmin, xmax, ymax, zmax */
+    int neighbors;      /* nonzero: keep each cell's neighbours and face areas */
+} fdt_voronoi_options;
+
+FDT_API int fdt_default_voronoi_options_sized(fdt_voronoi_options *o, size_t struct_size);
+static inline void fdt_default_voronoi_options(fdt_voronoi_options *o)
+{
+    (void)fdt_default_voronoi_options_sized(o, sizeof *o);
+}
+
+/* Cell flags (fdt_voronoi_flags). */
+#define FDT_CELL_CLIPPED 1u /* the box cut the cell (it left the box) */
+#define FDT_CELL_HULL 2u    /* a convex-hull point: the unclipped cell is
+                               unbounded, and its DTFE density counts only
+                               the tets it has */
+#define FDT_CELL_MERGED 4u  /* a duplicate merged into another point
+                               (fdt_result_duplicate_map): no cell */
+
+/*
+ * The cells of the n points xyz (borrowed, the array r was computed from)
+ * from r's tets and hull faces; r keeps the vertex adjacency this derives
+ * (fdt_result_vertex_neighbors), nothing else changes. o may be NULL (the
+ * defaults). *out is owned by the caller (fdt_voronoi_free). FDT_EINVAL
+ * for a NULL argument, a streamed result (no tets kept), n not r's point
+ * count, an empty or inverted box, or a point outside the given box (diag,
+ * when not NULL, says which; it is written in every case, "" on success);
+ * FDT_ENOMEM; FDT_EINTERNAL when a cell could not be cut (a bug).
+ */
+FDT_API int fdt_voronoi_compute(fdt_result *r, const double *xyz, size_t n,
+                                const fdt_voronoi_options *o, fdt_voronoi **out,
+                                char *diag, size_t diag_size);
+FDT_API void fdt_voronoi_free(fdt_voronoi **v);
+
+/* n entries each (3n for the centroids, absolute coordinates), owned by
+ * v. A merged duplicate's entries are 0 (density too). Faces are counted
+ * without the faces of zero area (fdt_voronoi_zero_faces). The DTFE
+ * density is 4 / (the sum of the volumes of the point's tets). */
+FDT_API size_t fdt_voronoi_num_points(const fdt_voronoi *v);
+FDT_API const double *fdt_voronoi_volumes(const fdt_voronoi *v);
+FDT_API const double *fdt_voronoi_areas(const fdt_voronoi *v);
+FDT_API const double *fdt_voronoi_centroids(const fdt_voronoi *v);
+FDT_API const int32_t *fdt_voronoi_num_faces(const fdt_voronoi *v);
+FDT_API const double *fdt_voronoi_densities(const fdt_voronoi *v);
+FDT_API const uint8_t *fdt_voronoi_flags(const fdt_voronoi *v);
+/* The box the cells were clipped by (xmin, ymin, zmin, xmax, ymax, zmax). */
+FDT_API void fdt_voronoi_box(const fdt_voronoi *v, double box[6]);
+/* Faces of area at most 2^-40 of their cell's surface (degenerate points:
+ * the extra Delaunay edges of cospherical points), left out of every count
+ * and list; how many there were over all cells. */
+FDT_API size_t fdt_voronoi_zero_faces(const fdt_voronoi *v);
+/* Point i's neighbours, ascending (the box's walls first, as voro++ numbers
+ * them: -1 x-min, -2 x-max, -3 y-min, -4 y-max, -5 z-min, -6 z-max), and
+ * the area of the face shared with each; both owned by v. FDT_EINVAL when
+ * options.neighbors was not set or i is out of range. */
+FDT_API int fdt_voronoi_neighbors(const fdt_voronoi *v, fdt_vid i, size_t *count,
+                                  const fdt_vid **ids, const double **areas);
+
 /* Frees memory the library allocated for the caller (the points of
  * fdt_read_points). NULL is fine. */
 FDT_API void fdt_free(void *p);

@@ -362,12 +362,54 @@ def test_lifetime_and_memory():
     check(grew < 16 * 2**20, "RSS grew %.1f MB over %d runs" % (grew / 2**20, runs))
 
 
+def test_voronoi():
+    """frontdt.voronoi: the volumes fill the box; the DTFE densities equal
+    4 / (the volumes of each point's tets) computed here from simplices; the
+    CSR lists are each face seen from both sides; the same bits for a
+    shuffled input and 1 or 3 threads; a box not holding a point raises."""
+    rng = np.random.default_rng(11)
+    pts = rng.random((3000, 3))
+    box = (-0.5, 0.0, 0.0, 1.0, 1.25, 1.0)
+    t = frontdt.delaunay(pts, threads=1)
+    c = t.voronoi(box)
+    check(abs(c["volumes"].sum() / (1.5 * 1.25) - 1) < 1e-12, "voronoi: volumes fill the box")
+    s = t.simplices
+    p = pts[s]
+    vol = np.abs(np.einsum("ij,ij->i", p[:, 1] - p[:, 0],
+                           np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]))) / 6
+    per = np.zeros(len(pts))
+    for k in range(4):
+        np.add.at(per, s[:, k], vol)
+    check(np.allclose(c["densities"], 4 / per, rtol=1e-12, atol=0), "voronoi: DTFE densities")
+    ptr, nb, fa = c["neighbor_ptr"], c["neighbors"], c["face_areas"]
+    check(ptr[-1] == len(nb) == len(fa) and np.all(np.diff(ptr) == c["num_faces"]),
+          "voronoi: CSR shape")
+    faces = {}
+    for i in range(len(pts)):
+        for j, a in zip(nb[ptr[i]:ptr[i + 1]], fa[ptr[i]:ptr[i + 1]]):
+            if j >= 0:
+                faces[(i, int(j))] = a
+    check(all(abs(a - faces.get((j, i), -1)) <= 1e-10 * a for (i, j), a in faces.items()),
+          "voronoi: each face has one area from both sides")
+    check(np.allclose(c["areas"], np.add.reduceat(fa, ptr[:-1]), rtol=1e-12),
+          "voronoi: the faces add up to the surface")
+    perm = rng.permutation(len(pts))
+    c3 = frontdt.voronoi(pts, box, threads=3)
+    cs = frontdt.voronoi(pts[perm], box, threads=2)
+    check(np.array_equal(c3["volumes"], c["volumes"]), "voronoi: same bits at 3 threads")
+    check(np.array_equal(cs["volumes"], c["volumes"][perm]) and
+          np.array_equal(cs["centroids"], c["centroids"][perm]),
+          "voronoi: same bits for a shuffled input")
+    raises(ValueError, t.voronoi, (0, 0, 0, 1, 1, 0.5))
+    raises(ValueError, t.voronoi, (0, 0, 0, 1, 1))
+
+
 def main():
     print("frontdt", frontdt.__version__, "from", frontdt._frontdt.__file__)
     with tempfile.TemporaryDirectory() as tmp:
         for test in [test_origin, test_scipy, test_faces, lambda: test_cli_degenerate(tmp),
                      test_errors, test_threads, test_gil_and_interrupt,
-                     test_lifetime_and_memory]:
+                     test_lifetime_and_memory, test_voronoi]:
             t0 = time.monotonic()
             test()
             print("%s: %.1f s" % (getattr(test, "__name__", "?"), time.monotonic() - t0),

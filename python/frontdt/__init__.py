@@ -6,10 +6,19 @@ front, parallelised after Merriam, NASA TM-103951, 1992) from Python.
     t.simplices     # int32 (m, 4), positively oriented, input numbering
     t.neighbors     # int64 (m, 4), -1 on the hull, opposite vertex k
     t.check()       # exact verification; raises frontdt.CheckError
+    c = t.voronoi() # Voronoi cells: c["volumes"], c["densities"], ...
 
 The arrays are read-only views of the library's result, which lives as
 long as any of them. See help(frontdt.delaunay) and README.md, "Python".
 """
 from ._frontdt import CheckError, Triangulation, __version__, check, delaunay
 
-__all__ = ["CheckError", "Triangulation", "check", "delaunay", "__version__"]
+
+def voronoi(points, box=None, threads=None):
+    """Each point's Voronoi cell, clipped by box (None: the points' bounding
+    box): frontdt.delaunay(points, threads).voronoi(box), a dict of arrays
+    (see help(frontdt.Triangulation.voronoi))."""
+    return delaunay(points, threads=threads).voronoi(box)
+
+
+__all__ = ["CheckError", "Triangulation", "check", "delaunay", "voronoi", "__version__"]

@@ -25,6 +25,7 @@
  */
 #include "frontdt.h"
 #include "cli/cli.h"
+#include "cli/dual.h"
 #include "base/clock.h"
 #include "base/hash.h"
 #include "cli/progress.h"
@@ -87,6 +88,7 @@ typedef struct cli {
     int stream;             /* --stream 1, --no-stream -1, else 0: when
                                every output can (stream_refusal) */
     unsigned long long memory_limit; /* --memory-limit bytes; 0: none */
+    fdt_cli_dual dual;      /* --voronoi, --voronoi-format, --density, --box */
     int demo;
     size_t demo_n;
 } cli;
@@ -143,6 +145,14 @@ static void usage(FILE *f)
         "      --stats-json FILE  write statistics as JSON ('-': stdout)\n"
         "      --hash             print the canonical hash of the tet set\n"
         "      --set-hash         print the set hash (order-independent, no sort)\n"
+        "      --voronoi FILE     write each point's Voronoi cell, clipped by the\n"
+        "                         box: a line a point (.csv: a table)\n"
+        "      --voronoi-format F the line, in voro++'s codes: %%i %%q %%v %%F %%s\n"
+        "                         %%n %%f %%c %%C, and %%d (DTFE density), %%h (flags)\n"
+        "                         (default '%%i %%q %%v %%F %%s %%n %%f')\n"
+        "      --density FILE     write each point's DTFE density and flags\n"
+        "      --box X0,Y0,Z0,X1,Y1,Z1  the box that clips the cells (default:\n"
+        "                         the points' bounding box; must hold them)\n"
         "      --stream           write the tets as they are built, never holding\n"
         "                         the mesh (.ele without .neigh, .vtu, .fdtb; no\n"
         "                         -o: count them); the points are stored once\n"
@@ -266,7 +276,8 @@ enum {
     OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH, OPT_SET_HASH,
     OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
     OPT_DELIMITER, OPT_DECIMAL_COMMA,
-    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT, OPT_NO_CLOBBER
+    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT, OPT_NO_CLOBBER,
+    OPT_VORONOI, OPT_VORONOI_FORMAT, OPT_DENSITY, OPT_BOX
 };
 
 static const struct option long_opts[] = {
@@ -293,6 +304,10 @@ static const struct option long_opts[] = {
     { "no-stream", no_argument, NULL, OPT_NO_STREAM },
     { "memory-limit", required_argument, NULL, OPT_MEMORY_LIMIT },
     { "no-clobber", no_argument, NULL, OPT_NO_CLOBBER },
+    { "voronoi", required_argument, NULL, OPT_VORONOI },
+    { "voronoi-format", required_argument, NULL, OPT_VORONOI_FORMAT },
+    { "density", required_argument, NULL, OPT_DENSITY },
+    { "box", required_argument, NULL, OPT_BOX },
     { "help", no_argument, NULL, 'h' },
     { "version", no_argument, NULL, 'V' },
     { NULL, 0, NULL, 0 },
@@ -504,6 +519,21 @@ static int parse_args(int argc, char **argv, cli *c)
         case OPT_NO_CLOBBER:
             c->no_clobber = 1;
             break;
+        case OPT_VORONOI:
+            c->dual.voronoi = optarg;
+            break;
+        case OPT_VORONOI_FORMAT:
+            c->dual.format = optarg;
+            break;
+        case OPT_DENSITY:
+            c->dual.density = optarg;
+            break;
+        case OPT_BOX:
+            if (fdt_cli_parse_box(optarg, c->dual.box) != 0)
+                return usage_error("--box wants six finite numbers xmin,ymin,zmin,xmax,ymax,zmax "
+                                   "with each min below its max, not '%s'", optarg);
+            c->dual.box_given = 1;
+            break;
         case OPT_MEMORY_LIMIT:
             if (parse_bytes(optarg, &c->memory_limit) != 0)
                 return usage_error("--memory-limit wants a byte count > 0 (suffix K, M or G), "
@@ -581,6 +611,9 @@ static int parse_args(int argc, char **argv, cli *c)
                     c->decimal_comma))
         return usage_error("--input-format, --columns, --delimiter and --decimal-comma need "
                            "an input file, not --demo");
+    char derr[512];
+    if (fdt_cli_dual_check(&c->dual, derr, sizeof derr) != 0)
+        return usage_error("%s", derr);
     return -1;
 }
 
@@ -1004,6 +1037,8 @@ static const char *stream_refusal(const cli *c, const fdt_format *const *fmts, i
         return "--hash sorts the whole mesh (--set-hash needs no sort)";
     if (c->all_faces)
         return "--all-faces needs the face list of the whole mesh";
+    if (fdt_cli_dual_wanted(&c->dual))
+        return "--voronoi and --density need the whole mesh";
     for (int o = 0; o < c->n_outputs; o++) {
         if (!strcmp(c->outputs[o], "-"))
             return "-o - (standard output) cannot stream";
@@ -1458,6 +1493,20 @@ static int run(const cli *c)
         }
         progress_clear(&prog);
         tm.write = fdt_now_s() - t0;
+    }
+
+    if (fdt_cli_dual_wanted(&c->dual)) {
+        t0 = fdt_now_s();
+        char derr[FDT_IO_PATH + 600];
+        progress_phase(&prog, "voronoi");
+        r = fdt_cli_dual_write(&c->dual, res, xyz, n, derr, sizeof derr);
+        progress_clear(&prog);
+        tm.write += fdt_now_s() - t0;
+        if (r != FDT_OK) {
+            say("%s: %s", name, derr);
+            code = r == FDT_EIO ? CLI_WRITE : exit_for_engine(r);
+            goto done;
+        }
     }
 
     fdt_stats st;

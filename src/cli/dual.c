@@ -1,0 +1,123 @@
+/* The CLI's Voronoi outputs: see dual.h. */
+#include "cli/dual.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/read/reader.h"
+#include "io/write/cells.h"
+#include "io/write/writer.h"
+
+int fdt_cli_dual_wanted(const fdt_cli_dual *d)
+{
+    return d->voronoi || d->density;
+}
+
+int fdt_cli_parse_box(const char *s, double box[6])
+{
+    const char *p = s;
+    for (int k = 0; k < 6; k++) {
+        char *end;
+        errno = 0;
+        box[k] = strtod(p, &end);
+        if (end == p || errno == ERANGE || !isfinite(box[k]))
+            return -1;
+        if (k < 5 && *end != ',')
+            return -1;
+        p = end + (k < 5);
+        if (k == 5 && *end)
+            return -1;
+    }
+    for (int k = 0; k < 3; k++)
+        if (!(box[k] < box[k + 3]))
+            return -1;
+    return 0;
+}
+
+static int is_csv(const char *path)
+{
+    size_t m = strlen(path);
+    return m >= 4 && !strcmp(path + m - 4, ".csv");
+}
+
+int fdt_cli_dual_check(const fdt_cli_dual *d, char *err, size_t errlen)
+{
+    if (d->format && !d->voronoi) {
+        snprintf(err, errlen, "--voronoi-format needs --voronoi FILE");
+        return -1;
+    }
+    if (d->box_given && !fdt_cli_dual_wanted(d)) {
+        snprintf(err, errlen, "--box clips the Voronoi cells: it needs --voronoi or --density");
+        return -1;
+    }
+    if (d->format && fdt_cells_format_check(d->format, NULL, err, errlen))
+        return -1;
+    return 0;
+}
+
+/* One file through the commit set: written by fn, renamed with the rest. */
+static int write_side(const char *path, int (*fn)(FILE *, const void *, const double *),
+                      const void *arg, const double *xyz, char *err, size_t errlen)
+{
+    fdt_wr_side *side = NULL;
+    FILE *f = fdt_wr_side_open(path, &side, err, errlen);
+    if (!f)
+        return FDT_EIO;
+    int e = fn(f, arg, xyz);
+    if (e) {
+        fdt_wr_side_abandon(side);
+        snprintf(err, errlen, "%s: %s", path, strerror(e));
+        return FDT_EIO;
+    }
+    return fdt_wr_side_commit(side, err, errlen) == FDT_IO_OK ? FDT_OK : FDT_EIO;
+}
+
+typedef struct cells_job {
+    const fdt_voronoi *v;
+    const char *format; /* NULL: CSV */
+} cells_job;
+
+static int put_cells(FILE *f, const void *arg, const double *xyz)
+{
+    const cells_job *j = arg;
+    return fdt_wr_cells(f, j->format, j->v, xyz);
+}
+
+static int put_density(FILE *f, const void *arg, const double *xyz)
+{
+    (void)xyz;
+    return fdt_wr_density(f, arg);
+}
+
+int fdt_cli_dual_write(const fdt_cli_dual *d, fdt_result *res, const double *xyz, size_t n,
+                       char *err, size_t errlen)
+{
+    fdt_voronoi_options o;
+    fdt_default_voronoi_options(&o);
+    o.box_given = d->box_given;
+    memcpy(o.box, d->box, sizeof o.box);
+    cells_job job = {NULL, d->format};
+    if (d->voronoi && !job.format && !is_csv(d->voronoi))
+        job.format = FDT_CELLS_DEFAULT_FORMAT;
+    int nb = 0;
+    if (job.format)
+        (void)fdt_cells_format_check(job.format, &nb, err, errlen);
+    o.neighbors = nb;
+    fdt_voronoi *v = NULL;
+    char diag[512];
+    int r = fdt_voronoi_compute(res, xyz, n, &o, &v, diag, sizeof diag);
+    if (r != FDT_OK) {
+        snprintf(err, errlen, "Voronoi cells: %s%s%s", fdt_strerror(r), *diag ? ": " : "", diag);
+        return r;
+    }
+    job.v = v;
+    if (d->voronoi)
+        r = write_side(d->voronoi, put_cells, &job, xyz, err, errlen);
+    if (r == FDT_OK && d->density)
+        r = write_side(d->density, put_density, v, xyz, err, errlen);
+    fdt_voronoi_free(&v);
+    return r;
+}

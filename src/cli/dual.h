@@ -1,0 +1,42 @@
+/*
+ * The CLI's Voronoi outputs (issue 32): --voronoi FILE, --voronoi-format,
+ * --density FILE and --box, one step of src/cli/main.c's run. The cells come
+ * from the library (fdt_voronoi_compute), the text from
+ * src/io/write/cells.c; the files go through the run's commit set, so they
+ * are renamed with the mesh, all or none.
+ */
+#ifndef FDT_CLI_DUAL_H
+#define FDT_CLI_DUAL_H
+
+#include <stddef.h>
+
+#include "frontdt.h"
+
+typedef struct fdt_cli_dual {
+    const char *voronoi; /* --voronoi FILE, or NULL */
+    const char *format;  /* --voronoi-format, or NULL: CSV for a .csv file,
+                            else FDT_CELLS_DEFAULT_FORMAT */
+    const char *density; /* --density FILE, or NULL */
+    int box_given;       /* --box given */
+    double box[6];       /* xmin, ymin, zmin, xmax, ymax, zmax */
+} fdt_cli_dual;
+
+/* Is anything asked for? */
+int fdt_cli_dual_wanted(const fdt_cli_dual *d);
+
+/* --box "xmin,ymin,zmin,xmax,ymax,zmax": 0, or -1 (not six finite numbers
+ * with each min below its max). */
+int fdt_cli_parse_box(const char *s, double box[6]);
+
+/* Checks the options before the run: 0, or -1 with the reason in err (a
+ * usage error). */
+int fdt_cli_dual_check(const fdt_cli_dual *d, char *err, size_t errlen);
+
+/* Computes the cells of res (the result of triangulating xyz[0 .. 3n))
+ * and writes the files into the open commit set. 0, or an FDT_E* code
+ * with the message in err: FDT_EINVAL (a point outside --box), FDT_ENOMEM,
+ * FDT_EIO (a file could not be written), FDT_EINTERNAL. */
+int fdt_cli_dual_write(const fdt_cli_dual *d, fdt_result *res, const double *xyz, size_t n,
+                       char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,277 @@
+/* A convex cell cut from a box by half-spaces: see cell.h. */
+#include "geom/cell.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { IN = 0, ON = 1, OUT = 2 };
+
+/* Grows *pp (elements of `size` bytes, capacity *cap) to hold `need`. */
+static int grow(void *pp, int *cap, int need, size_t size)
+{
+    if (need <= *cap)
+        return 0;
+    int nc = *cap ? *cap : 16;
+    while (nc < need)
+        nc *= 2;
+    void **p = (void **)pp;
+    void *q = realloc(*p, (size_t)nc * size);
+    if (!q)
+        return -1;
+    *p = q;
+    *cap = nc;
+    return 0;
+}
+
+void fdt_cell_init(fdt_cell *c)
+{
+    memset(c, 0, sizeof *c);
+}
+
+void fdt_cell_free(fdt_cell *c)
+{
+    free(c->p);
+    free(c->ring);
+    free(c->f);
+    free(c->v);
+    free(c->ekey);
+    free(c->tring);
+    free(c->tf);
+    free(c->tp);
+    fdt_cell_init(c);
+}
+
+static double norm3(const double x[3])
+{
+    return sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+}
+
+int fdt_cell_box(fdt_cell *c, const double lo[3], const double hi[3])
+{
+    /* Vertex i has x = hi if bit 0, y = hi if bit 1, z = hi if bit 2;
+     * each ring counter-clockwise seen from outside. */
+    static const int faces[6][4] = {
+        {0, 4, 6, 2}, /* x-min */
+        {1, 3, 7, 5}, /* x-max */
+        {0, 1, 5, 4}, /* y-min */
+        {2, 6, 7, 3}, /* y-max */
+        {0, 2, 3, 1}, /* z-min */
+        {4, 5, 7, 6}, /* z-max */
+    };
+    if (grow(&c->p, &c->capp, 8, sizeof *c->p) || grow(&c->ring, &c->capring, 24, sizeof(int)) ||
+        grow(&c->f, &c->capf, 6, sizeof *c->f))
+        return -1;
+    c->radius = 0;
+    for (int i = 0; i < 8; i++) {
+        for (int k = 0; k < 3; k++)
+            c->p[i][k] = (i >> k) & 1 ? hi[k] : lo[k];
+        if (norm3(c->p[i]) > c->radius)
+            c->radius = norm3(c->p[i]);
+    }
+    c->np = 8;
+    for (int f = 0; f < 6; f++) {
+        c->f[f] = (fdt_cell_ring){4 * f, 4, FDT_CELL_WALL(f)};
+        memcpy(c->ring + 4 * f, faces[f], sizeof faces[f]);
+    }
+    c->nf = 6;
+    c->nring = 24;
+    return 0;
+}
+
+/* The point where the plane crosses edge (a, b), a inside and b outside:
+ * made once per edge and shared by the two faces along it, and computed
+ * from the inside end for both. -1 when out of memory. */
+static int crossing(fdt_cell *c, int a, int b)
+{
+    for (int i = 0; i < c->ne; i++)
+        if (c->ekey[3 * i] == a && c->ekey[3 * i + 1] == b)
+            return c->ekey[3 * i + 2];
+    if (grow(&c->ekey, &c->cape, 3 * (c->ne + 1), sizeof(int)) ||
+        grow(&c->p, &c->capp, c->np + 1, sizeof *c->p) ||
+        grow(&c->v, &c->capv, c->np + 1, sizeof *c->v))
+        return -1;
+    double t = c->v[a].s / (c->v[a].s - c->v[b].s);
+    int x = c->np++;
+    for (int k = 0; k < 3; k++)
+        c->p[x][k] = c->p[a][k] + t * (c->p[b][k] - c->p[a][k]);
+    c->v[x] = (fdt_cell_scratch){0, ON, -1, -1};
+    c->ekey[3 * c->ne] = a;
+    c->ekey[3 * c->ne + 1] = b;
+    c->ekey[3 * c->ne + 2] = x;
+    c->ne++;
+    return x;
+}
+
+static int push_ring(fdt_cell *c, int v)
+{
+    if (grow(&c->tring, &c->captring, c->ntring + 1, sizeof(int)))
+        return -1;
+    c->tring[c->ntring++] = v;
+    return 0;
+}
+
+static int push_face(fdt_cell *c, int start, long label)
+{
+    if (grow(&c->tf, &c->captf, c->ntf + 1, sizeof *c->tf))
+        return -1;
+    c->tf[c->ntf++] = (fdt_cell_ring){start, c->ntring - start, label};
+    return 0;
+}
+
+/* Face f cut by the plane: its kept part goes to the scratch faces, and
+ * its one crossing of the plane, entry -> exit as the cap runs it, into
+ * next[] (the face runs exit -> entry; the cap shares that edge, so it
+ * runs it the other way). Returns the entry, -1 for no crossing, -2 when
+ * out of memory, -3 for a second crossing (not convex). */
+static int cut_face(fdt_cell *c, const fdt_cell_ring *f)
+{
+    const int *r = c->ring + f->start;
+    int k = f->count, start = c->ntring, entry = -1, exitp = -1;
+    for (int j = 0; j < k; j++) {
+        int a = r[j], b = r[(j + 1) % k];
+        int sa = c->v[a].side, sb = c->v[b].side;
+        if (sa != OUT && push_ring(c, a))
+            return -2;
+        if (sa != OUT && sb == OUT) {
+            exitp = a;
+            if (sa == IN && ((exitp = crossing(c, a, b)) < 0 || push_ring(c, exitp)))
+                return -2;
+        } else if (sa == OUT && sb != OUT) {
+            entry = b;
+            if (sb == IN && ((entry = crossing(c, b, a)) < 0 || push_ring(c, entry)))
+                return -2;
+        }
+    }
+    if (c->ntring - start >= 3 && push_face(c, start, f->label))
+        return -2;
+    if (c->ntring - start < 3) /* nothing of the face is left */
+        c->ntring = start;
+    if (entry < 0 || exitp < 0 || entry == exitp)
+        return -1;
+    if (c->v[entry].next >= 0)
+        return -3;
+    c->v[entry].next = exitp;
+    return entry;
+}
+
+/* The new vertex array: the vertices the scratch faces use, renumbered in
+ * first use; the scratch faces become the cell's. */
+static int compact(fdt_cell *c)
+{
+    int m = 0;
+    for (int i = 0; i < c->np; i++)
+        c->v[i].map = -1;
+    for (int i = 0; i < c->ntring; i++)
+        if (c->v[c->tring[i]].map < 0)
+            c->v[c->tring[i]].map = m++;
+    if (grow(&c->tp, &c->captp, m, sizeof *c->tp) ||
+        grow(&c->ring, &c->capring, c->ntring, sizeof(int)) ||
+        grow(&c->f, &c->capf, c->ntf, sizeof *c->f))
+        return -1;
+    c->radius = 0;
+    for (int i = 0; i < c->np; i++)
+        if (c->v[i].map >= 0) {
+            memcpy(c->tp[c->v[i].map], c->p[i], sizeof c->tp[0]);
+            if (norm3(c->p[i]) > c->radius)
+                c->radius = norm3(c->p[i]);
+        }
+    double(*t)[3] = c->p; /* swap the vertex arrays */
+    int tc = c->capp;
+    c->p = c->tp;
+    c->capp = c->captp;
+    c->tp = t;
+    c->captp = tc;
+    c->np = m;
+    for (int i = 0; i < c->ntring; i++)
+        c->ring[i] = c->v[c->tring[i]].map;
+    memcpy(c->f, c->tf, (size_t)c->ntf * sizeof *c->f);
+    c->nring = c->ntring;
+    c->nf = c->ntf;
+    return 0;
+}
+
+int fdt_cell_cut(fdt_cell *c, const double n[3], double h, long label)
+{
+    /* Each vertex classed once; a crossing point is ON by construction. */
+    if (grow(&c->v, &c->capv, c->np, sizeof *c->v))
+        return -1;
+    double eps = FDT_CELL_TOL * norm3(n) * c->radius;
+    int nout = 0, nin = 0;
+    for (int i = 0; i < c->np; i++) {
+        double s = n[0] * c->p[i][0] + n[1] * c->p[i][1] + n[2] * c->p[i][2] - h;
+        int side = s > eps ? OUT : s < -eps ? IN : ON;
+        c->v[i] = (fdt_cell_scratch){s, side, -1, -1};
+        nout += side == OUT;
+        nin += side == IN;
+    }
+    if (nout == 0)
+        return 0;
+    if (nin == 0)
+        return -2;
+
+    c->ne = c->ntring = c->ntf = 0;
+    int first = -1, edges = 0;
+    for (int f = 0; f < c->nf; f++) {
+        int e = cut_face(c, &c->f[f]);
+        if (e == -2)
+            return -1;
+        if (e == -3)
+            return -2;
+        if (e >= 0) {
+            edges++;
+            if (first < 0)
+                first = e;
+        }
+    }
+    /* The cap: from an entry, round the next[] chain to it again. */
+    if (edges >= 3) {
+        int start = c->ntring, v = first, steps = 0;
+        do {
+            if (push_ring(c, v))
+                return -1;
+            v = c->v[v].next;
+            if (v < 0 || ++steps > edges)
+                return -2; /* an open chain: not a convex cell */
+        } while (v != first);
+        if (push_face(c, start, label))
+            return -1;
+    }
+    return compact(c) ? -1 : 1;
+}
+
+void fdt_cell_measure(const fdt_cell *c, double *volume, double *area, double centroid[3],
+                      fdt_cell_face *faces)
+{
+    double vol = 0, ar = 0, mom[3] = {0, 0, 0};
+    for (int f = 0; f < c->nf; f++) {
+        const int *r = c->ring + c->f[f].start;
+        int k = c->f[f].count;
+        const double *p0 = c->p[r[0]];
+        double nv[3] = {0, 0, 0};
+        for (int j = 1; j + 1 < k; j++) {
+            const double *p1 = c->p[r[j]], *p2 = c->p[r[j + 1]];
+            double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+            double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+            nv[0] += u[1] * w[2] - u[2] * w[1];
+            nv[1] += u[2] * w[0] - u[0] * w[2];
+            nv[2] += u[0] * w[1] - u[1] * w[0];
+            /* The tet (site, p0, p1, p2), the site at the origin: six
+             * times its volume, and its centroid times 4. */
+            double v6 = p0[0] * (p1[1] * p2[2] - p1[2] * p2[1]) -
+                        p0[1] * (p1[0] * p2[2] - p1[2] * p2[0]) +
+                        p0[2] * (p1[0] * p2[1] - p1[1] * p2[0]);
+            vol += v6;
+            for (int d = 0; d < 3; d++)
+                mom[d] += v6 * (p0[d] + p1[d] + p2[d]);
+        }
+        double a = 0.5 * norm3(nv);
+        ar += a;
+        if (faces)
+            faces[f] = (fdt_cell_face){c->f[f].label, a};
+    }
+    *volume = vol / 6;
+    *area = ar;
+    for (int d = 0; d < 3; d++)
+        centroid[d] = vol != 0 ? mom[d] / (4 * vol) : 0;
+}

@@ -1,0 +1,84 @@
+/* A convex cell cut from a box by half-spaces (src/mesh/voronoi.c, issue 32).
+ *
+ * The Voronoi cell of a site whose cell leaves the box (a hull point, or
+ * one with a Voronoi vertex outside the box) is computed as voro++ computes
+ * every cell: start from the box and cut it by the bisector plane of each
+ * Delaunay neighbour. Coordinates are relative to the site, which lies in
+ * the cell (a cut never removes the origin).
+ *
+ * The polyhedron is a vertex array and a list of faces, each a ring of
+ * vertex indices counter-clockwise seen from outside, with a label: the
+ * neighbour whose bisector made it, or a wall (FDT_CELL_WALL(k) for
+ * k = 0..5: x-min, x-max, y-min, y-max, z-min, z-max, voro++'s -1..-6).
+ *
+ * A vertex within FDT_CELL_TOL of a cutting plane, relative to the cell's
+ * size, counts as on it: it stays, and no sliver of area 2^-40 of the
+ * cell's is made (voro++ has the same kind of tolerance). Not thread-safe
+ * per object; one object per thread, reused from cell to cell.
+ */
+#ifndef FDT_CELL_H
+#define FDT_CELL_H
+
+#include <stddef.h>
+
+#define FDT_CELL_WALL(k) (-1 - (k))
+#define FDT_CELL_TOL 0x1p-40
+
+typedef struct fdt_cell_ring {
+    int start, count; /* ring[start .. start + count) */
+    long label;       /* neighbour id, or FDT_CELL_WALL(k) */
+} fdt_cell_ring;
+
+typedef struct fdt_cell_scratch {
+    double s;            /* signed distance to the cutting plane */
+    int side, next, map; /* class; the cap's next vertex; compaction */
+} fdt_cell_scratch;
+
+typedef struct fdt_cell {
+    double (*p)[3];     /* vertices (owned) */
+    int np, capp;
+    int *ring;          /* the faces' rings, one after another (owned) */
+    int nring, capring;
+    fdt_cell_ring *f;   /* faces (owned) */
+    int nf, capf;
+    double radius;      /* the largest |vertex|, for the tolerance */
+    /* scratch, kept from call to call (owned) */
+    fdt_cell_scratch *v;
+    int capv;
+    int *ekey;          /* this cut's crossing points: (in, out, index) */
+    int ne, cape;
+    int *tring;         /* the faces being built */
+    int ntring, captring;
+    fdt_cell_ring *tf;
+    int ntf, captf;
+    double (*tp)[3];    /* vertices being compacted */
+    int captp;
+} fdt_cell;
+
+/* One face of a measured cell. */
+typedef struct fdt_cell_face {
+    long label;
+    double area;
+} fdt_cell_face;
+
+void fdt_cell_init(fdt_cell *c);
+void fdt_cell_free(fdt_cell *c);
+
+/* Makes c the box [lo, hi] (coordinates relative to the site, lo < 0 < hi
+ * in each coordinate up to the site lying on a wall: lo <= 0 <= hi).
+ * Returns 0, or -1 when out of memory. */
+int fdt_cell_box(fdt_cell *c, const double lo[3], const double hi[3]);
+
+/* Keeps the part of c where n . x <= h, the new face labelled `label`.
+ * Returns 1 when the cut removed something, 0 when it did not, -1 when
+ * out of memory, -2 when the cut would leave no cell (never for h > 0 and
+ * a cell containing the origin). */
+int fdt_cell_cut(fdt_cell *c, const double n[3], double h, long label);
+
+/* The cell's volume, surface area, centroid (relative to the site), and
+ * its faces (labels and areas, faces of zero area included) into
+ * faces[0 .. c->nf) when faces is not NULL. */
+void fdt_cell_measure(const fdt_cell *c, double *volume, double *area, double centroid[3],
+                      fdt_cell_face *faces);
+
+#endif

@@ -1,0 +1,38 @@
+/*
+ * The Voronoi cells as text (issue 32; the CLI's --voronoi and --density):
+ * one line a point, in input order, from an fdt_voronoi (include/frontdt.h).
+ *
+ * A --voronoi-format string is voro++'s custom output (its -c option):
+ * text, with these codes replaced for each point (doc/reference.md):
+ *   %i the point's index (0-based input order)  %x %y %z %q its coordinates
+ *   %v volume  %F surface area  %s number of faces  %n neighbours (walls
+ *   -1..-6)  %f the faces' areas, in %n's order  %c centroid relative to
+ *   the point  %C centroid  %d DTFE density  %h flags (1 clipped, 2 hull,
+ *   4 merged duplicate)  %% a percent sign
+ * Numbers are written with 17 significant digits (they read back exactly).
+ */
+#ifndef FDT_CELLS_H
+#define FDT_CELLS_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "frontdt.h"
+
+/* The format used when none is given. */
+#define FDT_CELLS_DEFAULT_FORMAT "%i %q %v %F %s %n %f"
+
+/* 0 when fmt is a valid format; else -1 and a message in err. *needs_nbrs
+ * (may be NULL) says whether it lists neighbours (%n, %f). */
+int fdt_cells_format_check(const char *fmt, int *needs_nbrs, char *err, size_t errlen);
+
+/* Writes the cells in format fmt (checked), or as CSV (fmt NULL: a header
+ * line, then id,x,y,z,volume,area,faces,cx,cy,cz,density,flags). Returns 0,
+ * or the errno of a failed write (the stream's error flag set). */
+int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *xyz);
+
+/* Writes the DTFE density of each point: "density flags" a line (flags as
+ * %h: a hull point's density counts only the tets it has). */
+int fdt_wr_density(FILE *f, const fdt_voronoi *v);
+
+#endif

@@ -1,0 +1,316 @@
+/*
+ * Tests for src/mesh/voronoi.c (fdt_voronoi_compute), against facts that
+ * do not come from the module:
+ *  - a cubic lattice (every point cospherical with many others): each
+ *    cell is a unit cube cut by the box, so volumes 1, 1/2, 1/4, 1/8,
+ *    areas and face counts known, the diagonal edges' faces of zero area;
+ *  - uniform and clustered points in a box: the volumes add up to the
+ *    box's, each interior face has one area seen from both sides, the wall
+ *    faces add up to the box's surface, and every cell summed from its tets
+ *    equals the same cell cut from the box by its neighbours' bisectors
+ *    (src/geom/cell.c, the other method) to 1e-10;
+ *  - the same bits for a shuffled input, and for 1 and 3 threads;
+ *  - DTFE: the points' tet volumes add up to 4 times the hull's volume;
+ *  - refusals: a point outside a given box, a streamed result.
+ * voro++ itself is compared in tests/voronoi_voro.py (CLI, end to end).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "frontdt.h"
+#include "geom/cell.h"
+#include "testutil.h"
+
+static fdt_result *triangulate(const double *xyz, size_t n, int threads)
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.n_threads = threads;
+    fdt_context *ctx = NULL;
+    CHECK(fdt_open(&ctx, &s) == FDT_OK);
+    fdt_result *r = NULL;
+    CHECK(fdt_triangulate(ctx, xyz, n, &r) == FDT_OK);
+    fdt_close(&ctx);
+    return r;
+}
+
+static fdt_voronoi *cells(fdt_result *r, const double *xyz, size_t n, const double *box)
+{
+    fdt_voronoi_options o;
+    fdt_default_voronoi_options(&o);
+    o.neighbors = 1;
+    if (box) {
+        o.box_given = 1;
+        memcpy(o.box, box, sizeof o.box);
+    }
+    fdt_voronoi *v = NULL;
+    char diag[256];
+    int err = fdt_voronoi_compute(r, xyz, n, &o, &v, diag, sizeof diag);
+    if (err)
+        fprintf(stderr, "fdt_voronoi_compute: %s: %s\n", fdt_strerror(err), diag);
+    CHECK(err == FDT_OK);
+    return v;
+}
+
+static int close_to(double a, double b, double rel)
+{
+    return fabs(a - b) <= rel * fmax(fabs(a), fabs(b)) + 1e-300;
+}
+
+/* k^3 lattice points 0..k-1: cell (i,j,l) is a unit cube halved on each
+ * wall it touches. */
+static void test_lattice(int k)
+{
+    size_t n = (size_t)k * k * k;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    CHECK(xyz);
+    for (size_t i = 0; i < n; i++) {
+        xyz[3 * i] = (double)(i % (size_t)k);
+        xyz[3 * i + 1] = (double)(i / (size_t)k % (size_t)k);
+        xyz[3 * i + 2] = (double)(i / ((size_t)k * k));
+    }
+    fdt_result *r = triangulate(xyz, n, 1);
+    fdt_voronoi *v = cells(r, xyz, n, NULL);
+    const double *vol = fdt_voronoi_volumes(v), *area = fdt_voronoi_areas(v);
+    const int32_t *nf = fdt_voronoi_num_faces(v);
+    double sum = 0;
+    for (size_t i = 0; i < n; i++) {
+        double side[3];
+        for (int d = 0; d < 3; d++) {
+            double c = xyz[3 * i + d];
+            side[d] = c == 0 || c == k - 1 ? 0.5 : 1.0;
+        }
+        double want_v = side[0] * side[1] * side[2];
+        double want_a = 2 * (side[0] * side[1] + side[1] * side[2] + side[0] * side[2]);
+        EXPECTF(close_to(vol[i], want_v, 1e-12), "lattice %d point %zu volume %.17g, want %g", k,
+                i, vol[i], want_v);
+        EXPECTF(close_to(area[i], want_a, 1e-12), "lattice %d point %zu area %.17g, want %g", k,
+                i, area[i], want_a);
+        EXPECTF(nf[i] == 6, "lattice %d point %zu has %d faces", k, i, (int)nf[i]);
+        size_t cnt;
+        const fdt_vid *ids;
+        const double *fa;
+        CHECK(fdt_voronoi_neighbors(v, (fdt_vid)i, &cnt, &ids, &fa) == FDT_OK);
+        EXPECT(cnt == 6);
+        sum += vol[i];
+    }
+    EXPECTF(close_to(sum, pow(k - 1, 3), 1e-13), "lattice %d volumes add up to %.17g", k, sum);
+    /* Interior points have Delaunay neighbours across face and body
+     * diagonals whose Voronoi faces have no area. */
+    if (k > 2)
+        EXPECT(fdt_voronoi_zero_faces(v) > 0);
+    fdt_voronoi_free(&v);
+    fdt_result_free(&r);
+    free(xyz);
+}
+
+/* Point i's cell cut from the box, the other method. */
+static void cut_cell(const double *xyz, fdt_result *r, fdt_vid i, const double box[6],
+                     double *vol, double *area)
+{
+    fdt_cell c;
+    fdt_cell_init(&c);
+    const double *p = xyz + 3 * (size_t)i;
+    double lo[3], hi[3];
+    for (int d = 0; d < 3; d++) {
+        lo[d] = box[d] - p[d];
+        hi[d] = box[d + 3] - p[d];
+    }
+    CHECK(fdt_cell_box(&c, lo, hi) == 0);
+    size_t cnt;
+    const fdt_vid *ids;
+    CHECK(fdt_result_vertex_neighbors(r, i, &cnt, &ids) == FDT_OK);
+    for (size_t e = 0; e < cnt; e++) {
+        double nrm[3];
+        for (int d = 0; d < 3; d++)
+            nrm[d] = xyz[3 * (size_t)ids[e] + d] - p[d];
+        CHECK(fdt_cell_cut(&c, nrm, 0.5 * (nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]),
+                           ids[e]) >= 0);
+    }
+    double cen[3];
+    fdt_cell_measure(&c, vol, area, cen, NULL);
+    fdt_cell_free(&c);
+}
+
+static double *random_points(size_t n, int clustered, uint64_t seed)
+{
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    CHECK(xyz);
+    uint64_t s = seed;
+    for (size_t i = 0; i < n; i++) {
+        if (!clustered) {
+            for (int d = 0; d < 3; d++)
+                xyz[3 * i + d] = test_unif(&s);
+        } else {
+            /* 8 tight clusters and a uniform background. */
+            int c = (int)(test_rand64(&s) % 10);
+            for (int d = 0; d < 3; d++) {
+                double u = test_unif(&s);
+                xyz[3 * i + d] = c < 8 ? 0.2 + 0.6 * ((c >> d) & 1) + 0.05 * (u - 0.5) : u;
+            }
+        }
+    }
+    return xyz;
+}
+
+static void test_box_sums(size_t n, int clustered, uint64_t seed)
+{
+    double *xyz = random_points(n, clustered, seed);
+    const double box[6] = {-0.25, 0, -0.5, 1, 1.5, 1};
+    double bvol = 1.25 * 1.5 * 1.5, bsurf = 2 * (1.25 * 1.5 + 1.5 * 1.5 + 1.25 * 1.5);
+    fdt_result *r = triangulate(xyz, n, 1);
+    fdt_voronoi *v = cells(r, xyz, n, box);
+    const double *vol = fdt_voronoi_volumes(v), *area = fdt_voronoi_areas(v);
+    const double *cen = fdt_voronoi_centroids(v);
+    const uint8_t *fl = fdt_voronoi_flags(v);
+    double sum = 0, walls = 0;
+    size_t summed = 0, clipped = 0;
+    for (size_t i = 0; i < n; i++) {
+        sum += vol[i];
+        EXPECT(vol[i] > 0);
+        for (int d = 0; d < 3; d++)
+            EXPECT(cen[3 * i + d] >= box[d] && cen[3 * i + d] <= box[d + 3]);
+        size_t cnt;
+        const fdt_vid *ids;
+        const double *fa;
+        CHECK(fdt_voronoi_neighbors(v, (fdt_vid)i, &cnt, &ids, &fa) == FDT_OK);
+        double asum = 0;
+        for (size_t e = 0; e < cnt; e++) {
+            asum += fa[e];
+            if (ids[e] < 0) {
+                walls += fa[e];
+                continue;
+            }
+            /* The same face seen from the other side. */
+            size_t c2;
+            const fdt_vid *i2;
+            const double *f2;
+            CHECK(fdt_voronoi_neighbors(v, ids[e], &c2, &i2, &f2) == FDT_OK);
+            size_t m = 0;
+            while (m < c2 && i2[m] != (fdt_vid)i)
+                m++;
+            double scale = fmax(area[i], area[ids[e]]);
+            EXPECTF(m < c2 && fabs(fa[e] - f2[m]) <= 1e-10 * scale,
+                    "face %zu-%d: area %.17g, from the other side %.17g", i, (int)ids[e], fa[e],
+                    m < c2 ? f2[m] : -1.0);
+        }
+        EXPECTF(close_to(asum, area[i], 1e-12), "point %zu: faces add to %.17g, area %.17g", i,
+                asum, area[i]);
+        double cv, ca;
+        cut_cell(xyz, r, (fdt_vid)i, box, &cv, &ca);
+        EXPECTF(close_to(cv, vol[i], 1e-10) && close_to(ca, area[i], 1e-10),
+                "point %zu (%s): volume %.17g area %.17g, cut from the box %.17g %.17g", i,
+                fl[i] & FDT_CELL_CLIPPED ? "clipped" : "summed", vol[i], area[i], cv, ca);
+        if (fl[i] & FDT_CELL_CLIPPED)
+            clipped++;
+        else
+            summed++;
+    }
+    EXPECT(summed > n / 4 && clipped > 0);
+    EXPECTF(close_to(sum, bvol, 1e-12), "volumes add up to %.17g, box %.17g", sum, bvol);
+    EXPECTF(close_to(walls, bsurf, 1e-12), "wall faces add up to %.17g, box %.17g", walls, bsurf);
+    /* DTFE: each tet's volume goes to its 4 points. */
+    const double *rho = fdt_voronoi_densities(v);
+    double dsum = 0, tsum = 0;
+    for (size_t i = 0; i < n; i++)
+        dsum += 4 / rho[i];
+    const fdt_vid *t = fdt_result_tets(r);
+    for (size_t j = 0; j < fdt_result_num_tets(r); j++) {
+        const double *a = xyz + 3 * (size_t)t[4 * j];
+        double e[3][3];
+        for (int m = 0; m < 3; m++)
+            for (int d = 0; d < 3; d++)
+                e[m][d] = xyz[3 * (size_t)t[4 * j + 1 + m] + d] - a[d];
+        tsum += (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                 e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                 e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6;
+    }
+    EXPECTF(close_to(dsum, 4 * tsum, 1e-12), "DTFE volumes %.17g, 4 x tets %.17g", dsum, 4 * tsum);
+    fdt_voronoi_free(&v);
+    fdt_result_free(&r);
+    free(xyz);
+}
+
+/* The same bits for a shuffled input and for 1 and 3 threads. */
+static void test_same_bits(size_t n)
+{
+    double *xyz = random_points(n, 1, 7);
+    double *sh = malloc(3 * n * sizeof *sh);
+    size_t *perm = malloc(n * sizeof *perm);
+    CHECK(sh && perm);
+    uint64_t s = 99;
+    for (size_t i = 0; i < n; i++)
+        perm[i] = i;
+    for (size_t i = n - 1; i > 0; i--) {
+        size_t j = (size_t)(test_rand64(&s) % (i + 1)), t = perm[i];
+        perm[i] = perm[j];
+        perm[j] = t;
+    }
+    for (size_t i = 0; i < n; i++)
+        memcpy(sh + 3 * i, xyz + 3 * perm[i], 3 * sizeof *sh);
+    fdt_result *r1 = triangulate(xyz, n, 1), *r3 = triangulate(xyz, n, 3);
+    fdt_result *rs = triangulate(sh, n, 2);
+    fdt_voronoi *v1 = cells(r1, xyz, n, NULL), *v3 = cells(r3, xyz, n, NULL);
+    fdt_voronoi *vs = cells(rs, sh, n, NULL);
+    const double *a1 = fdt_voronoi_volumes(v1), *a3 = fdt_voronoi_volumes(v3);
+    const double *as = fdt_voronoi_volumes(vs);
+    const double *c1 = fdt_voronoi_centroids(v1), *cs = fdt_voronoi_centroids(vs);
+    size_t diff3 = 0, diffs = 0;
+    for (size_t i = 0; i < n; i++) {
+        diff3 += memcmp(&a1[i], &a3[i], sizeof a1[i]) != 0;
+        diff3 += memcmp(&fdt_voronoi_areas(v1)[i], &fdt_voronoi_areas(v3)[i], sizeof(double)) != 0;
+        diffs += memcmp(&a1[perm[i]], &as[i], sizeof a1[i]) != 0;
+        diffs += memcmp(c1 + 3 * perm[i], cs + 3 * i, 3 * sizeof *c1) != 0;
+        diffs += fdt_voronoi_num_faces(v1)[perm[i]] != fdt_voronoi_num_faces(vs)[i];
+    }
+    EXPECTF(diff3 == 0, "%zu values differ between 1 and 3 threads", diff3);
+    EXPECTF(diffs == 0, "%zu values differ for the shuffled input", diffs);
+    fdt_voronoi_free(&v1);
+    fdt_voronoi_free(&v3);
+    fdt_voronoi_free(&vs);
+    fdt_result_free(&r1);
+    fdt_result_free(&r3);
+    fdt_result_free(&rs);
+    free(xyz);
+    free(sh);
+    free(perm);
+}
+
+static void test_refusals(void)
+{
+    size_t n = 200;
+    double *xyz = random_points(n, 0, 3);
+    fdt_result *r = triangulate(xyz, n, 1);
+    fdt_voronoi_options o;
+    fdt_default_voronoi_options(&o);
+    o.box_given = 1;
+    const double box[6] = {0, 0, 0, 1, 1, 0.5};
+    memcpy(o.box, box, sizeof box);
+    fdt_voronoi *v = NULL;
+    char diag[256];
+    EXPECT(fdt_voronoi_compute(r, xyz, n, &o, &v, diag, sizeof diag) == FDT_EINVAL);
+    EXPECTF(v == NULL && strstr(diag, "outside the box"), "diag: %s", diag);
+    o.box[5] = -1;
+    EXPECT(fdt_voronoi_compute(r, xyz, n, &o, &v, diag, sizeof diag) == FDT_EINVAL);
+    EXPECTF(strstr(diag, "box is empty"), "diag: %s", diag);
+    EXPECT(fdt_voronoi_compute(r, xyz, n - 1, NULL, &v, diag, sizeof diag) == FDT_EINVAL);
+    size_t cnt;
+    const fdt_vid *ids;
+    const double *fa;
+    CHECK(fdt_voronoi_compute(r, xyz, n, NULL, &v, NULL, 0) == FDT_OK);
+    EXPECT(fdt_voronoi_neighbors(v, 0, &cnt, &ids, &fa) == FDT_EINVAL); /* not kept */
+    fdt_voronoi_free(&v);
+    fdt_result_free(&r);
+    free(xyz);
+}
+
+int main(void)
+{
+    test_lattice(2);
+    test_lattice(5);
+    test_box_sums(3000, 0, 1);
+    test_box_sums(3000, 1, 2);
+    test_same_bits(4000);
+    test_refusals();
+    return test_report("voronoi");
+}

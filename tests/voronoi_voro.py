@@ -1,0 +1,235 @@
+#!/usr/bin/env python3
+"""End-to-end checks of the Voronoi cells (issue 32) through the CLI.
+
+Usage: voronoi_voro.py FRONTDT GEN_POINTS VORO_REF|none SCRATCH
+
+1. Against voro++ (tests/voro_ref.cpp, Debian's libvoro++): for uniform,
+   clustered (gaussian), lattice, rotated and skewed lattice and cylinder
+   points in a box 1 % larger than their bounding box, every cell's volume,
+   surface area and centroid, and every face's area, agree to 1e-10 of
+   the cell's size (volume, area, cube root of the volume); the
+   neighbour lists are equal but for faces of area at most 1e-10 of their
+   cell's surface on either side (zero-area faces of degenerate points:
+   counted and printed); the volumes add up to the box's to 1e-12.
+2. The same bytes from --voronoi at 1 and 3 threads and in message mode,
+   and, row for row, for a shuffled input.
+3. DTFE: --density equals 4 / (the sum of the volumes of each point's tets)
+   computed here from the .tets output, to 1e-12.
+4. Refusals: --box not holding every point (exit 1, the point named),
+   --voronoi-format with a bad code, --voronoi with --stream.
+"""
+import os
+import random
+import subprocess
+import sys
+
+FRONTDT, GEN, VORO, SCRATCH = sys.argv[1:5]
+FMT = "%i %v %F %s %C %h|%n|%f"
+failures = []
+
+
+def fail(msg):
+    failures.append(msg)
+    if len(failures) <= 30:
+        print("FAIL:", msg)
+
+
+def run(args, **kw):
+    return subprocess.run([FRONTDT] + args, capture_output=True, text=True, **kw)
+
+
+def read_xyz(path):
+    pts = []
+    for line in open(path):
+        f = line.split()
+        if len(f) >= 3 and not f[0][0].isalpha():
+            pts.append(tuple(float(x) for x in f[:3]))
+    return pts
+
+
+def write_xyz(path, pts):
+    with open(path, "w") as f:
+        for p in pts:
+            f.write("%.17g %.17g %.17g\n" % p)
+
+
+def box_of(pts):
+    lo = [min(p[k] for p in pts) for k in range(3)]
+    hi = [max(p[k] for p in pts) for k in range(3)]
+    ext = [h - l for l, h in zip(lo, hi)]
+    return [l - 0.01 * e for l, e in zip(lo, ext)] + [h + 0.01 * e for h, e in zip(hi, ext)]
+
+
+def cells(path, box, extra=()):
+    out = os.path.join(SCRATCH, "cells.txt")
+    r = run([path, "-q", "--box", ",".join("%.17g" % b for b in box), "--voronoi", out,
+             "--voronoi-format", FMT] + list(extra))
+    if r.returncode != 0:
+        fail("frontdt %s: exit %d: %s" % (path, r.returncode, r.stderr.strip()))
+        return None
+    return open(out).read()
+
+
+def parse_mine(text):
+    rows = []
+    for line in text.splitlines():
+        head, nb, ar = line.split("|")
+        h = head.split()
+        rows.append({"v": float(h[1]), "F": float(h[2]), "s": int(h[3]),
+                     "C": [float(x) for x in h[4:7]], "flags": int(h[7]),
+                     "faces": dict(zip(map(int, nb.split()), map(float, ar.split())))})
+    return rows
+
+
+def parse_ref(text):
+    rows = []
+    for line in text.splitlines():
+        if "|" not in line:
+            rows.append(None)
+            continue
+        head, rest = line.split("|")
+        h, r = head.split(), rest.split()
+        rows.append({"v": float(h[1]), "F": float(h[2]), "C": [float(x) for x in h[4:7]],
+                     "faces": dict(zip(map(int, r[0::2]), map(float, r[1::2])))})
+    return rows
+
+
+def against_voro(family, n):
+    path = os.path.join(SCRATCH, family + ".xyz")
+    subprocess.run([GEN, family, str(n), "1", path], check=True)
+    pts = read_xyz(path)
+    box = box_of(pts)
+    text = cells(path, box)
+    if text is None:
+        return
+    mine = parse_mine(text)
+    ref = parse_ref(subprocess.run([VORO, ",".join("%.17g" % b for b in box)],
+                                   input="".join("%.17g %.17g %.17g\n" % p for p in pts),
+                                   capture_output=True, text=True, check=True).stdout)
+    worst = [0.0] * 4
+    zero = compared = 0
+    total = 0.0
+    for i, (m, r) in enumerate(zip(mine, ref)):
+        total += m["v"]
+        if m["flags"] & 4 or r is None:
+            continue
+        compared += 1
+        scale = r["v"] ** (1.0 / 3)
+        errs = [abs(m["v"] - r["v"]) / r["v"], abs(m["F"] - r["F"]) / r["F"],
+                max(abs(a - b) for a, b in zip(m["C"], r["C"])) / scale, 0.0]
+        real_r = {k: a for k, a in r["faces"].items() if a > 1e-10 * r["F"]}
+        real_m = {k: a for k, a in m["faces"].items() if a > 1e-10 * m["F"]}
+        zero += len(r["faces"]) - len(real_r) + len(m["faces"]) - len(real_m)
+        if set(real_r) != set(real_m):
+            fail("%s point %d: neighbours differ from voro++'s: %s" %
+                 (family, i, sorted(set(real_r) ^ set(real_m))))
+        else:
+            errs[3] = max([abs(real_r[k] - real_m[k]) / r["F"] for k in real_r] + [0.0])
+        if m["s"] != len(m["faces"]):
+            fail("%s point %d: %%s %d but %d neighbours" % (family, i, m["s"], len(m["faces"])))
+        for k in range(4):
+            worst[k] = max(worst[k], errs[k])
+    bvol = (box[3] - box[0]) * (box[4] - box[1]) * (box[5] - box[2])
+    print("%-12s %6d points: %d cells compared with voro++; worst relative differences: volume "
+          "%.1e, area %.1e, centroid %.1e, face %.1e; zero-area faces excepted %d; volumes add "
+          "to the box's %+.1e" % (family, n, compared, worst[0], worst[1], worst[2], worst[3],
+                                  zero, total / bvol - 1))
+    if compared < len(pts) * 0.9:
+        fail("%s: only %d of %d cells compared" % (family, compared, len(pts)))
+    if max(worst) > 1e-10:
+        fail("%s: a difference over 1e-10: %s" % (family, worst))
+    if abs(total / bvol - 1) > 1e-12:
+        fail("%s: the volumes add up to %.17g, the box holds %.17g" % (family, total, bvol))
+
+
+def same_bits():
+    path = os.path.join(SCRATCH, "bits.xyz")
+    subprocess.run([GEN, "clusters", "4000", "5", path], check=True)
+    pts = read_xyz(path)
+    box = box_of(pts)
+    base = cells(path, box, ["-t", "1"])
+    for extra in (["-t", "3"], ["-t", "2", "--mode", "message"], ["-t", "2", "--mode", "shared"]):
+        if cells(path, box, extra) != base:
+            fail("--voronoi differs between -t 1 and %s" % " ".join(extra))
+    perm = list(range(len(pts)))
+    random.Random(3).shuffle(perm)
+    spath = os.path.join(SCRATCH, "shuffled.xyz")
+    write_xyz(spath, [pts[p] for p in perm])
+    shuffled = cells(spath, box, ["-t", "2"])
+    if base is None or shuffled is None:
+        return
+    rows = base.splitlines()
+    differ = 0
+    for j, line in enumerate(shuffled.splitlines()):
+        # The values but the id and the neighbour ids (renumbered).
+        a = rows[perm[j]].split("|")
+        b = line.split("|")
+        if a[0].split()[1:] != b[0].split()[1:] or sorted(a[2].split()) != sorted(b[2].split()):
+            differ += 1
+    if differ:
+        fail("%d cells differ for the shuffled input" % differ)
+    print("same bits: 1, 3 threads, message and shared modes, and a shuffled input (%d points)"
+          % len(pts))
+
+
+def dtfe():
+    path = os.path.join(SCRATCH, "dtfe.xyz")
+    subprocess.run([GEN, "gaussian", "3000", "2", path], check=True)
+    pts = read_xyz(path)
+    tets = os.path.join(SCRATCH, "dtfe.tets")
+    dens = os.path.join(SCRATCH, "dtfe.txt")
+    r = run([path, "-q", "-o", tets, "--density", dens])
+    if r.returncode != 0:
+        fail("--density: exit %d: %s" % (r.returncode, r.stderr.strip()))
+        return
+    vol = [0.0] * len(pts)
+    for line in open(tets):
+        ids = [int(x) for x in line.split()]
+        a, b, c, d = (pts[i] for i in ids)
+        u = [b[k] - a[k] for k in range(3)]
+        v = [c[k] - a[k] for k in range(3)]
+        w = [d[k] - a[k] for k in range(3)]
+        det = (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+               u[2] * (v[0] * w[1] - v[1] * w[0]))
+        for i in ids:
+            vol[i] += abs(det) / 6
+    worst = 0.0
+    for i, line in enumerate(open(dens)):
+        rho, flags = line.split()
+        want = 4 / vol[i]
+        worst = max(worst, abs(float(rho) - want) / want)
+    print("DTFE: --density against the .tets: worst relative difference %.1e" % worst)
+    if worst > 1e-12:
+        fail("DTFE densities differ from the .tets' by %.3g" % worst)
+
+
+def refusals():
+    path = os.path.join(SCRATCH, "ref.xyz")
+    subprocess.run([GEN, "uniform", "500", "1", path], check=True)
+    out = os.path.join(SCRATCH, "never.txt")
+    cases = [
+        (["--box", "0,0,0,1,1,0.5", "--voronoi", out], 1, "outside the box"),
+        (["--voronoi", out, "--voronoi-format", "%i %Q"], 1, "'%Q'"),
+        (["--voronoi", out, "--stream"], 1, "need the whole mesh"),
+        (["--box", "0,0,0,1,1"], 1, "--box wants six"),
+        (["--voronoi-format", "%v"], 1, "needs --voronoi"),
+    ]
+    for args, code, text in cases:
+        r = run([path, "-q"] + args)
+        if r.returncode != code or text not in r.stderr:
+            fail("%s: exit %d (want %d), stderr %r (want %r)" % (args, r.returncode, code,
+                                                                  r.stderr.strip(), text))
+        if os.path.exists(out):
+            fail("%s left %s" % (args, out))
+
+
+if VORO != "none":
+    for fam in ("uniform", "gaussian", "lattice", "rotlattice", "skewlattice", "cylinder"):
+        against_voro(fam, 3000)
+else:
+    print("voro++ not found: the comparison with voro++ is skipped")
+same_bits()
+dtfe()
+refusals()
+print("%d failures" % len(failures))
+sys.exit(1 if failures else 0)
