@@ -680,6 +680,8 @@ typedef struct fdt_voronoi_options {
     int box_given;      /* nonzero: clip by box, not the points' bounding box */
     double box[6];      /* xmin, ymin, zmin, xmax, ymax, zmax */
     int neighbors;      /* nonzero: keep each cell's neighbours and face areas */
+    int threads;        /* 0: one per physical core (as fdt_settings.n_threads);
+                           the values do not depend on it */
 } fdt_voronoi_options;
 
 FDT_API int fdt_default_voronoi_options_sized(fdt_voronoi_options *o, size_t struct_size);
@@ -702,7 +704,7 @@ static inline void fdt_default_voronoi_options(fdt_voronoi_options *o)
  * (fdt_result_vertex_neighbors), nothing else changes. o may be NULL (the
  * defaults). *out is owned by the caller (fdt_voronoi_free). FDT_EINVAL
  * for a NULL argument, a streamed result (no tets kept), n not r's point
- * count, an empty or inverted box, or a point outside the given box (diag,
+ * count, threads outside 0..1024, an empty or inverted box, or a point outside the given box (diag,
  * when not NULL, says which; it is written in every case, "" on success);
  * FDT_ENOMEM; FDT_EINTERNAL when a cell could not be cut (a bug).
  */

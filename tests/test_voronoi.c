@@ -9,7 +9,8 @@
  *    faces add up to the box's surface, and every cell summed from its tets
  *    equals the same cell cut from the box by its neighbours' bisectors
  *    (src/geom/cell.c, the other method) to 1e-10;
- *  - the same bits for a shuffled input, and for 1 and 3 threads;
+ *  - the same bits for a shuffled input, and for meshes and cells made on
+ *    1, 3 and 7 threads;
  *  - DTFE: the points' tet volumes add up to 4 times the hull's volume;
  *  - refusals: a point outside a given box, a streamed result.
  * voro++ itself is compared in tests/voronoi_voro.py (CLI, end to end).
@@ -34,11 +35,13 @@ static fdt_result *triangulate(const double *xyz, size_t n, int threads)
     return r;
 }
 
-static fdt_voronoi *cells(fdt_result *r, const double *xyz, size_t n, const double *box)
+static fdt_voronoi *cells_t(fdt_result *r, const double *xyz, size_t n, const double *box,
+                            int threads)
 {
     fdt_voronoi_options o;
     fdt_default_voronoi_options(&o);
     o.neighbors = 1;
+    o.threads = threads;
     if (box) {
         o.box_given = 1;
         memcpy(o.box, box, sizeof o.box);
@@ -50,6 +53,11 @@ static fdt_voronoi *cells(fdt_result *r, const double *xyz, size_t n, const doub
         fprintf(stderr, "fdt_voronoi_compute: %s: %s\n", fdt_strerror(err), diag);
     CHECK(err == FDT_OK);
     return v;
+}
+
+static fdt_voronoi *cells(fdt_result *r, const double *xyz, size_t n, const double *box)
+{
+    return cells_t(r, xyz, n, box, 1);
 }
 
 static int close_to(double a, double b, double rel)
@@ -250,8 +258,9 @@ static void test_same_bits(size_t n)
         memcpy(sh + 3 * i, xyz + 3 * perm[i], 3 * sizeof *sh);
     fdt_result *r1 = triangulate(xyz, n, 1), *r3 = triangulate(xyz, n, 3);
     fdt_result *rs = triangulate(sh, n, 2);
-    fdt_voronoi *v1 = cells(r1, xyz, n, NULL), *v3 = cells(r3, xyz, n, NULL);
-    fdt_voronoi *vs = cells(rs, sh, n, NULL);
+    /* the mesh of 1 and 3 threads, the cells on 1 and 3 threads */
+    fdt_voronoi *v1 = cells(r1, xyz, n, NULL), *v3 = cells_t(r3, xyz, n, NULL, 3);
+    fdt_voronoi *vs = cells_t(rs, sh, n, NULL, 7);
     const double *a1 = fdt_voronoi_volumes(v1), *a3 = fdt_voronoi_volumes(v3);
     const double *as = fdt_voronoi_volumes(vs);
     const double *c1 = fdt_voronoi_centroids(v1), *cs = fdt_voronoi_centroids(vs);

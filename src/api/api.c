@@ -17,6 +17,7 @@
 #include "par/parallel.h"
 #include "geom/prepare.h"
 #include "mesh/result.h"
+#include "mesh/voronoi.h"
 #include "front/seed.h"
 #include "base/sethash.h"
 #include "front/sink.h"
@@ -239,6 +240,24 @@ static int one_part(const fdt_settings *s, fdt_mode mode, int streamed)
         return 0;
     return mode == FDT_MODE_SERIAL ||
            (s->mode == FDT_MODE_AUTO && s->search == FDT_SEARCH_AUTO && !s->pin);
+}
+
+/* The Voronoi cells (src/mesh/voronoi.c) on the threads the options ask
+ * for. */
+int fdt_voronoi_compute(fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
+                        fdt_voronoi **out, char *diag, size_t diag_size)
+{
+    fdt_voronoi_options defaults;
+    if (diag && diag_size)
+        diag[0] = 0;
+    if (!o) {
+        fdt_default_voronoi_options(&defaults);
+        o = &defaults;
+    }
+    if (!r || !xyz || !out || o->struct_size != sizeof *o || o->threads < 0 || o->threads > 1024)
+        return FDT_EINVAL;
+    int threads = o->threads ? o->threads : fdt_parallel_default_threads();
+    return fdt_voronoi_build(r, xyz, n, o, threads, out, diag, diag_size);
 }
 
 int fdt_engine_one_part(const fdt_settings *s, int streamed)

@@ -21,18 +21,32 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 typedef struct fdt_fix {
     uint64_t lo;
     int64_t hi; /* two's complement: value = hi 2^64 + lo */
 } fdt_fix;
 
+/* The grid 2^e's two scales: inv = 2^-e and step = 2^e (-1022 <= e <=
+ * 1023 and the terms' range as above, so that x inv is exact or, below
+ * 2^-1022, rounds to the same 0 as the grid would). */
+typedef struct fdt_fix_grid {
+    double inv, step;
+} fdt_fix_grid;
+
+static inline fdt_fix_grid fdt_fix_grid_of(int e)
+{
+    fdt_fix_grid g = {ldexp(1.0, -e), ldexp(1.0, e)};
+    return g;
+}
+
 /* acc += round(x 2^-e), x finite with |x 2^-e| < 2^126. The rounding is
  * llrint's (the current mode, to nearest by default) for |x 2^-e| < 2^62;
  * above that x 2^-e is an integer already (53 bits of significand). */
-static inline void fdt_fix_add(fdt_fix *acc, double x, int e)
+static inline void fdt_fix_add(fdt_fix *acc, double x, fdt_fix_grid g)
 {
-    double y = ldexp(x, -e);
+    double y = x * g.inv;
     uint64_t lo;
     int64_t hi;
     if (fabs(y) < 0x1p62) {
@@ -40,12 +54,20 @@ static inline void fdt_fix_add(fdt_fix *acc, double x, int e)
         lo = (uint64_t)q;
         hi = q < 0 ? -1 : 0;
     } else {
-        /* y is an integer; y = h 2^64 + l with h = floor(y 2^-64) and
-         * 0 <= l < 2^64: l keeps the bits of y below 2^64, so it is exact. */
-        double h = floor(ldexp(y, -64));
-        double l = y - ldexp(h, 64);
-        hi = (int64_t)h;
-        lo = (uint64_t)l;
+        /* y is an integer: its 53-bit significand shifted left by
+         * e - 52 >= 10 bits, exactly, then negated if y < 0. */
+        uint64_t b;
+        memcpy(&b, &y, sizeof b);
+        int sh = (int)((b >> 52) & 0x7ff) - 1075;
+        uint64_t m = (b & ((UINT64_C(1) << 52) - 1)) | UINT64_C(1) << 52;
+        uint64_t mh = sh >= 64 ? m << (sh - 64) : m >> (64 - sh);
+        uint64_t ml = sh >= 64 ? 0 : m << sh;
+        if (b >> 63) { /* two's complement negation */
+            ml = ~ml + 1;
+            mh = ~mh + (ml == 0);
+        }
+        lo = ml;
+        hi = (int64_t)mh;
     }
     uint64_t s = acc->lo + lo;
     acc->hi += hi + (s < lo);
@@ -64,15 +86,15 @@ static inline void fdt_fix_merge(fdt_fix *acc, fdt_fix b)
  * apart and added (both nonnegative, so no cancellation), which rounds at
  * most twice: within 2^-52 relative of the exact sum, and the same bits for
  * the same sum. */
-static inline double fdt_fix_value(fdt_fix a, int e)
+static inline double fdt_fix_value(fdt_fix a, fdt_fix_grid g)
 {
     int neg = a.hi < 0;
     if (neg) { /* two's complement negation of the 128-bit value */
         a.lo = ~a.lo + 1;
         a.hi = (int64_t)(~(uint64_t)a.hi + (a.lo == 0));
     }
-    double m = ldexp((double)(uint64_t)a.hi, 64) + (double)a.lo;
-    return ldexp(neg ? -m : m, e);
+    double m = (double)(uint64_t)a.hi * 0x1p64 + (double)a.lo;
+    return (neg ? -m : m) * g.step;
 }
 
 #endif

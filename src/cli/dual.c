@@ -98,6 +98,7 @@ int fdt_cli_dual_write(const fdt_cli_dual *d, fdt_result *res, const double *xyz
     fdt_voronoi_options o;
     fdt_default_voronoi_options(&o);
     o.box_given = d->box_given;
+    o.threads = d->threads;
     memcpy(o.box, d->box, sizeof o.box);
     cells_job job = {NULL, d->format};
     if (d->voronoi && !job.format && !is_csv(d->voronoi))

@@ -17,6 +17,7 @@ typedef struct fdt_cli_dual {
     const char *format;  /* --voronoi-format, or NULL: CSV for a .csv file,
                             else FDT_CELLS_DEFAULT_FORMAT */
     const char *density; /* --density FILE, or NULL */
+    int threads;         /* -t (0: one per physical core) */
     int box_given;       /* --box given */
     double box[6];       /* xmin, ymin, zmin, xmax, ymax, zmax */
 } fdt_cli_dual;

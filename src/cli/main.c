@@ -1499,7 +1499,9 @@ static int run(const cli *c)
         t0 = fdt_now_s();
         char derr[FDT_IO_PATH + 600];
         progress_phase(&prog, "voronoi");
-        r = fdt_cli_dual_write(&c->dual, res, xyz, n, derr, sizeof derr);
+        fdt_cli_dual dual = c->dual;
+        dual.threads = c->mode == FDT_MODE_SERIAL ? 1 : c->threads < 0 ? 0 : c->threads;
+        r = fdt_cli_dual_write(&dual, res, xyz, n, derr, sizeof derr);
         progress_clear(&prog);
         tm.write += fdt_now_s() - t0;
         if (r != FDT_OK) {

@@ -234,7 +234,7 @@ static int build_edges(fdt_result *r)
     for (size_t v = 0; v < n; v++) {
         uint32_t *a = other + start[v];
         size_t m = start[v + 1] - start[v];
-        if (m > 24) {
+        if (m > 64) { /* about 39 a bucket: insertion sort up to 64 */
             qsort(a, m, sizeof *a, u32_cmp);
         } else {
             for (size_t i = 1; i < m; i++) {

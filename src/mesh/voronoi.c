@@ -22,6 +22,7 @@
  * (src/geom/cell.c), as voro++ computes every cell.
  */
 #include <math.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,9 +30,11 @@
 
 #include "base/abi.h"
 #include "base/fixsum.h"
+#include "base/spawn.h"
 #include "geom/cell.h"
 #include "geom/predicates.h"
 #include "mesh/result.h"
+#include "mesh/voronoi.h"
 
 struct fdt_voronoi {
     size_t n;
@@ -45,14 +48,48 @@ struct fdt_voronoi {
     double *narea;  /* owned */
 };
 
-/* The accumulators of the tet pass: per point, its volume, its volume's
- * moment about the point (centroid times volume, relative to the point)
- * and the volume of its tets (DTFE); per adjacency entry (r->adj), the
- * area of the face to that neighbour. */
-typedef struct accum {
-    fdt_fix *vol, *mom, *dtfe, *face;
-    int e_area, e_vol, e_mom; /* the grids: 2^e */
-} accum;
+/* The computation's own numbering (entry 92 of bench/NOTES.md): the
+ * distinct points in Morton order of their coordinates, so that a tet's
+ * points and accumulators lie near the previous tet's. Shares are
+ * computed from coordinates, never from numbers, so the numbering changes
+ * no bit of the result. */
+typedef struct vwork {
+    size_t n, m;        /* input points; distinct points, numbered 0..m-1 */
+    uint32_t *perm;     /* local -> input id (owned) */
+    uint32_t *loc;      /* input id -> local id, UINT32_MAX if merged (owned) */
+    double *xyz;        /* 3m local coordinates (owned) */
+    uint32_t *tets;     /* 4 local ids a tet, by lowest id (owned) */
+    size_t ntets;
+    uint8_t *flags;     /* local (owned) */
+    double box[6];
+    /* the accumulators: per point its volume, its moment about itself
+     * (centroid times volume, relative to the point) and the volume of
+     * its tets (DTFE); the faces' are the jobs' */
+    fdt_fix *vol, *mom, *dtfe; /* owned */
+    fdt_fix_grid g_area, g_vol, g_mom;
+} vwork;
+
+/* One thread's share: the points [lo, hi) of the local numbering. */
+typedef struct vjob {
+    vwork *w;
+    fdt_voronoi *v;
+    uint32_t lo, hi;
+    /* point l's neighbours, ascending, adj[adj_start[l - lo] ..
+     * adj_start[l - lo + 1]), and the area of the face to each (owned) */
+    size_t *adj_start;
+    uint32_t *adj;
+    fdt_fix *fsum;
+    fdt_cell cell;
+    fdt_cell_face *face; /* its cut cells' real faces, by label (owned) */
+    size_t nface, capface;
+    uint32_t *order;     /* scratch: a cell's neighbours in cutting order */
+    size_t cap_order;
+    size_t *first;       /* cut cell lo + k: its faces from face[first[k]] */
+    size_t zero_faces;
+    int err;
+    pthread_t th;
+    int started;
+} vjob;
 
 int fdt_default_voronoi_options_sized(fdt_voronoi_options *o, size_t struct_size)
 {
@@ -121,36 +158,125 @@ static int set_box(fdt_voronoi *v, const fdt_result *r, const double *xyz,
     return FDT_OK;
 }
 
-/* Flags: merged duplicates, hull points. */
-static void set_flags(fdt_voronoi *v, const fdt_result *r)
-{
-    for (size_t i = 0; i < v->n; i++)
-        v->flags[i] = r->dupmap[i] != (fdt_vid)i ? FDT_CELL_MERGED : 0;
-    for (size_t f = 0; f < 3 * r->nhull; f++)
-        v->flags[r->hull[f]] |= FDT_CELL_HULL | FDT_CELL_CLIPPED;
-}
-
 /* The grids: terms up to about 16 D^k for the box's largest side D land
  * near 2^102 grid steps (fixsum.h's range). */
-static void set_grids(accum *a, const double box[6])
+static void set_grids(vwork *w)
 {
     double d = 0;
     for (int k = 0; k < 3; k++)
-        d = fmax(d, box[k + 3] - box[k]);
+        d = fmax(d, w->box[k + 3] - w->box[k]);
     int ed;
     (void)frexp(d, &ed);
-    a->e_area = 2 * ed - 98;
-    a->e_vol = 3 * ed - 98;
-    a->e_mom = 4 * ed - 98;
+    w->g_area = fdt_fix_grid_of(2 * ed - 98);
+    w->g_vol = fdt_fix_grid_of(3 * ed - 98);
+    w->g_mom = fdt_fix_grid_of(4 * ed - 98);
 }
 
-/* The adjacency entry of neighbour w in i's list (sorted). */
-static size_t slot(const fdt_result *r, fdt_vid i, fdt_vid w)
+/* ---------------------------------------------------------------- numbering */
+
+typedef struct keyed {
+    uint64_t key;
+    uint32_t id;
+} keyed;
+
+static int keyed_cmp(const void *x, const void *y)
 {
-    size_t lo = r->adj_start[i], hi = r->adj_start[i + 1];
+    const keyed *a = x, *b = y;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return a->id < b->id ? -1 : a->id > b->id;
+}
+
+/* 21 bits of each coordinate in the box, interleaved. */
+static uint64_t morton(const double *p, const double box[6])
+{
+    uint64_t key = 0;
+    uint32_t c[3];
+    for (int k = 0; k < 3; k++) {
+        double t = (p[k] - box[k]) / (box[k + 3] - box[k]);
+        t = t < 0 ? 0 : t > 1 ? 1 : t;
+        c[k] = (uint32_t)(t * 2097151.0);
+    }
+    for (int b = 20; b >= 0; b--)
+        for (int k = 0; k < 3; k++)
+            key = key << 1 | ((c[k] >> b) & 1);
+    return key;
+}
+
+/* perm, loc and the local coordinates. */
+static int number_points(vwork *w, const fdt_result *r, const double *xyz)
+{
+    keyed *kp = malloc((w->n ? w->n : 1) * sizeof *kp);
+    w->loc = malloc((w->n ? w->n : 1) * sizeof *w->loc);
+    if (!kp || !w->loc) {
+        free(kp);
+        return FDT_ENOMEM;
+    }
+    size_t m = 0;
+    for (size_t i = 0; i < w->n; i++) {
+        w->loc[i] = UINT32_MAX;
+        if (r->dupmap[i] == (fdt_vid)i)
+            kp[m++] = (keyed){morton(xyz + 3 * i, w->box), (uint32_t)i};
+    }
+    qsort(kp, m, sizeof *kp, keyed_cmp);
+    w->m = m;
+    w->perm = malloc((m ? m : 1) * sizeof *w->perm);
+    w->xyz = malloc(3 * (m ? m : 1) * sizeof *w->xyz);
+    if (!w->perm || !w->xyz) {
+        free(kp);
+        return FDT_ENOMEM;
+    }
+    for (size_t l = 0; l < m; l++) {
+        uint32_t g = kp[l].id;
+        w->perm[l] = g;
+        w->loc[g] = (uint32_t)l;
+        memcpy(w->xyz + 3 * l, xyz + 3 * (size_t)g, 3 * sizeof *xyz);
+    }
+    free(kp);
+    return FDT_OK;
+}
+
+/* The tets in local ids, bucketed by their lowest id. */
+static int local_tets(vwork *w, const fdt_result *r)
+{
+    size_t *cnt = calloc(w->m + 1, sizeof *cnt);
+    w->ntets = r->ntets;
+    w->tets = malloc((w->ntets ? 4 * w->ntets : 1) * sizeof *w->tets);
+    if (!cnt || !w->tets) {
+        free(cnt);
+        return FDT_ENOMEM;
+    }
+    for (size_t t = 0; t < w->ntets; t++) {
+        uint32_t lo = UINT32_MAX;
+        for (int k = 0; k < 4; k++) {
+            uint32_t x = w->loc[r->tets[4 * t + k]];
+            lo = x < lo ? x : lo;
+        }
+        cnt[lo + 1]++;
+    }
+    for (size_t l = 0; l < w->m; l++)
+        cnt[l + 1] += cnt[l];
+    for (size_t t = 0; t < w->ntets; t++) {
+        uint32_t x[4], lo = UINT32_MAX;
+        for (int k = 0; k < 4; k++) {
+            x[k] = w->loc[r->tets[4 * t + k]];
+            lo = x[k] < lo ? x[k] : lo;
+        }
+        memcpy(w->tets + 4 * cnt[lo]++, x, sizeof x);
+    }
+    free(cnt);
+    return FDT_OK;
+}
+
+/* ---------------------------------------------------------------- tet pass */
+
+/* The entry of nb in the job's point i's neighbour list (ascending). */
+static size_t slot(const vjob *j, uint32_t i, uint32_t nb)
+{
+    size_t lo = j->adj_start[i - j->lo], hi = j->adj_start[i - j->lo + 1];
     while (lo < hi) {
         size_t mid = lo + (hi - lo) / 2;
-        if (r->adj[mid] < w)
+        if (j->adj[mid] < nb)
             lo = mid + 1;
         else
             hi = mid;
@@ -165,25 +291,61 @@ static void sub3(const double *a, const double *b, double *d)
     d[2] = a[2] - b[2];
 }
 
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const double *a, const double *b, double *c)
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 static double triple(const double *a, const double *b, const double *c)
 {
-    return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-           a[2] * (b[0] * c[1] - b[1] * c[0]);
+    double x[3];
+    cross3(b, c, x);
+    return dot3(a, x);
 }
 
 /* The circumcentre of the triangle (0, a, b), relative to its first vertex:
  * (|a|^2 b - |b|^2 a) x (a x b) / (2 |a x b|^2). */
 static void tri_centre(const double *a, const double *b, double *x)
 {
-    double n[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-                   a[0] * b[1] - a[1] * b[0]};
-    double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    double bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
-    double t[3] = {aa * b[0] - bb * a[0], aa * b[1] - bb * a[1], aa * b[2] - bb * a[2]};
-    double nn = 2 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    x[0] = (t[1] * n[2] - t[2] * n[1]) / nn;
-    x[1] = (t[2] * n[0] - t[0] * n[2]) / nn;
-    x[2] = (t[0] * n[1] - t[1] * n[0]) / nn;
+    double n[3], t[3];
+    cross3(a, b, n);
+    double aa = dot3(a, a), bb = dot3(b, b);
+    for (int k = 0; k < 3; k++)
+        t[k] = aa * b[k] - bb * a[k];
+    cross3(t, n, x);
+    double nn = 2 * dot3(n, n);
+    for (int k = 0; k < 3; k++)
+        x[k] /= nn;
+}
+
+/* The circumcentre of (p0, p0 + q1, p0 + q2, p0 + q3), relative to p0:
+ * the floating formula where the tet is well shaped (its determinant at
+ * least 2^-16 of the product of the edges from p0, so that the error is at
+ * most about 2^16 x 8 ulps of the circumradius), the exact one
+ * (fdt_circumcenter_exact) for the flatter tets. -1 when flat. */
+static int tet_centre(const double *p0, const double q[4][3], const double *p1,
+                      const double *p2, const double *p3, double *c)
+{
+    double x[3], y[3], z[3];
+    cross3(q[2], q[3], x);
+    cross3(q[3], q[1], y);
+    cross3(q[1], q[2], z);
+    double det = dot3(q[1], x);
+    double l = sqrt(dot3(q[1], q[1]) * dot3(q[2], q[2]) * dot3(q[3], q[3]));
+    if (fabs(det) >= 0x1p-16 * l) {
+        double a = dot3(q[1], q[1]), b = dot3(q[2], q[2]), d = dot3(q[3], q[3]);
+        for (int k = 0; k < 3; k++)
+            c[k] = (a * x[k] + b * y[k] + d * z[k]) / (2 * det);
+        return 0;
+    }
+    return fdt_circumcenter_exact(p0, p1, p2, p3, c);
 }
 
 /* The six edges (i, j) of a tet with its other two vertices (k, l), and
@@ -193,44 +355,60 @@ static const int tet_edge[6][5] = {
     {1, 2, 0, 3, +1}, {1, 3, 0, 2, -1}, {2, 3, 0, 1, +1},
 };
 
-/* One tet's shares (the file's comment). Returns 1 when its circumcentre
- * lies outside the box: then it adds nothing and its points are clipped. */
-static int add_tet(const fdt_result *r, const double *xyz, const double box[6],
-                   const fdt_vid *tv, accum *a, uint8_t *flags)
+/* p after q in lexicographic (x, y, z) order (distinct points). */
+static inline int lex_after(const double *p, const double *q)
 {
-    /* Canonical order, the points' lexicographic order (ids would change
-     * with the input order), so that a tet gives the same bits whichever
-     * way round it came and however the input was numbered; sigma: the
-     * orientation in that order. */
-    fdt_vid s[4] = {tv[0], tv[1], tv[2], tv[3]};
+    if (p[0] != q[0])
+        return p[0] > q[0];
+    if (p[1] != q[1])
+        return p[1] > q[1];
+    return p[2] > q[2];
+}
+
+static int mine(const vjob *j, uint32_t x)
+{
+    return x >= j->lo && x < j->hi;
+}
+
+/* One tet's shares to the job's points (the file's comment). A tet whose
+ * circumcentre lies outside the box adds no share: it marks its points,
+ * whose cells are then cut from the box. */
+static void add_tet(vjob *j, const uint32_t *tv)
+{
+    vwork *w = j->w;
+    const double *X = w->xyz;
+    /* Canonical order, the points' lexicographic order (not their ids, which
+     * change with the input's order): the same bits whichever way round the
+     * tet came. sigma: the orientation in that order. */
+    uint32_t s[4] = {tv[0], tv[1], tv[2], tv[3]};
     int sigma = 1;
     for (int x = 1; x < 4; x++)
-        for (int y = x; y > 0 && fdt_lex_compare(xyz + 3 * (size_t)s[y - 1],
-                                                 xyz + 3 * (size_t)s[y]) > 0; y--) {
-            fdt_vid t = s[y];
+        for (int y = x; y > 0 && lex_after(X + 3 * (size_t)s[y - 1], X + 3 * (size_t)s[y]);
+             y--) {
+            uint32_t t = s[y];
             s[y] = s[y - 1];
             s[y - 1] = t;
             sigma = -sigma;
         }
-    const double *p0 = xyz + 3 * (size_t)s[0];
+    const double *p0 = X + 3 * (size_t)s[0];
     double q[4][3] = {{0, 0, 0}};
     for (int m = 1; m < 4; m++)
-        sub3(xyz + 3 * (size_t)s[m], p0, q[m]);
+        sub3(X + 3 * (size_t)s[m], p0, q[m]);
     double v6 = sigma * triple(q[1], q[2], q[3]);
     for (int m = 0; m < 4; m++)
-        fdt_fix_add(&a->dtfe[s[m]], v6 / 6, a->e_vol);
+        if (mine(j, s[m]))
+            fdt_fix_add(&w->dtfe[s[m]], v6 / 6, w->g_vol);
     double c[3];
-    if (fdt_circumcenter_exact(p0, xyz + 3 * (size_t)s[1], xyz + 3 * (size_t)s[2],
-                               xyz + 3 * (size_t)s[3], c) != 0)
-        c[0] = c[1] = c[2] = INFINITY; /* flat or overflowing: clip its points */
-    int outside = 0;
+    int outside = tet_centre(p0, q, X + 3 * (size_t)s[1], X + 3 * (size_t)s[2],
+                             X + 3 * (size_t)s[3], c) != 0;
     for (int k = 0; k < 3; k++)
-        if (!(p0[k] + c[k] >= box[k] && p0[k] + c[k] <= box[k + 3]))
+        if (!(p0[k] + c[k] >= w->box[k] && p0[k] + c[k] <= w->box[k + 3]))
             outside = 1;
     if (outside) {
         for (int m = 0; m < 4; m++)
-            flags[s[m]] |= FDT_CELL_CLIPPED;
-        return 1;
+            if (mine(j, s[m]))
+                w->flags[s[m]] |= FDT_CELL_CLIPPED;
+        return;
     }
     /* f[m]: the circumcentre of the face opposite m, relative to p0. */
     double f[4][3];
@@ -243,42 +421,54 @@ static int add_tet(const fdt_result *r, const double *xyz, const double box[6],
         for (int k = 0; k < 3; k++)
             f[m][k] = q[u0][k] + x[k];
     }
+    /* Each point's volume and moment shares, summed here in a fixed order
+     * (the edges') and added to the grid once a tet. */
+    double vsum[4] = {0, 0, 0, 0}, msum[4][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
     for (int e = 0; e < 6; e++) {
-        int i = tet_edge[e][0], j = tet_edge[e][1], k = tet_edge[e][2], l = tet_edge[e][3];
+        int i = tet_edge[e][0], jj = tet_edge[e][1], k = tet_edge[e][2], l = tet_edge[e][3];
+        int mi = mine(j, s[i]), mj = mine(j, s[jj]);
+        if (!mi && !mj)
+            continue;
         double o = sigma * tet_edge[e][4];
         double u[3], mid[3], cm[3], fp[3], fn[3];
-        sub3(q[j], q[i], u);
+        sub3(q[jj], q[i], u);
         for (int d = 0; d < 3; d++)
-            mid[d] = 0.5 * (q[i][d] + q[j][d]);
+            mid[d] = 0.5 * (q[i][d] + q[jj][d]);
         sub3(c, mid, cm);
         /* Counter-clockwise about u, face (i,j,k) comes before (i,j,l)
          * when (i,j,k,l) is positive: F_prev is the face without l. */
         sub3(o > 0 ? f[l] : f[k], mid, fp);
         sub3(o > 0 ? f[k] : f[l], mid, fn);
-        double len = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+        double len = sqrt(dot3(u, u));
         /* Twice the signed areas of (M, F, C), seen along u, times |u|. */
         double ap = triple(u, fp, cm), an = triple(u, fn, cm);
         double area = (ap - an) / (2 * len);
-        size_t sij = slot(r, s[i], s[j]), sji = slot(r, s[j], s[i]);
-        fdt_fix_add(&a->face[sij], area, a->e_area);
-        fdt_fix_add(&a->face[sji], area, a->e_area);
         /* The cones from i (and from j, its mirror image): volume
          * area |u| / 6, each piece's centroid (P + M + F + C) / 4. */
         double vp = ap / 12, vn = an / 12;
         for (int end = 0; end < 2; end++) {
-            fdt_vid pt = s[end ? j : i];
-            const double *qp = q[end ? j : i];
-            fdt_fix_add(&a->vol[pt], vp - vn, a->e_vol);
+            int at = end ? jj : i;
+            if (!(end ? mj : mi))
+                continue;
+            fdt_fix_add(&j->fsum[slot(j, s[at], s[end ? i : jj])], area, w->g_area);
+            vsum[at] += vp - vn;
             for (int d = 0; d < 3; d++) {
-                double base = mid[d] + c[d] - 2 * qp[d];
-                double mp = vp * (base + fp[d] + mid[d] - qp[d]) / 4;
-                double mn = vn * (base + fn[d] + mid[d] - qp[d]) / 4;
-                fdt_fix_add(&a->mom[3 * (size_t)pt + d], mp - mn, a->e_mom);
+                double base = mid[d] + c[d] - 2 * q[at][d];
+                double mp = vp * (base + fp[d] + mid[d] - q[at][d]) / 4;
+                double mn = vn * (base + fn[d] + mid[d] - q[at][d]) / 4;
+                msum[at][d] += mp - mn;
             }
         }
     }
-    return 0;
+    for (int m = 0; m < 4; m++)
+        if (mine(j, s[m])) {
+            fdt_fix_add(&w->vol[s[m]], vsum[m], w->g_vol);
+            for (int d = 0; d < 3; d++)
+                fdt_fix_add(&w->mom[3 * (size_t)s[m] + d], msum[m][d], w->g_mom);
+        }
 }
+
+/* ---------------------------------------------------------------- cells */
 
 /* A face counts when its area is above 2^-40 of its cell's surface. */
 static int real_face(double area, double total)
@@ -286,81 +476,75 @@ static int real_face(double area, double total)
     return area > FDT_CELL_TOL * total;
 }
 
-/* The faces of the clipped cells, kept from the cut until the neighbour
- * lists are built: cell i's are face[fstart[i] .. fstart[i + 1]). */
-typedef struct clipped {
-    fdt_cell_face *face;
-    size_t nface, cap;
-    fdt_vid *order; /* scratch: a cell's neighbours in cutting order */
-    size_t cap_order;
-} clipped;
-
-/* The neighbours in the points' lexicographic order: the cuts, and so the
- * cell's bits, do not depend on how the input was numbered. */
-static int cut_order(clipped *cl, const fdt_result *r, const double *xyz, fdt_vid i)
+/* Point l's neighbours in the points' lexicographic order: the cuts, and
+ * so the cell's bits, do not depend on how the input was numbered. */
+static int cut_order(vjob *j, uint32_t l)
 {
-    size_t m = r->adj_start[i + 1] - r->adj_start[i];
-    if (m > cl->cap_order) {
-        fdt_vid *q = realloc(cl->order, m * sizeof *q);
+    const vwork *w = j->w;
+    size_t b = j->adj_start[l - j->lo], m = j->adj_start[l - j->lo + 1] - b;
+    if (m > j->cap_order) {
+        uint32_t *q = realloc(j->order, m * sizeof *q);
         if (!q)
             return FDT_ENOMEM;
-        cl->order = q;
-        cl->cap_order = m;
+        j->order = q;
+        j->cap_order = m;
     }
     for (size_t e = 0; e < m; e++) {
-        fdt_vid w = r->adj[r->adj_start[i] + e];
+        uint32_t nb = j->adj[b + e];
         size_t y = e;
-        for (; y > 0 && fdt_lex_compare(xyz + 3 * (size_t)cl->order[y - 1],
-                                        xyz + 3 * (size_t)w) > 0; y--)
-            cl->order[y] = cl->order[y - 1];
-        cl->order[y] = w;
+        for (; y > 0 && fdt_lex_compare(w->xyz + 3 * (size_t)j->order[y - 1],
+                                        w->xyz + 3 * (size_t)nb) > 0; y--)
+            j->order[y] = j->order[y - 1];
+        j->order[y] = nb;
     }
     return FDT_OK;
 }
 
-/* Point i's cell cut from the box by its neighbours' bisectors. */
-static int cut_cell(fdt_voronoi *v, const fdt_result *r, const double *xyz, fdt_vid i,
-                    fdt_cell *cell, clipped *cl, size_t *first)
+/* Point l's cell cut from the box by its neighbours' bisectors; its real
+ * faces kept, by label (input ids; walls first). */
+static int cut_cell(vjob *j, uint32_t l)
 {
-    const double *p = xyz + 3 * (size_t)i;
+    const vwork *w = j->w;
+    fdt_voronoi *v = j->v;
+    const double *p = w->xyz + 3 * (size_t)l;
     double lo[3], hi[3];
     for (int k = 0; k < 3; k++) {
-        lo[k] = v->box[k] - p[k];
-        hi[k] = v->box[k + 3] - p[k];
+        lo[k] = w->box[k] - p[k];
+        hi[k] = w->box[k + 3] - p[k];
     }
-    if (fdt_cell_box(cell, lo, hi) || cut_order(cl, r, xyz, i))
+    if (fdt_cell_box(&j->cell, lo, hi) || cut_order(j, l))
         return FDT_ENOMEM;
-    for (size_t e = 0; e < r->adj_start[i + 1] - r->adj_start[i]; e++) {
-        fdt_vid w = cl->order[e];
+    for (size_t e = 0; e < j->adj_start[l - j->lo + 1] - j->adj_start[l - j->lo]; e++) {
+        uint32_t nb = j->order[e];
         double nrm[3];
-        sub3(xyz + 3 * (size_t)w, p, nrm);
-        int got = fdt_cell_cut(cell, nrm, 0.5 * (nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]),
-                               w);
+        sub3(w->xyz + 3 * (size_t)nb, p, nrm);
+        int got = fdt_cell_cut(&j->cell, nrm, 0.5 * dot3(nrm, nrm), (long)w->perm[nb]);
         if (got == -1)
             return FDT_ENOMEM;
         if (got < 0)
             return FDT_EINTERNAL;
     }
-    if (cl->nface + (size_t)cell->nf > cl->cap) {
-        size_t nc = cl->cap ? 2 * cl->cap : 1024;
-        while (nc < cl->nface + (size_t)cell->nf)
+    size_t need = j->nface + (size_t)j->cell.nf;
+    if (need > j->capface) {
+        size_t nc = j->capface ? 2 * j->capface : 1024;
+        while (nc < need)
             nc *= 2;
-        fdt_cell_face *q = realloc(cl->face, nc * sizeof *q);
+        fdt_cell_face *q = realloc(j->face, nc * sizeof *q);
         if (!q)
             return FDT_ENOMEM;
-        cl->face = q;
-        cl->cap = nc;
+        j->face = q;
+        j->capface = nc;
     }
+    uint32_t g = w->perm[l];
     double cen[3];
-    fdt_cell_measure(cell, &v->volume[i], &v->area[i], cen, cl->face + cl->nface);
+    fdt_cell_face *fc = j->face + j->nface;
+    fdt_cell_measure(&j->cell, &v->volume[g], &v->area[g], cen, fc);
     for (int k = 0; k < 3; k++)
-        v->centroid[3 * (size_t)i + k] = p[k] + cen[k];
-    /* Faces ascending by label (walls first), zero-area ones dropped. */
-    fdt_cell_face *fc = cl->face + cl->nface;
+        v->centroid[3 * (size_t)g + k] = p[k] + cen[k];
     size_t m = 0;
-    for (int f = 0; f < cell->nf; f++) {
-        if (!real_face(fc[f].area, v->area[i])) {
-            v->zero_faces++;
+    for (int f = 0; f < j->cell.nf; f++) {
+        if (!real_face(fc[f].area, v->area[g])) {
+            j->zero_faces++;
             continue;
         }
         fdt_cell_face x = fc[f];
@@ -369,72 +553,177 @@ static int cut_cell(fdt_voronoi *v, const fdt_result *r, const double *xyz, fdt_
             fc[y] = fc[y - 1];
         fc[y] = x;
     }
-    *first = cl->nface;
-    cl->nface += m;
-    v->nfaces[i] = (int32_t)m;
+    j->first[l - j->lo] = j->nface;
+    j->nface += m;
+    v->nfaces[g] = (int32_t)m;
     return FDT_OK;
 }
 
-/* A cell summed from its tets: its values, and its real faces counted. */
-static void sum_cell(fdt_voronoi *v, const fdt_result *r, const double *xyz, fdt_vid i,
-                     const accum *a)
+/* A cell summed from its tets: its values, its real faces counted. */
+static void sum_cell(vjob *j, uint32_t l)
 {
+    const vwork *w = j->w;
+    fdt_voronoi *v = j->v;
+    uint32_t g = w->perm[l];
+    size_t e0 = j->adj_start[l - j->lo], e1 = j->adj_start[l - j->lo + 1];
     fdt_fix total = {0, 0};
-    for (size_t e = r->adj_start[i]; e < r->adj_start[i + 1]; e++)
-        fdt_fix_merge(&total, a->face[e]);
-    double area = fdt_fix_value(total, a->e_area);
+    for (size_t e = e0; e < e1; e++)
+        fdt_fix_merge(&total, j->fsum[e]);
+    double area = fdt_fix_value(total, w->g_area);
     int32_t m = 0;
-    for (size_t e = r->adj_start[i]; e < r->adj_start[i + 1]; e++) {
-        if (real_face(fdt_fix_value(a->face[e], a->e_area), area))
+    for (size_t e = e0; e < e1; e++) {
+        if (real_face(fdt_fix_value(j->fsum[e], w->g_area), area))
             m++;
         else
-            v->zero_faces++;
+            j->zero_faces++;
     }
-    double vol = fdt_fix_value(a->vol[i], a->e_vol);
-    v->volume[i] = vol;
-    v->area[i] = area;
-    v->nfaces[i] = m;
+    double vol = fdt_fix_value(w->vol[l], w->g_vol);
+    v->volume[g] = vol;
+    v->area[g] = area;
+    v->nfaces[g] = m;
     for (int k = 0; k < 3; k++)
-        v->centroid[3 * (size_t)i + k] =
-            xyz[3 * (size_t)i + k] + fdt_fix_value(a->mom[3 * (size_t)i + k], a->e_mom) / vol;
+        v->centroid[3 * (size_t)g + k] =
+            w->xyz[3 * (size_t)l + k] + fdt_fix_value(w->mom[3 * (size_t)l + k], w->g_mom) / vol;
 }
 
-/* The neighbour lists (options.neighbors): the summed cells' from their
- * adjacency entries, the clipped cells' from their cut faces. */
-static int list_neighbors(fdt_voronoi *v, const fdt_result *r, const accum *a,
-                          const clipped *cl, const size_t *first)
+/* The job's points' neighbour lists in local ids, ascending: each point's
+ * tets listed (a counting sort over the tets), the other points of those
+ * tets taken once each (a bit a point, cleared after each point: m / 8
+ * bytes a thread) and sorted (about 15 of the 78), and a face accumulator
+ * for each. */
+static int job_adjacency(vjob *j)
 {
-    v->nstart = malloc((v->n + 1) * sizeof *v->nstart);
-    if (!v->nstart)
+    const vwork *w = j->w;
+    size_t k = j->hi - j->lo;
+    size_t *ts = calloc(k + 1, sizeof *ts);
+    uint64_t *seen = calloc(w->m / 64 + 1, sizeof *seen);
+    j->adj_start = malloc((k + 1) * sizeof *j->adj_start);
+    if (!ts || !seen || !j->adj_start) {
+        free(ts);
+        free(seen);
         return FDT_ENOMEM;
-    v->nstart[0] = 0;
-    for (size_t i = 0; i < v->n; i++)
-        v->nstart[i + 1] = v->nstart[i] + (size_t)v->nfaces[i];
-    size_t tot = v->nstart[v->n];
-    v->nid = malloc((tot ? tot : 1) * sizeof *v->nid);
-    v->narea = malloc((tot ? tot : 1) * sizeof *v->narea);
-    if (!v->nid || !v->narea)
+    }
+    for (size_t c = 0; c < 4 * w->ntets; c++)
+        if (w->tets[c] >= j->lo && w->tets[c] < j->hi)
+            ts[w->tets[c] - j->lo + 1]++;
+    for (size_t l = 0; l < k; l++)
+        ts[l + 1] += ts[l];
+    uint32_t *inc = malloc((ts[k] ? ts[k] : 1) * sizeof *inc);
+    if (!inc) {
+        free(ts);
+        free(seen);
         return FDT_ENOMEM;
-    for (size_t i = 0; i < v->n; i++) {
-        size_t o = v->nstart[i];
-        if (v->flags[i] & FDT_CELL_MERGED)
-            continue;
-        if (v->flags[i] & FDT_CELL_CLIPPED) {
-            for (int32_t f = 0; f < v->nfaces[i]; f++) {
-                v->nid[o + (size_t)f] = (fdt_vid)cl->face[first[i] + (size_t)f].label;
-                v->narea[o + (size_t)f] = cl->face[first[i] + (size_t)f].area;
+    }
+    for (size_t c = 0; c < 4 * w->ntets; c++) /* ts[x]: x's next free entry */
+        if (w->tets[c] >= j->lo && w->tets[c] < j->hi)
+            inc[ts[w->tets[c] - j->lo]++] = (uint32_t)(c / 4);
+    /* ts[x] is now the end of point lo + x's tets, ts[x - 1] their start */
+    size_t cap = 16 * (k ? k : 1), o = 0;
+    j->adj = malloc(cap * sizeof *j->adj);
+    for (size_t x = 0; x < k && j->adj; x++) {
+        uint32_t l = j->lo + (uint32_t)x;
+        size_t b = j->adj_start[x] = o;
+        for (size_t c = x ? ts[x - 1] : 0; c < ts[x] && j->adj; c++) {
+            const uint32_t *tv = w->tets + 4 * (size_t)inc[c];
+            for (int q = 0; q < 4; q++) {
+                uint32_t u = tv[q];
+                if (u == l || (seen[u / 64] >> (u % 64) & 1))
+                    continue;
+                seen[u / 64] |= UINT64_C(1) << (u % 64);
+                if (o == cap) {
+                    uint32_t *nq = realloc(j->adj, 2 * cap * sizeof *nq);
+                    if (!nq) {
+                        free(j->adj);
+                        j->adj = NULL;
+                        break;
+                    }
+                    j->adj = nq;
+                    cap *= 2;
+                }
+                size_t y = o++; /* ascending: insertion, about 15 */
+                for (; y > b && j->adj[y - 1] > u; y--)
+                    j->adj[y] = j->adj[y - 1];
+                j->adj[y] = u;
+            }
+        }
+        for (size_t e = b; e < o && j->adj; e++)
+            seen[j->adj[e] / 64] = 0;
+    }
+    j->adj_start[k] = o;
+    free(ts);
+    free(seen);
+    free(inc);
+    j->fsum = j->adj ? calloc(o ? o : 1, sizeof *j->fsum) : NULL;
+    return j->fsum ? FDT_OK : FDT_ENOMEM;
+}
+
+/* A thread: the tet pass for its points, then their cells. Threads write
+ * disjoint entries only (their own points' accumulators, flags and output
+ * rows); pthread_join orders all of it before the caller reads it. */
+static void *run_job(void *arg)
+{
+    vjob *j = arg;
+    vwork *w = j->w;
+    if ((j->err = job_adjacency(j)) != FDT_OK)
+        return NULL;
+    for (size_t t = 0; t < w->ntets; t++) {
+        const uint32_t *tv = w->tets + 4 * t;
+        if (mine(j, tv[0]) || mine(j, tv[1]) || mine(j, tv[2]) || mine(j, tv[3]))
+            add_tet(j, tv);
+    }
+    for (uint32_t l = j->lo; l < j->hi && !j->err; l++) {
+        uint32_t g = w->perm[l];
+        j->v->flags[g] = w->flags[l];
+        double dt = fdt_fix_value(w->dtfe[l], w->g_vol);
+        j->v->density[g] = dt > 0 ? 4 / dt : 0;
+        if (w->flags[l] & FDT_CELL_CLIPPED)
+            j->err = cut_cell(j, l);
+        else
+            sum_cell(j, l);
+        if (j->err == FDT_EINTERNAL)
+            j->lo = l; /* the point, for the message */
+    }
+    return NULL;
+}
+
+/* ---------------------------------------------------------------- results */
+
+/* The neighbour lists in input order, the job's points' part: a summed
+ * cell's from its list's entries, a cut cell's from its faces (both by
+ * input id, walls first). v->nstart is set; the lists of different jobs'
+ * points are disjoint. */
+static void *fill_neighbors(void *arg)
+{
+    vjob *j = arg;
+    const vwork *w = j->w;
+    fdt_voronoi *v = j->v;
+    for (uint32_t l = j->lo; l < j->hi; l++) {
+        uint32_t g = w->perm[l];
+        size_t o = v->nstart[g], k = (size_t)v->nfaces[g];
+        if (w->flags[l] & FDT_CELL_CLIPPED) {
+            const fdt_cell_face *fc = j->face + j->first[l - j->lo];
+            for (size_t f = 0; f < k; f++) {
+                v->nid[o + f] = (fdt_vid)fc[f].label;
+                v->narea[o + f] = fc[f].area;
             }
             continue;
         }
-        for (size_t e = r->adj_start[i]; e < r->adj_start[i + 1]; e++) {
-            double ar = fdt_fix_value(a->face[e], a->e_area);
-            if (real_face(ar, v->area[i])) {
-                v->nid[o] = r->adj[e];
-                v->narea[o++] = ar;
+        size_t m = 0;
+        for (size_t e = j->adj_start[l - j->lo]; e < j->adj_start[l - j->lo + 1]; e++) {
+            double ar = fdt_fix_value(j->fsum[e], w->g_area);
+            if (!real_face(ar, v->area[g]))
+                continue;
+            fdt_vid id = (fdt_vid)w->perm[j->adj[e]];
+            size_t y = o + m++; /* ascending input ids: insertion, a dozen */
+            for (; y > o && v->nid[y - 1] > id; y--) {
+                v->nid[y] = v->nid[y - 1];
+                v->narea[y] = v->narea[y - 1];
             }
+            v->nid[y] = id;
+            v->narea[y] = ar;
         }
     }
-    return FDT_OK;
+    return NULL;
 }
 
 static int alloc_cells(fdt_voronoi *v)
@@ -451,108 +740,164 @@ static int alloc_cells(fdt_voronoi *v)
                : FDT_ENOMEM;
 }
 
-static int alloc_accum(accum *a, size_t n, size_t nadj)
+/* The local flags (hull points) and accumulators. */
+static int alloc_work(vwork *w, const fdt_result *r)
 {
-    a->vol = calloc(n ? n : 1, sizeof *a->vol);
-    a->mom = calloc(3 * (n ? n : 1), sizeof *a->mom);
-    a->dtfe = calloc(n ? n : 1, sizeof *a->dtfe);
-    a->face = calloc(nadj ? nadj : 1, sizeof *a->face);
-    return a->vol && a->mom && a->dtfe && a->face ? FDT_OK : FDT_ENOMEM;
+    size_t m = w->m ? w->m : 1;
+    w->flags = calloc(m, sizeof *w->flags);
+    w->vol = calloc(m, sizeof *w->vol);
+    w->mom = calloc(3 * m, sizeof *w->mom);
+    w->dtfe = calloc(m, sizeof *w->dtfe);
+    if (!w->flags || !w->vol || !w->mom || !w->dtfe)
+        return FDT_ENOMEM;
+    for (size_t f = 0; f < 3 * r->nhull; f++)
+        w->flags[w->loc[r->hull[f]]] |= FDT_CELL_HULL | FDT_CELL_CLIPPED;
+    return FDT_OK;
 }
 
-static void free_accum(accum *a)
+static void free_work(vwork *w)
 {
-    free(a->vol);
-    free(a->mom);
-    free(a->dtfe);
-    free(a->face);
+    free(w->perm);
+    free(w->loc);
+    free(w->xyz);
+    free(w->tets);
+    free(w->flags);
+    free(w->vol);
+    free(w->mom);
+    free(w->dtfe);
 }
 
-int fdt_voronoi_compute(fdt_result *r, const double *xyz, size_t n,
-                        const fdt_voronoi_options *o, fdt_voronoi **out, char *diag,
-                        size_t diag_size)
+/* The jobs over the points, in equal ranges of the local numbering. */
+static int make_jobs(vwork *w, fdt_voronoi *v, vjob *jobs, int threads)
 {
-    fdt_voronoi_options defaults;
+    for (int t = 0; t < threads; t++) {
+        vjob *j = &jobs[t];
+        j->w = w;
+        j->v = v;
+        j->lo = (uint32_t)(w->m * (size_t)t / (size_t)threads);
+        j->hi = (uint32_t)(w->m * (size_t)(t + 1) / (size_t)threads);
+        fdt_cell_init(&j->cell);
+        j->first = malloc(((size_t)(j->hi - j->lo) + 1) * sizeof *j->first);
+        if (!j->first)
+            return FDT_ENOMEM;
+    }
+    return FDT_OK;
+}
+
+/* fn on every job, on `threads` threads (the caller's is the last; a job
+ * whose thread could not start runs on the caller's). pthread_create and
+ * pthread_join order everything before and after. */
+static int fork_join(vjob *jobs, int threads, void *(*fn)(void *))
+{
+    for (int t = 0; t < threads - 1; t++)
+        jobs[t].started = fdt_spawn(&jobs[t].th, 0, fn, &jobs[t]) == 0;
+    fn(&jobs[threads - 1]);
+    for (int t = 0; t < threads - 1; t++) {
+        if (jobs[t].started)
+            pthread_join(jobs[t].th, NULL);
+        else
+            fn(&jobs[t]);
+    }
+    int err = FDT_OK;
+    for (int t = 0; t < threads && !err; t++)
+        err = jobs[t].err;
+    return err;
+}
+
+/* The neighbour lists' offsets (input order), then their entries on the
+ * threads. */
+static int list_neighbors(fdt_voronoi *v, vjob *jobs, int threads)
+{
+    v->nstart = malloc((v->n + 1) * sizeof *v->nstart);
+    if (!v->nstart)
+        return FDT_ENOMEM;
+    v->nstart[0] = 0;
+    for (size_t i = 0; i < v->n; i++)
+        v->nstart[i + 1] = v->nstart[i] + (size_t)v->nfaces[i];
+    size_t tot = v->nstart[v->n];
+    v->nid = malloc((tot ? tot : 1) * sizeof *v->nid);
+    v->narea = malloc((tot ? tot : 1) * sizeof *v->narea);
+    if (!v->nid || !v->narea)
+        return FDT_ENOMEM;
+    return fork_join(jobs, threads, fill_neighbors);
+}
+
+int fdt_voronoi_build(fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
+                      int threads, fdt_voronoi **out, char *diag, size_t diag_size)
+{
     if (diag && diag_size)
         diag[0] = 0;
-    if (!o) {
-        fdt_default_voronoi_options(&defaults);
-        o = &defaults;
-    }
-    if (!r || !xyz || !out || o->struct_size != sizeof *o)
-        return FDT_EINVAL;
     *out = NULL;
     if (r->streamed || n != r->n) {
         say(diag, diag_size, "%zu points given; the cells need the result of "
                              "fdt_triangulate on the same points, with its tets", n);
         return FDT_EINVAL;
     }
-    /* The vertex adjacency is derived on request and kept in the result
-     * (src/mesh/faces.c): asking for one vertex's neighbours builds it. */
-    size_t cnt;
-    const fdt_vid *ids;
-    int err = n ? fdt_result_vertex_neighbors(r, 0, &cnt, &ids) : FDT_OK;
-    if (err)
-        return err;
+    int err = FDT_OK;
     fdt_voronoi *v = calloc(1, sizeof *v);
-    accum a = {0};
-    clipped cl = {0};
-    size_t *first = NULL;
-    fdt_cell cell;
-    fdt_cell_init(&cell);
-    if (!v)
+    vwork w;
+    memset(&w, 0, sizeof w);
+    w.n = n;
+    if (threads < 1)
+        threads = 1;
+    if ((size_t)threads > n / 64 + 1)
+        threads = (int)(n / 64 + 1);
+    vjob *jobs = calloc((size_t)threads, sizeof *jobs);
+    if (!v || !jobs) {
+        free(v);
+        free(jobs);
         return FDT_ENOMEM;
+    }
     v->n = n;
     err = alloc_cells(v);
     if (!err)
         err = set_box(v, r, xyz, o, diag, diag_size);
     if (err)
-        goto fail;
-    set_flags(v, r);
-    set_grids(&a, v->box);
-    err = alloc_accum(&a, n, n ? r->adj_start[n] : 0);
-    first = calloc(n ? n : 1, sizeof *first);
-    if (!err && !first)
-        err = FDT_ENOMEM;
-    if (err)
-        goto fail;
-    /* The tet pass: shares of the cells inside the box, DTFE volumes. */
-    for (size_t t = 0; t < r->ntets; t++)
-        add_tet(r, xyz, v->box, r->tets + 4 * t, &a, v->flags);
-    /* Each cell: summed, or cut from the box. */
-    for (size_t i = 0; i < n && !err; i++) {
-        if (v->flags[i] & FDT_CELL_MERGED)
-            continue;
-        double dt = fdt_fix_value(a.dtfe[i], a.e_vol);
-        v->density[i] = dt > 0 ? 4 / dt : 0;
-        if (v->flags[i] & FDT_CELL_CLIPPED) {
-            err = cut_cell(v, r, xyz, (fdt_vid)i, &cell, &cl, &first[i]);
-            if (err == FDT_EINTERNAL)
-                say(diag, diag_size, "the cell of point %zu (%.17g %.17g %.17g) could not be cut "
-                                     "from the box (a bug: please report)", i, xyz[3 * i],
-                    xyz[3 * i + 1], xyz[3 * i + 2]);
-        } else {
-            sum_cell(v, r, xyz, (fdt_vid)i, &a);
-        }
-    }
+        goto done;
+    memcpy(w.box, v->box, sizeof w.box);
+    set_grids(&w);
+    /* The steps: number the points and their tets; on the threads, the
+     * neighbour lists, the tet pass and the cells; the neighbour lists. */
+    err = number_points(&w, r, xyz);
+    if (!err)
+        err = local_tets(&w, r);
+    if (!err)
+        err = alloc_work(&w, r);
+    if (!err)
+        err = make_jobs(&w, v, jobs, threads);
+    if (!err)
+        err = fork_join(jobs, threads, run_job);
+    if (err == FDT_EINTERNAL)
+        for (int t = 0; t < threads; t++)
+            if (jobs[t].err == FDT_EINTERNAL) {
+                const double *p = w.xyz + 3 * (size_t)jobs[t].lo;
+                say(diag, diag_size, "the cell of point %u (%.17g %.17g %.17g) could not be "
+                    "cut from the box (a bug: please report)", w.perm[jobs[t].lo], p[0], p[1],
+                    p[2]);
+                break;
+            }
+    for (size_t i = 0; !err && i < n; i++)
+        if (r->dupmap[i] != (fdt_vid)i)
+            v->flags[i] = FDT_CELL_MERGED;
+    for (int t = 0; !err && t < threads; t++)
+        v->zero_faces += jobs[t].zero_faces;
     if (!err && o->neighbors)
-        err = list_neighbors(v, r, &a, &cl, first);
+        err = list_neighbors(v, jobs, threads);
+done:
+    for (int t = 0; t < threads; t++) {
+        fdt_cell_free(&jobs[t].cell);
+        free(jobs[t].face);
+        free(jobs[t].order);
+        free(jobs[t].first);
+        free(jobs[t].adj_start);
+        free(jobs[t].adj);
+        free(jobs[t].fsum);
+    }
+    free(jobs);
+    free_work(&w);
     if (err)
-        goto fail;
-    free_accum(&a);
-    free(cl.face);
-    free(cl.order);
-    free(first);
-    fdt_cell_free(&cell);
+        fdt_voronoi_free(&v);
     *out = v;
-    return FDT_OK;
-fail:
-    free_accum(&a);
-    free(cl.face);
-    free(cl.order);
-    free(first);
-    fdt_cell_free(&cell);
-    fdt_voronoi_free(&v);
     return err;
 }
 

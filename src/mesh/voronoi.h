@@ -1,0 +1,13 @@
+/* The Voronoi cells' computation (src/mesh/voronoi.c) behind the public
+ * fdt_voronoi_compute (src/api/api.c, which resolves the thread count). */
+#ifndef FDT_VORONOI_H
+#define FDT_VORONOI_H
+
+#include "frontdt.h"
+
+/* fdt_voronoi_compute on `threads` threads (at least 1; the caller's is
+ * one of them), o not NULL and of this library's size. */
+int fdt_voronoi_build(fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
+                      int threads, fdt_voronoi **out, char *diag, size_t diag_size);
+
+#endif
