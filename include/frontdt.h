@@ -700,15 +700,14 @@ static inline void fdt_default_voronoi_options(fdt_voronoi_options *o)
 
 /*
  * The cells of the n points xyz (borrowed, the array r was computed from)
- * from r's tets and hull faces; r keeps the vertex adjacency this derives
- * (fdt_result_vertex_neighbors), nothing else changes. o may be NULL (the
+ * from r's tets and hull faces (r is not changed). o may be NULL (the
  * defaults). *out is owned by the caller (fdt_voronoi_free). FDT_EINVAL
  * for a NULL argument, a streamed result (no tets kept), n not r's point
  * count, threads outside 0..1024, an empty or inverted box, or a point outside the given box (diag,
  * when not NULL, says which; it is written in every case, "" on success);
  * FDT_ENOMEM; FDT_EINTERNAL when a cell could not be cut (a bug).
  */
-FDT_API int fdt_voronoi_compute(fdt_result *r, const double *xyz, size_t n,
+FDT_API int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n,
                                 const fdt_voronoi_options *o, fdt_voronoi **out,
                                 char *diag, size_t diag_size);
 FDT_API void fdt_voronoi_free(fdt_voronoi **v);
@@ -736,6 +735,40 @@ FDT_API size_t fdt_voronoi_zero_faces(const fdt_voronoi *v);
  * options.neighbors was not set or i is out of range. */
 FDT_API int fdt_voronoi_neighbors(const fdt_voronoi *v, fdt_vid i, size_t *count,
                                   const fdt_vid **ids, const double **areas);
+
+/*
+ * Point location and interpolation in a result's mesh (issue 32). r is the
+ * result of fdt_triangulate on the n points xyz (borrowed; not streamed).
+ * Where r keeps no neighbours (settings.neighbors 0) they are derived from
+ * its face list, which r then keeps (as fdt_result_faces): not to be
+ * called on one such r from two threads at once. threads: 0 for one per physical core (as
+ * fdt_settings.n_threads), or 1 to 1024; the results do not depend on it.
+ * The queries are taken in Morton order (short walks between them).
+ *
+ * fdt_locate: for each of the nq queries q (3 doubles each), tet[k], the
+ * index of a tet holding it (fdt_result_tets; on a face shared by two,
+ * either), or -1 outside the hull (or not finite); when bary is not NULL,
+ * its 4 barycentric coordinates in the order of that tet's vertices (0
+ * outside). The walk decides with exact orient3d. FDT_EINVAL, FDT_ENOMEM.
+ */
+FDT_API int fdt_locate(fdt_result *r, const double *xyz, size_t n, const double *q, size_t nq,
+                       fdt_tid *tet, double *bary, int threads);
+
+typedef enum fdt_interp {
+    FDT_INTERP_LINEAR = 0,  /* barycentric in the tet holding the query */
+    FDT_INTERP_NATURAL = 1  /* Sibson's natural-neighbour coordinates */
+} fdt_interp;
+
+/*
+ * values: nv values a point (values[nv i + c], input numbering; a merged
+ * duplicate's are not read: its first occurrence's are). out: nv values a
+ * query. Both methods reproduce linear functions; a query outside the hull
+ * gets NaN (natural: on the hull too), one at a point that point's values. FDT_EINVAL, FDT_ENOMEM,
+ * FDT_EINTERNAL (diag, when not NULL, names the query).
+ */
+FDT_API int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
+                            size_t nv, const double *q, size_t nq, fdt_interp method,
+                            int threads, double *out, char *diag, size_t diag_size);
 
 /* Frees memory the library allocated for the caller (the points of
  * fdt_read_points). NULL is fine. */

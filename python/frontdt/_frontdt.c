@@ -482,10 +482,8 @@ static PyObject *tri_voronoi(TriObject *self, PyObject *args, PyObject *kw)
     fdt_voronoi *v = NULL;
     char diag[512];
     int err;
-    Py_BEGIN_ALLOW_THREADS
-    PyThread_acquire_lock(self->lock, WAIT_LOCK); /* derives r's adjacency */
+    Py_BEGIN_ALLOW_THREADS /* r is only read */
     err = fdt_voronoi_compute(self->r, xyz, n, &o, &v, diag, sizeof diag);
-    PyThread_release_lock(self->lock);
     Py_END_ALLOW_THREADS
     if (err)
         return raise_fdt(err, diag);

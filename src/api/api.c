@@ -17,6 +17,7 @@
 #include "par/parallel.h"
 #include "geom/prepare.h"
 #include "mesh/result.h"
+#include "mesh/locate.h"
 #include "mesh/voronoi.h"
 #include "front/seed.h"
 #include "base/sethash.h"
@@ -244,7 +245,7 @@ static int one_part(const fdt_settings *s, fdt_mode mode, int streamed)
 
 /* The Voronoi cells (src/mesh/voronoi.c) on the threads the options ask
  * for. */
-int fdt_voronoi_compute(fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
+int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
                         fdt_voronoi **out, char *diag, size_t diag_size)
 {
     fdt_voronoi_options defaults;
@@ -258,6 +259,28 @@ int fdt_voronoi_compute(fdt_result *r, const double *xyz, size_t n, const fdt_vo
         return FDT_EINVAL;
     int threads = o->threads ? o->threads : fdt_parallel_default_threads();
     return fdt_voronoi_build(r, xyz, n, o, threads, out, diag, diag_size);
+}
+
+/* Point location and interpolation (src/mesh/locate.c, interpolate.c) on
+ * the threads asked for. */
+int fdt_locate(fdt_result *r, const double *xyz, size_t n, const double *q, size_t nq,
+               fdt_tid *tet, double *bary, int threads)
+{
+    if (threads < 0 || threads > 1024)
+        return FDT_EINVAL;
+    return fdt_locate_build(r, xyz, n, q, nq, tet, bary,
+                            threads ? threads : fdt_parallel_default_threads());
+}
+
+int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
+                    size_t nv, const double *q, size_t nq, fdt_interp method, int threads,
+                    double *out, char *diag, size_t diag_size)
+{
+    if (threads < 0 || threads > 1024)
+        return FDT_EINVAL;
+    return fdt_interpolate_build(r, xyz, n, values, nv, q, nq, method,
+                                 threads ? threads : fdt_parallel_default_threads(), out, diag,
+                                 diag_size);
 }
 
 int fdt_engine_one_part(const fdt_settings *s, int streamed)

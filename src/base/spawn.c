@@ -72,3 +72,28 @@ int fdt_spawn(pthread_t *th, size_t stack_bytes, void *(*fn)(void *), void *arg)
     pthread_attr_destroy(&attr);
     return rc;
 }
+
+void fdt_fork_join(void *jobs, size_t size, int count, void *(*fn)(void *))
+{
+    char *j = jobs;
+    pthread_t *th = count > 1 ? malloc((size_t)(count - 1) * sizeof *th) : NULL;
+    char *started = count > 1 ? calloc((size_t)(count - 1), 1) : NULL;
+    if (count > 1 && (!th || !started)) {
+        free(th);
+        free(started);
+        th = NULL;
+        started = NULL;
+    }
+    for (int i = 0; th && i < count - 1; i++)
+        started[i] = fdt_spawn(&th[i], 0, fn, j + (size_t)i * size) == 0;
+    if (count > 0)
+        fn(j + (size_t)(count - 1) * size);
+    for (int i = 0; i < count - 1; i++) {
+        if (th && started[i])
+            pthread_join(th[i], NULL);
+        else
+            fn(j + (size_t)i * size); /* no thread: on the caller's */
+    }
+    free(th);
+    free(started);
+}

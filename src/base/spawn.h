@@ -29,4 +29,11 @@
  * default), placed as above. Returns pthread_create's result. */
 int fdt_spawn(pthread_t *th, size_t stack_bytes, void *(*fn)(void *), void *arg);
 
+/* fn(jobs + i size) for every i < count, each on a thread of its own
+ * started by fdt_spawn, the last on the caller's (a job whose thread could
+ * not start runs on the caller's too, afterwards); returns when all are
+ * done. pthread_create and pthread_join order each job's writes after
+ * the caller's before and before the caller's after. */
+void fdt_fork_join(void *jobs, size_t size, int count, void *(*fn)(void *));
+
 #endif

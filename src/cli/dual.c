@@ -92,7 +92,7 @@ static int put_density(FILE *f, const void *arg, const double *xyz)
     return fdt_wr_density(f, arg);
 }
 
-int fdt_cli_dual_write(const fdt_cli_dual *d, fdt_result *res, const double *xyz, size_t n,
+int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const double *xyz, size_t n,
                        char *err, size_t errlen)
 {
     fdt_voronoi_options o;

@@ -37,7 +37,7 @@ int fdt_cli_dual_check(const fdt_cli_dual *d, char *err, size_t errlen);
  * and writes the files into the open commit set. 0, or an FDT_E* code
  * with the message in err: FDT_EINVAL (a point outside --box), FDT_ENOMEM,
  * FDT_EIO (a file could not be written), FDT_EINTERNAL. */
-int fdt_cli_dual_write(const fdt_cli_dual *d, fdt_result *res, const double *xyz, size_t n,
+int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const double *xyz, size_t n,
                        char *err, size_t errlen);
 
 #endif

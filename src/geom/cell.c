@@ -79,6 +79,22 @@ int fdt_cell_box(fdt_cell *c, const double lo[3], const double hi[3])
     return 0;
 }
 
+int fdt_cell_copy(fdt_cell *dst, const fdt_cell *src)
+{
+    if (grow(&dst->p, &dst->capp, src->np, sizeof *dst->p) ||
+        grow(&dst->ring, &dst->capring, src->nring, sizeof(int)) ||
+        grow(&dst->f, &dst->capf, src->nf, sizeof *dst->f))
+        return -1;
+    memcpy(dst->p, src->p, (size_t)src->np * sizeof *dst->p);
+    memcpy(dst->ring, src->ring, (size_t)src->nring * sizeof(int));
+    memcpy(dst->f, src->f, (size_t)src->nf * sizeof *dst->f);
+    dst->np = src->np;
+    dst->nring = src->nring;
+    dst->nf = src->nf;
+    dst->radius = src->radius;
+    return 0;
+}
+
 /* The point where the plane crosses edge (a, b), a inside and b outside:
  * made once per edge and shared by the two faces along it, and computed
  * from the inside end for both. -1 when out of memory. */
@@ -165,7 +181,9 @@ static int compact(fdt_cell *c)
     for (int i = 0; i < c->ntring; i++)
         if (c->v[c->tring[i]].map < 0)
             c->v[c->tring[i]].map = m++;
-    if (grow(&c->tp, &c->captp, m, sizeof *c->tp) ||
+    /* tp as large as p: after the swap below, the next crossings find
+     * room without a realloc */
+    if (grow(&c->tp, &c->captp, m > c->capp ? m : c->capp, sizeof *c->tp) ||
         grow(&c->ring, &c->capring, c->ntring, sizeof(int)) ||
         grow(&c->f, &c->capf, c->ntf, sizeof *c->f))
         return -1;
@@ -217,7 +235,7 @@ int fdt_cell_cut(fdt_cell *c, const double n[3], double h, long label)
         if (e == -2)
             return -1;
         if (e == -3)
-            return -2;
+            return -3;
         if (e >= 0) {
             edges++;
             if (first < 0)
@@ -232,7 +250,7 @@ int fdt_cell_cut(fdt_cell *c, const double n[3], double h, long label)
                 return -1;
             v = c->v[v].next;
             if (v < 0 || ++steps > edges)
-                return -2; /* an open chain: not a convex cell */
+                return -3; /* an open chain: not a convex cell */
         } while (v != first);
         if (push_face(c, start, label))
             return -1;

@@ -64,6 +64,10 @@ typedef struct fdt_cell_face {
 void fdt_cell_init(fdt_cell *c);
 void fdt_cell_free(fdt_cell *c);
 
+/* Makes dst a copy of src (dst's arrays reused). 0, or -1 when out of
+ * memory. */
+int fdt_cell_copy(fdt_cell *dst, const fdt_cell *src);
+
 /* Makes c the box [lo, hi] (coordinates relative to the site, lo < 0 < hi
  * in each coordinate up to the site lying on a wall: lo <= 0 <= hi).
  * Returns 0, or -1 when out of memory. */
@@ -71,8 +75,9 @@ int fdt_cell_box(fdt_cell *c, const double lo[3], const double hi[3]);
 
 /* Keeps the part of c where n . x <= h, the new face labelled `label`.
  * Returns 1 when the cut removed something, 0 when it did not, -1 when
- * out of memory, -2 when the cut would leave no cell (never for h > 0 and
- * a cell containing the origin). */
+ * out of memory, -2 when the cut would leave nothing of c (never for h > 0
+ * and a cell containing the origin; c is unchanged), -3 when the cut found
+ * c not convex (rounding gone wrong: a bug; c keeps its shape). */
 int fdt_cell_cut(fdt_cell *c, const double n[3], double h, long label);
 
 /* The cell's volume, surface area, centroid (relative to the site), and

@@ -22,7 +22,6 @@
  * (src/geom/cell.c), as voro++ computes every cell.
  */
 #include <math.h>
-#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,6 +31,7 @@
 #include "base/fixsum.h"
 #include "base/spawn.h"
 #include "geom/cell.h"
+#include "geom/morton.h"
 #include "geom/predicates.h"
 #include "mesh/result.h"
 #include "mesh/voronoi.h"
@@ -87,8 +87,6 @@ typedef struct vjob {
     size_t *first;       /* cut cell lo + k: its faces from face[first[k]] */
     size_t zero_faces;
     int err;
-    pthread_t th;
-    int started;
 } vjob;
 
 int fdt_default_voronoi_options_sized(fdt_voronoi_options *o, size_t struct_size)
@@ -174,65 +172,33 @@ static void set_grids(vwork *w)
 
 /* ---------------------------------------------------------------- numbering */
 
-typedef struct keyed {
-    uint64_t key;
-    uint32_t id;
-} keyed;
-
-static int keyed_cmp(const void *x, const void *y)
-{
-    const keyed *a = x, *b = y;
-    if (a->key != b->key)
-        return a->key < b->key ? -1 : 1;
-    return a->id < b->id ? -1 : a->id > b->id;
-}
-
-/* 21 bits of each coordinate in the box, interleaved. */
-static uint64_t morton(const double *p, const double box[6])
-{
-    uint64_t key = 0;
-    uint32_t c[3];
-    for (int k = 0; k < 3; k++) {
-        double t = (p[k] - box[k]) / (box[k + 3] - box[k]);
-        t = t < 0 ? 0 : t > 1 ? 1 : t;
-        c[k] = (uint32_t)(t * 2097151.0);
-    }
-    for (int b = 20; b >= 0; b--)
-        for (int k = 0; k < 3; k++)
-            key = key << 1 | ((c[k] >> b) & 1);
-    return key;
-}
-
 /* perm, loc and the local coordinates. */
 static int number_points(vwork *w, const fdt_result *r, const double *xyz)
 {
-    keyed *kp = malloc((w->n ? w->n : 1) * sizeof *kp);
+    uint8_t *merged = malloc(w->n ? w->n : 1);
     w->loc = malloc((w->n ? w->n : 1) * sizeof *w->loc);
-    if (!kp || !w->loc) {
-        free(kp);
+    w->perm = malloc((w->n ? w->n : 1) * sizeof *w->perm);
+    if (!merged || !w->loc || !w->perm) {
+        free(merged);
         return FDT_ENOMEM;
     }
-    size_t m = 0;
     for (size_t i = 0; i < w->n; i++) {
+        merged[i] = r->dupmap[i] != (fdt_vid)i;
         w->loc[i] = UINT32_MAX;
-        if (r->dupmap[i] == (fdt_vid)i)
-            kp[m++] = (keyed){morton(xyz + 3 * i, w->box), (uint32_t)i};
     }
-    qsort(kp, m, sizeof *kp, keyed_cmp);
-    w->m = m;
-    w->perm = malloc((m ? m : 1) * sizeof *w->perm);
-    w->xyz = malloc(3 * (m ? m : 1) * sizeof *w->xyz);
-    if (!w->perm || !w->xyz) {
-        free(kp);
+    long m = fdt_morton_order(xyz, w->n, w->box, merged, w->perm);
+    free(merged);
+    if (m < 0)
         return FDT_ENOMEM;
-    }
-    for (size_t l = 0; l < m; l++) {
-        uint32_t g = kp[l].id;
-        w->perm[l] = g;
+    w->m = (size_t)m;
+    w->xyz = malloc(3 * (w->m ? w->m : 1) * sizeof *w->xyz);
+    if (!w->xyz)
+        return FDT_ENOMEM;
+    for (size_t l = 0; l < w->m; l++) {
+        uint32_t g = w->perm[l];
         w->loc[g] = (uint32_t)l;
         memcpy(w->xyz + 3 * l, xyz + 3 * (size_t)g, 3 * sizeof *xyz);
     }
-    free(kp);
     return FDT_OK;
 }
 
@@ -784,20 +750,10 @@ static int make_jobs(vwork *w, fdt_voronoi *v, vjob *jobs, int threads)
     return FDT_OK;
 }
 
-/* fn on every job, on `threads` threads (the caller's is the last; a job
- * whose thread could not start runs on the caller's). pthread_create and
- * pthread_join order everything before and after. */
+/* fn on every job (fdt_fork_join), then the first error of any. */
 static int fork_join(vjob *jobs, int threads, void *(*fn)(void *))
 {
-    for (int t = 0; t < threads - 1; t++)
-        jobs[t].started = fdt_spawn(&jobs[t].th, 0, fn, &jobs[t]) == 0;
-    fn(&jobs[threads - 1]);
-    for (int t = 0; t < threads - 1; t++) {
-        if (jobs[t].started)
-            pthread_join(jobs[t].th, NULL);
-        else
-            fn(&jobs[t]);
-    }
+    fdt_fork_join(jobs, sizeof *jobs, threads, fn);
     int err = FDT_OK;
     for (int t = 0; t < threads && !err; t++)
         err = jobs[t].err;
@@ -822,7 +778,7 @@ static int list_neighbors(fdt_voronoi *v, vjob *jobs, int threads)
     return fork_join(jobs, threads, fill_neighbors);
 }
 
-int fdt_voronoi_build(fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
+int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
                       int threads, fdt_voronoi **out, char *diag, size_t diag_size)
 {
     if (diag && diag_size)

@@ -7,7 +7,7 @@
 
 /* fdt_voronoi_compute on `threads` threads (at least 1; the caller's is
  * one of them), o not NULL and of this library's size. */
-int fdt_voronoi_build(fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
+int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
                       int threads, fdt_voronoi **out, char *diag, size_t diag_size);
 
 #endif

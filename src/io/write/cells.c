@@ -1,8 +1,11 @@
-/* The Voronoi cells as text: see cells.h. */
+/* The Voronoi cells as text: see cells.h. Written through the mesh
+ * writers' buffer (outfile.h): one stdio call a megabyte, not a number. */
 #include "io/write/cells.h"
 
 #include <errno.h>
 #include <string.h>
+
+#include "io/write/outfile.h"
 
 static const char codes[] = "ixyzqvFsnfcCdh%";
 
@@ -26,13 +29,8 @@ int fdt_cells_format_check(const char *fmt, int *needs_nbrs, char *err, size_t e
     return 0;
 }
 
-static void num(FILE *f, double x)
-{
-    fprintf(f, "%.17g", x);
-}
-
-/* Point i's neighbours (%n) or face areas (%f), space separated. */
-static void list(FILE *f, const fdt_voronoi *v, size_t i, int areas)
+/* Point i's neighbours (%n) or face areas (%f), separated by blanks. */
+static void list(out_file *o, const fdt_voronoi *v, size_t i, int areas)
 {
     size_t cnt = 0;
     const fdt_vid *ids;
@@ -41,97 +39,93 @@ static void list(FILE *f, const fdt_voronoi *v, size_t i, int areas)
         return;
     for (size_t e = 0; e < cnt; e++) {
         if (e)
-            fputc(' ', f);
+            out_char(o, ' ');
         if (areas)
-            num(f, fa[e]);
+            out_double(o, fa[e]);
         else
-            fprintf(f, "%d", (int)ids[e]);
+            out_i64(o, ids[e]);
     }
 }
 
-static void code(FILE *f, char c, const fdt_voronoi *v, const double *xyz, size_t i)
+/* Three values, separated by sep. */
+static void three(out_file *o, const double *x, char sep)
 {
-    const double *p = xyz + 3 * i, *cen = fdt_voronoi_centroids(v) + 3 * i;
+    for (int k = 0; k < 3; k++) {
+        if (k)
+            out_char(o, sep);
+        out_double(o, x[k]);
+    }
+}
+
+static void code(out_file *o, char c, const fdt_voronoi *v, const double *xyz, size_t i,
+                 char sep)
+{
+    const double *p = xyz ? xyz + 3 * i : NULL; /* NULL: no code reads it */
+    const double *cen = fdt_voronoi_centroids(v) + 3 * i;
     int merged = (fdt_voronoi_flags(v)[i] & FDT_CELL_MERGED) != 0;
+    double rel[3];
     switch (c) {
-    case 'i': fprintf(f, "%zu", i); break;
-    case 'x': num(f, p[0]); break;
-    case 'y': num(f, p[1]); break;
-    case 'z': num(f, p[2]); break;
-    case 'q': num(f, p[0]); fputc(' ', f); num(f, p[1]); fputc(' ', f); num(f, p[2]); break;
-    case 'v': num(f, fdt_voronoi_volumes(v)[i]); break;
-    case 'F': num(f, fdt_voronoi_areas(v)[i]); break;
-    case 's': fprintf(f, "%d", (int)fdt_voronoi_num_faces(v)[i]); break;
-    case 'n': list(f, v, i, 0); break;
-    case 'f': list(f, v, i, 1); break;
+    case 'i': out_i64(o, (int64_t)i); break;
+    case 'x': out_double(o, p[0]); break;
+    case 'y': out_double(o, p[1]); break;
+    case 'z': out_double(o, p[2]); break;
+    case 'q': three(o, p, sep); break;
+    case 'v': out_double(o, fdt_voronoi_volumes(v)[i]); break;
+    case 'F': out_double(o, fdt_voronoi_areas(v)[i]); break;
+    case 's': out_i64(o, fdt_voronoi_num_faces(v)[i]); break;
+    case 'n': list(o, v, i, 0); break;
+    case 'f': list(o, v, i, 1); break;
     case 'c':
-        for (int k = 0; k < 3; k++) {
-            if (k)
-                fputc(' ', f);
-            num(f, merged ? 0 : cen[k] - p[k]);
-        }
+        for (int k = 0; k < 3; k++)
+            rel[k] = merged ? 0 : cen[k] - p[k];
+        three(o, rel, sep);
         break;
-    case 'C':
-        for (int k = 0; k < 3; k++) {
-            if (k)
-                fputc(' ', f);
-            num(f, merged ? p[k] : cen[k]);
-        }
-        break;
-    case 'd': num(f, fdt_voronoi_densities(v)[i]); break;
-    case 'h': fprintf(f, "%d", (int)fdt_voronoi_flags(v)[i]); break;
-    default: fputc('%', f); break;
+    case 'C': three(o, merged ? p : cen, sep); break;
+    case 'd': out_double(o, fdt_voronoi_densities(v)[i]); break;
+    case 'h': out_i64(o, fdt_voronoi_flags(v)[i]); break;
+    default: out_char(o, '%'); break;
     }
 }
 
-static int status(FILE *f)
+/* The rows through a buffer on f; 0 or the errno of the first failure. */
+static int put_rows(FILE *f, const char *fmt, const fdt_voronoi *v, const double *xyz, int csv)
 {
-    return ferror(f) ? (errno ? errno : EIO) : 0;
+    out_file o;
+    memset(&o, 0, sizeof o);
+    o.f = f;
+    o.slot = -1;
+    o.path = "";
+    o.buf = malloc(OUT_BUF_SIZE);
+    if (!o.buf)
+        return ENOMEM;
+    size_t n = fdt_voronoi_num_points(v);
+    if (csv)
+        out_str(&o, "id,x,y,z,volume,area,faces,cx,cy,cz,density,flags\n");
+    for (size_t i = 0; i < n && !o.err; i++) {
+        for (const char *p = fmt; *p; p++) {
+            if (csv && p != fmt)
+                out_char(&o, ',');
+            if (csv)
+                code(&o, *p, v, xyz, i, ',');
+            else if (*p != '%')
+                out_char(&o, *p);
+            else
+                code(&o, *++p, v, xyz, i, ' ');
+        }
+        out_char(&o, '\n');
+    }
+    out_flush(&o);
+    free(o.buf);
+    return o.err;
 }
 
 int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *xyz)
 {
-    size_t n = fdt_voronoi_num_points(v);
-    errno = 0;
-    if (!fmt) {
-        fputs("id,x,y,z,volume,area,faces,cx,cy,cz,density,flags\n", f);
-        static const char row[] = "ixyzvFsCdh";
-        for (size_t i = 0; i < n && !ferror(f); i++) {
-            for (const char *c = row; *c; c++) {
-                if (c != row)
-                    fputc(',', f);
-                if (*c == 'C')
-                    for (int k = 0; k < 3; k++) {
-                        if (k)
-                            fputc(',', f);
-                        num(f, fdt_voronoi_centroids(v)[3 * i + (size_t)k]);
-                    }
-                else
-                    code(f, *c, v, xyz, i);
-            }
-            fputc('\n', f);
-        }
-        return status(f);
-    }
-    for (size_t i = 0; i < n && !ferror(f); i++) {
-        for (const char *p = fmt; *p; p++) {
-            if (*p != '%')
-                fputc(*p, f);
-            else
-                code(f, *++p, v, xyz, i);
-        }
-        fputc('\n', f);
-    }
-    return status(f);
+    /* CSV: the table's columns, each a code */
+    return fmt ? put_rows(f, fmt, v, xyz, 0) : put_rows(f, "iqvFsCdh", v, xyz, 1);
 }
 
 int fdt_wr_density(FILE *f, const fdt_voronoi *v)
 {
-    size_t n = fdt_voronoi_num_points(v);
-    errno = 0;
-    for (size_t i = 0; i < n && !ferror(f); i++) {
-        num(f, fdt_voronoi_densities(v)[i]);
-        fprintf(f, " %d\n", (int)fdt_voronoi_flags(v)[i]);
-    }
-    return status(f);
+    return put_rows(f, "%d %h", v, NULL, 0);
 }

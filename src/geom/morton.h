@@ -1,0 +1,18 @@
+/* Points in Morton (Z) order of their coordinates: the order in which
+ * src/mesh/voronoi.c numbers its points and src/mesh/interpolate.c takes
+ * its queries, so that consecutive ones lie close together. */
+#ifndef FDT_MORTON_H
+#define FDT_MORTON_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Writes to order[] the indices i < n of the points pts (3 doubles each)
+ * with skip[i] 0 (skip NULL: every point), sorted by the Morton key of 21
+ * bits a coordinate in box (xmin, ymin, zmin, xmax, ymax, zmax; points
+ * outside count as on its walls), ties by index. Returns how many, or -1
+ * when out of memory. */
+long fdt_morton_order(const double *pts, size_t n, const double box[6], const uint8_t *skip,
+                      uint32_t *order);
+
+#endif

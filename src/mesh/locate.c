@@ -1,0 +1,221 @@
+/*
+ * Point location in a result's mesh (issue 32): the public fdt_locate,
+ * and the walk src/mesh/interpolate.c starts from.
+ *
+ * A visibility walk: from a tet, cross a face that has the query strictly on
+ * its outer side (exact orient3d), until none has (the tet holds the query,
+ * on its boundary included) or the face crossed is a hull face (the query
+ * lies outside the hull, which is convex). On a Delaunay mesh such a walk
+ * cannot cycle (Edelsbrunner 1990, the acyclic "in front of" relation);
+ * a cap of steps and a scan of every tet back that up, so a walk always
+ * ends. Each query starts at the previous query's tet: a run of nearby
+ * queries walks a few steps each.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/spawn.h"
+#include "geom/morton.h"
+#include "geom/predicates.h"
+#include "mesh/locate.h"
+#include "mesh/result.h"
+
+int fdt_locator_init(fdt_locator *L, fdt_result *r, const double *xyz, size_t n)
+{
+    memset(L, 0, sizeof *L);
+    if (!r || !xyz || r->streamed || n != r->n || r->ntets == 0)
+        return FDT_EINVAL;
+    L->r = r;
+    L->xyz = xyz;
+    if (r->nbrs) {
+        L->nbrs = r->nbrs;
+        return FDT_OK;
+    }
+    /* No neighbours kept (settings.neighbors 0): from the face list. */
+    size_t nf;
+    const fdt_vid *fv;
+    const fdt_tid *ft;
+    int err = fdt_result_faces(r, &nf, &fv, &ft);
+    if (err)
+        return err;
+    fdt_tid *nb = malloc(4 * r->ntets * sizeof *nb);
+    if (!nb)
+        return FDT_ENOMEM;
+    for (size_t f = 0; f < nf; f++)
+        for (int side = 0; side < 2; side++) {
+            fdt_tid t = ft[2 * f + side];
+            if (t < 0)
+                continue;
+            /* the face of t opposite the vertex that is not in it */
+            const fdt_vid *tv = r->tets + 4 * (size_t)t;
+            for (int i = 0; i < 4; i++)
+                if (tv[i] != fv[3 * f] && tv[i] != fv[3 * f + 1] && tv[i] != fv[3 * f + 2])
+                    nb[4 * (size_t)t + (size_t)i] = ft[2 * f + 1 - side];
+        }
+    L->nbrs = L->owned = nb;
+    return FDT_OK;
+}
+
+void fdt_locator_free(fdt_locator *L)
+{
+    free(L->owned);
+    memset(L, 0, sizeof *L);
+}
+
+/* Face i of tet t has q strictly on its outer side. */
+static int beyond(const fdt_locator *L, size_t t, int i, const double *q)
+{
+    const fdt_vid *tv = L->r->tets + 4 * t;
+    const double *X = L->xyz;
+    return fdt_orient3d(X + 3 * (size_t)tv[fdt_tet_face[i][0]],
+                        X + 3 * (size_t)tv[fdt_tet_face[i][1]],
+                        X + 3 * (size_t)tv[fdt_tet_face[i][2]], q, NULL) > 0;
+}
+
+/* The tet holding q, by scanning them all (the walk's backstop). */
+static fdt_tid scan(const fdt_locator *L, const double *q)
+{
+    for (size_t t = 0; t < L->r->ntets; t++) {
+        int in = 1;
+        for (int i = 0; i < 4 && in; i++)
+            in = !beyond(L, t, i, q);
+        if (in)
+            return (fdt_tid)t;
+    }
+    return -1;
+}
+
+fdt_tid fdt_locate_one(const fdt_locator *L, size_t *hint, const double *q)
+{
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(q[k]))
+            return -1;
+    size_t t = *hint < L->r->ntets ? *hint : 0;
+    /* The faces are tried from a rotating start, so that a walk does not
+     * favour one direction. */
+    size_t cap = 64 + 4 * L->r->ntets;
+    for (size_t step = 0; step < cap; step++) {
+        int moved = 0;
+        for (int k = 0; k < 4 && !moved; k++) {
+            int i = (int)((step + (size_t)k) & 3);
+            if (!beyond(L, t, i, q))
+                continue;
+            fdt_tid next = L->nbrs[4 * t + (size_t)i];
+            if (next < 0) {
+                *hint = t;
+                return -1; /* beyond a hull face: outside the hull */
+            }
+            t = (size_t)next;
+            moved = 1;
+        }
+        if (!moved) {
+            *hint = t;
+            return (fdt_tid)t;
+        }
+    }
+    fdt_tid s = scan(L, q);
+    if (s >= 0)
+        *hint = (size_t)s;
+    return s;
+}
+
+uint32_t *fdt_query_order(const double *q, size_t nq)
+{
+    double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (size_t k = 0; k < nq; k++)
+        for (int d = 0; d < 3; d++)
+            if (isfinite(q[3 * k + d])) {
+                box[d] = fmin(box[d], q[3 * k + d]);
+                box[d + 3] = fmax(box[d + 3], q[3 * k + d]);
+            }
+    uint32_t *order = malloc((nq ? nq : 1) * sizeof *order);
+    if (order && fdt_morton_order(q, nq, box, NULL, order) < 0) {
+        free(order);
+        order = NULL;
+    }
+    return order;
+}
+
+void fdt_barycentric(const fdt_locator *L, fdt_tid t, const double *q, double b[4])
+{
+    const fdt_vid *tv = L->r->tets + 4 * (size_t)t;
+    const double *X = L->xyz;
+    /* b[i]: the volume of the tet with vertex i replaced by q, over the
+     * tet's, each relative to q (differences first, for accuracy). */
+    double d[4][3];
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++)
+            d[i][k] = X[3 * (size_t)tv[i] + k] - q[k];
+    double s = 0;
+    for (int i = 0; i < 4; i++) {
+        const double *a = d[fdt_tet_face[i][0]], *bb = d[fdt_tet_face[i][1]],
+                     *c = d[fdt_tet_face[i][2]];
+        /* orient(face_i, q) with q at the origin: -det[a, b, c] */
+        double det = a[0] * (bb[1] * c[2] - bb[2] * c[1]) - a[1] * (bb[0] * c[2] - bb[2] * c[0]) +
+                     a[2] * (bb[0] * c[1] - bb[1] * c[0]);
+        b[i] = det;
+        s += det;
+    }
+    for (int i = 0; i < 4; i++)
+        b[i] = s != 0 ? b[i] / s : 0.25;
+}
+
+typedef struct ljob {
+    const fdt_locator *L;
+    const double *q;
+    const uint32_t *order; /* this job's run of the queries */
+    size_t count;
+    fdt_tid *tet;
+    double *bary;
+} ljob;
+
+static void *locate_run(void *arg)
+{
+    ljob *j = arg;
+    size_t hint = 0;
+    for (size_t i = 0; i < j->count; i++) {
+        size_t k = j->order[i];
+        const double *qk = j->q + 3 * k;
+        j->tet[k] = fdt_locate_one(j->L, &hint, qk);
+        if (!j->bary)
+            continue;
+        if (j->tet[k] >= 0)
+            fdt_barycentric(j->L, j->tet[k], qk, j->bary + 4 * k);
+        else
+            memset(j->bary + 4 * k, 0, 4 * sizeof *j->bary);
+    }
+    return NULL;
+}
+
+int fdt_locate_build(fdt_result *r, const double *xyz, size_t n, const double *q, size_t nq,
+                     fdt_tid *tet, double *bary, int threads)
+{
+    if (!r || !xyz || (nq && (!q || !tet)))
+        return FDT_EINVAL;
+    fdt_locator L;
+    int err = fdt_locator_init(&L, r, xyz, n);
+    if (err)
+        return err;
+    uint32_t *order = fdt_query_order(q, nq);
+    if (threads < 1)
+        threads = 1;
+    if ((size_t)threads > nq / 64 + 1)
+        threads = (int)(nq / 64 + 1);
+    ljob *jobs = calloc((size_t)threads, sizeof *jobs);
+    if (!order || !jobs) {
+        free(order);
+        free(jobs);
+        fdt_locator_free(&L);
+        return FDT_ENOMEM;
+    }
+    for (int t = 0; t < threads; t++) {
+        size_t a = nq * (size_t)t / (size_t)threads, b = nq * (size_t)(t + 1) / (size_t)threads;
+        jobs[t] = (ljob){&L, q, order + a, b - a, tet, bary};
+    }
+    fdt_fork_join(jobs, sizeof *jobs, threads, locate_run);
+    free(jobs);
+    free(order);
+    fdt_locator_free(&L);
+    return FDT_OK;
+}
