@@ -406,12 +406,55 @@ def test_voronoi():
     raises(ValueError, t.voronoi, (0, 0, 0, 1, 1))
 
 
+def test_interpolation():
+    """find_simplex against scipy's (the same tets for random points: the
+    Delaunay mesh is unique), barycentric coordinates, and both methods
+    reproducing a linear function; linear against scipy's
+    LinearNDInterpolator; NaN outside; refusals."""
+    rng = np.random.default_rng(5)
+    pts = rng.random((2000, 3))
+    q = rng.random((400, 3)) * 1.2 - 0.1
+    t = frontdt.delaunay(pts, threads=2)
+    idx, bary = t.find_simplex(q, bary=True)
+    inside = idx >= 0
+    check(inside.sum() > 100 and (~inside).sum() > 10, "find_simplex: inside and outside queries")
+    check(np.allclose(np.einsum("kv,kvd->kd", bary[inside], pts[t.simplices[idx[inside]]]),
+                      q[inside], atol=1e-12), "find_simplex: barycentric coordinates rebuild q")
+    try:
+        import scipy.spatial
+        import scipy.interpolate
+        sd = scipy.spatial.Delaunay(pts)
+        si = sd.find_simplex(q)
+        check(np.array_equal(si >= 0, inside), "find_simplex: inside the hull as scipy says")
+        same = [set(t.simplices[a]) == set(sd.simplices[b]) for a, b in zip(idx[inside],
+                                                                             si[inside])]
+        check(all(same), "find_simplex: the tet scipy finds")
+        f = np.sin(3 * pts[:, 0]) + pts[:, 1] * pts[:, 2]
+        ours = t.interpolate(f, q, method="linear")
+        theirs = scipy.interpolate.LinearNDInterpolator(sd, f)(q)
+        check(np.array_equal(np.isnan(ours), np.isnan(theirs)) and
+              np.allclose(ours[inside], theirs[inside], rtol=0, atol=1e-12),
+              "interpolate linear: scipy's LinearNDInterpolator's values")
+    except ImportError:
+        print("test_interpolation: no scipy, compared with nothing")
+    lin = np.c_[pts @ [1.0, -2.0, 0.5] + 3, pts[:, 2]]
+    want = np.c_[q @ [1.0, -2.0, 0.5] + 3, q[:, 2]]
+    for method in ("linear", "natural"):
+        got = frontdt.interpolate(pts, lin, q, method=method, threads=3)
+        ok = ~np.isnan(got[:, 0])
+        check(ok.sum() > 100 and np.abs(got[ok] - want[ok]).max() < 1e-12,
+              "interpolate %s: a linear function reproduced" % method)
+        check(np.all(np.isnan(got[~inside])), "interpolate %s: NaN outside" % method)
+    raises(ValueError, t.interpolate, np.zeros(5), q)
+    raises(ValueError, t.interpolate, lin[:, 0], q, method="cubic")
+
+
 def main():
     print("frontdt", frontdt.__version__, "from", frontdt._frontdt.__file__)
     with tempfile.TemporaryDirectory() as tmp:
         for test in [test_origin, test_scipy, test_faces, lambda: test_cli_degenerate(tmp),
                      test_errors, test_threads, test_gil_and_interrupt,
-                     test_lifetime_and_memory, test_voronoi]:
+                     test_lifetime_and_memory, test_voronoi, test_interpolation]:
             t0 = time.monotonic()
             test()
             print("%s: %.1f s" % (getattr(test, "__name__", "?"), time.monotonic() - t0),

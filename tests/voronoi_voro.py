@@ -17,6 +17,10 @@ Usage: voronoi_voro.py FRONTDT GEN_POINTS VORO_REF|none SCRATCH
    computed here from the .tets output, to 1e-12.
 4. Refusals: --box not holding every point (exit 1, the point named),
    --voronoi-format with a bad code, --voronoi with --stream.
+5. Interpolation (--values, --interpolate, --interpolated, --method): a
+   linear function reproduced by both methods to 1e-12, nan outside the
+   hull; a malformed values file (exit 2, file and line named), an output
+   that is the input or a missing partner option (exit 1).
 """
 import os
 import random
@@ -223,6 +227,55 @@ def refusals():
             fail("%s left %s" % (args, out))
 
 
+def interpolation():
+    path = os.path.join(SCRATCH, "interp.xyz")
+    subprocess.run([GEN, "uniform", "3000", "4", path], check=True)
+    pts = read_xyz(path)
+    vals = os.path.join(SCRATCH, "vals.txt")
+    with open(vals, "w") as f:
+        for p in pts:
+            f.write("%.17g %.17g\n" % (1 + 2 * p[0] - p[1], p[2]))
+    rng = random.Random(9)
+    box = box_of(pts)
+    qs = [tuple(box[k] + (box[k + 3] - box[k]) * (1.4 * rng.random() - 0.2) for k in range(3))
+          for _ in range(500)]
+    qpath = os.path.join(SCRATCH, "queries.xyz")
+    write_xyz(qpath, qs)
+    out = os.path.join(SCRATCH, "interp.txt")
+    for method in ("natural", "linear"):
+        r = run([path, "-q", "--values", vals, "--interpolate", qpath, "--interpolated", out,
+                 "--method", method, "-t", "2"])
+        if r.returncode != 0:
+            fail("--interpolate %s: exit %d: %s" % (method, r.returncode, r.stderr.strip()))
+            continue
+        worst, nan = 0.0, 0
+        for q, line in zip(qs, open(out)):
+            a, b = (float(x) for x in line.split())
+            if a != a:
+                nan += 1
+                continue
+            worst = max(worst, abs(a - (1 + 2 * q[0] - q[1])), abs(b - q[2]))
+        print("interpolate %s: %d queries, %d outside (nan), worst error %.1e" %
+              (method, len(qs), nan, worst))
+        if worst > 1e-12 or nan == 0 or nan == len(qs):
+            fail("--interpolate %s: worst %.3g, %d nan" % (method, worst, nan))
+    bad = os.path.join(SCRATCH, "badvals.txt")
+    with open(bad, "w") as f:
+        f.write("1 2\n3 x\n")
+    cases = [
+        (["--values", bad, "--interpolate", qpath, "--interpolated", out], 2, "badvals.txt:2:"),
+        (["--values", vals, "--interpolate", qpath, "--interpolated", path], 1, "would overwrite"),
+        (["--values", vals, "--interpolate", qpath], 1, "needs all three"),
+        (["--values", vals, "--interpolate", qpath, "--interpolated", out, "--method", "cubic"],
+         1, "--method"),
+    ]
+    for args, code, text in cases:
+        r = run([path, "-q"] + args)
+        if r.returncode != code or text not in r.stderr:
+            fail("%s: exit %d (want %d), stderr %r (want %r)" % (args, r.returncode, code,
+                                                                  r.stderr.strip(), text))
+
+
 if VORO != "none":
     for fam in ("uniform", "gaussian", "lattice", "rotlattice", "skewlattice", "cylinder"):
         against_voro(fam, 3000)
@@ -231,5 +284,6 @@ else:
 same_bits()
 dtfe()
 refusals()
+interpolation()
 print("%d failures" % len(failures))
 sys.exit(1 if failures else 0)

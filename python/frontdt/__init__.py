@@ -21,4 +21,12 @@ def voronoi(points, box=None, threads=None):
     return delaunay(points, threads=threads).voronoi(box)
 
 
-__all__ = ["CheckError", "Triangulation", "check", "delaunay", "voronoi", "__version__"]
+def interpolate(points, values, queries, method="natural", threads=None):
+    """Interpolates values given at points (shape (n,) or (n, k)) at the
+    queries: frontdt.delaunay(points, threads).interpolate(values, queries,
+    method), method "natural" (Sibson) or "linear"."""
+    return delaunay(points, threads=threads).interpolate(values, queries, method)
+
+
+__all__ = ["CheckError", "Triangulation", "check", "delaunay", "interpolate", "voronoi",
+           "__version__"]

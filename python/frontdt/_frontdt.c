@@ -145,6 +145,21 @@ static PyObject *view(PyObject *owner, const void *data, npy_intp rows,
     return a;
 }
 
+/* Index of s in names[] (NULL-terminated), or -1 with a ValueError that
+ * lists the choices. */
+static int pick(const char *what, const char *s, const char *const *names)
+{
+    char choices[128] = "";
+    for (int i = 0; names[i]; i++) {
+        if (strcmp(s, names[i]) == 0)
+            return i;
+        size_t used = strlen(choices);
+        snprintf(choices + used, sizeof choices - used, "%s'%s'", i ? ", " : "", names[i]);
+    }
+    PyErr_Format(PyExc_ValueError, "%s must be one of %s, got '%s'", what, choices, s);
+    return -1;
+}
+
 /* ------------------------------------------------------------ Triangulation */
 
 typedef struct {
@@ -537,6 +552,100 @@ nomem:
     return PyErr_NoMemory();
 }
 
+/* Triangulation.find_simplex(q, bruteforce=False, tol=None)-like: the tet
+ * holding each query (fdt_locate), -1 outside; with bary=True also the
+ * barycentric coordinates. */
+static PyObject *tri_find_simplex(TriObject *self, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"q", "bary", NULL};
+    PyObject *qo;
+    int want_bary = 0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|p:find_simplex", kwlist, &qo, &want_bary))
+        return NULL;
+    PyArrayObject *q = points_array(qo);
+    if (!q)
+        return NULL;
+    npy_intp nq = PyArray_DIM(q, 0), d4[2] = {nq, 4};
+    PyObject *tet = PyArray_SimpleNew(1, &nq, NPY_INT64);
+    PyObject *bary = want_bary ? PyArray_SimpleNew(2, d4, NPY_DOUBLE) : NULL;
+    if (!tet || (want_bary && !bary)) {
+        Py_XDECREF(tet);
+        Py_XDECREF(bary);
+        Py_DECREF(q);
+        return NULL;
+    }
+    const double *xyz = PyArray_DATA(self->points);
+    size_t n = (size_t)PyArray_DIM(self->points, 0);
+    int err;
+    Py_BEGIN_ALLOW_THREADS /* r keeps neighbours: only read */
+    err = fdt_locate(self->r, xyz, n, PyArray_DATA(q), (size_t)nq,
+                     PyArray_DATA((PyArrayObject *)tet),
+                     bary ? PyArray_DATA((PyArrayObject *)bary) : NULL, 0);
+    Py_END_ALLOW_THREADS
+    Py_DECREF(q);
+    if (err) {
+        Py_DECREF(tet);
+        Py_XDECREF(bary);
+        return raise_fdt(err, "locating the queries");
+    }
+    if (!bary)
+        return tet;
+    return Py_BuildValue("NN", tet, bary);
+}
+
+/* Triangulation.interpolate(values, q, method="natural") (fdt_interpolate). */
+static PyObject *tri_interpolate(TriObject *self, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"values", "q", "method", NULL};
+    static const char *const methods[] = {"linear", "natural", NULL};
+    PyObject *vo, *qo;
+    const char *method_s = "natural";
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|s:interpolate", kwlist, &vo, &qo, &method_s))
+        return NULL;
+    int m = pick("method", method_s, methods);
+    if (m < 0)
+        return NULL;
+    size_t n = (size_t)PyArray_DIM(self->points, 0);
+    PyArrayObject *v = (PyArrayObject *)PyArray_FROMANY(
+        vo, NPY_DOUBLE, 1, 2, NPY_ARRAY_C_CONTIGUOUS | NPY_ARRAY_ALIGNED | NPY_ARRAY_ENSURECOPY);
+    if (!v)
+        return NULL;
+    if ((size_t)PyArray_DIM(v, 0) != n || (PyArray_NDIM(v) == 2 && PyArray_DIM(v, 1) < 1)) {
+        Py_DECREF(v);
+        PyErr_Format(PyExc_ValueError, "values must have one row a point (%zu), got %zd", n,
+                     (Py_ssize_t)PyArray_DIM(v, 0));
+        return NULL;
+    }
+    PyArrayObject *q = points_array(qo);
+    if (!q) {
+        Py_DECREF(v);
+        return NULL;
+    }
+    size_t nv = PyArray_NDIM(v) == 2 ? (size_t)PyArray_DIM(v, 1) : 1;
+    npy_intp dims[2] = {PyArray_DIM(q, 0), (npy_intp)nv};
+    PyObject *out = PyArray_SimpleNew(PyArray_NDIM(v), dims, NPY_DOUBLE);
+    if (!out) {
+        Py_DECREF(v);
+        Py_DECREF(q);
+        return NULL;
+    }
+    const double *xyz = PyArray_DATA(self->points);
+    char diag[512];
+    int err;
+    Py_BEGIN_ALLOW_THREADS
+    err = fdt_interpolate(self->r, xyz, n, PyArray_DATA(v), nv, PyArray_DATA(q),
+                          (size_t)PyArray_DIM(q, 0), (fdt_interp)m, 0,
+                          PyArray_DATA((PyArrayObject *)out), diag, sizeof diag);
+    Py_END_ALLOW_THREADS
+    Py_DECREF(v);
+    Py_DECREF(q);
+    if (err) {
+        Py_DECREF(out);
+        return raise_fdt(err, diag);
+    }
+    return out;
+}
+
 static PyMethodDef tri_methods[] = {
     {"check", (PyCFunction)tri_check, METH_NOARGS,
      "check()\n--\n\nVerifies exactly that the mesh is the Delaunay "
@@ -548,6 +657,17 @@ static PyMethodDef tri_methods[] = {
      "clipped, 2 hull, 4 merged duplicate), and the neighbours in CSR form: "
      "neighbors[neighbor_ptr[i]:neighbor_ptr[i+1]] (walls -1..-6) with face_areas "
      "alongside. The same bits for every thread count and input order. The GIL is "
+     "released while it runs."},
+    {"find_simplex", (PyCFunction)(void (*)(void))tri_find_simplex, METH_VARARGS | METH_KEYWORDS,
+     "find_simplex(q, bary=False)\n--\n\nThe index of a tet holding each query of the (k, 3) "
+     "array-like q (int64, -1 outside the hull), by a walk with exact predicates; with "
+     "bary=True a tuple (indices, (k, 4) barycentric coordinates in the order of the tet's "
+     "vertices). The GIL is released while it runs."},
+    {"interpolate", (PyCFunction)(void (*)(void))tri_interpolate, METH_VARARGS | METH_KEYWORDS,
+     "interpolate(values, q, method='natural')\n--\n\nInterpolates values given at the points "
+     "(shape (n,) or (n, k)) at the queries q: 'natural' (Sibson's natural-neighbour "
+     "coordinates) or 'linear' (barycentric in the tet holding the query). NaN outside the "
+     "hull ('natural': on it too); a query at a point gets that point's values. The GIL is "
      "released while it runs."},
     {"vertex_neighbors", (PyCFunction)tri_vertex_neighbors, METH_O,
      "vertex_neighbors(v)\n--\n\nThe Delaunay neighbours of point v, int32, "
@@ -568,21 +688,6 @@ static PyTypeObject TriType = {
 };
 
 /* ------------------------------------------------------------ delaunay */
-
-/* Index of s in names[] (NULL-terminated), or -1 with a ValueError that
- * lists the choices. */
-static int pick(const char *what, const char *s, const char *const *names)
-{
-    char choices[128] = "";
-    for (int i = 0; names[i]; i++) {
-        if (strcmp(s, names[i]) == 0)
-            return i;
-        size_t used = strlen(choices);
-        snprintf(choices + used, sizeof choices - used, "%s'%s'", i ? ", " : "", names[i]);
-    }
-    PyErr_Format(PyExc_ValueError, "%s must be one of %s, got '%s'", what, choices, s);
-    return -1;
-}
 
 static PyObject *py_delaunay(PyObject *mod, PyObject *args, PyObject *kw)
 {

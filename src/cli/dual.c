@@ -43,8 +43,33 @@ static int is_csv(const char *path)
     return m >= 4 && !strcmp(path + m - 4, ".csv");
 }
 
-int fdt_cli_dual_check(const fdt_cli_dual *d, char *err, size_t errlen)
+int fdt_cli_interp_wanted(const fdt_cli_dual *d)
 {
+    return d->values || d->queries || d->interpolated;
+}
+
+int fdt_cli_dual_check(const fdt_cli_dual *d, const char *input, char *err, size_t errlen)
+{
+    if (fdt_cli_interp_wanted(d) && !(d->values && d->queries && d->interpolated)) {
+        snprintf(err, errlen, "interpolation needs all three of --values FILE, --interpolate "
+                 "QUERIES and --interpolated OUT");
+        return -1;
+    }
+    const char *outs[3] = {d->voronoi, d->density, d->interpolated};
+    const char *ins[3] = {input, d->values, d->queries};
+    for (int o = 0; o < 3; o++)
+        for (int i = 0; i < 3; i++)
+            if (outs[o] && ins[i] && strcmp(ins[i], "-") && fdt_same_file(outs[o], ins[i])) {
+                snprintf(err, errlen, "%s would overwrite %s, which this run reads", outs[o],
+                         ins[i]);
+                return -1;
+            }
+    for (int o = 0; o < 3; o++)
+        for (int p = o + 1; p < 3; p++)
+            if (outs[o] && outs[p] && fdt_same_file(outs[o], outs[p])) {
+                snprintf(err, errlen, "%s is named for two outputs", outs[o]);
+                return -1;
+            }
     if (d->format && !d->voronoi) {
         snprintf(err, errlen, "--voronoi-format needs --voronoi FILE");
         return -1;
@@ -120,5 +145,53 @@ int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const doubl
     if (r == FDT_OK && d->density)
         r = write_side(d->density, put_density, v, xyz, err, errlen);
     fdt_voronoi_free(&v);
+    return r;
+}
+
+typedef struct rows_job {
+    const double *v;
+    size_t rows, k;
+} rows_job;
+
+static int put_table(FILE *f, const void *arg, const double *xyz)
+{
+    (void)xyz;
+    const rows_job *j = arg;
+    return fdt_wr_rows(f, j->v, j->rows, j->k);
+}
+
+int fdt_cli_interp_write(const fdt_cli_dual *d, fdt_result *res, const double *xyz, size_t n,
+                         char *err, size_t errlen)
+{
+    double *vals = NULL, *q = NULL, *out = NULL;
+    size_t k = 0, nq = 0;
+    int r = fdt_rd_values(d->values, n, &vals, &k, err, errlen);
+    if (r != FDT_IO_OK)
+        return r == FDT_IO_ENOMEM ? FDT_ENOMEM : FDT_EFORMAT;
+    r = fdt_rd_points(d->queries, &q, &nq, err, errlen);
+    if (r != FDT_IO_OK) {
+        free(vals);
+        return r == FDT_IO_ENOMEM ? FDT_ENOMEM : FDT_EFORMAT;
+    }
+    out = malloc((nq && k ? nq * k : 1) * sizeof *out);
+    if (!out) {
+        r = FDT_ENOMEM;
+        snprintf(err, errlen, "interpolation: out of memory");
+    } else {
+        char diag[512];
+        r = fdt_interpolate(res, xyz, n, vals, k, q, nq,
+                            d->natural ? FDT_INTERP_NATURAL : FDT_INTERP_LINEAR, d->threads, out,
+                            diag, sizeof diag);
+        if (r != FDT_OK)
+            snprintf(err, errlen, "interpolation: %s%s%s", fdt_strerror(r), *diag ? ": " : "",
+                     diag);
+    }
+    if (r == FDT_OK) {
+        rows_job job = {out, nq, k};
+        r = write_side(d->interpolated, put_table, &job, xyz, err, errlen);
+    }
+    free(vals);
+    free(q);
+    free(out);
     return r;
 }

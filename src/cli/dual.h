@@ -1,7 +1,9 @@
 /*
- * The CLI's Voronoi outputs (issue 32): --voronoi FILE, --voronoi-format,
- * --density FILE and --box, one step of src/cli/main.c's run. The cells come
- * from the library (fdt_voronoi_compute), the text from
+ * The CLI's uses of the mesh's dual (issue 32), one step of src/cli/main.c's
+ * run: the Voronoi cells (--voronoi FILE, --voronoi-format, --density FILE,
+ * --box) and interpolation (--values FILE --interpolate QUERIES
+ * --interpolated OUT [--method natural|linear]). The numbers come from the
+ * library (fdt_voronoi_compute, fdt_interpolate), the text from
  * src/io/write/cells.c; the files go through the run's commit set, so they
  * are renamed with the mesh, all or none.
  */
@@ -20,6 +22,10 @@ typedef struct fdt_cli_dual {
     int threads;         /* -t (0: one per physical core) */
     int box_given;       /* --box given */
     double box[6];       /* xmin, ymin, zmin, xmax, ymax, zmax */
+    const char *values;  /* --values FILE, or NULL */
+    const char *queries; /* --interpolate QUERIES, or NULL */
+    const char *interpolated; /* --interpolated OUT, or NULL */
+    int natural;         /* --method: 1 natural (default), 0 linear */
 } fdt_cli_dual;
 
 /* Is anything asked for? */
@@ -29,9 +35,11 @@ int fdt_cli_dual_wanted(const fdt_cli_dual *d);
  * with each min below its max). */
 int fdt_cli_parse_box(const char *s, double box[6]);
 
-/* Checks the options before the run: 0, or -1 with the reason in err (a
- * usage error). */
-int fdt_cli_dual_check(const fdt_cli_dual *d, char *err, size_t errlen);
+/* Checks the options before the run (input: the input file, or NULL for
+ * --demo or standard input): 0, or -1 with the reason in err (a usage
+ * error: a missing partner option, a bad format, an output that is the
+ * input or one of the files read). */
+int fdt_cli_dual_check(const fdt_cli_dual *d, const char *input, char *err, size_t errlen);
 
 /* Computes the cells of res (the result of triangulating xyz[0 .. 3n))
  * and writes the files into the open commit set. 0, or an FDT_E* code
@@ -39,5 +47,15 @@ int fdt_cli_dual_check(const fdt_cli_dual *d, char *err, size_t errlen);
  * FDT_EIO (a file could not be written), FDT_EINTERNAL. */
 int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const double *xyz, size_t n,
                        char *err, size_t errlen);
+
+/* Interpolation wanted? */
+int fdt_cli_interp_wanted(const fdt_cli_dual *d);
+
+/* Reads the values and the queries, interpolates on `threads` threads and
+ * writes --interpolated into the open commit set. 0, or FDT_EFORMAT (a
+ * file read is malformed), FDT_EIO, FDT_ENOMEM, FDT_EINTERNAL, with the
+ * message in err. */
+int fdt_cli_interp_write(const fdt_cli_dual *d, fdt_result *res, const double *xyz, size_t n,
+                         char *err, size_t errlen);
 
 #endif

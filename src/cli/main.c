@@ -153,6 +153,10 @@ static void usage(FILE *f)
         "      --density FILE     write each point's DTFE density and flags\n"
         "      --box X0,Y0,Z0,X1,Y1,Z1  the box that clips the cells (default:\n"
         "                         the points' bounding box; must hold them)\n"
+        "      --values FILE      values at the points (a line a point, k numbers)\n"
+        "      --interpolate Q    interpolate them at the points of file Q into\n"
+        "      --interpolated OUT (a line a query; nan outside the hull)\n"
+        "      --method M         natural (Sibson, default) or linear\n"
         "      --stream           write the tets as they are built, never holding\n"
         "                         the mesh (.ele without .neigh, .vtu, .fdtb; no\n"
         "                         -o: count them); the points are stored once\n"
@@ -277,7 +281,8 @@ enum {
     OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
     OPT_DELIMITER, OPT_DECIMAL_COMMA,
     OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT, OPT_NO_CLOBBER,
-    OPT_VORONOI, OPT_VORONOI_FORMAT, OPT_DENSITY, OPT_BOX
+    OPT_VORONOI, OPT_VORONOI_FORMAT, OPT_DENSITY, OPT_BOX, OPT_VALUES, OPT_INTERPOLATE,
+    OPT_INTERPOLATED, OPT_METHOD
 };
 
 static const struct option long_opts[] = {
@@ -308,6 +313,10 @@ static const struct option long_opts[] = {
     { "voronoi-format", required_argument, NULL, OPT_VORONOI_FORMAT },
     { "density", required_argument, NULL, OPT_DENSITY },
     { "box", required_argument, NULL, OPT_BOX },
+    { "values", required_argument, NULL, OPT_VALUES },
+    { "interpolate", required_argument, NULL, OPT_INTERPOLATE },
+    { "interpolated", required_argument, NULL, OPT_INTERPOLATED },
+    { "method", required_argument, NULL, OPT_METHOD },
     { "help", no_argument, NULL, 'h' },
     { "version", no_argument, NULL, 'V' },
     { NULL, 0, NULL, 0 },
@@ -397,6 +406,7 @@ static int parse_args(int argc, char **argv, cli *c)
     memset(c, 0, sizeof *c);
     c->mode = FDT_MODE_AUTO;
     c->threads = -1;
+    c->dual.natural = 1;
     c->demo_n = DEMO_DEFAULT_N;
     opterr = 0; /* we print our own messages */
     optind = 1;
@@ -534,6 +544,20 @@ static int parse_args(int argc, char **argv, cli *c)
                                    "with each min below its max, not '%s'", optarg);
             c->dual.box_given = 1;
             break;
+        case OPT_VALUES:
+            c->dual.values = optarg;
+            break;
+        case OPT_INTERPOLATE:
+            c->dual.queries = optarg;
+            break;
+        case OPT_INTERPOLATED:
+            c->dual.interpolated = optarg;
+            break;
+        case OPT_METHOD:
+            if (strcmp(optarg, "natural") && strcmp(optarg, "linear"))
+                return usage_error("--method is natural or linear, not '%s'", optarg);
+            c->dual.natural = !strcmp(optarg, "natural");
+            break;
         case OPT_MEMORY_LIMIT:
             if (parse_bytes(optarg, &c->memory_limit) != 0)
                 return usage_error("--memory-limit wants a byte count > 0 (suffix K, M or G), "
@@ -612,7 +636,8 @@ static int parse_args(int argc, char **argv, cli *c)
         return usage_error("--input-format, --columns, --delimiter and --decimal-comma need "
                            "an input file, not --demo");
     char derr[512];
-    if (fdt_cli_dual_check(&c->dual, derr, sizeof derr) != 0)
+    if (fdt_cli_dual_check(&c->dual, c->input && strcmp(c->input, "-") ? c->input : NULL, derr,
+                           sizeof derr) != 0)
         return usage_error("%s", derr);
     return -1;
 }
@@ -1038,8 +1063,8 @@ static const char *stream_refusal(const cli *c, const fdt_format *const *fmts, i
         return "--hash sorts the whole mesh (--set-hash needs no sort)";
     if (c->all_faces)
         return "--all-faces needs the face list of the whole mesh";
-    if (fdt_cli_dual_wanted(&c->dual))
-        return "--voronoi and --density need the whole mesh";
+    if (fdt_cli_dual_wanted(&c->dual) || fdt_cli_interp_wanted(&c->dual))
+        return "--voronoi, --density and --interpolate need the whole mesh";
     for (int o = 0; o < c->n_outputs; o++) {
         if (!strcmp(c->outputs[o], "-"))
             return "-o - (standard output) cannot stream";
@@ -1508,6 +1533,21 @@ static int run(const cli *c)
         if (r != FDT_OK) {
             say("%s: %s", name, derr);
             code = r == FDT_EIO ? CLI_WRITE : exit_for_engine(r);
+            goto done;
+        }
+    }
+    if (fdt_cli_interp_wanted(&c->dual)) {
+        t0 = fdt_now_s();
+        char derr[FDT_IO_PATH + 600];
+        progress_phase(&prog, "interpolate");
+        fdt_cli_dual dual = c->dual;
+        dual.threads = c->mode == FDT_MODE_SERIAL ? 1 : c->threads < 0 ? 0 : c->threads;
+        r = fdt_cli_interp_write(&dual, res, xyz, n, derr, sizeof derr);
+        progress_clear(&prog);
+        tm.voronoi += fdt_now_s() - t0;
+        if (r != FDT_OK) {
+            say("%s", derr);
+            code = r == FDT_EIO ? CLI_WRITE : r == FDT_EFORMAT ? CLI_INPUT : exit_for_engine(r);
             goto done;
         }
     }

@@ -99,6 +99,16 @@ int fdt_rd_points_mem_threads(const char *name, const void *data, size_t len, in
                                 size_t min_slice, double **xyz, size_t *n, char *err,
                                 size_t errlen);
 
+/*
+ * Values given at the points (src/io/read/read_values.c; the CLI's
+ * --values): n rows, k numbers each (k from the first row), into *vals
+ * (malloc'd, row after row). FDT_IO_EOPEN, FDT_IO_EFORMAT (err names the
+ * line: a bad number, a row of another length, too few or too many rows),
+ * FDT_IO_ENOMEM.
+ */
+int fdt_rd_values(const char *path, size_t n, double **vals, size_t *k, char *err,
+                  size_t errlen);
+
 /* Formats (fdt_rd_opts.format). */
 enum {
     FDT_RD_AUTO = 0, /* by the name's extension */

@@ -87,16 +87,30 @@ static void code(out_file *o, char c, const fdt_voronoi *v, const double *xyz, s
     }
 }
 
+/* An output buffer on f (outfile.h); 0 or ENOMEM. */
+static int open_out(out_file *o, FILE *f)
+{
+    memset(o, 0, sizeof *o);
+    o->f = f;
+    o->slot = -1;
+    o->path = "";
+    o->buf = malloc(OUT_BUF_SIZE);
+    return o->buf ? 0 : ENOMEM;
+}
+
+/* Flushes and frees o's buffer: 0 or the errno of the first failure. */
+static int close_out(out_file *o)
+{
+    out_flush(o);
+    free(o->buf);
+    return o->err;
+}
+
 /* The rows through a buffer on f; 0 or the errno of the first failure. */
 static int put_rows(FILE *f, const char *fmt, const fdt_voronoi *v, const double *xyz, int csv)
 {
     out_file o;
-    memset(&o, 0, sizeof o);
-    o.f = f;
-    o.slot = -1;
-    o.path = "";
-    o.buf = malloc(OUT_BUF_SIZE);
-    if (!o.buf)
+    if (open_out(&o, f))
         return ENOMEM;
     size_t n = fdt_voronoi_num_points(v);
     if (csv)
@@ -114,9 +128,7 @@ static int put_rows(FILE *f, const char *fmt, const fdt_voronoi *v, const double
         }
         out_char(&o, '\n');
     }
-    out_flush(&o);
-    free(o.buf);
-    return o.err;
+    return close_out(&o);
 }
 
 int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *xyz)
@@ -128,4 +140,20 @@ int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *x
 int fdt_wr_density(FILE *f, const fdt_voronoi *v)
 {
     return put_rows(f, "%d %h", v, NULL, 0);
+}
+
+int fdt_wr_rows(FILE *f, const double *v, size_t rows, size_t k)
+{
+    out_file o;
+    if (open_out(&o, f))
+        return ENOMEM;
+    for (size_t i = 0; i < rows && !o.err; i++) {
+        for (size_t c = 0; c < k; c++) {
+            if (c)
+                out_char(&o, ' ');
+            out_double(&o, v[k * i + c]);
+        }
+        out_char(&o, '\n');
+    }
+    return close_out(&o);
 }

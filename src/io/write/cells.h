@@ -35,4 +35,7 @@ int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *x
  * %h: a hull point's density counts only the tets it has). */
 int fdt_wr_density(FILE *f, const fdt_voronoi *v);
 
+/* rows lines of k numbers each (NaN as "nan"): the interpolated values. */
+int fdt_wr_rows(FILE *f, const double *v, size_t rows, size_t k);
+
 #endif
