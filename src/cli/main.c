@@ -88,7 +88,8 @@ typedef struct cli {
     int stream;             /* --stream 1, --no-stream -1, else 0: when
                                every output can (stream_refusal) */
     unsigned long long memory_limit; /* --memory-limit bytes; 0: none */
-    fdt_cli_dual dual;      /* --voronoi, --voronoi-format, --density, --box */
+    fdt_cli_dual dual;      /* --voronoi, --voronoi-format, --density, --box,
+                               --values, --interpolate, --interpolated, --method */
     int demo;
     size_t demo_n;
 } cli;
@@ -825,7 +826,7 @@ static const char *mode_name(fdt_mode m)
 /* ------------------------------------------------------------------------ */
 
 typedef struct timings {
-    double read, triangulate, check, canon, write, voronoi;
+    double read, triangulate, check, canon, write, voronoi, interpolate;
 } timings;
 
 /* Which engine ran, read off the counters (src/api/api.c, one_part):
@@ -905,14 +906,16 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  time check        %.3f s\n"
         "  time canon+hash   %.3f s\n"
         "  time write        %.3f s\n"
-        "  time voronoi      %.3f s\n",
+        "  time voronoi      %.3f s\n"
+        "  time interpolate  %.3f s\n",
         st->points, st->vertices, dups, st->tets, st->hull_faces,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
         st->max_front, st->mesh_faces, st->mesh_parts, st->t_mesh, st->final_tets,
         st->certified_tets, st->t_certify, st->threads, mode_name(st->mode),
         engine_name(st), st->t_prepare, st->t_front, st->t_finish,
-        tm->read, tm->triangulate, tm->check, tm->canon, tm->write, tm->voronoi);
+        tm->read, tm->triangulate, tm->check, tm->canon, tm->write, tm->voronoi,
+        tm->interpolate);
     if ((st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE) && !ran_one_part(st))
         print_parallel_stats(res, st);
 }
@@ -999,7 +1002,8 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         ", \"t_certify\": %.9g, \"threads\": %d, \"mode\": \"%s\""
         ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
         ", \"t_read\": %.9g, \"t_triangulate\": %.9g, \"t_check\": %.9g"
-        ", \"t_canon\": %.9g, \"t_write\": %.9g, \"t_voronoi\": %.9g",
+        ", \"t_canon\": %.9g, \"t_write\": %.9g, \"t_voronoi\": %.9g"
+        ", \"t_interpolate\": %.9g",
         st->points, st->vertices, dups, st->tets, st->hull_faces,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
@@ -1008,7 +1012,8 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         st->threads, mode_name(st->mode), finite_or_zero(st->t_prepare),
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
-        finite_or_zero(tm->check), finite_or_zero(tm->canon), finite_or_zero(tm->write), finite_or_zero(tm->voronoi));
+        finite_or_zero(tm->check), finite_or_zero(tm->canon), finite_or_zero(tm->write),
+        finite_or_zero(tm->voronoi), finite_or_zero(tm->interpolate));
     json_msgs(f, "sent", st->sent);
     json_msgs(f, "received", st->received);
     fprintf(f,
@@ -1544,7 +1549,7 @@ static int run(const cli *c)
         dual.threads = c->mode == FDT_MODE_SERIAL ? 1 : c->threads < 0 ? 0 : c->threads;
         r = fdt_cli_interp_write(&dual, res, xyz, n, derr, sizeof derr);
         progress_clear(&prog);
-        tm.voronoi += fdt_now_s() - t0;
+        tm.interpolate = fdt_now_s() - t0;
         if (r != FDT_OK) {
             say("%s", derr);
             code = r == FDT_EIO ? CLI_WRITE : r == FDT_EFORMAT ? CLI_INPUT : exit_for_engine(r);
