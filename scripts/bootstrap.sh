@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 packages=(
   build-essential meson ninja-build pkg-config cmake
   libhwloc-dev hwloc libgmp-dev libmpfr-dev
-  libcgal-dev libtet1.5-dev tetgen libboost-dev voro++-dev
+  libcgal-dev libtet1.5-dev tetgen libboost-dev voro++-dev voro++
   libtbb-dev libqhull-dev
   python3 python3-vtk9 python3-meshio gmsh openfoam
   gnuplot-nox valgrind clang libclang-rt-14-dev

@@ -9,7 +9,8 @@
  * on a failed allocation by design; README.md, Limits.)
  *
  * For each scenario (a read, a triangulation, a sort, a hash, a check, a write,
- * a streamed write through fdt_stream_writer_*) and k = 1, 2, ...:
+ * a streamed write through fdt_stream_writer_*, the Voronoi cells, point
+ * location, interpolation) and k = 1, 2, ...:
  *   - "once":  the k-th allocation of the scenario fails, later ones work;
  *   - "from":  the k-th and every later allocation fail (error paths that
  *              allocate while cleaning up fail too);
@@ -499,6 +500,76 @@ static int derived(fdt_result *r, const post_arg *a, const char **bad)
             *bad = "faces, edges or neighbours differ from the reference";
     }
     fdt_result_free(&ref);
+    atomic_store(&fault_at, at);
+    return rc;
+}
+
+/* The dual (issue 32) under injection: the Voronoi cells on two threads
+ * (their volumes' sum compared), point location and both interpolations
+ * (compared with a run without injection), on a result made without it. */
+typedef struct dual_arg {
+    const ptset *ps;
+    int what;      /* 0: cells, 1: locate, 2: linear, 3: natural */
+    double *want;  /* the answer without injection */
+} dual_arg;
+
+enum { DUAL_Q = 40 };
+
+static int dual_run(fdt_result *r, const dual_arg *a, double *got)
+{
+    double q[3 * DUAL_Q];
+    for (int k = 0; k < DUAL_Q; k++) /* between pairs of points: inside the hull */
+        for (int d = 0; d < 3; d++)
+            q[3 * k + d] = 0.5 * (a->ps->xyz[3 * (size_t)(k % a->ps->n) + (size_t)d] +
+                                  a->ps->xyz[3 * (size_t)((7 * k + 3) % a->ps->n) + (size_t)d]);
+    if (a->what == 0) {
+        fdt_voronoi_options o;
+        fdt_default_voronoi_options(&o);
+        o.neighbors = 1;
+        o.threads = 2;
+        fdt_voronoi *v = NULL;
+        int rc = fdt_voronoi_compute(r, a->ps->xyz, a->ps->n, &o, &v, NULL, 0);
+        got[0] = 0;
+        for (size_t i = 0; rc == FDT_OK && i < a->ps->n; i++)
+            got[0] += fdt_voronoi_volumes(v)[i];
+        fdt_voronoi_free(&v);
+        return rc;
+    }
+    if (a->what == 1) {
+        fdt_tid t[DUAL_Q];
+        int rc = fdt_locate(r, a->ps->xyz, a->ps->n, q, DUAL_Q, t, got, 2);
+        return rc;
+    }
+    double *val = malloc(a->ps->n * sizeof *val);
+    if (!val)
+        return FDT_ENOMEM;
+    for (size_t i = 0; i < a->ps->n; i++)
+        val[i] = a->ps->xyz[3 * i] - 2 * a->ps->xyz[3 * i + 2];
+    int rc = fdt_interpolate(r, a->ps->xyz, a->ps->n, val, 1, q, DUAL_Q,
+                             a->what == 2 ? FDT_INTERP_LINEAR : FDT_INTERP_NATURAL, 2, got,
+                             NULL, 0);
+    free(val);
+    return rc;
+}
+
+static int sc_dual(void *arg, const char **bad)
+{
+    dual_arg *a = arg;
+    long at = atomic_load(&fault_at);
+    atomic_store(&fault_at, 0);
+    fdt_result *r = NULL;
+    double got[4 * DUAL_Q];
+    if (triangulate(a->ps, &serial_cfg, 0, &r) != FDT_OK) {
+        *bad = "cannot make the result";
+        return FDT_OK;
+    }
+    atomic_store(&fault_at, at);
+    int rc = dual_run(r, a, got);
+    atomic_store(&fault_at, 0);
+    size_t m = a->what == 0 ? 1 : a->what == 1 ? 4 * DUAL_Q : DUAL_Q;
+    if (rc == FDT_OK && memcmp(got, a->want, m * sizeof *got) != 0)
+        *bad = "a different answer";
+    fdt_result_free(&r);
     atomic_store(&fault_at, at);
     return rc;
 }
@@ -1149,6 +1220,20 @@ int main(int argc, char **argv)
                 post_arg pa = {ps, nb, w, h};
                 scenario post = {nm[w + 1], FDT_ENOMEM, sc_post, &pa};
                 inject_all(&post);
+            }
+            /* the dual: neighbours derived (the longer path), two sets */
+            static const char *const dual_what[4] = {"voronoi", "locate", "interpolate linear",
+                                                     "interpolate natural"};
+            for (int w = 0; w < 4 && !nb && si != 1; w++) {
+                char dn[96];
+                double want[4 * DUAL_Q];
+                dual_arg da = {ps, w, want};
+                CHECK_EQ(triangulate(ps, &serial_cfg, 0, &r), FDT_OK);
+                EXPECTF(dual_run(r, &da, want) == FDT_OK, "%s: reference", dual_what[w]);
+                fdt_result_free(&r);
+                snprintf(dn, sizeof dn, "%s %s", dual_what[w], ps->name);
+                scenario sd = {dn, FDT_ENOMEM, sc_dual, &da};
+                inject_all(&sd);
             }
         }
     }

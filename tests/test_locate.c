@@ -8,13 +8,15 @@
  *    1e-12 of the box;
  *  - a lattice (cospherical points, queries on faces, edges and vertices);
  *  - the same answers with and without the result's neighbours (the
- *    locator derives them from the face list), and a non-finite query.
+ *    locator derives them from the face list), and a non-finite query;
+ *  - the scan that backs the walk up, forced.
  */
 #include <math.h>
 #include <string.h>
 
 #include "frontdt.h"
 #include "geom/predicates.h"
+#include "mesh/locate.h"
 #include "testutil.h"
 
 static fdt_result *triangulate(const double *xyz, size_t n, int nbrs)
@@ -150,8 +152,43 @@ static void test_lattice(void)
     free(q);
 }
 
+/* The scan that backs the walk up: a locator whose walks give way to it
+ * at once finds the same containing tets. */
+static void test_scan(void)
+{
+    size_t n = 300, nq = 100;
+    double *xyz = malloc(3 * n * sizeof *xyz), *q = malloc(3 * nq * sizeof *q);
+    CHECK(xyz && q);
+    uint64_t s = 11;
+    for (size_t i = 0; i < 3 * n; i++)
+        xyz[i] = test_unif(&s);
+    for (size_t i = 0; i < 3 * nq; i++)
+        q[i] = 1.2 * test_unif(&s) - 0.1;
+    fdt_result *r = triangulate(xyz, n, 1);
+    fdt_locator L;
+    CHECK(fdt_locator_init(&L, r, xyz, n) == FDT_OK);
+    L.cap = 0;
+    size_t hint = 0, found = 0;
+    for (size_t k = 0; k < nq; k++) {
+        fdt_tid t = fdt_locate_one(&L, &hint, q + 3 * k);
+        if (t >= 0) {
+            found++;
+            EXPECTF(holds(r, xyz, (size_t)t, q + 3 * k), "scan: query %zu not in tet %lld", k,
+                    (long long)t);
+        } else {
+            EXPECTF(!held_by_any(r, xyz, q + 3 * k), "scan: query %zu held but not found", k);
+        }
+    }
+    EXPECT(found > 0 && found < nq);
+    fdt_locator_free(&L);
+    fdt_result_free(&r);
+    free(xyz);
+    free(q);
+}
+
 int main(void)
 {
+    test_scan();
     test_random();
     test_lattice();
     return test_report("locate");

@@ -28,6 +28,7 @@ import subprocess
 import sys
 
 FRONTDT, GEN, VORO, SCRATCH = sys.argv[1:5]
+os.makedirs(SCRATCH, exist_ok=True)
 FMT = "%i %v %F %s %C %h|%n|%f"
 failures = []
 

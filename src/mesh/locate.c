@@ -28,6 +28,7 @@ int fdt_locator_init(fdt_locator *L, fdt_result *r, const double *xyz, size_t n)
         return FDT_EINVAL;
     L->r = r;
     L->xyz = xyz;
+    L->cap = 64 + 4 * r->ntets;
     if (r->nbrs) {
         L->nbrs = r->nbrs;
         return FDT_OK;
@@ -94,8 +95,7 @@ fdt_tid fdt_locate_one(const fdt_locator *L, size_t *hint, const double *q)
     size_t t = *hint < L->r->ntets ? *hint : 0;
     /* The faces are tried from a rotating start, so that a walk does not
      * favour one direction. */
-    size_t cap = 64 + 4 * L->r->ntets;
-    for (size_t step = 0; step < cap; step++) {
+    for (size_t step = 0; step < L->cap; step++) {
         int moved = 0;
         for (int k = 0; k < 4 && !moved; k++) {
             int i = (int)((step + (size_t)k) & 3);

@@ -13,6 +13,8 @@ typedef struct fdt_locator {
     const double *xyz;    /* borrowed: the points r was computed from */
     const fdt_tid *nbrs;  /* 4 a tet: r's, or owned */
     fdt_tid *owned;       /* derived from the face list when r has none */
+    size_t cap;           /* steps before a walk gives way to the scan
+                             (64 + 4 a tet; tests lower it) */
 } fdt_locator;
 
 /* FDT_EINVAL (no tets, n not r's), FDT_ENOMEM; r gains its face list
