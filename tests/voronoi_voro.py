@@ -17,7 +17,11 @@ Usage: voronoi_voro.py FRONTDT GEN_POINTS VORO_REF|none SCRATCH
    computed here from the .tets output, to 1e-12.
 4. Refusals: --box not holding every point (exit 1, the point named),
    --voronoi-format with a bad code, --voronoi with --stream.
-5. Interpolation (--values, --interpolate, --interpolated, --method): a
+5. --voronoi cells.vtu: VTK polyhedra read back with VTK (python3-vtk9):
+   one VTK_POLYHEDRON a point, the volume of each from its faces (the
+   divergence theorem) equal to its "volume" to 1e-10, which is --voronoi's
+   %v (skipped without VTK's Python module).
+6. Interpolation (--values, --interpolate, --interpolated, --method): a
    linear function reproduced by both methods to 1e-12, nan outside the
    hull; a malformed values file (exit 2, file and line named), an output
    that is the input or a missing partner option (exit 1).
@@ -228,6 +232,60 @@ def refusals():
             fail("%s left %s" % (args, out))
 
 
+def polyhedra():
+    try:
+        import vtk
+        from vtk.util.numpy_support import vtk_to_numpy
+    except ImportError:
+        print("polyhedra: no VTK Python module, not read back")
+        return
+    path = os.path.join(SCRATCH, "poly.xyz")
+    subprocess.run([GEN, "gaussian", "1500", "3", path], check=True)
+    vtu = os.path.join(SCRATCH, "cells.vtu")
+    txt = os.path.join(SCRATCH, "cells_v.txt")
+    r = run([path, "-q", "--voronoi", vtu])
+    r2 = run([path, "-q", "--voronoi", txt, "--voronoi-format", "%i %v %h"])
+    if r.returncode or r2.returncode:
+        fail("--voronoi .vtu: exit %d / %d: %s" % (r.returncode, r2.returncode, r.stderr))
+        return
+    rows = [line.split() for line in open(txt)]
+    want = {int(i): float(v) for i, v, h in rows if not int(h) & 4}
+    rd = vtk.vtkXMLUnstructuredGridReader()
+    rd.SetFileName(vtu)
+    rd.Update()
+    g = rd.GetOutput()
+    pts = vtk_to_numpy(g.GetPoints().GetData())
+    site = vtk_to_numpy(g.GetCellData().GetArray("point"))
+    vol = vtk_to_numpy(g.GetCellData().GetArray("volume"))
+    if g.GetNumberOfCells() != len(want):
+        fail("cells.vtu: %d cells for %d distinct points" % (g.GetNumberOfCells(), len(want)))
+        return
+    worst = 0.0
+    for c in range(g.GetNumberOfCells()):
+        cell = g.GetCell(c)
+        if cell.GetCellType() != 42:
+            fail("cells.vtu: cell %d has type %d" % (c, cell.GetCellType()))
+            return
+        v = 0.0
+        base = None
+        for k in range(cell.GetNumberOfFaces()):
+            f = cell.GetFace(k)
+            p = [pts[f.GetPointId(j)] for j in range(f.GetNumberOfPoints())]
+            if base is None:
+                base = p[0]
+            q = [x - base for x in p]
+            for j in range(1, len(q) - 1):
+                a, b, d = q[0], q[j], q[j + 1]
+                v += (a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) +
+                      a[2] * (b[0] * d[1] - b[1] * d[0])) / 6
+        s = int(site[c])
+        worst = max(worst, abs(v - want[s]) / want[s], abs(vol[c] - want[s]) / want[s])
+    print("polyhedra: %d VTK polyhedra read back; volumes from their faces against %%v: worst "
+          "%.1e" % (g.GetNumberOfCells(), worst))
+    if worst > 1e-10:
+        fail("cells.vtu: a polyhedron's volume is off by %.3g" % worst)
+
+
 def interpolation():
     path = os.path.join(SCRATCH, "interp.xyz")
     subprocess.run([GEN, "uniform", "3000", "4", path], check=True)
@@ -285,6 +343,7 @@ else:
 same_bits()
 dtfe()
 refusals()
+polyhedra()
 interpolation()
 print("%d failures" % len(failures))
 sys.exit(1 if failures else 0)

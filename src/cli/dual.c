@@ -37,10 +37,11 @@ int fdt_cli_parse_box(const char *s, double box[6])
     return 0;
 }
 
-static int is_csv(const char *path)
+/* Does path end in ext (".csv", ".vtu")? */
+static int has_ext(const char *path, const char *ext)
 {
-    size_t m = strlen(path);
-    return m >= 4 && !strcmp(path + m - 4, ".csv");
+    size_t m = strlen(path), e = strlen(ext);
+    return m >= e && !strcmp(path + m - e, ext);
 }
 
 int fdt_cli_interp_wanted(const fdt_cli_dual *d)
@@ -78,12 +79,17 @@ int fdt_cli_dual_check(const fdt_cli_dual *d, const char *input, char *err, size
         snprintf(err, errlen, "--box clips the Voronoi cells: it needs --voronoi or --density");
         return -1;
     }
+    if (d->format && d->voronoi && has_ext(d->voronoi, ".vtu")) {
+        snprintf(err, errlen, "--voronoi-format does not apply to a .vtu file (polyhedra)");
+        return -1;
+    }
     if (d->format && fdt_cells_format_check(d->format, NULL, err, errlen))
         return -1;
     return 0;
 }
 
-/* One file through the commit set: written by fn, renamed with the rest. */
+/* One file through the commit set: written by fn (0, an errno, or a
+ * negative FDT_E* code), renamed with the rest. */
 static int write_side(const char *path, int (*fn)(FILE *, const void *, const double *),
                       const void *arg, const double *xyz, char *err, size_t errlen)
 {
@@ -94,21 +100,22 @@ static int write_side(const char *path, int (*fn)(FILE *, const void *, const do
     int e = fn(f, arg, xyz);
     if (e) {
         fdt_wr_side_abandon(side);
-        snprintf(err, errlen, "%s: %s", path, strerror(e));
-        return FDT_EIO;
+        snprintf(err, errlen, "%s: %s", path, e < 0 ? fdt_strerror(e) : strerror(e));
+        return e < 0 ? e : FDT_EIO;
     }
     return fdt_wr_side_commit(side, err, errlen) == FDT_IO_OK ? FDT_OK : FDT_EIO;
 }
 
 typedef struct cells_job {
-    const fdt_voronoi *v;
+    fdt_voronoi *v;
     const char *format; /* NULL: CSV */
+    int vtu;            /* VTK polyhedra */
 } cells_job;
 
 static int put_cells(FILE *f, const void *arg, const double *xyz)
 {
     const cells_job *j = arg;
-    return fdt_wr_cells(f, j->format, j->v, xyz);
+    return j->vtu ? fdt_wr_cells_vtu(f, j->v, xyz) : fdt_wr_cells(f, j->format, j->v, xyz);
 }
 
 static int put_density(FILE *f, const void *arg, const double *xyz)
@@ -125,11 +132,11 @@ int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const doubl
     o.box_given = d->box_given;
     o.threads = d->threads;
     memcpy(o.box, d->box, sizeof o.box);
-    cells_job job = {NULL, d->format};
-    if (d->voronoi && !job.format && !is_csv(d->voronoi))
+    cells_job job = {NULL, d->format, d->voronoi && has_ext(d->voronoi, ".vtu")};
+    if (d->voronoi && !job.format && !job.vtu && !has_ext(d->voronoi, ".csv"))
         job.format = FDT_CELLS_DEFAULT_FORMAT;
-    int nb = 0;
-    if (job.format)
+    int nb = job.vtu;
+    if (job.format && !job.vtu)
         (void)fdt_cells_format_check(job.format, &nb, err, errlen);
     o.neighbors = nb;
     fdt_voronoi *v = NULL;

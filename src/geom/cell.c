@@ -62,13 +62,9 @@ int fdt_cell_box(fdt_cell *c, const double lo[3], const double hi[3])
     if (grow(&c->p, &c->capp, 8, sizeof *c->p) || grow(&c->ring, &c->capring, 24, sizeof(int)) ||
         grow(&c->f, &c->capf, 6, sizeof *c->f))
         return -1;
-    c->radius = 0;
-    for (int i = 0; i < 8; i++) {
+    for (int i = 0; i < 8; i++)
         for (int k = 0; k < 3; k++)
             c->p[i][k] = (i >> k) & 1 ? hi[k] : lo[k];
-        if (norm3(c->p[i]) > c->radius)
-            c->radius = norm3(c->p[i]);
-    }
     c->np = 8;
     for (int f = 0; f < 6; f++) {
         c->f[f] = (fdt_cell_ring){4 * f, 4, FDT_CELL_WALL(f)};
@@ -91,7 +87,6 @@ int fdt_cell_copy(fdt_cell *dst, const fdt_cell *src)
     dst->np = src->np;
     dst->nring = src->nring;
     dst->nf = src->nf;
-    dst->radius = src->radius;
     return 0;
 }
 
@@ -187,13 +182,9 @@ static int compact(fdt_cell *c)
         grow(&c->ring, &c->capring, c->ntring, sizeof(int)) ||
         grow(&c->f, &c->capf, c->ntf, sizeof *c->f))
         return -1;
-    c->radius = 0;
     for (int i = 0; i < c->np; i++)
-        if (c->v[i].map >= 0) {
+        if (c->v[i].map >= 0)
             memcpy(c->tp[c->v[i].map], c->p[i], sizeof c->tp[0]);
-            if (norm3(c->p[i]) > c->radius)
-                c->radius = norm3(c->p[i]);
-        }
     double(*t)[3] = c->p; /* swap the vertex arrays */
     int tc = c->capp;
     c->p = c->tp;
@@ -214,10 +205,16 @@ int fdt_cell_cut(fdt_cell *c, const double n[3], double h, long label)
     /* Each vertex classed once; a crossing point is ON by construction. */
     if (grow(&c->v, &c->capv, c->np, sizeof *c->v))
         return -1;
-    double eps = FDT_CELL_TOL * norm3(n) * c->radius;
+    /* Each vertex's own tolerance, the size of the rounding in its s: a
+     * far vertex's is coarse, a near one's fine, so a small cell cut from
+     * a large box keeps its precision (one tolerance for all, scaled by
+     * the box, cost a cell 1e-6 of the box 1e-7 of its volume). */
+    double n1 = fabs(n[0]) + fabs(n[1]) + fabs(n[2]);
     int nout = 0, nin = 0;
     for (int i = 0; i < c->np; i++) {
-        double s = n[0] * c->p[i][0] + n[1] * c->p[i][1] + n[2] * c->p[i][2] - h;
+        const double *p = c->p[i];
+        double s = n[0] * p[0] + n[1] * p[1] + n[2] * p[2] - h;
+        double eps = FDT_CELL_TOL * (n1 * (fabs(p[0]) + fabs(p[1]) + fabs(p[2])) + fabs(h));
         int side = s > eps ? OUT : s < -eps ? IN : ON;
         c->v[i] = (fdt_cell_scratch){s, side, -1, -1};
         nout += side == OUT;

@@ -11,9 +11,10 @@
  * neighbour whose bisector made it, or a wall (FDT_CELL_WALL(k) for
  * k = 0..5: x-min, x-max, y-min, y-max, z-min, z-max, voro++'s -1..-6).
  *
- * A vertex within FDT_CELL_TOL of a cutting plane, relative to the cell's
- * size, counts as on it: it stays, and no sliver of area 2^-40 of the
- * cell's is made (voro++ has the same kind of tolerance). Not thread-safe
+ * A vertex whose distance to a cutting plane is within FDT_CELL_TOL of the
+ * size of the numbers that give it (|n| |x| + |h|, the rounding's scale)
+ * counts as on it: it stays, and no sliver of rounding is cut off (voro++
+ * has the same kind of tolerance). Not thread-safe
  * per object; one object per thread, reused from cell to cell.
  */
 #ifndef FDT_CELL_H
@@ -41,7 +42,6 @@ typedef struct fdt_cell {
     int nring, capring;
     fdt_cell_ring *f;   /* faces (owned) */
     int nf, capf;
-    double radius;      /* the largest |vertex|, for the tolerance */
     /* scratch, kept from call to call (owned) */
     fdt_cell_scratch *v;
     int capv;

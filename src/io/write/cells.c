@@ -157,3 +157,119 @@ int fdt_wr_rows(FILE *f, const double *v, size_t rows, size_t k)
     }
     return close_out(&o);
 }
+
+/* A growable array of bytes. */
+typedef struct bytes {
+    unsigned char *p;
+    size_t len, cap;
+} bytes;
+
+static int put_bytes(bytes *b, const void *x, size_t n)
+{
+    if (b->len + n > b->cap) {
+        size_t nc = b->cap ? 2 * b->cap : 4096;
+        while (nc < b->len + n)
+            nc *= 2;
+        unsigned char *q = realloc(b->p, nc);
+        if (!q)
+            return -1;
+        b->p = q;
+        b->cap = nc;
+    }
+    memcpy(b->p + b->len, x, n);
+    b->len += n;
+    return 0;
+}
+
+static int put_i64(bytes *b, int64_t x)
+{
+    return put_bytes(b, &x, sizeof x);
+}
+
+int fdt_wr_cells_vtu(FILE *f, fdt_voronoi *v, const double *xyz)
+{
+    /* The arrays, in their order in the file: points, connectivity,
+     * offsets, types, faces, faceoffsets, volume, point. */
+    enum { NARR = 8 };
+    bytes a[NARR];
+    memset(a, 0, sizeof a);
+    size_t n = fdt_voronoi_num_points(v), nv_all = 0, ncells = 0;
+    int64_t conn_end = 0;
+    int err = 0;
+    for (size_t i = 0; i < n && !err; i++) {
+        size_t nv, nf;
+        const double *vs;
+        const int32_t *fs;
+        int rc = fdt_voronoi_polyhedron(v, xyz, (fdt_vid)i, &nv, &vs, &nf, &fs);
+        if (rc != FDT_OK) {
+            err = rc;
+            break;
+        }
+        if (nv == 0)
+            continue; /* a merged duplicate */
+        const unsigned char type = 42; /* VTK_POLYHEDRON */
+        int bad = put_bytes(&a[0], vs, 3 * nv * sizeof *vs);
+        for (size_t j = 0; j < nv && !bad; j++)
+            bad = put_i64(&a[1], (int64_t)(nv_all + j));
+        conn_end += (int64_t)nv;
+        bad = bad || put_i64(&a[2], conn_end) || put_bytes(&a[3], &type, 1) ||
+              put_i64(&a[4], (int64_t)nf);
+        for (size_t k = 0, o = 0; k < nf && !bad; k++) {
+            int32_t cnt = fs[o++];
+            bad = put_i64(&a[4], cnt);
+            for (int32_t j = 0; j < cnt && !bad; j++)
+                bad = put_i64(&a[4], (int64_t)nv_all + fs[o++]);
+        }
+        bad = bad || put_i64(&a[5], (int64_t)(a[4].len / sizeof(int64_t))) ||
+              put_bytes(&a[6], &fdt_voronoi_volumes(v)[i], sizeof(double)) ||
+              put_i64(&a[7], (int64_t)i);
+        if (bad)
+            err = FDT_ENOMEM;
+        nv_all += nv;
+        ncells++;
+    }
+    if (!err) {
+        static const char *const what[NARR] = {
+            "<Points>\n        <DataArray type=\"Float64\" NumberOfComponents=\"3\"",
+            "</Points>\n      <Cells>\n        <DataArray type=\"Int64\" Name=\"connectivity\"",
+            "        <DataArray type=\"Int64\" Name=\"offsets\"",
+            "        <DataArray type=\"UInt8\" Name=\"types\"",
+            "        <DataArray type=\"Int64\" Name=\"faces\"",
+            "        <DataArray type=\"Int64\" Name=\"faceoffsets\"",
+            "</Cells>\n      <CellData Scalars=\"volume\">\n"
+            "        <DataArray type=\"Float64\" Name=\"volume\"",
+            "        <DataArray type=\"Int64\" Name=\"point\"",
+        };
+        uint16_t one = 1;
+        unsigned char little;
+        memcpy(&little, &one, 1);
+        errno = 0;
+        fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+                   "byte_order=\"%s\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n"
+                   "    <Piece NumberOfPoints=\"%zu\" NumberOfCells=\"%zu\">\n",
+                little ? "LittleEndian" : "BigEndian", nv_all, ncells);
+        uint64_t off = 0;
+        for (int k = 0; k < NARR; k++) {
+            const char *w = what[k];
+            if (*w != ' ')
+                fputs("      ", f);
+            fprintf(f, "%s format=\"appended\" offset=\"%llu\"/>\n", w,
+                    (unsigned long long)off);
+            off += sizeof(uint64_t) + a[k].len;
+        }
+        fputs("      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n"
+              "  <AppendedData encoding=\"raw\">\n_", f);
+        for (int k = 0; k < NARR; k++) {
+            uint64_t len = a[k].len;
+            fwrite(&len, sizeof len, 1, f);
+            if (len)
+                fwrite(a[k].p, 1, a[k].len, f);
+        }
+        fputs("\n  </AppendedData>\n</VTKFile>\n", f);
+        if (ferror(f))
+            err = errno ? errno : EIO;
+    }
+    for (int k = 0; k < NARR; k++)
+        free(a[k].p);
+    return err;
+}

@@ -35,6 +35,14 @@ int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *x
  * %h: a hull point's density counts only the tets it has). */
 int fdt_wr_density(FILE *f, const fdt_voronoi *v);
 
+/* The cells as VTK polyhedra (a .vtu file, VTK_POLYHEDRON cells with
+ * their faces, ParaView's reader): one cell a distinct point, cell data
+ * "point" (its index) and "volume". v needs its neighbours
+ * (options.neighbors). All polyhedra are made first (about 2 KB a cell),
+ * then written as appended raw arrays. 0, an errno of the write, or a
+ * negative FDT_E* code of fdt_voronoi_polyhedron. */
+int fdt_wr_cells_vtu(FILE *f, fdt_voronoi *v, const double *xyz);
+
 /* rows lines of k numbers each (NaN as "nan"): the interpolated values. */
 int fdt_wr_rows(FILE *f, const double *v, size_t rows, size_t k);
 
