@@ -309,8 +309,10 @@ static void tri_centre(const double *a, const double *b, double *x)
  * |c - a|, n the normal); for a flatter one (nearly collinear, its
  * circumcentre far and the formula's error near |that distance| eps /
  * sin), the exact circumcentre X of the tet (a, b, c, a + n) projected on
- * the plane: X lies on the triangle's axis |n| / 2 from it, so a normal
- * off by eps / sin moves the projection by only about |b - a| |c - a| eps.
+ * the plane: X lies on the triangle's axis about |n| / 2 from it, so a
+ * normal off by eps / sin moves the projection by about |n| eps / (2 sin)
+ * = |b - a| |c - a| eps / 2. Where a + n rounds back onto the plane, n is
+ * scaled up (by a power of two, to about |b - a|) and tried again.
  * Without it the shares of a cell next to such a face lost up to 1e-8 of
  * its volume (gen_points clusters). */
 static void face_centre(const double *a, const double *b, const double *c, double *x)
@@ -325,8 +327,16 @@ static void face_centre(const double *a, const double *b, const double *c, doubl
         return;
     }
     double d[3] = {a[0] + n[0], a[1] + n[1], a[2] + n[2]}, X[3];
-    if (nn == 0 || fdt_circumcenter_exact(a, b, c, d, X) != 0) {
-        tri_centre(e1, e2, x); /* a + n rounded back onto the plane: nothing better */
+    int got = nn > 0 ? fdt_circumcenter_exact(a, b, c, d, X) : -1;
+    if (got != 0 && nn > 0) {
+        int ex;
+        (void)frexp(sqrt(dot3(e1, e1) / nn), &ex);
+        for (int k = 0; k < 3; k++)
+            d[k] = a[k] + ldexp(n[k], ex);
+        got = fdt_circumcenter_exact(a, b, c, d, X);
+    }
+    if (got != 0) {
+        tri_centre(e1, e2, x); /* collinear to the last bit: nothing better */
         return;
     }
     double t = dot3(X, n) / nn;
