@@ -289,6 +289,14 @@ static void test_same_bits(size_t n)
     free(perm);
 }
 
+static int count_tets(void *user, const fdt_vid *t, size_t count)
+{
+    (void)user;
+    (void)t;
+    (void)count;
+    return 0;
+}
+
 static void test_refusals(void)
 {
     size_t n = 200;
@@ -310,8 +318,41 @@ static void test_refusals(void)
     size_t cnt;
     const fdt_vid *ids;
     const double *fa;
+    fdt_default_voronoi_options(&o);
+    o.threads = -1;
+    EXPECT(fdt_voronoi_compute(r, xyz, n, &o, &v, diag, sizeof diag) == FDT_EINVAL);
+    o.threads = 0;
+    o.struct_size = 8;
+    EXPECT(fdt_voronoi_compute(r, xyz, n, &o, &v, diag, sizeof diag) == FDT_EINVAL);
+    EXPECT(fdt_voronoi_compute(r, xyz, n, NULL, NULL, diag, sizeof diag) == FDT_EINVAL);
+    EXPECT(fdt_default_voronoi_options_sized(&o, 3) == FDT_EINVAL);
+    /* a streamed result keeps no tets */
+    fdt_settings st;
+    fdt_default_settings(&st);
+    fdt_context *ctx = NULL;
+    CHECK(fdt_open(&ctx, &st) == FDT_OK);
+    fdt_result *sr = NULL;
+    fdt_sink sink = {sizeof sink, count_tets, NULL, NULL};
+    CHECK(fdt_triangulate_stream(ctx, xyz, n, &sink, &sr) == FDT_OK);
+    fdt_close(&ctx);
+    EXPECT(fdt_voronoi_compute(sr, xyz, n, NULL, &v, diag, sizeof diag) == FDT_EINVAL);
+    EXPECTF(strstr(diag, "with its tets"), "diag: %s", diag);
+    double q[3] = {0.5, 0.5, 0.5}, out;
+    fdt_tid t;
+    EXPECT(fdt_locate(sr, xyz, n, q, 1, &t, NULL, 1) == FDT_EINVAL);
+    EXPECT(fdt_interpolate(sr, xyz, n, xyz, 1, q, 1, FDT_INTERP_LINEAR, 1, &out, NULL, 0) ==
+           FDT_EINVAL);
+    fdt_result_free(&sr);
     CHECK(fdt_voronoi_compute(r, xyz, n, NULL, &v, NULL, 0) == FDT_OK);
     EXPECT(fdt_voronoi_neighbors(v, 0, &cnt, &ids, &fa) == FDT_EINVAL); /* not kept */
+    size_t nv, nf;
+    const double *vs;
+    const int32_t *fs;
+    EXPECT(fdt_voronoi_polyhedron(v, xyz, 0, &nv, &vs, &nf, &fs) == FDT_EINVAL);
+    double vbox[6];
+    fdt_voronoi_box(v, vbox);
+    EXPECT(vbox[0] >= 0 && vbox[3] <= 1 && vbox[0] < vbox[3]);
+    EXPECT(fdt_voronoi_num_points(v) == n && fdt_voronoi_num_points(NULL) == 0);
     fdt_voronoi_free(&v);
     fdt_result_free(&r);
     free(xyz);

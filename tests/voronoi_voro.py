@@ -232,6 +232,85 @@ def refusals():
             fail("%s left %s" % (args, out))
 
 
+def formats_and_refusals():
+    """Every --voronoi-format code and the CSV on an input with a duplicate;
+    --box and output refusals; malformed --values files."""
+    path = os.path.join(SCRATCH, "codes.xyz")
+    pts = [(0.1 * (i % 5), 0.13 * (i // 5 % 5), 0.17 * (i // 25)) for i in range(125)]
+    pts = [(x + 1e-3 * ((7 * i) % 11), y, z) for i, (x, y, z) in enumerate(pts)] + [pts[0]]
+    pts[-1] = (pts[0][0] + 1e-3 * 0, pts[0][1], pts[0][2])
+    write_xyz(path, pts)
+    out = os.path.join(SCRATCH, "codes.txt")
+    r = run([path, "-q", "--voronoi", out, "--voronoi-format", "%i|%x|%y|%z|%c|%C|%d|%h|%%",
+             "--density", os.path.join(SCRATCH, "codes_d.txt")])
+    if r.returncode:
+        fail("all codes: exit %d: %s" % (r.returncode, r.stderr.strip()))
+    else:
+        rows = [line.rstrip("\n").split("|") for line in open(out)]
+        last = rows[-1]
+        if len(rows) != len(pts) or last[8] != "%" or int(last[7]) != 4 or \
+                [float(x) for x in last[4].split()] != [0.0, 0.0, 0.0]:
+            fail("all codes: rows %d, last %r" % (len(rows), last))
+        first = rows[0]
+        cen = [float(x) for x in first[5].split()]
+        rel = [float(x) for x in first[4].split()]
+        pos = [float(first[k]) for k in (1, 2, 3)]
+        if max(abs(c - (p + q)) for c, p, q in zip(cen, pos, rel)) > 1e-12:
+            fail("all codes: %%C is not the point plus %%c: %r" % first)
+    csv = os.path.join(SCRATCH, "codes.csv")
+    r = run([path, "-q", "--voronoi", csv])
+    if r.returncode or not open(csv).readline().startswith("id,x,y,z,volume"):
+        fail("csv: exit %d" % r.returncode)
+    elif len(open(csv).readlines()) != len(pts) + 1:
+        fail("csv: %d lines" % len(open(csv).readlines()))
+    vals = os.path.join(SCRATCH, "codes_vals.txt")
+    qs = os.path.join(SCRATCH, "codes_q.xyz")
+    write_xyz(qs, [(0.2, 0.2, 0.2)])
+    iout = os.path.join(SCRATCH, "codes_i.txt")
+    cases = [
+        (["--box", "0,0,0,1,1,x", "--voronoi", out], 1, "--box wants six"),
+        (["--box", "0,0,0;1,1,1", "--voronoi", out], 1, "--box wants six"),
+        (["--box", "0,0,0,1,1,1"], 1, "needs --voronoi or --density"),
+        (["--voronoi", out, "--density", out], 1, "named for two outputs"),
+        (["--voronoi", os.path.join(SCRATCH, "c.vtu"), "--voronoi-format", "%v"], 1,
+         "does not apply to a .vtu"),
+        (["--voronoi", out, "--voronoi-format", "%v %"], 1, "not a cell code"),
+        (["--voronoi", os.path.join(SCRATCH, "no", "such", "dir.txt")], 5, ""),
+    ]
+    bad_values = [
+        ("1 2\n3\n", ":2:"),            # fewer than the first row
+        ("1\n2 3\n", ":2:"),            # more than the first row
+        ("1\nnan\n", ":2:"),            # not finite
+        ("1,\n", "rows of values"),      # too few rows
+    ]
+    for b, (text, want) in enumerate(bad_values):
+        bv = "%s.%d" % (vals, b)
+        with open(bv, "w") as f:
+            f.write(text)
+        cases.append((["--values", bv, "--interpolate", qs, "--interpolated", iout], 2, want))
+    many = os.path.join(SCRATCH, "codes_many.txt")
+    with open(many, "w") as f:
+        f.write("# values\n\n" + "".join("%d, %d\n" % (i, -i) for i in range(len(pts) + 1)))
+    cases.append((["--values", many, "--interpolate", qs, "--interpolated", iout], 2,
+                  "more rows than points"))
+    cases.append((["--values", os.path.join(SCRATCH, "missing.txt"), "--interpolate", qs,
+                   "--interpolated", iout], 2, "missing.txt"))
+    for args, code, text in cases:
+        r = run([path, "-q"] + args)
+        if r.returncode != code or text not in r.stderr:
+            fail("%s: exit %d (want %d), stderr %r (want %r)" % (args, r.returncode, code,
+                                                                  r.stderr.strip(), text))
+    good = os.path.join(SCRATCH, "codes_good.txt")
+    with open(good, "w") as f:
+        f.write("# two values a point, comments, a blank line, commas\n\n" +
+                "".join("%r, %r # x and -x\n" % (p[0], -p[0]) for p in pts))
+    r = run([path, "-q", "--values", good, "--interpolate", qs, "--interpolated", iout,
+             "--method", "linear"])
+    got = open(iout).read().split() if r.returncode == 0 else []
+    if r.returncode or len(got) != 2 or abs(float(got[0]) - 0.2) > 1e-12:
+        fail("values with comments and commas: exit %d, %r" % (r.returncode, got))
+
+
 def polyhedra():
     try:
         import vtk
@@ -343,6 +422,7 @@ else:
 same_bits()
 dtfe()
 refusals()
+formats_and_refusals()
 polyhedra()
 interpolation()
 print("%d failures" % len(failures))
