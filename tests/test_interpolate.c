@@ -134,6 +134,12 @@ static void test_continuity_and_refusals(void)
     EXPECT(fdt_interpolate(r, xyz, n, val, 0, q, 1, FDT_INTERP_LINEAR, THREADS, out, NULL, 0) ==
            FDT_EINVAL);
     EXPECT(fdt_interpolate(r, xyz, n, val, 1, q, 1, (fdt_interp)7, THREADS, out, NULL, 0) == FDT_EINVAL);
+    EXPECT(fdt_interpolate(r, xyz, n, val, 1, q, 1, FDT_INTERP_LINEAR, -2, out, NULL, 0) ==
+           FDT_EINVAL);
+    EXPECT(fdt_interpolate(NULL, xyz, n, val, 1, q, 1, FDT_INTERP_LINEAR, 1, out, NULL, 0) ==
+           FDT_EINVAL);
+    EXPECT(fdt_interpolate(r, xyz, n, val, 1, q, 0, FDT_INTERP_NATURAL, 1, NULL, NULL, 0) ==
+           FDT_OK); /* no queries */
     fdt_result_free(&r);
     free(xyz);
     free(val);

@@ -117,6 +117,9 @@ static void test_random(void)
     EXPECT(t == -1);
     EXPECT(fdt_locate(with, xyz, n - 1, q, 1, &t, NULL, 1) == FDT_EINVAL);
     EXPECT(fdt_locate(with, xyz, n, q, 1, &t, NULL, -1) == FDT_EINVAL);
+    EXPECT(fdt_locate(NULL, xyz, n, q, 1, &t, NULL, 1) == FDT_EINVAL);
+    EXPECT(fdt_locate(with, xyz, n, NULL, 1, &t, NULL, 1) == FDT_EINVAL);
+    EXPECT(fdt_locate(with, xyz, n, q, 0, NULL, NULL, 1) == FDT_OK); /* no queries */
     fdt_result_free(&with);
     fdt_result_free(&without);
     free(xyz);

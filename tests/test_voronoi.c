@@ -358,8 +358,43 @@ static void test_refusals(void)
     free(xyz);
 }
 
+/* The getters' and the lists' refusals, and a merged duplicate's cell. */
+static void test_getters(void)
+{
+    size_t n = 300;
+    double *xyz = random_points(n, 0, 8);
+    memcpy(xyz + 3 * (n - 1), xyz, 3 * sizeof *xyz); /* the last is the first again */
+    fdt_result *r = triangulate(xyz, n, 1);
+    fdt_voronoi *v = cells(r, xyz, n, NULL);
+    size_t cnt, nv, nf;
+    const fdt_vid *ids;
+    const double *fa, *vs;
+    const int32_t *fs;
+    EXPECT(fdt_voronoi_neighbors(v, -1, &cnt, &ids, &fa) == FDT_EINVAL);
+    EXPECT(fdt_voronoi_neighbors(v, (fdt_vid)n, &cnt, &ids, &fa) == FDT_EINVAL);
+    EXPECT(fdt_voronoi_neighbors(v, 0, NULL, &ids, &fa) == FDT_EINVAL);
+    EXPECT(fdt_voronoi_neighbors(NULL, 0, &cnt, &ids, &fa) == FDT_EINVAL);
+    EXPECT(fdt_voronoi_polyhedron(v, xyz, -1, &nv, &vs, &nf, &fs) == FDT_EINVAL);
+    EXPECT(fdt_voronoi_polyhedron(v, NULL, 0, &nv, &vs, &nf, &fs) == FDT_EINVAL);
+    EXPECT(fdt_voronoi_polyhedron(v, xyz, (fdt_vid)(n - 1), &nv, &vs, &nf, &fs) == FDT_OK &&
+           nv == 0 && nf == 0);
+    EXPECT(fdt_voronoi_flags(v)[n - 1] == FDT_CELL_MERGED && fdt_voronoi_volumes(v)[n - 1] == 0);
+    EXPECT(fdt_voronoi_neighbors(v, (fdt_vid)(n - 1), &cnt, &ids, &fa) == FDT_OK && cnt == 0);
+    EXPECT(fdt_voronoi_polyhedron(v, xyz, 0, &nv, &vs, &nf, &fs) == FDT_OK && nv >= 4 && nf >= 4);
+    EXPECT(!fdt_voronoi_volumes(NULL) && !fdt_voronoi_areas(NULL) && !fdt_voronoi_centroids(NULL) &&
+           !fdt_voronoi_num_faces(NULL) && !fdt_voronoi_densities(NULL) &&
+           !fdt_voronoi_flags(NULL) && fdt_voronoi_zero_faces(NULL) == 0);
+    fdt_voronoi_box(NULL, NULL);
+    fdt_voronoi_free(&v);
+    fdt_voronoi_free(&v); /* NULL: nothing */
+    fdt_voronoi_free(NULL);
+    fdt_result_free(&r);
+    free(xyz);
+}
+
 int main(void)
 {
+    test_getters();
     test_lattice(2);
     test_lattice(5);
     test_box_sums(3000, 0, 1);
