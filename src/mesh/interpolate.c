@@ -305,16 +305,12 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
         (method != FDT_INTERP_LINEAR && method != FDT_INTERP_NATURAL))
         return FDT_EINVAL;
     fdt_locator L;
-    int err = fdt_locator_init(&L, r, xyz, n);
+    uint32_t *order;
+    int err = fdt_queries_begin(&L, r, xyz, n, q, nq, &threads, &order);
     if (err)
         return err;
-    if (threads < 1)
-        threads = 1;
-    if ((size_t)threads > nq / 64 + 1)
-        threads = (int)(nq / 64 + 1);
-    uint32_t *order = fdt_query_order(q, nq);
     ijob *jobs = calloc((size_t)threads, sizeof *jobs);
-    if (!order || !jobs) {
+    if (!jobs) {
         free(order);
         free(jobs);
         fdt_locator_free(&L);

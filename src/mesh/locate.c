@@ -120,8 +120,16 @@ fdt_tid fdt_locate_one(const fdt_locator *L, size_t *hint, const double *q)
     return s;
 }
 
-uint32_t *fdt_query_order(const double *q, size_t nq)
+int fdt_queries_begin(fdt_locator *L, fdt_result *r, const double *xyz, size_t n, const double *q,
+                      size_t nq, int *threads, uint32_t **order)
 {
+    int err = fdt_locator_init(L, r, xyz, n);
+    if (err)
+        return err;
+    if (*threads < 1)
+        *threads = 1;
+    if ((size_t)*threads > nq / 64 + 1)
+        *threads = (int)(nq / 64 + 1);
     double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     for (size_t k = 0; k < nq; k++)
         for (int d = 0; d < 3; d++)
@@ -129,12 +137,14 @@ uint32_t *fdt_query_order(const double *q, size_t nq)
                 box[d] = fmin(box[d], q[3 * k + d]);
                 box[d + 3] = fmax(box[d + 3], q[3 * k + d]);
             }
-    uint32_t *order = malloc((nq ? nq : 1) * sizeof *order);
-    if (order && fdt_morton_order(q, nq, box, NULL, order) < 0) {
-        free(order);
-        order = NULL;
+    *order = malloc((nq ? nq : 1) * sizeof **order);
+    if (!*order || fdt_morton_order(q, nq, box, NULL, *order) < 0) {
+        free(*order);
+        *order = NULL;
+        fdt_locator_free(L);
+        return FDT_ENOMEM;
     }
-    return order;
+    return FDT_OK;
 }
 
 void fdt_barycentric(const fdt_locator *L, fdt_tid t, const double *q, double b[4])
@@ -194,16 +204,12 @@ int fdt_locate_build(fdt_result *r, const double *xyz, size_t n, const double *q
     if (!r || !xyz || (nq && (!q || !tet)))
         return FDT_EINVAL;
     fdt_locator L;
-    int err = fdt_locator_init(&L, r, xyz, n);
+    uint32_t *order;
+    int err = fdt_queries_begin(&L, r, xyz, n, q, nq, &threads, &order);
     if (err)
         return err;
-    uint32_t *order = fdt_query_order(q, nq);
-    if (threads < 1)
-        threads = 1;
-    if ((size_t)threads > nq / 64 + 1)
-        threads = (int)(nq / 64 + 1);
     ljob *jobs = calloc((size_t)threads, sizeof *jobs);
-    if (!order || !jobs) {
+    if (!jobs) {
         free(order);
         free(jobs);
         fdt_locator_free(&L);

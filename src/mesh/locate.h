@@ -27,10 +27,13 @@ void fdt_locator_free(fdt_locator *L);
  * where it ended: a thread's next query starts there. */
 fdt_tid fdt_locate_one(const fdt_locator *L, size_t *hint, const double *q);
 
-/* The queries q[0 .. 3 nq) in Morton order of their box (order[0 .. nq),
- * malloc'd), and the equal runs of it the `threads` threads take: the
- * walks of consecutive queries are short. NULL when out of memory. */
-uint32_t *fdt_query_order(const double *q, size_t nq);
+/* What both query calls start with: the locator over r, *threads cut to
+ * one a 64 queries (at least 1), and the queries q[0 .. 3 nq) in Morton
+ * order of their box (*order, nq entries, malloc'd), of which each thread
+ * takes an equal run: the walks of consecutive queries are short. On
+ * failure (FDT_EINVAL, FDT_ENOMEM) nothing is left to free. */
+int fdt_queries_begin(fdt_locator *L, fdt_result *r, const double *xyz, size_t n, const double *q,
+                      size_t nq, int *threads, uint32_t **order);
 
 /* q's barycentric coordinates in tet t, in the order of its vertices. */
 void fdt_barycentric(const fdt_locator *L, fdt_tid t, const double *q, double b[4]);
