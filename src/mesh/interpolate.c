@@ -16,6 +16,7 @@
  * at a point that point's value.
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -24,10 +25,9 @@
 #include "geom/predicates.h"
 #include "mesh/locate.h"
 #include "mesh/result.h"
-#include <stdio.h>
 
 typedef struct sibson {
-    fdt_locator L;
+    const fdt_locator *L;    /* shared, read only */
     fdt_cell cell, part;
     fdt_tid *stack, *cavity; /* growable lists of tets */
     size_t cap_stack, cap_cavity;
@@ -64,8 +64,8 @@ static int has_tet(const fdt_tid *a, size_t n, fdt_tid t)
  * out of memory. */
 static long cavity(sibson *S, fdt_tid t0, const double *q)
 {
-    const fdt_result *r = S->L.r;
-    const double *X = S->L.xyz;
+    const fdt_result *r = S->L->r;
+    const double *X = S->L->xyz;
     size_t nc = 0, ns = 0;
     if (push(&S->cavity, &S->cap_cavity, 0, sizeof *S->cavity) ||
         push(&S->stack, &S->cap_stack, 0, sizeof *S->stack))
@@ -75,7 +75,7 @@ static long cavity(sibson *S, fdt_tid t0, const double *q)
     while (ns) {
         fdt_tid t = S->stack[--ns];
         for (int i = 0; i < 4; i++) {
-            fdt_tid u = S->L.nbrs[4 * (size_t)t + (size_t)i];
+            fdt_tid u = S->L->nbrs[4 * (size_t)t + (size_t)i];
             if (u < 0 || has_tet(S->cavity, nc, u))
                 continue;
             const fdt_vid *tv = r->tets + 4 * (size_t)u;
@@ -95,8 +95,8 @@ static long cavity(sibson *S, fdt_tid t0, const double *q)
 /* Grows the box [lo, hi] (relative to q) to hold the ball of tet t. */
 static int add_ball(const sibson *S, fdt_tid t, const double *q, double lo[3], double hi[3])
 {
-    const double *X = S->L.xyz;
-    const fdt_vid *tv = S->L.r->tets + 4 * (size_t)t;
+    const double *X = S->L->xyz;
+    const fdt_vid *tv = S->L->r->tets + 4 * (size_t)t;
     const double *a = X + 3 * (size_t)tv[0];
     double cc[3];
     if (fdt_circumcenter_exact(a, X + 3 * (size_t)tv[1], X + 3 * (size_t)tv[2],
@@ -117,8 +117,8 @@ static int add_ball(const sibson *S, fdt_tid t, const double *q, double lo[3], d
  * either side: spheres of one pencil). */
 static long neighbours(sibson *S, size_t nc, const double *q, double lo[3], double hi[3])
 {
-    const fdt_result *r = S->L.r;
-    const double *X = S->L.xyz;
+    const fdt_result *r = S->L->r;
+    const double *X = S->L->xyz;
     size_t m = 0;
     for (int k = 0; k < 3; k++) {
         lo[k] = 0;
@@ -140,7 +140,7 @@ static long neighbours(sibson *S, size_t nc, const double *q, double lo[3], doub
             m++;
         }
         for (int i = 0; i < 4; i++) {
-            fdt_tid u = S->L.nbrs[4 * (size_t)t + (size_t)i];
+            fdt_tid u = S->L->nbrs[4 * (size_t)t + (size_t)i];
             if (u >= 0 && has_tet(S->cavity, nc, u))
                 continue; /* not on the boundary */
             double cc[3];
@@ -165,8 +165,8 @@ static long neighbours(sibson *S, size_t nc, const double *q, double lo[3], doub
  * of memory, -2 a cut that failed (a bug). */
 static long coordinates(sibson *S, fdt_tid t0, const double *q)
 {
-    const fdt_result *r = S->L.r;
-    const double *X = S->L.xyz;
+    const fdt_result *r = S->L->r;
+    const double *X = S->L->xyz;
     const fdt_vid *tv = r->tets + 4 * (size_t)t0;
     for (int i = 0; i < 4; i++) /* q at a point: that point alone */
         if (X[3 * (size_t)tv[i]] == q[0] && X[3 * (size_t)tv[i] + 1] == q[1] &&
@@ -241,12 +241,11 @@ static long coordinates(sibson *S, fdt_tid t0, const double *q)
 
 /* One thread's run of the queries. */
 typedef struct ijob {
+    fdt_query_run run; /* first: fdt_queries_begin fills it */
     sibson S;
-    const double *values, *q;
+    const double *values;
     size_t nv;
     fdt_interp method;
-    const uint32_t *order;
-    size_t count;
     double *out;
     int err;
     size_t bad; /* the query that failed */
@@ -256,21 +255,21 @@ static void *interpolate_run(void *arg)
 {
     ijob *j = arg;
     sibson *S = &j->S;
-    const fdt_result *r = S->L.r;
+    const fdt_result *r = S->L->r;
     size_t hint = 0, nv = j->nv;
-    for (size_t i = 0; i < j->count && !j->err; i++) {
-        size_t k = j->order[i];
-        const double *qk = j->q + 3 * k;
+    for (size_t i = 0; i < j->run.count && !j->err; i++) {
+        size_t k = j->run.order[i];
+        const double *qk = j->run.q + 3 * k;
         double *o = j->out + nv * k;
         for (size_t c = 0; c < nv; c++)
             o[c] = NAN;
-        fdt_tid t = fdt_locate_one(&S->L, &hint, qk);
+        fdt_tid t = fdt_locate_one(S->L, &hint, qk);
         if (t < 0)
             continue;
         const fdt_vid *tv = r->tets + 4 * (size_t)t;
         if (j->method == FDT_INTERP_LINEAR) {
             double b[4];
-            fdt_barycentric(&S->L, t, qk, b);
+            fdt_barycentric(S->L, t, qk, b);
             for (size_t c = 0; c < nv; c++) {
                 o[c] = 0;
                 for (int v = 0; v < 4; v++)
@@ -306,28 +305,19 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
         return FDT_EINVAL;
     fdt_locator L;
     uint32_t *order;
-    int err = fdt_queries_begin(&L, r, xyz, n, q, nq, &threads, &order);
+    void *jp;
+    int err = fdt_queries_begin(&L, r, xyz, n, q, nq, &threads, &order, sizeof(ijob), &jp);
     if (err)
         return err;
-    ijob *jobs = calloc((size_t)threads, sizeof *jobs);
-    if (!jobs) {
-        free(order);
-        free(jobs);
-        fdt_locator_free(&L);
-        return FDT_ENOMEM;
-    }
+    ijob *jobs = jp;
     for (int t = 0; t < threads; t++) {
-        size_t a = nq * (size_t)t / (size_t)threads, b = nq * (size_t)(t + 1) / (size_t)threads;
         ijob *j = &jobs[t];
-        j->S.L = L; /* shared, read only */
+        j->S.L = &L;
         fdt_cell_init(&j->S.cell);
         fdt_cell_init(&j->S.part);
         j->values = values;
-        j->q = q;
         j->nv = nv;
         j->method = method;
-        j->order = order + a;
-        j->count = b - a;
         j->out = out;
     }
     fdt_fork_join(jobs, sizeof *jobs, threads, interpolate_run);
@@ -348,8 +338,6 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
         free(j->S.nn);
         free(j->S.w);
     }
-    free(jobs);
-    free(order);
-    fdt_locator_free(&L);
+    fdt_queries_end(&L, order, jobs);
     return err;
 }

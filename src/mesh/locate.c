@@ -121,7 +121,7 @@ fdt_tid fdt_locate_one(const fdt_locator *L, size_t *hint, const double *q)
 }
 
 int fdt_queries_begin(fdt_locator *L, fdt_result *r, const double *xyz, size_t n, const double *q,
-                      size_t nq, int *threads, uint32_t **order)
+                      size_t nq, int *threads, uint32_t **order, size_t job_size, void **jobs)
 {
     int err = fdt_locator_init(L, r, xyz, n);
     if (err)
@@ -138,13 +138,26 @@ int fdt_queries_begin(fdt_locator *L, fdt_result *r, const double *xyz, size_t n
                 box[d + 3] = fmax(box[d + 3], q[3 * k + d]);
             }
     *order = malloc((nq ? nq : 1) * sizeof **order);
-    if (!*order || fdt_morton_order(q, nq, box, NULL, *order) < 0) {
-        free(*order);
+    *jobs = calloc((size_t)*threads, job_size);
+    if (!*order || !*jobs || fdt_morton_order(q, nq, box, NULL, *order) < 0) {
+        fdt_queries_end(L, *order, *jobs);
         *order = NULL;
-        fdt_locator_free(L);
+        *jobs = NULL;
         return FDT_ENOMEM;
     }
+    for (int t = 0; t < *threads; t++) {
+        size_t a = nq * (size_t)t / (size_t)*threads, b = nq * (size_t)(t + 1) / (size_t)*threads;
+        fdt_query_run *run = (fdt_query_run *)((char *)*jobs + (size_t)t * job_size);
+        *run = (fdt_query_run){L, q, *order + a, b - a};
+    }
     return FDT_OK;
+}
+
+void fdt_queries_end(fdt_locator *L, uint32_t *order, void *jobs)
+{
+    free(jobs);
+    free(order);
+    fdt_locator_free(L);
 }
 
 void fdt_barycentric(const fdt_locator *L, fdt_tid t, const double *q, double b[4])
@@ -172,10 +185,7 @@ void fdt_barycentric(const fdt_locator *L, fdt_tid t, const double *q, double b[
 }
 
 typedef struct ljob {
-    const fdt_locator *L;
-    const double *q;
-    const uint32_t *order; /* this job's run of the queries */
-    size_t count;
+    fdt_query_run run; /* first: fdt_queries_begin fills it */
     fdt_tid *tet;
     double *bary;
 } ljob;
@@ -183,15 +193,16 @@ typedef struct ljob {
 static void *locate_run(void *arg)
 {
     ljob *j = arg;
+    const fdt_query_run *run = &j->run;
     size_t hint = 0;
-    for (size_t i = 0; i < j->count; i++) {
-        size_t k = j->order[i];
-        const double *qk = j->q + 3 * k;
-        j->tet[k] = fdt_locate_one(j->L, &hint, qk);
+    for (size_t i = 0; i < run->count; i++) {
+        size_t k = run->order[i];
+        const double *qk = run->q + 3 * k;
+        j->tet[k] = fdt_locate_one(run->L, &hint, qk);
         if (!j->bary)
             continue;
         if (j->tet[k] >= 0)
-            fdt_barycentric(j->L, j->tet[k], qk, j->bary + 4 * k);
+            fdt_barycentric(run->L, j->tet[k], qk, j->bary + 4 * k);
         else
             memset(j->bary + 4 * k, 0, 4 * sizeof *j->bary);
     }
@@ -205,23 +216,16 @@ int fdt_locate_build(fdt_result *r, const double *xyz, size_t n, const double *q
         return FDT_EINVAL;
     fdt_locator L;
     uint32_t *order;
-    int err = fdt_queries_begin(&L, r, xyz, n, q, nq, &threads, &order);
+    void *jp;
+    int err = fdt_queries_begin(&L, r, xyz, n, q, nq, &threads, &order, sizeof(ljob), &jp);
     if (err)
         return err;
-    ljob *jobs = calloc((size_t)threads, sizeof *jobs);
-    if (!jobs) {
-        free(order);
-        free(jobs);
-        fdt_locator_free(&L);
-        return FDT_ENOMEM;
-    }
+    ljob *jobs = jp;
     for (int t = 0; t < threads; t++) {
-        size_t a = nq * (size_t)t / (size_t)threads, b = nq * (size_t)(t + 1) / (size_t)threads;
-        jobs[t] = (ljob){&L, q, order + a, b - a, tet, bary};
+        jobs[t].tet = tet;
+        jobs[t].bary = bary;
     }
     fdt_fork_join(jobs, sizeof *jobs, threads, locate_run);
-    free(jobs);
-    free(order);
-    fdt_locator_free(&L);
+    fdt_queries_end(&L, order, jobs);
     return FDT_OK;
 }

@@ -27,13 +27,25 @@ void fdt_locator_free(fdt_locator *L);
  * where it ended: a thread's next query starts there. */
 fdt_tid fdt_locate_one(const fdt_locator *L, size_t *hint, const double *q);
 
+/* A thread's run of the queries: the first member of each query call's
+ * job (src/mesh/locate.c's, src/mesh/interpolate.c's). */
+typedef struct fdt_query_run {
+    const fdt_locator *L;  /* shared, read only */
+    const double *q;       /* all the queries */
+    const uint32_t *order; /* this run's query indices */
+    size_t count;
+} fdt_query_run;
+
 /* What both query calls start with: the locator over r, *threads cut to
- * one a 64 queries (at least 1), and the queries q[0 .. 3 nq) in Morton
- * order of their box (*order, nq entries, malloc'd), of which each thread
- * takes an equal run: the walks of consecutive queries are short. On
- * failure (FDT_EINVAL, FDT_ENOMEM) nothing is left to free. */
+ * one a 64 queries (at least 1), the queries q[0 .. 3 nq) in Morton order
+ * of their box (*order, malloc'd), and *jobs: *threads zeroed jobs of
+ * job_size bytes (malloc'd), each starting with an fdt_query_run that
+ * holds an equal run of that order: the walks of consecutive queries are
+ * short. On failure (FDT_EINVAL, FDT_ENOMEM) nothing is left to free. */
 int fdt_queries_begin(fdt_locator *L, fdt_result *r, const double *xyz, size_t n, const double *q,
-                      size_t nq, int *threads, uint32_t **order);
+                      size_t nq, int *threads, uint32_t **order, size_t job_size, void **jobs);
+/* Frees what fdt_queries_begin made. */
+void fdt_queries_end(fdt_locator *L, uint32_t *order, void *jobs);
 
 /* q's barycentric coordinates in tet t, in the order of its vertices. */
 void fdt_barycentric(const fdt_locator *L, fdt_tid t, const double *q, double b[4]);
