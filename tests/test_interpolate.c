@@ -20,19 +20,6 @@
 /* the queries on 3 threads (the results do not depend on it) */
 #define THREADS 3
 
-static fdt_result *triangulate(const double *xyz, size_t n)
-{
-    fdt_settings s;
-    fdt_default_settings(&s);
-    s.n_threads = 1;
-    fdt_context *ctx = NULL;
-    CHECK(fdt_open(&ctx, &s) == FDT_OK);
-    fdt_result *r = NULL;
-    CHECK(fdt_triangulate(ctx, xyz, n, &r) == FDT_OK);
-    fdt_close(&ctx);
-    return r;
-}
-
 static void test_linear_reproduction(fdt_interp method, const char *name)
 {
     size_t n = 1500, nq = 300;
@@ -51,7 +38,7 @@ static void test_linear_reproduction(fdt_interp method, const char *name)
             q[3 * k + d] = k % 10 == 9 ? xyz[3 * k + (size_t)d]       /* at a point */
                          : k % 10 == 8 ? 2 + test_unif(&s)             /* outside */
                                        : 0.2 + 0.6 * test_unif(&s);    /* well inside */
-    fdt_result *r = triangulate(xyz, n);
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
     char diag[256];
     CHECK(fdt_interpolate(r, xyz, n, val, 2, q, nq, method, THREADS, out, diag, sizeof diag) == FDT_OK);
     for (size_t k = 0; k < nq; k++) {
@@ -87,7 +74,7 @@ static void test_symmetry(void)
         xyz[3 * i + 2] = z;
         val[i] = (x - 1) * (y - 1) * (z - 1); /* 1 at (2,2,2), 0 elsewhere in the cube */
     }
-    fdt_result *r = triangulate(xyz, n);
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
     /* the centre of the cube [1,2]^3; the centre of its face z = 1; a
      * point on the hull (natural: NaN; linear: the face's value) */
     const double q[9] = {1.5, 1.5, 1.5, 1.5, 1.5, 1, 1.5, 1.5, 0};
@@ -115,7 +102,7 @@ static void test_continuity_and_refusals(void)
             xyz[3 * i + d] = test_unif(&s);
         val[i] = xyz[3 * i] * xyz[3 * i] + sin(5 * xyz[3 * i + 1]);
     }
-    fdt_result *r = triangulate(xyz, n);
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
     /* a segment of queries through the middle: the values change little
      * between neighbours 1e-9 apart (no jump at the tets' faces) */
     size_t nq = 2000;

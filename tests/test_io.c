@@ -298,21 +298,6 @@ static const double cube[] = {
 };
 #define CUBE_N 10
 
-static fdt_result *triangulate(const double *xyz, size_t n, int neighbors)
-{
-    fdt_settings s;
-    fdt_default_settings(&s);
-    s.mode = FDT_MODE_SERIAL;
-    s.n_threads = 1;
-    s.neighbors = neighbors;
-    fdt_context *ctx = NULL;
-    fdt_result *r = NULL;
-    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
-    CHECK_EQ(fdt_triangulate(ctx, xyz, n, &r), FDT_OK);
-    fdt_close(&ctx);
-    return r;
-}
-
 /* Does the tet (a b c d) appear in r, as a set of ids? */
 static int has_tet(const fdt_result *r, const long long *v)
 {
@@ -341,7 +326,7 @@ static uint64_t fnv1a(const char *s, size_t len)
 static void test_write_formats(void)
 {
     char diag[1024];
-    fdt_result *r = triangulate(cube, CUBE_N, 1);
+    fdt_result *r = test_triangulate(cube, CUBE_N, 1, 1);
     size_t T = fdt_result_num_tets(r), H = fdt_result_num_hull_faces(r);
     CHECK(T >= 12 && H == 12); /* the centre cones each of 12 triangles */
     CHECK_EQ(fdt_result_num_duplicates(r), 1);
@@ -575,7 +560,7 @@ static void test_write_sorts(void)
     uint64_t seed = 7;
     for (int i = 0; i < 3 * N; i++)
         pts[i] = test_unif(&seed);
-    fdt_result *r = triangulate(pts, N, 0);
+    fdt_result *r = test_triangulate(pts, N, 1, 0);
     char diag[512];
     /* tetgen needs neighbours: refused before any file is made */
     CHECK_EQ(fdt_write_mesh(r, pts, N, at("nn.ele"), NULL, diag, sizeof diag), FDT_EINVAL);
@@ -607,7 +592,7 @@ static void test_write_sorts(void)
 static void test_write_errors(void)
 {
     char diag[1024];
-    fdt_result *r = triangulate(cube, CUBE_N, 1);
+    fdt_result *r = test_triangulate(cube, CUBE_N, 1, 1);
     /* a missing directory */
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("nodir/m.vtu"), NULL, diag, sizeof diag),
              FDT_EIO);
@@ -704,7 +689,7 @@ static void test_write_progress(void)
     uint64_t seed = 11;
     for (int i = 0; i < 3 * N; i++)
         pts[i] = test_unif(&seed);
-    fdt_result *r = triangulate(pts, N, 1);
+    fdt_result *r = test_triangulate(pts, N, 1, 1);
     const char *fmts[] = {"tets", "tetgen", "vtu", "vtk", "msh", "msh2", "medit", "openfoam"};
     const char *names[] = {"p.tets", "p.ele", "p.vtu", "p.vtk", "p.msh", "p2.msh", "p.mesh",
                            "pcase/polyMesh"};
@@ -761,7 +746,7 @@ static void test_write_full(void)
     uint64_t seed = 77;
     for (size_t i = 0; i < 3 * N; i++)
         pts[i] = test_unif(&seed);
-    fdt_result *r = triangulate(pts, N, 1);
+    fdt_result *r = test_triangulate(pts, N, 1, 1);
     static const char *const fmts[][2] = {{"tets", "full.tets"},   {"vtk", "full.vtk"},
                                           {"vtu", "full.vtu"},     {"msh", "full.msh"},
                                           {"msh2", "full2.msh"},   {"medit", "full.mesh"},

@@ -19,20 +19,6 @@
 #include "mesh/locate.h"
 #include "testutil.h"
 
-static fdt_result *triangulate(const double *xyz, size_t n, int nbrs)
-{
-    fdt_settings s;
-    fdt_default_settings(&s);
-    s.n_threads = 1;
-    s.neighbors = nbrs;
-    fdt_context *ctx = NULL;
-    CHECK(fdt_open(&ctx, &s) == FDT_OK);
-    fdt_result *r = NULL;
-    CHECK(fdt_triangulate(ctx, xyz, n, &r) == FDT_OK);
-    fdt_close(&ctx);
-    return r;
-}
-
 static int holds(const fdt_result *r, const double *xyz, size_t t, const double *q)
 {
     const fdt_vid *tv = fdt_result_tets(r) + 4 * t;
@@ -98,7 +84,8 @@ static void test_random(void)
         for (int d = 0; d < 3; d++)
             q[3 * k + d] = k % 5 == 4 ? xyz[3 * (k * 7 % n) + (size_t)d] /* at a point */
                                       : 1.4 * test_unif(&s) - 0.2; /* some outside */
-    fdt_result *with = triangulate(xyz, n, 1), *without = triangulate(xyz, n, 0);
+    fdt_result *with = test_triangulate(xyz, n, 1, 1);
+    fdt_result *without = test_triangulate(xyz, n, 1, 0);
     check_queries(with, xyz, n, q, nq, 1, "random, neighbours kept");
     check_queries(with, xyz, n, q, nq, 3, "random, neighbours kept, 3 threads");
     check_queries(without, xyz, n, q, nq, 2, "random, neighbours derived");
@@ -148,7 +135,7 @@ static void test_lattice(void)
                 q[3 * nq + 2] = z / 2.0;
                 nq++;
             }
-    fdt_result *r = triangulate(xyz, n, 0);
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
     check_queries(r, xyz, n, q, nq, 2, "lattice");
     fdt_result_free(&r);
     free(xyz);
@@ -167,7 +154,7 @@ static void test_scan(void)
         xyz[i] = test_unif(&s);
     for (size_t i = 0; i < 3 * nq; i++)
         q[i] = 1.2 * test_unif(&s) - 0.1;
-    fdt_result *r = triangulate(xyz, n, 1);
+    fdt_result *r = test_triangulate(xyz, n, 1, 1);
     fdt_locator L;
     CHECK(fdt_locator_init(&L, r, xyz, n) == FDT_OK);
     L.cap = 0;

@@ -22,19 +22,6 @@
 #include "geom/cell.h"
 #include "testutil.h"
 
-static fdt_result *triangulate(const double *xyz, size_t n, int threads)
-{
-    fdt_settings s;
-    fdt_default_settings(&s);
-    s.n_threads = threads;
-    fdt_context *ctx = NULL;
-    CHECK(fdt_open(&ctx, &s) == FDT_OK);
-    fdt_result *r = NULL;
-    CHECK(fdt_triangulate(ctx, xyz, n, &r) == FDT_OK);
-    fdt_close(&ctx);
-    return r;
-}
-
 static fdt_voronoi *cells_t(fdt_result *r, const double *xyz, size_t n, const double *box,
                             int threads)
 {
@@ -77,7 +64,7 @@ static void test_lattice(int k)
         xyz[3 * i + 1] = (double)(i / (size_t)k % (size_t)k);
         xyz[3 * i + 2] = (double)(i / ((size_t)k * k));
     }
-    fdt_result *r = triangulate(xyz, n, 1);
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
     fdt_voronoi *v = cells(r, xyz, n, NULL);
     const double *vol = fdt_voronoi_volumes(v), *area = fdt_voronoi_areas(v);
     const int32_t *nf = fdt_voronoi_num_faces(v);
@@ -169,7 +156,7 @@ static void test_box_sums(size_t n, int clustered, uint64_t seed)
     double *xyz = random_points(n, clustered, seed);
     const double box[6] = {-0.25, 0, -0.5, 1, 1.5, 1};
     double bvol = 1.25 * 1.5 * 1.5, bsurf = 2 * (1.25 * 1.5 + 1.5 * 1.5 + 1.25 * 1.5);
-    fdt_result *r = triangulate(xyz, n, 1);
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
     fdt_voronoi *v = cells(r, xyz, n, box);
     const double *vol = fdt_voronoi_volumes(v), *area = fdt_voronoi_areas(v);
     const double *cen = fdt_voronoi_centroids(v);
@@ -260,8 +247,8 @@ static void test_same_bits(size_t n)
     }
     for (size_t i = 0; i < n; i++)
         memcpy(sh + 3 * i, xyz + 3 * perm[i], 3 * sizeof *sh);
-    fdt_result *r1 = triangulate(xyz, n, 1), *r3 = triangulate(xyz, n, 3);
-    fdt_result *rs = triangulate(sh, n, 2);
+    fdt_result *r1 = test_triangulate(xyz, n, 1, 0), *r3 = test_triangulate(xyz, n, 3, 0);
+    fdt_result *rs = test_triangulate(sh, n, 2, 0);
     /* the mesh of 1 and 3 threads, the cells on 1 and 3 threads */
     fdt_voronoi *v1 = cells(r1, xyz, n, NULL), *v3 = cells_t(r3, xyz, n, NULL, 3);
     fdt_voronoi *vs = cells_t(rs, sh, n, NULL, 7);
@@ -301,7 +288,7 @@ static void test_refusals(void)
 {
     size_t n = 200;
     double *xyz = random_points(n, 0, 3);
-    fdt_result *r = triangulate(xyz, n, 1);
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
     fdt_voronoi_options o;
     fdt_default_voronoi_options(&o);
     o.box_given = 1;
@@ -364,7 +351,7 @@ static void test_getters(void)
     size_t n = 300;
     double *xyz = random_points(n, 0, 8);
     memcpy(xyz + 3 * (n - 1), xyz, 3 * sizeof *xyz); /* the last is the first again */
-    fdt_result *r = triangulate(xyz, n, 1);
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
     fdt_voronoi *v = cells(r, xyz, n, NULL);
     size_t cnt, nv, nf;
     const fdt_vid *ids;

@@ -10,6 +10,8 @@
  *   TEST_PRINT_LIMIT failures are printed, all are counted.
  * - test_note_failure() counts a failure a test prints itself (a point
  *   set, a matrix) and says whether it is still within the print limit.
+ * - test_triangulate is fdt_triangulate with the settings a test names
+ *   (threads, neighbours), any failure ending the test.
  * - now_s is a monotonic clock for watchdogs and timings; test_rand64 and
  *   test_unif a deterministic random stream for inputs.
  */
@@ -23,6 +25,7 @@
 #include <time.h>
 
 #include "base/hash.h"
+#include "frontdt.h"
 
 #define CHECK(cond)                                                          \
     do {                                                                     \
@@ -139,6 +142,24 @@ static inline uint64_t test_rand64(uint64_t *s)
 static inline double test_unif(uint64_t *s)
 {
     return (double)(test_rand64(s) >> 11) * 0x1.0p-53;
+}
+
+/* The mesh of xyz on `threads` threads (1: serial mode), with the tets'
+ * neighbours when `neighbors`; any failure ends the test. */
+static inline fdt_result *test_triangulate(const double *xyz, size_t n, int threads,
+                                           int neighbors)
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = threads == 1 ? FDT_MODE_SERIAL : FDT_MODE_AUTO;
+    s.n_threads = threads;
+    s.neighbors = neighbors;
+    fdt_context *ctx = NULL;
+    fdt_result *r = NULL;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    CHECK_EQ(fdt_triangulate(ctx, xyz, n, &r), FDT_OK);
+    fdt_close(&ctx);
+    return r;
 }
 
 static inline double now_s(void)
