@@ -11,9 +11,9 @@
  *
  * Range: a term rounds to round(x 2^-e) and must stay below 2^126 in
  * magnitude, as must every partial sum: the caller picks e so that its
- * largest term is about 2^100 grid steps (src/mesh/voronoi.c: e =
- * exponent of diameter^k - 100), which leaves 2^26 terms of headroom and
- * 2^-100 of the domain's scale as the grid step. Two 64-bit words rather
+ * largest term is about 2^102 grid steps (src/mesh/voronoi.c: terms up to
+ * about 16 D^k for the box's largest side D, e = k exponent(D) - 98),
+ * which leaves 2^24 terms of headroom and 2^-98 of D^k as the grid step. Two 64-bit words rather
  * than a compiler's __int128, so that it builds on every Debian port.
  */
 #ifndef FDT_FIXSUM_H
