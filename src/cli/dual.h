@@ -19,7 +19,8 @@ typedef struct fdt_cli_dual {
     const char *format;  /* --voronoi-format, or NULL: CSV for a .csv file,
                             else FDT_CELLS_DEFAULT_FORMAT */
     const char *density; /* --density FILE, or NULL */
-    int threads;         /* -t (0: one per physical core) */
+    int threads;         /* the run's threads (0: one per physical core; 1
+                            in serial mode), set after the options */
     int box_given;       /* --box given */
     double box[6];       /* xmin, ymin, zmin, xmax, ymax, zmax */
     const char *values;  /* --values FILE, or NULL */

@@ -636,6 +636,8 @@ static int parse_args(int argc, char **argv, cli *c)
                     c->decimal_comma))
         return usage_error("--input-format, --columns, --delimiter and --decimal-comma need "
                            "an input file, not --demo");
+    /* the dual's threads: the run's */
+    c->dual.threads = c->mode == FDT_MODE_SERIAL ? 1 : c->threads < 0 ? 0 : c->threads;
     char derr[512];
     if (fdt_cli_dual_check(&c->dual, c->input && strcmp(c->input, "-") ? c->input : NULL, derr,
                            sizeof derr) != 0)
@@ -770,6 +772,13 @@ static int exit_for_engine(int err)
     default: /* FDT_EINTERNAL, and FDT_ECANCELED which we never ask for */
         return CLI_INTERNAL;
     }
+}
+
+/* The exit code of the dual's step (src/cli/dual.h): a file it could not
+ * write, a malformed file it read, else as the engine's. */
+static int exit_for_dual(int err)
+{
+    return err == FDT_EIO ? CLI_WRITE : err == FDT_EFORMAT ? CLI_INPUT : exit_for_engine(err);
 }
 
 /* Threads for reading a text file: those of the triangulation, at most
@@ -1530,14 +1539,12 @@ static int run(const cli *c)
         t0 = fdt_now_s();
         char derr[FDT_IO_PATH + 600];
         progress_phase(&prog, "voronoi");
-        fdt_cli_dual dual = c->dual;
-        dual.threads = c->mode == FDT_MODE_SERIAL ? 1 : c->threads < 0 ? 0 : c->threads;
-        r = fdt_cli_dual_write(&dual, res, xyz, n, derr, sizeof derr);
+        r = fdt_cli_dual_write(&c->dual, res, xyz, n, derr, sizeof derr);
         progress_clear(&prog);
         tm.voronoi = fdt_now_s() - t0;
         if (r != FDT_OK) {
             say("%s: %s", name, derr);
-            code = r == FDT_EIO ? CLI_WRITE : exit_for_engine(r);
+            code = exit_for_dual(r);
             goto done;
         }
     }
@@ -1545,14 +1552,12 @@ static int run(const cli *c)
         t0 = fdt_now_s();
         char derr[FDT_IO_PATH + 600];
         progress_phase(&prog, "interpolate");
-        fdt_cli_dual dual = c->dual;
-        dual.threads = c->mode == FDT_MODE_SERIAL ? 1 : c->threads < 0 ? 0 : c->threads;
-        r = fdt_cli_interp_write(&dual, res, xyz, n, derr, sizeof derr);
+        r = fdt_cli_interp_write(&c->dual, res, xyz, n, derr, sizeof derr);
         progress_clear(&prog);
         tm.interpolate = fdt_now_s() - t0;
         if (r != FDT_OK) {
             say("%s", derr);
-            code = r == FDT_EIO ? CLI_WRITE : r == FDT_EFORMAT ? CLI_INPUT : exit_for_engine(r);
+            code = exit_for_dual(r);
             goto done;
         }
     }
