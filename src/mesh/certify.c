@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "base/bits.h"
 #include "base/spawn.h"
 
 #define INF FDT_NONE
@@ -103,6 +104,23 @@ static int glued(const uint32_t *v, int k, const uint32_t *w, int nk)
     return inv & 1 ? 1 : -1;
 }
 
+/*
+ * glued(v, k, w, nk) == 1, without its branches: the face of v opposite k
+ * in outward order (fdt_tet_face) is a rotation of the reverse of w's
+ * face nk in outward order (the same three ids, listed the other way
+ * round). Branch-free: one test a face, taken nearly always (bench/NOTES.md
+ * entry 93: glued's loops mispredicted 4 times a tet); glued names what
+ * failed when this says no.
+ */
+static inline int glued_opposite(const uint32_t *v, int k, const uint32_t *w, int nk)
+{
+    const int *f = fdt_tet_face[k], *g = fdt_tet_face[nk];
+    uint32_t a0 = v[f[0]], a1 = v[f[1]], a2 = v[f[2]];
+    uint32_t b0 = w[g[0]], b1 = w[g[1]], b2 = w[g[2]];
+    return ((b0 == a0) & (b1 == a2) & (b2 == a1)) | ((b0 == a1) & (b1 == a0) & (b2 == a2)) |
+           ((b0 == a2) & (b1 == a1) & (b2 == a0));
+}
+
 /* The pair checks of face k of tet v (slot t, infinite vertex at inf, -1
  * if none) and face nk of its neighbour w: the geometric half of checks
  * 2-3 that involve both. NULL if they pass, else what failed. */
@@ -149,11 +167,12 @@ static const char *check_pair(const fdt_ins *m, const uint32_t *v, int k, int in
  * slot" did not (0.87 s against 0.53 s for the two halves of 1M uniform
  * points).
  */
-static inline int checks_here(uint32_t t, uint32_t nt, uint32_t lo, uint32_t hi)
+static inline unsigned checks_here(uint32_t t, uint32_t nt, uint32_t lo, uint32_t hi)
 {
-    if (nt >= lo && nt < hi)
-        return t < nt;
-    return ((t ^ nt) & 1) ? t < nt : t > nt;
+    /* t < nt, flipped for an even xor outside the range; in bit operations,
+     * as it decides at random (a branch on it mispredicted half the time) */
+    unsigned lower = t < nt, in = (nt >= lo) & (nt < hi), odd = (t ^ nt) & 1;
+    return lower ^ (~in & ~odd & 1u);
 }
 
 /*
@@ -171,51 +190,51 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_co
                          fdt_certify_fail *why, size_t *skipped, size_t *pairs)
 {
     for (uint32_t t = lo; t < hi; t++) {
-        if (t + AHEAD < hi) { /* the neighbours this range will read */
-            uint32_t u = t + AHEAD;
-            const uint32_t *a = m->T + 8 * (size_t)u;
+        if (t + AHEAD < hi) { /* the neighbours (a freed slot's are any value) */
+            const uint32_t *a = m->T + 8 * (size_t)(t + AHEAD);
             for (int k = 0; k < 4; k++) {
                 uint32_t nu = a[4 + k] >> 2;
-                if (nu < m->nslots && checks_here(u, nu, lo, hi))
-                    __builtin_prefetch(m->T + 8 * (size_t)nu);
+                __builtin_prefetch(m->T + 8 * (size_t)(nu < m->nslots ? nu : 0));
             }
         }
         const uint32_t *v = m->T + 8 * (size_t)t;
         if (is_freed(v))
             continue;
-        int inf = -1, ninf = 0;
-        for (int i = 0; i < 4; i++)
-            if (v[i] == INF) {
-                inf = i;
-                ninf++;
-            }
+        int ninf = (v[0] == INF) + (v[1] == INF) + (v[2] == INF) + (v[3] == INF);
         if (ninf > 1)
             return fail(why, t, -1, "more than one infinite vertex");
+        int inf = !ninf ? -1 : v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : 3;
         if (inf < 0 && orient(m, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), cnt) <= 0)
             return fail(why, t, -1, "a finite tet is not positively oriented");
+        /* Which faces this end checks, as bits: one loop over them instead
+         * of a coin-flip branch a face. */
+        unsigned here = 0, bad = 0;
         for (int k = 0; k < 4; k++) {
+            uint32_t nt = v[4 + k] >> 2;
+            bad |= (unsigned)((nt >= m->nslots) | (nt == t)) << k;
+            here |= checks_here(t, nt, lo, hi) << k;
+        }
+        if (bad)
+            return fail(why, t, fdt_ctz64(bad), "a neighbour reference past the slots, or to itself");
+        *skipped += 4 - (size_t)__builtin_popcount(here);
+        for (; here; here &= here - 1) {
+            int k = fdt_ctz64(here);
             uint32_t r = v[4 + k], nt = r >> 2;
             int nk = (int)(r & 3);
-            if (nt >= m->nslots || nt == t)
-                return fail(why, t, k, "a neighbour reference past the slots, or to itself");
-            if (!checks_here(t, nt, lo, hi)) {
-                (*skipped)++;
-                continue;
-            }
             const uint32_t *w = m->T + 8 * (size_t)nt;
             if (is_freed(w))
                 return fail(why, t, k, "a neighbour is a freed slot");
             if (w[4 + nk] != ((t << 2) | (uint32_t)k))
                 return fail(why, t, k, "the neighbour does not refer back");
-            int g = glued(v, k, w, nk);
-            if (g == 0)
-                return fail(why, t, k, "the neighbours do not share the face");
-            if (g < 0)
-                return fail(why, t, k, "two tets on the same side of their face");
+            if (!glued_opposite(v, k, w, nk))
+                return fail(why, t, k,
+                            glued(v, k, w, nk) == 0
+                                ? "the neighbours do not share the face"
+                                : "two tets on the same side of their face");
             (*pairs)++;
-            const char *bad = check_pair(m, v, k, inf, w, nk, cnt);
-            if (bad)
-                return fail(why, t, k, bad);
+            const char *bad_pair = check_pair(m, v, k, inf, w, nk, cnt);
+            if (bad_pair)
+                return fail(why, t, k, bad_pair);
         }
     }
     return FDT_OK;
