@@ -354,8 +354,8 @@ static const uint8_t ins_star_edge[4][3][3] = {
 
 /*
  * Links the tets slots[0 .. n) of a star (see ins_edges), tet i with its
- * centre at index ks[i] & 3 (the packed boundary faces serve), the table
- * emptied for 3n keys by ins_edges_begin: every face through the centre
+ * centre at index ks[i] & 3 (ks NULL: at index 0, as ins_star_tet puts
+ * it), the table emptied for 3n keys by ins_edges_begin: every face through the centre
  * gets its neighbour. FDT_EINTERNAL, with some links written, when the
  * outer faces are not a closed surface walked once each way (a directed
  * edge twice, or one whose reverse is missing): a cavity that is no ball,
@@ -367,7 +367,7 @@ static inline int ins_link_star(ins_edges *e, uint32_t *T, const uint32_t *slots
     uint32_t mask = (UINT32_C(1) << e->bits) - 1, stamp = e->stamp;
     for (size_t i = 0; i < n; i++) {
         const uint32_t *v = T + 8 * (size_t)slots[i];
-        const uint8_t(*se)[3] = ins_star_edge[ks[i] & 3];
+        const uint8_t(*se)[3] = ins_star_edge[ks ? ks[i] & 3 : 0];
         for (int j = 0; j < 3; j++) {
             uint64_t key = ((uint64_t)v[se[j][0]] << 32) | v[se[j][1]];
             uint32_t h = ins_edge_hash(e, key);
@@ -381,7 +381,7 @@ static inline int ins_link_star(ins_edges *e, uint32_t *T, const uint32_t *slots
     }
     for (size_t i = 0; i < n; i++) {
         uint32_t *v = T + 8 * (size_t)slots[i];
-        const uint8_t(*se)[3] = ins_star_edge[ks[i] & 3];
+        const uint8_t(*se)[3] = ins_star_edge[ks ? ks[i] & 3 : 0];
         for (int j = 0; j < 3; j++) {
             uint64_t key = ((uint64_t)v[se[j][1]] << 32) | v[se[j][0]];
             uint32_t h = ins_edge_hash(e, key);
@@ -398,12 +398,23 @@ static inline int ins_link_star(ins_edges *e, uint32_t *T, const uint32_t *slots
 }
 
 /*
+ * A star tet's vertices put with the new point first: an even permutation
+ * (so the orientation stays) taking index k to index 0. Every tet of a
+ * star then has its centre at index 0, its outer face at 1, 2, 3 in
+ * outward order and its outer neighbour at 4, so the star is linked
+ * through fixed indices (ins_link_star_local).
+ */
+static const uint8_t ins_to_front[4][4] = {
+    {0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
+
+/*
  * One tet of an insertion's star, in slot s: the cavity's boundary face
  * bnd (packed: cavity tet c, face opposite its vertex k) with pid in place
  * of vertex k, on the same side of the face as c's vertex k was (the
- * cavity is star-shaped), so positively oriented. It takes over c's
- * neighbour across the face; ins_link_star links its three other faces.
- * c must still be readable (its slot is freed after the star is built).
+ * cavity is star-shaped), so positively oriented; its vertices reordered
+ * by ins_to_front, pid at index 0. It takes over c's neighbour across the
+ * face; ins_link_star(_local) links its three other faces. c must still
+ * be readable (its slot is freed after the star is built).
  */
 static inline void ins_star_tet(uint32_t *T, uint32_t bnd, uint32_t pid, uint32_t s)
 {
@@ -411,11 +422,117 @@ static inline void ins_star_tet(uint32_t *T, uint32_t bnd, uint32_t pid, uint32_
     int k = (int)(bnd & 3);
     uint32_t *nw = T + 8 * (size_t)s;
     const uint32_t *cv = T + 8 * (size_t)c;
-    memcpy(nw, cv, 4 * sizeof *nw);
-    nw[k] = pid;
+    const uint8_t *f = ins_to_front[k];
+    nw[0] = pid;
+    nw[1] = cv[f[1]];
+    nw[2] = cv[f[2]];
+    nw[3] = cv[f[3]];
     uint32_t o = cv[4 + k];
-    nw[4 + k] = o;
-    T[8 * (size_t)(o >> 2) + 4 + (o & 3)] = PACK(s, k);
+    nw[4] = o;
+    T[8 * (size_t)(o >> 2) + 4 + (o & 3)] = PACK(s, 0);
+}
+
+/*
+ * A small star linked through local numbers of its outer vertices
+ * instead of the edge table (HXT's small-cavity adjacency, Marot,
+ * Pellerin and Remacle 2019): the finite outer vertices get the numbers
+ * 1 .. INS_LOCAL_N - 1 in a byte a point (0: unnumbered, and the infinite
+ * vertex's number), and the directed outer edge x -> y is the cell
+ * x * INS_LOCAL_N + y of a table. A star of F outer faces has F / 2 + 2
+ * vertices (a closed triangulated sphere), so a star of up to
+ * INS_LOCAL_MAXF faces fits (on uniform points 27 faces on average). The
+ * cells carry a stamp, so no pass clears them, and the checks of
+ * ins_link_star hold: a directed edge twice, or a missing reverse, is
+ * FDT_EINTERNAL. bench/NOTES.md entry 93.
+ */
+#define INS_LOCAL_N 32
+#define INS_LOCAL_MAXF (2 * (INS_LOCAL_N - 3))
+/* ins_link_star_local's answer for a star it does not number: link it
+ * with ins_link_star. */
+#define INS_LINK_BIG 1
+
+typedef struct ins_local {
+    uint8_t *lid;                /* a byte a point, index id - base; 0 outside a star */
+    uint32_t base;
+    uint32_t stamp;              /* the cells of the current star */
+    uint64_t cell[INS_LOCAL_N * INS_LOCAL_N]; /* stamp << 32 | packed face */
+    uint32_t vert[INS_LOCAL_N];  /* the ids numbered, to clear lid after */
+    uint8_t loc[3 * INS_LOCAL_MAXF]; /* each star tet's outer vertices' numbers */
+} ins_local;
+
+/*
+ * Links the tets slots[0 .. n) of a star made by ins_star_tet, as
+ * ins_link_star does: FDT_OK, FDT_EINTERNAL (some links written), or
+ * INS_LINK_BIG with nothing written (over INS_LOCAL_MAXF faces, or more
+ * vertices than numbers: then not a star). The numbering has no branch
+ * on whether a vertex is new (about one read in five is, at random).
+ */
+static inline int ins_link_star_local(ins_local *L, uint32_t *T, const uint32_t *slots, size_t n)
+{
+    if (n > INS_LOCAL_MAXF)
+        return INS_LINK_BIG;
+    /* Locals, not L's fields: the byte stores below may alias anything, and
+     * would make the compiler reload every field after each. */
+    uint8_t *const lid = L->lid, *const loc = L->loc;
+    uint32_t *const vert = L->vert;
+    const uint32_t base = L->base;
+    uint32_t nv = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (nv > INS_LOCAL_N - 4) { /* the next three might not fit */
+            for (uint32_t q = 0; q < nv; q++)
+                lid[vert[q] - base] = 0;
+            return INS_LINK_BIG;
+        }
+        const uint32_t *v = T + 8 * (size_t)slots[i];
+        const uint32_t x[3] = {v[1], v[2], v[3]};
+        for (int q = 0; q < 3; q++) {
+            uint32_t cur = 0;
+            if (x[q] != INF) {
+                uint8_t *l = lid + (x[q] - base);
+                uint32_t old = *l, fresh = old == 0;
+                vert[nv] = x[q];
+                nv += fresh;
+                cur = fresh ? nv : old;
+                *l = (uint8_t)cur;
+            }
+            loc[3 * i + q] = (uint8_t)cur;
+        }
+    }
+    uint32_t stamp = L->stamp + 1;
+    if (stamp == 0) { /* wrapped: old stamps would read as current */
+        memset(L->cell, 0, sizeof L->cell);
+        stamp = 1;
+    }
+    L->stamp = stamp;
+    const uint64_t st = (uint64_t)stamp << 32;
+    uint64_t *const cell = L->cell;
+    uint64_t bad = 0;
+    /* Tet (p, a, b, c): its outer face's edges a -> b, b -> c, c -> a are
+     * in its faces 3, 1, 2 (the ones without c, a, b). A cell holds a
+     * current edge when its high half is the stamp. */
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t a = loc[3 * i], b = loc[3 * i + 1], c = loc[3 * i + 2];
+        uint64_t *ab = &cell[a * INS_LOCAL_N + b], *bc = &cell[b * INS_LOCAL_N + c],
+                 *ca = &cell[c * INS_LOCAL_N + a];
+        bad |= ((*ab ^ st) >> 32 == 0) | ((*bc ^ st) >> 32 == 0) | ((*ca ^ st) >> 32 == 0);
+        const uint32_t s4 = slots[i] << 2;
+        *ab = st | (s4 | 3);
+        *bc = st | (s4 | 1);
+        *ca = st | (s4 | 2);
+    }
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t a = loc[3 * i], b = loc[3 * i + 1], c = loc[3 * i + 2];
+        uint32_t *v = T + 8 * (size_t)slots[i];
+        const uint64_t ba = cell[b * INS_LOCAL_N + a], cb = cell[c * INS_LOCAL_N + b],
+                       ac = cell[a * INS_LOCAL_N + c];
+        bad |= ((ba ^ st) >> 32) | ((cb ^ st) >> 32) | ((ac ^ st) >> 32);
+        v[4 + 3] = (uint32_t)ba;
+        v[4 + 1] = (uint32_t)cb;
+        v[4 + 2] = (uint32_t)ac;
+    }
+    for (uint32_t q = 0; q < nv; q++)
+        lid[vert[q] - base] = 0;
+    return bad ? FDT_EINTERNAL : FDT_OK;
 }
 
 /*

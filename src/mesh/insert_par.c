@@ -572,7 +572,7 @@ static int insert_point(worker *w, uint32_t pid)
         w->newt[i] = alloc_slot(w);
         ins_star_tet(T, w->bnd[i], pid, w->newt[i]);
     }
-    if (ins_link_star(&w->edges, T, w->newt, w->bnd, w->nbnd) != FDT_OK)
+    if (ins_link_star(&w->edges, T, w->newt, NULL, w->nbnd) != FDT_OK)
         return FDT_EINTERNAL; /* the build fails: what stays locked does not matter */
     for (size_t i = 0; i < w->ncav; i++)
         free_slot(w, w->cav[i]);
