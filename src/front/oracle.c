@@ -171,7 +171,8 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
     size_t df = faces - o->w_faces;
     size_t points = kq->points - o->w_points;
     size_t exact = kq->pc.orient_exact + kq->pc.insphere_exact - o->w_exact;
-    double cost = df > 0 ? ((double)points + FDT_ORACLE_EXACT_WEIGHT * (double)exact) / (double)df : 0.0;
+    double cost = df > 0 ? ((double)points + FDT_ORACLE_EXACT_WEIGHT * (double)exact) / (double)df
+                         : 0.0;
     double total = FACES_PER_POINT * (double)o->t->n;
     double left = total > (double)faces ? total - (double)faces : 0.0;
     if (df > 0 && (cost - MESH_FACE_COST) * left > (SWITCH_COST - MESH_FACE_COST) * total) {

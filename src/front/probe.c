@@ -69,7 +69,8 @@ static double probe_cost(double *S, uint32_t k, int leaf_size)
     if (fdt_front_probe(&t, k / 2, PROBE_FACES, &budget, &st) != FDT_OK)
         goto done;
     double work = (double)st.kq.points +
-                  FDT_ORACLE_EXACT_WEIGHT * (double)(st.kq.pc.orient_exact + st.kq.pc.insphere_exact);
+                  FDT_ORACLE_EXACT_WEIGHT *
+                      (double)(st.kq.pc.orient_exact + st.kq.pc.insphere_exact);
     /* The budget spent, even before the first face (the seed's own search
      * on points of one sphere: intsphere 2,500 cost it all, and a cost of
      * "unknown" sent such an input to the kd search, 7.6 s where the mesh
