@@ -26,6 +26,7 @@ static inline engine *fix_engine(int n, fdt_mode mode, const double *P, uint32_t
     e->mode = mode;
     e->msg_term = mode == FDT_MODE_MESSAGE;
     e->P = P;
+    e->ops = &fdt_eng_ops;
     e->fail_part = -1;
     CHECK_EQ(fdt_transport_mailbox(&e->tp, n + 1), FDT_OK);
     e->w = calloc((size_t)n, sizeof *e->w);

@@ -32,6 +32,7 @@
 #include "base/clock.h"
 #include "frontdt.h"
 #include "front/oracle.h"
+#include "front/probe.h"
 #include "geom/prepare.h"
 
 #include "testutil.h"
@@ -318,7 +319,7 @@ static void test_family(pts p, int want_auto, int quick)
     printf("ok %s (%zu points)\n", p.name, p.n);
 }
 
-/* fdt_oracle_probe_take copies its samples (an MPI rank's vote for the
+/* fdt_probe_take copies its samples (an MPI rank's vote for the
  * replica mesh), so the answer is the one on the points as they were when
  * taken: expensive on a rotated lattice, not on uniform points. 74,088 points: both samples (every second point,
  * and a run of consecutive ones). */
@@ -337,14 +338,14 @@ static void test_probe_samples(void)
     CHECK(save);
     memcpy(save, a.p, 3 * n * sizeof *save);
     fdt_probe_samples ps;
-    fdt_oracle_probe_take(&ps, b.p, (uint32_t)n, 0);
-    CHECK(fdt_oracle_probe_cost(&ps) < FDT_PROBE_SHARED_MESH);
-    fdt_oracle_probe_take(&ps, a.p, (uint32_t)n, 0);
+    fdt_probe_take(&ps, b.p, (uint32_t)n, 0);
+    CHECK(fdt_probe_cost(&ps) < FDT_PROBE_SHARED_MESH);
+    fdt_probe_take(&ps, a.p, (uint32_t)n, 0);
     memcpy(a.p, b.p, 3 * n * sizeof *save); /* changed after the take */
-    CHECK(fdt_oracle_probe_cost(&ps) > FDT_PROBE_REPLICA);
-    fdt_oracle_probe_take(&ps, a.p, (uint32_t)n, 0);
+    CHECK(fdt_probe_cost(&ps) > FDT_PROBE_REPLICA);
+    fdt_probe_take(&ps, a.p, (uint32_t)n, 0);
     memcpy(a.p, save, 3 * n * sizeof *save);
-    CHECK(fdt_oracle_probe_cost(&ps) < FDT_PROBE_SHARED_MESH);
+    CHECK(fdt_probe_cost(&ps) < FDT_PROBE_SHARED_MESH);
     CHECK(ps.S[0] == NULL && ps.S[1] == NULL); /* decide frees them */
     free(save);
     fdt_prepared_free(&a);

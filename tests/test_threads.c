@@ -26,6 +26,7 @@
 
 #include "frontdt.h"
 #include "par/parallel.h"
+#include "par/threads.h"
 #include "testutil.h"
 
 static double *uniform(size_t n, uint64_t seed)
@@ -81,18 +82,18 @@ static outcome run(const double *p, size_t n, fdt_mode mode, int nthreads, int p
 static void test_default_threads(const double *p, size_t n, uint64_t ref)
 {
     long online = sysconf(_SC_NPROCESSORS_ONLN);
-    int d = fdt_parallel_default_threads();
+    int d = fdt_threads_default();
     EXPECT(d >= 1 && d <= 1024 && d <= (online > 1 ? online : 1));
 #ifdef TEST_HWLOC
     setenv("HWLOC_SYNTHETIC", "core:3 pu:1", 1);
-    EXPECT(fdt_parallel_default_threads() == 3);
+    EXPECT(fdt_threads_default() == 3);
     /* n_threads 0: that many, in either mode, the same mesh */
     for (int m = FDT_MODE_SHARED; m <= FDT_MODE_MESSAGE; m++) {
         outcome o = run(p, n, (fdt_mode)m, 0, 0, NULL, NULL);
         EXPECT(o.err == FDT_OK && o.st.threads == 3 && o.hash == ref);
     }
     setenv("HWLOC_SYNTHETIC", "core:2000 pu:1", 1);
-    EXPECT(fdt_parallel_default_threads() == 1024);
+    EXPECT(fdt_threads_default() == 1024);
     unsetenv("HWLOC_SYNTHETIC");
 #else
     (void)p;

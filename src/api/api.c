@@ -15,6 +15,7 @@
 #include "front/oracle.h"
 #include "front/partmesh.h"
 #include "par/parallel.h"
+#include "par/threads.h"
 #include "geom/prepare.h"
 #include "mesh/result.h"
 #include "mesh/locate.h"
@@ -172,7 +173,7 @@ static void run_mode(const fdt_settings *s, fdt_mode *mode, int *nthreads)
     *mode = s->mode;
     *nthreads = s->n_threads;
     if (*mode != FDT_MODE_SERIAL && *nthreads == 0)
-        *nthreads = fdt_parallel_default_threads();
+        *nthreads = fdt_threads_default();
     if (*mode == FDT_MODE_AUTO)
         *mode = *nthreads == 1 ? FDT_MODE_SERIAL : FDT_MODE_SHARED;
 }
@@ -257,7 +258,7 @@ int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const 
     }
     if (!r || !xyz || !out || o->struct_size != sizeof *o || o->threads < 0 || o->threads > 1024)
         return FDT_EINVAL;
-    int threads = o->threads ? o->threads : fdt_parallel_default_threads();
+    int threads = o->threads ? o->threads : fdt_threads_default();
     return fdt_voronoi_build(r, xyz, n, o, threads, out, diag, diag_size);
 }
 
@@ -269,7 +270,7 @@ int fdt_locate(fdt_result *r, const double *xyz, size_t n, const double *q, size
     if (threads < 0 || threads > 1024)
         return FDT_EINVAL;
     return fdt_locate_build(r, xyz, n, q, nq, tet, bary,
-                            threads ? threads : fdt_parallel_default_threads());
+                            threads ? threads : fdt_threads_default());
 }
 
 int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
@@ -279,7 +280,7 @@ int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *va
     if (threads < 0 || threads > 1024)
         return FDT_EINVAL;
     return fdt_interpolate_build(r, xyz, n, values, nv, q, nq, method,
-                                 threads ? threads : fdt_parallel_default_threads(), out, diag,
+                                 threads ? threads : fdt_threads_default(), out, diag,
                                  diag_size);
 }
 

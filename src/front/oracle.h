@@ -43,8 +43,8 @@ typedef struct fdt_oracle {
     size_t mtcap;
     /* The switching window: counter values at its start. */
     size_t next_check, w_faces, w_points, w_exact;
-    /* Work (points tested + EXACT_WEIGHT x exact tests, since the run's
-     * start) past which the window in progress must end in a switch:
+    /* Work (points tested + FDT_ORACLE_EXACT_WEIGHT x exact tests, since
+     * the run's start) past which the window in progress must end in a switch:
      * the switch is made as soon as it is passed (SIZE_MAX: never). */
     size_t w_budget;
     /* Statistics. */
@@ -66,6 +66,11 @@ typedef struct fdt_oracle {
     size_t certified;     /* finite tets of the meshes it certified */
     double t_certify;     /* seconds certifying them */
 } fdt_oracle;
+
+/* The weight of one exact test in the kd search's cost, counted in points
+ * tested (src/front/oracle.c, the switching rule, says why 150); the probe
+ * costs its faces the same way (src/front/probe.c). */
+#define FDT_ORACLE_EXACT_WEIGHT 150
 
 /* What an insertion mesh of n points takes at its peak, in bytes: about
  * 220 kept a point (src/mesh/insert.h) plus the build's scratch and the tet
@@ -139,32 +144,5 @@ int fdt_oracle_offer_star(fdt_oracle *o, const uint32_t f[3], fdt_apex *ap, fdt_
 /* Notes that output tet tid is mesh tet mtet (FDT_NONE: not known). Only
  * stores while the mesh is in use. FDT_OK or FDT_ENOMEM. */
 int fdt_oracle_note(fdt_oracle *o, int64_t tid, uint32_t mtet);
-
-/*
- * Whether the kd search is clearly expensive on these points (a rank's m
- * distinct points P, 3 doubles each): the first faces of a serial front
- * over samples of them, costed as fdt_oracle_tick does, by points tested,
- * never by time. An MPI run's ranks vote with it for the replica mesh
- * (src/mpi/mpi_run.c, replica_mesh): there a face whose sphere crosses a
- * cut asks the other ranks, and a pipe's or a grid's spheres are as wide
- * as the object (bench/NOTES.md, entry 52). take copies the samples (no
- * memory for one: that sample counts as cheap); cost costs them, frees
- * them and returns the larger of their costs a face (0 for a sample that
- * cannot be costed: no memory, a flat sample), stopping once one passes
- * FDT_PROBE_REPLICA.
- */
-typedef struct fdt_probe_samples {
-    double *S[2]; /* every stride-th point; a run of consecutive points */
-    uint32_t k;   /* points in each (0: too few points, not expensive) */
-    int leaf_size;
-} fdt_probe_samples;
-void fdt_oracle_probe_take(fdt_probe_samples *ps, const double *P, uint32_t m, int leaf_size);
-double fdt_oracle_probe_cost(fdt_probe_samples *ps);
-
-/* The probe's cost past which the ranks of an MPI run build the replica
- * mesh, and the threads of a run the mesh of every point
- * (src/par/parallel.c). */
-#define FDT_PROBE_REPLICA 500.0
-#define FDT_PROBE_SHARED_MESH 135.0
 
 #endif

@@ -31,7 +31,7 @@ static int build_progress(void *user, double fraction)
 /* Tet ids in slot order (tid[s] for each finite slot s), then the
  * neighbours of each finite tet from the mesh's adjacency into nbrs (4 a
  * tet from index `first`; entry k across the face opposite vertex k, -1 on
- * the hull, as src/front/front.h's meshbuf keeps them). */
+ * the hull, as src/front/meshbuf.h's meshbuf keeps them). */
 static void link_neighbours(const fdt_ins *mesh, const uint32_t *tid, int64_t first,
                             int64_t *nbrs)
 {

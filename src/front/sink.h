@@ -36,7 +36,7 @@
 #include <string.h>
 
 #include "frontdt.h"
-#include "front/front.h"
+#include "front/meshbuf.h"
 #include "base/sethash.h"
 
 /* Tets a thread's batch holds before it goes to the caller's sink: 64k

@@ -41,6 +41,7 @@
 #include "geom/kdtree.h"
 #include "base/mem.h"
 #include "front/oracle.h"
+#include "front/probe.h"
 #include "par/parallel.h"
 #include "geom/partition.h"
 #include "par/termination.h"
@@ -327,7 +328,7 @@ static int gather_points(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L,
  * the threads of shared mode read the one mesh they built together
  * (src/par/parallel.c): the ranks still own their points, faces and tets, and
  * still send FACESENDs; no NODESEND is needed. Chosen when a majority of
- * the ranks' probes (fdt_oracle_probe_take and _decide over each rank's own points) find
+ * the ranks' probes (fdt_probe_take and _cost over each rank's own points) find
  * the kd search clearly expensive and the replica fits the memory of every
  * node (its ranks counted by MPI_Comm_split_type); --search kd or mesh
  * never builds one. A rank that cannot build it (no memory) goes on with
@@ -352,9 +353,9 @@ static int replica_mesh(MPI_Comm comm, const fdt_mpi_local *L, const fdt_mpi_opt
     int vote = 0, votes = 0;
     if (e) {
         fdt_probe_samples ps;
-        fdt_oracle_probe_take(&ps, L->p, (uint32_t)L->nloc,
+        fdt_probe_take(&ps, L->p, (uint32_t)L->nloc,
                               o->leaf_size > 0 ? o->leaf_size : FDT_DEFAULT_LEAF);
-        vote = fdt_oracle_probe_cost(&ps) > FDT_PROBE_REPLICA;
+        vote = fdt_probe_cost(&ps) > FDT_PROBE_REPLICA;
     }
     MPI_Allreduce(&vote, &votes, 1, MPI_INT, MPI_SUM, comm);
     if (2 * votes <= size)

@@ -26,6 +26,7 @@
 
 #include "base/bits.h"
 #include "base/mem.h"
+#include "par/protocol.h"
 #include "par/termination.h"
 #include "front/partmesh.h"
 #include "mesh/certify.h"
@@ -175,55 +176,6 @@ int fdt_eng_build_requested(worker *w, const uint32_t v[4], int64_t mtet)
  * of the queries (200k uniform points, 2 threads): a search ball that
  * crosses the cut nearly always reaches a box next to it.
  */
-/*
- * Shared mode, part j's mesh published: the first of j's points in the
- * pencil of the face (ia, ib, ic) is a neighbour that ia would have in
- * the DT of j's points and ia (fdt_ins_conflict_vertices: every front face
- * is a face of the DT of all points, so of the DT of j's points and the
- * face's vertices, where the first point is joined to ia, and adding the
- * other vertices takes edges from ia, never gives it new ones). Offering
- * those few to the search state replaces the kd search of j, which on
- * cylinders and cospherical sets tests thousands of points a face. The
- * faces come in runs with the same lowest vertex (the bucket order of
- * src/front/faceq.c), so the last answer is kept.
- */
-/* Conflict regions larger than this are not used: a point just outside a
- * part's large flat hull facet (the cut of a grid) is in conflict with
- * every infinite tet over it, and walking them all for each query cost
- * more than the kd search (an O-grid of 40k points on two threads: 2.6 s
- * CPU with the kd search of the other part, 15.5 s with whole regions). */
-#define MESH_QUERY_MAX_TETS 256
-
-int fdt_eng_offer_from_mesh(worker *w, fdt_apex *s, int part)
-{
-    const fdt_ins *m = &w->e->w[part].orc.mesh;
-    if (w->qcache_part != part || w->qcache_v != s->ia) {
-        if (!w->qhint) {
-            w->qhint = malloc((size_t)w->e->n * sizeof *w->qhint);
-            if (!w->qhint)
-                return FDT_ENOMEM;
-            memset(w->qhint, 0xff, (size_t)w->e->n * sizeof *w->qhint);
-        }
-        w->qcache_part = -1;
-        int rc = fdt_ins_conflict_vertices(m, s->a, &w->qhint[part], MESH_QUERY_MAX_TETS,
-                                           &w->iq, &w->kq.pc);
-        if (rc < 0)
-            return rc;
-        w->qcache_part = part;
-        w->qcache_v = s->ia;
-        w->qcache_big = rc == 1;
-    }
-    if (w->qcache_big) {
-        fdt_apex_search(s, &w->e->pt->trees[part], &w->kq);
-        return FDT_OK;
-    }
-    const double *P = w->e->P;
-    for (size_t i = 0; i < w->iq.nvs; i++)
-        fdt_apex_offer(s, w->iq.vs[i], P + 3 * (size_t)w->iq.vs[i], &w->kq);
-    w->st.mesh_queries++;
-    return FDT_OK;
-}
-
 /* The walk stopped: a parked face's NODESEND is out (engine.park). */
 enum { WALK_PARKED = 2 };
 
@@ -319,7 +271,7 @@ static int walk_others(worker *w, fdt_apex *s, qbuf *qb, int *stack, int *sp, pa
                     pub = atomic_load_explicit(&w->e->w[nd->part].mesh_pub, memory_order_acquire);
                 }
                 if (pub == 1) {
-                    int rc = fdt_eng_offer_from_mesh(w, s, nd->part);
+                    int rc = fdt_proto_offer_from_mesh(w, s, nd->part);
                     if (rc)
                         return rc;
                 } else {
@@ -752,6 +704,12 @@ void fdt_eng_worker_free(worker *w)
     free(w->pk);
 }
 
+const fdt_proto_ops fdt_eng_ops = {
+    .face_arrives = fdt_eng_face_arrives,
+    .build_requested = fdt_eng_build_requested,
+    .resume = fdt_eng_resume,
+};
+
 engine *fdt_eng_new(int n)
 {
     /* The engine holds atomics and 64-aligned workers: aligned_alloc
@@ -766,6 +724,7 @@ engine *fdt_eng_new(int n)
     atomic_init(&e->abort, 0);
     atomic_init(&e->pin_refused, 0);
     e->n = n;
+    e->ops = &fdt_eng_ops;
     e->w = aligned_alloc(alignof(worker), (size_t)n * sizeof(worker));
     if (!e->w) {
         free(e);

@@ -5,7 +5,7 @@
 #ifndef FDT_GATHER_H
 #define FDT_GATHER_H
 
-#include "par/engine.h"
+#include "par/state.h"
 
 /* Calling thread, every worker done: offsets, thread 0's buffers grown. */
 int fdt_gather_prepare(engine *e);

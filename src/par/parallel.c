@@ -25,6 +25,7 @@
 #include "par/gather.h"
 #include "base/mem.h"
 #include "front/oracle.h"
+#include "front/probe.h"
 #include "front/seed.h"
 #include "par/termination.h"
 #include "par/threads.h"
@@ -636,13 +637,13 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     memset(&kq0, 0, sizeof kq0);
     double t_gm = 0.0;
     /* --search auto: the probe's count of points tested a face on samples
-     * of the points (src/front/oracle.h), taken before the partition
+     * of the points (src/front/probe.h), taken before the partition
      * permutes them, chooses the mesh of every point (global_mesh). */
     double probe = 0.0;
     if (s->search == FDT_SEARCH_AUTO) {
         fdt_probe_samples ps;
-        fdt_oracle_probe_take(&ps, pr->p, (uint32_t)pr->m, s->leaf_size);
-        probe = fdt_oracle_probe_cost(&ps);
+        fdt_probe_take(&ps, pr->p, (uint32_t)pr->m, s->leaf_size);
+        probe = fdt_probe_cost(&ps);
     }
     int err = partition(pr, s, nthreads, &pt);
     if (err != FDT_OK)

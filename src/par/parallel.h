@@ -28,10 +28,6 @@ typedef struct fdt_par_out {
     double t_gather;           /* seconds: gathering the threads' tets */
 } fdt_par_out;
 
-/* The default thread count: physical cores (hwloc), else online CPUs,
- * clamped to [1, 1024]. */
-int fdt_parallel_default_threads(void);
-
 /* How a run is carried out beyond the settings (tests). */
 typedef struct fdt_par_opts {
     int shuffle;        /* nonzero: the test transport of src/par/transport.h,

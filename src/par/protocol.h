@@ -1,7 +1,9 @@
 /*
- * The messages of the parallel engine (§4): what a FACESEND carries, how a
- * part sends faces and tet requests, handles them, answers range queries
- * (NODESEND) and waits for their answers (NODERECV). See src/par/protocol.c.
+ * The messages of the parallel engine (§4): how a part sends faces and tet
+ * requests, handles them, answers range queries (NODESEND) and waits for
+ * their answers (NODERECV). See src/par/protocol.c. What a FACESEND
+ * carries, and what a part keeps of its messages, is part of the state
+ * (src/par/state.h).
  */
 #ifndef FDT_PROTOCOL_H
 #define FDT_PROTOCOL_H
@@ -9,51 +11,25 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "geom/kdtree.h"
-#include "par/mailbox.h"
-
-struct worker;
-
-/* ---- FACESEND payload ------------------------------------------------- */
+#include "par/state.h"
 
 /*
- * The mailbox's fdt_msg_facesend (v, apex, tet), followed, in message mode,
- * by the coordinates of the message's ids other than the lowest, in the
- * order v[0], v[1], v[2], apex with the lowest skipped: the receiver owns
- * the lowest (the face's lowest for a face, the tet's lowest for a tet
- * request) and reads it from its own part. The whole payload lives in the
- * message's union (112 bytes) and is moved with memcpy.
+ * What the handlers ask of the part's front: the engine's step
+ * (src/par/engine.c), which sits above the messages and calls them, so
+ * they call it back through this table (engine.ops).
  */
-typedef struct face_payload {
-    fdt_msg_facesend f;
-    double xyz[3][3];
-} face_payload;
+typedef struct fdt_proto_ops {
+    /* A FACESEND's face arrives at its owner (fdt_eng_face_arrives). */
+    int (*face_arrives)(struct worker *w, const uint32_t v[3], int thread, int64_t link,
+                        fdt_face *known);
+    /* A FACESEND asks us to build its tet (fdt_eng_build_requested). */
+    int (*build_requested)(struct worker *w, const uint32_t v[4], int64_t mtet);
+    /* NODERECV m answers a parked face (fdt_eng_resume). */
+    int (*resume)(struct worker *w, const fdt_msg *m);
+} fdt_proto_ops;
 
-_Static_assert(sizeof(face_payload) <= sizeof(((fdt_msg *)0)->u),
-               "a FACESEND with coordinates fits in one message");
-
-/* An unpacked FACESEND, also the element of the deferred queue. */
-typedef struct pface {
-    face_payload p;
-    int sender;
-} pface;
-
-
-/* FIFO of FACESENDs that arrived while a message-mode search waited. */
-typedef struct pfqueue {
-    pface *q;
-    size_t head, n, cap;
-} pfqueue;
-
+/* Appends f to the FIFO of FACESENDs deferred while a search waits. */
 int fdt_pfq_push(pfqueue *q, const pface *f);
-
-/* Coordinates of the best point when it came from another part: two
- * buffers, so the state's bp (the old best) stays valid while the new
- * candidate is offered. */
-typedef struct qbuf {
-    double x[2][3];
-    int next;
-} qbuf;
 
 /* A range query a part waits on (fdt_proto_remote_query): its id, the
  * part asked, the search state and the buffers its answer goes to, and
@@ -81,6 +57,11 @@ int fdt_proto_send_face(struct worker *w, int to, const uint32_t v[3], uint32_t 
  * error. */
 int fdt_proto_handle_face(struct worker *w, const pface *pf);
 void fdt_proto_unpack_face(const fdt_msg *m, pface *pf);
+/* Offers to s the first of part's points in its pencil from part's
+ * published mesh (fdt_ins_conflict_vertices; part's kd search where the
+ * conflict region is too large): other parts' meshes in shared mode,
+ * the part's own when it answers a NODESEND in the wall engine. */
+int fdt_proto_offer_from_mesh(struct worker *w, fdt_apex *s, int part);
 /* Answers a NODESEND from our own tree with a NODERECV. */
 int fdt_proto_answer_query(struct worker *w, const fdt_msg *m);
 /* Blocks until the mailbox holds something (or a kick), after `spin`

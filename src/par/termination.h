@@ -5,7 +5,7 @@
 #ifndef FDT_TERMINATION_H
 #define FDT_TERMINATION_H
 
-#include "par/engine.h"
+#include "par/state.h"
 
 /* Adds this thread's activity unit before it puts a face in an empty
  * table (R1; R3: the caller holds another unit while doing so). */

@@ -7,7 +7,6 @@
 #include <unistd.h>
 
 #include "par/gather.h"
-#include "par/parallel.h"
 #include "base/spawn.h"
 #include "par/termination.h"
 
@@ -101,7 +100,7 @@ static void *worker_main(void *arg)
     return NULL;
 }
 
-int fdt_parallel_default_threads(void)
+int fdt_threads_default(void)
 {
     long n = 0;
 #ifdef FDT_HAVE_HWLOC

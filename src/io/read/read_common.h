@@ -15,7 +15,7 @@
 #ifndef FDT_READ_COMMON_H
 #define FDT_READ_COMMON_H
 
-#include "io/read/reader.h"
+#include "io/read/read_types.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -42,6 +42,10 @@
  * points of any file worth streaming (8 MiB: 350,000 text points). With
  * several threads a block holds two slices a thread (src/io/read/read_xyz.c). */
 #define RD_CHUNK ((size_t)8 << 20)
+
+/* Bytes a single read() asks for: a bounded request keeps a signal's
+ * EINTR cheap and is all the kernel gives a pipe at once anyway. */
+#define RD_READ_MAX ((size_t)1 << 30)
 
 /* A streamed read's first buffer when the input's size is not known (a
  * pipe): small inputs stay small; it doubles up to the chunk while the
@@ -135,11 +139,11 @@ typedef struct rd_points {
     int fixed;   /* xyz is a slice of another array: it cannot grow */
 } rd_points;
 
-/* src/io/read/reader.c: messages and point storage. */
+/* src/io/read/read_common.c: messages, point storage, streamed input. */
 
 /* Writes "PATH" followed by the formatted text; always returns code. */
 int fdt_rd_fail(const rd_ctx *c, int code, const char *fmt, ...) RD_PRINTF(3, 4);
-/* The token s[0..len) as 'text' for a message (see src/io/read/reader.c). */
+/* The token s[0..len) as 'text' for a message (see src/io/read/read_common.c). */
 const char *fdt_rd_quote(char out[RD_QUOTE_CAP], const char *s, size_t len);
 /* Grows pb to cap points; -1 when out of memory or pb is fixed. */
 int fdt_rd_points_reserve(rd_points *pb, size_t cap);
@@ -207,7 +211,8 @@ int fdt_rd_stream_xyz_range(rd_ctx *c, rd_points *pb, size_t ncols, size_t line0
 /* The head of a text point file in buf[0, len) (eof: the file ends there):
  * 1 when it is enough to tell fdt_rd_text_head's answers, set in *h; 0
  * when more bytes are needed. */
-int fdt_rd_xyz_head(const char *buf, size_t len, int eof, char sep, fdt_rd_head *h);
+struct fdt_rd_head; /* src/io/read/reader.h */
+int fdt_rd_xyz_head(const char *buf, size_t len, int eof, char sep, struct fdt_rd_head *h);
 int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned);
 int fdt_rd_read_node(const rd_ctx *c, const char *start, rd_points *pb);
 

@@ -11,6 +11,7 @@
 #endif
 
 #include "io/read/read_common.h"
+#include "io/read/reader.h"
 
 #include <errno.h>
 #include <fcntl.h>

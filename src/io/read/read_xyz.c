@@ -10,6 +10,7 @@
 #endif
 
 #include "io/read/read_common.h"
+#include "io/read/reader.h"
 #include "base/spawn.h"
 
 #include <pthread.h>

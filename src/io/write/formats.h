@@ -8,8 +8,8 @@
 #ifndef FDT_FORMATS_H
 #define FDT_FORMATS_H
 
+#include "io/write/meshview.h"
 #include "io/write/outfile.h"
-#include "io/write/writer.h"
 
 /* Writes one file of a format into o (a temporary the caller renames).
  * prep is what the row's prepare made (NULL without one). Returns

@@ -20,7 +20,8 @@
 #include <sys/types.h>
 #include <unistd.h>
 
-#include "io/read/reader.h" /* FDT_IO_* codes; frontdt.h */
+#include "frontdt.h"
+#include "io/read/read_types.h" /* FDT_IO_* codes */
 
 #define OUT_BUF_SIZE (1u << 20)
 /* The longest item put in one go: a %.17g double is at most 24 chars. */

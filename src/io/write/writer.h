@@ -14,22 +14,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include "frontdt.h"
-
-typedef struct fdt_mesh_view {
-    const double *xyz;       /* 3 * n_points input coordinates (borrowed) */
-    size_t n_points;         /* input points, duplicates included */
-    const fdt_vid *tets;     /* 4 per tet, input numbering, positive */
-    size_t n_tets;
-    const fdt_tid *nbrs;     /* 4 per tet or NULL (required for .ele) */
-    const fdt_vid *hull;     /* 3 per hull face, outward */
-    size_t n_hull;
-    /* The face list of fdt_result_faces, or NULL (required by the formats
-     * whose row needs FDT_NEED_FACES, and by all_faces). */
-    const fdt_vid *faces;    /* 3 per face, tets[2i] on the positive side */
-    const fdt_tid *face_tets;/* 2 per face, -1 on the hull */
-    size_t n_faces;
-    int all_faces;           /* TetGen .face: every face (TetGen -f) */
-} fdt_mesh_view;
+#include "io/write/meshview.h"
 
 typedef struct fdt_format fdt_format; /* a row of src/io/write/formats.h's table */
 
@@ -94,12 +79,6 @@ int fdt_wr_mesh_stream(FILE *stream, const char *name, const fdt_format *f,
 int fdt_wr_mesh_stream_ex(FILE *stream, const char *name, const fdt_format *f,
                           const fdt_mesh_view *m, fdt_io_progress_fn progress,
                           void *progress_user, char *err, size_t errlen);
-
-/* The longest path the writer takes (its temporary names live in fixed
- * buffers a signal handler can read), and the most files one output
- * family writes (an OpenFOAM polyMesh: five). */
-#define FDT_IO_PATH 4096
-#define FDT_IO_MAX_FILES 5
 
 /*
  * The files fdt_wr_mesh(path, ...) writes, in the order it writes them,
