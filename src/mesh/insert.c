@@ -474,15 +474,6 @@ static void ins_bounds(fdt_ins *m)
 
 /* ------------------------------------------------------------------ */
 
-void fdt_ins_free(fdt_ins *m)
-{
-    if (!m)
-        return;
-    free(m->T);
-    free(m->vtet);
-    memset(m, 0, sizeof *m);
-}
-
 static void build_free(build *b)
 {
     free(b->mark);

@@ -7,23 +7,7 @@
  * is unique (src/geom/predicates.h), so this kernel and the kd search give the
  * same apex for every face and the two can be mixed face by face.
  *
- * Representation (CGAL's Triangulation_data_structure_3, in flat arrays):
- *   - tet slot t holds T[8t .. 8t+3], its four vertices (global point ids;
- *     FDT_NONE is the infinite vertex), and T[8t+4 .. 8t+7], its four
- *     neighbours: entry 4+k is the neighbour across the face opposite
- *     vertex k, packed as 4 * neighbour + (index of that face in the
- *     neighbour);
- *   - finite tets are positively oriented (fdt_orient3d > 0); an infinite
- *     tet lies over one hull face, and is "positive" in the sense that
- *     putting any point strictly outside that hull face in place of the
- *     infinite vertex gives a positively oriented tet;
- *   - freed slots are recycled (a free list through them): a freed slot
- *     has FDT_NONE as vertex 0 and vertex 1 (a live tet has at most one).
- * Memory: 32 bytes a slot and about 6.7 slots a point (6.5 finite tets a
- * point on uniform points, plus the hull's infinite tets and growth
- * slack), plus 4 bytes a point for the incident-tet table: about 220
- * bytes a point kept. During the build also 1 byte a slot (conflict
- * marks) and 4 bytes a point (insertion order), and the cavity scratch.
+ * Representation: src/mesh/insmesh.h.
  *
  * Threads: fdt_ins_build runs on one thread, fdt_ins_build_parallel on
  * several; afterwards the structure is immutable and any thread may query
@@ -37,41 +21,7 @@
 #include "frontdt.h"
 #include "geom/kdtree.h"
 #include "geom/predicates.h"
-
-/* Work counters of one build (fdt_ins.stats). */
-typedef struct fdt_ins_stats {
-    size_t inserted;      /* points inserted (n) */
-    size_t walk_steps;    /* tets visited by point location */
-    size_t cavity_tets;   /* tets destroyed (sum of the cavity sizes) */
-    size_t created_tets;  /* tets created */
-    size_t max_cavity;    /* largest cavity */
-    size_t conflict_tests;/* conflict (insphere / hull side) tests */
-    size_t deferred;      /* fdt_ins_build_parallel: insertions put off (a tet held
-                           * by another thread, or the slots spent) */
-    size_t serial_finish; /* fdt_ins_build_parallel: points left to its serial end */
-    size_t stolen;        /* fdt_ins_build_parallel: points a worker took from the
-                           * end of another's last round */
-    /* fdt_ins_build_parallel: thread CPU seconds of its serial start, of
-     * its workers (the busiest one, and all together) and of its serial
-     * end (finish included). start + workers_max + finish is the wall
-     * time with a free core a worker. */
-    double cpu_start_s, cpu_workers_max_s, cpu_workers_sum_s, cpu_finish_s;
-} fdt_ins_stats;
-
-typedef struct fdt_ins {
-    const double *P;      /* borrowed: global coordinates, 3 per id */
-    uint32_t base, n;     /* the points: global ids [base, base + n) */
-    uint32_t *T;          /* owned: 8 per slot, see above */
-    uint32_t nslots;      /* slots in use or freed ([0, nslots) are valid) */
-    uint32_t cap;         /* slots allocated */
-    uint32_t free_head;   /* first freed slot, FDT_NONE if none */
-    uint32_t *vtet;       /* owned: n entries, a live tet holding id base + i */
-    double lo[3], hi[3];  /* the points' bounding box */
-    fdt_pred_static sf;   /* its semi-static filter bounds (src/geom/predicates.h) */
-    size_t nfinite;       /* finite tets */
-    size_t ninfinite;     /* infinite tets = hull faces */
-    fdt_ins_stats stats;
-} fdt_ins;
+#include "mesh/insmesh.h"
 
 /*
  * Builds the perturbed DT of the points with global ids [base, base + n)
@@ -110,42 +60,11 @@ int fdt_ins_build_progress(fdt_ins *m, const double *P, uint32_t base, uint32_t 
  */
 int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                            int nthreads, fdt_pred_counts *cnt);
-/* Frees what m owns and zeroes it; m may be zeroed or freed already. */
-void fdt_ins_free(fdt_ins *m);
-
-/* The four vertices of live slot t (FDT_NONE: the infinite vertex). */
-static inline const uint32_t *fdt_ins_tet(const fdt_ins *m, uint32_t t)
-{
-    return m->T + 8 * (size_t)t;
-}
-
-/* Whether slot t holds a finite tet (not infinite, not freed). */
-static inline int fdt_ins_is_finite(const fdt_ins *m, uint32_t t)
-{
-    const uint32_t *v = m->T + 8 * (size_t)t;
-    return v[0] != FDT_NONE && v[1] != FDT_NONE && v[2] != FDT_NONE && v[3] != FDT_NONE;
-}
 
 /* The first finite tet in a slot >= t, FDT_NONE if none: iterate with
  * for (t = fdt_ins_next_finite(m, 0); t != FDT_NONE;
  *      t = fdt_ins_next_finite(m, t + 1)). */
 uint32_t fdt_ins_next_finite(const fdt_ins *m, uint32_t t);
-
-/*
- * The neighbour of tet `tet` across its face k (the face opposite vertex
- * k): *ntet gets the neighbour's slot, *nk the index of the shared face in
- * it. Returns the neighbour's vertex nk, the apex of that face seen from
- * tet: a point id, or FDT_NONE when the neighbour is the infinite tet over
- * a hull face (for a finite face). O(1).
- */
-static inline uint32_t fdt_ins_across(const fdt_ins *m, uint32_t tet, int k,
-                                      uint32_t *ntet, int *nk)
-{
-    uint32_t r = m->T[8 * (size_t)tet + 4 + (unsigned)k];
-    *ntet = r >> 2;
-    *nk = (int)(r & 3);
-    return m->T[8 * (size_t)(r >> 2) + (r & 3)];
-}
 
 /*
  * For the oriented face (a, b, c), whose open side is where
@@ -212,5 +131,46 @@ void fdt_ins_query_free(fdt_ins_query *qs);
  * star holds more than max_tets tets (no answer); FDT_ENOMEM.
  */
 int fdt_ins_star_vertices(const fdt_ins *m, uint32_t a, size_t max_tets, fdt_ins_query *qs);
+
+/* The kernel's own phases, for src/mesh/insert_par.c and the tests. */
+
+/*
+ * order[] = the ids [base, base + n) of P's points by BRIO round
+ * (src/mesh/insert.c), the first round first, the point nearest the centre of
+ * their bounding box at order[0]; round_end[r] (r = 0 .. *nrounds - 1) is
+ * the end of round r in order[]. round_end has room for 32 entries.
+ */
+void fdt_ins_brio(const double *P, uint32_t base, uint32_t n, uint32_t *order,
+                  uint32_t *round_end, int *nrounds);
+
+/*
+ * The serial start of a build: m is set up for the points [base, base +
+ * n) of P with room for `slots` tets (more if the serial phase needs it),
+ * the first tetrahedron is found in order[0 .. n) (first[] gets its four
+ * ids) and order[0 .. prefix) is inserted, first[] skipped. progress
+ * (may be NULL) is called every 64k insertions with the fraction done;
+ * nonzero cancels (FDT_ECANCELED). On error m holds nothing.
+ */
+int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                         const uint32_t *order, uint32_t prefix, uint64_t slots,
+                         uint32_t first[4], fdt_pred_counts *cnt, fdt_progress_fn progress,
+                         void *puser);
+
+/*
+ * The end of a build, once every point is in: the incident-tet table, the
+ * finite and infinite counts, and the free list rebuilt through every
+ * freed slot of [0, nslots). FDT_EINTERNAL if a point is in no tet,
+ * FDT_ENOMEM; on error m holds nothing.
+ */
+int fdt_ins_finish(fdt_ins *m);
+
+/*
+ * fdt_ins_build_parallel with the slots' first capacity forced to
+ * slots_a_point a point (0: its own estimate): the tests make it small,
+ * so the workers run out of slots and the arrays grow between passes,
+ * then in the serial finish.
+ */
+int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                                 int nthreads, double slots_a_point, fdt_pred_counts *cnt);
 
 #endif

@@ -1,11 +1,12 @@
 /*
  * What src/mesh/insert.c (the serial build) and src/mesh/insert_par.c (the parallel
- * build) share: the predicates' inline filters, the growth of the tets
+ * build) share, inline: the predicates' filters, the growth of the tets
  * array, the walk's step, the conflict rule, the duplicate check, the
- * counters, the edge table that links a cavity's new tets, and the serial
- * phases the parallel build starts and ends with. Each lives here once;
- * what differs (the parallel build's locks) stays in its file. Internal
- * to the insertion kernel; src/mesh/insert.h is its API.
+ * counters, and the linking of a cavity's new tets. Each lives here once;
+ * what differs (the parallel build's locks) stays in its file. The serial
+ * phases the parallel build starts and ends with are declared in
+ * src/mesh/insert.h. Internal to the insertion kernel; it needs only the
+ * representation (src/mesh/insmesh.h).
  */
 #ifndef FDT_INSERT_IMPL_H
 #define FDT_INSERT_IMPL_H
@@ -14,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/bits.h"
-#include "mesh/insert.h"
+#include "mesh/insmesh.h"
 
 /* Neighbour references are 4 * slot + face in 32 bits. */
 #define INS_MAX_SLOTS (UINT32_C(1) << 30)
@@ -534,44 +535,5 @@ static inline int ins_link_star_local(ins_local *L, uint32_t *T, const uint32_t 
         lid[vert[q] - base] = 0;
     return bad ? FDT_EINTERNAL : FDT_OK;
 }
-
-/*
- * order[] = the ids [base, base + n) of P's points by BRIO round
- * (src/mesh/insert.c), the first round first, the point nearest the centre of
- * their bounding box at order[0]; round_end[r] (r = 0 .. *nrounds - 1) is
- * the end of round r in order[]. round_end has room for 32 entries.
- */
-void fdt_ins_brio(const double *P, uint32_t base, uint32_t n, uint32_t *order,
-                  uint32_t *round_end, int *nrounds);
-
-/*
- * The serial start of a build: m is set up for the points [base, base +
- * n) of P with room for `slots` tets (more if the serial phase needs it),
- * the first tetrahedron is found in order[0 .. n) (first[] gets its four
- * ids) and order[0 .. prefix) is inserted, first[] skipped. progress
- * (may be NULL) is called every 64k insertions with the fraction done;
- * nonzero cancels (FDT_ECANCELED). On error m holds nothing.
- */
-int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
-                         const uint32_t *order, uint32_t prefix, uint64_t slots,
-                         uint32_t first[4], fdt_pred_counts *cnt, fdt_progress_fn progress,
-                         void *puser);
-
-/*
- * The end of a build, once every point is in: the incident-tet table, the
- * finite and infinite counts, and the free list rebuilt through every
- * freed slot of [0, nslots). FDT_EINTERNAL if a point is in no tet,
- * FDT_ENOMEM; on error m holds nothing.
- */
-int fdt_ins_finish(fdt_ins *m);
-
-/*
- * fdt_ins_build_parallel with the slots' first capacity forced to
- * slots_a_point a point (0: its own estimate): the tests make it small,
- * so the workers run out of slots and the arrays grow between passes,
- * then in the serial finish.
- */
-int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
-                                 int nthreads, double slots_a_point, fdt_pred_counts *cnt);
 
 #endif
