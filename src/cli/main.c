@@ -26,6 +26,7 @@
 #include "frontdt.h"
 #include "cli/cli.h"
 #include "cli/dual.h"
+#include "cli/options.h"
 #include "base/clock.h"
 #include "base/hash.h"
 #include "cli/progress.h"
@@ -59,9 +60,7 @@ enum {
     CLI_INTERNAL = 7
 };
 
-#define DEMO_DEFAULT_N 1000000u
-/* -o given more often than this is a usage error */
-#define MAX_OUTPUTS 8
+#define MAX_OUTPUTS FDT_CLI_MAX_OUTPUTS
 /* Fixed so that "--demo N" is the same point set on every run and host. */
 #define DEMO_SEED UINT64_C(0x5eed0f0f1992)
 
@@ -82,6 +81,7 @@ typedef struct cli {
     const char *stats_json; /* NULL, a path, or "-" for stdout */
     fdt_mode mode;
     fdt_search search;
+    int leaf;               /* --leaf; 0: the library's default */
     int threads;            /* -1: the library's default */
     int pin, check, stats, hash, set_hash, quiet;
     int no_clobber;         /* --no-clobber: refuse to replace any output */
@@ -96,95 +96,32 @@ typedef struct cli {
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-        "Usage: frontdt [options] INPUT [-o OUTPUT]\n"
-        "       frontdt --demo [N] [options] [-o OUTPUT]\n"
-        "Exact 3D Delaunay tetrahedralization by the advancing front.\n"
-        "\n"
-        "INPUT:  .xyz/.txt/.csv (x y z per line; more columns skipped; a first\n"
-        "        line of words is a header), .node (TetGen), .ply; '-' is standard\n"
-        "        input (needs --input-format)\n"
-        "OUTPUT: .tets (canonical sorted text), .ele (TetGen .node/.ele/\n"
-        "        .face/.neigh), .vtu (VTK XML, ParaView), .vtk (VTK legacy),\n"
-        "        .msh (gmsh 4.1), .mesh (Medit), DIR/polyMesh (OpenFOAM),\n"
-        "        .fdtb (frontdt binary)\n"
-        "\n"
-        "Options:\n"
-        "  -o, --output FILE      write the mesh (format by extension); may be\n"
-        "                         given up to %d times; '-': standard output.\n"
-        "                         An existing output is replaced (as TetGen and\n"
-        "                         gmsh do); an input never is (exit 1)\n"
-        "      --no-clobber       refuse (exit 5, before any work) when any\n"
-        "                         output file exists (.node of -o m.ele too)\n"
-        "      --format NAME      format of the next -o (of the last -o when\n"
-        "                         none follows): tets, tetgen, vtu, bin, vtk, msh,\n"
-        "                         msh2, medit, openfoam; an -o whose extension\n"
-        "                         names another format is refused; or, named xyz,\n"
-        "                         txt, csv, node or ply, the input's (--input-format)\n"
-        "      --all-faces        TetGen .face lists every face (TetGen -f)\n"
-        "      --input-format FMT xyz (also txt, csv), node or ply: the input's\n"
-        "                         format whatever its name (needed for '-')\n"
-        "      --columns X,Y,Z    the columns of x, y and z in .xyz/.txt/.csv,\n"
-        "                         counted from 1 as cut -f and awk do (1,2,3)\n"
-        "      --delimiter C      the field separator of .xyz/.txt/.csv besides\n"
-        "                         blanks: ',' (default) or ';'; ' ': blanks only\n"
-        "      --decimal-comma    numbers are written 0,5 (then the delimiter\n"
-        "                         is ';' or blanks: blanks unless given)\n"
-        "      --mode MODE        serial, shared, message or auto (default)\n"
-        "      --search HOW       how apexes are found: auto (default: in memory\n"
-        "                         without --mode, the certified insertion mesh\n"
-        "                         built on the threads is the answer; with\n"
-        "                         --mode, the parts read the mesh of every point\n"
-        "                         where a probe finds the kd search costly, else\n"
-        "                         the kd search), kd, or mesh (threads: each\n"
-        "                         part's own mesh, its inner tets final, fronts\n"
-        "                         at the walls)\n"
-        "  -t, --threads N        worker threads (0: one per core)\n"
-        "      --pin              bind thread i to core i\n"
-        "      --check            verify the result exactly (exit 3 if not Delaunay)\n"
-        "      --stats            print statistics to stderr\n"
-        "      --stats-json FILE  write statistics as JSON ('-': stdout)\n"
-        "      --hash             print the canonical hash of the tet set\n"
-        "      --set-hash         print the set hash (order-independent, no sort)\n"
-        "      --voronoi FILE     write each point's Voronoi cell, clipped by the\n"
-        "                         box: a line a point (.csv: a table)\n"
-        "      --voronoi-format F the line, in voro++'s codes: %%i %%q %%v %%F %%s\n"
-        "                         %%n %%f %%c %%C, and %%d (DTFE density), %%h (flags)\n"
-        "                         (default '%%i %%q %%v %%F %%s %%n %%f')\n"
-        "      --density FILE     write each point's DTFE density and flags\n"
-        "      --box X0,Y0,Z0,X1,Y1,Z1  the box that clips the cells (default:\n"
-        "                         the points' bounding box; must hold them)\n"
-        "      --values FILE      values at the points (a line a point, k numbers)\n"
-        "      --interpolate Q    interpolate them at the points of file Q into\n"
-        "      --interpolated OUT (a line a query; nan outside the hull)\n"
-        "      --method M         natural (Sibson, default) or linear\n"
-        "      --stream           write the tets as they are built, never holding\n"
-        "                         the mesh (.ele without .neigh, .vtu, .fdtb; no\n"
-        "                         -o: count them); the points are stored once\n"
-        "                         (about 60 bytes a point); refuses an output or\n"
-        "                         option that needs the mesh\n"
-        "      --no-stream        keep the whole mesh (default streams when every\n"
-        "                         -o is .vtu or .fdtb and nothing needs the mesh)\n"
-        "      --memory-limit B   refuse (exit 4) a run whose estimated memory\n"
-        "                         exceeds B bytes (suffixes K, M, G: 2^10..2^30)\n"
-        "  -q, --quiet            no summary, no progress, no notes\n"
-        "      --progress         draw the progress line on stderr even when it\n"
-        "                         is not a terminal (it is drawn on terminals)\n"
-        "      --demo [N]         triangulate N random points in the unit cube\n"
-        "                         (fixed seed; default %u)\n"
-        "  -h, --help             this help\n"
-        "  -V, --version          version\n"
-        "\n"
-        "Exit codes:\n"
-        "  0 success             1 usage error (also '-' without --input-format,\n"
-        "                          --columns for .node/.ply)   2 bad input\n"
-        "  3 --check failed      4 out of resources (also over --memory-limit)\n"
-        "  5 cannot write output (also --no-clobber)\n"
-        "  6 interrupted (every output left as it was)\n"
-        "  7 internal error\n"
-        "Outputs are all or none: each is written to a temporary file, and only\n"
-        "when all are complete are they renamed over their names.\n",
-        MAX_OUTPUTS, DEMO_DEFAULT_N);
+    fputs("Usage: frontdt [options] INPUT [-o OUTPUT]\n"
+          "       frontdt --demo [N] [options] [-o OUTPUT]\n"
+          "Exact 3D Delaunay tetrahedralization by the advancing front.\n"
+          "\n"
+          "INPUT:  .xyz/.txt/.csv (x y z per line; more columns skipped; a first\n"
+          "        line of words is a header), .node (TetGen), .ply; '-' is standard\n"
+          "        input (needs --input-format)\n"
+          "OUTPUT: .tets (canonical sorted text), .ele (TetGen .node/.ele/\n"
+          "        .face/.neigh), .vtu (VTK XML, ParaView), .vtk (VTK legacy),\n"
+          "        .msh (gmsh 4.1), .mesh (Medit), DIR/polyMesh (OpenFOAM),\n"
+          "        .fdtb (frontdt binary)\n"
+          "\n"
+          "Options:\n",
+          f);
+    fdt_cli_help(f, FDT_CLI_FRONTDT);
+    fputs("\n"
+          "Exit codes:\n"
+          "  0 success             1 usage error (also '-' without --input-format,\n"
+          "                          --columns for .node/.ply)   2 bad input\n"
+          "  3 --check failed      4 out of resources (also over --memory-limit)\n"
+          "  5 cannot write output (also --no-clobber)\n"
+          "  6 interrupted (every output left as it was)\n"
+          "  7 internal error\n"
+          "Outputs are all or none: each is written to a temporary file, and only\n"
+          "when all are complete are they renamed over their names.\n",
+          f);
 }
 
 static void say(const char *fmt, ...)
@@ -277,52 +214,6 @@ static int parse_bytes(const char *s, unsigned long long *v)
     return 0;
 }
 
-enum {
-    OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH, OPT_SET_HASH,
-    OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
-    OPT_DELIMITER, OPT_DECIMAL_COMMA,
-    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT, OPT_NO_CLOBBER,
-    OPT_VORONOI, OPT_VORONOI_FORMAT, OPT_DENSITY, OPT_BOX, OPT_VALUES, OPT_INTERPOLATE,
-    OPT_INTERPOLATED, OPT_METHOD
-};
-
-static const struct option long_opts[] = {
-    { "output", required_argument, NULL, 'o' },
-    { "format", required_argument, NULL, OPT_FORMAT },
-    { "all-faces", no_argument, NULL, OPT_ALL_FACES },
-    { "mode", required_argument, NULL, OPT_MODE },
-    { "search", required_argument, NULL, OPT_SEARCH },
-    { "threads", required_argument, NULL, 't' },
-    { "pin", no_argument, NULL, OPT_PIN },
-    { "check", no_argument, NULL, OPT_CHECK },
-    { "stats", no_argument, NULL, OPT_STATS },
-    { "stats-json", required_argument, NULL, OPT_STATS_JSON },
-    { "hash", no_argument, NULL, OPT_HASH },
-    { "set-hash", no_argument, NULL, OPT_SET_HASH },
-    { "quiet", no_argument, NULL, 'q' },
-    { "demo", optional_argument, NULL, OPT_DEMO },
-    { "input-format", required_argument, NULL, OPT_INPUT_FORMAT },
-    { "columns", required_argument, NULL, OPT_COLUMNS },
-    { "delimiter", required_argument, NULL, OPT_DELIMITER },
-    { "decimal-comma", no_argument, NULL, OPT_DECIMAL_COMMA },
-    { "progress", no_argument, NULL, OPT_PROGRESS },
-    { "stream", no_argument, NULL, OPT_STREAM },
-    { "no-stream", no_argument, NULL, OPT_NO_STREAM },
-    { "memory-limit", required_argument, NULL, OPT_MEMORY_LIMIT },
-    { "no-clobber", no_argument, NULL, OPT_NO_CLOBBER },
-    { "voronoi", required_argument, NULL, OPT_VORONOI },
-    { "voronoi-format", required_argument, NULL, OPT_VORONOI_FORMAT },
-    { "density", required_argument, NULL, OPT_DENSITY },
-    { "box", required_argument, NULL, OPT_BOX },
-    { "values", required_argument, NULL, OPT_VALUES },
-    { "interpolate", required_argument, NULL, OPT_INTERPOLATE },
-    { "interpolated", required_argument, NULL, OPT_INTERPOLATED },
-    { "method", required_argument, NULL, OPT_METHOD },
-    { "help", no_argument, NULL, 'h' },
-    { "version", no_argument, NULL, 'V' },
-    { NULL, 0, NULL, 0 },
-};
-
 /*
  * getopt_long's optional_argument only takes "--demo=N"; "--demo N" with a
  * separate numeric word is rewritten to "--demo=N" before parsing (an
@@ -401,221 +292,247 @@ static int parse_columns(const char *s, int cols[3])
     return 0;
 }
 
-/* Returns -1 to go on, or an exit code (0 after --help/--version). */
-static int parse_args(int argc, char **argv, cli *c)
+/* -o FILE: at most MAX_OUTPUTS, each named once; it takes the --format
+ * given before it. */
+static int take_output(cli *c, const char *out)
 {
-    memset(c, 0, sizeof *c);
-    c->mode = FDT_MODE_AUTO;
-    c->threads = -1;
-    c->dual.natural = 1;
-    c->demo_n = DEMO_DEFAULT_N;
-    opterr = 0; /* we print our own messages */
-    optind = 1;
-    int ch;
-    unsigned long long v;
-    int format_last = 0; /* the last --format came after every -o */
-    while ((ch = getopt_long(argc, argv, ":o:t:qhV", long_opts, NULL)) != -1) {
-        switch (ch) {
-        case 'o':
-            if (c->n_outputs == MAX_OUTPUTS)
-                return usage_error("-o given more than %d times", MAX_OUTPUTS);
-            if (!*optarg)
-                return usage_error("empty output file name");
-            for (int i = 0; i < c->n_outputs; i++)
-                if (!strcmp(c->outputs[i], optarg))
-                    return usage_error("-o %s given twice", optarg);
-            if (!c->output)
-                c->output = optarg;
-            c->out_format[c->n_outputs] = c->format;
-            c->outputs[c->n_outputs++] = optarg;
-            c->format = NULL; /* --format is one -o's */
-            format_last = 0;
-            break;
-        case OPT_FORMAT:
-            /* One option names both, as issue 17 asks (--format xyz for
-             * standard input, --format msh2 for an output): the input
-             * formats' names (xyz, txt, csv, node, ply) and the output
-             * formats' never meet, so the name says which is meant. */
-            if (!fdt_format_by_name(optarg) &&
-                fdt_rd_format_by_name(optarg) != FDT_RD_AUTO) {
-                c->input_format = fdt_rd_format_by_name(optarg);
-                c->input_format_name = optarg;
-                break;
-            }
-            if (!fdt_format_by_name(optarg))
-                return usage_error("unknown format '%s' (input: xyz, txt, csv, node, ply; "
-                                   "output: %s)", optarg, fdt_format_list());
-            c->format = optarg;
-            format_last = 1;
-            break;
-        case OPT_ALL_FACES:
-            c->all_faces = 1;
-            break;
-        case OPT_MODE:
-            if (!strcmp(optarg, "serial"))
-                c->mode = FDT_MODE_SERIAL;
-            else if (!strcmp(optarg, "shared"))
-                c->mode = FDT_MODE_SHARED;
-            else if (!strcmp(optarg, "message"))
-                c->mode = FDT_MODE_MESSAGE;
-            else if (!strcmp(optarg, "auto"))
-                c->mode = FDT_MODE_AUTO;
-            else
-                return usage_error("unknown mode '%s' (serial, shared, "
-                                   "message or auto)", optarg);
-            break;
-        case OPT_SEARCH:
-            if (fdt_cli_search(optarg, &c->search) != 0)
-                return usage_error("unknown search '%s' (auto, kd or mesh)", optarg);
-            break;
-        case 't':
-            if (parse_count(optarg, INT_MAX, &v) != 0)
-                return usage_error("--threads wants a count, not '%s'",
-                                   optarg);
-            c->threads = (int)v;
-            break;
-        case OPT_PIN:
-            c->pin = 1;
-            break;
-        case OPT_CHECK:
-            c->check = 1;
-            break;
-        case OPT_STATS:
-            c->stats = 1;
-            break;
-        case OPT_STATS_JSON:
-            if (!*optarg)
-                return usage_error("empty --stats-json file name");
-            c->stats_json = optarg;
-            break;
-        case OPT_HASH:
-            c->hash = 1;
-            break;
-        case OPT_SET_HASH:
-            c->set_hash = 1;
-            break;
-        case OPT_STREAM:
-        case OPT_NO_STREAM:
-            if (c->stream != 0 && c->stream != (ch == OPT_STREAM ? 1 : -1))
-                return usage_error("--stream and --no-stream together");
-            c->stream = ch == OPT_STREAM ? 1 : -1;
-            break;
-        case 'q':
-            c->quiet = 1;
-            break;
-        case OPT_INPUT_FORMAT:
-            c->input_format = fdt_rd_format_by_name(optarg);
-            c->input_format_name = optarg;
-            if (c->input_format == FDT_RD_AUTO)
-                return usage_error("unknown input format '%s' (xyz, txt, csv, node or "
-                                   "ply)", optarg);
-            break;
-        case OPT_COLUMNS:
-            if (parse_columns(optarg, c->columns) != 0)
-                return usage_error("--columns wants three different column numbers "
-                                   "from 1, as 3,4,5, not '%s'", optarg);
-            break;
-        case OPT_DELIMITER:
-            if (strlen(optarg) != 1 || !strchr(",; ", optarg[0]))
-                return usage_error("--delimiter is ',', ';' or ' ' (blanks only), not '%s'",
-                                   optarg);
-            c->delimiter = optarg[0];
-            break;
-        case OPT_DECIMAL_COMMA:
-            c->decimal_comma = 1;
-            break;
-        case OPT_PROGRESS:
-            c->progress = 1;
-            break;
-        case OPT_NO_CLOBBER:
-            c->no_clobber = 1;
-            break;
-        case OPT_VORONOI:
-            c->dual.voronoi = optarg;
-            break;
-        case OPT_VORONOI_FORMAT:
-            c->dual.format = optarg;
-            break;
-        case OPT_DENSITY:
-            c->dual.density = optarg;
-            break;
-        case OPT_BOX:
-            if (fdt_cli_parse_box(optarg, c->dual.box) != 0)
-                return usage_error("--box wants six finite numbers xmin,ymin,zmin,xmax,ymax,zmax "
-                                   "with each min below its max, not '%s'", optarg);
-            c->dual.box_given = 1;
-            break;
-        case OPT_VALUES:
-            c->dual.values = optarg;
-            break;
-        case OPT_INTERPOLATE:
-            c->dual.queries = optarg;
-            break;
-        case OPT_INTERPOLATED:
-            c->dual.interpolated = optarg;
-            break;
-        case OPT_METHOD:
-            if (strcmp(optarg, "natural") && strcmp(optarg, "linear"))
-                return usage_error("--method is natural or linear, not '%s'", optarg);
-            c->dual.natural = !strcmp(optarg, "natural");
-            break;
-        case OPT_MEMORY_LIMIT:
-            if (parse_bytes(optarg, &c->memory_limit) != 0)
-                return usage_error("--memory-limit wants a byte count > 0 (suffix K, M or G), "
-                                   "not '%s'", optarg);
-            break;
-        case OPT_DEMO:
-            c->demo = 1;
-            if (optarg) {
-                if (parse_count(optarg, SIZE_MAX, &v) != 0)
-                    return usage_error("--demo wants a point count, not '%s'",
-                                       optarg);
-                c->demo_n = (size_t)v;
-            }
-            break;
-        case 'h':
-        case 'V':
-            if (ch == 'h')
-                usage(stdout);
-            else
-                printf("frontdt %s (library %s)\n", FDT_VERSION_STRING,
-                       fdt_version());
-            /* a help longer than stdio's buffer meets the error in
-             * fprintf already: the stream's error flag keeps it (and
-             * errno its reason) */
-            if (fflush(stdout) != 0 || ferror(stdout)) {
-                say("stdout: %s", strerror(errno ? errno : EIO));
-                return CLI_WRITE;
-            }
-            return CLI_OK;
-        case ':':
-            if (short_opt(argv, optind))
-                return usage_error("option -%c needs a value", optopt);
-            return usage_error("option %s needs a value", argv[optind - 1]);
-        case '?':
-        default:
-            if (short_opt(argv, optind))
-                return usage_error("unknown option -%c", optopt);
-            return usage_error("unknown, ambiguous or misused option %s",
-                               argv[optind - 1]);
-        }
+    if (c->n_outputs == MAX_OUTPUTS)
+        return usage_error("-o given more than %d times", MAX_OUTPUTS);
+    if (!*out)
+        return usage_error("empty output file name");
+    for (int i = 0; i < c->n_outputs; i++)
+        if (!strcmp(c->outputs[i], out))
+            return usage_error("-o %s given twice", out);
+    if (!c->output)
+        c->output = out;
+    c->out_format[c->n_outputs] = c->format;
+    c->outputs[c->n_outputs++] = out;
+    c->format = NULL; /* --format is one -o's */
+    return -1;
+}
+
+/* One option names both, as issue 17 asks (--format xyz for standard
+ * input, --format msh2 for an output): the input formats' names (xyz,
+ * txt, csv, node, ply) and the output formats' never meet, so the name
+ * says which is meant. */
+static int take_format(cli *c, const char *name)
+{
+    if (!fdt_format_by_name(name) && fdt_rd_format_by_name(name) != FDT_RD_AUTO) {
+        c->input_format = fdt_rd_format_by_name(name);
+        c->input_format_name = name;
+        return -1;
     }
+    if (!fdt_format_by_name(name))
+        return usage_error("unknown format '%s' (input: xyz, txt, csv, node, ply; "
+                           "output: %s)", name, fdt_format_list());
+    c->format = name;
+    return -1;
+}
+
+static int take_mode(cli *c, const char *name)
+{
+    if (!strcmp(name, "serial"))
+        c->mode = FDT_MODE_SERIAL;
+    else if (!strcmp(name, "shared"))
+        c->mode = FDT_MODE_SHARED;
+    else if (!strcmp(name, "message"))
+        c->mode = FDT_MODE_MESSAGE;
+    else if (!strcmp(name, "auto"))
+        c->mode = FDT_MODE_AUTO;
+    else
+        return usage_error("unknown mode '%s' (serial, shared, message or auto)", name);
+    return -1;
+}
+
+/* The options of the Voronoi and interpolation step (src/cli/dual.h). */
+static int take_dual(fdt_cli_dual *d, int id, const char *v)
+{
+    switch (id) {
+    case FDT_OPT_VORONOI:
+        d->voronoi = v;
+        break;
+    case FDT_OPT_VORONOI_FORMAT:
+        d->format = v;
+        break;
+    case FDT_OPT_DENSITY:
+        d->density = v;
+        break;
+    case FDT_OPT_BOX:
+        if (fdt_cli_parse_box(v, d->box) != 0)
+            return usage_error("--box wants six finite numbers xmin,ymin,zmin,xmax,ymax,zmax "
+                               "with each min below its max, not '%s'", v);
+        d->box_given = 1;
+        break;
+    case FDT_OPT_VALUES:
+        d->values = v;
+        break;
+    case FDT_OPT_INTERPOLATE:
+        d->queries = v;
+        break;
+    case FDT_OPT_INTERPOLATED:
+        d->interpolated = v;
+        break;
+    default: /* FDT_OPT_METHOD */
+        if (strcmp(v, "natural") && strcmp(v, "linear"))
+            return usage_error("--method is natural or linear, not '%s'", v);
+        d->natural = !strcmp(v, "natural");
+        break;
+    }
+    return -1;
+}
+
+/* --help and --version: 0, or 5 when standard output fails. */
+static int help_or_version(int id)
+{
+    if (id == FDT_OPT_HELP)
+        usage(stdout);
+    else
+        printf("frontdt %s (library %s)\n", FDT_VERSION_STRING, fdt_version());
+    /* a help longer than stdio's buffer meets the error in fprintf
+     * already: the stream's error flag keeps it (and errno its reason) */
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        say("stdout: %s", strerror(errno ? errno : EIO));
+        return CLI_WRITE;
+    }
+    return CLI_OK;
+}
+
+/* The options that only switch something on: the field, or NULL. */
+static int *flag_of(cli *c, int id)
+{
+    switch (id) {
+    case FDT_OPT_NO_CLOBBER: return &c->no_clobber;
+    case FDT_OPT_ALL_FACES: return &c->all_faces;
+    case FDT_OPT_DECIMAL_COMMA: return &c->decimal_comma;
+    case FDT_OPT_PIN: return &c->pin;
+    case FDT_OPT_CHECK: return &c->check;
+    case FDT_OPT_STATS: return &c->stats;
+    case FDT_OPT_HASH: return &c->hash;
+    case FDT_OPT_SET_HASH: return &c->set_hash;
+    case FDT_OPT_QUIET: return &c->quiet;
+    case FDT_OPT_PROGRESS: return &c->progress;
+    default: return NULL;
+    }
+}
+
+/* One option of the table's (src/cli/options.h) with its value v (NULL
+ * when it takes none). -1 to go on, or an exit code. */
+static int take_option(cli *c, int id, const char *v)
+{
+    char err[256];
+    unsigned long long n;
+    int *flag = flag_of(c, id);
+    if (flag) {
+        *flag = 1;
+        return -1;
+    }
+    switch (id) {
+    case FDT_OPT_OUTPUT:
+        return take_output(c, v);
+    case FDT_OPT_FORMAT:
+        return take_format(c, v);
+    case FDT_OPT_INPUT_FORMAT:
+        if (fdt_cli_input_format(v, &c->input_format, err, sizeof err) != 0)
+            return usage_error("%s", err);
+        c->input_format_name = v;
+        return -1;
+    case FDT_OPT_COLUMNS:
+        if (parse_columns(v, c->columns) != 0)
+            return usage_error("--columns wants three different column numbers "
+                               "from 1, as 3,4,5, not '%s'", v);
+        return -1;
+    case FDT_OPT_DELIMITER:
+        if (strlen(v) != 1 || !strchr(",; ", v[0]))
+            return usage_error("--delimiter is ',', ';' or ' ' (blanks only), not '%s'", v);
+        c->delimiter = v[0];
+        return -1;
+    case FDT_OPT_MODE:
+        return take_mode(c, v);
+    case FDT_OPT_SEARCH:
+        if (fdt_cli_search(v, &c->search, err, sizeof err) != 0)
+            return usage_error("%s", err);
+        return -1;
+    case FDT_OPT_LEAF:
+        if (fdt_cli_leaf(v, &c->leaf, err, sizeof err) != 0)
+            return usage_error("%s", err);
+        return -1;
+    case FDT_OPT_THREADS:
+        if (parse_count(v, INT_MAX, &n) != 0)
+            return usage_error("--threads wants a count, not '%s'", v);
+        c->threads = (int)n;
+        return -1;
+    case FDT_OPT_STATS_JSON:
+        if (!*v)
+            return usage_error("empty --stats-json file name");
+        c->stats_json = v;
+        return -1;
+    case FDT_OPT_STREAM:
+    case FDT_OPT_NO_STREAM:
+        if (c->stream != 0 && c->stream != (id == FDT_OPT_STREAM ? 1 : -1))
+            return usage_error("--stream and --no-stream together");
+        c->stream = id == FDT_OPT_STREAM ? 1 : -1;
+        return -1;
+    case FDT_OPT_MEMORY_LIMIT:
+        if (parse_bytes(v, &c->memory_limit) != 0)
+            return usage_error("--memory-limit wants a byte count > 0 (suffix K, M or G), "
+                               "not '%s'", v);
+        return -1;
+    case FDT_OPT_DEMO:
+        c->demo = 1;
+        if (v) {
+            if (parse_count(v, SIZE_MAX, &n) != 0)
+                return usage_error("--demo wants a point count, not '%s'", v);
+            c->demo_n = (size_t)n;
+        }
+        return -1;
+    case FDT_OPT_VORONOI:
+    case FDT_OPT_VORONOI_FORMAT:
+    case FDT_OPT_DENSITY:
+    case FDT_OPT_BOX:
+    case FDT_OPT_VALUES:
+    case FDT_OPT_INTERPOLATE:
+    case FDT_OPT_INTERPOLATED:
+    case FDT_OPT_METHOD:
+        return take_dual(&c->dual, id, v);
+    case FDT_OPT_HELP:
+    case FDT_OPT_VERSION:
+        return help_or_version(id);
+    default:
+        say("internal error: option row %d has no parser", id);
+        return CLI_INTERNAL;
+    }
+}
+
+/* What getopt_long refused (ch ':' for a missing value, else '?'). */
+static int bad_option(int ch, char **argv)
+{
+    if (ch == ':') {
+        if (short_opt(argv, optind))
+            return usage_error("option -%c needs a value", optopt);
+        return usage_error("option %s needs a value", argv[optind - 1]);
+    }
+    if (short_opt(argv, optind))
+        return usage_error("unknown option -%c", optopt);
+    return usage_error("unknown, ambiguous or misused option %s", argv[optind - 1]);
+}
+
+/* The input (npos words from pos) and the options that depend on each
+ * other, once all are read. -1 to go on, or an exit code. */
+static int check_args(cli *c, int npos, char **pos)
+{
     /* "-o m.msh --format msh2": a --format after the last -o is that
      * -o's (the others keep their extensions) */
-    if (format_last && c->n_outputs > 0 && !c->out_format[c->n_outputs - 1])
+    if (c->format && c->n_outputs > 0 && !c->out_format[c->n_outputs - 1])
         c->out_format[c->n_outputs - 1] = c->format;
-    int npos = argc - optind;
     if (c->demo) {
         if (npos > 0)
-            return usage_error("--demo takes no input file (got '%s')",
-                               argv[optind]);
+            return usage_error("--demo takes no input file (got '%s')", pos[0]);
     } else {
         if (npos == 0)
             return usage_error("no input file");
         if (npos > 1)
-            return usage_error("one input file only (got '%s' and '%s')",
-                               argv[optind], argv[optind + 1]);
-        c->input = argv[optind];
+            return usage_error("one input file only (got '%s' and '%s')", pos[0], pos[1]);
+        c->input = pos[0];
         /* "-" has no extension to go by; a format without columns cannot
          * take --columns. Both refused before anything is read. */
         int fmt = c->input_format != FDT_RD_AUTO ? c->input_format
@@ -643,6 +560,29 @@ static int parse_args(int argc, char **argv, cli *c)
                            sizeof derr) != 0)
         return usage_error("%s", derr);
     return -1;
+}
+
+/* Returns -1 to go on, or an exit code (0 after --help/--version). */
+static int parse_args(int argc, char **argv, cli *c)
+{
+    memset(c, 0, sizeof *c);
+    c->mode = FDT_MODE_AUTO;
+    c->threads = -1;
+    c->dual.natural = 1;
+    c->demo_n = FDT_CLI_DEMO_POINTS;
+    struct option longs[FDT_OPT_END + 1];
+    char shorts[2 * FDT_OPT_END + 2];
+    fdt_cli_getopt_args(FDT_CLI_FRONTDT, longs, shorts);
+    opterr = 0; /* we print our own messages */
+    optind = 1;
+    int ch;
+    while ((ch = getopt_long(argc, argv, shorts, longs, NULL)) != -1) {
+        int id = fdt_cli_getopt_id(ch);
+        int code = id < 0 ? bad_option(ch, argv) : take_option(c, id, optarg);
+        if (code >= 0)
+            return code;
+    }
+    return check_args(c, argc - optind, argv + optind);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -1366,6 +1306,7 @@ static int run(const cli *c)
     fdt_default_settings(&s);
     s.mode = c->mode;
     s.search = c->search;
+    s.leaf_size = c->leaf;
     if (c->threads >= 0)
         s.n_threads = c->threads;
     s.pin = c->pin;
