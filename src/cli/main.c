@@ -1149,133 +1149,145 @@ static unsigned long long peak_rss_bytes(void)
     return (unsigned long long)ru.ru_maxrss * 1024ull; /* Linux: KiB */
 }
 
-static int run(const cli *c)
-{
-    int code = CLI_OK;
-    double *xyz = NULL;
-    size_t n = 0;
-    fdt_context *ctx = NULL;
-    fdt_result *res = NULL;
-    timings tm = { 0 };
-    const char *name = !c->input ? "demo" : strcmp(c->input, "-") ? c->input : "stdin";
-    /* The progress line (src/cli/progress.h): on a terminal, or asked for. */
-    progress prog;
-    progress_init(&prog, !c->quiet && (c->progress || isatty(STDERR_FILENO)));
-    int json_stdout = c->stats_json && !strcmp(c->stats_json, "-");
-    /* stdout carries the JSON object alone when asked to. */
-    FILE *info = json_stdout ? stderr : stdout;
+/* What the run's steps hand on to each other. */
+typedef struct run_state {
+    const char *name;     /* the input in messages: its path, "stdin" or "demo" */
+    progress prog;        /* the progress line (src/cli/progress.h) */
+    int json_stdout;      /* "--stats-json -" */
+    FILE *info;           /* the summary and the hashes: stdout, unless the
+                             JSON object or the mesh claims it */
+    const fdt_format *fmts[MAX_OUTPUTS]; /* each -o's format */
+    int need;             /* FDT_NEED_* of all the outputs */
+    int to_stdout;        /* an -o - */
+    int streaming;        /* the tets go to the outputs as they are built */
+    double *xyz;          /* the points (owned), n of them */
+    size_t n;
+    fdt_context *ctx;
+    fdt_result *res;
+    fanout fo;            /* a streamed run's writers */
+    unsigned long long estimate; /* memory_estimate's bytes */
+    size_t nt;            /* tets made */
+    size_t dups;          /* duplicate points merged */
+    uint64_t hash, set_hash;
+    timings tm;
+} run_state;
 
-    /* Refuse doomed or destructive outputs before reading or computing
-     * anything: each -o's format, its files against the input, the
-     * --stats-json file and every other -o's files. */
-    const fdt_format *fmts[MAX_OUTPUTS];
-    int need = 0, to_stdout = 0;
-    for (int o = 0; o < c->n_outputs; o++) {
-        const char *out = c->outputs[o];
-        if (!strcmp(out, "-")) {
-            /* standard output: text only, the canonical .tets by default */
-            fmts[o] = fdt_format_by_name(c->out_format[o] ? c->out_format[o] : "tets");
-            if (!fdt_format_is_text(fmts[o]) || !strcmp(fdt_format_name(fmts[o]), "tetgen") ||
-                !strcmp(fdt_format_name(fmts[o]), "openfoam"))
-                return usage_error("-o -: format %s cannot go to standard output "
-                                   "(one text file only: tets, vtk, msh, msh2, medit)",
-                                   fdt_format_name(fmts[o]));
-            if (json_stdout)
-                return usage_error("-o - and --stats-json - both want standard output");
-            to_stdout = 1;
-            need |= fdt_format_needs(fmts[o], c->all_faces);
+/* Refuses one -o's doomed or destructive output before anything is read:
+ * its format, its files against the input, the --stats-json file and the
+ * earlier -o's files. CLI_OK, or the exit code. */
+static int plan_output(const cli *c, run_state *rs, int o)
+{
+    const fdt_format **fmts = rs->fmts;
+    const char *out = c->outputs[o];
+    if (!strcmp(out, "-")) {
+        /* standard output: text only, the canonical .tets by default */
+        fmts[o] = fdt_format_by_name(c->out_format[o] ? c->out_format[o] : "tets");
+        if (!fdt_format_is_text(fmts[o]) || !strcmp(fdt_format_name(fmts[o]), "tetgen") ||
+            !strcmp(fdt_format_name(fmts[o]), "openfoam"))
+            return usage_error("-o -: format %s cannot go to standard output "
+                               "(one text file only: tets, vtk, msh, msh2, medit)",
+                               fdt_format_name(fmts[o]));
+        if (rs->json_stdout)
+            return usage_error("-o - and --stats-json - both want standard output");
+        rs->to_stdout = 1;
+        rs->need |= fdt_format_needs(fmts[o], c->all_faces);
+        return CLI_OK;
+    }
+    fmts[o] = c->out_format[o] ? fdt_format_by_name(c->out_format[o]) : fdt_format_by_path(out);
+    if (!fmts[o])
+        return usage_error("%s: unknown output format (use %s, or --format)", out,
+                           fdt_format_list());
+    /* "-o m.vtu --format msh2" would write gmsh into m.vtu */
+    const fdt_format *by_ext = fdt_format_contradicted(out, fmts[o]);
+    if (by_ext)
+        return usage_error("--format %s contradicts the extension of %s (%s)",
+                           fdt_format_name(fmts[o]), out, fdt_format_name(by_ext));
+    rs->need |= fdt_format_needs(fmts[o], c->all_faces);
+    char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+    int n_names = fdt_output_files_as(out, fmts[o], names);
+    if (n_names <= 0) {
+        say("%s: %s", out, strerror(ENAMETOOLONG));
+        return CLI_WRITE;
+    }
+    int code = refuse_overwrites(c, out, names, n_names);
+    if (code >= 0)
+        return code;
+    code = refuse_clobber(c, out, names, n_names);
+    if (code >= 0)
+        return code;
+    for (int p = 0; p < o; p++) {
+        if (!strcmp(c->outputs[p], "-"))
             continue;
-        }
-        fmts[o] = c->out_format[o] ? fdt_format_by_name(c->out_format[o])
-                                   : fdt_format_by_path(out);
-        if (!fmts[o])
-            return usage_error("%s: unknown output format (use %s, or --format)", out,
-                               fdt_format_list());
-        /* "-o m.vtu --format msh2" would write gmsh into m.vtu */
-        const fdt_format *by_ext = fdt_format_contradicted(out, fmts[o]);
-        if (by_ext)
-            return usage_error("--format %s contradicts the extension of %s (%s)",
-                               fdt_format_name(fmts[o]), out, fdt_format_name(by_ext));
-        need |= fdt_format_needs(fmts[o], c->all_faces);
-        char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
-        int n_names = fdt_output_files_as(out, fmts[o], names);
-        if (n_names <= 0) {
-            say("%s: %s", out, strerror(ENAMETOOLONG));
-            return CLI_WRITE;
-        }
-        code = refuse_overwrites(c, out, names, n_names);
-        if (code >= 0)
-            return code;
-        code = refuse_clobber(c, out, names, n_names);
-        if (code >= 0)
-            return code;
-        for (int p = 0; p < o; p++) {
-            if (!strcmp(c->outputs[p], "-"))
-                continue;
-            char other[FDT_IO_MAX_FILES][FDT_IO_PATH];
-            int k = fdt_output_files_as(c->outputs[p], fmts[p], other);
-            for (int i = 0; i < n_names; i++)
-                for (int j = 0; j < k; j++)
-                    if (fdt_same_file(names[i], other[j])) {
-                        say("output %s (-o %s) is also written by -o %s", names[i], out,
-                            c->outputs[p]);
-                        return CLI_USAGE;
-                    }
-        }
-        /* a directory format's path may be an existing directory: then
-         * its files are what must be creatable */
-        struct stat dst;
-        const char *probe = fmts[o] == fdt_format_by_name("openfoam") &&
-                                    stat(out, &dst) == 0 && S_ISDIR(dst.st_mode)
-                                ? names[0]
-                                : out;
-        if (!output_dir_ok("output", probe))
-            return CLI_WRITE;
+        char other[FDT_IO_MAX_FILES][FDT_IO_PATH];
+        int k = fdt_output_files_as(c->outputs[p], fmts[p], other);
+        for (int i = 0; i < n_names; i++)
+            for (int j = 0; j < k; j++)
+                if (fdt_same_file(names[i], other[j])) {
+                    say("output %s (-o %s) is also written by -o %s", names[i], out,
+                        c->outputs[p]);
+                    return CLI_USAGE;
+                }
     }
-    {
-        char none[1][FDT_IO_PATH];
-        code = refuse_overwrites(c, "", none, 0); /* --stats-json vs the input */
-        if (code >= 0)
+    /* a directory format's path may be an existing directory: then its
+     * files are what must be creatable */
+    struct stat dst;
+    const char *probe = fmts[o] == fdt_format_by_name("openfoam") && stat(out, &dst) == 0 &&
+                                S_ISDIR(dst.st_mode)
+                            ? names[0]
+                            : out;
+    if (!output_dir_ok("output", probe))
+        return CLI_WRITE;
+    return CLI_OK;
+}
+
+/* Refuses doomed or destructive outputs before reading or computing
+ * anything (each -o, the --stats-json file) and settles where things go:
+ * streamed or not, the summary on stdout or stderr. CLI_OK, or the exit
+ * code. */
+static int plan_outputs(const cli *c, run_state *rs)
+{
+    for (int o = 0; o < c->n_outputs; o++) {
+        int code = plan_output(c, rs, o);
+        if (code != CLI_OK)
             return code;
     }
+    char none[1][FDT_IO_PATH];
+    int code = refuse_overwrites(c, "", none, 0); /* --stats-json vs the input */
+    if (code >= 0)
+        return code;
     /* Stream (the tets go to the files as they are built) when asked, or
      * when every output can and nothing needs the mesh. */
     char why[FDT_IO_PATH + 200];
-    const char *refusal = stream_refusal(c, fmts, c->stream > 0, why, sizeof why);
+    const char *refusal = stream_refusal(c, rs->fmts, c->stream > 0, why, sizeof why);
     if (c->stream > 0 && refusal)
         return usage_error("--stream: %s", refusal);
-    int streaming = c->stream > 0 || (c->stream == 0 && !refusal && c->n_outputs > 0);
-    code = CLI_OK;
-    if (c->stats_json && !json_stdout && !output_dir_ok("--stats-json file", c->stats_json))
+    rs->streaming = c->stream > 0 || (c->stream == 0 && !refusal && c->n_outputs > 0);
+    if (c->stats_json && !rs->json_stdout &&
+        !output_dir_ok("--stats-json file", c->stats_json))
         return CLI_WRITE;
-    /* a device or a pipe is written in place, not replaced (below) */
+    /* a device or a pipe is written in place, not replaced (write_stats) */
     struct stat jst0;
-    if (c->no_clobber && c->stats_json && !json_stdout && lstat(c->stats_json, &jst0) == 0 &&
+    if (c->no_clobber && c->stats_json && !rs->json_stdout && lstat(c->stats_json, &jst0) == 0 &&
         (stat(c->stats_json, &jst0) != 0 || S_ISREG(jst0.st_mode))) {
         say("--stats-json file %s exists; --no-clobber keeps it", c->stats_json);
         return CLI_WRITE;
     }
     /* the summary goes to stderr when the mesh goes to stdout */
-    if (to_stdout)
-        info = stderr;
-    /* Every file output of the run (the meshes, streamed or not, and the
-     * --stats-json file) waits complete in its temporary until all are,
-     * then all are renamed together (fdt_wr_set_commit, below): all new,
-     * or, after any failure or signal, all as they were. */
-    if (fdt_wr_set_begin(c->no_clobber) != 0) {
-        say("internal error: a commit set is already open");
-        return CLI_INTERNAL;
-    }
+    if (rs->to_stdout)
+        rs->info = stderr;
+    return CLI_OK;
+}
 
-    /* Points. */
+/* The points: --demo's, or the input file's. */
+static int read_points(const cli *c, run_state *rs)
+{
     double t0 = fdt_now_s();
     if (c->demo) {
-        n = c->demo_n;
-        xyz = demo_points(n);
-        if (!xyz) {
-            say("demo: no memory for %zu points", n);
-            code = CLI_RESOURCES;
-            goto done;
+        rs->n = c->demo_n;
+        rs->xyz = demo_points(rs->n);
+        if (!rs->xyz) {
+            say("demo: no memory for %zu points", rs->n);
+            return CLI_RESOURCES;
         }
     } else {
         char err[1024];
@@ -1286,22 +1298,26 @@ static int run(const cli *c)
         ro.delimiter = c->delimiter;
         ro.decimal_comma = c->decimal_comma;
         ro.n_threads = reader_threads(c);
-        if (prog.enabled) {
+        if (rs->prog.enabled) {
             ro.progress = progress_io;
-            ro.progress_user = &prog;
+            ro.progress_user = &rs->prog;
         }
-        progress_phase(&prog, "read");
-        int r = fdt_read_points_opts(c->input, &ro, &xyz, &n, err, sizeof err);
-        progress_clear(&prog);
+        progress_phase(&rs->prog, "read");
+        int r = fdt_read_points_opts(c->input, &ro, &rs->xyz, &rs->n, err, sizeof err);
+        progress_clear(&rs->prog);
         if (r != FDT_OK) {
             say("%s", err);
-            code = exit_for_reader(r);
-            goto done;
+            return exit_for_reader(r);
         }
     }
-    tm.read = fdt_now_s() - t0;
+    rs->tm.read = fdt_now_s() - t0;
+    return CLI_OK;
+}
 
-    /* Triangulation. */
+/* The library's settings for this run, and its memory estimate against
+ * --memory-limit; then the context. */
+static int open_engine(const cli *c, run_state *rs)
+{
     fdt_settings s;
     fdt_default_settings(&s);
     s.mode = c->mode;
@@ -1310,281 +1326,316 @@ static int run(const cli *c)
     if (c->threads >= 0)
         s.n_threads = c->threads;
     s.pin = c->pin;
-    s.neighbors = !streaming && (c->check || (need & FDT_NEED_NBRS));
-    if (prog.enabled) {
+    s.neighbors = !rs->streaming && (c->check || (rs->need & FDT_NEED_NBRS));
+    if (rs->prog.enabled) {
         s.progress = progress_engine;
-        s.progress_user = &prog;
+        s.progress_user = &rs->prog;
     }
     /* A streamed run prepares the points in the array we read them into
      * (the writers took what they need of it when they were opened,
-     * below, before the run): the points are stored once. */
-    s.permute_input = streaming;
+     * before the run): the points are stored once. */
+    s.permute_input = rs->streaming;
     int run_threads = c->mode == FDT_MODE_SERIAL ? 1
                       : c->threads > 0           ? c->threads
                                                  : (int)sysconf(_SC_NPROCESSORS_ONLN);
-    unsigned long long estimate = memory_estimate(n, streaming, run_threads, s.neighbors,
-                                                  fdt_engine_one_part(&s, streaming));
-    if (c->memory_limit && estimate > c->memory_limit) {
+    rs->estimate = memory_estimate(rs->n, rs->streaming, run_threads, s.neighbors,
+                                   fdt_engine_one_part(&s, rs->streaming));
+    if (c->memory_limit && rs->estimate > c->memory_limit) {
         say("%s: %zu points need about %llu MiB (%s%s), more than --memory-limit %llu MiB",
-            name, n, estimate >> 20, streaming ? "streamed" : "in memory",
+            rs->name, rs->n, rs->estimate >> 20, rs->streaming ? "streamed" : "in memory",
             s.neighbors ? ", with neighbours" : "", c->memory_limit >> 20);
-        code = CLI_RESOURCES;
-        goto done;
+        return CLI_RESOURCES;
     }
-    int r = fdt_open(&ctx, &s);
+    int r = fdt_open(&rs->ctx, &s);
     if (r != FDT_OK) {
         say("cannot use these settings: %s", fdt_strerror(r));
-        code = exit_for_engine(r);
-        goto done;
+        return exit_for_engine(r);
     }
-    fanout fo;
-    memset(&fo, 0, sizeof fo);
-    fo.failed = -1;
-    if (streaming) {
-        for (int o = 0; o < c->n_outputs; o++) {
-            char err[1024];
-            r = fdt_stream_writer_open(&fo.w[o], c->outputs[o], fdt_format_name(fmts[o]), xyz,
-                                       n, 0, err, sizeof err);
-            if (r != FDT_OK) {
-                say("%s", err);
-                (void)fanout_close(&fo, 0);
-                code = exit_for_writer(r);
-                goto done;
-            }
-            fo.n = o + 1;
-            (void)fdt_stream_writer_sink(fo.w[o], &fo.sink[o]);
+    return CLI_OK;
+}
+
+/* A streamed run's writers, one an -o, opened before the run. */
+static int open_stream_writers(const cli *c, run_state *rs)
+{
+    fanout *fo = &rs->fo;
+    for (int o = 0; o < c->n_outputs; o++) {
+        char err[1024];
+        int r = fdt_stream_writer_open(&fo->w[o], c->outputs[o], fdt_format_name(rs->fmts[o]),
+                                       rs->xyz, rs->n, 0, err, sizeof err);
+        if (r != FDT_OK) {
+            say("%s", err);
+            (void)fanout_close(fo, 0);
+            return exit_for_writer(r);
         }
+        fo->n = o + 1;
+        (void)fdt_stream_writer_sink(fo->w[o], &fo->sink[o]);
     }
-    t0 = fdt_now_s();
-    progress_phase(&prog, "merge"); /* "triangulate" at the library's first report */
-    if (streaming) {
-        fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &fo};
-        r = fdt_triangulate_stream(ctx, xyz, n, &sink, &res);
+    return CLI_OK;
+}
+
+/* The library's run: the mesh in memory, or streamed to the writers. */
+static int triangulate(const cli *c, run_state *rs)
+{
+    int code = open_engine(c, rs);
+    if (code != CLI_OK)
+        return code;
+    rs->fo.failed = -1;
+    if (rs->streaming && (code = open_stream_writers(c, rs)) != CLI_OK)
+        return code;
+    double t0 = fdt_now_s();
+    progress_phase(&rs->prog, "merge"); /* "triangulate" at the library's first report */
+    int r;
+    if (rs->streaming) {
+        fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &rs->fo};
+        r = fdt_triangulate_stream(rs->ctx, rs->xyz, rs->n, &sink, &rs->res);
     } else {
-        r = fdt_triangulate(ctx, xyz, n, &res);
+        r = fdt_triangulate(rs->ctx, rs->xyz, rs->n, &rs->res);
     }
-    tm.triangulate = fdt_now_s() - t0;
-    progress_clear(&prog);
-    if (streaming) {
+    rs->tm.triangulate = fdt_now_s() - t0;
+    progress_clear(&rs->prog);
+    if (rs->streaming) {
         /* the writers end with the run: committed (counts patched, all
          * renamed) after a whole run, removed after a failed one */
         t0 = fdt_now_s();
-        int wcode = fanout_close(&fo, r == FDT_OK);
-        tm.write = fdt_now_s() - t0;
-        if (fo.failed >= 0) {
-            code = wcode; /* the run stopped for the writer's error */
-            goto done;
-        }
-        if (r == FDT_OK && wcode != CLI_OK) {
-            code = wcode;
-            goto done;
-        }
+        int wcode = fanout_close(&rs->fo, r == FDT_OK);
+        rs->tm.write = fdt_now_s() - t0;
+        if (rs->fo.failed >= 0)
+            return wcode; /* the run stopped for the writer's error */
+        if (r == FDT_OK && wcode != CLI_OK)
+            return wcode;
     }
     if (r != FDT_OK) {
-        const char *diag = fdt_context_diagnostic(ctx);
-        say("%s: %s", name, diag && *diag ? diag : fdt_strerror(r));
-        code = exit_for_engine(r);
-        goto done;
+        const char *diag = fdt_context_diagnostic(rs->ctx);
+        say("%s: %s", rs->name, diag && *diag ? diag : fdt_strerror(r));
+        return exit_for_engine(r);
     }
     /* No engine threads may outlive this point: the signal handler then
      * runs on the thread that is writing, never beside it. */
-    fdt_close(&ctx);
+    fdt_close(&rs->ctx);
 
-    size_t dups = fdt_result_num_duplicates(res);
-    if (dups > 0 && !c->quiet)
-        say("%s: merged %zu duplicate points", name, dups);
+    rs->dups = fdt_result_num_duplicates(rs->res);
+    if (rs->dups > 0 && !c->quiet)
+        say("%s: merged %zu duplicate points", rs->name, rs->dups);
     /* --pin where the system refuses a binding (or hwloc is missing): the
      * run went on unpinned, which the user who asked should hear once. */
     fdt_stats pst;
-    if (c->pin && !c->quiet && fdt_result_stats(res, &pst) == FDT_OK && pst.pinned < 0)
+    if (c->pin && !c->quiet && fdt_result_stats(rs->res, &pst) == FDT_OK && pst.pinned < 0)
         say("--pin: a thread could not be bound to its core; ran unpinned");
+    rs->nt = rs->streaming ? (size_t)rs->fo.tets : fdt_result_num_tets(rs->res);
+    return CLI_OK;
+}
 
-    size_t nt = streaming ? (size_t)fo.tets : fdt_result_num_tets(res);
-    if (c->check) {
-        char msg[1024];
-        t0 = fdt_now_s();
-        progress_phase(&prog, "check");
-        r = fdt_check(xyz, n, fdt_result_tets(res), nt,
-                      fdt_result_neighbors(res), msg, sizeof msg);
-        progress_clear(&prog);
-        tm.check = fdt_now_s() - t0;
-        if (r != FDT_OK) {
-            if (r == FDT_ECHECK)
-                say("%s: check failed: %s", name, msg);
-            else
-                say("%s: check could not run: %s", name, fdt_strerror(r));
-            code = exit_for_engine(r);
-            goto done;
-        }
+/* --check: the mesh against the definition, exactly. */
+static int check_mesh(const cli *c, run_state *rs)
+{
+    if (!c->check)
+        return CLI_OK;
+    char msg[1024];
+    double t0 = fdt_now_s();
+    progress_phase(&rs->prog, "check");
+    int r = fdt_check(rs->xyz, rs->n, fdt_result_tets(rs->res), rs->nt,
+                      fdt_result_neighbors(rs->res), msg, sizeof msg);
+    progress_clear(&rs->prog);
+    rs->tm.check = fdt_now_s() - t0;
+    if (r != FDT_OK) {
+        if (r == FDT_ECHECK)
+            say("%s: check failed: %s", rs->name, msg);
+        else
+            say("%s: check could not run: %s", rs->name, fdt_strerror(r));
+        return exit_for_engine(r);
     }
+    return CLI_OK;
+}
 
-    /* The canonical order makes .tets and the hash independent of thread
-     * count and mode; the other formats do not need it. */
-    t0 = fdt_now_s();
-    uint64_t hash = 0, set_hash = 0;
+/* The hashes, and the canonical order: it makes .tets and the hash
+ * independent of thread count and mode; the other formats do not need
+ * it. */
+static int canonical_order(const cli *c, run_state *rs)
+{
+    double t0 = fdt_now_s();
     if (c->set_hash)
-        (void)fdt_result_set_hash(res, &set_hash); /* res is not NULL: cannot fail */
-    if (c->hash || (need & FDT_NEED_SORTED))
-        progress_phase(&prog, "sort");
+        (void)fdt_result_set_hash(rs->res, &rs->set_hash); /* res is not NULL: cannot fail */
+    if (c->hash || (rs->need & FDT_NEED_SORTED))
+        progress_phase(&rs->prog, "sort");
     if (c->hash) {
         /* sorts too, hashing each part of the sort while it is in cache */
-        r = fdt_result_hash(res, &hash);
-        progress_clear(&prog);
+        int r = fdt_result_hash(rs->res, &rs->hash);
+        progress_clear(&rs->prog);
         if (r != FDT_OK) {
-            say("%s: sorting and hashing the tets failed: %s", name, fdt_strerror(r));
-            code = exit_for_engine(r);
-            goto done;
+            say("%s: sorting and hashing the tets failed: %s", rs->name, fdt_strerror(r));
+            return exit_for_engine(r);
         }
-    } else if (need & FDT_NEED_SORTED) {
-        r = fdt_result_sort(res);
-        progress_clear(&prog);
+    } else if (rs->need & FDT_NEED_SORTED) {
+        int r = fdt_result_sort(rs->res);
+        progress_clear(&rs->prog);
         if (r != FDT_OK) {
-            say("%s: sorting the tets failed: %s", name, fdt_strerror(r));
-            code = exit_for_engine(r);
-            goto done;
+            say("%s: sorting the tets failed: %s", rs->name, fdt_strerror(r));
+            return exit_for_engine(r);
         }
     }
-    progress_clear(&prog);
-    tm.canon = fdt_now_s() - t0;
+    progress_clear(&rs->prog);
+    rs->tm.canon = fdt_now_s() - t0;
+    return CLI_OK;
+}
 
-    if (c->n_outputs > 0 && !streaming) {
-        t0 = fdt_now_s();
-        char err[1024];
-        /* The public writer computes the face list where a format needs
-         * it (after the sort above: it names tets by their numbers) and
-         * reports its bytes (progress_io: the write phase moves). */
-        fdt_write_options wo;
-        fdt_default_write_options(&wo);
-        wo.all_faces = c->all_faces;
-        if (prog.enabled) {
-            wo.progress = progress_io;
-            wo.progress_user = &prog;
-        }
-        progress_phase(&prog, "write");
-        for (int o = 0; o < c->n_outputs; o++) {
-            wo.format = fdt_format_name(fmts[o]);
-            r = fdt_write_mesh_opts(res, xyz, n, c->outputs[o], &wo, err, sizeof err);
-            if (r != FDT_OK) {
-                progress_clear(&prog);
-                say("%s", err);
-                code = exit_for_writer(r);
-                tm.write = fdt_now_s() - t0;
-                goto done;
-            }
-        }
-        progress_clear(&prog);
-        tm.write = fdt_now_s() - t0;
+/* Every -o of a run in memory (a streamed run wrote them as it went). */
+static int write_meshes(const cli *c, run_state *rs)
+{
+    if (c->n_outputs == 0 || rs->streaming)
+        return CLI_OK;
+    double t0 = fdt_now_s();
+    char err[1024];
+    /* The public writer computes the face list where a format needs it
+     * (after the sort above: it names tets by their numbers) and reports
+     * its bytes (progress_io: the write phase moves). */
+    fdt_write_options wo;
+    fdt_default_write_options(&wo);
+    wo.all_faces = c->all_faces;
+    if (rs->prog.enabled) {
+        wo.progress = progress_io;
+        wo.progress_user = &rs->prog;
     }
+    progress_phase(&rs->prog, "write");
+    int code = CLI_OK;
+    for (int o = 0; o < c->n_outputs && code == CLI_OK; o++) {
+        wo.format = fdt_format_name(rs->fmts[o]);
+        int r = fdt_write_mesh_opts(rs->res, rs->xyz, rs->n, c->outputs[o], &wo, err, sizeof err);
+        if (r != FDT_OK) {
+            progress_clear(&rs->prog);
+            say("%s", err);
+            code = exit_for_writer(r);
+        }
+    }
+    progress_clear(&rs->prog);
+    rs->tm.write = fdt_now_s() - t0;
+    return code;
+}
 
+/* The Voronoi cells and the interpolation (src/cli/dual.h), each when
+ * asked. */
+static int dual_steps(const cli *c, run_state *rs)
+{
+    char derr[FDT_IO_PATH + 600];
     if (fdt_cli_dual_wanted(&c->dual)) {
-        t0 = fdt_now_s();
-        char derr[FDT_IO_PATH + 600];
-        progress_phase(&prog, "voronoi");
-        r = fdt_cli_dual_write(&c->dual, res, xyz, n, derr, sizeof derr);
-        progress_clear(&prog);
-        tm.voronoi = fdt_now_s() - t0;
+        double t0 = fdt_now_s();
+        progress_phase(&rs->prog, "voronoi");
+        int r = fdt_cli_dual_write(&c->dual, rs->res, rs->xyz, rs->n, derr, sizeof derr);
+        progress_clear(&rs->prog);
+        rs->tm.voronoi = fdt_now_s() - t0;
         if (r != FDT_OK) {
-            say("%s: %s", name, derr);
-            code = exit_for_dual(r);
-            goto done;
+            say("%s: %s", rs->name, derr);
+            return exit_for_dual(r);
         }
     }
     if (fdt_cli_interp_wanted(&c->dual)) {
-        t0 = fdt_now_s();
-        char derr[FDT_IO_PATH + 600];
-        progress_phase(&prog, "interpolate");
-        r = fdt_cli_interp_write(&c->dual, res, xyz, n, derr, sizeof derr);
-        progress_clear(&prog);
-        tm.interpolate = fdt_now_s() - t0;
+        double t0 = fdt_now_s();
+        progress_phase(&rs->prog, "interpolate");
+        int r = fdt_cli_interp_write(&c->dual, rs->res, rs->xyz, rs->n, derr, sizeof derr);
+        progress_clear(&rs->prog);
+        rs->tm.interpolate = fdt_now_s() - t0;
         if (r != FDT_OK) {
             say("%s", derr);
-            code = exit_for_dual(r);
-            goto done;
+            return exit_for_dual(r);
         }
     }
+    return CLI_OK;
+}
 
+/* --stats-json's object to its file or stdout. A file goes through a
+ * temporary renamed at the end, as the mesh does: a failed or interrupted
+ * write leaves what was there. A device or a pipe (named, or reached
+ * through a link) is written in place: renaming over it would replace a
+ * /dev node or a FIFO someone reads with a plain file. */
+static int write_stats_file(const cli *c, run_state *rs, const fdt_stats *st)
+{
+    char jerr[1024];
+    fdt_wr_side *side = NULL;
+    struct stat jst;
+    int json_stdout = rs->json_stdout;
+    int in_place = json_stdout || (stat(c->stats_json, &jst) == 0 && !S_ISREG(jst.st_mode));
+    FILE *f = json_stdout ? stdout
+              : in_place  ? fopen(c->stats_json, "w")
+                          : fdt_wr_side_open(c->stats_json, &side, jerr, sizeof jerr);
+    if (!f) {
+        if (in_place)
+            say("%s: %s", c->stats_json, strerror(errno));
+        else
+            say("%s", jerr);
+        return CLI_WRITE;
+    }
+    errno = 0;
+    write_stats_json(f, c, rs->res, st, rs->dups, &rs->tm, c->hash, rs->hash);
+    int e = ferror(f) ? (errno ? errno : EIO) : 0;
+    if (in_place) {
+        if ((json_stdout ? fflush(f) : fclose(f)) != 0 && !e)
+            e = errno ? errno : EIO;
+        if (e) {
+            say("%s: %s", json_stdout ? "stdout" : c->stats_json, strerror(e));
+            return CLI_WRITE;
+        }
+    } else if (e) {
+        fdt_wr_side_abandon(side);
+        say("%s: %s", c->stats_json, strerror(e));
+        return CLI_WRITE;
+    } else if (fdt_wr_side_commit(side, jerr, sizeof jerr) != FDT_IO_OK) {
+        say("%s", jerr);
+        return CLI_WRITE;
+    }
+    return CLI_OK;
+}
+
+/* --stats on stderr, --stats-json to its file. */
+static int write_stats(const cli *c, run_state *rs)
+{
     fdt_stats st;
     memset(&st, 0, sizeof st);
-    r = fdt_result_stats(res, &st);
+    int r = fdt_result_stats(rs->res, &st);
     if (r != FDT_OK && (c->stats || c->stats_json)) {
-        say("%s: no statistics: %s", name, fdt_strerror(r));
-        code = exit_for_engine(r);
-        goto done;
+        say("%s: no statistics: %s", rs->name, fdt_strerror(r));
+        return exit_for_engine(r);
     }
     if (c->stats) {
-        print_stats(res, &st, dups, &tm);
-        print_memory(&st, n, estimate, peak_rss_bytes());
+        print_stats(rs->res, &st, rs->dups, &rs->tm);
+        print_memory(&st, rs->n, rs->estimate, peak_rss_bytes());
     }
-    if (c->stats_json) {
-        /* A file goes through a temporary renamed at the end, as the
-         * mesh does: a failed or interrupted write leaves what was there.
-         * A device or a pipe (named, or reached through a link) is
-         * written in place: renaming over it would replace a /dev node
-         * or a FIFO someone reads with a plain file. */
-        char jerr[1024];
-        fdt_wr_side *side = NULL;
-        struct stat jst;
-        int in_place = json_stdout || (stat(c->stats_json, &jst) == 0 && !S_ISREG(jst.st_mode));
-        FILE *f = json_stdout ? stdout
-                  : in_place  ? fopen(c->stats_json, "w")
-                              : fdt_wr_side_open(c->stats_json, &side, jerr, sizeof jerr);
-        if (!f) {
-            if (in_place)
-                say("%s: %s", c->stats_json, strerror(errno));
-            else
-                say("%s", jerr);
-            code = CLI_WRITE;
-            goto done;
-        }
-        errno = 0;
-        write_stats_json(f, c, res, &st, dups, &tm, c->hash, hash);
-        int e = ferror(f) ? (errno ? errno : EIO) : 0;
-        if (in_place) {
-            if ((json_stdout ? fflush(f) : fclose(f)) != 0 && !e)
-                e = errno ? errno : EIO;
-            if (e) {
-                say("%s: %s", json_stdout ? "stdout" : c->stats_json, strerror(e));
-                code = CLI_WRITE;
-                goto done;
-            }
-        } else if (e) {
-            fdt_wr_side_abandon(side);
-            say("%s: %s", c->stats_json, strerror(e));
-            code = CLI_WRITE;
-            goto done;
-        } else if (fdt_wr_side_commit(side, jerr, sizeof jerr) != FDT_IO_OK) {
-            say("%s", jerr);
-            code = CLI_WRITE;
-            goto done;
-        }
-    }
+    return c->stats_json ? write_stats_file(c, rs, &st) : CLI_OK;
+}
 
-    {
-        char cerr[FDT_IO_PATH + 300];
-        if (fdt_wr_set_commit(cerr, sizeof cerr) != FDT_IO_OK) {
-            say("%s", cerr);
-            code = CLI_WRITE;
-            goto done;
-        }
+/* Every file of the run, complete in its temporary, renamed over its name
+ * at once (fdt_wr_set_commit). */
+static int commit_outputs(const cli *c, run_state *rs)
+{
+    (void)c;
+    (void)rs;
+    char cerr[FDT_IO_PATH + 300];
+    if (fdt_wr_set_commit(cerr, sizeof cerr) != FDT_IO_OK) {
+        say("%s", cerr);
+        return CLI_WRITE;
     }
+    return CLI_OK;
+}
 
+/* The hashes and, unless --quiet, the summary. */
+static int print_summary(const cli *c, run_state *rs)
+{
+    FILE *info = rs->info;
     if (c->hash)
-        fprintf(info, "hash: %016" PRIx64 "\n", hash);
+        fprintf(info, "hash: %016" PRIx64 "\n", rs->hash);
     if (c->set_hash)
-        fprintf(info, "set-hash: %016" PRIx64 "\n", set_hash);
+        fprintf(info, "set-hash: %016" PRIx64 "\n", rs->set_hash);
     if (!c->quiet) {
-        size_t nh = streaming ? (size_t)fo.hull : fdt_result_num_hull_faces(res);
+        size_t nh = rs->streaming ? (size_t)rs->fo.hull : fdt_result_num_hull_faces(rs->res);
         if (c->demo)
-            fprintf(info, "demo: %zu random points in the unit cube\n", n);
+            fprintf(info, "demo: %zu random points in the unit cube\n", rs->n);
         else
             fprintf(info, "input: %s\n", c->input);
-        fprintf(info, "points: %zu", n);
-        if (dups)
-            fprintf(info, " (%zu duplicates merged)", dups);
-        fprintf(info, "\ntets: %zu\nhull faces: %zu\n", nt, nh);
-        fprintf(info, "time: %.3f s\n", tm.triangulate);
+        fprintf(info, "points: %zu", rs->n);
+        if (rs->dups)
+            fprintf(info, " (%zu duplicates merged)", rs->dups);
+        fprintf(info, "\ntets: %zu\nhull faces: %zu\n", rs->nt, nh);
+        fprintf(info, "time: %.3f s\n", rs->tm.triangulate);
         fprintf(info, "tets/s: %.0f\n",
-                tm.triangulate > 0 ? (double)nt / tm.triangulate : 0.0);
+                rs->tm.triangulate > 0 ? (double)rs->nt / rs->tm.triangulate : 0.0);
         if (c->check)
             fprintf(info, "check: passed\n");
         if (c->output)
@@ -1592,14 +1643,44 @@ static int run(const cli *c)
     }
     if (fflush(stdout) != 0) {
         say("stdout: %s", strerror(errno));
-        code = CLI_WRITE;
+        return CLI_WRITE;
     }
+    return CLI_OK;
+}
 
-done:
+static int run(const cli *c)
+{
+    run_state rs;
+    memset(&rs, 0, sizeof rs);
+    rs.name = !c->input ? "demo" : strcmp(c->input, "-") ? c->input : "stdin";
+    /* The progress line (src/cli/progress.h): on a terminal, or asked for. */
+    progress_init(&rs.prog, !c->quiet && (c->progress || isatty(STDERR_FILENO)));
+    rs.json_stdout = c->stats_json && !strcmp(c->stats_json, "-");
+    /* stdout carries the JSON object alone when asked to. */
+    rs.info = rs.json_stdout ? stderr : stdout;
+    int code = plan_outputs(c, &rs);
+    if (code != CLI_OK)
+        return code;
+    /* Every file output of the run (the meshes, streamed or not, the
+     * dual's files and the --stats-json file) waits complete in its
+     * temporary until all are, then all are renamed together
+     * (commit_outputs): all new, or, after any failure or signal, all as
+     * they were. */
+    if (fdt_wr_set_begin(c->no_clobber) != 0) {
+        say("internal error: a commit set is already open");
+        return CLI_INTERNAL;
+    }
+    /* Each step in turn, until one fails: its exit code. */
+    static int (*const steps[])(const cli *, run_state *) = {
+        read_points, triangulate, check_mesh, canonical_order, write_meshes,
+        dual_steps, write_stats, commit_outputs, print_summary,
+    };
+    for (size_t i = 0; i < sizeof steps / sizeof *steps && code == CLI_OK; i++)
+        code = steps[i](c, &rs);
     fdt_wr_set_abandon(); /* after a failure: every temporary goes */
-    fdt_result_free(&res);
-    fdt_close(&ctx);
-    free(xyz);
+    fdt_result_free(&rs.res);
+    fdt_close(&rs.ctx);
+    free(rs.xyz);
     return code;
 }
 
