@@ -60,7 +60,6 @@ enum {
     CLI_INTERNAL = 7
 };
 
-#define MAX_OUTPUTS FDT_CLI_MAX_OUTPUTS
 /* Fixed so that "--demo N" is the same point set on every run and host. */
 #define DEMO_SEED UINT64_C(0x5eed0f0f1992)
 
@@ -73,8 +72,8 @@ typedef struct cli {
     int decimal_comma;      /* --decimal-comma */
     int progress;           /* --progress: draw even when not a terminal */
     const char *output;     /* the first -o; NULL: triangulate and report only */
-    const char *outputs[MAX_OUTPUTS]; /* every -o, in order ("-": stdout) */
-    const char *out_format[MAX_OUTPUTS]; /* its --format, NULL: by extension */
+    const char *outputs[FDT_CLI_MAX_OUTPUTS]; /* every -o, in order ("-": stdout) */
+    const char *out_format[FDT_CLI_MAX_OUTPUTS]; /* its --format, NULL: by extension */
     int n_outputs;
     const char *format;     /* a --format not yet taken by an -o */
     int all_faces;          /* --all-faces: TetGen .face with every face */
@@ -292,12 +291,12 @@ static int parse_columns(const char *s, int cols[3])
     return 0;
 }
 
-/* -o FILE: at most MAX_OUTPUTS, each named once; it takes the --format
- * given before it. */
+/* -o FILE: at most FDT_CLI_MAX_OUTPUTS, each named once; it takes the
+ * --format given before it. */
 static int take_output(cli *c, const char *out)
 {
-    if (c->n_outputs == MAX_OUTPUTS)
-        return usage_error("-o given more than %d times", MAX_OUTPUTS);
+    if (c->n_outputs == FDT_CLI_MAX_OUTPUTS)
+        return usage_error("-o given more than %d times", FDT_CLI_MAX_OUTPUTS);
     if (!*out)
         return usage_error("empty output file name");
     for (int i = 0; i < c->n_outputs; i++)
@@ -1036,8 +1035,8 @@ static const char *stream_refusal(const cli *c, const fdt_format *const *fmts, i
 /* The sink of a streamed run: each batch to every -o's writer in turn;
  * counts what went by (the summary's tets and hull faces). */
 typedef struct fanout {
-    fdt_stream_writer *w[MAX_OUTPUTS];
-    fdt_sink sink[MAX_OUTPUTS];
+    fdt_stream_writer *w[FDT_CLI_MAX_OUTPUTS];
+    fdt_sink sink[FDT_CLI_MAX_OUTPUTS];
     int n;
     int failed;      /* the writer that refused a batch, -1: none */
     uint64_t tets, hull;
@@ -1156,7 +1155,7 @@ typedef struct run_state {
     int json_stdout;      /* "--stats-json -" */
     FILE *info;           /* the summary and the hashes: stdout, unless the
                              JSON object or the mesh claims it */
-    const fdt_format *fmts[MAX_OUTPUTS]; /* each -o's format */
+    const fdt_format *fmts[FDT_CLI_MAX_OUTPUTS]; /* each -o's format */
     int need;             /* FDT_NEED_* of all the outputs */
     int to_stdout;        /* an -o - */
     int streaming;        /* the tets go to the outputs as they are built */
