@@ -15,6 +15,8 @@
 # and comments, duplicates spread across slices, the whole-read fallback,
 # standard input, a bad line in a later rank's slice (every rank exits 2
 # with the serial run's message, line number included, and writes nothing).
+# Every option both programs' --help list (one table, src/cli/options.c) is
+# accepted by both with the same hashes, and frontdt-mpi's are documented.
 # Usage: test_mpi.sh FRONTDT FRONTDT_MPI GEN_POINTS MPIRUN DATA_DIR [PYTHON3]
 set -u
 frontdt=$1 fmpi=$2 gen=$3 mpirun=$4 data=$5 python=${6:-python3}
@@ -114,6 +116,60 @@ checks=$((checks + 1))
 mpi 2 300 "$fmpi" -q --hash -o "$work/h.pvtu" "$work/skewlattice.xyz" >/dev/null 2>"$work/q.err" &&
   fail "--hash with a piece output was accepted"
 grep -q -- "--hash gathers the mesh to rank 0" "$work/q.err" || fail "--hash with pieces: no message"
+# Every option both programs accept (issue 35: one table, src/cli/options.c),
+# as their --help lists it, short and long: given to frontdt and to
+# frontdt-mpi on 2 ranks, with a value where the help names one, both
+# accept it and print the same hashes (-o: the same file). A row new to
+# both fails here until it has a value below.
+declare -A optval=([--input-format]=xyz [--search]=kd [--leaf]=7)
+# "-x VALUE" and "--name VALUE" of each option line of a --help
+help_opts() {
+  sed -nE 's/^  (-(.), |    )--([a-z-]+)( ([^ ]+))?.*/-\2 \5\n--\3 \5/p' | grep -v '^- \|^-$' |
+    sed 's/ *$//' | sort -u
+}
+"$frontdt" --help | help_opts >"$work/opts.f"
+mpi 1 60 "$fmpi" --help | help_opts >"$work/opts.m"
+comm -12 "$work/opts.f" "$work/opts.m" >"$work/opts.both"
+[[ $(wc -l <"$work/opts.both") -ge 12 ]] ||
+  fail "options of both: only $(tr '\n' ' ' <"$work/opts.both")"
+# (fd 3: mpirun reads standard input)
+while read -r opt value <&3; do
+  checks=$((checks + 1))
+  case $opt in
+  -h | --help | -V | --version)
+    "$frontdt" "$opt" >"$work/o.f" || fail "frontdt $opt: exit $?"
+    mpi 2 60 "$fmpi" "$opt" >"$work/o.m" || fail "frontdt-mpi $opt: exit $?"
+    [[ -s $work/o.f && -s $work/o.m ]] || fail "$opt: printed nothing"
+    continue ;;
+  esac
+  af=("$opt") am=("$opt")
+  if [[ $opt == -o || $opt == --output ]]; then
+    af+=("$work/o.f.tets") am+=("$work/o.m.tets")
+  elif [[ -n $value ]]; then
+    [[ -n ${optval[$opt]:-} ]] || { fail "$opt $value: no value to test it with"; continue; }
+    af+=("${optval[$opt]}") am+=("${optval[$opt]}")
+  fi
+  "$frontdt" -q --set-hash "${af[@]}" "$work/clusters.xyz" >"$work/o.f" 2>"$work/o.fe" ||
+    { fail "frontdt ${af[*]}: exit $?"; sed 's/^/    /' "$work/o.fe" | head -5; continue; }
+  mpi 2 120 "$fmpi" -q --set-hash "${am[@]}" "$work/clusters.xyz" >"$work/o.m" 2>"$work/o.me" ||
+    { fail "frontdt-mpi ${am[*]}: exit $?"; sed 's/^/    /' "$work/o.me" | head -5; continue; }
+  hf=$(grep -E '^(set-)?hash: ' "$work/o.f" | sort) hm=$(grep -E '^(set-)?hash: ' "$work/o.m" | sort)
+  [[ -n $hf && $hf == "$hm" ]] || fail "$opt: frontdt printed '$hf', frontdt-mpi '$hm'"
+  if [[ $opt == -o || $opt == --output ]]; then
+    cmp -s "$work/o.f.tets" "$work/o.m.tets" || fail "$opt: the two programs' files differ"
+    rm -f "$work/o.f.tets" "$work/o.m.tets"
+  fi
+done 3<"$work/opts.both"
+# frontdt-mpi has no man page: each long option of its --help is in
+# doc/reference.md's section on it (frontdt's are in doc/frontdt.1, the
+# docs test)
+awk '/^### Distributed runs/ {t = 1; next} /^### / {t = 0} t' \
+  "$(dirname "$0")/../doc/reference.md" >"$work/mpi.md"
+checks=$((checks + 1))
+for opt in $(awk '$1 ~ /^--/ {print $1}' "$work/opts.m"); do
+  grep -qE -- "(^|[^a-z-])$opt([^a-z-]|$)" "$work/mpi.md" ||
+    fail "doc/reference.md (Distributed runs) does not mention frontdt-mpi's $opt"
+done
 # A cone (rings of cocircular points, empty spheres as wide as the part):
 # the ranks' probes vote for the replica mesh (src/mpi/mpi_run.c), every rank
 # reads its apexes from its own copy, and no rank asks another (before it,

@@ -75,17 +75,3 @@ int fdt_cli_signals(const char *prog, void (*cleanup)(void), int exit_code)
     }
     return 0;
 }
-
-int fdt_cli_search(const char *name, fdt_search *out)
-{
-    static const struct {
-        const char *name;
-        fdt_search search;
-    } names[] = {{"auto", FDT_SEARCH_AUTO}, {"kd", FDT_SEARCH_KD}, {"mesh", FDT_SEARCH_MESH}};
-    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
-        if (!strcmp(name, names[i].name)) {
-            *out = names[i].search;
-            return 0;
-        }
-    return -1;
-}

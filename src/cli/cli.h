@@ -1,8 +1,8 @@
 /*
  * What the two command-line programs (frontdt, src/cli/main.c; frontdt-mpi,
  * src/cli/mpi_main.c) share, so they cannot drift apart: their signal
- * handling and the names of their options' values. Not part of the
- * library, which never installs handlers or reads option text.
+ * handling (their options: src/cli/options.h). Not part of the library,
+ * which never installs handlers.
  */
 #ifndef FDT_CLI_H
 #define FDT_CLI_H
@@ -21,9 +21,5 @@
  * any thread starts. 0, or -1 with errno set.
  */
 int fdt_cli_signals(const char *prog, void (*cleanup)(void), int exit_code);
-
-/* --search NAME: auto, kd or mesh into *out (0), or -1 (unknown; *out
- * untouched). The caller words the error. */
-int fdt_cli_search(const char *name, fdt_search *out);
 
 #endif

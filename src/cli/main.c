@@ -26,6 +26,7 @@
 #include "frontdt.h"
 #include "cli/cli.h"
 #include "cli/dual.h"
+#include "cli/options.h"
 #include "base/clock.h"
 #include "base/hash.h"
 #include "cli/progress.h"
@@ -59,9 +60,6 @@ enum {
     CLI_INTERNAL = 7
 };
 
-#define DEMO_DEFAULT_N 1000000u
-/* -o given more often than this is a usage error */
-#define MAX_OUTPUTS 8
 /* Fixed so that "--demo N" is the same point set on every run and host. */
 #define DEMO_SEED UINT64_C(0x5eed0f0f1992)
 
@@ -74,14 +72,15 @@ typedef struct cli {
     int decimal_comma;      /* --decimal-comma */
     int progress;           /* --progress: draw even when not a terminal */
     const char *output;     /* the first -o; NULL: triangulate and report only */
-    const char *outputs[MAX_OUTPUTS]; /* every -o, in order ("-": stdout) */
-    const char *out_format[MAX_OUTPUTS]; /* its --format, NULL: by extension */
+    const char *outputs[FDT_CLI_MAX_OUTPUTS]; /* every -o, in order ("-": stdout) */
+    const char *out_format[FDT_CLI_MAX_OUTPUTS]; /* its --format, NULL: by extension */
     int n_outputs;
     const char *format;     /* a --format not yet taken by an -o */
     int all_faces;          /* --all-faces: TetGen .face with every face */
     const char *stats_json; /* NULL, a path, or "-" for stdout */
     fdt_mode mode;
     fdt_search search;
+    int leaf;               /* --leaf; 0: the library's default */
     int threads;            /* -1: the library's default */
     int pin, check, stats, hash, set_hash, quiet;
     int no_clobber;         /* --no-clobber: refuse to replace any output */
@@ -96,95 +95,32 @@ typedef struct cli {
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-        "Usage: frontdt [options] INPUT [-o OUTPUT]\n"
-        "       frontdt --demo [N] [options] [-o OUTPUT]\n"
-        "Exact 3D Delaunay tetrahedralization by the advancing front.\n"
-        "\n"
-        "INPUT:  .xyz/.txt/.csv (x y z per line; more columns skipped; a first\n"
-        "        line of words is a header), .node (TetGen), .ply; '-' is standard\n"
-        "        input (needs --input-format)\n"
-        "OUTPUT: .tets (canonical sorted text), .ele (TetGen .node/.ele/\n"
-        "        .face/.neigh), .vtu (VTK XML, ParaView), .vtk (VTK legacy),\n"
-        "        .msh (gmsh 4.1), .mesh (Medit), DIR/polyMesh (OpenFOAM),\n"
-        "        .fdtb (frontdt binary)\n"
-        "\n"
-        "Options:\n"
-        "  -o, --output FILE      write the mesh (format by extension); may be\n"
-        "                         given up to %d times; '-': standard output.\n"
-        "                         An existing output is replaced (as TetGen and\n"
-        "                         gmsh do); an input never is (exit 1)\n"
-        "      --no-clobber       refuse (exit 5, before any work) when any\n"
-        "                         output file exists (.node of -o m.ele too)\n"
-        "      --format NAME      format of the next -o (of the last -o when\n"
-        "                         none follows): tets, tetgen, vtu, bin, vtk, msh,\n"
-        "                         msh2, medit, openfoam; an -o whose extension\n"
-        "                         names another format is refused; or, named xyz,\n"
-        "                         txt, csv, node or ply, the input's (--input-format)\n"
-        "      --all-faces        TetGen .face lists every face (TetGen -f)\n"
-        "      --input-format FMT xyz (also txt, csv), node or ply: the input's\n"
-        "                         format whatever its name (needed for '-')\n"
-        "      --columns X,Y,Z    the columns of x, y and z in .xyz/.txt/.csv,\n"
-        "                         counted from 1 as cut -f and awk do (1,2,3)\n"
-        "      --delimiter C      the field separator of .xyz/.txt/.csv besides\n"
-        "                         blanks: ',' (default) or ';'; ' ': blanks only\n"
-        "      --decimal-comma    numbers are written 0,5 (then the delimiter\n"
-        "                         is ';' or blanks: blanks unless given)\n"
-        "      --mode MODE        serial, shared, message or auto (default)\n"
-        "      --search HOW       how apexes are found: auto (default: in memory\n"
-        "                         without --mode, the certified insertion mesh\n"
-        "                         built on the threads is the answer; with\n"
-        "                         --mode, the parts read the mesh of every point\n"
-        "                         where a probe finds the kd search costly, else\n"
-        "                         the kd search), kd, or mesh (threads: each\n"
-        "                         part's own mesh, its inner tets final, fronts\n"
-        "                         at the walls)\n"
-        "  -t, --threads N        worker threads (0: one per core)\n"
-        "      --pin              bind thread i to core i\n"
-        "      --check            verify the result exactly (exit 3 if not Delaunay)\n"
-        "      --stats            print statistics to stderr\n"
-        "      --stats-json FILE  write statistics as JSON ('-': stdout)\n"
-        "      --hash             print the canonical hash of the tet set\n"
-        "      --set-hash         print the set hash (order-independent, no sort)\n"
-        "      --voronoi FILE     write each point's Voronoi cell, clipped by the\n"
-        "                         box: a line a point (.csv: a table)\n"
-        "      --voronoi-format F the line, in voro++'s codes: %%i %%q %%v %%F %%s\n"
-        "                         %%n %%f %%c %%C, and %%d (DTFE density), %%h (flags)\n"
-        "                         (default '%%i %%q %%v %%F %%s %%n %%f')\n"
-        "      --density FILE     write each point's DTFE density and flags\n"
-        "      --box X0,Y0,Z0,X1,Y1,Z1  the box that clips the cells (default:\n"
-        "                         the points' bounding box; must hold them)\n"
-        "      --values FILE      values at the points (a line a point, k numbers)\n"
-        "      --interpolate Q    interpolate them at the points of file Q into\n"
-        "      --interpolated OUT (a line a query; nan outside the hull)\n"
-        "      --method M         natural (Sibson, default) or linear\n"
-        "      --stream           write the tets as they are built, never holding\n"
-        "                         the mesh (.ele without .neigh, .vtu, .fdtb; no\n"
-        "                         -o: count them); the points are stored once\n"
-        "                         (about 60 bytes a point); refuses an output or\n"
-        "                         option that needs the mesh\n"
-        "      --no-stream        keep the whole mesh (default streams when every\n"
-        "                         -o is .vtu or .fdtb and nothing needs the mesh)\n"
-        "      --memory-limit B   refuse (exit 4) a run whose estimated memory\n"
-        "                         exceeds B bytes (suffixes K, M, G: 2^10..2^30)\n"
-        "  -q, --quiet            no summary, no progress, no notes\n"
-        "      --progress         draw the progress line on stderr even when it\n"
-        "                         is not a terminal (it is drawn on terminals)\n"
-        "      --demo [N]         triangulate N random points in the unit cube\n"
-        "                         (fixed seed; default %u)\n"
-        "  -h, --help             this help\n"
-        "  -V, --version          version\n"
-        "\n"
-        "Exit codes:\n"
-        "  0 success             1 usage error (also '-' without --input-format,\n"
-        "                          --columns for .node/.ply)   2 bad input\n"
-        "  3 --check failed      4 out of resources (also over --memory-limit)\n"
-        "  5 cannot write output (also --no-clobber)\n"
-        "  6 interrupted (every output left as it was)\n"
-        "  7 internal error\n"
-        "Outputs are all or none: each is written to a temporary file, and only\n"
-        "when all are complete are they renamed over their names.\n",
-        MAX_OUTPUTS, DEMO_DEFAULT_N);
+    fputs("Usage: frontdt [options] INPUT [-o OUTPUT]\n"
+          "       frontdt --demo [N] [options] [-o OUTPUT]\n"
+          "Exact 3D Delaunay tetrahedralization by the advancing front.\n"
+          "\n"
+          "INPUT:  .xyz/.txt/.csv (x y z per line; more columns skipped; a first\n"
+          "        line of words is a header), .node (TetGen), .ply; '-' is standard\n"
+          "        input (needs --input-format)\n"
+          "OUTPUT: .tets (canonical sorted text), .ele (TetGen .node/.ele/\n"
+          "        .face/.neigh), .vtu (VTK XML, ParaView), .vtk (VTK legacy),\n"
+          "        .msh (gmsh 4.1), .mesh (Medit), DIR/polyMesh (OpenFOAM),\n"
+          "        .fdtb (frontdt binary)\n"
+          "\n"
+          "Options:\n",
+          f);
+    fdt_cli_help(f, FDT_CLI_FRONTDT);
+    fputs("\n"
+          "Exit codes:\n"
+          "  0 success             1 usage error (also '-' without --input-format,\n"
+          "                          --columns for .node/.ply)   2 bad input\n"
+          "  3 --check failed      4 out of resources (also over --memory-limit)\n"
+          "  5 cannot write output (also --no-clobber)\n"
+          "  6 interrupted (every output left as it was)\n"
+          "  7 internal error\n"
+          "Outputs are all or none: each is written to a temporary file, and only\n"
+          "when all are complete are they renamed over their names.\n",
+          f);
 }
 
 static void say(const char *fmt, ...)
@@ -277,52 +213,6 @@ static int parse_bytes(const char *s, unsigned long long *v)
     return 0;
 }
 
-enum {
-    OPT_MODE = 256, OPT_PIN, OPT_CHECK, OPT_STATS, OPT_STATS_JSON, OPT_HASH, OPT_SET_HASH,
-    OPT_DEMO, OPT_SEARCH, OPT_FORMAT, OPT_ALL_FACES, OPT_INPUT_FORMAT, OPT_COLUMNS,
-    OPT_DELIMITER, OPT_DECIMAL_COMMA,
-    OPT_PROGRESS, OPT_STREAM, OPT_NO_STREAM, OPT_MEMORY_LIMIT, OPT_NO_CLOBBER,
-    OPT_VORONOI, OPT_VORONOI_FORMAT, OPT_DENSITY, OPT_BOX, OPT_VALUES, OPT_INTERPOLATE,
-    OPT_INTERPOLATED, OPT_METHOD
-};
-
-static const struct option long_opts[] = {
-    { "output", required_argument, NULL, 'o' },
-    { "format", required_argument, NULL, OPT_FORMAT },
-    { "all-faces", no_argument, NULL, OPT_ALL_FACES },
-    { "mode", required_argument, NULL, OPT_MODE },
-    { "search", required_argument, NULL, OPT_SEARCH },
-    { "threads", required_argument, NULL, 't' },
-    { "pin", no_argument, NULL, OPT_PIN },
-    { "check", no_argument, NULL, OPT_CHECK },
-    { "stats", no_argument, NULL, OPT_STATS },
-    { "stats-json", required_argument, NULL, OPT_STATS_JSON },
-    { "hash", no_argument, NULL, OPT_HASH },
-    { "set-hash", no_argument, NULL, OPT_SET_HASH },
-    { "quiet", no_argument, NULL, 'q' },
-    { "demo", optional_argument, NULL, OPT_DEMO },
-    { "input-format", required_argument, NULL, OPT_INPUT_FORMAT },
-    { "columns", required_argument, NULL, OPT_COLUMNS },
-    { "delimiter", required_argument, NULL, OPT_DELIMITER },
-    { "decimal-comma", no_argument, NULL, OPT_DECIMAL_COMMA },
-    { "progress", no_argument, NULL, OPT_PROGRESS },
-    { "stream", no_argument, NULL, OPT_STREAM },
-    { "no-stream", no_argument, NULL, OPT_NO_STREAM },
-    { "memory-limit", required_argument, NULL, OPT_MEMORY_LIMIT },
-    { "no-clobber", no_argument, NULL, OPT_NO_CLOBBER },
-    { "voronoi", required_argument, NULL, OPT_VORONOI },
-    { "voronoi-format", required_argument, NULL, OPT_VORONOI_FORMAT },
-    { "density", required_argument, NULL, OPT_DENSITY },
-    { "box", required_argument, NULL, OPT_BOX },
-    { "values", required_argument, NULL, OPT_VALUES },
-    { "interpolate", required_argument, NULL, OPT_INTERPOLATE },
-    { "interpolated", required_argument, NULL, OPT_INTERPOLATED },
-    { "method", required_argument, NULL, OPT_METHOD },
-    { "help", no_argument, NULL, 'h' },
-    { "version", no_argument, NULL, 'V' },
-    { NULL, 0, NULL, 0 },
-};
-
 /*
  * getopt_long's optional_argument only takes "--demo=N"; "--demo N" with a
  * separate numeric word is rewritten to "--demo=N" before parsing (an
@@ -401,221 +291,247 @@ static int parse_columns(const char *s, int cols[3])
     return 0;
 }
 
-/* Returns -1 to go on, or an exit code (0 after --help/--version). */
-static int parse_args(int argc, char **argv, cli *c)
+/* -o FILE: at most FDT_CLI_MAX_OUTPUTS, each named once; it takes the
+ * --format given before it. */
+static int take_output(cli *c, const char *out)
 {
-    memset(c, 0, sizeof *c);
-    c->mode = FDT_MODE_AUTO;
-    c->threads = -1;
-    c->dual.natural = 1;
-    c->demo_n = DEMO_DEFAULT_N;
-    opterr = 0; /* we print our own messages */
-    optind = 1;
-    int ch;
-    unsigned long long v;
-    int format_last = 0; /* the last --format came after every -o */
-    while ((ch = getopt_long(argc, argv, ":o:t:qhV", long_opts, NULL)) != -1) {
-        switch (ch) {
-        case 'o':
-            if (c->n_outputs == MAX_OUTPUTS)
-                return usage_error("-o given more than %d times", MAX_OUTPUTS);
-            if (!*optarg)
-                return usage_error("empty output file name");
-            for (int i = 0; i < c->n_outputs; i++)
-                if (!strcmp(c->outputs[i], optarg))
-                    return usage_error("-o %s given twice", optarg);
-            if (!c->output)
-                c->output = optarg;
-            c->out_format[c->n_outputs] = c->format;
-            c->outputs[c->n_outputs++] = optarg;
-            c->format = NULL; /* --format is one -o's */
-            format_last = 0;
-            break;
-        case OPT_FORMAT:
-            /* One option names both, as issue 17 asks (--format xyz for
-             * standard input, --format msh2 for an output): the input
-             * formats' names (xyz, txt, csv, node, ply) and the output
-             * formats' never meet, so the name says which is meant. */
-            if (!fdt_format_by_name(optarg) &&
-                fdt_rd_format_by_name(optarg) != FDT_RD_AUTO) {
-                c->input_format = fdt_rd_format_by_name(optarg);
-                c->input_format_name = optarg;
-                break;
-            }
-            if (!fdt_format_by_name(optarg))
-                return usage_error("unknown format '%s' (input: xyz, txt, csv, node, ply; "
-                                   "output: %s)", optarg, fdt_format_list());
-            c->format = optarg;
-            format_last = 1;
-            break;
-        case OPT_ALL_FACES:
-            c->all_faces = 1;
-            break;
-        case OPT_MODE:
-            if (!strcmp(optarg, "serial"))
-                c->mode = FDT_MODE_SERIAL;
-            else if (!strcmp(optarg, "shared"))
-                c->mode = FDT_MODE_SHARED;
-            else if (!strcmp(optarg, "message"))
-                c->mode = FDT_MODE_MESSAGE;
-            else if (!strcmp(optarg, "auto"))
-                c->mode = FDT_MODE_AUTO;
-            else
-                return usage_error("unknown mode '%s' (serial, shared, "
-                                   "message or auto)", optarg);
-            break;
-        case OPT_SEARCH:
-            if (fdt_cli_search(optarg, &c->search) != 0)
-                return usage_error("unknown search '%s' (auto, kd or mesh)", optarg);
-            break;
-        case 't':
-            if (parse_count(optarg, INT_MAX, &v) != 0)
-                return usage_error("--threads wants a count, not '%s'",
-                                   optarg);
-            c->threads = (int)v;
-            break;
-        case OPT_PIN:
-            c->pin = 1;
-            break;
-        case OPT_CHECK:
-            c->check = 1;
-            break;
-        case OPT_STATS:
-            c->stats = 1;
-            break;
-        case OPT_STATS_JSON:
-            if (!*optarg)
-                return usage_error("empty --stats-json file name");
-            c->stats_json = optarg;
-            break;
-        case OPT_HASH:
-            c->hash = 1;
-            break;
-        case OPT_SET_HASH:
-            c->set_hash = 1;
-            break;
-        case OPT_STREAM:
-        case OPT_NO_STREAM:
-            if (c->stream != 0 && c->stream != (ch == OPT_STREAM ? 1 : -1))
-                return usage_error("--stream and --no-stream together");
-            c->stream = ch == OPT_STREAM ? 1 : -1;
-            break;
-        case 'q':
-            c->quiet = 1;
-            break;
-        case OPT_INPUT_FORMAT:
-            c->input_format = fdt_rd_format_by_name(optarg);
-            c->input_format_name = optarg;
-            if (c->input_format == FDT_RD_AUTO)
-                return usage_error("unknown input format '%s' (xyz, txt, csv, node or "
-                                   "ply)", optarg);
-            break;
-        case OPT_COLUMNS:
-            if (parse_columns(optarg, c->columns) != 0)
-                return usage_error("--columns wants three different column numbers "
-                                   "from 1, as 3,4,5, not '%s'", optarg);
-            break;
-        case OPT_DELIMITER:
-            if (strlen(optarg) != 1 || !strchr(",; ", optarg[0]))
-                return usage_error("--delimiter is ',', ';' or ' ' (blanks only), not '%s'",
-                                   optarg);
-            c->delimiter = optarg[0];
-            break;
-        case OPT_DECIMAL_COMMA:
-            c->decimal_comma = 1;
-            break;
-        case OPT_PROGRESS:
-            c->progress = 1;
-            break;
-        case OPT_NO_CLOBBER:
-            c->no_clobber = 1;
-            break;
-        case OPT_VORONOI:
-            c->dual.voronoi = optarg;
-            break;
-        case OPT_VORONOI_FORMAT:
-            c->dual.format = optarg;
-            break;
-        case OPT_DENSITY:
-            c->dual.density = optarg;
-            break;
-        case OPT_BOX:
-            if (fdt_cli_parse_box(optarg, c->dual.box) != 0)
-                return usage_error("--box wants six finite numbers xmin,ymin,zmin,xmax,ymax,zmax "
-                                   "with each min below its max, not '%s'", optarg);
-            c->dual.box_given = 1;
-            break;
-        case OPT_VALUES:
-            c->dual.values = optarg;
-            break;
-        case OPT_INTERPOLATE:
-            c->dual.queries = optarg;
-            break;
-        case OPT_INTERPOLATED:
-            c->dual.interpolated = optarg;
-            break;
-        case OPT_METHOD:
-            if (strcmp(optarg, "natural") && strcmp(optarg, "linear"))
-                return usage_error("--method is natural or linear, not '%s'", optarg);
-            c->dual.natural = !strcmp(optarg, "natural");
-            break;
-        case OPT_MEMORY_LIMIT:
-            if (parse_bytes(optarg, &c->memory_limit) != 0)
-                return usage_error("--memory-limit wants a byte count > 0 (suffix K, M or G), "
-                                   "not '%s'", optarg);
-            break;
-        case OPT_DEMO:
-            c->demo = 1;
-            if (optarg) {
-                if (parse_count(optarg, SIZE_MAX, &v) != 0)
-                    return usage_error("--demo wants a point count, not '%s'",
-                                       optarg);
-                c->demo_n = (size_t)v;
-            }
-            break;
-        case 'h':
-        case 'V':
-            if (ch == 'h')
-                usage(stdout);
-            else
-                printf("frontdt %s (library %s)\n", FDT_VERSION_STRING,
-                       fdt_version());
-            /* a help longer than stdio's buffer meets the error in
-             * fprintf already: the stream's error flag keeps it (and
-             * errno its reason) */
-            if (fflush(stdout) != 0 || ferror(stdout)) {
-                say("stdout: %s", strerror(errno ? errno : EIO));
-                return CLI_WRITE;
-            }
-            return CLI_OK;
-        case ':':
-            if (short_opt(argv, optind))
-                return usage_error("option -%c needs a value", optopt);
-            return usage_error("option %s needs a value", argv[optind - 1]);
-        case '?':
-        default:
-            if (short_opt(argv, optind))
-                return usage_error("unknown option -%c", optopt);
-            return usage_error("unknown, ambiguous or misused option %s",
-                               argv[optind - 1]);
-        }
+    if (c->n_outputs == FDT_CLI_MAX_OUTPUTS)
+        return usage_error("-o given more than %d times", FDT_CLI_MAX_OUTPUTS);
+    if (!*out)
+        return usage_error("empty output file name");
+    for (int i = 0; i < c->n_outputs; i++)
+        if (!strcmp(c->outputs[i], out))
+            return usage_error("-o %s given twice", out);
+    if (!c->output)
+        c->output = out;
+    c->out_format[c->n_outputs] = c->format;
+    c->outputs[c->n_outputs++] = out;
+    c->format = NULL; /* --format is one -o's */
+    return -1;
+}
+
+/* One option names both, as issue 17 asks (--format xyz for standard
+ * input, --format msh2 for an output): the input formats' names (xyz,
+ * txt, csv, node, ply) and the output formats' never meet, so the name
+ * says which is meant. */
+static int take_format(cli *c, const char *name)
+{
+    if (!fdt_format_by_name(name) && fdt_rd_format_by_name(name) != FDT_RD_AUTO) {
+        c->input_format = fdt_rd_format_by_name(name);
+        c->input_format_name = name;
+        return -1;
     }
+    if (!fdt_format_by_name(name))
+        return usage_error("unknown format '%s' (input: xyz, txt, csv, node, ply; "
+                           "output: %s)", name, fdt_format_list());
+    c->format = name;
+    return -1;
+}
+
+static int take_mode(cli *c, const char *name)
+{
+    if (!strcmp(name, "serial"))
+        c->mode = FDT_MODE_SERIAL;
+    else if (!strcmp(name, "shared"))
+        c->mode = FDT_MODE_SHARED;
+    else if (!strcmp(name, "message"))
+        c->mode = FDT_MODE_MESSAGE;
+    else if (!strcmp(name, "auto"))
+        c->mode = FDT_MODE_AUTO;
+    else
+        return usage_error("unknown mode '%s' (serial, shared, message or auto)", name);
+    return -1;
+}
+
+/* The options of the Voronoi and interpolation step (src/cli/dual.h). */
+static int take_dual(fdt_cli_dual *d, int id, const char *v)
+{
+    switch (id) {
+    case FDT_OPT_VORONOI:
+        d->voronoi = v;
+        break;
+    case FDT_OPT_VORONOI_FORMAT:
+        d->format = v;
+        break;
+    case FDT_OPT_DENSITY:
+        d->density = v;
+        break;
+    case FDT_OPT_BOX:
+        if (fdt_cli_parse_box(v, d->box) != 0)
+            return usage_error("--box wants six finite numbers xmin,ymin,zmin,xmax,ymax,zmax "
+                               "with each min below its max, not '%s'", v);
+        d->box_given = 1;
+        break;
+    case FDT_OPT_VALUES:
+        d->values = v;
+        break;
+    case FDT_OPT_INTERPOLATE:
+        d->queries = v;
+        break;
+    case FDT_OPT_INTERPOLATED:
+        d->interpolated = v;
+        break;
+    default: /* FDT_OPT_METHOD */
+        if (strcmp(v, "natural") && strcmp(v, "linear"))
+            return usage_error("--method is natural or linear, not '%s'", v);
+        d->natural = !strcmp(v, "natural");
+        break;
+    }
+    return -1;
+}
+
+/* --help and --version: 0, or 5 when standard output fails. */
+static int help_or_version(int id)
+{
+    if (id == FDT_OPT_HELP)
+        usage(stdout);
+    else
+        printf("frontdt %s (library %s)\n", FDT_VERSION_STRING, fdt_version());
+    /* a help longer than stdio's buffer meets the error in fprintf
+     * already: the stream's error flag keeps it (and errno its reason) */
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        say("stdout: %s", strerror(errno ? errno : EIO));
+        return CLI_WRITE;
+    }
+    return CLI_OK;
+}
+
+/* The options that only switch something on: the field, or NULL. */
+static int *flag_of(cli *c, int id)
+{
+    switch (id) {
+    case FDT_OPT_NO_CLOBBER: return &c->no_clobber;
+    case FDT_OPT_ALL_FACES: return &c->all_faces;
+    case FDT_OPT_DECIMAL_COMMA: return &c->decimal_comma;
+    case FDT_OPT_PIN: return &c->pin;
+    case FDT_OPT_CHECK: return &c->check;
+    case FDT_OPT_STATS: return &c->stats;
+    case FDT_OPT_HASH: return &c->hash;
+    case FDT_OPT_SET_HASH: return &c->set_hash;
+    case FDT_OPT_QUIET: return &c->quiet;
+    case FDT_OPT_PROGRESS: return &c->progress;
+    default: return NULL;
+    }
+}
+
+/* One option of the table's (src/cli/options.h) with its value v (NULL
+ * when it takes none). -1 to go on, or an exit code. */
+static int take_option(cli *c, int id, const char *v)
+{
+    char err[256];
+    unsigned long long n;
+    int *flag = flag_of(c, id);
+    if (flag) {
+        *flag = 1;
+        return -1;
+    }
+    switch (id) {
+    case FDT_OPT_OUTPUT:
+        return take_output(c, v);
+    case FDT_OPT_FORMAT:
+        return take_format(c, v);
+    case FDT_OPT_INPUT_FORMAT:
+        if (fdt_cli_input_format(v, &c->input_format, err, sizeof err) != 0)
+            return usage_error("%s", err);
+        c->input_format_name = v;
+        return -1;
+    case FDT_OPT_COLUMNS:
+        if (parse_columns(v, c->columns) != 0)
+            return usage_error("--columns wants three different column numbers "
+                               "from 1, as 3,4,5, not '%s'", v);
+        return -1;
+    case FDT_OPT_DELIMITER:
+        if (strlen(v) != 1 || !strchr(",; ", v[0]))
+            return usage_error("--delimiter is ',', ';' or ' ' (blanks only), not '%s'", v);
+        c->delimiter = v[0];
+        return -1;
+    case FDT_OPT_MODE:
+        return take_mode(c, v);
+    case FDT_OPT_SEARCH:
+        if (fdt_cli_search(v, &c->search, err, sizeof err) != 0)
+            return usage_error("%s", err);
+        return -1;
+    case FDT_OPT_LEAF:
+        if (fdt_cli_leaf(v, &c->leaf, err, sizeof err) != 0)
+            return usage_error("%s", err);
+        return -1;
+    case FDT_OPT_THREADS:
+        if (parse_count(v, INT_MAX, &n) != 0)
+            return usage_error("--threads wants a count, not '%s'", v);
+        c->threads = (int)n;
+        return -1;
+    case FDT_OPT_STATS_JSON:
+        if (!*v)
+            return usage_error("empty --stats-json file name");
+        c->stats_json = v;
+        return -1;
+    case FDT_OPT_STREAM:
+    case FDT_OPT_NO_STREAM:
+        if (c->stream != 0 && c->stream != (id == FDT_OPT_STREAM ? 1 : -1))
+            return usage_error("--stream and --no-stream together");
+        c->stream = id == FDT_OPT_STREAM ? 1 : -1;
+        return -1;
+    case FDT_OPT_MEMORY_LIMIT:
+        if (parse_bytes(v, &c->memory_limit) != 0)
+            return usage_error("--memory-limit wants a byte count > 0 (suffix K, M or G), "
+                               "not '%s'", v);
+        return -1;
+    case FDT_OPT_DEMO:
+        c->demo = 1;
+        if (v) {
+            if (parse_count(v, SIZE_MAX, &n) != 0)
+                return usage_error("--demo wants a point count, not '%s'", v);
+            c->demo_n = (size_t)n;
+        }
+        return -1;
+    case FDT_OPT_VORONOI:
+    case FDT_OPT_VORONOI_FORMAT:
+    case FDT_OPT_DENSITY:
+    case FDT_OPT_BOX:
+    case FDT_OPT_VALUES:
+    case FDT_OPT_INTERPOLATE:
+    case FDT_OPT_INTERPOLATED:
+    case FDT_OPT_METHOD:
+        return take_dual(&c->dual, id, v);
+    case FDT_OPT_HELP:
+    case FDT_OPT_VERSION:
+        return help_or_version(id);
+    default:
+        say("internal error: option row %d has no parser", id);
+        return CLI_INTERNAL;
+    }
+}
+
+/* What getopt_long refused (ch ':' for a missing value, else '?'). */
+static int bad_option(int ch, char **argv)
+{
+    if (ch == ':') {
+        if (short_opt(argv, optind))
+            return usage_error("option -%c needs a value", optopt);
+        return usage_error("option %s needs a value", argv[optind - 1]);
+    }
+    if (short_opt(argv, optind))
+        return usage_error("unknown option -%c", optopt);
+    return usage_error("unknown, ambiguous or misused option %s", argv[optind - 1]);
+}
+
+/* The input (npos words from pos) and the options that depend on each
+ * other, once all are read. -1 to go on, or an exit code. */
+static int check_args(cli *c, int npos, char **pos)
+{
     /* "-o m.msh --format msh2": a --format after the last -o is that
      * -o's (the others keep their extensions) */
-    if (format_last && c->n_outputs > 0 && !c->out_format[c->n_outputs - 1])
+    if (c->format && c->n_outputs > 0 && !c->out_format[c->n_outputs - 1])
         c->out_format[c->n_outputs - 1] = c->format;
-    int npos = argc - optind;
     if (c->demo) {
         if (npos > 0)
-            return usage_error("--demo takes no input file (got '%s')",
-                               argv[optind]);
+            return usage_error("--demo takes no input file (got '%s')", pos[0]);
     } else {
         if (npos == 0)
             return usage_error("no input file");
         if (npos > 1)
-            return usage_error("one input file only (got '%s' and '%s')",
-                               argv[optind], argv[optind + 1]);
-        c->input = argv[optind];
+            return usage_error("one input file only (got '%s' and '%s')", pos[0], pos[1]);
+        c->input = pos[0];
         /* "-" has no extension to go by; a format without columns cannot
          * take --columns. Both refused before anything is read. */
         int fmt = c->input_format != FDT_RD_AUTO ? c->input_format
@@ -643,6 +559,29 @@ static int parse_args(int argc, char **argv, cli *c)
                            sizeof derr) != 0)
         return usage_error("%s", derr);
     return -1;
+}
+
+/* Returns -1 to go on, or an exit code (0 after --help/--version). */
+static int parse_args(int argc, char **argv, cli *c)
+{
+    memset(c, 0, sizeof *c);
+    c->mode = FDT_MODE_AUTO;
+    c->threads = -1;
+    c->dual.natural = 1;
+    c->demo_n = FDT_CLI_DEMO_POINTS;
+    struct option longs[FDT_OPT_END + 1];
+    char shorts[2 * FDT_OPT_END + 2];
+    fdt_cli_getopt_args(FDT_CLI_FRONTDT, longs, shorts);
+    opterr = 0; /* we print our own messages */
+    optind = 1;
+    int ch;
+    while ((ch = getopt_long(argc, argv, shorts, longs, NULL)) != -1) {
+        int id = fdt_cli_getopt_id(ch);
+        int code = id < 0 ? bad_option(ch, argv) : take_option(c, id, optarg);
+        if (code >= 0)
+            return code;
+    }
+    return check_args(c, argc - optind, argv + optind);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -1096,8 +1035,8 @@ static const char *stream_refusal(const cli *c, const fdt_format *const *fmts, i
 /* The sink of a streamed run: each batch to every -o's writer in turn;
  * counts what went by (the summary's tets and hull faces). */
 typedef struct fanout {
-    fdt_stream_writer *w[MAX_OUTPUTS];
-    fdt_sink sink[MAX_OUTPUTS];
+    fdt_stream_writer *w[FDT_CLI_MAX_OUTPUTS];
+    fdt_sink sink[FDT_CLI_MAX_OUTPUTS];
     int n;
     int failed;      /* the writer that refused a batch, -1: none */
     uint64_t tets, hull;
@@ -1209,133 +1148,145 @@ static unsigned long long peak_rss_bytes(void)
     return (unsigned long long)ru.ru_maxrss * 1024ull; /* Linux: KiB */
 }
 
-static int run(const cli *c)
-{
-    int code = CLI_OK;
-    double *xyz = NULL;
-    size_t n = 0;
-    fdt_context *ctx = NULL;
-    fdt_result *res = NULL;
-    timings tm = { 0 };
-    const char *name = !c->input ? "demo" : strcmp(c->input, "-") ? c->input : "stdin";
-    /* The progress line (src/cli/progress.h): on a terminal, or asked for. */
-    progress prog;
-    progress_init(&prog, !c->quiet && (c->progress || isatty(STDERR_FILENO)));
-    int json_stdout = c->stats_json && !strcmp(c->stats_json, "-");
-    /* stdout carries the JSON object alone when asked to. */
-    FILE *info = json_stdout ? stderr : stdout;
+/* What the run's steps hand on to each other. */
+typedef struct run_state {
+    const char *name;     /* the input in messages: its path, "stdin" or "demo" */
+    progress prog;        /* the progress line (src/cli/progress.h) */
+    int json_stdout;      /* "--stats-json -" */
+    FILE *info;           /* the summary and the hashes: stdout, unless the
+                             JSON object or the mesh claims it */
+    const fdt_format *fmts[FDT_CLI_MAX_OUTPUTS]; /* each -o's format */
+    int need;             /* FDT_NEED_* of all the outputs */
+    int to_stdout;        /* an -o - */
+    int streaming;        /* the tets go to the outputs as they are built */
+    double *xyz;          /* the points (owned), n of them */
+    size_t n;
+    fdt_context *ctx;
+    fdt_result *res;
+    fanout fo;            /* a streamed run's writers */
+    unsigned long long estimate; /* memory_estimate's bytes */
+    size_t nt;            /* tets made */
+    size_t dups;          /* duplicate points merged */
+    uint64_t hash, set_hash;
+    timings tm;
+} run_state;
 
-    /* Refuse doomed or destructive outputs before reading or computing
-     * anything: each -o's format, its files against the input, the
-     * --stats-json file and every other -o's files. */
-    const fdt_format *fmts[MAX_OUTPUTS];
-    int need = 0, to_stdout = 0;
-    for (int o = 0; o < c->n_outputs; o++) {
-        const char *out = c->outputs[o];
-        if (!strcmp(out, "-")) {
-            /* standard output: text only, the canonical .tets by default */
-            fmts[o] = fdt_format_by_name(c->out_format[o] ? c->out_format[o] : "tets");
-            if (!fdt_format_is_text(fmts[o]) || !strcmp(fdt_format_name(fmts[o]), "tetgen") ||
-                !strcmp(fdt_format_name(fmts[o]), "openfoam"))
-                return usage_error("-o -: format %s cannot go to standard output "
-                                   "(one text file only: tets, vtk, msh, msh2, medit)",
-                                   fdt_format_name(fmts[o]));
-            if (json_stdout)
-                return usage_error("-o - and --stats-json - both want standard output");
-            to_stdout = 1;
-            need |= fdt_format_needs(fmts[o], c->all_faces);
+/* Refuses one -o's doomed or destructive output before anything is read:
+ * its format, its files against the input, the --stats-json file and the
+ * earlier -o's files. CLI_OK, or the exit code. */
+static int plan_output(const cli *c, run_state *rs, int o)
+{
+    const fdt_format **fmts = rs->fmts;
+    const char *out = c->outputs[o];
+    if (!strcmp(out, "-")) {
+        /* standard output: text only, the canonical .tets by default */
+        fmts[o] = fdt_format_by_name(c->out_format[o] ? c->out_format[o] : "tets");
+        if (!fdt_format_is_text(fmts[o]) || !strcmp(fdt_format_name(fmts[o]), "tetgen") ||
+            !strcmp(fdt_format_name(fmts[o]), "openfoam"))
+            return usage_error("-o -: format %s cannot go to standard output "
+                               "(one text file only: tets, vtk, msh, msh2, medit)",
+                               fdt_format_name(fmts[o]));
+        if (rs->json_stdout)
+            return usage_error("-o - and --stats-json - both want standard output");
+        rs->to_stdout = 1;
+        rs->need |= fdt_format_needs(fmts[o], c->all_faces);
+        return CLI_OK;
+    }
+    fmts[o] = c->out_format[o] ? fdt_format_by_name(c->out_format[o]) : fdt_format_by_path(out);
+    if (!fmts[o])
+        return usage_error("%s: unknown output format (use %s, or --format)", out,
+                           fdt_format_list());
+    /* "-o m.vtu --format msh2" would write gmsh into m.vtu */
+    const fdt_format *by_ext = fdt_format_contradicted(out, fmts[o]);
+    if (by_ext)
+        return usage_error("--format %s contradicts the extension of %s (%s)",
+                           fdt_format_name(fmts[o]), out, fdt_format_name(by_ext));
+    rs->need |= fdt_format_needs(fmts[o], c->all_faces);
+    char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+    int n_names = fdt_output_files_as(out, fmts[o], names);
+    if (n_names <= 0) {
+        say("%s: %s", out, strerror(ENAMETOOLONG));
+        return CLI_WRITE;
+    }
+    int code = refuse_overwrites(c, out, names, n_names);
+    if (code >= 0)
+        return code;
+    code = refuse_clobber(c, out, names, n_names);
+    if (code >= 0)
+        return code;
+    for (int p = 0; p < o; p++) {
+        if (!strcmp(c->outputs[p], "-"))
             continue;
-        }
-        fmts[o] = c->out_format[o] ? fdt_format_by_name(c->out_format[o])
-                                   : fdt_format_by_path(out);
-        if (!fmts[o])
-            return usage_error("%s: unknown output format (use %s, or --format)", out,
-                               fdt_format_list());
-        /* "-o m.vtu --format msh2" would write gmsh into m.vtu */
-        const fdt_format *by_ext = fdt_format_contradicted(out, fmts[o]);
-        if (by_ext)
-            return usage_error("--format %s contradicts the extension of %s (%s)",
-                               fdt_format_name(fmts[o]), out, fdt_format_name(by_ext));
-        need |= fdt_format_needs(fmts[o], c->all_faces);
-        char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
-        int n_names = fdt_output_files_as(out, fmts[o], names);
-        if (n_names <= 0) {
-            say("%s: %s", out, strerror(ENAMETOOLONG));
-            return CLI_WRITE;
-        }
-        code = refuse_overwrites(c, out, names, n_names);
-        if (code >= 0)
-            return code;
-        code = refuse_clobber(c, out, names, n_names);
-        if (code >= 0)
-            return code;
-        for (int p = 0; p < o; p++) {
-            if (!strcmp(c->outputs[p], "-"))
-                continue;
-            char other[FDT_IO_MAX_FILES][FDT_IO_PATH];
-            int k = fdt_output_files_as(c->outputs[p], fmts[p], other);
-            for (int i = 0; i < n_names; i++)
-                for (int j = 0; j < k; j++)
-                    if (fdt_same_file(names[i], other[j])) {
-                        say("output %s (-o %s) is also written by -o %s", names[i], out,
-                            c->outputs[p]);
-                        return CLI_USAGE;
-                    }
-        }
-        /* a directory format's path may be an existing directory: then
-         * its files are what must be creatable */
-        struct stat dst;
-        const char *probe = fmts[o] == fdt_format_by_name("openfoam") &&
-                                    stat(out, &dst) == 0 && S_ISDIR(dst.st_mode)
-                                ? names[0]
-                                : out;
-        if (!output_dir_ok("output", probe))
-            return CLI_WRITE;
+        char other[FDT_IO_MAX_FILES][FDT_IO_PATH];
+        int k = fdt_output_files_as(c->outputs[p], fmts[p], other);
+        for (int i = 0; i < n_names; i++)
+            for (int j = 0; j < k; j++)
+                if (fdt_same_file(names[i], other[j])) {
+                    say("output %s (-o %s) is also written by -o %s", names[i], out,
+                        c->outputs[p]);
+                    return CLI_USAGE;
+                }
     }
-    {
-        char none[1][FDT_IO_PATH];
-        code = refuse_overwrites(c, "", none, 0); /* --stats-json vs the input */
-        if (code >= 0)
+    /* a directory format's path may be an existing directory: then its
+     * files are what must be creatable */
+    struct stat dst;
+    const char *probe = fmts[o] == fdt_format_by_name("openfoam") && stat(out, &dst) == 0 &&
+                                S_ISDIR(dst.st_mode)
+                            ? names[0]
+                            : out;
+    if (!output_dir_ok("output", probe))
+        return CLI_WRITE;
+    return CLI_OK;
+}
+
+/* Refuses doomed or destructive outputs before reading or computing
+ * anything (each -o, the --stats-json file) and settles where things go:
+ * streamed or not, the summary on stdout or stderr. CLI_OK, or the exit
+ * code. */
+static int plan_outputs(const cli *c, run_state *rs)
+{
+    for (int o = 0; o < c->n_outputs; o++) {
+        int code = plan_output(c, rs, o);
+        if (code != CLI_OK)
             return code;
     }
+    char none[1][FDT_IO_PATH];
+    int code = refuse_overwrites(c, "", none, 0); /* --stats-json vs the input */
+    if (code >= 0)
+        return code;
     /* Stream (the tets go to the files as they are built) when asked, or
      * when every output can and nothing needs the mesh. */
     char why[FDT_IO_PATH + 200];
-    const char *refusal = stream_refusal(c, fmts, c->stream > 0, why, sizeof why);
+    const char *refusal = stream_refusal(c, rs->fmts, c->stream > 0, why, sizeof why);
     if (c->stream > 0 && refusal)
         return usage_error("--stream: %s", refusal);
-    int streaming = c->stream > 0 || (c->stream == 0 && !refusal && c->n_outputs > 0);
-    code = CLI_OK;
-    if (c->stats_json && !json_stdout && !output_dir_ok("--stats-json file", c->stats_json))
+    rs->streaming = c->stream > 0 || (c->stream == 0 && !refusal && c->n_outputs > 0);
+    if (c->stats_json && !rs->json_stdout &&
+        !output_dir_ok("--stats-json file", c->stats_json))
         return CLI_WRITE;
-    /* a device or a pipe is written in place, not replaced (below) */
+    /* a device or a pipe is written in place, not replaced (write_stats) */
     struct stat jst0;
-    if (c->no_clobber && c->stats_json && !json_stdout && lstat(c->stats_json, &jst0) == 0 &&
+    if (c->no_clobber && c->stats_json && !rs->json_stdout && lstat(c->stats_json, &jst0) == 0 &&
         (stat(c->stats_json, &jst0) != 0 || S_ISREG(jst0.st_mode))) {
         say("--stats-json file %s exists; --no-clobber keeps it", c->stats_json);
         return CLI_WRITE;
     }
     /* the summary goes to stderr when the mesh goes to stdout */
-    if (to_stdout)
-        info = stderr;
-    /* Every file output of the run (the meshes, streamed or not, and the
-     * --stats-json file) waits complete in its temporary until all are,
-     * then all are renamed together (fdt_wr_set_commit, below): all new,
-     * or, after any failure or signal, all as they were. */
-    if (fdt_wr_set_begin(c->no_clobber) != 0) {
-        say("internal error: a commit set is already open");
-        return CLI_INTERNAL;
-    }
+    if (rs->to_stdout)
+        rs->info = stderr;
+    return CLI_OK;
+}
 
-    /* Points. */
+/* The points: --demo's, or the input file's. */
+static int read_points(const cli *c, run_state *rs)
+{
     double t0 = fdt_now_s();
     if (c->demo) {
-        n = c->demo_n;
-        xyz = demo_points(n);
-        if (!xyz) {
-            say("demo: no memory for %zu points", n);
-            code = CLI_RESOURCES;
-            goto done;
+        rs->n = c->demo_n;
+        rs->xyz = demo_points(rs->n);
+        if (!rs->xyz) {
+            say("demo: no memory for %zu points", rs->n);
+            return CLI_RESOURCES;
         }
     } else {
         char err[1024];
@@ -1346,304 +1297,344 @@ static int run(const cli *c)
         ro.delimiter = c->delimiter;
         ro.decimal_comma = c->decimal_comma;
         ro.n_threads = reader_threads(c);
-        if (prog.enabled) {
+        if (rs->prog.enabled) {
             ro.progress = progress_io;
-            ro.progress_user = &prog;
+            ro.progress_user = &rs->prog;
         }
-        progress_phase(&prog, "read");
-        int r = fdt_read_points_opts(c->input, &ro, &xyz, &n, err, sizeof err);
-        progress_clear(&prog);
+        progress_phase(&rs->prog, "read");
+        int r = fdt_read_points_opts(c->input, &ro, &rs->xyz, &rs->n, err, sizeof err);
+        progress_clear(&rs->prog);
         if (r != FDT_OK) {
             say("%s", err);
-            code = exit_for_reader(r);
-            goto done;
+            return exit_for_reader(r);
         }
     }
-    tm.read = fdt_now_s() - t0;
+    rs->tm.read = fdt_now_s() - t0;
+    return CLI_OK;
+}
 
-    /* Triangulation. */
+/* The library's settings for this run, and its memory estimate against
+ * --memory-limit; then the context. */
+static int open_engine(const cli *c, run_state *rs)
+{
     fdt_settings s;
     fdt_default_settings(&s);
     s.mode = c->mode;
     s.search = c->search;
+    s.leaf_size = c->leaf;
     if (c->threads >= 0)
         s.n_threads = c->threads;
     s.pin = c->pin;
-    s.neighbors = !streaming && (c->check || (need & FDT_NEED_NBRS));
-    if (prog.enabled) {
+    s.neighbors = !rs->streaming && (c->check || (rs->need & FDT_NEED_NBRS));
+    if (rs->prog.enabled) {
         s.progress = progress_engine;
-        s.progress_user = &prog;
+        s.progress_user = &rs->prog;
     }
     /* A streamed run prepares the points in the array we read them into
      * (the writers took what they need of it when they were opened,
-     * below, before the run): the points are stored once. */
-    s.permute_input = streaming;
+     * before the run): the points are stored once. */
+    s.permute_input = rs->streaming;
     int run_threads = c->mode == FDT_MODE_SERIAL ? 1
                       : c->threads > 0           ? c->threads
                                                  : (int)sysconf(_SC_NPROCESSORS_ONLN);
-    unsigned long long estimate = memory_estimate(n, streaming, run_threads, s.neighbors,
-                                                  fdt_engine_one_part(&s, streaming));
-    if (c->memory_limit && estimate > c->memory_limit) {
+    rs->estimate = memory_estimate(rs->n, rs->streaming, run_threads, s.neighbors,
+                                   fdt_engine_one_part(&s, rs->streaming));
+    if (c->memory_limit && rs->estimate > c->memory_limit) {
         say("%s: %zu points need about %llu MiB (%s%s), more than --memory-limit %llu MiB",
-            name, n, estimate >> 20, streaming ? "streamed" : "in memory",
+            rs->name, rs->n, rs->estimate >> 20, rs->streaming ? "streamed" : "in memory",
             s.neighbors ? ", with neighbours" : "", c->memory_limit >> 20);
-        code = CLI_RESOURCES;
-        goto done;
+        return CLI_RESOURCES;
     }
-    int r = fdt_open(&ctx, &s);
+    int r = fdt_open(&rs->ctx, &s);
     if (r != FDT_OK) {
         say("cannot use these settings: %s", fdt_strerror(r));
-        code = exit_for_engine(r);
-        goto done;
+        return exit_for_engine(r);
     }
-    fanout fo;
-    memset(&fo, 0, sizeof fo);
-    fo.failed = -1;
-    if (streaming) {
-        for (int o = 0; o < c->n_outputs; o++) {
-            char err[1024];
-            r = fdt_stream_writer_open(&fo.w[o], c->outputs[o], fdt_format_name(fmts[o]), xyz,
-                                       n, 0, err, sizeof err);
-            if (r != FDT_OK) {
-                say("%s", err);
-                (void)fanout_close(&fo, 0);
-                code = exit_for_writer(r);
-                goto done;
-            }
-            fo.n = o + 1;
-            (void)fdt_stream_writer_sink(fo.w[o], &fo.sink[o]);
+    return CLI_OK;
+}
+
+/* A streamed run's writers, one an -o, opened before the run. */
+static int open_stream_writers(const cli *c, run_state *rs)
+{
+    fanout *fo = &rs->fo;
+    for (int o = 0; o < c->n_outputs; o++) {
+        char err[1024];
+        int r = fdt_stream_writer_open(&fo->w[o], c->outputs[o], fdt_format_name(rs->fmts[o]),
+                                       rs->xyz, rs->n, 0, err, sizeof err);
+        if (r != FDT_OK) {
+            say("%s", err);
+            (void)fanout_close(fo, 0);
+            return exit_for_writer(r);
         }
+        fo->n = o + 1;
+        (void)fdt_stream_writer_sink(fo->w[o], &fo->sink[o]);
     }
-    t0 = fdt_now_s();
-    progress_phase(&prog, "merge"); /* "triangulate" at the library's first report */
-    if (streaming) {
-        fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &fo};
-        r = fdt_triangulate_stream(ctx, xyz, n, &sink, &res);
+    return CLI_OK;
+}
+
+/* The library's run: the mesh in memory, or streamed to the writers. */
+static int triangulate(const cli *c, run_state *rs)
+{
+    int code = open_engine(c, rs);
+    if (code != CLI_OK)
+        return code;
+    rs->fo.failed = -1;
+    if (rs->streaming && (code = open_stream_writers(c, rs)) != CLI_OK)
+        return code;
+    double t0 = fdt_now_s();
+    progress_phase(&rs->prog, "merge"); /* "triangulate" at the library's first report */
+    int r;
+    if (rs->streaming) {
+        fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &rs->fo};
+        r = fdt_triangulate_stream(rs->ctx, rs->xyz, rs->n, &sink, &rs->res);
     } else {
-        r = fdt_triangulate(ctx, xyz, n, &res);
+        r = fdt_triangulate(rs->ctx, rs->xyz, rs->n, &rs->res);
     }
-    tm.triangulate = fdt_now_s() - t0;
-    progress_clear(&prog);
-    if (streaming) {
+    rs->tm.triangulate = fdt_now_s() - t0;
+    progress_clear(&rs->prog);
+    if (rs->streaming) {
         /* the writers end with the run: committed (counts patched, all
          * renamed) after a whole run, removed after a failed one */
         t0 = fdt_now_s();
-        int wcode = fanout_close(&fo, r == FDT_OK);
-        tm.write = fdt_now_s() - t0;
-        if (fo.failed >= 0) {
-            code = wcode; /* the run stopped for the writer's error */
-            goto done;
-        }
-        if (r == FDT_OK && wcode != CLI_OK) {
-            code = wcode;
-            goto done;
-        }
+        int wcode = fanout_close(&rs->fo, r == FDT_OK);
+        rs->tm.write = fdt_now_s() - t0;
+        if (rs->fo.failed >= 0)
+            return wcode; /* the run stopped for the writer's error */
+        if (r == FDT_OK && wcode != CLI_OK)
+            return wcode;
     }
     if (r != FDT_OK) {
-        const char *diag = fdt_context_diagnostic(ctx);
-        say("%s: %s", name, diag && *diag ? diag : fdt_strerror(r));
-        code = exit_for_engine(r);
-        goto done;
+        const char *diag = fdt_context_diagnostic(rs->ctx);
+        say("%s: %s", rs->name, diag && *diag ? diag : fdt_strerror(r));
+        return exit_for_engine(r);
     }
     /* No engine threads may outlive this point: the signal handler then
      * runs on the thread that is writing, never beside it. */
-    fdt_close(&ctx);
+    fdt_close(&rs->ctx);
 
-    size_t dups = fdt_result_num_duplicates(res);
-    if (dups > 0 && !c->quiet)
-        say("%s: merged %zu duplicate points", name, dups);
+    rs->dups = fdt_result_num_duplicates(rs->res);
+    if (rs->dups > 0 && !c->quiet)
+        say("%s: merged %zu duplicate points", rs->name, rs->dups);
     /* --pin where the system refuses a binding (or hwloc is missing): the
      * run went on unpinned, which the user who asked should hear once. */
     fdt_stats pst;
-    if (c->pin && !c->quiet && fdt_result_stats(res, &pst) == FDT_OK && pst.pinned < 0)
+    if (c->pin && !c->quiet && fdt_result_stats(rs->res, &pst) == FDT_OK && pst.pinned < 0)
         say("--pin: a thread could not be bound to its core; ran unpinned");
+    rs->nt = rs->streaming ? (size_t)rs->fo.tets : fdt_result_num_tets(rs->res);
+    return CLI_OK;
+}
 
-    size_t nt = streaming ? (size_t)fo.tets : fdt_result_num_tets(res);
-    if (c->check) {
-        char msg[1024];
-        t0 = fdt_now_s();
-        progress_phase(&prog, "check");
-        r = fdt_check(xyz, n, fdt_result_tets(res), nt,
-                      fdt_result_neighbors(res), msg, sizeof msg);
-        progress_clear(&prog);
-        tm.check = fdt_now_s() - t0;
-        if (r != FDT_OK) {
-            if (r == FDT_ECHECK)
-                say("%s: check failed: %s", name, msg);
-            else
-                say("%s: check could not run: %s", name, fdt_strerror(r));
-            code = exit_for_engine(r);
-            goto done;
-        }
+/* --check: the mesh against the definition, exactly. */
+static int check_mesh(const cli *c, run_state *rs)
+{
+    if (!c->check)
+        return CLI_OK;
+    char msg[1024];
+    double t0 = fdt_now_s();
+    progress_phase(&rs->prog, "check");
+    int r = fdt_check(rs->xyz, rs->n, fdt_result_tets(rs->res), rs->nt,
+                      fdt_result_neighbors(rs->res), msg, sizeof msg);
+    progress_clear(&rs->prog);
+    rs->tm.check = fdt_now_s() - t0;
+    if (r != FDT_OK) {
+        if (r == FDT_ECHECK)
+            say("%s: check failed: %s", rs->name, msg);
+        else
+            say("%s: check could not run: %s", rs->name, fdt_strerror(r));
+        return exit_for_engine(r);
     }
+    return CLI_OK;
+}
 
-    /* The canonical order makes .tets and the hash independent of thread
-     * count and mode; the other formats do not need it. */
-    t0 = fdt_now_s();
-    uint64_t hash = 0, set_hash = 0;
+/* The hashes, and the canonical order: it makes .tets and the hash
+ * independent of thread count and mode; the other formats do not need
+ * it. */
+static int canonical_order(const cli *c, run_state *rs)
+{
+    double t0 = fdt_now_s();
     if (c->set_hash)
-        (void)fdt_result_set_hash(res, &set_hash); /* res is not NULL: cannot fail */
-    if (c->hash || (need & FDT_NEED_SORTED))
-        progress_phase(&prog, "sort");
+        (void)fdt_result_set_hash(rs->res, &rs->set_hash); /* res is not NULL: cannot fail */
+    if (c->hash || (rs->need & FDT_NEED_SORTED))
+        progress_phase(&rs->prog, "sort");
     if (c->hash) {
         /* sorts too, hashing each part of the sort while it is in cache */
-        r = fdt_result_hash(res, &hash);
-        progress_clear(&prog);
+        int r = fdt_result_hash(rs->res, &rs->hash);
+        progress_clear(&rs->prog);
         if (r != FDT_OK) {
-            say("%s: sorting and hashing the tets failed: %s", name, fdt_strerror(r));
-            code = exit_for_engine(r);
-            goto done;
+            say("%s: sorting and hashing the tets failed: %s", rs->name, fdt_strerror(r));
+            return exit_for_engine(r);
         }
-    } else if (need & FDT_NEED_SORTED) {
-        r = fdt_result_sort(res);
-        progress_clear(&prog);
+    } else if (rs->need & FDT_NEED_SORTED) {
+        int r = fdt_result_sort(rs->res);
+        progress_clear(&rs->prog);
         if (r != FDT_OK) {
-            say("%s: sorting the tets failed: %s", name, fdt_strerror(r));
-            code = exit_for_engine(r);
-            goto done;
+            say("%s: sorting the tets failed: %s", rs->name, fdt_strerror(r));
+            return exit_for_engine(r);
         }
     }
-    progress_clear(&prog);
-    tm.canon = fdt_now_s() - t0;
+    progress_clear(&rs->prog);
+    rs->tm.canon = fdt_now_s() - t0;
+    return CLI_OK;
+}
 
-    if (c->n_outputs > 0 && !streaming) {
-        t0 = fdt_now_s();
-        char err[1024];
-        /* The public writer computes the face list where a format needs
-         * it (after the sort above: it names tets by their numbers) and
-         * reports its bytes (progress_io: the write phase moves). */
-        fdt_write_options wo;
-        fdt_default_write_options(&wo);
-        wo.all_faces = c->all_faces;
-        if (prog.enabled) {
-            wo.progress = progress_io;
-            wo.progress_user = &prog;
-        }
-        progress_phase(&prog, "write");
-        for (int o = 0; o < c->n_outputs; o++) {
-            wo.format = fdt_format_name(fmts[o]);
-            r = fdt_write_mesh_opts(res, xyz, n, c->outputs[o], &wo, err, sizeof err);
-            if (r != FDT_OK) {
-                progress_clear(&prog);
-                say("%s", err);
-                code = exit_for_writer(r);
-                tm.write = fdt_now_s() - t0;
-                goto done;
-            }
-        }
-        progress_clear(&prog);
-        tm.write = fdt_now_s() - t0;
+/* Every -o of a run in memory (a streamed run wrote them as it went). */
+static int write_meshes(const cli *c, run_state *rs)
+{
+    if (c->n_outputs == 0 || rs->streaming)
+        return CLI_OK;
+    double t0 = fdt_now_s();
+    char err[1024];
+    /* The public writer computes the face list where a format needs it
+     * (after the sort above: it names tets by their numbers) and reports
+     * its bytes (progress_io: the write phase moves). */
+    fdt_write_options wo;
+    fdt_default_write_options(&wo);
+    wo.all_faces = c->all_faces;
+    if (rs->prog.enabled) {
+        wo.progress = progress_io;
+        wo.progress_user = &rs->prog;
     }
+    progress_phase(&rs->prog, "write");
+    int code = CLI_OK;
+    for (int o = 0; o < c->n_outputs && code == CLI_OK; o++) {
+        wo.format = fdt_format_name(rs->fmts[o]);
+        int r = fdt_write_mesh_opts(rs->res, rs->xyz, rs->n, c->outputs[o], &wo, err, sizeof err);
+        if (r != FDT_OK) {
+            progress_clear(&rs->prog);
+            say("%s", err);
+            code = exit_for_writer(r);
+        }
+    }
+    progress_clear(&rs->prog);
+    rs->tm.write = fdt_now_s() - t0;
+    return code;
+}
 
+/* The Voronoi cells and the interpolation (src/cli/dual.h), each when
+ * asked. */
+static int dual_steps(const cli *c, run_state *rs)
+{
+    char derr[FDT_IO_PATH + 600];
     if (fdt_cli_dual_wanted(&c->dual)) {
-        t0 = fdt_now_s();
-        char derr[FDT_IO_PATH + 600];
-        progress_phase(&prog, "voronoi");
-        r = fdt_cli_dual_write(&c->dual, res, xyz, n, derr, sizeof derr);
-        progress_clear(&prog);
-        tm.voronoi = fdt_now_s() - t0;
+        double t0 = fdt_now_s();
+        progress_phase(&rs->prog, "voronoi");
+        int r = fdt_cli_dual_write(&c->dual, rs->res, rs->xyz, rs->n, derr, sizeof derr);
+        progress_clear(&rs->prog);
+        rs->tm.voronoi = fdt_now_s() - t0;
         if (r != FDT_OK) {
-            say("%s: %s", name, derr);
-            code = exit_for_dual(r);
-            goto done;
+            say("%s: %s", rs->name, derr);
+            return exit_for_dual(r);
         }
     }
     if (fdt_cli_interp_wanted(&c->dual)) {
-        t0 = fdt_now_s();
-        char derr[FDT_IO_PATH + 600];
-        progress_phase(&prog, "interpolate");
-        r = fdt_cli_interp_write(&c->dual, res, xyz, n, derr, sizeof derr);
-        progress_clear(&prog);
-        tm.interpolate = fdt_now_s() - t0;
+        double t0 = fdt_now_s();
+        progress_phase(&rs->prog, "interpolate");
+        int r = fdt_cli_interp_write(&c->dual, rs->res, rs->xyz, rs->n, derr, sizeof derr);
+        progress_clear(&rs->prog);
+        rs->tm.interpolate = fdt_now_s() - t0;
         if (r != FDT_OK) {
             say("%s", derr);
-            code = exit_for_dual(r);
-            goto done;
+            return exit_for_dual(r);
         }
     }
+    return CLI_OK;
+}
 
+/* --stats-json's object to its file or stdout. A file goes through a
+ * temporary renamed at the end, as the mesh does: a failed or interrupted
+ * write leaves what was there. A device or a pipe (named, or reached
+ * through a link) is written in place: renaming over it would replace a
+ * /dev node or a FIFO someone reads with a plain file. */
+static int write_stats_file(const cli *c, run_state *rs, const fdt_stats *st)
+{
+    char jerr[1024];
+    fdt_wr_side *side = NULL;
+    struct stat jst;
+    int json_stdout = rs->json_stdout;
+    int in_place = json_stdout || (stat(c->stats_json, &jst) == 0 && !S_ISREG(jst.st_mode));
+    FILE *f = json_stdout ? stdout
+              : in_place  ? fopen(c->stats_json, "w")
+                          : fdt_wr_side_open(c->stats_json, &side, jerr, sizeof jerr);
+    if (!f) {
+        if (in_place)
+            say("%s: %s", c->stats_json, strerror(errno));
+        else
+            say("%s", jerr);
+        return CLI_WRITE;
+    }
+    errno = 0;
+    write_stats_json(f, c, rs->res, st, rs->dups, &rs->tm, c->hash, rs->hash);
+    int e = ferror(f) ? (errno ? errno : EIO) : 0;
+    if (in_place) {
+        if ((json_stdout ? fflush(f) : fclose(f)) != 0 && !e)
+            e = errno ? errno : EIO;
+        if (e) {
+            say("%s: %s", json_stdout ? "stdout" : c->stats_json, strerror(e));
+            return CLI_WRITE;
+        }
+    } else if (e) {
+        fdt_wr_side_abandon(side);
+        say("%s: %s", c->stats_json, strerror(e));
+        return CLI_WRITE;
+    } else if (fdt_wr_side_commit(side, jerr, sizeof jerr) != FDT_IO_OK) {
+        say("%s", jerr);
+        return CLI_WRITE;
+    }
+    return CLI_OK;
+}
+
+/* --stats on stderr, --stats-json to its file. */
+static int write_stats(const cli *c, run_state *rs)
+{
     fdt_stats st;
     memset(&st, 0, sizeof st);
-    r = fdt_result_stats(res, &st);
+    int r = fdt_result_stats(rs->res, &st);
     if (r != FDT_OK && (c->stats || c->stats_json)) {
-        say("%s: no statistics: %s", name, fdt_strerror(r));
-        code = exit_for_engine(r);
-        goto done;
+        say("%s: no statistics: %s", rs->name, fdt_strerror(r));
+        return exit_for_engine(r);
     }
     if (c->stats) {
-        print_stats(res, &st, dups, &tm);
-        print_memory(&st, n, estimate, peak_rss_bytes());
+        print_stats(rs->res, &st, rs->dups, &rs->tm);
+        print_memory(&st, rs->n, rs->estimate, peak_rss_bytes());
     }
-    if (c->stats_json) {
-        /* A file goes through a temporary renamed at the end, as the
-         * mesh does: a failed or interrupted write leaves what was there.
-         * A device or a pipe (named, or reached through a link) is
-         * written in place: renaming over it would replace a /dev node
-         * or a FIFO someone reads with a plain file. */
-        char jerr[1024];
-        fdt_wr_side *side = NULL;
-        struct stat jst;
-        int in_place = json_stdout || (stat(c->stats_json, &jst) == 0 && !S_ISREG(jst.st_mode));
-        FILE *f = json_stdout ? stdout
-                  : in_place  ? fopen(c->stats_json, "w")
-                              : fdt_wr_side_open(c->stats_json, &side, jerr, sizeof jerr);
-        if (!f) {
-            if (in_place)
-                say("%s: %s", c->stats_json, strerror(errno));
-            else
-                say("%s", jerr);
-            code = CLI_WRITE;
-            goto done;
-        }
-        errno = 0;
-        write_stats_json(f, c, res, &st, dups, &tm, c->hash, hash);
-        int e = ferror(f) ? (errno ? errno : EIO) : 0;
-        if (in_place) {
-            if ((json_stdout ? fflush(f) : fclose(f)) != 0 && !e)
-                e = errno ? errno : EIO;
-            if (e) {
-                say("%s: %s", json_stdout ? "stdout" : c->stats_json, strerror(e));
-                code = CLI_WRITE;
-                goto done;
-            }
-        } else if (e) {
-            fdt_wr_side_abandon(side);
-            say("%s: %s", c->stats_json, strerror(e));
-            code = CLI_WRITE;
-            goto done;
-        } else if (fdt_wr_side_commit(side, jerr, sizeof jerr) != FDT_IO_OK) {
-            say("%s", jerr);
-            code = CLI_WRITE;
-            goto done;
-        }
-    }
+    return c->stats_json ? write_stats_file(c, rs, &st) : CLI_OK;
+}
 
-    {
-        char cerr[FDT_IO_PATH + 300];
-        if (fdt_wr_set_commit(cerr, sizeof cerr) != FDT_IO_OK) {
-            say("%s", cerr);
-            code = CLI_WRITE;
-            goto done;
-        }
+/* Every file of the run, complete in its temporary, renamed over its name
+ * at once (fdt_wr_set_commit). */
+static int commit_outputs(const cli *c, run_state *rs)
+{
+    (void)c;
+    (void)rs;
+    char cerr[FDT_IO_PATH + 300];
+    if (fdt_wr_set_commit(cerr, sizeof cerr) != FDT_IO_OK) {
+        say("%s", cerr);
+        return CLI_WRITE;
     }
+    return CLI_OK;
+}
 
+/* The hashes and, unless --quiet, the summary. */
+static int print_summary(const cli *c, run_state *rs)
+{
+    FILE *info = rs->info;
     if (c->hash)
-        fprintf(info, "hash: %016" PRIx64 "\n", hash);
+        fprintf(info, "hash: %016" PRIx64 "\n", rs->hash);
     if (c->set_hash)
-        fprintf(info, "set-hash: %016" PRIx64 "\n", set_hash);
+        fprintf(info, "set-hash: %016" PRIx64 "\n", rs->set_hash);
     if (!c->quiet) {
-        size_t nh = streaming ? (size_t)fo.hull : fdt_result_num_hull_faces(res);
+        size_t nh = rs->streaming ? (size_t)rs->fo.hull : fdt_result_num_hull_faces(rs->res);
         if (c->demo)
-            fprintf(info, "demo: %zu random points in the unit cube\n", n);
+            fprintf(info, "demo: %zu random points in the unit cube\n", rs->n);
         else
             fprintf(info, "input: %s\n", c->input);
-        fprintf(info, "points: %zu", n);
-        if (dups)
-            fprintf(info, " (%zu duplicates merged)", dups);
-        fprintf(info, "\ntets: %zu\nhull faces: %zu\n", nt, nh);
-        fprintf(info, "time: %.3f s\n", tm.triangulate);
+        fprintf(info, "points: %zu", rs->n);
+        if (rs->dups)
+            fprintf(info, " (%zu duplicates merged)", rs->dups);
+        fprintf(info, "\ntets: %zu\nhull faces: %zu\n", rs->nt, nh);
+        fprintf(info, "time: %.3f s\n", rs->tm.triangulate);
         fprintf(info, "tets/s: %.0f\n",
-                tm.triangulate > 0 ? (double)nt / tm.triangulate : 0.0);
+                rs->tm.triangulate > 0 ? (double)rs->nt / rs->tm.triangulate : 0.0);
         if (c->check)
             fprintf(info, "check: passed\n");
         if (c->output)
@@ -1651,14 +1642,44 @@ static int run(const cli *c)
     }
     if (fflush(stdout) != 0) {
         say("stdout: %s", strerror(errno));
-        code = CLI_WRITE;
+        return CLI_WRITE;
     }
+    return CLI_OK;
+}
 
-done:
+static int run(const cli *c)
+{
+    run_state rs;
+    memset(&rs, 0, sizeof rs);
+    rs.name = !c->input ? "demo" : strcmp(c->input, "-") ? c->input : "stdin";
+    /* The progress line (src/cli/progress.h): on a terminal, or asked for. */
+    progress_init(&rs.prog, !c->quiet && (c->progress || isatty(STDERR_FILENO)));
+    rs.json_stdout = c->stats_json && !strcmp(c->stats_json, "-");
+    /* stdout carries the JSON object alone when asked to. */
+    rs.info = rs.json_stdout ? stderr : stdout;
+    int code = plan_outputs(c, &rs);
+    if (code != CLI_OK)
+        return code;
+    /* Every file output of the run (the meshes, streamed or not, the
+     * dual's files and the --stats-json file) waits complete in its
+     * temporary until all are, then all are renamed together
+     * (commit_outputs): all new, or, after any failure or signal, all as
+     * they were. */
+    if (fdt_wr_set_begin(c->no_clobber) != 0) {
+        say("internal error: a commit set is already open");
+        return CLI_INTERNAL;
+    }
+    /* Each step in turn, until one fails: its exit code. */
+    static int (*const steps[])(const cli *, run_state *) = {
+        read_points, triangulate, check_mesh, canonical_order, write_meshes,
+        dual_steps, write_stats, commit_outputs, print_summary,
+    };
+    for (size_t i = 0; i < sizeof steps / sizeof *steps && code == CLI_OK; i++)
+        code = steps[i](c, &rs);
     fdt_wr_set_abandon(); /* after a failure: every temporary goes */
-    fdt_result_free(&res);
-    fdt_close(&ctx);
-    free(xyz);
+    fdt_result_free(&rs.res);
+    fdt_close(&rs.ctx);
+    free(rs.xyz);
     return code;
 }
 

@@ -10,6 +10,7 @@
 #include <inttypes.h>
 #include <limits.h>
 #include <mpi.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +18,7 @@
 #include <unistd.h>
 
 #include "cli/cli.h"
+#include "cli/options.h"
 #include "frontdt.h"
 #include "mpi/mpi_output.h"
 #include "mpi/mpi_run.h"
@@ -57,141 +59,125 @@ static void cleanup_outputs(void)
 typedef struct opts {
     const char *input, *output, *format;
     int set_hash, hash, stats, quiet, leaf, no_park;
-    int search;          /* fdt_search: --search */
+    fdt_search search;   /* --search */
     int fail_rank;
     size_t fail_after;
     int fail_write;      /* --inject-write-failure RANK, -1: none */
     int kind;            /* FDT_MPO_* of -o */
 } opts;
 
-static const char usage[] =
-    "Usage: mpirun -np N frontdt-mpi [options] INPUT\n"
-    "  The Delaunay tetrahedralization of INPUT (.xyz .txt .csv .node .ply),\n"
-    "  one part per MPI rank; each rank reads its slice of a .xyz .txt .csv\n"
-    "  file or a binary .ply (other inputs: every rank reads them whole;\n"
-    "  standard input, -: rank 0 reads it and scatters the slices).\n"
-    "  -o FILE             write the mesh, gathered to rank 0 (.tets .vtu .vtk\n"
-    "                      .msh .mesh polyMesh; not .ele: no neighbours yet)\n"
-    "  -o BASE.pvtu        one piece a rank, BASE_RANK.vtu, and the index BASE.pvtu\n"
-    "  -o BASE.pfdtb       one .fdtb piece a rank, BASE_RANK.fdtb (tets and hull\n"
-    "                      faces, ids numbering the input's points), and the\n"
-    "                      text index BASE.pfdtb\n"
-    "  -o BASE.pele        BASE.node (every rank writes its lines), one TetGen\n"
-    "                      piece a rank, BASE_RANK.ele and .face, and the text\n"
-    "                      index BASE.pele"
-    "  --input-format F    xyz, node or ply (default: by extension)\n"
-    "  --set-hash          print the mesh's set hash (equals frontdt's)\n"
-    "  --hash              print the canonical hash of the tet set (equals\n"
-    "                      frontdt's --hash; the mesh is gathered to rank 0)\n"
-    "  --stats             per-rank tets and message counts, and their totals\n"
-    "  --leaf N            kd-tree leaf size (default 30)\n"
-    "  --search HOW        auto (default: the kd search; where it degenerates,\n"
-    "                      every rank reads a replica of the DT of every point),\n"
-    "                      kd or mesh (each rank a mesh of its own points)\n"
-    "  --no-park           a face waits for each answer of another rank, as\n"
-    "                      frontdt --mode message does (for comparison)\n"
-    "  -q, --quiet         print nothing but errors (and what is asked)\n";
-
-/* -1: go on; else an exit code. Only rank 0 prints. */
-static int parse(int argc, char **argv, opts *o, int rank, int size)
+static void usage(FILE *f)
 {
-    memset(o, 0, sizeof *o);
-    o->fail_rank = -1;
-    o->fail_write = -1;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            if (rank == 0)
-                fputs(usage, stdout);
-            return EX_OK;
-        } else if (!strcmp(a, "-o") && v) {
-            o->output = v;
-            i++;
-        } else if (!strcmp(a, "--input-format") && v) {
-            o->format = v;
-            i++;
-        } else if (!strcmp(a, "--set-hash")) {
-            o->set_hash = 1;
-        } else if (!strcmp(a, "--hash")) {
-            o->hash = 1;
-        } else if (!strcmp(a, "--stats")) {
-            o->stats = 1;
-        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-            o->quiet = 1;
-        } else if (!strcmp(a, "--no-park")) {
-            o->no_park = 1;
-        } else if (!strcmp(a, "--search") && v) {
-            fdt_search sv;
-            if (fdt_cli_search(v, &sv) == 0) {
-                o->search = (int)sv;
-            } else {
-                if (rank == 0)
-                    fprintf(stderr, "frontdt-mpi: --search wants auto, kd or mesh, not '%s'\n",
-                            v);
-                return EX_USAGE;
-            }
-            i++;
-        } else if (!strcmp(a, "--leaf") && v) {
-            char *end;
-            long x = strtol(v, &end, 10);
-            if (*end || x < 1 || x > 1000000) {
-                if (rank == 0)
-                    fprintf(stderr, "frontdt-mpi: --leaf wants 1..1000000, not '%s'\n", v);
-                return EX_USAGE;
-            }
-            o->leaf = (int)x;
-            i++;
-        } else if (!strcmp(a, "--inject-failure") && v) {
-            /* Hidden, for tests/test_mpi.sh: RANK:FACES, rank RANK fails
-             * once it advanced FACES faces. */
-            char *end;
-            long r = strtol(v, &end, 10);
-            unsigned long long f = *end == ':' ? strtoull(end + 1, &end, 10) : 0;
-            if (*end || r < 0 || r > INT_MAX) {
-                if (rank == 0)
-                    fprintf(stderr, "frontdt-mpi: --inject-failure wants RANK:FACES\n");
-                return EX_USAGE;
-            }
-            o->fail_rank = (int)r;
-            o->fail_after = (size_t)f;
-            i++;
-        } else if (!strcmp(a, "--inject-write-failure") && v) {
-            /* Hidden, for tests/test_mpi.sh: rank RANK's piece fails once
-             * written (the others' are then removed). */
-            char *end;
-            long r = strtol(v, &end, 10);
-            if (*end || r < 0 || r > INT_MAX) {
-                if (rank == 0)
-                    fprintf(stderr, "frontdt-mpi: --inject-write-failure wants RANK\n");
-                return EX_USAGE;
-            }
-            o->fail_write = (int)r;
-            i++;
-        } else if (a[0] == '-' && a[1]) {
-            if (rank == 0)
-                fprintf(stderr, "frontdt-mpi: unknown option or missing value: '%s'\n%s", a,
-                        usage);
-            return EX_USAGE;
-        } else if (!o->input) {
-            o->input = a;
-        } else {
-            if (rank == 0)
-                fprintf(stderr, "frontdt-mpi: one input only ('%s')\n", a);
+    fputs("Usage: mpirun -np N frontdt-mpi [options] INPUT\n"
+          "  The Delaunay tetrahedralization of INPUT (.xyz .txt .csv .node .ply),\n"
+          "  one part per MPI rank; each rank reads its slice of a .xyz .txt .csv\n"
+          "  file or a binary .ply (other inputs: every rank reads them whole;\n"
+          "  standard input, -: rank 0 reads it and scatters the slices).\n"
+          "\n"
+          "Options:\n",
+          f);
+    fdt_cli_help(f, FDT_CLI_MPI);
+}
+
+/* Rank 0 says it (the ranks all parse the same words: one says why). */
+static void say0(int rank, const char *fmt, ...)
+{
+    if (rank != 0)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("frontdt-mpi: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+/* One option of the table's (src/cli/options.h) with its value v (NULL
+ * when it takes none): -1 to go on, or an exit code. */
+static int take_option(opts *o, int id, const char *v, int rank)
+{
+    char err[256], *end;
+    long r;
+    int fmt; /* checked here; the setup reads o->format by name */
+    switch (id) {
+    case FDT_OPT_HELP:
+        if (rank == 0)
+            usage(stdout);
+        return EX_OK;
+    case FDT_OPT_VERSION:
+        if (rank == 0)
+            printf("frontdt-mpi %s (library %s)\n", FDT_VERSION_STRING, fdt_version());
+        return EX_OK;
+    case FDT_OPT_OUTPUT:
+        o->output = v;
+        return -1;
+    case FDT_OPT_INPUT_FORMAT:
+        if (fdt_cli_input_format(v, &fmt, err, sizeof err) != 0) {
+            say0(rank, "%s", err);
             return EX_USAGE;
         }
+        o->format = v;
+        return -1;
+    case FDT_OPT_SET_HASH:
+        o->set_hash = 1;
+        return -1;
+    case FDT_OPT_HASH:
+        o->hash = 1;
+        return -1;
+    case FDT_OPT_STATS:
+        o->stats = 1;
+        return -1;
+    case FDT_OPT_QUIET:
+        o->quiet = 1;
+        return -1;
+    case FDT_OPT_NO_PARK:
+        o->no_park = 1;
+        return -1;
+    case FDT_OPT_SEARCH:
+        if (fdt_cli_search(v, &o->search, err, sizeof err) != 0) {
+            say0(rank, "%s", err);
+            return EX_USAGE;
+        }
+        return -1;
+    case FDT_OPT_LEAF:
+        if (fdt_cli_leaf(v, &o->leaf, err, sizeof err) != 0) {
+            say0(rank, "%s", err);
+            return EX_USAGE;
+        }
+        return -1;
+    case FDT_OPT_INJECT_FAILURE: {
+        r = strtol(v, &end, 10);
+        unsigned long long f = *end == ':' ? strtoull(end + 1, &end, 10) : 0;
+        if (*end || r < 0 || r > INT_MAX) {
+            say0(rank, "--inject-failure wants RANK:FACES");
+            return EX_USAGE;
+        }
+        o->fail_rank = (int)r;
+        o->fail_after = (size_t)f;
+        return -1;
     }
-    if (!o->input) {
-        if (rank == 0)
-            fprintf(stderr, "frontdt-mpi: no input file\n%s", usage);
-        return EX_USAGE;
+    case FDT_OPT_INJECT_WRITE_FAILURE:
+        r = strtol(v, &end, 10);
+        if (*end || r < 0 || r > INT_MAX) {
+            say0(rank, "--inject-write-failure wants RANK");
+            return EX_USAGE;
+        }
+        o->fail_write = (int)r;
+        return -1;
+    default:
+        say0(rank, "internal error: option row %d has no parser", id);
+        return EX_INTERNAL;
     }
+}
+
+/* -o against the input and the other options, once all are read: -1 to go
+ * on, or an exit code. */
+static int check_output(opts *o, int rank, int size)
+{
     o->kind = o->output ? fdt_mpo_kind(o->output) : FDT_MPO_GATHER;
     if (o->kind != FDT_MPO_GATHER && o->hash) {
-        if (rank == 0)
-            fprintf(stderr, "frontdt-mpi: --hash gathers the mesh to rank 0, which a piece "
-                            "output ('%s') does not: use --set-hash\n",
-                    o->output);
+        say0(rank, "--hash gathers the mesh to rank 0, which a piece output ('%s') does not: "
+                   "use --set-hash", o->output);
         return EX_USAGE;
     }
     if (o->kind != FDT_MPO_GATHER) {
@@ -201,14 +187,12 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
         for (size_t k = 0;; k++) {
             int got = fdt_mpo_file(o->output, size, k, name, sizeof name);
             if (got < 0) {
-                if (rank == 0)
-                    fprintf(stderr, "frontdt-mpi: '%s': piece names too long\n", o->output);
+                say0(rank, "'%s': piece names too long", o->output);
                 return EX_USAGE;
             }
             const char *x = got ? name : o->output;
             if (fdt_same_file(x, o->input)) {
-                if (rank == 0)
-                    fprintf(stderr, "frontdt-mpi: output '%s' is the input '%s'\n", x, o->input);
+                say0(rank, "output '%s' is the input '%s'", x, o->input);
                 return EX_USAGE;
             }
             if (!got)
@@ -219,26 +203,57 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
         char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
         int nf = fdt_output_files(o->output, names);
         if (!f || nf <= 0) {
-            if (rank == 0)
-                fprintf(stderr, "frontdt-mpi: unknown output extension: '%s'\n", o->output);
+            say0(rank, "unknown output extension: '%s'", o->output);
             return EX_USAGE;
         }
         if (fdt_format_needs(f, 0) & FDT_NEED_NBRS) {
-            if (rank == 0)
-                fprintf(stderr, "frontdt-mpi: %s needs tet neighbours, which the MPI run "
-                                "does not gather yet; use frontdt, or -o BASE.pele for\n"
-                                "TetGen pieces without neighbours\n", fdt_format_name(f));
+            say0(rank, "%s needs tet neighbours, which the MPI run does not gather yet; use "
+                       "frontdt, or -o BASE.pele for\nTetGen pieces without neighbours",
+                 fdt_format_name(f));
             return EX_USAGE;
         }
         for (int k = 0; k < nf; k++)
             if (fdt_same_file(names[k], o->input)) {
-                if (rank == 0)
-                    fprintf(stderr, "frontdt-mpi: output '%s' is the input '%s'\n", names[k],
-                            o->input);
+                say0(rank, "output '%s' is the input '%s'", names[k], o->input);
                 return EX_USAGE;
             }
     }
     return -1;
+}
+
+/* -1: go on; else an exit code. Only rank 0 prints. */
+static int parse(int argc, char **argv, opts *o, int rank, int size)
+{
+    memset(o, 0, sizeof *o);
+    o->fail_rank = -1;
+    o->fail_write = -1;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        int id = fdt_cli_find(a, FDT_CLI_MPI);
+        int takes = id >= 0 && fdt_cli_opts[id].arg != no_argument;
+        if (id >= 0 && (!takes || i + 1 < argc)) {
+            int rc = take_option(o, id, takes ? argv[++i] : NULL, rank);
+            if (rc >= 0)
+                return rc;
+        } else if (a[0] == '-' && a[1]) {
+            say0(rank, "unknown option or missing value: '%s'", a);
+            if (rank == 0)
+                usage(stderr);
+            return EX_USAGE;
+        } else if (!o->input) {
+            o->input = a;
+        } else {
+            say0(rank, "one input only ('%s')", a);
+            return EX_USAGE;
+        }
+    }
+    if (!o->input) {
+        say0(rank, "no input file");
+        if (rank == 0)
+            usage(stderr);
+        return EX_USAGE;
+    }
+    return check_output(o, rank, size);
 }
 
 static int exit_code(int err)
