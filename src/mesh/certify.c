@@ -190,11 +190,20 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_co
                          fdt_certify_fail *why, size_t *skipped, size_t *pairs)
 {
     for (uint32_t t = lo; t < hi; t++) {
-        if (t + AHEAD < hi) { /* the neighbours (a freed slot's are any value) */
-            const uint32_t *a = m->T + 8 * (size_t)(t + AHEAD);
+        if (t + 2 * AHEAD < hi) { /* the neighbours (a freed slot's are any value) */
+            const uint32_t *a = m->T + 8 * (size_t)(t + 2 * AHEAD);
             for (int k = 0; k < 4; k++) {
                 uint32_t nu = a[4 + k] >> 2;
                 __builtin_prefetch(m->T + 8 * (size_t)(nu < m->nslots ? nu : 0));
+            }
+        }
+        if (t + AHEAD < hi) { /* the points those tets will read, their rows now in cache */
+            const uint32_t *a = m->T + 8 * (size_t)(t + AHEAD);
+            for (int k = 0; k < 4; k++) {
+                uint32_t nu = a[4 + k] >> 2, r = a[4 + k] & 3;
+                uint32_t q = m->T[8 * (size_t)(nu < m->nslots ? nu : 0) + r], x = a[k];
+                __builtin_prefetch(m->P + 3 * (size_t)(q < m->base + m->n ? q : m->base));
+                __builtin_prefetch(m->P + 3 * (size_t)(x < m->base + m->n ? x : m->base));
             }
         }
         const uint32_t *v = m->T + 8 * (size_t)t;
