@@ -181,18 +181,6 @@ static inline int conflict(build *b, uint32_t t, const double *p)
     return ins_conflict(b->m, t, p, &b->m->sf, b->cnt);
 }
 
-/* Links the new tets b->newt[0 .. b->nbnd) of a star: by local numbers
- * when it is small (nearly always), else by the edge table. */
-static int link_star(build *b, uint32_t *T)
-{
-    int err = ins_link_star_local(&b->local, T, b->newt, b->nbnd);
-    if (err != INS_LINK_BIG)
-        return err;
-    if ((err = ins_edges_begin(&b->edges, 3 * b->nbnd)) != FDT_OK)
-        return err;
-    return ins_link_star(&b->edges, T, b->newt, NULL, b->nbnd);
-}
-
 static int insert_point(build *b, uint32_t pid, uint32_t *last)
 {
     fdt_ins *m = b->m;
@@ -275,7 +263,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
         b->newt[i] = alloc_slot(b);
         ins_star_tet(T, b->bnd[i], pid, b->newt[i]);
     }
-    if ((err = link_star(b, T)) != FDT_OK)
+    if ((err = ins_link_new_star(&b->local, &b->edges, T, b->newt, b->nbnd)) != FDT_OK)
         return err;
     for (size_t i = 0; i < b->ncav; i++) {
         mark[b->cav[i]] = MARK_NONE;

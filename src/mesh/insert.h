@@ -56,7 +56,8 @@ int fdt_ins_build_progress(fdt_ins *m, const double *P, uint32_t base, uint32_t 
  * Memory: the slots are reserved up front from the serial rounds' slots
  * a point (x1.35, so about 300 bytes a point kept on uniform points,
  * against fdt_ins_build's 220), plus during the build 1 byte a slot
- * (its lock and conflict mark) and 4 bytes a point (start hints).
+ * (its lock and conflict mark), 4 bytes a point (start hints) and up to
+ * 1 byte a point a thread (the star links' local numbers).
  */
 int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                            int nthreads, fdt_pred_counts *cnt);

@@ -536,4 +536,18 @@ static inline int ins_link_star_local(ins_local *L, uint32_t *T, const uint32_t 
     return bad ? FDT_EINTERNAL : FDT_OK;
 }
 
+/* Links the new tets slots[0 .. n) of a star made by ins_star_tet: by
+ * local numbers when it is small (nearly always), else by the edge table
+ * e. FDT_OK, FDT_EINTERNAL (ins_link_star) or FDT_ENOMEM. */
+static inline int ins_link_new_star(ins_local *L, ins_edges *e, uint32_t *T,
+                                    const uint32_t *slots, size_t n)
+{
+    int err = ins_link_star_local(L, T, slots, n);
+    if (err != INS_LINK_BIG)
+        return err;
+    if ((err = ins_edges_begin(e, 3 * n)) != FDT_OK)
+        return err;
+    return ins_link_star(e, T, slots, NULL, n);
+}
+
 #endif

@@ -153,7 +153,8 @@ typedef struct worker {
     size_t newcap;
     uint32_t *bnd;             /* its boundary faces, packed (tet, k) */
     size_t nbnd, bndcap;
-    ins_edges edges;
+    ins_local local;           /* links small stars (ins_link_new_star) */
+    ins_edges edges;           /* links the others */
     uint32_t free_head, nfree; /* this worker's freed slots, all locked by it */
     uint32_t fresh, fresh_end; /* the rest of its chunk of fresh slots */
     uint32_t last;             /* the last tet it made: the next walk's start */
@@ -562,18 +563,17 @@ static int insert_point(worker *w, uint32_t pid)
         goto abort;
     }
     if ((err = reserve(w, w->nbnd)) != FDT_OK ||
-        (err = ins_grow_u32(&w->newt, &w->newcap, w->nbnd)) != FDT_OK ||
-        (err = ins_edges_begin(&w->edges, 3 * w->nbnd)) != FDT_OK)
+        (err = ins_grow_u32(&w->newt, &w->newcap, w->nbnd)) != FDT_OK)
         goto abort;
 
-    /* The new tets (ins_star_tet, ins_link_star), as in src/mesh/insert.c. */
+    /* The new tets (ins_star_tet, ins_link_new_star), as in src/mesh/insert.c. */
     uint32_t *T = m->T;
     for (size_t i = 0; i < w->nbnd; i++) {
         w->newt[i] = alloc_slot(w);
         ins_star_tet(T, w->bnd[i], pid, w->newt[i]);
     }
-    if (ins_link_star(&w->edges, T, w->newt, NULL, w->nbnd) != FDT_OK)
-        return FDT_EINTERNAL; /* the build fails: what stays locked does not matter */
+    if ((err = ins_link_new_star(&w->local, &w->edges, T, w->newt, w->nbnd)) != FDT_OK)
+        return err; /* the build fails: what stays locked does not matter */
     for (size_t i = 0; i < w->ncav; i++)
         free_slot(w, w->cav[i]);
     ins_count_cavity(&w->st, w->ncav, w->nbnd);
@@ -811,6 +811,7 @@ static void worker_free(worker *w)
     free(w->cav);
     free(w->bnd);
     free(w->edges.eh);
+    free(w->local.lid);
     free(w->def);
     free(w->todo);
     free(w->mine);
@@ -832,7 +833,11 @@ static int worker_init(worker *w, shared *sh, int id, int nw, uint32_t base, uin
         return FDT_ENOMEM;
     w->free_head = FDT_NONE;
     w->rng = UINT64_C(0x853c49e6748fea9b) ^ ((uint64_t)id * UINT64_C(0x9E3779B97F4A7C15));
-    if (ins_grow_u32(&w->outl, &w->outcap, 256) != FDT_OK ||
+    /* A byte a point for the star links' local numbers: calloc's pages are
+     * touched only where this worker's stars lie. */
+    w->local.base = base;
+    if (!(w->local.lid = calloc(n, 1)) ||
+        ins_grow_u32(&w->outl, &w->outcap, 256) != FDT_OK ||
         ins_grow_u32(&w->newt, &w->newcap, 256) != FDT_OK ||
         ins_grow_u32(&w->cav, &w->cavcap, 64) != FDT_OK ||
         ins_grow_u32(&w->bnd, &w->bndcap, 256) != FDT_OK)

@@ -20,8 +20,8 @@
  * point on uniform points, plus the hull's infinite tets and growth
  * slack), plus 4 bytes a point for the incident-tet table: about 220
  * bytes a point kept. During the build also 1 byte a slot (conflict
- * marks) and 4 bytes a point (insertion order), and the cavity scratch.
- *
+ * marks), 4 bytes a point (insertion order), 1 byte a point (the star
+ * links' local numbers) and the cavity scratch.
  */
 #ifndef FDT_INSMESH_H
 #define FDT_INSMESH_H
