@@ -225,7 +225,7 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_co
         }
         if (bad)
             return fail(why, t, fdt_ctz64(bad), "a neighbour reference past the slots, or to itself");
-        *skipped += 4 - (size_t)__builtin_popcount(here);
+        *skipped += 4 - (size_t)((here & 1) + (here >> 1 & 1) + (here >> 2 & 1) + (here >> 3));
         for (; here; here &= here - 1) {
             int k = fdt_ctz64(here);
             uint32_t r = v[4 + k], nt = r >> 2;
