@@ -167,192 +167,185 @@ static const char *ply_item_label(char *out, size_t cap, const ply_hdr *h,
     return out;
 }
 
-static int ply_parse_header(const rd_ctx *c, ply_hdr *h)
-{
-    rd_lines L = {c->buf, c->buf + c->size, 0};
-    const char *s = c->buf, *e = c->buf, *ts;
-    size_t tl;
-    char q[RD_QUOTE_CAP], q2[RD_QUOTE_CAP];
+/* A header line's first five words, how many words it has, its number. */
+typedef struct ply_line {
+    const char *tk[5];
+    size_t tn[5];
+    size_t nt;
+    size_t ln;
+} ply_line;
 
-    h->format = -1;
-    h->vertex = SIZE_MAX;
-    if (fdt_rd_next_line(&L, &s, &e)) {
-        rd_fields f = {s, e, 0, 0};
-        int r = fdt_rd_next_field(&f, &ts, &tl);
-        if (r <= 0 || !rd_tok_is(ts, tl, "ply") || fdt_rd_count_rest(&f) != 0)
-            return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                           ":1: not a PLY file (the first line is %s, "
-                           "expected 'ply')",
-                           fdt_rd_quote(q, s, (size_t)(e - s)));
-    }
-    int ended = 0;
-    while (!ended && fdt_rd_next_line(&L, &s, &e)) {
-        rd_fields f = {s, e, 0, 0};
-        const char *tk[5] = {0};
-        size_t tn[5] = {0};
-        size_t nt = 0;
-        while (nt < 5 && fdt_rd_next_field(&f, &tk[nt], &tn[nt]) > 0)
-            nt++;
-        if (nt == 0)
-            continue;
-        if (rd_tok_is(tk[0], tn[0], "comment") ||
-            rd_tok_is(tk[0], tn[0], "obj_info"))
-            continue;
-        nt += fdt_rd_count_rest(&f);
-        size_t ln = L.lineno;
-        if (rd_tok_is(tk[0], tn[0], "format")) {
-            if (h->format >= 0)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: second format line", ln);
-            int fm = -1;
-            if (nt == 3 && rd_tok_is(tk[1], tn[1], "ascii"))
-                fm = PLY_ASCII;
-            else if (nt == 3 &&
-                     rd_tok_is(tk[1], tn[1], "binary_little_endian"))
-                fm = PLY_LE;
-            else if (nt == 3 && rd_tok_is(tk[1], tn[1], "binary_big_endian"))
-                fm = PLY_BE;
-            if (fm < 0 || !rd_tok_is(tk[2], tn[2], "1.0"))
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: expected 'format ascii|"
-                               "binary_little_endian|binary_big_endian 1.0'",
-                               ln);
-            h->format = fm;
-        } else if (rd_tok_is(tk[0], tn[0], "element")) {
-            if (h->format < 0)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: element before the format line", ln);
-            if (nt != 3)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: expected 'element NAME COUNT'", ln);
-            uint64_t cnt;
-            int st = fdt_rd_parse_count(tk[2], tn[2], &cnt);
-            if (st == NUM_OVERFLOW)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: element count %s is too large", ln,
-                               fdt_rd_quote(q, tk[2], tn[2]));
-            if (st != NUM_OK)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: element count %s is not a non-negative "
-                               "integer",
-                               ln, fdt_rd_quote(q, tk[2], tn[2]));
-            int is_vertex = rd_tok_is(tk[1], tn[1], "vertex");
-            if (is_vertex && h->vertex != SIZE_MAX)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: second 'vertex' element", ln);
-            if (h->n_elems > 0 && h->elems[h->n_elems - 1].n_props == 0)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: element %s has no properties",
-                               h->elems[h->n_elems - 1].line,
-                               fdt_rd_quote(q, h->elems[h->n_elems - 1].name,
-                                        h->elems[h->n_elems - 1].name_len));
-            if (ply_add_elem(h) != 0)
-                return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
-            ply_elem *el = &h->elems[h->n_elems - 1];
-            memset(el, 0, sizeof *el);
-            el->name = tk[1];
-            el->name_len = tn[1];
-            el->count = cnt;
-            el->first_prop = h->n_props;
-            el->line = ln;
-            if (is_vertex)
-                h->vertex = h->n_elems - 1;
-        } else if (rd_tok_is(tk[0], tn[0], "property")) {
-            if (h->n_elems == 0)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: property before any element", ln);
-            ply_prop p = {0, 0, 0, 0};
-            const char *name;
-            size_t name_len;
-            if (nt == 5 && rd_tok_is(tk[1], tn[1], "list")) {
-                int ct = ply_type_lookup(tk[2], tn[2]);
-                int it = ply_type_lookup(tk[3], tn[3]);
-                if (ct < 0 || it < 0)
-                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                                   ":%zu: unknown property type %s",
-                                   ln, ct < 0 ? fdt_rd_quote(q, tk[2], tn[2])
-                                              : fdt_rd_quote(q, tk[3], tn[3]));
-                if (ply_is_float(ct))
-                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                                   ":%zu: list length type %s is not an "
-                                   "integer type",
-                                   ln, fdt_rd_quote(q, tk[2], tn[2]));
-                p.is_list = 1;
-                p.count_type = (unsigned char)ct;
-                p.type = (unsigned char)it;
-                name = tk[4];
-                name_len = tn[4];
-            } else if (nt == 3) {
-                int t = ply_type_lookup(tk[1], tn[1]);
-                if (t < 0)
-                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                                   ":%zu: unknown property type %s", ln,
-                                   fdt_rd_quote(q, tk[1], tn[1]));
-                p.type = (unsigned char)t;
-                name = tk[2];
-                name_len = tn[2];
-            } else {
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: expected 'property TYPE NAME' or "
-                               "'property list COUNTTYPE ITEMTYPE NAME'",
-                               ln);
-            }
-            ply_elem *el = &h->elems[h->n_elems - 1];
-            if (h->vertex == h->n_elems - 1 && name_len == 1 &&
-                name[0] >= 'x' && name[0] <= 'z') {
-                int role = name[0] - 'x' + 1;
-                for (size_t i = el->first_prop; i < h->n_props; i++)
-                    if (h->props[i].role == role)
-                        return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                                       ":%zu: second vertex property %s", ln,
-                                       fdt_rd_quote(q, name, name_len));
-                if (p.is_list)
-                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                                   ":%zu: vertex property %s is a list", ln,
-                                   fdt_rd_quote(q, name, name_len));
-                p.role = (unsigned char)role;
-            }
-            if (ply_add_prop(h) != 0)
-                return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
-            h->props[h->n_props - 1] = p;
-            el->n_props++;
-            if (p.is_list) {
-                el->has_list = 1;
-                el->min_bytes += ply_size[p.count_type];
-            } else {
-                el->n_scalar++;
-                el->min_bytes += ply_size[p.type];
-            }
-        } else if (rd_tok_is(tk[0], tn[0], "end_header")) {
-            if (nt != 1)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: unexpected text after end_header", ln);
-            ended = 1;
-        } else {
-            /* a number here is data: the end_header line is missing */
-            int data = rd_is_digit(tk[0][0]) || tk[0][0] == '-' ||
-                       tk[0][0] == '+' || tk[0][0] == '.';
-            return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                           ":%zu: unknown header keyword %s%s", ln,
-                           fdt_rd_quote(q, tk[0], tn[0]),
-                           data ? " (no end_header line before the data?)"
-                                : "");
-        }
-    }
-    if (!ended) {
-        h->no_end = 1;
-        return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                       ":%zu: the header has no end_header line", L.lineno);
-    }
-    h->data_off = (size_t)(L.p - c->buf);
-    h->data_line = L.lineno;
-    if (h->format < 0)
-        return fdt_rd_fail(c, FDT_IO_EFORMAT, ": the header has no format line");
+/* An element declared without properties: the error, once the next
+ * element or the end of the header shows it. */
+static int ply_check_last_props(const rd_ctx *c, const ply_hdr *h)
+{
+    char q[RD_QUOTE_CAP];
     if (h->n_elems > 0 && h->elems[h->n_elems - 1].n_props == 0)
         return fdt_rd_fail(c, FDT_IO_EFORMAT, ":%zu: element %s has no properties",
                        h->elems[h->n_elems - 1].line,
                        fdt_rd_quote(q, h->elems[h->n_elems - 1].name,
                                 h->elems[h->n_elems - 1].name_len));
+    return FDT_IO_OK;
+}
+
+/* 'format ascii|binary_little_endian|binary_big_endian 1.0' into h->format. */
+static int ply_header_format(const rd_ctx *c, ply_hdr *h, const ply_line *w)
+{
+    const char *const *tk = w->tk;
+    const size_t *tn = w->tn;
+    size_t nt = w->nt, ln = w->ln;
+    if (h->format >= 0)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: second format line", ln);
+    int fm = -1;
+    if (nt == 3 && rd_tok_is(tk[1], tn[1], "ascii"))
+        fm = PLY_ASCII;
+    else if (nt == 3 &&
+             rd_tok_is(tk[1], tn[1], "binary_little_endian"))
+        fm = PLY_LE;
+    else if (nt == 3 && rd_tok_is(tk[1], tn[1], "binary_big_endian"))
+        fm = PLY_BE;
+    if (fm < 0 || !rd_tok_is(tk[2], tn[2], "1.0"))
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: expected 'format ascii|"
+                       "binary_little_endian|binary_big_endian 1.0'",
+                       ln);
+    h->format = fm;
+    return FDT_IO_OK;
+}
+
+/* 'element NAME COUNT': a new element of h, the vertex one if so named. */
+static int ply_header_element(const rd_ctx *c, ply_hdr *h, const ply_line *w)
+{
+    const char *const *tk = w->tk;
+    const size_t *tn = w->tn;
+    size_t nt = w->nt, ln = w->ln;
+    char q[RD_QUOTE_CAP];
+    if (h->format < 0)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: element before the format line", ln);
+    if (nt != 3)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: expected 'element NAME COUNT'", ln);
+    uint64_t cnt;
+    int st = fdt_rd_parse_count(tk[2], tn[2], &cnt);
+    if (st == NUM_OVERFLOW)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: element count %s is too large", ln,
+                       fdt_rd_quote(q, tk[2], tn[2]));
+    if (st != NUM_OK)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: element count %s is not a non-negative "
+                       "integer",
+                       ln, fdt_rd_quote(q, tk[2], tn[2]));
+    int is_vertex = rd_tok_is(tk[1], tn[1], "vertex");
+    if (is_vertex && h->vertex != SIZE_MAX)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: second 'vertex' element", ln);
+    int rc = ply_check_last_props(c, h);
+    if (rc != FDT_IO_OK)
+        return rc;
+    if (ply_add_elem(h) != 0)
+        return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+    ply_elem *el = &h->elems[h->n_elems - 1];
+    memset(el, 0, sizeof *el);
+    el->name = tk[1];
+    el->name_len = tn[1];
+    el->count = cnt;
+    el->first_prop = h->n_props;
+    el->line = ln;
+    if (is_vertex)
+        h->vertex = h->n_elems - 1;
+    return FDT_IO_OK;
+}
+
+/* 'property TYPE NAME' or 'property list COUNTTYPE ITEMTYPE NAME': a new
+ * property of the last element; x, y, z of the vertex element get their
+ * roles. */
+static int ply_header_property(const rd_ctx *c, ply_hdr *h, const ply_line *w)
+{
+    const char *const *tk = w->tk;
+    const size_t *tn = w->tn;
+    size_t nt = w->nt, ln = w->ln;
+    char q[RD_QUOTE_CAP];
+    if (h->n_elems == 0)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: property before any element", ln);
+    ply_prop p = {0, 0, 0, 0};
+    const char *name;
+    size_t name_len;
+    if (nt == 5 && rd_tok_is(tk[1], tn[1], "list")) {
+        int ct = ply_type_lookup(tk[2], tn[2]);
+        int it = ply_type_lookup(tk[3], tn[3]);
+        if (ct < 0 || it < 0)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: unknown property type %s",
+                           ln, ct < 0 ? fdt_rd_quote(q, tk[2], tn[2])
+                                      : fdt_rd_quote(q, tk[3], tn[3]));
+        if (ply_is_float(ct))
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: list length type %s is not an "
+                           "integer type",
+                           ln, fdt_rd_quote(q, tk[2], tn[2]));
+        p.is_list = 1;
+        p.count_type = (unsigned char)ct;
+        p.type = (unsigned char)it;
+        name = tk[4];
+        name_len = tn[4];
+    } else if (nt == 3) {
+        int t = ply_type_lookup(tk[1], tn[1]);
+        if (t < 0)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: unknown property type %s", ln,
+                           fdt_rd_quote(q, tk[1], tn[1]));
+        p.type = (unsigned char)t;
+        name = tk[2];
+        name_len = tn[2];
+    } else {
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: expected 'property TYPE NAME' or "
+                       "'property list COUNTTYPE ITEMTYPE NAME'",
+                       ln);
+    }
+    ply_elem *el = &h->elems[h->n_elems - 1];
+    if (h->vertex == h->n_elems - 1 && name_len == 1 &&
+        name[0] >= 'x' && name[0] <= 'z') {
+        int role = name[0] - 'x' + 1;
+        for (size_t i = el->first_prop; i < h->n_props; i++)
+            if (h->props[i].role == role)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: second vertex property %s", ln,
+                               fdt_rd_quote(q, name, name_len));
+        if (p.is_list)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: vertex property %s is a list", ln,
+                           fdt_rd_quote(q, name, name_len));
+        p.role = (unsigned char)role;
+    }
+    if (ply_add_prop(h) != 0)
+        return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+    h->props[h->n_props - 1] = p;
+    el->n_props++;
+    if (p.is_list) {
+        el->has_list = 1;
+        el->min_bytes += ply_size[p.count_type];
+    } else {
+        el->n_scalar++;
+        el->min_bytes += ply_size[p.type];
+    }
+    return FDT_IO_OK;
+}
+
+/* What a complete header must have: a format line, properties in its last
+ * element, a vertex element with x, y and z and a nonzero count. */
+static int ply_header_complete(const rd_ctx *c, const ply_hdr *h)
+{
+    char q2[RD_QUOTE_CAP];
+    if (h->format < 0)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT, ": the header has no format line");
+    int rc = ply_check_last_props(c, h);
+    if (rc != FDT_IO_OK)
+        return rc;
     if (h->vertex == SIZE_MAX)
         return fdt_rd_fail(c, FDT_IO_EFORMAT,
                        ": no points (the header has no 'vertex' element)");
@@ -373,6 +366,77 @@ static int ply_parse_header(const rd_ctx *c, ply_hdr *h)
                        "count 0)",
                        v->line);
     return FDT_IO_OK;
+}
+
+/* The header in c->buf into *h: the 'ply' line, then each line's keyword
+ * dispatched to its step, up to end_header; then the checks of the whole. */
+static int ply_parse_header(const rd_ctx *c, ply_hdr *h)
+{
+    rd_lines L = {c->buf, c->buf + c->size, 0};
+    const char *s = c->buf, *e = c->buf, *ts;
+    size_t tl;
+    char q[RD_QUOTE_CAP];
+
+    h->format = -1;
+    h->vertex = SIZE_MAX;
+    if (fdt_rd_next_line(&L, &s, &e)) {
+        rd_fields f = {s, e, 0, 0};
+        int r = fdt_rd_next_field(&f, &ts, &tl);
+        if (r <= 0 || !rd_tok_is(ts, tl, "ply") || fdt_rd_count_rest(&f) != 0)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":1: not a PLY file (the first line is %s, "
+                           "expected 'ply')",
+                           fdt_rd_quote(q, s, (size_t)(e - s)));
+    }
+    int ended = 0;
+    while (!ended && fdt_rd_next_line(&L, &s, &e)) {
+        rd_fields f = {s, e, 0, 0};
+        ply_line w = {{0}, {0}, 0, 0};
+        const char *const *tk = w.tk;
+        const size_t *tn = w.tn;
+        while (w.nt < 5 && fdt_rd_next_field(&f, &w.tk[w.nt], &w.tn[w.nt]) > 0)
+            w.nt++;
+        if (w.nt == 0)
+            continue;
+        if (rd_tok_is(tk[0], tn[0], "comment") ||
+            rd_tok_is(tk[0], tn[0], "obj_info"))
+            continue;
+        w.nt += fdt_rd_count_rest(&f);
+        w.ln = L.lineno;
+        int rc;
+        if (rd_tok_is(tk[0], tn[0], "format")) {
+            rc = ply_header_format(c, h, &w);
+        } else if (rd_tok_is(tk[0], tn[0], "element")) {
+            rc = ply_header_element(c, h, &w);
+        } else if (rd_tok_is(tk[0], tn[0], "property")) {
+            rc = ply_header_property(c, h, &w);
+        } else if (rd_tok_is(tk[0], tn[0], "end_header")) {
+            if (w.nt != 1)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: unexpected text after end_header", w.ln);
+            rc = FDT_IO_OK;
+            ended = 1;
+        } else {
+            /* a number here is data: the end_header line is missing */
+            int data = rd_is_digit(tk[0][0]) || tk[0][0] == '-' ||
+                       tk[0][0] == '+' || tk[0][0] == '.';
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: unknown header keyword %s%s", w.ln,
+                           fdt_rd_quote(q, tk[0], tn[0]),
+                           data ? " (no end_header line before the data?)"
+                                : "");
+        }
+        if (rc != FDT_IO_OK)
+            return rc;
+    }
+    if (!ended) {
+        h->no_end = 1;
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: the header has no end_header line", L.lineno);
+    }
+    h->data_off = (size_t)(L.p - c->buf);
+    h->data_line = L.lineno;
+    return ply_header_complete(c, h);
 }
 
 /* Loads an unsigned integer of sz bytes in the file's byte order. */
