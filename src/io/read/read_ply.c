@@ -888,13 +888,24 @@ static int ply_plain_doubles(const ply_hdr *h, const ply_elem *el, int big)
 #endif
 }
 
-/* The vertex element (the streamed ply_bin_vertex). */
-static int ply_st_vertex(ply_in *in, const ply_hdr *h, const ply_elem *el, int big,
-                         rd_points *pb)
+/* The first error of a streamed vertex read, kept to be worded once the
+ * input's size is known (ply_st_vertex_fail). */
+typedef struct ply_vbad {
+    int rc;     /* FDT_IO_ENOMEM; 1: the data ends inside vertex i; 2: a
+                   negative list length at byte `at`; FDT_IO_OK: none, or
+                   (k >= 0) coordinate k of vertex i, v at byte `at`, is not
+                   finite */
+    int k;
+    uint64_t i;
+    size_t at;
+    double v;
+} ply_vbad;
+
+/* Room for the vertices before they are read: FDT_IO_OK to read them. */
+static int ply_st_vertex_reserve(ply_in *in, const ply_hdr *h, const ply_elem *el, size_t start,
+                                 rd_points *pb)
 {
     const rd_ctx *c = in->c;
-    char lab[160];
-    size_t start = in->off;
     /* A count the file's known size holds is allocated at once (the
      * usual file); otherwise the array grows as vertices arrive. */
     if (c->size > start && el->count <= (c->size - start) / el->min_bytes &&
@@ -908,135 +919,170 @@ static int ply_st_vertex(ply_in *in, const ply_hdr *h, const ply_elem *el, int b
         int rc = ply_vertex_precheck(c, h, el, start, ply_total(in));
         return in->failed ? FDT_IO_EOPEN : rc;
     }
-    int rc = FDT_IO_OK;
-    size_t bad_at = 0;
-    int bad_k = -1;
-    double bad_v = 0.0;
-    uint64_t i = 0;
-    if (ply_plain_doubles(h, el, big)) {
-        /* Straight into the array: the window's bytes first, then read()
-         * into place, a buffer's worth at a time (progress, growth). */
-        unsigned char *dst = (unsigned char *)pb->xyz;
-        uint64_t bytes = el->count * 24, got = 0;
-        while (got < bytes) {
-            if (ply_vertex_room(pb, el->count, (size_t)(got / 24)) != 0) {
-                rc = FDT_IO_ENOMEM;
-                break;
-            }
-            dst = (unsigned char *)pb->xyz;
-            size_t room = pb->cap * 24 - (size_t)got, k;
-            if (room > in->cap)
-                room = in->cap;
-            if (in->hi > in->lo) {
-                k = in->hi - in->lo < room ? in->hi - in->lo : room;
-                memcpy(dst + got, in->buf + in->lo, k);
-                in->lo += k;
-            } else {
-                ptrdiff_t r = in->failed ? -1 : fdt_rd_src_read(c, dst + got, room);
-                if (r < 0) {
-                    in->failed = 1;
-                    return FDT_IO_EOPEN;
-                }
-                k = (size_t)r;
-            }
-            /* every double now complete is checked, in file order */
-            for (uint64_t v = got / 8; v < (got + k) / 8; v++) {
-                double x = pb->xyz[v];
-                if (!isfinite(x)) {
-                    bad_at = start + (size_t)v * 8;
-                    bad_k = (int)(v % 3);
-                    bad_v = x;
-                    i = v / 3;
-                    break;
-                }
-            }
-            got += k;
-            in->off += k;
-            fdt_rd_progress(c, in->off);
-            if (bad_k >= 0 || k == 0)
-                break;
+    return FDT_IO_OK;
+}
+
+/* Vertices that are three little-endian doubles (ply_plain_doubles) from
+ * byte start: FDT_IO_EOPEN when a read fails, else FDT_IO_OK with the
+ * first error, if any, in *bad. */
+static int ply_st_plain(ply_in *in, const ply_elem *el, size_t start, rd_points *pb,
+                        ply_vbad *bad)
+{
+    const rd_ctx *c = in->c;
+    /* Straight into the array: the window's bytes first, then read()
+     * into place, a buffer's worth at a time (progress, growth). */
+    unsigned char *dst = (unsigned char *)pb->xyz;
+    uint64_t bytes = el->count * 24, got = 0;
+    while (got < bytes) {
+        if (ply_vertex_room(pb, el->count, (size_t)(got / 24)) != 0) {
+            bad->rc = FDT_IO_ENOMEM;
+            break;
         }
-        if (bad_k < 0 && rc == FDT_IO_OK) {
-            if (got == bytes) {
-                pb->n = (size_t)el->count;
-                return FDT_IO_OK;
-            }
-            rc = 1; /* the data ended inside vertex got / 24 */
-        }
-        if (bad_k < 0)
-            i = got / 24;
-    } else {
-        int type[3] = {0, 0, 0};
-        size_t fixed_off[3] = {0, 0, 0};
-        for (size_t j = 0, o = 0; j < el->n_props; j++) {
-            const ply_prop *p = &h->props[el->first_prop + j];
-            if (p->role) {
-                type[p->role - 1] = p->type;
-                fixed_off[p->role - 1] = o;
-            }
-            o += ply_size[p->type];
-        }
-        int r = 0;
-        for (; i < el->count; i++) {
-            if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
-                fdt_rd_progress(c, in->off);
-            if (ply_vertex_room(pb, el->count, (size_t)i) != 0) {
-                rc = FDT_IO_ENOMEM;
-                break;
-            }
-            double *d = pb->xyz + 3 * i;
-            size_t roff[3];
-            if (el->has_list) {
-                r = ply_st_item(in, h, el, big, d, roff, &bad_at);
-            } else if (!ply_need(in, el->min_bytes)) {
-                r = 1;
-            } else {
-                for (int k = 0; k < 3; k++) {
-                    roff[k] = in->off + fixed_off[k];
-                    d[k] = ply_get(in->buf + in->lo + fixed_off[k], type[k], big);
-                }
-                ply_take(in, el->min_bytes);
-            }
-            if (in->failed)
+        dst = (unsigned char *)pb->xyz;
+        size_t room = pb->cap * 24 - (size_t)got, k;
+        if (room > in->cap)
+            room = in->cap;
+        if (in->hi > in->lo) {
+            k = in->hi - in->lo < room ? in->hi - in->lo : room;
+            memcpy(dst + got, in->buf + in->lo, k);
+            in->lo += k;
+        } else {
+            ptrdiff_t r = in->failed ? -1 : fdt_rd_src_read(c, dst + got, room);
+            if (r < 0) {
+                in->failed = 1;
                 return FDT_IO_EOPEN;
-            if (r != 0) {
-                rc = r; /* 1: ends inside; 2: negative list length at bad_at */
+            }
+            k = (size_t)r;
+        }
+        /* every double now complete is checked, in file order */
+        for (uint64_t v = got / 8; v < (got + k) / 8; v++) {
+            double x = pb->xyz[v];
+            if (!isfinite(x)) {
+                bad->at = start + (size_t)v * 8;
+                bad->k = (int)(v % 3);
+                bad->v = x;
+                bad->i = v / 3;
                 break;
             }
-            for (int k = 0; k < 3 && bad_k < 0; k++)
-                if (!isfinite(d[k])) {
-                    bad_k = k;
-                    bad_at = roff[k];
-                    bad_v = d[k];
-                }
-            if (bad_k >= 0)
-                break;
         }
-        if (rc == FDT_IO_OK && bad_k < 0) {
-            pb->n = (size_t)el->count;
-            return FDT_IO_OK;
-        }
+        got += k;
+        in->off += k;
+        fdt_rd_progress(c, in->off);
+        if (bad->k >= 0 || k == 0)
+            break;
     }
-    /* The first error: the size checks come first, as in the buffered
-     * read, which makes them before it reads a vertex. */
+    if (bad->k < 0 && bad->rc == FDT_IO_OK && got != bytes)
+        bad->rc = 1; /* the data ended inside vertex got / 24 */
+    if (bad->k < 0)
+        bad->i = got / 24;
+    return FDT_IO_OK;
+}
+
+/* Vertices of any other layout, one at a time through the window: as
+ * ply_st_plain. */
+static int ply_st_fields(ply_in *in, const ply_hdr *h, const ply_elem *el, int big,
+                         rd_points *pb, ply_vbad *bad)
+{
+    const rd_ctx *c = in->c;
+    int type[3] = {0, 0, 0};
+    size_t fixed_off[3] = {0, 0, 0};
+    for (size_t j = 0, o = 0; j < el->n_props; j++) {
+        const ply_prop *p = &h->props[el->first_prop + j];
+        if (p->role) {
+            type[p->role - 1] = p->type;
+            fixed_off[p->role - 1] = o;
+        }
+        o += ply_size[p->type];
+    }
+    int r = 0;
+    uint64_t i = 0;
+    for (; i < el->count; i++) {
+        if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
+            fdt_rd_progress(c, in->off);
+        if (ply_vertex_room(pb, el->count, (size_t)i) != 0) {
+            bad->rc = FDT_IO_ENOMEM;
+            break;
+        }
+        double *d = pb->xyz + 3 * i;
+        size_t roff[3];
+        if (el->has_list) {
+            r = ply_st_item(in, h, el, big, d, roff, &bad->at);
+        } else if (!ply_need(in, el->min_bytes)) {
+            r = 1;
+        } else {
+            for (int k = 0; k < 3; k++) {
+                roff[k] = in->off + fixed_off[k];
+                d[k] = ply_get(in->buf + in->lo + fixed_off[k], type[k], big);
+            }
+            ply_take(in, el->min_bytes);
+        }
+        if (in->failed)
+            return FDT_IO_EOPEN;
+        if (r != 0) {
+            bad->rc = r; /* 1: ends inside; 2: negative list length at bad->at */
+            break;
+        }
+        for (int k = 0; k < 3 && bad->k < 0; k++)
+            if (!isfinite(d[k])) {
+                bad->k = k;
+                bad->at = roff[k];
+                bad->v = d[k];
+            }
+        if (bad->k >= 0)
+            break;
+    }
+    bad->i = i;
+    return FDT_IO_OK;
+}
+
+/* The message of the first error *bad of the vertex element that starts
+ * at byte start. */
+static int ply_st_vertex_fail(ply_in *in, const ply_hdr *h, const ply_elem *el, size_t start,
+                              const ply_vbad *bad)
+{
+    const rd_ctx *c = in->c;
+    char lab[160];
+    /* The size checks come first, as in the buffered read, which makes
+     * them before it reads a vertex. */
     size_t total = ply_total(in);
     if (in->failed)
         return FDT_IO_EOPEN;
     int pre = ply_vertex_precheck(c, h, el, start, total);
     if (pre != FDT_IO_OK)
         return pre;
-    if (rc == FDT_IO_ENOMEM)
+    if (bad->rc == FDT_IO_ENOMEM)
         return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory for %llu points",
                            (unsigned long long)el->count);
-    if (rc == 1)
+    if (bad->rc == 1)
         return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: file ends inside %s", total,
-                           ply_item_label(lab, sizeof lab, h, el, i));
-    if (rc == 2)
-        return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: %s: negative list length", bad_at,
-                           ply_item_label(lab, sizeof lab, h, el, i));
-    return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: %s: %c is %s", bad_at,
-                       ply_item_label(lab, sizeof lab, h, el, i), 'x' + bad_k,
-                       isnan(bad_v) ? "NaN" : "infinite");
+                           ply_item_label(lab, sizeof lab, h, el, bad->i));
+    if (bad->rc == 2)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: %s: negative list length", bad->at,
+                           ply_item_label(lab, sizeof lab, h, el, bad->i));
+    return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: %s: %c is %s", bad->at,
+                       ply_item_label(lab, sizeof lab, h, el, bad->i), 'x' + bad->k,
+                       isnan(bad->v) ? "NaN" : "infinite");
+}
+
+/* The vertex element (the streamed ply_bin_vertex): room for it, its
+ * vertices read by the step for their layout, the first error worded. */
+static int ply_st_vertex(ply_in *in, const ply_hdr *h, const ply_elem *el, int big,
+                         rd_points *pb)
+{
+    size_t start = in->off;
+    int rc = ply_st_vertex_reserve(in, h, el, start, pb);
+    if (rc != FDT_IO_OK)
+        return rc;
+    ply_vbad bad = {FDT_IO_OK, -1, 0, 0, 0.0};
+    rc = ply_plain_doubles(h, el, big) ? ply_st_plain(in, el, start, pb, &bad)
+                                       : ply_st_fields(in, h, el, big, pb, &bad);
+    if (rc != FDT_IO_OK)
+        return rc;
+    if (bad.rc == FDT_IO_OK && bad.k < 0) {
+        pb->n = (size_t)el->count;
+        return FDT_IO_OK;
+    }
+    return ply_st_vertex_fail(in, h, el, start, &bad);
 }
 
 /* The body of a binary PLY whose header h was read; in holds the bytes
