@@ -151,216 +151,265 @@ static int sliceable(const fdt_mpi_setup_opts *o)
     return f == FDT_RD_XYZ ? 1 : f == FDT_RD_PLY ? 2 : 0;
 }
 
-/* This rank's points as records with input ids, into *out (*nout). */
-static int read_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, rec **out,
-                      size_t *nout, char *diag, size_t dlen)
+/* This rank's slice as read: n points xyz (owned), the input id of the
+ * first (set later for text slices, by the count of the slices before). */
+typedef struct slice {
+    double *xyz;
+    size_t n;
+    uint64_t first;
+} slice;
+
+/* How the input is read, which rank 0 decides and tells everyone (1: text
+ * slices, 2: binary PLY slices, 0: whole), with the PLY's layout for 2
+ * into *lay (collective). */
+static int read_kind(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_rd_ply_layout *lay,
+                     char *diag, size_t dlen)
 {
-    int rank, size;
+    int rank;
     MPI_Comm_rank(comm, &rank);
-    MPI_Comm_size(comm, &size);
-    double *xyz = NULL;
-    size_t n = 0;
-    int err = FDT_OK;
-    uint64_t first = 0; /* input id of this rank's first point */
-    /* Rank 0 decides how the input is read (1: text slices, 2: binary
-     * PLY slices, 0: whole) and tells everyone. */
     int kind = 0;
-    fdt_rd_ply_layout lay;
-    memset(&lay, 0, sizeof lay);
+    memset(lay, 0, sizeof *lay);
     if (rank == 0) {
         kind = sliceable(o);
         if (kind == 2) {
-            int lr = fdt_rd_ply_find_layout(o->input, &lay, diag, dlen);
+            int lr = fdt_rd_ply_find_layout(o->input, lay, diag, dlen);
             kind = lr == 1 ? 2 : 0; /* errors: the whole read words them */
         }
     }
     MPI_Bcast(&kind, 1, MPI_INT, 0, comm);
-    L->sliced = kind; /* 3 below for standard input */
     if (kind == 2) {
-        unsigned long long lv[8] = {lay.vertex_off, lay.rec, lay.count, lay.off[0], lay.off[1],
-                                    lay.off[2], 0, (unsigned long long)lay.big};
-        int ty[3] = {lay.type[0], lay.type[1], lay.type[2]};
+        unsigned long long lv[8] = {lay->vertex_off, lay->rec, lay->count, lay->off[0],
+                                    lay->off[1], lay->off[2], 0, (unsigned long long)lay->big};
+        int ty[3] = {lay->type[0], lay->type[1], lay->type[2]};
         MPI_Bcast(lv, 8, MPI_UNSIGNED_LONG_LONG, 0, comm);
         MPI_Bcast(ty, 3, MPI_INT, 0, comm);
-        lay.vertex_off = (size_t)lv[0];
-        lay.rec = (size_t)lv[1];
-        lay.count = lv[2];
+        lay->vertex_off = (size_t)lv[0];
+        lay->rec = (size_t)lv[1];
+        lay->count = lv[2];
         for (int k = 0; k < 3; k++) {
-            lay.off[k] = (size_t)lv[3 + k];
-            lay.type[k] = ty[k];
+            lay->off[k] = (size_t)lv[3 + k];
+            lay->type[k] = ty[k];
         }
-        lay.big = (int)lv[7];
-        /* vertices [N r / p, N (r + 1) / p), by pread of their bytes */
-        unsigned long long a = lay.count * (unsigned long long)rank / (unsigned long long)size;
-        unsigned long long b = lay.count * (unsigned long long)(rank + 1) / (unsigned long long)size;
-        n = (size_t)(b - a);
-        int rc = fdt_rd_ply_range(o->input, &lay, a, n, &xyz, diag, dlen);
-        int bad = rc == FDT_IO_EFORMAT, anybad = 0;
-        MPI_Allreduce(&bad, &anybad, 1, MPI_INT, MPI_MAX, comm);
-        if (anybad) {
-            /* a NaN or an infinity: rank 0 reads the file whole, which
-             * words the error exactly as frontdt does (only bad files pay) */
-            free(xyz);
-            xyz = NULL;
-            double *w = NULL;
-            size_t wn = 0;
-            err = FDT_EFORMAT;
-            if (rank == 0) {
-                err = fdt_read_points(o->input, o->format, &w, &wn, diag, dlen);
-                fdt_free(w);
-                if (!err) {
-                    snprintf(diag, dlen, "%s: a slice and the whole read disagree", o->input);
-                    err = FDT_EINTERNAL;
-                }
-            }
-            /* rank 0's message is the one: the others only follow */
-            int e0 = err;
-            MPI_Bcast(&e0, 1, MPI_INT, 0, comm);
-            char m0[512];
-            snprintf(m0, sizeof m0, "%s", diag);
-            MPI_Bcast(m0, (int)sizeof m0, MPI_CHAR, 0, comm);
-            snprintf(diag, dlen, "%s", m0);
-            return e0;
-        }
-        err = io_err(rc);
-        first = a;
-    } else if (kind == 1) {
-        fdt_rd_head h;
-        memset(&h, 0, sizeof h);
-        if (rank == 0)
-            err = io_err(fdt_rd_text_head(o->input, &h, diag, dlen));
-        if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
-            return err;
-        uint64_t hv[4] = {h.body, h.body_line, h.ncols, h.size};
-        MPI_Bcast(hv, 4, MPI_UINT64_T, 0, comm);
-        if (hv[2] == 0) {
-            snprintf(diag, dlen, "%s: no points%s", o->input, hv[3] == 0 ? " (empty file)" : "");
-            return FDT_EFORMAT;
-        }
-        /* [begin, end): from the first line start at or after this
-         * rank's share of the body, to the next rank's */
-        uint64_t body = hv[0], S = hv[3], span = S - body;
-        uint64_t want0 = body + span * (uint64_t)rank / (uint64_t)size;
-        uint64_t want1 = body + span * (uint64_t)(rank + 1) / (uint64_t)size;
-        size_t begin = (size_t)want0, end = (size_t)want1;
-        int rc = rank == 0 ? FDT_IO_OK
-                           : fdt_rd_text_line_start(o->input, (size_t)want0, &begin, diag, dlen);
-        if (rc == FDT_IO_OK && rank + 1 < size)
-            rc = fdt_rd_text_line_start(o->input, (size_t)want1, &end, diag, dlen);
-        if (end < begin)
-            end = begin;
-        size_t lines = 0;
-        fdt_rd_opts ro;
-        fdt_rd_opts_default(&ro);
-        ro.format = FDT_RD_XYZ;
-        if (rc == FDT_IO_OK)
-            rc = fdt_rd_text_range(o->input, &ro, begin, end, (size_t)hv[2], 0, &xyz, &n, &lines,
-                                   diag, dlen);
-        /* Lines before the slice: the head's and the slices' before it
-         * (complete: a slice's parse counts its line ends even when it
-         * fails only on a rank after the lowest failing one, whose own
-         * count does not matter then). */
-        uint64_t ml = lines, before = 0;
-        MPI_Exscan(&ml, &before, 1, MPI_UINT64_T, MPI_SUM, comm);
-        if (rank == 0)
-            before = 0;
-        if (rc == FDT_IO_EFORMAT && before + hv[1] > 0) {
-            /* word the error with the right line numbers */
-            rc = fdt_rd_text_range(o->input, &ro, begin, end, (size_t)hv[2],
-                                   (size_t)(before + hv[1]), &xyz, &n, &lines, diag, dlen);
-            if (rc == FDT_IO_OK) { /* cannot happen: the same bytes */
-                rc = FDT_IO_EFORMAT;
-                free(xyz);
-                xyz = NULL;
+        lay->big = (int)lv[7];
+    }
+    return kind;
+}
+
+/* Kind 2: this rank's vertices of a binary PLY of layout lay into *s
+ * (collective; the error, if any, the same on every rank). */
+static int read_ply_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o,
+                          const fdt_rd_ply_layout *lay, slice *s, char *diag, size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    /* vertices [N r / p, N (r + 1) / p), by pread of their bytes */
+    unsigned long long a = lay->count * (unsigned long long)rank / (unsigned long long)size;
+    unsigned long long b = lay->count * (unsigned long long)(rank + 1) / (unsigned long long)size;
+    s->n = (size_t)(b - a);
+    int rc = fdt_rd_ply_range(o->input, lay, a, s->n, &s->xyz, diag, dlen);
+    int bad = rc == FDT_IO_EFORMAT, anybad = 0;
+    MPI_Allreduce(&bad, &anybad, 1, MPI_INT, MPI_MAX, comm);
+    if (anybad) {
+        /* a NaN or an infinity: rank 0 reads the file whole, which
+         * words the error exactly as frontdt does (only bad files pay) */
+        free(s->xyz);
+        s->xyz = NULL;
+        double *w = NULL;
+        size_t wn = 0;
+        int err = FDT_EFORMAT;
+        if (rank == 0) {
+            err = fdt_read_points(o->input, o->format, &w, &wn, diag, dlen);
+            fdt_free(w);
+            if (!err) {
+                snprintf(diag, dlen, "%s: a slice and the whole read disagree", o->input);
+                err = FDT_EINTERNAL;
             }
         }
-        err = io_err(rc);
-    } else if (strcmp(o->input, "-") == 0) {
-        L->sliced = 3;
-        /* Standard input reaches rank 0 alone (mpirun forwards it there):
-         * rank 0 reads it and scatters slice r to rank r. */
-        double *all_xyz = NULL;
-        size_t all_n = 0;
-        if (rank == 0)
-            err = fdt_read_points(o->input, o->format, &all_xyz, &all_n, diag, dlen);
-        if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
-            return err;
-        uint64_t an = all_n;
-        MPI_Bcast(&an, 1, MPI_UINT64_T, 0, comm);
-        size_t a = (size_t)(an * (uint64_t)rank / (uint64_t)size);
-        n = (size_t)(an * (uint64_t)(rank + 1) / (uint64_t)size) - a;
-        first = a;
-        int *cnt = rank == 0 ? malloc(2 * (size_t)size * sizeof *cnt) : NULL;
-        xyz = malloc((3 * n + 1) * sizeof *xyz);
-        err = xyz && (rank != 0 || cnt) ? FDT_OK : FDT_ENOMEM;
-        snprintf(diag, dlen, "out of memory reading standard input");
-        if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
-            free(cnt);
-            free(xyz);
-            fdt_free(all_xyz);
-            return err;
+        /* rank 0's message is the one: the others only follow */
+        int e0 = err;
+        MPI_Bcast(&e0, 1, MPI_INT, 0, comm);
+        char m0[512];
+        snprintf(m0, sizeof m0, "%s", diag);
+        MPI_Bcast(m0, (int)sizeof m0, MPI_CHAR, 0, comm);
+        snprintf(diag, dlen, "%s", m0);
+        return e0;
+    }
+    s->first = a;
+    return fdt_mpi_agree(comm, io_err(rc), diag, dlen);
+}
+
+/* Kind 1: this rank's byte range of a text point file into *s, its errors
+ * worded with the file's line numbers (collective; the error, if any, the
+ * same on every rank). */
+static int read_text_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, slice *s, char *diag,
+                           size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    int err = FDT_OK;
+    fdt_rd_head h;
+    memset(&h, 0, sizeof h);
+    if (rank == 0)
+        err = io_err(fdt_rd_text_head(o->input, &h, diag, dlen));
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+        return err;
+    uint64_t hv[4] = {h.body, h.body_line, h.ncols, h.size};
+    MPI_Bcast(hv, 4, MPI_UINT64_T, 0, comm);
+    if (hv[2] == 0) {
+        snprintf(diag, dlen, "%s: no points%s", o->input, hv[3] == 0 ? " (empty file)" : "");
+        return FDT_EFORMAT;
+    }
+    /* [begin, end): from the first line start at or after this
+     * rank's share of the body, to the next rank's */
+    uint64_t body = hv[0], S = hv[3], span = S - body;
+    uint64_t want0 = body + span * (uint64_t)rank / (uint64_t)size;
+    uint64_t want1 = body + span * (uint64_t)(rank + 1) / (uint64_t)size;
+    size_t begin = (size_t)want0, end = (size_t)want1;
+    int rc = rank == 0 ? FDT_IO_OK
+                       : fdt_rd_text_line_start(o->input, (size_t)want0, &begin, diag, dlen);
+    if (rc == FDT_IO_OK && rank + 1 < size)
+        rc = fdt_rd_text_line_start(o->input, (size_t)want1, &end, diag, dlen);
+    if (end < begin)
+        end = begin;
+    size_t lines = 0;
+    fdt_rd_opts ro;
+    fdt_rd_opts_default(&ro);
+    ro.format = FDT_RD_XYZ;
+    if (rc == FDT_IO_OK)
+        rc = fdt_rd_text_range(o->input, &ro, begin, end, (size_t)hv[2], 0, &s->xyz, &s->n,
+                               &lines, diag, dlen);
+    /* Lines before the slice: the head's and the slices' before it
+     * (complete: a slice's parse counts its line ends even when it
+     * fails only on a rank after the lowest failing one, whose own
+     * count does not matter then). */
+    uint64_t ml = lines, before = 0;
+    MPI_Exscan(&ml, &before, 1, MPI_UINT64_T, MPI_SUM, comm);
+    if (rank == 0)
+        before = 0;
+    if (rc == FDT_IO_EFORMAT && before + hv[1] > 0) {
+        /* word the error with the right line numbers */
+        rc = fdt_rd_text_range(o->input, &ro, begin, end, (size_t)hv[2],
+                               (size_t)(before + hv[1]), &s->xyz, &s->n, &lines, diag, dlen);
+        if (rc == FDT_IO_OK) { /* cannot happen: the same bytes */
+            rc = FDT_IO_EFORMAT;
+            free(s->xyz);
+            s->xyz = NULL;
         }
-        diag[0] = '\0';
-        MPI_Datatype pt3;
-        MPI_Type_contiguous(3, MPI_DOUBLE, &pt3);
-        MPI_Type_commit(&pt3);
-        for (int q = 0; cnt && q < size; q++) {
-            size_t qa = (size_t)(an * (uint64_t)q / (uint64_t)size);
-            cnt[q] = (int)((size_t)(an * (uint64_t)(q + 1) / (uint64_t)size) - qa);
-            cnt[size + q] = (int)qa;
-        }
-        MPI_Scatterv(all_xyz, cnt, cnt ? cnt + size : NULL, pt3, xyz, (int)n, pt3, 0, comm);
-        MPI_Type_free(&pt3);
+    }
+    return fdt_mpi_agree(comm, io_err(rc), diag, dlen);
+}
+
+/* Standard input, which reaches rank 0 alone (mpirun forwards it there):
+ * rank 0 reads it and scatters slice r to rank r, into *s (collective;
+ * the error, if any, the same on every rank). */
+static int read_stdin_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, slice *s, char *diag,
+                            size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    int err = FDT_OK;
+    double *all_xyz = NULL;
+    size_t all_n = 0;
+    if (rank == 0)
+        err = fdt_read_points(o->input, o->format, &all_xyz, &all_n, diag, dlen);
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+        return err;
+    uint64_t an = all_n;
+    MPI_Bcast(&an, 1, MPI_UINT64_T, 0, comm);
+    size_t a = (size_t)(an * (uint64_t)rank / (uint64_t)size);
+    size_t n = (size_t)(an * (uint64_t)(rank + 1) / (uint64_t)size) - a;
+    s->n = n;
+    s->first = a;
+    int *cnt = rank == 0 ? malloc(2 * (size_t)size * sizeof *cnt) : NULL;
+    s->xyz = malloc((3 * n + 1) * sizeof *s->xyz);
+    err = s->xyz && (rank != 0 || cnt) ? FDT_OK : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory reading standard input");
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
         free(cnt);
         fdt_free(all_xyz);
-    } else {
-        double *all_xyz = NULL;
-        size_t all_n = 0;
-        err = fdt_read_points(o->input, o->format, &all_xyz, &all_n, diag, dlen);
-        if (!err) {
-            /* keep slice r of the points: the rest of the setup is the
-             * same whatever was read */
-            size_t a = all_n * (size_t)rank / (size_t)size, b = all_n * (size_t)(rank + 1) / (size_t)size;
-            n = b - a;
-            first = a;
-            xyz = malloc((3 * n + 1) * sizeof *xyz);
-            if (!xyz)
-                err = FDT_ENOMEM;
-            else
-                memcpy(xyz, all_xyz + 3 * a, 3 * n * sizeof *xyz);
-            fdt_free(all_xyz);
-        }
-    }
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
-        free(xyz);
         return err;
     }
+    diag[0] = '\0';
+    MPI_Datatype pt3;
+    MPI_Type_contiguous(3, MPI_DOUBLE, &pt3);
+    MPI_Type_commit(&pt3);
+    for (int q = 0; cnt && q < size; q++) {
+        size_t qa = (size_t)(an * (uint64_t)q / (uint64_t)size);
+        cnt[q] = (int)((size_t)(an * (uint64_t)(q + 1) / (uint64_t)size) - qa);
+        cnt[size + q] = (int)qa;
+    }
+    MPI_Scatterv(all_xyz, cnt, cnt ? cnt + size : NULL, pt3, s->xyz, (int)n, pt3, 0, comm);
+    MPI_Type_free(&pt3);
+    free(cnt);
+    fdt_free(all_xyz);
+    /* nothing has failed since the last agreement, but every way of
+     * reading ends with one */
+    return fdt_mpi_agree(comm, FDT_OK, diag, dlen);
+}
+
+/* Kind 0 of a file: every rank reads the whole input and keeps slice r of
+ * its points, so that the rest of the setup is the same whatever was read
+ * (collective; the error, if any, the same on every rank). */
+static int read_whole_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, slice *s, char *diag,
+                            size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    double *all_xyz = NULL;
+    size_t all_n = 0;
+    int err = fdt_read_points(o->input, o->format, &all_xyz, &all_n, diag, dlen);
+    if (!err) {
+        size_t a = all_n * (size_t)rank / (size_t)size, b = all_n * (size_t)(rank + 1) / (size_t)size;
+        s->n = b - a;
+        s->first = a;
+        s->xyz = malloc((3 * s->n + 1) * sizeof *s->xyz);
+        if (!s->xyz)
+            err = FDT_ENOMEM;
+        else
+            memcpy(s->xyz, all_xyz + 3 * a, 3 * s->n * sizeof *s->xyz);
+        fdt_free(all_xyz);
+    }
+    return fdt_mpi_agree(comm, err, diag, dlen);
+}
+
+/* The slices' points as records with input ids, into *out (*nout), and
+ * their total into L->n; frees s->xyz (collective). */
+static int slice_records(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, slice *s,
+                         rec **out, size_t *nout, char *diag, size_t dlen)
+{
+    int rank;
+    MPI_Comm_rank(comm, &rank);
+    size_t n = s->n;
     uint64_t mn = n, tot = 0, off = 0;
     MPI_Allreduce(&mn, &tot, 1, MPI_UINT64_T, MPI_SUM, comm);
     MPI_Exscan(&mn, &off, 1, MPI_UINT64_T, MPI_SUM, comm);
     if (rank == 0)
         off = 0;
     if (L->sliced == 1)
-        first = off;
+        s->first = off;
     if (tot == 0) {
-        free(xyz);
         snprintf(diag, dlen, "%s: no points", o->input);
         return FDT_EFORMAT;
     }
     if (tot > (uint64_t)INT32_MAX) {
-        free(xyz);
         snprintf(diag, dlen, "%s: more than %d points", o->input, INT32_MAX);
         return FDT_ETOOBIG;
     }
     L->n = (size_t)tot;
+    int err = FDT_OK;
     rec *r = malloc((n + 1) * sizeof *r);
     if (!r)
         err = FDT_ENOMEM;
     for (size_t i = 0; r && i < n; i++) {
-        memcpy(r[i].x, xyz + 3 * i, sizeof r[i].x);
-        r[i].id = first + i;
+        memcpy(r[i].x, s->xyz + 3 * i, sizeof r[i].x);
+        r[i].id = s->first + i;
     }
-    free(xyz);
+    free(s->xyz);
+    s->xyz = NULL;
     snprintf(diag, dlen, "out of memory after reading");
     if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
         free(r);
@@ -370,6 +419,32 @@ static int read_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local 
     *out = r;
     *nout = n;
     return FDT_OK;
+}
+
+/* This rank's points as records with input ids, into *out (*nout): read
+ * by the step for how the input is read, then numbered. */
+static int read_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, rec **out,
+                      size_t *nout, char *diag, size_t dlen)
+{
+    slice s = {NULL, 0, 0};
+    fdt_rd_ply_layout lay;
+    int kind = read_kind(comm, o, &lay, diag, dlen);
+    L->sliced = kind; /* 3 below for standard input */
+    int err;
+    if (kind == 2) {
+        err = read_ply_slice(comm, o, &lay, &s, diag, dlen);
+    } else if (kind == 1) {
+        err = read_text_slice(comm, o, &s, diag, dlen);
+    } else if (strcmp(o->input, "-") == 0) {
+        L->sliced = 3;
+        err = read_stdin_slice(comm, o, &s, diag, dlen);
+    } else {
+        err = read_whole_slice(comm, o, &s, diag, dlen);
+    }
+    if (err == FDT_OK)
+        err = slice_records(comm, o, L, &s, out, nout, diag, dlen);
+    free(s.xyz);
+    return err;
 }
 
 /* ---- 2. bisection by exchange -------------------------------------------- */
