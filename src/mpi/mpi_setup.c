@@ -951,113 +951,113 @@ static int seed_key_cmp(const void *x, const void *y)
     return 0;
 }
 
-/* Every rank's seed, deduplicated into L->seeds (collective). */
-static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const double *gbox,
-                      int leaf, char *diag, size_t dlen)
+/* The point a of tree t nearest its box's centre, as this rank's
+ * first ball about it into *me: its id (FDT_NONE, me inactive, when t is
+ * empty). P: global indexing; gdiag: the whole box's diagonal; m: the
+ * number of distinct points. */
+static uint32_t seed_start(const fdt_kdtree *t, const double *P, double gdiag, size_t m,
+                           seed_msg *me, fdt_kdq *kq)
 {
-    int rank, size;
-    MPI_Comm_rank(comm, &rank);
+    if (t->n == 0)
+        return FDT_NONE;
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = t->nodes[0].lo[k] * 0.5 + t->nodes[0].hi[k] * 0.5;
+    uint32_t aid = fdt_kd_nearest(t, c, FDT_NONE, kq);
+    memcpy(me->a, P + 3 * (size_t)aid, sizeof me->a);
+    /* a first radius holding a few dozen points where they are even:
+     * four times the nearest neighbour's distance */
+    uint32_t b = fdt_kd_nearest(t, me->a, aid, kq);
+    double R = gdiag * cbrt(64.0 / (double)m);
+    if (b != FDT_NONE) {
+        const double *pb = P + 3 * (size_t)b;
+        double d[3] = {pb[0] - me->a[0], pb[1] - me->a[1], pb[2] - me->a[2]};
+        R = 4.0 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    }
+    me->R = R > 0 ? R : gdiag;
+    me->active = 1;
+    return aid;
+}
+
+/* Our points in each active asker's ball (all[q], q < size) into bc[q]:
+ * FDT_OK or FDT_ENOMEM. */
+static int seed_balls(const fdt_kdtree *t, const double *P, const seed_msg *all, int size,
+                      ball_ctx *bc, fdt_kdq *kq)
+{
+    int e = FDT_OK;
+    for (int q = 0; q < size; q++) {
+        bc[q].P = P;
+        bc[q].n = 0;
+        if (all[q].active != 0 && t->n > 0) {
+            fdt_kd_ball(t, all[q].a, all[q].R, ball_cb, &bc[q], kq);
+            if (bc[q].nomem)
+                e = FDT_ENOMEM;
+        }
+    }
+    return e;
+}
+
+/* The balls' points sent, bc[q]'s to rank q, and the points of our ball
+ * received into *got (*nr); cnt: 4 size counts. e: this rank's error so
+ * far, agreed on with the exchange's allocations first (collective). */
+static int seed_exchange(MPI_Comm comm, MPI_Datatype rt, const ball_ctx *bc, int *cnt, int e,
+                         rec **got, size_t *nr, uint64_t *bytes, char *diag, size_t dlen)
+{
+    int size;
     MPI_Comm_size(comm, &size);
-    const fdt_kdtree *t = &L->pt.trees[rank];
-    const double *P = L->p - 3 * (size_t)L->lo; /* global indexing */
-    double gd[3] = {gbox[3] - gbox[0], gbox[4] - gbox[1], gbox[5] - gbox[2]};
-    double gdiag = sqrt(gd[0] * gd[0] + gd[1] * gd[1] + gd[2] * gd[2]);
-    seed_msg me = {{0, 0, 0}, 0, 0};
-    uint32_t aid = FDT_NONE;
-    fdt_kdq kq;
-    memset(&kq, 0, sizeof kq);
-    if (t->n > 0) {
-        double c[3];
-        for (int k = 0; k < 3; k++)
-            c[k] = t->nodes[0].lo[k] * 0.5 + t->nodes[0].hi[k] * 0.5;
-        aid = fdt_kd_nearest(t, c, FDT_NONE, &kq);
-        memcpy(me.a, P + 3 * (size_t)aid, sizeof me.a);
-        /* a first radius holding a few dozen points where they are even:
-         * four times the nearest neighbour's distance */
-        uint32_t b = fdt_kd_nearest(t, me.a, aid, &kq);
-        double R = gdiag * cbrt(64.0 / (double)L->m);
-        if (b != FDT_NONE) {
-            const double *pb = P + 3 * (size_t)b;
-            double d[3] = {pb[0] - me.a[0], pb[1] - me.a[1], pb[2] - me.a[2]};
-            R = 4.0 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        }
-        me.R = R > 0 ? R : gdiag;
-        me.active = 1;
-    }
-    seed_out so;
-    memset(&so, 0, sizeof so);
-    seed_msg *all = malloc((size_t)size * sizeof *all);
-    int *cnt = malloc(4 * (size_t)size * sizeof *cnt);
-    ball_ctx *bc = calloc((size_t)size, sizeof *bc);
-    rec *got = NULL;
-    int err = all && cnt && bc ? FDT_OK : FDT_ENOMEM;
+    int *scount = cnt, *sdisp = cnt + size, *rcount = cnt + 2 * size, *rdisp = cnt + 3 * size;
+    for (int q = 0; q < size; q++)
+        scount[q] = bc[q].n > (size_t)INT_MAX / 2 ? 0 : (int)bc[q].n;
+    *nr = fdt_mpi_counts(comm, scount, sdisp, rcount, rdisp, sizeof(rec), bytes);
+    size_t ns = (size_t)sdisp[size - 1] + (size_t)scount[size - 1];
+    /* one send buffer: the balls in rank order */
+    rec *sb = malloc((ns + 1) * sizeof *sb);
+    free(*got);
+    *got = malloc((*nr + 1) * sizeof **got);
+    if (!sb || !*got)
+        e = FDT_ENOMEM;
     snprintf(diag, dlen, "out of memory finding the seeds");
-    err = fdt_mpi_agree(comm, err, diag, dlen);
-    while (!err) {
-        MPI_Allgather(&me, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, comm);
-        int any = 0;
-        for (int q = 0; q < size; q++)
-            any |= all[q].active != 0;
-        if (!any)
-            break;
-        /* our points in each asker's ball */
-        int e = FDT_OK;
-        for (int q = 0; q < size; q++) {
-            bc[q].P = P;
-            bc[q].n = 0;
-            if (all[q].active != 0 && t->n > 0) {
-                fdt_kd_ball(t, all[q].a, all[q].R, ball_cb, &bc[q], &kq);
-                if (bc[q].nomem)
-                    e = FDT_ENOMEM;
-            }
-        }
-        int *scount = cnt, *sdisp = cnt + size, *rcount = cnt + 2 * size, *rdisp = cnt + 3 * size;
-        for (int q = 0; q < size; q++)
-            scount[q] = bc[q].n > (size_t)INT_MAX / 2 ? 0 : (int)bc[q].n;
-        size_t nr = fdt_mpi_counts(comm, scount, sdisp, rcount, rdisp, sizeof(rec),
-                                   &L->bytes_sent);
-        size_t ns = (size_t)sdisp[size - 1] + (size_t)scount[size - 1];
-        /* one send buffer: the balls in rank order */
-        rec *sb = malloc((ns + 1) * sizeof *sb);
-        free(got);
-        got = malloc((nr + 1) * sizeof *got);
-        if (!sb || !got)
-            e = FDT_ENOMEM;
-        snprintf(diag, dlen, "out of memory finding the seeds");
-        if ((err = fdt_mpi_agree(comm, e, diag, dlen)) != FDT_OK) {
-            free(sb);
-            break;
-        }
-        for (int q = 0; q < size; q++)
-            if (scount[q] > 0)
-                memcpy(sb + sdisp[q], bc[q].buf, (size_t)scount[q] * sizeof *sb);
-        MPI_Alltoallv(sb, scount, sdisp, rt, got, rcount, rdisp, rt, comm);
+    int err = fdt_mpi_agree(comm, e, diag, dlen);
+    if (err != FDT_OK) {
         free(sb);
-        if (me.active != 0) {
-            /* the ball holds every point once R reaches past all of them */
-            int everything = me.R > 2.0 * gdiag;
-            int r = seed_from(got, nr, aid, me.a, me.R, everything, leaf, so.v, so.x);
-            if (r < 0) {
-                e = r;
-            } else if (r == 1) {
-                so.has = 1;
-                me.active = 0;
-            } else {
-                me.R *= 2.0;
-            }
-        }
-        snprintf(diag, dlen, "rank %d: out of memory finding its seed", rank);
-        if ((err = fdt_mpi_agree(comm, e, diag, dlen)) != FDT_OK)
-            break;
-    }
-    free(got);
-    for (int q = 0; bc && q < size; q++)
-        free(bc[q].buf);
-    free(bc);
-    free(all);
-    free(cnt);
-    if (err)
         return err;
+    }
+    for (int q = 0; q < size; q++)
+        if (scount[q] > 0)
+            memcpy(sb + sdisp[q], bc[q].buf, (size_t)scount[q] * sizeof *sb);
+    MPI_Alltoallv(sb, scount, sdisp, rt, *got, rcount, rdisp, rt, comm);
+    free(sb);
+    return FDT_OK;
+}
+
+/* One try at this rank's seed from the nr points got of its ball me about
+ * point aid: found, into *so, with me made inactive; else the ball
+ * doubled. FDT_OK or <0 an error. */
+static int seed_try(const rec *got, size_t nr, uint32_t aid, double gdiag, int leaf,
+                    seed_msg *me, seed_out *so)
+{
+    /* the ball holds every point once R reaches past all of them */
+    int everything = me->R > 2.0 * gdiag;
+    int r = seed_from(got, nr, aid, me->a, me->R, everything, leaf, so->v, so->x);
+    if (r < 0)
+        return r;
+    if (r == 1) {
+        so->has = 1;
+        me->active = 0;
+    } else {
+        me->R *= 2.0;
+    }
+    return FDT_OK;
+}
+
+/* Every rank's seed so gathered and deduplicated by their sorted ids into
+ * L->seeds, in rank order: the same on every rank (collective). */
+static int keep_seeds(MPI_Comm comm, fdt_mpi_local *L, const seed_out *so, char *diag,
+                      size_t dlen)
+{
+    int size;
+    MPI_Comm_size(comm, &size);
+    int err = FDT_OK;
     seed_out *so_all = malloc((size_t)size * sizeof *so_all);
     if (!so_all)
         err = FDT_ENOMEM;
@@ -1066,8 +1066,7 @@ static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const do
         free(so_all);
         return err;
     }
-    MPI_Allgather(&so, (int)sizeof so, MPI_BYTE, so_all, (int)sizeof so, MPI_BYTE, comm);
-    /* deduplicate by the sorted ids, in rank order: the same on every rank */
+    MPI_Allgather(so, (int)sizeof *so, MPI_BYTE, so_all, (int)sizeof *so, MPI_BYTE, comm);
     uint32_t(*key)[8] = malloc((size_t)size * sizeof *key);
     L->seeds = malloc((size_t)size * sizeof *L->seeds);
     L->seed_xyz = malloc((size_t)size * sizeof *L->seed_xyz);
@@ -1103,6 +1102,60 @@ static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const do
         err = FDT_EINTERNAL;
     }
     return err;
+}
+
+/* Every rank's seed, deduplicated into L->seeds (collective): rounds in
+ * which every rank sends the active askers their points in their balls and
+ * tries its own seed, until no rank is active; then the seeds kept. */
+static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const double *gbox,
+                      int leaf, char *diag, size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    const fdt_kdtree *t = &L->pt.trees[rank];
+    const double *P = L->p - 3 * (size_t)L->lo; /* global indexing */
+    double gd[3] = {gbox[3] - gbox[0], gbox[4] - gbox[1], gbox[5] - gbox[2]};
+    double gdiag = sqrt(gd[0] * gd[0] + gd[1] * gd[1] + gd[2] * gd[2]);
+    seed_msg me = {{0, 0, 0}, 0, 0};
+    fdt_kdq kq;
+    memset(&kq, 0, sizeof kq);
+    uint32_t aid = seed_start(t, P, gdiag, L->m, &me, &kq);
+    seed_out so;
+    memset(&so, 0, sizeof so);
+    seed_msg *all = malloc((size_t)size * sizeof *all);
+    int *cnt = malloc(4 * (size_t)size * sizeof *cnt);
+    ball_ctx *bc = calloc((size_t)size, sizeof *bc);
+    rec *got = NULL;
+    int err = all && cnt && bc ? FDT_OK : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory finding the seeds");
+    err = fdt_mpi_agree(comm, err, diag, dlen);
+    while (!err) {
+        MPI_Allgather(&me, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, comm);
+        int any = 0;
+        for (int q = 0; q < size; q++)
+            any |= all[q].active != 0;
+        if (!any)
+            break;
+        int e = seed_balls(t, P, all, size, bc, &kq);
+        size_t nr = 0;
+        err = seed_exchange(comm, rt, bc, cnt, e, &got, &nr, &L->bytes_sent, diag, dlen);
+        if (err != FDT_OK)
+            break;
+        e = me.active != 0 ? seed_try(got, nr, aid, gdiag, leaf, &me, &so) : FDT_OK;
+        snprintf(diag, dlen, "rank %d: out of memory finding its seed", rank);
+        if ((err = fdt_mpi_agree(comm, e, diag, dlen)) != FDT_OK)
+            break;
+    }
+    free(got);
+    for (int q = 0; bc && q < size; q++)
+        free(bc[q].buf);
+    free(bc);
+    free(all);
+    free(cnt);
+    if (err)
+        return err;
+    return keep_seeds(comm, L, &so, diag, dlen);
 }
 
 /* The dimension check over every rank's affine basis (collective). */
