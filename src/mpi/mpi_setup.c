@@ -771,6 +771,108 @@ static uint64_t point_mix(const double *x)
     return h ^ (h >> 32);
 }
 
+/* The classes of equal points among the n records r: each class's first
+ * (least) input id survives. A hash table of record indices, one pass:
+ * slot[h] (cap entries, a power of two, all UINT32_MAX at first) holds the
+ * class's survivor so far, cls[i] the slot of record i's class (a sort of
+ * the 32-byte records cost 0.37 s a rank at 1M on 2 ranks). Also ext[0],
+ * the greatest |x|, and ext[1], -(the least nonzero |x|), where greater.
+ * The number of classes. */
+static size_t merge_classes(const rec *r, size_t n, uint32_t *slot, size_t cap, uint32_t *cls,
+                            double ext[2])
+{
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t h = (size_t)point_mix(r[i].x) & (cap - 1);
+        for (;; h = (h + 1) & (cap - 1)) {
+            uint32_t q = slot[h];
+            if (q == UINT32_MAX) {
+                slot[h] = (uint32_t)i;
+                m++;
+                break;
+            }
+            if (key_cmp(r[q].x, r[i].x, 0) == 0) {
+                if (r[i].id < r[q].id)
+                    slot[h] = (uint32_t)i;
+                break;
+            }
+        }
+        cls[i] = (uint32_t)h;
+        for (int k = 0; k < 3; k++) {
+            double ax = fabs(r[i].x[k]);
+            if (ax > ext[0])
+                ext[0] = ax;
+            if (ax != 0.0 && -ax > ext[1])
+                ext[1] = -ax;
+        }
+    }
+    return m;
+}
+
+/* The n records r after the bisection into this rank's distinct points,
+ * scaled (L->p, L->orig, L->nloc), the input's map kept if asked
+ * (L->in_*), the counts L->m and L->ndup (collective). */
+static int merge_duplicates(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L,
+                            const rec *r, size_t n, char *diag, size_t dlen)
+{
+    size_t cap = 16;
+    while (cap < 2 * n)
+        cap *= 2;
+    uint32_t *slot = malloc(cap * sizeof *slot), *cls = malloc((n + 1) * sizeof *cls);
+    int err = slot && cls && n < UINT32_MAX ? FDT_OK : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory merging the duplicates");
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
+        free(slot);
+        free(cls);
+        return err;
+    }
+    memset(slot, 0xff, cap * sizeof *slot);
+    double ext[2] = {0.0, -INFINITY}; /* max |x|, -(min nonzero |x|) */
+    size_t m = merge_classes(r, n, slot, cap, cls, ext);
+    double gext[2];
+    MPI_Allreduce(ext, gext, 2, MPI_DOUBLE, MPI_MAX, comm);
+    L->scale_exp = fdt_prepare_scale_exp(gext[0], -gext[1]);
+    L->p = malloc((3 * m + 1) * sizeof *L->p);
+    L->orig = malloc((m + 1) * sizeof *L->orig);
+    if (o->keep_input) {
+        L->in_id = malloc((n + 1) * sizeof *L->in_id);
+        L->in_vertex = malloc((n + 1) * sizeof *L->in_vertex);
+        L->in_xyz = malloc((3 * n + 1) * sizeof *L->in_xyz);
+    }
+    err = L->p && L->orig && (!o->keep_input || (L->in_id && L->in_vertex && L->in_xyz))
+              ? FDT_OK
+              : FDT_ENOMEM;
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
+        free(slot);
+        free(cls);
+        return err;
+    }
+    diag[0] = '\0';
+    size_t j = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t q = slot[cls[i]];
+        if (q == (uint32_t)i) { /* the survivor of its class */
+            for (int k = 0; k < 3; k++)
+                L->p[3 * j + k] = ldexp(r[i].x[k], L->scale_exp); /* exact */
+            L->orig[j++] = (fdt_vid)r[i].id;
+        }
+        if (o->keep_input) {
+            L->in_id[i] = (fdt_vid)r[i].id;
+            L->in_vertex[i] = (fdt_vid)r[q].id;
+            memcpy(L->in_xyz + 3 * i, r[i].x, sizeof r[i].x);
+        }
+    }
+    L->nloc = m;
+    L->nin = o->keep_input ? n : 0;
+    free(slot);
+    free(cls);
+    uint64_t mm = m, gm = 0;
+    MPI_Allreduce(&mm, &gm, 1, MPI_UINT64_T, MPI_SUM, comm);
+    L->m = (size_t)gm;
+    L->ndup = L->n - L->m;
+    return FDT_OK;
+}
+
 /* ---- 4. trees: the bisection's nodes on every rank ------------------------ */
 
 typedef struct node_ctx {
@@ -811,6 +913,63 @@ static void make_nodes(node_ctx *c, int id, int p0, int k, int depth)
         nd->lo[j] = l->lo[j] < r->lo[j] ? l->lo[j] : r->lo[j];
         nd->hi[j] = l->hi[j] > r->hi[j] ? l->hi[j] : r->hi[j];
     }
+}
+
+/* The partition L->pt: every rank's range of global ids, the bisection
+ * nodes from every rank's box and split axes dims, and this rank's own
+ * tree of leaf size leaf (collective). */
+static int build_partition(MPI_Comm comm, fdt_mpi_local *L, const int dims[SETUP_DEPTH],
+                           int leaf, char *diag, size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    size_t m = L->nloc;
+    fdt_partition *pt = &L->pt;
+    pt->nparts = size;
+    pt->m = (uint32_t)L->m;
+    pt->start = malloc(((size_t)size + 1) * sizeof *pt->start);
+    pt->nodes = malloc((2 * (size_t)size - 1) * sizeof *pt->nodes);
+    pt->trees = calloc((size_t)size, sizeof *pt->trees);
+    uint32_t *cnts = malloc((size_t)size * sizeof *cnts);
+    double(*box)[6] = malloc((size_t)size * sizeof *box);
+    int(*alld)[SETUP_DEPTH] = malloc((size_t)size * sizeof *alld);
+    int err = pt->start && pt->nodes && pt->trees && cnts && box && alld ? FDT_OK : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory for the partition");
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
+        free(cnts);
+        free(box);
+        free(alld);
+        return err;
+    }
+    uint32_t m32 = (uint32_t)m;
+    MPI_Allgather(&m32, 1, MPI_UINT32_T, cnts, 1, MPI_UINT32_T, comm);
+    pt->start[0] = 0;
+    for (int q = 0; q < size; q++)
+        pt->start[q + 1] = pt->start[q] + cnts[q];
+    L->lo = pt->start[rank];
+    double mybox[6];
+    fdt_points_box(L->p, 0, (uint32_t)m, mybox, mybox + 3);
+    if (m == 0)
+        for (int k = 0; k < 3; k++) {
+            mybox[k] = INFINITY;
+            mybox[3 + k] = -INFINITY;
+        }
+    MPI_Allgather(mybox, 6, MPI_DOUBLE, box, 6, MPI_DOUBLE, comm);
+    MPI_Allgather(dims, SETUP_DEPTH, MPI_INT, alld, SETUP_DEPTH, MPI_INT, comm);
+    node_ctx nc = {pt, (const double(*)[6])box, (const int(*)[SETUP_DEPTH])alld};
+    pt->nnodes = 1;
+    make_nodes(&nc, 0, 0, size, 0);
+    free(cnts);
+    free(box);
+    free(alld);
+    /* The engine indexes points by global id; this rank holds ids [lo,
+     * lo + m) only, so its arrays are addressed from lo back (no other
+     * id of them is ever read: message mode reads other parts' points
+     * from their messages alone). */
+    err = fdt_partition_build_own(pt, L->p - 3 * (size_t)L->lo, L->orig - L->lo, rank, leaf);
+    snprintf(diag, dlen, "rank %d: out of memory building its kd-tree", rank);
+    return fdt_mpi_agree(comm, err, diag, dlen);
 }
 
 /* ---- 5. seeds ------------------------------------------------------------ */
@@ -1107,15 +1266,17 @@ static int keep_seeds(MPI_Comm comm, fdt_mpi_local *L, const seed_out *so, char 
 /* Every rank's seed, deduplicated into L->seeds (collective): rounds in
  * which every rank sends the active askers their points in their balls and
  * tries its own seed, until no rank is active; then the seeds kept. */
-static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const double *gbox,
-                      int leaf, char *diag, size_t dlen)
+static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, int leaf, char *diag,
+                      size_t dlen)
 {
     int rank, size;
     MPI_Comm_rank(comm, &rank);
     MPI_Comm_size(comm, &size);
     const fdt_kdtree *t = &L->pt.trees[rank];
     const double *P = L->p - 3 * (size_t)L->lo; /* global indexing */
-    double gd[3] = {gbox[3] - gbox[0], gbox[4] - gbox[1], gbox[5] - gbox[2]};
+    const fdt_pnode *root = &L->pt.nodes[0]; /* the whole input's box */
+    double gd[3] = {root->hi[0] - root->lo[0], root->hi[1] - root->lo[1],
+                    root->hi[2] - root->lo[2]};
     double gdiag = sqrt(gd[0] * gd[0] + gd[1] * gd[1] + gd[2] * gd[2]);
     seed_msg me = {{0, 0, 0}, 0, 0};
     fdt_kdq kq;
@@ -1231,8 +1392,7 @@ int fdt_mpi_setup(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, 
 {
     memset(L, 0, sizeof *L);
     diag[0] = '\0';
-    int rank, size;
-    MPI_Comm_rank(comm, &rank);
+    int size;
     MPI_Comm_size(comm, &size);
     int leaf = o->leaf_size > 0 ? o->leaf_size : FDT_DEFAULT_LEAF;
     if (size > FDT_PARTITION_MAX) {
@@ -1255,159 +1415,21 @@ int fdt_mpi_setup(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, 
     L->t[FDT_MPI_T_EXCHANGE] = t2 - t1;
     if (err)
         goto fail;
-
-    /* 3. merge: each class's first (least) input id survives. A hash
-     * table of record indices, one pass: slot[h] holds the class's
-     * survivor so far, cls[i] the slot of record i's class (a sort of the
-     * 32-byte records cost 0.37 s a rank at 1M on 2 ranks). */
-    size_t cap = 16;
-    while (cap < 2 * n)
-        cap *= 2;
-    uint32_t *slot = malloc(cap * sizeof *slot), *cls = malloc((n + 1) * sizeof *cls);
-    err = slot && cls && n < UINT32_MAX ? FDT_OK : FDT_ENOMEM;
-    snprintf(diag, dlen, "out of memory merging the duplicates");
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
-        free(slot);
-        free(cls);
-        goto fail;
-    }
-    memset(slot, 0xff, cap * sizeof *slot);
-    size_t m = 0;
-    double ext[2] = {0.0, -INFINITY}; /* max |x|, -(min nonzero |x|) */
-    for (size_t i = 0; i < n; i++) {
-        size_t h = (size_t)point_mix(r[i].x) & (cap - 1);
-        for (;; h = (h + 1) & (cap - 1)) {
-            uint32_t q = slot[h];
-            if (q == UINT32_MAX) {
-                slot[h] = (uint32_t)i;
-                m++;
-                break;
-            }
-            if (key_cmp(r[q].x, r[i].x, 0) == 0) {
-                if (r[i].id < r[q].id)
-                    slot[h] = (uint32_t)i;
-                break;
-            }
-        }
-        cls[i] = (uint32_t)h;
-        for (int k = 0; k < 3; k++) {
-            double ax = fabs(r[i].x[k]);
-            if (ax > ext[0])
-                ext[0] = ax;
-            if (ax != 0.0 && -ax > ext[1])
-                ext[1] = -ax;
-        }
-    }
-    double gext[2];
-    MPI_Allreduce(ext, gext, 2, MPI_DOUBLE, MPI_MAX, comm);
-    L->scale_exp = fdt_prepare_scale_exp(gext[0], -gext[1]);
-    L->p = malloc((3 * m + 1) * sizeof *L->p);
-    L->orig = malloc((m + 1) * sizeof *L->orig);
-    if (o->keep_input) {
-        L->in_id = malloc((n + 1) * sizeof *L->in_id);
-        L->in_vertex = malloc((n + 1) * sizeof *L->in_vertex);
-        L->in_xyz = malloc((3 * n + 1) * sizeof *L->in_xyz);
-    }
-    err = L->p && L->orig && (!o->keep_input || (L->in_id && L->in_vertex && L->in_xyz))
-              ? FDT_OK
-              : FDT_ENOMEM;
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
-        free(slot);
-        free(cls);
-        goto fail;
-    }
-    diag[0] = '\0';
-    {
-        size_t j = 0;
-        for (size_t i = 0; i < n; i++) {
-            uint32_t q = slot[cls[i]];
-            if (q == (uint32_t)i) { /* the survivor of its class */
-                for (int k = 0; k < 3; k++)
-                    L->p[3 * j + k] = ldexp(r[i].x[k], L->scale_exp); /* exact */
-                L->orig[j++] = (fdt_vid)r[i].id;
-            }
-            if (o->keep_input) {
-                L->in_id[i] = (fdt_vid)r[i].id;
-                L->in_vertex[i] = (fdt_vid)r[q].id;
-                memcpy(L->in_xyz + 3 * i, r[i].x, sizeof r[i].x);
-            }
-        }
-        L->nloc = m;
-        L->nin = o->keep_input ? n : 0;
-    }
-    free(slot);
-    free(cls);
+    err = merge_duplicates(comm, o, L, r, n, diag, dlen);
     free(r);
     r = NULL;
-    uint64_t mm = m, gm = 0;
-    MPI_Allreduce(&mm, &gm, 1, MPI_UINT64_T, MPI_SUM, comm);
-    L->m = (size_t)gm;
-    L->ndup = L->n - L->m;
-    double t3 = fdt_now_s();
-    L->t[FDT_MPI_T_MERGE] = t3 - t2;
-
-    /* 4. the partition: ranges, nodes, this rank's tree */
-    err = check_dimension(comm, L, strcmp(o->input, "-") == 0 ? "stdin" : o->input, diag, dlen);
     if (err)
         goto fail;
-    fdt_partition *pt = &L->pt;
-    pt->nparts = size;
-    pt->m = (uint32_t)L->m;
-    pt->start = malloc(((size_t)size + 1) * sizeof *pt->start);
-    pt->nodes = malloc((2 * (size_t)size - 1) * sizeof *pt->nodes);
-    pt->trees = calloc((size_t)size, sizeof *pt->trees);
-    uint32_t *cnts = malloc((size_t)size * sizeof *cnts);
-    double(*box)[6] = malloc((size_t)size * sizeof *box);
-    int(*alld)[SETUP_DEPTH] = malloc((size_t)size * sizeof *alld);
-    err = pt->start && pt->nodes && pt->trees && cnts && box && alld ? FDT_OK : FDT_ENOMEM;
-    snprintf(diag, dlen, "out of memory for the partition");
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
-        free(cnts);
-        free(box);
-        free(alld);
-        goto fail;
-    }
-    uint32_t m32 = (uint32_t)m;
-    MPI_Allgather(&m32, 1, MPI_UINT32_T, cnts, 1, MPI_UINT32_T, comm);
-    pt->start[0] = 0;
-    for (int q = 0; q < size; q++)
-        pt->start[q + 1] = pt->start[q] + cnts[q];
-    L->lo = pt->start[rank];
-    double mybox[6];
-    fdt_points_box(L->p, 0, (uint32_t)m, mybox, mybox + 3);
-    if (m == 0)
-        for (int k = 0; k < 3; k++) {
-            mybox[k] = INFINITY;
-            mybox[3 + k] = -INFINITY;
-        }
-    MPI_Allgather(mybox, 6, MPI_DOUBLE, box, 6, MPI_DOUBLE, comm);
-    MPI_Allgather(dims, SETUP_DEPTH, MPI_INT, alld, SETUP_DEPTH, MPI_INT, comm);
-    node_ctx nc = {pt, (const double(*)[6])box, (const int(*)[SETUP_DEPTH])alld};
-    pt->nnodes = 1;
-    make_nodes(&nc, 0, 0, size, 0);
-    free(cnts);
-    free(box);
-    free(alld);
-    /* The engine indexes points by global id; this rank holds ids [lo,
-     * lo + m) only, so its arrays are addressed from lo back (no other
-     * id of them is ever read: message mode reads other parts' points
-     * from their messages alone). */
-    err = fdt_partition_build_own(pt, L->p - 3 * (size_t)L->lo, L->orig - L->lo, rank, leaf);
-    snprintf(diag, dlen, "rank %d: out of memory building its kd-tree", rank);
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+    double t3 = fdt_now_s();
+    L->t[FDT_MPI_T_MERGE] = t3 - t2;
+    err = check_dimension(comm, L, strcmp(o->input, "-") == 0 ? "stdin" : o->input, diag, dlen);
+    if (!err)
+        err = build_partition(comm, L, dims, leaf, diag, dlen);
+    if (err)
         goto fail;
     double t4 = fdt_now_s();
     L->t[FDT_MPI_T_TREES] = t4 - t3;
-
-    /* 5. seeds */
-    {
-        double gbox[6];
-        for (int k = 0; k < 3; k++) {
-            gbox[k] = pt->nodes[0].lo[k];
-            gbox[3 + k] = pt->nodes[0].hi[k];
-        }
-        err = find_seeds(comm, rt, L, gbox, leaf, diag, dlen);
-    }
+    err = find_seeds(comm, rt, L, leaf, diag, dlen);
     L->t[FDT_MPI_T_SEEDS] = fdt_now_s() - t4;
     if (err)
         goto fail;
