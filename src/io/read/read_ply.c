@@ -1110,6 +1110,76 @@ static int ply_st_binary(ply_in *in, const ply_hdr *h, rd_points *pb)
     return PLY_READ_FAILED(in);
 }
 
+/* An ASCII PLY whose first len bytes are in hb (cap + 1 bytes, owned):
+ * the rest loaded too, and the whole parsed as a buffer (the header
+ * again: its names point into the buffer, which grows); the buffer is
+ * handed to *owned. */
+static int ply_load_ascii(rd_ctx *c, char *hb, size_t len, size_t cap, rd_points *pb,
+                          char **owned)
+{
+    while (!c->src->eof) {
+        if (len == cap) {
+            if (cap > (SIZE_MAX - 1) / 2) {
+                free(hb);
+                return fdt_rd_fail(c, FDT_IO_ENOMEM, ": file too large for memory");
+            }
+            char *nb = realloc(hb, 2 * cap + 1);
+            if (nb == NULL) {
+                free(hb);
+                return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory reading the file");
+            }
+            hb = nb;
+            cap *= 2;
+        }
+        ptrdiff_t r = fdt_rd_src_read(c, hb + len, cap - len);
+        if (r < 0) {
+            free(hb);
+            return FDT_IO_EOPEN;
+        }
+        len += (size_t)r;
+        if (c->progress != NULL)
+            c->progress(c->progress_user, FDT_RD_LOADING, len, c->size > len ? c->size : 0);
+    }
+    hb[len] = '\0';
+    *owned = hb;
+    c->buf = hb;
+    c->size = len;
+    return ply_read_buffered(c, pb);
+}
+
+/* The body of a binary PLY of header h, read from the input through a
+ * buffer of its own, after the len - h->data_off bytes of it that hb (the
+ * header's buffer, len bytes) holds. */
+static int ply_stream_body(rd_ctx *c, const ply_hdr *h, const char *hb, size_t len,
+                           rd_points *pb)
+{
+    ply_in in;
+    memset(&in, 0, sizeof in);
+    in.c = c;
+    size_t chunk = c->chunk ? c->chunk : RD_CHUNK;
+    in.cap = fdt_rd_first_cap(c, chunk, c->size > h->data_off ? c->size - h->data_off + 1 : 1);
+    if (in.cap < 8)
+        in.cap = 8; /* the largest scalar */
+    for (size_t ei = 0; ei < h->n_elems; ei++)
+        if (in.cap < h->elems[ei].min_bytes)
+            in.cap = h->elems[ei].min_bytes; /* a whole item without lists */
+    size_t extra = len - h->data_off;
+    if (in.cap < extra)
+        in.cap = extra;
+    in.buf = malloc(in.cap);
+    int rc;
+    if (in.buf == NULL) {
+        rc = fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+    } else {
+        memcpy(in.buf, hb + h->data_off, extra);
+        in.hi = extra;
+        in.off = h->data_off;
+        rc = ply_st_binary(&in, h, pb);
+    }
+    free(in.buf);
+    return rc;
+}
+
 int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned)
 {
     /* The header: complete lines read until one is end_header. Its parse
@@ -1173,64 +1243,12 @@ int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned)
         return rc;
     }
     if (h.format == PLY_ASCII) {
-        /* ASCII: the rest loaded too, and the whole parsed as a buffer
-         * (the header again: its names point into the buffer, which
-         * grows). */
         ply_hdr_free(&h);
-        while (!c->src->eof) {
-            if (len == cap) {
-                if (cap > (SIZE_MAX - 1) / 2) {
-                    free(hb);
-                    return fdt_rd_fail(c, FDT_IO_ENOMEM, ": file too large for memory");
-                }
-                char *nb = realloc(hb, 2 * cap + 1);
-                if (nb == NULL) {
-                    free(hb);
-                    return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory reading the file");
-                }
-                hb = nb;
-                cap *= 2;
-            }
-            ptrdiff_t r = fdt_rd_src_read(c, hb + len, cap - len);
-            if (r < 0) {
-                free(hb);
-                return FDT_IO_EOPEN;
-            }
-            len += (size_t)r;
-            if (c->progress != NULL)
-                c->progress(c->progress_user, FDT_RD_LOADING, len, c->size > len ? c->size : 0);
-        }
-        hb[len] = '\0';
-        *owned = hb;
-        c->buf = hb;
-        c->size = len;
-        return ply_read_buffered(c, pb);
+        return ply_load_ascii(c, hb, len, cap, pb, owned);
     }
     /* Binary: the header's buffer stays (the elements' names point into
      * it); the body streams through its own. */
-    ply_in in;
-    memset(&in, 0, sizeof in);
-    in.c = c;
-    size_t chunk = c->chunk ? c->chunk : RD_CHUNK;
-    in.cap = fdt_rd_first_cap(c, chunk, c->size > h.data_off ? c->size - h.data_off + 1 : 1);
-    if (in.cap < 8)
-        in.cap = 8; /* the largest scalar */
-    for (size_t ei = 0; ei < h.n_elems; ei++)
-        if (in.cap < h.elems[ei].min_bytes)
-            in.cap = h.elems[ei].min_bytes; /* a whole item without lists */
-    size_t extra = len - h.data_off;
-    if (in.cap < extra)
-        in.cap = extra;
-    in.buf = malloc(in.cap);
-    if (in.buf == NULL) {
-        rc = fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
-    } else {
-        memcpy(in.buf, hb + h.data_off, extra);
-        in.hi = extra;
-        in.off = h.data_off;
-        rc = ply_st_binary(&in, &h, pb);
-    }
-    free(in.buf);
+    rc = ply_stream_body(c, &h, hb, len, pb);
     ply_hdr_free(&h);
     free(hb);
     return rc;
