@@ -151,216 +151,265 @@ static int sliceable(const fdt_mpi_setup_opts *o)
     return f == FDT_RD_XYZ ? 1 : f == FDT_RD_PLY ? 2 : 0;
 }
 
-/* This rank's points as records with input ids, into *out (*nout). */
-static int read_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, rec **out,
-                      size_t *nout, char *diag, size_t dlen)
+/* This rank's slice as read: n points xyz (owned), the input id of the
+ * first (set later for text slices, by the count of the slices before). */
+typedef struct slice {
+    double *xyz;
+    size_t n;
+    uint64_t first;
+} slice;
+
+/* How the input is read, which rank 0 decides and tells everyone (1: text
+ * slices, 2: binary PLY slices, 0: whole), with the PLY's layout for 2
+ * into *lay (collective). */
+static int read_kind(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_rd_ply_layout *lay,
+                     char *diag, size_t dlen)
 {
-    int rank, size;
+    int rank;
     MPI_Comm_rank(comm, &rank);
-    MPI_Comm_size(comm, &size);
-    double *xyz = NULL;
-    size_t n = 0;
-    int err = FDT_OK;
-    uint64_t first = 0; /* input id of this rank's first point */
-    /* Rank 0 decides how the input is read (1: text slices, 2: binary
-     * PLY slices, 0: whole) and tells everyone. */
     int kind = 0;
-    fdt_rd_ply_layout lay;
-    memset(&lay, 0, sizeof lay);
+    memset(lay, 0, sizeof *lay);
     if (rank == 0) {
         kind = sliceable(o);
         if (kind == 2) {
-            int lr = fdt_rd_ply_find_layout(o->input, &lay, diag, dlen);
+            int lr = fdt_rd_ply_find_layout(o->input, lay, diag, dlen);
             kind = lr == 1 ? 2 : 0; /* errors: the whole read words them */
         }
     }
     MPI_Bcast(&kind, 1, MPI_INT, 0, comm);
-    L->sliced = kind; /* 3 below for standard input */
     if (kind == 2) {
-        unsigned long long lv[8] = {lay.vertex_off, lay.rec, lay.count, lay.off[0], lay.off[1],
-                                    lay.off[2], 0, (unsigned long long)lay.big};
-        int ty[3] = {lay.type[0], lay.type[1], lay.type[2]};
+        unsigned long long lv[8] = {lay->vertex_off, lay->rec, lay->count, lay->off[0],
+                                    lay->off[1], lay->off[2], 0, (unsigned long long)lay->big};
+        int ty[3] = {lay->type[0], lay->type[1], lay->type[2]};
         MPI_Bcast(lv, 8, MPI_UNSIGNED_LONG_LONG, 0, comm);
         MPI_Bcast(ty, 3, MPI_INT, 0, comm);
-        lay.vertex_off = (size_t)lv[0];
-        lay.rec = (size_t)lv[1];
-        lay.count = lv[2];
+        lay->vertex_off = (size_t)lv[0];
+        lay->rec = (size_t)lv[1];
+        lay->count = lv[2];
         for (int k = 0; k < 3; k++) {
-            lay.off[k] = (size_t)lv[3 + k];
-            lay.type[k] = ty[k];
+            lay->off[k] = (size_t)lv[3 + k];
+            lay->type[k] = ty[k];
         }
-        lay.big = (int)lv[7];
-        /* vertices [N r / p, N (r + 1) / p), by pread of their bytes */
-        unsigned long long a = lay.count * (unsigned long long)rank / (unsigned long long)size;
-        unsigned long long b = lay.count * (unsigned long long)(rank + 1) / (unsigned long long)size;
-        n = (size_t)(b - a);
-        int rc = fdt_rd_ply_range(o->input, &lay, a, n, &xyz, diag, dlen);
-        int bad = rc == FDT_IO_EFORMAT, anybad = 0;
-        MPI_Allreduce(&bad, &anybad, 1, MPI_INT, MPI_MAX, comm);
-        if (anybad) {
-            /* a NaN or an infinity: rank 0 reads the file whole, which
-             * words the error exactly as frontdt does (only bad files pay) */
-            free(xyz);
-            xyz = NULL;
-            double *w = NULL;
-            size_t wn = 0;
-            err = FDT_EFORMAT;
-            if (rank == 0) {
-                err = fdt_read_points(o->input, o->format, &w, &wn, diag, dlen);
-                fdt_free(w);
-                if (!err) {
-                    snprintf(diag, dlen, "%s: a slice and the whole read disagree", o->input);
-                    err = FDT_EINTERNAL;
-                }
-            }
-            /* rank 0's message is the one: the others only follow */
-            int e0 = err;
-            MPI_Bcast(&e0, 1, MPI_INT, 0, comm);
-            char m0[512];
-            snprintf(m0, sizeof m0, "%s", diag);
-            MPI_Bcast(m0, (int)sizeof m0, MPI_CHAR, 0, comm);
-            snprintf(diag, dlen, "%s", m0);
-            return e0;
-        }
-        err = io_err(rc);
-        first = a;
-    } else if (kind == 1) {
-        fdt_rd_head h;
-        memset(&h, 0, sizeof h);
-        if (rank == 0)
-            err = io_err(fdt_rd_text_head(o->input, &h, diag, dlen));
-        if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
-            return err;
-        uint64_t hv[4] = {h.body, h.body_line, h.ncols, h.size};
-        MPI_Bcast(hv, 4, MPI_UINT64_T, 0, comm);
-        if (hv[2] == 0) {
-            snprintf(diag, dlen, "%s: no points%s", o->input, hv[3] == 0 ? " (empty file)" : "");
-            return FDT_EFORMAT;
-        }
-        /* [begin, end): from the first line start at or after this
-         * rank's share of the body, to the next rank's */
-        uint64_t body = hv[0], S = hv[3], span = S - body;
-        uint64_t want0 = body + span * (uint64_t)rank / (uint64_t)size;
-        uint64_t want1 = body + span * (uint64_t)(rank + 1) / (uint64_t)size;
-        size_t begin = (size_t)want0, end = (size_t)want1;
-        int rc = rank == 0 ? FDT_IO_OK
-                           : fdt_rd_text_line_start(o->input, (size_t)want0, &begin, diag, dlen);
-        if (rc == FDT_IO_OK && rank + 1 < size)
-            rc = fdt_rd_text_line_start(o->input, (size_t)want1, &end, diag, dlen);
-        if (end < begin)
-            end = begin;
-        size_t lines = 0;
-        fdt_rd_opts ro;
-        fdt_rd_opts_default(&ro);
-        ro.format = FDT_RD_XYZ;
-        if (rc == FDT_IO_OK)
-            rc = fdt_rd_text_range(o->input, &ro, begin, end, (size_t)hv[2], 0, &xyz, &n, &lines,
-                                   diag, dlen);
-        /* Lines before the slice: the head's and the slices' before it
-         * (complete: a slice's parse counts its line ends even when it
-         * fails only on a rank after the lowest failing one, whose own
-         * count does not matter then). */
-        uint64_t ml = lines, before = 0;
-        MPI_Exscan(&ml, &before, 1, MPI_UINT64_T, MPI_SUM, comm);
-        if (rank == 0)
-            before = 0;
-        if (rc == FDT_IO_EFORMAT && before + hv[1] > 0) {
-            /* word the error with the right line numbers */
-            rc = fdt_rd_text_range(o->input, &ro, begin, end, (size_t)hv[2],
-                                   (size_t)(before + hv[1]), &xyz, &n, &lines, diag, dlen);
-            if (rc == FDT_IO_OK) { /* cannot happen: the same bytes */
-                rc = FDT_IO_EFORMAT;
-                free(xyz);
-                xyz = NULL;
+        lay->big = (int)lv[7];
+    }
+    return kind;
+}
+
+/* Kind 2: this rank's vertices of a binary PLY of layout lay into *s
+ * (collective; the error, if any, the same on every rank). */
+static int read_ply_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o,
+                          const fdt_rd_ply_layout *lay, slice *s, char *diag, size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    /* vertices [N r / p, N (r + 1) / p), by pread of their bytes */
+    unsigned long long a = lay->count * (unsigned long long)rank / (unsigned long long)size;
+    unsigned long long b = lay->count * (unsigned long long)(rank + 1) / (unsigned long long)size;
+    s->n = (size_t)(b - a);
+    int rc = fdt_rd_ply_range(o->input, lay, a, s->n, &s->xyz, diag, dlen);
+    int bad = rc == FDT_IO_EFORMAT, anybad = 0;
+    MPI_Allreduce(&bad, &anybad, 1, MPI_INT, MPI_MAX, comm);
+    if (anybad) {
+        /* a NaN or an infinity: rank 0 reads the file whole, which
+         * words the error exactly as frontdt does (only bad files pay) */
+        free(s->xyz);
+        s->xyz = NULL;
+        double *w = NULL;
+        size_t wn = 0;
+        int err = FDT_EFORMAT;
+        if (rank == 0) {
+            err = fdt_read_points(o->input, o->format, &w, &wn, diag, dlen);
+            fdt_free(w);
+            if (!err) {
+                snprintf(diag, dlen, "%s: a slice and the whole read disagree", o->input);
+                err = FDT_EINTERNAL;
             }
         }
-        err = io_err(rc);
-    } else if (strcmp(o->input, "-") == 0) {
-        L->sliced = 3;
-        /* Standard input reaches rank 0 alone (mpirun forwards it there):
-         * rank 0 reads it and scatters slice r to rank r. */
-        double *all_xyz = NULL;
-        size_t all_n = 0;
-        if (rank == 0)
-            err = fdt_read_points(o->input, o->format, &all_xyz, &all_n, diag, dlen);
-        if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
-            return err;
-        uint64_t an = all_n;
-        MPI_Bcast(&an, 1, MPI_UINT64_T, 0, comm);
-        size_t a = (size_t)(an * (uint64_t)rank / (uint64_t)size);
-        n = (size_t)(an * (uint64_t)(rank + 1) / (uint64_t)size) - a;
-        first = a;
-        int *cnt = rank == 0 ? malloc(2 * (size_t)size * sizeof *cnt) : NULL;
-        xyz = malloc((3 * n + 1) * sizeof *xyz);
-        err = xyz && (rank != 0 || cnt) ? FDT_OK : FDT_ENOMEM;
-        snprintf(diag, dlen, "out of memory reading standard input");
-        if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
-            free(cnt);
-            free(xyz);
-            fdt_free(all_xyz);
-            return err;
+        /* rank 0's message is the one: the others only follow */
+        int e0 = err;
+        MPI_Bcast(&e0, 1, MPI_INT, 0, comm);
+        char m0[512];
+        snprintf(m0, sizeof m0, "%s", diag);
+        MPI_Bcast(m0, (int)sizeof m0, MPI_CHAR, 0, comm);
+        snprintf(diag, dlen, "%s", m0);
+        return e0;
+    }
+    s->first = a;
+    return fdt_mpi_agree(comm, io_err(rc), diag, dlen);
+}
+
+/* Kind 1: this rank's byte range of a text point file into *s, its errors
+ * worded with the file's line numbers (collective; the error, if any, the
+ * same on every rank). */
+static int read_text_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, slice *s, char *diag,
+                           size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    int err = FDT_OK;
+    fdt_rd_head h;
+    memset(&h, 0, sizeof h);
+    if (rank == 0)
+        err = io_err(fdt_rd_text_head(o->input, &h, diag, dlen));
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+        return err;
+    uint64_t hv[4] = {h.body, h.body_line, h.ncols, h.size};
+    MPI_Bcast(hv, 4, MPI_UINT64_T, 0, comm);
+    if (hv[2] == 0) {
+        snprintf(diag, dlen, "%s: no points%s", o->input, hv[3] == 0 ? " (empty file)" : "");
+        return FDT_EFORMAT;
+    }
+    /* [begin, end): from the first line start at or after this
+     * rank's share of the body, to the next rank's */
+    uint64_t body = hv[0], S = hv[3], span = S - body;
+    uint64_t want0 = body + span * (uint64_t)rank / (uint64_t)size;
+    uint64_t want1 = body + span * (uint64_t)(rank + 1) / (uint64_t)size;
+    size_t begin = (size_t)want0, end = (size_t)want1;
+    int rc = rank == 0 ? FDT_IO_OK
+                       : fdt_rd_text_line_start(o->input, (size_t)want0, &begin, diag, dlen);
+    if (rc == FDT_IO_OK && rank + 1 < size)
+        rc = fdt_rd_text_line_start(o->input, (size_t)want1, &end, diag, dlen);
+    if (end < begin)
+        end = begin;
+    size_t lines = 0;
+    fdt_rd_opts ro;
+    fdt_rd_opts_default(&ro);
+    ro.format = FDT_RD_XYZ;
+    if (rc == FDT_IO_OK)
+        rc = fdt_rd_text_range(o->input, &ro, begin, end, (size_t)hv[2], 0, &s->xyz, &s->n,
+                               &lines, diag, dlen);
+    /* Lines before the slice: the head's and the slices' before it
+     * (complete: a slice's parse counts its line ends even when it
+     * fails only on a rank after the lowest failing one, whose own
+     * count does not matter then). */
+    uint64_t ml = lines, before = 0;
+    MPI_Exscan(&ml, &before, 1, MPI_UINT64_T, MPI_SUM, comm);
+    if (rank == 0)
+        before = 0;
+    if (rc == FDT_IO_EFORMAT && before + hv[1] > 0) {
+        /* word the error with the right line numbers */
+        rc = fdt_rd_text_range(o->input, &ro, begin, end, (size_t)hv[2],
+                               (size_t)(before + hv[1]), &s->xyz, &s->n, &lines, diag, dlen);
+        if (rc == FDT_IO_OK) { /* cannot happen: the same bytes */
+            rc = FDT_IO_EFORMAT;
+            free(s->xyz);
+            s->xyz = NULL;
         }
-        diag[0] = '\0';
-        MPI_Datatype pt3;
-        MPI_Type_contiguous(3, MPI_DOUBLE, &pt3);
-        MPI_Type_commit(&pt3);
-        for (int q = 0; cnt && q < size; q++) {
-            size_t qa = (size_t)(an * (uint64_t)q / (uint64_t)size);
-            cnt[q] = (int)((size_t)(an * (uint64_t)(q + 1) / (uint64_t)size) - qa);
-            cnt[size + q] = (int)qa;
-        }
-        MPI_Scatterv(all_xyz, cnt, cnt ? cnt + size : NULL, pt3, xyz, (int)n, pt3, 0, comm);
-        MPI_Type_free(&pt3);
+    }
+    return fdt_mpi_agree(comm, io_err(rc), diag, dlen);
+}
+
+/* Standard input, which reaches rank 0 alone (mpirun forwards it there):
+ * rank 0 reads it and scatters slice r to rank r, into *s (collective;
+ * the error, if any, the same on every rank). */
+static int read_stdin_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, slice *s, char *diag,
+                            size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    int err = FDT_OK;
+    double *all_xyz = NULL;
+    size_t all_n = 0;
+    if (rank == 0)
+        err = fdt_read_points(o->input, o->format, &all_xyz, &all_n, diag, dlen);
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+        return err;
+    uint64_t an = all_n;
+    MPI_Bcast(&an, 1, MPI_UINT64_T, 0, comm);
+    size_t a = (size_t)(an * (uint64_t)rank / (uint64_t)size);
+    size_t n = (size_t)(an * (uint64_t)(rank + 1) / (uint64_t)size) - a;
+    s->n = n;
+    s->first = a;
+    int *cnt = rank == 0 ? malloc(2 * (size_t)size * sizeof *cnt) : NULL;
+    s->xyz = malloc((3 * n + 1) * sizeof *s->xyz);
+    err = s->xyz && (rank != 0 || cnt) ? FDT_OK : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory reading standard input");
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
         free(cnt);
         fdt_free(all_xyz);
-    } else {
-        double *all_xyz = NULL;
-        size_t all_n = 0;
-        err = fdt_read_points(o->input, o->format, &all_xyz, &all_n, diag, dlen);
-        if (!err) {
-            /* keep slice r of the points: the rest of the setup is the
-             * same whatever was read */
-            size_t a = all_n * (size_t)rank / (size_t)size, b = all_n * (size_t)(rank + 1) / (size_t)size;
-            n = b - a;
-            first = a;
-            xyz = malloc((3 * n + 1) * sizeof *xyz);
-            if (!xyz)
-                err = FDT_ENOMEM;
-            else
-                memcpy(xyz, all_xyz + 3 * a, 3 * n * sizeof *xyz);
-            fdt_free(all_xyz);
-        }
-    }
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
-        free(xyz);
         return err;
     }
+    diag[0] = '\0';
+    MPI_Datatype pt3;
+    MPI_Type_contiguous(3, MPI_DOUBLE, &pt3);
+    MPI_Type_commit(&pt3);
+    for (int q = 0; cnt && q < size; q++) {
+        size_t qa = (size_t)(an * (uint64_t)q / (uint64_t)size);
+        cnt[q] = (int)((size_t)(an * (uint64_t)(q + 1) / (uint64_t)size) - qa);
+        cnt[size + q] = (int)qa;
+    }
+    MPI_Scatterv(all_xyz, cnt, cnt ? cnt + size : NULL, pt3, s->xyz, (int)n, pt3, 0, comm);
+    MPI_Type_free(&pt3);
+    free(cnt);
+    fdt_free(all_xyz);
+    /* nothing has failed since the last agreement, but every way of
+     * reading ends with one */
+    return fdt_mpi_agree(comm, FDT_OK, diag, dlen);
+}
+
+/* Kind 0 of a file: every rank reads the whole input and keeps slice r of
+ * its points, so that the rest of the setup is the same whatever was read
+ * (collective; the error, if any, the same on every rank). */
+static int read_whole_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, slice *s, char *diag,
+                            size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    double *all_xyz = NULL;
+    size_t all_n = 0;
+    int err = fdt_read_points(o->input, o->format, &all_xyz, &all_n, diag, dlen);
+    if (!err) {
+        size_t a = all_n * (size_t)rank / (size_t)size, b = all_n * (size_t)(rank + 1) / (size_t)size;
+        s->n = b - a;
+        s->first = a;
+        s->xyz = malloc((3 * s->n + 1) * sizeof *s->xyz);
+        if (!s->xyz)
+            err = FDT_ENOMEM;
+        else
+            memcpy(s->xyz, all_xyz + 3 * a, 3 * s->n * sizeof *s->xyz);
+        fdt_free(all_xyz);
+    }
+    return fdt_mpi_agree(comm, err, diag, dlen);
+}
+
+/* The slices' points as records with input ids, into *out (*nout), and
+ * their total into L->n; frees s->xyz (collective). */
+static int slice_records(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, slice *s,
+                         rec **out, size_t *nout, char *diag, size_t dlen)
+{
+    int rank;
+    MPI_Comm_rank(comm, &rank);
+    size_t n = s->n;
     uint64_t mn = n, tot = 0, off = 0;
     MPI_Allreduce(&mn, &tot, 1, MPI_UINT64_T, MPI_SUM, comm);
     MPI_Exscan(&mn, &off, 1, MPI_UINT64_T, MPI_SUM, comm);
     if (rank == 0)
         off = 0;
     if (L->sliced == 1)
-        first = off;
+        s->first = off;
     if (tot == 0) {
-        free(xyz);
         snprintf(diag, dlen, "%s: no points", o->input);
         return FDT_EFORMAT;
     }
     if (tot > (uint64_t)INT32_MAX) {
-        free(xyz);
         snprintf(diag, dlen, "%s: more than %d points", o->input, INT32_MAX);
         return FDT_ETOOBIG;
     }
     L->n = (size_t)tot;
+    int err = FDT_OK;
     rec *r = malloc((n + 1) * sizeof *r);
     if (!r)
         err = FDT_ENOMEM;
     for (size_t i = 0; r && i < n; i++) {
-        memcpy(r[i].x, xyz + 3 * i, sizeof r[i].x);
-        r[i].id = first + i;
+        memcpy(r[i].x, s->xyz + 3 * i, sizeof r[i].x);
+        r[i].id = s->first + i;
     }
-    free(xyz);
+    free(s->xyz);
+    s->xyz = NULL;
     snprintf(diag, dlen, "out of memory after reading");
     if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
         free(r);
@@ -370,6 +419,32 @@ static int read_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local 
     *out = r;
     *nout = n;
     return FDT_OK;
+}
+
+/* This rank's points as records with input ids, into *out (*nout): read
+ * by the step for how the input is read, then numbered. */
+static int read_slice(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, rec **out,
+                      size_t *nout, char *diag, size_t dlen)
+{
+    slice s = {NULL, 0, 0};
+    fdt_rd_ply_layout lay;
+    int kind = read_kind(comm, o, &lay, diag, dlen);
+    L->sliced = kind; /* 3 below for standard input */
+    int err;
+    if (kind == 2) {
+        err = read_ply_slice(comm, o, &lay, &s, diag, dlen);
+    } else if (kind == 1) {
+        err = read_text_slice(comm, o, &s, diag, dlen);
+    } else if (strcmp(o->input, "-") == 0) {
+        L->sliced = 3;
+        err = read_stdin_slice(comm, o, &s, diag, dlen);
+    } else {
+        err = read_whole_slice(comm, o, &s, diag, dlen);
+    }
+    if (err == FDT_OK)
+        err = slice_records(comm, o, L, &s, out, nout, diag, dlen);
+    free(s.xyz);
+    return err;
 }
 
 /* ---- 2. bisection by exchange -------------------------------------------- */
@@ -696,6 +771,108 @@ static uint64_t point_mix(const double *x)
     return h ^ (h >> 32);
 }
 
+/* The classes of equal points among the n records r: each class's first
+ * (least) input id survives. A hash table of record indices, one pass:
+ * slot[h] (cap entries, a power of two, all UINT32_MAX at first) holds the
+ * class's survivor so far, cls[i] the slot of record i's class (a sort of
+ * the 32-byte records cost 0.37 s a rank at 1M on 2 ranks). Also ext[0],
+ * the greatest |x|, and ext[1], -(the least nonzero |x|), where greater.
+ * The number of classes. */
+static size_t merge_classes(const rec *r, size_t n, uint32_t *slot, size_t cap, uint32_t *cls,
+                            double ext[2])
+{
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t h = (size_t)point_mix(r[i].x) & (cap - 1);
+        for (;; h = (h + 1) & (cap - 1)) {
+            uint32_t q = slot[h];
+            if (q == UINT32_MAX) {
+                slot[h] = (uint32_t)i;
+                m++;
+                break;
+            }
+            if (key_cmp(r[q].x, r[i].x, 0) == 0) {
+                if (r[i].id < r[q].id)
+                    slot[h] = (uint32_t)i;
+                break;
+            }
+        }
+        cls[i] = (uint32_t)h;
+        for (int k = 0; k < 3; k++) {
+            double ax = fabs(r[i].x[k]);
+            if (ax > ext[0])
+                ext[0] = ax;
+            if (ax != 0.0 && -ax > ext[1])
+                ext[1] = -ax;
+        }
+    }
+    return m;
+}
+
+/* The n records r after the bisection into this rank's distinct points,
+ * scaled (L->p, L->orig, L->nloc), the input's map kept if asked
+ * (L->in_*), the counts L->m and L->ndup (collective). */
+static int merge_duplicates(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L,
+                            const rec *r, size_t n, char *diag, size_t dlen)
+{
+    size_t cap = 16;
+    while (cap < 2 * n)
+        cap *= 2;
+    uint32_t *slot = malloc(cap * sizeof *slot), *cls = malloc((n + 1) * sizeof *cls);
+    int err = slot && cls && n < UINT32_MAX ? FDT_OK : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory merging the duplicates");
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
+        free(slot);
+        free(cls);
+        return err;
+    }
+    memset(slot, 0xff, cap * sizeof *slot);
+    double ext[2] = {0.0, -INFINITY}; /* max |x|, -(min nonzero |x|) */
+    size_t m = merge_classes(r, n, slot, cap, cls, ext);
+    double gext[2];
+    MPI_Allreduce(ext, gext, 2, MPI_DOUBLE, MPI_MAX, comm);
+    L->scale_exp = fdt_prepare_scale_exp(gext[0], -gext[1]);
+    L->p = malloc((3 * m + 1) * sizeof *L->p);
+    L->orig = malloc((m + 1) * sizeof *L->orig);
+    if (o->keep_input) {
+        L->in_id = malloc((n + 1) * sizeof *L->in_id);
+        L->in_vertex = malloc((n + 1) * sizeof *L->in_vertex);
+        L->in_xyz = malloc((3 * n + 1) * sizeof *L->in_xyz);
+    }
+    err = L->p && L->orig && (!o->keep_input || (L->in_id && L->in_vertex && L->in_xyz))
+              ? FDT_OK
+              : FDT_ENOMEM;
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
+        free(slot);
+        free(cls);
+        return err;
+    }
+    diag[0] = '\0';
+    size_t j = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t q = slot[cls[i]];
+        if (q == (uint32_t)i) { /* the survivor of its class */
+            for (int k = 0; k < 3; k++)
+                L->p[3 * j + k] = ldexp(r[i].x[k], L->scale_exp); /* exact */
+            L->orig[j++] = (fdt_vid)r[i].id;
+        }
+        if (o->keep_input) {
+            L->in_id[i] = (fdt_vid)r[i].id;
+            L->in_vertex[i] = (fdt_vid)r[q].id;
+            memcpy(L->in_xyz + 3 * i, r[i].x, sizeof r[i].x);
+        }
+    }
+    L->nloc = m;
+    L->nin = o->keep_input ? n : 0;
+    free(slot);
+    free(cls);
+    uint64_t mm = m, gm = 0;
+    MPI_Allreduce(&mm, &gm, 1, MPI_UINT64_T, MPI_SUM, comm);
+    L->m = (size_t)gm;
+    L->ndup = L->n - L->m;
+    return FDT_OK;
+}
+
 /* ---- 4. trees: the bisection's nodes on every rank ------------------------ */
 
 typedef struct node_ctx {
@@ -736,6 +913,63 @@ static void make_nodes(node_ctx *c, int id, int p0, int k, int depth)
         nd->lo[j] = l->lo[j] < r->lo[j] ? l->lo[j] : r->lo[j];
         nd->hi[j] = l->hi[j] > r->hi[j] ? l->hi[j] : r->hi[j];
     }
+}
+
+/* The partition L->pt: every rank's range of global ids, the bisection
+ * nodes from every rank's box and split axes dims, and this rank's own
+ * tree of leaf size leaf (collective). */
+static int build_partition(MPI_Comm comm, fdt_mpi_local *L, const int dims[SETUP_DEPTH],
+                           int leaf, char *diag, size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    size_t m = L->nloc;
+    fdt_partition *pt = &L->pt;
+    pt->nparts = size;
+    pt->m = (uint32_t)L->m;
+    pt->start = malloc(((size_t)size + 1) * sizeof *pt->start);
+    pt->nodes = malloc((2 * (size_t)size - 1) * sizeof *pt->nodes);
+    pt->trees = calloc((size_t)size, sizeof *pt->trees);
+    uint32_t *cnts = malloc((size_t)size * sizeof *cnts);
+    double(*box)[6] = malloc((size_t)size * sizeof *box);
+    int(*alld)[SETUP_DEPTH] = malloc((size_t)size * sizeof *alld);
+    int err = pt->start && pt->nodes && pt->trees && cnts && box && alld ? FDT_OK : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory for the partition");
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
+        free(cnts);
+        free(box);
+        free(alld);
+        return err;
+    }
+    uint32_t m32 = (uint32_t)m;
+    MPI_Allgather(&m32, 1, MPI_UINT32_T, cnts, 1, MPI_UINT32_T, comm);
+    pt->start[0] = 0;
+    for (int q = 0; q < size; q++)
+        pt->start[q + 1] = pt->start[q] + cnts[q];
+    L->lo = pt->start[rank];
+    double mybox[6];
+    fdt_points_box(L->p, 0, (uint32_t)m, mybox, mybox + 3);
+    if (m == 0)
+        for (int k = 0; k < 3; k++) {
+            mybox[k] = INFINITY;
+            mybox[3 + k] = -INFINITY;
+        }
+    MPI_Allgather(mybox, 6, MPI_DOUBLE, box, 6, MPI_DOUBLE, comm);
+    MPI_Allgather(dims, SETUP_DEPTH, MPI_INT, alld, SETUP_DEPTH, MPI_INT, comm);
+    node_ctx nc = {pt, (const double(*)[6])box, (const int(*)[SETUP_DEPTH])alld};
+    pt->nnodes = 1;
+    make_nodes(&nc, 0, 0, size, 0);
+    free(cnts);
+    free(box);
+    free(alld);
+    /* The engine indexes points by global id; this rank holds ids [lo,
+     * lo + m) only, so its arrays are addressed from lo back (no other
+     * id of them is ever read: message mode reads other parts' points
+     * from their messages alone). */
+    err = fdt_partition_build_own(pt, L->p - 3 * (size_t)L->lo, L->orig - L->lo, rank, leaf);
+    snprintf(diag, dlen, "rank %d: out of memory building its kd-tree", rank);
+    return fdt_mpi_agree(comm, err, diag, dlen);
 }
 
 /* ---- 5. seeds ------------------------------------------------------------ */
@@ -876,113 +1110,113 @@ static int seed_key_cmp(const void *x, const void *y)
     return 0;
 }
 
-/* Every rank's seed, deduplicated into L->seeds (collective). */
-static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const double *gbox,
-                      int leaf, char *diag, size_t dlen)
+/* The point a of tree t nearest its box's centre, as this rank's
+ * first ball about it into *me: its id (FDT_NONE, me inactive, when t is
+ * empty). P: global indexing; gdiag: the whole box's diagonal; m: the
+ * number of distinct points. */
+static uint32_t seed_start(const fdt_kdtree *t, const double *P, double gdiag, size_t m,
+                           seed_msg *me, fdt_kdq *kq)
 {
-    int rank, size;
-    MPI_Comm_rank(comm, &rank);
+    if (t->n == 0)
+        return FDT_NONE;
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = t->nodes[0].lo[k] * 0.5 + t->nodes[0].hi[k] * 0.5;
+    uint32_t aid = fdt_kd_nearest(t, c, FDT_NONE, kq);
+    memcpy(me->a, P + 3 * (size_t)aid, sizeof me->a);
+    /* a first radius holding a few dozen points where they are even:
+     * four times the nearest neighbour's distance */
+    uint32_t b = fdt_kd_nearest(t, me->a, aid, kq);
+    double R = gdiag * cbrt(64.0 / (double)m);
+    if (b != FDT_NONE) {
+        const double *pb = P + 3 * (size_t)b;
+        double d[3] = {pb[0] - me->a[0], pb[1] - me->a[1], pb[2] - me->a[2]};
+        R = 4.0 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    }
+    me->R = R > 0 ? R : gdiag;
+    me->active = 1;
+    return aid;
+}
+
+/* Our points in each active asker's ball (all[q], q < size) into bc[q]:
+ * FDT_OK or FDT_ENOMEM. */
+static int seed_balls(const fdt_kdtree *t, const double *P, const seed_msg *all, int size,
+                      ball_ctx *bc, fdt_kdq *kq)
+{
+    int e = FDT_OK;
+    for (int q = 0; q < size; q++) {
+        bc[q].P = P;
+        bc[q].n = 0;
+        if (all[q].active != 0 && t->n > 0) {
+            fdt_kd_ball(t, all[q].a, all[q].R, ball_cb, &bc[q], kq);
+            if (bc[q].nomem)
+                e = FDT_ENOMEM;
+        }
+    }
+    return e;
+}
+
+/* The balls' points sent, bc[q]'s to rank q, and the points of our ball
+ * received into *got (*nr); cnt: 4 size counts. e: this rank's error so
+ * far, agreed on with the exchange's allocations first (collective). */
+static int seed_exchange(MPI_Comm comm, MPI_Datatype rt, const ball_ctx *bc, int *cnt, int e,
+                         rec **got, size_t *nr, uint64_t *bytes, char *diag, size_t dlen)
+{
+    int size;
     MPI_Comm_size(comm, &size);
-    const fdt_kdtree *t = &L->pt.trees[rank];
-    const double *P = L->p - 3 * (size_t)L->lo; /* global indexing */
-    double gd[3] = {gbox[3] - gbox[0], gbox[4] - gbox[1], gbox[5] - gbox[2]};
-    double gdiag = sqrt(gd[0] * gd[0] + gd[1] * gd[1] + gd[2] * gd[2]);
-    seed_msg me = {{0, 0, 0}, 0, 0};
-    uint32_t aid = FDT_NONE;
-    fdt_kdq kq;
-    memset(&kq, 0, sizeof kq);
-    if (t->n > 0) {
-        double c[3];
-        for (int k = 0; k < 3; k++)
-            c[k] = t->nodes[0].lo[k] * 0.5 + t->nodes[0].hi[k] * 0.5;
-        aid = fdt_kd_nearest(t, c, FDT_NONE, &kq);
-        memcpy(me.a, P + 3 * (size_t)aid, sizeof me.a);
-        /* a first radius holding a few dozen points where they are even:
-         * four times the nearest neighbour's distance */
-        uint32_t b = fdt_kd_nearest(t, me.a, aid, &kq);
-        double R = gdiag * cbrt(64.0 / (double)L->m);
-        if (b != FDT_NONE) {
-            const double *pb = P + 3 * (size_t)b;
-            double d[3] = {pb[0] - me.a[0], pb[1] - me.a[1], pb[2] - me.a[2]};
-            R = 4.0 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        }
-        me.R = R > 0 ? R : gdiag;
-        me.active = 1;
-    }
-    seed_out so;
-    memset(&so, 0, sizeof so);
-    seed_msg *all = malloc((size_t)size * sizeof *all);
-    int *cnt = malloc(4 * (size_t)size * sizeof *cnt);
-    ball_ctx *bc = calloc((size_t)size, sizeof *bc);
-    rec *got = NULL;
-    int err = all && cnt && bc ? FDT_OK : FDT_ENOMEM;
+    int *scount = cnt, *sdisp = cnt + size, *rcount = cnt + 2 * size, *rdisp = cnt + 3 * size;
+    for (int q = 0; q < size; q++)
+        scount[q] = bc[q].n > (size_t)INT_MAX / 2 ? 0 : (int)bc[q].n;
+    *nr = fdt_mpi_counts(comm, scount, sdisp, rcount, rdisp, sizeof(rec), bytes);
+    size_t ns = (size_t)sdisp[size - 1] + (size_t)scount[size - 1];
+    /* one send buffer: the balls in rank order */
+    rec *sb = malloc((ns + 1) * sizeof *sb);
+    free(*got);
+    *got = malloc((*nr + 1) * sizeof **got);
+    if (!sb || !*got)
+        e = FDT_ENOMEM;
     snprintf(diag, dlen, "out of memory finding the seeds");
-    err = fdt_mpi_agree(comm, err, diag, dlen);
-    while (!err) {
-        MPI_Allgather(&me, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, comm);
-        int any = 0;
-        for (int q = 0; q < size; q++)
-            any |= all[q].active != 0;
-        if (!any)
-            break;
-        /* our points in each asker's ball */
-        int e = FDT_OK;
-        for (int q = 0; q < size; q++) {
-            bc[q].P = P;
-            bc[q].n = 0;
-            if (all[q].active != 0 && t->n > 0) {
-                fdt_kd_ball(t, all[q].a, all[q].R, ball_cb, &bc[q], &kq);
-                if (bc[q].nomem)
-                    e = FDT_ENOMEM;
-            }
-        }
-        int *scount = cnt, *sdisp = cnt + size, *rcount = cnt + 2 * size, *rdisp = cnt + 3 * size;
-        for (int q = 0; q < size; q++)
-            scount[q] = bc[q].n > (size_t)INT_MAX / 2 ? 0 : (int)bc[q].n;
-        size_t nr = fdt_mpi_counts(comm, scount, sdisp, rcount, rdisp, sizeof(rec),
-                                   &L->bytes_sent);
-        size_t ns = (size_t)sdisp[size - 1] + (size_t)scount[size - 1];
-        /* one send buffer: the balls in rank order */
-        rec *sb = malloc((ns + 1) * sizeof *sb);
-        free(got);
-        got = malloc((nr + 1) * sizeof *got);
-        if (!sb || !got)
-            e = FDT_ENOMEM;
-        snprintf(diag, dlen, "out of memory finding the seeds");
-        if ((err = fdt_mpi_agree(comm, e, diag, dlen)) != FDT_OK) {
-            free(sb);
-            break;
-        }
-        for (int q = 0; q < size; q++)
-            if (scount[q] > 0)
-                memcpy(sb + sdisp[q], bc[q].buf, (size_t)scount[q] * sizeof *sb);
-        MPI_Alltoallv(sb, scount, sdisp, rt, got, rcount, rdisp, rt, comm);
+    int err = fdt_mpi_agree(comm, e, diag, dlen);
+    if (err != FDT_OK) {
         free(sb);
-        if (me.active != 0) {
-            /* the ball holds every point once R reaches past all of them */
-            int everything = me.R > 2.0 * gdiag;
-            int r = seed_from(got, nr, aid, me.a, me.R, everything, leaf, so.v, so.x);
-            if (r < 0) {
-                e = r;
-            } else if (r == 1) {
-                so.has = 1;
-                me.active = 0;
-            } else {
-                me.R *= 2.0;
-            }
-        }
-        snprintf(diag, dlen, "rank %d: out of memory finding its seed", rank);
-        if ((err = fdt_mpi_agree(comm, e, diag, dlen)) != FDT_OK)
-            break;
-    }
-    free(got);
-    for (int q = 0; bc && q < size; q++)
-        free(bc[q].buf);
-    free(bc);
-    free(all);
-    free(cnt);
-    if (err)
         return err;
+    }
+    for (int q = 0; q < size; q++)
+        if (scount[q] > 0)
+            memcpy(sb + sdisp[q], bc[q].buf, (size_t)scount[q] * sizeof *sb);
+    MPI_Alltoallv(sb, scount, sdisp, rt, *got, rcount, rdisp, rt, comm);
+    free(sb);
+    return FDT_OK;
+}
+
+/* One try at this rank's seed from the nr points got of its ball me about
+ * point aid: found, into *so, with me made inactive; else the ball
+ * doubled. FDT_OK or <0 an error. */
+static int seed_try(const rec *got, size_t nr, uint32_t aid, double gdiag, int leaf,
+                    seed_msg *me, seed_out *so)
+{
+    /* the ball holds every point once R reaches past all of them */
+    int everything = me->R > 2.0 * gdiag;
+    int r = seed_from(got, nr, aid, me->a, me->R, everything, leaf, so->v, so->x);
+    if (r < 0)
+        return r;
+    if (r == 1) {
+        so->has = 1;
+        me->active = 0;
+    } else {
+        me->R *= 2.0;
+    }
+    return FDT_OK;
+}
+
+/* Every rank's seed so gathered and deduplicated by their sorted ids into
+ * L->seeds, in rank order: the same on every rank (collective). */
+static int keep_seeds(MPI_Comm comm, fdt_mpi_local *L, const seed_out *so, char *diag,
+                      size_t dlen)
+{
+    int size;
+    MPI_Comm_size(comm, &size);
+    int err = FDT_OK;
     seed_out *so_all = malloc((size_t)size * sizeof *so_all);
     if (!so_all)
         err = FDT_ENOMEM;
@@ -991,8 +1225,7 @@ static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const do
         free(so_all);
         return err;
     }
-    MPI_Allgather(&so, (int)sizeof so, MPI_BYTE, so_all, (int)sizeof so, MPI_BYTE, comm);
-    /* deduplicate by the sorted ids, in rank order: the same on every rank */
+    MPI_Allgather(so, (int)sizeof *so, MPI_BYTE, so_all, (int)sizeof *so, MPI_BYTE, comm);
     uint32_t(*key)[8] = malloc((size_t)size * sizeof *key);
     L->seeds = malloc((size_t)size * sizeof *L->seeds);
     L->seed_xyz = malloc((size_t)size * sizeof *L->seed_xyz);
@@ -1028,6 +1261,62 @@ static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, const do
         err = FDT_EINTERNAL;
     }
     return err;
+}
+
+/* Every rank's seed, deduplicated into L->seeds (collective): rounds in
+ * which every rank sends the active askers their points in their balls and
+ * tries its own seed, until no rank is active; then the seeds kept. */
+static int find_seeds(MPI_Comm comm, MPI_Datatype rt, fdt_mpi_local *L, int leaf, char *diag,
+                      size_t dlen)
+{
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    const fdt_kdtree *t = &L->pt.trees[rank];
+    const double *P = L->p - 3 * (size_t)L->lo; /* global indexing */
+    const fdt_pnode *root = &L->pt.nodes[0]; /* the whole input's box */
+    double gd[3] = {root->hi[0] - root->lo[0], root->hi[1] - root->lo[1],
+                    root->hi[2] - root->lo[2]};
+    double gdiag = sqrt(gd[0] * gd[0] + gd[1] * gd[1] + gd[2] * gd[2]);
+    seed_msg me = {{0, 0, 0}, 0, 0};
+    fdt_kdq kq;
+    memset(&kq, 0, sizeof kq);
+    uint32_t aid = seed_start(t, P, gdiag, L->m, &me, &kq);
+    seed_out so;
+    memset(&so, 0, sizeof so);
+    seed_msg *all = malloc((size_t)size * sizeof *all);
+    int *cnt = malloc(4 * (size_t)size * sizeof *cnt);
+    ball_ctx *bc = calloc((size_t)size, sizeof *bc);
+    rec *got = NULL;
+    int err = all && cnt && bc ? FDT_OK : FDT_ENOMEM;
+    snprintf(diag, dlen, "out of memory finding the seeds");
+    err = fdt_mpi_agree(comm, err, diag, dlen);
+    while (!err) {
+        MPI_Allgather(&me, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, comm);
+        int any = 0;
+        for (int q = 0; q < size; q++)
+            any |= all[q].active != 0;
+        if (!any)
+            break;
+        int e = seed_balls(t, P, all, size, bc, &kq);
+        size_t nr = 0;
+        err = seed_exchange(comm, rt, bc, cnt, e, &got, &nr, &L->bytes_sent, diag, dlen);
+        if (err != FDT_OK)
+            break;
+        e = me.active != 0 ? seed_try(got, nr, aid, gdiag, leaf, &me, &so) : FDT_OK;
+        snprintf(diag, dlen, "rank %d: out of memory finding its seed", rank);
+        if ((err = fdt_mpi_agree(comm, e, diag, dlen)) != FDT_OK)
+            break;
+    }
+    free(got);
+    for (int q = 0; bc && q < size; q++)
+        free(bc[q].buf);
+    free(bc);
+    free(all);
+    free(cnt);
+    if (err)
+        return err;
+    return keep_seeds(comm, L, &so, diag, dlen);
 }
 
 /* The dimension check over every rank's affine basis (collective). */
@@ -1103,8 +1392,7 @@ int fdt_mpi_setup(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, 
 {
     memset(L, 0, sizeof *L);
     diag[0] = '\0';
-    int rank, size;
-    MPI_Comm_rank(comm, &rank);
+    int size;
     MPI_Comm_size(comm, &size);
     int leaf = o->leaf_size > 0 ? o->leaf_size : FDT_DEFAULT_LEAF;
     if (size > FDT_PARTITION_MAX) {
@@ -1127,159 +1415,21 @@ int fdt_mpi_setup(MPI_Comm comm, const fdt_mpi_setup_opts *o, fdt_mpi_local *L, 
     L->t[FDT_MPI_T_EXCHANGE] = t2 - t1;
     if (err)
         goto fail;
-
-    /* 3. merge: each class's first (least) input id survives. A hash
-     * table of record indices, one pass: slot[h] holds the class's
-     * survivor so far, cls[i] the slot of record i's class (a sort of the
-     * 32-byte records cost 0.37 s a rank at 1M on 2 ranks). */
-    size_t cap = 16;
-    while (cap < 2 * n)
-        cap *= 2;
-    uint32_t *slot = malloc(cap * sizeof *slot), *cls = malloc((n + 1) * sizeof *cls);
-    err = slot && cls && n < UINT32_MAX ? FDT_OK : FDT_ENOMEM;
-    snprintf(diag, dlen, "out of memory merging the duplicates");
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
-        free(slot);
-        free(cls);
-        goto fail;
-    }
-    memset(slot, 0xff, cap * sizeof *slot);
-    size_t m = 0;
-    double ext[2] = {0.0, -INFINITY}; /* max |x|, -(min nonzero |x|) */
-    for (size_t i = 0; i < n; i++) {
-        size_t h = (size_t)point_mix(r[i].x) & (cap - 1);
-        for (;; h = (h + 1) & (cap - 1)) {
-            uint32_t q = slot[h];
-            if (q == UINT32_MAX) {
-                slot[h] = (uint32_t)i;
-                m++;
-                break;
-            }
-            if (key_cmp(r[q].x, r[i].x, 0) == 0) {
-                if (r[i].id < r[q].id)
-                    slot[h] = (uint32_t)i;
-                break;
-            }
-        }
-        cls[i] = (uint32_t)h;
-        for (int k = 0; k < 3; k++) {
-            double ax = fabs(r[i].x[k]);
-            if (ax > ext[0])
-                ext[0] = ax;
-            if (ax != 0.0 && -ax > ext[1])
-                ext[1] = -ax;
-        }
-    }
-    double gext[2];
-    MPI_Allreduce(ext, gext, 2, MPI_DOUBLE, MPI_MAX, comm);
-    L->scale_exp = fdt_prepare_scale_exp(gext[0], -gext[1]);
-    L->p = malloc((3 * m + 1) * sizeof *L->p);
-    L->orig = malloc((m + 1) * sizeof *L->orig);
-    if (o->keep_input) {
-        L->in_id = malloc((n + 1) * sizeof *L->in_id);
-        L->in_vertex = malloc((n + 1) * sizeof *L->in_vertex);
-        L->in_xyz = malloc((3 * n + 1) * sizeof *L->in_xyz);
-    }
-    err = L->p && L->orig && (!o->keep_input || (L->in_id && L->in_vertex && L->in_xyz))
-              ? FDT_OK
-              : FDT_ENOMEM;
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
-        free(slot);
-        free(cls);
-        goto fail;
-    }
-    diag[0] = '\0';
-    {
-        size_t j = 0;
-        for (size_t i = 0; i < n; i++) {
-            uint32_t q = slot[cls[i]];
-            if (q == (uint32_t)i) { /* the survivor of its class */
-                for (int k = 0; k < 3; k++)
-                    L->p[3 * j + k] = ldexp(r[i].x[k], L->scale_exp); /* exact */
-                L->orig[j++] = (fdt_vid)r[i].id;
-            }
-            if (o->keep_input) {
-                L->in_id[i] = (fdt_vid)r[i].id;
-                L->in_vertex[i] = (fdt_vid)r[q].id;
-                memcpy(L->in_xyz + 3 * i, r[i].x, sizeof r[i].x);
-            }
-        }
-        L->nloc = m;
-        L->nin = o->keep_input ? n : 0;
-    }
-    free(slot);
-    free(cls);
+    err = merge_duplicates(comm, o, L, r, n, diag, dlen);
     free(r);
     r = NULL;
-    uint64_t mm = m, gm = 0;
-    MPI_Allreduce(&mm, &gm, 1, MPI_UINT64_T, MPI_SUM, comm);
-    L->m = (size_t)gm;
-    L->ndup = L->n - L->m;
-    double t3 = fdt_now_s();
-    L->t[FDT_MPI_T_MERGE] = t3 - t2;
-
-    /* 4. the partition: ranges, nodes, this rank's tree */
-    err = check_dimension(comm, L, strcmp(o->input, "-") == 0 ? "stdin" : o->input, diag, dlen);
     if (err)
         goto fail;
-    fdt_partition *pt = &L->pt;
-    pt->nparts = size;
-    pt->m = (uint32_t)L->m;
-    pt->start = malloc(((size_t)size + 1) * sizeof *pt->start);
-    pt->nodes = malloc((2 * (size_t)size - 1) * sizeof *pt->nodes);
-    pt->trees = calloc((size_t)size, sizeof *pt->trees);
-    uint32_t *cnts = malloc((size_t)size * sizeof *cnts);
-    double(*box)[6] = malloc((size_t)size * sizeof *box);
-    int(*alld)[SETUP_DEPTH] = malloc((size_t)size * sizeof *alld);
-    err = pt->start && pt->nodes && pt->trees && cnts && box && alld ? FDT_OK : FDT_ENOMEM;
-    snprintf(diag, dlen, "out of memory for the partition");
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK) {
-        free(cnts);
-        free(box);
-        free(alld);
-        goto fail;
-    }
-    uint32_t m32 = (uint32_t)m;
-    MPI_Allgather(&m32, 1, MPI_UINT32_T, cnts, 1, MPI_UINT32_T, comm);
-    pt->start[0] = 0;
-    for (int q = 0; q < size; q++)
-        pt->start[q + 1] = pt->start[q] + cnts[q];
-    L->lo = pt->start[rank];
-    double mybox[6];
-    fdt_points_box(L->p, 0, (uint32_t)m, mybox, mybox + 3);
-    if (m == 0)
-        for (int k = 0; k < 3; k++) {
-            mybox[k] = INFINITY;
-            mybox[3 + k] = -INFINITY;
-        }
-    MPI_Allgather(mybox, 6, MPI_DOUBLE, box, 6, MPI_DOUBLE, comm);
-    MPI_Allgather(dims, SETUP_DEPTH, MPI_INT, alld, SETUP_DEPTH, MPI_INT, comm);
-    node_ctx nc = {pt, (const double(*)[6])box, (const int(*)[SETUP_DEPTH])alld};
-    pt->nnodes = 1;
-    make_nodes(&nc, 0, 0, size, 0);
-    free(cnts);
-    free(box);
-    free(alld);
-    /* The engine indexes points by global id; this rank holds ids [lo,
-     * lo + m) only, so its arrays are addressed from lo back (no other
-     * id of them is ever read: message mode reads other parts' points
-     * from their messages alone). */
-    err = fdt_partition_build_own(pt, L->p - 3 * (size_t)L->lo, L->orig - L->lo, rank, leaf);
-    snprintf(diag, dlen, "rank %d: out of memory building its kd-tree", rank);
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+    double t3 = fdt_now_s();
+    L->t[FDT_MPI_T_MERGE] = t3 - t2;
+    err = check_dimension(comm, L, strcmp(o->input, "-") == 0 ? "stdin" : o->input, diag, dlen);
+    if (!err)
+        err = build_partition(comm, L, dims, leaf, diag, dlen);
+    if (err)
         goto fail;
     double t4 = fdt_now_s();
     L->t[FDT_MPI_T_TREES] = t4 - t3;
-
-    /* 5. seeds */
-    {
-        double gbox[6];
-        for (int k = 0; k < 3; k++) {
-            gbox[k] = pt->nodes[0].lo[k];
-            gbox[3 + k] = pt->nodes[0].hi[k];
-        }
-        err = find_seeds(comm, rt, L, gbox, leaf, diag, dlen);
-    }
+    err = find_seeds(comm, rt, L, leaf, diag, dlen);
     L->t[FDT_MPI_T_SEEDS] = fdt_now_s() - t4;
     if (err)
         goto fail;

@@ -167,192 +167,185 @@ static const char *ply_item_label(char *out, size_t cap, const ply_hdr *h,
     return out;
 }
 
-static int ply_parse_header(const rd_ctx *c, ply_hdr *h)
-{
-    rd_lines L = {c->buf, c->buf + c->size, 0};
-    const char *s = c->buf, *e = c->buf, *ts;
-    size_t tl;
-    char q[RD_QUOTE_CAP], q2[RD_QUOTE_CAP];
+/* A header line's first five words, how many words it has, its number. */
+typedef struct ply_line {
+    const char *tk[5];
+    size_t tn[5];
+    size_t nt;
+    size_t ln;
+} ply_line;
 
-    h->format = -1;
-    h->vertex = SIZE_MAX;
-    if (fdt_rd_next_line(&L, &s, &e)) {
-        rd_fields f = {s, e, 0, 0};
-        int r = fdt_rd_next_field(&f, &ts, &tl);
-        if (r <= 0 || !rd_tok_is(ts, tl, "ply") || fdt_rd_count_rest(&f) != 0)
-            return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                           ":1: not a PLY file (the first line is %s, "
-                           "expected 'ply')",
-                           fdt_rd_quote(q, s, (size_t)(e - s)));
-    }
-    int ended = 0;
-    while (!ended && fdt_rd_next_line(&L, &s, &e)) {
-        rd_fields f = {s, e, 0, 0};
-        const char *tk[5] = {0};
-        size_t tn[5] = {0};
-        size_t nt = 0;
-        while (nt < 5 && fdt_rd_next_field(&f, &tk[nt], &tn[nt]) > 0)
-            nt++;
-        if (nt == 0)
-            continue;
-        if (rd_tok_is(tk[0], tn[0], "comment") ||
-            rd_tok_is(tk[0], tn[0], "obj_info"))
-            continue;
-        nt += fdt_rd_count_rest(&f);
-        size_t ln = L.lineno;
-        if (rd_tok_is(tk[0], tn[0], "format")) {
-            if (h->format >= 0)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: second format line", ln);
-            int fm = -1;
-            if (nt == 3 && rd_tok_is(tk[1], tn[1], "ascii"))
-                fm = PLY_ASCII;
-            else if (nt == 3 &&
-                     rd_tok_is(tk[1], tn[1], "binary_little_endian"))
-                fm = PLY_LE;
-            else if (nt == 3 && rd_tok_is(tk[1], tn[1], "binary_big_endian"))
-                fm = PLY_BE;
-            if (fm < 0 || !rd_tok_is(tk[2], tn[2], "1.0"))
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: expected 'format ascii|"
-                               "binary_little_endian|binary_big_endian 1.0'",
-                               ln);
-            h->format = fm;
-        } else if (rd_tok_is(tk[0], tn[0], "element")) {
-            if (h->format < 0)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: element before the format line", ln);
-            if (nt != 3)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: expected 'element NAME COUNT'", ln);
-            uint64_t cnt;
-            int st = fdt_rd_parse_count(tk[2], tn[2], &cnt);
-            if (st == NUM_OVERFLOW)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: element count %s is too large", ln,
-                               fdt_rd_quote(q, tk[2], tn[2]));
-            if (st != NUM_OK)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: element count %s is not a non-negative "
-                               "integer",
-                               ln, fdt_rd_quote(q, tk[2], tn[2]));
-            int is_vertex = rd_tok_is(tk[1], tn[1], "vertex");
-            if (is_vertex && h->vertex != SIZE_MAX)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: second 'vertex' element", ln);
-            if (h->n_elems > 0 && h->elems[h->n_elems - 1].n_props == 0)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: element %s has no properties",
-                               h->elems[h->n_elems - 1].line,
-                               fdt_rd_quote(q, h->elems[h->n_elems - 1].name,
-                                        h->elems[h->n_elems - 1].name_len));
-            if (ply_add_elem(h) != 0)
-                return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
-            ply_elem *el = &h->elems[h->n_elems - 1];
-            memset(el, 0, sizeof *el);
-            el->name = tk[1];
-            el->name_len = tn[1];
-            el->count = cnt;
-            el->first_prop = h->n_props;
-            el->line = ln;
-            if (is_vertex)
-                h->vertex = h->n_elems - 1;
-        } else if (rd_tok_is(tk[0], tn[0], "property")) {
-            if (h->n_elems == 0)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: property before any element", ln);
-            ply_prop p = {0, 0, 0, 0};
-            const char *name;
-            size_t name_len;
-            if (nt == 5 && rd_tok_is(tk[1], tn[1], "list")) {
-                int ct = ply_type_lookup(tk[2], tn[2]);
-                int it = ply_type_lookup(tk[3], tn[3]);
-                if (ct < 0 || it < 0)
-                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                                   ":%zu: unknown property type %s",
-                                   ln, ct < 0 ? fdt_rd_quote(q, tk[2], tn[2])
-                                              : fdt_rd_quote(q, tk[3], tn[3]));
-                if (ply_is_float(ct))
-                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                                   ":%zu: list length type %s is not an "
-                                   "integer type",
-                                   ln, fdt_rd_quote(q, tk[2], tn[2]));
-                p.is_list = 1;
-                p.count_type = (unsigned char)ct;
-                p.type = (unsigned char)it;
-                name = tk[4];
-                name_len = tn[4];
-            } else if (nt == 3) {
-                int t = ply_type_lookup(tk[1], tn[1]);
-                if (t < 0)
-                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                                   ":%zu: unknown property type %s", ln,
-                                   fdt_rd_quote(q, tk[1], tn[1]));
-                p.type = (unsigned char)t;
-                name = tk[2];
-                name_len = tn[2];
-            } else {
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: expected 'property TYPE NAME' or "
-                               "'property list COUNTTYPE ITEMTYPE NAME'",
-                               ln);
-            }
-            ply_elem *el = &h->elems[h->n_elems - 1];
-            if (h->vertex == h->n_elems - 1 && name_len == 1 &&
-                name[0] >= 'x' && name[0] <= 'z') {
-                int role = name[0] - 'x' + 1;
-                for (size_t i = el->first_prop; i < h->n_props; i++)
-                    if (h->props[i].role == role)
-                        return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                                       ":%zu: second vertex property %s", ln,
-                                       fdt_rd_quote(q, name, name_len));
-                if (p.is_list)
-                    return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                                   ":%zu: vertex property %s is a list", ln,
-                                   fdt_rd_quote(q, name, name_len));
-                p.role = (unsigned char)role;
-            }
-            if (ply_add_prop(h) != 0)
-                return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
-            h->props[h->n_props - 1] = p;
-            el->n_props++;
-            if (p.is_list) {
-                el->has_list = 1;
-                el->min_bytes += ply_size[p.count_type];
-            } else {
-                el->n_scalar++;
-                el->min_bytes += ply_size[p.type];
-            }
-        } else if (rd_tok_is(tk[0], tn[0], "end_header")) {
-            if (nt != 1)
-                return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                               ":%zu: unexpected text after end_header", ln);
-            ended = 1;
-        } else {
-            /* a number here is data: the end_header line is missing */
-            int data = rd_is_digit(tk[0][0]) || tk[0][0] == '-' ||
-                       tk[0][0] == '+' || tk[0][0] == '.';
-            return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                           ":%zu: unknown header keyword %s%s", ln,
-                           fdt_rd_quote(q, tk[0], tn[0]),
-                           data ? " (no end_header line before the data?)"
-                                : "");
-        }
-    }
-    if (!ended) {
-        h->no_end = 1;
-        return fdt_rd_fail(c, FDT_IO_EFORMAT,
-                       ":%zu: the header has no end_header line", L.lineno);
-    }
-    h->data_off = (size_t)(L.p - c->buf);
-    h->data_line = L.lineno;
-    if (h->format < 0)
-        return fdt_rd_fail(c, FDT_IO_EFORMAT, ": the header has no format line");
+/* An element declared without properties: the error, once the next
+ * element or the end of the header shows it. */
+static int ply_check_last_props(const rd_ctx *c, const ply_hdr *h)
+{
+    char q[RD_QUOTE_CAP];
     if (h->n_elems > 0 && h->elems[h->n_elems - 1].n_props == 0)
         return fdt_rd_fail(c, FDT_IO_EFORMAT, ":%zu: element %s has no properties",
                        h->elems[h->n_elems - 1].line,
                        fdt_rd_quote(q, h->elems[h->n_elems - 1].name,
                                 h->elems[h->n_elems - 1].name_len));
+    return FDT_IO_OK;
+}
+
+/* 'format ascii|binary_little_endian|binary_big_endian 1.0' into h->format. */
+static int ply_header_format(const rd_ctx *c, ply_hdr *h, const ply_line *w)
+{
+    const char *const *tk = w->tk;
+    const size_t *tn = w->tn;
+    size_t nt = w->nt, ln = w->ln;
+    if (h->format >= 0)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: second format line", ln);
+    int fm = -1;
+    if (nt == 3 && rd_tok_is(tk[1], tn[1], "ascii"))
+        fm = PLY_ASCII;
+    else if (nt == 3 &&
+             rd_tok_is(tk[1], tn[1], "binary_little_endian"))
+        fm = PLY_LE;
+    else if (nt == 3 && rd_tok_is(tk[1], tn[1], "binary_big_endian"))
+        fm = PLY_BE;
+    if (fm < 0 || !rd_tok_is(tk[2], tn[2], "1.0"))
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: expected 'format ascii|"
+                       "binary_little_endian|binary_big_endian 1.0'",
+                       ln);
+    h->format = fm;
+    return FDT_IO_OK;
+}
+
+/* 'element NAME COUNT': a new element of h, the vertex one if so named. */
+static int ply_header_element(const rd_ctx *c, ply_hdr *h, const ply_line *w)
+{
+    const char *const *tk = w->tk;
+    const size_t *tn = w->tn;
+    size_t nt = w->nt, ln = w->ln;
+    char q[RD_QUOTE_CAP];
+    if (h->format < 0)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: element before the format line", ln);
+    if (nt != 3)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: expected 'element NAME COUNT'", ln);
+    uint64_t cnt;
+    int st = fdt_rd_parse_count(tk[2], tn[2], &cnt);
+    if (st == NUM_OVERFLOW)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: element count %s is too large", ln,
+                       fdt_rd_quote(q, tk[2], tn[2]));
+    if (st != NUM_OK)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: element count %s is not a non-negative "
+                       "integer",
+                       ln, fdt_rd_quote(q, tk[2], tn[2]));
+    int is_vertex = rd_tok_is(tk[1], tn[1], "vertex");
+    if (is_vertex && h->vertex != SIZE_MAX)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: second 'vertex' element", ln);
+    int rc = ply_check_last_props(c, h);
+    if (rc != FDT_IO_OK)
+        return rc;
+    if (ply_add_elem(h) != 0)
+        return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+    ply_elem *el = &h->elems[h->n_elems - 1];
+    memset(el, 0, sizeof *el);
+    el->name = tk[1];
+    el->name_len = tn[1];
+    el->count = cnt;
+    el->first_prop = h->n_props;
+    el->line = ln;
+    if (is_vertex)
+        h->vertex = h->n_elems - 1;
+    return FDT_IO_OK;
+}
+
+/* 'property TYPE NAME' or 'property list COUNTTYPE ITEMTYPE NAME': a new
+ * property of the last element; x, y, z of the vertex element get their
+ * roles. */
+static int ply_header_property(const rd_ctx *c, ply_hdr *h, const ply_line *w)
+{
+    const char *const *tk = w->tk;
+    const size_t *tn = w->tn;
+    size_t nt = w->nt, ln = w->ln;
+    char q[RD_QUOTE_CAP];
+    if (h->n_elems == 0)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: property before any element", ln);
+    ply_prop p = {0, 0, 0, 0};
+    const char *name;
+    size_t name_len;
+    if (nt == 5 && rd_tok_is(tk[1], tn[1], "list")) {
+        int ct = ply_type_lookup(tk[2], tn[2]);
+        int it = ply_type_lookup(tk[3], tn[3]);
+        if (ct < 0 || it < 0)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: unknown property type %s",
+                           ln, ct < 0 ? fdt_rd_quote(q, tk[2], tn[2])
+                                      : fdt_rd_quote(q, tk[3], tn[3]));
+        if (ply_is_float(ct))
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: list length type %s is not an "
+                           "integer type",
+                           ln, fdt_rd_quote(q, tk[2], tn[2]));
+        p.is_list = 1;
+        p.count_type = (unsigned char)ct;
+        p.type = (unsigned char)it;
+        name = tk[4];
+        name_len = tn[4];
+    } else if (nt == 3) {
+        int t = ply_type_lookup(tk[1], tn[1]);
+        if (t < 0)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: unknown property type %s", ln,
+                           fdt_rd_quote(q, tk[1], tn[1]));
+        p.type = (unsigned char)t;
+        name = tk[2];
+        name_len = tn[2];
+    } else {
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: expected 'property TYPE NAME' or "
+                       "'property list COUNTTYPE ITEMTYPE NAME'",
+                       ln);
+    }
+    ply_elem *el = &h->elems[h->n_elems - 1];
+    if (h->vertex == h->n_elems - 1 && name_len == 1 &&
+        name[0] >= 'x' && name[0] <= 'z') {
+        int role = name[0] - 'x' + 1;
+        for (size_t i = el->first_prop; i < h->n_props; i++)
+            if (h->props[i].role == role)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: second vertex property %s", ln,
+                               fdt_rd_quote(q, name, name_len));
+        if (p.is_list)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: vertex property %s is a list", ln,
+                           fdt_rd_quote(q, name, name_len));
+        p.role = (unsigned char)role;
+    }
+    if (ply_add_prop(h) != 0)
+        return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+    h->props[h->n_props - 1] = p;
+    el->n_props++;
+    if (p.is_list) {
+        el->has_list = 1;
+        el->min_bytes += ply_size[p.count_type];
+    } else {
+        el->n_scalar++;
+        el->min_bytes += ply_size[p.type];
+    }
+    return FDT_IO_OK;
+}
+
+/* What a complete header must have: a format line, properties in its last
+ * element, a vertex element with x, y and z and a nonzero count. */
+static int ply_header_complete(const rd_ctx *c, const ply_hdr *h)
+{
+    char q2[RD_QUOTE_CAP];
+    if (h->format < 0)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT, ": the header has no format line");
+    int rc = ply_check_last_props(c, h);
+    if (rc != FDT_IO_OK)
+        return rc;
     if (h->vertex == SIZE_MAX)
         return fdt_rd_fail(c, FDT_IO_EFORMAT,
                        ": no points (the header has no 'vertex' element)");
@@ -373,6 +366,77 @@ static int ply_parse_header(const rd_ctx *c, ply_hdr *h)
                        "count 0)",
                        v->line);
     return FDT_IO_OK;
+}
+
+/* The header in c->buf into *h: the 'ply' line, then each line's keyword
+ * dispatched to its step, up to end_header; then the checks of the whole. */
+static int ply_parse_header(const rd_ctx *c, ply_hdr *h)
+{
+    rd_lines L = {c->buf, c->buf + c->size, 0};
+    const char *s = c->buf, *e = c->buf, *ts;
+    size_t tl;
+    char q[RD_QUOTE_CAP];
+
+    h->format = -1;
+    h->vertex = SIZE_MAX;
+    if (fdt_rd_next_line(&L, &s, &e)) {
+        rd_fields f = {s, e, 0, 0};
+        int r = fdt_rd_next_field(&f, &ts, &tl);
+        if (r <= 0 || !rd_tok_is(ts, tl, "ply") || fdt_rd_count_rest(&f) != 0)
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":1: not a PLY file (the first line is %s, "
+                           "expected 'ply')",
+                           fdt_rd_quote(q, s, (size_t)(e - s)));
+    }
+    int ended = 0;
+    while (!ended && fdt_rd_next_line(&L, &s, &e)) {
+        rd_fields f = {s, e, 0, 0};
+        ply_line w = {{0}, {0}, 0, 0};
+        const char *const *tk = w.tk;
+        const size_t *tn = w.tn;
+        while (w.nt < 5 && fdt_rd_next_field(&f, &w.tk[w.nt], &w.tn[w.nt]) > 0)
+            w.nt++;
+        if (w.nt == 0)
+            continue;
+        if (rd_tok_is(tk[0], tn[0], "comment") ||
+            rd_tok_is(tk[0], tn[0], "obj_info"))
+            continue;
+        w.nt += fdt_rd_count_rest(&f);
+        w.ln = L.lineno;
+        int rc;
+        if (rd_tok_is(tk[0], tn[0], "format")) {
+            rc = ply_header_format(c, h, &w);
+        } else if (rd_tok_is(tk[0], tn[0], "element")) {
+            rc = ply_header_element(c, h, &w);
+        } else if (rd_tok_is(tk[0], tn[0], "property")) {
+            rc = ply_header_property(c, h, &w);
+        } else if (rd_tok_is(tk[0], tn[0], "end_header")) {
+            if (w.nt != 1)
+                return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                               ":%zu: unexpected text after end_header", w.ln);
+            rc = FDT_IO_OK;
+            ended = 1;
+        } else {
+            /* a number here is data: the end_header line is missing */
+            int data = rd_is_digit(tk[0][0]) || tk[0][0] == '-' ||
+                       tk[0][0] == '+' || tk[0][0] == '.';
+            return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                           ":%zu: unknown header keyword %s%s", w.ln,
+                           fdt_rd_quote(q, tk[0], tn[0]),
+                           data ? " (no end_header line before the data?)"
+                                : "");
+        }
+        if (rc != FDT_IO_OK)
+            return rc;
+    }
+    if (!ended) {
+        h->no_end = 1;
+        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                       ":%zu: the header has no end_header line", L.lineno);
+    }
+    h->data_off = (size_t)(L.p - c->buf);
+    h->data_line = L.lineno;
+    return ply_header_complete(c, h);
 }
 
 /* Loads an unsigned integer of sz bytes in the file's byte order. */
@@ -824,13 +888,24 @@ static int ply_plain_doubles(const ply_hdr *h, const ply_elem *el, int big)
 #endif
 }
 
-/* The vertex element (the streamed ply_bin_vertex). */
-static int ply_st_vertex(ply_in *in, const ply_hdr *h, const ply_elem *el, int big,
-                         rd_points *pb)
+/* The first error of a streamed vertex read, kept to be worded once the
+ * input's size is known (ply_st_vertex_fail). */
+typedef struct ply_vbad {
+    int rc;     /* FDT_IO_ENOMEM; 1: the data ends inside vertex i; 2: a
+                   negative list length at byte `at`; FDT_IO_OK: none, or
+                   (k >= 0) coordinate k of vertex i, v at byte `at`, is not
+                   finite */
+    int k;
+    uint64_t i;
+    size_t at;
+    double v;
+} ply_vbad;
+
+/* Room for the vertices before they are read: FDT_IO_OK to read them. */
+static int ply_st_vertex_reserve(ply_in *in, const ply_hdr *h, const ply_elem *el, size_t start,
+                                 rd_points *pb)
 {
     const rd_ctx *c = in->c;
-    char lab[160];
-    size_t start = in->off;
     /* A count the file's known size holds is allocated at once (the
      * usual file); otherwise the array grows as vertices arrive. */
     if (c->size > start && el->count <= (c->size - start) / el->min_bytes &&
@@ -844,135 +919,170 @@ static int ply_st_vertex(ply_in *in, const ply_hdr *h, const ply_elem *el, int b
         int rc = ply_vertex_precheck(c, h, el, start, ply_total(in));
         return in->failed ? FDT_IO_EOPEN : rc;
     }
-    int rc = FDT_IO_OK;
-    size_t bad_at = 0;
-    int bad_k = -1;
-    double bad_v = 0.0;
-    uint64_t i = 0;
-    if (ply_plain_doubles(h, el, big)) {
-        /* Straight into the array: the window's bytes first, then read()
-         * into place, a buffer's worth at a time (progress, growth). */
-        unsigned char *dst = (unsigned char *)pb->xyz;
-        uint64_t bytes = el->count * 24, got = 0;
-        while (got < bytes) {
-            if (ply_vertex_room(pb, el->count, (size_t)(got / 24)) != 0) {
-                rc = FDT_IO_ENOMEM;
-                break;
-            }
-            dst = (unsigned char *)pb->xyz;
-            size_t room = pb->cap * 24 - (size_t)got, k;
-            if (room > in->cap)
-                room = in->cap;
-            if (in->hi > in->lo) {
-                k = in->hi - in->lo < room ? in->hi - in->lo : room;
-                memcpy(dst + got, in->buf + in->lo, k);
-                in->lo += k;
-            } else {
-                ptrdiff_t r = in->failed ? -1 : fdt_rd_src_read(c, dst + got, room);
-                if (r < 0) {
-                    in->failed = 1;
-                    return FDT_IO_EOPEN;
-                }
-                k = (size_t)r;
-            }
-            /* every double now complete is checked, in file order */
-            for (uint64_t v = got / 8; v < (got + k) / 8; v++) {
-                double x = pb->xyz[v];
-                if (!isfinite(x)) {
-                    bad_at = start + (size_t)v * 8;
-                    bad_k = (int)(v % 3);
-                    bad_v = x;
-                    i = v / 3;
-                    break;
-                }
-            }
-            got += k;
-            in->off += k;
-            fdt_rd_progress(c, in->off);
-            if (bad_k >= 0 || k == 0)
-                break;
+    return FDT_IO_OK;
+}
+
+/* Vertices that are three little-endian doubles (ply_plain_doubles) from
+ * byte start: FDT_IO_EOPEN when a read fails, else FDT_IO_OK with the
+ * first error, if any, in *bad. */
+static int ply_st_plain(ply_in *in, const ply_elem *el, size_t start, rd_points *pb,
+                        ply_vbad *bad)
+{
+    const rd_ctx *c = in->c;
+    /* Straight into the array: the window's bytes first, then read()
+     * into place, a buffer's worth at a time (progress, growth). */
+    unsigned char *dst = (unsigned char *)pb->xyz;
+    uint64_t bytes = el->count * 24, got = 0;
+    while (got < bytes) {
+        if (ply_vertex_room(pb, el->count, (size_t)(got / 24)) != 0) {
+            bad->rc = FDT_IO_ENOMEM;
+            break;
         }
-        if (bad_k < 0 && rc == FDT_IO_OK) {
-            if (got == bytes) {
-                pb->n = (size_t)el->count;
-                return FDT_IO_OK;
-            }
-            rc = 1; /* the data ended inside vertex got / 24 */
-        }
-        if (bad_k < 0)
-            i = got / 24;
-    } else {
-        int type[3] = {0, 0, 0};
-        size_t fixed_off[3] = {0, 0, 0};
-        for (size_t j = 0, o = 0; j < el->n_props; j++) {
-            const ply_prop *p = &h->props[el->first_prop + j];
-            if (p->role) {
-                type[p->role - 1] = p->type;
-                fixed_off[p->role - 1] = o;
-            }
-            o += ply_size[p->type];
-        }
-        int r = 0;
-        for (; i < el->count; i++) {
-            if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
-                fdt_rd_progress(c, in->off);
-            if (ply_vertex_room(pb, el->count, (size_t)i) != 0) {
-                rc = FDT_IO_ENOMEM;
-                break;
-            }
-            double *d = pb->xyz + 3 * i;
-            size_t roff[3];
-            if (el->has_list) {
-                r = ply_st_item(in, h, el, big, d, roff, &bad_at);
-            } else if (!ply_need(in, el->min_bytes)) {
-                r = 1;
-            } else {
-                for (int k = 0; k < 3; k++) {
-                    roff[k] = in->off + fixed_off[k];
-                    d[k] = ply_get(in->buf + in->lo + fixed_off[k], type[k], big);
-                }
-                ply_take(in, el->min_bytes);
-            }
-            if (in->failed)
+        dst = (unsigned char *)pb->xyz;
+        size_t room = pb->cap * 24 - (size_t)got, k;
+        if (room > in->cap)
+            room = in->cap;
+        if (in->hi > in->lo) {
+            k = in->hi - in->lo < room ? in->hi - in->lo : room;
+            memcpy(dst + got, in->buf + in->lo, k);
+            in->lo += k;
+        } else {
+            ptrdiff_t r = in->failed ? -1 : fdt_rd_src_read(c, dst + got, room);
+            if (r < 0) {
+                in->failed = 1;
                 return FDT_IO_EOPEN;
-            if (r != 0) {
-                rc = r; /* 1: ends inside; 2: negative list length at bad_at */
+            }
+            k = (size_t)r;
+        }
+        /* every double now complete is checked, in file order */
+        for (uint64_t v = got / 8; v < (got + k) / 8; v++) {
+            double x = pb->xyz[v];
+            if (!isfinite(x)) {
+                bad->at = start + (size_t)v * 8;
+                bad->k = (int)(v % 3);
+                bad->v = x;
+                bad->i = v / 3;
                 break;
             }
-            for (int k = 0; k < 3 && bad_k < 0; k++)
-                if (!isfinite(d[k])) {
-                    bad_k = k;
-                    bad_at = roff[k];
-                    bad_v = d[k];
-                }
-            if (bad_k >= 0)
-                break;
         }
-        if (rc == FDT_IO_OK && bad_k < 0) {
-            pb->n = (size_t)el->count;
-            return FDT_IO_OK;
-        }
+        got += k;
+        in->off += k;
+        fdt_rd_progress(c, in->off);
+        if (bad->k >= 0 || k == 0)
+            break;
     }
-    /* The first error: the size checks come first, as in the buffered
-     * read, which makes them before it reads a vertex. */
+    if (bad->k < 0 && bad->rc == FDT_IO_OK && got != bytes)
+        bad->rc = 1; /* the data ended inside vertex got / 24 */
+    if (bad->k < 0)
+        bad->i = got / 24;
+    return FDT_IO_OK;
+}
+
+/* Vertices of any other layout, one at a time through the window: as
+ * ply_st_plain. */
+static int ply_st_fields(ply_in *in, const ply_hdr *h, const ply_elem *el, int big,
+                         rd_points *pb, ply_vbad *bad)
+{
+    const rd_ctx *c = in->c;
+    int type[3] = {0, 0, 0};
+    size_t fixed_off[3] = {0, 0, 0};
+    for (size_t j = 0, o = 0; j < el->n_props; j++) {
+        const ply_prop *p = &h->props[el->first_prop + j];
+        if (p->role) {
+            type[p->role - 1] = p->type;
+            fixed_off[p->role - 1] = o;
+        }
+        o += ply_size[p->type];
+    }
+    int r = 0;
+    uint64_t i = 0;
+    for (; i < el->count; i++) {
+        if ((i & (RD_PROGRESS_EVERY - 1)) == 0)
+            fdt_rd_progress(c, in->off);
+        if (ply_vertex_room(pb, el->count, (size_t)i) != 0) {
+            bad->rc = FDT_IO_ENOMEM;
+            break;
+        }
+        double *d = pb->xyz + 3 * i;
+        size_t roff[3];
+        if (el->has_list) {
+            r = ply_st_item(in, h, el, big, d, roff, &bad->at);
+        } else if (!ply_need(in, el->min_bytes)) {
+            r = 1;
+        } else {
+            for (int k = 0; k < 3; k++) {
+                roff[k] = in->off + fixed_off[k];
+                d[k] = ply_get(in->buf + in->lo + fixed_off[k], type[k], big);
+            }
+            ply_take(in, el->min_bytes);
+        }
+        if (in->failed)
+            return FDT_IO_EOPEN;
+        if (r != 0) {
+            bad->rc = r; /* 1: ends inside; 2: negative list length at bad->at */
+            break;
+        }
+        for (int k = 0; k < 3 && bad->k < 0; k++)
+            if (!isfinite(d[k])) {
+                bad->k = k;
+                bad->at = roff[k];
+                bad->v = d[k];
+            }
+        if (bad->k >= 0)
+            break;
+    }
+    bad->i = i;
+    return FDT_IO_OK;
+}
+
+/* The message of the first error *bad of the vertex element that starts
+ * at byte start. */
+static int ply_st_vertex_fail(ply_in *in, const ply_hdr *h, const ply_elem *el, size_t start,
+                              const ply_vbad *bad)
+{
+    const rd_ctx *c = in->c;
+    char lab[160];
+    /* The size checks come first, as in the buffered read, which makes
+     * them before it reads a vertex. */
     size_t total = ply_total(in);
     if (in->failed)
         return FDT_IO_EOPEN;
     int pre = ply_vertex_precheck(c, h, el, start, total);
     if (pre != FDT_IO_OK)
         return pre;
-    if (rc == FDT_IO_ENOMEM)
+    if (bad->rc == FDT_IO_ENOMEM)
         return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory for %llu points",
                            (unsigned long long)el->count);
-    if (rc == 1)
+    if (bad->rc == 1)
         return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: file ends inside %s", total,
-                           ply_item_label(lab, sizeof lab, h, el, i));
-    if (rc == 2)
-        return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: %s: negative list length", bad_at,
-                           ply_item_label(lab, sizeof lab, h, el, i));
-    return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: %s: %c is %s", bad_at,
-                       ply_item_label(lab, sizeof lab, h, el, i), 'x' + bad_k,
-                       isnan(bad_v) ? "NaN" : "infinite");
+                           ply_item_label(lab, sizeof lab, h, el, bad->i));
+    if (bad->rc == 2)
+        return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: %s: negative list length", bad->at,
+                           ply_item_label(lab, sizeof lab, h, el, bad->i));
+    return fdt_rd_fail(c, FDT_IO_EFORMAT, ": byte %zu: %s: %c is %s", bad->at,
+                       ply_item_label(lab, sizeof lab, h, el, bad->i), 'x' + bad->k,
+                       isnan(bad->v) ? "NaN" : "infinite");
+}
+
+/* The vertex element (the streamed ply_bin_vertex): room for it, its
+ * vertices read by the step for their layout, the first error worded. */
+static int ply_st_vertex(ply_in *in, const ply_hdr *h, const ply_elem *el, int big,
+                         rd_points *pb)
+{
+    size_t start = in->off;
+    int rc = ply_st_vertex_reserve(in, h, el, start, pb);
+    if (rc != FDT_IO_OK)
+        return rc;
+    ply_vbad bad = {FDT_IO_OK, -1, 0, 0, 0.0};
+    rc = ply_plain_doubles(h, el, big) ? ply_st_plain(in, el, start, pb, &bad)
+                                       : ply_st_fields(in, h, el, big, pb, &bad);
+    if (rc != FDT_IO_OK)
+        return rc;
+    if (bad.rc == FDT_IO_OK && bad.k < 0) {
+        pb->n = (size_t)el->count;
+        return FDT_IO_OK;
+    }
+    return ply_st_vertex_fail(in, h, el, start, &bad);
 }
 
 /* The body of a binary PLY whose header h was read; in holds the bytes
@@ -998,6 +1108,76 @@ static int ply_st_binary(ply_in *in, const ply_hdr *h, rd_points *pb)
                            off, total - off);
     }
     return PLY_READ_FAILED(in);
+}
+
+/* An ASCII PLY whose first len bytes are in hb (cap + 1 bytes, owned):
+ * the rest loaded too, and the whole parsed as a buffer (the header
+ * again: its names point into the buffer, which grows); the buffer is
+ * handed to *owned. */
+static int ply_load_ascii(rd_ctx *c, char *hb, size_t len, size_t cap, rd_points *pb,
+                          char **owned)
+{
+    while (!c->src->eof) {
+        if (len == cap) {
+            if (cap > (SIZE_MAX - 1) / 2) {
+                free(hb);
+                return fdt_rd_fail(c, FDT_IO_ENOMEM, ": file too large for memory");
+            }
+            char *nb = realloc(hb, 2 * cap + 1);
+            if (nb == NULL) {
+                free(hb);
+                return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory reading the file");
+            }
+            hb = nb;
+            cap *= 2;
+        }
+        ptrdiff_t r = fdt_rd_src_read(c, hb + len, cap - len);
+        if (r < 0) {
+            free(hb);
+            return FDT_IO_EOPEN;
+        }
+        len += (size_t)r;
+        if (c->progress != NULL)
+            c->progress(c->progress_user, FDT_RD_LOADING, len, c->size > len ? c->size : 0);
+    }
+    hb[len] = '\0';
+    *owned = hb;
+    c->buf = hb;
+    c->size = len;
+    return ply_read_buffered(c, pb);
+}
+
+/* The body of a binary PLY of header h, read from the input through a
+ * buffer of its own, after the len - h->data_off bytes of it that hb (the
+ * header's buffer, len bytes) holds. */
+static int ply_stream_body(rd_ctx *c, const ply_hdr *h, const char *hb, size_t len,
+                           rd_points *pb)
+{
+    ply_in in;
+    memset(&in, 0, sizeof in);
+    in.c = c;
+    size_t chunk = c->chunk ? c->chunk : RD_CHUNK;
+    in.cap = fdt_rd_first_cap(c, chunk, c->size > h->data_off ? c->size - h->data_off + 1 : 1);
+    if (in.cap < 8)
+        in.cap = 8; /* the largest scalar */
+    for (size_t ei = 0; ei < h->n_elems; ei++)
+        if (in.cap < h->elems[ei].min_bytes)
+            in.cap = h->elems[ei].min_bytes; /* a whole item without lists */
+    size_t extra = len - h->data_off;
+    if (in.cap < extra)
+        in.cap = extra;
+    in.buf = malloc(in.cap);
+    int rc;
+    if (in.buf == NULL) {
+        rc = fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
+    } else {
+        memcpy(in.buf, hb + h->data_off, extra);
+        in.hi = extra;
+        in.off = h->data_off;
+        rc = ply_st_binary(&in, h, pb);
+    }
+    free(in.buf);
+    return rc;
 }
 
 int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned)
@@ -1063,64 +1243,12 @@ int fdt_rd_stream_ply(rd_ctx *c, rd_points *pb, char **owned)
         return rc;
     }
     if (h.format == PLY_ASCII) {
-        /* ASCII: the rest loaded too, and the whole parsed as a buffer
-         * (the header again: its names point into the buffer, which
-         * grows). */
         ply_hdr_free(&h);
-        while (!c->src->eof) {
-            if (len == cap) {
-                if (cap > (SIZE_MAX - 1) / 2) {
-                    free(hb);
-                    return fdt_rd_fail(c, FDT_IO_ENOMEM, ": file too large for memory");
-                }
-                char *nb = realloc(hb, 2 * cap + 1);
-                if (nb == NULL) {
-                    free(hb);
-                    return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory reading the file");
-                }
-                hb = nb;
-                cap *= 2;
-            }
-            ptrdiff_t r = fdt_rd_src_read(c, hb + len, cap - len);
-            if (r < 0) {
-                free(hb);
-                return FDT_IO_EOPEN;
-            }
-            len += (size_t)r;
-            if (c->progress != NULL)
-                c->progress(c->progress_user, FDT_RD_LOADING, len, c->size > len ? c->size : 0);
-        }
-        hb[len] = '\0';
-        *owned = hb;
-        c->buf = hb;
-        c->size = len;
-        return ply_read_buffered(c, pb);
+        return ply_load_ascii(c, hb, len, cap, pb, owned);
     }
     /* Binary: the header's buffer stays (the elements' names point into
      * it); the body streams through its own. */
-    ply_in in;
-    memset(&in, 0, sizeof in);
-    in.c = c;
-    size_t chunk = c->chunk ? c->chunk : RD_CHUNK;
-    in.cap = fdt_rd_first_cap(c, chunk, c->size > h.data_off ? c->size - h.data_off + 1 : 1);
-    if (in.cap < 8)
-        in.cap = 8; /* the largest scalar */
-    for (size_t ei = 0; ei < h.n_elems; ei++)
-        if (in.cap < h.elems[ei].min_bytes)
-            in.cap = h.elems[ei].min_bytes; /* a whole item without lists */
-    size_t extra = len - h.data_off;
-    if (in.cap < extra)
-        in.cap = extra;
-    in.buf = malloc(in.cap);
-    if (in.buf == NULL) {
-        rc = fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
-    } else {
-        memcpy(in.buf, hb + h.data_off, extra);
-        in.hi = extra;
-        in.off = h.data_off;
-        rc = ply_st_binary(&in, &h, pb);
-    }
-    free(in.buf);
+    rc = ply_stream_body(c, &h, hb, len, pb);
     ply_hdr_free(&h);
     free(hb);
     return rc;
