@@ -111,6 +111,16 @@ typedef enum fdt_search {
     FDT_SEARCH_MESH = 2   /* each part's insertion mesh from the start */
 } fdt_search;
 
+/* The name users type for search s (the CLI's --search NAME, the Python
+ * module's search='NAME': "auto", "kd", "mesh"), static; NULL when s is
+ * not an fdt_search. The searches are the values from 0 up to the first
+ * NULL. */
+FDT_API const char *fdt_search_name(fdt_search s);
+/* Sets *out to the search named name (exactly, as fdt_search_name spells
+ * it): FDT_OK, or FDT_EINVAL for an unknown name or a NULL argument (*out
+ * unchanged). */
+FDT_API int fdt_search_from_name(const char *name, fdt_search *out);
+
 /*
  * Progress callback: called now and then from the calling thread with the
  * fraction of tetrahedra believed built (an estimate in [0, 1]). Return
@@ -172,7 +182,8 @@ FDT_API void fdt_close(fdt_context **ctx);
  * FDT_SEARCH_AUTO: the insertion mesh of every point, built on the run's
  * threads, is the answer), rather than fronts: in memory (streamed 0,
  * fdt_triangulate) or streamed (nonzero, fdt_triangulate_stream: never).
- * A function of the settings alone; for a caller's memory estimate. */
+ * A function of the settings alone; for a caller's memory estimate. 0 for
+ * a search that is not an fdt_search (fdt_open refuses it). */
 FDT_API int fdt_engine_one_part(const fdt_settings *s, int streamed);
 
 /*

@@ -15,7 +15,14 @@ Usage: check_docs.py FRONTDT SOURCE_ROOT BUILD_ROOT
    all-capitals word in it that does not exist is a placeholder
    (`tests/test_MODULE.c` is checked as tests/test_*.c). In a README
    under src/, a path may also start at src/ (`geom/kdtree.c`).
-Exit 0 when both hold, 1 otherwise (each problem printed).
+3. Every apex search of the table (src/front/search.c), read at test time
+   from the names `FRONTDT --search ''` refuses the value with, is named
+   where the searches are listed by hand: the --search entry of
+   doc/frontdt.1 (as .B NAME), the `--search a|b|c` of doc/reference.md
+   and the search= text of delaunay's docstring in
+   python/frontdt/_frontdt.c ('NAME'). So a new row fails the test until
+   those say what it is.
+Exit 0 when all hold, 1 otherwise (each problem printed).
 """
 import glob
 import os
@@ -51,6 +58,42 @@ def check_man(frontdt, root):
             problems.append("doc/frontdt.1 does not mention %s (printed by frontdt --help)" % o)
     print("docs: %d long options of --help, %d missing from doc/frontdt.1"
           % (len(opts), len(problems)))
+    return problems
+
+
+def search_names(frontdt):
+    """The table's names, from the usage message "unknown search '' (auto, kd or mesh)"."""
+    out = subprocess.run([frontdt, "--search", ""], stdout=subprocess.PIPE,
+                         stderr=subprocess.STDOUT, check=False, universal_newlines=True).stdout
+    m = re.search(r"unknown search '' \(([^)]*)\)", out)
+    return re.split(r", | or ", m.group(1)) if m else [], out
+
+
+def check_searches(frontdt, root):
+    names, out = search_names(frontdt)
+    if not names:
+        return ["frontdt --search '' did not list the searches:\n%s" % out]
+
+    def read(rel):
+        with open(os.path.join(root, rel), encoding="utf-8") as f:
+            return f.read()
+
+    problems = []
+    man = re.search(r"^\.BI \\-\\-search .*?(?=^\.TP)", read("doc/frontdt.1"), re.S | re.M)
+    ref = re.search(r"`--search ([^`]*)`", read("doc/reference.md"))
+    py = re.search(r"search: (.*?) \(as the", read("python/frontdt/_frontdt.c"), re.S)
+    places = [("doc/frontdt.1's --search entry", man and man.group(0), r"^\.B %s$"),
+              ("doc/reference.md's `--search ...`", ref and "|" + ref.group(1) + "|", r"\|%s\|"),
+              ("delaunay's search= docstring", py and py.group(1), r"'%s'")]
+    for where, text, pattern in places:
+        if not text:
+            problems.append("%s not found" % where)
+            continue
+        for name in names:
+            if not re.search(pattern % re.escape(name), text, re.M):
+                problems.append("%s does not name the search %s" % (where, name))
+    print("docs: %d searches, %d places that list them by hand, %d missing"
+          % (len(names), len(places), len(problems)))
     return problems
 
 
@@ -120,7 +163,7 @@ def main(argv):
         print("usage: check_docs.py FRONTDT SOURCE_ROOT BUILD_ROOT", file=sys.stderr)
         return 2
     frontdt, root, build = argv[1:]
-    problems = check_man(frontdt, root) + check_paths(root, build)
+    problems = check_man(frontdt, root) + check_paths(root, build) + check_searches(frontdt, root)
     for p in problems:
         print("FAIL: " + p)
     return 1 if problems else 0

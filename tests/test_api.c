@@ -283,8 +283,7 @@ static void test_search(void)
         for (size_t i = 0; i < 3 * n; i++)
             xyz[i] = test_unif(&seed);
         uint64_t ref = 0;
-        const fdt_search searches[3] = {FDT_SEARCH_KD, FDT_SEARCH_MESH, FDT_SEARCH_AUTO};
-        for (int si = 0; si < 3; si++)
+        for (int si = 0; fdt_search_name((fdt_search)si); si++)
             for (int mode = FDT_MODE_SERIAL; mode <= FDT_MODE_MESSAGE; mode++)
                 for (int threads = 1; threads <= 16; threads *= 4) {
                     if (mode == FDT_MODE_SERIAL && threads > 1)
@@ -293,7 +292,7 @@ static void test_search(void)
                     fdt_default_settings(&s);
                     s.mode = (fdt_mode)mode;
                     s.n_threads = threads;
-                    s.search = searches[si];
+                    s.search = (fdt_search)si;
                     fdt_context *ctx = NULL;
                     CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
                     fdt_result *r = NULL;
@@ -311,6 +310,43 @@ static void test_search(void)
                 }
         free(xyz);
     }
+}
+
+/* The searches' names (the table of src/front/search.c): values from 0
+ * without a gap, each name back to its value, and a value past them or an
+ * unknown name refused. */
+static void test_search_names(void)
+{
+    int n = 0;
+    while (fdt_search_name((fdt_search)n))
+        n++;
+    EXPECT(n >= 3 && strcmp(fdt_search_name(FDT_SEARCH_AUTO), "auto") == 0 &&
+           strcmp(fdt_search_name(FDT_SEARCH_KD), "kd") == 0 &&
+           strcmp(fdt_search_name(FDT_SEARCH_MESH), "mesh") == 0);
+    for (int i = 0; i < n; i++) {
+        fdt_search s = (fdt_search)-1;
+        EXPECTF(fdt_search_from_name(fdt_search_name((fdt_search)i), &s) == FDT_OK &&
+                    s == (fdt_search)i,
+                "search %d", i);
+    }
+    for (int i = n; i < n + 64; i++)
+        EXPECTF(fdt_search_name((fdt_search)i) == NULL, "a gap before search %d", i);
+    EXPECT(fdt_search_name((fdt_search)-1) == NULL);
+    fdt_search s = FDT_SEARCH_KD;
+    EXPECT(fdt_search_from_name("fast", &s) == FDT_EINVAL && s == FDT_SEARCH_KD);
+    EXPECT(fdt_search_from_name("", &s) == FDT_EINVAL && s == FDT_SEARCH_KD);
+    EXPECT(fdt_search_from_name("Auto", &s) == FDT_EINVAL && s == FDT_SEARCH_KD);
+    EXPECT(fdt_search_from_name(NULL, &s) == FDT_EINVAL);
+    EXPECT(fdt_search_from_name("auto", NULL) == FDT_EINVAL);
+
+    fdt_settings st;
+    fdt_default_settings(&st);
+    st.search = (fdt_search)n;
+    fdt_context *ctx = (fdt_context *)&st;
+    EXPECT(fdt_open(&ctx, &st) == FDT_EINVAL && ctx == NULL);
+    EXPECT(fdt_engine_one_part(&st, 0) == 0);
+    st.search = (fdt_search)-1;
+    EXPECT(fdt_open(&ctx, &st) == FDT_EINVAL && ctx == NULL);
 }
 
 /* A struct followed by canary bytes, to see what a call writes. */
@@ -464,6 +500,7 @@ int main(void)
     test_result();
     test_progress();
     test_search();
+    test_search_names();
     test_engine_rule();
     return test_report("test_api");
 }

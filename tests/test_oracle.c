@@ -432,7 +432,7 @@ static void test_mem_cap(void)
     const int want[3] = {-1, 1, 1};
     for (int i = 0; i < 3; i++) {
         fdt_oracle o;
-        fdt_oracle_init(&o, &cy.t, FDT_SEARCH_AUTO);
+        fdt_oracle_init(&o, &cy.t, FDT_ORACLE_SWITCH);
         o.mem_cap = caps[i];
         o.w_budget = 0;
         fdt_kdq kq;
@@ -443,9 +443,9 @@ static void test_mem_cap(void)
                 caps[i], o.state);
         fdt_oracle_free(&o);
     }
-    /* an explicit --search mesh is kept whatever the cap */
+    /* the mesh policy (--search mesh) is kept whatever the cap */
     fdt_oracle o;
-    fdt_oracle_init(&o, &cy.t, FDT_SEARCH_MESH);
+    fdt_oracle_init(&o, &cy.t, FDT_ORACLE_MESH);
     o.mem_cap = 1;
     fdt_kdq kq;
     memset(&kq, 0, sizeof kq);
@@ -481,7 +481,7 @@ static void test_counts_decide(void)
     for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
         for (int again = 0; again < 2; again++) {
             fdt_oracle o;
-            fdt_oracle_init(&o, &cy.t, FDT_SEARCH_AUTO);
+            fdt_oracle_init(&o, &cy.t, FDT_ORACLE_SWITCH);
             fdt_kdq kq;
             memset(&kq, 0, sizeof kq);
             kq.points = 256 * c[i].points;
@@ -502,7 +502,7 @@ static void test_counts_decide(void)
      * next window has no budget */
     fdt_oracle o;
     fdt_kdq kq;
-    fdt_oracle_init(&o, &cy.t, FDT_SEARCH_AUTO);
+    fdt_oracle_init(&o, &cy.t, FDT_ORACLE_SWITCH);
     memset(&kq, 0, sizeof kq);
     size_t late = (size_t)(7.0 * (double)cy.t.n);
     fdt_oracle_tick(&o, late, &kq);
@@ -510,9 +510,9 @@ static void test_counts_decide(void)
     fdt_oracle_free(&o);
     fdt_kd_free(&cy.t);
 
-    /* --search mesh over a part of 3 points: no mesh, the kd search */
+    /* the mesh policy over a part of 3 points: no mesh, the kd search */
     CHECK_EQ(fdt_kd_build(&cy.t, cy.pr.p, cy.pr.orig, 0, 3, 18), FDT_OK);
-    fdt_oracle_init(&o, &cy.t, FDT_SEARCH_MESH);
+    fdt_oracle_init(&o, &cy.t, FDT_ORACLE_MESH);
     fdt_oracle_tick(&o, 0, &kq);
     EXPECT(o.state == -1);
     fdt_oracle_free(&o);

@@ -145,16 +145,16 @@ static PyObject *view(PyObject *owner, const void *data, npy_intp rows,
     return a;
 }
 
-/* Index of s in names[] (NULL-terminated), or -1 with a ValueError that
- * lists the choices. */
-static int pick(const char *what, const char *s, const char *const *names)
+/* The i such that name(i) is s (name answers 0, 1, ... up to its first
+ * NULL), or -1 with a ValueError that lists the choices. */
+static int pick(const char *what, const char *s, const char *(*name)(int i))
 {
     char choices[128] = "";
-    for (int i = 0; names[i]; i++) {
-        if (strcmp(s, names[i]) == 0)
+    for (int i = 0; name(i); i++) {
+        if (strcmp(s, name(i)) == 0)
             return i;
         size_t used = strlen(choices);
-        snprintf(choices + used, sizeof choices - used, "%s'%s'", i ? ", " : "", names[i]);
+        snprintf(choices + used, sizeof choices - used, "%s'%s'", i ? ", " : "", name(i));
     }
     PyErr_Format(PyExc_ValueError, "%s must be one of %s, got '%s'", what, choices, s);
     return -1;
@@ -593,16 +593,22 @@ static PyObject *tri_find_simplex(TriObject *self, PyObject *args, PyObject *kw)
     return Py_BuildValue("NN", tet, bary);
 }
 
+/* fdt_interpolate's methods, in the enum's order (pick). */
+static const char *method_choice(int i)
+{
+    static const char *const names[] = {"linear", "natural", NULL};
+    return names[i];
+}
+
 /* Triangulation.interpolate(values, q, method="natural") (fdt_interpolate). */
 static PyObject *tri_interpolate(TriObject *self, PyObject *args, PyObject *kw)
 {
     static char *kwlist[] = {"values", "q", "method", NULL};
-    static const char *const methods[] = {"linear", "natural", NULL};
     PyObject *vo, *qo;
     const char *method_s = "natural";
     if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|s:interpolate", kwlist, &vo, &qo, &method_s))
         return NULL;
-    int m = pick("method", method_s, methods);
+    int m = pick("method", method_s, method_choice);
     if (m < 0)
         return NULL;
     size_t n = (size_t)PyArray_DIM(self->points, 0);
@@ -689,12 +695,23 @@ static PyTypeObject TriType = {
 
 /* ------------------------------------------------------------ delaunay */
 
+/* fdt_mode's names, in its order (pick). */
+static const char *mode_choice(int i)
+{
+    static const char *const names[] = {"auto", "serial", "shared", "message", NULL};
+    return names[i];
+}
+
+/* fdt_search's names: the library's table (fdt_search_name). */
+static const char *search_choice(int i)
+{
+    return fdt_search_name((fdt_search)i);
+}
+
 static PyObject *py_delaunay(PyObject *mod, PyObject *args, PyObject *kw)
 {
     (void)mod;
     static char *kwlist[] = {"points", "threads", "mode", "search", NULL};
-    static const char *const modes[] = {"auto", "serial", "shared", "message", NULL};
-    static const char *const searches[] = {"auto", "kd", "mesh", NULL};
     PyObject *obj, *threads_obj = Py_None;
     const char *mode_s = "auto", *search_s = "auto";
     if (!PyArg_ParseTupleAndKeywords(args, kw, "O|Oss:delaunay", kwlist, &obj,
@@ -702,10 +719,11 @@ static PyObject *py_delaunay(PyObject *mod, PyObject *args, PyObject *kw)
         return NULL;
     fdt_settings s;
     fdt_default_settings(&s);
-    int m = pick("mode", mode_s, modes), se = m < 0 ? -1 : pick("search", search_s, searches);
+    int m = pick("mode", mode_s, mode_choice);
+    int se = m < 0 ? -1 : pick("search", search_s, search_choice);
     if (m < 0 || se < 0)
         return NULL;
-    /* the tables list the enums in their order */
+    /* the names come in the enums' order */
     s.mode = (fdt_mode)m;
     s.search = (fdt_search)se;
     if (threads_obj != Py_None) {

@@ -13,6 +13,7 @@
 #include "front/front.h"
 #include "geom/kdtree.h"
 #include "front/oracle.h"
+#include "front/search.h"
 #include "front/partmesh.h"
 #include "par/parallel.h"
 #include "par/threads.h"
@@ -107,7 +108,7 @@ int fdt_open(fdt_context **ctx, const fdt_settings *s)
     fdt_default_settings_sized(&all, sizeof all);
     memcpy(&all, s, s->struct_size);
     if (all.n_threads < 0 || all.n_threads > 1024 || all.leaf_size < 0 ||
-        all.mode < FDT_MODE_AUTO || all.mode > FDT_MODE_MESSAGE)
+        all.mode < FDT_MODE_AUTO || all.mode > FDT_MODE_MESSAGE || !fdt_search_row_of(all.search))
         return FDT_EINVAL;
     fdt_context *c = calloc(1, sizeof *c);
     if (!c)
@@ -227,21 +228,21 @@ static int run_parallel(fdt_context *ctx, fdt_mode mode, int nthreads, const fdt
 
 /*
  * Which engine a run takes (issue 31), a function of the settings alone:
- * in memory, with --search auto or mesh on one thread, and with --search
- * auto and the default mode on several, the one-part engine (the
- * insertion mesh of every point, built on the run's threads and
- * certified, is the answer: no front re-derives it, bench/NOTES.md entry
- * 91); --search kd, a stream (whose memory must stay bounded), an explicit
- * --mode shared or message, --pin (which binds the parts' threads) and
- * --search mesh on several threads run the fronts: serial, or the parts'
- * engine (src/par/parallel.c).
+ * in memory, the one-part engine (the insertion mesh of every point, built
+ * on the run's threads and certified, is the answer: no front re-derives
+ * it, bench/NOTES.md entry 91) where the search's row lets it run
+ * (src/front/search.c): on one thread, or on several with the default mode
+ * and no --pin (which binds the parts' threads). A stream (whose memory
+ * must stay bounded) and every other run take the fronts: serial, or the
+ * parts' engine (src/par/parallel.c).
  */
 static int one_part(const fdt_settings *s, fdt_mode mode, int streamed)
 {
-    if (streamed || s->search == FDT_SEARCH_KD)
+    if (streamed)
         return 0;
-    return mode == FDT_MODE_SERIAL ||
-           (s->mode == FDT_MODE_AUTO && s->search == FDT_SEARCH_AUTO && !s->pin);
+    const fdt_search_row *r = fdt_search_row_of(s->search);
+    return mode == FDT_MODE_SERIAL ? r->one_part_serial
+                                   : r->one_part_threads && s->mode == FDT_MODE_AUTO && !s->pin;
 }
 
 /* The Voronoi cells (src/mesh/voronoi.c) on the threads the options ask
@@ -286,7 +287,7 @@ int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *va
 
 int fdt_engine_one_part(const fdt_settings *s, int streamed)
 {
-    if (!s)
+    if (!s || !fdt_search_row_of(s->search))
         return 0;
     fdt_mode mode;
     int nthreads;
@@ -327,7 +328,7 @@ static int run_single(fdt_context *ctx, const fdt_sink *user, int one, int nthre
                                     ctx->s.progress, ctx->s.progress_user, &rs->pms, ctx->diag,
                                     sizeof ctx->diag);
     } else
-        err = fdt_front_emit(&rs->tree, central_point(&rs->tree), (int)ctx->s.search, &rs->em,
+        err = fdt_front_emit(&rs->tree, central_point(&rs->tree), ctx->s.search, &rs->em,
                              ctx->s.progress, ctx->s.progress_user, &rs->fst);
     if (!err)
         err = fdt_emit_flush(&rs->em);

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "front/search.h"
 #include "geom/kdtree.h"
 #include "io/read/reader.h"
 
@@ -62,18 +63,19 @@ const fdt_cli_opt fdt_cli_opts[FDT_OPT_END] = {
     [FDT_OPT_MODE] = {"mode", 0, required_argument, "MODE", F, 0,
         "serial, shared, message or auto (default)", NULL},
     [FDT_OPT_SEARCH] = {"search", 0, required_argument, "HOW", FM, 0,
-        "how apexes are found: auto (default: in memory\n"
-        "without --mode, the certified insertion mesh\n"
-        "built on the threads is the answer; with\n"
-        "--mode, the parts read the mesh of every point\n"
-        "where a probe finds the kd search costly, else\n"
-        "the kd search), kd, or mesh (threads: each\n"
-        "part's own mesh, its inner tets final, fronts\n"
-        "at the walls)",
-        "auto (default: the kd search; where it\n"
-        "degenerates, every rank reads a replica of the\n"
-        "DT of every point), kd or mesh (each rank a mesh\n"
-        "of its own points)"},
+        "how apexes are found, each way giving the same\n"
+        "mesh. auto, in memory without --mode: the\n"
+        "certified insertion mesh built on the threads\n"
+        "is the answer; with --mode, the parts read the\n"
+        "mesh of every point where a probe finds the kd\n"
+        "search costly, else the kd search. mesh, on\n"
+        "threads: each part's own mesh, its inner tets\n"
+        "final, fronts at the walls. HOW is one of:",
+        "how apexes are found, each way giving the same\n"
+        "mesh. auto: the kd search; where it degenerates,\n"
+        "every rank reads a replica of the DT of every\n"
+        "point. mesh: each rank a mesh of its own points.\n"
+        "HOW is one of:"},
     [FDT_OPT_LEAF] = {"leaf", 0, required_argument, "N", FM, 0,
         "kd-tree leaf size (default " STR(FDT_DEFAULT_LEAF) ")", NULL},
     [FDT_OPT_NO_PARK] = {"no-park", 0, no_argument, NULL, M, 0,
@@ -154,6 +156,21 @@ const fdt_cli_opt fdt_cli_opts[FDT_OPT_END] = {
         1, NULL, NULL},
 };
 
+/* --search's list under its text: a line a row of src/front/search.c, so
+ * a new search is listed by its row alone. */
+static void help_searches(FILE *f)
+{
+    int width = 0;
+    for (int s = 0; fdt_search_row_of((fdt_search)s); s++) {
+        int k = (int)strlen(fdt_search_row_of((fdt_search)s)->name);
+        width = k > width ? k : width;
+    }
+    for (int s = 0; fdt_search_row_of((fdt_search)s); s++) {
+        const fdt_search_row *r = fdt_search_row_of((fdt_search)s);
+        fprintf(f, "\n%*s  %-*s  %s", HELP_COLUMN, "", width, r->name, r->help);
+    }
+}
+
 void fdt_cli_help(FILE *f, unsigned prog)
 {
     for (int i = 0; i < FDT_OPT_END; i++) {
@@ -176,6 +193,8 @@ void fdt_cli_help(FILE *f, unsigned prog)
             if (*p == '\n')
                 fprintf(f, "%*s", HELP_COLUMN, "");
         }
+        if (i == FDT_OPT_SEARCH)
+            help_searches(f);
         fputc('\n', f);
     }
 }
@@ -226,16 +245,16 @@ int fdt_cli_find(const char *word, unsigned prog)
 
 int fdt_cli_search(const char *name, fdt_search *out, char *err, size_t len)
 {
-    static const struct {
-        const char *name;
-        fdt_search search;
-    } names[] = {{"auto", FDT_SEARCH_AUTO}, {"kd", FDT_SEARCH_KD}, {"mesh", FDT_SEARCH_MESH}};
-    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
-        if (!strcmp(name, names[i].name)) {
-            *out = names[i].search;
-            return 0;
-        }
-    snprintf(err, len, "unknown search '%s' (auto, kd or mesh)", name);
+    if (fdt_search_from_name(name, out) == FDT_OK)
+        return 0;
+    /* the table's names, "auto, kd or mesh" */
+    char names[128] = "";
+    for (int s = 0; fdt_search_name((fdt_search)s); s++) {
+        size_t used = strlen(names);
+        const char *sep = s == 0 ? "" : fdt_search_name((fdt_search)(s + 1)) ? ", " : " or ";
+        snprintf(names + used, sizeof names - used, "%s%s", sep, fdt_search_name((fdt_search)s));
+    }
+    snprintf(err, len, "unknown search '%s' (%s)", name, names);
     return -1;
 }
 

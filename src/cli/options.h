@@ -81,7 +81,8 @@ typedef struct fdt_cli_opt {
 extern const fdt_cli_opt fdt_cli_opts[FDT_OPT_END];
 
 /* The option lines of prog's --help (FDT_CLI_FRONTDT or FDT_CLI_MPI): a
- * row it accepts and that is not hidden, in the table's order. */
+ * row it accepts and that is not hidden, in the table's order; --search's
+ * text is followed by a line a search (src/front/search.c). */
 void fdt_cli_help(FILE *f, unsigned prog);
 
 /* getopt_long's arguments for prog's rows: longs gets FDT_OPT_END + 1
@@ -98,7 +99,7 @@ int fdt_cli_find(const char *word, unsigned prog);
 
 /*
  * The values both programs check, with one message each (in err, without
- * the program's name): 0, or -1. --search NAME (auto, kd or mesh), --leaf
+ * the program's name): 0, or -1. --search NAME (fdt_search_from_name), --leaf
  * N (1 .. 1000000), --input-format NAME (an FDT_RD_* of
  * src/io/read/reader.h, not FDT_RD_AUTO).
  */

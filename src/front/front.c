@@ -6,6 +6,7 @@
 #include "front/faceq.h"
 #include "front/facetab.h"
 #include "front/oracle.h"
+#include "front/search.h"
 #include "front/seed.h"
 #include "front/sink.h"
 
@@ -79,7 +80,7 @@ static int add_tet_faces(fdt_facetab *ft, fdt_faceq *fq, fdt_emit *em, const uin
 
 /* The serial front, stopped after max_faces faces (SIZE_MAX: the whole
  * triangulation; fdt_front_probe: a few hundred). */
-static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *out,
+static int front_run(const fdt_kdtree *t, uint32_t start, fdt_oracle_policy policy, fdt_emit *out,
                      fdt_progress_fn progress, void *puser, fdt_front_stats *st,
                      size_t max_faces, const fdt_probe_budget *budget)
 {
@@ -90,8 +91,8 @@ static int front_run(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *
     int err = fdt_seed_tet(t, start, seed, &st->kq);
     if (err)
         return err;
-    fdt_oracle_init(&orc, t, search);
-    if (search == FDT_SEARCH_AUTO)
+    fdt_oracle_init(&orc, t, policy);
+    if (policy == FDT_ORACLE_SWITCH)
         orc.mem_cap = fdt_oracle_mem_share(1);
     if ((err = fdt_facetab_init(&ft, 4096)) != FDT_OK)
         return err;
@@ -214,13 +215,14 @@ size_t fdt_front_bytes(const fdt_facetab *ft, const fdt_faceq *fq)
     return b;
 }
 
-int fdt_front_emit(const fdt_kdtree *t, uint32_t start, int search, fdt_emit *out,
+int fdt_front_emit(const fdt_kdtree *t, uint32_t start, fdt_search search, fdt_emit *out,
                    fdt_progress_fn progress, void *puser, fdt_front_stats *st)
 {
-    return front_run(t, start, search, out, progress, puser, st, SIZE_MAX, NULL);
+    return front_run(t, start, fdt_search_row_of(search)->front_oracle, out, progress, puser, st,
+                     SIZE_MAX, NULL);
 }
 
-int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
+int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_search search, fdt_meshbuf *out,
                      fdt_progress_fn progress, void *puser, fdt_front_stats *st)
 {
     fdt_tsink s;
@@ -229,7 +231,8 @@ int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbu
     if (err)
         return err;
     if ((err = fdt_emit_init(&em, &s, out)) == FDT_OK)
-        err = front_run(t, start, search, &em, progress, puser, st, SIZE_MAX, NULL);
+        err = front_run(t, start, fdt_search_row_of(search)->front_oracle, &em, progress, puser,
+                        st, SIZE_MAX, NULL);
     fdt_emit_free(&em);
     fdt_tsink_free(&s);
     return err;
@@ -245,7 +248,7 @@ int fdt_front_probe(const fdt_kdtree *t, uint32_t start, size_t faces,
     if (err)
         return err;
     if ((err = fdt_emit_init(&em, &s, NULL)) == FDT_OK)
-        err = front_run(t, start, FDT_SEARCH_KD, &em, NULL, NULL, st, faces, budget);
+        err = front_run(t, start, FDT_ORACLE_KD, &em, NULL, NULL, st, faces, budget);
     fdt_emit_free(&em);
     fdt_tsink_free(&s);
     return err;

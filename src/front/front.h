@@ -36,18 +36,18 @@ struct fdt_faceq;
 size_t fdt_front_bytes(const fdt_facetab *ft, const struct fdt_faceq *fq);
 
 /* Triangulates all points of tree t (ids [t->base, t->base + t->n)),
- * starting from a seed near point `start`; search is an fdt_search
- * (src/front/oracle.h: how each face's apex is found). The tets and hull faces
- * go to `out` (tree-order ids: an in-memory meshbuf, with neighbours if
- * it keeps them). */
-int fdt_front_serial(const fdt_kdtree *t, uint32_t start, int search, fdt_meshbuf *out,
+ * starting from a seed near point `start`; the front's oracle is its
+ * search's front_oracle (src/front/search.h: how each face's apex is
+ * found). The tets and hull faces go to `out` (tree-order ids: an
+ * in-memory meshbuf, with neighbours if it keeps them). */
+int fdt_front_serial(const fdt_kdtree *t, uint32_t start, fdt_search search, fdt_meshbuf *out,
                      fdt_progress_fn progress, void *puser,
                      fdt_front_stats *st);
 
 /* The same, every tet and hull face emitted through em (src/front/sink.h: kept
  * in memory, streamed to a caller's sink or dropped) as it is built. */
 struct fdt_emit;
-int fdt_front_emit(const fdt_kdtree *t, uint32_t start, int search, struct fdt_emit *em,
+int fdt_front_emit(const fdt_kdtree *t, uint32_t start, fdt_search search, struct fdt_emit *em,
                    fdt_progress_fn progress, void *puser, fdt_front_stats *st);
 
 /* A cap on the probe's work: it stops before the next face once

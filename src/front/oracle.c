@@ -78,15 +78,15 @@ static size_t window_budget(const fdt_oracle *o, size_t w0, size_t faces_end, si
     return b < (double)SIZE_MAX / 2 ? (size_t)b : SIZE_MAX;
 }
 
-void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy)
+void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, fdt_oracle_policy policy)
 {
     memset(o, 0, sizeof *o);
     o->t = t;
     o->policy = policy;
-    o->state = policy == FDT_SEARCH_KD ? -1 : 0;
-    o->next_check = policy == FDT_SEARCH_MESH ? 0 : FIRST_WINDOW;
-    o->w_budget = policy == FDT_SEARCH_AUTO ? window_budget(o, 0, FIRST_WINDOW, FIRST_WINDOW)
-                                            : SIZE_MAX;
+    o->state = policy == FDT_ORACLE_KD ? -1 : 0;
+    o->next_check = policy == FDT_ORACLE_MESH ? 0 : FIRST_WINDOW;
+    o->w_budget = policy == FDT_ORACLE_SWITCH ? window_budget(o, 0, FIRST_WINDOW, FIRST_WINDOW)
+                                              : SIZE_MAX;
 }
 
 void fdt_oracle_free(fdt_oracle *o)
@@ -107,7 +107,7 @@ size_t fdt_oracle_mem_share(int parts)
 
 static void build_mesh(fdt_oracle *o, size_t faces, fdt_kdq *kq)
 {
-    if (o->policy == FDT_SEARCH_AUTO && o->mem_cap &&
+    if (o->policy == FDT_ORACLE_SWITCH && o->mem_cap &&
         FDT_ORACLE_MESH_BYTES * (double)o->t->n > (double)o->mem_cap) {
         o->state = -1;
         o->mesh_refused = 1;
@@ -161,7 +161,7 @@ void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq)
             build_mesh(o, faces, kq);
         return;
     }
-    if (o->policy == FDT_SEARCH_MESH || o->t->n == 0) {
+    if (o->policy == FDT_ORACLE_MESH || o->t->n == 0) {
         if (o->t->n >= 4)
             build_mesh(o, faces, kq);
         else

@@ -31,9 +31,18 @@
 #include "mesh/insert.h"
 #include "geom/kdtree.h"
 
+/* What an oracle starts as and whether it may switch (a search's row,
+ * src/front/search.c, says which a front gets). */
+typedef enum fdt_oracle_policy {
+    FDT_ORACLE_KD,     /* the kd search only: no mesh is ever built */
+    FDT_ORACLE_SWITCH, /* the kd search, switching to the mesh by the cost
+                          rule of fdt_oracle_tick, if it fits mem_cap */
+    FDT_ORACLE_MESH    /* the mesh, built at the first tick */
+} fdt_oracle_policy;
+
 typedef struct fdt_oracle {
     const fdt_kdtree *t;  /* borrowed: the part's tree (its points) */
-    int policy;           /* FDT_SEARCH_AUTO, _KD or _MESH */
+    fdt_oracle_policy policy;
     int state;            /* 0: kd search; 1: mesh; -1: mesh unavailable */
     fdt_ins mesh;         /* owned, valid when state == 1 and !gm */
     const fdt_ins *gm;    /* borrowed: a mesh of every point (shared by
@@ -54,7 +63,7 @@ typedef struct fdt_oracle {
                              fdt_oracle_offer_star */
     size_t switched_at;   /* faces advanced when the mesh was built (0: never) */
     double t_mesh;        /* seconds building the mesh */
-    /* Auto policy: the bytes this part's mesh may take (0: no cap). A
+    /* FDT_ORACLE_SWITCH: the bytes this part's mesh may take (0: no cap). A
      * switch whose mesh would not fit is not made (the kd search stays:
      * always right, only slower); mesh_refused says it happened. */
     size_t mem_cap;
@@ -86,7 +95,7 @@ typedef struct fdt_oracle {
  * kd search alone peaks at 5.8 GiB (bench/NOTES.md entry 58). */
 size_t fdt_oracle_mem_share(int parts);
 
-void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, int policy);
+void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, fdt_oracle_policy policy);
 void fdt_oracle_free(fdt_oracle *o);
 
 /*

@@ -41,6 +41,7 @@
 #include "geom/kdtree.h"
 #include "base/mem.h"
 #include "front/oracle.h"
+#include "front/search.h"
 #include "front/probe.h"
 #include "par/parallel.h"
 #include "geom/partition.h"
@@ -330,8 +331,8 @@ static int gather_points(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L,
  * still send FACESENDs; no NODESEND is needed. Chosen when a majority of
  * the ranks' probes (fdt_probe_take and _cost over each rank's own points) find
  * the kd search clearly expensive and the replica fits the memory of every
- * node (its ranks counted by MPI_Comm_split_type); --search kd or mesh
- * never builds one. A rank that cannot build it (no memory) goes on with
+ * node (its ranks counted by MPI_Comm_split_type); a search whose row
+ * does not probe (src/front/search.c: --search kd, mesh) never builds one. A rank that cannot build it (no memory) goes on with
  * its kd search and asks the others: the answers are the same either way
  * (the perturbed DT is unique), so the ranks need not agree after the
  * vote. Collective over comm up to the build: a rank that failed before
@@ -348,7 +349,7 @@ static int replica_mesh(MPI_Comm comm, const fdt_mpi_local *L, const fdt_mpi_opt
     *t_build = 0.0;
     int size;
     MPI_Comm_size(comm, &size);
-    if (o->search != FDT_SEARCH_AUTO || size < 2 || 3 * L->m > (size_t)INT_MAX)
+    if (!fdt_search_row_of(o->search)->probe || size < 2 || 3 * L->m > (size_t)INT_MAX)
         return FDT_OK;
     int vote = 0, votes = 0;
     if (e) {

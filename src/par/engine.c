@@ -29,6 +29,7 @@
 #include "par/protocol.h"
 #include "par/termination.h"
 #include "front/partmesh.h"
+#include "front/search.h"
 #include "mesh/certify.h"
 
 /*
@@ -516,13 +517,10 @@ int fdt_eng_worker_setup(worker *w)
         return FDT_ENOMEM;
     /* The part's mesh, if it comes to one, is built by this thread: its
      * pages are first touched here, near the core that reads them. */
-    /* --search auto reads the mesh of every point or, where the probe
-     * found the kd search cheap (src/par/parallel.c), keeps it: a part
-     * that switched to its own mesh alone still asked the other part's
-     * tree about every face near the cut (37M points tested on citylidar
-     * 100k where the kd search tests 1.4M; bench/NOTES.md entry 90). */
-    fdt_oracle_init(&w->orc, w->tree,
-                    w->e->search == FDT_SEARCH_AUTO ? FDT_SEARCH_KD : w->e->search);
+    /* The search's part_oracle (src/front/search.c says why --search
+     * auto's parts keep the kd search), unless the parts share the mesh
+     * of every point. */
+    fdt_oracle_init(&w->orc, w->tree, fdt_search_row_of(w->e->search)->part_oracle);
     if (w->e->gmesh_ok)
         fdt_oracle_share(&w->orc, &w->e->gmesh);
     w->qcache_part = -1;

@@ -25,6 +25,7 @@
 #include "par/gather.h"
 #include "base/mem.h"
 #include "front/oracle.h"
+#include "front/search.h"
 #include "front/probe.h"
 #include "front/seed.h"
 #include "par/termination.h"
@@ -296,7 +297,7 @@ static int global_mesh(engine *e, fdt_prepared *pr, const fdt_settings *s,
                        const fdt_par_opts *opt, double probe, int nthreads, fdt_partition *pt,
                        fdt_kdq *kq0, double *t_gm, char *diag, size_t dlen)
 {
-    int want = s->search == FDT_SEARCH_AUTO && probe > FDT_PROBE_SHARED_MESH &&
+    int want = fdt_search_row_of(s->search)->probe && probe > FDT_PROBE_SHARED_MESH &&
                FDT_ORACLE_MESH_BYTES * (double)pr->m <= (double)fdt_mem_available();
     if (!want && !(opt && opt->global_mesh))
         return FDT_OK;
@@ -636,11 +637,13 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
     fdt_kdq kq0;
     memset(&kq0, 0, sizeof kq0);
     double t_gm = 0.0;
-    /* --search auto: the probe's count of points tested a face on samples
-     * of the points (src/front/probe.h), taken before the partition
-     * permutes them, chooses the mesh of every point (global_mesh). */
+    /* A search that probes (--search auto): the probe's count of points
+     * tested a face on samples of the points (src/front/probe.h), taken
+     * before the partition permutes them, chooses the mesh of every point
+     * (global_mesh). */
+    const fdt_search_row *sr = fdt_search_row_of(s->search);
     double probe = 0.0;
-    if (s->search == FDT_SEARCH_AUTO) {
+    if (sr->probe) {
         fdt_probe_samples ps;
         fdt_probe_take(&ps, pr->p, (uint32_t)pr->m, s->leaf_size);
         probe = fdt_probe_cost(&ps);
@@ -653,11 +656,12 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
         (err = global_mesh(e, pr, s, opt, probe, nthreads, &pt, &kq0, &t_gm, diag, dlen)) !=
             FDT_OK)
         goto fail;
-    /* --search mesh: the wall engine (src/par/engine.c, walls_start).
-     * --search auto: the mesh of every point, or the kd search where the
-     * probe found it cheap; the input, the settings and the memory
-     * decide, never a clock (bench/NOTES.md entry 90). */
-    e->walls = s->search == FDT_SEARCH_MESH && !e->gmesh_ok;
+    /* A search with walls (--search mesh): the wall engine (src/par/
+     * engine.c, walls_start). One that probes (--search auto): the mesh
+     * of every point, or the kd search where the probe found it cheap;
+     * the input, the settings and the memory decide, never a clock
+     * (bench/NOTES.md entry 90). */
+    e->walls = sr->walls && !e->gmesh_ok;
     /* The seeds, after the mesh of every point where it was built: its
      * tets are Delaunay tets already (seeds_from_mesh). */
     err = e->gmesh_ok ? seeds_from_mesh(&pt, &e->gmesh, &seeds, &nseeds)
