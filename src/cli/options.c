@@ -7,6 +7,7 @@
 #include "front/search.h"
 #include "geom/kdtree.h"
 #include "io/read/reader.h"
+#include "io/write/writer.h"
 
 #define STR_(x) #x
 #define STR(x) STR_(x)
@@ -42,10 +43,10 @@ const fdt_cli_opt fdt_cli_opts[FDT_OPT_END] = {
         "output file exists (.node of -o m.ele too)", NULL},
     [FDT_OPT_FORMAT] = {"format", 0, required_argument, "NAME", F, 0,
         "format of the next -o (of the last -o when\n"
-        "none follows): tets, tetgen, vtu, bin, vtk, msh,\n"
-        "msh2, medit, openfoam; an -o whose extension\n"
-        "names another format is refused; or, named xyz,\n"
-        "txt, csv, node or ply, the input's (--input-format)", NULL},
+        "none follows); an -o whose extension names\n"
+        "another format is refused; or, named xyz, txt,\n"
+        "csv, node or ply, the input's (--input-format).\n"
+        "The output formats (and their extensions):", NULL},
     [FDT_OPT_ALL_FACES] = {"all-faces", 0, no_argument, NULL, F, 0,
         "TetGen .face lists every face (TetGen -f)", NULL},
     [FDT_OPT_INPUT_FORMAT] = {"input-format", 0, required_argument, "FMT", FM, 0,
@@ -171,6 +172,32 @@ static void help_searches(FILE *f)
     }
 }
 
+/* --format's list under its text: the writers' table (src/io/write/
+ * writer.c), so a new format is listed by its row alone; wrapped at
+ * the help's width. */
+static void help_formats(FILE *f)
+{
+    const char *p = fdt_format_list();
+    int col = HELP_COLUMN + 48;
+    int x = col; /* start a line at once */
+    while (*p) {
+        const char *e = strchr(p, ',');
+        int len = e ? (int)(e - p) + 1 : (int)strlen(p);
+        if (x + 1 + len > col) {
+            fprintf(f, "\n%*s", HELP_COLUMN, "");
+            x = HELP_COLUMN;
+        } else {
+            fputc(' ', f);
+            x++;
+        }
+        fprintf(f, "%.*s", len, p);
+        x += len;
+        p += len;
+        while (*p == ' ')
+            p++;
+    }
+}
+
 void fdt_cli_help(FILE *f, unsigned prog)
 {
     for (int i = 0; i < FDT_OPT_END; i++) {
@@ -195,6 +222,8 @@ void fdt_cli_help(FILE *f, unsigned prog)
         }
         if (i == FDT_OPT_SEARCH)
             help_searches(f);
+        if (i == FDT_OPT_FORMAT)
+            help_formats(f);
         fputc('\n', f);
     }
 }
