@@ -1093,6 +1093,73 @@ static void test_star_edges(void)
         }
 }
 
+/* A bipyramid's boundary as a star around point 0 (ids 1 .. r the ring,
+ * r + 1 the top, the bottom `bottom`: an id or FDT_NONE, the infinite
+ * vertex), tets (0, a, b, c) in slots 0 .. 2r of T with their outer faces
+ * consistently oriented, as ins_star_tet leaves them. */
+static size_t bipyramid_star(uint32_t *T, uint32_t *slots, uint32_t r, uint32_t bottom)
+{
+    size_t n = 0;
+    for (uint32_t i = 0; i < r; i++) {
+        uint32_t a = 1 + i, b = 1 + (i + 1) % r;
+        uint32_t top[3] = {r + 1, a, b}, bot[3] = {bottom, b, a};
+        for (int h = 0; h < 2; h++) {
+            uint32_t *v = T + 8 * n;
+            const uint32_t *f = h ? bot : top;
+            v[0] = 0;
+            v[1] = f[0];
+            v[2] = f[1];
+            v[3] = f[2];
+            v[4] = v[5] = v[6] = v[7] = FDT_NONE;
+            slots[n] = (uint32_t)n;
+            n++;
+        }
+    }
+    return n;
+}
+
+/* ins_link_star_local (src/mesh/insert_impl.h) links a star as the edge
+ * table does, says INS_LINK_BIG past INS_LOCAL_MAXF faces, and refuses a
+ * star whose outer faces are not a closed surface walked once each way. */
+static void test_star_links(void)
+{
+    enum { R = 40 };
+    uint32_t T1[8 * 2 * R], T2[8 * 2 * R], slots[2 * R];
+    uint8_t lid[R + 2] = {0};
+    static ins_local L; /* the cells: 8 KiB */
+    ins_edges e = {0};
+    L.lid = lid;
+    L.base = 0;
+    /* every ring size to past the local numbers' reach, the bottom a
+     * point (id r + 2) or the infinite vertex */
+    for (uint32_t r = 3; r < R; r++) {
+        for (int inf = 0; inf < 2; inf++) {
+            size_t n = bipyramid_star(T1, slots, r, inf ? FDT_NONE : r + 2);
+            memcpy(T2, T1, sizeof T1);
+            int big = n > INS_LOCAL_MAXF;
+            int rc = ins_link_star_local(&L, T1, slots, n);
+            CHECK(rc == (big ? INS_LINK_BIG : FDT_OK));
+            CHECK(ins_edges_begin(&e, 3 * n) == FDT_OK);
+            CHECK(ins_link_star(&e, T2, slots, NULL, n) == FDT_OK);
+            if (!big)
+                CHECK(memcmp(T1, T2, 8 * n * sizeof *T1) == 0);
+            for (size_t i = 0; i < sizeof lid; i++)
+                CHECK(lid[i] == 0); /* the numbers cleared after */
+            /* one tet turned over: two directed edges twice */
+            size_t j = n / 2;
+            uint32_t t = T1[8 * j + 2];
+            T1[8 * j + 2] = T1[8 * j + 3];
+            T1[8 * j + 3] = t;
+            memcpy(T2, T1, sizeof T1);
+            rc = ins_link_star_local(&L, T1, slots, n);
+            CHECK(rc == (big ? INS_LINK_BIG : FDT_EINTERNAL));
+            CHECK(ins_edges_begin(&e, 3 * n) == FDT_OK);
+            CHECK(ins_link_star(&e, T2, slots, NULL, n) == FDT_EINTERNAL);
+        }
+    }
+    free(e.eh);
+}
+
 int main(int argc, char **argv)
 {
     if (argc >= 3 && strcmp(argv[1], "--time") == 0)
@@ -1110,6 +1177,7 @@ int main(int argc, char **argv)
     test_refusals();
     test_brio_order();
     test_star_edges();
+    test_star_links();
 
     /* Every family of gen_points; sizes keep the reference (the front,
      * quadratic on cospherical sets) within a few seconds. */

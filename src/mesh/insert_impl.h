@@ -441,13 +441,15 @@ static inline void ins_star_tet(uint32_t *T, uint32_t bnd, uint32_t pid, uint32_
  * vertex's number), and the directed outer edge x -> y is the cell
  * x * INS_LOCAL_N + y of a table. A star of F outer faces has F / 2 + 2
  * vertices (a closed triangulated sphere), so a star of up to
- * INS_LOCAL_MAXF faces fits (on uniform points 27 faces on average). The
+ * INS_LOCAL_MAXF faces has at most INS_LOCAL_N - 4 finite ones, and the
+ * numbering's guard (a tet brings at most three new ones) never stops it
+ * (on uniform points 27 faces on average; bigger stars are rare). The
  * cells carry a stamp, so no pass clears them, and the checks of
  * ins_link_star hold: a directed edge twice, or a missing reverse, is
  * FDT_EINTERNAL. bench/NOTES.md entry 93.
  */
 #define INS_LOCAL_N 32
-#define INS_LOCAL_MAXF (2 * (INS_LOCAL_N - 3))
+#define INS_LOCAL_MAXF (2 * (INS_LOCAL_N - 6))
 /* ins_link_star_local's answer for a star it does not number: link it
  * with ins_link_star. */
 #define INS_LINK_BIG 1
@@ -465,7 +467,7 @@ typedef struct ins_local {
  * Links the tets slots[0 .. n) of a star made by ins_star_tet, as
  * ins_link_star does: FDT_OK, FDT_EINTERNAL (some links written), or
  * INS_LINK_BIG with nothing written (over INS_LOCAL_MAXF faces, or more
- * vertices than numbers: then not a star). The numbering has no branch
+ * vertices than such a star has: then not a star). The numbering has no branch
  * on whether a vertex is new (about one read in five is, at random).
  */
 static inline int ins_link_star_local(ins_local *L, uint32_t *T, const uint32_t *slots, size_t n)
