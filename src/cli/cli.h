@@ -1,13 +1,26 @@
 /*
  * What the two command-line programs (frontdt, src/cli/main.c; frontdt-mpi,
  * src/cli/mpi_main.c) share, so they cannot drift apart: their signal
- * handling (their options: src/cli/options.h). Not part of the library,
+ * handling and exit codes (their options: src/cli/options.h). Not part of the library,
  * which never installs handlers.
  */
 #ifndef FDT_CLI_H
 #define FDT_CLI_H
 
 #include "frontdt.h"
+
+/* The exit codes of both programs (doc/reference.md, "Exit codes";
+ * doc/frontdt.1). */
+enum {
+    CLI_OK = 0,
+    CLI_USAGE = 1,     /* bad options or arguments */
+    CLI_INPUT = 2,     /* the input cannot be read or parsed */
+    CLI_CHECK = 3,     /* --check, or the mesh certificate, failed */
+    CLI_RESOURCES = 4, /* out of memory, or too many points */
+    CLI_WRITE = 5,     /* an output cannot be written */
+    CLI_SIGNAL = 6,    /* interrupted (SIGINT, SIGTERM) */
+    CLI_INTERNAL = 7   /* a bug */
+};
 
 /*
  * SIGINT and SIGTERM call cleanup (not NULL; async-signal-safe: it

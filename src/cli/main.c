@@ -49,17 +49,6 @@
 #include <time.h>
 #include <unistd.h>
 
-enum {
-    CLI_OK = 0,
-    CLI_USAGE = 1,
-    CLI_INPUT = 2,
-    CLI_CHECK = 3,
-    CLI_RESOURCES = 4,
-    CLI_WRITE = 5,
-    CLI_SIGNAL = 6,
-    CLI_INTERNAL = 7
-};
-
 /* Fixed so that "--demo N" is the same point set on every run and host. */
 #define DEMO_SEED UINT64_C(0x5eed0f0f1992)
 

@@ -28,16 +28,6 @@
 #include "front/seed.h"
 #include "io/write/writer.h"
 
-enum {
-    EX_OK = 0,
-    EX_USAGE = 1,
-    EX_INPUT = 2,
-    EX_RESOURCES = 4,
-    EX_WRITE = 5,
-    EX_SIGNAL = 6,
-    EX_INTERNAL = 7
-};
-
 /* ---- SIGINT / SIGTERM / SIGXFSZ ------------------------------------------
  *
  * mpirun passes an interrupt on to every rank (Open MPI forwards SIGINT
@@ -103,18 +93,18 @@ static int take_option(opts *o, int id, const char *v, int rank)
     case FDT_OPT_HELP:
         if (rank == 0)
             usage(stdout);
-        return EX_OK;
+        return CLI_OK;
     case FDT_OPT_VERSION:
         if (rank == 0)
             printf("frontdt-mpi %s (library %s)\n", FDT_VERSION_STRING, fdt_version());
-        return EX_OK;
+        return CLI_OK;
     case FDT_OPT_OUTPUT:
         o->output = v;
         return -1;
     case FDT_OPT_INPUT_FORMAT:
         if (fdt_cli_input_format(v, &fmt, err, sizeof err) != 0) {
             say0(rank, "%s", err);
-            return EX_USAGE;
+            return CLI_USAGE;
         }
         o->format = v;
         return -1;
@@ -136,13 +126,13 @@ static int take_option(opts *o, int id, const char *v, int rank)
     case FDT_OPT_SEARCH:
         if (fdt_cli_search(v, &o->search, err, sizeof err) != 0) {
             say0(rank, "%s", err);
-            return EX_USAGE;
+            return CLI_USAGE;
         }
         return -1;
     case FDT_OPT_LEAF:
         if (fdt_cli_leaf(v, &o->leaf, err, sizeof err) != 0) {
             say0(rank, "%s", err);
-            return EX_USAGE;
+            return CLI_USAGE;
         }
         return -1;
     case FDT_OPT_INJECT_FAILURE: {
@@ -150,7 +140,7 @@ static int take_option(opts *o, int id, const char *v, int rank)
         unsigned long long f = *end == ':' ? strtoull(end + 1, &end, 10) : 0;
         if (*end || r < 0 || r > INT_MAX) {
             say0(rank, "--inject-failure wants RANK:FACES");
-            return EX_USAGE;
+            return CLI_USAGE;
         }
         o->fail_rank = (int)r;
         o->fail_after = (size_t)f;
@@ -160,13 +150,13 @@ static int take_option(opts *o, int id, const char *v, int rank)
         r = strtol(v, &end, 10);
         if (*end || r < 0 || r > INT_MAX) {
             say0(rank, "--inject-write-failure wants RANK");
-            return EX_USAGE;
+            return CLI_USAGE;
         }
         o->fail_write = (int)r;
         return -1;
     default:
         say0(rank, "internal error: option row %d has no parser", id);
-        return EX_INTERNAL;
+        return CLI_INTERNAL;
     }
 }
 
@@ -178,7 +168,7 @@ static int check_output(opts *o, int rank, int size)
     if (o->kind != FDT_MPO_GATHER && o->hash) {
         say0(rank, "--hash gathers the mesh to rank 0, which a piece output ('%s') does not: "
                    "use --set-hash", o->output);
-        return EX_USAGE;
+        return CLI_USAGE;
     }
     if (o->kind != FDT_MPO_GATHER) {
         /* pieces: none of them (nor the .node, nor the index) may be the
@@ -188,12 +178,12 @@ static int check_output(opts *o, int rank, int size)
             int got = fdt_mpo_file(o->output, size, k, name, sizeof name);
             if (got < 0) {
                 say0(rank, "'%s': piece names too long", o->output);
-                return EX_USAGE;
+                return CLI_USAGE;
             }
             const char *x = got ? name : o->output;
             if (fdt_same_file(x, o->input)) {
                 say0(rank, "output '%s' is the input '%s'", x, o->input);
-                return EX_USAGE;
+                return CLI_USAGE;
             }
             if (!got)
                 break;
@@ -204,18 +194,18 @@ static int check_output(opts *o, int rank, int size)
         int nf = fdt_output_files(o->output, names);
         if (!f || nf <= 0) {
             say0(rank, "unknown output extension: '%s'", o->output);
-            return EX_USAGE;
+            return CLI_USAGE;
         }
         if (fdt_format_needs(f, 0) & FDT_NEED_NBRS) {
             say0(rank, "%s needs tet neighbours, which the MPI run does not gather yet; use "
                        "frontdt, or -o BASE.pele for\nTetGen pieces without neighbours",
                  fdt_format_name(f));
-            return EX_USAGE;
+            return CLI_USAGE;
         }
         for (int k = 0; k < nf; k++)
             if (fdt_same_file(names[k], o->input)) {
                 say0(rank, "output '%s' is the input '%s'", names[k], o->input);
-                return EX_USAGE;
+                return CLI_USAGE;
             }
     }
     return -1;
@@ -239,19 +229,19 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
             say0(rank, "unknown option or missing value: '%s'", a);
             if (rank == 0)
                 usage(stderr);
-            return EX_USAGE;
+            return CLI_USAGE;
         } else if (!o->input) {
             o->input = a;
         } else {
             say0(rank, "one input only ('%s')", a);
-            return EX_USAGE;
+            return CLI_USAGE;
         }
     }
     if (!o->input) {
         say0(rank, "no input file");
         if (rank == 0)
             usage(stderr);
-        return EX_USAGE;
+        return CLI_USAGE;
     }
     return check_output(o, rank, size);
 }
@@ -260,12 +250,12 @@ static int exit_code(int err)
 {
     switch (err) {
     case FDT_OK:
-        return EX_OK;
+        return CLI_OK;
     case FDT_ENOMEM:
     case FDT_ETOOBIG:
-        return EX_RESOURCES;
+        return CLI_RESOURCES;
     default:
-        return EX_INTERNAL;
+        return CLI_INTERNAL;
     }
 }
 
@@ -274,14 +264,14 @@ static int setup_exit_code(int err)
 {
     switch (err) {
     case FDT_EINVAL:
-        return EX_USAGE;
+        return CLI_USAGE;
     case FDT_ENOMEM:
     case FDT_ETOOBIG:
-        return EX_RESOURCES;
+        return CLI_RESOURCES;
     case FDT_EINTERNAL:
-        return EX_INTERNAL;
+        return CLI_INTERNAL;
     default: /* FDT_EIO, FDT_EFORMAT, FDT_EDEGENERATE */
-        return EX_INPUT;
+        return CLI_INPUT;
     }
 }
 
@@ -390,16 +380,16 @@ static int run(int argc, char **argv, int rank, int size)
         rc = exit_code(err);
         goto out;
     }
-    rc = EX_OK;
+    rc = CLI_OK;
     if (rank == 0) {
         /* The balance over all ranks: every message sent was received, one
          * FACERECV per FACESEND (src/par/termination.c), no ABORT. */
         for (int k = 1; k < FDT_MSG_KIND_END; k++)
             if (r.all_sent[k] != r.all_received[k])
-                rc = EX_INTERNAL;
+                rc = CLI_INTERNAL;
         if (r.all_sent[FDT_MSG_FACERECV] != r.all_sent[FDT_MSG_FACESEND] ||
             r.all_sent[FDT_MSG_ABORT] != 0)
-            rc = EX_INTERNAL;
+            rc = CLI_INTERNAL;
         if (rc)
             fprintf(stderr, "frontdt-mpi: internal error: messages sent and received differ\n");
         if (o.stats)
@@ -415,7 +405,7 @@ static int run(int argc, char **argv, int rank, int size)
              * (temporary file, renamed at the end). */
             res = calloc(1, sizeof *res);
             if (!res) {
-                rc = EX_RESOURCES;
+                rc = CLI_RESOURCES;
             } else {
                 res->tets = r.all_tets;
                 res->ntets = r.ntets;
@@ -432,14 +422,14 @@ static int run(int argc, char **argv, int rank, int size)
                     if (fdt_result_hash(res, &h) == FDT_OK)
                         printf("hash: %016" PRIx64 "\n", h);
                     else
-                        rc = EX_RESOURCES;
+                        rc = CLI_RESOURCES;
                 }
                 err = rc || !o.output ? FDT_OK
                                       : fdt_write_mesh(res, r.all_xyz, r.n_input, o.output,
                                                        NULL, diag, sizeof diag);
                 if (err) {
                     fprintf(stderr, "frontdt-mpi: %s\n", diag);
-                    rc = err == FDT_ENOMEM ? EX_RESOURCES : EX_WRITE;
+                    rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
                 }
             }
         }
@@ -457,7 +447,7 @@ static int run(int argc, char **argv, int rank, int size)
         err = fdt_mpo_write(MPI_COMM_WORLD, &oa, &L, &r, &mine, io, diag, sizeof diag);
         if (mine)
             fprintf(stderr, "frontdt-mpi: rank %d: %s\n", rank, diag);
-        rc = err == FDT_OK ? EX_OK : err == FDT_ENOMEM ? EX_RESOURCES : EX_WRITE;
+        rc = err == FDT_OK ? CLI_OK : err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
         if (o.stats) {
             double t[3] = {MPI_Wtime() - tw, (double)io[0], (double)io[1]};
             double *all = rank == 0 ? malloc(3 * (size_t)size * sizeof *all) : NULL;
@@ -482,12 +472,12 @@ int main(int argc, char **argv)
 {
     if (MPI_Init(&argc, &argv) != MPI_SUCCESS) {
         fprintf(stderr, "frontdt-mpi: MPI_Init failed\n");
-        return EX_INTERNAL;
+        return CLI_INTERNAL;
     }
     int rank = 0, size = 1;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
-    if (fdt_cli_signals("frontdt-mpi", cleanup_outputs, EX_SIGNAL) != 0)
+    if (fdt_cli_signals("frontdt-mpi", cleanup_outputs, CLI_SIGNAL) != 0)
         fprintf(stderr, "frontdt-mpi: cannot install signal handlers\n"); /* runs on */
     int rc = run(argc, argv, rank, size);
     MPI_Finalize();
