@@ -213,14 +213,16 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
          * it mispredicted about twice a cavity tet (bench/NOTES.md entry
          * 93). */
         const uint32_t *nb = m->T + 8 * (size_t)c + 4;
+        uint32_t os[4];
         int ks[4], nk = 0;
         for (int k = 0; k < 4; k++) {
             ks[nk] = k;
-            nk += mark[nb[k] >> 2] != MARK_IN;
+            os[nk] = nb[k] >> 2;
+            nk += mark[os[nk]] != MARK_IN;
         }
         for (int j = 0; j < nk; j++) {
             int k = ks[j];
-            uint32_t o = m->T[8 * (size_t)c + 4 + k] >> 2;
+            uint32_t o = os[j];
             if (mark[o] == MARK_NONE) {
                 int cf = conflict(b, o, p);
                 if (cf < 0)
@@ -428,20 +430,21 @@ static int start_simplex(build *b, const uint32_t *order, uint32_t n, uint32_t f
     uint32_t t0 = alloc_slot(b);
     memcpy(T + 8 * (size_t)t0, v, sizeof v);
     /* Over face k (outward order fdt_tet_face[k]: v[k] on its negative
-     * side, the outside on its positive side) the infinite tet
-     * (face, INF), positive in the sense of src/mesh/insert.h. */
-    uint32_t hull[4], centre[4] = {3, 3, 3, 3};
+     * side, the outside on its positive side) the infinite tet (face, INF),
+     * positive in the sense of src/mesh/insmesh.h, its vertices reordered
+     * by ins_to_front as a star tet's: (INF, f2, f1, f0). */
+    uint32_t hull[4];
     for (int k = 0; k < 4; k++) {
         uint32_t s = hull[k] = alloc_slot(b);
         uint32_t *w = T + 8 * (size_t)s;
+        w[0] = INF;
         for (int j = 0; j < 3; j++)
-            w[j] = v[fdt_tet_face[k][j]];
-        w[3] = INF;
-        w[7] = PACK(t0, k);
-        T[8 * (size_t)t0 + 4 + k] = PACK(s, 3);
+            w[1 + j] = v[fdt_tet_face[k][2 - j]];
+        w[4] = PACK(t0, k);
+        T[8 * (size_t)t0 + 4 + k] = PACK(s, 0);
     }
     /* The four are the star of the infinite vertex over t0's faces. */
-    return ins_link_star(&b->edges, T, hull, centre, 4);
+    return ins_link_star(&b->edges, T, hull, 4);
 }
 
 /* The points' bounding box and its semi-static filter bounds. */

@@ -340,35 +340,28 @@ static inline uint32_t ins_edge_hash(const ins_edges *e, uint64_t key)
     return (uint32_t)((key * UINT64_C(0x9E3779B97F4A7C15)) >> (64 - e->bits));
 }
 
-/* For a star tet with its centre at index k, the faces through the
- * centre: j = 0, 1, 2 gives {tail, head, face}, the directed outer edge
- * (tail -> head, in the outward order fdt_tet_face[k] of the face opposite
+/* For a star tet, its centre at index 0 (ins_star_tet), the faces through
+ * the centre: j = 0, 1, 2 gives {tail, head, face}, the directed outer edge
+ * (tail -> head, in the outward order fdt_tet_face[0] of the face opposite
  * the centre) and the index of the face through the centre and that edge
  * (the outer face's third vertex). tests/test_insert.c derives it from
  * fdt_tet_face. */
-static const uint8_t ins_star_edge[4][3][3] = {
-    {{2, 3, 1}, {3, 1, 2}, {1, 2, 3}},
-    {{3, 2, 0}, {2, 0, 3}, {0, 3, 2}},
-    {{1, 3, 0}, {3, 0, 1}, {0, 1, 3}},
-    {{2, 1, 0}, {1, 0, 2}, {0, 2, 1}},
-};
+static const uint8_t ins_star_edge[3][3] = {{2, 3, 1}, {3, 1, 2}, {1, 2, 3}};
 
 /*
- * Links the tets slots[0 .. n) of a star (see ins_edges), tet i with its
- * centre at index ks[i] & 3 (ks NULL: at index 0, as ins_star_tet puts
- * it), the table emptied for 3n keys by ins_edges_begin: every face through the centre
- * gets its neighbour. FDT_EINTERNAL, with some links written, when the
+ * Links the tets slots[0 .. n) of a star (see ins_edges), each with its
+ * centre at index 0, the table emptied for 3n keys by ins_edges_begin:
+ * every face through the centre gets its neighbour. FDT_EINTERNAL, with some links written, when the
  * outer faces are not a closed surface walked once each way (a directed
  * edge twice, or one whose reverse is missing): a cavity that is no ball,
  * which a wrong predicate can make (tests/test_plant.sh).
  */
-static inline int ins_link_star(ins_edges *e, uint32_t *T, const uint32_t *slots,
-                                const uint32_t *ks, size_t n)
+static inline int ins_link_star(ins_edges *e, uint32_t *T, const uint32_t *slots, size_t n)
 {
     uint32_t mask = (UINT32_C(1) << e->bits) - 1, stamp = e->stamp;
     for (size_t i = 0; i < n; i++) {
         const uint32_t *v = T + 8 * (size_t)slots[i];
-        const uint8_t(*se)[3] = ins_star_edge[ks ? ks[i] & 3 : 0];
+        const uint8_t(*se)[3] = ins_star_edge;
         for (int j = 0; j < 3; j++) {
             uint64_t key = ((uint64_t)v[se[j][0]] << 32) | v[se[j][1]];
             uint32_t h = ins_edge_hash(e, key);
@@ -382,7 +375,7 @@ static inline int ins_link_star(ins_edges *e, uint32_t *T, const uint32_t *slots
     }
     for (size_t i = 0; i < n; i++) {
         uint32_t *v = T + 8 * (size_t)slots[i];
-        const uint8_t(*se)[3] = ins_star_edge[ks ? ks[i] & 3 : 0];
+        const uint8_t(*se)[3] = ins_star_edge;
         for (int j = 0; j < 3; j++) {
             uint64_t key = ((uint64_t)v[se[j][1]] << 32) | v[se[j][0]];
             uint32_t h = ins_edge_hash(e, key);
@@ -549,7 +542,7 @@ static inline int ins_link_new_star(ins_local *L, ins_edges *e, uint32_t *T,
         return err;
     if ((err = ins_edges_begin(e, 3 * n)) != FDT_OK)
         return err;
-    return ins_link_star(e, T, slots, NULL, n);
+    return ins_link_star(e, T, slots, n);
 }
 
 #endif
