@@ -1217,6 +1217,83 @@ static void test_static_filter(tctx *T, double scale)
     report_section(T, __func__, failures_before);
 }
 
+/*
+ * The lifted cofactors (fdt_sphere_cof): every sign they decide is the
+ * exact one, for orient3d and, on positive tets, insphere; on spread
+ * points they decide nearly every call; outside their range never. The
+ * families and scales of test_static_filter, plus a tiny tet beside a far
+ * apex (the bound's mq is the apex's distance).
+ */
+static void test_sphere_cof(tctx *T, double scale)
+{
+    const long failures_before = test_failures();
+    const long n = (long)fmax(20000 * scale, 500);
+    long spread = 0, spread_decided = 0, near_decided = 0, out_decided = 0;
+    for (long it = 0; it < n; it++) {
+        double p[5][3];
+        int kind = (int)(it % 4);
+        if (kind == 0)
+            for (int i = 0; i < 5; i++)
+                for (int k = 0; k < 3; k++)
+                    p[i][k] = sunif(T);
+        else if (kind == 1)
+            gen_near_coplanar(T, p);
+        else if (kind == 2)
+            gen_near_cospherical(T, p, 0.0);
+        else {
+            for (int i = 0; i < 4; i++)
+                for (int k = 0; k < 3; k++)
+                    p[i][k] = 1e-6 * sunif(T);
+            for (int k = 0; k < 3; k++)
+                p[4][k] = 10 * sunif(T);
+        }
+        int e = (int)irand(T, -130, 130);
+        for (int i = 0; i < 5; i++)
+            for (int k = 0; k < 3; k++)
+                p[i][k] = ldexp(p[i][k], e);
+        int ro = ref_of(T, 0, p);
+        if (ro < 0) { /* make the tet positive where it has an orientation */
+            for (int k = 0; k < 3; k++) {
+                double t = p[0][k];
+                p[0][k] = p[1][k];
+                p[1][k] = t;
+            }
+            ro = 1;
+        }
+        fdt_sphere_cof cof;
+        fdt_sphere_cof_init(&cof, p[0], p[1], p[2], p[3]);
+        int o = fdt_sphere_cof_orient(&cof);
+        double mq = cof.m;
+        for (int k = 0; k < 3; k++)
+            mq = fmax(mq, fabs(p[4][k] - p[0][k]));
+        int in_range = mq >= 0x1p-100 && mq <= 0x1p100;
+        if (o != FDT_PRED_UNSURE) {
+            EXPECT(o == ro);
+            out_decided += !(cof.m >= 0x1p-100 && cof.m <= 0x1p100);
+            near_decided += kind == 1 || kind == 2;
+        }
+        if (ro <= 0)
+            continue;
+        int s = fdt_sphere_cof_insphere(&cof, p[4]);
+        if (kind == 0 && in_range) {
+            spread++;
+            spread_decided += s != FDT_PRED_UNSURE && o != FDT_PRED_UNSURE;
+        }
+        if (s == FDT_PRED_UNSURE)
+            continue;
+        out_decided += !in_range;
+        near_decided += kind == 1 || kind == 2;
+        int ref = ref_of(T, 1, p);
+        if (s != ref)
+            print_pts((const double(*)[3])p, 5);
+        EXPECT(s == ref);
+    }
+    EXPECT(out_decided == 0);
+    EXPECT(spread > 0 && spread_decided > spread * 9 / 10);
+    EXPECT(near_decided > 0);
+    report_section(T, __func__, failures_before);
+}
+
 /* A random integer below 2^L in magnitude, L uniform in [0, maxbits], so
  * that magnitudes spread over the whole range; negative half the time if
  * sgn. */
@@ -2487,6 +2564,7 @@ int main(int argc, char **argv)
     test_compare_dist(&T, scale, verbose);
     test_lex_compare(&T, scale);
     test_static_filter(&T, scale);
+    test_sphere_cof(&T, scale);
     double t3 = now_s();
     bench(&T);
     bench_adapt(&T);

@@ -367,6 +367,115 @@ static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
     return FDT_PRED_UNSURE;
 }
 
+/*
+ * Lifted cofactors of one tet, for testing its sphere against several
+ * points (the certificate, src/mesh/certify.c, tests each finite tet's
+ * orientation and about two of its faces' opposite apexes; computing the
+ * tet's part once halves the flops of a test).
+ *
+ * With a as the origin, B = b - a, C = c - a, D = d - a, U = q - a (rows)
+ * and |B|^2 etc., expanding the lifted determinant along its last column:
+ *   det[B |B|^2; C |C|^2; D |D|^2; U |U|^2] = |U|^2 det - U . N,
+ *   det = B . (C x D),  N = |B|^2 (C x D) + |C|^2 (D x B) + |D|^2 (B x C).
+ * det is orient3d(a, b, c, d), evaluated exactly as fdt_orient3d_filter_diff
+ * evaluates it; for det > 0, E = |U|^2 det - U . N is positive exactly when
+ * q is outside the sphere of (a, b, c, d), so the CGAL insphere sign is
+ * -sign(E) (tests/test_predicates.c, test_sphere_cof, against the exact
+ * predicates).
+ *
+ * Error bounds, local and static: m bounds every computed difference of
+ * the tet (B, C, D), mq = max(m, |U|) those of a test. In the model of
+ * fdt_orient3d_filter (fl(x op y) = (x op y)(1 + delta) + mu), as long as
+ * nothing underflows, each monomial of det meets at most 8 roundings and
+ * each of E at most 17 (U . N's: the difference in U, 12 in N's component
+ * -- two differences, a product and a difference in the cross product, two
+ * differences squared, a product and two sums in the lift, the product of
+ * the two and two sums --, its product, two sums and E's difference;
+ * |U|^2 det's fewer). So |error| <= gamma_k P, with P the sum of the
+ * monomials' magnitudes, which is at most the same expressions with every
+ * difference's magnitude m (mq): 6 m^3 and 72 mq^5, each difference's
+ * exact magnitude being at most its rounded one over 1 - eps. The
+ * constants FDT_O3D_COF_BOUND = 48 eps (1 + 2^-7) and FDT_ISP_COF_BOUND =
+ * 1224 eps (1 + 2^-8), rounded up, exceed gamma_8 6 and gamma_17 72 times (1 - eps)^-5
+ * and the roundings of computing fl(K m^3), fl(K mq^5) with a wide
+ * margin. Underflow: with m (mq) in [2^-100, 2^100], a product's absolute
+ * error mu <= 2^-1075 reaches E multiplied by at most 100 mq^3 < 2^307
+ * (a difference's rounding enters relative, a sum's is exact), some fifty
+ * times: under 2^-760, while the bound is at least 2^-500 * 2^-43: the
+ * margin above covers it. Overflow: every intermediate is at most
+ * 72 mq^5 <= 2^507. Outside that range the calls answer FDT_PRED_UNSURE.
+ */
+#define FDT_O3D_COF_BOUND 0x1.83p-48
+#define FDT_ISP_COF_BOUND 0x1.34p-43
+
+typedef struct fdt_sphere_cof {
+    const double *a; /* the origin, borrowed */
+    double det;      /* orient3d(a, b, c, d) as computed */
+    double n[3];     /* N */
+    double m;        /* the largest computed |difference| of B, C, D */
+} fdt_sphere_cof;
+
+static inline void fdt_sphere_cof_init(fdt_sphere_cof *s, const double *a, const double *b,
+                                       const double *c, const double *d)
+{
+    const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+    const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
+    const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
+    /* C x D, D x B, B x C, det as in fdt_orient3d_filter_diff */
+    const double cdx = vy * wz - vz * wy, cdy = vz * wx - vx * wz, cdz = vx * wy - vy * wx;
+    const double dbx = wy * uz - wz * uy, dby = wz * ux - wx * uz, dbz = wx * uy - wy * ux;
+    const double bcx = uy * vz - uz * vy, bcy = uz * vx - ux * vz, bcz = ux * vy - uy * vx;
+    const double lb = ux * ux + uy * uy + uz * uz;
+    const double lc = vx * vx + vy * vy + vz * vz;
+    const double ld = wx * wx + wy * wy + wz * wz;
+    s->a = a;
+    s->det = ux * cdx + uy * cdy + uz * cdz;
+    s->n[0] = lb * cdx + lc * dbx + ld * bcx;
+    s->n[1] = lb * cdy + lc * dby + ld * bcy;
+    s->n[2] = lb * cdz + lc * dbz + ld * bcz;
+    /* the largest magnitude as maxsd, branch-free (fmax would be a call) */
+    const double e[9] = {ux, uy, uz, vx, vy, vz, wx, wy, wz};
+    double m = 0;
+    for (int i = 0; i < 9; i++)
+        m = fabs(e[i]) > m ? fabs(e[i]) : m;
+    s->m = m;
+}
+
+/* Whether the magnitude bound x keeps the static bounds above sound. */
+static inline int fdt_sphere_cof_in_range(double x)
+{
+    return x >= 0x1p-100 && x <= 0x1p100;
+}
+
+/* orient3d(a, b, c, d) of the cofactors' tet: +1 / -1 when certain,
+ * FDT_PRED_UNSURE otherwise. */
+static inline int fdt_sphere_cof_orient(const fdt_sphere_cof *s)
+{
+    if (!fdt_sphere_cof_in_range(s->m))
+        return FDT_PRED_UNSURE;
+    const double bound = FDT_O3D_COF_BOUND * (s->m * s->m * s->m);
+    return s->det > bound ? 1 : s->det < -bound ? -1 : FDT_PRED_UNSURE;
+}
+
+/* The CGAL insphere sign of (a, b, c, d, q) for a tet whose det is known
+ * to be positive (fdt_sphere_cof_orient, or an exact orient3d): -1 when q
+ * is certainly outside, +1 certainly inside, FDT_PRED_UNSURE otherwise. */
+static inline int fdt_sphere_cof_insphere(const fdt_sphere_cof *s, const double *q)
+{
+    const double *a = s->a;
+    const double x = q[0] - a[0], y = q[1] - a[1], z = q[2] - a[2];
+    const double lu = x * x + y * y + z * z;
+    const double e = lu * s->det - (x * s->n[0] + y * s->n[1] + z * s->n[2]);
+    double mq = s->m;
+    mq = fabs(x) > mq ? fabs(x) : mq;
+    mq = fabs(y) > mq ? fabs(y) : mq;
+    mq = fabs(z) > mq ? fabs(z) : mq;
+    if (!fdt_sphere_cof_in_range(mq))
+        return FDT_PRED_UNSURE;
+    const double m2 = mq * mq, bound = FDT_ISP_COF_BOUND * (m2 * m2 * mq);
+    return e > bound ? -1 : e < -bound ? 1 : FDT_PRED_UNSURE;
+}
+
 /* As for orient3d: the proper filter takes the rounded differences
  * A = a - e, ..., D = d - e; the _sf form tests sf's stage first. */
 static inline int fdt_insphere_filter_sf(const double *a, const double *b, const double *c,

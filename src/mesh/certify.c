@@ -121,11 +121,12 @@ static inline int glued_opposite(const uint32_t *v, int k, const uint32_t *w, in
            ((b0 == a2) & (b1 == a1) & (b2 == a0));
 }
 
-/* The pair checks of face k of tet v (slot t, infinite vertex at inf, -1
- * if none) and face nk of its neighbour w: the geometric half of checks
- * 2-3 that involve both. NULL if they pass, else what failed. */
-static const char *check_pair(const fdt_ins *m, const uint32_t *v, int k, int inf,
-                              const uint32_t *w, int nk, fdt_pred_counts *cnt)
+/* The pair checks of face k of an infinite tet v (infinite vertex at
+ * index inf) and face nk of its neighbour w: the geometric half of checks
+ * 2-3 that involve both. NULL if they pass, else what failed. (A finite
+ * v's are in certify_range.) */
+static const char *check_pair_infinite(const fdt_ins *m, const uint32_t *v, int k, int inf,
+                                       const uint32_t *w, int nk, fdt_pred_counts *cnt)
 {
     uint32_t p = v[k], q = w[nk];
     int winf = w[0] == INF ? 0 : w[1] == INF ? 1 : w[2] == INF ? 2 : w[3] == INF ? 3 : -1;
@@ -134,14 +135,7 @@ static const char *check_pair(const fdt_ins *m, const uint32_t *v, int k, int in
      * opposite orders (glued). */
     if (p == INF || q == INF)
         return NULL;
-    if (inf < 0 && winf < 0) {
-        /* Two finite tets, on opposite sides of their face (glued): q
-         * outside the sphere of v (which, for a pair, is p outside w's). */
-        if (insphere(m, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), pt(m, q), cnt) > 0)
-            return "a face is not locally Delaunay";
-        return NULL;
-    }
-    if (inf < 0 || winf < 0)
+    if (winf < 0)
         return "a finite face between a finite and an infinite tet";
     /* Two hull faces through an edge: convex, or coplanar and locally
      * Delaunay in their plane; both sides checked. */
@@ -149,6 +143,23 @@ static const char *check_pair(const fdt_ins *m, const uint32_t *v, int k, int in
         conflicts_infinite(m, w, winf, pt(m, p), cnt))
         return "the hull is not convex (or not Delaunay in a plane)";
     return NULL;
+}
+
+/* The pair check of face k of a finite, positive tet v (its cofactors
+ * cof) whose neighbour across it is glued to it with apex q: a hull face
+ * (q infinite: w's finite face is v's, so w's infinite vertex can only
+ * be its apex) or two finite tets on opposite sides of their face, and
+ * then q outside the sphere of v (which, for a pair, is p outside w's). */
+static inline const char *check_pair_finite(const fdt_ins *m, const uint32_t *v,
+                                            const fdt_sphere_cof *cof, uint32_t q,
+                                            fdt_pred_counts *cnt)
+{
+    if (q == INF)
+        return NULL;
+    int s = fdt_sphere_cof_insphere(cof, pt(m, q));
+    if (s == FDT_PRED_UNSURE)
+        s = insphere(m, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), pt(m, q), cnt);
+    return s > 0 ? "a face is not locally Delaunay" : NULL;
 }
 
 /* How many tets ahead the loop prefetches its neighbours: the neighbour
@@ -179,16 +190,18 @@ static inline unsigned checks_here(uint32_t t, uint32_t nt, uint32_t lo, uint32_
  * Checks 1-3 for the slots [lo, hi) of m. Each face is checked once, from
  * one of its two slots (checks_here). That end checks the geometry and
  * the other end's reference back; the other end only counts its reference
- * (*skipped) and the checking end counts the pair (*pairs). Over the
- * whole mesh every skipped reference must be the back half of a checked
- * pair, so the two sums must be equal (the caller compares them): a
- * reference with no way back breaks the equality even when its target is
- * consistent with someone else. Each neighbour slot is read once a face,
- * where the neighbour reads are most of the time.
+ * (*skipped: four a tet in use, less the ones it checked) and the
+ * checking end counts the pair (*pairs). Over the whole mesh every
+ * skipped reference must be the back half of a checked pair, so the two
+ * sums must be equal (the caller compares them): a reference with no way
+ * back breaks the equality even when its target is consistent with
+ * someone else. Each neighbour slot is read once a face, where the
+ * neighbour reads are most of the time.
  */
 static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_counts *cnt,
                          fdt_certify_fail *why, size_t *skipped, size_t *pairs)
 {
+    size_t used = 0, npairs = 0; /* tets in use, pairs checked */
     for (uint32_t t = lo; t < hi; t++) {
         if (t + 2 * AHEAD < hi) { /* the neighbours (a freed slot's are any value) */
             const uint32_t *a = m->T + 8 * (size_t)(t + 2 * AHEAD);
@@ -213,8 +226,17 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_co
         if (ninf > 1)
             return fail(why, t, -1, "more than one infinite vertex");
         int inf = !ninf ? -1 : v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : 3;
-        if (inf < 0 && orient(m, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), cnt) <= 0)
-            return fail(why, t, -1, "a finite tet is not positively oriented");
+        /* A finite tet's lifted cofactors serve its orientation and the
+         * spheres of the faces it checks (fdt_sphere_cof). */
+        fdt_sphere_cof cof = {0}; /* read only where inf < 0 */
+        if (inf < 0) {
+            fdt_sphere_cof_init(&cof, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]));
+            int o = fdt_sphere_cof_orient(&cof);
+            if (o == FDT_PRED_UNSURE)
+                o = orient(m, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), cnt);
+            if (o <= 0)
+                return fail(why, t, -1, "a finite tet is not positively oriented");
+        }
         /* Which faces this end checks, as bits: one loop over them instead
          * of a coin-flip branch a face. */
         unsigned here = 0, bad = 0;
@@ -225,7 +247,7 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_co
         }
         if (bad)
             return fail(why, t, fdt_ctz64(bad), "a neighbour reference past the slots, or to itself");
-        *skipped += 4 - (size_t)((here & 1) + (here >> 1 & 1) + (here >> 2 & 1) + (here >> 3));
+        used++;
         for (; here; here &= here - 1) {
             int k = fdt_ctz64(here);
             uint32_t r = v[4 + k], nt = r >> 2;
@@ -240,12 +262,15 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_co
                             glued(v, k, w, nk) == 0
                                 ? "the neighbours do not share the face"
                                 : "two tets on the same side of their face");
-            (*pairs)++;
-            const char *bad_pair = check_pair(m, v, k, inf, w, nk, cnt);
+            npairs++;
+            const char *bad_pair = inf < 0 ? check_pair_finite(m, v, &cof, w[nk], cnt)
+                                           : check_pair_infinite(m, v, k, inf, w, nk, cnt);
             if (bad_pair)
                 return fail(why, t, k, bad_pair);
         }
     }
+    *skipped += 4 * used - npairs;
+    *pairs += npairs;
     return FDT_OK;
 }
 
