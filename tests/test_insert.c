@@ -1092,70 +1092,103 @@ static void test_star_edges(void)
     }
 }
 
-/* A bipyramid's boundary as a star around point 0 (ids 1 .. r the ring,
+/* A bipyramid's boundary as the cavity of point 0 (ids 1 .. r the ring,
  * r + 1 the top, the bottom `bottom`: an id or FDT_NONE, the infinite
- * vertex), tets (0, a, b, c) in slots 0 .. 2r of T with their outer faces
- * consistently oriented, as ins_star_tet leaves them. */
-static size_t bipyramid_star(uint32_t *T, uint32_t *slots, uint32_t r, uint32_t bottom)
+ * vertex): cavity tet i in slot i of T is (Z, a, b, c) with its outer
+ * face abc consistently oriented and its neighbour across it the outer
+ * tet in slot n + i (which refers back), and the star is to go in slots
+ * 2n + i. bnd[i] = the face opposite vertex 0 of slot i. */
+static size_t bipyramid_cavity(uint32_t *T, uint32_t *bnd, uint32_t *slots, uint32_t r,
+                               uint32_t bottom)
 {
-    size_t n = 0;
+    size_t n = 2 * (size_t)r;
+    for (size_t i = 0; i < 3 * n; i++)
+        for (int j = 0; j < 8; j++)
+            T[8 * i + j] = FDT_NONE;
     for (uint32_t i = 0; i < r; i++) {
         uint32_t a = 1 + i, b = 1 + (i + 1) % r;
         uint32_t top[3] = {r + 1, a, b}, bot[3] = {bottom, b, a};
         for (int h = 0; h < 2; h++) {
-            uint32_t *v = T + 8 * n;
+            size_t c = 2 * (size_t)i + (size_t)h;
+            uint32_t *v = T + 8 * c;
             const uint32_t *f = h ? bot : top;
-            v[0] = 0;
+            v[0] = 9999; /* the vertex the new point replaces */
             v[1] = f[0];
             v[2] = f[1];
             v[3] = f[2];
-            v[4] = v[5] = v[6] = v[7] = FDT_NONE;
-            slots[n] = (uint32_t)n;
-            n++;
+            v[4] = (uint32_t)((n + c) << 2);
+            T[8 * (n + c) + 4] = (uint32_t)(c << 2);
+            bnd[c] = (uint32_t)(c << 2);
+            slots[c] = (uint32_t)(2 * n + c);
         }
     }
     return n;
 }
 
-/* ins_link_star_local (src/mesh/insert_impl.h) links a star as the edge
- * table does, says INS_LINK_BIG past INS_LOCAL_MAXF faces, and refuses a
- * star whose outer faces are not a closed surface walked once each way. */
+/* ins_make_star (src/mesh/insert_impl.h) makes a star as ins_star_tet
+ * does and links it as the edge table does, by local numbers up to
+ * INS_LOCAL_MAXF faces and by the table past them (or past the local
+ * numbers' reach), and refuses a star whose faces do not count as a
+ * sphere's, or (the edge table) are not a closed surface walked once each
+ * way. */
 static void test_star_links(void)
 {
-    enum { R = 40 };
-    uint32_t T1[8 * 2 * R], T2[8 * 2 * R], slots[2 * R];
-    uint8_t lid[R + 2] = {0};
+    enum { R = 40, MAXN = 2 * R };
+    static uint32_t T1[8 * 3 * MAXN], T2[8 * 3 * MAXN];
+    uint32_t bnd[MAXN], slots[MAXN];
+    uint8_t lid[R + 3] = {0}; /* ids 0 .. R + 1, the infinite vertex R + 2 */
     static ins_local L; /* the cells: 8 KiB */
     ins_edges e = {0};
     L.lid = lid;
     L.base = 0;
+    L.n = R + 2;
     /* every ring size to past the local numbers' reach, the bottom a
      * point (id r + 2) or the infinite vertex */
     for (uint32_t r = 3; r < R; r++) {
         for (int inf = 0; inf < 2; inf++) {
-            size_t n = bipyramid_star(T1, slots, r, inf ? FDT_NONE : r + 2);
+            size_t n = bipyramid_cavity(T1, bnd, slots, r, inf ? FDT_NONE : r + 2);
             memcpy(T2, T1, sizeof T1);
-            int big = n > INS_LOCAL_MAXF;
-            int rc = ins_link_star_local(&L, T1, slots, n);
-            CHECK(rc == (big ? INS_LINK_BIG : FDT_OK));
+            CHECK(ins_make_star(&L, &e, T1, bnd, n, 0, slots) == FDT_OK);
+            for (size_t i = 0; i < n; i++)
+                ins_star_tet(T2, bnd[i], 0, slots[i]);
             CHECK(ins_edges_begin(&e, 3 * n) == FDT_OK);
             CHECK(ins_link_star(&e, T2, slots, n) == FDT_OK);
-            if (!big)
-                CHECK(memcmp(T1, T2, 8 * n * sizeof *T1) == 0);
+            CHECK(memcmp(T1, T2, 8 * 3 * n * sizeof *T1) == 0);
+            for (size_t i = 0; i < n; i++) /* the outer tets refer to the star */
+                CHECK(T1[8 * (n + i) + 4] == (uint32_t)((2 * n + i) << 2));
             for (size_t i = 0; i < sizeof lid; i++)
                 CHECK(lid[i] == 0); /* the numbers cleared after */
-            /* one tet turned over: two directed edges twice */
+            /* one cavity face missing: not a sphere's count */
+            bipyramid_cavity(T1, bnd, slots, r, inf ? FDT_NONE : r + 2);
+            CHECK(ins_make_star(&L, &e, T1, bnd + 1, n - 1, 0, slots + 1) == FDT_EINTERNAL);
+            for (size_t i = 0; i < sizeof lid; i++)
+                CHECK(lid[i] == 0);
+            /* one face turned over: the edge table sees two directed edges
+             * twice (the local numbers do not look: the certificate
+             * checks every link of the finished mesh) */
+            bipyramid_cavity(T1, bnd, slots, r, inf ? FDT_NONE : r + 2);
             size_t j = n / 2;
             uint32_t t = T1[8 * j + 2];
             T1[8 * j + 2] = T1[8 * j + 3];
             T1[8 * j + 3] = t;
-            memcpy(T2, T1, sizeof T1);
-            rc = ins_link_star_local(&L, T1, slots, n);
-            CHECK(rc == (big ? INS_LINK_BIG : FDT_EINTERNAL));
+            for (size_t i = 0; i < n; i++)
+                ins_star_tet(T1, bnd[i], 0, slots[i]);
             CHECK(ins_edges_begin(&e, 3 * n) == FDT_OK);
-            CHECK(ins_link_star(&e, T2, slots, n) == FDT_EINTERNAL);
+            CHECK(ins_link_star(&e, T1, slots, n) == FDT_EINTERNAL);
         }
     }
+    /* Faces of distinct vertices, fewer than INS_LOCAL_MAXF: the numbers
+     * run out mid-star, the edge table takes it and finds no surface. */
+    uint8_t lid2[3 * 30 + 2] = {0};
+    L.lid = lid2;
+    L.n = 3 * 30 + 1;
+    size_t n = bipyramid_cavity(T1, bnd, slots, 15, 17);
+    for (size_t i = 0; i < n; i++)
+        for (int q = 0; q < 3; q++)
+            T1[8 * i + 1 + q] = (uint32_t)(1 + 3 * i + (size_t)q);
+    CHECK(ins_make_star(&L, &e, T1, bnd, n, 0, slots) == FDT_EINTERNAL);
+    for (size_t i = 0; i < sizeof lid2; i++)
+        CHECK(lid2[i] == 0);
     free(e.eh);
 }
 

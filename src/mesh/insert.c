@@ -78,7 +78,7 @@ typedef struct build {
     size_t nout, outcap;
     uint32_t *newt;                /* the new tets' slots */
     size_t newcap;
-    ins_local local;               /* links small stars (ins_link_star_local) */
+    ins_local local;               /* links small stars (ins_make_star) */
     ins_edges edges;               /* links the others */
     uint64_t rng;                  /* the walk's choices */
 } build;
@@ -260,12 +260,10 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
 
     /* The new tets (ins_star_tet), allocated before the cavity is freed,
      * so reading it is safe; the cavity's slots serve the next insertion. */
-    uint32_t *T = m->T;
-    for (size_t i = 0; i < b->nbnd; i++) {
+    for (size_t i = 0; i < b->nbnd; i++)
         b->newt[i] = alloc_slot(b);
-        ins_star_tet(T, b->bnd[i], pid, b->newt[i]);
-    }
-    if ((err = ins_link_new_star(&b->local, &b->edges, T, b->newt, b->nbnd)) != FDT_OK)
+    if ((err = ins_make_star(&b->local, &b->edges, m->T, b->bnd, b->nbnd, pid, b->newt)) !=
+        FDT_OK)
         return err;
     for (size_t i = 0; i < b->ncav; i++) {
         mark[b->cav[i]] = MARK_NONE;
@@ -502,8 +500,9 @@ int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
         slots = 64;
     m->T = malloc((size_t)slots * 8 * sizeof *m->T);
     b.mark = calloc((size_t)slots, 1);
-    b.local.lid = calloc(n, 1);
+    b.local.lid = calloc((size_t)n + 1, 1);
     b.local.base = base;
+    b.local.n = n;
     if (!m->T || !b.mark || !b.local.lid)
         goto fail;
     fdt_mem_advise_huge(m->T, (size_t)slots * 8 * sizeof *m->T);

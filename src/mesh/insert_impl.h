@@ -396,7 +396,7 @@ static inline int ins_link_star(ins_edges *e, uint32_t *T, const uint32_t *slots
  * (so the orientation stays) taking index k to index 0. Every tet of a
  * star then has its centre at index 0, its outer face at 1, 2, 3 in
  * outward order and its outer neighbour at 4, so the star is linked
- * through fixed indices (ins_link_star_local).
+ * through fixed indices (ins_make_star).
  */
 static const uint8_t ins_to_front[4][4] = {
     {0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
@@ -427,122 +427,120 @@ static inline void ins_star_tet(uint32_t *T, uint32_t bnd, uint32_t pid, uint32_
 }
 
 /*
- * A small star linked through local numbers of its outer vertices
+ * A small star is linked through local numbers of its outer vertices
  * instead of the edge table (HXT's small-cavity adjacency, Marot,
- * Pellerin and Remacle 2019): the finite outer vertices get the numbers
- * 1 .. INS_LOCAL_N - 1 in a byte a point (0: unnumbered, and the infinite
- * vertex's number), and the directed outer edge x -> y is the cell
- * x * INS_LOCAL_N + y of a table. A star of F outer faces has F / 2 + 2
- * vertices (a closed triangulated sphere), so a star of up to
- * INS_LOCAL_MAXF faces has at most INS_LOCAL_N - 4 finite ones, and the
- * numbering's guard (a tet brings at most three new ones) never stops it
- * (on uniform points 27 faces on average; bigger stars are rare). The
- * cells carry a stamp, so no pass clears them, and the checks of
- * ins_link_star hold: a directed edge twice, or a missing reverse, is
- * FDT_EINTERNAL. bench/NOTES.md entry 93.
+ * Pellerin and Remacle 2019): the directed outer edge x -> y is the cell
+ * x * INS_LOCAL_N + y of a table (ins_make_star).
  */
 #define INS_LOCAL_N 32
 #define INS_LOCAL_MAXF (2 * (INS_LOCAL_N - 6))
-/* ins_link_star_local's answer for a star it does not number: link it
- * with ins_link_star. */
-#define INS_LINK_BIG 1
 
 typedef struct ins_local {
-    uint8_t *lid;                /* a byte a point, index id - base; 0 outside a star */
-    uint32_t base;
-    uint32_t stamp;              /* the cells of the current star */
-    uint64_t cell[INS_LOCAL_N * INS_LOCAL_N]; /* stamp << 32 | packed face */
-    uint32_t vert[INS_LOCAL_N];  /* the ids numbered, to clear lid after */
+    uint8_t *lid;                /* n + 1 bytes: point id - base, the infinite vertex n;
+                                    0 outside a star */
+    uint32_t base, n;
+    uint32_t cell[INS_LOCAL_N * INS_LOCAL_N]; /* packed face of a directed edge */
+    uint32_t vert[INS_LOCAL_N];  /* the lid entries numbered, to clear after */
     uint8_t loc[3 * INS_LOCAL_MAXF]; /* each star tet's outer vertices' numbers */
 } ins_local;
 
 /*
- * Links the tets slots[0 .. n) of a star made by ins_star_tet, as
- * ins_link_star does: FDT_OK, FDT_EINTERNAL (some links written), or
- * INS_LINK_BIG with nothing written (over INS_LOCAL_MAXF faces, or more
- * vertices than such a star has: then not a star). The numbering has no branch
- * on whether a vertex is new (about one read in five is, at random).
+ * The star of point pid over the cavity's boundary faces bnd[0 .. n), in
+ * the slots slots[0 .. n) (allocated, none of them a cavity tet), made and
+ * linked: each tet written as ins_star_tet writes it, its outer vertices
+ * numbered and its outer edges put in the table of directed edges while
+ * its row is in registers; then each tet reads its three reverse edges.
+ * Outer vertices, the infinite one included, get local numbers 0 ..
+ * INS_LOCAL_N - 1 (in lid, a byte a point, 0 meaning unnumbered, so
+ * stored plus one). A star of F outer faces has F / 2 + 2 vertices (a
+ * closed triangulated sphere), so one of up to INS_LOCAL_MAXF faces has
+ * at most INS_LOCAL_N - 4, and the numbering's guard (a tet brings at
+ * most three new ones) never stops such a star (on uniform points 27
+ * faces on average). A bigger star, or more vertices than a star that
+ * size has (then it is no star), is linked by the edge table e instead
+ * (ins_link_star, which checks every edge) once its tets are made.
+ *
+ * The local table is not cleared between stars and not checked edge by
+ * edge (a stamp a cell and its tests cost 3 % of a serial build, bench/
+ * NOTES.md entry 94): a star-shaped cavity's boundary is a closed
+ * surface, so every cell read was written by this star, and that the
+ * cavity is star-shaped is what the exact predicates (and ins_star_ok,
+ * where a filter could not decide) guarantee. What is checked here is
+ * the star's Euler count (F = 2 V - 4, a sphere's), the cheap symptom of
+ * a bug that made it otherwise, and the certificate (src/mesh/certify.c)
+ * checks every link of the finished mesh. The numbering has no branch on
+ * whether a vertex is new (about one read in five is, at random) or on
+ * the infinite vertex. FDT_OK, FDT_EINTERNAL, or FDT_ENOMEM (the edge
+ * table). bench/NOTES.md entries 93 and 94.
  */
-static inline int ins_link_star_local(ins_local *L, uint32_t *T, const uint32_t *slots, size_t n)
+static inline int ins_make_star(ins_local *L, ins_edges *e, uint32_t *T, const uint32_t *bnd,
+                                size_t n, uint32_t pid, const uint32_t *slots)
 {
-    if (n > INS_LOCAL_MAXF)
-        return INS_LINK_BIG;
     /* Locals, not L's fields: the byte stores below may alias anything, and
      * would make the compiler reload every field after each. */
     uint8_t *const lid = L->lid, *const loc = L->loc;
-    uint32_t *const vert = L->vert;
-    const uint32_t base = L->base;
+    uint32_t *const vert = L->vert, *const cell = L->cell;
+    const uint32_t base = L->base, ninf = L->n;
+    int local = n <= INS_LOCAL_MAXF;
     uint32_t nv = 0;
     for (size_t i = 0; i < n; i++) {
-        if (nv > INS_LOCAL_N - 4) { /* the next three might not fit */
+        /* ins_star_tet, its outer vertices kept in registers (the byte
+         * stores below would make the compiler read the row back) */
+        const uint32_t sl = slots[i], bd = bnd[i];
+        const uint32_t *cv = T + 8 * (size_t)(bd >> 2);
+        const uint8_t *f = ins_to_front[bd & 3];
+        const uint32_t x[3] = {cv[f[1]], cv[f[2]], cv[f[3]]}, o = cv[4 + (bd & 3)];
+        uint32_t *nw = T + 8 * (size_t)sl;
+        nw[0] = pid;
+        nw[1] = x[0];
+        nw[2] = x[1];
+        nw[3] = x[2];
+        nw[4] = o;
+        T[8 * (size_t)(o >> 2) + 4 + (o & 3)] = PACK(sl, 0);
+        if (!local)
+            continue;
+        if (nv > INS_LOCAL_N - 3) { /* the next three might not fit */
             for (uint32_t q = 0; q < nv; q++)
-                lid[vert[q] - base] = 0;
-            return INS_LINK_BIG;
+                lid[vert[q]] = 0;
+            local = 0;
+            continue;
         }
-        const uint32_t *v = T + 8 * (size_t)slots[i];
-        const uint32_t x[3] = {v[1], v[2], v[3]};
+        uint32_t id[3];
         for (int q = 0; q < 3; q++) {
-            uint32_t cur = 0;
-            if (x[q] != INF) {
-                uint8_t *l = lid + (x[q] - base);
-                uint32_t old = *l, fresh = old == 0;
-                vert[nv] = x[q];
-                nv += fresh;
-                cur = fresh ? nv : old;
-                *l = (uint8_t)cur;
-            }
-            loc[3 * i + q] = (uint8_t)cur;
+            const uint32_t ix = x[q] == INF ? ninf : x[q] - base;
+            const uint32_t old = lid[ix], fresh = old == 0;
+            vert[nv] = ix;
+            nv += fresh;
+            const uint32_t cur = fresh ? nv : old; /* the number plus one */
+            lid[ix] = (uint8_t)cur;
+            id[q] = cur - 1;
         }
+        /* Tet (p, a, b, c): its outer face's edges a -> b, b -> c, c -> a
+         * are in its faces 3, 1, 2 (the ones without c, a, b). */
+        const uint32_t a = id[0], b = id[1], c = id[2], s4 = sl << 2;
+        cell[a * INS_LOCAL_N + b] = s4 | 3;
+        cell[b * INS_LOCAL_N + c] = s4 | 1;
+        cell[c * INS_LOCAL_N + a] = s4 | 2;
+        loc[3 * i] = (uint8_t)a;
+        loc[3 * i + 1] = (uint8_t)b;
+        loc[3 * i + 2] = (uint8_t)c;
     }
-    uint32_t stamp = L->stamp + 1;
-    if (stamp == 0) { /* wrapped: old stamps would read as current */
-        memset(L->cell, 0, sizeof L->cell);
-        stamp = 1;
+    if (!local) {
+        int err = ins_edges_begin(e, 3 * n);
+        return err ? err : ins_link_star(e, T, slots, n);
     }
-    L->stamp = stamp;
-    const uint64_t st = (uint64_t)stamp << 32;
-    uint64_t *const cell = L->cell;
-    uint64_t bad = 0;
-    /* Tet (p, a, b, c): its outer face's edges a -> b, b -> c, c -> a are
-     * in its faces 3, 1, 2 (the ones without c, a, b). A cell holds a
-     * current edge when its high half is the stamp. */
-    for (size_t i = 0; i < n; i++) {
-        const uint32_t a = loc[3 * i], b = loc[3 * i + 1], c = loc[3 * i + 2];
-        uint64_t *ab = &cell[a * INS_LOCAL_N + b], *bc = &cell[b * INS_LOCAL_N + c],
-                 *ca = &cell[c * INS_LOCAL_N + a];
-        bad |= ((*ab ^ st) >> 32 == 0) | ((*bc ^ st) >> 32 == 0) | ((*ca ^ st) >> 32 == 0);
-        const uint32_t s4 = slots[i] << 2;
-        *ab = st | (s4 | 3);
-        *bc = st | (s4 | 1);
-        *ca = st | (s4 | 2);
-    }
+    for (uint32_t q = 0; q < nv; q++)
+        lid[vert[q]] = 0;
+    if (n != 2 * (size_t)nv - 4)
+        return FDT_EINTERNAL; /* not a sphere's count: no star (nothing linked) */
     for (size_t i = 0; i < n; i++) {
         const uint32_t a = loc[3 * i], b = loc[3 * i + 1], c = loc[3 * i + 2];
         uint32_t *v = T + 8 * (size_t)slots[i];
-        const uint64_t ba = cell[b * INS_LOCAL_N + a], cb = cell[c * INS_LOCAL_N + b],
-                       ac = cell[a * INS_LOCAL_N + c];
-        bad |= ((ba ^ st) >> 32) | ((cb ^ st) >> 32) | ((ac ^ st) >> 32);
-        v[4 + 3] = (uint32_t)ba;
-        v[4 + 1] = (uint32_t)cb;
-        v[4 + 2] = (uint32_t)ac;
+        v[4 + 3] = cell[b * INS_LOCAL_N + a];
+        v[4 + 1] = cell[c * INS_LOCAL_N + b];
+        v[4 + 2] = cell[a * INS_LOCAL_N + c];
     }
-    for (uint32_t q = 0; q < nv; q++)
-        lid[vert[q] - base] = 0;
-    return bad ? FDT_EINTERNAL : FDT_OK;
-}
-
-/* Links the new tets slots[0 .. n) of a star made by ins_star_tet: by
- * local numbers when it is small (nearly always), else by the edge table
- * e. FDT_OK, FDT_EINTERNAL (ins_link_star) or FDT_ENOMEM. */
-static inline int ins_link_new_star(ins_local *L, ins_edges *e, uint32_t *T,
-                                    const uint32_t *slots, size_t n)
-{
-    int err = ins_link_star_local(L, T, slots, n);
-    if (err != INS_LINK_BIG)
-        return err;
-    if ((err = ins_edges_begin(e, 3 * n)) != FDT_OK)
-        return err;
-    return ins_link_star(e, T, slots, n);
+    return FDT_OK;
 }
 
 #endif

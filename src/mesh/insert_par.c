@@ -153,7 +153,7 @@ typedef struct worker {
     size_t newcap;
     uint32_t *bnd;             /* its boundary faces, packed (tet, k) */
     size_t nbnd, bndcap;
-    ins_local local;           /* links small stars (ins_link_new_star) */
+    ins_local local;           /* links small stars (ins_make_star) */
     ins_edges edges;           /* links the others */
     uint32_t free_head, nfree; /* this worker's freed slots, all locked by it */
     uint32_t fresh, fresh_end; /* the rest of its chunk of fresh slots */
@@ -566,13 +566,11 @@ static int insert_point(worker *w, uint32_t pid)
         (err = ins_grow_u32(&w->newt, &w->newcap, w->nbnd)) != FDT_OK)
         goto abort;
 
-    /* The new tets (ins_star_tet, ins_link_new_star), as in src/mesh/insert.c. */
-    uint32_t *T = m->T;
-    for (size_t i = 0; i < w->nbnd; i++) {
+    /* The new tets (ins_make_star), as in src/mesh/insert.c. */
+    for (size_t i = 0; i < w->nbnd; i++)
         w->newt[i] = alloc_slot(w);
-        ins_star_tet(T, w->bnd[i], pid, w->newt[i]);
-    }
-    if ((err = ins_link_new_star(&w->local, &w->edges, T, w->newt, w->nbnd)) != FDT_OK)
+    if ((err = ins_make_star(&w->local, &w->edges, m->T, w->bnd, w->nbnd, pid, w->newt)) !=
+        FDT_OK)
         return err; /* the build fails: what stays locked does not matter */
     for (size_t i = 0; i < w->ncav; i++)
         free_slot(w, w->cav[i]);
@@ -836,7 +834,8 @@ static int worker_init(worker *w, shared *sh, int id, int nw, uint32_t base, uin
     /* A byte a point for the star links' local numbers: calloc's pages are
      * touched only where this worker's stars lie. */
     w->local.base = base;
-    if (!(w->local.lid = calloc(n, 1)) ||
+    w->local.n = n;
+    if (!(w->local.lid = calloc((size_t)n + 1, 1)) ||
         ins_grow_u32(&w->outl, &w->outcap, 256) != FDT_OK ||
         ins_grow_u32(&w->newt, &w->newcap, 256) != FDT_OK ||
         ins_grow_u32(&w->cav, &w->cavcap, 64) != FDT_OK ||
