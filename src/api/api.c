@@ -17,6 +17,7 @@
 #include "front/partmesh.h"
 #include "par/parallel.h"
 #include "par/threads.h"
+#include "geom/morton.h"
 #include "geom/prepare.h"
 #include "mesh/result.h"
 #include "mesh/locate.h"
@@ -295,18 +296,18 @@ int fdt_engine_one_part(const fdt_settings *s, int streamed)
     return one_part(s, mode, streamed);
 }
 
-/* The points put in order (one kd-tree; on threads, the parts' trees),
- * then the one-part engine on nthreads threads or (not one) the serial
- * front on the tree; *t1: when the preparation ended. */
+/* The points put in order (the one-part engine: Morton order, which its
+ * BRIO rounds keep and whose ranges are its threads' regions; the serial
+ * front: its kd-tree's), then the one-part engine on nthreads threads or
+ * (not one) the serial front on the tree; *t1: when the preparation
+ * ended. */
 static int run_single(fdt_context *ctx, const fdt_sink *user, int one, int nthreads,
                       run_state *rs, double *t1)
 {
     fdt_prepared *pr = &rs->pr;
-    if (one && nthreads > 1) {
-        /* the parts' trees, built on the threads, only order the points */
-        int err = fdt_parallel_order(pr, &ctx->s, nthreads, &rs->mem_tree);
-        if (err)
-            return err;
+    if (one) {
+        if (fdt_morton_sort(pr->p, pr->orig, pr->m) != 0)
+            return FDT_ENOMEM;
     } else {
         if (fdt_kd_build(&rs->tree, pr->p, pr->orig, 0, (uint32_t)pr->m, ctx->s.leaf_size) !=
             FDT_OK)
@@ -321,9 +322,6 @@ static int run_single(fdt_context *ctx, const fdt_sink *user, int one, int nthre
     *t1 = fdt_now_s();
     int err;
     if (one) {
-        /* the tree only put the points in its (spatially coherent) order,
-         * which the insertion's BRIO rounds keep */
-        fdt_kd_free(&rs->tree);
         err = fdt_partmesh_emit_all(pr->p, (uint32_t)pr->m, nthreads, &rs->em,
                                     ctx->s.progress, ctx->s.progress_user, &rs->pms, ctx->diag,
                                     sizeof ctx->diag);

@@ -3,50 +3,133 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 typedef struct keyed {
     uint64_t key;
     uint32_t id;
 } keyed;
 
-static int keyed_cmp(const void *x, const void *y)
+/* The 21 low bits of x spread to every third bit (bit i to bit 3i). */
+static inline uint64_t spread3(uint64_t x)
 {
-    const keyed *a = x, *b = y;
-    if (a->key != b->key)
-        return a->key < b->key ? -1 : 1;
-    return a->id < b->id ? -1 : a->id > b->id;
+    x &= 0x1fffff;
+    x = (x | x << 32) & UINT64_C(0x1f00000000ffff);
+    x = (x | x << 16) & UINT64_C(0x1f0000ff0000ff);
+    x = (x | x << 8) & UINT64_C(0x100f00f00f00f00f);
+    x = (x | x << 4) & UINT64_C(0x10c30c30c30c30c3);
+    x = (x | x << 2) & UINT64_C(0x1249249249249249);
+    return x;
 }
 
-/* 21 bits of each coordinate in the box, interleaved. */
+/* 21 bits of each coordinate in the box, interleaved x, y, z from the
+ * top (x's bit above y's above z's at each level). */
 static uint64_t morton(const double *p, const double box[6])
 {
-    uint64_t key = 0;
-    uint32_t c[3];
+    uint64_t c[3];
     for (int k = 0; k < 3; k++) {
         double w = box[k + 3] - box[k];
         double t = w > 0 ? (p[k] - box[k]) / w : 0;
         t = t > 0 ? (t < 1 ? t : 1) : 0; /* NaN too: 0 */
-        c[k] = (uint32_t)(t * 2097151.0);
+        c[k] = (uint64_t)(t * 2097151.0);
     }
-    for (int b = 20; b >= 0; b--)
-        for (int k = 0; k < 3; k++)
-            key = key << 1 | ((c[k] >> b) & 1);
-    return key;
+    return spread3(c[0]) << 2 | spread3(c[1]) << 1 | spread3(c[2]);
+}
+
+/*
+ * a[0 .. n) sorted by key, ties in the order they come (ids ascending
+ * when they came so): least significant digit first, 11 bits a pass, so
+ * six passes over 63 bits, a pass skipped where every key has the same
+ * digit. tmp: n entries. The sorted array is a or tmp: returned.
+ */
+static keyed *radix_sort(keyed *a, keyed *tmp, size_t n)
+{
+    enum { BITS = 11, B = 1 << BITS };
+    size_t *count = malloc(B * sizeof *count);
+    if (!count)
+        return NULL;
+    for (int shift = 0; shift < 63; shift += BITS) {
+        memset(count, 0, B * sizeof *count);
+        for (size_t i = 0; i < n; i++)
+            count[a[i].key >> shift & (B - 1)]++;
+        if (n == 0 || count[a[0].key >> shift & (B - 1)] == n)
+            continue; /* one digit everywhere: the pass would not move anything */
+        size_t acc = 0;
+        for (size_t d = 0; d < B; d++) {
+            size_t c = count[d];
+            count[d] = acc;
+            acc += c;
+        }
+        for (size_t i = 0; i < n; i++)
+            tmp[count[a[i].key >> shift & (B - 1)]++] = a[i];
+        keyed *t = a;
+        a = tmp;
+        tmp = t;
+    }
+    free(count);
+    return a;
+}
+
+/* The keys of the points not skipped, sorted (ids ascending within a key);
+ * *m: how many. NULL when out of memory; the caller frees *block. */
+static keyed *sorted_keys(const double *pts, size_t n, const double box[6], const uint8_t *skip,
+                          size_t *m, keyed **block)
+{
+    keyed *kp = malloc(2 * (n ? n : 1) * sizeof *kp);
+    *block = kp;
+    if (!kp)
+        return NULL;
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++)
+        if (!skip || !skip[i])
+            kp[k++] = (keyed){morton(pts + 3 * i, box), (uint32_t)i};
+    *m = k;
+    return radix_sort(kp, kp + (n ? n : 1), k);
 }
 
 long fdt_morton_order(const double *pts, size_t n, const double box[6], const uint8_t *skip,
                       uint32_t *order)
 {
-    keyed *kp = malloc((n ? n : 1) * sizeof *kp);
-    if (!kp)
-        return -1;
-    size_t m = 0;
+    size_t m;
+    keyed *block, *s = sorted_keys(pts, n, box, skip, &m, &block);
+    if (s)
+        for (size_t i = 0; i < m; i++)
+            order[i] = s[i].id;
+    free(block);
+    return s ? (long)m : -1;
+}
+
+int fdt_morton_sort(double *pts, fdt_vid *orig, size_t n)
+{
+    double box[6] = {0, 0, 0, 0, 0, 0};
     for (size_t i = 0; i < n; i++)
-        if (!skip || !skip[i])
-            kp[m++] = (keyed){morton(pts + 3 * i, box), (uint32_t)i};
-    qsort(kp, m, sizeof *kp, keyed_cmp);
-    for (size_t i = 0; i < m; i++)
-        order[i] = kp[i].id;
-    free(kp);
-    return (long)m;
+        for (int k = 0; k < 3; k++) {
+            double x = pts[3 * i + k];
+            if (i == 0 || x < box[k])
+                box[k] = x;
+            if (i == 0 || x > box[k + 3])
+                box[k + 3] = x;
+        }
+    size_t m;
+    keyed *block, *s = sorted_keys(pts, n, box, NULL, &m, &block);
+    double *p2 = s ? malloc((n ? n : 1) * 3 * sizeof *p2) : NULL;
+    fdt_vid *o2 = p2 ? malloc((n ? n : 1) * sizeof *o2) : NULL;
+    if (!o2) {
+        free(p2);
+        free(block);
+        return -1;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const double *q = pts + 3 * (size_t)s[i].id;
+        p2[3 * i] = q[0];
+        p2[3 * i + 1] = q[1];
+        p2[3 * i + 2] = q[2];
+        o2[i] = orig[s[i].id];
+    }
+    memcpy(pts, p2, n * 3 * sizeof *pts);
+    memcpy(orig, o2, n * sizeof *orig);
+    free(o2);
+    free(p2);
+    free(block);
+    return 0;
 }

@@ -1,11 +1,13 @@
 /* Points in Morton (Z) order of their coordinates: the order in which
- * src/mesh/voronoi.c numbers its points and src/mesh/interpolate.c takes
- * its queries, so that consecutive ones lie close together. */
+ * src/mesh/voronoi.c numbers its points, src/mesh/interpolate.c takes
+ * its queries and the one-part engine inserts its points, so that
+ * consecutive ones lie close together. Keys are sorted by radix. */
 #ifndef FDT_MORTON_H
 #define FDT_MORTON_H
 
 #include <stddef.h>
 #include <stdint.h>
+#include "frontdt.h"
 
 /* Writes to order[] the indices i < n of the points pts (3 doubles each)
  * with skip[i] 0 (skip NULL: every point), sorted by the Morton key of 21
@@ -14,5 +16,11 @@
  * when out of memory. */
 long fdt_morton_order(const double *pts, size_t n, const double box[6], const uint8_t *skip,
                       uint32_t *order);
+
+/* Puts the n points pts (3 doubles each) and their input indices orig in
+ * the Morton order of their bounding box, ties by their current index:
+ * the insertion order of the one-part engine (src/api/api.c), whose BRIO
+ * rounds keep it. 0, or -1 when out of memory (nothing moved then). */
+int fdt_morton_sort(double *pts, fdt_vid *orig, size_t n);
 
 #endif

@@ -43,8 +43,10 @@
  * Order: BRIO (Amenta, Choi, Rote 2003). Each point falls in a round by a
  * hash of its id (half the points in the last round, a quarter in the one
  * before, ...), rounds go from the smallest to the largest, and within a
- * round the points go in id order, which is kd-tree order: spatially
- * coherent, so each point is located from the last tet made, nearby.
+ * round the points go in id order, which is spatially coherent (Morton
+ * order in the one-part engine, src/geom/morton.h; a part's kd-tree order
+ * in the wall engine), so each point is located from the last tet made,
+ * nearby.
  *
  * Location: the remembering stochastic visibility walk (Devillers, Pion,
  * Teillaud 2002): from the current tet, cross a face that has p strictly on

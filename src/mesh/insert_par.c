@@ -12,8 +12,9 @@
  *      deferrals stayed at tens a 100k run, and the serial start fell
  *      from 3-8 % of the build's wall time to under 2 %.
  *   2. Concurrent insertion: the points of the later rounds are split by
- *      id range, and ids are kd-tree order, so each thread gets one
- *      spatial region (a bisection of the kd order). Each thread inserts
+ *      id range, and ids are in a spatially coherent order (Morton order
+ *      in the one-part engine), so each thread gets one spatial region
+ *      (a range of that curve). Each thread inserts
  *      its points round by round, in id order within a round (BRIO kept
  *      per region). Both threads sweep their region in the same direction,
  *      so when thread i is at the cut with thread i + 1, thread i + 1 is at

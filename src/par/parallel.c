@@ -236,18 +236,6 @@ static int partition(fdt_prepared *pr, const fdt_settings *s, int nthreads, fdt_
                                cores < nthreads ? cores : nthreads);
 }
 
-int fdt_parallel_order(fdt_prepared *pr, const fdt_settings *s, int nthreads,
-                       size_t *tree_bytes)
-{
-    fdt_partition pt;
-    int err = partition(pr, s, nthreads, &pt);
-    *tree_bytes = 0;
-    for (int i = 0; !err && i < pt.nparts; i++)
-        *tree_bytes += fdt_kd_bytes(&pt.trees[i]);
-    fdt_partition_free(&pt);
-    return err;
-}
-
 /* The engine over the partition pt, its tets going to opt's sink or, when
  * there is none, to mem_sink (set up here, *mem_sink_ok). *ep is set
  * whenever it was allocated, failure or not: engine_free frees it. */

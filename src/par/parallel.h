@@ -55,17 +55,6 @@ typedef struct fdt_par_opts {
 } fdt_par_opts;
 
 /*
- * The points of pr put in the order the parts' engine gives them: split
- * into nthreads parts by the recursive bisection (§3.1), each part in its
- * kd-tree's order, the trees built on the threads; the trees are freed.
- * For the one-part engine on threads (src/api/api.c): its parallel
- * insertion gives each thread one range of ids, so each one part's region.
- * *tree_bytes: what the trees held. FDT_OK, FDT_EINVAL or FDT_ENOMEM.
- */
-int fdt_parallel_order(fdt_prepared *pr, const fdt_settings *s, int nthreads,
-                       size_t *tree_bytes);
-
-/*
  * Triangulates the prepared points (pr->p and pr->orig are permuted into
  * partition and tree order, as fdt_kd_build does for the serial engine)
  * with nthreads threads (1..1024) in mode FDT_MODE_SHARED or

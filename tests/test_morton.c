@@ -1,0 +1,146 @@
+/*
+ * Tests for src/geom/morton.c: Morton order by radix sort, against keys
+ * interleaved here bit by bit (an independent spelling of the same key).
+ *  - fdt_morton_order: every point not skipped once, keys ascending, ties
+ *    (equal points, a cell shared) by index;
+ *  - fdt_morton_sort: each point keeps its input index, in the order of
+ *    fdt_morton_order over the points' own bounding box;
+ *  - no point, one point, all points equal (a box of width 0).
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "geom/morton.h"
+#include "testutil.h"
+
+/* 21 bits a coordinate in the box, x's bit above y's above z's. */
+static uint64_t ref_key(const double *p, const double box[6])
+{
+    uint64_t key = 0;
+    uint32_t c[3];
+    for (int k = 0; k < 3; k++) {
+        double w = box[k + 3] - box[k], t = w > 0 ? (p[k] - box[k]) / w : 0;
+        t = t > 0 ? (t < 1 ? t : 1) : 0;
+        c[k] = (uint32_t)(t * 2097151.0);
+    }
+    for (int b = 20; b >= 0; b--)
+        for (int k = 0; k < 3; k++)
+            key = key << 1 | ((c[k] >> b) & 1);
+    return key;
+}
+
+static uint64_t rng = 88172645463325252u;
+static double unif(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (double)(rng >> 11) * 0x1p-53;
+}
+
+/* n points, some repeated and some in one fine cell, so ties occur, and
+ * a fifth in a small box, so that the keys' low digits decide. */
+static double *points(size_t n)
+{
+    double *p = malloc(3 * n * sizeof *p);
+    CHECK(p != NULL);
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++)
+            p[3 * i + k] = i % 7 == 3 && i > 0 ? p[3 * (i - 1) + k]
+                           : i % 11 == 5      ? 0.5 + 1e-9 * unif()
+                           : i % 5 == 2       ? 0.25 + 1e-4 * unif() /* keys apart in
+                                                                        their low bits */
+                                              : unif() * 4 - 1;
+    return p;
+}
+
+static void check_order(const double *p, size_t n, const double box[6], const uint8_t *skip,
+                        const uint32_t *order, long m)
+{
+    size_t want = 0;
+    for (size_t i = 0; i < n; i++)
+        want += !skip || !skip[i];
+    CHECK(m == (long)want);
+    uint8_t *seen = calloc(n ? n : 1, 1);
+    CHECK(seen != NULL);
+    for (long i = 0; i < m; i++) {
+        CHECK(order[i] < n && !seen[order[i]] && (!skip || !skip[order[i]]));
+        seen[order[i]] = 1;
+        if (i > 0) {
+            uint64_t a = ref_key(p + 3 * (size_t)order[i - 1], box);
+            uint64_t b = ref_key(p + 3 * (size_t)order[i], box);
+            CHECK(a < b || (a == b && order[i - 1] < order[i]));
+        }
+    }
+    free(seen);
+}
+
+static void test_order(size_t n)
+{
+    double *p = points(n);
+    const double box[6] = {-1, -1, -1, 3, 3, 3};
+    uint32_t *order = malloc((n ? n : 1) * sizeof *order);
+    uint8_t *skip = malloc(n ? n : 1);
+    CHECK(order && skip);
+    check_order(p, n, box, NULL, order, fdt_morton_order(p, n, box, NULL, order));
+    for (size_t i = 0; i < n; i++)
+        skip[i] = i % 3 == 1;
+    check_order(p, n, box, skip, order, fdt_morton_order(p, n, box, skip, order));
+    free(skip);
+    free(order);
+    free(p);
+}
+
+static void test_sort(size_t n)
+{
+    double *p = points(n), *q = malloc((3 * n + 1) * sizeof *q);
+    fdt_vid *orig = malloc((n + 1) * sizeof *orig);
+    uint32_t *order = malloc((n + 1) * sizeof *order);
+    CHECK(q && orig && order);
+    memcpy(q, p, 3 * n * sizeof *p);
+    for (size_t i = 0; i < n; i++)
+        orig[i] = (fdt_vid)(1000 + i);
+    double box[6] = {0, 0, 0, 0, 0, 0};
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = p[3 * i + k];
+            box[k] = i == 0 || x < box[k] ? x : box[k];
+            box[k + 3] = i == 0 || x > box[k + 3] ? x : box[k + 3];
+        }
+    CHECK(fdt_morton_order(p, n, box, NULL, order) == (long)n);
+    CHECK(fdt_morton_sort(q, orig, n) == 0);
+    for (size_t i = 0; i < n; i++) {
+        CHECK(orig[i] == (fdt_vid)(1000 + order[i])); /* the order, ties by index */
+        CHECK(memcmp(q + 3 * i, p + 3 * (size_t)order[i], 3 * sizeof *q) == 0);
+    }
+    free(order);
+    free(orig);
+    free(q);
+    free(p);
+}
+
+static void test_equal_points(void)
+{
+    double p[3 * 5];
+    fdt_vid orig[5];
+    for (int i = 0; i < 5; i++) {
+        p[3 * i] = 2;
+        p[3 * i + 1] = -1;
+        p[3 * i + 2] = 0.25;
+        orig[i] = (fdt_vid)(4 - i);
+    }
+    CHECK(fdt_morton_sort(p, orig, 5) == 0);
+    for (int i = 0; i < 5; i++)
+        CHECK(orig[i] == (fdt_vid)(4 - i)); /* one key: the order as it was */
+}
+
+int main(void)
+{
+    const size_t sizes[] = {0, 1, 2, 17, 1000, 50000};
+    for (size_t i = 0; i < sizeof sizes / sizeof *sizes; i++) {
+        test_order(sizes[i]);
+        test_sort(sizes[i]);
+    }
+    test_equal_points();
+    return test_report("morton");
+}
