@@ -1,0 +1,1366 @@
+/*
+ * The Voronoi diagram clipped by a box as one polyhedral mesh (see
+ * dualmesh.h; doc/design.md, "The dual as a polyhedral mesh").
+ *
+ * Everything is keyed by the Delaunay primitive it is dual to, so that a
+ * vertex or a face is computed once and every cell that has it names it
+ * by the same number:
+ *  - a Voronoi vertex is a tet's circumcentre; neighbouring tets whose
+ *    five points are cospherical (unperturbed exact insphere = 0) have the
+ *    same one, and are merged with a union-find: a lattice's cube is one
+ *    vertex, not six at one place;
+ *  - a Voronoi face is a Delaunay edge (a, b), a < b: the circumcentres of
+ *    the tets about it, counter-clockwise about b - a (so the right-hand
+ *    normal points from cell a, the owner, to cell b); a hull edge's face
+ *    is open, with a ray out of each of its two hull faces (the ray of a
+ *    hull face goes from its tet's circumcentre along the outward normal;
+ *    adjacent coplanar hull faces whose tets share a vertex share it);
+ *  - each face is clipped by the six walls in turn (Sutherland-Hodgman in
+ *    homogeneous coordinates, so the rays and the edge at infinity clip
+ *    like segments). Every in/out decision compares a stored coordinate
+ *    with the wall's bound, so the faces that share a Voronoi edge decide
+ *    alike; the point where a Voronoi edge (a pair of merged vertices) or
+ *    a ray crosses a wall is computed once, from the whole edge, and kept
+ *    under that key; a point where a face's own clipped edge crosses a
+ *    second wall (on a box edge) belongs to that face alone. A crossing's
+ *    coordinate on its wall is the bound itself, exactly;
+ *  - a face left with fewer than 3 distinct vertices has no area and is
+ *    dropped (its cells then share no face);
+ *  - a cell's face on a wall is the convex polygon of the cell's vertices
+ *    that lie exactly on the wall, with the box corners nearest to the
+ *    cell's point, sorted about their centroid.
+ * The result is checked (fdt_dualmesh_check) before it is handed out: a
+ * configuration this cannot number (a box corner equidistant from two
+ * points, rounding that turns a wall polygon) is an error, never a
+ * broken mesh.
+ */
+#include "mesh/dualmesh.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/hash.h"
+#include "geom/predicates.h"
+#include "mesh/locate.h"
+#include "mesh/result.h"
+#include "mesh/voronoi.h"
+
+const char *const fdt_dualmesh_patch[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+
+/* ------------------------------------------------------------ small tools */
+
+static void say(char *diag, size_t size, const char *fmt, ...)
+{
+    if (!diag || !size)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(diag, size, fmt, ap);
+    va_end(ap);
+}
+
+/* Grows *p (elements of size sz) to hold at least need; 0 or -1. */
+static int grow(void *pp, size_t *cap, size_t need, size_t sz)
+{
+    if (need <= *cap)
+        return 0;
+    size_t c = *cap ? *cap : 64;
+    while (c < need)
+        c *= 2;
+    void *q = realloc(*(void **)pp, c * sz);
+    if (!q)
+        return -1;
+    *(void **)pp = q;
+    *cap = c;
+    return 0;
+}
+
+/* Open addressing from a pair of 64-bit keys to an index. */
+typedef struct kmap {
+    uint64_t *k;  /* 2 a slot; k[0] == UINT64_MAX: empty */
+    int64_t *val;
+    size_t cap, count;
+} kmap;
+
+static int kmap_init(kmap *m, size_t expect)
+{
+    m->cap = 64;
+    while (m->cap < 2 * expect)
+        m->cap *= 2;
+    m->count = 0;
+    m->k = malloc(2 * m->cap * sizeof *m->k);
+    m->val = malloc(m->cap * sizeof *m->val);
+    if (!m->k || !m->val)
+        return -1;
+    memset(m->k, 0xff, 2 * m->cap * sizeof *m->k);
+    return 0;
+}
+
+static void kmap_free(kmap *m)
+{
+    free(m->k);
+    free(m->val);
+    memset(m, 0, sizeof *m);
+}
+
+static size_t kmap_slot(const kmap *m, uint64_t a, uint64_t b)
+{
+    size_t i = (size_t)fdt_mix64(a * 0x9e3779b97f4a7c15ull ^ fdt_mix64(b)) & (m->cap - 1);
+    while (m->k[2 * i] != UINT64_MAX && (m->k[2 * i] != a || m->k[2 * i + 1] != b))
+        i = (i + 1) & (m->cap - 1);
+    return i;
+}
+
+/* The value under (a, b), or -1. a is never UINT64_MAX. */
+static int64_t kmap_get(const kmap *m, uint64_t a, uint64_t b)
+{
+    size_t i = kmap_slot(m, a, b);
+    return m->k[2 * i] == UINT64_MAX ? -1 : m->val[i];
+}
+
+static int kmap_put(kmap *m, uint64_t a, uint64_t b, int64_t v)
+{
+    if (2 * (m->count + 1) > m->cap) {
+        kmap old = *m;
+        if (kmap_init(m, old.cap) != 0) {
+            kmap_free(m);
+            *m = old;
+            return -1;
+        }
+        for (size_t i = 0; i < old.cap; i++)
+            if (old.k[2 * i] != UINT64_MAX) {
+                size_t j = kmap_slot(m, old.k[2 * i], old.k[2 * i + 1]);
+                m->k[2 * j] = old.k[2 * i];
+                m->k[2 * j + 1] = old.k[2 * i + 1];
+                m->val[j] = old.val[i];
+            }
+        m->count = old.count;
+        kmap_free(&old);
+    }
+    size_t i = kmap_slot(m, a, b);
+    if (m->k[2 * i] == UINT64_MAX)
+        m->count++;
+    m->k[2 * i] = a;
+    m->k[2 * i + 1] = b;
+    m->val[i] = v;
+    return 0;
+}
+
+static int64_t uf_find(int64_t *uf, int64_t x)
+{
+    while (uf[x] != x) {
+        uf[x] = uf[uf[x]];
+        x = uf[x];
+    }
+    return x;
+}
+
+/* The lower root becomes the root: the same roots for every order. */
+static void uf_union(int64_t *uf, int64_t a, int64_t b)
+{
+    a = uf_find(uf, a);
+    b = uf_find(uf, b);
+    if (a < b)
+        uf[b] = a;
+    else if (b < a)
+        uf[a] = b;
+}
+
+/* ------------------------------------------------------------ the work */
+
+/* An entry of a face being clipped: a point (homogeneous: h[3] 1 for a
+ * point, 0 for a direction at infinity) and the edge to the next entry. */
+enum { E_VOR, E_RAY, E_OWN };
+typedef struct cv {
+    double h[4];
+    int64_t id;   /* provisional vertex, or -1 (a Voronoi vertex not yet
+                     numbered: root >= 0; or a point at infinity) */
+    int64_t root; /* the Voronoi vertex's root tet, or -1 */
+    int ekind;    /* the edge to the next entry: a Voronoi edge (ea, eb the
+                     roots of its ends), a ray (ea its root hull face), or
+                     the face's own (on a wall, or at infinity) */
+    int64_t ea, eb;
+    fdt_vid tri[3]; /* a Voronoi edge's Delaunay triangle (E_VOR) */
+    fdt_tid t0, t1; /* a Voronoi vertex's first and last tets in the ring */
+} cv;
+
+typedef struct dwork {
+    fdt_result *r;
+    const double *X;
+    size_t n, T;
+    double box[6];
+    fdt_locator loc;
+    const fdt_tid *nb;
+    int64_t *uf;    /* T: cospherical neighbours merged */
+    double *cc;     /* 3 a tet: its circumcentre */
+    int64_t *rvid;  /* T: a root's provisional vertex, -1 none yet */
+    kmap hull;      /* 4 t + i -> hull face */
+    size_t nhull;
+    int64_t *huf;   /* hull faces merged into rays */
+    double *hdir;   /* 3 a hull face: unit outward normal */
+    fdt_vid *htri;  /* 3 a hull face: its points */
+    int64_t *htet;  /* a hull face's tet */
+    kmap cross;     /* a Voronoi edge or ray crossing a wall -> vertex */
+    double *vx;     /* provisional vertices */
+    size_t nv, capv;
+    int64_t *fv;    /* faces' provisional vertices */
+    size_t nfv, capfv;
+    size_t *fs;     /* nf + 1 starts */
+    int32_t *fown, *fnbr; /* fnbr: the neighbour cell, or -1 - wall */
+    size_t nf, capf, capfo, capfn;
+    int32_t *cell_of;
+    size_t ncells;
+    cv *poly, *tmp;
+    size_t cappoly, captmp;
+    fdt_tid *ring;
+    size_t capring;
+    char *diag;
+    size_t ds;
+} dwork;
+
+static int64_t new_vertex(dwork *w, const double x[3])
+{
+    if (grow(&w->vx, &w->capv, 3 * (w->nv + 1), sizeof *w->vx) != 0)
+        return -1;
+    memcpy(w->vx + 3 * w->nv, x, 3 * sizeof *x);
+    return (int64_t)w->nv++;
+}
+
+/* Wall p: axis p / 2, its upper bound when p is odd. */
+static double bound(const dwork *w, int p)
+{
+    return w->box[(p >> 1) + ((p & 1) ? 3 : 0)];
+}
+
+/* > 0: h lies beyond wall p (outside the box), <= 0 inside or on it. */
+static double side(const dwork *w, const double h[4], int p)
+{
+    int k = p >> 1;
+    double b = bound(w, p);
+    if (h[3] == 0)
+        return (p & 1) ? h[k] : -h[k];
+    return (p & 1) ? h[k] - b : b - h[k];
+}
+
+/* ------------------------------------------------------------ merging */
+
+/* The tets' circumcentres, and neighbours on one sphere merged. */
+static int merge_tets(dwork *w)
+{
+    const fdt_vid *tv = w->r->tets;
+    for (size_t t = 0; t < w->T; t++) {
+        const fdt_vid *v = tv + 4 * t;
+        w->uf[t] = (int64_t)t;
+        w->rvid[t] = -1;
+        if (fdt_voronoi_tet_centre(w->X + 3 * (size_t)v[0], w->X + 3 * (size_t)v[1],
+                                   w->X + 3 * (size_t)v[2], w->X + 3 * (size_t)v[3],
+                                   w->cc + 3 * t) != 0) {
+            say(w->diag, w->ds, "tet %zu is flat: it has no circumcentre", t);
+            return FDT_EINTERNAL;
+        }
+    }
+    for (size_t t = 0; t < w->T; t++) {
+        const fdt_vid *v = tv + 4 * t;
+        for (int i = 0; i < 4; i++) {
+            fdt_tid u = w->nb[4 * t + (size_t)i];
+            if (u <= (fdt_tid)t)
+                continue;
+            const fdt_vid *uv = tv + 4 * (size_t)u;
+            int e = 0;
+            while (e < 4 && w->nb[4 * (size_t)u + (size_t)e] != (fdt_tid)t)
+                e++;
+            if (e == 4) {
+                say(w->diag, w->ds, "tets %zu and %lld are not mutual neighbours", t,
+                    (long long)u);
+                return FDT_EINTERNAL;
+            }
+            if (fdt_insphere(w->X + 3 * (size_t)v[0], w->X + 3 * (size_t)v[1],
+                             w->X + 3 * (size_t)v[2], w->X + 3 * (size_t)v[3],
+                             w->X + 3 * (size_t)uv[e], NULL) == 0)
+                uf_union(w->uf, (int64_t)t, (int64_t)u);
+        }
+    }
+    return FDT_OK;
+}
+
+/* Positions k, l of tet v's other vertices such that (a, b, k, l) is an
+ * even permutation of the tet's: counter-clockwise about b - a, the face
+ * without l comes before the tet, the face without k after it. */
+static void edge_frame(const fdt_vid *v, fdt_vid a, fdt_vid b, int *pk, int *pl)
+{
+    int p[4], m = 2;
+    for (int i = 0; i < 4; i++) {
+        if (v[i] == a)
+            p[0] = i;
+        else if (v[i] == b)
+            p[1] = i;
+        else
+            p[m++] = i;
+    }
+    int inv = 0;
+    for (int i = 0; i < 4; i++)
+        for (int j = i + 1; j < 4; j++)
+            inv += p[i] > p[j];
+    *pk = p[(inv & 1) ? 3 : 2];
+    *pl = p[(inv & 1) ? 2 : 3];
+}
+
+/* The tet after t about edge (a, b) (ccw: counter-clockwise about b - a,
+ * else clockwise), or -1 with *hull the position of t's hull face. */
+static fdt_tid ring_step(const dwork *w, fdt_tid t, fdt_vid a, fdt_vid b, int ccw, int *hull)
+{
+    int pk, pl;
+    edge_frame(w->r->tets + 4 * (size_t)t, a, b, &pk, &pl);
+    int q = ccw ? pk : pl;
+    fdt_tid u = w->nb[4 * (size_t)t + (size_t)q];
+    if (u < 0)
+        *hull = q;
+    return u;
+}
+
+static int64_t hull_face(const dwork *w, fdt_tid t, int q)
+{
+    return kmap_get(&w->hull, 4 * (uint64_t)t + (uint64_t)q, 0);
+}
+
+/* The hull faces, their normals, and adjacent coplanar ones whose tets
+ * share a Voronoi vertex merged: one ray. */
+static int number_hull(dwork *w)
+{
+    const fdt_vid *tv = w->r->tets;
+    size_t nh = 0;
+    for (size_t t = 0; t < w->T; t++)
+        for (int q = 0; q < 4; q++)
+            nh += w->nb[4 * t + (size_t)q] < 0;
+    if (kmap_init(&w->hull, nh) != 0 || !(w->huf = malloc((nh + 1) * sizeof *w->huf)) ||
+        !(w->hdir = malloc(3 * (nh + 1) * sizeof *w->hdir)) ||
+        !(w->htri = malloc(3 * (nh + 1) * sizeof *w->htri)) ||
+        !(w->htet = malloc((nh + 1) * sizeof *w->htet)))
+        return FDT_ENOMEM;
+    for (size_t t = 0; t < w->T; t++)
+        for (int q = 0; q < 4; q++) {
+            if (w->nb[4 * t + (size_t)q] >= 0)
+                continue;
+            const double *p0 = w->X + 3 * (size_t)tv[4 * t + (size_t)fdt_tet_face[q][0]];
+            const double *p1 = w->X + 3 * (size_t)tv[4 * t + (size_t)fdt_tet_face[q][1]];
+            const double *p2 = w->X + 3 * (size_t)tv[4 * t + (size_t)fdt_tet_face[q][2]];
+            double e1[3], e2[3], *d = w->hdir + 3 * w->nhull;
+            for (int k = 0; k < 3; k++) {
+                e1[k] = p1[k] - p0[k];
+                e2[k] = p2[k] - p0[k];
+            }
+            d[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            d[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            d[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (int k = 0; k < 3; k++)
+                d[k] /= len;
+            for (int k = 0; k < 3; k++)
+                w->htri[3 * w->nhull + (size_t)k] = tv[4 * t + (size_t)fdt_tet_face[q][k]];
+            w->huf[w->nhull] = (int64_t)w->nhull;
+            w->htet[w->nhull] = (int64_t)t;
+            if (kmap_put(&w->hull, 4 * (uint64_t)t + (uint64_t)q, 0, (int64_t)w->nhull) != 0)
+                return FDT_ENOMEM;
+            w->nhull++;
+        }
+    /* each hull face's three edges: the hull face across it */
+    for (size_t h = 0; h < w->nhull; h++) {
+        fdt_tid t = w->htet[h];
+        const fdt_vid *v = tv + 4 * (size_t)t;
+        int q = 0;
+        while (hull_face(w, t, q) != (int64_t)h)
+            q++;
+        for (int e = 0; e < 3; e++) {
+            fdt_vid a = v[fdt_tet_face[q][e]], b = v[fdt_tet_face[q][(e + 1) % 3]];
+            fdt_vid c = v[fdt_tet_face[q][(e + 2) % 3]];
+            /* rotate about (a, b) away from this hull face to the other */
+            int pk, pl;
+            edge_frame(v, a, b, &pk, &pl);
+            int ccw = pl == q; /* the hull face comes before t: walk on ccw */
+            fdt_tid u = t, next;
+            int hq = -1;
+            size_t steps = 0;
+            while ((next = ring_step(w, u, a, b, ccw, &hq)) >= 0 && steps++ < w->T)
+                u = next;
+            if (next >= 0)
+                return FDT_EINTERNAL;
+            int64_t h2 = hull_face(w, u, hq);
+            if (h2 <= (int64_t)h)
+                continue;
+            if (uf_find(w->uf, (int64_t)t) != uf_find(w->uf, (int64_t)u))
+                continue;
+            /* coplanar: the other face's far vertex on this one's plane */
+            const fdt_vid *uv = tv + 4 * (size_t)u;
+            fdt_vid far = -1;
+            for (int i = 0; i < 3; i++) {
+                fdt_vid x = uv[fdt_tet_face[hq][i]];
+                if (x != a && x != b)
+                    far = x;
+            }
+            if (fdt_orient3d(w->X + 3 * (size_t)a, w->X + 3 * (size_t)b, w->X + 3 * (size_t)c,
+                             w->X + 3 * (size_t)far, NULL) == 0)
+                uf_union(w->huf, (int64_t)h, h2);
+        }
+    }
+    return FDT_OK;
+}
+
+/* ------------------------------------------------------------ clipping */
+
+/* The point x on wall p equidistant from the triangle tri's points (where
+ * its Voronoi edge meets the wall), solved relative to its first point so
+ * that the error scales with the triangle, not with a far circumcentre.
+ * 0, or -1 when the edge runs (nearly) along the wall. */
+static int wall_point(const dwork *w, const fdt_vid *tri, int p, double x[3])
+{
+    int k = p >> 1, u = (k + 1) % 3, t = (k + 2) % 3;
+    const double *p0 = w->X + 3 * (size_t)tri[0];
+    double d1[3], d2[3];
+    for (int c = 0; c < 3; c++) {
+        d1[c] = w->X[3 * (size_t)tri[1] + (size_t)c] - p0[c];
+        d2[c] = w->X[3 * (size_t)tri[2] + (size_t)c] - p0[c];
+    }
+    double yk = bound(w, p) - p0[k];
+    double r1 = 0.5 * (d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2]) - d1[k] * yk;
+    double r2 = 0.5 * (d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2]) - d2[k] * yk;
+    double det = d1[u] * d2[t] - d1[t] * d2[u];
+    double scale = (fabs(d1[u]) + fabs(d1[t])) * (fabs(d2[u]) + fabs(d2[t]));
+    if (!(fabs(det) > 0x1p-20 * scale))
+        return -1;
+    double yu = (r1 * d2[t] - r2 * d1[t]) / det, yt = (d1[u] * r2 - d2[u] * r1) / det;
+    if (!isfinite(yu) || !isfinite(yt))
+        return -1;
+    x[k] = bound(w, p);
+    x[u] = p0[u] + yu;
+    x[t] = p0[t] + yt;
+    return 0;
+}
+
+/* The point where the edge labelled (kind, ea, eb) crosses wall p, from
+ * the entry cur inside to nxt beyond: a shared Voronoi edge's or ray's is
+ * computed from the whole edge and kept under its key, the face's own
+ * edge's from the two entries (a point at infinity where both are).
+ * Fills *x (id set, or -1 at infinity); 0 or FDT_ENOMEM. */
+static int crossing(dwork *w, const cv *cur, const cv *nxt, int p, cv *x)
+{
+    int k = p >> 1;
+    double b = bound(w, p);
+    uint64_t ka, kb;
+    double pt[3];
+    x->root = -1;
+    x->h[3] = 1;
+    if (cur->ekind == E_OWN) {
+        double su = side(w, cur->h, p), sv = side(w, nxt->h, p), y[4];
+        for (int c = 0; c < 4; c++)
+            y[c] = cur->h[c] * fabs(sv) + nxt->h[c] * fabs(su); /* between them */
+        if (y[3] > 0) {
+            for (int c = 0; c < 3; c++) {
+                pt[c] = y[c] / y[3];
+                /* on a wall with both ends (or along it, to infinity):
+                 * on it exactly, as the walls' faces find their points */
+                const double *f = cur->h[3] != 0 ? cur->h : nxt->h, *g = cur->h[3] != 0 ? nxt->h : cur->h;
+                if (g[3] != 0 ? g[c] == f[c] : g[c] == 0)
+                    pt[c] = f[c];
+            }
+            pt[k] = b;
+            memcpy(x->h, pt, sizeof pt);
+            x->id = new_vertex(w, pt);
+            return x->id < 0 ? FDT_ENOMEM : FDT_OK;
+        }
+        double len = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+        for (int c = 0; c < 3; c++)
+            x->h[c] = y[c] / len;
+        x->h[k] = 0; /* along the wall */
+        x->h[3] = 0;
+        x->id = -1;
+        return FDT_OK;
+    }
+    if (cur->ekind == E_VOR) {
+        ka = (uint64_t)(cur->ea < cur->eb ? cur->ea : cur->eb);
+        kb = ((uint64_t)(cur->ea < cur->eb ? cur->eb : cur->ea) << 3) | (uint64_t)p;
+    } else {
+        ka = (UINT64_C(1) << 62) | (uint64_t)cur->ea;
+        kb = (uint64_t)p;
+    }
+    int64_t id = kmap_get(&w->cross, ka, kb);
+    if (id < 0) {
+        const fdt_vid *tri = cur->ekind == E_VOR ? cur->tri : w->htri + 3 * (size_t)cur->ea;
+        const double *A, *B = NULL, *d = NULL;
+        if (cur->ekind == E_VOR) {
+            A = w->cc + 3 * (size_t)(int64_t)ka;
+            B = w->cc + 3 * (size_t)(int64_t)(kb >> 3);
+        } else {
+            A = w->cc + 3 * (size_t)cur->eb;
+            d = w->hdir + 3 * (size_t)cur->ea;
+        }
+        if (wall_point(w, tri, p, pt) != 0) {
+            /* the edge nearly along the wall: from its ends */
+            double t;
+            if (B) {
+                double den = B[k] - A[k];
+                t = den != 0 ? (b - A[k]) / den : 0.5;
+                t = t < 0 ? 0 : t > 1 ? 1 : t;
+            } else {
+                t = (b - A[k]) / d[k];
+                t = t < 0 ? 0 : t;
+            }
+            for (int c = 0; c < 3; c++)
+                pt[c] = A[c] + t * (B ? B[c] - A[c] : d[c]);
+        }
+        for (int c = 0; c < 3; c++)
+            if (B ? A[c] == B[c] : d[c] == 0)
+                pt[c] = A[c]; /* along a wall: on it exactly */
+        pt[k] = b;
+        id = new_vertex(w, pt);
+        if (id < 0 || kmap_put(&w->cross, ka, kb, id) != 0)
+            return FDT_ENOMEM;
+    }
+    memcpy(x->h, w->vx + 3 * (size_t)id, 3 * sizeof(double));
+    x->id = id;
+    return FDT_OK;
+}
+
+/* The face in w->poly (*m entries) clipped by wall p (Sutherland-
+ * Hodgman; a point on the wall counts as inside and makes no crossing). */
+static int clip_wall(dwork *w, size_t *m, int p)
+{
+    size_t cnt = *m, out = 0, nin = 0;
+    for (size_t i = 0; i < cnt; i++)
+        nin += side(w, w->poly[i].h, p) <= 0;
+    if (nin == cnt)
+        return FDT_OK;
+    if (nin == 0) {
+        *m = 0;
+        return FDT_OK;
+    }
+    if (grow(&w->tmp, &w->captmp, 2 * cnt, sizeof *w->tmp) != 0)
+        return FDT_ENOMEM;
+    for (size_t i = 0; i < cnt; i++) {
+        const cv *cur = &w->poly[i], *nxt = &w->poly[(i + 1) % cnt];
+        double sc = side(w, cur->h, p), sn = side(w, nxt->h, p);
+        if (sc <= 0) {
+            w->tmp[out] = *cur;
+            if (sn > 0) {
+                if (sc < 0) {
+                    cv x;
+                    int e = crossing(w, cur, nxt, p, &x);
+                    if (e)
+                        return e;
+                    out++;
+                    w->tmp[out] = x;
+                }
+                w->tmp[out].ekind = E_OWN; /* on the wall, to where it comes back */
+                w->tmp[out].ea = w->tmp[out].eb = -1;
+            }
+            out++;
+        } else if (sn < 0) {
+            cv x;
+            int e = crossing(w, cur, nxt, p, &x);
+            if (e)
+                return e;
+            x.ekind = cur->ekind;
+            x.ea = cur->ea;
+            x.eb = cur->eb;
+            memcpy(x.tri, cur->tri, sizeof x.tri);
+            w->tmp[out++] = x;
+        }
+    }
+    cv *t = w->poly;
+    size_t ct = w->cappoly;
+    w->poly = w->tmp;
+    w->cappoly = w->captmp;
+    w->tmp = t;
+    w->captmp = ct;
+    *m = out;
+    return FDT_OK;
+}
+
+/* Appends a face (fnbr: a cell, or -1 - wall) of vertices ids[0 .. m). */
+static int append_face(dwork *w, const int64_t *ids, size_t m, int32_t own, int32_t nbr)
+{
+    if (grow(&w->fv, &w->capfv, w->nfv + m, sizeof *w->fv) != 0 ||
+        grow(&w->fs, &w->capf, w->nf + 2, sizeof *w->fs) != 0 ||
+        grow(&w->fown, &w->capfo, w->nf + 1, sizeof *w->fown) != 0 ||
+        grow(&w->fnbr, &w->capfn, w->nf + 1, sizeof *w->fnbr) != 0)
+        return FDT_ENOMEM;
+    if (ids != w->fv + w->nfv)
+        memcpy(w->fv + w->nfv, ids, m * sizeof *ids);
+    w->fs[w->nf] = w->nfv;
+    w->nfv += m;
+    w->fs[w->nf + 1] = w->nfv;
+    w->fown[w->nf] = own;
+    w->fnbr[w->nf] = nbr;
+    w->nf++;
+    return FDT_OK;
+}
+
+/* The clipped face in w->poly[0 .. m), numbered (its Voronoi vertices
+ * get their numbers now), added when 3 distinct vertices are left. */
+static int put_face(dwork *w, size_t m, int32_t own, int32_t nbr)
+{
+    if (grow(&w->fv, &w->capfv, w->nfv + m, sizeof *w->fv) != 0)
+        return FDT_ENOMEM;
+    int64_t *ids = w->fv + w->nfv;
+    size_t k = 0;
+    for (size_t i = 0; i < m; i++) {
+        const cv *e = &w->poly[i];
+        int64_t id = e->id;
+        if (e->h[3] == 0) {
+            say(w->diag, w->ds, "the face of cells %d and %d keeps a point at infinity "
+                "after the box cut it", own, nbr);
+            return FDT_EINTERNAL;
+        }
+        if (id < 0) {
+            if (w->rvid[e->root] < 0 && (w->rvid[e->root] = new_vertex(w, e->h)) < 0)
+                return FDT_ENOMEM;
+            id = w->rvid[e->root];
+        }
+        if (k == 0 || ids[k - 1] != id)
+            ids[k++] = id;
+    }
+    while (k > 1 && ids[k - 1] == ids[0])
+        k--;
+    return k < 3 ? FDT_OK : append_face(w, ids, k, own, nbr);
+}
+
+static void entry_vertex(dwork *w, cv *e, int64_t root)
+{
+    memcpy(e->h, w->cc + 3 * (size_t)root, 3 * sizeof(double));
+    e->h[3] = 1;
+    e->id = -1;
+    e->root = root;
+}
+
+static void entry_ray(dwork *w, cv *e, int64_t ray)
+{
+    memcpy(e->h, w->hdir + 3 * (size_t)ray, 3 * sizeof(double));
+    e->h[3] = 0;
+    e->id = -1;
+    e->root = -1;
+}
+
+/* The face of edge (a, b) from the tets ring[0 .. nr) counter-clockwise
+ * about it, rays out of hull faces hin (before ring[0]) and hout (after
+ * the last) when open (-1 when closed): clipped and, when it keeps an
+ * area, added. */
+static int add_face(dwork *w, fdt_vid a, fdt_vid b, size_t nr, int64_t hin, int64_t hout)
+{
+    if (grow(&w->poly, &w->cappoly, nr + 2, sizeof *w->poly) != 0)
+        return FDT_ENOMEM;
+    size_t m = 0;
+    int64_t rin = hin >= 0 ? uf_find(w->huf, hin) : -1;
+    int64_t rout = hout >= 0 ? uf_find(w->huf, hout) : -1;
+    if (rin >= 0) {
+        entry_ray(w, &w->poly[m], rin);
+        w->poly[m].ekind = E_RAY;
+        w->poly[m].ea = rin;
+        m++;
+    }
+    size_t first = m;
+    for (size_t i = 0; i < nr; i++) {
+        int64_t root = uf_find(w->uf, (int64_t)w->ring[i]);
+        if (m > first && w->poly[m - 1].root == root) {
+            w->poly[m - 1].t1 = w->ring[i];
+            continue;
+        }
+        entry_vertex(w, &w->poly[m], root);
+        w->poly[m].t0 = w->poly[m].t1 = w->ring[i];
+        m++;
+    }
+    if (rin < 0 && m - first > 1 && w->poly[m - 1].root == w->poly[first].root)
+        w->poly[first].t0 = w->poly[--m].t0;
+    for (size_t i = first; i < m; i++) {
+        cv *e = &w->poly[i];
+        if (i + 1 < m || rin < 0) {
+            /* the triangle between this run's last tet and the next's first */
+            int pk, pl;
+            edge_frame(w->r->tets + 4 * (size_t)e->t1, a, b, &pk, &pl);
+            e->ekind = E_VOR;
+            e->ea = e->root;
+            e->eb = w->poly[i + 1 < m ? i + 1 : first].root;
+            e->tri[0] = a;
+            e->tri[1] = b;
+            e->tri[2] = w->r->tets[4 * (size_t)e->t1 + (size_t)pl];
+        } else {
+            e->ekind = E_RAY;
+            e->ea = rout;
+        }
+    }
+    if (rin >= 0) {
+        w->poly[first - 1].eb = w->poly[first].root;
+        w->poly[m - 1].eb = w->poly[m - 1].root;
+        if (rin == rout)
+            return FDT_OK; /* one ray there and back: no area */
+        entry_ray(w, &w->poly[m], rout);
+        w->poly[m].ekind = E_OWN;
+        w->poly[m].ea = w->poly[m].eb = -1;
+        m++;
+    }
+    if (m < 3)
+        return FDT_OK;
+    for (int p = 0; p < 6 && m > 0; p++) {
+        int e = clip_wall(w, &m, p);
+        if (e)
+            return e;
+    }
+    return m ? put_face(w, m, w->cell_of[a], w->cell_of[b]) : FDT_OK;
+}
+
+/* Edge (a, b) of tet t, a < b: when t is the lowest tet about it, its
+ * face (the tets in counter-clockwise order, from the hull when open). */
+static int edge_face(dwork *w, fdt_tid t, fdt_vid a, fdt_vid b)
+{
+    size_t nr = 0;
+    fdt_tid u = t, next;
+    int hq = -1, closed = 0;
+    for (;;) {
+        if (grow(&w->ring, &w->capring, nr + 1, sizeof *w->ring) != 0)
+            return FDT_ENOMEM;
+        w->ring[nr++] = u;
+        next = ring_step(w, u, a, b, 1, &hq);
+        if (next < 0)
+            break;
+        if (next == t) {
+            closed = 1;
+            break;
+        }
+        if (next < t || nr > w->T)
+            return nr > w->T ? FDT_EINTERNAL : FDT_OK;
+        u = next;
+    }
+    int64_t hin = -1, hout = -1;
+    if (!closed) {
+        hout = hull_face(w, u, hq);
+        /* back from t to the hull: those tets come first */
+        size_t nback = 0;
+        u = t;
+        while ((next = ring_step(w, u, a, b, 0, &hq)) >= 0) {
+            if (next < t || nr + nback > w->T)
+                return nr + nback > w->T ? FDT_EINTERNAL : FDT_OK;
+            if (grow(&w->ring, &w->capring, nr + nback + 1, sizeof *w->ring) != 0)
+                return FDT_ENOMEM;
+            w->ring[nr + nback++] = next;
+            u = next;
+        }
+        hin = hull_face(w, u, hq);
+        /* ring: [t .. last, back1 .. backk]: rotate to [backk .. back1, t .. last] */
+        if (nback) {
+            fdt_tid *tmp = malloc((nr + nback) * sizeof *tmp);
+            if (!tmp)
+                return FDT_ENOMEM;
+            for (size_t i = 0; i < nback; i++)
+                tmp[i] = w->ring[nr + nback - 1 - i];
+            memcpy(tmp + nback, w->ring, nr * sizeof *tmp);
+            memcpy(w->ring, tmp, (nr + nback) * sizeof *tmp);
+            free(tmp);
+            nr += nback;
+        }
+        if (hin < 0 || hout < 0)
+            return FDT_EINTERNAL;
+    }
+    return add_face(w, a, b, nr, hin, hout);
+}
+
+/* Every Delaunay edge's face, once (from its lowest tet). */
+static int all_faces(dwork *w)
+{
+    static const int pairs[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+    for (size_t t = 0; t < w->T; t++) {
+        const fdt_vid *v = w->r->tets + 4 * t;
+        for (int e = 0; e < 6; e++) {
+            fdt_vid a = v[pairs[e][0]], b = v[pairs[e][1]];
+            int err = edge_face(w, (fdt_tid)t, a < b ? a : b, a < b ? b : a);
+            if (err) {
+                if (err == FDT_EINTERNAL && !w->diag[0])
+                    say(w->diag, w->ds, "the tets about edge (%d, %d) do not close", a, b);
+                return err;
+            }
+        }
+    }
+    return FDT_OK;
+}
+
+/* ------------------------------------------------------------ walls */
+
+int fdt_dualmesh_cell_faces(const fdt_dualmesh *d, size_t **start, size_t **faces)
+{
+    size_t *s = calloc(d->n_cells + 2, sizeof *s);
+    size_t *f = malloc((2 * d->n_faces + 1) * sizeof *f);
+    if (!s || !f) {
+        free(s);
+        free(f);
+        return FDT_ENOMEM;
+    }
+    for (size_t i = 0; i < d->n_faces; i++) {
+        s[d->owner[i] + 2]++;
+        if (i < d->n_internal)
+            s[d->neighbour[i] + 2]++;
+    }
+    for (size_t c = 0; c < d->n_cells; c++)
+        s[c + 2] += s[c + 1];
+    for (size_t i = 0; i < d->n_faces; i++) {
+        f[s[d->owner[i] + 1]++] = i;
+        if (i < d->n_internal)
+            f[s[d->neighbour[i] + 1]++] = i;
+    }
+    *start = s;
+    *faces = f;
+    return FDT_OK;
+}
+
+/* The box corner c (bit k: the upper bound in axis k) and the cell of the
+ * point nearest to it, -1 on a tie (then the corner lies on a face, which
+ * brings it). */
+static int32_t corner_cell(const dwork *w, int c, double x[3])
+{
+    for (int k = 0; k < 3; k++)
+        x[k] = w->box[k + ((c >> k) & 1 ? 3 : 0)];
+    size_t best = SIZE_MAX;
+    int tie = 0;
+    double bd = INFINITY;
+    for (size_t i = 0; i < w->n; i++) {
+        if (w->cell_of[i] < 0)
+            continue;
+        const double *p = w->X + 3 * i;
+        double d = (p[0] - x[0]) * (p[0] - x[0]) + (p[1] - x[1]) * (p[1] - x[1]) +
+                   (p[2] - x[2]) * (p[2] - x[2]);
+        if (d > bd * (1 + 1e-12))
+            continue;
+        int s = best == SIZE_MAX ? -1 : fdt_compare_dist(x, p, w->X + 3 * best);
+        if (s < 0) {
+            best = i;
+            bd = d;
+            tie = 0;
+        } else if (s == 0) {
+            tie = 1;
+        }
+    }
+    return tie || best == SIZE_MAX ? -1 : w->cell_of[best];
+}
+
+typedef struct wallv {
+    int p;
+    int64_t id;
+    double ang;
+} wallv;
+
+static int wallv_cmp(const void *x, const void *y)
+{
+    const wallv *a = x, *b = y;
+    if (a->p != b->p)
+        return a->p < b->p ? -1 : 1;
+    if (a->id != b->id)
+        return a->id < b->id ? -1 : 1;
+    return 0;
+}
+
+static int wallv_ang(const void *x, const void *y)
+{
+    const wallv *a = x, *b = y;
+    return a->ang < b->ang ? -1 : a->ang > b->ang;
+}
+
+/* Cell c's face on wall p from its vertices v[0 .. m) on it (distinct):
+ * sorted about their centroid, counter-clockwise about the outward
+ * normal; none when they span no area. */
+static int wall_face(dwork *w, int32_t c, int p, wallv *v, size_t m)
+{
+    if (m < 3)
+        return FDT_OK;
+    int k = p >> 1, u = (k + 1) % 3, t = (k + 2) % 3;
+    double cu = 0, ct = 0;
+    for (size_t i = 0; i < m; i++) {
+        cu += w->vx[3 * (size_t)v[i].id + (size_t)u];
+        ct += w->vx[3 * (size_t)v[i].id + (size_t)t];
+    }
+    cu /= (double)m;
+    ct /= (double)m;
+    for (size_t i = 0; i < m; i++)
+        v[i].ang = atan2(w->vx[3 * (size_t)v[i].id + (size_t)t] - ct,
+                         w->vx[3 * (size_t)v[i].id + (size_t)u] - cu);
+    qsort(v, m, sizeof *v, wallv_ang);
+    double area = 0;
+    for (size_t i = 0; i < m; i++) {
+        const double *a = w->vx + 3 * (size_t)v[i].id, *b = w->vx + 3 * (size_t)v[(i + 1) % m].id;
+        area += (a[u] - cu) * (b[t] - ct) - (b[u] - cu) * (a[t] - ct);
+    }
+    if (!(area > 0))
+        return FDT_OK;
+    if (grow(&w->fv, &w->capfv, w->nfv + m, sizeof *w->fv) != 0)
+        return FDT_ENOMEM;
+    int64_t *ids = w->fv + w->nfv;
+    for (size_t i = 0; i < m; i++)
+        ids[i] = v[(p & 1) ? i : m - 1 - i].id;
+    return append_face(w, ids, m, c, -1 - p);
+}
+
+/* Every cell's faces on the walls. */
+static int all_walls(dwork *w)
+{
+    fdt_dualmesh tmp;
+    memset(&tmp, 0, sizeof tmp);
+    tmp.n_cells = w->ncells;
+    tmp.n_faces = tmp.n_internal = w->nf;
+    tmp.owner = w->fown;
+    tmp.neighbour = w->fnbr;
+    size_t *cs = NULL, *cf = NULL;
+    if (fdt_dualmesh_cell_faces(&tmp, &cs, &cf) != FDT_OK)
+        return FDT_ENOMEM;
+    int64_t corner_id[8];
+    int32_t corner_of[8];
+    int err = FDT_OK;
+    for (int c = 0; c < 8 && !err; c++) {
+        double x[3];
+        corner_of[c] = corner_cell(w, c, x);
+        corner_id[c] = corner_of[c] >= 0 ? new_vertex(w, x) : 0;
+        if (corner_id[c] < 0)
+            err = FDT_ENOMEM;
+    }
+    wallv *v = NULL;
+    size_t capv = 0;
+    for (size_t c = 0; c < w->ncells && !err; c++) {
+        size_t m = 0;
+        for (size_t j = cs[c]; j < cs[c + 1] && !err; j++) {
+            size_t f = cf[j];
+            for (size_t i = w->fs[f]; i < w->fs[f + 1]; i++) {
+                const double *x = w->vx + 3 * (size_t)w->fv[i];
+                for (int p = 0; p < 6; p++)
+                    if (x[p >> 1] == bound(w, p)) {
+                        if (grow(&v, &capv, m + 1, sizeof *v) != 0) {
+                            err = FDT_ENOMEM;
+                            break;
+                        }
+                        v[m].p = p;
+                        v[m++].id = w->fv[i];
+                    }
+            }
+        }
+        for (int k = 0; k < 8 && !err; k++) {
+            if (corner_of[k] != (int32_t)c)
+                continue;
+            for (int a = 0; a < 3; a++) {
+                if (grow(&v, &capv, m + 1, sizeof *v) != 0) {
+                    err = FDT_ENOMEM;
+                    break;
+                }
+                v[m].p = 2 * a + ((k >> a) & 1);
+                v[m++].id = corner_id[k];
+            }
+        }
+        if (err || m == 0)
+            continue;
+        qsort(v, m, sizeof *v, wallv_cmp);
+        size_t u = 0;
+        for (size_t i = 0; i < m; i++)
+            if (u == 0 || v[i].p != v[u - 1].p || v[i].id != v[u - 1].id)
+                v[u++] = v[i];
+        for (size_t i = 0; i < u && !err;) {
+            size_t j = i;
+            while (j < u && v[j].p == v[i].p)
+                j++;
+            err = wall_face(w, (int32_t)c, v[i].p, v + i, j - i);
+            i = j;
+        }
+    }
+    free(v);
+    free(cs);
+    free(cf);
+    return err;
+}
+
+/* ------------------------------------------------------------ assembly */
+
+/* OpenFOAM's order into d: the internal faces by owner then neighbour,
+ * then the walls' by wall (each by owner, as made); the vertices that
+ * are used, numbered by first use. */
+static int assemble(dwork *w, fdt_dualmesh *d)
+{
+    size_t nf = w->nf, nint = 0;
+    size_t *order = malloc((nf + 1) * sizeof *order);
+    size_t *cnt = calloc(w->ncells + 8, sizeof *cnt);
+    int64_t *newid = malloc((w->nv + 1) * sizeof *newid);
+    if (!order || !cnt || !newid) {
+        free(order);
+        free(cnt);
+        free(newid);
+        return FDT_ENOMEM;
+    }
+    /* two stable counting sorts: by neighbour, then by owner for an
+     * internal face and ncells + wall for a wall face */
+    size_t *first = malloc((nf + 1) * sizeof *first);
+    if (!first) {
+        free(order);
+        free(cnt);
+        free(newid);
+        return FDT_ENOMEM;
+    }
+    for (size_t f = 0; f < nf; f++)
+        cnt[(w->fnbr[f] >= 0 ? (size_t)w->fnbr[f] : 0) + 1]++;
+    for (size_t k = 0; k < w->ncells + 6; k++)
+        cnt[k + 1] += cnt[k];
+    for (size_t f = 0; f < nf; f++)
+        first[cnt[w->fnbr[f] >= 0 ? (size_t)w->fnbr[f] : 0]++] = f;
+    memset(cnt, 0, (w->ncells + 8) * sizeof *cnt);
+    for (size_t f = 0; f < nf; f++) {
+        size_t key = w->fnbr[f] >= 0 ? (size_t)w->fown[f] : w->ncells + (size_t)(-1 - w->fnbr[f]);
+        cnt[key + 1]++;
+        nint += w->fnbr[f] >= 0;
+    }
+    for (size_t k = 0; k < w->ncells + 6; k++)
+        cnt[k + 1] += cnt[k];
+    for (size_t p = 0; p < 6; p++) {
+        d->patch_start[p] = cnt[w->ncells + p];
+        d->patch_size[p] = cnt[w->ncells + p + 1] - cnt[w->ncells + p];
+    }
+    for (size_t i = 0; i < nf; i++) {
+        size_t f = first[i];
+        size_t key = w->fnbr[f] >= 0 ? (size_t)w->fown[f] : w->ncells + (size_t)(-1 - w->fnbr[f]);
+        order[cnt[key]++] = f;
+    }
+    free(first);
+    free(cnt);
+    d->n_cells = w->ncells;
+    d->n_faces = nf;
+    d->n_internal = nint;
+    d->fstart = malloc((nf + 1) * sizeof *d->fstart);
+    d->fverts = malloc((w->nfv + 1) * sizeof *d->fverts);
+    d->owner = malloc((nf + 1) * sizeof *d->owner);
+    d->neighbour = malloc((nint + 1) * sizeof *d->neighbour);
+    int err = FDT_OK;
+    if (!d->fstart || !d->fverts || !d->owner || !d->neighbour) {
+        err = FDT_ENOMEM;
+        goto out;
+    }
+    for (size_t v = 0; v < w->nv; v++)
+        newid[v] = -1;
+    size_t nv = 0, k = 0;
+    for (size_t i = 0; i < nf; i++) {
+        size_t f = order[i];
+        d->fstart[i] = k;
+        d->owner[i] = w->fown[f];
+        if (i < nint)
+            d->neighbour[i] = w->fnbr[f];
+        for (size_t j = w->fs[f]; j < w->fs[f + 1]; j++) {
+            int64_t v = w->fv[j];
+            if (newid[v] < 0)
+                newid[v] = (int64_t)nv++;
+            d->fverts[k++] = (int32_t)newid[v];
+        }
+    }
+    d->fstart[nf] = k;
+    d->n_verts = nv;
+    d->xyz = malloc((3 * nv + 1) * sizeof *d->xyz);
+    if (!d->xyz) {
+        err = FDT_ENOMEM;
+        goto out;
+    }
+    for (size_t v = 0; v < w->nv; v++)
+        if (newid[v] >= 0)
+            memcpy(d->xyz + 3 * (size_t)newid[v], w->vx + 3 * v, 3 * sizeof *d->xyz);
+out:
+    free(order);
+    free(newid);
+    return err;
+}
+
+/* ------------------------------------------------------------ check */
+
+double fdt_dualmesh_cell_volume(const fdt_dualmesh *d, const size_t *cs, const size_t *cf,
+                                size_t c)
+{
+    if (cs[c] == cs[c + 1])
+        return 0;
+    const double *ref = d->xyz + 3 * (size_t)d->fverts[d->fstart[cf[cs[c]]]];
+    double vol = 0;
+    for (size_t j = cs[c]; j < cs[c + 1]; j++) {
+        size_t f = cf[j];
+        double sg = d->owner[f] == (int32_t)c ? 1 : -1, sum = 0;
+        const int32_t *v = d->fverts + d->fstart[f];
+        size_t m = d->fstart[f + 1] - d->fstart[f];
+        double a[3];
+        for (int k = 0; k < 3; k++)
+            a[k] = d->xyz[3 * (size_t)v[0] + (size_t)k] - ref[k];
+        for (size_t i = 1; i + 1 < m; i++) {
+            double b[3], e[3];
+            for (int k = 0; k < 3; k++) {
+                b[k] = d->xyz[3 * (size_t)v[i] + (size_t)k] - ref[k];
+                e[k] = d->xyz[3 * (size_t)v[i + 1] + (size_t)k] - ref[k];
+            }
+            sum += a[0] * (b[1] * e[2] - b[2] * e[1]) + a[1] * (b[2] * e[0] - b[0] * e[2]) +
+                   a[2] * (b[0] * e[1] - b[1] * e[0]);
+        }
+        vol += sg * sum / 6;
+    }
+    return vol;
+}
+
+static int u64_cmp(const void *x, const void *y)
+{
+    uint64_t a = *(const uint64_t *)x, b = *(const uint64_t *)y;
+    return a < b ? -1 : a > b;
+}
+
+/* The faces' own rules: sizes, ranges, repeats, order, every vertex used. */
+static int check_faces(const fdt_dualmesh *d, char *diag, size_t ds)
+{
+    size_t at = d->n_internal;
+    for (int p = 0; p < 6; p++) {
+        if (d->patch_start[p] != at) {
+            say(diag, ds, "patch %s starts at face %zu, not %zu", fdt_dualmesh_patch[p],
+                d->patch_start[p], at);
+            return -1;
+        }
+        at += d->patch_size[p];
+    }
+    if (at != d->n_faces) {
+        say(diag, ds, "the patches end at face %zu of %zu", at, d->n_faces);
+        return -1;
+    }
+    uint8_t *used = calloc(d->n_verts + 1, 1);
+    if (!used) {
+        say(diag, ds, "out of memory");
+        return -1;
+    }
+    int bad = 0;
+    for (size_t f = 0; f < d->n_faces && !bad; f++) {
+        size_t m = d->fstart[f + 1] - d->fstart[f];
+        const int32_t *v = d->fverts + d->fstart[f];
+        if (d->fstart[f + 1] < d->fstart[f] || m < 3) {
+            say(diag, ds, "face %zu has %zu vertices", f, m);
+            bad = 1;
+        }
+        for (size_t i = 0; i < m && !bad; i++) {
+            if (v[i] < 0 || (size_t)v[i] >= d->n_verts) {
+                say(diag, ds, "face %zu names vertex %d of %zu", f, v[i], d->n_verts);
+                bad = 1;
+                break;
+            }
+            used[v[i]] = 1;
+            for (size_t j = 0; j < i; j++)
+                if (v[j] == v[i]) {
+                    say(diag, ds, "face %zu has vertex %d twice", f, v[i]);
+                    bad = 1;
+                }
+        }
+        int32_t o = d->owner[f];
+        if (!bad && (o < 0 || (size_t)o >= d->n_cells)) {
+            say(diag, ds, "face %zu's owner %d is no cell", f, o);
+            bad = 1;
+        }
+        if (!bad && f < d->n_internal) {
+            int32_t nb = d->neighbour[f];
+            if (nb <= o || (size_t)nb >= d->n_cells) {
+                say(diag, ds, "face %zu: owner %d, neighbour %d", f, o, nb);
+                bad = 1;
+            } else if (f > 0 && (d->owner[f - 1] > o ||
+                                 (d->owner[f - 1] == o && d->neighbour[f - 1] >= nb))) {
+                say(diag, ds, "face %zu (%d, %d) is out of upper-triangular order", f, o, nb);
+                bad = 1;
+            }
+        }
+    }
+    for (size_t v = 0; v < d->n_verts && !bad; v++)
+        if (!used[v]) {
+            say(diag, ds, "vertex %zu is in no face", v);
+            bad = 1;
+        }
+    free(used);
+    return bad ? -1 : 0;
+}
+
+/* Cell c closed: its faces turned outward name each edge once each way. */
+static int check_cell(const fdt_dualmesh *d, const size_t *cs, const size_t *cf, size_t c,
+                      uint64_t **buf, size_t *cap, char *diag, size_t ds)
+{
+    size_t m = 0;
+    for (size_t j = cs[c]; j < cs[c + 1]; j++) {
+        size_t f = cf[j], k = d->fstart[f + 1] - d->fstart[f];
+        const int32_t *v = d->fverts + d->fstart[f];
+        int out = d->owner[f] == (int32_t)c;
+        if (grow(buf, cap, m + k, sizeof **buf) != 0) {
+            say(diag, ds, "out of memory");
+            return -1;
+        }
+        for (size_t i = 0; i < k; i++) {
+            uint64_t a = (uint32_t)v[i], b = (uint32_t)v[(i + 1) % k];
+            (*buf)[m++] = out ? a << 32 | b : b << 32 | a;
+        }
+    }
+    if (m == 0) {
+        say(diag, ds, "cell %zu has no faces", c);
+        return -1;
+    }
+    qsort(*buf, m, sizeof **buf, u64_cmp);
+    for (size_t i = 0; i < m; i++) {
+        uint64_t e = (*buf)[i], r = (e << 32) | (e >> 32);
+        if (i > 0 && (*buf)[i - 1] == e) {
+            say(diag, ds, "cell %zu has edge %u-%u twice the same way round", c,
+                (unsigned)(e >> 32), (unsigned)e);
+            return -1;
+        }
+        if (!bsearch(&r, *buf, m, sizeof **buf, u64_cmp)) {
+            say(diag, ds, "cell %zu is not closed at edge %u-%u", c, (unsigned)(e >> 32),
+                (unsigned)e);
+            return -1;
+        }
+    }
+    double vol = fdt_dualmesh_cell_volume(d, cs, cf, c);
+    if (!(vol > 0)) {
+        say(diag, ds, "cell %zu has volume %g", c, vol);
+        return -1;
+    }
+    return 0;
+}
+
+int fdt_dualmesh_check(const fdt_dualmesh *d, char *diag, size_t ds)
+{
+    say(diag, ds, "%s", "");
+    if (check_faces(d, diag, ds) != 0)
+        return -1;
+    size_t *cs = NULL, *cf = NULL;
+    if (fdt_dualmesh_cell_faces(d, &cs, &cf) != FDT_OK) {
+        say(diag, ds, "out of memory");
+        return -1;
+    }
+    uint64_t *buf = NULL;
+    size_t cap = 0;
+    int bad = 0;
+    for (size_t c = 0; c < d->n_cells && !bad; c++)
+        bad = check_cell(d, cs, cf, c, &buf, &cap, diag, ds) != 0;
+    free(buf);
+    free(cs);
+    free(cf);
+    return bad ? -1 : 0;
+}
+
+/* ------------------------------------------------------------ entry */
+
+void fdt_dualmesh_free(fdt_dualmesh *d)
+{
+    free(d->xyz);
+    free(d->fstart);
+    free(d->fverts);
+    free(d->owner);
+    free(d->neighbour);
+    free(d->cell_of);
+    memset(d, 0, sizeof *d);
+}
+
+static void free_work(dwork *w)
+{
+    fdt_locator_free(&w->loc);
+    free(w->uf);
+    free(w->cc);
+    free(w->rvid);
+    kmap_free(&w->hull);
+    free(w->huf);
+    free(w->hdir);
+    free(w->htri);
+    free(w->htet);
+    kmap_free(&w->cross);
+    free(w->vx);
+    free(w->fv);
+    free(w->fs);
+    free(w->fown);
+    free(w->fnbr);
+    free(w->poly);
+    free(w->tmp);
+    free(w->ring);
+}
+
+/* The cells: the points that are not merged duplicates, in input order. */
+static int number_cells(dwork *w, fdt_dualmesh *d)
+{
+    d->n_input = w->n;
+    d->cell_of = malloc((w->n + 1) * sizeof *d->cell_of);
+    if (!d->cell_of)
+        return FDT_ENOMEM;
+    for (size_t i = 0; i < w->n; i++)
+        d->cell_of[i] = w->r->dupmap[i] == (fdt_vid)i ? (int32_t)w->ncells++ : -1;
+    w->cell_of = d->cell_of;
+    return FDT_OK;
+}
+
+int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
+                       const fdt_voronoi_options *o, fdt_dualmesh *d, char *diag,
+                       size_t diag_size)
+{
+    char own[256];
+    if (!diag || !diag_size) {
+        diag = own;
+        diag_size = sizeof own;
+    }
+    diag[0] = 0;
+    memset(d, 0, sizeof *d);
+    if (!r || !xyz || !o || r->streamed || n != r->n || r->ntets == 0) {
+        say(diag, diag_size, "the dual needs the result of fdt_triangulate on the same %zu "
+            "points, with its tets", n);
+        return FDT_EINVAL;
+    }
+    if (r->ntets > (size_t)INT32_MAX || n > (size_t)INT32_MAX) {
+        say(diag, diag_size, "too many points or tets for OpenFOAM's 32-bit labels");
+        return FDT_ETOOBIG;
+    }
+    dwork w;
+    memset(&w, 0, sizeof w);
+    w.r = r;
+    w.X = xyz;
+    w.n = n;
+    w.T = r->ntets;
+    w.diag = diag;
+    w.ds = diag_size;
+    int err = fdt_voronoi_box_of(r, xyz, n, o, w.box, diag, diag_size);
+    if (!err)
+        err = fdt_locator_init(&w.loc, r, xyz, n);
+    if (err)
+        goto done;
+    memcpy(d->box, w.box, sizeof w.box);
+    w.nb = w.loc.nbrs;
+    w.uf = malloc(w.T * sizeof *w.uf);
+    w.cc = malloc(3 * w.T * sizeof *w.cc);
+    w.rvid = malloc(w.T * sizeof *w.rvid);
+    if (!w.uf || !w.cc || !w.rvid || kmap_init(&w.cross, 1024) != 0) {
+        err = FDT_ENOMEM;
+        goto done;
+    }
+    err = number_cells(&w, d);
+    if (!err)
+        err = merge_tets(&w);
+    if (!err)
+        err = number_hull(&w);
+    if (!err)
+        err = all_faces(&w);
+    if (!err)
+        err = all_walls(&w);
+    if (!err && (w.nv > (size_t)INT32_MAX || w.nf > (size_t)INT32_MAX ||
+                 w.nfv > (size_t)INT32_MAX)) {
+        say(diag, diag_size, "too many vertices or faces for OpenFOAM's 32-bit labels");
+        err = FDT_ETOOBIG;
+    }
+    if (!err)
+        err = assemble(&w, d);
+#ifdef DUAL_DEBUG
+    if (getenv("DUAL_NOCHECK"))
+        goto done;
+#endif
+    if (!err && fdt_dualmesh_check(d, diag, diag_size) != 0)
+        err = FDT_EDEGENERATE;
+done:
+#ifdef DUAL_DEBUG
+    if (getenv("DUAL_NOCHECK"))
+        fprintf(stderr, "check: %d\n", fdt_dualmesh_check(d, diag, diag_size));
+#endif
+    if (err == FDT_ENOMEM && !diag[0])
+        say(diag, diag_size, "out of memory");
+    free_work(&w);
+    if (err) {
+        char keep[512];
+        snprintf(keep, sizeof keep, "%s", diag);
+        fdt_dualmesh_free(d);
+        say(diag, diag_size, "%s", keep);
+    }
+    return err;
+}
