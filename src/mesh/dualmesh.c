@@ -1347,7 +1347,7 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
         goto done;
 #endif
     if (!err && fdt_dualmesh_check(d, diag, diag_size) != 0)
-        err = FDT_EDEGENERATE;
+        err = FDT_EINTERNAL;
 done:
 #ifdef DUAL_DEBUG
     if (getenv("DUAL_NOCHECK"))

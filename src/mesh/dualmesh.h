@@ -48,9 +48,10 @@ extern const char *const fdt_dualmesh_patch[6];
  * filled and owned by the caller (fdt_dualmesh_free) and has passed
  * fdt_dualmesh_check. FDT_EINVAL (a streamed result, n not r's, a bad
  * box or a point outside it), FDT_ETOOBIG (more than OpenFOAM's 32-bit
- * labels hold), FDT_ENOMEM, FDT_EDEGENERATE (the clipped diagram came out
- * not closed: a configuration this construction cannot number; diag says
- * where), each with diag written ("" on success).
+ * labels hold), FDT_ENOMEM, FDT_EINTERNAL (the clipped diagram came out
+ * failing fdt_dualmesh_check: a configuration this construction cannot
+ * number, never written; diag says which cell and edge), each with diag
+ * written ("" on success).
  */
 int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
                        const fdt_voronoi_options *o, fdt_dualmesh *d, char *diag,
