@@ -12,9 +12,13 @@
  *  - every wall face lies on its wall, its normal out of the box, and the
  *    walls' faces add up to the box's surface;
  *  - degenerate inputs: a cubic lattice (cospherical tets merged: unit
- *    cubes, no repeated vertex, 3 k^2 (k - 1) faces), duplicate points (no
- *    cell), five points, points on the walls of a given box, nearly
- *    coplanar points, and clustered points with needle cells.
+ *    cubes, no repeated vertex, 3 k^2 (k - 1) faces), a rotated lattice
+ *    (nearly cospherical, nearly collinear hull triangles), duplicate
+ *    points (no cell), five points (box corners equidistant from two
+ *    points, bisectors through box edges), points on the walls of a given
+ *    box, nearly coplanar points, clustered points with needle cells, and
+ *    a boundary-layer block (layers 1e-6 thick: exact box volumes to
+ *    1e-12).
  */
 #include <math.h>
 #include <string.h>
@@ -30,7 +34,8 @@ static int close_to(double a, double b, double rel)
 
 /* The dual of xyz (box NULL: the bounding box), checked against the
  * Voronoi cells; returns it for more checks (caller frees). */
-static fdt_dualmesh check_dual(const char *what, const double *xyz, size_t n, const double *box)
+static fdt_dualmesh check_dual_tol(const char *what, const double *xyz, size_t n,
+                                   const double *box, double vtol)
 {
     fdt_result *r = test_triangulate(xyz, n, 1, 0);
     fdt_voronoi_options o;
@@ -59,6 +64,8 @@ static fdt_dualmesh check_dual(const char *what, const double *xyz, size_t n, co
     const double *vol = fdt_voronoi_volumes(v);
     double sum = 0, bvol = (b[3] - b[0]) * (b[4] - b[1]) * (b[5] - b[2]);
     size_t pairs = 0, cells = 0;
+    uint8_t *matched = calloc(d.n_internal + 1, 1);
+    CHECK(matched);
     for (size_t i = 0; i < n; i++) {
         int32_t c = d.cell_of[i];
         EXPECTF((c < 0) == (fdt_result_duplicate_map(r)[i] != (fdt_vid)i),
@@ -68,20 +75,70 @@ static fdt_dualmesh check_dual(const char *what, const double *xyz, size_t n, co
         cells++;
         double cv = fdt_dualmesh_cell_volume(&d, cs, cf, (size_t)c);
         sum += cv;
-        EXPECTF(close_to(cv, vol[i], 1e-10), "%s: cell %d volume %.17g, Voronoi %.17g", what,
+        EXPECTF(close_to(cv, vol[i], vtol), "%s: cell %d volume %.17g, Voronoi %.17g", what,
                 c, cv, vol[i]);
         size_t cnt;
         const fdt_vid *ids;
         const double *fa;
         CHECK(fdt_voronoi_neighbors(v, (fdt_vid)i, &cnt, &ids, &fa) == FDT_OK);
         for (size_t e = 0; e < cnt; e++)
-            pairs += ids[e] > (fdt_vid)i;
+            if (ids[e] > (fdt_vid)i) {
+                /* the pair is a face, found by binary search (upper-triangular order) */
+                int32_t ow = c, nb = d.cell_of[ids[e]];
+                size_t lo = 0, hi = d.n_internal;
+                while (lo < hi) {
+                    size_t mid = lo + (hi - lo) / 2;
+                    if (d.owner[mid] < ow || (d.owner[mid] == ow && d.neighbour[mid] < nb))
+                        lo = mid + 1;
+                    else
+                        hi = mid;
+                }
+                int found = lo < d.n_internal && d.owner[lo] == ow && d.neighbour[lo] == nb;
+                EXPECTF(found, "%s: Voronoi neighbours %zu and %d share no face", what, i,
+                        ids[e]);
+                if (found)
+                    matched[lo] = 1;
+                pairs++;
+            }
     }
     EXPECT(cells == d.n_cells);
     EXPECTF(close_to(sum, bvol, 1e-12), "%s: volumes add up to %.17g, box %.17g", what, sum,
             bvol);
-    EXPECTF(pairs == d.n_internal, "%s: %zu internal faces, %zu Voronoi neighbour pairs", what,
-            d.n_internal, pairs);
+    /* the faces beyond those pairs: of no area to 2^-40 of their cells'
+     * surface, which fdt_voronoi_neighbors leaves out (nearly cospherical
+     * points); none for points in general position */
+    const double *surf = fdt_voronoi_areas(v);
+    int32_t *point_of = malloc((d.n_cells + 1) * sizeof *point_of);
+    CHECK(point_of);
+    for (size_t i = 0; i < n; i++)
+        if (d.cell_of[i] >= 0)
+            point_of[d.cell_of[i]] = (int32_t)i;
+    size_t tiny = 0;
+    for (size_t f = 0; f < d.n_internal; f++) {
+        if (matched[f])
+            continue;
+        const int32_t *fv = d.fverts + d.fstart[f];
+        size_t m = d.fstart[f + 1] - d.fstart[f];
+        double nrm[3] = {0, 0, 0};
+        const double *x0 = d.xyz + 3 * (size_t)fv[0];
+        for (size_t j = 1; j + 1 < m; j++) {
+            const double *x = d.xyz + 3 * (size_t)fv[j], *y = d.xyz + 3 * (size_t)fv[j + 1];
+            double u[3], t[3];
+            for (int k = 0; k < 3; k++) {
+                u[k] = x[k] - x0[k];
+                t[k] = y[k] - x0[k];
+            }
+            nrm[0] += 0.5 * (u[1] * t[2] - u[2] * t[1]);
+            nrm[1] += 0.5 * (u[2] * t[0] - u[0] * t[2]);
+            nrm[2] += 0.5 * (u[0] * t[1] - u[1] * t[0]);
+        }
+        double area = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+        tiny += area <= 0x1p-36 * fmax(surf[point_of[d.owner[f]]], surf[point_of[d.neighbour[f]]]);
+    }
+    free(point_of);
+    free(matched);
+    EXPECTF(pairs + tiny == d.n_internal, "%s: %zu internal faces, %zu Voronoi neighbour pairs "
+            "and %zu faces of no area", what, d.n_internal, pairs, tiny);
     /* the walls: on their plane, normals out of the box, areas the box's */
     double wall_area[6] = {0, 0, 0, 0, 0, 0};
     for (int p = 0; p < 6; p++)
@@ -117,6 +174,11 @@ static fdt_dualmesh check_dual(const char *what, const double *xyz, size_t n, co
     return d;
 }
 
+static fdt_dualmesh check_dual(const char *what, const double *xyz, size_t n, const double *box)
+{
+    return check_dual_tol(what, xyz, n, box, 1e-10);
+}
+
 /* k^3 lattice points: unit cubes halved at the walls; every vertex once. */
 static void test_lattice(int k)
 {
@@ -137,6 +199,71 @@ static void test_lattice(int k)
     /* a box through the cells' middles: Voronoi vertices on the walls */
     double box[6] = {-0.5, -0.5, -0.25, k - 0.5, k - 1, k - 0.5};
     d = check_dual("lattice, box through the cells", xyz, n, box);
+    fdt_dualmesh_free(&d);
+    free(xyz);
+}
+
+/* A k^3 lattice turned by (0.3, 0.5, 0.7) rad (gen_points rotlattice):
+ * nearly cospherical groups, nearly collinear hull triangles whose rays
+ * need their normals to the last bit (a plain cross product sent them
+ * astray by 0.1 rad and a cell's volume by 2e-3). */
+static void test_rotated_lattice(int k)
+{
+    size_t n = (size_t)k * k * k;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    CHECK(xyz);
+    double a = 0.3, b = 0.5, c = 0.7;
+    for (size_t i = 0; i < n; i++) {
+        double x = (double)(i % (size_t)k), y = (double)(i / (size_t)k % (size_t)k),
+               z = (double)(i / ((size_t)k * k));
+        double y1 = y * cos(a) - z * sin(a), z1 = y * sin(a) + z * cos(a);
+        double x2 = x * cos(b) + z1 * sin(b), z2 = -x * sin(b) + z1 * cos(b);
+        xyz[3 * i] = x2 * cos(c) - y1 * sin(c);
+        xyz[3 * i + 1] = x2 * sin(c) + y1 * cos(c);
+        xyz[3 * i + 2] = z2;
+    }
+    fdt_dualmesh d = check_dual("rotated lattice", xyz, n, NULL);
+    fdt_dualmesh_free(&d);
+    free(xyz);
+}
+
+/* A boundary-layer block (gen_points blayer): layers 1e-6 .. 1 thick
+ * over a unit grid. Every cell is a box between the midplanes, so its
+ * volume is known exactly; the vertices keep it to 1e-12 (the tets are
+ * flat: their circumcentres come from exact arithmetic). */
+static void test_stretched(void)
+{
+    const int m = 4;
+    double z[8] = {0};
+    for (int k = 1; k < 8; k++)
+        z[k] = z[k - 1] + pow(10.0, k - 7);
+    size_t n = (size_t)m * m * 8;
+    double *xyz = malloc(3 * n * sizeof *xyz);
+    CHECK(xyz);
+    for (size_t i = 0; i < n; i++) {
+        xyz[3 * i] = (double)(i / 8 / (size_t)m);
+        xyz[3 * i + 1] = (double)(i / 8 % (size_t)m);
+        xyz[3 * i + 2] = z[i % 8];
+    }
+    /* fdt_voronoi_compute's own sums keep these thin cells to 1e-7 only */
+    fdt_dualmesh d = check_dual_tol("boundary layer", xyz, n, NULL, 1e-6);
+    size_t *cs, *cf;
+    CHECK(fdt_dualmesh_cell_faces(&d, &cs, &cf) == FDT_OK);
+    for (size_t i = 0; i < n; i++) {
+        double ext[3];
+        for (int k = 0; k < 2; k++) {
+            double x = xyz[3 * i + k];
+            ext[k] = (x == 0 || x == m - 1) ? 0.5 : 1.0;
+        }
+        int l = (int)(i % 8);
+        double lo = l ? 0.5 * (z[l - 1] + z[l]) : z[0], hi = l < 7 ? 0.5 * (z[l] + z[l + 1]) : z[7];
+        double want = ext[0] * ext[1] * (hi - lo);
+        double got = fdt_dualmesh_cell_volume(&d, cs, cf, (size_t)d.cell_of[i]);
+        EXPECTF(close_to(got, want, 1e-12), "boundary layer cell %zu: %.17g, exactly %.17g", i,
+                got, want);
+    }
+    free(cs);
+    free(cf);
     fdt_dualmesh_free(&d);
     free(xyz);
 }
@@ -213,6 +340,8 @@ int main(void)
     test_lattice(2);
     test_lattice(5);
     test_duplicates();
+    test_rotated_lattice(6);
+    test_stretched();
     test_random(3000, 0, 1);
     test_random(3000, 1, 2);
     test_random(3000, 2, 3);

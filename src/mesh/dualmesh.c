@@ -36,6 +36,7 @@
  */
 #include "mesh/dualmesh.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -212,11 +213,13 @@ typedef struct dwork {
     int32_t *fown, *fnbr; /* fnbr: the neighbour cell, or -1 - wall */
     size_t nf, capf, capfo, capfn;
     int32_t *cell_of;
+    int32_t *point_of; /* ncells: a cell's point (owned) */
     size_t ncells;
     cv *poly, *tmp;
     size_t cappoly, captmp;
     fdt_tid *ring;
     size_t capring;
+    double *scaled; /* the points times 2^-e (owned; NULL: not scaled) */
     char *diag;
     size_t ds;
 } dwork;
@@ -247,6 +250,71 @@ static double side(const dwork *w, const double h[4], int p)
 
 /* ------------------------------------------------------------ merging */
 
+/*
+ * A tet's circumcentre, accurate to a small part of its shortest edge (the
+ * vertices of a thin cell, a stretched grid's, must be as good as its
+ * thickness): the floating formula relative to the first point where its
+ * error bound (16 eps of the terms, over |det|, plus det's own relative
+ * error times the result) is within 2^-36 of the shortest edge, else the
+ * exact one (fdt_circumcenter_exact). The points in lexicographic order:
+ * the same bits however the tet comes. -1 when the tet is flat.
+ */
+static int tet_circumcentre(const double *a, const double *b, const double *c, const double *d,
+                            double x[3])
+{
+    const double *s[4] = {a, b, c, d};
+    for (int i = 1; i < 4; i++)
+        for (int j = i; j > 0 && fdt_lex_compare(s[j - 1], s[j]) > 0; j--) {
+            const double *t = s[j];
+            s[j] = s[j - 1];
+            s[j - 1] = t;
+        }
+    double q[3][3], len[3], emin = INFINITY;
+    for (int m = 0; m < 3; m++) {
+        for (int k = 0; k < 3; k++)
+            q[m][k] = s[m + 1][k] - s[0][k];
+        len[m] = sqrt(q[m][0] * q[m][0] + q[m][1] * q[m][1] + q[m][2] * q[m][2]);
+        emin = fmin(emin, len[m]);
+        for (int n = m + 1; n < 3; n++) {
+            double e2 = 0;
+            for (int k = 0; k < 3; k++) {
+                double dk = s[n + 1][k] - s[m + 1][k];
+                e2 += dk * dk;
+            }
+            emin = fmin(emin, sqrt(e2));
+        }
+    }
+    double cr[3][3]; /* q1 x q2, q2 x q0, q0 x q1 */
+    for (int m = 0; m < 3; m++) {
+        const double *u = q[(m + 1) % 3], *v = q[(m + 2) % 3];
+        cr[m][0] = u[1] * v[2] - u[2] * v[1];
+        cr[m][1] = u[2] * v[0] - u[0] * v[2];
+        cr[m][2] = u[0] * v[1] - u[1] * v[0];
+    }
+    double det = q[0][0] * cr[0][0] + q[0][1] * cr[0][1] + q[0][2] * cr[0][2];
+    if (det != 0) {
+        const double eps = 0x1p-53;
+        double l2[3] = {len[0] * len[0], len[1] * len[1], len[2] * len[2]}, r = 0;
+        for (int k = 0; k < 3; k++) {
+            x[k] = (l2[0] * cr[0][k] + l2[1] * cr[1][k] + l2[2] * cr[2][k]) / (2 * det);
+            r += x[k] * x[k];
+        }
+        double terms = (l2[0] + l2[1] + l2[2]) * (len[1] * len[2] + len[2] * len[0] + len[0] * len[1]);
+        double bound = 16 * eps * (terms / fabs(2 * det) + len[0] * len[1] * len[2] / fabs(det) * sqrt(r));
+        if (bound <= 0x1p-36 * emin && isfinite(bound)) {
+            for (int k = 0; k < 3; k++)
+                x[k] += s[0][k];
+            return 0;
+        }
+    }
+    double rel[3];
+    if (fdt_circumcenter_exact(s[0], s[1], s[2], s[3], rel) != 0)
+        return -1;
+    for (int k = 0; k < 3; k++)
+        x[k] = s[0][k] + rel[k];
+    return 0;
+}
+
 /* The tets' circumcentres, and neighbours on one sphere merged. */
 static int merge_tets(dwork *w)
 {
@@ -255,9 +323,9 @@ static int merge_tets(dwork *w)
         const fdt_vid *v = tv + 4 * t;
         w->uf[t] = (int64_t)t;
         w->rvid[t] = -1;
-        if (fdt_voronoi_tet_centre(w->X + 3 * (size_t)v[0], w->X + 3 * (size_t)v[1],
-                                   w->X + 3 * (size_t)v[2], w->X + 3 * (size_t)v[3],
-                                   w->cc + 3 * t) != 0) {
+        if (tet_circumcentre(w->X + 3 * (size_t)v[0], w->X + 3 * (size_t)v[1],
+                             w->X + 3 * (size_t)v[2], w->X + 3 * (size_t)v[3],
+                             w->cc + 3 * t) != 0) {
             say(w->diag, w->ds, "tet %zu is flat: it has no circumcentre", t);
             return FDT_EINTERNAL;
         }
@@ -326,6 +394,65 @@ static int64_t hull_face(const dwork *w, fdt_tid t, int q)
     return kmap_get(&w->hull, 4 * (uint64_t)t + (uint64_t)q, 0);
 }
 
+/* s + e = a + b exactly. */
+static void two_sum(double a, double b, double *s, double *e)
+{
+    *s = a + b;
+    double bb = *s - a;
+    *e = (a - (*s - bb)) + (b - bb);
+}
+
+/* u x v for u = b - a, v = c - a, component k, with the differences and
+ * products kept exactly as pairs of doubles and the terms summed with
+ * their errors (Neumaier): accurate to about eps |result| + eps^2 |terms|,
+ * so a nearly collinear triangle's normal keeps its direction (the plain
+ * formula lost all of it on a rotated lattice's hull). */
+static double cross_k(const double *a, const double *b, const double *c, int k)
+{
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    double ui[2], uj[2], vi[2], vj[2];
+    two_sum(b[i], -a[i], &ui[0], &ui[1]);
+    two_sum(b[j], -a[j], &uj[0], &uj[1]);
+    two_sum(c[i], -a[i], &vi[0], &vi[1]);
+    two_sum(c[j], -a[j], &vj[0], &vj[1]);
+    double t[16];
+    int m = 0;
+    for (int x = 0; x < 2; x++)
+        for (int y = 0; y < 2; y++) {
+            double p = ui[x] * vj[y], q = vi[x] * uj[y]; /* ui vj - uj vi */
+            t[m++] = p;
+            t[m++] = fma(ui[x], vj[y], -p);
+            t[m++] = -q;
+            t[m++] = -fma(vi[x], uj[y], -q);
+        }
+    double sum = 0, comp = 0;
+    for (int x = 0; x < m; x++) {
+        double s2, e2;
+        two_sum(sum, t[x], &s2, &e2);
+        sum = s2;
+        comp += e2;
+    }
+    return sum + comp;
+}
+
+/* The unit normal of triangle (a, b, c) by the right-hand rule. */
+static void unit_normal(const double *a, const double *b, const double *c, double d[3])
+{
+    double big = 0;
+    for (int k = 0; k < 3; k++) {
+        d[k] = cross_k(a, b, c, k);
+        big = fmax(big, fabs(d[k]));
+    }
+    double len = 0;
+    for (int k = 0; k < 3; k++) {
+        d[k] /= big; /* no over- or underflow in the squares */
+        len += d[k] * d[k];
+    }
+    len = sqrt(len);
+    for (int k = 0; k < 3; k++)
+        d[k] /= len;
+}
+
 /* The hull faces, their normals, and adjacent coplanar ones whose tets
  * share a Voronoi vertex merged: one ray. */
 static int number_hull(dwork *w)
@@ -347,17 +474,7 @@ static int number_hull(dwork *w)
             const double *p0 = w->X + 3 * (size_t)tv[4 * t + (size_t)fdt_tet_face[q][0]];
             const double *p1 = w->X + 3 * (size_t)tv[4 * t + (size_t)fdt_tet_face[q][1]];
             const double *p2 = w->X + 3 * (size_t)tv[4 * t + (size_t)fdt_tet_face[q][2]];
-            double e1[3], e2[3], *d = w->hdir + 3 * w->nhull;
-            for (int k = 0; k < 3; k++) {
-                e1[k] = p1[k] - p0[k];
-                e2[k] = p2[k] - p0[k];
-            }
-            d[0] = e1[1] * e2[2] - e1[2] * e2[1];
-            d[1] = e1[2] * e2[0] - e1[0] * e2[2];
-            d[2] = e1[0] * e2[1] - e1[1] * e2[0];
-            double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            for (int k = 0; k < 3; k++)
-                d[k] /= len;
+            unit_normal(p0, p1, p2, w->hdir + 3 * w->nhull);
             for (int k = 0; k < 3; k++)
                 w->htri[3 * w->nhull + (size_t)k] = tv[4 * t + (size_t)fdt_tet_face[q][k]];
             w->huf[w->nhull] = (int64_t)w->nhull;
@@ -841,60 +958,232 @@ static int32_t corner_cell(const dwork *w, int c, double x[3])
     return tie || best == SIZE_MAX ? -1 : w->cell_of[best];
 }
 
-typedef struct wallv {
-    int p;
-    int64_t id;
-    double ang;
-} wallv;
+/* Where a point lies on the rim of wall p (the rectangle's boundary),
+ * going round it counter-clockwise in the wall's (u, t) axes: the side
+ * (0 t = tmin, 1 u = umax, 2 t = tmax, 3 u = umin) and the position along
+ * it; side -1 off the rim. Compared exactly: near-equal points keep
+ * their order. */
+typedef struct rimkey {
+    int side;
+    double pos;
+} rimkey;
 
-static int wallv_cmp(const void *x, const void *y)
+static rimkey rim_key(const dwork *w, int p, const double *x)
 {
-    const wallv *a = x, *b = y;
-    if (a->p != b->p)
-        return a->p < b->p ? -1 : 1;
-    if (a->id != b->id)
-        return a->id < b->id ? -1 : 1;
-    return 0;
-}
-
-static int wallv_ang(const void *x, const void *y)
-{
-    const wallv *a = x, *b = y;
-    return a->ang < b->ang ? -1 : a->ang > b->ang;
-}
-
-/* Cell c's face on wall p from its vertices v[0 .. m) on it (distinct):
- * sorted about their centroid, counter-clockwise about the outward
- * normal; none when they span no area. */
-static int wall_face(dwork *w, int32_t c, int p, wallv *v, size_t m)
-{
-    if (m < 3)
-        return FDT_OK;
     int k = p >> 1, u = (k + 1) % 3, t = (k + 2) % 3;
-    double cu = 0, ct = 0;
-    for (size_t i = 0; i < m; i++) {
-        cu += w->vx[3 * (size_t)v[i].id + (size_t)u];
-        ct += w->vx[3 * (size_t)v[i].id + (size_t)t];
+    double u0 = w->box[u], u1 = w->box[u + 3], t0 = w->box[t], t1 = w->box[t + 3];
+    rimkey r = {-1, 0};
+    if (x[t] == t0 && x[u] != u1)
+        r = (rimkey){0, x[u]};
+    else if (x[u] == u1 && x[t] != t1)
+        r = (rimkey){1, x[t]};
+    else if (x[t] == t1 && x[u] != u0)
+        r = (rimkey){2, -x[u]};
+    else if (x[u] == u0)
+        r = (rimkey){3, -x[t]};
+    return r;
+}
+
+/* A piece of a wall face: a chain of the cell's edges on the wall (from
+ * the edge at `at`), or a box corner (at == SIZE_MAX). */
+typedef struct wallitem {
+    rimkey key;
+    size_t at;
+    int64_t corner;
+} wallitem;
+
+static int item_cmp(const void *x, const void *y)
+{
+    const wallitem *a = x, *b = y;
+    if (a->key.side != b->key.side)
+        return a->key.side < b->key.side ? -1 : 1;
+    return a->key.pos < b->key.pos ? -1 : a->key.pos > b->key.pos;
+}
+
+static int u64_cmp(const void *x, const void *y)
+{
+    uint64_t a = *(const uint64_t *)x, b = *(const uint64_t *)y;
+    return a < b ? -1 : a > b;
+}
+
+/* The index of the edge leaving vertex v in e[0 .. m) (sorted, from in
+ * the high half), or SIZE_MAX. */
+static size_t edge_from(const uint64_t *e, size_t m, uint64_t v)
+{
+    size_t lo = 0, hi = m;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if ((e[mid] >> 32) < v)
+            lo = mid + 1;
+        else
+            hi = mid;
     }
-    cu /= (double)m;
-    ct /= (double)m;
-    for (size_t i = 0; i < m; i++)
-        v[i].ang = atan2(w->vx[3 * (size_t)v[i].id + (size_t)t] - ct,
-                         w->vx[3 * (size_t)v[i].id + (size_t)u] - cu);
-    qsort(v, m, sizeof *v, wallv_ang);
-    double area = 0;
-    for (size_t i = 0; i < m; i++) {
-        const double *a = w->vx + 3 * (size_t)v[i].id, *b = w->vx + 3 * (size_t)v[(i + 1) % m].id;
-        area += (a[u] - cu) * (b[t] - ct) - (b[u] - cu) * (a[t] - ct);
-    }
-    if (!(area > 0))
-        return FDT_OK;
-    if (grow(&w->fv, &w->capfv, w->nfv + m, sizeof *w->fv) != 0)
+    return lo < m && (e[lo] >> 32) == v ? lo : SIZE_MAX;
+}
+
+typedef struct hedge hedge;
+typedef struct wallwork {
+    hedge *he;       /* the cell's half-edges, then its wall edges */
+    size_t caphe;
+    uint64_t *we;    /* one wall's edges (from << 32 | to), sorted */
+    size_t capwe;
+    wallitem *it;
+    size_t capit;
+    uint64_t *to;    /* one wall's edges' ends, sorted */
+    size_t capto;
+} wallwork;
+
+/* Cell c's face on wall p: its edges e[0 .. m) on the wall (each the
+ * reverse of an edge its other faces use once), chained, and the box
+ * corners it holds there, put in the order of their chains' starts round
+ * the rim (the face is convex: its rim points come in the rim's order). */
+static int wall_face(dwork *w, wallwork *ww, int32_t c, int p, size_t m, const int64_t *corners,
+                     int nc)
+{
+    uint64_t *e = ww->we;
+    qsort(e, m, sizeof *e, u64_cmp);
+    if (grow(&ww->it, &ww->capit, m + (size_t)nc + 1, sizeof *ww->it) != 0 ||
+        grow(&w->fv, &w->capfv, w->nfv + 2 * m + (size_t)nc + 1, sizeof *w->fv) != 0)
         return FDT_ENOMEM;
-    int64_t *ids = w->fv + w->nfv;
+    if (grow(&ww->to, &ww->capto, m + 1, sizeof *ww->to) != 0)
+        return FDT_ENOMEM;
     for (size_t i = 0; i < m; i++)
-        ids[i] = v[(p & 1) ? i : m - 1 - i].id;
-    return append_face(w, ids, m, c, -1 - p);
+        ww->to[i] = e[i] & 0xffffffffu;
+    qsort(ww->to, m, sizeof *ww->to, u64_cmp);
+    size_t ni = 0;
+    for (size_t i = 0; i < m; i++) {
+        if (i > 0 && (e[i] >> 32) == (e[i - 1] >> 32))
+            goto bad;
+        uint64_t from = e[i] >> 32;
+        if (bsearch(&from, ww->to, m, sizeof *ww->to, u64_cmp))
+            continue; /* not a chain's start */
+        ww->it[ni] = (wallitem){rim_key(w, p, w->vx + 3 * (e[i] >> 32)), i, -1};
+        if (ww->it[ni++].key.side < 0)
+            goto bad;
+    }
+    for (int k = 0; k < nc; k++)
+        ww->it[ni++] = (wallitem){rim_key(w, p, w->vx + 3 * (size_t)corners[k]), SIZE_MAX,
+                                  corners[k]};
+    if (ni == 0 && m > 0)
+        ww->it[ni++] = (wallitem){{0, 0}, 0, -1}; /* one closed chain inside the wall */
+    qsort(ww->it, ni, sizeof *ww->it, item_cmp);
+    int64_t *ids = w->fv + w->nfv;
+    size_t k = 0, used = 0;
+    for (size_t a = 0; a < ni; a++) {
+        const wallitem *x = &ww->it[(p & 1) ? a : ni - 1 - a];
+        if (x->at == SIZE_MAX) {
+            ids[k++] = x->corner;
+            continue;
+        }
+        uint64_t v = e[x->at] >> 32, first = v;
+        size_t at = x->at;
+        do {
+            ids[k++] = (int64_t)v;
+            v = e[at] & 0xffffffffu;
+            if (++used > m)
+                goto bad;
+            at = edge_from(e, m, v);
+        } while (at != SIZE_MAX && v != first);
+        if (v != first)
+            ids[k++] = (int64_t)v;
+    }
+    if (used != m)
+        goto bad;
+    return k < 3 ? FDT_OK : append_face(w, ids, k, c, -1 - p);
+bad:
+    say(w->diag, w->ds, "the face of cell %d on wall %s does not chain (%zu edges)", c,
+        fdt_dualmesh_patch[p], m);
+    return FDT_EINTERNAL;
+}
+
+/* A half-edge of a cell's face, turned out of the cell, and the cell
+ * on the face's other side. */
+typedef struct hedge {
+    uint64_t key; /* from << 32 | to */
+    int32_t other;
+    int wall;
+} hedge;
+
+static int hedge_cmp(const void *x, const void *y)
+{
+    return u64_cmp(&((const hedge *)x)->key, &((const hedge *)y)->key);
+}
+
+/* The wall the reverse of cell c's half-edge h lies on: the one both its
+ * ends are on; along a box edge (two walls p, q), the one the cell
+ * touches there: p when the face's normal out of c (its point towards
+ * the other cell's) leans out through q. -1 when on none. */
+static int hedge_wall(const dwork *w, int32_t c, const hedge *h)
+{
+    const double *a = w->vx + 3 * (h->key >> 32), *b = w->vx + 3 * (h->key & 0xffffffffu);
+    int on[2], n = 0;
+    for (int p = 0; p < 6 && n < 2; p++)
+        if (a[p >> 1] == bound(w, p) && b[p >> 1] == bound(w, p))
+            on[n++] = p;
+    if (n < 2)
+        return n ? on[0] : -1;
+    const double *x = w->X + 3 * (size_t)w->point_of[c];
+    const double *y = w->X + 3 * (size_t)w->point_of[h->other];
+    int q = on[1], kq = q >> 1; /* does y - x lean out through q? */
+    int out = (q & 1) ? y[kq] > x[kq] : y[kq] < x[kq];
+    return out ? on[0] : on[1];
+}
+
+/* Cell c's faces on the walls: the reverses of the edges its faces use
+ * once, by wall, and the corners it holds. */
+static int cell_walls(dwork *w, wallwork *ww, int32_t c, const size_t *cs, const size_t *cf,
+                      const int64_t corner_id[8], const int32_t corner_of[8])
+{
+    size_t m = 0;
+    for (size_t j = cs[c]; j < cs[c + 1]; j++) {
+        size_t f = cf[j], k = w->fs[f + 1] - w->fs[f];
+        const int64_t *v = w->fv + w->fs[f];
+        int own = w->fown[f] == c;
+        if (grow(&ww->he, &ww->caphe, m + k, sizeof *ww->he) != 0)
+            return FDT_ENOMEM;
+        for (size_t i = 0; i < k; i++) {
+            uint64_t a = (uint64_t)v[i], b = (uint64_t)v[(i + 1) % k];
+            ww->he[m].key = own ? a << 32 | b : b << 32 | a;
+            ww->he[m++].other = own ? w->fnbr[f] : w->fown[f];
+        }
+    }
+    qsort(ww->he, m, sizeof *ww->he, hedge_cmp);
+    /* the unmatched ones, reversed, after the first m */
+    size_t nw = 0;
+    if (grow(&ww->he, &ww->caphe, 2 * m + 1, sizeof *ww->he) != 0)
+        return FDT_ENOMEM;
+    for (size_t i = 0; i < m; i++) {
+        hedge r = ww->he[i];
+        r.key = (r.key << 32) | (r.key >> 32);
+        if (bsearch(&r, ww->he, m, sizeof *ww->he, hedge_cmp))
+            continue;
+        r.wall = hedge_wall(w, c, &r);
+        if (r.wall < 0) {
+            say(w->diag, w->ds, "cell %d is open at edge %llu-%llu, on no wall", c,
+                (unsigned long long)(r.key >> 32), (unsigned long long)(r.key & 0xffffffffu));
+            return FDT_EINTERNAL;
+        }
+        ww->he[m + nw++] = r;
+    }
+    for (int p = 0; p < 6; p++) {
+        int64_t corners[4];
+        int nc = 0;
+        for (int k = 0; k < 8; k++)
+            if (corner_of[k] == c && ((k >> (p >> 1)) & 1) == (p & 1))
+                corners[nc++] = corner_id[k];
+        size_t me = 0;
+        if (grow(&ww->we, &ww->capwe, nw + 1, sizeof *ww->we) != 0)
+            return FDT_ENOMEM;
+        for (size_t i = 0; i < nw; i++)
+            if (ww->he[m + i].wall == p)
+                ww->we[me++] = ww->he[m + i].key;
+        if (me == 0 && nc == 0)
+            continue;
+        int err = wall_face(w, ww, c, p, me, corners, nc);
+        if (err)
+            return err;
+    }
+    return FDT_OK;
 }
 
 /* Every cell's faces on the walls. */
@@ -907,6 +1196,10 @@ static int all_walls(dwork *w)
     tmp.owner = w->fown;
     tmp.neighbour = w->fnbr;
     size_t *cs = NULL, *cf = NULL;
+    if (w->nv >= (UINT64_C(1) << 31)) {
+        say(w->diag, w->ds, "too many vertices for OpenFOAM's 32-bit labels");
+        return FDT_ETOOBIG;
+    }
     if (fdt_dualmesh_cell_faces(&tmp, &cs, &cf) != FDT_OK)
         return FDT_ENOMEM;
     int64_t corner_id[8];
@@ -919,53 +1212,14 @@ static int all_walls(dwork *w)
         if (corner_id[c] < 0)
             err = FDT_ENOMEM;
     }
-    wallv *v = NULL;
-    size_t capv = 0;
-    for (size_t c = 0; c < w->ncells && !err; c++) {
-        size_t m = 0;
-        for (size_t j = cs[c]; j < cs[c + 1] && !err; j++) {
-            size_t f = cf[j];
-            for (size_t i = w->fs[f]; i < w->fs[f + 1]; i++) {
-                const double *x = w->vx + 3 * (size_t)w->fv[i];
-                for (int p = 0; p < 6; p++)
-                    if (x[p >> 1] == bound(w, p)) {
-                        if (grow(&v, &capv, m + 1, sizeof *v) != 0) {
-                            err = FDT_ENOMEM;
-                            break;
-                        }
-                        v[m].p = p;
-                        v[m++].id = w->fv[i];
-                    }
-            }
-        }
-        for (int k = 0; k < 8 && !err; k++) {
-            if (corner_of[k] != (int32_t)c)
-                continue;
-            for (int a = 0; a < 3; a++) {
-                if (grow(&v, &capv, m + 1, sizeof *v) != 0) {
-                    err = FDT_ENOMEM;
-                    break;
-                }
-                v[m].p = 2 * a + ((k >> a) & 1);
-                v[m++].id = corner_id[k];
-            }
-        }
-        if (err || m == 0)
-            continue;
-        qsort(v, m, sizeof *v, wallv_cmp);
-        size_t u = 0;
-        for (size_t i = 0; i < m; i++)
-            if (u == 0 || v[i].p != v[u - 1].p || v[i].id != v[u - 1].id)
-                v[u++] = v[i];
-        for (size_t i = 0; i < u && !err;) {
-            size_t j = i;
-            while (j < u && v[j].p == v[i].p)
-                j++;
-            err = wall_face(w, (int32_t)c, v[i].p, v + i, j - i);
-            i = j;
-        }
-    }
-    free(v);
+    wallwork ww;
+    memset(&ww, 0, sizeof ww);
+    for (size_t c = 0; c < w->ncells && !err; c++)
+        err = cell_walls(w, &ww, (int32_t)c, cs, cf, corner_id, corner_of);
+    free(ww.he);
+    free(ww.to);
+    free(ww.we);
+    free(ww.it);
     free(cs);
     free(cf);
     return err;
@@ -1097,12 +1351,6 @@ double fdt_dualmesh_cell_volume(const fdt_dualmesh *d, const size_t *cs, const s
     return vol;
 }
 
-static int u64_cmp(const void *x, const void *y)
-{
-    uint64_t a = *(const uint64_t *)x, b = *(const uint64_t *)y;
-    return a < b ? -1 : a > b;
-}
-
 /* The faces' own rules: sizes, ranges, repeats, order, every vertex used. */
 static int check_faces(const fdt_dualmesh *d, char *diag, size_t ds)
 {
@@ -1209,7 +1457,8 @@ static int check_cell(const fdt_dualmesh *d, const size_t *cs, const size_t *cf,
     }
     double vol = fdt_dualmesh_cell_volume(d, cs, cf, c);
     if (!(vol > 0)) {
-        say(diag, ds, "cell %zu has volume %g", c, vol);
+        say(diag, ds, "cell %zu has volume %g (turned inward, or too small for doubles "
+            "beside the box)", c, vol);
         return -1;
     }
     return 0;
@@ -1269,6 +1518,8 @@ static void free_work(dwork *w)
     free(w->poly);
     free(w->tmp);
     free(w->ring);
+    free(w->scaled);
+    free(w->point_of);
 }
 
 /* The cells: the points that are not merged duplicates, in input order. */
@@ -1278,10 +1529,45 @@ static int number_cells(dwork *w, fdt_dualmesh *d)
     d->cell_of = malloc((w->n + 1) * sizeof *d->cell_of);
     if (!d->cell_of)
         return FDT_ENOMEM;
-    for (size_t i = 0; i < w->n; i++)
+    w->point_of = malloc((w->n + 1) * sizeof *w->point_of);
+    if (!w->point_of)
+        return FDT_ENOMEM;
+    for (size_t i = 0; i < w->n; i++) {
         d->cell_of[i] = w->r->dupmap[i] == (fdt_vid)i ? (int32_t)w->ncells++ : -1;
+        if (d->cell_of[i] >= 0)
+            w->point_of[d->cell_of[i]] = (int32_t)i;
+    }
     w->cell_of = d->cell_of;
     return FDT_OK;
+}
+
+/* The points and the box scaled by a power of two so that the box's
+ * largest side is about 1 (1e-150 and 1e150 wide sets: no squared
+ * length under- or overflows), when every coordinate scales exactly;
+ * the exponent to scale the vertices back by (0: not scaled), INT_MIN when
+ * out of memory. Signs of predicates and order along the walls do not
+ * change. */
+static int scale_points(dwork *w)
+{
+    double side = 0;
+    for (int k = 0; k < 3; k++)
+        side = fmax(side, w->box[k + 3] - w->box[k]);
+    int e;
+    (void)frexp(side, &e);
+    if (e > -4 && e < 4)
+        return 0;
+    for (size_t i = 0; i < 3 * w->n; i++)
+        if (ldexp(ldexp(w->X[i], -e), e) != w->X[i])
+            return 0;
+    w->scaled = malloc((3 * w->n + 1) * sizeof *w->scaled);
+    if (!w->scaled)
+        return INT_MIN;
+    for (size_t i = 0; i < 3 * w->n; i++)
+        w->scaled[i] = ldexp(w->X[i], -e);
+    for (int k = 0; k < 6; k++)
+        w->box[k] = ldexp(w->box[k], -e);
+    w->X = w->scaled;
+    return e;
 }
 
 int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
@@ -1318,6 +1604,11 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
     if (err)
         goto done;
     memcpy(d->box, w.box, sizeof w.box);
+    int ex = scale_points(&w);
+    if (ex == INT_MIN) {
+        err = FDT_ENOMEM;
+        goto done;
+    }
     w.nb = w.loc.nbrs;
     w.uf = malloc(w.T * sizeof *w.uf);
     w.cc = malloc(3 * w.T * sizeof *w.cc);
@@ -1348,6 +1639,8 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
 #endif
     if (!err && fdt_dualmesh_check(d, diag, diag_size) != 0)
         err = FDT_EINTERNAL;
+    for (size_t i = 0; !err && ex && i < 3 * d->n_verts; i++)
+        d->xyz[i] = ldexp(d->xyz[i], ex);
 done:
 #ifdef DUAL_DEBUG
     if (getenv("DUAL_NOCHECK"))
