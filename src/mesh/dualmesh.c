@@ -26,13 +26,16 @@
  *    coordinate on its wall is the bound itself, exactly;
  *  - a face left with fewer than 3 distinct vertices has no area and is
  *    dropped (its cells then share no face);
- *  - a cell's face on a wall is the convex polygon of the cell's vertices
- *    that lie exactly on the wall, with the box corners nearest to the
- *    cell's point, sorted about their centroid.
+ *  - a cell's face on a wall is chained from the edges that only one of
+ *    the cell's faces uses (turned round), the chains put in the order of
+ *    their starts round the wall's rim, with the box corners nearest to
+ *    the cell's point; an edge along a box edge goes to the wall the cell
+ *    touches there;
+ *  - the points are scaled by a power of two (exactly) so that the box is
+ *    about 1 wide, the vertices scaled back at the end.
  * The result is checked (fdt_dualmesh_check) before it is handed out: a
- * configuration this cannot number (a box corner equidistant from two
- * points, rounding that turns a wall polygon) is an error, never a
- * broken mesh.
+ * configuration this cannot number (cells too small for doubles beside
+ * the box) is an error, never a broken mesh.
  */
 #include "mesh/dualmesh.h"
 
@@ -1006,6 +1009,46 @@ static int u64_cmp(const void *x, const void *y)
     return a < b ? -1 : a > b;
 }
 
+/* Sorts a[0 .. m) ascending: a quicksort on the keys themselves (no
+ * comparator calls; a cell's ~90 half-edges are sorted a million times). */
+static void sort_u64(uint64_t *a, size_t m)
+{
+    while (m > 16) {
+        uint64_t x = a[0], y = a[m / 2], z = a[m - 1];
+        uint64_t piv = x < y ? (y < z ? y : (x < z ? z : x)) : (x < z ? x : (y < z ? z : y));
+        size_t i = 0, j = m - 1;
+        for (;;) {
+            while (a[i] < piv)
+                i++;
+            while (a[j] > piv)
+                j--;
+            if (i >= j)
+                break;
+            uint64_t t = a[i];
+            a[i++] = a[j];
+            a[j--] = t;
+        }
+        /* [0, j] <= piv <= [j + 1, m): recurse on the smaller part */
+        if (j + 1 < m - j - 1) {
+            sort_u64(a, j + 1);
+            a += j + 1;
+            m -= j + 1;
+        } else {
+            sort_u64(a + j + 1, m - j - 1);
+            m = j + 1;
+        }
+    }
+    for (size_t i = 1; i < m; i++) {
+        uint64_t x = a[i];
+        size_t j = i;
+        while (j > 0 && a[j - 1] > x) {
+            a[j] = a[j - 1];
+            j--;
+        }
+        a[j] = x;
+    }
+}
+
 /* The index of the edge leaving vertex v in e[0 .. m) (sorted, from in
  * the high half), or SIZE_MAX. */
 static size_t edge_from(const uint64_t *e, size_t m, uint64_t v)
@@ -1041,7 +1084,7 @@ static int wall_face(dwork *w, wallwork *ww, int32_t c, int p, size_t m, const i
                      int nc)
 {
     uint64_t *e = ww->we;
-    qsort(e, m, sizeof *e, u64_cmp);
+    sort_u64(e, m);
     if (grow(&ww->it, &ww->capit, m + (size_t)nc + 1, sizeof *ww->it) != 0 ||
         grow(&w->fv, &w->capfv, w->nfv + 2 * m + (size_t)nc + 1, sizeof *w->fv) != 0)
         return FDT_ENOMEM;
@@ -1049,7 +1092,7 @@ static int wall_face(dwork *w, wallwork *ww, int32_t c, int p, size_t m, const i
         return FDT_ENOMEM;
     for (size_t i = 0; i < m; i++)
         ww->to[i] = e[i] & 0xffffffffu;
-    qsort(ww->to, m, sizeof *ww->to, u64_cmp);
+    sort_u64(ww->to, m);
     size_t ni = 0;
     for (size_t i = 0; i < m; i++) {
         if (i > 0 && (e[i] >> 32) == (e[i - 1] >> 32))
@@ -1186,6 +1229,24 @@ static int cell_walls(dwork *w, wallwork *ww, int32_t c, const size_t *cs, const
     return FDT_OK;
 }
 
+/* Has cell c a vertex on a wall, or a box corner? (Else it has no wall
+ * face, and its edges all pair up.) */
+static int touches_wall(const dwork *w, int32_t c, const size_t *cs, const size_t *cf,
+                        const int32_t corner_of[8])
+{
+    for (int k = 0; k < 8; k++)
+        if (corner_of[k] == c)
+            return 1;
+    for (size_t j = cs[c]; j < cs[c + 1]; j++)
+        for (size_t i = w->fs[cf[j]]; i < w->fs[cf[j] + 1]; i++) {
+            const double *x = w->vx + 3 * (size_t)w->fv[i];
+            for (int p = 0; p < 6; p++)
+                if (x[p >> 1] == bound(w, p))
+                    return 1;
+        }
+    return 0;
+}
+
 /* Every cell's faces on the walls. */
 static int all_walls(dwork *w)
 {
@@ -1215,7 +1276,8 @@ static int all_walls(dwork *w)
     wallwork ww;
     memset(&ww, 0, sizeof ww);
     for (size_t c = 0; c < w->ncells && !err; c++)
-        err = cell_walls(w, &ww, (int32_t)c, cs, cf, corner_id, corner_of);
+        if (touches_wall(w, (int32_t)c, cs, cf, corner_of))
+            err = cell_walls(w, &ww, (int32_t)c, cs, cf, corner_id, corner_of);
     free(ww.he);
     free(ww.to);
     free(ww.we);
@@ -1441,7 +1503,7 @@ static int check_cell(const fdt_dualmesh *d, const size_t *cs, const size_t *cf,
         say(diag, ds, "cell %zu has no faces", c);
         return -1;
     }
-    qsort(*buf, m, sizeof **buf, u64_cmp);
+    sort_u64(*buf, m);
     for (size_t i = 0; i < m; i++) {
         uint64_t e = (*buf)[i], r = (e << 32) | (e >> 32);
         if (i > 0 && (*buf)[i - 1] == e) {
@@ -1633,19 +1695,11 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
     }
     if (!err)
         err = assemble(&w, d);
-#ifdef DUAL_DEBUG
-    if (getenv("DUAL_NOCHECK"))
-        goto done;
-#endif
     if (!err && fdt_dualmesh_check(d, diag, diag_size) != 0)
         err = FDT_EINTERNAL;
     for (size_t i = 0; !err && ex && i < 3 * d->n_verts; i++)
         d->xyz[i] = ldexp(d->xyz[i], ex);
 done:
-#ifdef DUAL_DEBUG
-    if (getenv("DUAL_NOCHECK"))
-        fprintf(stderr, "check: %d\n", fdt_dualmesh_check(d, diag, diag_size));
-#endif
     if (err == FDT_ENOMEM && !diag[0])
         say(diag, diag_size, "out of memory");
     free_work(&w);

@@ -389,28 +389,6 @@ static inline int lex_after(const double *p, const double *q)
     return p[2] > q[2];
 }
 
-int fdt_voronoi_tet_centre(const double *a, const double *b, const double *c, const double *d,
-                           double x[3])
-{
-    /* the lexicographic order, as add_tet takes a tet: the same bits for
-     * every order of the four points */
-    const double *s[4] = {a, b, c, d};
-    for (int i = 1; i < 4; i++)
-        for (int j = i; j > 0 && lex_after(s[j - 1], s[j]); j--) {
-            const double *t = s[j];
-            s[j] = s[j - 1];
-            s[j - 1] = t;
-        }
-    double q[4][3] = {{0, 0, 0}}, rel[3];
-    for (int m = 1; m < 4; m++)
-        sub3(s[m], s[0], q[m]);
-    if (tet_centre(s[0], q, s[1], s[2], s[3], rel) != 0)
-        return -1;
-    for (int k = 0; k < 3; k++)
-        x[k] = s[0][k] + rel[k];
-    return 0;
-}
-
 static int mine(const vjob *j, uint32_t x)
 {
     return x >= j->lo && x < j->hi;

@@ -17,12 +17,4 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
 int fdt_voronoi_box_of(const fdt_result *r, const double *xyz, size_t n,
                        const fdt_voronoi_options *o, double box[6], char *diag, size_t ds);
 
-/* The circumcentre of the tet (a, b, c, d), absolute, as the cells' sums
- * take it: from the points in lexicographic order (the same bits for
- * every order of them), the floating formula for a well-shaped tet, the
- * exact one (fdt_circumcenter_exact) for a flat one. -1 when the four
- * points are coplanar. */
-int fdt_voronoi_tet_centre(const double *a, const double *b, const double *c, const double *d,
-                           double x[3]);
-
 #endif
