@@ -14,7 +14,8 @@ faces, every cell is closed (each edge once each way round, the faces
 turned out of it), each cell's volume from its faces equals --voronoi's %v
 for its point (1e-10 relative; merged duplicates have no cell) and the
 volumes add up to the box's (1e-12). Refusals: --dual without an OpenFOAM
--o, --dual with --stream, a point outside --box (exit 1 each).
+-o, --dual with --stream, a point outside --box (exit 1 each). Written
+again over the existing polyMesh beside a .tets output of the same run.
 
 With --checkmesh: OpenFOAM's checkMesh on the same cases, every topology
 check OK ("Boundary definition OK" .. "Number of regions: 1 (OK)"), face
@@ -246,6 +247,19 @@ def main():
             fail(f"a point outside --box: {p.stderr.strip()}")
         if os.path.exists(os.path.join(SCRATCH, "b", "polyMesh")):
             fail("a refused --dual left a polyMesh")
+        # over an existing polyMesh (its five files replaced), beside a
+        # Delaunay output of the same run (the tets as ever)
+        case = dict(cases)["uniform"]
+        poly = os.path.join(case, "constant", "polyMesh")
+        tets = os.path.join(SCRATCH, "m.tets")
+        run([uni, "-q", "-o", tets, "-o", poly, "--dual"])
+        points, faces, owner, neighbour, patches = read_polymesh(poly)
+        check_topology("uniform again", points, faces, owner, neighbour, patches)
+        with open(tets) as f:
+            if len(f.readline().split()) != 4:
+                fail("-o m.tets beside --dual: not a .tets file")
+        if any(".tmp." in x for x in os.listdir(os.path.join(case, "constant"))):
+            fail("--dual left a temporary beside the polyMesh")
     if failures:
         print(f"{len(failures)} failures")
         sys.exit(1)
