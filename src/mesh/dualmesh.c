@@ -1229,22 +1229,33 @@ static int cell_walls(dwork *w, wallwork *ww, int32_t c, const size_t *cs, const
     return FDT_OK;
 }
 
-/* Has cell c a vertex on a wall, or a box corner? (Else it has no wall
- * face, and its edges all pair up.) */
-static int touches_wall(const dwork *w, int32_t c, const size_t *cs, const size_t *cf,
-                        const int32_t corner_of[8])
+/* touch[c] = 1 for each cell with a vertex on a wall or a box corner
+ * (the others have no wall face: their edges all pair up). 0 or
+ * FDT_ENOMEM. */
+static int touching_cells(const dwork *w, const int32_t corner_of[8], uint8_t *touch)
 {
+    uint8_t *on = malloc(w->nv + 1);
+    if (!on)
+        return FDT_ENOMEM;
+    for (size_t v = 0; v < w->nv; v++) {
+        const double *x = w->vx + 3 * v;
+        on[v] = 0;
+        for (int p = 0; p < 6; p++)
+            on[v] |= x[p >> 1] == bound(w, p);
+    }
+    memset(touch, 0, w->ncells);
+    for (size_t f = 0; f < w->nf; f++)
+        for (size_t i = w->fs[f]; i < w->fs[f + 1]; i++)
+            if (on[w->fv[i]]) {
+                touch[w->fown[f]] = 1;
+                touch[w->fnbr[f]] = 1;
+                break;
+            }
     for (int k = 0; k < 8; k++)
-        if (corner_of[k] == c)
-            return 1;
-    for (size_t j = cs[c]; j < cs[c + 1]; j++)
-        for (size_t i = w->fs[cf[j]]; i < w->fs[cf[j] + 1]; i++) {
-            const double *x = w->vx + 3 * (size_t)w->fv[i];
-            for (int p = 0; p < 6; p++)
-                if (x[p >> 1] == bound(w, p))
-                    return 1;
-        }
-    return 0;
+        if (corner_of[k] >= 0)
+            touch[corner_of[k]] = 1;
+    free(on);
+    return FDT_OK;
 }
 
 /* Every cell's faces on the walls. */
@@ -1275,9 +1286,15 @@ static int all_walls(dwork *w)
     }
     wallwork ww;
     memset(&ww, 0, sizeof ww);
+    uint8_t *touch = malloc(w->ncells + 1);
+    if (!err && !touch)
+        err = FDT_ENOMEM;
+    if (!err)
+        err = touching_cells(w, corner_of, touch);
     for (size_t c = 0; c < w->ncells && !err; c++)
-        if (touches_wall(w, (int32_t)c, cs, cf, corner_of))
+        if (touch[c])
             err = cell_walls(w, &ww, (int32_t)c, cs, cf, corner_id, corner_of);
+    free(touch);
     free(ww.he);
     free(ww.to);
     free(ww.we);
