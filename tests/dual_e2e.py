@@ -210,7 +210,7 @@ def checkmesh(name, case, rc):
 
 def main():
     sets = []
-    for fam, n in (("uniform", 3000), ("gaussian", 3000), ("lattice", 512), ("dup", 500)):
+    for fam, n in (("uniform", 2000), ("gaussian", 2000), ("lattice", 512), ("dup", 500)):
         xyz = os.path.join(SCRATCH, fam + ".xyz")
         subprocess.run([GEN, fam, str(n), "1", xyz], check=True, capture_output=True)
         sets.append((fam, xyz, None))
