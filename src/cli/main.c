@@ -1340,10 +1340,10 @@ static int open_engine(const cli *c, run_state *rs)
                                                  : (int)sysconf(_SC_NPROCESSORS_ONLN);
     rs->estimate = memory_estimate(rs->n, rs->streaming, run_threads, s.neighbors,
                                    fdt_engine_one_part(&s, rs->streaming));
-    /* --dual's polyhedral mesh, built after the tets beside them: 2,219
+    /* --dual's polyhedral mesh, built after the tets beside them: 1,425
      * bytes a point at the peak for 1M uniform points (bench/NOTES.md
      * entry 94) */
-    unsigned long long dual = c->dual.dual ? 2300ull * rs->n + (16ull << 20) : 0;
+    unsigned long long dual = c->dual.dual ? 1500ull * rs->n + (16ull << 20) : 0;
     if (dual > rs->estimate)
         rs->estimate = dual;
     if (c->memory_limit && rs->estimate > c->memory_limit) {

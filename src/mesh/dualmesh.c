@@ -1678,8 +1678,11 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
     w.diag = diag;
     w.ds = diag_size;
     int err = fdt_voronoi_box_of(r, xyz, n, o, w.box, diag, diag_size);
+    int had_faces = r->face_verts != NULL;
     if (!err)
         err = fdt_locator_init(&w.loc, r, xyz, n);
+    if (!had_faces)
+        fdt_result_drop_faces(r); /* the neighbours are derived: 28 bytes a face back */
     if (err)
         goto done;
     memcpy(d->box, w.box, sizeof w.box);
@@ -1710,6 +1713,14 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
         say(diag, diag_size, "too many vertices or faces for OpenFOAM's 32-bit labels");
         err = FDT_ETOOBIG;
     }
+    /* what the faces were built from goes before the mesh is copied out */
+    fdt_locator_free(&w.loc);
+    free(w.uf);
+    free(w.cc);
+    free(w.rvid);
+    w.uf = w.rvid = NULL;
+    w.cc = NULL;
+    kmap_free(&w.cross);
     if (!err)
         err = assemble(&w, d);
     if (!err && fdt_dualmesh_check(d, diag, diag_size) != 0)

@@ -43,7 +43,8 @@ extern const char *const fdt_dualmesh_patch[6];
 
 /*
  * The dual of r (the result of fdt_triangulate on the n points xyz, with
- * its tets; r gains its face list when it keeps no neighbours), clipped
+ * its tets; not changed: a face list derived for the neighbours when r
+ * keeps none is dropped again, as r had none), clipped
  * by o's box rule (fdt_voronoi_box_of; o not NULL). On success *d is
  * filled and owned by the caller (fdt_dualmesh_free) and has passed
  * fdt_dualmesh_check. FDT_EINVAL (a streamed result, n not r's, a bad
