@@ -17,10 +17,10 @@ volumes add up to the box's (1e-12). Refusals: --dual without an OpenFOAM
 -o, --dual with --stream, a point outside --box (exit 1 each). Written
 again over the existing polyMesh beside a .tets output of the same run.
 
-With --checkmesh: OpenFOAM's checkMesh on the same cases, every topology
-check OK ("Boundary definition OK" .. "Number of regions: 1 (OK)"), face
-pyramids and cell volumes OK; exit 77 (skipped) when OpenFOAM is not
-installed.
+With --checkmesh: OpenFOAM's checkMesh -allTopology on the same cases,
+every topology check OK ("Boundary definition OK" .. "Number of regions: 1
+(OK)", cell zip-up, face-face connectivity), face pyramids and cell
+volumes OK; exit 77 (skipped) when OpenFOAM is not installed.
 """
 import os
 import re
@@ -192,11 +192,12 @@ def one_case(name, xyz, box=None):
 
 def checkmesh(name, case, rc):
     src = f". '{rc}' >/dev/null 2>&1; " if rc else ""
-    p = subprocess.run(["bash", "-c", src + f"checkMesh -case '{case}'"], capture_output=True,
-                       text=True)
+    p = subprocess.run(["bash", "-c", src + f"checkMesh -allTopology -case '{case}'"],
+                       capture_output=True, text=True)
     out = p.stdout + p.stderr
     for ok in ("Boundary definition OK", "Cell to face addressing OK", "Point usage OK",
                "Upper triangular ordering OK", "Face vertices OK", "Number of regions: 1 (OK)",
+               "Topological cell zip-up check OK", "Face-face connectivity OK",
                "Face pyramids OK", "Cell volumes OK", "Boundary openness", "Max cell openness"):
         if ok not in out:
             fail(f"checkMesh {name}: no '{ok}'\n{out}")
