@@ -60,7 +60,8 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
 void fdt_dualmesh_free(fdt_dualmesh *d);
 
 /*
- * An independent check of a dual's numbering: every vertex used and every
+ * The check (src/mesh/dualcheck.c, sharing nothing with the construction):
+ * an independent check of a dual's numbering: every vertex used and every
  * index in range, no face with fewer than 3 or repeated vertices, owner <
  * neighbour, the internal faces in upper-triangular order, the patches
  * contiguous after them by owner, every cell closed (each of its edges in
