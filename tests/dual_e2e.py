@@ -15,7 +15,8 @@ turned out of it), each cell's volume from its faces equals --voronoi's %v
 for its point (1e-10 relative; merged duplicates have no cell) and the
 volumes add up to the box's (1e-12). Refusals: --dual without an OpenFOAM
 -o, --dual with --stream, a point outside --box (exit 1 each). Written
-again over the existing polyMesh beside a .tets output of the same run.
+again over the existing polyMesh beside a .tets output of the same run;
+the same bytes in serial, shared and message modes.
 
 With --checkmesh: OpenFOAM's checkMesh -allTopology on the same cases,
 every topology check OK ("Boundary definition OK" .. "Number of regions: 1
@@ -261,6 +262,20 @@ def main():
                 fail("-o m.tets beside --dual: not a .tets file")
         if any(".tmp." in x for x in os.listdir(os.path.join(case, "constant"))):
             fail("--dual left a temporary beside the polyMesh")
+        # the same bytes in every mode and thread count (the tets sorted first)
+        ref = None
+        for mode in (["--mode", "serial"], ["--mode", "shared", "-t", "2"],
+                     ["--mode", "message", "-t", "3"]):
+            d = os.path.join(SCRATCH, "mode-" + mode[1])
+            shutil.rmtree(d, ignore_errors=True)
+            os.makedirs(d)
+            run([uni, "-q", "-o", os.path.join(d, "polyMesh"), "--dual"] + mode)
+            got = [open(os.path.join(d, "polyMesh", f), "rb").read()
+                   for f in ("points", "faces", "owner", "neighbour", "boundary")]
+            if ref is None:
+                ref = got
+            elif got != ref:
+                fail(f"--dual {' '.join(mode)}: not the serial mode's bytes")
     if failures:
         print(f"{len(failures)} failures")
         sys.exit(1)

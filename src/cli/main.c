@@ -1251,6 +1251,10 @@ static int plan_outputs(const cli *c, run_state *rs)
     if (c->dual.dual && !foam)
         return usage_error("--dual writes the Voronoi cells as an OpenFOAM polyMesh: it needs "
                            "an -o CASE/constant/polyMesh");
+    /* the dual numbers its vertices and faces in the tets' order: the
+     * canonical one makes them the same for every mode and thread count */
+    if (c->dual.dual)
+        rs->need |= FDT_NEED_SORTED;
     char none[1][FDT_IO_PATH];
     int code = refuse_overwrites(c, "", none, 0); /* --stats-json vs the input */
     if (code >= 0)
