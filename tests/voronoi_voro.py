@@ -270,7 +270,7 @@ def formats_and_refusals():
     cases = [
         (["--box", "0,0,0,1,1,x", "--voronoi", out], 1, "--box wants six"),
         (["--box", "0,0,0;1,1,1", "--voronoi", out], 1, "--box wants six"),
-        (["--box", "0,0,0,1,1,1"], 1, "needs --voronoi or --density"),
+        (["--box", "0,0,0,1,1,1"], 1, "needs --voronoi, --density or --dual"),
         (["--voronoi", out, "--density", out], 1, "named for two outputs"),
         (["--voronoi", os.path.join(SCRATCH, "c.vtu"), "--voronoi-format", "%v"], 1,
          "does not apply to a .vtu"),

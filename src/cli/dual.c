@@ -10,6 +10,7 @@
 #include "io/read/reader.h"
 #include "io/write/cells.h"
 #include "io/write/writer.h"
+#include "mesh/dualmesh.h"
 
 int fdt_cli_dual_wanted(const fdt_cli_dual *d)
 {
@@ -75,8 +76,9 @@ int fdt_cli_dual_check(const fdt_cli_dual *d, const char *input, char *err, size
         snprintf(err, errlen, "--voronoi-format needs --voronoi FILE");
         return -1;
     }
-    if (d->box_given && !fdt_cli_dual_wanted(d)) {
-        snprintf(err, errlen, "--box clips the Voronoi cells: it needs --voronoi or --density");
+    if (d->box_given && !fdt_cli_dual_wanted(d) && !d->dual) {
+        snprintf(err, errlen, "--box clips the Voronoi cells: it needs --voronoi, --density "
+                 "or --dual");
         return -1;
     }
     if (d->format && d->voronoi && has_ext(d->voronoi, ".vtu")) {
@@ -200,5 +202,25 @@ int fdt_cli_interp_write(const fdt_cli_dual *d, fdt_result *res, const double *x
     free(vals);
     free(q);
     free(out);
+    return r;
+}
+
+int fdt_cli_dual_mesh(const fdt_cli_dual *d, fdt_result *res, const double *xyz, size_t n,
+                      const char *path, char *err, size_t errlen)
+{
+    fdt_voronoi_options o;
+    fdt_default_voronoi_options(&o);
+    o.box_given = d->box_given;
+    memcpy(o.box, d->box, sizeof o.box);
+    fdt_dualmesh dm;
+    char diag[512];
+    int r = fdt_dualmesh_build(res, xyz, n, &o, &dm, diag, sizeof diag);
+    if (r != FDT_OK) {
+        snprintf(err, errlen, "%s: the Voronoi cells as a polyMesh (--dual): %s%s%s", path,
+                 fdt_strerror(r), *diag ? ": " : "", diag);
+        return r;
+    }
+    r = fdt_wr_dual_polymesh(path, &dm, err, errlen) == FDT_IO_OK ? FDT_OK : FDT_EIO;
+    fdt_dualmesh_free(&dm);
     return r;
 }

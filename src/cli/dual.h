@@ -27,7 +27,16 @@ typedef struct fdt_cli_dual {
     const char *queries; /* --interpolate QUERIES, or NULL */
     const char *interpolated; /* --interpolated OUT, or NULL */
     int natural;         /* --method: 1 natural (default), 0 linear */
+    int dual;            /* --dual: OpenFOAM outputs get the Voronoi cells */
 } fdt_cli_dual;
+
+/* --dual's output: the Voronoi cells of res clipped by d's box, as an
+ * OpenFOAM polyMesh at path (in the run's commit set). FDT_OK, or the
+ * error with the message in err: FDT_EINVAL (a point outside --box),
+ * FDT_ENOMEM, FDT_ETOOBIG, FDT_EINTERNAL (a diagram this construction
+ * cannot number: nothing written), FDT_EIO. */
+int fdt_cli_dual_mesh(const fdt_cli_dual *d, fdt_result *res, const double *xyz, size_t n,
+                      const char *path, char *err, size_t errlen);
 
 /* Is anything asked for? */
 int fdt_cli_dual_wanted(const fdt_cli_dual *d);

@@ -345,6 +345,9 @@ static int take_dual(fdt_cli_dual *d, int id, const char *v)
     case FDT_OPT_DENSITY:
         d->density = v;
         break;
+    case FDT_OPT_DUAL:
+        d->dual = 1;
+        break;
     case FDT_OPT_BOX:
         if (fdt_cli_parse_box(v, d->box) != 0)
             return usage_error("--box wants six finite numbers xmin,ymin,zmin,xmax,ymax,zmax "
@@ -477,6 +480,7 @@ static int take_option(cli *c, int id, const char *v)
     case FDT_OPT_VORONOI_FORMAT:
     case FDT_OPT_DENSITY:
     case FDT_OPT_BOX:
+    case FDT_OPT_DUAL:
     case FDT_OPT_VALUES:
     case FDT_OPT_INTERPOLATE:
     case FDT_OPT_INTERPOLATED:
@@ -1007,6 +1011,8 @@ static const char *stream_refusal(const cli *c, const fdt_format *const *fmts, i
         return "--all-faces needs the face list of the whole mesh";
     if (fdt_cli_dual_wanted(&c->dual) || fdt_cli_interp_wanted(&c->dual))
         return "--voronoi, --density and --interpolate need the whole mesh";
+    if (c->dual.dual)
+        return "--dual needs the whole mesh";
     for (int o = 0; o < c->n_outputs; o++) {
         if (!strcmp(c->outputs[o], "-"))
             return "-o - (standard output) cannot stream";
@@ -1239,6 +1245,16 @@ static int plan_outputs(const cli *c, run_state *rs)
         if (code != CLI_OK)
             return code;
     }
+    int foam = 0;
+    for (int o = 0; o < c->n_outputs; o++)
+        foam |= rs->fmts[o] == fdt_format_by_name("openfoam");
+    if (c->dual.dual && !foam)
+        return usage_error("--dual writes the Voronoi cells as an OpenFOAM polyMesh: it needs "
+                           "an -o CASE/constant/polyMesh");
+    /* the dual numbers its vertices and faces in the tets' order: the
+     * canonical one makes them the same for every mode and thread count */
+    if (c->dual.dual)
+        rs->need |= FDT_NEED_SORTED;
     char none[1][FDT_IO_PATH];
     int code = refuse_overwrites(c, "", none, 0); /* --stats-json vs the input */
     if (code >= 0)
@@ -1328,10 +1344,17 @@ static int open_engine(const cli *c, run_state *rs)
                                                  : (int)sysconf(_SC_NPROCESSORS_ONLN);
     rs->estimate = memory_estimate(rs->n, rs->streaming, run_threads, s.neighbors,
                                    fdt_engine_one_part(&s, rs->streaming));
+    /* --dual's polyhedral mesh, built after the tets beside them: 1,425
+     * bytes a point at the peak for 1M uniform points (bench/NOTES.md
+     * entry 97) */
+    unsigned long long dual = c->dual.dual ? 1500ull * rs->n + (16ull << 20) : 0;
+    if (dual > rs->estimate)
+        rs->estimate = dual;
     if (c->memory_limit && rs->estimate > c->memory_limit) {
-        say("%s: %zu points need about %llu MiB (%s%s), more than --memory-limit %llu MiB",
+        say("%s: %zu points need about %llu MiB (%s%s%s), more than --memory-limit %llu MiB",
             rs->name, rs->n, rs->estimate >> 20, rs->streaming ? "streamed" : "in memory",
-            s.neighbors ? ", with neighbours" : "", c->memory_limit >> 20);
+            s.neighbors ? ", with neighbours" : "", c->dual.dual ? ", --dual" : "",
+            c->memory_limit >> 20);
         return CLI_RESOURCES;
     }
     int r = fdt_open(&rs->ctx, &s);
@@ -1487,6 +1510,16 @@ static int write_meshes(const cli *c, run_state *rs)
     int code = CLI_OK;
     for (int o = 0; o < c->n_outputs && code == CLI_OK; o++) {
         wo.format = fdt_format_name(rs->fmts[o]);
+        if (c->dual.dual && rs->fmts[o] == fdt_format_by_name("openfoam")) {
+            int r = fdt_cli_dual_mesh(&c->dual, rs->res, rs->xyz, rs->n, c->outputs[o], err,
+                                      sizeof err);
+            if (r != FDT_OK) {
+                progress_clear(&rs->prog);
+                say("%s", err);
+                code = exit_for_dual(r);
+            }
+            continue;
+        }
         int r = fdt_write_mesh_opts(rs->res, rs->xyz, rs->n, c->outputs[o], &wo, err, sizeof err);
         if (r != FDT_OK) {
             progress_clear(&rs->prog);

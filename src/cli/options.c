@@ -114,6 +114,12 @@ const fdt_cli_opt fdt_cli_opts[FDT_OPT_END] = {
     [FDT_OPT_BOX] = {"box", 0, required_argument, "X0,Y0,Z0,X1,Y1,Z1", F, 0,
         "the box that clips the cells (default: the\n"
         "points' bounding box; must hold them)", NULL},
+    [FDT_OPT_DUAL] = {"dual", 0, no_argument, NULL, F, 0,
+        "each OpenFOAM -o (DIR/polyMesh) gets the Voronoi\n"
+        "cells clipped by the box instead of the tets:\n"
+        "a polyhedral cell a point (duplicates none),\n"
+        "the walls patches xmin, xmax, ymin, ymax, zmin,\n"
+        "zmax", NULL},
     [FDT_OPT_VALUES] = {"values", 0, required_argument, "FILE", F, 0,
         "values at the points (a line a point, k numbers)", NULL},
     [FDT_OPT_INTERPOLATE] = {"interpolate", 0, required_argument, "Q", F, 0,

@@ -135,21 +135,19 @@ static void say(char *diag, size_t size, const char *fmt, ...)
     va_end(ap);
 }
 
-/* The box: given (and holding every point), or the points' bounding box. */
-static int set_box(fdt_voronoi *v, const fdt_result *r, const double *xyz,
-                   const fdt_voronoi_options *o, char *diag, size_t ds)
+int fdt_voronoi_box_of(const fdt_result *r, const double *xyz, size_t n,
+                       const fdt_voronoi_options *o, double box[6], char *diag, size_t ds)
 {
     if (o->box_given) {
-        memcpy(v->box, o->box, sizeof v->box);
+        memcpy(box, o->box, 6 * sizeof *box);
         for (int k = 0; k < 3; k++)
-            if (!(v->box[k] < v->box[k + 3]) || !isfinite(v->box[k]) ||
-                !isfinite(v->box[k + 3])) {
+            if (!(box[k] < box[k + 3]) || !isfinite(box[k]) || !isfinite(box[k + 3])) {
                 say(diag, ds, "the box is empty or not finite in %c", "xyz"[k]);
                 return FDT_EINVAL;
             }
-        for (size_t i = 0; i < v->n; i++)
+        for (size_t i = 0; i < n; i++)
             for (int k = 0; k < 3; k++)
-                if (xyz[3 * i + k] < v->box[k] || xyz[3 * i + k] > v->box[k + 3]) {
+                if (xyz[3 * i + k] < box[k] || xyz[3 * i + k] > box[k + 3]) {
                     say(diag, ds, "point %zu (%.17g %.17g %.17g) lies outside the box", i,
                         xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
                     return FDT_EINVAL;
@@ -157,16 +155,23 @@ static int set_box(fdt_voronoi *v, const fdt_result *r, const double *xyz,
         return FDT_OK;
     }
     for (int k = 0; k < 3; k++) {
-        v->box[k] = INFINITY;
-        v->box[k + 3] = -INFINITY;
+        box[k] = INFINITY;
+        box[k + 3] = -INFINITY;
     }
-    for (size_t i = 0; i < v->n; i++)
+    for (size_t i = 0; i < n; i++)
         if (r->dupmap[i] == (fdt_vid)i)
             for (int k = 0; k < 3; k++) {
-                v->box[k] = fmin(v->box[k], xyz[3 * i + k]);
-                v->box[k + 3] = fmax(v->box[k + 3], xyz[3 * i + k]);
+                box[k] = fmin(box[k], xyz[3 * i + k]);
+                box[k + 3] = fmax(box[k + 3], xyz[3 * i + k]);
             }
     return FDT_OK;
+}
+
+/* The box: given (and holding every point), or the points' bounding box. */
+static int set_box(fdt_voronoi *v, const fdt_result *r, const double *xyz,
+                   const fdt_voronoi_options *o, char *diag, size_t ds)
+{
+    return fdt_voronoi_box_of(r, xyz, v->n, o, v->box, diag, ds);
 }
 
 /* The grids: terms up to about 16 D^k for the box's largest side D land

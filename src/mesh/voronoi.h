@@ -10,4 +10,11 @@
 int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
                       int threads, fdt_voronoi **out, char *diag, size_t diag_size);
 
+/* The box the cells are clipped by: o's (FDT_EINVAL, with diag, when it is
+ * empty, not finite or leaves a point out) or the bounding box of the
+ * points that are not merged duplicates. The rule of fdt_voronoi_compute
+ * and of the polyMesh dual (src/mesh/dualmesh.c). */
+int fdt_voronoi_box_of(const fdt_result *r, const double *xyz, size_t n,
+                       const fdt_voronoi_options *o, double box[6], char *diag, size_t ds);
+
 #endif

@@ -15,6 +15,7 @@
  * is written reversed. The hull is one patch, "hull", of type patch.
  */
 #include "io/write/formats.h"
+#include "mesh/dualmesh.h"
 
 typedef struct foam_prep {
     size_t n_internal, n_faces, n_points, n_cells;
@@ -91,28 +92,37 @@ int fdt_foam_prepare(const fdt_mesh_view *m, void **prep, const char *path, char
     return FDT_IO_OK;
 }
 
-static void header(out_file *o, const char *cls, const char *object, const foam_prep *p)
+/* The FoamFile header of one file; counts (points, cells, faces, internal
+ * faces) go into owner's note, which some utilities (decomposePar) read
+ * instead of counting. */
+static void header_of(out_file *o, const char *what, const char *cls, const char *object,
+                      const size_t counts[4])
 {
-    out_str(o, "/* written by frontdt " FDT_VERSION_STRING
-               ": Delaunay tetrahedralization */\nFoamFile\n{\n"
+    out_str(o, "/* written by frontdt " FDT_VERSION_STRING ": ");
+    out_str(o, what);
+    out_str(o, " */\nFoamFile\n{\n"
                "    version     2.0;\n    format      ascii;\n    class       ");
     out_str(o, cls);
     out_str(o, ";\n");
-    if (p && !strcmp(object, "owner")) {
-        /* read by some utilities (decomposePar) instead of counting */
-        out_str(o, "    note        \"nPoints:");
-        out_i64(o, (int64_t)p->n_points);
-        out_str(o, " nCells:");
-        out_i64(o, (int64_t)p->n_cells);
-        out_str(o, " nFaces:");
-        out_i64(o, (int64_t)p->n_faces);
-        out_str(o, " nInternalFaces:");
-        out_i64(o, (int64_t)p->n_internal);
+    if (counts && !strcmp(object, "owner")) {
+        static const char *const names[4] = {"nPoints:", " nCells:", " nFaces:",
+                                             " nInternalFaces:"};
+        out_str(o, "    note        \"");
+        for (int i = 0; i < 4; i++) {
+            out_str(o, names[i]);
+            out_i64(o, (int64_t)counts[i]);
+        }
         out_str(o, "\";\n");
     }
     out_str(o, "    location    \"constant/polyMesh\";\n    object      ");
     out_str(o, object);
     out_str(o, ";\n}\n\n");
+}
+
+static void header(out_file *o, const char *cls, const char *object, const foam_prep *p)
+{
+    size_t counts[4] = {p->n_points, p->n_cells, p->n_faces, p->n_internal};
+    header_of(o, "Delaunay tetrahedralization", cls, object, counts);
 }
 
 int fdt_put_foam_points(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
@@ -197,6 +207,18 @@ int fdt_put_foam_neighbour(out_file *o, const fdt_mesh_view *m, const void *prep
     return FDT_IO_OK;
 }
 
+/* One patch of the boundary file, of type patch. */
+static void put_patch(out_file *o, const char *name, size_t n_faces, size_t start)
+{
+    out_str(o, "    ");
+    out_str(o, name);
+    out_str(o, "\n    {\n        type            patch;\n        nFaces          ");
+    out_i64(o, (int64_t)n_faces);
+    out_str(o, ";\n        startFace       ");
+    out_i64(o, (int64_t)start);
+    out_str(o, ";\n    }\n");
+}
+
 int fdt_put_foam_boundary(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
                           size_t errlen)
 {
@@ -205,11 +227,118 @@ int fdt_put_foam_boundary(out_file *o, const fdt_mesh_view *m, const void *prep,
     (void)errlen;
     const foam_prep *p = prep;
     header(o, "polyBoundaryMesh", "boundary", p);
-    out_str(o, "1\n(\n    hull\n    {\n        type            patch;\n"
-               "        nFaces          ");
-    out_i64(o, (int64_t)(p->n_faces - p->n_internal));
-    out_str(o, ";\n        startFace       ");
-    out_i64(o, (int64_t)p->n_internal);
-    out_str(o, ";\n    }\n)\n");
+    out_str(o, "1\n(\n");
+    put_patch(o, "hull", p->n_faces - p->n_internal, p->n_internal);
+    out_str(o, ")\n");
+    return FDT_IO_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* The Voronoi dual (src/mesh/dualmesh.h): prep is the fdt_dualmesh, the
+ * view unused. Its faces are in OpenFOAM's order and turned already. */
+
+#define DUAL_WHAT "Voronoi cells clipped by a box, a cell a point"
+
+static void dual_header(out_file *o, const char *cls, const char *object,
+                        const fdt_dualmesh *d)
+{
+    size_t counts[4] = {d->n_verts, d->n_cells, d->n_faces, d->n_internal};
+    header_of(o, DUAL_WHAT, cls, object, counts);
+}
+
+int fdt_put_foam_dual_points(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
+                             size_t errlen)
+{
+    (void)m;
+    (void)err;
+    (void)errlen;
+    const fdt_dualmesh *d = prep;
+    dual_header(o, "vectorField", "points", d);
+    out_i64(o, (int64_t)d->n_verts);
+    out_str(o, "\n(\n");
+    for (size_t i = 0; i < d->n_verts && !o->err; i++) {
+        out_char(o, '(');
+        for (int c = 0; c < 3; c++) {
+            if (c)
+                out_char(o, ' ');
+            out_double(o, d->xyz[3 * i + (size_t)c]);
+        }
+        out_str(o, ")\n");
+    }
+    out_str(o, ")\n");
+    return FDT_IO_OK;
+}
+
+int fdt_put_foam_dual_faces(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
+                            size_t errlen)
+{
+    (void)m;
+    (void)err;
+    (void)errlen;
+    const fdt_dualmesh *d = prep;
+    dual_header(o, "faceList", "faces", d);
+    out_i64(o, (int64_t)d->n_faces);
+    out_str(o, "\n(\n");
+    for (size_t f = 0; f < d->n_faces && !o->err; f++) {
+        out_i64(o, (int64_t)(d->fstart[f + 1] - d->fstart[f]));
+        out_char(o, '(');
+        for (size_t i = d->fstart[f]; i < d->fstart[f + 1]; i++) {
+            if (i > d->fstart[f])
+                out_char(o, ' ');
+            out_i64(o, d->fverts[i]);
+        }
+        out_str(o, ")\n");
+    }
+    out_str(o, ")\n");
+    return FDT_IO_OK;
+}
+
+static void put_list(out_file *o, const int32_t *v, size_t count)
+{
+    out_i64(o, (int64_t)count);
+    out_str(o, "\n(\n");
+    for (size_t i = 0; i < count && !o->err; i++) {
+        out_i64(o, v[i]);
+        out_char(o, '\n');
+    }
+    out_str(o, ")\n");
+}
+
+int fdt_put_foam_dual_owner(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
+                            size_t errlen)
+{
+    (void)m;
+    (void)err;
+    (void)errlen;
+    const fdt_dualmesh *d = prep;
+    dual_header(o, "labelList", "owner", d);
+    put_list(o, d->owner, d->n_faces);
+    return FDT_IO_OK;
+}
+
+int fdt_put_foam_dual_neighbour(out_file *o, const fdt_mesh_view *m, const void *prep,
+                                char *err, size_t errlen)
+{
+    (void)m;
+    (void)err;
+    (void)errlen;
+    const fdt_dualmesh *d = prep;
+    dual_header(o, "labelList", "neighbour", d);
+    put_list(o, d->neighbour, d->n_internal);
+    return FDT_IO_OK;
+}
+
+int fdt_put_foam_dual_boundary(out_file *o, const fdt_mesh_view *m, const void *prep,
+                               char *err, size_t errlen)
+{
+    (void)m;
+    (void)err;
+    (void)errlen;
+    const fdt_dualmesh *d = prep;
+    dual_header(o, "polyBoundaryMesh", "boundary", d);
+    out_str(o, "6\n(\n");
+    for (int p = 0; p < 6; p++)
+        put_patch(o, fdt_dualmesh_patch[p], d->patch_size[p], d->patch_start[p]);
+    out_str(o, ")\n");
     return FDT_IO_OK;
 }

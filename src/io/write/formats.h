@@ -153,5 +153,17 @@ int fdt_put_foam_neighbour(out_file *o, const fdt_mesh_view *m, const void *prep
                            size_t errlen);
 int fdt_put_foam_boundary(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
                           size_t errlen);
+/* The Voronoi dual's five files (fdt_wr_dual_polymesh): prep is a
+ * const fdt_dualmesh * (src/mesh/dualmesh.h), m is not read. */
+int fdt_put_foam_dual_points(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
+                             size_t errlen);
+int fdt_put_foam_dual_faces(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
+                            size_t errlen);
+int fdt_put_foam_dual_owner(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
+                            size_t errlen);
+int fdt_put_foam_dual_neighbour(out_file *o, const fdt_mesh_view *m, const void *prep,
+                                char *err, size_t errlen);
+int fdt_put_foam_dual_boundary(out_file *o, const fdt_mesh_view *m, const void *prep,
+                               char *err, size_t errlen);
 
 #endif

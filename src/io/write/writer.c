@@ -1386,6 +1386,30 @@ out:
     return r;
 }
 
+/* Row f's files for path from m and what its prepare made: a new
+ * directory for a directory format whose path does not exist yet, else
+ * the files themselves (all or none). */
+static int write_prepared(const char *path, const fdt_format *f, const fdt_mesh_view *m,
+                          const void *prep, out_meter *mt, char *err, size_t errlen)
+{
+    int r;
+    struct stat st;
+    if (f->layout == FDT_LAYOUT_DIR && stat(path, &st) != 0 && errno == ENOENT) {
+        r = write_new_dir(f, path, m, prep, mt, err, errlen);
+    } else if (f->layout == FDT_LAYOUT_DIR && stat(path, &st) == 0 && !S_ISDIR(st.st_mode)) {
+        r = set_errno_err(err, errlen, path, ENOTDIR);
+    } else {
+        char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
+        int k = fdt_output_files_as(path, f, names);
+        out_file files[FDT_IO_MAX_FILES];
+        if (k != f->nparts)
+            r = set_errno_err(err, errlen, path, ENAMETOOLONG);
+        else
+            r = write_parts(f, names, k, m, prep, files, mt, err, errlen, KEEP_NONE);
+    }
+    return r;
+}
+
 int fdt_wr_mesh_as(const char *path, const fdt_format *f, const fdt_mesh_view *m,
                       char *err, size_t errlen)
 {
@@ -1416,23 +1440,29 @@ int fdt_wr_mesh_ex(const char *path, const fdt_format *f, const fdt_mesh_view *m
     if (f->prepare && (r = f->prepare(m, &prep, path, err, errlen)) != FDT_IO_OK)
         return r;
     out_meter meter = {progress, progress_user, 0, fdt_wr_estimate(f, m)};
-    out_meter *mt = progress ? &meter : NULL;
-    struct stat st;
-    if (f->layout == FDT_LAYOUT_DIR && stat(path, &st) != 0 && errno == ENOENT) {
-        r = write_new_dir(f, path, m, prep, mt, err, errlen);
-    } else if (f->layout == FDT_LAYOUT_DIR && stat(path, &st) == 0 && !S_ISDIR(st.st_mode)) {
-        r = set_errno_err(err, errlen, path, ENOTDIR);
-    } else {
-        char names[FDT_IO_MAX_FILES][FDT_IO_PATH];
-        int k = fdt_output_files_as(path, f, names);
-        out_file files[FDT_IO_MAX_FILES];
-        if (k != f->nparts)
-            r = set_errno_err(err, errlen, path, ENAMETOOLONG);
-        else
-            r = write_parts(f, names, k, m, prep, files, mt, err, errlen, KEEP_NONE);
-    }
+    r = write_prepared(path, f, m, prep, progress ? &meter : NULL, err, errlen);
     free(prep);
     return r;
+}
+
+/* The OpenFOAM row of the Voronoi dual: not in the table (no -o path
+ * chooses it; --dual does). */
+static const fdt_format dual_foam = {
+    "openfoam", {"polyMesh"}, "OpenFOAM polyMesh of the Voronoi cells", 0, FDT_LAYOUT_DIR, 0, 5,
+    {"points", "faces", "owner", "neighbour", "boundary"},
+    {fdt_put_foam_dual_points, fdt_put_foam_dual_faces, fdt_put_foam_dual_owner,
+     fdt_put_foam_dual_neighbour, fdt_put_foam_dual_boundary},
+    NULL, NULL};
+
+int fdt_wr_dual_polymesh(const char *path, const fdt_dualmesh *d, char *err, size_t errlen)
+{
+    if (err && errlen > 0)
+        err[0] = '\0';
+    if (!path || !d)
+        return set_err(err, errlen, FDT_IO_EFORMAT, path, "no path or no mesh");
+    fdt_mesh_view none;
+    memset(&none, 0, sizeof none);
+    return write_prepared(path, &dual_foam, &none, d, NULL, err, errlen);
 }
 
 int fdt_wr_mesh(const char *path, const fdt_mesh_view *m, char *err,

@@ -68,6 +68,12 @@ int fdt_wr_mesh_as(const char *path, const fdt_format *f, const fdt_mesh_view *m
  * (fdt_wr_estimate) summed over the output's files. */
 int fdt_wr_mesh_ex(const char *path, const fdt_format *f, const fdt_mesh_view *m,
                    fdt_io_progress_fn progress, void *progress_user, char *err, size_t errlen);
+/* The Voronoi dual d (src/mesh/dualmesh.h) as an OpenFOAM polyMesh at
+ * path (a directory), as fdt_wr_mesh_as writes one: a new directory
+ * renamed into place, or an existing one's five files replaced, all or
+ * none; in the commit set when one is open. FDT_IO_OK or a code with err. */
+typedef struct fdt_dualmesh fdt_dualmesh;
+int fdt_wr_dual_polymesh(const char *path, const fdt_dualmesh *d, char *err, size_t errlen);
 /* An estimate of the bytes format f writes for m, all files together:
  * the progress total. Within a few tens of percent for the text formats
  * (coordinates taken as 20 characters each). */
