@@ -60,6 +60,7 @@
  * any thread count, query order and numbering of the mesh's tets.
  */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -72,11 +73,20 @@
 typedef struct ctet ctet;
 typedef struct ntet ntet;
 
+typedef struct tslot {
+    fdt_tid t;
+    uint32_t stamp; /* the query that entered it; 0: never */
+    int at;
+} tslot;
+
 /* One thread's scratch, kept from query to query. */
 typedef struct sibson {
     const fdt_locator *L;    /* shared, read only */
     fdt_tid *stack, *cavity; /* growable lists of tets (owned) */
     size_t cap_stack, cap_cavity;
+    tslot *tab;              /* the tets met (tab_find; owned) */
+    size_t tab_mask, tab_used;
+    uint32_t stamp;
     ctet *ct;                /* the cavity's tets, canonically (owned) */
     size_t cap_ct;
     ntet *nt;                /* the new tets (owned) */
@@ -101,11 +111,56 @@ static int push(void *pp, size_t *cap, size_t n, size_t size)
     return 0;
 }
 
-static int has_tet(const fdt_tid *a, size_t n, fdt_tid t)
+/* The tets the cavity search met, and where: an open-addressing table
+ * keyed by tet id, an entry current when its stamp is the query's (no
+ * clearing between queries). at: the place in S->cavity, then in S->ct
+ * (canonical_cavity renumbers), or -1 for a tet tested and found outside.
+ * A cavity's tet has four neighbours, so a linear search of the cavity
+ * for each would cost O(cavity^2): a fifth of a query's time. */
+static tslot *tab_find(const sibson *S, fdt_tid t)
 {
-    for (size_t i = 0; i < n; i++)
-        if (a[i] == t)
-            return 1;
+    size_t h = (size_t)(((uint64_t)(uint32_t)t * 0x9E3779B97F4A7C15u) >> 32) & S->tab_mask;
+    while (S->tab[h].stamp == S->stamp && S->tab[h].t != t)
+        h = (h + 1) & S->tab_mask;
+    return &S->tab[h];
+}
+
+/* Enters t (absent) at `at`, doubling the table beyond half full. 0, or -1
+ * out of memory. */
+static int tab_put(sibson *S, fdt_tid t, int at)
+{
+    if (2 * (S->tab_used + 1) > S->tab_mask + 1) {
+        size_t size = 2 * (S->tab_mask + 1);
+        tslot *old = S->tab, *nt = calloc(size, sizeof *nt);
+        if (!nt)
+            return -1;
+        size_t oldsize = S->tab_mask + 1;
+        S->tab = nt;
+        S->tab_mask = size - 1;
+        for (size_t i = 0; i < oldsize; i++)
+            if (old[i].stamp == S->stamp)
+                *tab_find(S, old[i].t) = old[i];
+        free(old);
+    }
+    *tab_find(S, t) = (tslot){t, S->stamp, at};
+    S->tab_used++;
+    return 0;
+}
+
+/* A new query's table: a new stamp (the table cleared when they wrap). */
+static int tab_begin(sibson *S)
+{
+    if (!S->tab) {
+        S->tab = calloc(256, sizeof *S->tab);
+        if (!S->tab)
+            return -1;
+        S->tab_mask = 255;
+    }
+    if (++S->stamp == 0) {
+        memset(S->tab, 0, (S->tab_mask + 1) * sizeof *S->tab);
+        S->stamp = 1;
+    }
+    S->tab_used = 0;
     return 0;
 }
 
@@ -117,7 +172,8 @@ static long cavity(sibson *S, fdt_tid t0, const double *q)
     const fdt_result *r = S->L->r;
     const double *X = S->L->xyz;
     size_t nc = 0, ns = 0;
-    if (push(&S->cavity, &S->cap_cavity, 0, sizeof *S->cavity) ||
+    if (tab_begin(S) || tab_put(S, t0, 0) ||
+        push(&S->cavity, &S->cap_cavity, 0, sizeof *S->cavity) ||
         push(&S->stack, &S->cap_stack, 0, sizeof *S->stack))
         return -1;
     S->cavity[nc++] = t0;
@@ -126,11 +182,14 @@ static long cavity(sibson *S, fdt_tid t0, const double *q)
         fdt_tid t = S->stack[--ns];
         for (int i = 0; i < 4; i++) {
             fdt_tid u = S->L->nbrs[4 * (size_t)t + (size_t)i];
-            if (u < 0 || has_tet(S->cavity, nc, u))
-                continue;
+            if (u < 0 || tab_find(S, u)->stamp == S->stamp)
+                continue; /* the hull, or met before */
             const fdt_vid *tv = r->tets + 4 * (size_t)u;
-            if (fdt_insphere(X + 3 * (size_t)tv[0], X + 3 * (size_t)tv[1], X + 3 * (size_t)tv[2],
-                             X + 3 * (size_t)tv[3], q, NULL) <= 0)
+            int in = fdt_insphere(X + 3 * (size_t)tv[0], X + 3 * (size_t)tv[1],
+                                  X + 3 * (size_t)tv[2], X + 3 * (size_t)tv[3], q, NULL) > 0;
+            if (tab_put(S, u, in ? (int)nc : -1))
+                return -1;
+            if (!in)
                 continue;
             if (push(&S->cavity, &S->cap_cavity, nc, sizeof *S->cavity) ||
                 push(&S->stack, &S->cap_stack, ns, sizeof *S->stack))
@@ -246,6 +305,8 @@ static long canonical_cavity(sibson *S, size_t nc, const double *q)
             S->ct[y] = S->ct[y - 1];
         S->ct[y] = T;
     }
+    for (size_t a = 0; a < nc; a++)
+        tab_find(S, S->ct[a].t)->at = (int)a;
     long m = 0;
     for (size_t a = 0; a < nc; a++)
         for (int i = 0; i < 4; i++) {
@@ -292,11 +353,9 @@ static long boundary(sibson *S, size_t nc, const double *q)
         ctet *T = &S->ct[a];
         for (int m = 0; m < 4; m++) {
             fdt_tid u = S->L->nbrs[4 * (size_t)T->t + (size_t)T->mi[m]];
-            size_t b = 0;
-            while (b < nc && S->ct[b].t != u)
-                b++;
-            if (b < nc) {
-                T->split[m] = (int)(a < b ? a : b);
+            int b = u < 0 ? -1 : tab_find(S, u)->at; /* every neighbour was met */
+            if (b >= 0) {
+                T->split[m] = (int)a < b ? (int)a : b;
                 continue;
             }
             if (push(&S->nt, &S->cap_nt, nb, sizeof *S->nt))
@@ -517,6 +576,7 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
         }
         free(j->S.ct);
         free(j->S.nt);
+        free(j->S.tab);
         free(j->S.stack);
         free(j->S.cavity);
         free(j->S.nn);
