@@ -12,7 +12,7 @@
  *    apart; refusals;
  *  - the coordinates from circumcentres (src/mesh/interpolate.c) agree
  *    with the cells cut (the library's method until session 24, kept
- *    below as the reference) on uniform, clustered and lattice points,
+ *    below as the reference) on uniform, clustered, lattice and offset points,
  *    queries near points among them; and the values are the same bits
  *    for any thread count, query order and mesh numbering.
  */
@@ -404,12 +404,12 @@ static void ref_interpolate(fdt_result *r, const double *xyz, size_t n, const do
     fdt_locator_free(&L);
 }
 
-enum { FAM_UNIFORM, FAM_CLUSTERS, FAM_LATTICE };
+enum { FAM_UNIFORM, FAM_CLUSTERS, FAM_LATTICE, FAM_OFFSET };
 
 /* n points of a family into xyz (returns the count) and nq queries into
  * q: uniform in the unit cube; five clusters 1e-3 wide holding 90 % of
  * the points, the rest uniform; a 10^3 integer lattice (cospherical
- * cavities). Queries: inside the points' box, a quarter of them near a
+ * cavities); the uniform points 2^20 from the origin. Queries: inside the points' box, a quarter of them near a
  * point (1e-3 to 1e-6 of the spacing away), a few at half-integers on the
  * lattice (cube, face and edge centres). */
 static size_t make_family(int fam, size_t n, double *xyz, size_t nq, double *q, uint64_t *s)
@@ -428,16 +428,20 @@ static size_t make_family(int fam, size_t n, double *xyz, size_t nq, double *q, 
                                                              : u;
         }
     double lo = fam == FAM_LATTICE ? 1 : 0.1, hi = fam == FAM_LATTICE ? 8 : 0.9;
+    if (fam == FAM_OFFSET) /* the uniform points 2^20 away: 2^-32 resolution */
+        for (size_t i = 0; i < 3 * n; i++)
+            xyz[i] += 0x1p20;
+    double shift = fam == FAM_OFFSET ? 0x1p20 : 0;
     for (size_t k = 0; k < nq; k++) {
         const double *p = xyz + 3 * ((size_t)(test_unif(s) * (double)n) % n);
-        double near = fam == FAM_UNIFORM ? 0.05 : fam == FAM_CLUSTERS ? 1e-5 : 1;
+        double near = fam == FAM_CLUSTERS ? 1e-5 : fam == FAM_LATTICE ? 1 : 0.05;
         double off = near * pow(10, -3 - 3 * test_unif(s));
         for (int d = 0; d < 3; d++) {
             double u = test_unif(s);
             q[3 * k + d] = k % 4 == 1 ? p[d] + off * (u - 0.5)
                            : fam == FAM_LATTICE && k % 4 == 2 ? floor(lo + (hi - lo) * u) + 0.5 * (double)(k / 4 % 2 + d > 1)
                            : fam == FAM_CLUSTERS && k % 4 == 3 ? p[d] + 1e-3 * (u - 0.5)
-                                                               : lo + (hi - lo) * u;
+                                                               : shift + lo + (hi - lo) * u;
         }
     }
     return n;
@@ -517,5 +521,6 @@ int main(void)
     test_against_cuts(FAM_UNIFORM, "uniform", 1e-12);
     test_against_cuts(FAM_CLUSTERS, "clusters", 2e-12);
     test_against_cuts(FAM_LATTICE, "lattice", 2e-11);
+    test_against_cuts(FAM_OFFSET, "offset", 1e-12);
     return test_report("interpolate");
 }

@@ -45,6 +45,10 @@
  * permutation, so v0 is on the negative side of (v1,v2,v3): that face is
  * already outward; the others follow the same parity count. */
 const int fdt_tet_face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+const int fdt_tet_edge[6][5] = {
+    {0, 1, 2, 3, +1}, {0, 2, 1, 3, -1}, {0, 3, 1, 2, +1},
+    {1, 2, 0, 3, +1}, {1, 3, 0, 2, -1}, {2, 3, 0, 1, +1},
+};
 
 /* Expansion arithmetic needs each operation rounded once to double. */
 #if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0

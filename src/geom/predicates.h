@@ -51,6 +51,14 @@ typedef struct fdt_pred_counts {
  * and v[i] < 0). */
 extern const int fdt_tet_face[4][3];
 
+/* The six edges (i, j), i < j, of a tet with its other two vertices
+ * (k, l), and the sign of the permutation (i, j, k, l) of (0, 1, 2, 3):
+ * {i, j, k, l, sign}. About the direction v[j] - v[i] of a positively
+ * oriented tet, its face (i, j, k) comes before (i, j, l) counter-
+ * clockwise when the sign is +1 (the Voronoi cells' and the
+ * natural-neighbour coordinates' shares). */
+extern const int fdt_tet_edge[6][5];
+
 int fdt_orient3d(const double *a, const double *b, const double *c,
                  const double *d, fdt_pred_counts *cnt);
 int fdt_insphere(const double *a, const double *b, const double *c,

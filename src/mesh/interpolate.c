@@ -202,8 +202,8 @@ static long cavity(sibson *S, fdt_tid t0, const double *q)
 }
 
 /* A cavity tet in canonical order: its points by ascending id, so that
- * every number computed from it is the same whichever way the mesh
- * stores it (the thread count of the triangulation changes that). */
+ * every number computed from it is the same whichever way round the mesh
+ * stores it (that may change with the triangulation's thread count). */
 struct ctet {
     fdt_tid t;
     fdt_vid v[4];  /* ascending */
@@ -221,14 +221,6 @@ struct ntet {
     int at[3];
     int sigma;     /* the orientation of (q, v0, v1, v2) */
     double c[3];   /* circumcentre, relative to q */
-};
-
-/* The six edges (i, j), i < j, of a tet with its other two vertices
- * (k, l), and the sign of the permutation (i, j, k, l) of (0, 1, 2, 3)
- * (src/mesh/voronoi.c's table). */
-static const int tet_edge[6][5] = {
-    {0, 1, 2, 3, +1}, {0, 2, 1, 3, -1}, {0, 3, 1, 2, +1},
-    {1, 2, 0, 3, +1}, {1, 3, 0, 2, -1}, {2, 3, 0, 1, +1},
 };
 
 static double det3(const double *a, const double *b, const double *c)
@@ -353,7 +345,10 @@ static long boundary(sibson *S, size_t nc, const double *q)
         ctet *T = &S->ct[a];
         for (int m = 0; m < 4; m++) {
             fdt_tid u = S->L->nbrs[4 * (size_t)T->t + (size_t)T->mi[m]];
-            int b = u < 0 ? -1 : tab_find(S, u)->at; /* every neighbour was met */
+            /* The search met every neighbour of the cavity (tested in or
+             * out); the stamp check only guards that. */
+            const tslot *e = u < 0 ? NULL : tab_find(S, u);
+            int b = e && e->stamp == S->stamp ? e->at : -1;
             if (b >= 0) {
                 T->split[m] = (int)a < b ? (int)a : b;
                 continue;
@@ -396,14 +391,15 @@ static void sibson_shares(sibson *S, size_t nc, size_t nb, long m, const double 
                     : T->split[f] >= 0   ? S->ct[T->split[f]].c
                                          : S->nt[-1 - T->split[f]].c;
         for (int e = 0; e < 6; e++) {
-            int i = tet_edge[e][0], j = tet_edge[e][1], k = tet_edge[e][2], l = tet_edge[e][3];
+            const int *te = fdt_tet_edge[e];
+            int i = te[0], j = te[1], k = te[2], l = te[3];
             double f[3], v = 0;
             foot(X + 3 * (size_t)T->v[i], X + 3 * (size_t)T->v[j], q, f);
             if (sp[l])
                 v += det3(f, sp[l], T->c);
             if (sp[k])
                 v -= det3(f, sp[k], T->c);
-            v *= T->sigma * tet_edge[e][4];
+            v *= T->sigma * te[4];
             S->w[T->at[i]] += v;
             S->w[T->at[j]] -= v;
         }
@@ -422,7 +418,8 @@ static void sibson_shares(sibson *S, size_t nc, size_t nb, long m, const double 
         fdt_circumcenter_tri(q, p[1], p[3], g[2]);
         fdt_circumcenter_tri(q, p[1], p[2], g[3]);
         for (int e = 0; e < 6; e++) {
-            int i = tet_edge[e][0], j = tet_edge[e][1], k = tet_edge[e][2], l = tet_edge[e][3];
+            const int *te = fdt_tet_edge[e];
+            int i = te[0], j = te[1], k = te[2], l = te[3];
             double f[3], v = 0;
             if (i == 0)
                 for (int d = 0; d < 3; d++)
@@ -433,7 +430,7 @@ static void sibson_shares(sibson *S, size_t nc, size_t nb, long m, const double 
                 v += det3(f, g[l], N->c);
             if (k != 0)
                 v -= det3(f, g[k], N->c);
-            v *= -N->sigma * tet_edge[e][4];
+            v *= -N->sigma * te[4];
             if (i != 0)
                 S->w[N->at[i - 1]] += v;
             S->w[N->at[j - 1]] -= v;

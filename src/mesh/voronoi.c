@@ -289,13 +289,6 @@ static double triple(const double *a, const double *b, const double *c)
     return dot3(a, x);
 }
 
-/* The six edges (i, j) of a tet with its other two vertices (k, l), and
- * the sign of the permutation (i, j, k, l) of (0, 1, 2, 3). */
-static const int tet_edge[6][5] = {
-    {0, 1, 2, 3, +1}, {0, 2, 1, 3, -1}, {0, 3, 1, 2, +1},
-    {1, 2, 0, 3, +1}, {1, 3, 0, 2, -1}, {2, 3, 0, 1, +1},
-};
-
 /* p after q in lexicographic (x, y, z) order (distinct points). */
 static inline int lex_after(const double *p, const double *q)
 {
@@ -369,11 +362,12 @@ static void add_tet(vjob *j, const uint32_t *tv)
     double vsum[4] = {0, 0, 0, 0}, vabs[4] = {0, 0, 0, 0};
     double msum[4][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
     for (int e = 0; e < 6; e++) {
-        int i = tet_edge[e][0], jj = tet_edge[e][1], k = tet_edge[e][2], l = tet_edge[e][3];
+        const int *te = fdt_tet_edge[e];
+        int i = te[0], jj = te[1], k = te[2], l = te[3];
         int mi = mine(j, s[i]), mj = mine(j, s[jj]);
         if (!mi && !mj)
             continue;
-        double o = sigma * tet_edge[e][4];
+        double o = sigma * te[4];
         double u[3], mid[3], cm[3], fp[3], fn[3];
         sub3(q[jj], q[i], u);
         for (int d = 0; d < 3; d++)
