@@ -39,17 +39,18 @@
  *   between two cavity tets, the centre of the first of them in canonical
  *   order (its own piece there is then nothing); on a boundary face F, the
  *   centre of the new tet (q, F) (the old tet keeps the piece from c_T to
- *   c_T', the new tet's is nothing); on a new face (q, i, j), the
- *   circumcentre of the triangle (q, i, j), the foot of q on that Voronoi
- *   edge's line.
+ *   c_T', the new tet's is nothing); on a new face (q, i, j), the centre
+ *   of the first of its two new tets. Each split point is thus an end of
+ *   its segment, so no piece reaches beyond the polygon (pair_new_faces
+ *   says what another choice cost).
  *
  * Every point in these sums (feet, split points, centres of the cavity's
  * tets, which lie in V+) lies within V+'s circumradius of q, so the terms
  * are of V+'s size and cancel little; all of them are relative to q. The
  * centres come from fdt_circumcenter (floating, double words, exact by the
- * tet's flatness), triangles' from fdt_circumcenter_tri. Against exact
- * rationals the coordinates are within a few ulps on uniform and lattice
- * points and 2e-13 next to 1e-3 wide clusters (bench/NOTES.md entry 95).
+ * tet's flatness). Against exact rationals the coordinates are within a
+ * few ulps on uniform and lattice points and 5e-14 next to 1e-3 wide
+ * clusters (bench/NOTES.md entry 95).
  * A query costs O(cavity): no m^2 cuts.
  *
  * The coordinates reproduce linear functions (sum w_i p_i = q); a query
@@ -119,7 +120,7 @@ static int push(void *pp, size_t *cap, size_t n, size_t size)
  * for each would cost O(cavity^2): a fifth of a query's time. */
 static tslot *tab_find(const sibson *S, fdt_tid t)
 {
-    size_t h = (size_t)(((uint64_t)(uint32_t)t * 0x9E3779B97F4A7C15u) >> 32) & S->tab_mask;
+    size_t h = (size_t)(((uint64_t)t * 0x9E3779B97F4A7C15u) >> 32) & S->tab_mask;
     while (S->tab[h].stamp == S->stamp && S->tab[h].t != t)
         h = (h + 1) & S->tab_mask;
     return &S->tab[h];
@@ -220,6 +221,8 @@ struct ntet {
     fdt_vid v[3];  /* ascending */
     int at[3];
     int sigma;     /* the orientation of (q, v0, v1, v2) */
+    int split[4];  /* the face opposite vertex f (0: q, 1..3: v[f - 1]):
+                      the new tet whose centre splits its Voronoi edge */
     double c[3];   /* circumcentre, relative to q */
 };
 
@@ -375,6 +378,43 @@ static long boundary(sibson *S, size_t nc, const double *q)
     return (long)nb;
 }
 
+/* The new tets across each new face (q, x, y): the two whose boundary
+ * faces share the edge (x, y) (the boundary is a closed surface, each edge
+ * on two faces). Found through the table of tets, keyed by the edge's two
+ * local numbers as a negative id (tets' are not), so a query costs O(new
+ * tets). The split point of the Voronoi edge between them is the centre
+ * of the first in order: an end of the segment, so no piece reaches
+ * beyond it (a triangle's circumcentre, the first choice, lies on the
+ * line anywhere and cancelled 3e4 times a long thin cell's volume near
+ * clusters, 3e-13 off). 0, -1 out of memory, -2 an edge without its pair
+ * (a bug). */
+static int pair_new_faces(sibson *S, size_t nb)
+{
+    for (size_t b = 0; b < nb; b++) {
+        ntet *N = &S->nt[b];
+        N->split[0] = (int)b; /* the boundary face: the old tet's piece */
+        for (int f = 1; f < 4; f++) {
+            N->split[f] = -1;
+            int x = f == 1 ? 1 : 0, y = f == 3 ? 1 : 2; /* the edge: v[x], v[y] */
+            fdt_tid key = -1 - (((fdt_tid)N->at[x] << 31) | N->at[y]);
+            tslot *e = tab_find(S, key);
+            if (e->stamp != S->stamp) {
+                if (tab_put(S, key, 4 * (int)b + f))
+                    return -1;
+                continue;
+            }
+            int p = e->at / 4, first = p < (int)b ? p : (int)b;
+            N->split[f] = first;
+            S->nt[p].split[e->at % 4] = first;
+        }
+    }
+    for (size_t b = 0; b < nb; b++)
+        for (int f = 1; f < 4; f++)
+            if (S->nt[b].split[f] < 0)
+                return -2;
+    return 0;
+}
+
 /* Each natural neighbour's stolen volume (times 6) into S->w[0 .. m),
  * summed as the file's comment derives: the cavity tets add their shares,
  * the new tets take theirs away. */
@@ -407,16 +447,13 @@ static void sibson_shares(sibson *S, size_t nc, size_t nb, long m, const double 
     for (size_t b = 0; b < nb; b++) {
         const ntet *N = &S->nt[b];
         /* g[f]: where the Voronoi edge of the face opposite vertex f is
-         * split: on the boundary face (f = 0) at the tet's own centre, on
-         * a face (q, x, y) at that triangle's circumcentre (computed from
-         * the face alone: the new tet on its other side splits it there to
-         * the same bits). Vertex 0 is q, 1..3 N->v. */
-        double g[4][3];
+         * split (pair_new_faces), NULL at the tet's own centre. Vertex 0
+         * is q, 1..3 N->v. */
+        const double *g[4];
+        for (int f = 0; f < 4; f++)
+            g[f] = N->split[f] == (int)b ? NULL : S->nt[N->split[f]].c;
         const double *p[4] = {q, X + 3 * (size_t)N->v[0], X + 3 * (size_t)N->v[1],
                               X + 3 * (size_t)N->v[2]};
-        fdt_circumcenter_tri(q, p[2], p[3], g[1]);
-        fdt_circumcenter_tri(q, p[1], p[3], g[2]);
-        fdt_circumcenter_tri(q, p[1], p[2], g[3]);
         for (int e = 0; e < 6; e++) {
             const int *te = fdt_tet_edge[e];
             int i = te[0], j = te[1], k = te[2], l = te[3];
@@ -426,9 +463,9 @@ static void sibson_shares(sibson *S, size_t nc, size_t nb, long m, const double 
                     f[d] = 0.5 * (p[j][d] - q[d]);
             else
                 foot(p[i], p[j], q, f);
-            if (l != 0)
+            if (g[l])
                 v += det3(f, g[l], N->c);
-            if (k != 0)
+            if (g[k])
                 v -= det3(f, g[k], N->c);
             v *= -N->sigma * te[4];
             if (i != 0)
@@ -467,6 +504,9 @@ static long coordinates(sibson *S, fdt_tid t0, const double *q)
         return 0;
     if (nb < 0)
         return nb;
+    int got = pair_new_faces(S, (size_t)nb);
+    if (got < 0)
+        return got;
     while (S->cap_w < (size_t)m)
         if (push(&S->w, &S->cap_w, S->cap_w, sizeof *S->w))
             return -1;
