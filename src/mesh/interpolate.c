@@ -74,10 +74,12 @@
 typedef struct ctet ctet;
 typedef struct ntet ntet;
 
+/* An entry of the table of tets met (tab_find). */
 typedef struct tslot {
-    fdt_tid t;
+    fdt_tid t;      /* a tet, or a boundary edge's negative key */
     uint32_t stamp; /* the query that entered it; 0: never */
-    int at;
+    int at;         /* a tet's place in S->cavity, then S->ct (-1: tested
+                       outside); an edge's first new tet, 4 b + face */
 } tslot;
 
 /* One thread's scratch, kept from query to query. */
