@@ -1846,6 +1846,55 @@ static void test_circumcenter(tctx *T, double scale, int verbose)
     report_section(T, __func__, failures_before);
 }
 
+/*
+ * fdt_circumcenter (the floating, double-word and exact tiers) against
+ * fdt_circumcenter_exact on tets of condition K = |u||v||w| / |det| from 1
+ * to 2^48: the fourth point lifted 2^-e off the plane of the other three.
+ * The error, relative to the circumradius, stays within the tiers' stated
+ * figures: about 8 K ulps for K <= 2^4 (floating), a few beyond.
+ */
+static void test_circumcenter_tiers(tctx *T, double scale)
+{
+    const long failures_before = test_failures();
+    double worst[2] = {0, 0};
+    const long need = (long)fmax(200 * scale, 50);
+    for (long it = 0; it < need; it++)
+        for (int e = 0; e <= 48; e += 2) {
+            double p[5][3], x[3], X[3];
+            gen_random(T, p);
+            double s = 3.0 * unif(T) - 1.0, t = 3.0 * unif(T) - 1.0, h = ldexp(sunif(T), -e);
+            double n[3] = {(p[1][1] - p[0][1]) * (p[2][2] - p[0][2]) - (p[1][2] - p[0][2]) * (p[2][1] - p[0][1]),
+                           (p[1][2] - p[0][2]) * (p[2][0] - p[0][0]) - (p[1][0] - p[0][0]) * (p[2][2] - p[0][2]),
+                           (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0])};
+            for (int k = 0; k < 3; k++)
+                p[3][k] = p[0][k] + s * (p[1][k] - p[0][k]) + t * (p[2][k] - p[0][k]) + h * n[k];
+            if (fdt_circumcenter_exact(p[0], p[1], p[2], p[3], X) != 0) {
+                EXPECT(fdt_circumcenter(p[0], p[1], p[2], p[3], x) != 0);
+                continue;
+            }
+            CHECK(fdt_circumcenter(p[0], p[1], p[2], p[3], x) == 0);
+            double u[3][3], l = 1, det, r = sqrt(X[0] * X[0] + X[1] * X[1] + X[2] * X[2]);
+            for (int i = 0; i < 3; i++) {
+                for (int k = 0; k < 3; k++)
+                    u[i][k] = p[i + 1][k] - p[0][k];
+                l *= sqrt(u[i][0] * u[i][0] + u[i][1] * u[i][1] + u[i][2] * u[i][2]);
+            }
+            det = u[0][0] * (u[1][1] * u[2][2] - u[1][2] * u[2][1]) -
+                  u[0][1] * (u[1][0] * u[2][2] - u[1][2] * u[2][0]) +
+                  u[0][2] * (u[1][0] * u[2][1] - u[1][1] * u[2][0]);
+            double err = 0;
+            for (int k = 0; k < 3; k++)
+                err = fmax(err, fabs(x[k] - X[k]) / r / 0x1p-53);
+            int flat = fabs(det) < 0x1p-4 * l;
+            worst[flat] = fmax(worst[flat], err);
+            EXPECTF(err <= (flat ? 8 : 512), "circumcenter tiers: %.3g ulps of the radius "
+                    "(K %.3g)", err, l / fabs(det));
+        }
+    printf("  circumcenter tiers: largest error %.3g ulps of the radius (K <= 2^4, floating), "
+           "%.3g (flatter)\n", worst[0], worst[1]);
+    report_section(T, __func__, failures_before);
+}
+
 /* sign(|x - q|^2 - |y - q|^2) in rationals. */
 static int ref_compare_dist(const double *q, const double *x, const double *y)
 {
@@ -2561,6 +2610,7 @@ int main(int argc, char **argv)
     test_bound_windows(&T, scale, verbose);
     test_degenerate_magnitudes(&T, scale, verbose);
     test_circumcenter(&T, scale, verbose);
+    test_circumcenter_tiers(&T, scale);
     test_compare_dist(&T, scale, verbose);
     test_lex_compare(&T, scale);
     test_static_filter(&T, scale);

@@ -1330,7 +1330,7 @@ static int open_engine(const cli *c, run_state *rs)
     if (c->threads >= 0)
         s.n_threads = c->threads;
     s.pin = c->pin;
-    s.neighbors = !rs->streaming && (c->check || (rs->need & FDT_NEED_NBRS));
+    s.neighbors = !rs->streaming && (c->check || (rs->need & FDT_NEED_NBRS) || fdt_cli_interp_wanted(&c->dual));
     if (rs->prog.enabled) {
         s.progress = progress_engine;
         s.progress_user = &rs->prog;

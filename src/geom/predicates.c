@@ -45,6 +45,10 @@
  * permutation, so v0 is on the negative side of (v1,v2,v3): that face is
  * already outward; the others follow the same parity count. */
 const int fdt_tet_face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+const int fdt_tet_edge[6][5] = {
+    {0, 1, 2, 3, +1}, {0, 2, 1, 3, -1}, {0, 3, 1, 2, +1},
+    {1, 2, 0, 3, +1}, {1, 3, 0, 2, -1}, {2, 3, 0, 1, +1},
+};
 
 /* Expansion arithmetic needs each operation rounded once to double. */
 #if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
@@ -1426,6 +1430,147 @@ int fdt_circumcenter_exact(const double *a, const double *b, const double *c,
         for (int k = 0; k < 3; k++)
             mpz_clear(q[i][k]);
     return rc;
+}
+
+/* The circumcentre formula of fdt_circumcenter_exact in double words:
+ * the differences exact (Two-Diff), every product and sum a double word
+ * (dw_mul, dw_add: relative error a few eps^2 each). The numerators and
+ * the determinant cancel by at most the tet's condition K = |u||v||w| /
+ * |det| (what makes the floating formula lose 8 K ulps), so they keep
+ * about 2^-100 K of their size: for K <= 2^40 the centre is right to
+ * a few ulps of the circumradius (tests/test_predicates.c: at most 3.4). Needs the differences within
+ * [2^-200, 2^200] (no split overflows, no tail underflows); the caller
+ * checks. */
+static void circumcenter_dw(const double *a, const double *b, const double *c, const double *d,
+                            double x[3])
+{
+    dword u[3], v[3], w[3], vw[3], wu[3], uv[3];
+    for (int k = 0; k < 3; k++) {
+        two_diff(b[k], a[k], &u[k].hi, &u[k].lo);
+        two_diff(c[k], a[k], &v[k].hi, &v[k].lo);
+        two_diff(d[k], a[k], &w[k].hi, &w[k].lo);
+    }
+    const dword *rows[3][2] = {{v, w}, {w, u}, {u, v}};
+    dword *out[3] = {vw, wu, uv};
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+            out[i][k] = dw_sub(dw_mul(rows[i][0][k1], rows[i][1][k2]),
+                               dw_mul(rows[i][0][k2], rows[i][1][k1]));
+        }
+    dword len[3], det = {0, 0};
+    const dword *e[3] = {u, v, w};
+    for (int i = 0; i < 3; i++) {
+        len[i] = (dword){0, 0};
+        for (int k = 0; k < 3; k++) {
+            len[i] = dw_add(len[i], dw_mul(e[i][k], e[i][k]));
+            if (i == 0)
+                det = dw_add(det, dw_mul(u[k], vw[k]));
+        }
+    }
+    for (int k = 0; k < 3; k++) {
+        dword num = dw_add(dw_add(dw_mul(len[0], vw[k]), dw_mul(len[1], wu[k])),
+                           dw_mul(len[2], uv[k]));
+        x[k] = (num.hi + num.lo) / (2 * (det.hi + det.lo));
+    }
+}
+
+/* predicates.h. Three tiers by the tet's condition K = |u||v||w| / |det|
+ * (u, v, w the edges from a): the floating formula for K <= 2^4, whose
+ * error is then at most about 8 K = 2^7 ulps of the circumradius (with
+ * 2^16, the Voronoi cells' first bound, natural-neighbour coordinates next
+ * to 1e-3 wide clusters drifted by 3e-11, with 2^8 by 3e-13: bench/
+ * NOTES.md entry 95); double words up to K = 2^40 (a few ulps; about 0.3 us a tet);
+ * the exact centre (GMP, some microseconds) beyond, or where the
+ * differences leave the double words' range. */
+int fdt_circumcenter(const double *a, const double *b, const double *c, const double *d,
+                     double x[3])
+{
+    double u[3], v[3], w[3], vw[3], wu[3], uv[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = b[k] - a[k];
+        v[k] = c[k] - a[k];
+        w[k] = d[k] - a[k];
+    }
+    cross3(v, w, vw);
+    cross3(w, u, wu);
+    cross3(u, v, uv);
+    double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    double vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    double ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    double det = u[0] * vw[0] + u[1] * vw[1] + u[2] * vw[2];
+    double l = sqrt(uu * vv * ww);
+    if (fabs(det) >= 0x1p-4 * l) {
+        for (int k = 0; k < 3; k++)
+            x[k] = (uu * vw[k] + vv * wu[k] + ww * uv[k]) / (2 * det);
+        return 0;
+    }
+    double mx = 0, mn = INFINITY;
+    for (int k = 0; k < 3; k++) {
+        const double e[3] = {fabs(u[k]), fabs(v[k]), fabs(w[k])};
+        for (int i = 0; i < 3; i++) {
+            mx = fmax(mx, e[i]);
+            if (e[i] > 0)
+                mn = fmin(mn, e[i]);
+        }
+    }
+    if (fabs(det) >= 0x1p-40 * l && mx <= 0x1p200 && mn >= 0x1p-200) {
+        circumcenter_dw(a, b, c, d, x);
+        return 0;
+    }
+    return fdt_circumcenter_exact(a, b, c, d, x);
+}
+
+/* The circumcentre of the triangle (0, e1, e2):
+ * (|e1|^2 e2 - |e2|^2 e1) x (e1 x e2) / (2 |e1 x e2|^2). */
+static void tri_centre(const double *e1, const double *e2, double *x)
+{
+    double n[3], t[3];
+    cross3(e1, e2, n);
+    double aa = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+    double bb = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+    for (int k = 0; k < 3; k++)
+        t[k] = aa * e2[k] - bb * e1[k];
+    cross3(t, n, x);
+    double nn = 2 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int k = 0; k < 3; k++)
+        x[k] /= nn;
+}
+
+/* predicates.h: without the exact fallback the Voronoi cells next to a
+ * nearly collinear face lost up to 1e-8 of their volume (gen_points
+ * clusters, bench/NOTES.md entry 92). */
+void fdt_circumcenter_tri(const double *a, const double *b, const double *c, double x[3])
+{
+    double e1[3], e2[3], n[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = b[k] - a[k];
+        e2[k] = c[k] - a[k];
+    }
+    cross3(e1, e2, n);
+    double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    double l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+    double l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+    if (nn >= 0x1p-20 * l1 * l2) {
+        tri_centre(e1, e2, x);
+        return;
+    }
+    double d[3] = {a[0] + n[0], a[1] + n[1], a[2] + n[2]}, X[3];
+    int got = nn > 0 ? fdt_circumcenter_exact(a, b, c, d, X) : -1;
+    if (got != 0 && nn > 0) {
+        int ex;
+        (void)frexp(sqrt(l1 / nn), &ex);
+        for (int k = 0; k < 3; k++)
+            d[k] = a[k] + ldexp(n[k], ex);
+        got = fdt_circumcenter_exact(a, b, c, d, X);
+    }
+    if (got != 0) {
+        tri_centre(e1, e2, x); /* collinear to the last bit: nothing better */
+        return;
+    }
+    double t = (X[0] * n[0] + X[1] * n[1] + X[2] * n[2]) / nn;
+    for (int k = 0; k < 3; k++)
+        x[k] = X[k] - t * n[k];
 }
 
 /*

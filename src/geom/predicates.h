@@ -51,6 +51,14 @@ typedef struct fdt_pred_counts {
  * and v[i] < 0). */
 extern const int fdt_tet_face[4][3];
 
+/* The six edges (i, j), i < j, of a tet with its other two vertices
+ * (k, l), and the sign of the permutation (i, j, k, l) of (0, 1, 2, 3):
+ * {i, j, k, l, sign}. About the direction v[j] - v[i] of a positively
+ * oriented tet, its face (i, j, k) comes before (i, j, l) counter-
+ * clockwise when the sign is +1 (the Voronoi cells' and the
+ * natural-neighbour coordinates' shares). */
+extern const int fdt_tet_edge[6][5];
+
 int fdt_orient3d(const double *a, const double *b, const double *c,
                  const double *d, fdt_pred_counts *cnt);
 int fdt_insphere(const double *a, const double *b, const double *c,
@@ -84,6 +92,29 @@ int fdt_compare_dist(const double *q, const double *x, const double *y);
  * formula cannot bound. */
 int fdt_circumcenter_exact(const double *a, const double *b, const double *c,
                            const double *d, double x[3]);
+
+/* The circumcentre of the tetrahedron (a, b, c, d), relative to a, as the
+ * Voronoi cells and the natural-neighbour coordinates take it: the
+ * floating formula where the tet is well shaped (|det| at least 2^-4 of
+ * the product of the edges from a: the error is then at most about 2^7
+ * ulps of the circumradius), the same formula in double words for flatter
+ * tets (|det| down to 2^-40 of that product: a few ulps),
+ * fdt_circumcenter_exact for the flattest. 0, or -1 when the points are
+ * coplanar (or a component overflows). */
+int fdt_circumcenter(const double *a, const double *b, const double *c, const double *d,
+                     double x[3]);
+
+/* The circumcentre of the triangle (a, b, c), relative to a: the floating
+ * formula where the triangle is well shaped (|n| at least 2^-10 |b - a|
+ * |c - a|, n the normal); for a flatter one (nearly collinear, its
+ * circumcentre far and the formula's error near |that distance| eps /
+ * sin), the exact circumcentre X of the tet (a, b, c, a + n) projected on
+ * the plane: X lies on the triangle's axis about |n| / 2 from it, so a
+ * normal off by eps / sin moves the projection by about |n| eps / (2 sin)
+ * = |b - a| |c - a| eps / 2. Where a + n rounds back onto the plane, n is
+ * scaled up (by a power of two, to about |b - a|) and tried again; a
+ * triangle collinear to the last bit gets the floating formula's answer. */
+void fdt_circumcenter_tri(const double *a, const double *b, const double *c, double x[3]);
 
 /*
  * Perturbed insphere (Devillers & Teillaud 2011, as in CGAL's

@@ -294,91 +294,6 @@ static double triple(const double *a, const double *b, const double *c)
     return dot3(a, x);
 }
 
-/* The circumcentre of the triangle (0, a, b), relative to its first vertex:
- * (|a|^2 b - |b|^2 a) x (a x b) / (2 |a x b|^2). */
-static void tri_centre(const double *a, const double *b, double *x)
-{
-    double n[3], t[3];
-    cross3(a, b, n);
-    double aa = dot3(a, a), bb = dot3(b, b);
-    for (int k = 0; k < 3; k++)
-        t[k] = aa * b[k] - bb * a[k];
-    cross3(t, n, x);
-    double nn = 2 * dot3(n, n);
-    for (int k = 0; k < 3; k++)
-        x[k] /= nn;
-}
-
-/* The circumcentre of the triangle (a, b, c), relative to a: the floating
- * formula where the triangle is well shaped (|n| at least 2^-10 |b - a|
- * |c - a|, n the normal); for a flatter one (nearly collinear, its
- * circumcentre far and the formula's error near |that distance| eps /
- * sin), the exact circumcentre X of the tet (a, b, c, a + n) projected on
- * the plane: X lies on the triangle's axis about |n| / 2 from it, so a
- * normal off by eps / sin moves the projection by about |n| eps / (2 sin)
- * = |b - a| |c - a| eps / 2. Where a + n rounds back onto the plane, n is
- * scaled up (by a power of two, to about |b - a|) and tried again.
- * Without it the shares of a cell next to such a face lost up to 1e-8 of
- * its volume (gen_points clusters). */
-static void face_centre(const double *a, const double *b, const double *c, double *x)
-{
-    double e1[3], e2[3], n[3];
-    sub3(b, a, e1);
-    sub3(c, a, e2);
-    cross3(e1, e2, n);
-    double nn = dot3(n, n);
-    if (nn >= 0x1p-20 * dot3(e1, e1) * dot3(e2, e2)) {
-        tri_centre(e1, e2, x);
-        return;
-    }
-    double d[3] = {a[0] + n[0], a[1] + n[1], a[2] + n[2]}, X[3];
-    int got = nn > 0 ? fdt_circumcenter_exact(a, b, c, d, X) : -1;
-    if (got != 0 && nn > 0) {
-        int ex;
-        (void)frexp(sqrt(dot3(e1, e1) / nn), &ex);
-        for (int k = 0; k < 3; k++)
-            d[k] = a[k] + ldexp(n[k], ex);
-        got = fdt_circumcenter_exact(a, b, c, d, X);
-    }
-    if (got != 0) {
-        tri_centre(e1, e2, x); /* collinear to the last bit: nothing better */
-        return;
-    }
-    double t = dot3(X, n) / nn;
-    for (int k = 0; k < 3; k++)
-        x[k] = X[k] - t * n[k];
-}
-
-/* The circumcentre of (p0, p0 + q1, p0 + q2, p0 + q3), relative to p0:
- * the floating formula where the tet is well shaped (its determinant at
- * least 2^-16 of the product of the edges from p0, so that the error is at
- * most about 2^16 x 8 ulps of the circumradius), the exact one
- * (fdt_circumcenter_exact) for the flatter tets. -1 when flat. */
-static int tet_centre(const double *p0, const double q[4][3], const double *p1,
-                      const double *p2, const double *p3, double *c)
-{
-    double x[3], y[3], z[3];
-    cross3(q[2], q[3], x);
-    cross3(q[3], q[1], y);
-    cross3(q[1], q[2], z);
-    double det = dot3(q[1], x);
-    double l = sqrt(dot3(q[1], q[1]) * dot3(q[2], q[2]) * dot3(q[3], q[3]));
-    if (fabs(det) >= 0x1p-16 * l) {
-        double a = dot3(q[1], q[1]), b = dot3(q[2], q[2]), d = dot3(q[3], q[3]);
-        for (int k = 0; k < 3; k++)
-            c[k] = (a * x[k] + b * y[k] + d * z[k]) / (2 * det);
-        return 0;
-    }
-    return fdt_circumcenter_exact(p0, p1, p2, p3, c);
-}
-
-/* The six edges (i, j) of a tet with its other two vertices (k, l), and
- * the sign of the permutation (i, j, k, l) of (0, 1, 2, 3). */
-static const int tet_edge[6][5] = {
-    {0, 1, 2, 3, +1}, {0, 2, 1, 3, -1}, {0, 3, 1, 2, +1},
-    {1, 2, 0, 3, +1}, {1, 3, 0, 2, -1}, {2, 3, 0, 1, +1},
-};
-
 /* p after q in lexicographic (x, y, z) order (distinct points). */
 static inline int lex_after(const double *p, const double *q)
 {
@@ -423,8 +338,8 @@ static void add_tet(vjob *j, const uint32_t *tv)
         if (mine(j, s[m]))
             fdt_fix_add(&w->dtfe[s[m]], v6 / 6, w->g_vol);
     double c[3];
-    int outside = tet_centre(p0, q, X + 3 * (size_t)s[1], X + 3 * (size_t)s[2],
-                             X + 3 * (size_t)s[3], c) != 0;
+    int outside = fdt_circumcenter(p0, X + 3 * (size_t)s[1], X + 3 * (size_t)s[2],
+                                   X + 3 * (size_t)s[3], c) != 0;
     for (int k = 0; k < 3; k++)
         if (!(p0[k] + c[k] >= w->box[k] && p0[k] + c[k] <= w->box[k + 3]))
             outside = 1;
@@ -442,7 +357,8 @@ static void add_tet(vjob *j, const uint32_t *tv)
     for (int m = 0; m < 4; m++) {
         int u0 = m == 0 ? 1 : 0, u1 = m <= 1 ? 2 : 1, u2 = m <= 2 ? 3 : 2;
         double x[3];
-        face_centre(X + 3 * (size_t)s[u0], X + 3 * (size_t)s[u1], X + 3 * (size_t)s[u2], x);
+        fdt_circumcenter_tri(X + 3 * (size_t)s[u0], X + 3 * (size_t)s[u1],
+                             X + 3 * (size_t)s[u2], x);
         for (int k = 0; k < 3; k++)
             f[m][k] = q[u0][k] + x[k];
     }
@@ -451,11 +367,12 @@ static void add_tet(vjob *j, const uint32_t *tv)
     double vsum[4] = {0, 0, 0, 0}, vabs[4] = {0, 0, 0, 0};
     double msum[4][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
     for (int e = 0; e < 6; e++) {
-        int i = tet_edge[e][0], jj = tet_edge[e][1], k = tet_edge[e][2], l = tet_edge[e][3];
+        const int *te = fdt_tet_edge[e];
+        int i = te[0], jj = te[1], k = te[2], l = te[3];
         int mi = mine(j, s[i]), mj = mine(j, s[jj]);
         if (!mi && !mj)
             continue;
-        double o = sigma * tet_edge[e][4];
+        double o = sigma * te[4];
         double u[3], mid[3], cm[3], fp[3], fn[3];
         sub3(q[jj], q[i], u);
         for (int d = 0; d < 3; d++)
