@@ -5,23 +5,13 @@
  * not share (OpenFOAM's: tests/dual_e2e.py runs checkMesh as well).
  */
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/sortu64.h"
+#include "base/diag.h"
 #include "mesh/dualmesh.h"
-
-static void say(char *diag, size_t size, const char *fmt, ...)
-{
-    if (!diag || !size)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(diag, size, fmt, ap);
-    va_end(ap);
-}
 
 static int u64_cmp(const void *x, const void *y)
 {
@@ -106,19 +96,19 @@ static int check_faces(const fdt_dualmesh *d, char *diag, size_t ds)
     size_t at = d->n_internal;
     for (int p = 0; p < 6; p++) {
         if (d->patch_start[p] != at) {
-            say(diag, ds, "patch %s starts at face %zu, not %zu", fdt_dualmesh_patch[p],
+            fdt_diag(diag, ds, "patch %s starts at face %zu, not %zu", fdt_dualmesh_patch[p],
                 d->patch_start[p], at);
             return -1;
         }
         at += d->patch_size[p];
     }
     if (at != d->n_faces) {
-        say(diag, ds, "the patches end at face %zu of %zu", at, d->n_faces);
+        fdt_diag(diag, ds, "the patches end at face %zu of %zu", at, d->n_faces);
         return -1;
     }
     uint8_t *used = calloc(d->n_verts + 1, 1);
     if (!used) {
-        say(diag, ds, "out of memory");
+        fdt_diag(diag, ds, "out of memory");
         return -1;
     }
     int bad = 0;
@@ -126,42 +116,42 @@ static int check_faces(const fdt_dualmesh *d, char *diag, size_t ds)
         size_t m = d->fstart[f + 1] - d->fstart[f];
         const int32_t *v = d->fverts + d->fstart[f];
         if (d->fstart[f + 1] < d->fstart[f] || m < 3) {
-            say(diag, ds, "face %zu has %zu vertices", f, m);
+            fdt_diag(diag, ds, "face %zu has %zu vertices", f, m);
             bad = 1;
         }
         for (size_t i = 0; i < m && !bad; i++) {
             if (v[i] < 0 || (size_t)v[i] >= d->n_verts) {
-                say(diag, ds, "face %zu names vertex %d of %zu", f, v[i], d->n_verts);
+                fdt_diag(diag, ds, "face %zu names vertex %d of %zu", f, v[i], d->n_verts);
                 bad = 1;
                 break;
             }
             used[v[i]] = 1;
             for (size_t j = 0; j < i; j++)
                 if (v[j] == v[i]) {
-                    say(diag, ds, "face %zu has vertex %d twice", f, v[i]);
+                    fdt_diag(diag, ds, "face %zu has vertex %d twice", f, v[i]);
                     bad = 1;
                 }
         }
         int32_t o = d->owner[f];
         if (!bad && (o < 0 || (size_t)o >= d->n_cells)) {
-            say(diag, ds, "face %zu's owner %d is no cell", f, o);
+            fdt_diag(diag, ds, "face %zu's owner %d is no cell", f, o);
             bad = 1;
         }
         if (!bad && f < d->n_internal) {
             int32_t nb = d->neighbour[f];
             if (nb <= o || (size_t)nb >= d->n_cells) {
-                say(diag, ds, "face %zu: owner %d, neighbour %d", f, o, nb);
+                fdt_diag(diag, ds, "face %zu: owner %d, neighbour %d", f, o, nb);
                 bad = 1;
             } else if (f > 0 && (d->owner[f - 1] > o ||
                                  (d->owner[f - 1] == o && d->neighbour[f - 1] >= nb))) {
-                say(diag, ds, "face %zu (%d, %d) is out of upper-triangular order", f, o, nb);
+                fdt_diag(diag, ds, "face %zu (%d, %d) is out of upper-triangular order", f, o, nb);
                 bad = 1;
             }
         }
     }
     for (size_t v = 0; v < d->n_verts && !bad; v++)
         if (!used[v]) {
-            say(diag, ds, "vertex %zu is in no face", v);
+            fdt_diag(diag, ds, "vertex %zu is in no face", v);
             bad = 1;
         }
     free(used);
@@ -178,7 +168,7 @@ static int check_cell(const fdt_dualmesh *d, const size_t *cs, const size_t *cf,
         const int32_t *v = d->fverts + d->fstart[f];
         int out = d->owner[f] == (int32_t)c;
         if (grow(buf, cap, m + k) != 0) {
-            say(diag, ds, "out of memory");
+            fdt_diag(diag, ds, "out of memory");
             return -1;
         }
         for (size_t i = 0; i < k; i++) {
@@ -187,26 +177,26 @@ static int check_cell(const fdt_dualmesh *d, const size_t *cs, const size_t *cf,
         }
     }
     if (m == 0) {
-        say(diag, ds, "cell %zu has no faces", c);
+        fdt_diag(diag, ds, "cell %zu has no faces", c);
         return -1;
     }
     fdt_sort_u64(*buf, m);
     for (size_t i = 0; i < m; i++) {
         uint64_t e = (*buf)[i], r = (e << 32) | (e >> 32);
         if (i > 0 && (*buf)[i - 1] == e) {
-            say(diag, ds, "cell %zu has edge %u-%u twice the same way round", c,
+            fdt_diag(diag, ds, "cell %zu has edge %u-%u twice the same way round", c,
                 (unsigned)(e >> 32), (unsigned)e);
             return -1;
         }
         if (!bsearch(&r, *buf, m, sizeof **buf, u64_cmp)) {
-            say(diag, ds, "cell %zu is not closed at edge %u-%u", c, (unsigned)(e >> 32),
+            fdt_diag(diag, ds, "cell %zu is not closed at edge %u-%u", c, (unsigned)(e >> 32),
                 (unsigned)e);
             return -1;
         }
     }
     double vol = fdt_dualmesh_cell_volume(d, cs, cf, c);
     if (!(vol > 0)) {
-        say(diag, ds, "cell %zu has volume %g (turned inward, or too small for doubles "
+        fdt_diag(diag, ds, "cell %zu has volume %g (turned inward, or too small for doubles "
             "beside the box)", c, vol);
         return -1;
     }
@@ -215,12 +205,12 @@ static int check_cell(const fdt_dualmesh *d, const size_t *cs, const size_t *cf,
 
 int fdt_dualmesh_check(const fdt_dualmesh *d, char *diag, size_t ds)
 {
-    say(diag, ds, "%s", "");
+    fdt_diag(diag, ds, "%s", "");
     if (check_faces(d, diag, ds) != 0)
         return -1;
     size_t *cs = NULL, *cf = NULL;
     if (fdt_dualmesh_cell_faces(d, &cs, &cf) != FDT_OK) {
-        say(diag, ds, "out of memory");
+        fdt_diag(diag, ds, "out of memory");
         return -1;
     }
     uint64_t *buf = NULL;

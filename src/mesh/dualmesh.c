@@ -41,11 +41,11 @@
 
 #include <limits.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/diag.h"
 #include "base/hash.h"
 #include "base/sortu64.h"
 #include "geom/predicates.h"
@@ -56,16 +56,6 @@
 const char *const fdt_dualmesh_patch[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
 
 /* ------------------------------------------------------------ small tools */
-
-static void say(char *diag, size_t size, const char *fmt, ...)
-{
-    if (!diag || !size)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(diag, size, fmt, ap);
-    va_end(ap);
-}
 
 /* Grows *p (elements of size sz) to hold at least need; 0 or -1. */
 static int grow(void *pp, size_t *cap, size_t need, size_t sz)
@@ -330,7 +320,7 @@ static int merge_tets(dwork *w)
         if (tet_circumcentre(w->X + 3 * (size_t)v[0], w->X + 3 * (size_t)v[1],
                              w->X + 3 * (size_t)v[2], w->X + 3 * (size_t)v[3],
                              w->cc + 3 * t) != 0) {
-            say(w->diag, w->ds, "tet %zu is flat: it has no circumcentre", t);
+            fdt_diag(w->diag, w->ds, "tet %zu is flat: it has no circumcentre", t);
             return FDT_EINTERNAL;
         }
     }
@@ -345,7 +335,7 @@ static int merge_tets(dwork *w)
             while (e < 4 && w->nb[4 * (size_t)u + (size_t)e] != (fdt_tid)t)
                 e++;
             if (e == 4) {
-                say(w->diag, w->ds, "tets %zu and %lld are not mutual neighbours", t,
+                fdt_diag(w->diag, w->ds, "tets %zu and %lld are not mutual neighbours", t,
                     (long long)u);
                 return FDT_EINTERNAL;
             }
@@ -730,7 +720,7 @@ static int put_face(dwork *w, size_t m, int32_t own, int32_t nbr)
         const cv *e = &w->poly[i];
         int64_t id = e->id;
         if (e->h[3] == 0) {
-            say(w->diag, w->ds, "the face of cells %d and %d keeps a point at infinity "
+            fdt_diag(w->diag, w->ds, "the face of cells %d and %d keeps a point at infinity "
                 "after the box cut it", own, nbr);
             return FDT_EINTERNAL;
         }
@@ -896,7 +886,7 @@ static int all_faces(dwork *w)
             int err = edge_face(w, (fdt_tid)t, a < b ? a : b, a < b ? b : a);
             if (err) {
                 if (err == FDT_EINTERNAL && !w->diag[0])
-                    say(w->diag, w->ds, "the tets about edge (%d, %d) do not close", a, b);
+                    fdt_diag(w->diag, w->ds, "the tets about edge (%d, %d) do not close", a, b);
                 return err;
             }
         }
@@ -1069,7 +1059,7 @@ static int wall_face(dwork *w, wallwork *ww, int32_t c, int p, size_t m, const i
         goto bad;
     return k < 3 ? FDT_OK : append_face(w, ids, k, c, -1 - p);
 bad:
-    say(w->diag, w->ds, "the face of cell %d on wall %s does not chain (%zu edges)", c,
+    fdt_diag(w->diag, w->ds, "the face of cell %d on wall %s does not chain (%zu edges)", c,
         fdt_dualmesh_patch[p], m);
     return FDT_EINTERNAL;
 }
@@ -1137,7 +1127,7 @@ static int cell_walls(dwork *w, wallwork *ww, int32_t c, const size_t *cs, const
             continue;
         r.wall = hedge_wall(w, c, &r);
         if (r.wall < 0) {
-            say(w->diag, w->ds, "cell %d is open at edge %llu-%llu, on no wall", c,
+            fdt_diag(w->diag, w->ds, "cell %d is open at edge %llu-%llu, on no wall", c,
                 (unsigned long long)(r.key >> 32), (unsigned long long)(r.key & 0xffffffffu));
             return FDT_EINTERNAL;
         }
@@ -1204,7 +1194,7 @@ static int all_walls(dwork *w)
     tmp.neighbour = w->fnbr;
     size_t *cs = NULL, *cf = NULL;
     if (w->nv >= (UINT64_C(1) << 31)) {
-        say(w->diag, w->ds, "too many vertices for OpenFOAM's 32-bit labels");
+        fdt_diag(w->diag, w->ds, "too many vertices for OpenFOAM's 32-bit labels");
         return FDT_ETOOBIG;
     }
     if (fdt_dualmesh_cell_faces(&tmp, &cs, &cf) != FDT_OK)
@@ -1431,12 +1421,12 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
     diag[0] = 0;
     memset(d, 0, sizeof *d);
     if (!r || !xyz || !o || r->streamed || n != r->n || r->ntets == 0) {
-        say(diag, diag_size, "the dual needs the result of fdt_triangulate on the same %zu "
+        fdt_diag(diag, diag_size, "the dual needs the result of fdt_triangulate on the same %zu "
             "points, with its tets", n);
         return FDT_EINVAL;
     }
     if (r->ntets > (size_t)INT32_MAX || n > (size_t)INT32_MAX) {
-        say(diag, diag_size, "too many points or tets for OpenFOAM's 32-bit labels");
+        fdt_diag(diag, diag_size, "too many points or tets for OpenFOAM's 32-bit labels");
         return FDT_ETOOBIG;
     }
     dwork w;
@@ -1480,7 +1470,7 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
         err = all_walls(&w);
     if (!err && (w.nv > (size_t)INT32_MAX || w.nf > (size_t)INT32_MAX ||
                  w.nfv > (size_t)INT32_MAX)) {
-        say(diag, diag_size, "too many vertices or faces for OpenFOAM's 32-bit labels");
+        fdt_diag(diag, diag_size, "too many vertices or faces for OpenFOAM's 32-bit labels");
         err = FDT_ETOOBIG;
     }
     /* what the faces were built from goes before the mesh is copied out */
@@ -1499,13 +1489,13 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
         d->xyz[i] = ldexp(d->xyz[i], ex);
 done:
     if (err == FDT_ENOMEM && !diag[0])
-        say(diag, diag_size, "out of memory");
+        fdt_diag(diag, diag_size, "out of memory");
     free_work(&w);
     if (err) {
         char keep[512];
         snprintf(keep, sizeof keep, "%s", diag);
         fdt_dualmesh_free(d);
-        say(diag, diag_size, "%s", keep);
+        fdt_diag(diag, diag_size, "%s", keep);
     }
     return err;
 }

@@ -22,12 +22,12 @@
  * (src/geom/cell.c), as voro++ computes every cell.
  */
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/abi.h"
+#include "base/diag.h"
 #include "base/fixsum.h"
 #include "base/spawn.h"
 #include "geom/cell.h"
@@ -125,16 +125,6 @@ void fdt_voronoi_free(fdt_voronoi **pv)
     *pv = NULL;
 }
 
-static void say(char *diag, size_t size, const char *fmt, ...)
-{
-    if (!diag || !size)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(diag, size, fmt, ap);
-    va_end(ap);
-}
-
 int fdt_voronoi_box_of(const fdt_result *r, const double *xyz, size_t n,
                        const fdt_voronoi_options *o, double box[6], char *diag, size_t ds)
 {
@@ -142,13 +132,13 @@ int fdt_voronoi_box_of(const fdt_result *r, const double *xyz, size_t n,
         memcpy(box, o->box, 6 * sizeof *box);
         for (int k = 0; k < 3; k++)
             if (!(box[k] < box[k + 3]) || !isfinite(box[k]) || !isfinite(box[k + 3])) {
-                say(diag, ds, "the box is empty or not finite in %c", "xyz"[k]);
+                fdt_diag(diag, ds, "the box is empty or not finite in %c", "xyz"[k]);
                 return FDT_EINVAL;
             }
         for (size_t i = 0; i < n; i++)
             for (int k = 0; k < 3; k++)
                 if (xyz[3 * i + k] < box[k] || xyz[3 * i + k] > box[k + 3]) {
-                    say(diag, ds, "point %zu (%.17g %.17g %.17g) lies outside the box", i,
+                    fdt_diag(diag, ds, "point %zu (%.17g %.17g %.17g) lies outside the box", i,
                         xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
                     return FDT_EINVAL;
                 }
@@ -778,7 +768,7 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
         diag[0] = 0;
     *out = NULL;
     if (r->streamed || n != r->n) {
-        say(diag, diag_size, "%zu points given; the cells need the result of "
+        fdt_diag(diag, diag_size, "%zu points given; the cells need the result of "
                              "fdt_triangulate on the same points, with its tets", n);
         return FDT_EINVAL;
     }
@@ -820,7 +810,7 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
         for (int t = 0; t < threads; t++)
             if (jobs[t].err == FDT_EINTERNAL) {
                 const double *p = w.xyz + 3 * (size_t)jobs[t].lo;
-                say(diag, diag_size, "the cell of point %u (%.17g %.17g %.17g) could not be "
+                fdt_diag(diag, diag_size, "the cell of point %u (%.17g %.17g %.17g) could not be "
                     "cut from the box (a bug: please report)", w.perm[jobs[t].lo], p[0], p[1],
                     p[2]);
                 break;
