@@ -735,6 +735,19 @@ int fdt_wr_set_commit(char *err, size_t errlen)
     /* 4. the commit point */
     if (!e && fault_here(&fault, "commit"))
         e = EIO, at = -1, what = "cannot commit";
+    if (!e) {
+        /* The commit point is the journal's removal: a journal left
+         * behind would tell whoever finds it to undo renames of a commit
+         * reported done, so one that cannot be removed rolls the set back. */
+        block_signals(&old);
+        if (unlink(set_journal) == 0) {
+            set_journal_live = 0;
+            set_phase = PHASE_COMMITTED;
+        } else {
+            e = errno, at = -1, what = "cannot remove the commit journal";
+        }
+        restore_signals(&old);
+    }
     if (e) {
         block_signals(&old);
         set_rollback();
@@ -749,11 +762,6 @@ int fdt_wr_set_commit(char *err, size_t errlen)
         return set_err(err, errlen, e == ENOMEM ? FDT_IO_ENOMEM : FDT_IO_EWRITE,
                        at >= 0 ? set_dst[at] : set_journal, msg);
     }
-    block_signals(&old);
-    set_phase = PHASE_COMMITTED;
-    unlink(set_journal);
-    set_journal_live = 0;
-    restore_signals(&old);
     (void)fault_here(&fault, "committed");
     block_signals(&old);
     set_finish();
