@@ -772,9 +772,13 @@ int fdt_wr_set_commit(char *err, size_t errlen)
 
 /*
  * Closes files[0..k) and renames them over their targets, all or none:
- * if any close or rename fails, every temporary and every target already
- * renamed in this set is removed (a .ele set with a stale .neigh beside a
- * new .ele would be worse than none).
+ * if any close fails, every temporary is removed; several targets of
+ * which some exist are renamed as a commit set of their own
+ * (commit_own_set), so a failed rename puts every target back as it was
+ * (a .ele set with a stale .neigh beside a new .ele would be worse than
+ * none, and removing the old set would lose it). New targets, and a fresh
+ * polyMesh's files (KEEP_RENAMED, renamed inside their temporary folder),
+ * are renamed one by one here, and all removed if one rename fails.
  *
  * rename() replaces the directory entry, never the file behind it: a
  * target that is a symbolic link is replaced by the new file and what it
@@ -814,6 +818,33 @@ static int defer_all(out_file *files, int k, char *err, size_t errlen)
     return FDT_IO_OK;
 }
 
+/* Does any of files[0..k)'s targets exist (or cannot tell)? */
+static int any_target(const out_file *files, int k)
+{
+    struct stat st;
+    for (int i = 0; i < k; i++)
+        if (lstat(fdt_io_dst_path[files[i].slot], &st) == 0 || errno != ENOENT)
+            return 1;
+    return 0;
+}
+
+/* Several targets (a TetGen set, a polyMesh's files in its folder), some
+ * of them there already, with no commit set open: renamed as a set of
+ * their own, so a rename that fails part-way puts back the targets
+ * renamed before it (backed up) instead of removing them with the old
+ * files they replaced. (All new, removing them loses nothing: no journal
+ * then, and no backups.) */
+static int commit_own_set(out_file *files, int k, char *err, size_t errlen)
+{
+    fdt_wr_set_begin(0); /* none is open: cannot fail */
+    int r = defer_all(files, k, err, errlen);
+    if (r != FDT_IO_OK) {
+        fdt_wr_set_abandon();
+        return r;
+    }
+    return fdt_wr_set_commit(err, errlen);
+}
+
 static int commit_all(out_file *files, int k, char *err, size_t errlen, int keep)
 {
     for (int i = 0; i < k; i++) {
@@ -826,6 +857,8 @@ static int commit_all(out_file *files, int k, char *err, size_t errlen, int keep
     }
     if (set_phase == PHASE_OPEN)
         return defer_all(files, k, err, errlen);
+    if (k > 1 && !keep && any_target(files, k))
+        return commit_own_set(files, k, err, errlen);
     for (int i = 0; i < k; i++) {
         int slot = files[i].slot;
         fdt_io_state[slot] = SLOT_RENAMING;
