@@ -636,6 +636,63 @@ static int write_journal(void)
     return e;
 }
 
+/* Step 1 of fdt_wr_set_commit: each existing target checked and backed
+ * up (a hard link, or BAK_MOVE where links fail); 0, or an errno with
+ * the entry (*at) and what failed. */
+static int set_backups(set_fault *fault, int *at, const char **what)
+{
+    int n = (int)set_n, e = 0;
+    sigset_t old;
+    for (int i = 0; i < n && !e; i++) {
+        struct stat st;
+        if (lstat(set_dst[i], &st) != 0) {
+            if (errno != ENOENT) {
+                e = errno, *at = i, *what = "cannot check";
+            }
+            continue;
+        }
+        if (set_kind[i] == ENT_DIR) {
+            e = EEXIST, *at = i, *what = "appeared while the mesh was computed";
+            break;
+        }
+        if (S_ISDIR(st.st_mode)) {
+            e = EISDIR, *at = i, *what = "cannot replace";
+            break;
+        }
+        if (set_no_clobber) {
+            e = EEXIST, *at = i, *what = "--no-clobber";
+            break;
+        }
+        if ((e = backup_name(set_bak[i], set_dst[i], i)) != 0) {
+            *at = i, *what = "cannot back up";
+            break;
+        }
+        if (lstat(set_bak[i], &st) == 0) {
+            e = EEXIST, *at = i, *what = "cannot back up";
+            break;
+        }
+        if (set_kind[i] == ENT_REMOVE) {
+            set_bakmode[i] = BAK_MOVE; /* the removal is the move */
+            continue;
+        }
+        if (fault_here(fault, "backup")) {
+            e = EIO, *at = i, *what = "cannot back up";
+            break;
+        }
+        block_signals(&old);
+        if (link(set_dst[i], set_bak[i]) == 0) {
+            set_bakmode[i] = BAK_LINK;
+            set_step[i] = STEP_LINKED;
+        } else if (errno == EEXIST) {
+            e = EEXIST, *at = i, *what = "cannot back up";
+        } else {
+            set_bakmode[i] = BAK_MOVE; /* no links here: moved at its turn */
+        }
+        restore_signals(&old);
+    }
+    return e;
+}
+
 int fdt_wr_set_commit(char *err, size_t errlen)
 {
     if (set_phase != PHASE_OPEN)
@@ -650,53 +707,7 @@ int fdt_wr_set_commit(char *err, size_t errlen)
         return FDT_IO_OK;
     }
     /* 1. backups (and the checks that need no change on disk) */
-    for (int i = 0; i < n && !e; i++) {
-        struct stat st;
-        if (lstat(set_dst[i], &st) != 0) {
-            if (errno != ENOENT) {
-                e = errno, at = i, what = "cannot check";
-            }
-            continue;
-        }
-        if (set_kind[i] == ENT_DIR) {
-            e = EEXIST, at = i, what = "appeared while the mesh was computed";
-            break;
-        }
-        if (S_ISDIR(st.st_mode)) {
-            e = EISDIR, at = i, what = "cannot replace";
-            break;
-        }
-        if (set_no_clobber) {
-            e = EEXIST, at = i, what = "--no-clobber";
-            break;
-        }
-        if ((e = backup_name(set_bak[i], set_dst[i], i)) != 0) {
-            at = i, what = "cannot back up";
-            break;
-        }
-        if (lstat(set_bak[i], &st) == 0) {
-            e = EEXIST, at = i, what = "cannot back up";
-            break;
-        }
-        if (set_kind[i] == ENT_REMOVE) {
-            set_bakmode[i] = BAK_MOVE; /* the removal is the move */
-            continue;
-        }
-        if (fault_here(&fault, "backup")) {
-            e = EIO, at = i, what = "cannot back up";
-            break;
-        }
-        block_signals(&old);
-        if (link(set_dst[i], set_bak[i]) == 0) {
-            set_bakmode[i] = BAK_LINK;
-            set_step[i] = STEP_LINKED;
-        } else if (errno == EEXIST) {
-            e = EEXIST, at = i, what = "cannot back up";
-        } else {
-            set_bakmode[i] = BAK_MOVE; /* no links here: moved at its turn */
-        }
-        restore_signals(&old);
-    }
+    e = set_backups(&fault, &at, &what);
     /* 2. the journal */
     if (!e && fault_here(&fault, "journal"))
         e = EIO, at = -1, what = "cannot write the commit journal";
