@@ -413,6 +413,19 @@ static int count_fds(void)
     return n;
 }
 
+static int count_entries_of(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return -1;
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL)
+        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
+    closedir(d);
+    return n;
+}
+
 static void put_file(const char *dir, const char *name, const char *text)
 {
     char p[FDT_IO_PATH];
@@ -453,7 +466,11 @@ static void make_mesh(fdt_result **r)
 
 static void path_in(char out[FDT_IO_PATH], const char *dir, const char *name)
 {
-    snprintf(out, FDT_IO_PATH, "%s/%s", dir, name);
+    size_t ld = strlen(dir), ln = strlen(name);
+    CHECK(ld + 1 + ln + 1 <= FDT_IO_PATH);
+    memcpy(out, dir, ld);
+    out[ld] = '/';
+    memcpy(out + ld + 1, name, ln + 1);
 }
 
 static int write_mesh(const char *dir, const char *name, char *err, size_t errlen)
@@ -754,6 +771,134 @@ static void sweep(const scenario *sc, const char *root)
     free(s.after.p);
 }
 
+/* ------------------------------------------------------------------ */
+/* The writer's own limits                                            */
+/* ------------------------------------------------------------------ */
+
+/* Resources of the writer itself rather than the system's, failing the
+ * same way: every registry slot taken (EMFILE), a commit set full
+ * (EMFILE), a name too long for the registry (ENAMETOOLONG); the
+ * signal handler's clean-up run in the middle of a write; the messages
+ * of fdt_create_err. Each failure returns FDT_IO_EWRITE naming the file
+ * and leaves the folder as it was. */
+static void test_limits(const char *root)
+{
+    char dir[FDT_IO_PATH], p[FDT_IO_PATH], err[2 * FDT_IO_PATH];
+    snprintf(dir, sizeof dir, "%s/limits", root);
+    CHECK(mkdir(dir, 0755) == 0);
+    char *longp = malloc(FDT_IO_PATH + 8);
+    CHECK(longp);
+    memset(longp, 'a', FDT_IO_PATH + 7);
+    memcpy(longp + FDT_IO_PATH + 7 - 5, ".tets", 6);
+    EXPECT(fdt_io_guard(longp) == -1);
+    EXPECT(fdt_wr_mesh(longp, &mesh, err, sizeof err) == FDT_IO_EWRITE);
+    free(longp);
+
+    /* every slot guarded: no temporary can be made; then clean-up removes
+     * the guarded targets, as the signal handler does */
+    int slots[64], ng = 0;
+    path_in(p, dir, "guarded");
+    put_file(dir, "guarded", "a piece\n");
+    while (ng < 64 && (slots[ng] = fdt_io_guard(p)) >= 0)
+        ng++;
+    EXPECT(ng > 0 && ng < 64);
+    EXPECT(write_mesh(dir, "m.tets", err, sizeof err) == FDT_IO_EWRITE &&
+           strstr(err, strerror(EMFILE)));
+    fdt_io_unguard(-1);
+    fdt_io_unguard(slots[ng - 1]);
+    fdt_io_unguard(slots[ng - 1]); /* not guarded any more: nothing */
+    fdt_io_cleanup_temps();
+    EXPECT(access(p, F_OK) != 0 && count_entries_of(dir) == 0);
+
+    /* a commit set holds 64 files: the 65th write fails, the set goes */
+    EXPECT(fdt_wr_set_commit(err, sizeof err) == FDT_IO_OK); /* none open */
+    EXPECT(fdt_wr_set_begin(0) == 0);
+    int r = FDT_IO_OK, k;
+    for (k = 0; k < 70 && r == FDT_IO_OK; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "s%d.json", k);
+        r = side_file(dir, name, err, sizeof err);
+    }
+    EXPECTF(r == FDT_IO_EWRITE && k == 65 && strstr(err, dir), "%d at %d [%s]", r, k, err);
+    fdt_wr_set_abandon();
+    EXPECT(count_entries_of(dir) == 0);
+
+    /* the signal handler's clean-up in the middle of a set and a file */
+    EXPECT(fdt_wr_set_begin(0) == 0);
+    EXPECT(write_mesh(dir, "m.ele", err, sizeof err) == FDT_IO_OK);
+    fdt_wr_side *side;
+    path_in(p, dir, "s.json");
+    EXPECT(fdt_wr_side_open(p, &side, err, sizeof err) != NULL);
+    fdt_io_cleanup_temps();
+    EXPECT(!fdt_wr_set_active() && count_entries_of(dir) == 0);
+    fdt_wr_side_abandon(side);
+
+    /* a commit fault hook that names no step is ignored */
+    setenv("FDT_TEST_COMMIT_FAULT", "2", 1);
+    EXPECT(fdt_wr_set_begin(0) == 0);
+    EXPECT(write_mesh(dir, "m.tets", err, sizeof err) == FDT_IO_OK);
+    EXPECT(fdt_wr_set_commit(err, sizeof err) == FDT_IO_OK);
+    unsetenv("FDT_TEST_COMMIT_FAULT");
+    path_in(p, dir, "m.tets");
+    EXPECT(unlink(p) == 0);
+
+    /* why a file cannot be created, as the CLI says it */
+    static const int errs[] = {ENOENT, ENOTDIR, EACCES, EPERM, EROFS, EISDIR, ENOSPC, ENOMEM};
+    for (int i = 0; i < 8; i++) {
+        int want = errs[i] == ENOMEM ? FDT_IO_ENOMEM : FDT_IO_EWRITE;
+        EXPECT(fdt_create_err(err, sizeof err, "output", "/m.vtu", errs[i]) == want &&
+               strstr(err, "/m.vtu"));
+        EXPECT(fdt_create_err(NULL, 0, "output", "m.vtu", errs[i]) == want);
+    }
+    EXPECT(fdt_create_err(err, sizeof err, "output", "m.vtu", ENOENT) == FDT_IO_EWRITE &&
+           strstr(err, "folder . does not exist"));
+    rmdir(dir);
+}
+
+/* A streamed write whose caller takes no message (diag NULL, size 0):
+ * the same codes, nothing written where the message would go; a variant
+ * v's k-th call failing (k 0: none). */
+static int quiet_stream(const char *dir, const variant *v, long k)
+{
+    char p[FDT_IO_PATH];
+    path_in(p, dir, "q.ele");
+    fdt_stream_writer *w = NULL;
+    if (k)
+        fault_arm(v, k);
+    int rc = fdt_stream_writer_open(&w, p, NULL, mesh.xyz, mesh.n_points, 0, NULL, 0);
+    if (rc == FDT_OK) {
+        fdt_sink sink;
+        fdt_stream_writer_sink(w, &sink);
+        sink.tets(sink.user, mesh.tets, mesh.n_tets);
+        sink.hull(sink.user, mesh.hull, mesh.n_hull);
+        rc = fdt_stream_writer_close(&w, 1, NULL, 0);
+    }
+    fault_disarm();
+    return rc;
+}
+
+static void test_stream_quiet(const char *root)
+{
+    char dir[FDT_IO_PATH];
+    snprintf(dir, sizeof dir, "%s/quiet", root);
+    CHECK(mkdir(dir, 0755) == 0);
+    EXPECT(fdt_stream_format_ok("case/polyMesh", NULL) == 0);
+    EXPECT(fdt_stream_format_ok("m.vtk", NULL) == 0);
+    EXPECT(quiet_stream(dir, NULL, 0) == FDT_OK && count_entries_of(dir) == 3);
+    remove_tree(dir);
+    CHECK(mkdir(dir, 0755) == 0);
+    static const variant fails[] = {{C_FWRITE, ENOSPC, 0}, {C_RENAME, EIO, 0},
+                                    {C_FTELLO, EOVERFLOW, 0}};
+    for (int i = 0; i < 3; i++) {
+        EXPECTF(quiet_stream(dir, &fails[i], 1) == FDT_EIO, "%s", call_name[fails[i].call]);
+        EXPECTF(count_entries_of(dir) == 0, "%s", call_name[fails[i].call]);
+    }
+    /* the stale .neigh that cannot be removed after the renames */
+    static const variant unl = {C_UNLINK, EIO, 0};
+    EXPECT(quiet_stream(dir, &unl, 1) == FDT_EIO && count_entries_of(dir) == 3);
+    remove_tree(dir);
+}
+
 int main(void)
 {
     /* Every commit set fsyncs its journal and folder, a few thousand
@@ -769,6 +914,8 @@ int main(void)
     make_mesh(&r);
     for (int i = 0; i < N_SCENARIOS; i++)
         sweep(&scenarios[i], root);
+    test_limits(root);
+    test_stream_quiet(root);
     remove_tree(root);
     fdt_result_free(&r);
     return test_report("test_writer_faults");
