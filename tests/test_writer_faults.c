@@ -34,8 +34,16 @@
  *     set of its own, which finds it new), an unlink of a backup after
  *     the commit point (the new outputs are all in place; the backup
  *     stays, and is the only file a run may leave).
+ * One exception, documented in writer_stream.c: a streamed TetGen set
+ * outside a commit set whose stale .neigh cannot be removed after the
+ * renames fails (FDT_EIO, the .neigh named) with its new files in place.
  * Every run also closes every descriptor it opened and leaves no commit
  * set open. A run that hit none must succeed with the reference output.
+ *
+ * Then the writer's own limits, failing the same way (test_limits: the
+ * registry's slots, a commit set's size, a name too long, the signal
+ * clean-up mid-write, fdt_create_err's messages), and streamed writes
+ * whose caller takes no message (test_stream_quiet).
  *
  * Not injected: stat/access (the checks before a write: tests/test_writer.c
  * makes them fail for real), fprintf of the journal (its errors surface in
