@@ -619,8 +619,9 @@ FDT_API int fdt_write_mesh_opts(fdt_result *r, const double *xyz, size_t n, cons
 
 /* Async-signal-safe, for a SIGINT/SIGTERM handler that then ends the
  * process (_exit): removes the temporary files of a write in progress and
- * the targets already renamed of a multi-file output not yet complete, so
- * nothing partial is left. The interrupted write must not go on after. */
+ * undoes the renames of a multi-file output not yet complete (each old
+ * file put back, a new one that replaced none removed), so nothing partial
+ * is left. The interrupted write must not go on after. */
 FDT_API void fdt_write_cleanup(void);
 
 /*

@@ -636,6 +636,63 @@ static int write_journal(void)
     return e;
 }
 
+/* Step 1 of fdt_wr_set_commit: each existing target checked and backed
+ * up (a hard link, or BAK_MOVE where links fail); 0, or an errno with
+ * the entry (*at) and what failed. */
+static int set_backups(set_fault *fault, int *at, const char **what)
+{
+    int n = (int)set_n, e = 0;
+    sigset_t old;
+    for (int i = 0; i < n && !e; i++) {
+        struct stat st;
+        if (lstat(set_dst[i], &st) != 0) {
+            if (errno != ENOENT) {
+                e = errno, *at = i, *what = "cannot check";
+            }
+            continue;
+        }
+        if (set_kind[i] == ENT_DIR) {
+            e = EEXIST, *at = i, *what = "appeared while the mesh was computed";
+            break;
+        }
+        if (S_ISDIR(st.st_mode)) {
+            e = EISDIR, *at = i, *what = "cannot replace";
+            break;
+        }
+        if (set_no_clobber) {
+            e = EEXIST, *at = i, *what = "--no-clobber";
+            break;
+        }
+        if ((e = backup_name(set_bak[i], set_dst[i], i)) != 0) {
+            *at = i, *what = "cannot back up";
+            break;
+        }
+        if (lstat(set_bak[i], &st) == 0) {
+            e = EEXIST, *at = i, *what = "cannot back up";
+            break;
+        }
+        if (set_kind[i] == ENT_REMOVE) {
+            set_bakmode[i] = BAK_MOVE; /* the removal is the move */
+            continue;
+        }
+        if (fault_here(fault, "backup")) {
+            e = EIO, *at = i, *what = "cannot back up";
+            break;
+        }
+        block_signals(&old);
+        if (link(set_dst[i], set_bak[i]) == 0) {
+            set_bakmode[i] = BAK_LINK;
+            set_step[i] = STEP_LINKED;
+        } else if (errno == EEXIST) {
+            e = EEXIST, *at = i, *what = "cannot back up";
+        } else {
+            set_bakmode[i] = BAK_MOVE; /* no links here: moved at its turn */
+        }
+        restore_signals(&old);
+    }
+    return e;
+}
+
 int fdt_wr_set_commit(char *err, size_t errlen)
 {
     if (set_phase != PHASE_OPEN)
@@ -650,53 +707,7 @@ int fdt_wr_set_commit(char *err, size_t errlen)
         return FDT_IO_OK;
     }
     /* 1. backups (and the checks that need no change on disk) */
-    for (int i = 0; i < n && !e; i++) {
-        struct stat st;
-        if (lstat(set_dst[i], &st) != 0) {
-            if (errno != ENOENT) {
-                e = errno, at = i, what = "cannot check";
-            }
-            continue;
-        }
-        if (set_kind[i] == ENT_DIR) {
-            e = EEXIST, at = i, what = "appeared while the mesh was computed";
-            break;
-        }
-        if (S_ISDIR(st.st_mode)) {
-            e = EISDIR, at = i, what = "cannot replace";
-            break;
-        }
-        if (set_no_clobber) {
-            e = EEXIST, at = i, what = "--no-clobber";
-            break;
-        }
-        if ((e = backup_name(set_bak[i], set_dst[i], i)) != 0) {
-            at = i, what = "cannot back up";
-            break;
-        }
-        if (lstat(set_bak[i], &st) == 0) {
-            e = EEXIST, at = i, what = "cannot back up";
-            break;
-        }
-        if (set_kind[i] == ENT_REMOVE) {
-            set_bakmode[i] = BAK_MOVE; /* the removal is the move */
-            continue;
-        }
-        if (fault_here(&fault, "backup")) {
-            e = EIO, at = i, what = "cannot back up";
-            break;
-        }
-        block_signals(&old);
-        if (link(set_dst[i], set_bak[i]) == 0) {
-            set_bakmode[i] = BAK_LINK;
-            set_step[i] = STEP_LINKED;
-        } else if (errno == EEXIST) {
-            e = EEXIST, at = i, what = "cannot back up";
-        } else {
-            set_bakmode[i] = BAK_MOVE; /* no links here: moved at its turn */
-        }
-        restore_signals(&old);
-    }
+    e = set_backups(&fault, &at, &what);
     /* 2. the journal */
     if (!e && fault_here(&fault, "journal"))
         e = EIO, at = -1, what = "cannot write the commit journal";
@@ -735,6 +746,19 @@ int fdt_wr_set_commit(char *err, size_t errlen)
     /* 4. the commit point */
     if (!e && fault_here(&fault, "commit"))
         e = EIO, at = -1, what = "cannot commit";
+    if (!e) {
+        /* The commit point is the journal's removal: a journal left
+         * behind would tell whoever finds it to undo renames of a commit
+         * reported done, so one that cannot be removed rolls the set back. */
+        block_signals(&old);
+        if (unlink(set_journal) == 0) {
+            set_journal_live = 0;
+            set_phase = PHASE_COMMITTED;
+        } else {
+            e = errno, at = -1, what = "cannot remove the commit journal";
+        }
+        restore_signals(&old);
+    }
     if (e) {
         block_signals(&old);
         set_rollback();
@@ -749,11 +773,6 @@ int fdt_wr_set_commit(char *err, size_t errlen)
         return set_err(err, errlen, e == ENOMEM ? FDT_IO_ENOMEM : FDT_IO_EWRITE,
                        at >= 0 ? set_dst[at] : set_journal, msg);
     }
-    block_signals(&old);
-    set_phase = PHASE_COMMITTED;
-    unlink(set_journal);
-    set_journal_live = 0;
-    restore_signals(&old);
     (void)fault_here(&fault, "committed");
     block_signals(&old);
     set_finish();
@@ -764,9 +783,13 @@ int fdt_wr_set_commit(char *err, size_t errlen)
 
 /*
  * Closes files[0..k) and renames them over their targets, all or none:
- * if any close or rename fails, every temporary and every target already
- * renamed in this set is removed (a .ele set with a stale .neigh beside a
- * new .ele would be worse than none).
+ * if any close fails, every temporary is removed; several targets of
+ * which some exist are renamed as a commit set of their own
+ * (commit_own_set), so a failed rename puts every target back as it was
+ * (a .ele set with a stale .neigh beside a new .ele would be worse than
+ * none, and removing the old set would lose it). New targets, and a fresh
+ * polyMesh's files (KEEP_RENAMED, renamed inside their temporary folder),
+ * are renamed one by one here, and all removed if one rename fails.
  *
  * rename() replaces the directory entry, never the file behind it: a
  * target that is a symbolic link is replaced by the new file and what it
@@ -806,6 +829,33 @@ static int defer_all(out_file *files, int k, char *err, size_t errlen)
     return FDT_IO_OK;
 }
 
+/* Does any of files[0..k)'s targets exist (or cannot tell)? */
+static int any_target(const out_file *files, int k)
+{
+    struct stat st;
+    for (int i = 0; i < k; i++)
+        if (lstat(fdt_io_dst_path[files[i].slot], &st) == 0 || errno != ENOENT)
+            return 1;
+    return 0;
+}
+
+/* Several targets (a TetGen set, a polyMesh's files in its folder), some
+ * of them there already, with no commit set open: renamed as a set of
+ * their own, so a rename that fails part-way puts back the targets
+ * renamed before it (backed up) instead of removing them with the old
+ * files they replaced. (All new, removing them loses nothing: no journal
+ * then, and no backups.) */
+static int commit_own_set(out_file *files, int k, char *err, size_t errlen)
+{
+    fdt_wr_set_begin(0); /* none is open: cannot fail */
+    int r = defer_all(files, k, err, errlen);
+    if (r != FDT_IO_OK) {
+        fdt_wr_set_abandon();
+        return r;
+    }
+    return fdt_wr_set_commit(err, errlen);
+}
+
 static int commit_all(out_file *files, int k, char *err, size_t errlen, int keep)
 {
     for (int i = 0; i < k; i++) {
@@ -818,6 +868,8 @@ static int commit_all(out_file *files, int k, char *err, size_t errlen, int keep
     }
     if (set_phase == PHASE_OPEN)
         return defer_all(files, k, err, errlen);
+    if (k > 1 && !keep && any_target(files, k))
+        return commit_own_set(files, k, err, errlen);
     for (int i = 0; i < k; i++) {
         int slot = files[i].slot;
         fdt_io_state[slot] = SLOT_RENAMING;
