@@ -52,6 +52,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include "testdir.h"
 #include "testutil.h"
 
 /* ------------------------------------------------------------------ */
@@ -831,21 +832,6 @@ typedef struct write_arg {
     const char *ext;
     fdt_result *res; /* sorted, with neighbours */
 } write_arg;
-
-/* Entries of dir other than . and .. (-1 if it cannot be read). */
-static int count_entries(const char *dir)
-{
-    DIR *d = opendir(dir);
-    if (d == NULL)
-        return -1;
-    int k = 0;
-    struct dirent *de;
-    while ((de = readdir(d)) != NULL)
-        if (strcmp(de->d_name, ".") != 0 && strcmp(de->d_name, "..") != 0)
-            k++;
-    closedir(d);
-    return k;
-}
 
 static void empty_dir(const char *dir)
 {

@@ -12,6 +12,7 @@
  * Usage: test_io SCRATCH_DIR (made if missing, emptied of our files).
  */
 #include "frontdt.h"
+#include "testdir.h"
 #include "testutil.h"
 
 #include <dirent.h>
@@ -61,34 +62,6 @@ static char *slurp(const char *path, size_t *len)
     if (len)
         *len = (size_t)sz;
     return buf;
-}
-
-/* Entries of d whose name holds ".tmp." (the writer's temporaries). */
-static int count_temps(const char *d)
-{
-    DIR *dd = opendir(d);
-    if (!dd)
-        return -1;
-    int n = 0;
-    struct dirent *e;
-    while ((e = readdir(dd)) != NULL)
-        n += strstr(e->d_name, ".tmp.") != NULL;
-    closedir(dd);
-    return n;
-}
-
-/* Entries of d other than . and .. */
-static int count_entries(const char *d)
-{
-    DIR *dd = opendir(d);
-    if (!dd)
-        return -1;
-    int n = 0;
-    struct dirent *e;
-    while ((e = readdir(dd)) != NULL)
-        n += strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
-    closedir(dd);
-    return n;
 }
 
 /* The text after the first line equal to key (key without its newline). */

@@ -72,6 +72,7 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <unistd.h>
+#include "testdir.h"
 #include "testutil.h"
 
 /* ------------------------------------------------------------------ */
@@ -417,19 +418,6 @@ static int count_fds(void)
     int n = 0;
     while (readdir(d) != NULL)
         n++;
-    closedir(d);
-    return n;
-}
-
-static int count_entries_of(const char *dir)
-{
-    DIR *d = opendir(dir);
-    if (!d)
-        return -1;
-    int n = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL)
-        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
     closedir(d);
     return n;
 }
@@ -816,7 +804,7 @@ static void test_limits(const char *root)
     fdt_io_unguard(slots[ng - 1]);
     fdt_io_unguard(slots[ng - 1]); /* not guarded any more: nothing */
     fdt_io_cleanup_temps();
-    EXPECT(access(p, F_OK) != 0 && count_entries_of(dir) == 0);
+    EXPECT(access(p, F_OK) != 0 && count_entries(dir) == 0);
 
     /* a commit set holds 64 files: the 65th write fails, the set goes */
     EXPECT(fdt_wr_set_commit(err, sizeof err) == FDT_IO_OK); /* none open */
@@ -829,7 +817,7 @@ static void test_limits(const char *root)
     }
     EXPECTF(r == FDT_IO_EWRITE && k == 65 && strstr(err, dir), "%d at %d [%s]", r, k, err);
     fdt_wr_set_abandon();
-    EXPECT(count_entries_of(dir) == 0);
+    EXPECT(count_entries(dir) == 0);
 
     /* the signal handler's clean-up in the middle of a set and a file */
     EXPECT(fdt_wr_set_begin(0) == 0);
@@ -838,7 +826,7 @@ static void test_limits(const char *root)
     path_in(p, dir, "s.json");
     EXPECT(fdt_wr_side_open(p, &side, err, sizeof err) != NULL);
     fdt_io_cleanup_temps();
-    EXPECT(!fdt_wr_set_active() && count_entries_of(dir) == 0);
+    EXPECT(!fdt_wr_set_active() && count_entries(dir) == 0);
     fdt_wr_side_abandon(side);
 
     /* a commit fault hook that names no step is ignored */
@@ -892,18 +880,18 @@ static void test_stream_quiet(const char *root)
     CHECK(mkdir(dir, 0755) == 0);
     EXPECT(fdt_stream_format_ok("case/polyMesh", NULL) == 0);
     EXPECT(fdt_stream_format_ok("m.vtk", NULL) == 0);
-    EXPECT(quiet_stream(dir, NULL, 0) == FDT_OK && count_entries_of(dir) == 3);
+    EXPECT(quiet_stream(dir, NULL, 0) == FDT_OK && count_entries(dir) == 3);
     remove_tree(dir);
     CHECK(mkdir(dir, 0755) == 0);
     static const variant fails[] = {{C_FWRITE, ENOSPC, 0}, {C_RENAME, EIO, 0},
                                     {C_FTELLO, EOVERFLOW, 0}};
     for (int i = 0; i < 3; i++) {
         EXPECTF(quiet_stream(dir, &fails[i], 1) == FDT_EIO, "%s", call_name[fails[i].call]);
-        EXPECTF(count_entries_of(dir) == 0, "%s", call_name[fails[i].call]);
+        EXPECTF(count_entries(dir) == 0, "%s", call_name[fails[i].call]);
     }
     /* the stale .neigh that cannot be removed after the renames */
     static const variant unl = {C_UNLINK, EIO, 0};
-    EXPECT(quiet_stream(dir, &unl, 1) == FDT_EIO && count_entries_of(dir) == 3);
+    EXPECT(quiet_stream(dir, &unl, 1) == FDT_EIO && count_entries(dir) == 3);
     remove_tree(dir);
 }
 
