@@ -5,7 +5,8 @@ clipped by the box as an OpenFOAM polyMesh, through the CLI.
 Usage: dual_e2e.py FRONTDT GEN_POINTS SCRATCH [--checkmesh]
 
 Without --checkmesh (always runs, no OpenFOAM needed), on uniform,
-clustered, lattice (cospherical), duplicate and five points, with the
+clustered, lattice (cospherical), duplicate, cone and torus (rings of
+cocircular points) and five points, with the
 default box (hull points on the walls) and a given one, the polyMesh files
 are read back here and checked on their own: every face has 3 or more
 distinct vertices, every vertex is used, owner < neighbour in
@@ -14,7 +15,9 @@ faces, every cell is closed (each edge once each way round, the faces
 turned out of it), each cell's volume from its faces equals --voronoi's %v
 for its point (1e-10 relative; merged duplicates have no cell) and the
 volumes add up to the box's (1e-12). Refusals: --dual without an OpenFOAM
--o, --dual with --stream, a point outside --box (exit 1 each). Written
+-o, --dual with --stream, a point outside --box (exit 1 each); points
+closer than doubles resolve (gen_points mixed: 1e-150 beside 1e150;
+ulpgrid: steps of 2^-52 of the coordinates) refused as input (exit 2). Written
 again over the existing polyMesh beside a .tets output of the same run;
 the same bytes in serial, shared and message modes.
 
@@ -212,7 +215,10 @@ def checkmesh(name, case, rc):
 
 def main():
     sets = []
-    for fam, n in (("uniform", 2000), ("gaussian", 2000), ("lattice", 512), ("dup", 500)):
+    # cone and torus: rings of cocircular points, whose Voronoi edges meet
+    # the walls at box edges and corners (cells were left open there)
+    for fam, n in (("uniform", 2000), ("gaussian", 2000), ("lattice", 512), ("dup", 500),
+                   ("cone", 1000), ("torus", 4000)):
         xyz = os.path.join(SCRATCH, fam + ".xyz")
         subprocess.run([GEN, fam, str(n), "1", xyz], check=True, capture_output=True)
         sets.append((fam, xyz, None))
@@ -249,6 +255,16 @@ def main():
             fail(f"a point outside --box: {p.stderr.strip()}")
         if os.path.exists(os.path.join(SCRATCH, "b", "polyMesh")):
             fail("a refused --dual left a polyMesh")
+        # cells beyond doubles: refused as input (exit 2) naming two points,
+        # never an internal error or a mesh of noise
+        for fam in ("mixed", "ulpgrid"):
+            xyz = os.path.join(SCRATCH, fam + ".xyz")
+            subprocess.run([GEN, fam, "4000", "3", xyz], check=True, capture_output=True)
+            p = run([xyz, "-q", "--dual", "-o", os.path.join(SCRATCH, "b", "polyMesh")], want=2)
+            if not re.search(r"points \d+ and \d+ are .* beyond what doubles hold", p.stderr):
+                fail(f"--dual on {fam}: {p.stderr.strip()}")
+            if os.path.exists(os.path.join(SCRATCH, "b", "polyMesh")):
+                fail(f"a refused --dual ({fam}) left a polyMesh")
         # over an existing polyMesh (its five files replaced), beside a
         # Delaunay output of the same run (the tets as ever)
         case = dict(cases)["uniform"]

@@ -7,7 +7,7 @@
  * upper-triangular order, a vertex in no face, a face naming a vertex that
  * is not there or one vertex twice, an owner that is no cell, patches that
  * do not end at the last face, every cell turned inward (mirrored), a face
- * missing. (tests/test_dualmesh.c checks the meshes src/mesh/dualmesh.c
+ * missing, a wall face off its wall, wall faces overlapping. (tests/test_dualmesh.c checks the meshes src/mesh/dualmesh.c
  * builds; this one that the check can fail.)
  */
 #include <stdlib.h>
@@ -164,6 +164,18 @@ int main(void)
     b.d.n_faces = NF - 1;
     b.d.patch_size[5] = NC - 1;
     refused(&b, "not closed", "a face missing");
+
+    build(&b); /* the box's xmin beyond the cells' */
+    b.d.box[0] = -1;
+    refused(&b, "off the wall", "a wall face off its wall");
+
+    build(&b); /* the top of the first internal face moved to x = -0.5: every
+                * cell still closed and of positive volume (cell 0 is 1 wide
+                * at the bottom, -0.5 at the top), but cell 0's faces on the
+                * walls there are turned into the box and cell 1's overlap them */
+    b.xyz[3 * vid(1, 0, 1)] = -0.5;
+    b.xyz[3 * vid(1, 1, 1)] = -0.5;
+    refused(&b, "cover", "wall faces overlapping");
 
     return test_report("dualcheck");
 }

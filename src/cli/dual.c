@@ -216,8 +216,10 @@ int fdt_cli_dual_mesh(const fdt_cli_dual *d, fdt_result *res, const double *xyz,
     char diag[512];
     int r = fdt_dualmesh_build(res, xyz, n, &o, &dm, diag, sizeof diag);
     if (r != FDT_OK) {
+        /* FDT_ERANGE: not a coordinate's value but the cells' (diag says) */
         snprintf(err, errlen, "%s: the Voronoi cells as a polyMesh (--dual): %s%s%s", path,
-                 fdt_strerror(r), *diag ? ": " : "", diag);
+                 r == FDT_ERANGE && *diag ? "" : fdt_strerror(r),
+                 r == FDT_ERANGE || !*diag ? "" : ": ", diag);
         return r;
     }
     r = fdt_wr_dual_polymesh(path, &dm, err, errlen) == FDT_IO_OK ? FDT_OK : FDT_EIO;

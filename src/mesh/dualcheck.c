@@ -203,6 +203,45 @@ static int check_cell(const fdt_dualmesh *d, const size_t *cs, const size_t *cf,
     return 0;
 }
 
+/* The walls' faces: each on its wall's plane, and per wall their areas,
+ * turned out of the box, add up to the wall's: a face turned in, or two
+ * overlapping (a closed cell can still have both, its volume right),
+ * does not. */
+static int check_walls(const fdt_dualmesh *d, char *diag, size_t ds)
+{
+    for (int p = 0; p < 6; p++) {
+        int k = p / 2, u = (k + 1) % 3, t = (k + 2) % 3;
+        double bnd = d->box[k + 3 * (p & 1)], out = 0, all = 0;
+        for (size_t f = d->patch_start[p]; f < d->patch_start[p] + d->patch_size[p]; f++) {
+            const int32_t *fv = d->fverts + d->fstart[f];
+            size_t m = d->fstart[f + 1] - d->fstart[f];
+            const double *x0 = d->xyz + 3 * (size_t)fv[0];
+            double a = 0;
+            for (size_t i = 0; i < m; i++) {
+                const double *x = d->xyz + 3 * (size_t)fv[i];
+                if (x[k] != bnd) {
+                    fdt_diag(diag, ds, "face %zu on wall %s has vertex %d off the wall", f,
+                        fdt_dualmesh_patch[p], fv[i]);
+                    return -1;
+                }
+                if (i >= 1 && i + 1 < m) {
+                    const double *y = d->xyz + 3 * (size_t)fv[i + 1];
+                    a += 0.5 * ((x[u] - x0[u]) * (y[t] - x0[t]) - (x[t] - x0[t]) * (y[u] - x0[u]));
+                }
+            }
+            out += (p & 1) ? a : -a;
+            all += fabs(a);
+        }
+        double want = (d->box[u + 3] - d->box[u]) * (d->box[t + 3] - d->box[t]);
+        if (!(fabs(out - want) <= 1e-9 * want && fabs(all - want) <= 1e-9 * want)) {
+            fdt_diag(diag, ds, "the faces on wall %s cover %.17g of its %.17g (%.17g turned "
+                "out)", fdt_dualmesh_patch[p], all, want, out);
+            return -1;
+        }
+    }
+    return 0;
+}
+
 int fdt_dualmesh_check(const fdt_dualmesh *d, char *diag, size_t ds)
 {
     fdt_diag(diag, ds, "%s", "");
@@ -218,6 +257,8 @@ int fdt_dualmesh_check(const fdt_dualmesh *d, char *diag, size_t ds)
     int bad = 0;
     for (size_t c = 0; c < d->n_cells && !bad; c++)
         bad = check_cell(d, cs, cf, c, &buf, &cap, diag, ds) != 0;
+    if (!bad)
+        bad = check_walls(d, diag, ds) != 0;
     free(buf);
     free(cs);
     free(cf);

@@ -550,6 +550,27 @@ static int wall_point(const dwork *w, const fdt_vid *tri, int p, double x[3])
     return 0;
 }
 
+/* A crossing point pt on wall k's axis moved onto a second wall where it
+ * lies within 2^-50 of the box's size of it: a Voronoi edge that meets the
+ * wall at a box edge or corner (a corner equidistant from two points, on
+ * the face between their cells) comes out a rounding off the other wall,
+ * and the cells at the corner then disagree on which walls their faces
+ * reach (gen_points `cone`, `torus`: cells not closed). The point is
+ * made once under its key, so every face that has it sees it moved. */
+static void snap_to_walls(const dwork *w, double pt[3], int k)
+{
+    double side = 0;
+    for (int c = 0; c < 3; c++)
+        side = fmax(side, w->box[c + 3] - w->box[c]);
+    for (int c = 0; c < 3; c++) {
+        if (c == k)
+            continue;
+        for (int hi = 0; hi < 2; hi++)
+            if (fabs(pt[c] - w->box[c + 3 * hi]) <= 0x1p-50 * side)
+                pt[c] = w->box[c + 3 * hi];
+    }
+}
+
 /* The point where the edge labelled (kind, ea, eb) crosses wall p, from
  * the entry cur inside to nxt beyond: a shared Voronoi edge's or ray's is
  * computed from the whole edge and kept under its key, the face's own
@@ -577,6 +598,7 @@ static int crossing(dwork *w, const cv *cur, const cv *nxt, int p, cv *x)
                     pt[c] = f[c];
             }
             pt[k] = b;
+            snap_to_walls(w, pt, k);
             memcpy(x->h, pt, sizeof pt);
             x->id = new_vertex(w, pt);
             return x->id < 0 ? FDT_ENOMEM : FDT_OK;
@@ -625,6 +647,7 @@ static int crossing(dwork *w, const cv *cur, const cv *nxt, int p, cv *x)
             if (B ? A[c] == B[c] : d[c] == 0)
                 pt[c] = A[c]; /* along a wall: on it exactly */
         pt[k] = b;
+        snap_to_walls(w, pt, k);
         id = new_vertex(w, pt);
         if (id < 0 || kmap_put(&w->cross, ka, kb, id) != 0)
             return FDT_ENOMEM;
@@ -1409,6 +1432,49 @@ static int scale_points(dwork *w)
     return e;
 }
 
+/*
+ * Whether doubles can hold the dual of these points: FDT_ERANGE, with
+ * diag naming the two points, when a Delaunay edge (its Chebyshev length:
+ * the square of a length can underflow where the length does not) is
+ * shorter than 2^-40 of its endpoints' coordinates, so the Voronoi
+ * vertices between them round to a grid of at most 2^12 steps across the
+ * cells (whose faces and volumes are then noise: the 2^40-offset lattice
+ * of tests/gen_points.c `ulpgrid` came out 3e-2 off in volume), or
+ * shorter than 2^-300 of the box, so the cells' volumes underflow (1e-150
+ * and 1e150 in one set: the cells could not even be closed). Checked up
+ * front, so that FDT_EINTERNAL from the construction stays a bug's. ex:
+ * the points' scale (scale_points), for the message.
+ */
+static int check_resolution(const dwork *w, int ex)
+{
+    double side = 0;
+    for (int k = 0; k < 3; k++)
+        side = fmax(side, w->box[k + 3] - w->box[k]);
+    static const int ends[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+    for (size_t t = 0; t < w->T; t++) {
+        const fdt_vid *v = w->r->tets + 4 * t;
+        for (int e = 0; e < 6; e++) {
+            const double *a = w->X + 3 * (size_t)v[ends[e][0]];
+            const double *b = w->X + 3 * (size_t)v[ends[e][1]];
+            double len = 0, mag = 0;
+            for (int k = 0; k < 3; k++) {
+                len = fmax(len, fabs(a[k] - b[k]));
+                mag = fmax(mag, fmax(fabs(a[k]), fabs(b[k])));
+            }
+            if (len < 0x1p-40 * mag || len < 0x1p-300 * side) {
+                fdt_diag(w->diag, w->ds, "points %lld and %lld are %g apart%s %g: their Voronoi "
+                    "cells are beyond what doubles hold (a Delaunay edge must be at least "
+                    "2^-40 of its points' coordinates and 2^-300 of the box)",
+                    (long long)v[ends[e][0]], (long long)v[ends[e][1]],
+                    ldexp(len, ex), len < 0x1p-40 * mag ? " at coordinates near" : " in a box",
+                    ldexp(len < 0x1p-40 * mag ? mag : side, ex));
+                return FDT_ERANGE;
+            }
+        }
+    }
+    return FDT_OK;
+}
+
 int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
                        const fdt_voronoi_options *o, fdt_dualmesh *d, char *diag,
                        size_t diag_size)
@@ -1451,6 +1517,8 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
         err = FDT_ENOMEM;
         goto done;
     }
+    if ((err = check_resolution(&w, ex)) != FDT_OK)
+        goto done;
     w.nb = w.loc.nbrs;
     w.uf = malloc(w.T * sizeof *w.uf);
     w.cc = malloc(3 * w.T * sizeof *w.cc);
@@ -1483,8 +1551,15 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
     kmap_free(&w.cross);
     if (!err)
         err = assemble(&w, d);
+    /* The check in the scaled frame (the volumes of 1e-150 wide cells
+     * underflow in the points' own), with the box scaled alike; then back
+     * to the points' scale (exact: a power of two). */
+    double box[6];
+    memcpy(box, d->box, sizeof box);
+    memcpy(d->box, w.box, sizeof box);
     if (!err && fdt_dualmesh_check(d, diag, diag_size) != 0)
         err = FDT_EINTERNAL;
+    memcpy(d->box, box, sizeof box);
     for (size_t i = 0; !err && ex && i < 3 * d->n_verts; i++)
         d->xyz[i] = ldexp(d->xyz[i], ex);
 done:

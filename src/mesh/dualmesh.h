@@ -48,7 +48,9 @@ extern const char *const fdt_dualmesh_patch[6];
  * by o's box rule (fdt_voronoi_box_of; o not NULL). On success *d is
  * filled and owned by the caller (fdt_dualmesh_free) and has passed
  * fdt_dualmesh_check. FDT_EINVAL (a streamed result, n not r's, a bad
- * box or a point outside it), FDT_ETOOBIG (more than OpenFOAM's 32-bit
+ * box or a point outside it), FDT_ERANGE (two points closer than doubles
+ * can hold the cells between: under 2^-40 of their coordinates or 2^-300
+ * of the box), FDT_ETOOBIG (more than OpenFOAM's 32-bit
  * labels hold), FDT_ENOMEM, FDT_EINTERNAL (the clipped diagram came out
  * failing fdt_dualmesh_check: a configuration this construction cannot
  * number, never written; diag says which cell and edge), each with diag
@@ -66,7 +68,9 @@ void fdt_dualmesh_free(fdt_dualmesh *d);
  * neighbour, the internal faces in upper-triangular order, the patches
  * contiguous after them by owner, every cell closed (each of its edges in
  * two of its faces, once each way round when the faces are turned out of
- * the cell) and of positive volume. 0, or -1 with the first fault in diag.
+ * the cell) and of positive volume, every wall face on its wall and each
+ * wall's faces covering it once (their areas, turned out of the box, add
+ * up to the wall's to 1e-9). 0, or -1 with the first fault in diag.
  */
 int fdt_dualmesh_check(const fdt_dualmesh *d, char *diag, size_t diag_size);
 
