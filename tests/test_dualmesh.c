@@ -18,9 +18,15 @@
  *    points, bisectors through box edges), points on the walls of a given
  *    box, nearly coplanar points, clustered points with needle cells, and
  *    a boundary-layer block (layers 1e-6 thick: exact box volumes to
- *    1e-12).
+ *    1e-12), rings of cocircular points (10 and 45 rings: Voronoi edges
+ *    through box edges and corners, edges between nearly cospherical
+ *    rings);
+ *  - refusals: points closer than doubles can hold the cells between
+ *    (FDT_ERANGE, the points named, nothing handed out).
  */
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "frontdt.h"
@@ -334,8 +340,75 @@ static void test_small_and_flat(void)
     free(xyz);
 }
 
+/* m rings of 2m cocircular points, as an axisymmetric CAD part's
+ * vertices (gen_points `cone`): at 10 rings the corner of the box at the
+ * top of the diagonal x = y is equidistant from two points, and the
+ * Voronoi edges there crossed a wall at a box edge a rounding inside the
+ * other wall (cells left open); at 45, the line of a Voronoi edge between
+ * nearly cospherical rings met a wall far outside the part of the edge
+ * its faces keep (a cell's wall face would not chain). */
+static void test_rings(size_t m)
+{
+    double *xyz = malloc(2 * m * m * 3 * sizeof *xyz);
+    CHECK(xyz);
+    size_t n = 0;
+    for (size_t i = 1; i <= m; i++)
+        for (size_t j = 0; j < 2 * m; j++) {
+            double a = 6.283185307179586 * (double)j / (double)(2 * m), r = 0.01 * (double)i;
+            xyz[3 * n] = r * cos(a);
+            xyz[3 * n + 1] = r * sin(a);
+            xyz[3 * n + 2] = 0.02 * (double)i;
+            n++;
+        }
+    char what[64];
+    snprintf(what, sizeof what, "%zu cocircular rings", m);
+    fdt_dualmesh d = check_dual(what, xyz, n, NULL);
+    fdt_dualmesh_free(&d);
+    free(xyz);
+}
+
+/* Points closer than doubles can hold the cells between: refused with
+ * FDT_ERANGE naming them, nothing handed out. */
+static void expect_beyond_doubles(const char *what, const double *xyz, size_t n)
+{
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
+    fdt_voronoi_options o;
+    fdt_default_voronoi_options(&o);
+    char diag[512];
+    fdt_dualmesh d;
+    int err = fdt_dualmesh_build(r, xyz, n, &o, &d, diag, sizeof diag);
+    EXPECTF(err == FDT_ERANGE, "%s: %s (%s)", what, fdt_strerror(err), diag);
+    EXPECTF(strstr(diag, "beyond what doubles hold") != NULL, "%s: %s", what, diag);
+    EXPECT(d.xyz == NULL && d.fverts == NULL && d.n_cells == 0);
+    fdt_dualmesh_free(&d);
+    fdt_result_free(&r);
+}
+
+static void test_beyond_doubles(void)
+{
+    size_t n = 200;
+    double *xyz = random_points(n, 0, 13);
+    /* two points 2^-45 apart at coordinates near 0.75 (under 2^-40 of them) */
+    for (int k = 0; k < 3; k++)
+        xyz[3 * 7 + (size_t)k] = 0.75;
+    memcpy(xyz + 3 * 8, xyz + 3 * 7, 3 * sizeof *xyz);
+    xyz[3 * 8] += 0x1p-45;
+    expect_beyond_doubles("2^-45 apart near 0.75", xyz, n);
+    free(xyz);
+    /* a cluster 1e-100 wide in a unit box (its cells' volumes underflow) */
+    xyz = random_points(n, 0, 17);
+    for (size_t i = 0; i < 20; i++)
+        for (int k = 0; k < 3; k++)
+            xyz[3 * i + (size_t)k] = 1e-100 * xyz[3 * i + (size_t)k];
+    expect_beyond_doubles("a 1e-100 cluster", xyz, n);
+    free(xyz);
+}
+
 int main(void)
 {
+    test_rings(10);
+    test_rings(45);
+    test_beyond_doubles();
     test_small_and_flat();
     test_lattice(2);
     test_lattice(5);

@@ -571,6 +571,49 @@ static void snap_to_walls(const dwork *w, double pt[3], int k)
     }
 }
 
+/* The point between entries cur (inside wall p) and nxt (beyond it)
+ * where their segment, or ray when nxt is at infinity, meets the wall,
+ * by interpolation: what the faces' own edges use, and a shared edge's
+ * fallback below. 0, or -1 when there is none (both at infinity). */
+static int between(const dwork *w, const cv *cur, const cv *nxt, int p, double pt[3])
+{
+    double su = side(w, cur->h, p), sv = side(w, nxt->h, p), y[4];
+    for (int c = 0; c < 4; c++)
+        y[c] = cur->h[c] * fabs(sv) + nxt->h[c] * fabs(su);
+    if (!(y[3] > 0))
+        return -1;
+    for (int c = 0; c < 3; c++)
+        pt[c] = y[c] / y[3];
+    return 0;
+}
+
+/* Whether pt lies within 2^-40 of the box of the span from cur to nxt
+ * (their coordinates' range; from cur on along nxt's direction when nxt
+ * is at infinity), off wall axis k. */
+static int in_span(const dwork *w, const double pt[3], int k, const cv *cur, const cv *nxt)
+{
+    double side = 0;
+    for (int c = 0; c < 3; c++)
+        side = fmax(side, w->box[c + 3] - w->box[c]);
+    double slack = 0x1p-40 * side;
+    for (int c = 0; c < 3; c++) {
+        if (c == k)
+            continue;
+        double lo = cur->h[c], hi = cur->h[c];
+        if (nxt->h[3] != 0) {
+            lo = fmin(lo, nxt->h[c]);
+            hi = fmax(hi, nxt->h[c]);
+        } else if (nxt->h[c] > 0) {
+            hi = INFINITY;
+        } else if (nxt->h[c] < 0) {
+            lo = -INFINITY;
+        }
+        if (pt[c] < lo - slack || pt[c] > hi + slack)
+            return 0;
+    }
+    return 1;
+}
+
 /* The point where the edge labelled (kind, ea, eb) crosses wall p, from
  * the entry cur inside to nxt beyond: a shared Voronoi edge's or ray's is
  * computed from the whole edge and kept under its key, the face's own
@@ -629,7 +672,16 @@ static int crossing(dwork *w, const cv *cur, const cv *nxt, int p, cv *x)
             A = w->cc + 3 * (size_t)cur->eb;
             d = w->hdir + 3 * (size_t)cur->ea;
         }
-        if (wall_point(w, tri, p, pt) != 0) {
+        int off = 0;
+        if (cur->h[3] != 0 && wall_point(w, tri, p, pt) == 0 && !in_span(w, pt, k, cur, nxt))
+            off = between(w, cur, nxt, p, pt) == 0;
+        if (off) {
+            /* The edge's line meets the wall, by its triangle, beyond the
+             * span of it this face keeps (and outside the walls already
+             * cut): its ends are rounded circumcentres of nearly
+             * cospherical groups (gen_points `cone`). The span is the
+             * same in every face that has the edge: from it. */
+        } else if (wall_point(w, tri, p, pt) != 0) {
             /* the edge nearly along the wall: from its ends */
             double t;
             if (B) {
