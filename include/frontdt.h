@@ -719,7 +719,9 @@ static inline void fdt_default_voronoi_options(fdt_voronoi_options *o)
  * for a NULL argument, a streamed result (no tets kept), n not r's point
  * count, threads outside 0..1024, an empty or inverted box, or a point outside the given box (diag,
  * when not NULL, says which; it is written in every case, "" on success);
- * FDT_ENOMEM; FDT_EINTERNAL when a cell could not be cut (a bug).
+ * FDT_ERANGE when two points are closer than 2^-48 of the box (the cells
+ * cut from the box could not be; diag names them); FDT_ENOMEM;
+ * FDT_EINTERNAL when a cell could not be cut (a bug).
  */
 FDT_API int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n,
                                 const fdt_voronoi_options *o, fdt_voronoi **out,

@@ -18,6 +18,8 @@
 #include <math.h>
 #include <string.h>
 
+#include <gmp.h>
+
 #include "frontdt.h"
 #include "geom/cell.h"
 #include "testutil.h"
@@ -379,8 +381,101 @@ static void test_getters(void)
     free(xyz);
 }
 
+/* Two clusters w wide among 2,000 uniform points in the unit cube, one
+ * at 0.25, one at the origin: each cell positive (the box's fixed grid
+ * summed those of w = 1e-10 to 0), the volumes adding up to the box's,
+ * the clusters' DTFE densities those of their tets' exact volumes (GMP
+ * rationals) to 1e-6 (1e-4 at w = 1e-12, whose tets are slivers of points
+ * a few thousand doubles apart; the box's grid gave 0, and tets of three clustered
+ * points and a far one, taken from the far one, came out 1e2 times too
+ * large, either sign; long double is not enough for a reference here);
+ * below 2^-48 of the box, refused (FDT_ERANGE, the cells could not be
+ * cut). */
+static void test_tiny_cells(double w)
+{
+    size_t n = 2060;
+    double *xyz = random_points(n, 0, 9);
+    uint64_t s = 77;
+    for (size_t i = 2000; i < n; i++)
+        for (int d = 0; d < 3; d++)
+            xyz[3 * i + d] = (i < 2030 ? 0.25 : 0.0) + w * test_unif(&s);
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
+    fdt_voronoi_options o;
+    fdt_default_voronoi_options(&o);
+    fdt_voronoi *v = NULL;
+    char diag[256];
+    int err = fdt_voronoi_compute(r, xyz, n, &o, &v, diag, sizeof diag);
+    if (w < 0x1p-48) {
+        EXPECTF(err == FDT_ERANGE && strstr(diag, "beyond what doubles hold"),
+                "w = %g: %s (%s)", w, fdt_strerror(err), diag);
+        fdt_result_free(&r);
+        free(xyz);
+        return;
+    }
+    CHECK(err == FDT_OK);
+    const double *vol = fdt_voronoi_volumes(v), *den = fdt_voronoi_densities(v);
+    double b[6], sum = 0;
+    fdt_voronoi_box(v, b);
+    for (size_t i = 0; i < n; i++) {
+        EXPECTF(vol[i] > 0, "w = %g: cell %zu has volume %g", w, i, vol[i]);
+        sum += vol[i];
+    }
+    double bvol = (b[3] - b[0]) * (b[4] - b[1]) * (b[5] - b[2]);
+    EXPECTF(close_to(sum, bvol, 1e-12), "w = %g: cells %.17g, box %.17g", w, sum, bvol);
+    mpq_t *tv = malloc(n * sizeof *tv), q[3][3], t1, t2, v6;
+    CHECK(tv);
+    for (size_t i = 0; i < n; i++)
+        mpq_init(tv[i]);
+    for (int m = 0; m < 9; m++)
+        mpq_init(q[m / 3][m % 3]);
+    mpq_inits(t1, t2, v6, NULL);
+    const fdt_vid *t = fdt_result_tets(r);
+    for (size_t k = 0; k < fdt_result_num_tets(r); k++) {
+        const fdt_vid *tk = t + 4 * k;
+        if (tk[0] < 2000 && tk[1] < 2000 && tk[2] < 2000 && tk[3] < 2000)
+            continue; /* only the clusters' densities are checked */
+        for (int m = 0; m < 3; m++)
+            for (int d = 0; d < 3; d++) {
+                mpq_set_d(t1, xyz[3 * (size_t)tk[m + 1] + d]);
+                mpq_set_d(t2, xyz[3 * (size_t)tk[0] + d]);
+                mpq_sub(q[m][d], t1, t2);
+            }
+        mpq_set_ui(v6, 0, 1);
+        for (int d = 0; d < 3; d++) { /* q0 . (q1 x q2) */
+            int e = (d + 1) % 3, f = (d + 2) % 3;
+            mpq_mul(t1, q[1][e], q[2][f]);
+            mpq_mul(t2, q[1][f], q[2][e]);
+            mpq_sub(t1, t1, t2);
+            mpq_mul(t1, t1, q[0][d]);
+            mpq_add(v6, v6, t1);
+        }
+        mpq_abs(v6, v6);
+        for (int m = 0; m < 4; m++)
+            mpq_add(tv[tk[m]], tv[tk[m]], v6);
+    }
+    for (size_t i = 2000; i < n; i++) {
+        double want = 24 / mpq_get_d(tv[i]); /* 4 / (sum of 6 volumes / 6) */
+        EXPECTF(close_to(den[i], want, w >= 1e-10 ? 1e-6 : 1e-4), "w = %g: point %zu's density "
+                "%.17g, from its "
+                "tets %.17g", w, i, den[i], want);
+    }
+    for (size_t i = 0; i < n; i++)
+        mpq_clear(tv[i]);
+    for (int m = 0; m < 9; m++)
+        mpq_clear(q[m / 3][m % 3]);
+    mpq_clears(t1, t2, v6, NULL);
+    free(tv);
+    fdt_voronoi_free(&v);
+    fdt_result_free(&r);
+    free(xyz);
+}
+
 int main(void)
 {
+    test_tiny_cells(1e-8);
+    test_tiny_cells(1e-10);
+    test_tiny_cells(1e-12);
+    test_tiny_cells(1e-16);
     test_getters();
     test_lattice(2);
     test_lattice(5);

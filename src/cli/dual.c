@@ -145,7 +145,9 @@ int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const doubl
     char diag[512];
     int r = fdt_voronoi_compute(res, xyz, n, &o, &v, diag, sizeof diag);
     if (r != FDT_OK) {
-        snprintf(err, errlen, "Voronoi cells: %s%s%s", fdt_strerror(r), *diag ? ": " : "", diag);
+        /* FDT_ERANGE: not a coordinate's value but the cells' (diag says) */
+        snprintf(err, errlen, "Voronoi cells: %s%s%s", r == FDT_ERANGE && *diag ? "" : fdt_strerror(r),
+                 r == FDT_ERANGE || !*diag ? "" : ": ", diag);
         return r;
     }
     job.v = v;

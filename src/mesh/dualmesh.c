@@ -1484,49 +1484,6 @@ static int scale_points(dwork *w)
     return e;
 }
 
-/*
- * Whether doubles can hold the dual of these points: FDT_ERANGE, with
- * diag naming the two points, when a Delaunay edge (its Chebyshev length:
- * the square of a length can underflow where the length does not) is
- * shorter than 2^-40 of its endpoints' coordinates, so the Voronoi
- * vertices between them round to a grid of at most 2^12 steps across the
- * cells (whose faces and volumes are then noise: the 2^40-offset lattice
- * of tests/gen_points.c `ulpgrid` came out 3e-2 off in volume), or
- * shorter than 2^-300 of the box, so the cells' volumes underflow (1e-150
- * and 1e150 in one set: the cells could not even be closed). Checked up
- * front, so that FDT_EINTERNAL from the construction stays a bug's. ex:
- * the points' scale (scale_points), for the message.
- */
-static int check_resolution(const dwork *w, int ex)
-{
-    double side = 0;
-    for (int k = 0; k < 3; k++)
-        side = fmax(side, w->box[k + 3] - w->box[k]);
-    static const int ends[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-    for (size_t t = 0; t < w->T; t++) {
-        const fdt_vid *v = w->r->tets + 4 * t;
-        for (int e = 0; e < 6; e++) {
-            const double *a = w->X + 3 * (size_t)v[ends[e][0]];
-            const double *b = w->X + 3 * (size_t)v[ends[e][1]];
-            double len = 0, mag = 0;
-            for (int k = 0; k < 3; k++) {
-                len = fmax(len, fabs(a[k] - b[k]));
-                mag = fmax(mag, fmax(fabs(a[k]), fabs(b[k])));
-            }
-            if (len < 0x1p-40 * mag || len < 0x1p-300 * side) {
-                fdt_diag(w->diag, w->ds, "points %lld and %lld are %g apart%s %g: their Voronoi "
-                    "cells are beyond what doubles hold (a Delaunay edge must be at least "
-                    "2^-40 of its points' coordinates and 2^-300 of the box)",
-                    (long long)v[ends[e][0]], (long long)v[ends[e][1]],
-                    ldexp(len, ex), len < 0x1p-40 * mag ? " at coordinates near" : " in a box",
-                    ldexp(len < 0x1p-40 * mag ? mag : side, ex));
-                return FDT_ERANGE;
-            }
-        }
-    }
-    return FDT_OK;
-}
-
 int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
                        const fdt_voronoi_options *o, fdt_dualmesh *d, char *diag,
                        size_t diag_size)
@@ -1555,7 +1512,11 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
     w.T = r->ntets;
     w.diag = diag;
     w.ds = diag_size;
+    /* The vertices are written as absolute coordinates: those of points
+     * closer than 2^-40 of theirs would be noise (fdt_voronoi_resolution). */
     int err = fdt_voronoi_box_of(r, xyz, n, o, w.box, diag, diag_size);
+    if (!err)
+        err = fdt_voronoi_resolution(r, xyz, w.box, -300, 1, diag, diag_size);
     int had_faces = r->face_verts != NULL;
     if (!err)
         err = fdt_locator_init(&w.loc, r, xyz, n);
@@ -1569,8 +1530,6 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
         err = FDT_ENOMEM;
         goto done;
     }
-    if ((err = check_resolution(&w, ex)) != FDT_OK)
-        goto done;
     w.nb = w.loc.nbrs;
     w.uf = malloc(w.T * sizeof *w.uf);
     w.cc = malloc(3 * w.T * sizeof *w.cc);

@@ -77,6 +77,7 @@ typedef struct vwork {
      * its tets (DTFE); the faces' are the jobs' */
     fdt_fix *vol, *vabs, *mom, *dtfe; /* owned */
     fdt_fix_grid g_area, g_vol, g_mom;
+    fdt_fix_grid *g_dtfe; /* per point: its tets' volumes' grid (owned) */
 } vwork;
 
 /* One thread's share: the points [lo, hi) of the local numbering. */
@@ -302,15 +303,15 @@ static int mine(const vjob *j, uint32_t x)
 /* One tet's shares to the job's points (the file's comment). A tet whose
  * circumcentre lies outside the box adds no share: it marks its points,
  * whose cells are then cut from the box. */
-static void add_tet(vjob *j, const uint32_t *tv)
+/* Tet tv's points in canonical order, the points' lexicographic order
+ * (not their ids, which change with the input's order) into s, their
+ * differences from s[0] into q[1 .. 3]: the same bits whichever way round
+ * the tet came. Returns the orientation in that order (+1 or -1). */
+static int canon_tet(const double *X, const uint32_t *tv, uint32_t s[4], double q[4][3])
 {
-    vwork *w = j->w;
-    const double *X = w->xyz;
-    /* Canonical order, the points' lexicographic order (not their ids, which
-     * change with the input's order): the same bits whichever way round the
-     * tet came. sigma: the orientation in that order. */
-    uint32_t s[4] = {tv[0], tv[1], tv[2], tv[3]};
     int sigma = 1;
+    for (int m = 0; m < 4; m++)
+        s[m] = tv[m];
     for (int x = 1; x < 4; x++)
         for (int y = x; y > 0 && lex_after(X + 3 * (size_t)s[y - 1], X + 3 * (size_t)s[y]);
              y--) {
@@ -320,13 +321,58 @@ static void add_tet(vjob *j, const uint32_t *tv)
             sigma = -sigma;
         }
     const double *p0 = X + 3 * (size_t)s[0];
-    double q[4][3] = {{0, 0, 0}};
+    q[0][0] = q[0][1] = q[0][2] = 0;
     for (int m = 1; m < 4; m++)
         sub3(X + 3 * (size_t)s[m], p0, q[m]);
-    double v6 = sigma * triple(q[1], q[2], q[3]);
+    return sigma;
+}
+
+/* Tet tv's volume for the DTFE sums, taken from its vertex nearest the
+ * others (the least reach: its longest edge, in any axis; ties: the
+ * lexicographically first): a sliver of three clustered points and a far
+ * one, taken from the far one as the shares take it (the lexicographic
+ * first), lost every bit in its three long rounded differences (1.5e-21
+ * for a true 1e-23, either sign); from a clustered one two differences are
+ * exact and the third long one rounds once. A function of the four
+ * points, whatever the tet's order. */
+static double tet_volume(const double *X, const uint32_t *tv)
+{
+    const double *p[4];
+    for (int m = 0; m < 4; m++)
+        p[m] = X + 3 * (size_t)tv[m];
+    int best = 0;
+    double least = INFINITY;
+    for (int m = 0; m < 4; m++) {
+        double reach = 0;
+        for (int o = 0; o < 4; o++)
+            for (int k = 0; o != m && k < 3; k++)
+                reach = fmax(reach, fabs(p[o][k] - p[m][k]));
+        if (reach < least || (reach == least && lex_after(p[best], p[m]))) {
+            least = reach;
+            best = m;
+        }
+    }
+    double q[3][3];
+    for (int o = 0, r = 0; o < 4; o++)
+        if (o != best) {
+            sub3(p[o], p[best], q[r]);
+            r++;
+        }
+    return fabs(triple(q[0], q[1], q[2])) / 6;
+}
+
+static void add_tet(vjob *j, const uint32_t *tv)
+{
+    vwork *w = j->w;
+    const double *X = w->xyz;
+    uint32_t s[4];
+    double q[4][3];
+    int sigma = canon_tet(X, tv, s, q);
+    double dv = tet_volume(X, tv);
+    const double *p0 = X + 3 * (size_t)s[0];
     for (int m = 0; m < 4; m++)
         if (mine(j, s[m]))
-            fdt_fix_add(&w->dtfe[s[m]], v6 / 6, w->g_vol);
+            fdt_fix_add(&w->dtfe[s[m]], dv, w->g_dtfe[s[m]]);
     double c[3];
     int outside = fdt_circumcenter(p0, X + 3 * (size_t)s[1], X + 3 * (size_t)s[2],
                                    X + 3 * (size_t)s[3], c) != 0;
@@ -604,6 +650,28 @@ static void *run_job(void *arg)
     vwork *w = j->w;
     if ((j->err = job_adjacency(j)) != FDT_OK)
         return NULL;
+    /* The DTFE sums' grids, per point from its largest tet (a maximum:
+     * the same whatever the tets' order), so that a cluster's small tets
+     * keep their bits: on the box's grid, those of a cluster 1e-10 wide in
+     * a unit box summed to 0, a density of 0. */
+    for (uint32_t l = j->lo; l < j->hi; l++)
+        w->g_dtfe[l].inv = 0; /* the largest tet's volume, for now */
+    for (size_t t = 0; t < w->ntets; t++) {
+        const uint32_t *tv = w->tets + 4 * t;
+        if (!(mine(j, tv[0]) || mine(j, tv[1]) || mine(j, tv[2]) || mine(j, tv[3])))
+            continue;
+        double v = tet_volume(w->xyz, tv);
+        for (int m = 0; m < 4; m++)
+            if (mine(j, tv[m]))
+                w->g_dtfe[tv[m]].inv = fmax(w->g_dtfe[tv[m]].inv, v);
+    }
+    for (uint32_t l = j->lo; l < j->hi; l++) {
+        int ev;
+        (void)frexp(w->g_dtfe[l].inv, &ev);
+        w->g_dtfe[l] = w->g_dtfe[l].inv > 0
+                           ? fdt_fix_grid_of(ev - 98 < -1022 ? -1022 : ev - 98)
+                           : w->g_vol;
+    }
     for (size_t t = 0; t < w->ntets; t++) {
         const uint32_t *tv = w->tets + 4 * t;
         if (mine(j, tv[0]) || mine(j, tv[1]) || mine(j, tv[2]) || mine(j, tv[3]))
@@ -612,7 +680,7 @@ static void *run_job(void *arg)
     for (uint32_t l = j->lo; l < j->hi && !j->err; l++) {
         uint32_t g = w->perm[l];
         j->v->flags[g] = w->flags[l] & (FDT_CELL_CLIPPED | FDT_CELL_HULL);
-        double dt = fdt_fix_value(w->dtfe[l], w->g_vol);
+        double dt = fdt_fix_value(w->dtfe[l], w->g_dtfe[l]);
         j->v->density[g] = dt > 0 ? 4 / dt : 0;
         /* A cell whose shares' rounding scale exceeds its volume 2^8 times
          * (a needle: its Voronoi vertices far from its point for its
@@ -620,8 +688,12 @@ static void *run_job(void *arg)
          * it instead (as precise as its cut planes; at 2^12, cells of
          * 1e-3 wide clusters still lost 2e-10). Both sums are exact, so
          * the choice is the same for every order of the tets. */
+        /* So is a cell too small for the grid: its summed volume within
+         * 2^40 steps of it keeps fewer bits than 1e-12 asks (a cluster
+         * 1e-10 wide in a unit box summed to 0). */
+        double vl = fabs(fdt_fix_value(w->vol[l], w->g_vol));
         if (!(w->flags[l] & FDT_CELL_CLIPPED) &&
-            fdt_fix_value(w->vabs[l], w->g_vol) > 0x1p8 * fabs(fdt_fix_value(w->vol[l], w->g_vol)))
+            (fdt_fix_value(w->vabs[l], w->g_vol) > 0x1p8 * vl || vl < 0x1p40 * w->g_vol.step))
             w->flags[l] |= CELL_CUT;
         if (w->flags[l] & (FDT_CELL_CLIPPED | CELL_CUT))
             j->err = cut_cell(j, l);
@@ -696,7 +768,8 @@ static int alloc_work(vwork *w, const fdt_result *r)
     w->vabs = calloc(m, sizeof *w->vabs);
     w->mom = calloc(3 * m, sizeof *w->mom);
     w->dtfe = calloc(m, sizeof *w->dtfe);
-    if (!w->flags || !w->vol || !w->vabs || !w->mom || !w->dtfe)
+    w->g_dtfe = malloc(m * sizeof *w->g_dtfe);
+    if (!w->flags || !w->vol || !w->vabs || !w->mom || !w->dtfe || !w->g_dtfe)
         return FDT_ENOMEM;
     for (size_t f = 0; f < 3 * r->nhull; f++)
         w->flags[w->loc[r->hull[f]]] |= FDT_CELL_HULL | FDT_CELL_CLIPPED;
@@ -714,6 +787,7 @@ static void free_work(vwork *w)
     free(w->vabs);
     free(w->mom);
     free(w->dtfe);
+    free(w->g_dtfe);
 }
 
 /* The jobs over the points, in equal ranges of the local numbering. */
@@ -761,6 +835,37 @@ static int list_neighbors(fdt_voronoi *v, vjob *jobs, int threads)
     return fork_join(jobs, threads, fill_neighbors);
 }
 
+int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double box[6],
+                           int box_exp, int coords, char *diag, size_t ds)
+{
+    double side = 0;
+    for (int k = 0; k < 3; k++)
+        side = fmax(side, box[k + 3] - box[k]);
+    static const int ends[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+    for (size_t t = 0; t < r->ntets; t++) {
+        const fdt_vid *v = r->tets + 4 * t;
+        for (int e = 0; e < 6; e++) {
+            const double *a = xyz + 3 * (size_t)v[ends[e][0]];
+            const double *b = xyz + 3 * (size_t)v[ends[e][1]];
+            double len = 0, mag = 0;
+            for (int k = 0; k < 3; k++) {
+                len = fmax(len, fabs(a[k] - b[k]));
+                mag = fmax(mag, fmax(fabs(a[k]), fabs(b[k])));
+            }
+            int near = coords && len < 0x1p-40 * mag;
+            if (near || len < ldexp(side, box_exp)) {
+                fdt_diag(diag, ds, "points %lld and %lld are %g apart %s %g: their Voronoi "
+                    "cells are beyond what doubles hold (a Delaunay edge must be at least "
+                    "2^%d of the box%s)", (long long)v[ends[e][0]], (long long)v[ends[e][1]],
+                    len, near ? "at coordinates near" : "in a box", near ? mag : side,
+                    box_exp, coords ? " and 2^-40 of its points' coordinates" : "");
+                return FDT_ERANGE;
+            }
+        }
+    }
+    return FDT_OK;
+}
+
 int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
                       int threads, fdt_voronoi **out, char *diag, size_t diag_size)
 {
@@ -791,6 +896,8 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
     err = alloc_cells(v);
     if (!err)
         err = set_box(v, r, xyz, o, diag, diag_size);
+    if (!err)
+        err = fdt_voronoi_resolution(r, xyz, v->box, -48, 0, diag, diag_size);
     if (err)
         goto done;
     memcpy(w.box, v->box, sizeof w.box);

@@ -17,4 +17,27 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
 int fdt_voronoi_box_of(const fdt_result *r, const double *xyz, size_t n,
                        const fdt_voronoi_options *o, double box[6], char *diag, size_t ds);
 
+/*
+ * Whether doubles hold the cells of r's points (xyz, as given to
+ * fdt_triangulate) in box: FDT_ERANGE, with diag naming two points, when a
+ * Delaunay edge (its Chebyshev length: the square of a length can
+ * underflow where the length does not) is shorter than 2^box_exp of the
+ * box, or, with coords set, than 2^-40 of its points' coordinates.
+ * FDT_OK otherwise. Checked before the cells are built, so that
+ * FDT_EINTERNAL from them stays a bug's. The limits:
+ *  - the cells fdt_voronoi_compute cuts from the box (hull, needle and
+ *    tiny cells) are cut relative to their point, from the box's walls:
+ *    a cell 1e-15 of the box came out exact, one of 1e-16 could not be
+ *    cut, so box_exp -48;
+ *  - the polyMesh dual computes everything in one frame and writes its
+ *    vertices as absolute coordinates: box_exp -300 (the cells' volumes
+ *    underflow: 1e-150 beside 1e150 in one set could not be closed) and
+ *    coords (Voronoi vertices between points 2^-40 of their coordinates
+ *    apart round to a grid a few thousand steps across the cells:
+ *    tests/gen_points.c `ulpgrid`, 2^-12 steps at 2^40, came out 3e-2 off
+ *    in volume).
+ */
+int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double box[6],
+                           int box_exp, int coords, char *diag, size_t ds);
+
 #endif
