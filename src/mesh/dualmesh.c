@@ -571,20 +571,15 @@ static void snap_to_walls(const dwork *w, double pt[3], int k)
     }
 }
 
-/* The point between entries cur (inside wall p) and nxt (beyond it)
- * where their segment, or ray when nxt is at infinity, meets the wall,
- * by interpolation: what the faces' own edges use, and a shared edge's
- * fallback below. 0, or -1 when there is none (both at infinity). */
-static int between(const dwork *w, const cv *cur, const cv *nxt, int p, double pt[3])
+/* The point y (homogeneous) between entries cur (inside wall p) and nxt
+ * (beyond it) where their segment, or ray, meets the wall, by
+ * interpolation: what a face's own edge uses, and a shared edge's fallback
+ * in crossing(). y[3] is 0 where both are at infinity. */
+static void between(const dwork *w, const cv *cur, const cv *nxt, int p, double y[4])
 {
-    double su = side(w, cur->h, p), sv = side(w, nxt->h, p), y[4];
+    double su = side(w, cur->h, p), sv = side(w, nxt->h, p);
     for (int c = 0; c < 4; c++)
         y[c] = cur->h[c] * fabs(sv) + nxt->h[c] * fabs(su);
-    if (!(y[3] > 0))
-        return -1;
-    for (int c = 0; c < 3; c++)
-        pt[c] = y[c] / y[3];
-    return 0;
 }
 
 /* Whether pt lies within 2^-40 of the box of the span from cur to nxt
@@ -628,9 +623,8 @@ static int crossing(dwork *w, const cv *cur, const cv *nxt, int p, cv *x)
     x->root = -1;
     x->h[3] = 1;
     if (cur->ekind == E_OWN) {
-        double su = side(w, cur->h, p), sv = side(w, nxt->h, p), y[4];
-        for (int c = 0; c < 4; c++)
-            y[c] = cur->h[c] * fabs(sv) + nxt->h[c] * fabs(su); /* between them */
+        double y[4];
+        between(w, cur, nxt, p, y);
         if (y[3] > 0) {
             for (int c = 0; c < 3; c++) {
                 pt[c] = y[c] / y[3];
@@ -672,16 +666,19 @@ static int crossing(dwork *w, const cv *cur, const cv *nxt, int p, cv *x)
             A = w->cc + 3 * (size_t)cur->eb;
             d = w->hdir + 3 * (size_t)cur->ea;
         }
-        int off = 0;
-        if (cur->h[3] != 0 && wall_point(w, tri, p, pt) == 0 && !in_span(w, pt, k, cur, nxt))
-            off = between(w, cur, nxt, p, pt) == 0;
-        if (off) {
+        int along = wall_point(w, tri, p, pt) != 0;
+        if (!along && cur->h[3] != 0 && !in_span(w, pt, k, cur, nxt)) {
             /* The edge's line meets the wall, by its triangle, beyond the
              * span of it this face keeps (and outside the walls already
              * cut): its ends are rounded circumcentres of nearly
              * cospherical groups (gen_points `cone`). The span is the
-             * same in every face that has the edge: from it. */
-        } else if (wall_point(w, tri, p, pt) != 0) {
+             * same in every face that has the edge: from it (cur is
+             * finite, so y[3] > 0). */
+            double y[4];
+            between(w, cur, nxt, p, y);
+            for (int c = 0; c < 3; c++)
+                pt[c] = y[c] / y[3];
+        } else if (along) {
             /* the edge nearly along the wall: from its ends */
             double t;
             if (B) {
