@@ -403,6 +403,14 @@ typedef struct fdt_stats {
     size_t certified_tets;    /* finite tets the mesh certificates checked
                                  before any was trusted */
     double t_certify;         /* seconds certifying meshes */
+    /* The one-part engine's insertion (issue 31). Added in 0.3: an older
+     * caller passes a shorter size and gets the fields above. With more
+     * than one thread the deferred and serial counts depend on how the
+     * threads met (try-locks), so they vary from run to run. */
+    size_t ins_conflict_tests;/* conflict tests of the insertion */
+    size_t ins_deferred;      /* insertions put off (a tet another thread held,
+                                 or the slots spent) */
+    size_t ins_serial;        /* points left to the build's serial finish */
 } fdt_stats;
 
 /* Fills the first struct_size bytes of *st (its struct_size included).

@@ -171,6 +171,9 @@ static void test_result(void)
      * mesh and no face advanced (src/front/partmesh.h) */
     EXPECT(st.threads == 1 && st.mode == FDT_MODE_SERIAL && st.faces_advanced == 0);
     EXPECT(st.final_tets == nt && st.certified_tets == nt);
+    /* its insertion's counts: conflict tests made, nothing deferred on one
+     * thread */
+    EXPECT(st.ins_conflict_tests > 0 && st.ins_deferred == 0 && st.ins_serial == 0);
     EXPECT(fdt_result_stats(r, NULL) == FDT_EINVAL);
     EXPECT(fdt_result_thread_stats(r, 0, &ts) == FDT_OK && ts.tets == nt);
     EXPECT(fdt_result_thread_stats(r, 1, &ts) == FDT_EINVAL);

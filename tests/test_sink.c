@@ -445,6 +445,12 @@ static void test_engine(void)
         EXPECT(((fdt_stats *)buf)->struct_size == old && ((fdt_stats *)buf)->tets == nt &&
                buf[old] == 0xA5 && buf[sizeof buf - 1] == 0xA5);
         EXPECT(fdt_result_stats_sized(r, (fdt_stats *)buf, old + 8) == FDT_EINVAL);
+        /* 0.2's size (before the insertion's counts): filled to it */
+        size_t v2 = offsetof(fdt_stats, ins_conflict_tests);
+        memset(buf, 0xA5, sizeof buf);
+        CHECK_EQ(fdt_result_stats_sized(r, (fdt_stats *)buf, v2), FDT_OK);
+        EXPECT(((fdt_stats *)buf)->struct_size == v2 && ((fdt_stats *)buf)->tets == nt &&
+               buf[v2] == 0xA5);
         fdt_result_free(&r);
         /* in memory: the mesh's bytes, no batches */
         s.permute_input = 0;

@@ -383,7 +383,8 @@ static PyObject *tri_stats(TriObject *self, void *closure)
         put(d, "pinned", PyLong_FromLong(st.pinned)) || PUT_SIZE(d, st, mesh_faces) ||
         PUT_SIZE(d, st, mesh_parts) || PUT_DBL(d, st, t_mesh) ||
         PUT_SIZE(d, st, final_tets) || PUT_SIZE(d, st, certified_tets) ||
-        PUT_DBL(d, st, t_certify) ||
+        PUT_DBL(d, st, t_certify) || PUT_SIZE(d, st, ins_conflict_tests) ||
+        PUT_SIZE(d, st, ins_deferred) || PUT_SIZE(d, st, ins_serial) ||
         put(d, "duplicates", PyLong_FromSize_t(fdt_result_num_duplicates(self->r)))) {
         Py_DECREF(d);
         return NULL;

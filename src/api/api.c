@@ -402,6 +402,9 @@ static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, int nthrea
     st->final_tets = pms->final_tets + fst->final_tets;
     st->certified_tets = pms->certified_tets + fst->certified_tets;
     st->t_certify = pms->t_certify + fst->t_certify;
+    st->ins_conflict_tests = pms->ins.conflict_tests;
+    st->ins_deferred = pms->ins.deferred;
+    st->ins_serial = pms->ins.serial_finish;
     st->exact_orient += pms->pc.orient_exact;
     st->exact_insphere += pms->pc.insphere_exact;
     st->adapt_orient += pms->pc.orient_adapt;

@@ -836,6 +836,7 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  largest front     %zu\n"
         "  mesh faces        %zu (%zu parts read a mesh; %.3f s building meshes)\n"
         "  final from mesh   %zu tets (certified %zu in %.3f s)\n"
+        "  insertion         %zu conflict tests, %zu deferred, %zu by the serial finish\n"
         "  threads           %d\n"
         "  mode              %s\n"
         "  engine            %s\n"
@@ -853,7 +854,8 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
         st->max_front, st->mesh_faces, st->mesh_parts, st->t_mesh, st->final_tets,
-        st->certified_tets, st->t_certify, st->threads, mode_name(st->mode),
+        st->certified_tets, st->t_certify, st->ins_conflict_tests, st->ins_deferred,
+        st->ins_serial, st->threads, mode_name(st->mode),
         engine_name(st), st->t_prepare, st->t_front, st->t_finish,
         tm->read, tm->triangulate, tm->check, tm->canon, tm->write, tm->voronoi,
         tm->interpolate);
@@ -940,7 +942,8 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         ", \"adapt_orient\": %zu, \"adapt_insphere\": %zu"
         ", \"max_front\": %zu, \"mesh_faces\": %zu, \"mesh_parts\": %zu"
         ", \"t_mesh\": %.9g, \"final_tets\": %zu, \"certified_tets\": %zu"
-        ", \"t_certify\": %.9g, \"threads\": %d, \"mode\": \"%s\""
+        ", \"t_certify\": %.9g, \"ins_conflict_tests\": %zu, \"ins_deferred\": %zu"
+        ", \"ins_serial\": %zu, \"threads\": %d, \"mode\": \"%s\""
         ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
         ", \"t_read\": %.9g, \"t_triangulate\": %.9g, \"t_check\": %.9g"
         ", \"t_canon\": %.9g, \"t_write\": %.9g, \"t_voronoi\": %.9g"
@@ -950,6 +953,7 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
         st->max_front, st->mesh_faces, st->mesh_parts, finite_or_zero(st->t_mesh),
         st->final_tets, st->certified_tets, finite_or_zero(st->t_certify),
+        st->ins_conflict_tests, st->ins_deferred, st->ins_serial,
         st->threads, mode_name(st->mode), finite_or_zero(st->t_prepare),
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),

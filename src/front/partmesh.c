@@ -165,6 +165,8 @@ int fdt_partmesh_emit_all(const double *P, uint32_t m, int nthreads, fdt_emit *e
                   : fdt_ins_build_progress(&mesh, P, 0, m, &st->pc,
                                            progress ? build_progress : NULL, &hp);
     st->t_mesh = fdt_now_s() - t0;
+    if (!err)
+        st->ins = mesh.stats;
     fdt_certify_fail why;
     if (err == FDT_EDEGENERATE || err == FDT_EINVAL || err == FDT_EINTERNAL) {
         /* The caller merged duplicates and checked the dimension, so each

@@ -43,6 +43,7 @@ typedef struct fdt_partmesh_stats {
     double t_mesh;         /* seconds building the mesh */
     double t_certify;      /* seconds certifying it */
     fdt_pred_counts pc;    /* exact predicate calls of both */
+    fdt_ins_stats ins;     /* the build's counts */
 } fdt_partmesh_stats;
 
 /*

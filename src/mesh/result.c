@@ -44,7 +44,8 @@ size_t fdt_result_num_duplicates(const fdt_result *r) { return r ? r->ndup : 0; 
 static int stats_size_known(size_t size)
 {
     return size == sizeof(fdt_stats) || size == offsetof(fdt_stats, mem_points) ||
-           size == offsetof(fdt_stats, final_tets);
+           size == offsetof(fdt_stats, final_tets) ||
+           size == offsetof(fdt_stats, ins_conflict_tests);
 }
 
 static int thread_stats_size_known(size_t size)
