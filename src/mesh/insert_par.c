@@ -1,8 +1,11 @@
 /*
  * The parallel Bowyer-Watson build (fdt_ins_build_parallel, src/mesh/insert.h):
  * the same perturbed DT as fdt_ins_build, built by several threads at once
- * (the design of CGAL's parallel Delaunay_triangulation_3 and of HXT:
- * optimistic insertions under per-tet try-locks).
+ * (the design of CGAL's parallel Delaunay_triangulation_3: optimistic
+ * insertions under per-tet try-locks; HXT instead gives each thread a
+ * region of space, which bench/NOTES.md entry 98 built and measured: no
+ * faster on volumes, and no parallelism on a pipe's scan, where every
+ * cavity crosses any wall).
  *
  * Phases.
  *   1. Serial start (src/mesh/insert.c): the first BRIO rounds, until about
