@@ -264,6 +264,10 @@ static void test_same_bits(size_t n)
         diffs += memcmp(&a1[perm[i]], &as[i], sizeof a1[i]) != 0;
         diffs += memcmp(c1 + 3 * perm[i], cs + 3 * i, 3 * sizeof *c1) != 0;
         diffs += fdt_voronoi_num_faces(v1)[perm[i]] != fdt_voronoi_num_faces(vs)[i];
+        diff3 += memcmp(&fdt_voronoi_densities(v1)[i], &fdt_voronoi_densities(v3)[i],
+                        sizeof(double)) != 0;
+        diffs += memcmp(&fdt_voronoi_densities(v1)[perm[i]], &fdt_voronoi_densities(vs)[i],
+                        sizeof(double)) != 0;
     }
     EXPECTF(diff3 == 0, "%zu values differ between 1 and 3 threads", diff3);
     EXPECTF(diffs == 0, "%zu values differ for the shuffled input", diffs);

@@ -334,7 +334,7 @@ static int canon_tet(const double *X, const uint32_t *tv, uint32_t s[4], double 
  * first), lost every bit in its three long rounded differences (1.5e-21
  * for a true 1e-23, either sign); from a clustered one two differences are
  * exact and the third long one rounds once. A function of the four
- * points, whatever the tet's order. */
+ * points, whatever the tet's order, to the bit. */
 static double tet_volume(const double *X, const uint32_t *tv)
 {
     const double *p[4];
@@ -352,12 +352,21 @@ static double tet_volume(const double *X, const uint32_t *tv)
             best = m;
         }
     }
-    double q[3][3];
+    /* the other three in lexicographic order too: the same rounding
+     * whichever way round the tet came */
+    const double *o3[3];
     for (int o = 0, r = 0; o < 4; o++)
-        if (o != best) {
-            sub3(p[o], p[best], q[r]);
-            r++;
+        if (o != best)
+            o3[r++] = p[o];
+    for (int x = 1; x < 3; x++)
+        for (int y = x; y > 0 && lex_after(o3[y - 1], o3[y]); y--) {
+            const double *t = o3[y];
+            o3[y] = o3[y - 1];
+            o3[y - 1] = t;
         }
+    double q[3][3];
+    for (int r = 0; r < 3; r++)
+        sub3(o3[r], p[best], q[r]);
     return fabs(triple(q[0], q[1], q[2])) / 6;
 }
 
