@@ -56,6 +56,9 @@ struct fdt_voronoi {
 /* A work flag beside the public ones: a cell inside the box cut rather
  * than summed (its shares cancel too much). */
 #define CELL_CUT 0x80u
+/* Another: a point whose DTFE sum is summed again on a grid of its own
+ * (run_job). */
+#define DTFE_FINE 0x40u
 
 /* The computation's own numbering (entry 92 of bench/NOTES.md): the
  * distinct points in Morton order of their coordinates, so that a tet's
@@ -77,7 +80,8 @@ typedef struct vwork {
      * its tets (DTFE); the faces' are the jobs' */
     fdt_fix *vol, *vabs, *mom, *dtfe; /* owned */
     fdt_fix_grid g_area, g_vol, g_mom;
-    fdt_fix_grid *g_dtfe; /* per point: its tets' volumes' grid (owned) */
+    double *vmax;         /* per point: its largest tet's volume, then (DTFE_FINE)
+                           * the step of its own DTFE grid (owned) */
 } vwork;
 
 /* One thread's share: the points [lo, hi) of the local numbering. */
@@ -307,7 +311,7 @@ static int mine(const vjob *j, uint32_t x)
  * (not their ids, which change with the input's order) into s, their
  * differences from s[0] into q[1 .. 3]: the same bits whichever way round
  * the tet came. Returns the orientation in that order (+1 or -1). */
-static int canon_tet(const double *X, const uint32_t *tv, uint32_t s[4], double q[4][3])
+static inline int canon_tet(const double *X, const uint32_t *tv, uint32_t s[4], double q[4][3])
 {
     int sigma = 1;
     for (int m = 0; m < 4; m++)
@@ -327,7 +331,12 @@ static int canon_tet(const double *X, const uint32_t *tv, uint32_t s[4], double 
     return sigma;
 }
 
-/* Tet tv's volume for the DTFE sums, taken from its vertex nearest the
+static inline double max2(double a, double b)
+{
+    return a > b ? a : b; /* finite operands: fmax is a library call here */
+}
+
+/* Tet tv's volume for the DTFE sums summed again (run_job), taken from its vertex nearest the
  * others (the least reach: its longest edge, in any axis; ties: the
  * lexicographically first): a sliver of three clustered points and a far
  * one, taken from the far one as the shares take it (the lexicographic
@@ -340,13 +349,19 @@ static double tet_volume(const double *X, const uint32_t *tv)
     const double *p[4];
     for (int m = 0; m < 4; m++)
         p[m] = X + 3 * (size_t)tv[m];
+    /* each edge's length in any axis once, then each vertex's reach */
+    double e[4][4];
+    for (int a = 0; a < 4; a++)
+        for (int b = a + 1; b < 4; b++)
+            e[a][b] = e[b][a] = max2(max2(fabs(p[a][0] - p[b][0]), fabs(p[a][1] - p[b][1])),
+                                     fabs(p[a][2] - p[b][2]));
     int best = 0;
     double least = INFINITY;
     for (int m = 0; m < 4; m++) {
         double reach = 0;
         for (int o = 0; o < 4; o++)
-            for (int k = 0; o != m && k < 3; k++)
-                reach = fmax(reach, fabs(p[o][k] - p[m][k]));
+            if (o != m)
+                reach = max2(reach, e[m][o]);
         if (reach < least || (reach == least && lex_after(p[best], p[m]))) {
             least = reach;
             best = m;
@@ -377,11 +392,15 @@ static void add_tet(vjob *j, const uint32_t *tv)
     uint32_t s[4];
     double q[4][3];
     int sigma = canon_tet(X, tv, s, q);
-    double dv = tet_volume(X, tv);
+    /* the DTFE share from the canonical differences (tet_volume, more
+     * careful and slower, for the sums too small for the box's grid) */
+    double dv = fabs(triple(q[1], q[2], q[3])) / 6;
     const double *p0 = X + 3 * (size_t)s[0];
     for (int m = 0; m < 4; m++)
-        if (mine(j, s[m]))
-            fdt_fix_add(&w->dtfe[s[m]], dv, w->g_dtfe[s[m]]);
+        if (mine(j, s[m])) {
+            fdt_fix_add(&w->dtfe[s[m]], dv, w->g_vol);
+            w->vmax[s[m]] = max2(w->vmax[s[m]], dv);
+        }
     double c[3];
     int outside = fdt_circumcenter(p0, X + 3 * (size_t)s[1], X + 3 * (size_t)s[2],
                                    X + 3 * (size_t)s[3], c) != 0;
@@ -659,37 +678,47 @@ static void *run_job(void *arg)
     vwork *w = j->w;
     if ((j->err = job_adjacency(j)) != FDT_OK)
         return NULL;
-    /* The DTFE sums' grids, per point from its largest tet (a maximum:
-     * the same whatever the tets' order), so that a cluster's small tets
-     * keep their bits: on the box's grid, those of a cluster 1e-10 wide in
-     * a unit box summed to 0, a density of 0. */
-    for (uint32_t l = j->lo; l < j->hi; l++)
-        w->g_dtfe[l].inv = 0; /* the largest tet's volume, for now */
-    for (size_t t = 0; t < w->ntets; t++) {
-        const uint32_t *tv = w->tets + 4 * t;
-        if (!(mine(j, tv[0]) || mine(j, tv[1]) || mine(j, tv[2]) || mine(j, tv[3])))
-            continue;
-        double v = tet_volume(w->xyz, tv);
-        for (int m = 0; m < 4; m++)
-            if (mine(j, tv[m]))
-                w->g_dtfe[tv[m]].inv = fmax(w->g_dtfe[tv[m]].inv, v);
-    }
-    for (uint32_t l = j->lo; l < j->hi; l++) {
-        int ev;
-        (void)frexp(w->g_dtfe[l].inv, &ev);
-        w->g_dtfe[l] = w->g_dtfe[l].inv > 0
-                           ? fdt_fix_grid_of(ev - 98 < -1022 ? -1022 : ev - 98)
-                           : w->g_vol;
-    }
     for (size_t t = 0; t < w->ntets; t++) {
         const uint32_t *tv = w->tets + 4 * t;
         if (mine(j, tv[0]) || mine(j, tv[1]) || mine(j, tv[2]) || mine(j, tv[3]))
             add_tet(j, tv);
     }
+    /* A DTFE sum within 2^40 steps of the box's grid (a cluster 1e-10 wide
+     * in a unit box summed to 0: a density of 0) is summed again on a grid
+     * of its own, from the point's largest tet (a maximum, and the sum an
+     * exact one: the same whatever the tets' order), each tet's volume by
+     * tet_volume. Uniform points have none, so this second pass over the
+     * tets rarely runs. */
+    size_t fine = 0;
+    for (uint32_t l = j->lo; l < j->hi; l++) {
+        if (fabs(fdt_fix_value(w->dtfe[l], w->g_vol)) >= 0x1p40 * w->g_vol.step ||
+            !(w->vmax[l] > 0))
+            continue;
+        int ev;
+        (void)frexp(w->vmax[l], &ev);
+        w->vmax[l] = ldexp(1.0, ev - 98 < -1022 ? -1022 : ev - 98); /* the grid's step */
+        memset(&w->dtfe[l], 0, sizeof w->dtfe[l]);
+        w->flags[l] |= DTFE_FINE;
+        fine++;
+    }
+    for (size_t t = 0; fine && t < w->ntets; t++) {
+        const uint32_t *tv = w->tets + 4 * t;
+        double dv = -1;
+        for (int m = 0; m < 4; m++) {
+            uint32_t l = tv[m];
+            if (!mine(j, l) || !(w->flags[l] & DTFE_FINE))
+                continue;
+            if (dv < 0)
+                dv = tet_volume(w->xyz, tv);
+            fdt_fix_add(&w->dtfe[l], dv, fdt_fix_grid_of(ilogb(w->vmax[l])));
+        }
+    }
     for (uint32_t l = j->lo; l < j->hi && !j->err; l++) {
         uint32_t g = w->perm[l];
         j->v->flags[g] = w->flags[l] & (FDT_CELL_CLIPPED | FDT_CELL_HULL);
-        double dt = fdt_fix_value(w->dtfe[l], w->g_dtfe[l]);
+        double dt = w->flags[l] & DTFE_FINE
+                        ? fdt_fix_value(w->dtfe[l], fdt_fix_grid_of(ilogb(w->vmax[l])))
+                        : fdt_fix_value(w->dtfe[l], w->g_vol);
         j->v->density[g] = dt > 0 ? 4 / dt : 0;
         /* A cell whose shares' rounding scale exceeds its volume 2^8 times
          * (a needle: its Voronoi vertices far from its point for its
@@ -777,8 +806,8 @@ static int alloc_work(vwork *w, const fdt_result *r)
     w->vabs = calloc(m, sizeof *w->vabs);
     w->mom = calloc(3 * m, sizeof *w->mom);
     w->dtfe = calloc(m, sizeof *w->dtfe);
-    w->g_dtfe = malloc(m * sizeof *w->g_dtfe);
-    if (!w->flags || !w->vol || !w->vabs || !w->mom || !w->dtfe || !w->g_dtfe)
+    w->vmax = calloc(m, sizeof *w->vmax);
+    if (!w->flags || !w->vol || !w->vabs || !w->mom || !w->dtfe || !w->vmax)
         return FDT_ENOMEM;
     for (size_t f = 0; f < 3 * r->nhull; f++)
         w->flags[w->loc[r->hull[f]]] |= FDT_CELL_HULL | FDT_CELL_CLIPPED;
@@ -796,7 +825,7 @@ static void free_work(vwork *w)
     free(w->vabs);
     free(w->mom);
     free(w->dtfe);
-    free(w->g_dtfe);
+    free(w->vmax);
 }
 
 /* The jobs over the points, in equal ranges of the local numbering. */
@@ -851,18 +880,18 @@ int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double 
     for (int k = 0; k < 3; k++)
         side = fmax(side, box[k + 3] - box[k]);
     static const int ends[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+    const double lim = ldexp(side, box_exp);
     for (size_t t = 0; t < r->ntets; t++) {
         const fdt_vid *v = r->tets + 4 * t;
         for (int e = 0; e < 6; e++) {
             const double *a = xyz + 3 * (size_t)v[ends[e][0]];
             const double *b = xyz + 3 * (size_t)v[ends[e][1]];
-            double len = 0, mag = 0;
-            for (int k = 0; k < 3; k++) {
-                len = fmax(len, fabs(a[k] - b[k]));
-                mag = fmax(mag, fmax(fabs(a[k]), fabs(b[k])));
-            }
+            double len = max2(max2(fabs(a[0] - b[0]), fabs(a[1] - b[1])), fabs(a[2] - b[2]));
+            double mag = 0;
+            for (int k = 0; coords && k < 3; k++)
+                mag = max2(mag, max2(fabs(a[k]), fabs(b[k])));
             int near = coords && len < 0x1p-40 * mag;
-            if (near || len < ldexp(side, box_exp)) {
+            if (near || len < lim) {
                 fdt_diag(diag, ds, "points %lld and %lld are %g apart %s %g: their Voronoi "
                     "cells are beyond what doubles hold (a Delaunay edge must be at least "
                     "2^%d of the box%s)", (long long)v[ends[e][0]], (long long)v[ends[e][1]],
