@@ -274,25 +274,9 @@ static void test_stretched(void)
     free(xyz);
 }
 
-static double *random_points(size_t n, int clustered, uint64_t seed)
-{
-    double *xyz = malloc(3 * n * sizeof *xyz);
-    CHECK(xyz);
-    uint64_t s = seed;
-    for (size_t i = 0; i < n; i++) {
-        int c = clustered ? (int)(test_rand64(&s) % 10) : 9;
-        double wd = clustered == 2 ? 1e-3 : 0.05;
-        for (int k = 0; k < 3; k++) {
-            double u = test_unif(&s);
-            xyz[3 * i + k] = c < 8 ? 0.2 + 0.6 * ((c >> k) & 1) + wd * (u - 0.5) : u;
-        }
-    }
-    return xyz;
-}
-
 static void test_random(size_t n, int clustered, uint64_t seed)
 {
-    double *xyz = random_points(n, clustered, seed);
+    double *xyz = test_cloud(n, clustered, seed);
     fdt_dualmesh d = check_dual(clustered ? "clustered" : "uniform", xyz, n, NULL);
     fdt_dualmesh_free(&d);
     const double box[6] = {-0.25, 0, -0.5, 1, 1.5, 1};
@@ -305,7 +289,7 @@ static void test_random(size_t n, int clustered, uint64_t seed)
 static void test_duplicates(void)
 {
     size_t n = 300;
-    double *xyz = random_points(n, 0, 7);
+    double *xyz = test_cloud(n, 0, 7);
     for (size_t i = 0; i < 40; i++)
         memcpy(xyz + 3 * (200 + i), xyz + 3 * (5 * i), 3 * sizeof *xyz);
     fdt_dualmesh d = check_dual("duplicates", xyz, n, NULL);
@@ -327,7 +311,7 @@ static void test_small_and_flat(void)
     d = check_dual("five points, unit box", five, 5, box);
     fdt_dualmesh_free(&d);
     size_t n = 400;
-    double *xyz = random_points(n, 0, 11);
+    double *xyz = test_cloud(n, 0, 11);
     for (size_t i = 0; i < n; i++)
         if (i % 3 == 0)
             xyz[3 * i + (i % 2)] = (i % 4) ? 0.0 : 1.0; /* on a wall */
@@ -387,7 +371,7 @@ static void expect_beyond_doubles(const char *what, const double *xyz, size_t n)
 static void test_beyond_doubles(void)
 {
     size_t n = 200;
-    double *xyz = random_points(n, 0, 13);
+    double *xyz = test_cloud(n, 0, 13);
     /* two points 2^-45 apart at coordinates near 0.75 (under 2^-40 of them) */
     for (int k = 0; k < 3; k++)
         xyz[3 * 7 + (size_t)k] = 0.75;
@@ -396,7 +380,7 @@ static void test_beyond_doubles(void)
     expect_beyond_doubles("2^-45 apart near 0.75", xyz, n);
     free(xyz);
     /* a cluster 1e-100 wide in a unit box (its cells' volumes underflow) */
-    xyz = random_points(n, 0, 17);
+    xyz = test_cloud(n, 0, 17);
     for (size_t i = 0; i < 20; i++)
         for (int k = 0; k < 3; k++)
             xyz[3 * i + (size_t)k] = 1e-100 * xyz[3 * i + (size_t)k];

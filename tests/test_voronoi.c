@@ -129,33 +129,9 @@ static void cut_cell(const double *xyz, fdt_result *r, fdt_vid i, const double b
     fdt_cell_free(&c);
 }
 
-static double *random_points(size_t n, int clustered, uint64_t seed)
-{
-    double *xyz = malloc(3 * n * sizeof *xyz);
-    CHECK(xyz);
-    uint64_t s = seed;
-    for (size_t i = 0; i < n; i++) {
-        if (!clustered) {
-            for (int d = 0; d < 3; d++)
-                xyz[3 * i + d] = test_unif(&s);
-        } else {
-            /* 8 tight clusters (0.05 wide; 1e-3 for clustered 2, whose
-             * cells are needles and slivers beside the background's) and a
-             * uniform background. */
-            int c = (int)(test_rand64(&s) % 10);
-            double wd = clustered == 2 ? 1e-3 : 0.05;
-            for (int d = 0; d < 3; d++) {
-                double u = test_unif(&s);
-                xyz[3 * i + d] = c < 8 ? 0.2 + 0.6 * ((c >> d) & 1) + wd * (u - 0.5) : u;
-            }
-        }
-    }
-    return xyz;
-}
-
 static void test_box_sums(size_t n, int clustered, uint64_t seed)
 {
-    double *xyz = random_points(n, clustered, seed);
+    double *xyz = test_cloud(n, clustered, seed);
     const double box[6] = {-0.25, 0, -0.5, 1, 1.5, 1};
     double bvol = 1.25 * 1.5 * 1.5, bsurf = 2 * (1.25 * 1.5 + 1.5 * 1.5 + 1.25 * 1.5);
     fdt_result *r = test_triangulate(xyz, n, 1, 0);
@@ -235,7 +211,7 @@ static void test_box_sums(size_t n, int clustered, uint64_t seed)
 /* The same bits for a shuffled input and for 1 and 3 threads. */
 static void test_same_bits(size_t n)
 {
-    double *xyz = random_points(n, 1, 7);
+    double *xyz = test_cloud(n, 1, 7);
     double *sh = malloc(3 * n * sizeof *sh);
     size_t *perm = malloc(n * sizeof *perm);
     CHECK(sh && perm);
@@ -293,7 +269,7 @@ static int count_tets(void *user, const fdt_vid *t, size_t count)
 static void test_refusals(void)
 {
     size_t n = 200;
-    double *xyz = random_points(n, 0, 3);
+    double *xyz = test_cloud(n, 0, 3);
     fdt_result *r = test_triangulate(xyz, n, 1, 0);
     fdt_voronoi_options o;
     fdt_default_voronoi_options(&o);
@@ -355,7 +331,7 @@ static void test_refusals(void)
 static void test_getters(void)
 {
     size_t n = 300;
-    double *xyz = random_points(n, 0, 8);
+    double *xyz = test_cloud(n, 0, 8);
     memcpy(xyz + 3 * (n - 1), xyz, 3 * sizeof *xyz); /* the last is the first again */
     fdt_result *r = test_triangulate(xyz, n, 1, 0);
     fdt_voronoi *v = cells(r, xyz, n, NULL);
@@ -398,7 +374,7 @@ static void test_getters(void)
 static void test_tiny_cells(double w)
 {
     size_t n = 2060;
-    double *xyz = random_points(n, 0, 9);
+    double *xyz = test_cloud(n, 0, 9);
     uint64_t s = 77;
     for (size_t i = 2000; i < n; i++)
         for (int d = 0; d < 3; d++)

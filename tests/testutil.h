@@ -144,6 +144,27 @@ static inline double test_unif(uint64_t *s)
     return (double)(test_rand64(s) >> 11) * 0x1.0p-53;
 }
 
+/* n points (3 doubles each, malloc'd: the caller frees them) from seed:
+ * uniform in the unit cube (clustered 0), or 8 tight clusters (0.05 wide;
+ * 1e-3 for clustered 2, whose Voronoi cells are needles and slivers beside
+ * the background's) and a uniform background: the Voronoi and dual tests'
+ * clouds. */
+static inline double *test_cloud(size_t n, int clustered, uint64_t seed)
+{
+    double *xyz = malloc(3 * (n ? n : 1) * sizeof *xyz);
+    CHECK(xyz);
+    uint64_t s = seed;
+    for (size_t i = 0; i < n; i++) {
+        int c = clustered ? (int)(test_rand64(&s) % 10) : 9;
+        double wd = clustered == 2 ? 1e-3 : 0.05;
+        for (int d = 0; d < 3; d++) {
+            double u = test_unif(&s);
+            xyz[3 * i + d] = c < 8 ? 0.2 + 0.6 * ((c >> d) & 1) + wd * (u - 0.5) : u;
+        }
+    }
+    return xyz;
+}
+
 /* The mesh of xyz on `threads` threads (1: serial mode), with the tets'
  * neighbours when `neighbors`; any failure ends the test. */
 static inline fdt_result *test_triangulate(const double *xyz, size_t n, int threads,
