@@ -214,6 +214,7 @@ typedef struct dwork {
     fdt_tid *ring;
     size_t capring;
     double *scaled; /* the points times 2^-e (owned; NULL: not scaled) */
+    double side;    /* the box's largest side, as scaled (the crossings' slack) */
     char *diag;
     size_t ds;
 } dwork;
@@ -559,14 +560,11 @@ static int wall_point(const dwork *w, const fdt_vid *tri, int p, double x[3])
  * made once under its key, so every face that has it sees it moved. */
 static void snap_to_walls(const dwork *w, double pt[3], int k)
 {
-    double side = 0;
-    for (int c = 0; c < 3; c++)
-        side = fmax(side, w->box[c + 3] - w->box[c]);
     for (int c = 0; c < 3; c++) {
         if (c == k)
             continue;
         for (int hi = 0; hi < 2; hi++)
-            if (fabs(pt[c] - w->box[c + 3 * hi]) <= 0x1p-50 * side)
+            if (fabs(pt[c] - w->box[c + 3 * hi]) <= 0x1p-50 * w->side)
                 pt[c] = w->box[c + 3 * hi];
     }
 }
@@ -587,10 +585,7 @@ static void between(const dwork *w, const cv *cur, const cv *nxt, int p, double 
  * is at infinity), off wall axis k. */
 static int in_span(const dwork *w, const double pt[3], int k, const cv *cur, const cv *nxt)
 {
-    double side = 0;
-    for (int c = 0; c < 3; c++)
-        side = fmax(side, w->box[c + 3] - w->box[c]);
-    double slack = 0x1p-40 * side;
+    double slack = 0x1p-40 * w->side;
     for (int c = 0; c < 3; c++) {
         if (c == k)
             continue;
@@ -950,11 +945,10 @@ static int edge_face(dwork *w, fdt_tid t, fdt_vid a, fdt_vid b)
 /* Every Delaunay edge's face, once (from its lowest tet). */
 static int all_faces(dwork *w)
 {
-    static const int pairs[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
     for (size_t t = 0; t < w->T; t++) {
         const fdt_vid *v = w->r->tets + 4 * t;
         for (int e = 0; e < 6; e++) {
-            fdt_vid a = v[pairs[e][0]], b = v[pairs[e][1]];
+            fdt_vid a = v[fdt_tet_edge[e][0]], b = v[fdt_tet_edge[e][1]];
             int err = edge_face(w, (fdt_tid)t, a < b ? a : b, a < b ? b : a);
             if (err) {
                 if (err == FDT_EINTERNAL && !w->diag[0])
@@ -1527,6 +1521,8 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
         err = FDT_ENOMEM;
         goto done;
     }
+    for (int k = 0; k < 3; k++)
+        w.side = fmax(w.side, w.box[k + 3] - w.box[k]);
     w.nb = w.loc.nbrs;
     w.uf = malloc(w.T * sizeof *w.uf);
     w.cc = malloc(3 * w.T * sizeof *w.cc);

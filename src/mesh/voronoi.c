@@ -879,13 +879,12 @@ int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double 
     double side = 0;
     for (int k = 0; k < 3; k++)
         side = fmax(side, box[k + 3] - box[k]);
-    static const int ends[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
     const double lim = ldexp(side, box_exp);
     for (size_t t = 0; t < r->ntets; t++) {
         const fdt_vid *v = r->tets + 4 * t;
         for (int e = 0; e < 6; e++) {
-            const double *a = xyz + 3 * (size_t)v[ends[e][0]];
-            const double *b = xyz + 3 * (size_t)v[ends[e][1]];
+            const fdt_vid va = v[fdt_tet_edge[e][0]], vb = v[fdt_tet_edge[e][1]];
+            const double *a = xyz + 3 * (size_t)va, *b = xyz + 3 * (size_t)vb;
             double len = max2(max2(fabs(a[0] - b[0]), fabs(a[1] - b[1])), fabs(a[2] - b[2]));
             double mag = 0;
             for (int k = 0; coords && k < 3; k++)
@@ -894,7 +893,7 @@ int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double 
             if (near || len < lim) {
                 fdt_diag(diag, ds, "points %lld and %lld are %g apart %s %g: their Voronoi "
                     "cells are beyond what doubles hold (a Delaunay edge must be at least "
-                    "2^%d of the box%s)", (long long)v[ends[e][0]], (long long)v[ends[e][1]],
+                    "2^%d of the box%s)", (long long)va, (long long)vb,
                     len, near ? "at coordinates near" : "in a box", near ? mag : side,
                     box_exp, coords ? " and 2^-40 of its points' coordinates" : "");
                 return FDT_ERANGE;
