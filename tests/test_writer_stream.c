@@ -31,8 +31,8 @@
 #include "frontdt.h"
 #include "base/sethash.h"
 #include "testutil.h"
+#include "testdir.h"
 
-#include <dirent.h>
 #include <errno.h>
 #include <signal.h>
 #include <stdio.h>
@@ -56,13 +56,8 @@ static char *path_in(const char *name)
 /* Entries in dir, "." and ".." aside. */
 static int entries(void)
 {
-    DIR *d = opendir(dir);
-    CHECK(d);
-    int n = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL)
-        n += strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
-    closedir(d);
+    int n = count_entries(dir);
+    CHECK(n >= 0);
     return n;
 }
 
