@@ -125,6 +125,18 @@ static void header(out_file *o, const char *cls, const char *object, const foam_
     header_of(o, "Delaunay tetrahedralization", cls, object, counts);
 }
 
+/* One point of a vectorField: "(x y z)" on a line. */
+static void put_point(out_file *o, const double *x)
+{
+    out_char(o, '(');
+    for (int c = 0; c < 3; c++) {
+        if (c)
+            out_char(o, ' ');
+        out_double(o, x[c]);
+    }
+    out_str(o, ")\n");
+}
+
 int fdt_put_foam_points(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
                         size_t errlen)
 {
@@ -137,13 +149,7 @@ int fdt_put_foam_points(out_file *o, const fdt_mesh_view *m, const void *prep, c
     for (size_t i = 0; i < m->n_points && !o->err; i++) {
         if (p->map[i] < 0)
             continue;
-        out_char(o, '(');
-        for (int c = 0; c < 3; c++) {
-            if (c)
-                out_char(o, ' ');
-            out_double(o, m->xyz[3 * i + (size_t)c]);
-        }
-        out_str(o, ")\n");
+        put_point(o, m->xyz + 3 * i);
     }
     out_str(o, ")\n");
     return FDT_IO_OK;
@@ -257,13 +263,7 @@ int fdt_put_foam_dual_points(out_file *o, const fdt_mesh_view *m, const void *pr
     out_i64(o, (int64_t)d->n_verts);
     out_str(o, "\n(\n");
     for (size_t i = 0; i < d->n_verts && !o->err; i++) {
-        out_char(o, '(');
-        for (int c = 0; c < 3; c++) {
-            if (c)
-                out_char(o, ' ');
-            out_double(o, d->xyz[3 * i + (size_t)c]);
-        }
-        out_str(o, ")\n");
+        put_point(o, d->xyz + 3 * i);
     }
     out_str(o, ")\n");
     return FDT_IO_OK;
