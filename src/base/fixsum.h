@@ -21,7 +21,6 @@
 
 #include <math.h>
 #include <stdint.h>
-#include <string.h>
 
 typedef struct fdt_fix {
     uint64_t lo;
@@ -41,37 +40,25 @@ static inline fdt_fix_grid fdt_fix_grid_of(int e)
     return g;
 }
 
-/* acc += round(x 2^-e), x finite with |x 2^-e| < 2^126. The rounding is
- * llrint's (the current mode, to nearest by default) for |x 2^-e| < 2^62;
- * above that x 2^-e is an integer already (53 bits of significand). */
+/* acc += round(x 2^-e), x finite with |x 2^-e| < 2^126. y = x 2^-e is
+ * split exactly as h 2^63 + r: h = trunc(y 2^-63) (a scaling by a power of
+ * two, then a truncation: |h| < 2^63), r = y - h 2^63 (exact: 2^63 times
+ * the fraction of y 2^-63, which a double holds; |r| < 2^63). Where y
+ * has bits below 1 (|y| < 2^52), h = 0 and r = y is rounded by llrint,
+ * in the current mode (to nearest by default); elsewhere r is an integer
+ * already. No branch: the terms' signs are a coin flip. */
 static inline void fdt_fix_add(fdt_fix *acc, double x, fdt_fix_grid g)
 {
     double y = x * g.inv;
-    uint64_t lo;
-    int64_t hi;
-    if (fabs(y) < 0x1p62) {
-        int64_t q = llrint(y);
-        lo = (uint64_t)q;
-        hi = q < 0 ? -1 : 0;
-    } else {
-        /* y is an integer: its 53-bit significand shifted left by
-         * e - 52 >= 10 bits, exactly, then negated if y < 0. */
-        uint64_t b;
-        memcpy(&b, &y, sizeof b);
-        int sh = (int)((b >> 52) & 0x7ff) - 1075;
-        uint64_t m = (b & ((UINT64_C(1) << 52) - 1)) | UINT64_C(1) << 52;
-        uint64_t mh = sh >= 64 ? m << (sh - 64) : m >> (64 - sh);
-        uint64_t ml = sh >= 64 ? 0 : m << sh;
-        if (b >> 63) { /* two's complement negation */
-            ml = ~ml + 1;
-            mh = ~mh + (ml == 0);
-        }
-        lo = ml;
-        hi = (int64_t)mh;
-    }
-    uint64_t s = acc->lo + lo;
-    acc->hi += hi + (s < lo);
-    acc->lo = s;
+    int64_t h = (int64_t)(y * 0x1p-63);
+    int64_t r = llrint(y - (double)h * 0x1p63);
+    /* h 2^63 is (h >> 1) 2^64 + (h & 1) 2^63 (>> rounds down); r is
+     * sign-extended */
+    uint64_t lo = (uint64_t)h << 63, s = lo + (uint64_t)r;
+    int64_t hi = (h >> 1) + (r >> 63) + (s < lo);
+    uint64_t t = acc->lo + s;
+    acc->hi += hi + (t < s);
+    acc->lo = t;
 }
 
 /* acc += b (merging partial sums). */

@@ -57,7 +57,7 @@ struct fdt_voronoi {
  * than summed (its shares cancel too much). */
 #define CELL_CUT 0x80u
 /* Another: a point whose DTFE sum is summed again on a grid of its own
- * (run_job). */
+ * (tet_pass). */
 #define DTFE_FINE 0x40u
 
 /* The computation's own numbering (entry 92 of bench/NOTES.md): the
@@ -80,6 +80,8 @@ typedef struct vwork {
      * its tets (DTFE); the faces' are the jobs' */
     fdt_fix *vol, *vabs, *mom, *dtfe; /* owned */
     fdt_fix_grid g_area, g_vol, g_mom;
+    const struct vjob *jobs; /* the threads' shares, in order of their points */
+    int njobs;
     double *vmax;         /* per point: its largest tet's volume, then (DTFE_FINE)
                            * the step of its own DTFE grid (owned) */
 } vwork;
@@ -249,18 +251,19 @@ static int local_tets(vwork *w, const fdt_result *r)
 
 /* ---------------------------------------------------------------- tet pass */
 
-/* The entry of nb in the job's point i's neighbour list (ascending). */
+/* The entry of nb in the job's point i's neighbour list (ascending, nb
+ * in it): a binary search whose steps are conditional moves, not branches
+ * (a list holds about 15; each step's side is a coin flip). */
 static size_t slot(const vjob *j, uint32_t i, uint32_t nb)
 {
-    size_t lo = j->adj_start[i - j->lo], hi = j->adj_start[i - j->lo + 1];
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (j->adj[mid] < nb)
-            lo = mid + 1;
-        else
-            hi = mid;
+    size_t b = j->adj_start[i - j->lo], n = j->adj_start[i - j->lo + 1] - b;
+    const uint32_t *a = j->adj + b;
+    while (n > 1) {
+        size_t half = n / 2;
+        a = a[half] <= nb ? a + half : a;
+        n -= half;
     }
-    return lo;
+    return (size_t)(a - j->adj);
 }
 
 static void sub3(const double *a, const double *b, double *d)
@@ -336,7 +339,7 @@ static inline double max2(double a, double b)
     return a > b ? a : b; /* finite operands: fmax is a library call here */
 }
 
-/* Tet tv's volume for the DTFE sums summed again (run_job), taken from its vertex nearest the
+/* Tet tv's volume for the DTFE sums summed again (tet_pass), taken from its vertex nearest the
  * others (the least reach: its longest edge, in any axis; ties: the
  * lexicographically first): a sliver of three clustered points and a far
  * one, taken from the far one as the shares take it (the lexicographic
@@ -427,9 +430,13 @@ static void add_tet(vjob *j, const uint32_t *tv)
             f[m][k] = q[u0][k] + x[k];
     }
     /* Each point's volume and moment shares, summed here in a fixed order
-     * (the edges') and added to the grid once a tet. */
+     * (the edges') and added to the grid once a tet. An edge's two cones
+     * (from i and from j over the same triangles) have the same volume;
+     * their moments about p0 differ by 3 (P_j - P_i) times it, so gm
+     * gathers the common part and each point's own part, -3 P vsum, is
+     * applied once after the loop. */
     double vsum[4] = {0, 0, 0, 0}, vabs[4] = {0, 0, 0, 0};
-    double msum[4][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    double gm[4][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
     for (int e = 0; e < 6; e++) {
         const int *te = fdt_tet_edge[e];
         int i = te[0], jj = te[1], k = te[2], l = te[3];
@@ -446,29 +453,31 @@ static void add_tet(vjob *j, const uint32_t *tv)
          * when (i,j,k,l) is positive: F_prev is the face without l. */
         sub3(o > 0 ? f[l] : f[k], mid, fp);
         sub3(o > 0 ? f[k] : f[l], mid, fn);
-        double len = sqrt(dot3(u, u));
         /* Twice the signed areas of (M, F, C), seen along u, times |u|. */
         double ap = triple(u, fp, cm), an = triple(u, fn, cm);
-        double area = (ap - an) / (2 * len);
+        /* The face's area, once a tet, in the entry of the edge's lower
+         * point (its other end reads it there after the pass: cell_pass). */
+        int low = s[i] < s[jj] ? i : jj;
+        if (low == i ? mi : mj)
+            fdt_fix_add(&j->fsum[slot(j, s[low], s[low == i ? jj : i])],
+                        (ap - an) / (2 * sqrt(dot3(u, u))), w->g_area);
         /* The cones from i (and from j, its mirror image): volume
          * area |u| / 6, each piece's centroid (P + M + F + C) / 4. */
-        double vp = ap / 12, vn = an / 12;
+        double vp = ap / 12, vn = an / 12, dv = vp - vn;
         /* the scale of their rounding: |u| (|F_prev - M| + |F_next - M|) |C - M| */
         double scale = (fabs(u[0]) + fabs(u[1]) + fabs(u[2])) * (fabs(cm[0]) + fabs(cm[1]) + fabs(cm[2])) *
                        (fabs(fp[0]) + fabs(fp[1]) + fabs(fp[2]) + fabs(fn[0]) + fabs(fn[1]) + fabs(fn[2])) / 12;
+        double g[3];
+        for (int d = 0; d < 3; d++)
+            g[d] = dv * (2 * mid[d] + c[d]) + vp * fp[d] - vn * fn[d];
         for (int end = 0; end < 2; end++) {
             int at = end ? jj : i;
             if (!(end ? mj : mi))
                 continue;
-            fdt_fix_add(&j->fsum[slot(j, s[at], s[end ? i : jj])], area, w->g_area);
-            vsum[at] += vp - vn;
+            vsum[at] += dv;
             vabs[at] += scale;
-            for (int d = 0; d < 3; d++) {
-                double base = mid[d] + c[d] - 2 * q[at][d];
-                double mp = vp * (base + fp[d] + mid[d] - q[at][d]) / 4;
-                double mn = vn * (base + fn[d] + mid[d] - q[at][d]) / 4;
-                msum[at][d] += mp - mn;
-            }
+            for (int d = 0; d < 3; d++)
+                gm[at][d] += g[d];
         }
     }
     for (int m = 0; m < 4; m++)
@@ -476,7 +485,8 @@ static void add_tet(vjob *j, const uint32_t *tv)
             fdt_fix_add(&w->vol[s[m]], vsum[m], w->g_vol);
             fdt_fix_add(&w->vabs[s[m]], vabs[m], w->g_vol);
             for (int d = 0; d < 3; d++)
-                fdt_fix_add(&w->mom[3 * (size_t)s[m] + d], msum[m][d], w->g_mom);
+                fdt_fix_add(&w->mom[3 * (size_t)s[m] + d], (gm[m][d] - 3 * q[m][d] * vsum[m]) / 4,
+                            w->g_mom);
         }
 }
 
@@ -669,10 +679,10 @@ static int job_adjacency(vjob *j)
     return j->fsum ? FDT_OK : FDT_ENOMEM;
 }
 
-/* A thread: the tet pass for its points, then their cells. Threads write
- * disjoint entries only (their own points' accumulators, flags and output
- * rows); pthread_join orders all of it before the caller reads it. */
-static void *run_job(void *arg)
+/* A thread's first pass: the tets' shares to its points. Threads write
+ * disjoint entries only (their own points' accumulators and face sums);
+ * pthread_join orders all of it before cell_pass reads it. */
+static void *tet_pass(void *arg)
 {
     vjob *j = arg;
     vwork *w = j->w;
@@ -713,6 +723,42 @@ static void *run_job(void *arg)
             fdt_fix_add(&w->dtfe[l], dv, fdt_fix_grid_of(ilogb(w->vmax[l])));
         }
     }
+    return NULL;
+}
+
+/* The job owning local point x. */
+static const vjob *owner(const vwork *w, uint32_t x)
+{
+    int lo = 0, hi = w->njobs - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (w->jobs[mid].lo <= x)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return &w->jobs[lo];
+}
+
+/* A thread's second pass, after every tet_pass: its points' faces shared
+ * with lower points, whose sums the lower point's job kept (add_tet),
+ * copied in; then its cells. It reads the other jobs' face sums (written
+ * before the join that ended the first pass) and writes only its own
+ * entries and output rows; pthread_join orders them before the caller. */
+static void *cell_pass(void *arg)
+{
+    vjob *j = arg;
+    vwork *w = j->w;
+    if (j->err)
+        return NULL;
+    for (uint32_t l = j->lo; l < j->hi; l++)
+        for (size_t e = j->adj_start[l - j->lo]; e < j->adj_start[l - j->lo + 1]; e++) {
+            uint32_t nb = j->adj[e];
+            if (nb > l)
+                break; /* ascending */
+            const vjob *oj = owner(w, nb);
+            j->fsum[e] = oj->fsum[slot(oj, nb, l)];
+        }
     for (uint32_t l = j->lo; l < j->hi && !j->err; l++) {
         uint32_t g = w->perm[l];
         j->v->flags[g] = w->flags[l] & (FDT_CELL_CLIPPED | FDT_CELL_HULL);
@@ -831,6 +877,8 @@ static void free_work(vwork *w)
 /* The jobs over the points, in equal ranges of the local numbering. */
 static int make_jobs(vwork *w, fdt_voronoi *v, vjob *jobs, int threads)
 {
+    w->jobs = jobs;
+    w->njobs = threads;
     for (int t = 0; t < threads; t++) {
         vjob *j = &jobs[t];
         j->w = w;
@@ -949,7 +997,9 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
     if (!err)
         err = make_jobs(&w, v, jobs, threads);
     if (!err)
-        err = fork_join(jobs, threads, run_job);
+        err = fork_join(jobs, threads, tet_pass);
+    if (!err)
+        err = fork_join(jobs, threads, cell_pass);
     if (err == FDT_EINTERNAL)
         for (int t = 0; t < threads; t++)
             if (jobs[t].err == FDT_EINTERNAL) {
