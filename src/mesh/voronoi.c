@@ -53,6 +53,10 @@ struct fdt_voronoi {
     size_t cap_pverts, cap_pfaces;
 };
 
+/* The cells' resolution (fdt_voronoi_resolution, voronoi.h): a Delaunay
+ * edge at least 2^-48 of the box's largest side. */
+#define VORONOI_BOX_EXP -48
+
 /* A work flag beside the public ones: a cell inside the box cut rather
  * than summed (its shares cancel too much). */
 #define CELL_CUT 0x80u
@@ -80,6 +84,7 @@ typedef struct vwork {
      * its tets (DTFE); the faces' are the jobs' */
     fdt_fix *vol, *vabs, *mom, *dtfe; /* owned */
     fdt_fix_grid g_area, g_vol, g_mom;
+    double min_edge;         /* the shortest Delaunay edge the cells hold */
     const struct vjob *jobs; /* the threads' shares, in order of their points */
     int njobs;
     double *vmax;         /* per point: its largest tet's volume, then (DTFE_FINE)
@@ -103,6 +108,7 @@ typedef struct vjob {
     size_t cap_order;
     size_t *first;       /* cut cell lo + k: its faces from face[first[k]] */
     size_t zero_faces;
+    uint32_t short_a, short_b; /* the first edge too short, local ids (or UINT32_MAX) */
     int err;
 } vjob;
 
@@ -171,15 +177,32 @@ static int set_box(fdt_voronoi *v, const fdt_result *r, const double *xyz,
     return fdt_voronoi_box_of(r, xyz, v->n, o, v->box, diag, ds);
 }
 
+static inline double max2(double a, double b)
+{
+    return a > b ? a : b; /* finite operands: fmax is a library call here */
+}
+
+/* The Chebyshev length of ab: the square of a length can underflow where
+ * the length does not. */
+static inline double cheb(const double *a, const double *b)
+{
+    return max2(max2(fabs(a[0] - b[0]), fabs(a[1] - b[1])), fabs(a[2] - b[2]));
+}
+
+static double box_side(const double box[6])
+{
+    double side = 0;
+    for (int k = 0; k < 3; k++)
+        side = max2(side, box[k + 3] - box[k]);
+    return side;
+}
+
 /* The grids: terms up to about 16 D^k for the box's largest side D land
  * near 2^102 grid steps (fixsum.h's range). */
 static void set_grids(vwork *w)
 {
-    double d = 0;
-    for (int k = 0; k < 3; k++)
-        d = fmax(d, w->box[k + 3] - w->box[k]);
     int ed;
-    (void)frexp(d, &ed);
+    (void)frexp(box_side(w->box), &ed);
     w->g_area = fdt_fix_grid_of(2 * ed - 98);
     w->g_vol = fdt_fix_grid_of(3 * ed - 98);
     w->g_mom = fdt_fix_grid_of(4 * ed - 98);
@@ -334,9 +357,16 @@ static inline int canon_tet(const double *X, const uint32_t *tv, uint32_t s[4], 
     return sigma;
 }
 
-static inline double max2(double a, double b)
+/* fdt_voronoi_resolution's refusal of points a and b (input ids), len
+ * apart: FDT_ERANGE. */
+static int too_close(long long a, long long b, double len, double scale, int near, int box_exp,
+                     int coords, char *diag, size_t ds)
 {
-    return a > b ? a : b; /* finite operands: fmax is a library call here */
+    fdt_diag(diag, ds, "points %lld and %lld are %g apart %s %g: their Voronoi "
+        "cells are beyond what doubles hold (a Delaunay edge must be at least "
+        "2^%d of the box%s)", a, b, len, near ? "at coordinates near" : "in a box", scale,
+        box_exp, coords ? " and 2^-40 of its points' coordinates" : "");
+    return FDT_ERANGE;
 }
 
 /* Tet tv's volume for the DTFE sums summed again (tet_pass), taken from its vertex nearest the
@@ -392,6 +422,20 @@ static void add_tet(vjob *j, const uint32_t *tv)
 {
     vwork *w = j->w;
     const double *X = w->xyz;
+    /* fdt_voronoi_resolution's rule for these cells (box_exp -48, no
+     * coords), checked here rather than in a pass of its own: a tet with
+     * an edge too short adds nothing (its terms could leave the grid's
+     * range), and its edge refuses the input after the pass. */
+    for (int e = 0; e < 6; e++) {
+        uint32_t a = tv[fdt_tet_edge[e][0]], b = tv[fdt_tet_edge[e][1]];
+        if (cheb(X + 3 * (size_t)a, X + 3 * (size_t)b) < w->min_edge) {
+            if (j->short_a == UINT32_MAX) {
+                j->short_a = a;
+                j->short_b = b;
+            }
+            return;
+        }
+    }
     uint32_t s[4];
     double q[4][3];
     int sigma = canon_tet(X, tv, s, q);
@@ -463,18 +507,18 @@ static void add_tet(vjob *j, const uint32_t *tv)
                         (ap - an) / (2 * sqrt(dot3(u, u))), w->g_area);
         /* The cones from i (and from j, its mirror image): volume
          * area |u| / 6, each piece's centroid (P + M + F + C) / 4. */
-        double vp = ap / 12, vn = an / 12, dv = vp - vn;
+        double vp = ap / 12, vn = an / 12, cone = vp - vn;
         /* the scale of their rounding: |u| (|F_prev - M| + |F_next - M|) |C - M| */
         double scale = (fabs(u[0]) + fabs(u[1]) + fabs(u[2])) * (fabs(cm[0]) + fabs(cm[1]) + fabs(cm[2])) *
                        (fabs(fp[0]) + fabs(fp[1]) + fabs(fp[2]) + fabs(fn[0]) + fabs(fn[1]) + fabs(fn[2])) / 12;
         double g[3];
         for (int d = 0; d < 3; d++)
-            g[d] = dv * (2 * mid[d] + c[d]) + vp * fp[d] - vn * fn[d];
+            g[d] = cone * (2 * mid[d] + c[d]) + vp * fp[d] - vn * fn[d];
         for (int end = 0; end < 2; end++) {
             int at = end ? jj : i;
             if (!(end ? mj : mi))
                 continue;
-            vsum[at] += dv;
+            vsum[at] += cone;
             vabs[at] += scale;
             for (int d = 0; d < 3; d++)
                 gm[at][d] += g[d];
@@ -885,6 +929,7 @@ static int make_jobs(vwork *w, fdt_voronoi *v, vjob *jobs, int threads)
         j->v = v;
         j->lo = (uint32_t)(w->m * (size_t)t / (size_t)threads);
         j->hi = (uint32_t)(w->m * (size_t)(t + 1) / (size_t)threads);
+        j->short_a = j->short_b = UINT32_MAX;
         fdt_cell_init(&j->cell);
         j->first = malloc(((size_t)(j->hi - j->lo) + 1) * sizeof *j->first);
         if (!j->first)
@@ -924,28 +969,19 @@ static int list_neighbors(fdt_voronoi *v, vjob *jobs, int threads)
 int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double box[6],
                            int box_exp, int coords, char *diag, size_t ds)
 {
-    double side = 0;
-    for (int k = 0; k < 3; k++)
-        side = fmax(side, box[k + 3] - box[k]);
-    const double lim = ldexp(side, box_exp);
+    const double lim = ldexp(box_side(box), box_exp);
     for (size_t t = 0; t < r->ntets; t++) {
         const fdt_vid *v = r->tets + 4 * t;
         for (int e = 0; e < 6; e++) {
             const fdt_vid va = v[fdt_tet_edge[e][0]], vb = v[fdt_tet_edge[e][1]];
             const double *a = xyz + 3 * (size_t)va, *b = xyz + 3 * (size_t)vb;
-            double len = max2(max2(fabs(a[0] - b[0]), fabs(a[1] - b[1])), fabs(a[2] - b[2]));
-            double mag = 0;
+            double len = cheb(a, b), mag = 0;
             for (int k = 0; coords && k < 3; k++)
                 mag = max2(mag, max2(fabs(a[k]), fabs(b[k])));
             int near = coords && len < 0x1p-40 * mag;
-            if (near || len < lim) {
-                fdt_diag(diag, ds, "points %lld and %lld are %g apart %s %g: their Voronoi "
-                    "cells are beyond what doubles hold (a Delaunay edge must be at least "
-                    "2^%d of the box%s)", (long long)va, (long long)vb,
-                    len, near ? "at coordinates near" : "in a box", near ? mag : side,
-                    box_exp, coords ? " and 2^-40 of its points' coordinates" : "");
-                return FDT_ERANGE;
-            }
+            if (near || len < lim)
+                return too_close(va, vb, len, near ? mag : box_side(box), near, box_exp, coords,
+                                 diag, ds);
         }
     }
     return FDT_OK;
@@ -981,11 +1017,10 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
     err = alloc_cells(v);
     if (!err)
         err = set_box(v, r, xyz, o, diag, diag_size);
-    if (!err)
-        err = fdt_voronoi_resolution(r, xyz, v->box, -48, 0, diag, diag_size);
     if (err)
         goto done;
     memcpy(w.box, v->box, sizeof w.box);
+    w.min_edge = ldexp(box_side(w.box), VORONOI_BOX_EXP);
     set_grids(&w);
     /* The steps: number the points and their tets; on the threads, the
      * neighbour lists, the tet pass and the cells; the neighbour lists. */
@@ -998,6 +1033,13 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
         err = make_jobs(&w, v, jobs, threads);
     if (!err)
         err = fork_join(jobs, threads, tet_pass);
+    for (int t = 0; !err && t < threads; t++)
+        if (jobs[t].short_a != UINT32_MAX) {
+            const vjob *j = &jobs[t];
+            err = too_close(w.perm[j->short_a], w.perm[j->short_b],
+                            cheb(w.xyz + 3 * (size_t)j->short_a, w.xyz + 3 * (size_t)j->short_b),
+                            box_side(w.box), 0, VORONOI_BOX_EXP, 0, diag, diag_size);
+        }
     if (!err)
         err = fork_join(jobs, threads, cell_pass);
     if (err == FDT_EINTERNAL)
