@@ -310,13 +310,7 @@ static int write_node(MPI_Comm comm, const char *name, const fdt_mpi_local *L, u
         len += fmt_u64(text + len, lo + i);
         for (int d = 0; d < 3; d++) {
             text[len++] = ' ';
-            int k = snprintf(text + len, OUT_MAX_ITEM, "%.17g", rb[i].x[d]);
-            if (k < 0 || k >= OUT_MAX_ITEM) {
-                err = FDT_EINTERNAL;
-                snprintf(diag, dlen, "%s: a coordinate does not format", name);
-                break;
-            }
-            len += (size_t)k;
+            len += fdt_dtoa17(text + len, rb[i].x[d]);
         }
         text[len++] = '\n';
     }

@@ -20,11 +20,13 @@
 #include <sys/types.h>
 #include <unistd.h>
 
+#include "base/dtoa.h"
 #include "frontdt.h"
 #include "io/read/read_types.h" /* FDT_IO_* codes */
 
 #define OUT_BUF_SIZE (1u << 20)
-/* The longest item put in one go: a %.17g double is at most 24 chars. */
+/* The longest item put in one go: a %.17g double is at most
+ * FDT_DTOA17_MAX (24) chars. */
 #define OUT_MAX_ITEM 64
 
 /*
@@ -160,12 +162,8 @@ static inline void out_char(out_file *o, char c)
 /* %.17g: enough digits that strtod gives back the very same double. */
 static inline void out_double(out_file *o, double x)
 {
-    char *p = out_room(o, OUT_MAX_ITEM);
-    int k = snprintf(p, OUT_MAX_ITEM, "%.17g", x);
-    if (k < 0 || k >= OUT_MAX_ITEM)
-        out_fail(o, EINVAL);
-    else
-        o->len += (size_t)k;
+    char *p = out_room(o, FDT_DTOA17_MAX);
+    o->len += fdt_dtoa17(p, x);
 }
 
 /* The byte offset the next byte put goes to. */
