@@ -11,6 +11,7 @@
 #include "io/write/cells.h"
 #include "io/write/writer.h"
 #include "mesh/dualmesh.h"
+#include "par/threads.h"
 
 int fdt_cli_dual_wanted(const fdt_cli_dual *d)
 {
@@ -112,18 +113,21 @@ typedef struct cells_job {
     fdt_voronoi *v;
     const char *format; /* NULL: CSV */
     int vtu;            /* VTK polyhedra */
+    int threads;        /* the text's (at least 1) */
 } cells_job;
 
 static int put_cells(FILE *f, const void *arg, const double *xyz)
 {
     const cells_job *j = arg;
-    return j->vtu ? fdt_wr_cells_vtu(f, j->v, xyz) : fdt_wr_cells(f, j->format, j->v, xyz);
+    return j->vtu ? fdt_wr_cells_vtu(f, j->v, xyz)
+                  : fdt_wr_cells(f, j->format, j->v, xyz, j->threads);
 }
 
 static int put_density(FILE *f, const void *arg, const double *xyz)
 {
     (void)xyz;
-    return fdt_wr_density(f, arg);
+    const cells_job *j = arg;
+    return fdt_wr_density(f, j->v, j->threads);
 }
 
 int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const double *xyz, size_t n,
@@ -134,7 +138,8 @@ int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const doubl
     o.box_given = d->box_given;
     o.threads = d->threads;
     memcpy(o.box, d->box, sizeof o.box);
-    cells_job job = {NULL, d->format, d->voronoi && has_ext(d->voronoi, ".vtu")};
+    cells_job job = {NULL, d->format, d->voronoi && has_ext(d->voronoi, ".vtu"),
+                     d->threads ? d->threads : fdt_threads_default()};
     if (d->voronoi && !job.format && !job.vtu && !has_ext(d->voronoi, ".csv"))
         job.format = FDT_CELLS_DEFAULT_FORMAT;
     int nb = job.vtu;
@@ -154,7 +159,7 @@ int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const doubl
     if (d->voronoi)
         r = write_side(d->voronoi, put_cells, &job, xyz, err, errlen);
     if (r == FDT_OK && d->density)
-        r = write_side(d->density, put_density, v, xyz, err, errlen);
+        r = write_side(d->density, put_density, &job, xyz, err, errlen);
     fdt_voronoi_free(&v);
     return r;
 }

@@ -27,13 +27,15 @@
 int fdt_cells_format_check(const char *fmt, int *needs_nbrs, char *err, size_t errlen);
 
 /* Writes the cells in format fmt (checked), or as CSV (fmt NULL: a header
- * line, then id,x,y,z,volume,area,faces,cx,cy,cz,density,flags). Returns 0,
+ * line, then id,x,y,z,volume,area,faces,cx,cy,cz,density,flags), the
+ * text formatted on `threads` threads (1: the caller's alone). Returns 0,
  * or the errno of a failed write (the stream's error flag set). */
-int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *xyz);
+int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *xyz, int threads);
 
 /* Writes the DTFE density of each point: "density flags" a line (flags as
- * %h: a hull point's density counts only the tets it has). */
-int fdt_wr_density(FILE *f, const fdt_voronoi *v);
+ * %h: a hull point's density counts only the tets it has), as
+ * fdt_wr_cells does. */
+int fdt_wr_density(FILE *f, const fdt_voronoi *v, int threads);
 
 /* The cells as VTK polyhedra (a .vtu file, VTK_POLYHEDRON cells with
  * their faces, ParaView's reader): one cell a distinct point, cell data
