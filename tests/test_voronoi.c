@@ -388,6 +388,15 @@ static void test_tiny_cells(double w)
     if (w < 0x1p-48) {
         EXPECTF(err == FDT_ERANGE && strstr(diag, "beyond what doubles hold"),
                 "w = %g: %s (%s)", w, fdt_strerror(err), diag);
+        /* the same two points named from another result's tets on
+         * three threads (the least edge too short, whatever the order) */
+        fdt_result *r3 = test_triangulate(xyz, n, 3, 0);
+        char diag3[256];
+        o.threads = 3;
+        int err3 = fdt_voronoi_compute(r3, xyz, n, &o, &v, diag3, sizeof diag3);
+        EXPECTF(err3 == FDT_ERANGE && strcmp(diag, diag3) == 0, "w = %g: '%s' at one thread, "
+                "'%s' at three", w, diag, diag3);
+        fdt_result_free(&r3);
         fdt_result_free(&r);
         free(xyz);
         return;

@@ -108,7 +108,8 @@ typedef struct vjob {
     size_t cap_order;
     size_t *first;       /* cut cell lo + k: its faces from face[first[k]] */
     size_t zero_faces;
-    uint32_t short_a, short_b; /* the first edge too short, local ids (or UINT32_MAX) */
+    uint32_t short_a, short_b; /* the least edge too short (least_pair), local ids, or
+                                  UINT32_MAX */
     int err;
 } vjob;
 
@@ -357,14 +358,25 @@ static inline int canon_tet(const double *X, const uint32_t *tv, uint32_t s[4], 
     return sigma;
 }
 
-/* fdt_voronoi_resolution's refusal of points a and b (input ids), len
- * apart: FDT_ERANGE. */
+/* Whether the edge ab comes before cd, both by input ids: the lower ids
+ * first, then the higher. The refusals name the least edge too short, so
+ * that the message is the same whatever the thread count and the tets'
+ * order. */
+static int least_pair(long long a, long long b, long long c, long long d)
+{
+    long long ab0 = a < b ? a : b, ab1 = a < b ? b : a;
+    long long cd0 = c < d ? c : d, cd1 = c < d ? d : c;
+    return ab0 < cd0 || (ab0 == cd0 && ab1 < cd1);
+}
+
+/* fdt_voronoi_resolution's refusal of points a and b (input ids, named
+ * lower first), len apart: FDT_ERANGE. */
 static int too_close(long long a, long long b, double len, double scale, int near, int box_exp,
                      int coords, char *diag, size_t ds)
 {
     fdt_diag(diag, ds, "points %lld and %lld are %g apart %s %g: their Voronoi "
         "cells are beyond what doubles hold (a Delaunay edge must be at least "
-        "2^%d of the box%s)", a, b, len, near ? "at coordinates near" : "in a box", scale,
+        "2^%d of the box%s)", a < b ? a : b, a < b ? b : a, len, near ? "at coordinates near" : "in a box", scale,
         box_exp, coords ? " and 2^-40 of its points' coordinates" : "");
     return FDT_ERANGE;
 }
@@ -426,16 +438,20 @@ static void add_tet(vjob *j, const uint32_t *tv)
      * coords), checked here rather than in a pass of its own: a tet with
      * an edge too short adds nothing (its terms could leave the grid's
      * range), and its edge refuses the input after the pass. */
+    int too_short = 0;
     for (int e = 0; e < 6; e++) {
         uint32_t a = tv[fdt_tet_edge[e][0]], b = tv[fdt_tet_edge[e][1]];
         if (cheb(X + 3 * (size_t)a, X + 3 * (size_t)b) < w->min_edge) {
-            if (j->short_a == UINT32_MAX) {
+            too_short = 1;
+            if (j->short_a == UINT32_MAX ||
+                least_pair(w->perm[a], w->perm[b], w->perm[j->short_a], w->perm[j->short_b])) {
                 j->short_a = a;
                 j->short_b = b;
             }
-            return;
         }
     }
+    if (too_short)
+        return;
     uint32_t s[4];
     double q[4][3];
     int sigma = canon_tet(X, tv, s, q);
@@ -970,6 +986,9 @@ int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double 
                            int box_exp, int coords, char *diag, size_t ds)
 {
     const double lim = ldexp(box_side(box), box_exp);
+    fdt_vid sa = -1, sb = -1; /* the least edge too short, if any */
+    double slen = 0, smag = 0;
+    int snear = 0;
     for (size_t t = 0; t < r->ntets; t++) {
         const fdt_vid *v = r->tets + 4 * t;
         for (int e = 0; e < 6; e++) {
@@ -979,11 +998,18 @@ int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double 
             for (int k = 0; coords && k < 3; k++)
                 mag = max2(mag, max2(fabs(a[k]), fabs(b[k])));
             int near = coords && len < 0x1p-40 * mag;
-            if (near || len < lim)
-                return too_close(va, vb, len, near ? mag : box_side(box), near, box_exp, coords,
-                                 diag, ds);
+            if ((near || len < lim) && (sa < 0 || least_pair(va, vb, sa, sb))) {
+                sa = va;
+                sb = vb;
+                slen = len;
+                smag = mag;
+                snear = near;
+            }
         }
     }
+    if (sa >= 0)
+        return too_close(sa, sb, slen, snear ? smag : box_side(box), snear, box_exp, coords, diag,
+                         ds);
     return FDT_OK;
 }
 
@@ -1033,13 +1059,16 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
         err = make_jobs(&w, v, jobs, threads);
     if (!err)
         err = fork_join(jobs, threads, tet_pass);
+    const vjob *least = NULL;
     for (int t = 0; !err && t < threads; t++)
-        if (jobs[t].short_a != UINT32_MAX) {
-            const vjob *j = &jobs[t];
-            err = too_close(w.perm[j->short_a], w.perm[j->short_b],
-                            cheb(w.xyz + 3 * (size_t)j->short_a, w.xyz + 3 * (size_t)j->short_b),
-                            box_side(w.box), 0, VORONOI_BOX_EXP, 0, diag, diag_size);
-        }
+        if (jobs[t].short_a != UINT32_MAX &&
+            (!least || least_pair(w.perm[jobs[t].short_a], w.perm[jobs[t].short_b],
+                                  w.perm[least->short_a], w.perm[least->short_b])))
+            least = &jobs[t];
+    if (least)
+        err = too_close(w.perm[least->short_a], w.perm[least->short_b],
+                        cheb(w.xyz + 3 * (size_t)least->short_a, w.xyz + 3 * (size_t)least->short_b),
+                        box_side(w.box), 0, VORONOI_BOX_EXP, 0, diag, diag_size);
     if (!err)
         err = fork_join(jobs, threads, cell_pass);
     if (err == FDT_EINTERNAL)
