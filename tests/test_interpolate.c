@@ -29,12 +29,17 @@
 /* the queries on 3 threads (the results do not depend on it) */
 #define THREADS 3
 
-static void test_linear_reproduction(fdt_interp method, const char *name)
+/* The points and queries in the unit cube times 2^e: a linear function of
+ * the unscaled coordinates reproduced (at 2^-490 and 2^490 the Sibson
+ * coordinates, products of six differences, were an internal error and
+ * the barycentric ones 3e-3 off or NaN before the frames were scaled). */
+static void test_linear_reproduction(fdt_interp method, const char *name, int e)
 {
     size_t n = 1500, nq = 300;
     double *xyz = malloc(3 * n * sizeof *xyz), *val = malloc(2 * n * sizeof *val);
     double *q = malloc(3 * nq * sizeof *q), *out = malloc(2 * nq * sizeof *out);
-    CHECK(xyz && val && q && out);
+    double *u = malloc(3 * nq * sizeof *u);
+    CHECK(xyz && val && q && out && u);
     uint64_t s = 17;
     for (size_t i = 0; i < n; i++) {
         for (int d = 0; d < 3; d++)
@@ -44,14 +49,19 @@ static void test_linear_reproduction(fdt_interp method, const char *name)
     }
     for (size_t k = 0; k < nq; k++)
         for (int d = 0; d < 3; d++)
-            q[3 * k + d] = k % 10 == 9 ? xyz[3 * k + (size_t)d]       /* at a point */
+            u[3 * k + d] = k % 10 == 9 ? xyz[3 * k + (size_t)d]       /* at a point */
                          : k % 10 == 8 ? 2 + test_unif(&s)             /* outside */
                                        : 0.2 + 0.6 * test_unif(&s);    /* well inside */
+    for (size_t i = 0; i < 3 * n; i++)
+        xyz[i] = ldexp(xyz[i], e);
+    for (size_t i = 0; i < 3 * nq; i++)
+        q[i] = ldexp(u[i], e);
     fdt_result *r = test_triangulate(xyz, n, 1, 0);
     char diag[256];
-    CHECK(fdt_interpolate(r, xyz, n, val, 2, q, nq, method, THREADS, out, diag, sizeof diag) == FDT_OK);
-    for (size_t k = 0; k < nq; k++) {
-        const double *x = q + 3 * k;
+    int err = fdt_interpolate(r, xyz, n, val, 2, q, nq, method, THREADS, out, diag, sizeof diag);
+    EXPECTF(err == FDT_OK, "%s at 2^%d: %s (%s)", name, e, fdt_strerror(err), diag);
+    for (size_t k = 0; k < nq && err == FDT_OK; k++) {
+        const double *x = u + 3 * k;
         if (k % 10 == 8) {
             EXPECTF(isnan(out[2 * k]) && isnan(out[2 * k + 1]), "%s: query %zu outside: %g", name,
                     k, out[2 * k]);
@@ -59,13 +69,14 @@ static void test_linear_reproduction(fdt_interp method, const char *name)
         }
         double want0 = 1 + 2 * x[0] - 3 * x[1] + 0.5 * x[2], want1 = -x[2];
         EXPECTF(fabs(out[2 * k] - want0) < 1e-12 && fabs(out[2 * k + 1] - want1) < 1e-12,
-                "%s: query %zu: %.17g %.17g, want %.17g %.17g", name, k, out[2 * k],
+                "%s at 2^%d: query %zu: %.17g %.17g, want %.17g %.17g", name, e, k, out[2 * k],
                 out[2 * k + 1], want0, want1);
     }
     fdt_result_free(&r);
     free(xyz);
     free(val);
     free(q);
+    free(u);
     free(out);
 }
 
@@ -514,8 +525,10 @@ static void test_against_cuts(int fam, const char *name, double tol)
 
 int main(void)
 {
-    test_linear_reproduction(FDT_INTERP_LINEAR, "linear");
-    test_linear_reproduction(FDT_INTERP_NATURAL, "natural");
+    for (int e = -490; e <= 490; e += 490) {
+        test_linear_reproduction(FDT_INTERP_LINEAR, "linear", e);
+        test_linear_reproduction(FDT_INTERP_NATURAL, "natural", e);
+    }
     test_symmetry();
     test_continuity_and_refusals();
     test_against_cuts(FAM_UNIFORM, "uniform", 1e-12);

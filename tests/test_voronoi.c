@@ -258,6 +258,62 @@ static void test_same_bits(size_t n)
     free(perm);
 }
 
+/* The cells of points scaled by 2^k are the cells scaled, bit for bit
+ * (volumes 2^3k, areas 2^2k, centroids 2^k, densities 2^-3k), wherever the
+ * volumes and densities are doubles; beyond, refused (points 1e-151 apart
+ * came out volume 0 with no faces, 1e149 apart NaN). */
+static void test_scales(void)
+{
+    size_t n = 2000;
+    double *xyz = test_cloud(n, 1, 5), *xs = malloc(3 * n * sizeof *xs);
+    CHECK(xs);
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
+    fdt_voronoi *v = cells(r, xyz, n, NULL);
+    const int ks[] = {-280, -120, 60, 200, 330, -300, 350};
+    for (size_t c = 0; c < sizeof ks / sizeof *ks; c++) {
+        int k = ks[c];
+        for (size_t i = 0; i < 3 * n; i++)
+            xs[i] = ldexp(xyz[i], k);
+        fdt_result *rk = test_triangulate(xs, n, 2, 0);
+        if (k < -290 || k > 340) {
+            fdt_voronoi_options o;
+            fdt_default_voronoi_options(&o);
+            fdt_voronoi *vk = NULL;
+            char diag[256];
+            int err = fdt_voronoi_compute(rk, xs, n, &o, &vk, diag, sizeof diag);
+            EXPECTF(err == FDT_ERANGE && strstr(diag, "would leave what doubles hold"),
+                    "2^%d: %s (%s)", k, fdt_strerror(err), diag);
+            fdt_result_free(&rk);
+            continue;
+        }
+        fdt_voronoi *vk = cells_t(rk, xs, n, NULL, 3);
+        size_t diff = 0;
+        for (size_t i = 0; i < n; i++) {
+            diff += ldexp(fdt_voronoi_volumes(v)[i], 3 * k) != fdt_voronoi_volumes(vk)[i];
+            diff += ldexp(fdt_voronoi_areas(v)[i], 2 * k) != fdt_voronoi_areas(vk)[i];
+            diff += ldexp(fdt_voronoi_densities(v)[i], -3 * k) != fdt_voronoi_densities(vk)[i];
+            for (int d = 0; d < 3; d++)
+                diff += ldexp(fdt_voronoi_centroids(v)[3 * i + d], k) !=
+                        fdt_voronoi_centroids(vk)[3 * i + d];
+            size_t c1, ck;
+            const fdt_vid *id1, *idk;
+            const double *a1, *ak;
+            CHECK(fdt_voronoi_neighbors(v, (fdt_vid)i, &c1, &id1, &a1) == FDT_OK);
+            CHECK(fdt_voronoi_neighbors(vk, (fdt_vid)i, &ck, &idk, &ak) == FDT_OK);
+            diff += c1 != ck;
+            for (size_t f = 0; f < c1 && f < ck; f++)
+                diff += id1[f] != idk[f] || ldexp(a1[f], 2 * k) != ak[f];
+        }
+        EXPECTF(diff == 0, "2^%d: %zu values are not the unscaled ones scaled", k, diff);
+        fdt_voronoi_free(&vk);
+        fdt_result_free(&rk);
+    }
+    fdt_voronoi_free(&v);
+    fdt_result_free(&r);
+    free(xyz);
+    free(xs);
+}
+
 static int count_tets(void *user, const fdt_vid *t, size_t count)
 {
     (void)user;
@@ -472,6 +528,7 @@ int main(void)
     test_box_sums(3000, 1, 2);
     test_box_sums(3000, 2, 4);
     test_same_bits(4000);
+    test_scales();
     test_refusals();
     return test_report("voronoi");
 }

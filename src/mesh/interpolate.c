@@ -70,6 +70,7 @@
 #include "geom/predicates.h"
 #include "mesh/locate.h"
 #include "mesh/result.h"
+#include "mesh/voronoi.h"
 
 typedef struct ctet ctet;
 typedef struct ntet ntet;
@@ -578,6 +579,19 @@ static void *interpolate_run(void *arg)
     return NULL;
 }
 
+static int interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
+                       size_t nv, const double *q, size_t nq, fdt_interp method, int threads,
+                       double *out, const double *q_named, char *diag, size_t diag_size);
+
+/* a copy of the k points p times 2^-e, or NULL */
+static double *scaled(const double *p, size_t k, int e)
+{
+    double *c = malloc((k > 0 ? 3 * k : 1) * sizeof *c);
+    for (size_t i = 0; c && i < 3 * k; i++)
+        c[i] = ldexp(p[i], -e);
+    return c;
+}
+
 int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const double *values,
                           size_t nv, const double *q, size_t nq, fdt_interp method,
                           int threads, double *out, char *diag, size_t diag_size)
@@ -587,6 +601,39 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
     if (!r || !xyz || !values || nv == 0 || (nq && (!q || !out)) ||
         (method != FDT_INTERP_LINEAR && method != FDT_INTERP_NATURAL))
         return FDT_EINVAL;
+    /* Sibson's coordinates are ratios of volumes, products of up to six
+     * coordinate differences in the circumcentres: for points whose box
+     * is outside 2^-100 .. 2^100 (1e-151 and 1e149 apart: an internal
+     * error) they are computed on the points and queries scaled by a
+     * power of two (exact: the coordinates are a function of the points'
+     * shape). */
+    fdt_voronoi_options vo;
+    fdt_default_voronoi_options(&vo);
+    double box[6], side = 0;
+    int e = 0;
+    if (method == FDT_INTERP_NATURAL && fdt_voronoi_box_of(r, xyz, n, &vo, box, NULL, 0) == FDT_OK)
+        for (int k = 0; k < 3; k++)
+            side = fmax(side, box[k + 3] - box[k]);
+    if (side > 0)
+        (void)frexp(side, &e);
+    if (e >= -100 && e <= 100)
+        return interpolate(r, xyz, n, values, nv, q, nq, method, threads, out, q, diag,
+                           diag_size);
+    double *xs = scaled(xyz, n, e), *qs = scaled(q, nq, e);
+    int err = xs && qs ? interpolate(r, xs, n, values, nv, qs, nq, method, threads, out, q, diag,
+                                     diag_size)
+                       : FDT_ENOMEM;
+    free(xs);
+    free(qs);
+    return err;
+}
+
+/* fdt_interpolate_build on xyz and q (perhaps scaled); q_named: the
+ * queries as given, for the message. */
+static int interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
+                       size_t nv, const double *q, size_t nq, fdt_interp method, int threads,
+                       double *out, const double *q_named, char *diag, size_t diag_size)
+{
     fdt_locator L;
     uint32_t *order;
     void *jp;
@@ -607,7 +654,7 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
         ijob *j = &jobs[t];
         if (j->err && !err) {
             err = j->err;
-            const double *qk = q + 3 * j->bad;
+            const double *qk = q_named + 3 * j->bad;
             if (err == FDT_EINTERNAL && diag && diag_size)
                 snprintf(diag, diag_size, "natural-neighbour coordinates of query %zu "
                          "(%.17g %.17g %.17g) could not be computed (a bug: please report)",

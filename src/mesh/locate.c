@@ -166,10 +166,24 @@ void fdt_barycentric(const fdt_locator *L, fdt_tid t, const double *q, double b[
     const double *X = L->xyz;
     /* b[i]: the volume of the tet with vertex i replaced by q, over the
      * tet's, each relative to q (differences first, for accuracy). */
-    double d[4][3];
+    double d[4][3], m = 0;
     for (int i = 0; i < 4; i++)
-        for (int k = 0; k < 3; k++)
+        for (int k = 0; k < 3; k++) {
             d[i][k] = X[3 * (size_t)tv[i] + k] - q[k];
+            m = fmax(m, fabs(d[i][k]));
+        }
+    /* The coordinates are ratios of cubes of the differences: outside
+     * 2^-200 .. 2^200 the cubes underflow or overflow (points 1e-151
+     * apart interpolated 3e-3 off, 1e149 apart NaN), so the differences
+     * are scaled by a power of two first (exact but for bits far below
+     * the largest's). */
+    if (m > 0 && (m < 0x1p-200 || m > 0x1p200)) {
+        int e;
+        (void)frexp(m, &e);
+        for (int i = 0; i < 4; i++)
+            for (int k = 0; k < 3; k++)
+                d[i][k] = ldexp(d[i][k], -e);
+    }
     double s = 0;
     for (int i = 0; i < 4; i++) {
         const double *a = d[fdt_tet_face[i][0]], *bb = d[fdt_tet_face[i][1]],

@@ -56,6 +56,12 @@ struct fdt_voronoi {
 /* The cells' resolution (fdt_voronoi_resolution, voronoi.h): a Delaunay
  * edge at least 2^-48 of the box's largest side. */
 #define VORONOI_BOX_EXP -48
+/* The box sizes whose cells doubles hold (fdt_voronoi_scale): the box's
+ * largest side D = f 2^ed, f in [1/2, 1), ed in this range. A cell's
+ * volume lies between about 2^-150 D^3 (edges down to 2^-48 D) and D^3,
+ * its density between 2^2 D^-3 and 2^152 D^-3: all normal doubles. */
+#define VORONOI_MIN_EXP (-290)
+#define VORONOI_MAX_EXP 340
 
 /* A work flag beside the public ones: a cell inside the box cut rather
  * than summed (its shares cancel too much). */
@@ -84,6 +90,7 @@ typedef struct vwork {
      * its tets (DTFE); the faces' are the jobs' */
     fdt_fix *vol, *vabs, *mom, *dtfe; /* owned */
     fdt_fix_grid g_area, g_vol, g_mom;
+    int ed;                  /* the frame's scale (scale_frame) */
     double min_edge;         /* the shortest Delaunay edge the cells hold */
     const struct vjob *jobs; /* the threads' shares, in order of their points */
     int njobs;
@@ -196,6 +203,55 @@ static double box_side(const double box[6])
     for (int k = 0; k < 3; k++)
         side = max2(side, box[k + 3] - box[k]);
     return side;
+}
+
+int fdt_voronoi_scale(const double box[6], int *ed, char *diag, size_t ds)
+{
+    double d = box_side(box);
+    (void)frexp(d, ed);
+    if (*ed >= VORONOI_MIN_EXP && *ed <= VORONOI_MAX_EXP)
+        return FDT_OK;
+    fdt_diag(diag, ds, "the box's largest side is %g: the Voronoi cells' volumes and densities "
+        "would leave what doubles hold (boxes from 2^%d to 2^%d, about %.1e to %.1e); scale the "
+        "points by a power of two, which changes none of their bits but the exponent", d,
+        VORONOI_MIN_EXP - 1, VORONOI_MAX_EXP, ldexp(1, VORONOI_MIN_EXP - 1), ldexp(1, VORONOI_MAX_EXP));
+    return FDT_ERANGE;
+}
+
+/* The computation's frame: the local coordinates and the box times
+ * 2^-ed, so that the box's largest side lies in [1/2, 1). Every operation
+ * of the cells commutes with a power of two, so the results scaled back
+ * (scale_back) are the same bits as in the points' own frame wherever
+ * that frame kept clear of underflow and overflow, and the same bits at
+ * every scale. */
+static void scale_frame(vwork *w)
+{
+    for (size_t c = 0; c < 3 * w->m; c++)
+        w->xyz[c] = ldexp(w->xyz[c], -w->ed);
+    for (int k = 0; k < 6; k++)
+        w->box[k] = ldexp(w->box[k], -w->ed);
+}
+
+/* The job's cells in the points' frame: volumes times 2^(3 ed), areas
+ * 2^(2 ed), centroids 2^ed, densities 2^(-3 ed), face areas 2^(2 ed). */
+static void *scale_back(void *arg)
+{
+    vjob *j = arg;
+    const vwork *w = j->w;
+    fdt_voronoi *v = j->v;
+    int e = w->ed;
+    for (uint32_t l = j->lo; l < j->hi; l++) {
+        uint32_t g = w->perm[l];
+        v->volume[g] = ldexp(v->volume[g], 3 * e);
+        v->area[g] = ldexp(v->area[g], 2 * e);
+        v->density[g] = ldexp(v->density[g], -3 * e);
+        for (int k = 0; k < 3; k++)
+            v->centroid[3 * (size_t)g + k] = ldexp(v->centroid[3 * (size_t)g + k], e);
+        if (v->nstart)
+            for (size_t f = v->nstart[g]; f < v->nstart[g + 1]; f++)
+                v->narea[f] = ldexp(v->narea[f], 2 * e);
+    }
+    return NULL;
 }
 
 /* The grids: terms up to about 16 D^k for the box's largest side D land
@@ -1043,16 +1099,21 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
     err = alloc_cells(v);
     if (!err)
         err = set_box(v, r, xyz, o, diag, diag_size);
+    if (!err)
+        err = fdt_voronoi_scale(v->box, &w.ed, diag, diag_size);
     if (err)
         goto done;
     memcpy(w.box, v->box, sizeof w.box);
-    w.min_edge = ldexp(box_side(w.box), VORONOI_BOX_EXP);
-    set_grids(&w);
-    /* The steps: number the points and their tets; on the threads, the
-     * neighbour lists, the tet pass and the cells; the neighbour lists. */
+    /* The steps: number the points and their tets, in the computation's
+     * frame; on the threads, the neighbour lists, the tet pass and the
+     * cells; the neighbour lists; the cells back in the points' frame. */
     err = number_points(&w, r, xyz);
-    if (!err)
+    if (!err) {
+        scale_frame(&w);
+        w.min_edge = ldexp(box_side(w.box), VORONOI_BOX_EXP);
+        set_grids(&w);
         err = local_tets(&w, r);
+    }
     if (!err)
         err = alloc_work(&w, r);
     if (!err)
@@ -1067,8 +1128,9 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
             least = &jobs[t];
     if (least)
         err = too_close(w.perm[least->short_a], w.perm[least->short_b],
-                        cheb(w.xyz + 3 * (size_t)least->short_a, w.xyz + 3 * (size_t)least->short_b),
-                        box_side(w.box), 0, VORONOI_BOX_EXP, 0, diag, diag_size);
+                        cheb(xyz + 3 * (size_t)w.perm[least->short_a],
+                             xyz + 3 * (size_t)w.perm[least->short_b]),
+                        box_side(v->box), 0, VORONOI_BOX_EXP, 0, diag, diag_size);
     if (!err)
         err = fork_join(jobs, threads, cell_pass);
     if (err == FDT_EINTERNAL)
@@ -1087,6 +1149,8 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
         v->zero_faces += jobs[t].zero_faces;
     if (!err && o->neighbors)
         err = list_neighbors(v, jobs, threads);
+    if (!err)
+        err = fork_join(jobs, threads, scale_back);
 done:
     for (int t = 0; t < threads; t++) {
         fdt_cell_free(&jobs[t].cell);

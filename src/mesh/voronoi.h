@@ -18,6 +18,16 @@ int fdt_voronoi_box_of(const fdt_result *r, const double *xyz, size_t n,
                        const fdt_voronoi_options *o, double box[6], char *diag, size_t ds);
 
 /*
+ * FDT_OK, and *ed the exponent of box's largest side D (D = f 2^*ed, f in
+ * [1/2, 1)), when the cells' volumes and densities in box are normal
+ * doubles (D from about 2.4e-88 to 2.2e102); else FDT_ERANGE with diag
+ * (points 1e-151 apart came out volume 0 with no faces, 1e149 apart NaN,
+ * before this check). The cells are computed with the points scaled by
+ * 2^-ed (src/mesh/voronoi.c, scale_frame).
+ */
+int fdt_voronoi_scale(const double box[6], int *ed, char *diag, size_t ds);
+
+/*
  * Whether doubles hold the cells of r's points (xyz, as given to
  * fdt_triangulate) in box: FDT_ERANGE, with diag naming two points, when a
  * Delaunay edge (its Chebyshev length: the square of a length can
