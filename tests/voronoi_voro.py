@@ -26,6 +26,7 @@ Usage: voronoi_voro.py FRONTDT GEN_POINTS VORO_REF|none SCRATCH
    hull; a malformed values file (exit 2, file and line named), an output
    that is the input or a missing partner option (exit 1).
 """
+import math
 import os
 import random
 import subprocess
@@ -415,6 +416,32 @@ def interpolation():
                                                                   r.stderr.strip(), text))
 
 
+def hard_families():
+    """Families that broke --voronoi (bench/NOTES.md entry 103): sphere12, nearly
+    cospherical, made a cut find its cell not convex (exit 7); tiny and
+    huge, whose cells' volumes leave what doubles hold, came out 0 and NaN
+    with exit 0 and must be refused (exit 2)."""
+    path = os.path.join(SCRATCH, "hard.xyz")
+    out = os.path.join(SCRATCH, "hard.txt")
+    subprocess.run([GEN, "sphere12", "20000", "3", path], check=True)
+    r = run([path, "-q", "--voronoi", out, "--voronoi-format", "%i %v"])
+    if r.returncode != 0:
+        fail("sphere12 20000 3: exit %d: %s" % (r.returncode, r.stderr.strip()))
+    else:
+        pts = read_xyz(path)
+        lo = [min(p[k] for p in pts) for k in range(3)]
+        hi = [max(p[k] for p in pts) for k in range(3)]
+        bvol = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2])
+        total = math.fsum(float(l.split()[1]) for l in open(out))
+        if abs(total / bvol - 1) > 1e-11:
+            fail("sphere12: the volumes add up to %.17g of the box's %.17g" % (total, bvol))
+    for fam in ("tiny", "huge"):
+        subprocess.run([GEN, fam, "2000", "1", path], check=True)
+        r = run([path, "-q", "--voronoi", out])
+        if r.returncode != 2 or "would leave what doubles hold" not in r.stderr:
+            fail("%s: exit %d (want 2), stderr %r" % (fam, r.returncode, r.stderr.strip()))
+
+
 if VORO != "none":
     for fam in ("uniform", "gaussian", "lattice", "rotlattice", "skewlattice", "cylinder"):
         against_voro(fam, 3000)
@@ -423,6 +450,7 @@ else:
 same_bits()
 dtfe()
 refusals()
+hard_families()
 formats_and_refusals()
 polyhedra()
 interpolation()

@@ -24,6 +24,9 @@
 
 #define FDT_CELL_WALL(k) (-1 - (k))
 #define FDT_CELL_TOL 0x1p-40
+/* The coarsest tolerance a cut retries with when FDT_CELL_TOL finds the
+ * cell not convex (fdt_cell_cut). */
+#define FDT_CELL_TOL_MAX 0x1p-24
 
 typedef struct fdt_cell_ring {
     int start, count; /* ring[start .. start + count) */
@@ -77,7 +80,8 @@ int fdt_cell_box(fdt_cell *c, const double lo[3], const double hi[3]);
  * Returns 1 when the cut removed something, 0 when it did not, -1 when
  * out of memory, -2 when the cut would leave nothing of c (never for h > 0
  * and a cell containing the origin; c is unchanged), -3 when the cut found
- * c not convex (rounding gone wrong: a bug; c keeps its shape). */
+ * c not convex with FDT_CELL_TOL, the coarser ones up to FDT_CELL_TOL_MAX
+ * and none (rounding gone wrong: a bug; c keeps its shape). */
 int fdt_cell_cut(fdt_cell *c, const double n[3], double h, long label);
 
 /* The cell's volume, surface area, centroid (relative to the site), and

@@ -1136,7 +1136,7 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
     if (err == FDT_EINTERNAL)
         for (int t = 0; t < threads; t++)
             if (jobs[t].err == FDT_EINTERNAL) {
-                const double *p = w.xyz + 3 * (size_t)jobs[t].lo;
+                const double *p = xyz + 3 * (size_t)w.perm[jobs[t].lo]; /* as given */
                 fdt_diag(diag, diag_size, "the cell of point %u (%.17g %.17g %.17g) could not be "
                     "cut from the box (a bug: please report)", w.perm[jobs[t].lo], p[0], p[1],
                     p[2]);
