@@ -523,8 +523,12 @@ static void add_tet(vjob *j, const uint32_t *tv)
     double c[3];
     int outside = fdt_circumcenter(p0, X + 3 * (size_t)s[1], X + 3 * (size_t)s[2],
                                    X + 3 * (size_t)s[3], c) != 0;
+    /* Against the walls relative to p0, as c is: p0 + c rounds at the
+     * coordinates' scale (points at 2^40 on a 2^-12 grid: a centre a
+     * half step outside rounded onto the wall, and its cells were summed
+     * past the box, 3e-6 off), box - p0 at the cell's. */
     for (int k = 0; k < 3; k++)
-        if (!(p0[k] + c[k] >= w->box[k] && p0[k] + c[k] <= w->box[k + 3]))
+        if (!(c[k] >= w->box[k] - p0[k] && c[k] <= w->box[k + 3] - p0[k]))
             outside = 1;
     if (outside) {
         for (int m = 0; m < 4; m++)
