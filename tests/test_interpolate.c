@@ -111,6 +111,37 @@ static void test_symmetry(void)
     free(val);
 }
 
+/* Points 1e20 apart around a cluster 1e-150 wide: the cluster's cells are
+ * beyond what doubles hold, and Sibson's coordinates of a query among them
+ * are refused as the cells would be (FDT_ERANGE, the two points named),
+ * not an internal error; linear interpolation there still works. */
+static void test_beyond_doubles(void)
+{
+    size_t n = 530;
+    double *xyz = malloc(3 * n * sizeof *xyz), *val = malloc(n * sizeof *val), q[3], out;
+    CHECK(xyz && val);
+    uint64_t s = 23;
+    for (size_t i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++)
+            xyz[3 * i + d] = (i < 500 ? 1e20 : 1e-150) * test_unif(&s);
+    for (size_t i = 0; i < n; i++)
+        val[i] = 1;
+    for (int d = 0; d < 3; d++)
+        q[d] = 1e-150 * test_unif(&s);
+    fdt_result *r = test_triangulate(xyz, n, 1, 0);
+    char diag[512];
+    int err = fdt_interpolate(r, xyz, n, val, 1, q, 1, FDT_INTERP_NATURAL, 1, &out, diag,
+                              sizeof diag);
+    EXPECTF(err == FDT_ERANGE && strstr(diag, "closer than doubles can hold"),
+            "natural among a 1e-150 cluster: %s (%s)", fdt_strerror(err), diag);
+    err = fdt_interpolate(r, xyz, n, val, 1, q, 1, FDT_INTERP_LINEAR, 1, &out, diag, sizeof diag);
+    EXPECTF(err == FDT_OK && (isnan(out) || fabs(out - 1) < 1e-12), "linear there: %s, %g",
+            fdt_strerror(err), out);
+    fdt_result_free(&r);
+    free(xyz);
+    free(val);
+}
+
 static void test_continuity_and_refusals(void)
 {
     size_t n = 400;
@@ -531,6 +562,7 @@ int main(void)
     }
     test_symmetry();
     test_continuity_and_refusals();
+    test_beyond_doubles();
     test_against_cuts(FAM_UNIFORM, "uniform", 1e-12);
     test_against_cuts(FAM_CLUSTERS, "clusters", 2e-12);
     test_against_cuts(FAM_LATTICE, "lattice", 2e-11);

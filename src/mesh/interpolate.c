@@ -99,6 +99,9 @@ typedef struct sibson {
     size_t cap_nn;
     double *w;               /* their coordinates (owned) */
     size_t cap_w;
+    size_t nc;               /* the last query's cavity tets, in ct */
+    double min_edge;         /* the shortest Delaunay edge whose cells
+                                doubles hold (2^-48 of the box's side) */
 } sibson;
 
 static int push(void *pp, size_t *cap, size_t n, size_t size)
@@ -509,6 +512,8 @@ static long coordinates(sibson *S, fdt_tid t0, const double *q)
     long nc = cavity(S, t0, q);
     if (nc < 0)
         return -1;
+    S->nc = 0;
+    S->nc = (size_t)nc; /* canonical_cavity fills ct before it can fail */
     long m = canonical_cavity(S, (size_t)nc, q);
     if (m < 0)
         return m;
@@ -534,6 +539,29 @@ static long coordinates(sibson *S, fdt_tid t0, const double *q)
     return m;
 }
 
+/* Why a query's coordinates could not be computed: FDT_ERANGE when its
+ * cavity has a Delaunay edge shorter than the cells of its points can be
+ * (fdt_voronoi_resolution's rule, 2^-48 of the box: gen_points mixed,
+ * points 1e-150 and 1e150 apart, failed so), *a and *b the least such
+ * edge's points; else FDT_EINTERNAL (a bug). */
+static int too_close(const sibson *S, fdt_vid *a, fdt_vid *b)
+{
+    const double *X = S->L->xyz;
+    *a = *b = -1;
+    for (size_t c = 0; c < S->nc; c++)
+        for (int e = 0; e < 6; e++) {
+            fdt_vid u = S->ct[c].v[fdt_tet_edge[e][0]], v = S->ct[c].v[fdt_tet_edge[e][1]];
+            const double *x = X + 3 * (size_t)u, *y = X + 3 * (size_t)v;
+            double len = fmax(fmax(fabs(x[0] - y[0]), fabs(x[1] - y[1])), fabs(x[2] - y[2]));
+            fdt_vid lo = u < v ? u : v, hi = u < v ? v : u;
+            if (len < S->min_edge && (*a < 0 || lo < *a || (lo == *a && hi < *b))) {
+                *a = lo;
+                *b = hi;
+            }
+        }
+    return *a < 0 ? FDT_EINTERNAL : FDT_ERANGE;
+}
+
 /* One thread's run of the queries. */
 typedef struct ijob {
     fdt_query_run run; /* first: fdt_queries_begin fills it */
@@ -543,7 +571,8 @@ typedef struct ijob {
     fdt_interp method;
     double *out;
     int err;
-    size_t bad; /* the query that failed */
+    size_t bad;               /* the query that failed */
+    fdt_vid short_a, short_b; /* FDT_ERANGE: the edge too short (too_close) */
 } ijob;
 
 static void *interpolate_run(void *arg)
@@ -576,7 +605,7 @@ static void *interpolate_run(void *arg)
         if (m == 0)
             continue; /* on the hull: NaN */
         if (m < 0) {
-            j->err = m == -1 ? FDT_ENOMEM : FDT_EINTERNAL;
+            j->err = m == -1 ? FDT_ENOMEM : too_close(S, &j->short_a, &j->short_b);
             j->bad = k;
             break;
         }
@@ -591,7 +620,8 @@ static void *interpolate_run(void *arg)
 
 static int interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
                        size_t nv, const double *q, size_t nq, fdt_interp method, int threads,
-                       double *out, const double *q_named, char *diag, size_t diag_size);
+                       double *out, double min_edge, const double *q_named, char *diag,
+                       size_t diag_size);
 
 /* a copy of the k points p times 2^-e, or NULL */
 static double *scaled(const double *p, size_t k, int e)
@@ -627,22 +657,23 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
     if (side > 0)
         (void)frexp(side, &e);
     if (e >= -100 && e <= 100)
-        return interpolate(r, xyz, n, values, nv, q, nq, method, threads, out, q, diag,
-                           diag_size);
+        return interpolate(r, xyz, n, values, nv, q, nq, method, threads, out,
+                           ldexp(side, -48), q, diag, diag_size);
     double *xs = scaled(xyz, n, e), *qs = scaled(q, nq, e);
-    int err = xs && qs ? interpolate(r, xs, n, values, nv, qs, nq, method, threads, out, q, diag,
-                                     diag_size)
+    int err = xs && qs ? interpolate(r, xs, n, values, nv, qs, nq, method, threads, out,
+                                     ldexp(side, -48 - e), q, diag, diag_size)
                        : FDT_ENOMEM;
     free(xs);
     free(qs);
     return err;
 }
 
-/* fdt_interpolate_build on xyz and q (perhaps scaled); q_named: the
- * queries as given, for the message. */
+/* fdt_interpolate_build on xyz and q (perhaps scaled); min_edge in their
+ * frame; q_named: the queries as given, for the messages. */
 static int interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
                        size_t nv, const double *q, size_t nq, fdt_interp method, int threads,
-                       double *out, const double *q_named, char *diag, size_t diag_size)
+                       double *out, double min_edge, const double *q_named, char *diag,
+                       size_t diag_size)
 {
     fdt_locator L;
     uint32_t *order;
@@ -658,6 +689,7 @@ static int interpolate(fdt_result *r, const double *xyz, size_t n, const double 
         j->nv = nv;
         j->method = method;
         j->out = out;
+        j->S.min_edge = min_edge;
     }
     fdt_fork_join(jobs, sizeof *jobs, threads, interpolate_run);
     for (int t = 0; t < threads; t++) {
@@ -669,6 +701,12 @@ static int interpolate(fdt_result *r, const double *xyz, size_t n, const double 
                 snprintf(diag, diag_size, "natural-neighbour coordinates of query %zu "
                          "(%.17g %.17g %.17g) could not be computed (a bug: please report)",
                          j->bad, qk[0], qk[1], qk[2]);
+            if (err == FDT_ERANGE && diag && diag_size)
+                snprintf(diag, diag_size, "natural-neighbour coordinates of query %zu "
+                         "(%.17g %.17g %.17g) need the Voronoi cells of points %lld and %lld, "
+                         "closer than doubles can hold the cells between (a Delaunay edge must "
+                         "be at least 2^-48 of the box)", j->bad, qk[0], qk[1], qk[2],
+                         (long long)j->short_a, (long long)j->short_b);
         }
         free(j->S.ct);
         free(j->S.nt);
