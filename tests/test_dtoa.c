@@ -33,10 +33,7 @@ static void same(double x)
 static uint64_t rng = 0x2545f4914f6cdd1du;
 static uint64_t next(void)
 {
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
+    return test_rand64(&rng);
 }
 
 static double from_bits(uint64_t b)

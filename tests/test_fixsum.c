@@ -42,10 +42,7 @@ static void grid_value(mpz_t z, double x, int e)
 static uint64_t rng = 0x9e3779b97f4a7c15u;
 static uint64_t next(void)
 {
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
+    return test_rand64(&rng);
 }
 
 /* A term of about 2^(k) grid steps, k in [-4, 125), either sign. */
