@@ -45,9 +45,11 @@ static double from_bits(uint64_t b)
 
 int main(void)
 {
-    const double specials[] = {0.0, -0.0, INFINITY, -INFINITY, NAN, 5e-324, 2.2250738585072014e-308,
-                               1.7976931348623157e308, 1, -1, 0.1, 1.0 / 3, 2.0 / 3, 123456789012345678.0,
-                               0.99999999999999989, 9.9999999999999982e16, 1e-11, 1e43, 0.5, 1e15 + 0.3};
+    const double specials[] = {0.0, -0.0, INFINITY, -INFINITY, NAN, 5e-324,
+                               2.2250738585072014e-308, 1.7976931348623157e308, 1, -1, 0.1,
+                               1.0 / 3, 2.0 / 3, 123456789012345678.0, 0.99999999999999989,
+                               9.9999999999999982e16, 1e-11, 1e43, 0.5, 1e15 + 0.3,
+                               1 + 0x1p-17 /* a tie at 17 digits */};
     for (size_t i = 0; i < sizeof specials / sizeof *specials; i++) {
         same(specials[i]);
         same(-specials[i]);

@@ -214,7 +214,8 @@ int fdt_voronoi_scale(const double box[6], int *ed, char *diag, size_t ds)
     fdt_diag(diag, ds, "the box's largest side is %g: the Voronoi cells' volumes and densities "
         "would leave what doubles hold (boxes from 2^%d to 2^%d, about %.1e to %.1e); scale the "
         "points by a power of two, which changes none of their bits but the exponent", d,
-        VORONOI_MIN_EXP - 1, VORONOI_MAX_EXP, ldexp(1, VORONOI_MIN_EXP - 1), ldexp(1, VORONOI_MAX_EXP));
+        VORONOI_MIN_EXP - 1, VORONOI_MAX_EXP, ldexp(1, VORONOI_MIN_EXP - 1),
+        ldexp(1, VORONOI_MAX_EXP));
     return FDT_ERANGE;
 }
 
@@ -432,8 +433,9 @@ static int too_close(long long a, long long b, double len, double scale, int nea
 {
     fdt_diag(diag, ds, "points %lld and %lld are %g apart %s %g: their Voronoi "
         "cells are beyond what doubles hold (a Delaunay edge must be at least "
-        "2^%d of the box%s)", a < b ? a : b, a < b ? b : a, len, near ? "at coordinates near" : "in a box", scale,
-        box_exp, coords ? " and 2^-40 of its points' coordinates" : "");
+        "2^%d of the box%s)", a < b ? a : b, a < b ? b : a, len,
+        near ? "at coordinates near" : "in a box", scale, box_exp,
+        coords ? " and 2^-40 of its points' coordinates" : "");
     return FDT_ERANGE;
 }
 
