@@ -765,7 +765,10 @@ FDT_API int fdt_voronoi_neighbors(const fdt_voronoi *v, fdt_vid i, size_t *count
  * clockwise seen from outside. Cut from the box by the neighbours'
  * bisectors, as the cut cells are (so a summed cell's polyhedron agrees
  * with its volume to rounding). Owned by v, valid until the next call on
- * v (not from two threads at once). A merged duplicate has none (0, 0). */
+ * v (not from two threads at once). A merged duplicate has none (0, 0).
+ * FDT_ERANGE when the cell has a neighbour closer than 2^-40 of their
+ * coordinates: its vertices, absolute coordinates, would round by as much
+ * as the cell is wide. */
 FDT_API int fdt_voronoi_polyhedron(fdt_voronoi *v, const double *xyz, fdt_vid i, size_t *nverts,
                                    const double **verts, size_t *nfaces,
                                    const int32_t **faces);

@@ -419,9 +419,10 @@ def interpolation():
 def hard_families():
     """Families that broke --voronoi (bench/NOTES.md entry 103): sphere12, nearly
     cospherical, made a cut find its cell not convex (exit 7); ulpgrid's
-    cells by the box were summed past it; tiny and huge, whose cells'
-    volumes leave what doubles hold, came out 0 and NaN with exit 0 and
-    must be refused (exit 2)."""
+    cells by the box were summed past it, and its polyhedra written with
+    vertices rounded by half a cell; tiny and huge, whose cells' volumes
+    leave what doubles hold, came out 0 and NaN with exit 0 and must be
+    refused (exit 2)."""
     path = os.path.join(SCRATCH, "hard.xyz")
     out = os.path.join(SCRATCH, "hard.txt")
     # ulpgrid (points at 2^40 on the doubles' own 2^-12 grid): centres a
@@ -439,6 +440,13 @@ def hard_families():
         total = math.fsum(float(l.split()[1]) for l in open(out))
         if abs(total / bvol - 1) > tol:
             fail("%s: the volumes add up to %.17g of the box's %.17g" % (fam, total, bvol))
+        # ulpgrid's Voronoi vertices, as absolute coordinates, round by half a
+        # cell: its polyhedra are refused (exit 2), as --dual refuses them
+        vtu = os.path.join(SCRATCH, "hard.vtu")
+        r = run([path, "-q", "--voronoi", vtu])
+        want = 2 if fam == "ulpgrid" else 0
+        if r.returncode != want or (want and "as polyhedra" not in r.stderr):
+            fail("%s as .vtu: exit %d (want %d): %s" % (fam, r.returncode, want, r.stderr.strip()))
     for fam in ("tiny", "huge"):
         subprocess.run([GEN, fam, "2000", "1", path], check=True)
         r = run([path, "-q", "--voronoi", out])

@@ -11,6 +11,7 @@
 #include "io/write/cells.h"
 #include "io/write/writer.h"
 #include "mesh/dualmesh.h"
+#include "mesh/voronoi.h"
 #include "par/threads.h"
 
 int fdt_cli_dual_wanted(const fdt_cli_dual *d)
@@ -156,6 +157,11 @@ int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const doubl
         return r;
     }
     job.v = v;
+    if (job.vtu && (r = fdt_voronoi_vertices_check(v, xyz, diag, sizeof diag)) != FDT_OK) {
+        snprintf(err, errlen, "Voronoi cells as polyhedra (%s): %s", d->voronoi, diag);
+        fdt_voronoi_free(&v);
+        return r;
+    }
     if (d->voronoi)
         r = write_side(d->voronoi, put_cells, &job, xyz, err, errlen);
     if (r == FDT_OK && d->density)

@@ -1201,6 +1201,43 @@ int fdt_voronoi_neighbors(const fdt_voronoi *v, fdt_vid i, size_t *count, const 
     return FDT_OK;
 }
 
+/* The least neighbour pair (input ids) of cell i closer than 2^-40 of
+ * their coordinates (fdt_voronoi_resolution's coords rule) into *a, *b,
+ * kept when less than theirs (*a < 0: none yet); its length and
+ * magnitude into *len, *mag. */
+static void near_pair(const fdt_voronoi *v, const double *xyz, fdt_vid i, fdt_vid *a,
+                      fdt_vid *b, double *len, double *mag)
+{
+    const double *p = xyz + 3 * (size_t)i;
+    for (size_t e = v->nstart[i]; e < v->nstart[i + 1]; e++) {
+        fdt_vid nb = v->nid[e];
+        if (nb < 0)
+            continue; /* a wall */
+        const double *q = xyz + 3 * (size_t)nb;
+        double l = cheb(p, q), m = 0;
+        for (int k = 0; k < 3; k++)
+            m = max2(m, max2(fabs(p[k]), fabs(q[k])));
+        if (l < 0x1p-40 * m && (*a < 0 || least_pair(i, nb, *a, *b))) {
+            *a = i < nb ? i : nb;
+            *b = i < nb ? nb : i;
+            *len = l;
+            *mag = m;
+        }
+    }
+}
+
+int fdt_voronoi_vertices_check(const fdt_voronoi *v, const double *xyz, char *diag, size_t ds)
+{
+    fdt_vid a = -1, b = -1;
+    double len = 0, mag = 0;
+    for (size_t i = 0; v->nstart && i < v->n; i++)
+        if (!(v->flags[i] & FDT_CELL_MERGED))
+            near_pair(v, xyz, (fdt_vid)i, &a, &b, &len, &mag);
+    if (a < 0)
+        return FDT_OK;
+    return too_close(a, b, len, mag, 1, VORONOI_BOX_EXP, 1, diag, ds);
+}
+
 int fdt_voronoi_polyhedron(fdt_voronoi *v, const double *xyz, fdt_vid i, size_t *nverts,
                            const double **verts, size_t *nfaces, const int32_t **faces)
 {
@@ -1210,6 +1247,13 @@ int fdt_voronoi_polyhedron(fdt_voronoi *v, const double *xyz, fdt_vid i, size_t 
     *nverts = *nfaces = 0;
     if (v->flags[i] & FDT_CELL_MERGED)
         return FDT_OK;
+    /* The vertices are absolute coordinates: where they cannot be told
+     * apart at the cell's size, a polyhedron would be noise. */
+    fdt_vid a = -1, b = -1;
+    double len, mag;
+    near_pair(v, xyz, i, &a, &b, &len, &mag);
+    if (a >= 0)
+        return FDT_ERANGE;
     /* The box cut by the bisectors of the cell's neighbours (its faces of
      * no area bound nothing): the cut cells' way, for every cell. */
     const double *p = xyz + 3 * (size_t)i;

@@ -28,6 +28,16 @@ int fdt_voronoi_box_of(const fdt_result *r, const double *xyz, size_t n,
 int fdt_voronoi_scale(const double box[6], int *ed, char *diag, size_t ds);
 
 /*
+ * Whether the cells' vertices can be written as absolute coordinates
+ * (fdt_voronoi_polyhedron, the .vtu polyhedra): FDT_ERANGE with diag
+ * naming two neighbours closer than 2^-40 of their coordinates (the dual's
+ * rule: points at 2^40 on the doubles' 2^-12 grid, tests/gen_points.c
+ * ulpgrid, have Voronoi vertices that round by half a cell), else FDT_OK.
+ * v needs its neighbours.
+ */
+int fdt_voronoi_vertices_check(const fdt_voronoi *v, const double *xyz, char *diag, size_t ds);
+
+/*
  * Whether doubles hold the cells of r's points (xyz, as given to
  * fdt_triangulate) in box: FDT_ERANGE, with diag naming two points, when a
  * Delaunay edge (its Chebyshev length: the square of a length can
