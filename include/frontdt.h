@@ -64,7 +64,9 @@ enum {
     FDT_EINVAL = -1,      /* invalid argument or setting */
     FDT_ENOMEM = -2,      /* out of memory */
     FDT_EDEGENERATE = -3, /* fewer than 4 distinct points, or all coplanar */
-    FDT_ERANGE = -4,      /* a coordinate is NaN or infinite */
+    FDT_ERANGE = -4,      /* a coordinate is NaN or infinite; for the Voronoi
+                             cells and natural-neighbour interpolation, points
+                             beyond what doubles hold (the diagnostic says) */
     FDT_ETOOBIG = -5,     /* more points or tets than the index types hold */
     FDT_ECHECK = -6,      /* fdt_check found the mesh is not the Delaunay mesh */
     FDT_ECANCELED = -7,   /* the progress callback asked to stop */

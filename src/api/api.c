@@ -38,7 +38,8 @@ const char *fdt_strerror(int err)
     case FDT_EINVAL: return "invalid argument";
     case FDT_ENOMEM: return "out of memory";
     case FDT_EDEGENERATE: return "degenerate input (fewer than 4 distinct points, or all coplanar)";
-    case FDT_ERANGE: return "a coordinate is NaN or infinite";
+    case FDT_ERANGE: return "a value out of range: a coordinate NaN or infinite, or points "
+                            "beyond what doubles hold for the cells (the diagnostic says which)";
     case FDT_ETOOBIG: return "too many points or tetrahedra for the index types";
     case FDT_ECHECK: return "the mesh failed verification";
     case FDT_ECANCELED: return "canceled";
