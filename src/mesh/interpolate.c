@@ -101,7 +101,7 @@ typedef struct sibson {
     size_t cap_w;
     size_t nc;               /* the last query's cavity tets, in ct */
     double min_edge;         /* the shortest Delaunay edge whose cells
-                                doubles hold (2^-48 of the box's side) */
+                                doubles hold (FDT_VORONOI_BOX_EXP) */
 } sibson;
 
 static int push(void *pp, size_t *cap, size_t n, size_t size)
@@ -512,7 +512,6 @@ static long coordinates(sibson *S, fdt_tid t0, const double *q)
     long nc = cavity(S, t0, q);
     if (nc < 0)
         return -1;
-    S->nc = 0;
     S->nc = (size_t)nc; /* canonical_cavity fills ct before it can fail */
     long m = canonical_cavity(S, (size_t)nc, q);
     if (m < 0)
@@ -541,7 +540,7 @@ static long coordinates(sibson *S, fdt_tid t0, const double *q)
 
 /* Why a query's coordinates could not be computed: FDT_ERANGE when its
  * cavity has a Delaunay edge shorter than the cells of its points can be
- * (fdt_voronoi_resolution's rule, 2^-48 of the box: gen_points mixed,
+ * (fdt_voronoi_resolution's rule, FDT_VORONOI_BOX_EXP: gen_points mixed,
  * points 1e-150 and 1e150 apart, failed so), *a and *b the least such
  * edge's points; else FDT_EINTERNAL (a bug). */
 static int too_close(const sibson *S, fdt_vid *a, fdt_vid *b)
@@ -551,12 +550,10 @@ static int too_close(const sibson *S, fdt_vid *a, fdt_vid *b)
     for (size_t c = 0; c < S->nc; c++)
         for (int e = 0; e < 6; e++) {
             fdt_vid u = S->ct[c].v[fdt_tet_edge[e][0]], v = S->ct[c].v[fdt_tet_edge[e][1]];
-            const double *x = X + 3 * (size_t)u, *y = X + 3 * (size_t)v;
-            double len = fmax(fmax(fabs(x[0] - y[0]), fabs(x[1] - y[1])), fabs(x[2] - y[2]));
-            fdt_vid lo = u < v ? u : v, hi = u < v ? v : u;
-            if (len < S->min_edge && (*a < 0 || lo < *a || (lo == *a && hi < *b))) {
-                *a = lo;
-                *b = hi;
+            if (fdt_cheb(X + 3 * (size_t)u, X + 3 * (size_t)v) < S->min_edge &&
+                (*a < 0 || fdt_edge_less(u, v, *a, *b))) {
+                *a = u < v ? u : v;
+                *b = u < v ? v : u;
             }
         }
     return *a < 0 ? FDT_EINTERNAL : FDT_ERANGE;
@@ -652,16 +649,15 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
     double box[6], side = 0;
     int e = 0;
     if (method == FDT_INTERP_NATURAL && fdt_voronoi_box_of(r, xyz, n, &vo, box, NULL, 0) == FDT_OK)
-        for (int k = 0; k < 3; k++)
-            side = fmax(side, box[k + 3] - box[k]);
+        side = fdt_box_side(box);
     if (side > 0)
         (void)frexp(side, &e);
     if (e >= -100 && e <= 100)
         return interpolate(r, xyz, n, values, nv, q, nq, method, threads, out,
-                           ldexp(side, -48), q, diag, diag_size);
+                           ldexp(side, FDT_VORONOI_BOX_EXP), q, diag, diag_size);
     double *xs = scaled(xyz, n, e), *qs = scaled(q, nq, e);
     int err = xs && qs ? interpolate(r, xs, n, values, nv, qs, nq, method, threads, out,
-                                     ldexp(side, -48 - e), q, diag, diag_size)
+                                     ldexp(side, FDT_VORONOI_BOX_EXP - e), q, diag, diag_size)
                        : FDT_ENOMEM;
     free(xs);
     free(qs);
@@ -705,8 +701,8 @@ static int interpolate(fdt_result *r, const double *xyz, size_t n, const double 
                 snprintf(diag, diag_size, "natural-neighbour coordinates of query %zu "
                          "(%.17g %.17g %.17g) need the Voronoi cells of points %lld and %lld, "
                          "closer than doubles can hold the cells between (a Delaunay edge must "
-                         "be at least 2^-48 of the box)", j->bad, qk[0], qk[1], qk[2],
-                         (long long)j->short_a, (long long)j->short_b);
+                         "be at least 2^%d of the box)", j->bad, qk[0], qk[1], qk[2],
+                         (long long)j->short_a, (long long)j->short_b, FDT_VORONOI_BOX_EXP);
         }
         free(j->S.ct);
         free(j->S.nt);

@@ -53,9 +53,10 @@ struct fdt_voronoi {
     size_t cap_pverts, cap_pfaces;
 };
 
-/* The cells' resolution (fdt_voronoi_resolution, voronoi.h): a Delaunay
- * edge at least 2^-48 of the box's largest side. */
-#define VORONOI_BOX_EXP -48
+/* The polyMesh dual's and the polyhedra's second rule
+ * (fdt_voronoi_resolution's coords): a Delaunay edge at least 2^-40 of
+ * its points' coordinates. */
+#define VORONOI_COORD_EXP -40
 /* The box sizes whose cells doubles hold (fdt_voronoi_scale): the box's
  * largest side D = f 2^ed, f in [1/2, 1), ed in this range. A cell's
  * volume lies between about 2^-150 D^3 (edges down to 2^-48 D) and D^3,
@@ -115,7 +116,7 @@ typedef struct vjob {
     size_t cap_order;
     size_t *first;       /* cut cell lo + k: its faces from face[first[k]] */
     size_t zero_faces;
-    uint32_t short_a, short_b; /* the least edge too short (least_pair), local ids, or
+    uint32_t short_a, short_b; /* the least edge too short (fdt_edge_less), local ids, or
                                   UINT32_MAX */
     int err;
 } vjob;
@@ -190,24 +191,18 @@ static inline double max2(double a, double b)
     return a > b ? a : b; /* finite operands: fmax is a library call here */
 }
 
-/* The Chebyshev length of ab: the square of a length can underflow where
- * the length does not. */
-static inline double cheb(const double *a, const double *b)
+/* The largest coordinate of a and b in magnitude (the coords rule). */
+static double coord_mag(const double *a, const double *b)
 {
-    return max2(max2(fabs(a[0] - b[0]), fabs(a[1] - b[1])), fabs(a[2] - b[2]));
-}
-
-static double box_side(const double box[6])
-{
-    double side = 0;
+    double mag = 0;
     for (int k = 0; k < 3; k++)
-        side = max2(side, box[k + 3] - box[k]);
-    return side;
+        mag = max2(mag, max2(fabs(a[k]), fabs(b[k])));
+    return mag;
 }
 
 int fdt_voronoi_scale(const double box[6], int *ed, char *diag, size_t ds)
 {
-    double d = box_side(box);
+    double d = fdt_box_side(box);
     (void)frexp(d, ed);
     if (*ed >= VORONOI_MIN_EXP && *ed <= VORONOI_MAX_EXP)
         return FDT_OK;
@@ -260,7 +255,7 @@ static void *scale_back(void *arg)
 static void set_grids(vwork *w)
 {
     int ed;
-    (void)frexp(box_side(w->box), &ed);
+    (void)frexp(fdt_box_side(w->box), &ed);
     w->g_area = fdt_fix_grid_of(2 * ed - 98);
     w->g_vol = fdt_fix_grid_of(3 * ed - 98);
     w->g_mom = fdt_fix_grid_of(4 * ed - 98);
@@ -415,17 +410,6 @@ static inline int canon_tet(const double *X, const uint32_t *tv, uint32_t s[4], 
     return sigma;
 }
 
-/* Whether the edge ab comes before cd, both by input ids: the lower ids
- * first, then the higher. The refusals name the least edge too short, so
- * that the message is the same whatever the thread count and the tets'
- * order. */
-static int least_pair(long long a, long long b, long long c, long long d)
-{
-    long long ab0 = a < b ? a : b, ab1 = a < b ? b : a;
-    long long cd0 = c < d ? c : d, cd1 = c < d ? d : c;
-    return ab0 < cd0 || (ab0 == cd0 && ab1 < cd1);
-}
-
 /* fdt_voronoi_resolution's refusal of points a and b (input ids, named
  * lower first), len apart: FDT_ERANGE. */
 static int too_close(long long a, long long b, double len, double scale, int near, int box_exp,
@@ -499,10 +483,10 @@ static void add_tet(vjob *j, const uint32_t *tv)
     int too_short = 0;
     for (int e = 0; e < 6; e++) {
         uint32_t a = tv[fdt_tet_edge[e][0]], b = tv[fdt_tet_edge[e][1]];
-        if (cheb(X + 3 * (size_t)a, X + 3 * (size_t)b) < w->min_edge) {
+        if (fdt_cheb(X + 3 * (size_t)a, X + 3 * (size_t)b) < w->min_edge) {
             too_short = 1;
-            if (j->short_a == UINT32_MAX ||
-                least_pair(w->perm[a], w->perm[b], w->perm[j->short_a], w->perm[j->short_b])) {
+            if (j->short_a == UINT32_MAX || fdt_edge_less(w->perm[a], w->perm[b],
+                                                          w->perm[j->short_a], w->perm[j->short_b])) {
                 j->short_a = a;
                 j->short_b = b;
             }
@@ -1047,7 +1031,7 @@ static int list_neighbors(fdt_voronoi *v, vjob *jobs, int threads)
 int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double box[6],
                            int box_exp, int coords, char *diag, size_t ds)
 {
-    const double lim = ldexp(box_side(box), box_exp);
+    const double lim = ldexp(fdt_box_side(box), box_exp);
     fdt_vid sa = -1, sb = -1; /* the least edge too short, if any */
     double slen = 0, smag = 0;
     int snear = 0;
@@ -1056,11 +1040,9 @@ int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double 
         for (int e = 0; e < 6; e++) {
             const fdt_vid va = v[fdt_tet_edge[e][0]], vb = v[fdt_tet_edge[e][1]];
             const double *a = xyz + 3 * (size_t)va, *b = xyz + 3 * (size_t)vb;
-            double len = cheb(a, b), mag = 0;
-            for (int k = 0; coords && k < 3; k++)
-                mag = max2(mag, max2(fabs(a[k]), fabs(b[k])));
-            int near = coords && len < 0x1p-40 * mag;
-            if ((near || len < lim) && (sa < 0 || least_pair(va, vb, sa, sb))) {
+            double len = fdt_cheb(a, b), mag = coords ? coord_mag(a, b) : 0;
+            int near = coords && len < ldexp(mag, VORONOI_COORD_EXP);
+            if ((near || len < lim) && (sa < 0 || fdt_edge_less(va, vb, sa, sb))) {
                 sa = va;
                 sb = vb;
                 slen = len;
@@ -1070,8 +1052,8 @@ int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double 
         }
     }
     if (sa >= 0)
-        return too_close(sa, sb, slen, snear ? smag : box_side(box), snear, box_exp, coords, diag,
-                         ds);
+        return too_close(sa, sb, slen, snear ? smag : fdt_box_side(box), snear, box_exp, coords,
+                         diag, ds);
     return FDT_OK;
 }
 
@@ -1116,7 +1098,7 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
     err = number_points(&w, r, xyz);
     if (!err) {
         scale_frame(&w);
-        w.min_edge = ldexp(box_side(w.box), VORONOI_BOX_EXP);
+        w.min_edge = ldexp(fdt_box_side(w.box), FDT_VORONOI_BOX_EXP);
         set_grids(&w);
         err = local_tets(&w, r);
     }
@@ -1129,14 +1111,14 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
     const vjob *least = NULL;
     for (int t = 0; !err && t < threads; t++)
         if (jobs[t].short_a != UINT32_MAX &&
-            (!least || least_pair(w.perm[jobs[t].short_a], w.perm[jobs[t].short_b],
+            (!least || fdt_edge_less(w.perm[jobs[t].short_a], w.perm[jobs[t].short_b],
                                   w.perm[least->short_a], w.perm[least->short_b])))
             least = &jobs[t];
     if (least)
         err = too_close(w.perm[least->short_a], w.perm[least->short_b],
-                        cheb(xyz + 3 * (size_t)w.perm[least->short_a],
+                        fdt_cheb(xyz + 3 * (size_t)w.perm[least->short_a],
                              xyz + 3 * (size_t)w.perm[least->short_b]),
-                        box_side(v->box), 0, VORONOI_BOX_EXP, 0, diag, diag_size);
+                        fdt_box_side(v->box), 0, FDT_VORONOI_BOX_EXP, 0, diag, diag_size);
     if (!err)
         err = fork_join(jobs, threads, cell_pass);
     if (err == FDT_EINTERNAL)
@@ -1214,10 +1196,8 @@ static void near_pair(const fdt_voronoi *v, const double *xyz, fdt_vid i, fdt_vi
         if (nb < 0)
             continue; /* a wall */
         const double *q = xyz + 3 * (size_t)nb;
-        double l = cheb(p, q), m = 0;
-        for (int k = 0; k < 3; k++)
-            m = max2(m, max2(fabs(p[k]), fabs(q[k])));
-        if (l < 0x1p-40 * m && (*a < 0 || least_pair(i, nb, *a, *b))) {
+        double l = fdt_cheb(p, q), m = coord_mag(p, q);
+        if (l < ldexp(m, VORONOI_COORD_EXP) && (*a < 0 || fdt_edge_less(i, nb, *a, *b))) {
             *a = i < nb ? i : nb;
             *b = i < nb ? nb : i;
             *len = l;
@@ -1235,7 +1215,7 @@ int fdt_voronoi_vertices_check(const fdt_voronoi *v, const double *xyz, char *di
             near_pair(v, xyz, (fdt_vid)i, &a, &b, &len, &mag);
     if (a < 0)
         return FDT_OK;
-    return too_close(a, b, len, mag, 1, VORONOI_BOX_EXP, 1, diag, ds);
+    return too_close(a, b, len, mag, 1, FDT_VORONOI_BOX_EXP, 1, diag, ds);
 }
 
 int fdt_voronoi_polyhedron(fdt_voronoi *v, const double *xyz, fdt_vid i, size_t *nverts,

@@ -3,7 +3,42 @@
 #ifndef FDT_VORONOI_H
 #define FDT_VORONOI_H
 
+#include <math.h>
+
 #include "frontdt.h"
+
+/* The cells' resolution: a Delaunay edge at least 2^FDT_VORONOI_BOX_EXP
+ * of the box's largest side (fdt_voronoi_resolution, below: the cells,
+ * the polyhedra and the natural-neighbour coordinates). */
+#define FDT_VORONOI_BOX_EXP (-48)
+
+/* The Chebyshev length of ab: the square of a length can underflow where
+ * the length does not. */
+static inline double fdt_cheb(const double *a, const double *b)
+{
+    double x = fabs(a[0] - b[0]), y = fabs(a[1] - b[1]), z = fabs(a[2] - b[2]);
+    x = x > y ? x : y; /* finite operands: fmax is a library call here */
+    return x > z ? x : z;
+}
+
+/* Whether the edge ab comes before cd, both by point ids: the lower ids
+ * first, then the higher. A refusal names the least edge it met, so that
+ * its message is the same whatever the thread count and the tets' order. */
+static inline int fdt_edge_less(long long a, long long b, long long c, long long d)
+{
+    long long ab0 = a < b ? a : b, ab1 = a < b ? b : a;
+    long long cd0 = c < d ? c : d, cd1 = c < d ? d : c;
+    return ab0 < cd0 || (ab0 == cd0 && ab1 < cd1);
+}
+
+/* The largest side of box (xmin, ymin, zmin, xmax, ymax, zmax). */
+static inline double fdt_box_side(const double box[6])
+{
+    double side = 0;
+    for (int k = 0; k < 3; k++)
+        side = box[k + 3] - box[k] > side ? box[k + 3] - box[k] : side;
+    return side;
+}
 
 /* fdt_voronoi_compute on `threads` threads (at least 1; the caller's is
  * one of them), o not NULL and of this library's size. */
