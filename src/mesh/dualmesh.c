@@ -1521,8 +1521,7 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
         err = FDT_ENOMEM;
         goto done;
     }
-    for (int k = 0; k < 3; k++)
-        w.side = fmax(w.side, w.box[k + 3] - w.box[k]);
+    w.side = fdt_box_side(w.box);
     w.nb = w.loc.nbrs;
     w.uf = malloc(w.T * sizeof *w.uf);
     w.cc = malloc(3 * w.T * sizeof *w.cc);
