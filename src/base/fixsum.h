@@ -40,6 +40,14 @@ static inline fdt_fix_grid fdt_fix_grid_of(int e)
     return g;
 }
 
+/* acc += b (merging partial sums). */
+static inline void fdt_fix_merge(fdt_fix *acc, fdt_fix b)
+{
+    uint64_t s = acc->lo + b.lo;
+    acc->hi += b.hi + (s < b.lo);
+    acc->lo = s;
+}
+
 /* acc += round(x 2^-e), x finite with |x 2^-e| < 2^126. y = x 2^-e is
  * split exactly as h 2^63 + r: h = trunc(y 2^-63) (a scaling by a power of
  * two, then a truncation: |h| < 2^63), r = y - h 2^63 (exact: 2^63 times
@@ -55,18 +63,8 @@ static inline void fdt_fix_add(fdt_fix *acc, double x, fdt_fix_grid g)
     /* h 2^63 is (h >> 1) 2^64 + (h & 1) 2^63 (>> rounds down); r is
      * sign-extended */
     uint64_t lo = (uint64_t)h << 63, s = lo + (uint64_t)r;
-    int64_t hi = (h >> 1) + (r >> 63) + (s < lo);
-    uint64_t t = acc->lo + s;
-    acc->hi += hi + (t < s);
-    acc->lo = t;
-}
-
-/* acc += b (merging partial sums). */
-static inline void fdt_fix_merge(fdt_fix *acc, fdt_fix b)
-{
-    uint64_t s = acc->lo + b.lo;
-    acc->hi += b.hi + (s < b.lo);
-    acc->lo = s;
+    fdt_fix term = {s, (h >> 1) + (r >> 63) + (s < lo)};
+    fdt_fix_merge(acc, term);
 }
 
 /* The sum times 2^e, as a double: the magnitude's two words are converted
