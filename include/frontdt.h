@@ -180,12 +180,14 @@ FDT_API int fdt_open(fdt_context **ctx, const fdt_settings *s);
 /* Frees the context and sets *ctx to NULL; NULL is fine. */
 FDT_API void fdt_close(fdt_context **ctx);
 
-/* Whether a run with settings s takes the one-part engine (fdt_search's
- * FDT_SEARCH_AUTO: the insertion mesh of every point, built on the run's
- * threads, is the answer), rather than fronts: in memory (streamed 0,
- * fdt_triangulate) or streamed (nonzero, fdt_triangulate_stream: never).
- * A function of the settings alone; for a caller's memory estimate. 0 for
- * a search that is not an fdt_search (fdt_open refuses it). */
+/* Whether a run with settings s takes the insertion engine (fdt_search's
+ * FDT_SEARCH_AUTO) rather than fronts: in memory (streamed 0,
+ * fdt_triangulate) the one-part engine, whose insertion mesh of every
+ * point, built on the run's threads, is the answer; streamed (nonzero,
+ * fdt_triangulate_stream) the parts in sweep order, the same meshes a slab
+ * at a time. A function of the settings alone; for a caller's memory
+ * estimate. 0 for a search that is not an fdt_search (fdt_open refuses
+ * it). */
 FDT_API int fdt_engine_one_part(const fdt_settings *s, int streamed);
 
 /*
@@ -413,6 +415,15 @@ typedef struct fdt_stats {
     size_t ins_deferred;      /* insertions put off (a tet another thread held,
                                  or the slots spent) */
     size_t ins_serial;        /* points left to the build's serial finish */
+    /* Parts in sweep order (issue 31, a streamed run's engine). Added in
+     * 0.4: an older caller passes a shorter size and gets the fields
+     * above. */
+    size_t sweep_parts;       /* parts: slabs of the points in sweep order,
+                                 each meshed, certified and freed (0: the
+                                 run took another engine) */
+    size_t sweep_reinserted;  /* live vertices a part carried into the next
+                                 (inserted again) */
+    size_t sweep_max_part;    /* the most points in one part's mesh */
 } fdt_stats;
 
 /* Fills the first struct_size bytes of *st (its struct_size included).

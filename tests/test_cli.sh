@@ -1071,7 +1071,7 @@ run st_limit_ok "$FRONTDT" st.xyz --memory-limit 2G --stream --stats
 expect_rc st_limit_ok 0 && {
     expect_in st_limit_ok err "memory estimate"
     expect_in st_limit_ok err "memory peak RSS"
-    expect_in st_limit_ok err "memory mesh              0.0 MiB"
+    expect_in st_limit_ok err "engine            parts in sweep order"
 }
 
 if [ "$FAILS" -gt 0 ]; then

@@ -203,8 +203,8 @@ static int drop_tets(void *user, const fdt_vid *t, size_t count)
     return 0;
 }
 
-/* A streamed serial run (the tets dropped): the paper's front, whose
- * oracle still switches by its rules (src/front/oracle.c). */
+/* A streamed serial run (the tets dropped): the parts in sweep order
+ * (src/front/sweep.h). */
 static fdt_result *run_stream(const pts *p, fdt_stats *st)
 {
     fdt_settings s;
@@ -240,9 +240,9 @@ static uint64_t hash_of(fdt_result *r)
 /* Every search, mode and thread count against the kd search in serial
  * mode. In memory, serial --search mesh and auto are the one-part engine
  * (src/front/partmesh.h): every tet from the certified mesh, no front.
- * want_auto: 1 the automatic rule of a streamed serial run (the front)
- * must switch, 0 it must not, -1 either. */
-static void test_family(pts p, int want_auto, int quick)
+ * Streamed, they are the parts in sweep order: every tet from a certified
+ * part's mesh, no front. */
+static void test_family(pts p, int quick)
 {
     fdt_stats st;
     fdt_result *ref = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_KD, &st);
@@ -273,11 +273,9 @@ static void test_family(pts p, int want_auto, int quick)
     fdt_result_free(&r);
     r = run_stream(&p, &st);
     CHECK(set_hash_of(r) == sref);
-    CHECK_EQ(st.final_tets, 0);
-    if (want_auto >= 0)
-        CHECK_EQ(st.mesh_parts, (size_t)want_auto);
-    if (st.mesh_parts)
-        CHECK(st.mesh_faces > 0);
+    CHECK_EQ(st.final_tets, st.tets);
+    CHECK_EQ(st.faces_advanced, 0);
+    CHECK(st.sweep_parts >= 1 && st.mesh_parts == st.sweep_parts);
     fdt_result_free(&r);
 
     static const int all_threads[] = {2, 3, 5};
@@ -529,15 +527,13 @@ int main(int argc, char **argv)
     test_flat_parts();
     test_probe_samples();
     test_early_switch();
-    test_family(gen_uniform(3000, 1), -1, quick);
-    /* 60 rings of 64: the kd search tests hundreds of points a face here,
-     * and the automatic rule must see it. */
-    test_family(gen_cylinder(60, 64), 1, quick);
-    test_family(gen_lattice("lattice", 9, 0, 0, 0), -1, quick);
-    test_family(gen_lattice("rotlattice", 10, 0.3, 0.5, 0.7), -1, quick);
-    test_family(gen_intsphere(25), -1, quick);
-    test_family(gen_layers(25, 3), -1, quick);
-    test_family(gen_mixed(600, 5), -1, quick);
+    test_family(gen_uniform(3000, 1), quick);
+    test_family(gen_cylinder(60, 64), quick);
+    test_family(gen_lattice("lattice", 9, 0, 0, 0), quick);
+    test_family(gen_lattice("rotlattice", 10, 0.3, 0.5, 0.7), quick);
+    test_family(gen_intsphere(25), quick);
+    test_family(gen_layers(25, 3), quick);
+    test_family(gen_mixed(600, 5), quick);
     /* FDT_MODE_AUTO with threads and --search auto: the one-part engine
      * (src/api/api.c, one_part), the mesh of every point built on the
      * threads is the answer, no front, no part, no message; an explicit
@@ -592,17 +588,6 @@ int main(int argc, char **argv)
         fdt_result_free(&r);
         free(p.xyz);
         printf("ok auto mode: the one-part engine on threads; explicit modes: the parts\n");
-    }
-    /* Uniform points must never pay for a mesh in the front (a streamed
-     * serial run; in memory the serial run is the one-part engine). */
-    {
-        pts p = gen_uniform(40000, 11);
-        fdt_stats st;
-        fdt_result *r = run_stream(&p, &st);
-        CHECK_EQ(st.mesh_parts, 0);
-        fdt_result_free(&r);
-        free(p.xyz);
-        printf("ok uniform stays on the kd search\n");
     }
     return test_report("oracle");
 }

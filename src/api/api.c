@@ -15,6 +15,7 @@
 #include "front/oracle.h"
 #include "front/search.h"
 #include "front/partmesh.h"
+#include "front/sweep.h"
 #include "par/parallel.h"
 #include "par/threads.h"
 #include "geom/morton.h"
@@ -163,6 +164,7 @@ typedef struct run_state {
     fdt_emit em;              /* serial: the front's emitter */
     fdt_front_stats fst;
     fdt_partmesh_stats pms;   /* the one-part engine's counters */
+    fdt_sweep_stats sws;      /* the sweep's counters */
     int parts;                /* nonzero: the parts' engine ran (src/par) */
     size_t mem_tree, mem_mesh, mem_sink;
 } run_state;
@@ -229,22 +231,25 @@ static int run_parallel(fdt_context *ctx, fdt_mode mode, int nthreads, const fdt
 }
 
 /*
- * Which engine a run takes (issue 31), a function of the settings alone:
- * in memory, the one-part engine (the insertion mesh of every point, built
- * on the run's threads and certified, is the answer: no front re-derives
- * it, bench/NOTES.md entry 91) where the search's row lets it run
- * (src/front/search.c): on one thread, or on several with the default mode
- * and no --pin (which binds the parts' threads). A stream (whose memory
- * must stay bounded) and every other run take the fronts: serial, or the
- * parts' engine (src/par/parallel.c).
+ * Which engine a run takes (issue 31), a function of the settings alone.
+ * The insertion engines run where the search's row lets them
+ * (src/front/search.c): on one thread, or on several with the default
+ * mode and no --pin (which binds the parts' threads). In memory that is
+ * the one-part engine (the insertion mesh of every point, built on the
+ * run's threads and certified, is the answer: no front re-derives it,
+ * bench/NOTES.md entry 91); streamed, whose memory must stay bounded, the
+ * parts in sweep order (src/front/sweep.h, entry 104). Every other run
+ * takes the fronts: serial, or the parts' engine (src/par/parallel.c).
  */
-static int one_part(const fdt_settings *s, fdt_mode mode, int streamed)
+typedef enum run_engine { ENGINE_FRONTS, ENGINE_ONE_PART, ENGINE_SWEEP } run_engine;
+
+static run_engine pick_engine(const fdt_settings *s, fdt_mode mode, int streamed)
 {
-    if (streamed)
-        return 0;
     const fdt_search_row *r = fdt_search_row_of(s->search);
-    return mode == FDT_MODE_SERIAL ? r->one_part_serial
-                                   : r->one_part_threads && s->mode == FDT_MODE_AUTO && !s->pin;
+    int insertion = mode == FDT_MODE_SERIAL
+                        ? r->one_part_serial
+                        : r->one_part_threads && s->mode == FDT_MODE_AUTO && !s->pin;
+    return !insertion ? ENGINE_FRONTS : streamed ? ENGINE_SWEEP : ENGINE_ONE_PART;
 }
 
 /* The Voronoi cells (src/mesh/voronoi.c) on the threads the options ask
@@ -294,22 +299,21 @@ int fdt_engine_one_part(const fdt_settings *s, int streamed)
     fdt_mode mode;
     int nthreads;
     run_mode(s, &mode, &nthreads);
-    return one_part(s, mode, streamed);
+    return pick_engine(s, mode, streamed) != ENGINE_FRONTS;
 }
 
 /* The points put in order (the one-part engine: Morton order, which its
- * BRIO rounds keep and whose ranges are its threads' regions; the serial
- * front: its kd-tree's), then the one-part engine on nthreads threads or
- * (not one) the serial front on the tree; *t1: when the preparation
- * ended. */
-static int run_single(fdt_context *ctx, const fdt_sink *user, int one, int nthreads,
+ * BRIO rounds keep and whose ranges are its threads' regions; the sweep:
+ * its slabs; the serial front: its kd-tree's), then that engine on
+ * nthreads threads (the front: one); *t1: when the preparation ended. */
+static int run_single(fdt_context *ctx, const fdt_sink *user, run_engine eng, int nthreads,
                       run_state *rs, double *t1)
 {
     fdt_prepared *pr = &rs->pr;
-    if (one) {
+    if (eng == ENGINE_ONE_PART) {
         if (fdt_morton_sort(pr->p, pr->orig, pr->m) != 0)
             return FDT_ENOMEM;
-    } else {
+    } else if (eng == ENGINE_FRONTS) {
         if (fdt_kd_build(&rs->tree, pr->p, pr->orig, 0, (uint32_t)pr->m, ctx->s.leaf_size) !=
             FDT_OK)
             return FDT_ENOMEM;
@@ -322,10 +326,14 @@ static int run_single(fdt_context *ctx, const fdt_sink *user, int one, int nthre
         return FDT_ENOMEM;
     *t1 = fdt_now_s();
     int err;
-    if (one) {
+    if (eng == ENGINE_ONE_PART) {
         err = fdt_partmesh_emit_all(pr->p, (uint32_t)pr->m, nthreads, &rs->em,
                                     ctx->s.progress, ctx->s.progress_user, &rs->pms, ctx->diag,
                                     sizeof ctx->diag);
+    } else if (eng == ENGINE_SWEEP) {
+        err = fdt_sweep_emit(pr->p, pr->orig, (uint32_t)pr->m, 0, nthreads, &rs->em,
+                             ctx->s.progress, ctx->s.progress_user, &rs->sws, ctx->diag,
+                             sizeof ctx->diag);
     } else
         err = fdt_front_emit(&rs->tree, central_point(&rs->tree), ctx->s.search, &rs->em,
                              ctx->s.progress, ctx->s.progress_user, &rs->fst);
@@ -398,18 +406,22 @@ static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, int nthrea
     st->adapt_insphere = fst->kq.pc.insphere_adapt;
     st->max_front = fst->max_front;
     st->mesh_faces = fst->mesh_faces;
-    st->mesh_parts = fst->mesh_parts + (pms->final_tets > 0);
-    st->t_mesh = fst->t_mesh + pms->t_mesh;
-    st->final_tets = pms->final_tets + fst->final_tets;
-    st->certified_tets = pms->certified_tets + fst->certified_tets;
-    st->t_certify = pms->t_certify + fst->t_certify;
-    st->ins_conflict_tests = pms->ins.conflict_tests;
-    st->ins_deferred = pms->ins.deferred;
-    st->ins_serial = pms->ins.serial_finish;
-    st->exact_orient += pms->pc.orient_exact;
-    st->exact_insphere += pms->pc.insphere_exact;
-    st->adapt_orient += pms->pc.orient_adapt;
-    st->adapt_insphere += pms->pc.insphere_adapt;
+    const fdt_sweep_stats *sws = &rs->sws;
+    st->mesh_parts = fst->mesh_parts + (pms->final_tets > 0) + sws->parts;
+    st->t_mesh = fst->t_mesh + pms->t_mesh + sws->t_mesh;
+    st->final_tets = pms->final_tets + fst->final_tets + sws->final_tets;
+    st->certified_tets = pms->certified_tets + fst->certified_tets + sws->certified_tets;
+    st->t_certify = pms->t_certify + fst->t_certify + sws->t_certify;
+    st->ins_conflict_tests = pms->ins.conflict_tests + sws->ins.conflict_tests;
+    st->ins_deferred = pms->ins.deferred + sws->ins.deferred;
+    st->ins_serial = pms->ins.serial_finish + sws->ins.serial_finish;
+    st->exact_orient += pms->pc.orient_exact + sws->pc.orient_exact;
+    st->exact_insphere += pms->pc.insphere_exact + sws->pc.insphere_exact;
+    st->adapt_orient += pms->pc.orient_adapt + sws->pc.orient_adapt;
+    st->adapt_insphere += pms->pc.insphere_adapt + sws->pc.insphere_adapt;
+    st->sweep_parts = sws->parts;
+    st->sweep_reinserted = sws->reinserted;
+    st->sweep_max_part = sws->max_part;
     st->threads = nthreads;
     st->mode = mode;
     /* Memory (include/frontdt.h): the points' three arrays, then each
@@ -418,7 +430,7 @@ static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, int nthrea
     st->mem_merge = pr->merge_bytes;
     st->mem_tree = rs->mem_tree;
     st->mem_front = fst->mem_front;
-    st->mem_mesh = rs->mem_mesh;
+    st->mem_mesh = rs->mem_mesh > rs->sws.mem_part ? rs->mem_mesh : rs->sws.mem_part;
     st->mem_sink = rs->mem_sink;
     st->t_prepare = t1 - t0;
     st->t_front = t2 - t1;
@@ -462,11 +474,12 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
                                         sizeof ctx->diag)) != FDT_OK)
         goto fail;
     double t1;
-    int one = one_part(&ctx->s, mode, user != NULL);
+    run_engine eng = pick_engine(&ctx->s, mode, user != NULL);
     if (mode == FDT_MODE_SERIAL)
         nthreads = 1;
-    err = one || mode == FDT_MODE_SERIAL ? run_single(ctx, user, one, nthreads, &rs, &t1)
-                                         : run_parallel(ctx, mode, nthreads, user, &rs, &t1);
+    err = eng != ENGINE_FRONTS || mode == FDT_MODE_SERIAL
+              ? run_single(ctx, user, eng, nthreads, &rs, &t1)
+              : run_parallel(ctx, mode, nthreads, user, &rs, &t1);
     if (err)
         goto fail;
     double t2 = fdt_now_s();

@@ -31,6 +31,7 @@
 #include "base/hash.h"
 #include "cli/progress.h"
 #include "front/partmesh.h"
+#include "front/sweep.h"
 #include "io/read/reader.h"
 #include "io/write/writer.h"
 
@@ -779,6 +780,8 @@ static int ran_one_part(const fdt_stats *st)
 
 static const char *engine_name(const fdt_stats *st)
 {
+    if (st->sweep_parts)
+        return "parts in sweep order: each slab's mesh, its final tets out, the rest carried";
     if (ran_one_part(st))
         return "one part: the insertion mesh of every point is the answer";
     if (st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE)
@@ -837,6 +840,7 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  mesh faces        %zu (%zu parts read a mesh; %.3f s building meshes)\n"
         "  final from mesh   %zu tets (certified %zu in %.3f s)\n"
         "  insertion         %zu conflict tests, %zu deferred, %zu by the serial finish\n"
+        "  sweep             %zu parts, %zu points inserted again, at most %zu in a part\n"
         "  threads           %d\n"
         "  mode              %s\n"
         "  engine            %s\n"
@@ -855,7 +859,8 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
         st->max_front, st->mesh_faces, st->mesh_parts, st->t_mesh, st->final_tets,
         st->certified_tets, st->t_certify, st->ins_conflict_tests, st->ins_deferred,
-        st->ins_serial, st->threads, mode_name(st->mode),
+        st->ins_serial, st->sweep_parts, st->sweep_reinserted, st->sweep_max_part,
+        st->threads, mode_name(st->mode),
         engine_name(st), st->t_prepare, st->t_front, st->t_finish,
         tm->read, tm->triangulate, tm->check, tm->canon, tm->write, tm->voronoi,
         tm->interpolate);
@@ -943,7 +948,8 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         ", \"max_front\": %zu, \"mesh_faces\": %zu, \"mesh_parts\": %zu"
         ", \"t_mesh\": %.9g, \"final_tets\": %zu, \"certified_tets\": %zu"
         ", \"t_certify\": %.9g, \"ins_conflict_tests\": %zu, \"ins_deferred\": %zu"
-        ", \"ins_serial\": %zu, \"threads\": %d, \"mode\": \"%s\""
+        ", \"ins_serial\": %zu, \"sweep_parts\": %zu, \"sweep_reinserted\": %zu"
+        ", \"sweep_max_part\": %zu, \"threads\": %d, \"mode\": \"%s\""
         ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
         ", \"t_read\": %.9g, \"t_triangulate\": %.9g, \"t_check\": %.9g"
         ", \"t_canon\": %.9g, \"t_write\": %.9g, \"t_voronoi\": %.9g"
@@ -953,7 +959,8 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
         st->max_front, st->mesh_faces, st->mesh_parts, finite_or_zero(st->t_mesh),
         st->final_tets, st->certified_tets, finite_or_zero(st->t_certify),
-        st->ins_conflict_tests, st->ins_deferred, st->ins_serial,
+        st->ins_conflict_tests, st->ins_deferred, st->ins_serial, st->sweep_parts,
+        st->sweep_reinserted, st->sweep_max_part,
         st->threads, mode_name(st->mode), finite_or_zero(st->t_prepare),
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
@@ -1124,8 +1131,18 @@ static unsigned long long memory_estimate(size_t n, int stream, int threads, int
     double sinks = stream ? (double)(threads > 1 ? threads : 1) * 1.2 * 1048576.0 : 0.0;
     double during_merge = pts + own + idx + merge;
     double during_front = pts + own + idx + tree + front + mesh + sinks;
-    if (one_part) {
-        /* The one-part engine (src/api/api.c's one_part):
+    if (one_part && stream) {
+        /* Parts in sweep order (src/front/sweep.h): the points and a
+         * part's copy of its points and mesh, a part about a slab and a
+         * half (what a part carries in) and, with threads, one a half of
+         * the sweep at once. Where nothing closes (surfaces) parts grow
+         * up to every point: the estimate is the usual case's. */
+        double part = 1.5 * (double)fdt_sweep_slab(n) * (threads > 1 ? 2.0 : 1.0);
+        if (part > (double)n)
+            part = (double)n;
+        during_front = pts + idx + FDT_SWEEP_PART_BYTES * part + sinks;
+    } else if (one_part) {
+        /* The one-part engine (src/api/api.c's pick_engine):
          * the insertion mesh instead of the tree and the front, whose tet
          * array becomes the output's (src/front/partmesh.h); neighbours
          * are written beside it. 1M uniform points: 289 bytes a point

@@ -45,7 +45,8 @@ static int stats_size_known(size_t size)
 {
     return size == sizeof(fdt_stats) || size == offsetof(fdt_stats, mem_points) ||
            size == offsetof(fdt_stats, final_tets) ||
-           size == offsetof(fdt_stats, ins_conflict_tests);
+           size == offsetof(fdt_stats, ins_conflict_tests) ||
+           size == offsetof(fdt_stats, sweep_parts);
 }
 
 static int thread_stats_size_known(size_t size)

@@ -1,0 +1,691 @@
+/* Parts in sweep order: src/front/sweep.h. */
+#include "front/sweep.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/clock.h"
+#include "base/spawn.h"
+#include "geom/kdtree.h"
+#include "geom/morton.h"
+#include "mesh/certify.h"
+#include "mesh/insert.h"
+
+#define INF FDT_NONE
+
+/* Per-slot marks of a part's mesh: bits 0-3 a face of B (the tet across
+ * it was emitted by an earlier part), then membership of U and
+ * finality. */
+enum { IN_U = 16, FINAL = 32 };
+
+uint32_t fdt_sweep_slab(size_t m)
+{
+    /* 64 c^2 with c the integer cube root of m: m^(2/3) without libm, so
+     * the cut is the same on every machine */
+    uint64_t c = 0;
+    while ((c + 1) * (c + 1) * (c + 1) <= (uint64_t)m)
+        c++;
+    uint64_t s = 64 * c * c;
+    return s < (UINT64_C(1) << 16) ? UINT32_C(1) << 16
+           : s > (UINT64_C(1) << 22) ? UINT32_C(1) << 22
+                                     : (uint32_t)s;
+}
+
+/* The sweep's state between parts, and the parts' scratch. */
+typedef struct sweep {
+    double *P;
+    fdt_vid *orig;
+    uint32_t m;
+    int axis, dir;       /* the sweep's axis, and its direction: +1 upwards,
+                            -1 downwards (the coordinates taken negated) */
+    int nthreads;        /* the threads building each part's mesh */
+    fdt_emit *em;
+    fdt_sweep_stats *st;
+    char *diag;
+    size_t dlen;
+    uint32_t *live;      /* L: global ids */
+    size_t nlive, lcap;
+    uint32_t *wall;      /* B: 3 global ids a face, oriented so that the
+                            live side is the open one (fdt_ins_find_face) */
+    size_t nwall, wcap;
+    uint32_t *nwalls;    /* the next part's B, built beside the old */
+    size_t nnw, nwcap;
+    double *Q;           /* the part's points */
+    fdt_vid *g;          /* the part's local id -> global id */
+    size_t qcap;
+    uint64_t *map;       /* global id + 1 << 32 | local id, of L's points */
+    size_t mapcap, mapn; /* allocated, in use (a power of two) */
+} sweep;
+
+static int grow(void **a, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap)
+        return FDT_OK;
+    size_t nc = *cap ? *cap : 1024;
+    while (nc < need)
+        nc += nc / 2;
+    void *p = realloc(*a, nc * size);
+    if (!p)
+        return FDT_ENOMEM;
+    *a = p;
+    *cap = nc;
+    return FDT_OK;
+}
+
+/* The slabs: quickselect along the axis at each boundary b[lo .. hi), the
+ * middle one first, so that every point of a slab is <= every point of the
+ * slabs after it (in place, no sort array). */
+static void cut_slabs(double *P, fdt_vid *orig, uint32_t begin, uint32_t end, const uint32_t *b,
+                      size_t lo, size_t hi, int axis)
+{
+    if (lo >= hi)
+        return;
+    size_t mid = lo + (hi - lo) / 2;
+    fdt_kd_select(P, orig, begin, end, b[mid], axis);
+    cut_slabs(P, orig, begin, b[mid], b, lo, mid, axis);
+    cut_slabs(P, orig, b[mid], end, b, mid + 1, hi, axis);
+}
+
+static uint32_t map_hash(uint32_t key, size_t cap)
+{
+    return (uint32_t)(((uint64_t)key * UINT64_C(0x9E3779B97F4A7C15)) >> 32) & (uint32_t)(cap - 1);
+}
+
+/* The local ids of L's points (the global ids outside the slabs'
+ * [begin, end)), for finding B's faces in the part's mesh. */
+static int map_build(sweep *sw, size_t nq, uint32_t begin, uint32_t end)
+{
+    size_t cap = 64;
+    while (cap < 2 * sw->nlive + 2)
+        cap *= 2;
+    if (cap > sw->mapcap) {
+        free(sw->map);
+        if (!(sw->map = malloc(cap * sizeof *sw->map))) {
+            sw->mapcap = 0;
+            return FDT_ENOMEM;
+        }
+        sw->mapcap = cap;
+    }
+    sw->mapn = cap;
+    memset(sw->map, 0, cap * sizeof *sw->map);
+    for (size_t i = 0; i < nq; i++) {
+        uint32_t gid = (uint32_t)sw->g[i];
+        if (gid >= begin && gid < end)
+            continue;
+        uint32_t h = map_hash(gid, cap);
+        while (sw->map[h])
+            h = (h + 1) & (uint32_t)(cap - 1);
+        sw->map[h] = ((uint64_t)(gid + 1) << 32) | (uint32_t)i;
+    }
+    return FDT_OK;
+}
+
+/* The local id of L's point gid, FDT_NONE if it is not in the part. */
+static uint32_t map_find(const sweep *sw, uint32_t gid)
+{
+    size_t cap = sw->mapn;
+    uint32_t h = map_hash(gid, cap);
+    for (;; h = (h + 1) & (uint32_t)(cap - 1)) {
+        uint64_t e = sw->map[h];
+        if (!e)
+            return FDT_NONE;
+        if ((uint32_t)(e >> 32) == gid + 1)
+            return (uint32_t)e;
+    }
+}
+
+/*
+ * Whether the circumsphere of the positive finite tet v (local ids of
+ * Q) ends strictly before `next` along the sweep (coordinates times dir):
+ * then no point at or past `next` lies in or on it. The ball is the apex
+ * search's conservative one (src/geom/kdtree.c: it holds the true sphere,
+ * widened by its rounding bound, infinite where the tet is too flat to
+ * bound), and its end is widened by the rounding of the one sum below.
+ */
+static int ball_before(const sweep *sw, const uint32_t *v, double next, fdt_kdq *kq)
+{
+    const double *Q = sw->Q;
+    const double dir = sw->dir;
+    const size_t ax = (size_t)sw->axis;
+    for (int i = 0; i < 4; i++)
+        if (!(dir * Q[3 * (size_t)v[i] + ax] < next))
+            return 0; /* the tet itself reaches next: so does its sphere */
+    fdt_apex ap;
+    fdt_apex_init(&ap, Q + 3 * (size_t)v[0], Q + 3 * (size_t)v[1], Q + 3 * (size_t)v[2], v[0],
+                  v[1], v[2]);
+    fdt_apex_offer(&ap, v[3], Q + 3 * (size_t)v[3], kq);
+    if (ap.best != v[3] || !(ap.rad < INFINITY))
+        return 0;
+    double c = dir * ap.center[ax], r = ap.rad;
+    double end = c + r;
+    end += (fabs(c) + r) * 0x1p-50;
+    return end < next;
+}
+
+static void add_ins_stats(fdt_ins_stats *a, const fdt_ins_stats *b)
+{
+    a->inserted += b->inserted;
+    a->walk_steps += b->walk_steps;
+    a->cavity_tets += b->cavity_tets;
+    a->created_tets += b->created_tets;
+    if (b->max_cavity > a->max_cavity)
+        a->max_cavity = b->max_cavity;
+    a->conflict_tests += b->conflict_tests;
+    a->deferred += b->deferred;
+    a->serial_finish += b->serial_finish;
+    a->stolen += b->stolen;
+}
+
+/* The part's points: L's, then the slab's [begin, end), Morton-sorted
+ * with their global ids (the insertion's order, src/mesh/insert.h). */
+static int gather(sweep *sw, uint32_t begin, uint32_t end, size_t *nq_out)
+{
+    size_t nq = sw->nlive + (end - begin);
+    size_t cap = sw->qcap;
+    if (grow((void **)&sw->g, &cap, nq, sizeof *sw->g))
+        return FDT_ENOMEM;
+    cap = sw->qcap;
+    if (grow((void **)&sw->Q, &cap, nq, 3 * sizeof *sw->Q))
+        return FDT_ENOMEM;
+    sw->qcap = cap;
+    for (size_t i = 0; i < nq; i++) {
+        uint32_t gid = i < sw->nlive ? sw->live[i] : begin + (uint32_t)(i - sw->nlive);
+        sw->g[i] = (fdt_vid)gid;
+        memcpy(sw->Q + 3 * i, sw->P + 3 * (size_t)gid, 3 * sizeof *sw->Q);
+    }
+    *nq_out = nq;
+    return fdt_morton_sort(sw->Q, sw->g, nq) ? FDT_ENOMEM : FDT_OK;
+}
+
+/* The part's mesh, built and certified on the sweep's threads. */
+static int build(sweep *sw, fdt_ins *mesh, size_t nq)
+{
+    fdt_sweep_stats *st = sw->st;
+    double t0 = fdt_now_s();
+    int err = sw->nthreads > 1
+                  ? fdt_ins_build_parallel(mesh, sw->Q, 0, (uint32_t)nq, sw->nthreads, &st->pc)
+                  : fdt_ins_build(mesh, sw->Q, 0, (uint32_t)nq, &st->pc);
+    st->t_mesh += fdt_now_s() - t0;
+    if (err)
+        return err;
+    add_ins_stats(&st->ins, &mesh->stats);
+    fdt_certify_fail why;
+    double t1 = fdt_now_s();
+    err = sw->nthreads > 1 ? fdt_certify_parallel(mesh, sw->nthreads, &st->pc, &why)
+                           : fdt_certify(mesh, &st->pc, &why);
+    st->t_certify += fdt_now_s() - t1;
+    st->certified_tets += mesh->nfinite;
+    if (err == FDT_ECHECK)
+        fdt_certify_describe(&why, sw->diag, sw->dlen);
+    return err;
+}
+
+static int internal(sweep *sw, const char *what)
+{
+    snprintf(sw->diag, sw->dlen, "internal error: the sweep's parts disagree: %s", what);
+    return FDT_EINTERNAL;
+}
+
+/*
+ * U: every live slot, less the region of tets over what earlier parts
+ * emitted (when they emitted anything). That region is bounded by B's
+ * faces and the hull, so a flood fill from the far side of each face of B
+ * (found in the mesh and marked) that never crosses one reaches all of it;
+ * it holds only tets whose vertices are all old live ones, far fewer than
+ * U's (filling U itself from B cost 3.5 % of a 1M run). mark[] zeroed,
+ * nslots bytes.
+ */
+static int region(sweep *sw, const fdt_ins *mesh, uint8_t *mark, uint32_t begin, uint32_t end,
+                  size_t nq)
+{
+    for (uint32_t s = 0; s < mesh->nslots; s++) {
+        const uint32_t *v = fdt_ins_tet(mesh, s);
+        if (!(v[0] == INF && v[1] == INF)) /* not a freed slot */
+            mark[s] = IN_U;
+    }
+    if (sw->nwall == 0)
+        return FDT_OK;
+    if (map_build(sw, nq, begin, end))
+        return FDT_ENOMEM;
+    uint32_t *queue = NULL;
+    size_t nqueue = 0, qcap = 0;
+    for (size_t w = 0; w < sw->nwall; w++) {
+        uint32_t l[3];
+        for (int i = 0; i < 3; i++)
+            if ((l[i] = map_find(sw, sw->wall[3 * w + i])) == FDT_NONE) {
+                free(queue);
+                return internal(sw, "a vertex of the emitted tets' boundary is not live");
+            }
+        uint32_t t;
+        int k;
+        if (!fdt_ins_find_face(mesh, l[0], l[1], l[2], &t, &k)) {
+            free(queue);
+            return internal(sw, "a face of the emitted tets' boundary is not in the next mesh");
+        }
+        mark[t] |= (uint8_t)(1u << k);
+        uint32_t r = fdt_ins_tet(mesh, t)[4 + k], o = r >> 2;
+        mark[o] |= (uint8_t)(1u << (r & 3)); /* the face seen from the far side */
+        if (mark[o] & IN_U) {
+            mark[o] &= (uint8_t)~IN_U;
+            if (grow((void **)&queue, &qcap, nqueue + 1, sizeof *queue)) {
+                free(queue);
+                return FDT_ENOMEM;
+            }
+            queue[nqueue++] = o;
+        }
+    }
+    for (size_t qi = 0; qi < nqueue; qi++) {
+        uint32_t t = queue[qi];
+        const uint32_t *v = fdt_ins_tet(mesh, t);
+        /* The emitted region lies inside the hull of the points so far,
+         * whose vertices are all live, so the mesh covers it with finite
+         * tets: an infinite one here says the parts disagree. */
+        if (!fdt_ins_is_finite(mesh, t)) {
+            free(queue);
+            return internal(sw, "the emitted region reaches past the hull");
+        }
+        for (int k = 0; k < 4; k++) {
+            if (mark[t] & (1u << k))
+                continue;
+            uint32_t n = v[4 + k] >> 2;
+            if (mark[n] & IN_U) {
+                mark[n] &= (uint8_t)~IN_U;
+                if (grow((void **)&queue, &qcap, nqueue + 1, sizeof *queue)) {
+                    free(queue);
+                    return FDT_ENOMEM;
+                }
+                queue[nqueue++] = n;
+            }
+        }
+    }
+    free(queue);
+    return FDT_OK;
+}
+
+/* Emits U's final tets (and, in the last part, U's hull faces) in slot
+ * order, marking them FINAL. */
+static int emit(sweep *sw, const fdt_ins *mesh, uint8_t *mark, int last, double next)
+{
+    fdt_kdq kq;
+    memset(&kq, 0, sizeof kq);
+    int err = FDT_OK;
+    for (uint32_t s = 0; s < mesh->nslots && !err; s++) {
+        if (!(mark[s] & IN_U))
+            continue;
+        const uint32_t *v = fdt_ins_tet(mesh, s);
+        int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
+        if (inf < 0) {
+            if (!last && !ball_before(sw, v, next, &kq))
+                continue;
+            uint32_t t[4];
+            for (int i = 0; i < 4; i++)
+                t[i] = (uint32_t)sw->g[v[i]];
+            int64_t id = fdt_emit_tet(sw->em, t);
+            if (id < 0)
+                err = (int)id;
+            sw->st->final_tets++;
+        } else {
+            if (!last)
+                continue;
+            /* the hull face outward: the infinite tet's face reversed
+             * (src/front/partmesh.c's emit_hull) */
+            const int *f = fdt_tet_face[inf];
+            uint32_t h[3] = {(uint32_t)sw->g[v[f[0]]], (uint32_t)sw->g[v[f[2]]],
+                             (uint32_t)sw->g[v[f[1]]]};
+            err = fdt_emit_hull(sw->em, h);
+        }
+        mark[s] |= FINAL;
+    }
+    sw->st->pc.orient_exact += kq.pc.orient_exact;
+    sw->st->pc.insphere_exact += kq.pc.insphere_exact;
+    sw->st->pc.orient_adapt += kq.pc.orient_adapt;
+    sw->st->pc.insphere_adapt += kq.pc.insphere_adapt;
+    return err;
+}
+
+/* What U keeps for the next part: L, the vertices of its tets not
+ * emitted, and B, their faces whose other side is emitted (an earlier
+ * part's wall, or a tet final now), oriented towards the live tet. */
+static int carry(sweep *sw, const fdt_ins *mesh, const uint8_t *mark, size_t nq)
+{
+    uint8_t *seen = calloc(nq ? nq : 1, 1);
+    if (!seen)
+        return FDT_ENOMEM;
+    sw->nlive = 0;
+    sw->nnw = 0;
+    int err = FDT_OK;
+    for (uint32_t s = 0; s < mesh->nslots && !err; s++) {
+        if ((mark[s] & (IN_U | FINAL)) != IN_U)
+            continue;
+        const uint32_t *v = fdt_ins_tet(mesh, s);
+        for (int k = 0; k < 4 && !err; k++) {
+            if (v[k] != INF && !seen[v[k]]) {
+                seen[v[k]] = 1;
+                if ((err = grow((void **)&sw->live, &sw->lcap, sw->nlive + 1, sizeof *sw->live)))
+                    break;
+                sw->live[sw->nlive++] = (uint32_t)sw->g[v[k]];
+            }
+            uint32_t n = v[4 + k] >> 2;
+            if (!(mark[s] & (1u << k)) && !(mark[n] & FINAL))
+                continue;
+            const int *f = fdt_tet_face[k];
+            uint32_t a = v[f[0]], b = v[f[2]], c = v[f[1]]; /* reversed: open towards s */
+            if (a == INF || b == INF || c == INF) {
+                err = internal(sw, "an emitted tet across a face with the infinite vertex");
+                break;
+            }
+            if ((err = grow((void **)&sw->nwalls, &sw->nwcap, 3 * (sw->nnw + 1),
+                            sizeof *sw->nwalls)))
+                break;
+            uint32_t *o = sw->nwalls + 3 * sw->nnw++;
+            o[0] = (uint32_t)sw->g[a];
+            o[1] = (uint32_t)sw->g[b];
+            o[2] = (uint32_t)sw->g[c];
+        }
+    }
+    free(seen);
+    if (err)
+        return err;
+    uint32_t *t = sw->wall;
+    size_t tc = sw->wcap;
+    sw->wall = sw->nwalls;
+    sw->wcap = sw->nwcap;
+    sw->nwall = sw->nnw;
+    sw->nwalls = t;
+    sw->nwcap = tc;
+    return FDT_OK;
+}
+
+/* One part: the slabs' points [begin, end) with L; next: the first
+ * coordinate along the sweep of the slabs after them (last: none). */
+static int part(sweep *sw, uint32_t begin, uint32_t end, int last, double next)
+{
+    fdt_sweep_stats *st = sw->st;
+    size_t nq;
+    int err = gather(sw, begin, end, &nq);
+    if (err)
+        return err;
+    st->parts++;
+    st->reinserted += sw->nlive;
+    if (sw->nlive > st->max_live)
+        st->max_live = sw->nlive;
+    if (nq > st->max_part)
+        st->max_part = nq;
+    fdt_ins mesh;
+    err = build(sw, &mesh, nq);
+    if (err == FDT_EDEGENERATE && !last && sw->nwall == 0) {
+        /* The points so far are flat (a first slab on one plane): nothing
+         * can be emitted yet, so all of them are live. */
+        if (grow((void **)&sw->live, &sw->lcap, nq, sizeof *sw->live))
+            return FDT_ENOMEM;
+        for (size_t i = 0; i < nq; i++)
+            sw->live[i] = (uint32_t)sw->g[i];
+        sw->nlive = nq;
+        return FDT_OK;
+    }
+    if (err == FDT_EDEGENERATE || err == FDT_EINVAL || err == FDT_EINTERNAL) {
+        /* the caller merged duplicates and checked the dimension: the
+         * insertion's own checks failed (src/front/partmesh.c) */
+        fdt_certify_fail why;
+        fdt_certify_build_failed(&why);
+        fdt_certify_describe(&why, sw->diag, sw->dlen);
+        err = FDT_ECHECK;
+    }
+    size_t bytes = nq * (3 * sizeof *sw->Q + sizeof *sw->g + sizeof *mesh.vtet) +
+                   (size_t)mesh.cap * (8 * sizeof *mesh.T + 1);
+    if (!err && bytes > st->mem_part)
+        st->mem_part = bytes;
+    uint8_t *mark = err ? NULL : calloc(mesh.nslots ? mesh.nslots : 1, 1);
+    if (!err && !mark)
+        err = FDT_ENOMEM;
+    if (!err)
+        err = region(sw, &mesh, mark, begin, end, nq);
+    if (!err)
+        err = emit(sw, &mesh, mark, last, next);
+    if (!err && !last)
+        err = carry(sw, &mesh, mark, nq);
+    free(mark);
+    fdt_ins_free(&mesh);
+    return err;
+}
+
+/* The points of the sweep's slabs j .. e - 1 (counted along the sweep
+ * over the slabs [j0, j1)). */
+static uint64_t slab_points(const uint32_t *b, size_t j0, size_t j1, int dir, size_t j, size_t e)
+{
+    return dir > 0 ? (uint64_t)b[j0 + e] - b[j0 + j] : (uint64_t)b[j1 - j] - b[j1 - e];
+}
+
+/* The least coordinate along the sweep (times dir) of the points
+ * [begin, end). */
+static double least(const sweep *sw, uint32_t begin, uint32_t end)
+{
+    double x = INFINITY;
+    for (uint32_t i = begin; i < end; i++) {
+        double c = sw->dir * sw->P[3 * (size_t)i + (size_t)sw->axis];
+        x = c < x ? c : x;
+    }
+    return x;
+}
+
+/*
+ * The sweep over the slabs [j0, j1) of b (boundaries, nslabs slabs in
+ * all), upwards from j0 when sw->dir is +1, downwards from j1 when -1; a
+ * part takes slabs until its new points are twice the live ones carried
+ * in (entry 104: the points inserted again stay under the points
+ * themselves, however little is final). finish: the sweep's last part is
+ * the run's last (it emits everything); else what is left stays in L and
+ * B for the meeting part.
+ */
+static int run_sweep(sweep *sw, const uint32_t *b, size_t nslabs, size_t j0, size_t j1,
+                     int finish, fdt_progress_fn progress, void *puser)
+{
+    int err = FDT_OK;
+    size_t done = 0;
+    for (size_t j = 0; j < j1 - j0 && !err;) {
+        size_t e = j + 1;
+        while (e < j1 - j0 && slab_points(b, j0, j1, sw->dir, j, e) < 2 * (uint64_t)sw->nlive)
+            e++;
+        int last = finish && e == j1 - j0;
+        /* the slabs of the part, and the one after it along the sweep */
+        size_t lo = sw->dir > 0 ? j0 + j : j1 - e, hi = sw->dir > 0 ? j0 + e : j1 - j;
+        size_t after = sw->dir > 0 ? hi : lo - 1;
+        double next = last || (sw->dir > 0 ? after >= nslabs : lo == 0)
+                          ? INFINITY
+                          : least(sw, b[after], b[after + 1]);
+        err = part(sw, b[lo], b[hi], last, next);
+        done += b[hi] - b[lo];
+        j = e;
+        if (!err && progress && progress(puser, (double)done / (double)sw->m))
+            err = FDT_ECANCELED;
+    }
+    return err;
+}
+
+static void sweep_free(sweep *sw)
+{
+    free(sw->live);
+    free(sw->wall);
+    free(sw->nwalls);
+    free(sw->Q);
+    free(sw->g);
+    free(sw->map);
+}
+
+/* One of the two sweeps that meet (fdt_sweep_emit on threads), on a
+ * thread of its own. */
+typedef struct half {
+    sweep sw;
+    const uint32_t *b;
+    size_t nslabs, j0, j1;
+    fdt_emit em;
+    fdt_meshbuf mb;
+    fdt_sweep_stats st;
+    char diag[512];
+    int err;
+} half;
+
+static void *half_run(void *arg)
+{
+    half *h = arg;
+    h->err = run_sweep(&h->sw, h->b, h->nslabs, h->j0, h->j1, 0, NULL, NULL);
+    if (!h->err)
+        h->err = fdt_emit_flush(&h->em);
+    return NULL;
+}
+
+static void add_stats(fdt_sweep_stats *a, const fdt_sweep_stats *b)
+{
+    a->parts += b->parts;
+    a->reinserted += b->reinserted;
+    a->max_live = a->max_live > b->max_live ? a->max_live : b->max_live;
+    a->max_part = a->max_part > b->max_part ? a->max_part : b->max_part;
+    /* the two halves run at once: their largest parts add up */
+    a->mem_part += b->mem_part;
+    a->final_tets += b->final_tets;
+    a->certified_tets += b->certified_tets;
+    a->t_mesh += b->t_mesh;
+    a->t_certify += b->t_certify;
+    a->pc.orient_exact += b->pc.orient_exact;
+    a->pc.insphere_exact += b->pc.insphere_exact;
+    a->pc.orient_adapt += b->pc.orient_adapt;
+    a->pc.insphere_adapt += b->pc.insphere_adapt;
+    a->pc.insphere_unsure += b->pc.insphere_unsure;
+    add_ins_stats(&a->ins, &b->ins);
+}
+
+/* Appends what the second half kept in memory (the in-memory sink's
+ * meshbuf, tests only) to the caller's emitter. */
+static int append(fdt_emit *em, const fdt_meshbuf *mb)
+{
+    for (size_t t = 0; t < mb->ntets; t++) {
+        int64_t id = fdt_emit_tet(em, mb->tets + 4 * t);
+        if (id < 0)
+            return (int)id;
+    }
+    for (size_t f = 0; f < mb->nhull; f++) {
+        int err = fdt_emit_hull(em, mb->hull + 3 * f);
+        if (err)
+            return err;
+    }
+    return FDT_OK;
+}
+
+/*
+ * Two sweeps that meet (two or more threads and two or more slabs): the
+ * lower half of the slabs swept upwards, the upper half downwards, each on
+ * a thread of its own with its own meshes (no lock; the build threads
+ * shared between them), then one meeting part whose points are both
+ * halves' live vertices and whose B is both halves' boundaries. A tet the
+ * lower sweep emits has its sphere below the upper half's points and one
+ * the upper sweep emits above the lower half's, so the two never share a
+ * vertex: the two boundaries are disjoint, and the meeting part's region
+ * is the rest of the mesh (fdt_sweep.h's argument with both in B).
+ */
+static int meet(sweep *base, const uint32_t *b, size_t nslabs, fdt_progress_fn progress,
+                void *puser)
+{
+    half h[2];
+    memset(h, 0, sizeof h);
+    size_t mid = nslabs / 2;
+    int err = FDT_OK;
+    for (int i = 0; i < 2 && !err; i++) {
+        h[i].sw = *base;
+        h[i].sw.dir = i == 0 ? 1 : -1;
+        h[i].sw.nthreads = i == 0 ? (base->nthreads + 1) / 2 : base->nthreads / 2;
+        h[i].sw.st = &h[i].st;
+        h[i].sw.diag = h[i].diag;
+        h[i].sw.dlen = sizeof h[i].diag;
+        h[i].b = b;
+        h[i].nslabs = nslabs;
+        h[i].j0 = i == 0 ? 0 : mid;
+        h[i].j1 = i == 0 ? mid : nslabs;
+        int inmem = base->em->mb != NULL;
+        if (i == 0)
+            h[i].sw.em = base->em;
+        else if ((inmem && fdt_meshbuf_init(&h[i].mb, 64, 0)) ||
+                 fdt_emit_init(&h[i].em, base->em->s, inmem ? &h[i].mb : NULL))
+            err = FDT_ENOMEM;
+        else
+            h[i].sw.em = &h[i].em;
+    }
+    if (!err) {
+        /* the lower half on this thread: its emitter is the caller's */
+        h[0].em = *base->em;
+        h[0].sw.em = &h[0].em;
+        fdt_fork_join(h, sizeof h[0], 2, half_run);
+        *base->em = h[0].em;
+        err = h[0].err ? h[0].err : h[1].err;
+        const char *d = h[0].err ? h[0].diag : h[1].diag;
+        if (err && d[0])
+            snprintf(base->diag, base->dlen, "%s", d);
+    }
+    for (int i = 0; i < 2; i++)
+        add_stats(base->st, &h[i].st);
+    if (!err && base->em->mb)
+        err = append(base->em, &h[1].mb);
+    if (!err && progress && progress(puser, 0.95))
+        err = FDT_ECANCELED;
+    /* the meeting part: both halves' live vertices and boundaries */
+    size_t nl = h[0].sw.nlive + h[1].sw.nlive, nw = h[0].sw.nwall + h[1].sw.nwall;
+    if (!err && (grow((void **)&base->live, &base->lcap, nl, sizeof *base->live) ||
+                 grow((void **)&base->wall, &base->wcap, 3 * nw, sizeof *base->wall)))
+        err = FDT_ENOMEM;
+    if (!err) {
+        for (int i = 0, l = 0, w = 0; i < 2; i++) {
+            memcpy(base->live + l, h[i].sw.live, h[i].sw.nlive * sizeof *base->live);
+            memcpy(base->wall + w, h[i].sw.wall, 3 * h[i].sw.nwall * sizeof *base->wall);
+            l += (int)h[i].sw.nlive;
+            w += 3 * (int)h[i].sw.nwall;
+        }
+        base->nlive = nl;
+        base->nwall = nw;
+        err = part(base, 0, 0, 1, INFINITY);
+    }
+    for (int i = 0; i < 2; i++)
+        sweep_free(&h[i].sw);
+    fdt_emit_free(&h[1].em);
+    fdt_meshbuf_free(&h[1].mb);
+    return err;
+}
+
+int fdt_sweep_emit(double *P, fdt_vid *orig, uint32_t m, uint32_t slab, int nthreads,
+                   fdt_emit *em, fdt_progress_fn progress, void *puser, fdt_sweep_stats *st,
+                   char *diag, size_t dlen)
+{
+    sweep sw;
+    memset(&sw, 0, sizeof sw);
+    sw.P = P;
+    sw.orig = orig;
+    sw.m = m;
+    sw.dir = 1;
+    sw.nthreads = nthreads < 1 ? 1 : nthreads;
+    sw.em = em;
+    sw.st = st;
+    sw.diag = diag;
+    sw.dlen = dlen;
+    if (!slab)
+        slab = fdt_sweep_slab(m);
+    double lo[3], hi[3];
+    fdt_points_box(P, 0, m, lo, hi);
+    for (int k = 1; k < 3; k++)
+        if (hi[k] - lo[k] > hi[sw.axis] - lo[sw.axis])
+            sw.axis = k;
+    size_t nslabs = m / slab + (m % slab != 0);
+    if (nslabs < 1)
+        nslabs = 1;
+    uint32_t *b = malloc((nslabs + 1) * sizeof *b);
+    if (!b)
+        return FDT_ENOMEM;
+    for (size_t j = 0; j <= nslabs; j++)
+        b[j] = (uint32_t)((uint64_t)j * m / nslabs);
+    cut_slabs(P, orig, 0, m, b, 1, nslabs, sw.axis);
+    int err = sw.nthreads > 1 && nslabs > 1
+                  ? meet(&sw, b, nslabs, progress, puser)
+                  : run_sweep(&sw, b, nslabs, 0, nslabs, 1, progress, puser);
+    free(b);
+    sweep_free(&sw);
+    return err;
+}
