@@ -1,23 +1,19 @@
 /*
  * Tests of the apex oracle (src/front/oracle.c) through the library: the kd
- * search, the insertion mesh from the start, and the automatic switch must
- * give the same mesh -- the same canonical hash, tet for tet -- in serial,
- * shared and message modes, for any thread count, on the families where the
- * kd search degenerates (an exact cylinder, rotated and plain lattices,
- * integer points on a sphere, two parallel grid layers whose parts hold one
- * layer each, mixed magnitudes) and on uniform points. And:
+ * search and the insertion mesh must give the same mesh -- the same
+ * canonical hash, tet for tet -- in serial, shared and message modes, for
+ * any thread count, on the families where the kd search degenerates (an
+ * exact cylinder, rotated and plain lattices, integer points on a sphere,
+ * two parallel grid layers whose parts hold one layer each, mixed
+ * magnitudes) and on uniform points. And:
  *   - `--search mesh` results pass fdt_check (independent exact check);
- *   - the mesh answers faces (stats.mesh_faces) where it is asked to, and
- *     the automatic rule switches on the cylinder but not on uniform
- *     points (so a broken rule or a mesh never consulted fails here);
- *   - a part whose points are coplanar cannot build a mesh and falls back
- *     to the kd search with the same result;
- *   - FDT_MODE_AUTO with threads builds one mesh of every point for the
- *     cylinder (the probe) and its parts read it; a part of such a run
- *     votes for that mesh rather than building its own (collective),
- *     uniform points on two parts;
- *   - the time rules, driven with a window start's CPU that gives a known
- *     ratio: a collective part's early vote and later rule, the serial rule;
+ *   - the serial auto run is the one-part engine in memory and the parts
+ *     in sweep order streamed, every tet from a certified mesh;
+ *   - a part whose points are coplanar, or too few, cannot build a mesh
+ *     and falls back to the kd search with the same result;
+ *   - FDT_MODE_AUTO with threads is the one-part engine; an explicit mode
+ *     builds one mesh of every point for the cylinder (the probe) and its
+ *     parts read it;
  *   - in shared mode other parts' meshes answer the faces whose sphere
  *     crosses a cut (thread stats mesh_queries).
  * Usage: test_oracle [--quick]   (--quick: fewer thread counts)
@@ -357,24 +353,6 @@ static void test_probe_samples(void)
  * made z by stretching), so a part within one layer is one plane and
  * cannot build a mesh; the kd search answers there instead, with the same
  * result. */
-/* The switch comes as soon as the window in progress has spent enough to
- * decide it (src/front/oracle.c, window_budget), not at the window's end: on a
- * cylinder, whose first faces test hundreds of points each, before the
- * first window's 256 faces are done. Work counts, not times: deterministic. */
-static void test_early_switch(void)
-{
-    pts p = gen_cylinder(60, 64);
-    fdt_stats st;
-    fdt_result *r = run(&p, FDT_MODE_SERIAL, 1, FDT_SEARCH_AUTO, &st);
-    CHECK_EQ(st.mesh_parts, 1);
-    if (!(st.mesh_faces + 256 > st.faces_advanced))
-        fprintf(stderr, "early switch: %zu of %zu faces from the mesh\n", st.mesh_faces,
-                st.faces_advanced);
-    CHECK(st.mesh_faces + 256 > st.faces_advanced);
-    fdt_result_free(&r);
-    free(p.xyz);
-}
-
 static void test_flat_parts(void)
 {
     pts p = gen_layers(12, 7);
@@ -418,115 +396,31 @@ static void cyl_tree_free(cyl_tree *c)
     free(c->p.xyz);
 }
 
-/* A switch whose mesh would not fit the part's share of memory
- * (fdt_oracle.mem_cap) is not made: the oracle stays on the kd search
- * and says so; with no cap, or room, the same switch builds the mesh. The
- * oracle is driven directly: a spent window budget asks for the switch. */
-static void test_mem_cap(void)
+/* The mesh policy over a part of 3 points: no mesh, the kd search. */
+static void test_small_part(void)
 {
     cyl_tree cy;
     cyl_tree_make(&cy, 20, 32);
-    const size_t caps[3] = {1, 0, (size_t)(FDT_ORACLE_MESH_BYTES * (double)cy.pr.m) + 1};
-    const int want[3] = {-1, 1, 1};
-    for (int i = 0; i < 3; i++) {
-        fdt_oracle o;
-        fdt_oracle_init(&o, &cy.t, FDT_ORACLE_SWITCH);
-        o.mem_cap = caps[i];
-        o.w_budget = 0;
-        fdt_kdq kq;
-        memset(&kq, 0, sizeof kq);
-        kq.points = 1000;
-        fdt_oracle_tick(&o, 10, &kq);
-        EXPECTF(o.state == want[i] && o.mesh_refused == (want[i] < 0), "cap %zu: state %d",
-                caps[i], o.state);
-        fdt_oracle_free(&o);
-    }
-    /* the mesh policy (--search mesh) is kept whatever the cap */
-    fdt_oracle o;
-    fdt_oracle_init(&o, &cy.t, FDT_ORACLE_MESH);
-    o.mem_cap = 1;
-    fdt_kdq kq;
-    memset(&kq, 0, sizeof kq);
-    fdt_oracle_tick(&o, 0, &kq);
-    EXPECT(o.state == 1 && !o.mesh_refused);
-    fdt_oracle_free(&o);
-    EXPECT(fdt_oracle_mem_share(2) <= fdt_oracle_mem_share(1));
-    cyl_tree_free(&cy);
-    printf("ok memory cap\n");
-}
-
-/*
- * The switch is a function of the counters alone (issue 31: no rule reads
- * a clock): a window's points tested decide, the same counters give the
- * same state whatever time has passed, and the kd walk's nodes do not
- * count. Driven directly, as test_mem_cap, at the end of the first
- * window (FIRST_WINDOW, 256 faces).
- */
-static void test_counts_decide(void)
-{
-    cyl_tree cy;
-    cyl_tree_make(&cy, 20, 32);
-    /* points a face, nodes a face -> state */
-    static const struct {
-        size_t points, nodes;
-        int state;
-    } c[] = {
-        {20000, 5, 1}, /* 2,000 units a face: the mesh */
-        {400, 5, 1},   /* 400 units: over SWITCH_COST, whatever the walk */
-        {400, 30, 1},
-        {50, 30, 0},   /* 50 units: the kd search, however slow its walk */
-    };
-    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
-        for (int again = 0; again < 2; again++) {
-            fdt_oracle o;
-            fdt_oracle_init(&o, &cy.t, FDT_ORACLE_SWITCH);
-            fdt_kdq kq;
-            memset(&kq, 0, sizeof kq);
-            kq.points = 256 * c[i].points;
-            kq.nodes = 256 * c[i].nodes;
-            /* the thread's CPU spent between the two tries */
-            if (again)
-                for (volatile long k = 0; k < 20000000; k++)
-                    ;
-            fdt_oracle_tick(&o, 256, &kq);
-            EXPECTF(o.state == c[i].state, "case %zu (try %d): state %d, want %d", i, again,
-                    o.state, c[i].state);
-            if (o.state == 0) /* a window goes on */
-                EXPECT(o.next_check > 256 && o.w_faces == 256);
-            fdt_oracle_free(&o);
-        }
-    }
-    /* a window starting past the faces the run is expected to have: the
-     * next window has no budget */
-    fdt_oracle o;
-    fdt_kdq kq;
-    fdt_oracle_init(&o, &cy.t, FDT_ORACLE_SWITCH);
-    memset(&kq, 0, sizeof kq);
-    size_t late = (size_t)(7.0 * (double)cy.t.n);
-    fdt_oracle_tick(&o, late, &kq);
-    EXPECT(o.state == 0 && o.w_budget == SIZE_MAX && o.next_check > late);
-    fdt_oracle_free(&o);
     fdt_kd_free(&cy.t);
-
-    /* the mesh policy over a part of 3 points: no mesh, the kd search */
     CHECK_EQ(fdt_kd_build(&cy.t, cy.pr.p, cy.pr.orig, 0, 3, 18), FDT_OK);
+    fdt_oracle o;
+    fdt_kdq kq;
+    memset(&kq, 0, sizeof kq);
     fdt_oracle_init(&o, &cy.t, FDT_ORACLE_MESH);
     fdt_oracle_tick(&o, 0, &kq);
     EXPECT(o.state == -1);
     fdt_oracle_free(&o);
     cyl_tree_free(&cy);
-    printf("ok the counts decide\n");
+    printf("ok a part too small for a mesh\n");
 }
 
 int main(int argc, char **argv)
 {
     int quick = argc > 1 && !strcmp(argv[1], "--quick");
     alarm(600);
-    test_counts_decide();
-    test_mem_cap();
+    test_small_part();
     test_flat_parts();
     test_probe_samples();
-    test_early_switch();
     test_family(gen_uniform(3000, 1), quick);
     test_family(gen_cylinder(60, 64), quick);
     test_family(gen_lattice("lattice", 9, 0, 0, 0), quick);

@@ -92,8 +92,6 @@ static int front_run(const fdt_kdtree *t, uint32_t start, fdt_oracle_policy poli
     if (err)
         return err;
     fdt_oracle_init(&orc, t, policy);
-    if (policy == FDT_ORACLE_SWITCH)
-        orc.mem_cap = fdt_oracle_mem_share(1);
     if ((err = fdt_facetab_init(&ft, 4096)) != FDT_OK)
         return err;
     if ((err = fdt_faceq_init(&fq, t->base, t->n)) != FDT_OK) {

@@ -12,10 +12,12 @@
  *     across the face, one array read when the face came from a tet the
  *     mesh gave.
  * The perturbed Delaunay tetrahedralization is unique, so both give the
- * same apex and may be mixed face by face: a front starts on the kd
- * search and switches to the mesh when a window of faces shows the
- * searches are expensive. The mesh is a read-only certificate; tets are
- * still emitted one by one by the front, final when built.
+ * same apex and may be mixed face by face. The mesh is a read-only
+ * certificate; tets are still emitted one by one by the front, final when
+ * built. Which one a front uses is its search's row (src/front/search.c);
+ * no rule switches a front from one to the other any more (the serial
+ * front's cost rule went with issue 31: the insertion engines take the
+ * runs it served, src/api/api.c's pick_engine).
  *
  * In a part of the parallel engine the mesh holds only the part's points:
  * its answer is the first of the part's points in the pencil, and the
@@ -31,12 +33,10 @@
 #include "mesh/insert.h"
 #include "geom/kdtree.h"
 
-/* What an oracle starts as and whether it may switch (a search's row,
- * src/front/search.c, says which a front gets). */
+/* Which oracle a front uses (a search's row, src/front/search.c, says
+ * which a front gets). */
 typedef enum fdt_oracle_policy {
     FDT_ORACLE_KD,     /* the kd search only: no mesh is ever built */
-    FDT_ORACLE_SWITCH, /* the kd search, switching to the mesh by the cost
-                          rule of fdt_oracle_tick, if it fits mem_cap */
     FDT_ORACLE_MESH    /* the mesh, built at the first tick */
 } fdt_oracle_policy;
 
@@ -50,12 +50,6 @@ typedef struct fdt_oracle {
     uint32_t *mt;         /* owned: mesh tet of output tet i, FDT_NONE unknown */
     fdt_ins_query sq;     /* scratch of fdt_oracle_offer_star */
     size_t mtcap;
-    /* The switching window: counter values at its start. */
-    size_t next_check, w_faces, w_points, w_exact;
-    /* Work (points tested + FDT_ORACLE_EXACT_WEIGHT x exact tests, since
-     * the run's start) past which the window in progress must end in a switch:
-     * the switch is made as soon as it is passed (SIZE_MAX: never). */
-    size_t w_budget;
     /* Statistics. */
     size_t mesh_faces;    /* faces whose apex the mesh gave */
     size_t star_walks;    /* of those, found by a walk around a vertex */
@@ -63,11 +57,6 @@ typedef struct fdt_oracle {
                              fdt_oracle_offer_star */
     size_t switched_at;   /* faces advanced when the mesh was built (0: never) */
     double t_mesh;        /* seconds building the mesh */
-    /* FDT_ORACLE_SWITCH: the bytes this part's mesh may take (0: no cap). A
-     * switch whose mesh would not fit is not made (the kd search stays:
-     * always right, only slower); mesh_refused says it happened. */
-    size_t mem_cap;
-    int mesh_refused;
     /* FDT_ECHECK once a mesh it built failed its certificate (src/mesh/
      * certify.h; err_what says which check): the caller stops the run. */
     int err;
@@ -77,8 +66,10 @@ typedef struct fdt_oracle {
 } fdt_oracle;
 
 /* The weight of one exact test in the kd search's cost, counted in points
- * tested (src/front/oracle.c, the switching rule, says why 150); the probe
- * costs its faces the same way (src/front/probe.c). */
+ * tested: a point test costs ~8 ns inside the walk, an exact test that
+ * leaves the filter 0.3 us (expansions) to 2 us (GMP), so one exact test
+ * weighs as ~150 points. The probe costs its faces this way
+ * (src/front/probe.c). */
 #define FDT_ORACLE_EXACT_WEIGHT 150
 
 /* What an insertion mesh of n points takes at its peak, in bytes: about
@@ -87,25 +78,16 @@ typedef struct fdt_oracle {
  * tet). */
 #define FDT_ORACLE_MESH_BYTES 330.0
 
-/* The cap (fdt_oracle.mem_cap) for each of `parts` oracles that may each
- * build a mesh at once: an equal share of the memory available now
- * (fdt_mem_available). At 1e8 uniform points on two threads auto mode
- * built an insertion mesh (a part's switch or the probe's mesh of every
- * point: not measured which) and the run was killed at 24 GiB, where the
- * kd search alone peaks at 5.8 GiB (bench/NOTES.md entry 58). */
-size_t fdt_oracle_mem_share(int parts);
-
 void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, fdt_oracle_policy policy);
 void fdt_oracle_free(fdt_oracle *o);
 
 /*
  * Called before each face is advanced, with the front's running counters
- * (faces advanced so far, and the kd work in kq). Decides at the end of
- * each window whether the kd search has become expensive and, if so,
- * builds the mesh (counting its exact tests in kq) and certifies it. A
- * part whose points do not span 3-D, or a build that runs out of memory,
- * stays on the kd search; a mesh that fails its certificate sets o->err
- * (FDT_ECHECK), which the caller must check. Cheap between windows.
+ * (faces advanced so far, and the kd work in kq). With the mesh policy the
+ * first call builds the mesh (counting its exact tests in kq) and
+ * certifies it; a part whose points do not span 3-D, or a build that runs
+ * out of memory, stays on the kd search; a mesh that fails its certificate
+ * sets o->err (FDT_ECHECK), which the caller must check. Nothing after.
  */
 void fdt_oracle_tick(fdt_oracle *o, size_t faces, fdt_kdq *kq);
 

@@ -108,6 +108,21 @@ int64_t fdt_emit_tet_any(fdt_emit *em, const uint32_t v[4])
     return em->ntets++;
 }
 
+int64_t fdt_emit_tet_known(fdt_emit *em, const uint32_t v[4], const fdt_vid in[4])
+{
+    if (!em->tb)
+        return fdt_emit_tet(em, v);
+    fdt_vid *d = em->tb + 4 * em->tn;
+    memcpy(d, in, 4 * sizeof *d);
+    fdt_sethash_add(&em->h, (const uint32_t *)d);
+    if (++em->tn == em->s->batch) {
+        int rc = hand_on(em);
+        if (rc)
+            return rc;
+    }
+    return em->ntets++;
+}
+
 int fdt_emit_hull(fdt_emit *em, const uint32_t f[3])
 {
     em->nhull++;

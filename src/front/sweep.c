@@ -54,6 +54,7 @@ typedef struct sweep {
     size_t nnw, nwcap;
     double *Q;           /* the part's points */
     fdt_vid *g;          /* the part's local id -> global id */
+    fdt_vid *gin;        /* the part's local id -> input index (orig[g]) */
     size_t qcap;
     uint64_t *map;       /* global id + 1 << 32 | local id, of L's points */
     size_t mapcap, mapn; /* allocated, in use (a power of two) */
@@ -187,6 +188,9 @@ static int gather(sweep *sw, uint32_t begin, uint32_t end, size_t *nq_out)
     if (grow((void **)&sw->g, &cap, nq, sizeof *sw->g))
         return FDT_ENOMEM;
     cap = sw->qcap;
+    if (grow((void **)&sw->gin, &cap, nq, sizeof *sw->gin))
+        return FDT_ENOMEM;
+    cap = sw->qcap;
     if (grow((void **)&sw->Q, &cap, nq, 3 * sizeof *sw->Q))
         return FDT_ENOMEM;
     sw->qcap = cap;
@@ -196,7 +200,11 @@ static int gather(sweep *sw, uint32_t begin, uint32_t end, size_t *nq_out)
         memcpy(sw->Q + 3 * i, sw->P + 3 * (size_t)gid, 3 * sizeof *sw->Q);
     }
     *nq_out = nq;
-    return fdt_morton_sort(sw->Q, sw->g, nq) ? FDT_ENOMEM : FDT_OK;
+    if (fdt_morton_sort(sw->Q, sw->g, nq))
+        return FDT_ENOMEM;
+    for (size_t i = 0; i < nq; i++)
+        sw->gin[i] = sw->orig[sw->g[i]];
+    return FDT_OK;
 }
 
 /* The part's mesh, built and certified on the sweep's threads. */
@@ -320,9 +328,12 @@ static int emit(sweep *sw, const fdt_ins *mesh, uint8_t *mark, int last, double 
             if (!last && !ball_before(sw, v, next, &kq))
                 continue;
             uint32_t t[4];
-            for (int i = 0; i < 4; i++)
+            fdt_vid in[4];
+            for (int i = 0; i < 4; i++) {
                 t[i] = (uint32_t)sw->g[v[i]];
-            int64_t id = fdt_emit_tet(sw->em, t);
+                in[i] = sw->gin[v[i]];
+            }
+            int64_t id = fdt_emit_tet_known(sw->em, t, in);
             if (id < 0)
                 err = (int)id;
             sw->st->final_tets++;
@@ -433,7 +444,7 @@ static int part(sweep *sw, uint32_t begin, uint32_t end, int last, double next)
         fdt_certify_describe(&why, sw->diag, sw->dlen);
         err = FDT_ECHECK;
     }
-    size_t bytes = nq * (3 * sizeof *sw->Q + sizeof *sw->g + sizeof *mesh.vtet) +
+    size_t bytes = nq * (3 * sizeof *sw->Q + 2 * sizeof *sw->g + sizeof *mesh.vtet) +
                    (size_t)mesh.cap * (8 * sizeof *mesh.T + 1);
     if (!err && bytes > st->mem_part)
         st->mem_part = bytes;
@@ -511,6 +522,7 @@ static void sweep_free(sweep *sw)
     free(sw->nwalls);
     free(sw->Q);
     free(sw->g);
+    free(sw->gin);
     free(sw->map);
 }
 
