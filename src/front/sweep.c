@@ -140,10 +140,28 @@ static uint32_t map_find(const sweep *sw, uint32_t gid)
 /*
  * Whether the circumsphere of the positive finite tet v (local ids of
  * Q) ends strictly before `next` along the sweep (coordinates times dir):
- * then no point at or past `next` lies in or on it. The ball is the apex
- * search's conservative one (src/geom/kdtree.c: it holds the true sphere,
- * widened by its rounding bound, infinite where the tet is too flat to
- * bound), and its end is widened by the rounding of the one sum below.
+ * then no point at or past `next` lies in or on it. Saying no is always
+ * safe (the tet waits for a later part); yes must be certain.
+ *
+ * First from the lifted cofactors (src/geom/predicates.h, fdt_sphere_cof:
+ * with a = v[0] as the origin, det and N; the centre is a + N / (2 det),
+ * the radius |N| / (2 det)). Their errors: |det - det~| <= Bd =
+ * FDT_O3D_COF_BOUND m^3 (proved there); each component of N is 18
+ * monomials of degree 4 in the differences, each through at most 12
+ * roundings (its four differences, the lift's product and two sums, the
+ * cross product's product and difference, N's product and two sums), so
+ * |N - N~| <= gamma_12 18 m^4 < 216.1 eps m^4, under BN = 2^-45 m^4 with
+ * room for computing m^4. With det~ > 4 Bd, the centre's offset o = N /
+ * (2 det) is off o~ = N~ / (2 det~) by at most
+ *   delta = (BN + |N~|max Bd / det~) / (2 (det~ - Bd))
+ * a component (|o - o~| <= |N - N~| / 2det + |N~| |det - det~| / 2 det det~),
+ * and the radius |o| by at most sqrt(3) delta; 3 delta covers both, and 8
+ * eps of the terms' magnitudes the roundings of o~, its norm and the sum.
+ * Where that cannot decide (a tet flat next to its size, differences
+ * outside [2^-100, 2^100]), the apex search's conservative ball decides
+ * (src/geom/kdtree.c: it holds the true sphere, widened by its rounding
+ * bound, infinite where the tet is too flat to bound; the cofactors'
+ * bound cost 5 % of a streamed run less).
  */
 static int ball_before(const sweep *sw, const uint32_t *v, double next, fdt_kdq *kq)
 {
@@ -153,15 +171,33 @@ static int ball_before(const sweep *sw, const uint32_t *v, double next, fdt_kdq 
     for (int i = 0; i < 4; i++)
         if (!(dir * Q[3 * (size_t)v[i] + ax] < next))
             return 0; /* the tet itself reaches next: so does its sphere */
+    const double *a = Q + 3 * (size_t)v[0];
+    fdt_sphere_cof c;
+    fdt_sphere_cof_init(&c, a, Q + 3 * (size_t)v[1], Q + 3 * (size_t)v[2], Q + 3 * (size_t)v[3]);
+    if (fdt_sphere_cof_in_range(c.m)) {
+        const double m3 = c.m * c.m * c.m, bd = FDT_O3D_COF_BOUND * m3, bn = 0x1p-45 * (m3 * c.m);
+        if (c.det > 4.0 * bd) {
+            double nmax = fabs(c.n[0]);
+            nmax = fabs(c.n[1]) > nmax ? fabs(c.n[1]) : nmax;
+            nmax = fabs(c.n[2]) > nmax ? fabs(c.n[2]) : nmax;
+            const double delta = (bn + nmax * (bd / c.det)) / (2.0 * (c.det - bd));
+            const double h = 0.5 / c.det;
+            const double o[3] = {c.n[0] * h, c.n[1] * h, c.n[2] * h};
+            const double r = sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+            const double ca = dir * a[ax], co = dir * o[ax];
+            const double end =
+                ca + co + r + 3.0 * delta + 0x1p-50 * (fabs(ca) + fabs(co) + r);
+            return end < next;
+        }
+    }
     fdt_apex ap;
-    fdt_apex_init(&ap, Q + 3 * (size_t)v[0], Q + 3 * (size_t)v[1], Q + 3 * (size_t)v[2], v[0],
-                  v[1], v[2]);
+    fdt_apex_init(&ap, a, Q + 3 * (size_t)v[1], Q + 3 * (size_t)v[2], v[0], v[1], v[2]);
     fdt_apex_offer(&ap, v[3], Q + 3 * (size_t)v[3], kq);
     if (ap.best != v[3] || !(ap.rad < INFINITY))
         return 0;
-    double c = dir * ap.center[ax], r = ap.rad;
-    double end = c + r;
-    end += (fabs(c) + r) * 0x1p-50;
+    double cc = dir * ap.center[ax], rr = ap.rad;
+    double end = cc + rr;
+    end += (fabs(cc) + rr) * 0x1p-50;
     return end < next;
 }
 
