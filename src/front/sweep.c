@@ -22,14 +22,14 @@ enum { IN_U = 16, FINAL = 32 };
 
 uint32_t fdt_sweep_slab(size_t m)
 {
-    /* 64 c^2 with c the integer cube root of m: m^(2/3) without libm, so
+    /* 32 c^2 with c the integer cube root of m: m^(2/3) without libm, so
      * the cut is the same on every machine */
     uint64_t c = 0;
     while ((c + 1) * (c + 1) * (c + 1) <= (uint64_t)m)
         c++;
-    uint64_t s = 64 * c * c;
-    return s < (UINT64_C(1) << 16) ? UINT32_C(1) << 16
-           : s > (UINT64_C(1) << 22) ? UINT32_C(1) << 22
+    uint64_t s = 32 * c * c;
+    return s < (UINT64_C(1) << 18) ? UINT32_C(1) << 18
+           : s > (UINT64_C(1) << 21) ? UINT32_C(1) << 21
                                      : (uint32_t)s;
 }
 
@@ -58,6 +58,7 @@ typedef struct sweep {
     size_t qcap;
     uint64_t *map;       /* global id + 1 << 32 | local id, of L's points */
     size_t mapcap, mapn; /* allocated, in use (a power of two) */
+    int closing;         /* the last part emitted a quarter of its tets or more */
 } sweep;
 
 static int grow(void **a, size_t *cap, size_t need, size_t size)
@@ -470,6 +471,7 @@ static int part(sweep *sw, uint32_t begin, uint32_t end, int last, double next)
         for (size_t i = 0; i < nq; i++)
             sw->live[i] = (uint32_t)sw->g[i];
         sw->nlive = nq;
+        sw->closing = 1; /* no sign of spheres that stay open yet */
         return FDT_OK;
     }
     if (err == FDT_EDEGENERATE || err == FDT_EINVAL || err == FDT_EINTERNAL) {
@@ -489,8 +491,10 @@ static int part(sweep *sw, uint32_t begin, uint32_t end, int last, double next)
         err = FDT_ENOMEM;
     if (!err)
         err = region(sw, &mesh, mark, begin, end, nq);
+    size_t before = st->final_tets;
     if (!err)
         err = emit(sw, &mesh, mark, last, next);
+    sw->closing = 4 * (st->final_tets - before) >= mesh.nfinite;
     if (!err && !last)
         err = carry(sw, &mesh, mark, nq);
     free(mark);
@@ -517,6 +521,18 @@ static double least(const sweep *sw, uint32_t begin, uint32_t end)
     return x;
 }
 
+/* A half sweep's slabs from the j-th on (along the sweep) left, as live
+ * points, to the meeting part: as if that part took those slabs. */
+static int carry_rest(sweep *sw, const uint32_t *b, size_t j0, size_t j1, size_t j)
+{
+    uint32_t lo = sw->dir > 0 ? b[j0 + j] : b[j0], hi = sw->dir > 0 ? b[j1] : b[j1 - j];
+    if (grow((void **)&sw->live, &sw->lcap, sw->nlive + (hi - lo), sizeof *sw->live))
+        return FDT_ENOMEM;
+    for (uint32_t i = lo; i < hi; i++)
+        sw->live[sw->nlive++] = i;
+    return FDT_OK;
+}
+
 /*
  * The sweep over the slabs [j0, j1) of b (boundaries, nslabs slabs in
  * all), upwards from j0 when sw->dir is +1, downwards from j1 when -1; a
@@ -531,10 +547,20 @@ static int run_sweep(sweep *sw, const uint32_t *b, size_t nslabs, size_t j0, siz
 {
     int err = FDT_OK;
     size_t done = 0;
+    sw->closing = 1;
     for (size_t j = 0; j < j1 - j0 && !err;) {
         size_t e = j + 1;
         while (e < j1 - j0 && slab_points(b, j0, j1, sw->dir, j, e) < 2 * (uint64_t)sw->nlive)
             e++;
+        if (!sw->closing) {
+            /* Under a quarter of the last part's tets closed (a surface,
+             * whose spheres span the object): every part after would mesh
+             * its live vertices again for little, so the rest goes in one
+             * part (the meeting part, for a half sweep). */
+            if (!finish)
+                return carry_rest(sw, b, j0, j1, j);
+            e = j1 - j0;
+        }
         int last = finish && e == j1 - j0;
         /* the slabs of the part, and the one after it along the sweep */
         size_t lo = sw->dir > 0 ? j0 + j : j1 - e, hi = sw->dir > 0 ? j0 + e : j1 - j;

@@ -53,9 +53,15 @@ typedef struct fdt_sweep_stats {
     fdt_ins_stats ins;     /* the builds' counts, summed */
 } fdt_sweep_stats;
 
-/* The slab size for m points, a function of m alone: 64 m^(2/3) (the live
+/* The slab size for m points, a function of m alone: 32 m^(2/3) (the live
  * layer a part carries over is a few point layers of the cross-section,
- * about 3 m^(2/3) on well-spread points), at least 2^16, at most 2^22. */
+ * about 3 m^(2/3) on well-spread points, so about a tenth of the points
+ * are inserted twice), at least 2^18 (a smaller input is one part, the
+ * one-part engine's mesh: a first slab of a surface, where nothing closes,
+ * would be meshed twice for no memory worth saving), at most 2^21 (a
+ * part's mesh about 0.5 GB: 64 m^(2/3) up to 2^22 was 10 % faster on 10M
+ * uniform points at two threads and took twice the memory, bench/NOTES.md
+ * entry 104). */
 uint32_t fdt_sweep_slab(size_t m);
 
 /*
@@ -64,7 +70,9 @@ uint32_t fdt_sweep_slab(size_t m);
  * face handed to em (tree-order ids: the points' indices after this call,
  * which permutes P and orig together into slab order). slab: points a
  * slab (0: fdt_sweep_slab(m)); a part takes more slabs while the live
- * vertices it carries are over half of them. nthreads: the threads that
+ * vertices it carries are over half of them, and all that are left once a
+ * part emitted under a quarter of its tets (a surface: its spheres span
+ * the object, so no later part would do better). nthreads: the threads that
  * build and certify each part's mesh. progress (may be NULL) is called
  * after each part with the fraction of points passed; nonzero cancels.
  * Returns FDT_OK, FDT_ECHECK (a certificate failed: diag says where),
