@@ -2,6 +2,10 @@
 #define _DEFAULT_SOURCE /* madvise and MADV_HUGEPAGE are not POSIX */
 #include "base/mem.h"
 
+#include <stdlib.h>
+
+#include "frontdt.h"
+
 #include <stdint.h>
 #include <stdio.h>
 #include <unistd.h>
@@ -50,4 +54,19 @@ size_t fdt_mem_available_at(const char *meminfo)
         return (size_t)pages * (size_t)size;
 #endif
     return SIZE_MAX;
+}
+
+int fdt_grow(void *pp, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap)
+        return 0;
+    size_t c = *cap ? *cap : 64;
+    while (c < need)
+        c *= 2;
+    void *q = realloc(*(void **)pp, c * size);
+    if (!q)
+        return FDT_ENOMEM;
+    *(void **)pp = q;
+    *cap = c;
+    return 0;
 }

@@ -18,10 +18,16 @@
  * touch already gets a huge page. */
 void fdt_mem_advise_huge(void *p, size_t bytes);
 
+/* Grows the array *pp of elements of `size` bytes, holding *cap, to hold
+ * at least need (doubling from 64): 0, or FDT_ENOMEM (*pp and *cap
+ * unchanged). */
+int fdt_grow(void *pp, size_t *cap, size_t need, size_t size);
+
 /* The memory the system can still give without swapping, in bytes: the
  * kernel's MemAvailable (free memory plus the page cache it can drop),
  * else the free pages, else SIZE_MAX (unknown: no limit). For choices
- * that may trade memory for speed (src/front/oracle.c) only, never for
+ * that may trade memory for speed (the mesh of every point of an explicit
+ * --mode, src/par/parallel.c; an MPI rank's replica) only, never for
  * correctness. */
 size_t fdt_mem_available(void);
 /* The same with the kernel's file at meminfo (fdt_mem_available passes

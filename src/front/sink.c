@@ -86,6 +86,20 @@ static int hand_on(fdt_emit *em)
     return rc;
 }
 
+/* The stream's part of an emission: the tet just written at the batch's
+ * end (input numbering) hashed and counted, the batch handed on when
+ * full. */
+static int64_t stream_tet(fdt_emit *em)
+{
+    fdt_sethash_add(&em->h, (const uint32_t *)(em->tb + 4 * em->tn));
+    if (++em->tn == em->s->batch) {
+        int rc = hand_on(em);
+        if (rc)
+            return rc;
+    }
+    return em->ntets++;
+}
+
 int64_t fdt_emit_tet_any(fdt_emit *em, const uint32_t v[4])
 {
     if (em->mb) {
@@ -95,32 +109,18 @@ int64_t fdt_emit_tet_any(fdt_emit *em, const uint32_t v[4])
         em->ntets = tid + 1;
         return tid;
     }
-    if (em->tb) {
-        fdt_vid *d = em->tb + 4 * em->tn;
-        fdt_sink_renumber(em->s->orig, d, v, 4);
-        fdt_sethash_add(&em->h, (const uint32_t *)d);
-        if (++em->tn == em->s->batch) {
-            int rc = hand_on(em);
-            if (rc)
-                return rc;
-        }
-    }
-    return em->ntets++;
+    if (!em->tb)
+        return em->ntets++;
+    fdt_sink_renumber(em->s->orig, em->tb + 4 * em->tn, v, 4);
+    return stream_tet(em);
 }
 
 int64_t fdt_emit_tet_known(fdt_emit *em, const uint32_t v[4], const fdt_vid in[4])
 {
     if (!em->tb)
         return fdt_emit_tet(em, v);
-    fdt_vid *d = em->tb + 4 * em->tn;
-    memcpy(d, in, 4 * sizeof *d);
-    fdt_sethash_add(&em->h, (const uint32_t *)d);
-    if (++em->tn == em->s->batch) {
-        int rc = hand_on(em);
-        if (rc)
-            return rc;
-    }
-    return em->ntets++;
+    memcpy(em->tb + 4 * em->tn, in, 4 * sizeof *in);
+    return stream_tet(em);
 }
 
 int fdt_emit_hull(fdt_emit *em, const uint32_t f[3])

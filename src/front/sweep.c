@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "base/clock.h"
+#include "base/mem.h"
 #include "base/spawn.h"
 #include "geom/kdtree.h"
 #include "geom/morton.h"
@@ -55,26 +56,11 @@ typedef struct sweep {
     double *Q;           /* the part's points */
     fdt_vid *g;          /* the part's local id -> global id */
     fdt_vid *gin;        /* the part's local id -> input index (orig[g]) */
-    size_t qcap;
+    size_t qcap, gcap, gincap;
     uint64_t *map;       /* global id + 1 << 32 | local id, of L's points */
     size_t mapcap, mapn; /* allocated, in use (a power of two) */
     int closing;         /* the last part emitted a quarter of its tets or more */
 } sweep;
-
-static int grow(void **a, size_t *cap, size_t need, size_t size)
-{
-    if (need <= *cap)
-        return FDT_OK;
-    size_t nc = *cap ? *cap : 1024;
-    while (nc < need)
-        nc += nc / 2;
-    void *p = realloc(*a, nc * size);
-    if (!p)
-        return FDT_ENOMEM;
-    *a = p;
-    *cap = nc;
-    return FDT_OK;
-}
 
 /* The slabs: quickselect along the axis at each boundary b[lo .. hi), the
  * middle one first, so that every point of a slab is <= every point of the
@@ -221,16 +207,10 @@ static void add_ins_stats(fdt_ins_stats *a, const fdt_ins_stats *b)
 static int gather(sweep *sw, uint32_t begin, uint32_t end, size_t *nq_out)
 {
     size_t nq = sw->nlive + (end - begin);
-    size_t cap = sw->qcap;
-    if (grow((void **)&sw->g, &cap, nq, sizeof *sw->g))
+    if (fdt_grow(&sw->g, &sw->gcap, nq, sizeof *sw->g) ||
+        fdt_grow(&sw->gin, &sw->gincap, nq, sizeof *sw->gin) ||
+        fdt_grow(&sw->Q, &sw->qcap, nq, 3 * sizeof *sw->Q))
         return FDT_ENOMEM;
-    cap = sw->qcap;
-    if (grow((void **)&sw->gin, &cap, nq, sizeof *sw->gin))
-        return FDT_ENOMEM;
-    cap = sw->qcap;
-    if (grow((void **)&sw->Q, &cap, nq, 3 * sizeof *sw->Q))
-        return FDT_ENOMEM;
-    sw->qcap = cap;
     for (size_t i = 0; i < nq; i++) {
         uint32_t gid = i < sw->nlive ? sw->live[i] : begin + (uint32_t)(i - sw->nlive);
         sw->g[i] = (fdt_vid)gid;
@@ -273,6 +253,18 @@ static int internal(sweep *sw, const char *what)
     return FDT_EINTERNAL;
 }
 
+/* Slot t out of U, queued for the flood fill, if it was in U. */
+static int take_out(uint8_t *mark, uint32_t t, uint32_t **queue, size_t *n, size_t *cap)
+{
+    if (!(mark[t] & IN_U))
+        return FDT_OK;
+    mark[t] &= (uint8_t)~IN_U;
+    if (fdt_grow(queue, cap, *n + 1, sizeof **queue))
+        return FDT_ENOMEM;
+    (*queue)[(*n)++] = t;
+    return FDT_OK;
+}
+
 /*
  * U: every live slot, less the region of tets over what earlier parts
  * emitted (when they emitted anything). That region is bounded by B's
@@ -312,13 +304,9 @@ static int region(sweep *sw, const fdt_ins *mesh, uint8_t *mark, uint32_t begin,
         mark[t] |= (uint8_t)(1u << k);
         uint32_t r = fdt_ins_tet(mesh, t)[4 + k], o = r >> 2;
         mark[o] |= (uint8_t)(1u << (r & 3)); /* the face seen from the far side */
-        if (mark[o] & IN_U) {
-            mark[o] &= (uint8_t)~IN_U;
-            if (grow((void **)&queue, &qcap, nqueue + 1, sizeof *queue)) {
-                free(queue);
-                return FDT_ENOMEM;
-            }
-            queue[nqueue++] = o;
+        if (take_out(mark, o, &queue, &nqueue, &qcap)) {
+            free(queue);
+            return FDT_ENOMEM;
         }
     }
     for (size_t qi = 0; qi < nqueue; qi++) {
@@ -334,14 +322,9 @@ static int region(sweep *sw, const fdt_ins *mesh, uint8_t *mark, uint32_t begin,
         for (int k = 0; k < 4; k++) {
             if (mark[t] & (1u << k))
                 continue;
-            uint32_t n = v[4 + k] >> 2;
-            if (mark[n] & IN_U) {
-                mark[n] &= (uint8_t)~IN_U;
-                if (grow((void **)&queue, &qcap, nqueue + 1, sizeof *queue)) {
-                    free(queue);
-                    return FDT_ENOMEM;
-                }
-                queue[nqueue++] = n;
+            if (take_out(mark, v[4 + k] >> 2, &queue, &nqueue, &qcap)) {
+                free(queue);
+                return FDT_ENOMEM;
             }
         }
     }
@@ -411,7 +394,7 @@ static int carry(sweep *sw, const fdt_ins *mesh, const uint8_t *mark, size_t nq)
         for (int k = 0; k < 4 && !err; k++) {
             if (v[k] != INF && !seen[v[k]]) {
                 seen[v[k]] = 1;
-                if ((err = grow((void **)&sw->live, &sw->lcap, sw->nlive + 1, sizeof *sw->live)))
+                if ((err = fdt_grow(&sw->live, &sw->lcap, sw->nlive + 1, sizeof *sw->live)))
                     break;
                 sw->live[sw->nlive++] = (uint32_t)sw->g[v[k]];
             }
@@ -424,7 +407,7 @@ static int carry(sweep *sw, const fdt_ins *mesh, const uint8_t *mark, size_t nq)
                 err = internal(sw, "an emitted tet across a face with the infinite vertex");
                 break;
             }
-            if ((err = grow((void **)&sw->nwalls, &sw->nwcap, 3 * (sw->nnw + 1),
+            if ((err = fdt_grow(&sw->nwalls, &sw->nwcap, 3 * (sw->nnw + 1),
                             sizeof *sw->nwalls)))
                 break;
             uint32_t *o = sw->nwalls + 3 * sw->nnw++;
@@ -466,7 +449,7 @@ static int part(sweep *sw, uint32_t begin, uint32_t end, int last, double next)
     if (err == FDT_EDEGENERATE && !last && sw->nwall == 0) {
         /* The points so far are flat (a first slab on one plane): nothing
          * can be emitted yet, so all of them are live. */
-        if (grow((void **)&sw->live, &sw->lcap, nq, sizeof *sw->live))
+        if (fdt_grow(&sw->live, &sw->lcap, nq, sizeof *sw->live))
             return FDT_ENOMEM;
         for (size_t i = 0; i < nq; i++)
             sw->live[i] = (uint32_t)sw->g[i];
@@ -526,7 +509,7 @@ static double least(const sweep *sw, uint32_t begin, uint32_t end)
 static int carry_rest(sweep *sw, const uint32_t *b, size_t j0, size_t j1, size_t j)
 {
     uint32_t lo = sw->dir > 0 ? b[j0 + j] : b[j0], hi = sw->dir > 0 ? b[j1] : b[j1 - j];
-    if (grow((void **)&sw->live, &sw->lcap, sw->nlive + (hi - lo), sizeof *sw->live))
+    if (fdt_grow(&sw->live, &sw->lcap, sw->nlive + (hi - lo), sizeof *sw->live))
         return FDT_ENOMEM;
     for (uint32_t i = lo; i < hi; i++)
         sw->live[sw->nlive++] = i;
@@ -704,8 +687,8 @@ static int meet(sweep *base, const uint32_t *b, size_t nslabs, fdt_progress_fn p
         err = FDT_ECANCELED;
     /* the meeting part: both halves' live vertices and boundaries */
     size_t nl = h[0].sw.nlive + h[1].sw.nlive, nw = h[0].sw.nwall + h[1].sw.nwall;
-    if (!err && (grow((void **)&base->live, &base->lcap, nl, sizeof *base->live) ||
-                 grow((void **)&base->wall, &base->wcap, 3 * nw, sizeof *base->wall)))
+    if (!err && (fdt_grow(&base->live, &base->lcap, nl, sizeof *base->live) ||
+                 fdt_grow(&base->wall, &base->wcap, 3 * nw, sizeof *base->wall)))
         err = FDT_ENOMEM;
     if (!err) {
         for (int i = 0, l = 0, w = 0; i < 2; i++) {

@@ -38,6 +38,7 @@
  * the box) is an error, never a broken mesh.
  */
 #include "mesh/dualmesh.h"
+#include "base/mem.h"
 
 #include <limits.h>
 #include <math.h>
@@ -56,22 +57,6 @@
 const char *const fdt_dualmesh_patch[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
 
 /* ------------------------------------------------------------ small tools */
-
-/* Grows *p (elements of size sz) to hold at least need; 0 or -1. */
-static int grow(void *pp, size_t *cap, size_t need, size_t sz)
-{
-    if (need <= *cap)
-        return 0;
-    size_t c = *cap ? *cap : 64;
-    while (c < need)
-        c *= 2;
-    void *q = realloc(*(void **)pp, c * sz);
-    if (!q)
-        return -1;
-    *(void **)pp = q;
-    *cap = c;
-    return 0;
-}
 
 /* Open addressing from a pair of 64-bit keys to an index. */
 typedef struct kmap {
@@ -221,7 +206,7 @@ typedef struct dwork {
 
 static int64_t new_vertex(dwork *w, const double x[3])
 {
-    if (grow(&w->vx, &w->capv, 3 * (w->nv + 1), sizeof *w->vx) != 0)
+    if (fdt_grow(&w->vx, &w->capv, 3 * (w->nv + 1), sizeof *w->vx) != 0)
         return -1;
     memcpy(w->vx + 3 * w->nv, x, 3 * sizeof *x);
     return (int64_t)w->nv++;
@@ -714,7 +699,7 @@ static int clip_wall(dwork *w, size_t *m, int p)
         *m = 0;
         return FDT_OK;
     }
-    if (grow(&w->tmp, &w->captmp, 2 * cnt, sizeof *w->tmp) != 0)
+    if (fdt_grow(&w->tmp, &w->captmp, 2 * cnt, sizeof *w->tmp) != 0)
         return FDT_ENOMEM;
     for (size_t i = 0; i < cnt; i++) {
         const cv *cur = &w->poly[i], *nxt = &w->poly[(i + 1) % cnt];
@@ -759,10 +744,10 @@ static int clip_wall(dwork *w, size_t *m, int p)
 /* Appends a face (fnbr: a cell, or -1 - wall) of vertices ids[0 .. m). */
 static int append_face(dwork *w, const int64_t *ids, size_t m, int32_t own, int32_t nbr)
 {
-    if (grow(&w->fv, &w->capfv, w->nfv + m, sizeof *w->fv) != 0 ||
-        grow(&w->fs, &w->capf, w->nf + 2, sizeof *w->fs) != 0 ||
-        grow(&w->fown, &w->capfo, w->nf + 1, sizeof *w->fown) != 0 ||
-        grow(&w->fnbr, &w->capfn, w->nf + 1, sizeof *w->fnbr) != 0)
+    if (fdt_grow(&w->fv, &w->capfv, w->nfv + m, sizeof *w->fv) != 0 ||
+        fdt_grow(&w->fs, &w->capf, w->nf + 2, sizeof *w->fs) != 0 ||
+        fdt_grow(&w->fown, &w->capfo, w->nf + 1, sizeof *w->fown) != 0 ||
+        fdt_grow(&w->fnbr, &w->capfn, w->nf + 1, sizeof *w->fnbr) != 0)
         return FDT_ENOMEM;
     if (ids != w->fv + w->nfv)
         memcpy(w->fv + w->nfv, ids, m * sizeof *ids);
@@ -779,7 +764,7 @@ static int append_face(dwork *w, const int64_t *ids, size_t m, int32_t own, int3
  * get their numbers now), added when 3 distinct vertices are left. */
 static int put_face(dwork *w, size_t m, int32_t own, int32_t nbr)
 {
-    if (grow(&w->fv, &w->capfv, w->nfv + m, sizeof *w->fv) != 0)
+    if (fdt_grow(&w->fv, &w->capfv, w->nfv + m, sizeof *w->fv) != 0)
         return FDT_ENOMEM;
     int64_t *ids = w->fv + w->nfv;
     size_t k = 0;
@@ -826,7 +811,7 @@ static void entry_ray(dwork *w, cv *e, int64_t ray)
  * area, added. */
 static int add_face(dwork *w, fdt_vid a, fdt_vid b, size_t nr, int64_t hin, int64_t hout)
 {
-    if (grow(&w->poly, &w->cappoly, nr + 2, sizeof *w->poly) != 0)
+    if (fdt_grow(&w->poly, &w->cappoly, nr + 2, sizeof *w->poly) != 0)
         return FDT_ENOMEM;
     size_t m = 0;
     int64_t rin = hin >= 0 ? uf_find(w->huf, hin) : -1;
@@ -895,7 +880,7 @@ static int edge_face(dwork *w, fdt_tid t, fdt_vid a, fdt_vid b)
     fdt_tid u = t, next;
     int hq = -1, closed = 0;
     for (;;) {
-        if (grow(&w->ring, &w->capring, nr + 1, sizeof *w->ring) != 0)
+        if (fdt_grow(&w->ring, &w->capring, nr + 1, sizeof *w->ring) != 0)
             return FDT_ENOMEM;
         w->ring[nr++] = u;
         next = ring_step(w, u, a, b, 1, &hq);
@@ -918,7 +903,7 @@ static int edge_face(dwork *w, fdt_tid t, fdt_vid a, fdt_vid b)
         while ((next = ring_step(w, u, a, b, 0, &hq)) >= 0) {
             if (next < t || nr + nback > w->T)
                 return nr + nback > w->T ? FDT_EINTERNAL : FDT_OK;
-            if (grow(&w->ring, &w->capring, nr + nback + 1, sizeof *w->ring) != 0)
+            if (fdt_grow(&w->ring, &w->capring, nr + nback + 1, sizeof *w->ring) != 0)
                 return FDT_ENOMEM;
             w->ring[nr + nback++] = next;
             u = next;
@@ -1076,10 +1061,10 @@ static int wall_face(dwork *w, wallwork *ww, int32_t c, int p, size_t m, const i
 {
     uint64_t *e = ww->we;
     fdt_sort_u64(e, m);
-    if (grow(&ww->it, &ww->capit, m + (size_t)nc + 1, sizeof *ww->it) != 0 ||
-        grow(&w->fv, &w->capfv, w->nfv + 2 * m + (size_t)nc + 1, sizeof *w->fv) != 0)
+    if (fdt_grow(&ww->it, &ww->capit, m + (size_t)nc + 1, sizeof *ww->it) != 0 ||
+        fdt_grow(&w->fv, &w->capfv, w->nfv + 2 * m + (size_t)nc + 1, sizeof *w->fv) != 0)
         return FDT_ENOMEM;
-    if (grow(&ww->to, &ww->capto, m + 1, sizeof *ww->to) != 0)
+    if (fdt_grow(&ww->to, &ww->capto, m + 1, sizeof *ww->to) != 0)
         return FDT_ENOMEM;
     for (size_t i = 0; i < m; i++)
         ww->to[i] = e[i] & 0xffffffffu;
@@ -1173,7 +1158,7 @@ static int cell_walls(dwork *w, wallwork *ww, int32_t c, const size_t *cs, const
         size_t f = cf[j], k = w->fs[f + 1] - w->fs[f];
         const int64_t *v = w->fv + w->fs[f];
         int own = w->fown[f] == c;
-        if (grow(&ww->he, &ww->caphe, m + k, sizeof *ww->he) != 0)
+        if (fdt_grow(&ww->he, &ww->caphe, m + k, sizeof *ww->he) != 0)
             return FDT_ENOMEM;
         for (size_t i = 0; i < k; i++) {
             uint64_t a = (uint64_t)v[i], b = (uint64_t)v[(i + 1) % k];
@@ -1184,7 +1169,7 @@ static int cell_walls(dwork *w, wallwork *ww, int32_t c, const size_t *cs, const
     qsort(ww->he, m, sizeof *ww->he, hedge_cmp);
     /* the unmatched ones, reversed, after the first m */
     size_t nw = 0;
-    if (grow(&ww->he, &ww->caphe, 2 * m + 1, sizeof *ww->he) != 0)
+    if (fdt_grow(&ww->he, &ww->caphe, 2 * m + 1, sizeof *ww->he) != 0)
         return FDT_ENOMEM;
     for (size_t i = 0; i < m; i++) {
         hedge r = ww->he[i];
@@ -1206,7 +1191,7 @@ static int cell_walls(dwork *w, wallwork *ww, int32_t c, const size_t *cs, const
             if (corner_of[k] == c && ((k >> (p >> 1)) & 1) == (p & 1))
                 corners[nc++] = corner_id[k];
         size_t me = 0;
-        if (grow(&ww->we, &ww->capwe, nw + 1, sizeof *ww->we) != 0)
+        if (fdt_grow(&ww->we, &ww->capwe, nw + 1, sizeof *ww->we) != 0)
             return FDT_ENOMEM;
         for (size_t i = 0; i < nw; i++)
             if (ww->he[m + i].wall == p)
