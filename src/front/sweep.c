@@ -286,50 +286,48 @@ static int region(sweep *sw, const fdt_ins *mesh, uint8_t *mark, uint32_t begin,
         return FDT_OK;
     if (map_build(sw, nq, begin, end))
         return FDT_ENOMEM;
-    uint32_t *queue = NULL;
+    uint32_t *queue = NULL, *side = malloc(sw->nwall * sizeof *side);
     size_t nqueue = 0, qcap = 0;
-    for (size_t w = 0; w < sw->nwall; w++) {
+    if (!side)
+        return FDT_ENOMEM;
+    int err = FDT_OK;
+    for (size_t w = 0; w < sw->nwall && !err; w++) {
         uint32_t l[3];
-        for (int i = 0; i < 3; i++)
-            if ((l[i] = map_find(sw, sw->wall[3 * w + i])) == FDT_NONE) {
-                free(queue);
-                return internal(sw, "a vertex of the emitted tets' boundary is not live");
-            }
+        for (int i = 0; i < 3 && !err; i++)
+            if ((l[i] = map_find(sw, sw->wall[3 * w + i])) == FDT_NONE)
+                err = internal(sw, "a vertex of the emitted tets' boundary is not live");
         uint32_t t;
         int k;
-        if (!fdt_ins_find_face(mesh, l[0], l[1], l[2], &t, &k)) {
-            free(queue);
-            return internal(sw, "a face of the emitted tets' boundary is not in the next mesh");
-        }
+        if (!err && !fdt_ins_find_face(mesh, l[0], l[1], l[2], &t, &k))
+            err = internal(sw, "a face of the emitted tets' boundary is not in the next mesh");
+        if (err)
+            break;
+        side[w] = t;
         mark[t] |= (uint8_t)(1u << k);
         uint32_t r = fdt_ins_tet(mesh, t)[4 + k], o = r >> 2;
         mark[o] |= (uint8_t)(1u << (r & 3)); /* the face seen from the far side */
-        if (take_out(mark, o, &queue, &nqueue, &qcap)) {
-            free(queue);
-            return FDT_ENOMEM;
-        }
+        err = take_out(mark, o, &queue, &nqueue, &qcap);
     }
-    for (size_t qi = 0; qi < nqueue; qi++) {
+    for (size_t qi = 0; qi < nqueue && !err; qi++) {
         uint32_t t = queue[qi];
         const uint32_t *v = fdt_ins_tet(mesh, t);
         /* The emitted region lies inside the hull of the points so far,
          * whose vertices are all live, so the mesh covers it with finite
          * tets: an infinite one here says the parts disagree. */
-        if (!fdt_ins_is_finite(mesh, t)) {
-            free(queue);
-            return internal(sw, "the emitted region reaches past the hull");
-        }
-        for (int k = 0; k < 4; k++) {
-            if (mark[t] & (1u << k))
-                continue;
-            if (take_out(mark, v[4 + k] >> 2, &queue, &nqueue, &qcap)) {
-                free(queue);
-                return FDT_ENOMEM;
-            }
-        }
+        if (!fdt_ins_is_finite(mesh, t))
+            err = internal(sw, "the emitted region reaches past the hull");
+        for (int k = 0; k < 4 && !err; k++)
+            if (!(mark[t] & (1u << k)))
+                err = take_out(mark, v[4 + k] >> 2, &queue, &nqueue, &qcap);
     }
+    /* B separates the two regions: a fill that reached a live side crossed
+     * a face missing from B, and would drop live tets unseen. */
+    for (size_t w = 0; w < sw->nwall && !err; w++)
+        if (!(mark[side[w]] & IN_U))
+            err = internal(sw, "the emitted region reaches a live tet");
     free(queue);
-    return FDT_OK;
+    free(side);
+    return err;
 }
 
 /* Emits U's final tets (and, in the last part, U's hull faces) in slot
