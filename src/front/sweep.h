@@ -17,9 +17,16 @@
  * of DT(P)'s tets and belongs to no other tet of DT(P), so every tet of
  * DT(P_<=k) not yet emitted has its vertices in S_k and, its sphere empty
  * of P_<=k, is a tet of DT(S_k); those tets fill the region bounded by B
- * and the hull, which a flood fill from B's faces that never crosses one
- * reaches. A face of B that is not a face of the next part's mesh is an
- * internal error, so a wrong emission cannot pass unseen.
+ * and the hull: the rest of the mesh, over what was emitted, is what a
+ * flood fill from the far side of B's faces that never crosses one
+ * reaches. A face of B that is not a face of the next part's mesh, or a
+ * fill that reaches a live side, is an internal error, so a wrong
+ * emission cannot pass unseen.
+ *
+ * With two or more threads and slabs, two sweeps meet: the lower half of
+ * the slabs swept upwards and the upper half downwards, each on a thread
+ * of its own with its own meshes, then one meeting part of both halves'
+ * L and B (a tet one sweep emits shares no vertex with the other's).
  */
 #ifndef FDT_SWEEP_H
 #define FDT_SWEEP_H
@@ -72,9 +79,11 @@ uint32_t fdt_sweep_slab(size_t m);
  * slab (0: fdt_sweep_slab(m)); a part takes more slabs while the live
  * vertices it carries are over half of them, and all that are left once a
  * part emitted under a quarter of its tets (a surface: its spheres span
- * the object, so no later part would do better). nthreads: the threads that
- * build and certify each part's mesh. progress (may be NULL) is called
- * after each part with the fraction of points passed; nonzero cancels.
+ * the object, so no later part would do better). nthreads: the threads of
+ * the run (two sweeps that meet, each building its parts on half of them;
+ * the meeting part, or a single sweep, on all). progress (may be NULL) is
+ * called after each part with the fraction of points passed; nonzero
+ * cancels.
  * Returns FDT_OK, FDT_ECHECK (a certificate failed: diag says where),
  * FDT_ENOMEM, FDT_ETOOBIG, FDT_EINTERNAL, FDT_ECANCELED or the sink's stop
  * code.
