@@ -4,7 +4,7 @@
  * small enough for many parts (and the default), at 1 and 3 threads, are
  * exactly the Delaunay mesh of all the points built in one piece
  * (src/mesh/insert.c); with the smallest slabs every family's run must
- * have more than one part.
+ * have more than one part. A progress callback's nonzero return cancels.
  *
  * Usage: test_sweep GEN_POINTS
  */
@@ -192,6 +192,42 @@ static void test_family(const char *gen, const char *fam, size_t n)
     fdt_prepared_free(&pr);
 }
 
+static int cancel_now(void *user, double fraction)
+{
+    (void)fraction;
+    ++*(int *)user;
+    return 1;
+}
+
+/* A progress callback's nonzero return stops the sweep after the part it
+ * follows, one sweep or two that meet: FDT_ECANCELED. */
+static void test_cancel(const char *gen)
+{
+    size_t got;
+    double *xyz = family(gen, "uniform", 3000, &got);
+    char diag[512];
+    fdt_prepared pr;
+    CHECK_EQ(fdt_prepare(xyz, got, 1, &pr, diag, sizeof diag), FDT_OK);
+    free(xyz);
+    for (int threads = 1; threads <= 2; threads++) {
+        fdt_tsink sink;
+        fdt_emit em;
+        CHECK_EQ(fdt_tsink_init(&sink, pr.orig, NULL), FDT_OK);
+        CHECK_EQ(fdt_emit_init(&em, &sink, NULL), FDT_OK);
+        fdt_sweep_stats st;
+        memset(&st, 0, sizeof st);
+        int calls = 0;
+        int err = fdt_sweep_emit(pr.p, pr.orig, (uint32_t)pr.m, 500, threads, &em, cancel_now,
+                                 &calls, &st, diag, sizeof diag);
+        EXPECTF(err == FDT_ECANCELED && calls == 1,
+                "cancel at %d threads: %d after %d calls, %zu parts", threads, err, calls,
+                st.parts);
+        fdt_emit_free(&em);
+        fdt_tsink_free(&sink);
+    }
+    fdt_prepared_free(&pr);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -210,5 +246,6 @@ int main(int argc, char **argv)
     }
     pclose(f);
     EXPECTF(families > 30, "only %d families listed", families);
+    test_cancel(argv[1]);
     return test_report("sweep");
 }
