@@ -23,7 +23,6 @@ void fdt_oracle_init(fdt_oracle *o, const fdt_kdtree *t, fdt_oracle_policy polic
 {
     memset(o, 0, sizeof *o);
     o->t = t;
-    o->policy = policy;
     o->state = policy == FDT_ORACLE_KD ? -1 : 0;
 }
 

@@ -42,8 +42,9 @@ typedef enum fdt_oracle_policy {
 
 typedef struct fdt_oracle {
     const fdt_kdtree *t;  /* borrowed: the part's tree (its points) */
-    fdt_oracle_policy policy;
-    int state;            /* 0: kd search; 1: mesh; -1: mesh unavailable */
+    int state;            /* 0: the mesh to build at the next tick (the mesh
+                             policy); 1: mesh; -1: the kd search (the kd
+                             policy, or no mesh could be built) */
     fdt_ins mesh;         /* owned, valid when state == 1 and !gm */
     const fdt_ins *gm;    /* borrowed: a mesh of every point (shared by
                              all parts, fdt_oracle_share), or NULL */

@@ -53,15 +53,11 @@ static int emit_hull(const fdt_ins *mesh, fdt_emit *em)
 {
     for (uint32_t s = 0; s < mesh->nslots; s++) {
         const uint32_t *v = fdt_ins_tet(mesh, s);
-        int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
-        if (inf < 0 || (v[0] == INF && v[1] == INF)) /* finite, or a freed slot */
+        int inf = fdt_ins_inf_index(v);
+        if (inf < 0 || fdt_ins_is_free(mesh, s))
             continue;
-        /* An infinite tet is positive with any point outside its hull
-         * face in place of the infinite vertex (src/mesh/insert.h), so
-         * that point is on the negative side of the tet's outward face
-         * there: the hull face, outward, is that face reversed. */
-        const int *f = fdt_tet_face[inf];
-        uint32_t h[3] = {v[f[0]], v[f[2]], v[f[1]]};
+        uint32_t h[3];
+        fdt_ins_face_inward(v, inf, h);
         int err = fdt_emit_hull(em, h);
         if (err)
             return err;

@@ -277,11 +277,9 @@ static int take_out(uint8_t *mark, uint32_t t, uint32_t **queue, size_t *n, size
 static int region(sweep *sw, const fdt_ins *mesh, uint8_t *mark, uint32_t begin, uint32_t end,
                   size_t nq)
 {
-    for (uint32_t s = 0; s < mesh->nslots; s++) {
-        const uint32_t *v = fdt_ins_tet(mesh, s);
-        if (!(v[0] == INF && v[1] == INF)) /* not a freed slot */
+    for (uint32_t s = 0; s < mesh->nslots; s++)
+        if (!fdt_ins_is_free(mesh, s))
             mark[s] = IN_U;
-    }
     if (sw->nwall == 0)
         return FDT_OK;
     if (map_build(sw, nq, begin, end))
@@ -341,7 +339,7 @@ static int emit(sweep *sw, const fdt_ins *mesh, uint8_t *mark, int last, double 
         if (!(mark[s] & IN_U))
             continue;
         const uint32_t *v = fdt_ins_tet(mesh, s);
-        int inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : v[3] == INF ? 3 : -1;
+        int inf = fdt_ins_inf_index(v);
         if (inf < 0) {
             if (!last && !ball_before(sw, v, next, &kq))
                 continue;
@@ -358,19 +356,15 @@ static int emit(sweep *sw, const fdt_ins *mesh, uint8_t *mark, int last, double 
         } else {
             if (!last)
                 continue;
-            /* the hull face outward: the infinite tet's face reversed
-             * (src/front/partmesh.c's emit_hull) */
-            const int *f = fdt_tet_face[inf];
-            uint32_t h[3] = {(uint32_t)sw->g[v[f[0]]], (uint32_t)sw->g[v[f[2]]],
-                             (uint32_t)sw->g[v[f[1]]]};
+            uint32_t h[3];
+            fdt_ins_face_inward(v, inf, h); /* the hull face, outward */
+            for (int i = 0; i < 3; i++)
+                h[i] = (uint32_t)sw->g[h[i]];
             err = fdt_emit_hull(sw->em, h);
         }
         mark[s] |= FINAL;
     }
-    sw->st->pc.orient_exact += kq.pc.orient_exact;
-    sw->st->pc.insphere_exact += kq.pc.insphere_exact;
-    sw->st->pc.orient_adapt += kq.pc.orient_adapt;
-    sw->st->pc.insphere_adapt += kq.pc.insphere_adapt;
+    fdt_pred_counts_add(&sw->st->pc, &kq.pc);
     return err;
 }
 
@@ -399,9 +393,9 @@ static int carry(sweep *sw, const fdt_ins *mesh, const uint8_t *mark, size_t nq)
             uint32_t n = v[4 + k] >> 2;
             if (!(mark[s] & (1u << k)) && !(mark[n] & FINAL))
                 continue;
-            const int *f = fdt_tet_face[k];
-            uint32_t a = v[f[0]], b = v[f[2]], c = v[f[1]]; /* reversed: open towards s */
-            if (a == INF || b == INF || c == INF) {
+            uint32_t f[3];
+            fdt_ins_face_inward(v, k, f); /* open towards s */
+            if (f[0] == INF || f[1] == INF || f[2] == INF) {
                 err = internal(sw, "an emitted tet across a face with the infinite vertex");
                 break;
             }
@@ -409,9 +403,8 @@ static int carry(sweep *sw, const fdt_ins *mesh, const uint8_t *mark, size_t nq)
                             sizeof *sw->nwalls)))
                 break;
             uint32_t *o = sw->nwalls + 3 * sw->nnw++;
-            o[0] = (uint32_t)sw->g[a];
-            o[1] = (uint32_t)sw->g[b];
-            o[2] = (uint32_t)sw->g[c];
+            for (int i = 0; i < 3; i++)
+                o[i] = (uint32_t)sw->g[f[i]];
         }
     }
     free(seen);
@@ -494,12 +487,9 @@ static uint64_t slab_points(const uint32_t *b, size_t j0, size_t j1, int dir, si
  * [begin, end). */
 static double least(const sweep *sw, uint32_t begin, uint32_t end)
 {
-    double x = INFINITY;
-    for (uint32_t i = begin; i < end; i++) {
-        double c = sw->dir * sw->P[3 * (size_t)i + (size_t)sw->axis];
-        x = c < x ? c : x;
-    }
-    return x;
+    double lo[3], hi[3];
+    fdt_points_box(sw->P, begin, end, lo, hi);
+    return sw->dir > 0 ? lo[sw->axis] : -hi[sw->axis];
 }
 
 /* A half sweep's slabs from the j-th on (along the sweep) left, as live
@@ -603,11 +593,7 @@ static void add_stats(fdt_sweep_stats *a, const fdt_sweep_stats *b)
     a->certified_tets += b->certified_tets;
     a->t_mesh += b->t_mesh;
     a->t_certify += b->t_certify;
-    a->pc.orient_exact += b->pc.orient_exact;
-    a->pc.insphere_exact += b->pc.insphere_exact;
-    a->pc.orient_adapt += b->pc.orient_adapt;
-    a->pc.insphere_adapt += b->pc.insphere_adapt;
-    a->pc.insphere_unsure += b->pc.insphere_unsure;
+    fdt_pred_counts_add(&a->pc, &b->pc);
     add_ins_stats(&a->ins, &b->ins);
 }
 

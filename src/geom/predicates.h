@@ -46,6 +46,16 @@ typedef struct fdt_pred_counts {
     size_t insphere_unsure;
 } fdt_pred_counts;
 
+/* a += b's exact and adaptive calls (merging threads' or phases'
+ * counters; insphere_unsure is each insertion's own, not summed). */
+static inline void fdt_pred_counts_add(fdt_pred_counts *a, const fdt_pred_counts *b)
+{
+    a->orient_exact += b->orient_exact;
+    a->insphere_exact += b->insphere_exact;
+    a->orient_adapt += b->orient_adapt;
+    a->insphere_adapt += b->insphere_adapt;
+}
+
 /* The outward faces of a positively oriented tet: face i is opposite
  * vertex i and has that vertex on its negative side (orient3d of the face
  * and v[i] < 0). */

@@ -357,12 +357,8 @@ int fdt_certify_parallel(const fdt_ins *m, int nthreads, fdt_pred_counts *cnt,
     if (!err)
         err = certify_balance(m, skipped, pairs, why);
     if (cnt)
-        for (int i = 0; i < nthreads; i++) {
-            cnt->orient_exact += j[i].pc.orient_exact;
-            cnt->insphere_exact += j[i].pc.insphere_exact;
-            cnt->orient_adapt += j[i].pc.orient_adapt;
-            cnt->insphere_adapt += j[i].pc.insphere_adapt;
-        }
+        for (int i = 0; i < nthreads; i++)
+            fdt_pred_counts_add(cnt, &j[i].pc);
     free(j);
     return err ? err : fdt_certify_vertices(m, why);
 }

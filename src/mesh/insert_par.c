@@ -1088,12 +1088,8 @@ static void sum_worker_stats(fdt_ins *m, const worker *ws, int nw, fdt_pred_coun
         m->stats.stolen += s->stolen;
         if (s->max_cavity > m->stats.max_cavity)
             m->stats.max_cavity = s->max_cavity;
-        if (cnt) {
-            cnt->orient_exact += ws[i].cnt.orient_exact;
-            cnt->insphere_exact += ws[i].cnt.insphere_exact;
-            cnt->orient_adapt += ws[i].cnt.orient_adapt;
-            cnt->insphere_adapt += ws[i].cnt.insphere_adapt;
-        }
+        if (cnt)
+            fdt_pred_counts_add(cnt, &ws[i].cnt);
     }
 }
 

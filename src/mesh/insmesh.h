@@ -81,6 +81,35 @@ static inline int fdt_ins_is_finite(const fdt_ins *m, uint32_t t)
     return v[0] != FDT_NONE && v[1] != FDT_NONE && v[2] != FDT_NONE && v[3] != FDT_NONE;
 }
 
+/* Whether slot t is freed (a free-list slot: FDT_NONE as vertices 0 and
+ * 1, which no live tet has). */
+static inline int fdt_ins_is_free(const fdt_ins *m, uint32_t t)
+{
+    const uint32_t *v = m->T + 8 * (size_t)t;
+    return v[0] == FDT_NONE && v[1] == FDT_NONE;
+}
+
+/* The index of the infinite vertex in the live tet row v, -1 for a
+ * finite tet. */
+static inline int fdt_ins_inf_index(const uint32_t *v)
+{
+    return v[0] == FDT_NONE ? 0 : v[1] == FDT_NONE ? 1 : v[2] == FDT_NONE ? 2
+         : v[3] == FDT_NONE ? 3 : -1;
+}
+
+/* Face k of the positive tet row v (the face opposite vertex k) oriented
+ * with v on its open side: fdt_tet_face[k] reversed. For an infinite tet
+ * and k its infinite vertex's index, the hull face, outward (a point
+ * outside the face in the infinite vertex's place makes the tet
+ * positive, so that point is on the negative side of fdt_tet_face[k]). */
+static inline void fdt_ins_face_inward(const uint32_t *v, int k, uint32_t f[3])
+{
+    const int *o = fdt_tet_face[k];
+    f[0] = v[o[0]];
+    f[1] = v[o[2]];
+    f[2] = v[o[1]];
+}
+
 /*
  * The neighbour of tet `tet` across its face k (the face opposite vertex
  * k): *ntet gets the neighbour's slot, *nk the index of the shared face in

@@ -555,10 +555,7 @@ static int collect_stats(engine *e, const fdt_partition *pt, int nthreads, const
     out->fst.t_certify += e->gm_t_certify;
     out->fst.kq.nodes += kq0->nodes;
     out->fst.kq.points += kq0->points;
-    out->fst.kq.pc.orient_exact += kq0->pc.orient_exact;
-    out->fst.kq.pc.insphere_exact += kq0->pc.insphere_exact;
-    out->fst.kq.pc.orient_adapt += kq0->pc.orient_adapt;
-    out->fst.kq.pc.insphere_adapt += kq0->pc.insphere_adapt;
+    fdt_pred_counts_add(&out->fst.kq.pc, &kq0->pc);
     ps->load_imbalance = sumt ? (double)maxt * nthreads / (double)sumt : 1.0;
     ps->pinned = e->pin ? (atomic_load_explicit(&e->pin_refused, memory_order_relaxed) ? -1 : 1) : 0;
     return FDT_OK;
