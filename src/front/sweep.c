@@ -676,8 +676,12 @@ static int meet(sweep *base, const uint32_t *b, size_t nslabs, fdt_progress_fn p
         err = FDT_ENOMEM;
     if (!err) {
         for (int i = 0, l = 0, w = 0; i < 2; i++) {
-            memcpy(base->live + l, h[i].sw.live, h[i].sw.nlive * sizeof *base->live);
-            memcpy(base->wall + w, h[i].sw.wall, 3 * h[i].sw.nwall * sizeof *base->wall);
+            /* a half may end with no live vertex or no boundary: its
+               arrays are then NULL, which memcpy may not take even for 0 */
+            if (h[i].sw.nlive)
+                memcpy(base->live + l, h[i].sw.live, h[i].sw.nlive * sizeof *base->live);
+            if (h[i].sw.nwall)
+                memcpy(base->wall + w, h[i].sw.wall, 3 * h[i].sw.nwall * sizeof *base->wall);
             l += (int)h[i].sw.nlive;
             w += 3 * (int)h[i].sw.nwall;
         }
