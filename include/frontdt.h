@@ -754,6 +754,9 @@ FDT_API void fdt_voronoi_free(fdt_voronoi **v);
  * without the faces of zero area (fdt_voronoi_zero_faces). The DTFE
  * density is 4 / (the sum of the volumes of the point's tets). */
 FDT_API size_t fdt_voronoi_num_points(const fdt_voronoi *v);
+/* The rows' points: NULL for fdt_voronoi_compute's cells (row i is point
+ * i); for a batch of fdt_voronoi_stream, each row's input id. */
+FDT_API const fdt_vid *fdt_voronoi_ids(const fdt_voronoi *v);
 FDT_API const double *fdt_voronoi_volumes(const fdt_voronoi *v);
 FDT_API const double *fdt_voronoi_areas(const fdt_voronoi *v);
 FDT_API const double *fdt_voronoi_centroids(const fdt_voronoi *v);
@@ -785,6 +788,39 @@ FDT_API int fdt_voronoi_neighbors(const fdt_voronoi *v, fdt_vid i, size_t *count
 FDT_API int fdt_voronoi_polyhedron(fdt_voronoi *v, const double *xyz, fdt_vid i, size_t *nverts,
                                    const double **verts, size_t *nfaces,
                                    const int32_t **faces);
+
+/*
+ * Streamed cells (issue 32): the triangulation of fdt_triangulate_stream
+ * with each point's Voronoi cell handed to cells->cells as soon as the
+ * point's last tet is out, so that no more cells are held than a part's
+ * points (the run's parts in sweep order: settings.search FDT_SEARCH_AUTO,
+ * FDT_MODE_AUTO or serial, no pin; else FDT_EINVAL, ctx's diagnostic
+ * says why). Each batch is an fdt_voronoi of some points' cells, as
+ * fdt_voronoi_compute computes them (the same bits, whatever the threads,
+ * the parts or the input's order): fdt_voronoi_ids gives each row's input
+ * id, and the accessors take rows (fdt_voronoi_neighbors too, with
+ * o->neighbors; fdt_voronoi_polyhedron is not available). Every input
+ * point is in exactly one batch, the merged duplicates in the last
+ * (FDT_CELL_MERGED). The calls are serialized as fdt_sink's (never two
+ * at once, from any of the library's threads); the batch is valid during
+ * the call only; a nonzero return stops the run (FDT_ECANCELED, or the
+ * value if it is a negative FDT_E* code). sink (may be NULL: the tets
+ * are counted, hashed and dropped) gets the tets and hull faces as with
+ * fdt_triangulate_stream. o: as fdt_voronoi_compute's (its threads are
+ * the run's). Errors as fdt_triangulate_stream's and fdt_voronoi_compute's;
+ * a point outside the box is reported before any work, two points too
+ * close for the cells (FDT_ERANGE) when the run is over, the least such
+ * edge named, and cells handed on before then are not to be used.
+ */
+typedef struct fdt_cell_sink {
+    size_t struct_size; /* sizeof(fdt_cell_sink) as compiled by the caller */
+    int (*cells)(void *user, const fdt_voronoi *batch);
+    void *user;
+} fdt_cell_sink;
+
+FDT_API int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
+                               const fdt_voronoi_options *o, const fdt_sink *sink,
+                               const fdt_cell_sink *cells, fdt_result **out);
 
 /*
  * Point location and interpolation in a result's mesh (issue 32). r is the

@@ -78,43 +78,13 @@ static uint64_t rnext(void)
     return test_rand64(&rng_s);
 }
 
-/* Reads "x y z" lines (what gen_points writes, %.17g: exact). */
-static pts read_xyz(const char *name, const char *path)
-{
-    FILE *f = fopen(path, "r");
-    CHECK(f);
-    size_t cap = 1024, n = 0;
-    pts p = pts_alloc(name, cap);
-    double x, y, z;
-    while (fscanf(f, "%lf %lf %lf", &x, &y, &z) == 3) {
-        if (n == cap) {
-            cap *= 2;
-            p.xyz = realloc(p.xyz, cap * 3 * sizeof *p.xyz);
-            CHECK(p.xyz);
-        }
-        p.xyz[3 * n] = x;
-        p.xyz[3 * n + 1] = y;
-        p.xyz[3 * n + 2] = z;
-        n++;
-    }
-    fclose(f);
-    p.n = n;
-    return p;
-}
-
 static pts gen_family(const char *gen, const char *fam, size_t n, int seed)
 {
-    char tmp[] = "/tmp/fdt_test_insert.XXXXXX";
-    int fd = mkstemp(tmp);
-    CHECK(fd >= 0);
-    close(fd);
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "'%s' %s %zu %d %s", gen, fam, n, seed, tmp);
-    CHECK(system(cmd) == 0);
     char name[64];
     snprintf(name, sizeof name, "%s-%zu", fam, n);
-    pts p = read_xyz(name, tmp);
-    unlink(tmp);
+    pts p = pts_alloc(name, 1);
+    free(p.xyz);
+    p.xyz = test_gen_family(gen, fam, n, seed, &p.n);
     return p;
 }
 
@@ -1032,7 +1002,9 @@ static double proc_cpu_now(void)
  * (CPU time is then the whole process's, all threads). */
 static int time_file(const char *path, int reps, int threads)
 {
-    pts p = read_xyz(path, path);
+    pts p = pts_alloc(path, 1);
+    free(p.xyz);
+    p.xyz = test_read_xyz(path, &p.n);
     prepped pp;
     double t0 = now_s();
     prep(&p, &pp);

@@ -88,50 +88,12 @@ static key4 *swept(const fdt_meshbuf *mb, size_t *n)
     return k;
 }
 
-static double *read_xyz(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "r");
-    CHECK(f != NULL);
-    size_t cap = 1024, c = 0;
-    double *p = malloc(cap * 3 * sizeof *p);
-    CHECK(p != NULL);
-    double x, y, z;
-    while (fscanf(f, "%lf %lf %lf", &x, &y, &z) == 3) {
-        if (c == cap) {
-            cap *= 2;
-            p = realloc(p, cap * 3 * sizeof *p);
-            CHECK(p != NULL);
-        }
-        p[3 * c] = x;
-        p[3 * c + 1] = y;
-        p[3 * c + 2] = z;
-        c++;
-    }
-    fclose(f);
-    *n = c;
-    return p;
-}
-
-static double *family(const char *gen, const char *fam, size_t n, size_t *got)
-{
-    char tmp[] = "/tmp/fdt_test_sweep.XXXXXX";
-    int fd = mkstemp(tmp);
-    CHECK(fd >= 0);
-    close(fd);
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "'%s' %s %zu 3 %s", gen, fam, n, tmp);
-    CHECK(system(cmd) == 0);
-    double *p = read_xyz(tmp, got);
-    unlink(tmp);
-    return p;
-}
-
 /* One family: the sweep at each slab size and thread count against the
  * whole mesh. */
 static void test_family(const char *gen, const char *fam, size_t n)
 {
     size_t got;
-    double *xyz = family(gen, fam, n, &got);
+    double *xyz = test_gen_family(gen, fam, n, 3, &got);
     char diag[512];
     fdt_prepared pr;
     int err = fdt_prepare(xyz, got, 1, &pr, diag, sizeof diag);
@@ -163,7 +125,7 @@ static void test_family(const char *gen, const char *fam, size_t n)
             memset(&st, 0, sizeof st);
             /* the sweep permutes the points: the reference is rebuilt on
              * its order */
-            err = fdt_sweep_emit(pr.p, pr.orig, (uint32_t)pr.m, slabs[si], threads[ti], &em,
+            err = fdt_sweep_emit(pr.p, pr.orig, (uint32_t)pr.m, slabs[si], threads[ti], &em, NULL,
                                  NULL, NULL, &st, diag, sizeof diag);
             EXPECTF(err == FDT_OK, "%s slab %u threads %d: %d %s", fam, slabs[si], threads[ti],
                     err, diag);
@@ -204,7 +166,7 @@ static int cancel_now(void *user, double fraction)
 static void test_cancel(const char *gen)
 {
     size_t got;
-    double *xyz = family(gen, "uniform", 3000, &got);
+    double *xyz = test_gen_family(gen, "uniform", 3000, 3, &got);
     char diag[512];
     fdt_prepared pr;
     CHECK_EQ(fdt_prepare(xyz, got, 1, &pr, diag, sizeof diag), FDT_OK);
@@ -217,7 +179,7 @@ static void test_cancel(const char *gen)
         fdt_sweep_stats st;
         memset(&st, 0, sizeof st);
         int calls = 0;
-        int err = fdt_sweep_emit(pr.p, pr.orig, (uint32_t)pr.m, 500, threads, &em, cancel_now,
+        int err = fdt_sweep_emit(pr.p, pr.orig, (uint32_t)pr.m, 500, threads, &em, NULL, cancel_now,
                                  &calls, &st, diag, sizeof diag);
         EXPECTF(err == FDT_ECANCELED && calls == 1,
                 "cancel at %d threads: %d after %d calls, %zu parts", threads, err, calls,

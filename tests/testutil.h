@@ -23,6 +23,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "base/hash.h"
 #include "frontdt.h"
@@ -181,6 +182,49 @@ static inline fdt_result *test_triangulate(const double *xyz, size_t n, int thre
     CHECK_EQ(fdt_triangulate(ctx, xyz, n, &r), FDT_OK);
     fdt_close(&ctx);
     return r;
+}
+
+/* Reads "x y z" lines (what tests/gen_points writes, %.17g: exact) into
+ * a new array; *n the points. */
+static inline double *test_read_xyz(const char *path, size_t *n)
+{
+    FILE *f = fopen(path, "r");
+    CHECK(f != NULL);
+    size_t cap = 1024, c = 0;
+    double *p = malloc(cap * 3 * sizeof *p);
+    CHECK(p != NULL);
+    double x, y, z;
+    while (fscanf(f, "%lf %lf %lf", &x, &y, &z) == 3) {
+        if (c == cap) {
+            cap *= 2;
+            p = realloc(p, cap * 3 * sizeof *p);
+            CHECK(p != NULL);
+        }
+        p[3 * c] = x;
+        p[3 * c + 1] = y;
+        p[3 * c + 2] = z;
+        c++;
+    }
+    fclose(f);
+    *n = c;
+    return p;
+}
+
+/* n points of tests/gen_points family fam (gen: its path) with seed, read
+ * back through a temporary file; *got the points. */
+static inline double *test_gen_family(const char *gen, const char *fam, size_t n, int seed,
+                                      size_t *got)
+{
+    char tmp[] = "/tmp/fdt_test_family.XXXXXX";
+    int fd = mkstemp(tmp);
+    CHECK(fd >= 0);
+    close(fd);
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "'%s' %s %zu %d %s", gen, fam, n, seed, tmp);
+    CHECK(system(cmd) == 0);
+    double *p = test_read_xyz(tmp, got);
+    unlink(tmp);
+    return p;
 }
 
 static inline double now_s(void)

@@ -165,6 +165,7 @@ typedef struct run_state {
     fdt_front_stats fst;
     fdt_partmesh_stats pms;   /* the one-part engine's counters */
     fdt_sweep_stats sws;      /* the sweep's counters */
+    fdt_cellstream *cs;       /* streamed Voronoi cells, or NULL */
     int parts;                /* nonzero: the parts' engine ran (src/par) */
     size_t mem_tree, mem_mesh, mem_sink;
 } run_state;
@@ -331,7 +332,7 @@ static int run_single(fdt_context *ctx, const fdt_sink *user, run_engine eng, in
                                     ctx->s.progress, ctx->s.progress_user, &rs->pms, ctx->diag,
                                     sizeof ctx->diag);
     } else if (eng == ENGINE_SWEEP) {
-        err = fdt_sweep_emit(pr->p, pr->orig, (uint32_t)pr->m, 0, nthreads, &rs->em,
+        err = fdt_sweep_emit(pr->p, pr->orig, (uint32_t)pr->m, 0, nthreads, &rs->em, rs->cs,
                              ctx->s.progress, ctx->s.progress_user, &rs->sws, ctx->diag,
                              sizeof ctx->diag);
     } else
@@ -448,8 +449,30 @@ static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, int nthrea
     }
 }
 
+/* The streamed cells' state for the prepared points, when the engine is
+ * the sweep (the one whose parts say when a point's last tet is out). */
+static int cells_setup(fdt_context *ctx, fdt_cellstream *cs, run_engine eng,
+                       const fdt_prepared *pr)
+{
+    if (eng != ENGINE_SWEEP) {
+        snprintf(ctx->diag, sizeof ctx->diag, "streamed Voronoi cells need the parts in sweep "
+                 "order: search auto, mode auto or serial, no pin");
+        return FDT_EINVAL;
+    }
+    cs->p_exp = pr->scale_exp;
+    return fdt_cellstream_init(cs, pr->m);
+}
+
+/* A streamed run's cells over: the least edge too short for them, if any. */
+static int cells_done(fdt_context *ctx, const fdt_cellstream *cs)
+{
+    if (cs->sh.a < 0)
+        return FDT_OK;
+    return fdt_voronoi_too_close(&cs->sh, cs->box, ctx->diag, sizeof ctx->diag);
+}
+
 static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *user,
-               fdt_result **out)
+               fdt_cellstream *cs, fdt_result **out)
 {
     if (!ctx || !out || (!xyz && n))
         return FDT_EINVAL;
@@ -477,9 +500,14 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     run_engine eng = pick_engine(&ctx->s, mode, user != NULL);
     if (mode == FDT_MODE_SERIAL)
         nthreads = 1;
+    if (cs && (err = cells_setup(ctx, cs, eng, &rs.pr)) != FDT_OK)
+        goto fail;
+    rs.cs = cs;
     err = eng != ENGINE_FRONTS || mode == FDT_MODE_SERIAL
               ? run_single(ctx, user, eng, nthreads, &rs, &t1)
               : run_parallel(ctx, mode, nthreads, user, &rs, &t1);
+    if (!err && cs)
+        err = cells_done(ctx, cs);
     if (err)
         goto fail;
     double t2 = fdt_now_s();
@@ -514,7 +542,7 @@ fail:
 
 int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n, fdt_result **out)
 {
-    return run(ctx, xyz, n, NULL, out);
+    return run(ctx, xyz, n, NULL, NULL, out);
 }
 
 int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
@@ -527,5 +555,79 @@ int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
         snprintf(ctx->diag, sizeof ctx->diag, "a streamed run has no neighbours");
         return FDT_EINVAL;
     }
-    return run(ctx, xyz, n, sink, out);
+    return run(ctx, xyz, n, sink, NULL, out);
+}
+
+/* The tets of a cells-only stream: counted and hashed by the sink, then
+ * dropped. */
+static int drop_tets(void *user, const fdt_vid *tets, size_t count)
+{
+    (void)user;
+    (void)tets;
+    (void)count;
+    return 0;
+}
+
+/* The merged duplicates' rows, the stream's last batch. */
+static int cells_merged(const fdt_result *r, const fdt_cellstream *cs, const fdt_cell_sink *cells)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < r->n; i++)
+        k += r->dupmap[i] != (fdt_vid)i;
+    if (!k)
+        return FDT_OK;
+    fdt_vid *ids = malloc(k * sizeof *ids);
+    if (!ids)
+        return FDT_ENOMEM;
+    k = 0;
+    for (size_t i = 0; i < r->n; i++)
+        if (r->dupmap[i] != (fdt_vid)i)
+            ids[k++] = (fdt_vid)i;
+    fdt_voronoi *v = NULL;
+    int err = fdt_voronoi_merged(ids, k, cs->box, cs->neighbors, &v);
+    free(ids);
+    if (!err) {
+        int got = cells->cells(cells->user, v);
+        err = got ? fdt_sink_code(got) : FDT_OK;
+    }
+    fdt_voronoi_free(&v);
+    return err;
+}
+
+int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
+                       const fdt_voronoi_options *o, const fdt_sink *sink,
+                       const fdt_cell_sink *cells, fdt_result **out)
+{
+    fdt_voronoi_options defaults;
+    if (!o) {
+        fdt_default_voronoi_options(&defaults);
+        o = &defaults;
+    }
+    if (!ctx || !out || !cells || cells->struct_size < sizeof(fdt_cell_sink) || !cells->cells ||
+        o->struct_size != sizeof *o || (sink && (sink->struct_size < sizeof(fdt_sink) ||
+                                                 !sink->tets)))
+        return FDT_EINVAL;
+    *out = NULL;
+    ctx->diag[0] = '\0';
+    if (ctx->s.neighbors) {
+        snprintf(ctx->diag, sizeof ctx->diag, "a streamed run has no neighbours");
+        return FDT_EINVAL;
+    }
+    fdt_sink dropped = {sizeof dropped, drop_tets, NULL, NULL};
+    fdt_cellstream cs;
+    memset(&cs, 0, sizeof cs);
+    cs.neighbors = o->neighbors;
+    cs.sink = cells;
+    /* The box and its scale before any work (xyz is the caller's still:
+     * a permuted input is moved by the run). The bounding box of the
+     * distinct points is that of all of them. */
+    int err = fdt_voronoi_box_of(xyz, n, o, cs.box, ctx->diag, sizeof ctx->diag);
+    if (!err)
+        err = fdt_voronoi_scale(cs.box, &cs.ed, ctx->diag, sizeof ctx->diag);
+    if (!err)
+        err = run(ctx, xyz, n, sink ? sink : &dropped, &cs, out);
+    if (!err && (err = cells_merged(*out, &cs, cells)) != FDT_OK)
+        fdt_result_free(out);
+    fdt_cellstream_free(&cs);
+    return err;
 }

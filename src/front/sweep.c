@@ -9,6 +9,7 @@
 #include "base/clock.h"
 #include "base/mem.h"
 #include "base/spawn.h"
+#include "front/cellstream.h"
 #include "geom/kdtree.h"
 #include "geom/morton.h"
 #include "mesh/certify.h"
@@ -60,6 +61,10 @@ typedef struct sweep {
     uint64_t *map;       /* global id + 1 << 32 | local id, of L's points */
     size_t mapcap, mapn; /* allocated, in use (a power of two) */
     int closing;         /* the last part emitted a quarter of its tets or more */
+    fdt_cellstream *cs;  /* the streamed cells, or NULL (borrowed) */
+    fdt_cellheld held;   /* the sweep's tets held for the cells */
+    uint32_t *hullpts;   /* the last part's hull faces' points, for the cells */
+    size_t nhullpts, hpcap;
 } sweep;
 
 /* The slabs: quickselect along the axis at each boundary b[lo .. hi), the
@@ -353,6 +358,11 @@ static int emit(sweep *sw, const fdt_ins *mesh, uint8_t *mark, int last, double 
             if (id < 0)
                 err = (int)id;
             sw->st->final_tets++;
+            uint32_t *c = sw->cs ? fdt_cellheld_add(&sw->held, 1) : NULL;
+            if (c)
+                memcpy(c, t, sizeof t);
+            else if (sw->cs && !err)
+                err = FDT_ENOMEM;
         } else {
             if (!last)
                 continue;
@@ -361,6 +371,13 @@ static int emit(sweep *sw, const fdt_ins *mesh, uint8_t *mark, int last, double 
             for (int i = 0; i < 3; i++)
                 h[i] = (uint32_t)sw->g[h[i]];
             err = fdt_emit_hull(sw->em, h);
+            if (sw->cs && !err) {
+                if (fdt_grow(&sw->hullpts, &sw->hpcap, sw->nhullpts + 3, sizeof *sw->hullpts))
+                    err = FDT_ENOMEM;
+                else
+                    for (int i = 0; i < 3; i++)
+                        sw->hullpts[sw->nhullpts++] = h[i];
+            }
         }
         mark[s] |= FINAL;
     }
@@ -473,6 +490,14 @@ static int part(sweep *sw, uint32_t begin, uint32_t end, int last, double next)
         err = carry(sw, &mesh, mark, nq);
     free(mark);
     fdt_ins_free(&mesh);
+    if (!err && sw->cs) {
+        /* the part's points that are not live close: their cells */
+        double t0 = fdt_now_s();
+        err = fdt_cellstream_part(sw->cs, &sw->held, sw->g, nq, sw->live, last ? 0 : sw->nlive,
+                                  sw->hullpts, sw->nhullpts, sw->nthreads, sw->diag, sw->dlen);
+        st->t_cells += fdt_now_s() - t0;
+        sw->nhullpts = 0;
+    }
     return err;
 }
 
@@ -550,6 +575,8 @@ static int run_sweep(sweep *sw, const uint32_t *b, size_t nslabs, size_t j0, siz
 
 static void sweep_free(sweep *sw)
 {
+    fdt_cellheld_free(&sw->held);
+    free(sw->hullpts);
     free(sw->live);
     free(sw->wall);
     free(sw->nwalls);
@@ -593,6 +620,7 @@ static void add_stats(fdt_sweep_stats *a, const fdt_sweep_stats *b)
     a->certified_tets += b->certified_tets;
     a->t_mesh += b->t_mesh;
     a->t_certify += b->t_certify;
+    a->t_cells += b->t_cells;
     fdt_pred_counts_add(&a->pc, &b->pc);
     add_ins_stats(&a->ins, &b->ins);
 }
@@ -663,8 +691,11 @@ static int meet(sweep *base, const uint32_t *b, size_t nslabs, fdt_progress_fn p
         if (err && d[0])
             snprintf(base->diag, base->dlen, "%s", d);
     }
-    for (int i = 0; i < 2; i++)
+    for (int i = 0; i < 2; i++) {
         add_stats(base->st, &h[i].st);
+        if (!err && base->cs && fdt_cellheld_take(&base->held, &h[i].sw.held))
+            err = FDT_ENOMEM;
+    }
     if (!err && base->em->mb)
         err = append(base->em, &h[1].mb);
     if (!err && progress && progress(puser, 0.95))
@@ -697,8 +728,8 @@ static int meet(sweep *base, const uint32_t *b, size_t nslabs, fdt_progress_fn p
 }
 
 int fdt_sweep_emit(double *P, fdt_vid *orig, uint32_t m, uint32_t slab, int nthreads,
-                   fdt_emit *em, fdt_progress_fn progress, void *puser, fdt_sweep_stats *st,
-                   char *diag, size_t dlen)
+                   fdt_emit *em, fdt_cellstream *cs, fdt_progress_fn progress, void *puser,
+                   fdt_sweep_stats *st, char *diag, size_t dlen)
 {
     sweep sw;
     memset(&sw, 0, sizeof sw);
@@ -708,6 +739,11 @@ int fdt_sweep_emit(double *P, fdt_vid *orig, uint32_t m, uint32_t slab, int nthr
     sw.dir = 1;
     sw.nthreads = nthreads < 1 ? 1 : nthreads;
     sw.em = em;
+    sw.cs = cs;
+    if (cs) {
+        cs->P = P;
+        cs->orig = orig;
+    }
     sw.st = st;
     sw.diag = diag;
     sw.dlen = dlen;

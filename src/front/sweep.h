@@ -34,6 +34,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "frontdt.h"
+#include "front/cellstream.h"
 #include "front/sink.h"
 #include "geom/predicates.h"
 #include "mesh/insert.h"
@@ -56,6 +57,7 @@ typedef struct fdt_sweep_stats {
     size_t certified_tets; /* finite tets the certificates checked */
     double t_mesh;         /* seconds building the parts' meshes */
     double t_certify;      /* seconds certifying them */
+    double t_cells;        /* seconds computing the streamed cells */
     fdt_pred_counts pc;    /* exact predicate calls of both */
     fdt_ins_stats ins;     /* the builds' counts, summed */
 } fdt_sweep_stats;
@@ -83,13 +85,15 @@ uint32_t fdt_sweep_slab(size_t m);
  * the run (two sweeps that meet, each building its parts on half of them;
  * the meeting part, or a single sweep, on all). progress (may be NULL) is
  * called after each part with the fraction of points passed; nonzero
- * cancels.
+ * cancels. cs (may be NULL): the Voronoi cells, each handed on when its
+ * point's last tet is out (src/front/cellstream.h; its P and orig are
+ * this call's).
  * Returns FDT_OK, FDT_ECHECK (a certificate failed: diag says where),
  * FDT_ENOMEM, FDT_ETOOBIG, FDT_EINTERNAL, FDT_ECANCELED or the sink's stop
  * code.
  */
 int fdt_sweep_emit(double *P, fdt_vid *orig, uint32_t m, uint32_t slab, int nthreads,
-                   fdt_emit *em, fdt_progress_fn progress, void *puser, fdt_sweep_stats *st,
-                   char *diag, size_t dlen);
+                   fdt_emit *em, fdt_cellstream *cs, fdt_progress_fn progress, void *puser,
+                   fdt_sweep_stats *st, char *diag, size_t dlen);
 
 #endif

@@ -37,7 +37,9 @@
 #include "mesh/voronoi.h"
 
 struct fdt_voronoi {
-    size_t n;
+    size_t n;           /* cells (rows) */
+    fdt_vid *ids;       /* a batch's rows' input ids, or NULL: row i is
+                           point i (owned) */
     double box[6];
     double *volume, *area, *centroid, *density; /* owned */
     int32_t *nfaces;                            /* owned */
@@ -78,8 +80,13 @@ struct fdt_voronoi {
  * no bit of the result. */
 typedef struct vwork {
     size_t n, m;        /* input points; distinct points, numbered 0..m-1 */
+    size_t nown;        /* the points whose cells are wanted, 0..nown-1:
+                           all m, or a batch's (fdt_voronoi_batch: the
+                           rest are their neighbours, numbered after) */
+    int batch;          /* rows are local ids 0..nown-1, not input ids */
     uint32_t *perm;     /* local -> input id (owned) */
-    uint32_t *loc;      /* input id -> local id, UINT32_MAX if merged (owned) */
+    uint32_t *loc;      /* input id -> local id, UINT32_MAX if merged
+                           (owned; NULL in a batch) */
     double *xyz;        /* 3m local coordinates (owned) */
     uint32_t *tets;     /* 4 local ids a tet, by lowest id (owned) */
     size_t ntets;
@@ -131,6 +138,7 @@ void fdt_voronoi_free(fdt_voronoi **pv)
     if (!pv || !*pv)
         return;
     fdt_voronoi *v = *pv;
+    free(v->ids);
     free(v->volume);
     free(v->area);
     free(v->centroid);
@@ -147,8 +155,8 @@ void fdt_voronoi_free(fdt_voronoi **pv)
     *pv = NULL;
 }
 
-int fdt_voronoi_box_of(const fdt_result *r, const double *xyz, size_t n,
-                       const fdt_voronoi_options *o, double box[6], char *diag, size_t ds)
+int fdt_voronoi_box_of(const double *xyz, size_t n, const fdt_voronoi_options *o, double box[6],
+                       char *diag, size_t ds)
 {
     if (o->box_given) {
         memcpy(box, o->box, 6 * sizeof *box);
@@ -166,24 +174,21 @@ int fdt_voronoi_box_of(const fdt_result *r, const double *xyz, size_t n,
                 }
         return FDT_OK;
     }
+    /* a merged duplicate is where its point is; a point not finite (which
+     * the triangulation refuses) is left out */
     for (int k = 0; k < 3; k++) {
         box[k] = INFINITY;
         box[k + 3] = -INFINITY;
     }
-    for (size_t i = 0; i < n; i++)
-        if (r->dupmap[i] == (fdt_vid)i)
+    for (size_t i = 0; i < n; i++) {
+        const double *p = xyz + 3 * i;
+        if (isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))
             for (int k = 0; k < 3; k++) {
-                box[k] = fmin(box[k], xyz[3 * i + k]);
-                box[k + 3] = fmax(box[k + 3], xyz[3 * i + k]);
+                box[k] = fmin(box[k], p[k]);
+                box[k + 3] = fmax(box[k + 3], p[k]);
             }
+    }
     return FDT_OK;
-}
-
-/* The box: given (and holding every point), or the points' bounding box. */
-static int set_box(fdt_voronoi *v, const fdt_result *r, const double *xyz,
-                   const fdt_voronoi_options *o, char *diag, size_t ds)
-{
-    return fdt_voronoi_box_of(r, xyz, v->n, o, v->box, diag, ds);
 }
 
 static inline double max2(double a, double b)
@@ -214,6 +219,13 @@ int fdt_voronoi_scale(const double box[6], int *ed, char *diag, size_t ds)
     return FDT_ERANGE;
 }
 
+/* Local point l's row in the answer: its input id, or in a batch its
+ * place among the batch's own points. */
+static inline uint32_t row(const vwork *w, uint32_t l)
+{
+    return w->batch ? l : w->perm[l];
+}
+
 /* The computation's frame: the local coordinates and the box times
  * 2^-ed, so that the box's largest side lies in [1/2, 1). Every operation
  * of the cells commutes with a power of two, so the results scaled back
@@ -237,7 +249,7 @@ static void *scale_back(void *arg)
     fdt_voronoi *v = j->v;
     int e = w->ed;
     for (uint32_t l = j->lo; l < j->hi; l++) {
-        uint32_t g = w->perm[l];
+        uint32_t g = row(w, l);
         v->volume[g] = ldexp(v->volume[g], 3 * e);
         v->area[g] = ldexp(v->area[g], 2 * e);
         v->density[g] = ldexp(v->density[g], -3 * e);
@@ -663,7 +675,7 @@ static int cut_cell(vjob *j, uint32_t l)
         j->face = q;
         j->capface = nc;
     }
-    uint32_t g = w->perm[l];
+    uint32_t g = row(w, l);
     double cen[3];
     fdt_cell_face *fc = j->face + j->nface;
     fdt_cell_measure(&j->cell, &v->volume[g], &v->area[g], cen, fc);
@@ -692,7 +704,7 @@ static void sum_cell(vjob *j, uint32_t l)
 {
     const vwork *w = j->w;
     fdt_voronoi *v = j->v;
-    uint32_t g = w->perm[l];
+    uint32_t g = row(w, l);
     size_t e0 = j->adj_start[l - j->lo], e1 = j->adj_start[l - j->lo + 1];
     fdt_fix total = {0, 0};
     for (size_t e = e0; e < e1; e++)
@@ -866,7 +878,7 @@ static void *cell_pass(void *arg)
             j->fsum[e] = oj->fsum[slot(oj, nb, l)];
         }
     for (uint32_t l = j->lo; l < j->hi && !j->err; l++) {
-        uint32_t g = w->perm[l];
+        uint32_t g = row(w, l);
         j->v->flags[g] = w->flags[l] & (FDT_CELL_CLIPPED | FDT_CELL_HULL);
         double dt = w->flags[l] & DTFE_FINE
                         ? fdt_fix_value(w->dtfe[l], fdt_fix_grid_of(ilogb(w->vmax[l])))
@@ -907,7 +919,7 @@ static void *fill_neighbors(void *arg)
     const vwork *w = j->w;
     fdt_voronoi *v = j->v;
     for (uint32_t l = j->lo; l < j->hi; l++) {
-        uint32_t g = w->perm[l];
+        uint32_t g = row(w, l);
         size_t o = v->nstart[g], k = (size_t)v->nfaces[g];
         if (w->flags[l] & (FDT_CELL_CLIPPED | CELL_CUT)) {
             const fdt_cell_face *fc = j->face + j->first[l - j->lo];
@@ -949,8 +961,8 @@ static int alloc_cells(fdt_voronoi *v)
                : FDT_ENOMEM;
 }
 
-/* The local flags (hull points) and accumulators. */
-static int alloc_work(vwork *w, const fdt_result *r)
+/* The local flags and accumulators (the callers mark the hull points). */
+static int alloc_work(vwork *w)
 {
     size_t m = w->m ? w->m : 1;
     w->flags = calloc(m, sizeof *w->flags);
@@ -961,8 +973,6 @@ static int alloc_work(vwork *w, const fdt_result *r)
     w->vmax = calloc(m, sizeof *w->vmax);
     if (!w->flags || !w->vol || !w->vabs || !w->mom || !w->dtfe || !w->vmax)
         return FDT_ENOMEM;
-    for (size_t f = 0; f < 3 * r->nhull; f++)
-        w->flags[w->loc[r->hull[f]]] |= FDT_CELL_HULL | FDT_CELL_CLIPPED;
     return FDT_OK;
 }
 
@@ -980,7 +990,7 @@ static void free_work(vwork *w)
     free(w->vmax);
 }
 
-/* The jobs over the points, in equal ranges of the local numbering. */
+/* The jobs over the own points, in equal ranges of the local numbering. */
 static int make_jobs(vwork *w, fdt_voronoi *v, vjob *jobs, int threads)
 {
     w->jobs = jobs;
@@ -989,8 +999,8 @@ static int make_jobs(vwork *w, fdt_voronoi *v, vjob *jobs, int threads)
         vjob *j = &jobs[t];
         j->w = w;
         j->v = v;
-        j->lo = (uint32_t)(w->m * (size_t)t / (size_t)threads);
-        j->hi = (uint32_t)(w->m * (size_t)(t + 1) / (size_t)threads);
+        j->lo = (uint32_t)(w->nown * (size_t)t / (size_t)threads);
+        j->hi = (uint32_t)(w->nown * (size_t)(t + 1) / (size_t)threads);
         j->short_a = j->short_b = UINT32_MAX;
         fdt_cell_init(&j->cell);
         j->first = malloc(((size_t)(j->hi - j->lo) + 1) * sizeof *j->first);
@@ -1010,7 +1020,7 @@ static int fork_join(vjob *jobs, int threads, void *(*fn)(void *))
     return err;
 }
 
-/* The neighbour lists' offsets (input order), then their entries on the
+/* The neighbour lists' offsets (by row), then their entries on the
  * threads. */
 static int list_neighbors(fdt_voronoi *v, vjob *jobs, int threads)
 {
@@ -1057,6 +1067,103 @@ int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double 
     return FDT_OK;
 }
 
+
+/* The threads for nown cells: about 64 cells a thread at least. */
+static int cell_threads(int threads, size_t nown)
+{
+    if (threads < 1)
+        threads = 1;
+    if ((size_t)threads > nown / 64 + 1)
+        threads = (int)(nown / 64 + 1);
+    return threads;
+}
+
+/* The Chebyshev length of local edge ab in the points' own frame (the
+ * local coordinates are scaled by 2^-ed, exactly). */
+static double local_len(const vwork *w, uint32_t a, uint32_t b)
+{
+    return ldexp(fdt_cheb(w->xyz + 3 * (size_t)a, w->xyz + 3 * (size_t)b), w->ed);
+}
+
+/*
+ * The steps after the numbering, for the whole set and a batch alike: on
+ * the threads, the neighbour lists, the tet pass and the cells; the
+ * neighbour lists by row; the cells back in the points' frame. w holds
+ * the numbered points and tets in the computation's frame, its flags
+ * (the hull points) and its accumulators; v its rows. The least edge too
+ * short for the cells goes to *sh (kept when less than what it holds);
+ * then FDT_ERANGE, the cells not computed.
+ */
+static int cells_run(vwork *w, fdt_voronoi *v, int threads, int neighbors, fdt_vshort *sh,
+                     char *diag, size_t ds)
+{
+    vjob *jobs = calloc((size_t)threads, sizeof *jobs);
+    if (!jobs)
+        return FDT_ENOMEM;
+    int err = make_jobs(w, v, jobs, threads);
+    if (!err)
+        err = fork_join(jobs, threads, tet_pass);
+    int too_short = 0;
+    for (int t = 0; !err && t < threads; t++) {
+        const vjob *j = &jobs[t];
+        if (j->short_a == UINT32_MAX)
+            continue;
+        too_short = 1;
+        long long a = w->perm[j->short_a], b = w->perm[j->short_b];
+        if (sh->a < 0 || fdt_edge_less(a, b, sh->a, sh->b)) {
+            sh->a = a < b ? a : b;
+            sh->b = a < b ? b : a;
+            sh->len = local_len(w, j->short_a, j->short_b);
+        }
+    }
+    if (too_short)
+        err = FDT_ERANGE;
+    if (!err)
+        err = fork_join(jobs, threads, cell_pass);
+    if (err == FDT_EINTERNAL)
+        for (int t = 0; t < threads; t++)
+            if (jobs[t].err == FDT_EINTERNAL) {
+                uint32_t l = jobs[t].lo;
+                double p[3];
+                for (int k = 0; k < 3; k++) /* as given */
+                    p[k] = ldexp(w->xyz[3 * (size_t)l + k], w->ed);
+                fdt_diag(diag, ds, "the cell of point %u (%.17g %.17g %.17g) could not be "
+                    "cut from the box (a bug: please report)", w->perm[l], p[0], p[1], p[2]);
+                break;
+            }
+    for (int t = 0; !err && t < threads; t++)
+        v->zero_faces += jobs[t].zero_faces;
+    if (!err && neighbors)
+        err = list_neighbors(v, jobs, threads);
+    if (!err)
+        err = fork_join(jobs, threads, scale_back);
+    for (int t = 0; t < threads; t++) {
+        fdt_cell_free(&jobs[t].cell);
+        free(jobs[t].face);
+        free(jobs[t].order);
+        free(jobs[t].first);
+        free(jobs[t].adj_start);
+        free(jobs[t].adj);
+        free(jobs[t].fsum);
+    }
+    free(jobs);
+    return err;
+}
+
+/* The frame, the least edge and the grids of w's box (w->ed set). */
+static void set_frame(vwork *w)
+{
+    scale_frame(w);
+    w->min_edge = ldexp(fdt_box_side(w->box), FDT_VORONOI_BOX_EXP);
+    set_grids(w);
+}
+
+int fdt_voronoi_too_close(const fdt_vshort *sh, const double box[6], char *diag, size_t ds)
+{
+    return too_close(sh->a, sh->b, sh->len, fdt_box_side(box), 0, FDT_VORONOI_BOX_EXP, 0, diag,
+                     ds);
+}
+
 int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
                       int threads, fdt_voronoi **out, char *diag, size_t diag_size)
 {
@@ -1073,83 +1180,40 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
     vwork w;
     memset(&w, 0, sizeof w);
     w.n = n;
-    if (threads < 1)
-        threads = 1;
-    if ((size_t)threads > n / 64 + 1)
-        threads = (int)(n / 64 + 1);
-    vjob *jobs = calloc((size_t)threads, sizeof *jobs);
-    if (!v || !jobs) {
-        free(v);
-        free(jobs);
+    if (!v)
         return FDT_ENOMEM;
-    }
     v->n = n;
     err = alloc_cells(v);
     if (!err)
-        err = set_box(v, r, xyz, o, diag, diag_size);
+        err = fdt_voronoi_box_of(xyz, n, o, v->box, diag, diag_size);
     if (!err)
         err = fdt_voronoi_scale(v->box, &w.ed, diag, diag_size);
     if (err)
         goto done;
     memcpy(w.box, v->box, sizeof w.box);
-    /* The steps: number the points and their tets, in the computation's
-     * frame; on the threads, the neighbour lists, the tet pass and the
-     * cells; the neighbour lists; the cells back in the points' frame. */
+    /* The steps: number the points (every distinct one is own) and their
+     * tets, in the computation's frame; the hull points marked; the
+     * cells; the merged duplicates marked. */
     err = number_points(&w, r, xyz);
     if (!err) {
-        scale_frame(&w);
-        w.min_edge = ldexp(fdt_box_side(w.box), FDT_VORONOI_BOX_EXP);
-        set_grids(&w);
+        w.nown = w.m;
+        set_frame(&w);
         err = local_tets(&w, r);
     }
     if (!err)
-        err = alloc_work(&w, r);
+        err = alloc_work(&w);
     if (!err)
-        err = make_jobs(&w, v, jobs, threads);
+        for (size_t f = 0; f < 3 * r->nhull; f++)
+            w.flags[w.loc[r->hull[f]]] |= FDT_CELL_HULL | FDT_CELL_CLIPPED;
+    fdt_vshort sh = {-1, -1, 0};
     if (!err)
-        err = fork_join(jobs, threads, tet_pass);
-    const vjob *least = NULL;
-    for (int t = 0; !err && t < threads; t++)
-        if (jobs[t].short_a != UINT32_MAX &&
-            (!least || fdt_edge_less(w.perm[jobs[t].short_a], w.perm[jobs[t].short_b],
-                                  w.perm[least->short_a], w.perm[least->short_b])))
-            least = &jobs[t];
-    if (least)
-        err = too_close(w.perm[least->short_a], w.perm[least->short_b],
-                        fdt_cheb(xyz + 3 * (size_t)w.perm[least->short_a],
-                             xyz + 3 * (size_t)w.perm[least->short_b]),
-                        fdt_box_side(v->box), 0, FDT_VORONOI_BOX_EXP, 0, diag, diag_size);
-    if (!err)
-        err = fork_join(jobs, threads, cell_pass);
-    if (err == FDT_EINTERNAL)
-        for (int t = 0; t < threads; t++)
-            if (jobs[t].err == FDT_EINTERNAL) {
-                const double *p = xyz + 3 * (size_t)w.perm[jobs[t].lo]; /* as given */
-                fdt_diag(diag, diag_size, "the cell of point %u (%.17g %.17g %.17g) could not be "
-                    "cut from the box (a bug: please report)", w.perm[jobs[t].lo], p[0], p[1],
-                    p[2]);
-                break;
-            }
+        err = cells_run(&w, v, cell_threads(threads, w.nown), o->neighbors, &sh, diag, diag_size);
+    if (err == FDT_ERANGE && sh.a >= 0)
+        (void)fdt_voronoi_too_close(&sh, v->box, diag, diag_size);
     for (size_t i = 0; !err && i < n; i++)
         if (r->dupmap[i] != (fdt_vid)i)
             v->flags[i] = FDT_CELL_MERGED;
-    for (int t = 0; !err && t < threads; t++)
-        v->zero_faces += jobs[t].zero_faces;
-    if (!err && o->neighbors)
-        err = list_neighbors(v, jobs, threads);
-    if (!err)
-        err = fork_join(jobs, threads, scale_back);
 done:
-    for (int t = 0; t < threads; t++) {
-        fdt_cell_free(&jobs[t].cell);
-        free(jobs[t].face);
-        free(jobs[t].order);
-        free(jobs[t].first);
-        free(jobs[t].adj_start);
-        free(jobs[t].adj);
-        free(jobs[t].fsum);
-    }
-    free(jobs);
     free_work(&w);
     if (err)
         fdt_voronoi_free(&v);
@@ -1157,7 +1221,128 @@ done:
     return err;
 }
 
+/* A batch's local number of point id (xyz's numbering), made when new:
+ * an open-addressing table of id + 1 << 32 | local. */
+static uint32_t batch_local(vwork *w, uint64_t *tab, size_t cap, const fdt_vbatch *b,
+                            uint32_t id)
+{
+    size_t h = (size_t)(((uint64_t)id * UINT64_C(0x9E3779B97F4A7C15)) >> 32) & (cap - 1);
+    for (;; h = (h + 1) & (cap - 1)) {
+        if (!tab[h]) {
+            uint32_t l = (uint32_t)w->m++;
+            tab[h] = ((uint64_t)id + 1) << 32 | l;
+            w->perm[l] = (uint32_t)b->label[id];
+            for (int k = 0; k < 3; k++) /* the input's coordinates, exactly */
+                w->xyz[3 * (size_t)l + k] = ldexp(b->xyz[3 * (size_t)id + k], -b->xyz_exp);
+            return l;
+        }
+        if ((uint32_t)(tab[h] >> 32) == id + 1)
+            return (uint32_t)tab[h];
+    }
+}
+
+/* The batch's points numbered (its own first, in their order; then the
+ * other points of its tets as met) and its tets in those numbers, those
+ * with no own point left out; tets then bucketed as local_tets does. */
+static int batch_number(vwork *w, const fdt_vbatch *b)
+{
+    size_t most = b->nown + 4 * b->ntets, cap = 64;
+    while (cap < 2 * most)
+        cap *= 2;
+    uint64_t *tab = calloc(cap, sizeof *tab);
+    w->perm = malloc((most ? most : 1) * sizeof *w->perm);
+    w->xyz = malloc(3 * (most ? most : 1) * sizeof *w->xyz);
+    w->tets = malloc(4 * (b->ntets ? b->ntets : 1) * sizeof *w->tets);
+    if (!tab || !w->perm || !w->xyz || !w->tets) {
+        free(tab);
+        return FDT_ENOMEM;
+    }
+    w->m = 0;
+    for (size_t i = 0; i < b->nown; i++)
+        (void)batch_local(w, tab, cap, b, b->own[i]);
+    w->nown = w->m;
+    w->ntets = 0;
+    for (size_t t = 0; t < b->ntets; t++) {
+        uint32_t x[4];
+        int any = 0;
+        for (int k = 0; k < 4; k++) {
+            x[k] = batch_local(w, tab, cap, b, b->tets[4 * t + k]);
+            any |= x[k] < w->nown;
+        }
+        if (any)
+            memcpy(w->tets + 4 * w->ntets++, x, sizeof x);
+    }
+    free(tab);
+    return FDT_OK;
+}
+
+int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_vshort *sh,
+                      char *diag, size_t ds)
+{
+    *out = NULL;
+    fdt_voronoi *v = calloc(1, sizeof *v);
+    vwork w;
+    memset(&w, 0, sizeof w);
+    if (!v)
+        return FDT_ENOMEM;
+    w.batch = 1;
+    w.ed = b->ed;
+    memcpy(w.box, b->box, sizeof w.box);
+    memcpy(v->box, b->box, sizeof v->box);
+    /* The steps: number the batch's points and tets, in the computation's
+     * frame; the hull points marked; the cells; their ids. */
+    int err = batch_number(&w, b);
+    v->n = w.nown;
+    w.n = w.m;
+    if (!err)
+        err = alloc_cells(v);
+    if (!err) {
+        set_frame(&w);
+        err = alloc_work(&w);
+    }
+    for (size_t i = 0; !err && i < w.nown; i++)
+        if (b->own_hull[i])
+            w.flags[i] |= FDT_CELL_HULL | FDT_CELL_CLIPPED;
+    if (!err)
+        err = cells_run(&w, v, cell_threads(threads, w.nown), b->neighbors, sh, diag, ds);
+    if (!err && !(v->ids = malloc((w.nown ? w.nown : 1) * sizeof *v->ids)))
+        err = FDT_ENOMEM;
+    for (size_t i = 0; !err && i < w.nown; i++)
+        v->ids[i] = (fdt_vid)w.perm[i];
+    free_work(&w);
+    if (err)
+        fdt_voronoi_free(&v);
+    *out = v;
+    return err;
+}
+int fdt_voronoi_merged(const fdt_vid *ids, size_t k, const double box[6], int neighbors,
+                       fdt_voronoi **out)
+{
+    fdt_voronoi *v = calloc(1, sizeof *v);
+    *out = NULL;
+    if (!v)
+        return FDT_ENOMEM;
+    v->n = k;
+    memcpy(v->box, box, sizeof v->box);
+    int err = alloc_cells(v);
+    if (!err && !(v->ids = malloc((k ? k : 1) * sizeof *v->ids)))
+        err = FDT_ENOMEM;
+    if (!err && neighbors &&
+        (!(v->nstart = calloc(k + 1, sizeof *v->nstart)) || !(v->nid = malloc(sizeof *v->nid)) ||
+         !(v->narea = malloc(sizeof *v->narea))))
+        err = FDT_ENOMEM;
+    for (size_t i = 0; !err && i < k; i++) {
+        v->ids[i] = ids[i];
+        v->flags[i] = FDT_CELL_MERGED;
+    }
+    if (err)
+        fdt_voronoi_free(&v);
+    *out = v;
+    return err;
+}
+
 size_t fdt_voronoi_num_points(const fdt_voronoi *v) { return v ? v->n : 0; }
+const fdt_vid *fdt_voronoi_ids(const fdt_voronoi *v) { return v ? v->ids : NULL; }
 const double *fdt_voronoi_volumes(const fdt_voronoi *v) { return v ? v->volume : NULL; }
 const double *fdt_voronoi_areas(const fdt_voronoi *v) { return v ? v->area : NULL; }
 const double *fdt_voronoi_centroids(const fdt_voronoi *v) { return v ? v->centroid : NULL; }

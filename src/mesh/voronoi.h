@@ -4,6 +4,8 @@
 #define FDT_VORONOI_H
 
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 
 #include "frontdt.h"
 
@@ -45,12 +47,60 @@ static inline double fdt_box_side(const double box[6])
 int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
                       int threads, fdt_voronoi **out, char *diag, size_t diag_size);
 
+/* The least Delaunay edge too short for the cells (under
+ * 2^FDT_VORONOI_BOX_EXP of the box): its points' input ids, a < b, by
+ * fdt_edge_less over every edge met; a < 0 when none. */
+typedef struct fdt_vshort {
+    long long a, b;
+    double len; /* its Chebyshev length */
+} fdt_vshort;
+
+/* FDT_ERANGE with diag naming sh's edge, as fdt_voronoi_compute does. */
+int fdt_voronoi_too_close(const fdt_vshort *sh, const double box[6], char *diag, size_t ds);
+
+/*
+ * A batch of cells of a streamed run (src/front/cells.h): the cells of the
+ * points own[0 .. nown) from tets, which hold every tet of each of their
+ * stars (a tet with none of them is left out). Ids index xyz (3 doubles
+ * each, the input's coordinates times 2^xyz_exp: exactly, fdt_prepare's
+ * scale); label[id] is the point's input id (the cells' ids, their
+ * neighbours' labels, messages). Each cell is computed as
+ * fdt_voronoi_build computes it, from its own tets and neighbours alone,
+ * so it has the same bits whichever batch holds it.
+ */
+typedef struct fdt_vbatch {
+    const double *xyz;
+    int xyz_exp;
+    const fdt_vid *label;
+    const uint32_t *own;
+    size_t nown;
+    const uint8_t *own_hull; /* nonzero: own[i] is a hull point */
+    const uint32_t *tets;    /* 4 ids a tet */
+    size_t ntets;
+    double box[6];           /* holds every point (the caller checked) */
+    int ed;                  /* fdt_voronoi_scale's exponent of box */
+    int neighbors;           /* keep each cell's neighbours and face areas */
+} fdt_vbatch;
+
+/* The batch's cells into *out, row i the cell of own[i] (fdt_voronoi_ids:
+ * their input ids), on `threads` threads. FDT_ERANGE when one of its tets
+ * has an edge too short for the cells (kept in *sh when less than what it
+ * holds; diag not written for it); FDT_ENOMEM; FDT_EINTERNAL with diag. */
+int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_vshort *sh,
+                      char *diag, size_t ds);
+
+/* A batch of the k merged duplicates ids (input ids): no cells, flag
+ * FDT_CELL_MERGED, as fdt_voronoi_compute gives them. */
+int fdt_voronoi_merged(const fdt_vid *ids, size_t k, const double box[6], int neighbors,
+                       fdt_voronoi **out);
+
 /* The box the cells are clipped by: o's (FDT_EINVAL, with diag, when it is
  * empty, not finite or leaves a point out) or the bounding box of the
- * points that are not merged duplicates. The rule of fdt_voronoi_compute
- * and of the polyMesh dual (src/mesh/dualmesh.c). */
-int fdt_voronoi_box_of(const fdt_result *r, const double *xyz, size_t n,
-                       const fdt_voronoi_options *o, double box[6], char *diag, size_t ds);
+ * finite points (a merged duplicate lies on its point). The rule of
+ * fdt_voronoi_compute, of the streamed cells and of the polyMesh dual
+ * (src/mesh/dualmesh.c). */
+int fdt_voronoi_box_of(const double *xyz, size_t n, const fdt_voronoi_options *o, double box[6],
+                       char *diag, size_t ds);
 
 /*
  * FDT_OK, and *ed the exponent of box's largest side D (D = f 2^*ed, f in

@@ -1,0 +1,178 @@
+/* Voronoi cells streamed from the sweep: src/front/cellstream.h. */
+#include "front/cellstream.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/mem.h"
+#include "front/sink.h"
+
+/* A point's progress (fdt_cellstream.state): not yet in a part, in the
+ * part just over and not live after it (its cell is due now), live, its
+ * cell handed on. HULL beside them: a vertex of a hull face. */
+enum { UNSEEN = 0, CLOSING = 1, LIVE = 2, CLOSED = 3, PROGRESS = 3, HULL = 4 };
+
+int fdt_cellstream_init(fdt_cellstream *cs, size_t m)
+{
+    cs->rc = 0;
+    cs->cells = cs->batches = cs->max_held = 0;
+    cs->sh.a = cs->sh.b = -1;
+    cs->lock_ok = 0;
+    cs->state = calloc(m ? m : 1, 1);
+    if (!cs->state)
+        return FDT_ENOMEM;
+    if (pthread_mutex_init(&cs->lock, NULL)) {
+        free(cs->state);
+        cs->state = NULL;
+        return FDT_ENOMEM;
+    }
+    cs->lock_ok = 1;
+    return FDT_OK;
+}
+
+void fdt_cellstream_free(fdt_cellstream *cs)
+{
+    free(cs->state);
+    cs->state = NULL;
+    if (cs->lock_ok)
+        pthread_mutex_destroy(&cs->lock);
+    cs->lock_ok = 0;
+}
+
+void fdt_cellheld_free(fdt_cellheld *h)
+{
+    free(h->tets);
+    free(h->pool);
+    free(h->own);
+    free(h->own_hull);
+    memset(h, 0, sizeof *h);
+}
+
+int fdt_cellheld_take(fdt_cellheld *into, fdt_cellheld *h)
+{
+    if (fdt_grow(&into->tets, &into->cap, 4 * (into->n + h->n), sizeof *into->tets))
+        return FDT_ENOMEM;
+    if (h->n)
+        memcpy(into->tets + 4 * into->n, h->tets, 4 * h->n * sizeof *h->tets);
+    into->n += h->n;
+    h->n = 0;
+    return FDT_OK;
+}
+
+uint32_t *fdt_cellheld_add(fdt_cellheld *h, size_t count)
+{
+    if (fdt_grow(&h->pool, &h->poolcap, 4 * (h->npool + count), sizeof *h->pool))
+        return NULL;
+    uint32_t *at = h->pool + 4 * h->npool;
+    h->npool += count;
+    return at;
+}
+
+/* The pool (held tets, then the part's) split: those with a closing
+ * vertex are the batch's (moved to the pool's front), those with a live
+ * one held again (a tet can be both); the rest are done with. */
+static int split_pool(const uint8_t *state, fdt_cellheld *h, size_t *nbatch)
+{
+    /* the held tets go in front of the part's, so that one array holds
+     * the pool */
+    if (fdt_grow(&h->pool, &h->poolcap, 4 * (h->npool + h->n), sizeof *h->pool))
+        return FDT_ENOMEM;
+    memmove(h->pool + 4 * h->n, h->pool, 4 * h->npool * sizeof *h->pool);
+    if (h->n)
+        memcpy(h->pool, h->tets, 4 * h->n * sizeof *h->tets);
+    size_t np = h->npool + h->n, nb = 0, nh = 0;
+    for (size_t t = 0; t < np; t++) {
+        const uint32_t *v = h->pool + 4 * t;
+        int closing = 0, live = 0;
+        for (int k = 0; k < 4; k++) {
+            int s = state[v[k]] & PROGRESS;
+            closing |= s == CLOSING;
+            live |= s == LIVE;
+        }
+        if (live) {
+            if (fdt_grow(&h->tets, &h->cap, 4 * (nh + 1), sizeof *h->tets))
+                return FDT_ENOMEM;
+            memcpy(h->tets + 4 * nh++, v, 4 * sizeof *v);
+        }
+        if (closing) {
+            if (nb != t)
+                memcpy(h->pool + 4 * nb, v, 4 * sizeof *v);
+            nb++;
+        }
+    }
+    h->n = nh;
+    *nbatch = nb;
+    return FDT_OK;
+}
+
+/* The batch handed on (under the lock), unless the run is stopping or a
+ * tet was too short for the cells. */
+static int hand_on(fdt_cellstream *cs, const fdt_voronoi *v)
+{
+    pthread_mutex_lock(&cs->lock);
+    int rc = cs->rc;
+    if (!rc && cs->sh.a < 0 && v && cs->sink) {
+        int got = cs->sink->cells(cs->sink->user, v);
+        if (got)
+            rc = cs->rc = fdt_sink_code(got);
+        cs->cells += fdt_voronoi_num_points(v);
+        cs->batches++;
+    }
+    pthread_mutex_unlock(&cs->lock);
+    return rc;
+}
+
+int fdt_cellstream_part(fdt_cellstream *cs, fdt_cellheld *h, const fdt_vid *part, size_t npart,
+                        const uint32_t *live, size_t nlive, const uint32_t *hull, size_t nhull,
+                        int threads, char *diag, size_t dlen)
+{
+    uint8_t *state = cs->state;
+    /* The steps: the part's points closing, then the live ones live
+     * again; the hull's marked; the pool split into the batch's tets and
+     * the held ones; the closing points listed; their cells computed and
+     * handed on; the closing points closed. */
+    for (size_t i = 0; i < npart; i++)
+        state[part[i]] = (uint8_t)((state[part[i]] & HULL) | CLOSING);
+    for (size_t i = 0; i < nlive; i++)
+        state[live[i]] = (uint8_t)((state[live[i]] & HULL) | LIVE);
+    for (size_t i = 0; i < nhull; i++)
+        state[hull[i]] |= HULL;
+    size_t nb;
+    if (split_pool(state, h, &nb))
+        return FDT_ENOMEM;
+    h->npool = 0;
+    if (h->n > cs->max_held) /* a sweep's own high-water mark; read after the joins */
+        cs->max_held = h->n;
+    if (fdt_grow(&h->own, &h->owncap, npart, sizeof *h->own) ||
+        !(h->own_hull = realloc(h->own_hull, npart ? npart : 1)))
+        return FDT_ENOMEM;
+    size_t nown = 0;
+    for (size_t i = 0; i < npart; i++)
+        if ((state[part[i]] & PROGRESS) == CLOSING) {
+            h->own_hull[nown] = (state[part[i]] & HULL) != 0;
+            h->own[nown++] = (uint32_t)part[i];
+        }
+    int err = FDT_OK;
+    if (nown) {
+        fdt_vbatch b = {.xyz = cs->P, .xyz_exp = cs->p_exp, .label = cs->orig, .own = h->own,
+                        .nown = nown, .own_hull = h->own_hull, .tets = h->pool, .ntets = nb,
+                        .ed = cs->ed, .neighbors = cs->neighbors};
+        memcpy(b.box, cs->box, sizeof b.box);
+        fdt_voronoi *v = NULL;
+        fdt_vshort sh = {-1, -1, 0};
+        err = fdt_voronoi_batch(&b, threads, &v, &sh, diag, dlen);
+        if (err == FDT_ERANGE && sh.a >= 0) {
+            pthread_mutex_lock(&cs->lock);
+            if (cs->sh.a < 0 || fdt_edge_less(sh.a, sh.b, cs->sh.a, cs->sh.b))
+                cs->sh = sh;
+            pthread_mutex_unlock(&cs->lock);
+            err = FDT_OK; /* the run goes on to find the least */
+        } else if (!err)
+            err = hand_on(cs, v);
+        fdt_voronoi_free(&v);
+    }
+    for (size_t i = 0; i < nown; i++)
+        state[h->own[i]] = CLOSED;
+    return err;
+}
