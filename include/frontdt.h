@@ -755,8 +755,11 @@ FDT_API void fdt_voronoi_free(fdt_voronoi **v);
  * density is 4 / (the sum of the volumes of the point's tets). */
 FDT_API size_t fdt_voronoi_num_points(const fdt_voronoi *v);
 /* The rows' points: NULL for fdt_voronoi_compute's cells (row i is point
- * i); for a batch of fdt_voronoi_stream, each row's input id. */
+ * i); for a batch of fdt_voronoi_stream, each row's input id, and its
+ * coordinates as given (3 each: the caller's array may have been moved by
+ * settings.permute_input). */
 FDT_API const fdt_vid *fdt_voronoi_ids(const fdt_voronoi *v);
+FDT_API const double *fdt_voronoi_points(const fdt_voronoi *v);
 FDT_API const double *fdt_voronoi_volumes(const fdt_voronoi *v);
 FDT_API const double *fdt_voronoi_areas(const fdt_voronoi *v);
 FDT_API const double *fdt_voronoi_centroids(const fdt_voronoi *v);

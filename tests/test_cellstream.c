@@ -26,6 +26,7 @@
 /* The cells collected by input id. */
 typedef struct got {
     const fdt_voronoi *ref; /* the whole mesh's cells */
+    const double *xyz;      /* the points, as given */
     size_t n;
     int *seen;              /* times each id was handed on */
     size_t bad;             /* rows unlike ref's */
@@ -69,16 +70,19 @@ static int collect(void *user, const fdt_voronoi *v)
     for (size_t r = 0; r < fdt_voronoi_num_points(v); r++) {
         CHECK(ids[r] >= 0 && (size_t)ids[r] < g->n);
         g->seen[ids[r]]++;
-        if (g->ref && !same_cell(v, r, g->ref, ids[r]) && g->bad++ == 0)
+        const double *p = fdt_voronoi_points(v) + 3 * r, *q = g->xyz + 3 * (size_t)ids[r];
+        if (g->ref && (!same_cell(v, r, g->ref, ids[r]) || !same_d(p[0], q[0]) ||
+                       !same_d(p[1], q[1]) || !same_d(p[2], q[2])) && g->bad++ == 0)
             g->first_bad = ids[r];
     }
     return ++g->calls == g->stop_after;
 }
 
-static void got_init(got *g, const fdt_voronoi *ref, size_t n)
+static void got_init(got *g, const fdt_voronoi *ref, const double *xyz, size_t n)
 {
     memset(g, 0, sizeof *g);
     g->ref = ref;
+    g->xyz = xyz;
     g->n = n;
     g->seen = calloc(n ? n : 1, sizeof *g->seen);
     g->first_bad = -1;
@@ -131,7 +135,7 @@ static void test_family(const char *gen, const char *fam, size_t n)
         fdt_default_settings(&s);
         s.n_threads = 1;
         got g;
-        got_init(&g, NULL, m);
+        got_init(&g, NULL, xyz, m);
         fdt_result *sr = NULL;
         char diag[512];
         int err = run_stream(xyz, m, &s, NULL, &g, &sr, diag, sizeof diag);
@@ -157,7 +161,7 @@ static void test_family(const char *gen, const char *fam, size_t n)
             CHECK_EQ(fdt_tsink_init(&sink, pr.orig, NULL), FDT_OK);
             CHECK_EQ(fdt_emit_init(&em, &sink, NULL), FDT_OK);
             got g;
-            got_init(&g, ref, m);
+            got_init(&g, ref, xyz, m);
             fdt_cell_sink cells = {sizeof cells, collect, &g};
             fdt_cellstream cs;
             memset(&cs, 0, sizeof cs);
@@ -217,7 +221,7 @@ static void test_api(void)
         fdt_default_settings(&s);
         s.n_threads = t;
         got g;
-        got_init(&g, ref, n);
+        got_init(&g, ref, xyz, n);
         fdt_result *sr = NULL;
         int err = run_stream(xyz, n, &s, &o, &g, &sr, diag, sizeof diag);
         EXPECTF(err == FDT_OK, "fdt_voronoi_stream at %d threads: %d %s", t, err, diag);
@@ -239,14 +243,14 @@ static void test_api(void)
     s.n_threads = 1;
     got g;
     /* the sink's nonzero return stops the run */
-    got_init(&g, ref, n);
+    got_init(&g, ref, xyz, n);
     g.stop_after = 1;
     fdt_result *sr = NULL;
     EXPECT_IS(run_stream(xyz, n, &s, &o, &g, &sr, diag, sizeof diag), FDT_ECANCELED);
     EXPECT(sr == NULL && g.calls == 1);
     free(g.seen);
     /* a given box that leaves a point out: refused before any cell */
-    got_init(&g, ref, n);
+    got_init(&g, ref, xyz, n);
     fdt_voronoi_options ob = o;
     ob.box_given = 1;
     const double box[6] = {0.1, 0, 0, 1, 1, 1};
@@ -255,7 +259,7 @@ static void test_api(void)
     EXPECTF(strstr(diag, "outside the box") && g.calls == 0, "box: %s", diag);
     free(g.seen);
     /* the kd fronts say nothing of when a point's last tet is out */
-    got_init(&g, ref, n);
+    got_init(&g, ref, xyz, n);
     s.search = FDT_SEARCH_KD;
     EXPECT_IS(run_stream(xyz, n, &s, &o, &g, &sr, diag, sizeof diag), FDT_EINVAL);
     EXPECTF(strstr(diag, "sweep order") != NULL, "kd: %s", diag);
@@ -272,7 +276,7 @@ static void test_api(void)
     fdt_voronoi *v = NULL;
     EXPECT_IS(fdt_voronoi_compute(r, xyz, n, &o, &v, want, sizeof want), FDT_ERANGE);
     s.search = FDT_SEARCH_AUTO;
-    got_init(&g, NULL, n);
+    got_init(&g, NULL, xyz, n);
     g.stop_after = -1;
     EXPECT_IS(run_stream(xyz, n, &s, &o, &g, &sr, diag, sizeof diag), FDT_ERANGE);
     EXPECTF(!strcmp(diag, want), "too close: \"%s\" against \"%s\"", diag, want);

@@ -517,6 +517,8 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
         goto fail;
     result_take(r, &rs, user, n);
     result_stats(r, &rs, mode, nthreads, user, n, t0, t1, t2);
+    if (cs && (err = fdt_cellstream_merged(cs, r->dupmap, n, rs.pr.p, rs.pr.orig, rs.pr.m)))
+        goto fail;
     fdt_emit_free(&rs.em);
     fdt_tsink_free(&rs.sink);
     fdt_kd_free(&rs.tree);
@@ -568,32 +570,6 @@ static int drop_tets(void *user, const fdt_vid *tets, size_t count)
     return 0;
 }
 
-/* The merged duplicates' rows, the stream's last batch. */
-static int cells_merged(const fdt_result *r, const fdt_cellstream *cs, const fdt_cell_sink *cells)
-{
-    size_t k = 0;
-    for (size_t i = 0; i < r->n; i++)
-        k += r->dupmap[i] != (fdt_vid)i;
-    if (!k)
-        return FDT_OK;
-    fdt_vid *ids = malloc(k * sizeof *ids);
-    if (!ids)
-        return FDT_ENOMEM;
-    k = 0;
-    for (size_t i = 0; i < r->n; i++)
-        if (r->dupmap[i] != (fdt_vid)i)
-            ids[k++] = (fdt_vid)i;
-    fdt_voronoi *v = NULL;
-    int err = fdt_voronoi_merged(ids, k, cs->box, cs->neighbors, &v);
-    free(ids);
-    if (!err) {
-        int got = cells->cells(cells->user, v);
-        err = got ? fdt_sink_code(got) : FDT_OK;
-    }
-    fdt_voronoi_free(&v);
-    return err;
-}
-
 int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
                        const fdt_voronoi_options *o, const fdt_sink *sink,
                        const fdt_cell_sink *cells, fdt_result **out)
@@ -626,8 +602,6 @@ int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
         err = fdt_voronoi_scale(cs.box, &cs.ed, ctx->diag, sizeof ctx->diag);
     if (!err)
         err = run(ctx, xyz, n, sink ? sink : &dropped, &cs, out);
-    if (!err && (err = cells_merged(*out, &cs, cells)) != FDT_OK)
-        fdt_result_free(out);
     fdt_cellstream_free(&cs);
     return err;
 }

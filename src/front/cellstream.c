@@ -176,3 +176,59 @@ int fdt_cellstream_part(fdt_cellstream *cs, fdt_cellheld *h, const fdt_vid *part
         state[h->own[i]] = CLOSED;
     return err;
 }
+
+/* A merged duplicate and the input id of its point. */
+typedef struct dup_of {
+    fdt_vid rep, id;
+} dup_of;
+
+static int dup_cmp(const void *a, const void *b)
+{
+    const dup_of *x = a, *y = b;
+    return x->rep != y->rep ? (x->rep < y->rep ? -1 : 1) : (x->id > y->id) - (x->id < y->id);
+}
+
+int fdt_cellstream_merged(fdt_cellstream *cs, const fdt_vid *dupmap, size_t n, const double *P,
+                          const fdt_vid *orig, size_t m)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++)
+        k += dupmap[i] != (fdt_vid)i;
+    if (!k)
+        return FDT_OK;
+    dup_of *d = malloc(k * sizeof *d);
+    fdt_vid *ids = malloc(k * sizeof *ids);
+    double *pts = malloc(3 * k * sizeof *pts);
+    int err = d && ids && pts ? FDT_OK : FDT_ENOMEM;
+    for (size_t i = 0, j = 0; !err && i < n; i++)
+        if (dupmap[i] != (fdt_vid)i)
+            d[j++] = (dup_of){dupmap[i], (fdt_vid)i};
+    if (!err)
+        qsort(d, k, sizeof *d, dup_cmp);
+    /* each point's coordinates, as given, to the duplicates of it */
+    for (size_t g = 0; !err && g < m; g++) {
+        size_t lo = 0, hi = k;
+        while (lo < hi) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (d[mid].rep < orig[g])
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        for (; lo < k && d[lo].rep == orig[g]; lo++)
+            for (int c = 0; c < 3; c++)
+                pts[3 * lo + (size_t)c] = ldexp(P[3 * g + (size_t)c], -cs->p_exp);
+    }
+    for (size_t j = 0; !err && j < k; j++)
+        ids[j] = d[j].id;
+    fdt_voronoi *v = NULL;
+    if (!err)
+        err = fdt_voronoi_merged(ids, pts, k, cs->box, cs->neighbors, &v);
+    if (!err)
+        err = hand_on(cs, v);
+    fdt_voronoi_free(&v);
+    free(d);
+    free(ids);
+    free(pts);
+    return err;
+}

@@ -89,4 +89,11 @@ int fdt_cellstream_part(fdt_cellstream *cs, fdt_cellheld *h, const fdt_vid *part
                         const uint32_t *live, size_t nlive, const uint32_t *hull, size_t nhull,
                         int threads, char *diag, size_t dlen);
 
+/* The run is over: the merged duplicates (dupmap: input id -> the input
+ * id it was merged into; n input points) as the last batch, their points
+ * found through the sweep's points P and ids orig (m of them). FDT_OK,
+ * FDT_ENOMEM or the sink's stop code. */
+int fdt_cellstream_merged(fdt_cellstream *cs, const fdt_vid *dupmap, size_t n, const double *P,
+                          const fdt_vid *orig, size_t m);
+
 #endif

@@ -40,6 +40,7 @@ struct fdt_voronoi {
     size_t n;           /* cells (rows) */
     fdt_vid *ids;       /* a batch's rows' input ids, or NULL: row i is
                            point i (owned) */
+    double *pts;        /* a batch's rows' points, 3 each, or NULL (owned) */
     double box[6];
     double *volume, *area, *centroid, *density; /* owned */
     int32_t *nfaces;                            /* owned */
@@ -139,6 +140,7 @@ void fdt_voronoi_free(fdt_voronoi **pv)
         return;
     fdt_voronoi *v = *pv;
     free(v->ids);
+    free(v->pts);
     free(v->volume);
     free(v->area);
     free(v->centroid);
@@ -1296,6 +1298,10 @@ int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_v
     w.n = w.m;
     if (!err)
         err = alloc_cells(v);
+    if (!err && !(v->pts = malloc(3 * (w.nown ? w.nown : 1) * sizeof *v->pts)))
+        err = FDT_ENOMEM;
+    if (!err)
+        memcpy(v->pts, w.xyz, 3 * w.nown * sizeof *v->pts);
     if (!err) {
         set_frame(&w);
         err = alloc_work(&w);
@@ -1315,8 +1321,8 @@ int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_v
     *out = v;
     return err;
 }
-int fdt_voronoi_merged(const fdt_vid *ids, size_t k, const double box[6], int neighbors,
-                       fdt_voronoi **out)
+int fdt_voronoi_merged(const fdt_vid *ids, const double *pts, size_t k, const double box[6],
+                       int neighbors, fdt_voronoi **out)
 {
     fdt_voronoi *v = calloc(1, sizeof *v);
     *out = NULL;
@@ -1325,8 +1331,11 @@ int fdt_voronoi_merged(const fdt_vid *ids, size_t k, const double box[6], int ne
     v->n = k;
     memcpy(v->box, box, sizeof v->box);
     int err = alloc_cells(v);
-    if (!err && !(v->ids = malloc((k ? k : 1) * sizeof *v->ids)))
+    if (!err && (!(v->ids = malloc((k ? k : 1) * sizeof *v->ids)) ||
+                 !(v->pts = malloc(3 * (k ? k : 1) * sizeof *v->pts))))
         err = FDT_ENOMEM;
+    if (!err)
+        memcpy(v->pts, pts, 3 * k * sizeof *v->pts);
     if (!err && neighbors &&
         (!(v->nstart = calloc(k + 1, sizeof *v->nstart)) || !(v->nid = malloc(sizeof *v->nid)) ||
          !(v->narea = malloc(sizeof *v->narea))))
@@ -1343,6 +1352,7 @@ int fdt_voronoi_merged(const fdt_vid *ids, size_t k, const double box[6], int ne
 
 size_t fdt_voronoi_num_points(const fdt_voronoi *v) { return v ? v->n : 0; }
 const fdt_vid *fdt_voronoi_ids(const fdt_voronoi *v) { return v ? v->ids : NULL; }
+const double *fdt_voronoi_points(const fdt_voronoi *v) { return v ? v->pts : NULL; }
 const double *fdt_voronoi_volumes(const fdt_voronoi *v) { return v ? v->volume : NULL; }
 const double *fdt_voronoi_areas(const fdt_voronoi *v) { return v ? v->area : NULL; }
 const double *fdt_voronoi_centroids(const fdt_voronoi *v) { return v ? v->centroid : NULL; }

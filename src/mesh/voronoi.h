@@ -89,10 +89,11 @@ typedef struct fdt_vbatch {
 int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_vshort *sh,
                       char *diag, size_t ds);
 
-/* A batch of the k merged duplicates ids (input ids): no cells, flag
- * FDT_CELL_MERGED, as fdt_voronoi_compute gives them. */
-int fdt_voronoi_merged(const fdt_vid *ids, size_t k, const double box[6], int neighbors,
-                       fdt_voronoi **out);
+/* A batch of the k merged duplicates ids (input ids; pts their points, 3
+ * each): no cells, flag FDT_CELL_MERGED, as fdt_voronoi_compute gives
+ * them. */
+int fdt_voronoi_merged(const fdt_vid *ids, const double *pts, size_t k, const double box[6],
+                       int neighbors, fdt_voronoi **out);
 
 /* The box the cells are clipped by: o's (FDT_EINVAL, with diag, when it is
  * empty, not finite or leaves a point out) or the bounding box of the
