@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -131,22 +132,32 @@ static int put_density(FILE *f, const void *arg, const double *xyz)
     return fdt_wr_density(f, j->v, j->threads);
 }
 
+/* The cells' options and tables d asks for (job's format NULL and vtu 0
+ * with d->voronoi set: CSV). */
+static void cells_setup(const fdt_cli_dual *d, fdt_voronoi_options *o, cells_job *job)
+{
+    fdt_default_voronoi_options(o);
+    o->box_given = d->box_given;
+    o->threads = d->threads;
+    memcpy(o->box, d->box, sizeof o->box);
+    cells_job j = {NULL, d->format, d->voronoi && has_ext(d->voronoi, ".vtu"),
+                   d->threads ? d->threads : fdt_threads_default()};
+    if (d->voronoi && !j.format && !j.vtu && !has_ext(d->voronoi, ".csv"))
+        j.format = FDT_CELLS_DEFAULT_FORMAT;
+    int nb = j.vtu;
+    char err[256];
+    if (j.format && !j.vtu)
+        (void)fdt_cells_format_check(j.format, &nb, err, sizeof err);
+    o->neighbors = nb;
+    *job = j;
+}
+
 int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const double *xyz, size_t n,
                        char *err, size_t errlen)
 {
     fdt_voronoi_options o;
-    fdt_default_voronoi_options(&o);
-    o.box_given = d->box_given;
-    o.threads = d->threads;
-    memcpy(o.box, d->box, sizeof o.box);
-    cells_job job = {NULL, d->format, d->voronoi && has_ext(d->voronoi, ".vtu"),
-                     d->threads ? d->threads : fdt_threads_default()};
-    if (d->voronoi && !job.format && !job.vtu && !has_ext(d->voronoi, ".csv"))
-        job.format = FDT_CELLS_DEFAULT_FORMAT;
-    int nb = job.vtu;
-    if (job.format && !job.vtu)
-        (void)fdt_cells_format_check(job.format, &nb, err, errlen);
-    o.neighbors = nb;
+    cells_job job;
+    cells_setup(d, &o, &job);
     fdt_voronoi *v = NULL;
     char diag[512];
     int r = fdt_voronoi_compute(res, xyz, n, &o, &v, diag, sizeof diag);
@@ -168,6 +179,97 @@ int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const doubl
         r = write_side(d->density, put_density, &job, xyz, err, errlen);
     fdt_voronoi_free(&v);
     return r;
+}
+
+const char *fdt_cli_dual_stream_refusal(const fdt_cli_dual *d)
+{
+    if (fdt_cli_interp_wanted(d))
+        return "--interpolate needs the whole mesh";
+    if (d->voronoi && has_ext(d->voronoi, ".vtu"))
+        return "--voronoi FILE.vtu (the cells as polyhedra) needs the whole mesh";
+    return NULL;
+}
+
+struct fdt_cli_cells {
+    fdt_voronoi_options o;
+    cells_job job;
+    fdt_cells_spool *sp;
+    int err; /* the spool's first errno */
+};
+
+/* The batch's rows into the spool (an fdt_cell_sink's call). */
+static int spool_batch(void *user, const fdt_voronoi *v)
+{
+    fdt_cli_cells *c = user;
+    c->err = fdt_cells_spool_add(c->sp, v);
+    return c->err != 0;
+}
+
+int fdt_cli_cells_open(const fdt_cli_dual *d, size_t n, fdt_cli_cells **out,
+                       fdt_voronoi_options *o, fdt_cell_sink *sink, char *err, size_t errlen)
+{
+    fdt_cli_cells *c = calloc(1, sizeof *c);
+    *out = NULL;
+    if (!c) {
+        snprintf(err, errlen, "out of memory");
+        return FDT_ENOMEM;
+    }
+    cells_setup(d, &c->o, &c->job);
+    /* the spool beside the first table: the same file system, which
+     * must hold the tables anyway */
+    const char *path = d->voronoi ? d->voronoi : d->density;
+    const char *slash = strrchr(path, '/');
+    char dir[FDT_IO_PATH];
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + (slash == path) : 1,
+             slash ? path : ".");
+    int e = fdt_cells_spool_open(&c->sp, n, d->voronoi ? c->job.format : NULL,
+                                 d->voronoi && !c->job.format, d->density != NULL, dir);
+    if (e) {
+        snprintf(err, errlen, "%s: a temporary file for the cells: %s", dir, strerror(e));
+        free(c);
+        return e == ENOMEM ? FDT_ENOMEM : FDT_EIO;
+    }
+    *o = c->o;
+    fdt_cell_sink cs = {sizeof cs, spool_batch, c};
+    *sink = cs;
+    *out = c;
+    return FDT_OK;
+}
+
+int fdt_cli_cells_failed(const fdt_cli_cells *c, char *err, size_t errlen)
+{
+    if (!c->err)
+        return 0;
+    snprintf(err, errlen, "the cells' temporary file: %s", strerror(c->err));
+    return 1;
+}
+
+static int put_spooled(FILE *f, const void *arg, const double *xyz)
+{
+    (void)xyz;
+    const fdt_cli_cells *c = ((const fdt_cli_cells *const *)arg)[0];
+    int table = (int)(intptr_t)((const void *const *)arg)[1];
+    return fdt_cells_spool_put(c->sp, table, f);
+}
+
+int fdt_cli_cells_write(const fdt_cli_dual *d, fdt_cli_cells *c, char *err, size_t errlen)
+{
+    int r = FDT_OK;
+    const void *a0[2] = {c, (const void *)(intptr_t)0}, *a1[2] = {c, (const void *)(intptr_t)1};
+    if (d->voronoi)
+        r = write_side(d->voronoi, put_spooled, a0, NULL, err, errlen);
+    if (r == FDT_OK && d->density)
+        r = write_side(d->density, put_spooled, a1, NULL, err, errlen);
+    return r;
+}
+
+void fdt_cli_cells_close(fdt_cli_cells **c)
+{
+    if (!c || !*c)
+        return;
+    fdt_cells_spool_close(&(*c)->sp);
+    free(*c);
+    *c = NULL;
 }
 
 typedef struct rows_job {

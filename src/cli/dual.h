@@ -51,6 +51,28 @@ int fdt_cli_parse_box(const char *s, double box[6]);
  * input or one of the files read). */
 int fdt_cli_dual_check(const fdt_cli_dual *d, const char *input, char *err, size_t errlen);
 
+/*
+ * Streamed cells (--stream with --voronoi or --density, issue 32): the
+ * batches of fdt_voronoi_stream spooled (src/io/write/cells.h), the tables
+ * written in input order once the run is whole.
+ *
+ * fdt_cli_dual_stream_refusal: why d cannot stream (NULL: it can).
+ * fdt_cli_cells_open: the spool for n points beside the first table, the
+ *   options and the sink to give fdt_voronoi_stream; FDT_OK, or FDT_EIO /
+ *   FDT_ENOMEM with err.
+ * fdt_cli_cells_failed: nonzero, with err, when the spool failed (the
+ *   run then stopped as canceled).
+ * fdt_cli_cells_write: the tables into the open commit set, as
+ *   fdt_cli_dual_write's.
+ */
+typedef struct fdt_cli_cells fdt_cli_cells;
+const char *fdt_cli_dual_stream_refusal(const fdt_cli_dual *d);
+int fdt_cli_cells_open(const fdt_cli_dual *d, size_t n, fdt_cli_cells **out,
+                       fdt_voronoi_options *o, fdt_cell_sink *sink, char *err, size_t errlen);
+int fdt_cli_cells_failed(const fdt_cli_cells *c, char *err, size_t errlen);
+int fdt_cli_cells_write(const fdt_cli_dual *d, fdt_cli_cells *c, char *err, size_t errlen);
+void fdt_cli_cells_close(fdt_cli_cells **c);
+
 /* Computes the cells of res (the result of triangulating xyz[0 .. 3n))
  * and writes the files into the open commit set. 0, or an FDT_E* code
  * with the message in err: FDT_EINVAL (a point outside --box), FDT_ENOMEM,

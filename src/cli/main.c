@@ -1020,8 +1020,12 @@ static const char *stream_refusal(const cli *c, const fdt_format *const *fmts, i
         return "--hash sorts the whole mesh (--set-hash needs no sort)";
     if (c->all_faces)
         return "--all-faces needs the face list of the whole mesh";
-    if (fdt_cli_dual_wanted(&c->dual) || fdt_cli_interp_wanted(&c->dual))
-        return "--voronoi, --density and --interpolate need the whole mesh";
+    const char *dual = fdt_cli_dual_stream_refusal(&c->dual);
+    if (dual)
+        return dual;
+    /* the cells stream where asked to; else they take the whole mesh */
+    if (fdt_cli_dual_wanted(&c->dual) && !forced)
+        return "--voronoi and --density stream with --stream only";
     if (c->dual.dual)
         return "--dual needs the whole mesh";
     for (int o = 0; o < c->n_outputs; o++) {
@@ -1180,6 +1184,7 @@ typedef struct run_state {
     fdt_context *ctx;
     fdt_result *res;
     fanout fo;            /* a streamed run's writers */
+    fdt_cli_cells *cells; /* a streamed run's cells, spooled (src/cli/dual.h) */
     unsigned long long estimate; /* memory_estimate's bytes */
     size_t nt;            /* tets made */
     size_t dups;          /* duplicate points merged */
@@ -1417,7 +1422,20 @@ static int triangulate(const cli *c, run_state *rs)
     double t0 = fdt_now_s();
     progress_phase(&rs->prog, "merge"); /* "triangulate" at the library's first report */
     int r;
-    if (rs->streaming) {
+    char derr[FDT_IO_PATH + 600];
+    if (rs->streaming && fdt_cli_dual_wanted(&c->dual)) {
+        /* the cells as their points' last tets leave, spooled */
+        fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &rs->fo};
+        fdt_voronoi_options o;
+        fdt_cell_sink cells;
+        if ((r = fdt_cli_cells_open(&c->dual, rs->n, &rs->cells, &o, &cells, derr,
+                                    sizeof derr)) != FDT_OK) {
+            say("%s", derr);
+            (void)fanout_close(&rs->fo, 0);
+            return exit_for_dual(r);
+        }
+        r = fdt_voronoi_stream(rs->ctx, rs->xyz, rs->n, &o, &sink, &cells, &rs->res);
+    } else if (rs->streaming) {
         fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &rs->fo};
         r = fdt_triangulate_stream(rs->ctx, rs->xyz, rs->n, &sink, &rs->res);
     } else {
@@ -1435,6 +1453,10 @@ static int triangulate(const cli *c, run_state *rs)
             return wcode; /* the run stopped for the writer's error */
         if (r == FDT_OK && wcode != CLI_OK)
             return wcode;
+    }
+    if (r != FDT_OK && rs->cells && fdt_cli_cells_failed(rs->cells, derr, sizeof derr)) {
+        say("%s: %s", rs->name, derr);
+        return CLI_WRITE;
     }
     if (r != FDT_OK) {
         const char *diag = fdt_context_diagnostic(rs->ctx);
@@ -1561,7 +1583,10 @@ static int dual_steps(const cli *c, run_state *rs)
     if (fdt_cli_dual_wanted(&c->dual)) {
         double t0 = fdt_now_s();
         progress_phase(&rs->prog, "voronoi");
-        int r = fdt_cli_dual_write(&c->dual, rs->res, rs->xyz, rs->n, derr, sizeof derr);
+        /* streamed: computed during the run, written from the spool */
+        int r = rs->cells ? fdt_cli_cells_write(&c->dual, rs->cells, derr, sizeof derr)
+                          : fdt_cli_dual_write(&c->dual, rs->res, rs->xyz, rs->n, derr,
+                                               sizeof derr);
         progress_clear(&rs->prog);
         rs->tm.voronoi = fdt_now_s() - t0;
         if (r != FDT_OK) {
@@ -1721,6 +1746,7 @@ static int run(const cli *c)
         code = steps[i](c, &rs);
     fdt_wr_set_abandon(); /* after a failure: every temporary goes */
     fdt_result_free(&rs.res);
+    fdt_cli_cells_close(&rs.cells);
     fdt_close(&rs.ctx);
     free(rs.xyz);
     return code;

@@ -3,13 +3,21 @@
 #include "io/write/cells.h"
 
 #include <errno.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include "base/spawn.h"
 #include "io/write/outfile.h"
 
 static const char codes[] = "ixyzqvFsnfcCdh%";
+/* The CSV table's columns, each a code, and its header. */
+#define CSV_CODES "iqvFsCdh"
+#define CSV_HEADER "id,x,y,z,volume,area,faces,cx,cy,cz,density,flags\n"
+/* The density table's row. */
+#define DENSITY_FORMAT "%d %h"
 
 int fdt_cells_format_check(const char *fmt, int *needs_nbrs, char *err, size_t errlen)
 {
@@ -62,12 +70,16 @@ static void three(out_file *o, const double *x, char sep)
 static void code(out_file *o, char c, const fdt_voronoi *v, const double *xyz, size_t i,
                  char sep)
 {
-    const double *p = xyz ? xyz + 3 * i : NULL; /* NULL: no code reads it */
+    /* a streamed batch's rows name their points and carry them */
+    const fdt_vid *ids = fdt_voronoi_ids(v);
+    const double *p = ids  ? fdt_voronoi_points(v) + 3 * i
+                      : xyz ? xyz + 3 * i
+                            : NULL; /* NULL: no code reads it */
     const double *cen = fdt_voronoi_centroids(v) + 3 * i;
     int merged = (fdt_voronoi_flags(v)[i] & FDT_CELL_MERGED) != 0;
     double rel[3];
     switch (c) {
-    case 'i': out_i64(o, (int64_t)i); break;
+    case 'i': out_i64(o, ids ? (int64_t)ids[i] : (int64_t)i); break;
     case 'x': out_double(o, p[0]); break;
     case 'y': out_double(o, p[1]); break;
     case 'z': out_double(o, p[2]); break;
@@ -174,7 +186,7 @@ static int put_rows(FILE *f, const char *fmt, const fdt_voronoi *v, const double
         return ENOMEM;
     size_t n = fdt_voronoi_num_points(v);
     if (csv)
-        out_str(&o, "id,x,y,z,volume,area,faces,cx,cy,cz,density,flags\n");
+        out_str(&o, CSV_HEADER);
     rows_block *b = threads > 1 && n > ROWS_BLOCK ? calloc((size_t)threads, sizeof *b) : NULL;
     if (!b) {
         put_range(&o, fmt, v, xyz, csv, 0, n);
@@ -203,14 +215,168 @@ static int put_rows(FILE *f, const char *fmt, const fdt_voronoi *v, const double
 
 int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *xyz, int threads)
 {
-    /* CSV: the table's columns, each a code */
-    return fmt ? put_rows(f, fmt, v, xyz, 0, threads)
-               : put_rows(f, "iqvFsCdh", v, xyz, 1, threads);
+    return fmt ? put_rows(f, fmt, v, xyz, 0, threads) : put_rows(f, CSV_CODES, v, xyz, 1, threads);
 }
 
 int fdt_wr_density(FILE *f, const fdt_voronoi *v, int threads)
 {
-    return put_rows(f, "%d %h", v, NULL, 0, threads);
+    return put_rows(f, DENSITY_FORMAT, v, NULL, 0, threads);
+}
+
+/* ---------------------------------------------------------------- spool */
+
+struct fdt_cells_spool {
+    size_t n;
+    const char *fmt;  /* the cells' table: its format, or NULL for none */
+    int csv;          /* fmt is CSV_CODES */
+    int density;      /* the density table too */
+    FILE *f;          /* the spool: a record a row (unlinked temporary) */
+    uint64_t pos;     /* its length so far */
+    uint64_t *off;    /* by input id: its record's offset, UINT64_MAX none */
+};
+
+int fdt_cells_spool_open(fdt_cells_spool **sp, size_t n, const char *fmt, int csv, int density,
+                         const char *dir)
+{
+    fdt_cells_spool *s = calloc(1, sizeof *s);
+    *sp = NULL;
+    if (!s)
+        return ENOMEM;
+    s->n = n;
+    s->fmt = csv ? CSV_CODES : fmt;
+    s->csv = csv;
+    s->density = density;
+    s->off = malloc((n ? n : 1) * sizeof *s->off);
+    char path[4200];
+    snprintf(path, sizeof path, "%s/.frontdt-cells.XXXXXX", dir);
+    int fd = s->off ? mkstemp(path) : -1;
+    int e = !s->off ? ENOMEM : fd < 0 ? errno : 0;
+    if (fd >= 0) {
+        unlink(path); /* gone with the process, whatever happens */
+        if (!(s->f = fdopen(fd, "w+b"))) {
+            e = errno;
+            close(fd);
+        }
+    }
+    if (e) {
+        free(s->off);
+        free(s);
+        return e;
+    }
+    for (size_t i = 0; i < n; i++)
+        s->off[i] = UINT64_MAX;
+    *sp = s;
+    return 0;
+}
+
+void fdt_cells_spool_close(fdt_cells_spool **sp)
+{
+    if (!sp || !*sp)
+        return;
+    if ((*sp)->f)
+        fclose((*sp)->f);
+    free((*sp)->off);
+    free(*sp);
+    *sp = NULL;
+}
+
+static void no_report(void *user, int stage, uint64_t done, uint64_t total)
+{
+    (void)user;
+    (void)stage;
+    (void)done;
+    (void)total;
+}
+
+/* Rows a chunk of a batch formatted in memory before it is spooled. */
+#define SPOOL_CHUNK 4096
+
+/* Rows [lo, hi) of v into the spool: for each a record of the two
+ * tables' lengths (uint32 each) and their text. 0 or an errno. */
+static int spool_chunk(fdt_cells_spool *s, const fdt_voronoi *v, size_t lo, size_t hi)
+{
+    char *text = NULL;
+    size_t len = 0;
+    size_t *cut = malloc(2 * (hi - lo) * sizeof *cut); /* each row's two ends */
+    FILE *m = cut ? open_memstream(&text, &len) : NULL;
+    out_meter mt = {no_report, NULL, 0, 0};
+    out_file o;
+    int e = 0;
+    if (!m || open_out(&o, m)) {
+        e = ENOMEM;
+    } else {
+        o.meter = &mt; /* mt.done: the bytes flushed to m so far */
+        for (size_t r = lo; r < hi; r++) {
+            if (s->fmt)
+                put_range(&o, s->fmt, v, NULL, s->csv, r, r + 1);
+            cut[2 * (r - lo)] = (size_t)mt.done + o.len;
+            if (s->density)
+                put_range(&o, DENSITY_FORMAT, v, NULL, 0, r, r + 1);
+            cut[2 * (r - lo) + 1] = (size_t)mt.done + o.len;
+        }
+        e = close_out(&o);
+    }
+    if (m && fclose(m) != 0 && !e)
+        e = errno ? errno : ENOMEM;
+    const fdt_vid *ids = fdt_voronoi_ids(v);
+    for (size_t r = lo, at = 0; !e && r < hi; r++) {
+        size_t mid = cut[2 * (r - lo)], end = cut[2 * (r - lo) + 1];
+        uint32_t l[2] = {(uint32_t)(mid - at), (uint32_t)(end - mid)};
+        if (mid - at > UINT32_MAX || end - mid > UINT32_MAX) {
+            e = EFBIG;
+            break;
+        }
+        s->off[ids[r]] = s->pos;
+        errno = 0;
+        if (fwrite(l, sizeof l, 1, s->f) != 1 || fwrite(text + at, 1, end - at, s->f) != end - at)
+            e = errno ? errno : EIO;
+        s->pos += sizeof l + (end - at);
+        at = end;
+    }
+    free(text);
+    free(cut);
+    return e;
+}
+
+int fdt_cells_spool_add(fdt_cells_spool *s, const fdt_voronoi *v)
+{
+    size_t n = fdt_voronoi_num_points(v);
+    int e = 0;
+    for (size_t lo = 0; lo < n && !e; lo += SPOOL_CHUNK)
+        e = spool_chunk(s, v, lo, n - lo > SPOOL_CHUNK ? lo + SPOOL_CHUNK : n);
+    return e;
+}
+
+int fdt_cells_spool_put(fdt_cells_spool *s, int table, FILE *f)
+{
+    errno = 0;
+    if (fflush(s->f) != 0)
+        return errno ? errno : EIO;
+    for (size_t i = 0; i < s->n; i++)
+        if (s->off[i] == UINT64_MAX)
+            return EINVAL; /* a row never came: the run was not whole */
+    const char *base = NULL;
+    if (s->pos) {
+        void *mp = mmap(NULL, (size_t)s->pos, PROT_READ, MAP_PRIVATE, fileno(s->f), 0);
+        if (mp == MAP_FAILED)
+            return errno;
+        base = mp;
+    }
+    out_file o;
+    int e = open_out(&o, f);
+    if (!e && table == 0 && s->csv)
+        out_str(&o, CSV_HEADER);
+    for (size_t i = 0; i < s->n && !e && !o.err; i++) {
+        const char *rec = base + s->off[i];
+        uint32_t l[2];
+        memcpy(l, rec, sizeof l);
+        out_bytes(&o, rec + sizeof l + (table ? l[0] : 0), l[table]);
+    }
+    if (!e)
+        e = close_out(&o);
+    if (base)
+        munmap((void *)(uintptr_t)base, (size_t)s->pos);
+    return e;
 }
 
 int fdt_wr_rows(FILE *f, const double *v, size_t rows, size_t k)

@@ -1,6 +1,7 @@
 /*
  * The Voronoi cells as text (issue 32; the CLI's --voronoi and --density):
- * one line a point, in input order, from an fdt_voronoi (include/frontdt.h).
+ * one line a point, in input order, from an fdt_voronoi (include/frontdt.h)
+ * or from a stream's batches.
  *
  * A --voronoi-format string is voro++'s custom output (its -c option):
  * text, with these codes replaced for each point (doc/reference.md):
@@ -36,6 +37,24 @@ int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *x
  * %h: a hull point's density counts only the tets it has), as
  * fdt_wr_cells does. */
 int fdt_wr_density(FILE *f, const fdt_voronoi *v, int threads);
+
+/*
+ * The tables of a streamed run (fdt_voronoi_stream's batches, in any
+ * order) written in input order at the end: each batch's rows formatted
+ * as they come into a spool (an unlinked temporary in dir: a record a
+ * row, the two tables' text) with each input id's offset (8 bytes a
+ * point), then each table copied out in input order. fmt: the cells'
+ * format (NULL: none), csv: CSV instead; density: the density table too.
+ * The calls return 0 or an errno; fdt_cells_spool_put gives EINVAL if a
+ * point's row never came.
+ */
+typedef struct fdt_cells_spool fdt_cells_spool;
+int fdt_cells_spool_open(fdt_cells_spool **sp, size_t n, const char *fmt, int csv, int density,
+                         const char *dir);
+int fdt_cells_spool_add(fdt_cells_spool *sp, const fdt_voronoi *v);
+/* table 0: the cells' (fmt or CSV); 1: the densities. */
+int fdt_cells_spool_put(fdt_cells_spool *sp, int table, FILE *f);
+void fdt_cells_spool_close(fdt_cells_spool **sp);
 
 /* The cells as VTK polyhedra (a .vtu file, VTK_POLYHEDRON cells with
  * their faces, ParaView's reader): one cell a distinct point, cell data
