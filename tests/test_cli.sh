@@ -1047,6 +1047,28 @@ run st_count "$FRONTDT" st.xyz --mode serial
 run st_count_s "$FRONTDT" st.xyz --mode serial --stream
 [ "$(grep '^tets:' st_count.out)" = "$(grep '^tets:' st_count_s.out)" ] ||
     fail "--stream counts $(grep '^tets:' st_count_s.out), in memory $(grep '^tets:' st_count.out)"
+# streamed cells (issue 32): the same bytes as in memory, a text table and
+# a CSV one, at one and three threads, with duplicates; what cannot stream
+# is refused, and the kd fronts (which cannot say when a cell is whole) too
+{ cat st.xyz; head -50 st.xyz; } >stv.xyz
+run stv_mem "$FRONTDT" stv.xyz -q --voronoi stv_m.txt --density stv_md.txt --voronoi-format '%i %q %v %n %f %C %d %h'
+expect_rc stv_mem 0
+for t in 1 3; do
+    run stv_s$t "$FRONTDT" stv.xyz -q --stream -t $t --voronoi stv_s$t.txt --density stv_sd$t.txt --voronoi-format '%i %q %v %n %f %C %d %h' -o stv_s$t.vtu
+    expect_rc stv_s$t 0 && {
+        cmp -s stv_m.txt stv_s$t.txt || fail "--stream -t $t --voronoi: not the in-memory table"
+        cmp -s stv_md.txt stv_sd$t.txt || fail "--stream -t $t --density: not the in-memory table"
+        [ -s stv_s$t.vtu ] || fail "--stream -t $t --voronoi: no mesh beside the cells"
+    }
+done
+run stv_csv_m "$FRONTDT" stv.xyz -q --voronoi stv_m.csv
+run stv_csv_s "$FRONTDT" stv.xyz -q --stream --voronoi stv_s.csv
+cmp -s stv_m.csv stv_s.csv || fail "--stream --voronoi F.csv: not the in-memory table"
+ls -a | grep -q frontdt-cells && fail "--stream --voronoi left its spool"
+usage_case u_stream_vtu "polyhedra) needs the whole mesh" st.xyz --stream --voronoi st.vtu
+run stv_kd "$FRONTDT" stv.xyz -q --stream --search kd --voronoi stv_kd.txt
+expect_rc stv_kd 1 && expect_in stv_kd err "sweep order"
+[ ! -e stv_kd.txt ] || fail "--stream --search kd --voronoi wrote its table"
 usage_case u_stream_o "format tets needs the whole mesh" st.xyz --stream -o st.tets
 usage_case u_stream_check "--check needs the whole mesh" st.xyz --stream --check
 usage_case u_stream_hash "--hash sorts the whole mesh" st.xyz --stream --hash

@@ -307,36 +307,46 @@ static int number_points(vwork *w, const fdt_result *r, const double *xyz)
     return FDT_OK;
 }
 
-/* The tets in local ids, bucketed by their lowest id. */
-static int local_tets(vwork *w, const fdt_result *r)
+/* w's tets (local ids) bucketed by their lowest id, so that the tet pass
+ * meets the points' accumulators in order (about 3x faster at 1M than
+ * the insertion's slot order, bench/NOTES.md entry 105). */
+static int bucket_tets(vwork *w)
 {
     size_t *cnt = calloc(w->m + 1, sizeof *cnt);
-    w->ntets = r->ntets;
-    w->tets = malloc((w->ntets ? 4 * w->ntets : 1) * sizeof *w->tets);
-    if (!cnt || !w->tets) {
+    uint32_t *out = malloc((w->ntets ? 4 * w->ntets : 1) * sizeof *out);
+    if (!cnt || !out) {
         free(cnt);
+        free(out);
         return FDT_ENOMEM;
     }
     for (size_t t = 0; t < w->ntets; t++) {
-        uint32_t lo = UINT32_MAX;
-        for (int k = 0; k < 4; k++) {
-            uint32_t x = w->loc[r->tets[4 * t + k]];
-            lo = x < lo ? x : lo;
-        }
-        cnt[lo + 1]++;
+        const uint32_t *x = w->tets + 4 * t;
+        uint32_t lo = x[0] < x[1] ? x[0] : x[1], lo2 = x[2] < x[3] ? x[2] : x[3];
+        cnt[(lo < lo2 ? lo : lo2) + 1]++;
     }
     for (size_t l = 0; l < w->m; l++)
         cnt[l + 1] += cnt[l];
     for (size_t t = 0; t < w->ntets; t++) {
-        uint32_t x[4], lo = UINT32_MAX;
-        for (int k = 0; k < 4; k++) {
-            x[k] = w->loc[r->tets[4 * t + k]];
-            lo = x[k] < lo ? x[k] : lo;
-        }
-        memcpy(w->tets + 4 * cnt[lo]++, x, sizeof x);
+        const uint32_t *x = w->tets + 4 * t;
+        uint32_t lo = x[0] < x[1] ? x[0] : x[1], lo2 = x[2] < x[3] ? x[2] : x[3];
+        memcpy(out + 4 * cnt[lo < lo2 ? lo : lo2]++, x, 4 * sizeof *x);
     }
     free(cnt);
+    free(w->tets);
+    w->tets = out;
     return FDT_OK;
+}
+
+/* The result's tets in local ids, bucketed. */
+static int local_tets(vwork *w, const fdt_result *r)
+{
+    w->ntets = r->ntets;
+    w->tets = malloc((w->ntets ? 4 * w->ntets : 1) * sizeof *w->tets);
+    if (!w->tets)
+        return FDT_ENOMEM;
+    for (size_t c = 0; c < 4 * w->ntets; c++)
+        w->tets[c] = w->loc[r->tets[c]];
+    return bucket_tets(w);
 }
 
 /* ---------------------------------------------------------------- tet pass */
@@ -1223,59 +1233,106 @@ done:
     return err;
 }
 
-/* A batch's local number of point id (xyz's numbering), made when new:
- * an open-addressing table of id + 1 << 32 | local. */
-static uint32_t batch_local(vwork *w, uint64_t *tab, size_t cap, const fdt_vbatch *b,
-                            uint32_t id)
+/* A batch's numbering: an open-addressing table of id + 1 << 32 | local,
+ * at most half full, and the local arrays it fills. */
+typedef struct btab {
+    uint64_t *t;
+    size_t cap;     /* a power of two */
+    size_t room;    /* entries perm and xyz hold */
+} btab;
+
+static size_t bt_hash(uint32_t id, size_t cap)
 {
-    size_t h = (size_t)(((uint64_t)id * UINT64_C(0x9E3779B97F4A7C15)) >> 32) & (cap - 1);
-    for (;; h = (h + 1) & (cap - 1)) {
-        if (!tab[h]) {
-            uint32_t l = (uint32_t)w->m++;
-            tab[h] = ((uint64_t)id + 1) << 32 | l;
-            w->perm[l] = (uint32_t)b->label[id];
-            for (int k = 0; k < 3; k++) /* the input's coordinates, exactly */
-                w->xyz[3 * (size_t)l + k] = ldexp(b->xyz[3 * (size_t)id + k], -b->xyz_exp);
-            return l;
+    return (size_t)(((uint64_t)id * UINT64_C(0x9E3779B97F4A7C15)) >> 32) & (cap - 1);
+}
+
+/* The table and the local arrays twice as large. */
+static int bt_grow(vwork *w, btab *bt)
+{
+    size_t cap = 2 * bt->cap;
+    uint64_t *t = calloc(cap, sizeof *t);
+    uint32_t *perm = realloc(w->perm, cap / 2 * sizeof *perm);
+    if (perm)
+        w->perm = perm;
+    double *xyz = perm ? realloc(w->xyz, 3 * (cap / 2) * sizeof *xyz) : NULL;
+    if (xyz)
+        w->xyz = xyz;
+    if (!t || !perm || !xyz) {
+        free(t);
+        return FDT_ENOMEM;
+    }
+    for (size_t i = 0; i < bt->cap; i++)
+        if (bt->t[i]) {
+            size_t h = bt_hash((uint32_t)(bt->t[i] >> 32) - 1, cap);
+            while (t[h])
+                h = (h + 1) & (cap - 1);
+            t[h] = bt->t[i];
         }
-        if ((uint32_t)(tab[h] >> 32) == id + 1)
-            return (uint32_t)tab[h];
+    free(bt->t);
+    bt->t = t;
+    bt->cap = cap;
+    bt->room = cap / 2;
+    return FDT_OK;
+}
+
+/* A batch's local number of point id (xyz's numbering), made when new;
+ * UINT32_MAX when out of memory. */
+static uint32_t batch_local(vwork *w, btab *bt, const fdt_vbatch *b, uint32_t id)
+{
+    size_t h = bt_hash(id, bt->cap);
+    for (;; h = (h + 1) & (bt->cap - 1)) {
+        uint64_t e = bt->t[h];
+        if ((uint32_t)(e >> 32) == id + 1)
+            return (uint32_t)e;
+        if (e)
+            continue;
+        if (w->m + 1 > bt->room) {
+            if (bt_grow(w, bt))
+                return UINT32_MAX;
+            return batch_local(w, bt, b, id);
+        }
+        uint32_t l = (uint32_t)w->m++;
+        bt->t[h] = ((uint64_t)id + 1) << 32 | l;
+        w->perm[l] = (uint32_t)b->label[id];
+        for (int k = 0; k < 3; k++) /* the input's coordinates, exactly */
+            w->xyz[3 * (size_t)l + k] = ldexp(b->xyz[3 * (size_t)id + k], -b->xyz_exp);
+        return l;
     }
 }
 
 /* The batch's points numbered (its own first, in their order; then the
  * other points of its tets as met) and its tets in those numbers, those
- * with no own point left out; tets then bucketed as local_tets does. */
+ * with no own point left out, bucketed. */
 static int batch_number(vwork *w, const fdt_vbatch *b)
 {
-    size_t most = b->nown + 4 * b->ntets, cap = 64;
-    while (cap < 2 * most)
-        cap *= 2;
-    uint64_t *tab = calloc(cap, sizeof *tab);
-    w->perm = malloc((most ? most : 1) * sizeof *w->perm);
-    w->xyz = malloc(3 * (most ? most : 1) * sizeof *w->xyz);
+    btab bt = {NULL, 32, 0};
+    while (bt.cap < 2 * (b->nown + b->nown / 4 + 16)) /* about the own and a layer */
+        bt.cap *= 2;
+    bt.cap /= 2;
     w->tets = malloc(4 * (b->ntets ? b->ntets : 1) * sizeof *w->tets);
-    if (!tab || !w->perm || !w->xyz || !w->tets) {
-        free(tab);
+    if (!(bt.t = calloc(bt.cap, sizeof *bt.t)) || !w->tets || bt_grow(w, &bt)) {
+        free(bt.t);
         return FDT_ENOMEM;
     }
     w->m = 0;
-    for (size_t i = 0; i < b->nown; i++)
-        (void)batch_local(w, tab, cap, b, b->own[i]);
+    int err = FDT_OK;
+    for (size_t i = 0; i < b->nown && !err; i++)
+        err = batch_local(w, &bt, b, b->own[i]) == UINT32_MAX ? FDT_ENOMEM : FDT_OK;
     w->nown = w->m;
     w->ntets = 0;
-    for (size_t t = 0; t < b->ntets; t++) {
+    for (size_t t = 0; t < b->ntets && !err; t++) {
         uint32_t x[4];
         int any = 0;
-        for (int k = 0; k < 4; k++) {
-            x[k] = batch_local(w, tab, cap, b, b->tets[4 * t + k]);
+        for (int k = 0; k < 4 && !err; k++) {
+            x[k] = batch_local(w, &bt, b, b->tets[4 * t + k]);
+            err = x[k] == UINT32_MAX ? FDT_ENOMEM : FDT_OK;
             any |= x[k] < w->nown;
         }
-        if (any)
+        if (any && !err)
             memcpy(w->tets + 4 * w->ntets++, x, sizeof x);
     }
-    free(tab);
-    return FDT_OK;
+    free(bt.t);
+    return err ? err : bucket_tets(w);
 }
 
 int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_vshort *sh,
