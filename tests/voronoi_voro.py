@@ -159,7 +159,8 @@ def same_bits():
     pts = read_xyz(path)
     box = box_of(pts)
     base = cells(path, box, ["-t", "1"])
-    for extra in (["-t", "3"], ["-t", "2", "--mode", "message"], ["-t", "2", "--mode", "shared"]):
+    for extra in (["-t", "3"], ["-t", "2", "--mode", "message"], ["-t", "2", "--mode", "shared"],
+                  ["--stream", "-t", "1"], ["--stream", "-t", "3"]):
         if cells(path, box, extra) != base:
             fail("--voronoi differs between -t 1 and %s" % " ".join(extra))
     perm = list(range(len(pts)))
@@ -179,7 +180,8 @@ def same_bits():
             differ += 1
     if differ:
         fail("%d cells differ for the shuffled input" % differ)
-    print("same bits: 1, 3 threads, message and shared modes, and a shuffled input (%d points)"
+    print("same bits: 1, 3 threads, message and shared modes, streamed, and a shuffled input "
+          "(%d points)"
           % len(pts))
 
 
@@ -218,10 +220,14 @@ def refusals():
     path = os.path.join(SCRATCH, "ref.xyz")
     subprocess.run([GEN, "uniform", "500", "1", path], check=True)
     out = os.path.join(SCRATCH, "never.txt")
+    for stale in (out, out[:-4] + ".vtu"):  # an earlier run's failure
+        if os.path.exists(stale):
+            os.remove(stale)
     cases = [
         (["--box", "0,0,0,1,1,0.5", "--voronoi", out], 1, "outside the box"),
         (["--voronoi", out, "--voronoi-format", "%i %Q"], 1, "'%Q'"),
-        (["--voronoi", out, "--stream"], 1, "need the whole mesh"),
+        (["--voronoi", out[:-4] + ".vtu", "--stream"], 1, "needs the whole mesh"),
+        (["--voronoi", out, "--stream", "--search", "kd"], 1, "sweep order"),
         (["--box", "0,0,0,1,1"], 1, "--box wants six"),
         (["--voronoi-format", "%v"], 1, "needs --voronoi"),
     ]
@@ -230,8 +236,9 @@ def refusals():
         if r.returncode != code or text not in r.stderr:
             fail("%s: exit %d (want %d), stderr %r (want %r)" % (args, r.returncode, code,
                                                                   r.stderr.strip(), text))
-        if os.path.exists(out):
-            fail("%s left %s" % (args, out))
+        for left in (out, out[:-4] + ".vtu"):
+            if os.path.exists(left):
+                fail("%s left %s" % (args, left))
 
 
 def formats_and_refusals():
