@@ -1,7 +1,8 @@
 /*
  * Voronoi cells streamed from the sweep (src/front/cellstream.c, issue
  * 32): for every tests/gen_points family, the cells handed on part by
- * part, with slabs small enough for many parts, at 1 and 3 threads, are the cells of the whole mesh (fdt_voronoi_compute) to
+ * part, with slabs small enough for many parts, at 1 and 3 threads, in
+ * batches of a part's closing points or in chunks of them, are the cells of the whole mesh (fdt_voronoi_compute) to
  * the bit, neighbours and face areas included, each point's exactly once.
  * Through the public fdt_voronoi_stream: every input point once (merged
  * duplicates in the last batch), the same bits, the sink's stop, a point
@@ -167,6 +168,7 @@ static void test_family(const char *gen, const char *fam, size_t n)
             memset(&cs, 0, sizeof cs);
             cs.neighbors = 1;
             cs.sink = &cells;
+            cs.chunk = slabs[si] == 500 && threads[ti] == 1 ? 0 : 211; /* chunked batches */
             cs.p_exp = pr.scale_exp;
             fdt_voronoi_box(ref, cs.box);
             CHECK_EQ(fdt_voronoi_scale(cs.box, &cs.ed, diag, sizeof diag), FDT_OK);

@@ -11,7 +11,14 @@
 /* A point's progress (fdt_cellstream.state): not yet in a part, in the
  * part just over and not live after it (its cell is due now), live, its
  * cell handed on. HULL beside them: a vertex of a hull face. */
-enum { UNSEEN = 0, CLOSING = 1, LIVE = 2, CLOSED = 3, PROGRESS = 3, HULL = 4 };
+enum { UNSEEN = 0, CLOSING = 1, LIVE = 2, CLOSED = 3, PROGRESS = 3, HULL = 4, IN_CHUNK = 8 };
+
+/* Closing points a batch at most: a batch's working memory is about 550
+ * bytes a point (accumulators, neighbour lists and their face sums, its
+ * tets), so a part's 2M closing points at once took 1.1 GB beside its
+ * mesh; chunks of 2^18 in the part's Morton order recompute the tets
+ * shared between chunks (bench/NOTES.md entry 105). */
+#define CELL_CHUNK ((size_t)1 << 18)
 
 int fdt_cellstream_init(fdt_cellstream *cs, size_t m)
 {
@@ -46,6 +53,7 @@ void fdt_cellheld_free(fdt_cellheld *h)
     free(h->pool);
     free(h->own);
     free(h->own_hull);
+    free(h->chunk);
     memset(h, 0, sizeof *h);
 }
 
@@ -154,10 +162,33 @@ int fdt_cellstream_part(fdt_cellstream *cs, fdt_cellheld *h, const fdt_vid *part
             h->own[nown++] = (uint32_t)part[i];
         }
     int err = FDT_OK;
-    if (nown) {
-        fdt_vbatch b = {.xyz = cs->P, .xyz_exp = cs->p_exp, .label = cs->orig, .own = h->own,
-                        .nown = nown, .own_hull = h->own_hull, .tets = h->pool, .ntets = nb,
-                        .ed = cs->ed, .neighbors = cs->neighbors};
+    const size_t chunk = cs->chunk ? cs->chunk : CELL_CHUNK;
+    for (size_t c0 = 0; c0 < nown && !err; c0 += chunk) {
+        size_t c1 = nown - c0 > chunk ? c0 + chunk : nown;
+        /* the chunk's tets: those of the batch with a vertex in it (all of
+         * them when the batch is one chunk) */
+        const uint32_t *tets = h->pool;
+        size_t nt = nb;
+        if (c1 - c0 < nown) {
+            for (size_t i = c0; i < c1; i++)
+                state[h->own[i]] |= IN_CHUNK;
+            if (fdt_grow(&h->chunk, &h->chunkcap, 4 * nb, sizeof *h->chunk)) {
+                err = FDT_ENOMEM;
+                break;
+            }
+            nt = 0;
+            for (size_t t = 0; t < nb; t++) {
+                const uint32_t *v = h->pool + 4 * t;
+                if ((state[v[0]] | state[v[1]] | state[v[2]] | state[v[3]]) & IN_CHUNK)
+                    memcpy(h->chunk + 4 * nt++, v, 4 * sizeof *v);
+            }
+            for (size_t i = c0; i < c1; i++)
+                state[h->own[i]] &= (uint8_t)~IN_CHUNK;
+            tets = h->chunk;
+        }
+        fdt_vbatch b = {.xyz = cs->P, .xyz_exp = cs->p_exp, .label = cs->orig,
+                        .own = h->own + c0, .nown = c1 - c0, .own_hull = h->own_hull + c0,
+                        .tets = tets, .ntets = nt, .ed = cs->ed, .neighbors = cs->neighbors};
         memcpy(b.box, cs->box, sizeof b.box);
         fdt_voronoi *v = NULL;
         fdt_vshort sh = {-1, -1, 0};

@@ -36,6 +36,8 @@ typedef struct fdt_cellstream {
     double box[6];            /* the cells' box, the input's frame */
     int ed;                   /* fdt_voronoi_scale of box */
     int neighbors;            /* keep neighbours and face areas */
+    size_t chunk;             /* closing points a batch at most (0: 2^18;
+                                 tests make it small) */
     const fdt_cell_sink *sink;/* the caller's (borrowed) */
     /* Serializes the sink's calls (never two at once, as fdt_sink's) and
      * guards rc, sh and the counts: a sweep's unlock after its call
@@ -57,6 +59,8 @@ typedef struct fdt_cellheld {
     uint32_t *own;            /* scratch: the closing points */
     uint8_t *own_hull;
     size_t owncap;
+    uint32_t *chunk;          /* scratch: a chunk's tets */
+    size_t chunkcap;
 } fdt_cellheld;
 
 /* The state of m points, the lock and the counts; FDT_OK or FDT_ENOMEM.
@@ -79,7 +83,7 @@ uint32_t *fdt_cellheld_add(fdt_cellheld *h, size_t count);
  * added by fdt_cellheld_add, its live points live[0 .. nlive) and, in the
  * last part, its hull faces' points hull[0 .. nhull) (ids, repeats
  * allowed). The closing points' cells, in part's order, go to the sink
- * as one batch computed on `threads` threads. FDT_OK; FDT_ENOMEM;
+ * in batches of up to 2^18 computed on `threads` threads. FDT_OK; FDT_ENOMEM;
  * FDT_EINTERNAL (diag); the sink's stop code (FDT_ECANCELED, or its
  * negative FDT_E* value). A tet too short for the cells is kept in cs->sh
  * and the run goes on without handing on more cells (the caller reports
