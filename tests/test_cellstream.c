@@ -293,17 +293,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: test_cellstream GEN_POINTS\n");
         return 2;
     }
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "'%s' --list", argv[1]);
-    FILE *f = popen(cmd, "r");
-    CHECK(f != NULL);
-    char fam[64];
-    int families = 0;
-    while (fscanf(f, "%63s", fam) == 1) {
-        test_family(argv[1], fam, 3000);
-        families++;
-    }
-    pclose(f);
+    int families = test_each_family(argv[1], 3000, test_family);
     EXPECTF(families > 30, "only %d families listed", families);
     test_api();
     return test_report("cellstream");

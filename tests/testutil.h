@@ -227,6 +227,25 @@ static inline double *test_gen_family(const char *gen, const char *fam, size_t n
     return p;
 }
 
+/* fn(gen, family, n) for every family `gen --list` names; how many (a
+ * test expects the list it knows, e.g. more than 30). */
+static inline int test_each_family(const char *gen, size_t n,
+                                   void (*fn)(const char *, const char *, size_t))
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "'%s' --list", gen);
+    FILE *f = popen(cmd, "r");
+    CHECK(f != NULL);
+    char fam[64];
+    int families = 0;
+    while (fscanf(f, "%63s", fam) == 1) {
+        fn(gen, fam, n);
+        families++;
+    }
+    pclose(f);
+    return families;
+}
+
 static inline double now_s(void)
 {
     struct timespec ts;

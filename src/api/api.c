@@ -579,7 +579,8 @@ int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
         fdt_default_voronoi_options(&defaults);
         o = &defaults;
     }
-    if (!ctx || !out || !cells || cells->struct_size < sizeof(fdt_cell_sink) || !cells->cells ||
+    if (!ctx || !out || (!xyz && n) || !cells || cells->struct_size < sizeof(fdt_cell_sink) ||
+        !cells->cells ||
         o->struct_size != sizeof *o || (sink && (sink->struct_size < sizeof(fdt_sink) ||
                                                  !sink->tets)))
         return FDT_EINVAL;
@@ -598,7 +599,8 @@ int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
      * a permuted input is moved by the run). The bounding box of the
      * distinct points is that of all of them. */
     int err = fdt_voronoi_box_of(xyz, n, o, cs.box, ctx->diag, sizeof ctx->diag);
-    if (!err)
+    /* no finite point: the run refuses the input, with its own message */
+    if (!err && cs.box[0] <= cs.box[3])
         err = fdt_voronoi_scale(cs.box, &cs.ed, ctx->diag, sizeof ctx->diag);
     if (!err)
         err = run(ctx, xyz, n, sink ? sink : &dropped, &cs, out);

@@ -86,7 +86,8 @@ static int split_pool(const uint8_t *state, fdt_cellheld *h, size_t *nbatch)
      * the pool */
     if (fdt_grow(&h->pool, &h->poolcap, 4 * (h->npool + h->n), sizeof *h->pool))
         return FDT_ENOMEM;
-    memmove(h->pool + 4 * h->n, h->pool, 4 * h->npool * sizeof *h->pool);
+    if (h->npool) /* a part that emitted nothing has no pool yet (NULL) */
+        memmove(h->pool + 4 * h->n, h->pool, 4 * h->npool * sizeof *h->pool);
     if (h->n)
         memcpy(h->pool, h->tets, 4 * h->n * sizeof *h->tets);
     size_t np = h->npool + h->n, nb = 0, nh = 0;
@@ -150,8 +151,10 @@ int fdt_cellstream_part(fdt_cellstream *cs, fdt_cellheld *h, const fdt_vid *part
     if (split_pool(state, h, &nb))
         return FDT_ENOMEM;
     h->npool = 0;
-    if (h->n > cs->max_held) /* a sweep's own high-water mark; read after the joins */
+    pthread_mutex_lock(&cs->lock); /* both sweeps' high-water mark */
+    if (h->n > cs->max_held)
         cs->max_held = h->n;
+    pthread_mutex_unlock(&cs->lock);
     if (fdt_grow(&h->own, &h->owncap, npart, sizeof *h->own) ||
         !(h->own_hull = realloc(h->own_hull, npart ? npart : 1)))
         return FDT_ENOMEM;
