@@ -424,6 +424,14 @@ typedef struct fdt_stats {
     size_t sweep_reinserted;  /* live vertices a part carried into the next
                                  (inserted again) */
     size_t sweep_max_part;    /* the most points in one part's mesh */
+    /* Streamed Voronoi cells (issue 32, fdt_voronoi_stream). Added in 0.5:
+     * an older caller passes a shorter size and gets the fields above. */
+    size_t cell_batches;      /* batches of cells handed on (0: none asked) */
+    size_t cell_held_max;     /* the most emitted tets held at once for
+                                 points still live (both sweeps') */
+    double t_cells;           /* seconds computing them, within the
+                                 triangulation's time (summed over the
+                                 sweeps, which run at once) */
 } fdt_stats;
 
 /* Fills the first struct_size bytes of *st (its struct_size included).

@@ -386,7 +386,8 @@ static PyObject *tri_stats(TriObject *self, void *closure)
         PUT_DBL(d, st, t_certify) || PUT_SIZE(d, st, ins_conflict_tests) ||
         PUT_SIZE(d, st, ins_deferred) || PUT_SIZE(d, st, ins_serial) ||
         PUT_SIZE(d, st, sweep_parts) || PUT_SIZE(d, st, sweep_reinserted) ||
-        PUT_SIZE(d, st, sweep_max_part) ||
+        PUT_SIZE(d, st, sweep_max_part) || PUT_SIZE(d, st, cell_batches) ||
+        PUT_SIZE(d, st, cell_held_max) || PUT_DBL(d, st, t_cells) ||
         put(d, "duplicates", PyLong_FromSize_t(fdt_result_num_duplicates(self->r)))) {
         Py_DECREF(d);
         return NULL;

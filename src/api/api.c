@@ -423,6 +423,11 @@ static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, int nthrea
     st->sweep_parts = sws->parts;
     st->sweep_reinserted = sws->reinserted;
     st->sweep_max_part = sws->max_part;
+    if (rs->cs) {
+        st->cell_batches = rs->cs->batches;
+        st->cell_held_max = rs->cs->max_held;
+        st->t_cells = sws->t_cells;
+    }
     st->threads = nthreads;
     st->mode = mode;
     /* Memory (include/frontdt.h): the points' three arrays, then each
@@ -510,6 +515,9 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
         err = cells_done(ctx, cs);
     if (err)
         goto fail;
+    /* the merged duplicates' rows, the cells' last batch */
+    if (cs && (err = fdt_cellstream_merged(cs, rs.pr.dupmap, n, rs.pr.p, rs.pr.orig, rs.pr.m)))
+        goto fail;
     double t2 = fdt_now_s();
     err = FDT_ENOMEM;
     r = calloc(1, sizeof *r);
@@ -517,8 +525,6 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
         goto fail;
     result_take(r, &rs, user, n);
     result_stats(r, &rs, mode, nthreads, user, n, t0, t1, t2);
-    if (cs && (err = fdt_cellstream_merged(cs, r->dupmap, n, rs.pr.p, rs.pr.orig, rs.pr.m)))
-        goto fail;
     fdt_emit_free(&rs.em);
     fdt_tsink_free(&rs.sink);
     fdt_kd_free(&rs.tree);

@@ -841,6 +841,7 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  final from mesh   %zu tets (certified %zu in %.3f s)\n"
         "  insertion         %zu conflict tests, %zu deferred, %zu by the serial finish\n"
         "  sweep             %zu parts, %zu points inserted again, at most %zu in a part\n"
+        "  streamed cells    %zu batches, at most %zu tets held, %.3f s of the triangulation\n"
         "  threads           %d\n"
         "  mode              %s\n"
         "  engine            %s\n"
@@ -860,7 +861,7 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         st->max_front, st->mesh_faces, st->mesh_parts, st->t_mesh, st->final_tets,
         st->certified_tets, st->t_certify, st->ins_conflict_tests, st->ins_deferred,
         st->ins_serial, st->sweep_parts, st->sweep_reinserted, st->sweep_max_part,
-        st->threads, mode_name(st->mode),
+        st->cell_batches, st->cell_held_max, st->t_cells, st->threads, mode_name(st->mode),
         engine_name(st), st->t_prepare, st->t_front, st->t_finish,
         tm->read, tm->triangulate, tm->check, tm->canon, tm->write, tm->voronoi,
         tm->interpolate);
@@ -949,7 +950,8 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         ", \"t_mesh\": %.9g, \"final_tets\": %zu, \"certified_tets\": %zu"
         ", \"t_certify\": %.9g, \"ins_conflict_tests\": %zu, \"ins_deferred\": %zu"
         ", \"ins_serial\": %zu, \"sweep_parts\": %zu, \"sweep_reinserted\": %zu"
-        ", \"sweep_max_part\": %zu, \"threads\": %d, \"mode\": \"%s\""
+        ", \"sweep_max_part\": %zu, \"cell_batches\": %zu, \"cell_held_max\": %zu"
+        ", \"t_cells\": %.9g, \"threads\": %d, \"mode\": \"%s\""
         ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
         ", \"t_read\": %.9g, \"t_triangulate\": %.9g, \"t_check\": %.9g"
         ", \"t_canon\": %.9g, \"t_write\": %.9g, \"t_voronoi\": %.9g"
@@ -960,8 +962,9 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         st->max_front, st->mesh_faces, st->mesh_parts, finite_or_zero(st->t_mesh),
         st->final_tets, st->certified_tets, finite_or_zero(st->t_certify),
         st->ins_conflict_tests, st->ins_deferred, st->ins_serial, st->sweep_parts,
-        st->sweep_reinserted, st->sweep_max_part,
-        st->threads, mode_name(st->mode), finite_or_zero(st->t_prepare),
+        st->sweep_reinserted, st->sweep_max_part, st->cell_batches, st->cell_held_max,
+        finite_or_zero(st->t_cells), st->threads, mode_name(st->mode),
+        finite_or_zero(st->t_prepare),
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
         finite_or_zero(tm->check), finite_or_zero(tm->canon), finite_or_zero(tm->write),

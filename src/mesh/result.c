@@ -46,7 +46,8 @@ static int stats_size_known(size_t size)
     return size == sizeof(fdt_stats) || size == offsetof(fdt_stats, mem_points) ||
            size == offsetof(fdt_stats, final_tets) ||
            size == offsetof(fdt_stats, ins_conflict_tests) ||
-           size == offsetof(fdt_stats, sweep_parts);
+           size == offsetof(fdt_stats, sweep_parts) ||
+           size == offsetof(fdt_stats, cell_batches);
 }
 
 static int thread_stats_size_known(size_t size)
