@@ -169,13 +169,13 @@ int fdt_cellstream_part(fdt_cellstream *cs, fdt_cellheld *h, const fdt_vid *part
     for (size_t c0 = 0; c0 < nown && !err; c0 += chunk) {
         size_t c1 = nown - c0 > chunk ? c0 + chunk : nown;
         /* the chunk's tets: those of the batch with a vertex in it (all of
-         * them when the batch is one chunk) */
-        const uint32_t *tets = h->pool;
+         * them when the batch is one chunk), as indices into the pool */
+        const uint32_t *pick = NULL;
         size_t nt = nb;
         if (c1 - c0 < nown) {
             for (size_t i = c0; i < c1; i++)
                 state[h->own[i]] |= IN_CHUNK;
-            if (fdt_grow(&h->chunk, &h->chunkcap, 4 * nb, sizeof *h->chunk)) {
+            if (fdt_grow(&h->chunk, &h->chunkcap, nb, sizeof *h->chunk)) {
                 err = FDT_ENOMEM;
                 break;
             }
@@ -183,15 +183,16 @@ int fdt_cellstream_part(fdt_cellstream *cs, fdt_cellheld *h, const fdt_vid *part
             for (size_t t = 0; t < nb; t++) {
                 const uint32_t *v = h->pool + 4 * t;
                 if ((state[v[0]] | state[v[1]] | state[v[2]] | state[v[3]]) & IN_CHUNK)
-                    memcpy(h->chunk + 4 * nt++, v, 4 * sizeof *v);
+                    h->chunk[nt++] = (uint32_t)t;
             }
             for (size_t i = c0; i < c1; i++)
                 state[h->own[i]] &= (uint8_t)~IN_CHUNK;
-            tets = h->chunk;
+            pick = h->chunk;
         }
         fdt_vbatch b = {.xyz = cs->P, .xyz_exp = cs->p_exp, .label = cs->orig,
                         .own = h->own + c0, .nown = c1 - c0, .own_hull = h->own_hull + c0,
-                        .tets = tets, .ntets = nt, .ed = cs->ed, .neighbors = cs->neighbors};
+                        .tets = h->pool, .ntets = nt, .pick = pick, .ed = cs->ed,
+                        .neighbors = cs->neighbors};
         memcpy(b.box, cs->box, sizeof b.box);
         fdt_voronoi *v = NULL;
         fdt_vshort sh = {-1, -1, 0};

@@ -59,7 +59,7 @@ typedef struct fdt_cellheld {
     uint32_t *own;            /* scratch: the closing points */
     uint8_t *own_hull;
     size_t owncap;
-    uint32_t *chunk;          /* scratch: a chunk's tets */
+    uint32_t *chunk;          /* scratch: a chunk's tets, pool indices */
     size_t chunkcap;
 } fdt_cellheld;
 

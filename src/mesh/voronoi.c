@@ -1322,10 +1322,11 @@ static int batch_number(vwork *w, const fdt_vbatch *b)
     w->nown = w->m;
     w->ntets = 0;
     for (size_t t = 0; t < b->ntets && !err; t++) {
+        const uint32_t *tv = b->tets + 4 * (size_t)(b->pick ? b->pick[t] : t);
         uint32_t x[4];
         int any = 0;
         for (int k = 0; k < 4 && !err; k++) {
-            x[k] = batch_local(w, &bt, b, b->tets[4 * t + k]);
+            x[k] = batch_local(w, &bt, b, tv[k]);
             err = x[k] == UINT32_MAX ? FDT_ENOMEM : FDT_OK;
             any |= x[k] < w->nown;
         }

@@ -77,6 +77,8 @@ typedef struct fdt_vbatch {
     const uint8_t *own_hull; /* nonzero: own[i] is a hull point */
     const uint32_t *tets;    /* 4 ids a tet */
     size_t ntets;
+    const uint32_t *pick;    /* NULL, or the tets taken: ntets indices
+                                into tets (a chunk's, without a copy) */
     double box[6];           /* holds every point (the caller checked) */
     int ed;                  /* fdt_voronoi_scale's exponent of box */
     int neighbors;           /* keep each cell's neighbours and face areas */
