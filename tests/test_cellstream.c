@@ -251,6 +251,33 @@ static void test_api(void)
     EXPECT_IS(run_stream(xyz, n, &s, &o, &g, &sr, diag, sizeof diag), FDT_ECANCELED);
     EXPECT(sr == NULL && g.calls == 1);
     free(g.seen);
+    /* arguments refused: nothing run, no result */
+    {
+        fdt_context *ctx = NULL;
+        CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+        fdt_cell_sink good = {sizeof good, collect, &g}, small = {1, collect, &g},
+                      none = {sizeof none, NULL, &g};
+        fdt_sink notets = {sizeof notets, NULL, NULL, NULL};
+        fdt_voronoi_options osz = o;
+        osz.struct_size = 1;
+        EXPECT_IS(fdt_voronoi_stream(NULL, xyz, n, &o, NULL, &good, &sr), FDT_EINVAL);
+        EXPECT_IS(fdt_voronoi_stream(ctx, NULL, n, &o, NULL, &good, &sr), FDT_EINVAL);
+        EXPECT_IS(fdt_voronoi_stream(ctx, xyz, n, &o, NULL, NULL, &sr), FDT_EINVAL);
+        EXPECT_IS(fdt_voronoi_stream(ctx, xyz, n, &o, NULL, &small, &sr), FDT_EINVAL);
+        EXPECT_IS(fdt_voronoi_stream(ctx, xyz, n, &o, NULL, &none, &sr), FDT_EINVAL);
+        EXPECT_IS(fdt_voronoi_stream(ctx, xyz, n, &osz, NULL, &good, &sr), FDT_EINVAL);
+        EXPECT_IS(fdt_voronoi_stream(ctx, xyz, n, &o, &notets, &good, &sr), FDT_EINVAL);
+        EXPECT_IS(fdt_voronoi_stream(ctx, xyz, n, &o, NULL, &good, NULL), FDT_EINVAL);
+        fdt_close(&ctx);
+        fdt_settings sn = s;
+        sn.neighbors = 1;
+        CHECK_EQ(fdt_open(&ctx, &sn), FDT_OK);
+        EXPECT_IS(fdt_voronoi_stream(ctx, xyz, n, &o, NULL, &good, &sr), FDT_EINVAL);
+        EXPECT(strstr(fdt_context_diagnostic(ctx), "no neighbours") != NULL && sr == NULL);
+        fdt_close(&ctx);
+        EXPECT(fdt_voronoi_ids(NULL) == NULL && fdt_voronoi_points(NULL) == NULL);
+        EXPECT(fdt_voronoi_ids(ref) == NULL && fdt_voronoi_points(ref) == NULL);
+    }
     /* a given box that leaves a point out: refused before any cell */
     got_init(&g, ref, xyz, n);
     fdt_voronoi_options ob = o;

@@ -9,7 +9,8 @@
  * on a failed allocation by design; README.md, Limits.)
  *
  * For each scenario (a read, a triangulation, a sort, a hash, a check, a write,
- * a streamed write through fdt_stream_writer_*, the Voronoi cells, point
+ * a streamed write through fdt_stream_writer_*, the Voronoi cells (in
+ * memory and streamed), point
  * location, interpolation) and k = 1, 2, ...:
  *   - "once":  the k-th allocation of the scenario fails, later ones work;
  *   - "from":  the k-th and every later allocation fail (error paths that
@@ -452,6 +453,57 @@ static int sc_stream(void *arg, const char **bad)
     uint64_t h = 0;
     if (fdt_result_set_hash(r, &h) != FDT_OK || h != a->want_set || got != a->want_tets)
         *bad = "wrong streamed mesh";
+    fdt_result_free(&r);
+    return rc;
+}
+
+/* The streamed cells (fdt_voronoi_stream, issue 32): every point's cell
+ * once, neighbours kept, the tets dropped; the volumes summed in the
+ * batches' order (the same order and bits in every whole run). */
+typedef struct vstream_arg {
+    const ptset *ps;
+    double want_sum; /* NaN: not known yet */
+    double got_sum;
+} vstream_arg;
+
+static int sum_cells(void *user, const fdt_voronoi *v)
+{
+    double *acc = user; /* the volumes' sum, the cells */
+    for (size_t i = 0; i < fdt_voronoi_num_points(v); i++)
+        acc[0] += fdt_voronoi_volumes(v)[i];
+    acc[1] += (double)fdt_voronoi_num_points(v);
+    return 0;
+}
+
+static int sc_vstream(void *arg, const char **bad)
+{
+    vstream_arg *a = arg;
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.n_threads = 1;
+    fdt_context *ctx = NULL;
+    int rc = fdt_open(&ctx, &s);
+    if (rc != FDT_OK)
+        return rc;
+    double acc[2] = {0, 0};
+    fdt_cell_sink cells = {sizeof cells, sum_cells, acc};
+    fdt_voronoi_options o;
+    fdt_default_voronoi_options(&o);
+    o.neighbors = 1;
+    fdt_result *r = NULL;
+    rc = fdt_voronoi_stream(ctx, a->ps->xyz, a->ps->n, &o, NULL, &cells, &r);
+    if (rc == FDT_ENOMEM && fdt_context_diagnostic(ctx)[0] == '\0')
+        *bad = "FDT_ENOMEM without a diagnostic";
+    fdt_close(&ctx);
+    if (rc != FDT_OK) {
+        if (r != NULL)
+            *bad = "a failed fdt_voronoi_stream returned a result";
+        fdt_result_free(&r);
+        return rc;
+    }
+    a->got_sum = acc[0];
+    if (acc[1] != (double)a->ps->n || (!isnan(a->want_sum) && acc[0] != a->want_sum))
+        *bad = "wrong streamed cells";
     fdt_result_free(&r);
     return rc;
 }
@@ -1201,6 +1253,17 @@ int main(int argc, char **argv)
                 stream_arg sa = {ps, &serial_cfg, sh, nt};
                 scenario ss = {snm, FDT_ENOMEM, sc_stream, &sa};
                 inject_all(&ss);
+                if (si != 1) {
+                    /* the reference: a run with no failure */
+                    vstream_arg va = {ps, NAN, 0};
+                    const char *vbad = NULL;
+                    EXPECTF(sc_vstream(&va, &vbad) == FDT_OK && !vbad, "voronoi stream %s: "
+                            "reference", ps->name);
+                    va.want_sum = va.got_sum;
+                    snprintf(snm, sizeof snm, "voronoi stream %s", ps->name);
+                    scenario sv = {snm, FDT_ENOMEM, sc_vstream, &va};
+                    inject_all(&sv);
+                }
             }
             for (int w = 0; w < 4; w++) {
                 post_arg pa = {ps, nb, w, h};
