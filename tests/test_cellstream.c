@@ -320,7 +320,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: test_cellstream GEN_POINTS\n");
         return 2;
     }
-    int families = test_each_family(argv[1], 3000, test_family);
+    int families = test_each_family(argv[1], 2000, test_family);
     EXPECTF(families > 30, "only %d families listed", families);
     test_api();
     return test_report("cellstream");

@@ -3,7 +3,6 @@
 
 #include <errno.h>
 #include <math.h>
-#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -244,22 +243,27 @@ int fdt_cli_cells_failed(const fdt_cli_cells *c, char *err, size_t errlen)
     return 1;
 }
 
+/* One table of the spool (write_side's writer). */
+typedef struct spooled {
+    const fdt_cli_cells *c;
+    int table; /* 0 the cells', 1 the densities */
+} spooled;
+
 static int put_spooled(FILE *f, const void *arg, const double *xyz)
 {
     (void)xyz;
-    const fdt_cli_cells *c = ((const fdt_cli_cells *const *)arg)[0];
-    int table = (int)(intptr_t)((const void *const *)arg)[1];
-    return fdt_cells_spool_put(c->sp, table, f);
+    const spooled *t = arg;
+    return fdt_cells_spool_put(t->c->sp, t->table, f);
 }
 
 int fdt_cli_cells_write(const fdt_cli_dual *d, fdt_cli_cells *c, char *err, size_t errlen)
 {
     int r = FDT_OK;
-    const void *a0[2] = {c, (const void *)(intptr_t)0}, *a1[2] = {c, (const void *)(intptr_t)1};
+    const spooled cells = {c, 0}, density = {c, 1};
     if (d->voronoi)
-        r = write_side(d->voronoi, put_spooled, a0, NULL, err, errlen);
+        r = write_side(d->voronoi, put_spooled, &cells, NULL, err, errlen);
     if (r == FDT_OK && d->density)
-        r = write_side(d->density, put_spooled, a1, NULL, err, errlen);
+        r = write_side(d->density, put_spooled, &density, NULL, err, errlen);
     return r;
 }
 
