@@ -426,6 +426,23 @@ static int count_sink(void *user, const fdt_vid *t, size_t count)
     return 0;
 }
 
+/* A streamed call's status checked and ctx closed: FDT_ENOMEM must come
+ * with a diagnostic, and a failed call must leave no result (freed
+ * here). */
+static int stream_status(fdt_context **ctx, int rc, fdt_result **r, const char *failed,
+                         const char **bad)
+{
+    if (rc == FDT_ENOMEM && fdt_context_diagnostic(*ctx)[0] == '\0')
+        *bad = "FDT_ENOMEM without a diagnostic";
+    fdt_close(ctx);
+    if (rc != FDT_OK) {
+        if (*r != NULL)
+            *bad = failed;
+        fdt_result_free(r);
+    }
+    return rc;
+}
+
 static int sc_stream(void *arg, const char **bad)
 {
     stream_arg *a = arg;
@@ -441,15 +458,8 @@ static int sc_stream(void *arg, const char **bad)
     fdt_sink sink = {sizeof sink, count_sink, NULL, &got};
     fdt_result *r = NULL;
     rc = fdt_triangulate_stream(ctx, a->ps->xyz, a->ps->n, &sink, &r);
-    if (rc == FDT_ENOMEM && fdt_context_diagnostic(ctx)[0] == '\0')
-        *bad = "FDT_ENOMEM without a diagnostic";
-    fdt_close(&ctx);
-    if (rc != FDT_OK) {
-        if (r != NULL)
-            *bad = "a failed fdt_triangulate_stream returned a result";
-        fdt_result_free(&r);
+    if (stream_status(&ctx, rc, &r, "a failed fdt_triangulate_stream returned a result", bad))
         return rc;
-    }
     uint64_t h = 0;
     if (fdt_result_set_hash(r, &h) != FDT_OK || h != a->want_set || got != a->want_tets)
         *bad = "wrong streamed mesh";
@@ -492,15 +502,8 @@ static int sc_vstream(void *arg, const char **bad)
     o.neighbors = 1;
     fdt_result *r = NULL;
     rc = fdt_voronoi_stream(ctx, a->ps->xyz, a->ps->n, &o, NULL, &cells, &r);
-    if (rc == FDT_ENOMEM && fdt_context_diagnostic(ctx)[0] == '\0')
-        *bad = "FDT_ENOMEM without a diagnostic";
-    fdt_close(&ctx);
-    if (rc != FDT_OK) {
-        if (r != NULL)
-            *bad = "a failed fdt_voronoi_stream returned a result";
-        fdt_result_free(&r);
+    if (stream_status(&ctx, rc, &r, "a failed fdt_voronoi_stream returned a result", bad))
         return rc;
-    }
     a->got_sum = acc[0];
     if (acc[1] != (double)a->ps->n || (!isnan(a->want_sum) && acc[0] != a->want_sum))
         *bad = "wrong streamed cells";

@@ -483,6 +483,10 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
         return FDT_EINVAL;
     *out = NULL;
     ctx->diag[0] = '\0';
+    if (user && ctx->s.neighbors) { /* a streamed run keeps no tet to link */
+        snprintf(ctx->diag, sizeof ctx->diag, "a streamed run has no neighbours");
+        return FDT_EINVAL;
+    }
     fdt_mode mode;
     int nthreads;
     run_mode(&ctx->s, &mode, &nthreads);
@@ -553,16 +557,18 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n, fdt_result **
     return run(ctx, xyz, n, NULL, NULL, out);
 }
 
+/* A caller's tet sink as compiled against this header or a later one. */
+static int sink_ok(const fdt_sink *sink)
+{
+    return sink->struct_size >= sizeof(fdt_sink) && sink->tets;
+}
+
 int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
                            const fdt_sink *sink, fdt_result **out)
 {
-    if (!ctx || !out || !sink || sink->struct_size < sizeof(fdt_sink) || !sink->tets)
+    if (!ctx || !out || !sink || !sink_ok(sink))
         return FDT_EINVAL;
     *out = NULL;
-    if (ctx->s.neighbors) {
-        snprintf(ctx->diag, sizeof ctx->diag, "a streamed run has no neighbours");
-        return FDT_EINVAL;
-    }
     return run(ctx, xyz, n, sink, NULL, out);
 }
 
@@ -586,16 +592,10 @@ int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
         o = &defaults;
     }
     if (!ctx || !out || (!xyz && n) || !cells || cells->struct_size < sizeof(fdt_cell_sink) ||
-        !cells->cells ||
-        o->struct_size != sizeof *o || (sink && (sink->struct_size < sizeof(fdt_sink) ||
-                                                 !sink->tets)))
+        !cells->cells || o->struct_size != sizeof *o || (sink && !sink_ok(sink)))
         return FDT_EINVAL;
     *out = NULL;
     ctx->diag[0] = '\0';
-    if (ctx->s.neighbors) {
-        snprintf(ctx->diag, sizeof ctx->diag, "a streamed run has no neighbours");
-        return FDT_EINVAL;
-    }
     fdt_sink dropped = {sizeof dropped, drop_tets, NULL, NULL};
     fdt_cellstream cs;
     memset(&cs, 0, sizeof cs);

@@ -1426,9 +1426,9 @@ static int triangulate(const cli *c, run_state *rs)
     progress_phase(&rs->prog, "merge"); /* "triangulate" at the library's first report */
     int r;
     char derr[FDT_IO_PATH + 600];
+    fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &rs->fo};
     if (rs->streaming && fdt_cli_dual_wanted(&c->dual)) {
         /* the cells as their points' last tets leave, spooled */
-        fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &rs->fo};
         fdt_voronoi_options o;
         fdt_cell_sink cells;
         if ((r = fdt_cli_cells_open(&c->dual, rs->n, &rs->cells, &o, &cells, derr,
@@ -1439,7 +1439,6 @@ static int triangulate(const cli *c, run_state *rs)
         }
         r = fdt_voronoi_stream(rs->ctx, rs->xyz, rs->n, &o, &sink, &cells, &rs->res);
     } else if (rs->streaming) {
-        fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &rs->fo};
         r = fdt_triangulate_stream(rs->ctx, rs->xyz, rs->n, &sink, &rs->res);
     } else {
         r = fdt_triangulate(rs->ctx, rs->xyz, rs->n, &rs->res);
