@@ -120,8 +120,12 @@ grep -q -- "--hash gathers the mesh to rank 0" "$work/q.err" || fail "--hash wit
 # as their --help lists it, short and long: given to frontdt and to
 # frontdt-mpi on 2 ranks, with a value where the help names one, both
 # accept it and print the same hashes (-o: the same file). A row new to
-# both fails here until it has a value below.
-declare -A optval=([--input-format]=xyz [--search]=kd [--leaf]=7)
+# both fails here until it has a value below (several words: the option's
+# value, then partners it needs). The cells' tables are compared too.
+declare -A optval=([--input-format]=xyz [--search]=kd [--leaf]=7
+  [--voronoi]="$work/o.cells" [--density]="$work/o.dens"
+  [--voronoi-format]="%i;%v;%n;%f --voronoi $work/o.cells"
+  [--box]="-1,-1,-1,2,2,2 --density $work/o.dens")
 # "-x VALUE" and "--name VALUE" of each option line of a --help
 help_opts() {
   sed -nE 's/^  (-(.), |    )--([a-z-]+)( ([^ ]+))?.*/-\2 \5\n--\3 \5/p' | grep -v '^- \|^-$' |
@@ -147,10 +151,13 @@ while read -r opt value <&3; do
     af+=("$work/o.f.tets") am+=("$work/o.m.tets")
   elif [[ -n $value ]]; then
     [[ -n ${optval[$opt]:-} ]] || { fail "$opt $value: no value to test it with"; continue; }
-    af+=("${optval[$opt]}") am+=("${optval[$opt]}")
+    read -ra words <<<"${optval[$opt]}"
+    af+=("${words[@]}") am+=("${words[@]}")
   fi
+  rm -f "$work/o.cells" "$work/o.dens"
   "$frontdt" -q --set-hash "${af[@]}" "$work/clusters.xyz" >"$work/o.f" 2>"$work/o.fe" ||
     { fail "frontdt ${af[*]}: exit $?"; sed 's/^/    /' "$work/o.fe" | head -5; continue; }
+  for t in cells dens; do [[ -e $work/o.$t ]] && mv "$work/o.$t" "$work/o.$t.f"; done
   mpi 2 120 "$fmpi" -q --set-hash "${am[@]}" "$work/clusters.xyz" >"$work/o.m" 2>"$work/o.me" ||
     { fail "frontdt-mpi ${am[*]}: exit $?"; sed 's/^/    /' "$work/o.me" | head -5; continue; }
   hf=$(grep -E '^(set-)?hash: ' "$work/o.f" | sort) hm=$(grep -E '^(set-)?hash: ' "$work/o.m" | sort)
@@ -159,6 +166,12 @@ while read -r opt value <&3; do
     cmp -s "$work/o.f.tets" "$work/o.m.tets" || fail "$opt: the two programs' files differ"
     rm -f "$work/o.f.tets" "$work/o.m.tets"
   fi
+  for t in cells dens; do
+    if [[ -e $work/o.$t.f ]]; then
+      cmp -s "$work/o.$t.f" "$work/o.$t" || fail "$opt: the two programs' o.$t differ"
+    fi
+    rm -f "$work/o.$t.f" "$work/o.$t"
+  done
 done 3<"$work/opts.both"
 # frontdt-mpi has no man page: each long option of its --help is in
 # doc/reference.md's section on it (frontdt's are in doc/frontdt.1, the
@@ -196,6 +209,78 @@ if mpi 2 300 "$fmpi" -q --stats --search kd "$work/cone.xyz" >/dev/null 2>"$work
 else
   fail "cone --search kd, 2 ranks: exit $?"
 fi
+# The Voronoi cells (issue 32, src/mpi/mpi_cells.c): frontdt-mpi's tables
+# equal frontdt's byte for byte: the default format and the densities at
+# every rank count; CSV, and every code with --box, at 3 ranks; with -o
+# pieces beside them. On a lattice (cospherical), clusters, duplicates, a
+# sphere's shell (every point on the hull) and uniform points. Errors give
+# frontdt's message and exit code and leave no table: a point outside
+# --box, two points too close for the cells, .vtu polyhedra (frontdt's
+# alone).
+# "x0,y0,z0,x1,y1,z1": FILE's bounding box grown by half its size
+grown_box() {
+  awk 'NF >= 3 && $1 !~ /^#/ { for (k = 1; k <= 3; k++) { if (!(k in lo) || $k < lo[k]) lo[k] = $k
+         if (!(k in hi) || $k > hi[k]) hi[k] = $k } }
+       END { for (k = 1; k <= 3; k++) { d = (hi[k] - lo[k]) / 2; a[k] = lo[k] - d; b[k] = hi[k] + d }
+             printf "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", a[1], a[2], a[3], b[1], b[2], b[3] }' "$1"
+}
+# cells_same NAME NP FILE OPTIONS...: frontdt's and frontdt-mpi's tables
+# (the options name $work/c.t and $work/c.d)
+cells_same() {
+  local name=$1 np=$2 f=$3
+  shift 3
+  checks=$((checks + 1))
+  rm -f "$work"/c.t "$work"/c.d "$work"/c.t.f "$work"/c.d.f
+  "$frontdt" -q "$f" "$@" 2>"$work/c.err" ||
+    { fail "$name: frontdt exit $?"; head -3 "$work/c.err"; return; }
+  for x in t d; do [[ -e $work/c.$x ]] && mv "$work/c.$x" "$work/c.$x.f"; done
+  mpi "$np" 300 "$fmpi" -q "$f" "$@" 2>"$work/c.err" ||
+    { fail "$name, $np ranks: exit $?"; head -3 "$work/c.err"; return; }
+  for x in t d; do
+    [[ -e $work/c.$x.f ]] || continue
+    cmp -s "$work/c.$x.f" "$work/c.$x" || fail "$name, $np ranks: the table $x differs from frontdt's"
+  done
+}
+allcodes='%i %x %y %z %q %v %F %s %n %f %c %C %d %h %%'
+for fam in lattice clusters dup sphere uniform; do
+  f=$work/$fam.xyz
+  [[ -e $f ]] || "$gen" "$fam" 3000 19 "$f" >/dev/null || { fail "gen_points $fam"; continue; }
+  for np in "${nps[@]}"; do
+    cells_same "cells of $fam" "$np" "$f" --voronoi "$work/c.t" --density "$work/c.d"
+  done
+  cells_same "CSV cells of $fam" 3 "$f" --voronoi "$work/c.t" --voronoi-format "$allcodes" \
+    --box "$(grown_box "$f")"
+  mpi 3 300 "$fmpi" -q "$f" --voronoi "$work/c.csv" -o "$work/cp.pfdtb" 2>"$work/c.err" ||
+    fail "cells of $fam beside pieces: exit $?"
+  "$frontdt" -q "$f" --voronoi "$work/c.f.csv" && cmp -s "$work/c.f.csv" "$work/c.csv" ||
+    fail "CSV cells of $fam beside pieces: differ from frontdt's"
+  rm -f "$work"/cp*.fdtb "$work/cp.pfdtb" "$work/c.csv" "$work/c.f.csv"
+done
+# errors: frontdt's message and code, no table
+cells_error() {
+  local name=$1 f=$2
+  shift 2
+  checks=$((checks + 1))
+  rm -f "$work/c.t"
+  "$frontdt" -q "$f" --voronoi "$work/c.t" "$@" 2>"$work/c.ferr"
+  local want=$?
+  mpi 3 300 "$fmpi" -q "$f" --voronoi "$work/c.t" "$@" 2>"$work/c.err"
+  local got=$?
+  [[ $want -ne 0 && $got == "$want" ]] || fail "$name: frontdt-mpi exit $got, frontdt $want"
+  local mf mm
+  mf=$(grep -m1 '^frontdt:' "$work/c.ferr" | sed 's/^frontdt: //')
+  mm=$(grep -m1 '^frontdt-mpi:' "$work/c.err" | sed 's/^frontdt-mpi: //')
+  [[ -n $mf && $mf == "$mm" ]] || fail "$name: frontdt-mpi said '$mm', frontdt '$mf'"
+  [[ ! -e $work/c.t ]] || fail "$name: a table was left"
+}
+cells_error "a point outside --box" "$work/lattice.xyz" --box 0,0,0,1,1,1
+awk '{print} NR == 101 {printf "%.17g %.17g %.17g\n", $1, $2 + 2e-16, $3}' \
+  "$work/uniform.xyz" >"$work/close.xyz"
+cells_error "two points too close for the cells" "$work/close.xyz"
+checks=$((checks + 1))
+mpi 2 60 "$fmpi" -q "$work/uniform.xyz" --voronoi "$work/c.vtu" 2>"$work/c.err"
+[[ $? -eq 1 ]] && grep -q "frontdt's alone" "$work/c.err" && [[ ! -e $work/c.vtu ]] ||
+  fail "--voronoi FILE.vtu under MPI: not refused as a usage error"
 # A face waiting for each answer (--no-park, message mode's loop) gives the
 # same mesh as parked faces.
 extra=(--no-park)

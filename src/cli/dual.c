@@ -151,6 +151,13 @@ static void cells_setup(const fdt_cli_dual *d, fdt_voronoi_options *o, cells_job
     *job = j;
 }
 
+void fdt_cli_cells_message(const char *what, int r, const char *diag, char *err, size_t errlen)
+{
+    /* FDT_ERANGE: not a coordinate's value but the cells' (diag says) */
+    snprintf(err, errlen, "%s: %s%s%s", what, r == FDT_ERANGE && *diag ? "" : fdt_strerror(r),
+             r == FDT_ERANGE || !*diag ? "" : ": ", diag);
+}
+
 int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const double *xyz, size_t n,
                        char *err, size_t errlen)
 {
@@ -161,9 +168,7 @@ int fdt_cli_dual_write(const fdt_cli_dual *d, const fdt_result *res, const doubl
     char diag[512];
     int r = fdt_voronoi_compute(res, xyz, n, &o, &v, diag, sizeof diag);
     if (r != FDT_OK) {
-        /* FDT_ERANGE: not a coordinate's value but the cells' (diag says) */
-        snprintf(err, errlen, "Voronoi cells: %s%s%s", r == FDT_ERANGE && *diag ? "" : fdt_strerror(r),
-                 r == FDT_ERANGE || !*diag ? "" : ": ", diag);
+        fdt_cli_cells_message("Voronoi cells", r, diag, err, errlen);
         return r;
     }
     job.v = v;
@@ -221,7 +226,7 @@ int fdt_cli_cells_open(const fdt_cli_dual *d, size_t n, fdt_cli_cells **out,
     char dir[FDT_IO_PATH];
     snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + (slash == path) : 1,
              slash ? path : ".");
-    int e = fdt_cells_spool_open(&c->sp, n, d->voronoi ? c->job.format : NULL,
+    int e = fdt_cells_spool_open(&c->sp, 0, n, d->voronoi ? c->job.format : NULL,
                                  d->voronoi && !c->job.format, d->density != NULL, dir);
     if (e) {
         snprintf(err, errlen, "%s: a temporary file for the cells: %s", dir, strerror(e));
@@ -253,7 +258,7 @@ static int put_spooled(FILE *f, const void *arg, const double *xyz)
 {
     (void)xyz;
     const spooled *t = arg;
-    return fdt_cells_spool_put(t->c->sp, t->table, f);
+    return fdt_cells_spool_put(t->c->sp, t->table, 1, f);
 }
 
 int fdt_cli_cells_write(const fdt_cli_dual *d, fdt_cli_cells *c, char *err, size_t errlen)
@@ -335,10 +340,9 @@ int fdt_cli_dual_mesh(const fdt_cli_dual *d, fdt_result *res, const double *xyz,
     char diag[512];
     int r = fdt_dualmesh_build(res, xyz, n, &o, &dm, diag, sizeof diag);
     if (r != FDT_OK) {
-        /* FDT_ERANGE: not a coordinate's value but the cells' (diag says) */
-        snprintf(err, errlen, "%s: the Voronoi cells as a polyMesh (--dual): %s%s%s", path,
-                 r == FDT_ERANGE && *diag ? "" : fdt_strerror(r),
-                 r == FDT_ERANGE || !*diag ? "" : ": ", diag);
+        char what[FDT_IO_PATH + 64];
+        snprintf(what, sizeof what, "%s: the Voronoi cells as a polyMesh (--dual)", path);
+        fdt_cli_cells_message(what, r, diag, err, errlen);
         return r;
     }
     r = fdt_wr_dual_polymesh(path, &dm, err, errlen) == FDT_IO_OK ? FDT_OK : FDT_EIO;

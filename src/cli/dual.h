@@ -38,6 +38,11 @@ typedef struct fdt_cli_dual {
 int fdt_cli_dual_mesh(const fdt_cli_dual *d, fdt_result *res, const double *xyz, size_t n,
                       const char *path, char *err, size_t errlen);
 
+/* The message of the cells' error r (diag: the library's) into err:
+ * "WHAT: the error: diag", or "WHAT: diag" for FDT_ERANGE, where diag says
+ * all (the cells', not a coordinate's range). */
+void fdt_cli_cells_message(const char *what, int r, const char *diag, char *err, size_t errlen);
+
 /* Is anything asked for? */
 int fdt_cli_dual_wanted(const fdt_cli_dual *d);
 

@@ -6,6 +6,10 @@
  * same on every rank.
  *
  *   mpirun -np 4 frontdt-mpi [-o OUT] [--set-hash] [--stats] [-q] INPUT
+ *
+ * With --voronoi or --density the ranks then compute the Voronoi cells
+ * together (src/mpi/mpi_cells.h) and write the tables, each rank its
+ * block of rows.
  */
 #include <inttypes.h>
 #include <limits.h>
@@ -18,14 +22,17 @@
 #include <unistd.h>
 
 #include "cli/cli.h"
+#include "cli/dual.h"
 #include "cli/options.h"
 #include "frontdt.h"
+#include "mpi/mpi_cells.h"
 #include "mpi/mpi_output.h"
 #include "mpi/mpi_run.h"
 #include "geom/prepare.h"
 #include "io/read/reader.h"
 #include "mesh/result.h"
 #include "front/seed.h"
+#include "io/write/cells.h"
 #include "io/write/writer.h"
 
 /* ---- SIGINT / SIGTERM / SIGXFSZ ------------------------------------------
@@ -54,6 +61,7 @@ typedef struct opts {
     size_t fail_after;
     int fail_write;      /* --inject-write-failure RANK, -1: none */
     int kind;            /* FDT_MPO_* of -o */
+    fdt_cli_dual cells;  /* --voronoi, --voronoi-format, --density, --box */
 } opts;
 
 static void usage(FILE *f)
@@ -146,6 +154,23 @@ static int take_option(opts *o, int id, const char *v, int rank)
         o->fail_after = (size_t)f;
         return -1;
     }
+    case FDT_OPT_VORONOI:
+        o->cells.voronoi = v;
+        return -1;
+    case FDT_OPT_VORONOI_FORMAT:
+        o->cells.format = v;
+        return -1;
+    case FDT_OPT_DENSITY:
+        o->cells.density = v;
+        return -1;
+    case FDT_OPT_BOX:
+        if (fdt_cli_parse_box(v, o->cells.box) != 0) {
+            say0(rank, "--box wants six finite numbers xmin,ymin,zmin,xmax,ymax,zmax with each "
+                       "min below its max, not '%s'", v);
+            return CLI_USAGE;
+        }
+        o->cells.box_given = 1;
+        return -1;
     case FDT_OPT_INJECT_WRITE_FAILURE:
         r = strtol(v, &end, 10);
         if (*end || r < 0 || r > INT_MAX) {
@@ -158,6 +183,33 @@ static int take_option(opts *o, int id, const char *v, int rank)
         say0(rank, "internal error: option row %d has no parser", id);
         return CLI_INTERNAL;
     }
+}
+
+/* The cells' options (frontdt's rules, src/cli/dual.h), and what only
+ * frontdt does: -1 to go on, or an exit code. */
+static int check_cells(opts *o, int rank)
+{
+    char err[FDT_IO_PATH + 200];
+    if (fdt_cli_dual_check(&o->cells, o->input, err, sizeof err) != 0) {
+        say0(rank, "%s", err);
+        return CLI_USAGE;
+    }
+    const char *v = o->cells.voronoi;
+    size_t n = v ? strlen(v) : 0;
+    if (v && n >= 4 && strcasecmp(v + n - 4, ".vtu") == 0) {
+        say0(rank, "--voronoi FILE.vtu (the cells as polyhedra) is frontdt's alone; "
+                   "frontdt-mpi writes the cells as text or .csv");
+        return CLI_USAGE;
+    }
+    if (o->output && fdt_cli_dual_wanted(&o->cells))
+        for (int k = 0; k < 2; k++) {
+            const char *t = k ? o->cells.density : v;
+            if (t && fdt_same_file(t, o->output)) {
+                say0(rank, "%s is named for two outputs", t);
+                return CLI_USAGE;
+            }
+        }
+    return -1;
 }
 
 /* -o against the input and the other options, once all are read: -1 to go
@@ -243,7 +295,8 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
             usage(stderr);
         return CLI_USAGE;
     }
-    return check_output(o, rank, size);
+    int rc = check_cells(o, rank);
+    return rc >= 0 ? rc : check_output(o, rank, size);
 }
 
 static int exit_code(int err)
@@ -341,6 +394,56 @@ static void print_stats(const fdt_mpi_out *r, int size, double t_read)
                         "in %.3f s (src/mpi/mpi_run.c)\n", r->t_replica);
 }
 
+/* The Voronoi cells' tables (src/mpi/mpi_cells.h), after the mesh: the
+ * same exit code on every rank, frontdt's for the same error. */
+static int cells_step(const opts *o, const fdt_mpi_local *L, const fdt_mpi_out *r, int rank,
+                      int size)
+{
+    const fdt_cli_dual *d = &o->cells;
+    fdt_mpi_cells_opts co = {d->voronoi, d->format, d->density, d->box_given, {0}, 0};
+    memcpy(co.box, d->box, sizeof co.box);
+    if (d->voronoi && !d->format) {
+        size_t n = strlen(d->voronoi);
+        if (!(n >= 4 && strcasecmp(d->voronoi + n - 4, ".csv") == 0))
+            co.format = FDT_CELLS_DEFAULT_FORMAT; /* else NULL: CSV */
+    }
+    char err[256];
+    if (co.format)
+        (void)fdt_cells_format_check(co.format, &co.neighbors, err, sizeof err);
+    fdt_mpi_cells_stats st;
+    char diag[512], msg[1024];
+    int e = fdt_mpi_cells(MPI_COMM_WORLD, L, r, &co, &st, diag, sizeof diag);
+    if (e && rank == 0) {
+        if (e == FDT_EIO)
+            snprintf(msg, sizeof msg, "%s", diag); /* it names the file */
+        else
+            fdt_cli_cells_message("Voronoi cells", e, diag, msg, sizeof msg);
+        fprintf(stderr, "frontdt-mpi: %s: %s\n", o->input, msg);
+    }
+    if (o->stats) {
+        double mine[4] = {st.t, (double)st.star_tets, (double)st.bytes_sent,
+                          (double)st.bytes_written};
+        double *all = rank == 0 ? malloc(4 * (size_t)size * sizeof *all) : NULL;
+        MPI_Gather(mine, 4, MPI_DOUBLE, all, 4, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+        if (rank == 0 && all) {
+            fprintf(stderr, "  Voronoi cells (each rank its block of input ids)\n"
+                            "  rank   cells s   star tets   bytes sent   bytes written\n");
+            for (int q = 0; q < size; q++)
+                fprintf(stderr, "  %4d %9.3f %11.0f %12.0f %15.0f\n", q, all[4 * q],
+                        all[4 * q + 1], all[4 * q + 2], all[4 * q + 3]);
+        }
+        free(all);
+    }
+    switch (e) {
+    case FDT_OK: return CLI_OK;
+    case FDT_EINVAL: return CLI_USAGE;
+    case FDT_ERANGE: return CLI_INPUT;
+    case FDT_EIO: return CLI_WRITE;
+    case FDT_ENOMEM: return CLI_RESOURCES;
+    default: return CLI_INTERNAL;
+    }
+}
+
 /* The run after MPI_Init; every rank returns the same code. */
 static int run(int argc, char **argv, int rank, int size)
 {
@@ -359,8 +462,9 @@ static int run(int argc, char **argv, int rank, int size)
     /* The setup (src/mpi/mpi_setup.h) returns the same code on every rank,
      * with the lowest failing rank's message. */
     /* the gather (-o to rank 0, --hash) takes the points along */
+    int cells = fdt_cli_dual_wanted(&o.cells);
     fdt_mpi_setup_opts so = {o.input, o.format, o.leaf,
-                             (o.output && !pieces) || o.hash || o.kind == FDT_MPO_ELE};
+                             (o.output && !pieces) || o.hash || o.kind == FDT_MPO_ELE || cells};
     int err = fdt_mpi_setup(MPI_COMM_WORLD, &so, &L, diag, sizeof diag);
     double t_read = MPI_Wtime() - t0;
     if (err) {
@@ -371,6 +475,8 @@ static int run(int argc, char **argv, int rank, int size)
     }
     setup_stats(&L, rank, size, o.stats);
     int own = !pieces ? 0 : o.kind == FDT_MPO_VTU ? FDT_MPI_OWN_POINTS : FDT_MPI_OWN_HULL;
+    if (cells) /* a star's tets with their points, and the hull */
+        own |= FDT_MPI_OWN_POINTS | FDT_MPI_OWN_HULL;
     int gather = (o.output && !pieces) || o.hash;
     fdt_mpi_opts mo = {o.leaf, o.search, gather, own, o.fail_rank, o.fail_after, o.no_park};
     err = fdt_mpi_run(MPI_COMM_WORLD, &L, &mo, &r, diag, sizeof diag);
@@ -461,6 +567,8 @@ static int run(int argc, char **argv, int rank, int size)
             free(all);
         }
     }
+    if (!rc && cells)
+        rc = cells_step(&o, &L, &r, rank, size);
 out:
     fdt_result_free(&res);
     fdt_mpi_out_free(&r);

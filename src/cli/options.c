@@ -102,16 +102,16 @@ const fdt_cli_opt fdt_cli_opts[FDT_OPT_END] = {
         "print the set hash (order-independent, no sort)",
         "print the set hash (order-independent, no sort;\n"
         "equals frontdt's)"},
-    [FDT_OPT_VORONOI] = {"voronoi", 0, required_argument, "FILE", F, 0,
+    [FDT_OPT_VORONOI] = {"voronoi", 0, required_argument, "FILE", FM, 0,
         "write each point's Voronoi cell, clipped by the\n"
         "box: a line a point (.csv: a table)", NULL},
-    [FDT_OPT_VORONOI_FORMAT] = {"voronoi-format", 0, required_argument, "F", F, 0,
+    [FDT_OPT_VORONOI_FORMAT] = {"voronoi-format", 0, required_argument, "F", FM, 0,
         "the line, in voro++'s codes: %i %q %v %F %s\n"
         "%n %f %c %C, and %d (DTFE density), %h (flags)\n"
         "(default '%i %q %v %F %s %n %f')", NULL},
-    [FDT_OPT_DENSITY] = {"density", 0, required_argument, "FILE", F, 0,
+    [FDT_OPT_DENSITY] = {"density", 0, required_argument, "FILE", FM, 0,
         "write each point's DTFE density and flags", NULL},
-    [FDT_OPT_BOX] = {"box", 0, required_argument, "X0,Y0,Z0,X1,Y1,Z1", F, 0,
+    [FDT_OPT_BOX] = {"box", 0, required_argument, "X0,Y0,Z0,X1,Y1,Z1", FM, 0,
         "the box that clips the cells (default: the\n"
         "points' bounding box; must hold them)", NULL},
     [FDT_OPT_DUAL] = {"dual", 0, no_argument, NULL, F, 0,

@@ -208,21 +208,6 @@ typedef struct nrec {
     uint64_t id;
 } nrec;
 
-static size_t block_start(uint64_t n, int size, int q)
-{
-    return (size_t)(n * (uint64_t)q / (uint64_t)size);
-}
-
-static int block_owner(uint64_t n, int size, uint64_t id)
-{
-    int q = (int)(id * (uint64_t)size / n);
-    while (q + 1 < size && block_start(n, size, q + 1) <= id)
-        q++;
-    while (q > 0 && block_start(n, size, q) > id)
-        q--;
-    return q;
-}
-
 static int pwrite_all(int fd, const char *p, size_t n, uint64_t at)
 {
     while (n > 0) {
@@ -238,6 +223,97 @@ static int pwrite_all(int fd, const char *p, size_t n, uint64_t at)
     return 0;
 }
 
+/* Bytes [0, len) of part (from its start) through o, or at `at` of fd:
+ * 0 or an errno. */
+static int copy_part(FILE *part, uint64_t len, out_file *o, int fd, uint64_t at)
+{
+    char buf[1 << 16];
+    errno = 0;
+    if (fseeko(part, 0, SEEK_SET) != 0)
+        return errno ? errno : EIO;
+    for (uint64_t done = 0; done < len;) {
+        size_t want = len - done < sizeof buf ? (size_t)(len - done) : sizeof buf;
+        if (fread(buf, 1, want, part) != want)
+            return errno ? errno : EIO;
+        if (o) {
+            out_bytes(o, buf, want);
+            if (o->err)
+                return o->err;
+        } else {
+            int e = pwrite_all(fd, buf, want, at + done);
+            if (e)
+                return e;
+        }
+        done += want;
+    }
+    return 0;
+}
+
+int fdt_mpo_text(MPI_Comm comm, const char *name, const char *text, FILE *part, uint64_t len,
+                 uint64_t *io, char *diag, size_t dlen)
+{
+    int rank;
+    MPI_Comm_rank(comm, &rank);
+    int err = FDT_OK;
+    out_file of;
+    int of_open = 0;
+    uint64_t off = 0;
+    MPI_Exscan(&len, &off, 1, MPI_UINT64_T, MPI_SUM, comm);
+    if (rank == 0)
+        off = 0; /* MPI_Exscan leaves rank 0's undefined */
+    /* rank 0's temporary, its path to every rank */
+    char tpath[FDT_IO_PATH] = "";
+    if (rank == 0) {
+        fdt_write_lock();
+        int e = fdt_out_open(&of, name);
+        fdt_write_unlock();
+        if (e)
+            err = io_code(fdt_create_err(diag, dlen, "output", name, e));
+        else {
+            of_open = 1;
+            snprintf(tpath, sizeof tpath, "%s", fdt_out_temp(&of));
+        }
+    }
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+        goto done;
+    MPI_Bcast(tpath, (int)sizeof tpath, MPI_CHAR, 0, comm);
+    if (rank == 0) {
+        int e = 0;
+        if (text)
+            out_bytes(&of, text, (size_t)len);
+        else
+            e = copy_part(part, len, &of, -1, 0);
+        if (e)
+            err = io_code(set_errno_err(diag, dlen, name, e));
+        io[0] += len;
+    } else {
+        /* no O_CREAT: if rank 0's temporary is gone (an interrupt), fail */
+        int fd = open(tpath, O_WRONLY | O_CLOEXEC);
+        int e = fd < 0 ? errno
+                : text ? pwrite_all(fd, text, (size_t)len, off)
+                       : copy_part(part, len, NULL, fd, off);
+        if (fd >= 0 && close(fd) != 0 && !e)
+            e = errno;
+        if (e)
+            err = io_code(set_errno_err(diag, dlen, name, e));
+        io[0] += len;
+    }
+    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) == FDT_OK && rank == 0) {
+        fdt_write_lock();
+        err = io_code(fdt_out_commit(&of, 1, diag, dlen));
+        fdt_write_unlock();
+        of_open = 0;
+    }
+    err = fdt_mpi_agree(comm, err, diag, dlen);
+done:
+    if (of_open) {
+        fdt_write_lock();
+        fdt_out_abandon(&of);
+        fdt_write_unlock();
+    }
+    return err;
+}
+
 static int write_node(MPI_Comm comm, const char *name, const fdt_mpi_local *L, uint64_t *io,
                       char *diag, size_t dlen)
 {
@@ -245,24 +321,22 @@ static int write_node(MPI_Comm comm, const char *name, const fdt_mpi_local *L, u
     MPI_Comm_rank(comm, &rank);
     MPI_Comm_size(comm, &size);
     uint64_t n = L->n;
-    size_t lo = block_start(n, size, rank), nmine = block_start(n, size, rank + 1) - lo;
+    size_t lo = fdt_mpi_block_start(n, size, rank), nmine = fdt_mpi_block_start(n, size, rank + 1) - lo;
     int *c = malloc(4 * (size_t)size * sizeof *c);
     nrec *sb = malloc((L->nin + 1) * sizeof *sb), *rb = malloc((nmine + 1) * sizeof *rb);
     char *text = malloc(nmine * 100 + 64);
     int err = c && sb && rb && text ? FDT_OK : FDT_ENOMEM;
     snprintf(diag, dlen, "out of memory writing %s", name);
-    out_file of;
-    int of_open = 0;
     if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
         goto done;
     int *sc = c, *sd = c + size, *rc = c + 2 * size, *rd = c + 3 * size;
     memset(sc, 0, (size_t)size * sizeof *sc);
     for (size_t i = 0; i < L->nin; i++)
-        sc[block_owner(n, size, (uint64_t)(uint32_t)L->in_id[i])]++;
+        sc[fdt_mpi_block_owner(n, size, (uint64_t)(uint32_t)L->in_id[i])]++;
     size_t nr = fdt_mpi_counts(comm, sc, sd, rc, rd, sizeof(nrec), &io[1]);
     /* counting sort by destination (sd[] moves on; put back below) */
     for (size_t i = 0; i < L->nin; i++) {
-        int q = block_owner(n, size, (uint64_t)(uint32_t)L->in_id[i]);
+        int q = fdt_mpi_block_owner(n, size, (uint64_t)(uint32_t)L->in_id[i]);
         nrec *p = &sb[sd[q]++];
         memcpy(p->x, L->in_xyz + 3 * i, sizeof p->x);
         p->id = (uint64_t)(uint32_t)L->in_id[i];
@@ -314,54 +388,10 @@ static int write_node(MPI_Comm comm, const char *name, const fdt_mpi_local *L, u
         }
         text[len++] = '\n';
     }
-    uint64_t mylen = len, off = 0;
-    MPI_Exscan(&mylen, &off, 1, MPI_UINT64_T, MPI_SUM, comm);
-    if (rank == 0)
-        off = 0; /* MPI_Exscan leaves rank 0's undefined */
     if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
         goto done;
-    /* rank 0's temporary, its path to every rank */
-    char tpath[FDT_IO_PATH] = "";
-    if (rank == 0) {
-        fdt_write_lock();
-        int e = fdt_out_open(&of, name);
-        fdt_write_unlock();
-        if (e)
-            err = io_code(fdt_create_err(diag, dlen, "output", name, e));
-        else {
-            of_open = 1;
-            snprintf(tpath, sizeof tpath, "%s", fdt_out_temp(&of));
-        }
-    }
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
-        goto done;
-    MPI_Bcast(tpath, (int)sizeof tpath, MPI_CHAR, 0, comm);
-    if (rank == 0) {
-        out_bytes(&of, text, len);
-        io[0] += len;
-    } else {
-        /* no O_CREAT: if rank 0's temporary is gone (an interrupt), fail */
-        int fd = open(tpath, O_WRONLY | O_CLOEXEC);
-        int e = fd < 0 ? errno : pwrite_all(fd, text, len, off);
-        if (fd >= 0 && close(fd) != 0 && !e)
-            e = errno;
-        if (e)
-            err = io_code(set_errno_err(diag, dlen, name, e));
-        io[0] += len;
-    }
-    if ((err = fdt_mpi_agree(comm, err, diag, dlen)) == FDT_OK && rank == 0) {
-        fdt_write_lock();
-        err = io_code(fdt_out_commit(&of, 1, diag, dlen));
-        fdt_write_unlock();
-        of_open = 0;
-    }
-    err = fdt_mpi_agree(comm, err, diag, dlen);
+    err = fdt_mpo_text(comm, name, text, NULL, len, io, diag, dlen);
 done:
-    if (of_open) {
-        fdt_write_lock();
-        fdt_out_abandon(&of);
-        fdt_write_unlock();
-    }
     free(c);
     free(sb);
     free(rb);

@@ -30,6 +30,7 @@
 
 #include <mpi.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdint.h>
 
 #include "mpi/mpi_run.h"
@@ -71,5 +72,19 @@ typedef struct fdt_mpo_args {
  */
 int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
                   const fdt_mpi_out *r, int *mine, uint64_t io[2], char *diag, size_t dlen);
+
+/*
+ * One text file written by the ranks together (collective): each rank's
+ * len bytes, from text or else from the start of part, at the offset of
+ * the ranks' before it (an MPI_Exscan). Rank 0 creates the temporary
+ * (src/io/write/writer.c: the usual rename and signal cleanup), the others
+ * pwrite into it, and rank 0 renames it to name only once every rank's
+ * bytes are in: the file is complete, or nothing is renamed. The same code
+ * on every rank (FDT_OK, FDT_EIO, FDT_ENOMEM), the failing rank's message
+ * in diag; io[0] gains the bytes this rank wrote. The .node of a .pele,
+ * and the Voronoi cells' tables (src/mpi/mpi_cells.h).
+ */
+int fdt_mpo_text(MPI_Comm comm, const char *name, const char *text, FILE *part, uint64_t len,
+                 uint64_t *io, char *diag, size_t dlen);
 
 #endif

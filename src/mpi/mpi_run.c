@@ -538,9 +538,9 @@ static int rank_stats(MPI_Comm comm, int rank, int size, engine *e, worker *w, d
 
 /* This rank's tets in input numbering (collective): the set hash, whose
  * partial sums add over ranks (src/base/sethash.h), and the outputs: the
- * rank's own piece (o->keep_own) or the mesh gathered to rank 0
- * (o->gather). *minep: the renumbered tets, the caller's to free unless
- * a piece took them (then NULL). */
+ * rank's own tets (o->keep_own: a piece, the Voronoi cells), the mesh
+ * gathered to rank 0 (o->gather), or both. *minep: the renumbered tets,
+ * the caller's to free unless out->own_tets took them (then NULL). */
 static int rank_output(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L,
                        const fdt_mpi_opts *o, worker *w, int rank, int size, fdt_vid **minep,
                        fdt_mpi_out *out, char *diag, size_t dlen)
@@ -555,8 +555,7 @@ static int rank_output(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L,
     }
     xrec *used = NULL;
     size_t nused = 0;
-    int pieces = o->keep_own && !o->gather;
-    int with_pts = pieces && (o->keep_own & FDT_MPI_OWN_POINTS);
+    int with_pts = (o->keep_own & FDT_MPI_OWN_POINTS) != 0;
     int err = translate(comm, xt, L, w->out.tets, n4, mine, with_pts ? &used : NULL, &nused,
                         &out->bytes_out, diag, dlen);
     if (err)
@@ -568,42 +567,68 @@ static int rank_output(MPI_Comm comm, MPI_Datatype xt, const fdt_mpi_local *L,
     MPI_Reduce(hv, hs, 2, MPI_UINT64_T, MPI_SUM, 0, comm);
     out->hash.sum = hs[0];
     out->hash.count = hs[1];
-    if (pieces && !with_pts) {
-        /* .fdtb or .ele pieces: the ids alone, hull faces too */
+    if (o->gather) {
+        err = gather_ids(comm, rank, size, mine, w->out.ntets, 4, &out->all_tets, &out->ntets);
+        if (err) {
+            free(used);
+            snprintf(diag, dlen, "%s gathering the mesh to rank 0",
+                     err == FDT_ETOOBIG ? "too many tets (MPI int counts)" : "out of memory");
+            return err;
+        }
+    }
+    if (o->keep_own) {
         out->own_tets = mine;
         out->own_ntets = w->out.ntets;
         *minep = NULL;
-        out->own_hull = malloc((n3 + 1) * sizeof *out->own_hull);
-        err = out->own_hull ? FDT_OK : FDT_ENOMEM;
-        snprintf(diag, dlen, "out of memory for this rank's piece");
-        err = fdt_mpi_agree(comm, err, diag, dlen);
-        if (!err)
+        err = FDT_OK;
+        if (with_pts) {
+            /* the points those tets use (.vtu pieces, the cells) */
+            out->own_ids = malloc((nused + 1) * sizeof *out->own_ids);
+            out->own_xyz = malloc((3 * nused + 1) * sizeof *out->own_xyz);
+            err = out->own_ids && out->own_xyz ? FDT_OK : FDT_ENOMEM;
+            for (size_t i = 0; !err && i < nused; i++) {
+                out->own_ids[i] = (fdt_vid)used[i].id;
+                memcpy(out->own_xyz + 3 * i, used[i].x, sizeof used[i].x);
+            }
+            out->own_npts = nused;
+        }
+        if (!err && (o->keep_own & FDT_MPI_OWN_HULL)) /* .fdtb, .ele pieces, the cells */
+            err = (out->own_hull = malloc((n3 + 1) * sizeof *out->own_hull)) ? FDT_OK
+                                                                               : FDT_ENOMEM;
+        free(used);
+        snprintf(diag, dlen, "out of memory for this rank's own tets");
+        if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+            return err;
+        if (o->keep_own & FDT_MPI_OWN_HULL) {
             err = translate(comm, xt, L, w->out.hull, n3, out->own_hull, NULL, NULL,
                             &out->bytes_out, diag, dlen);
-        out->own_nhull = w->out.nhull;
-    } else if (pieces) {
-        out->own_tets = mine;
-        out->own_ntets = w->out.ntets;
-        *minep = NULL;
-        out->own_ids = malloc((nused + 1) * sizeof *out->own_ids);
-        out->own_xyz = malloc((3 * nused + 1) * sizeof *out->own_xyz);
-        err = out->own_ids && out->own_xyz ? FDT_OK : FDT_ENOMEM;
-        for (size_t i = 0; !err && i < nused; i++) {
-            out->own_ids[i] = (fdt_vid)used[i].id;
-            memcpy(out->own_xyz + 3 * i, used[i].x, sizeof used[i].x);
+            out->own_nhull = w->out.nhull;
+            if (err)
+                return err;
         }
-        out->own_npts = nused;
+    } else {
         free(used);
-        snprintf(diag, dlen, "out of memory for this rank's piece");
-        err = fdt_mpi_agree(comm, err, diag, dlen);
-    } else if (o->gather) {
-        err = gather_ids(comm, rank, size, mine, w->out.ntets, 4, &out->all_tets, &out->ntets);
+    }
+    if (o->gather) {
+        /* the hull faces: translated above, else into mine while it is
+         * still ours, else into a buffer of their own */
+        fdt_vid *hb = out->own_hull ? out->own_hull : !o->keep_own ? mine : NULL;
+        fdt_vid *tmp = NULL;
+        if (!hb) {
+            tmp = malloc((n3 + 1) * sizeof *tmp);
+            err = tmp ? FDT_OK : FDT_ENOMEM;
+            snprintf(diag, dlen, "out of memory gathering the mesh to rank 0");
+            if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
+                return err;
+            hb = tmp;
+        }
+        if (!out->own_hull)
+            err = translate(comm, xt, L, w->out.hull, n3, hb, NULL, NULL, &out->bytes_out, diag,
+                            dlen);
         if (!err)
-            err = translate(comm, xt, L, w->out.hull, n3, mine, NULL, NULL, &out->bytes_out,
-                            diag, dlen);
-        if (!err)
-            err = gather_ids(comm, rank, size, mine, w->out.nhull, 3, &out->all_hull,
+            err = gather_ids(comm, rank, size, hb, w->out.nhull, 3, &out->all_hull,
                              &out->nhull);
+        free(tmp);
         if (err)
             snprintf(diag, dlen, "%s gathering the mesh to rank 0",
                      err == FDT_ETOOBIG ? "too many tets (MPI int counts)" : "out of memory");

@@ -124,6 +124,21 @@ size_t fdt_mpi_counts(MPI_Comm comm, const int *sc, int *sd, int *rc, int *rd, s
     return nr;
 }
 
+size_t fdt_mpi_block_start(uint64_t n, int size, int q)
+{
+    return (size_t)(n * (uint64_t)q / (uint64_t)size);
+}
+
+int fdt_mpi_block_owner(uint64_t n, int size, uint64_t id)
+{
+    int q = (int)(id * (uint64_t)size / n);
+    while (q + 1 < size && fdt_mpi_block_start(n, size, q + 1) <= id)
+        q++;
+    while (q > 0 && fdt_mpi_block_start(n, size, q) > id)
+        q--;
+    return q;
+}
+
 static int io_err(int rc)
 {
     switch (rc) {

@@ -95,4 +95,11 @@ int fdt_mpi_agree(MPI_Comm comm, int err, char *diag, size_t dlen);
 size_t fdt_mpi_counts(MPI_Comm comm, const int *sc, int *sd, int *rc, int *rd, size_t rec_size,
                       uint64_t *bytes);
 
+/* The blocks of input ids by which the ranks write input-ordered files
+ * (a .pele's .node, the Voronoi cells' tables): rank q takes the ids
+ * [n q / size, n (q + 1) / size) of the n input points. The start of q's
+ * block, and the rank whose block holds id (id < n). */
+size_t fdt_mpi_block_start(uint64_t n, int size, int q);
+int fdt_mpi_block_owner(uint64_t n, int size, uint64_t id);
+
 #endif

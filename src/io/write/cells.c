@@ -226,7 +226,7 @@ int fdt_wr_density(FILE *f, const fdt_voronoi *v, int threads)
 /* ---------------------------------------------------------------- spool */
 
 struct fdt_cells_spool {
-    size_t n;
+    size_t base, n;   /* the input ids [base, base + n) */
     const char *fmt;  /* the cells' table: its format, or NULL for none */
     int csv;          /* fmt is CSV_CODES */
     int density;      /* the density table too */
@@ -235,13 +235,14 @@ struct fdt_cells_spool {
     uint64_t *off;    /* by input id: its record's offset, UINT64_MAX none */
 };
 
-int fdt_cells_spool_open(fdt_cells_spool **sp, size_t n, const char *fmt, int csv, int density,
-                         const char *dir)
+int fdt_cells_spool_open(fdt_cells_spool **sp, size_t base, size_t n, const char *fmt, int csv,
+                         int density, const char *dir)
 {
     fdt_cells_spool *s = calloc(1, sizeof *s);
     *sp = NULL;
     if (!s)
         return ENOMEM;
+    s->base = base;
     s->n = n;
     s->fmt = csv ? CSV_CODES : fmt;
     s->csv = csv;
@@ -326,7 +327,12 @@ static int spool_chunk(fdt_cells_spool *s, const fdt_voronoi *v, size_t lo, size
             e = EFBIG;
             break;
         }
-        s->off[ids[r]] = s->pos;
+        size_t j = (size_t)ids[r] - s->base;
+        if ((size_t)ids[r] < s->base || j >= s->n) {
+            e = EINVAL; /* not a row of this spool's ids */
+            break;
+        }
+        s->off[j] = s->pos;
         errno = 0;
         if (fwrite(l, sizeof l, 1, s->f) != 1 || fwrite(text + at, 1, end - at, s->f) != end - at)
             e = errno ? errno : EIO;
@@ -347,7 +353,7 @@ int fdt_cells_spool_add(fdt_cells_spool *s, const fdt_voronoi *v)
     return e;
 }
 
-int fdt_cells_spool_put(fdt_cells_spool *s, int table, FILE *f)
+int fdt_cells_spool_put(fdt_cells_spool *s, int table, int header, FILE *f)
 {
     errno = 0;
     if (fflush(s->f) != 0)
@@ -364,7 +370,7 @@ int fdt_cells_spool_put(fdt_cells_spool *s, int table, FILE *f)
     }
     out_file o;
     int e = open_out(&o, f);
-    if (!e && table == 0 && s->csv)
+    if (!e && table == 0 && s->csv && header)
         out_str(&o, CSV_HEADER);
     for (size_t i = 0; i < s->n && !e && !o.err; i++) {
         const char *rec = base + s->off[i];

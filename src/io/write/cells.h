@@ -40,20 +40,23 @@ int fdt_wr_density(FILE *f, const fdt_voronoi *v, int threads);
 
 /*
  * The tables of a streamed run (fdt_voronoi_stream's batches, in any
- * order) written in input order at the end: each batch's rows formatted
- * as they come into a spool (an unlinked temporary in dir: a record a
- * row, the two tables' text) with each input id's offset (8 bytes a
- * point), then each table copied out in input order. fmt: the cells'
- * format (NULL: none), csv: CSV instead; density: the density table too.
- * The calls return 0 or an errno; fdt_cells_spool_put gives EINVAL if a
- * point's row never came.
+ * order), or of one MPI rank's block of input ids (src/mpi/mpi_cells.c),
+ * written in input order at the end: each batch's rows formatted as they
+ * come into a spool (an unlinked temporary in dir: a record a row, the
+ * two tables' text) with each input id's offset (8 bytes a point), then
+ * each table copied out in input order. The spool holds the rows of the
+ * input ids [base, base + n); fmt: the cells' format (NULL: none), csv:
+ * CSV instead; density: the density table too. The calls return 0 or an
+ * errno; EINVAL when a batch has a row outside [base, base + n) or, from
+ * fdt_cells_spool_put, when a point's row never came.
  */
 typedef struct fdt_cells_spool fdt_cells_spool;
-int fdt_cells_spool_open(fdt_cells_spool **sp, size_t n, const char *fmt, int csv, int density,
-                         const char *dir);
+int fdt_cells_spool_open(fdt_cells_spool **sp, size_t base, size_t n, const char *fmt, int csv,
+                         int density, const char *dir);
 int fdt_cells_spool_add(fdt_cells_spool *sp, const fdt_voronoi *v);
-/* table 0: the cells' (fmt or CSV); 1: the densities. */
-int fdt_cells_spool_put(fdt_cells_spool *sp, int table, FILE *f);
+/* table 0: the cells' (fmt or CSV, its header line first when header is
+ * nonzero); 1: the densities. */
+int fdt_cells_spool_put(fdt_cells_spool *sp, int table, int header, FILE *f);
 void fdt_cells_spool_close(fdt_cells_spool **sp);
 
 /* The cells as VTK polyhedra (a .vtu file, VTK_POLYHEDRON cells with
