@@ -124,6 +124,34 @@ FDT_API const char *fdt_search_name(fdt_search s);
 FDT_API int fdt_search_from_name(const char *name, fdt_search *out);
 
 /*
+ * The engine a run took (fdt_stats.engine): a function of the settings,
+ * the thread count and, for the parts' fronts with FDT_SEARCH_AUTO, a
+ * probe that counts the points a search tests on samples of the input;
+ * never of a clock, so the same input and settings take the same engine
+ * on every run (doc/design.md, "The apex oracle").
+ */
+typedef enum fdt_engine {
+    FDT_ENGINE_FRONT = 1,     /* one front, the paper's method (serial) */
+    FDT_ENGINE_ONE_PART,      /* the certified insertion mesh of every
+                                 point is the answer, no front */
+    FDT_ENGINE_SWEEP,         /* parts in sweep order: each slab's mesh,
+                                 its final tets out, the rest carried (a
+                                 streamed run) */
+    FDT_ENGINE_PARTS,         /* parts with fronts and messages, the kd
+                                 search (§3-§5) */
+    FDT_ENGINE_PARTS_MESH,    /* the same parts reading their apexes from
+                                 the mesh of every point */
+    FDT_ENGINE_WALLS          /* each part's own mesh, its final tets at
+                                 once, fronts and messages at the walls */
+} fdt_engine;
+
+/* The engine's short name ("front", "one-part", "sweep", "parts",
+ * "parts-mesh", "walls"; --stats-json's "engine") and a line saying what
+ * it does (--stats), static; NULL when e is not an fdt_engine. */
+FDT_API const char *fdt_engine_name(int e);
+FDT_API const char *fdt_engine_about(int e);
+
+/*
  * Progress callback: called now and then from the calling thread with the
  * fraction of tetrahedra believed built (an estimate in [0, 1]). Return
  * nonzero to cancel: fdt_triangulate() then returns FDT_ECANCELED.
@@ -432,6 +460,7 @@ typedef struct fdt_stats {
     double t_cells;           /* seconds computing them, within the
                                  triangulation's time (summed over the
                                  sweeps, which run at once) */
+    int engine;               /* the fdt_engine that ran (fdt_engine_name) */
 } fdt_stats;
 
 /* Fills the first struct_size bytes of *st (its struct_size included).

@@ -308,6 +308,20 @@ static void test_search(void)
                         ref = h;
                     EXPECTF(h == ref, "%zu points, search %d, mode %d, %d threads: another mesh",
                             n, (int)s.search, mode, threads);
+                    /* the engine that ran, as fdt_stats says (the parts'
+                     * auto search: the probe picks the kd search or the
+                     * mesh of every point) */
+                    fdt_stats st;
+                    int e = r && fdt_result_stats(r, &st) == FDT_OK ? st.engine : -1;
+                    int want = mode == FDT_MODE_SERIAL
+                                   ? (si == FDT_SEARCH_KD ? FDT_ENGINE_FRONT : FDT_ENGINE_ONE_PART)
+                               : si == FDT_SEARCH_KD   ? FDT_ENGINE_PARTS
+                               : si == FDT_SEARCH_MESH ? FDT_ENGINE_WALLS
+                                                       : -1;
+                    EXPECTF(want < 0 ? e == FDT_ENGINE_PARTS || e == FDT_ENGINE_PARTS_MESH
+                                     : e == want,
+                            "%zu points, search %d, mode %d, %d threads: engine %d", n,
+                            (int)s.search, mode, threads, e);
                     fdt_result_free(&r);
                     fdt_close(&ctx);
                 }
@@ -466,6 +480,22 @@ static void test_abi_stats(void)
  * never with kd, an explicit parallel mode or pinning. The runs of
  * test_search and tests/test_oracle.c check that the engine that ran is
  * the one it names. */
+/* The engines' names (fdt_engine): each value from FDT_ENGINE_FRONT to
+ * FDT_ENGINE_WALLS has a distinct name and a line, the others none. */
+static void test_engine_names(void)
+{
+    EXPECT(fdt_engine_name(0) == NULL && fdt_engine_about(0) == NULL);
+    EXPECT(fdt_engine_name(FDT_ENGINE_WALLS + 1) == NULL && fdt_engine_name(-1) == NULL);
+    for (int e = FDT_ENGINE_FRONT; e <= FDT_ENGINE_WALLS; e++) {
+        EXPECTF(fdt_engine_name(e) && fdt_engine_about(e) && *fdt_engine_about(e),
+                "engine %d has no name", e);
+        for (int f = FDT_ENGINE_FRONT; f < e; f++)
+            EXPECTF(strcmp(fdt_engine_name(e), fdt_engine_name(f)) != 0,
+                    "engines %d and %d have one name", f, e);
+    }
+    EXPECT(strcmp(fdt_engine_name(FDT_ENGINE_ONE_PART), "one-part") == 0);
+}
+
 static void test_engine_rule(void)
 {
     fdt_settings s;
@@ -506,5 +536,6 @@ int main(void)
     test_search();
     test_search_names();
     test_engine_rule();
+    test_engine_names();
     return test_report("test_api");
 }

@@ -241,15 +241,20 @@ cells_same() {
     cmp -s "$work/c.$x.f" "$work/c.$x" || fail "$name, $np ranks: the table $x differs from frontdt's"
   done
 }
+# (every rank count on two families, two ranks on the others: the suite
+# runs three times in CI)
 allcodes='%i %x %y %z %q %v %F %s %n %f %c %C %d %h %%'
-for fam in lattice clusters dup sphere uniform; do
+for fam in lattice dup clusters sphere uniform; do
   f=$work/$fam.xyz
   [[ -e $f ]] || "$gen" "$fam" 3000 19 "$f" >/dev/null || { fail "gen_points $fam"; continue; }
-  for np in "${nps[@]}"; do
+  cnps=(2)
+  [[ $fam == lattice || $fam == dup ]] && cnps=("${nps[@]}")
+  for np in "${cnps[@]}"; do
     cells_same "cells of $fam" "$np" "$f" --voronoi "$work/c.t" --density "$work/c.d"
   done
   cells_same "CSV cells of $fam" 3 "$f" --voronoi "$work/c.t" --voronoi-format "$allcodes" \
     --box "$(grown_box "$f")"
+  [[ $fam == lattice || $fam == sphere ]] || continue
   mpi 3 300 "$fmpi" -q "$f" --voronoi "$work/c.csv" -o "$work/cp.pfdtb" 2>"$work/c.err" ||
     fail "cells of $fam beside pieces: exit $?"
   "$frontdt" -q "$f" --voronoi "$work/c.f.csv" && cmp -s "$work/c.f.csv" "$work/c.csv" ||

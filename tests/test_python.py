@@ -247,7 +247,8 @@ def test_errors():
 def test_threads():
     p = np.random.default_rng(11).random((20000, 3))
     ref = frontdt.delaunay(p, threads=1, mode="serial")
-    check(ref.stats["mode"] == "serial" and ref.stats["threads"] == 1, "serial stats")
+    check(ref.stats["mode"] == "serial" and ref.stats["threads"] == 1 and
+          ref.stats["engine"] == "one-part", "serial stats")
     for kw in [{"threads": 2}, {"threads": 2, "mode": "shared"}, {"threads": 2, "mode": "message"},
                {"threads": 3, "mode": "shared", "search": "mesh"}, {"search": "kd"}]:
         t = frontdt.delaunay(p, **kw)
@@ -256,7 +257,8 @@ def test_threads():
               np.array_equal(t.neighbors, ref.neighbors),
               "%s: canonical arrays differ from serial" % kw)
     t = frontdt.delaunay(p, threads=2, mode="shared")
-    check(t.stats["threads"] == 2 and t.stats["mode"] == "shared", "threads=2 shared ran on 2 threads")
+    check(t.stats["threads"] == 2 and t.stats["mode"] == "shared" and
+          t.stats["engine"] in ("parts", "parts-mesh"), "threads=2 shared ran on 2 threads")
 
 
 def test_gil_and_interrupt():

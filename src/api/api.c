@@ -167,6 +167,7 @@ typedef struct run_state {
     fdt_sweep_stats sws;      /* the sweep's counters */
     fdt_cellstream *cs;       /* streamed Voronoi cells, or NULL */
     int parts;                /* nonzero: the parts' engine ran (src/par) */
+    int engine;               /* the fdt_engine that ran */
     size_t mem_tree, mem_mesh, mem_sink;
 } run_state;
 
@@ -243,6 +244,31 @@ static int run_parallel(fdt_context *ctx, fdt_mode mode, int nthreads, const fdt
  * takes the fronts: serial, or the parts' engine (src/par/parallel.c).
  */
 typedef enum run_engine { ENGINE_FRONTS, ENGINE_ONE_PART, ENGINE_SWEEP } run_engine;
+
+/* The public names of the engines (fdt_engine, include/frontdt.h). */
+static const struct {
+    const char *name, *about;
+} engines[] = {
+    [FDT_ENGINE_FRONT] = {"front", "one front, the paper's method"},
+    [FDT_ENGINE_ONE_PART] = {"one-part", "the insertion mesh of every point is the answer"},
+    [FDT_ENGINE_SWEEP] = {"sweep", "parts in sweep order: each slab's mesh, its final tets "
+                                   "out, the rest carried"},
+    [FDT_ENGINE_PARTS] = {"parts", "parts with fronts and messages, the kd search"},
+    [FDT_ENGINE_PARTS_MESH] = {"parts-mesh", "parts with fronts and messages, their apexes "
+                                             "from the mesh of every point"},
+    [FDT_ENGINE_WALLS] = {"walls", "each part's own mesh, its final tets at once, fronts and "
+                                   "messages at the walls"},
+};
+
+const char *fdt_engine_name(int e)
+{
+    return e >= FDT_ENGINE_FRONT && e <= FDT_ENGINE_WALLS ? engines[e].name : NULL;
+}
+
+const char *fdt_engine_about(int e)
+{
+    return e >= FDT_ENGINE_FRONT && e <= FDT_ENGINE_WALLS ? engines[e].about : NULL;
+}
 
 static run_engine pick_engine(const fdt_settings *s, fdt_mode mode, int streamed)
 {
@@ -430,6 +456,7 @@ static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, int nthrea
     }
     st->threads = nthreads;
     st->mode = mode;
+    st->engine = rs->engine;
     /* Memory (include/frontdt.h): the points' three arrays, then each
      * structure at its largest. */
     st->mem_points = pr->m * (3 * sizeof *pr->p + sizeof *pr->orig) + n * sizeof *pr->dupmap;
@@ -505,7 +532,7 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     if ((err = fdt_seed_check_dimension(rs.pr.p, rs.pr.orig, (uint32_t)rs.pr.m, ctx->diag,
                                         sizeof ctx->diag)) != FDT_OK)
         goto fail;
-    double t1;
+    double t1 = 0.0;
     run_engine eng = pick_engine(&ctx->s, mode, user != NULL);
     if (mode == FDT_MODE_SERIAL)
         nthreads = 1;
@@ -515,6 +542,10 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     err = eng != ENGINE_FRONTS || mode == FDT_MODE_SERIAL
               ? run_single(ctx, user, eng, nthreads, &rs, &t1)
               : run_parallel(ctx, mode, nthreads, user, &rs, &t1);
+    rs.engine = eng == ENGINE_ONE_PART ? FDT_ENGINE_ONE_PART
+                : eng == ENGINE_SWEEP  ? FDT_ENGINE_SWEEP
+                : rs.parts             ? rs.par.engine
+                                       : FDT_ENGINE_FRONT;
     if (!err && cs)
         err = cells_done(ctx, cs);
     if (err)

@@ -771,22 +771,11 @@ typedef struct timings {
     double read, triangulate, check, canon, write, voronoi, interpolate;
 } timings;
 
-/* Which engine ran, read off the counters (src/api/api.c, one_part):
- * the one-part engine's mesh is the whole answer, with no face advanced. */
-static int ran_one_part(const fdt_stats *st)
+/* The parts' engines (fdt_engine): their messages and threads' figures. */
+static int ran_parts(const fdt_stats *st)
 {
-    return st->faces_advanced == 0 && st->final_tets == st->tets;
-}
-
-static const char *engine_name(const fdt_stats *st)
-{
-    if (st->sweep_parts)
-        return "parts in sweep order: each slab's mesh, its final tets out, the rest carried";
-    if (ran_one_part(st))
-        return "one part: the insertion mesh of every point is the answer";
-    if (st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE)
-        return "parts with fronts and messages";
-    return "the front";
+    return st->engine == FDT_ENGINE_PARTS || st->engine == FDT_ENGINE_PARTS_MESH ||
+           st->engine == FDT_ENGINE_WALLS;
 }
 
 /* Per-thread and per-kind figures of a parallel run (§4-§5): what the
@@ -840,11 +829,9 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         "  mesh faces        %zu (%zu parts read a mesh; %.3f s building meshes)\n"
         "  final from mesh   %zu tets (certified %zu in %.3f s)\n"
         "  insertion         %zu conflict tests, %zu deferred, %zu by the serial finish\n"
-        "  sweep             %zu parts, %zu points inserted again, at most %zu in a part\n"
-        "  streamed cells    %zu batches, at most %zu tets held, %.3f s of the triangulation\n"
         "  threads           %d\n"
         "  mode              %s\n"
-        "  engine            %s\n"
+        "  engine            %s (%s)\n"
         "  time prepare      %.3f s\n"
         "  time front        %.3f s\n"
         "  time finish       %.3f s\n"
@@ -860,12 +847,20 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
         st->max_front, st->mesh_faces, st->mesh_parts, st->t_mesh, st->final_tets,
         st->certified_tets, st->t_certify, st->ins_conflict_tests, st->ins_deferred,
-        st->ins_serial, st->sweep_parts, st->sweep_reinserted, st->sweep_max_part,
-        st->cell_batches, st->cell_held_max, st->t_cells, st->threads, mode_name(st->mode),
-        engine_name(st), st->t_prepare, st->t_front, st->t_finish,
+        st->ins_serial, st->threads, mode_name(st->mode), fdt_engine_name(st->engine),
+        fdt_engine_about(st->engine), st->t_prepare, st->t_front, st->t_finish,
         tm->read, tm->triangulate, tm->check, tm->canon, tm->write, tm->voronoi,
         tm->interpolate);
-    if ((st->mode == FDT_MODE_SHARED || st->mode == FDT_MODE_MESSAGE) && !ran_one_part(st))
+    /* what only some engines have */
+    if (st->engine == FDT_ENGINE_SWEEP)
+        fprintf(stderr, "  sweep             %zu parts, %zu points inserted again, at most %zu in "
+                        "a part\n",
+                st->sweep_parts, st->sweep_reinserted, st->sweep_max_part);
+    if (st->cell_batches)
+        fprintf(stderr, "  streamed cells    %zu batches, at most %zu tets held, %.3f s of the "
+                        "triangulation\n",
+                st->cell_batches, st->cell_held_max, st->t_cells);
+    if (ran_parts(st))
         print_parallel_stats(res, st);
 }
 
@@ -951,7 +946,7 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         ", \"t_certify\": %.9g, \"ins_conflict_tests\": %zu, \"ins_deferred\": %zu"
         ", \"ins_serial\": %zu, \"sweep_parts\": %zu, \"sweep_reinserted\": %zu"
         ", \"sweep_max_part\": %zu, \"cell_batches\": %zu, \"cell_held_max\": %zu"
-        ", \"t_cells\": %.9g, \"threads\": %d, \"mode\": \"%s\""
+        ", \"t_cells\": %.9g, \"threads\": %d, \"mode\": \"%s\", \"engine\": \"%s\""
         ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
         ", \"t_read\": %.9g, \"t_triangulate\": %.9g, \"t_check\": %.9g"
         ", \"t_canon\": %.9g, \"t_write\": %.9g, \"t_voronoi\": %.9g"
@@ -964,7 +959,7 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         st->ins_conflict_tests, st->ins_deferred, st->ins_serial, st->sweep_parts,
         st->sweep_reinserted, st->sweep_max_part, st->cell_batches, st->cell_held_max,
         finite_or_zero(st->t_cells), st->threads, mode_name(st->mode),
-        finite_or_zero(st->t_prepare),
+        fdt_engine_name(st->engine), finite_or_zero(st->t_prepare),
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
         finite_or_zero(tm->check), finite_or_zero(tm->canon), finite_or_zero(tm->write),

@@ -647,6 +647,8 @@ int fdt_parallel_run(fdt_prepared *pr, const fdt_settings *s, fdt_mode mode, int
      * the input, the settings and the memory decide, never a clock
      * (bench/NOTES.md entry 90). */
     e->walls = sr->walls && !e->gmesh_ok;
+    out->engine = e->walls ? FDT_ENGINE_WALLS : e->gmesh_ok ? FDT_ENGINE_PARTS_MESH
+                                                            : FDT_ENGINE_PARTS;
     /* The seeds, after the mesh of every point where it was built: its
      * tets are Delaunay tets already (seeds_from_mesh). */
     err = e->gmesh_ok ? seeds_from_mesh(&pt, &e->gmesh, &seeds, &nseeds)

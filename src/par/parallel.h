@@ -23,6 +23,7 @@ typedef struct fdt_par_out {
     fdt_stats pst;             /* only the parallel fields (sent .. pinned) */
     fdt_thread_stats *tstats;  /* nthreads entries (owned until taken) */
     int nthreads;
+    int engine;                /* FDT_ENGINE_PARTS, _PARTS_MESH or _WALLS */
     double t_setup;            /* seconds: partition, kd-trees, seed tets */
     double t_front;            /* seconds: the threads' run */
     double t_gather;           /* seconds: gathering the threads' tets */
