@@ -8,9 +8,12 @@ Every tests/gen_points family (4,000 points) and the bunny of ../shared/data
 the parts that read a mesh, the tets final at once, the sweep's parts and
 points inserted again, and per thread its points, final tets and wall
 faces), as is the tet count; the work counts (points tested, kd nodes
-visited, faces advanced, the insertion's conflict tests) are within 10 %
-of each other. Only what message timing decides may vary beyond that
-(FACESEND counts, tet requests, front sizes; not compared), and the wall
+visited, faces advanced; on one thread the insertion's conflict tests too)
+are within 10 % of each other: on threads the insertion retries what
+another thread held (try-locks), and its conflict tests spread by 10 %
+on 4,000 points of a sphere at 3 threads in one run of ten. Only what
+message timing decides may vary beyond that (FACESEND counts, tet
+requests, front sizes; not compared), and the wall
 engine's work counts (--search mesh on threads: which part's front meets a
 wall face first, and so which searches it, is timing; 12-18 % apart on
 4,000 points of rotlattice and citylidar), of which only the decisions are
@@ -40,7 +43,8 @@ SETTINGS = [
 EXACT = ["engine", "mesh_parts", "final_tets", "sweep_parts", "sweep_reinserted",
          "sweep_max_part", "tets", "hull_faces"]
 THREAD_EXACT = ["points", "final_tets", "wall_faces"]
-WORK = ["points_tested", "kd_nodes_visited", "faces_advanced", "ins_conflict_tests"]
+WORK = ["points_tested", "kd_nodes_visited", "faces_advanced"]
+SERIAL_WORK = ["ins_conflict_tests"]
 
 
 def run_once(frontdt, path, settings, out):
@@ -70,7 +74,8 @@ def compare(name, runs, work=True):
             vals = [p[i].get(k) if i < len(p) else None for p in per]
             if any(v != vals[0] for v in vals):
                 bad.append("%s: thread %d's %s differs between runs: %s" % (name, i, k, vals))
-    for k in WORK if work else []:
+    serial = first.get("threads") == 1
+    for k in (WORK + (SERIAL_WORK if serial else [])) if work else []:
         vals = [r.get(k, 0) for r in runs]
         lo, hi = min(vals), max(vals)
         if hi > 0 and (hi - lo) > 0.10 * hi:

@@ -635,7 +635,7 @@ int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
     /* The box and its scale before any work (xyz is the caller's still:
      * a permuted input is moved by the run). The bounding box of the
      * distinct points is that of all of them. */
-    int err = fdt_voronoi_box_of(xyz, n, o, cs.box, ctx->diag, sizeof ctx->diag);
+    int err = fdt_voronoi_box_of(xyz, NULL, n, o, cs.box, ctx->diag, sizeof ctx->diag);
     /* no finite point: the run refuses the input, with its own message */
     if (!err && cs.box[0] <= cs.box[3])
         err = fdt_voronoi_scale(cs.box, &cs.ed, ctx->diag, sizeof ctx->diag);

@@ -1490,7 +1490,7 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
     w.ds = diag_size;
     /* The vertices are written as absolute coordinates: those of points
      * closer than 2^-40 of theirs would be noise (fdt_voronoi_resolution). */
-    int err = fdt_voronoi_box_of(xyz, n, o, w.box, diag, diag_size);
+    int err = fdt_voronoi_box_of(xyz, NULL, n, o, w.box, diag, diag_size);
     if (!err)
         err = fdt_voronoi_resolution(r, xyz, w.box, -300, 1, diag, diag_size);
     int had_faces = r->face_verts != NULL;

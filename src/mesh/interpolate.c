@@ -648,7 +648,7 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
     fdt_default_voronoi_options(&vo);
     double box[6], side = 0;
     int e = 0;
-    if (method == FDT_INTERP_NATURAL && fdt_voronoi_box_of(xyz, n, &vo, box, NULL, 0) == FDT_OK)
+    if (method == FDT_INTERP_NATURAL && fdt_voronoi_box_of(xyz, NULL, n, &vo, box, NULL, 0) == FDT_OK)
         side = fdt_box_side(box);
     if (side > 0)
         (void)frexp(side, &e);

@@ -157,8 +157,8 @@ void fdt_voronoi_free(fdt_voronoi **pv)
     *pv = NULL;
 }
 
-int fdt_voronoi_box_of(const double *xyz, size_t n, const fdt_voronoi_options *o, double box[6],
-                       char *diag, size_t ds)
+int fdt_voronoi_box_of(const double *xyz, const fdt_vid *ids, size_t n,
+                       const fdt_voronoi_options *o, double box[6], char *diag, size_t ds)
 {
     if (o->box_given) {
         memcpy(box, o->box, 6 * sizeof *box);
@@ -170,8 +170,9 @@ int fdt_voronoi_box_of(const double *xyz, size_t n, const fdt_voronoi_options *o
         for (size_t i = 0; i < n; i++)
             for (int k = 0; k < 3; k++)
                 if (xyz[3 * i + k] < box[k] || xyz[3 * i + k] > box[k + 3]) {
-                    fdt_diag(diag, ds, "point %zu (%.17g %.17g %.17g) lies outside the box", i,
-                        xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+                    fdt_diag(diag, ds, "point %zu (%.17g %.17g %.17g) lies outside the box",
+                             ids ? (size_t)(uint32_t)ids[i] : i, xyz[3 * i], xyz[3 * i + 1],
+                             xyz[3 * i + 2]);
                     return FDT_EINVAL;
                 }
         return FDT_OK;
@@ -1205,7 +1206,7 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
     v->n = n;
     err = alloc_cells(v);
     if (!err)
-        err = fdt_voronoi_box_of(xyz, n, o, v->box, diag, diag_size);
+        err = fdt_voronoi_box_of(xyz, NULL, n, o, v->box, diag, diag_size);
     if (!err)
         err = fdt_voronoi_scale(v->box, &w.ed, diag, diag_size);
     if (err)

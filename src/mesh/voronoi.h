@@ -101,9 +101,10 @@ int fdt_voronoi_merged(const fdt_vid *ids, const double *pts, size_t k, const do
  * empty, not finite or leaves a point out) or the bounding box of the
  * finite points (a merged duplicate lies on its point). The rule of
  * fdt_voronoi_compute, of the streamed cells and of the polyMesh dual
- * (src/mesh/dualmesh.c). */
-int fdt_voronoi_box_of(const double *xyz, size_t n, const fdt_voronoi_options *o, double box[6],
-                       char *diag, size_t ds);
+ * (src/mesh/dualmesh.c). A point outside is
+ * named by its index, or by ids[i] (its input id) when ids is not NULL. */
+int fdt_voronoi_box_of(const double *xyz, const fdt_vid *ids, size_t n,
+                       const fdt_voronoi_options *o, double box[6], char *diag, size_t ds);
 
 /*
  * FDT_OK, and *ed the exponent of box's largest side D (D = f 2^*ed, f in

@@ -79,7 +79,7 @@ static int the_box(cells_run *c)
     vo.box_given = c->o->box_given;
     memcpy(vo.box, c->o->box, sizeof vo.box);
     /* the box itself (no points): empty or not finite */
-    int err = fdt_voronoi_box_of(NULL, 0, &vo, c->box, c->diag, c->dlen);
+    int err = fdt_voronoi_box_of(NULL, NULL, 0, &vo, c->box, c->diag, c->dlen);
     if ((err = agree(c, err)) != FDT_OK)
         return err;
     if (c->o->box_given) {
@@ -97,12 +97,9 @@ static int the_box(cells_run *c)
         }
         MPI_Allreduce(&least, &all, 1, MPI_UINT64_T, MPI_MIN, c->comm);
         err = FDT_OK;
-        if (all != UINT64_MAX && all == least) { /* its one holder says so */
-            const double *p = L->in_xyz + 3 * at;
-            snprintf(c->diag, c->dlen, "point %" PRIu64 " (%.17g %.17g %.17g) lies outside the box",
-                     least, p[0], p[1], p[2]);
-            err = FDT_EINVAL;
-        }
+        if (all != UINT64_MAX && all == least) /* its one holder says so */
+            err = fdt_voronoi_box_of(L->in_xyz + 3 * at, L->in_id + at, 1, &vo, c->box, c->diag,
+                                     c->dlen);
         if ((err = agree(c, err)) != FDT_OK)
             return err;
     } else {
