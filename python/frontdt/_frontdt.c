@@ -374,7 +374,8 @@ static PyObject *tri_stats(TriObject *self, void *closure)
         PUT_SIZE(d, st, adapt_orient) || PUT_SIZE(d, st, adapt_insphere) ||
         PUT_SIZE(d, st, max_front) || put(d, "threads", PyLong_FromLong(st.threads)) ||
         put(d, "mode", PyUnicode_FromString(mode_name(st.mode))) ||
-        put(d, "engine", PyUnicode_FromString(fdt_engine_name(st.engine))) ||
+        put(d, "engine", PyUnicode_FromString(fdt_engine_name(st.engine) ? fdt_engine_name(st.engine)
+                                                                          : "unknown")) ||
         PUT_DBL(d, st, t_prepare) || PUT_DBL(d, st, t_front) || PUT_DBL(d, st, t_finish) ||
         put(d, "sent", msg_dict(st.sent)) || put(d, "received", msg_dict(st.received)) ||
         PUT_SIZE(d, st, remote_queries) || PUT_SIZE(d, st, remote_answered) ||

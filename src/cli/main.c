@@ -771,6 +771,13 @@ typedef struct timings {
     double read, triangulate, check, canon, write, voronoi, interpolate;
 } timings;
 
+/* The engine's name and line (an unknown value: "unknown"). */
+static const char *engine_word(const fdt_stats *st, int about)
+{
+    const char *w = about ? fdt_engine_about(st->engine) : fdt_engine_name(st->engine);
+    return w ? w : "unknown";
+}
+
 /* The parts' engines (fdt_engine): their messages and threads' figures. */
 static int ran_parts(const fdt_stats *st)
 {
@@ -847,8 +854,8 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
         st->max_front, st->mesh_faces, st->mesh_parts, st->t_mesh, st->final_tets,
         st->certified_tets, st->t_certify, st->ins_conflict_tests, st->ins_deferred,
-        st->ins_serial, st->threads, mode_name(st->mode), fdt_engine_name(st->engine),
-        fdt_engine_about(st->engine), st->t_prepare, st->t_front, st->t_finish,
+        st->ins_serial, st->threads, mode_name(st->mode), engine_word(st, 0),
+        engine_word(st, 1), st->t_prepare, st->t_front, st->t_finish,
         tm->read, tm->triangulate, tm->check, tm->canon, tm->write, tm->voronoi,
         tm->interpolate);
     /* what only some engines have */
@@ -959,7 +966,7 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         st->ins_conflict_tests, st->ins_deferred, st->ins_serial, st->sweep_parts,
         st->sweep_reinserted, st->sweep_max_part, st->cell_batches, st->cell_held_max,
         finite_or_zero(st->t_cells), st->threads, mode_name(st->mode),
-        fdt_engine_name(st->engine), finite_or_zero(st->t_prepare),
+        engine_word(st, 0), finite_or_zero(st->t_prepare),
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
         finite_or_zero(tm->check), finite_or_zero(tm->canon), finite_or_zero(tm->write),

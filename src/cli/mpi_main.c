@@ -439,7 +439,8 @@ static int cells_step(const opts *o, const fdt_mpi_local *L, const fdt_mpi_out *
     case FDT_EINVAL: return CLI_USAGE;
     case FDT_ERANGE: return CLI_INPUT;
     case FDT_EIO: return CLI_WRITE;
-    case FDT_ENOMEM: return CLI_RESOURCES;
+    case FDT_ENOMEM:
+    case FDT_ETOOBIG: return CLI_RESOURCES;
     default: return CLI_INTERNAL;
     }
 }

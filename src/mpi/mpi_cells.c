@@ -4,6 +4,7 @@
 
 #include <errno.h>
 #include <inttypes.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -168,8 +169,9 @@ static int owners(const cells_run *c, const fdt_vid *t, int d[4])
  * Every tet this rank built goes to each rank owning one of its vertices,
  * with the points it uses: to each destination a list of points (input
  * id and coordinates, each once) and the tets as four positions in that
- * list, 48 bytes a point and 16 a tet instead of 112 a tet. The receiver
- * merges the lists of its sources by input id.
+ * list: 32 bytes a point and 16 a tet, instead of 112 a tet with its
+ * coordinates. The receiver merges the lists of its sources by input id.
+ * MPI counts are ints: more than INT_MAX records to send is FDT_ETOOBIG.
  */
 static int send_stars(cells_run *c)
 {
@@ -221,11 +223,16 @@ static int send_stars(cells_run *c)
     for (size_t t = 0; t < nt; t++)
         for (int k = owners(c, r->own_tets + 4 * t, d); k-- > 0;)
             tc[d[k]]++, npairs++;
-    byd = malloc((npairs + 1) * sizeof *byd);
-    ts = malloc((npairs + 1) * sizeof *ts);
+    if (npairs > INT_MAX) {
+        snprintf(c->diag, c->dlen, "too many tets on one rank for MPI's int counts");
+        err = FDT_ETOOBIG;
+    }
+    byd = err ? NULL : malloc((npairs + 1) * sizeof *byd);
+    ts = err ? NULL : malloc((npairs + 1) * sizeof *ts);
     size_t pcap = np + 1; /* a point once a destination: grown below */
-    plist = malloc(pcap * sizeof *plist);
-    err = byd && ts && plist ? FDT_OK : oom(c, "sending the stars");
+    plist = err ? NULL : malloc(pcap * sizeof *plist);
+    if (!err && !(byd && ts && plist))
+        err = oom(c, "sending the stars");
     if ((err = agree(c, err)) != FDT_OK)
         goto done;
     for (int q = 0, at = 0; q < size; q++) {
@@ -242,7 +249,7 @@ static int send_stars(cells_run *c)
         pos[i] = UINT32_MAX;
     for (int q = 0; q < size && !err; q++) {
         size_t first = nps;
-        for (int i = td[q]; i < td[q] + tc[q]; i++) {
+        for (int i = td[q]; i < td[q] + tc[q] && !err; i++) {
             const uint32_t *v = tv + 4 * (size_t)byd[i];
             for (int j = 0; j < 4; j++) {
                 if (pos[v[j]] == UINT32_MAX) {
@@ -260,11 +267,13 @@ static int send_stars(cells_run *c)
         for (size_t i = first; i < nps; i++)
             pos[plist[i]] = UINT32_MAX;
     }
+    if (!err && nps > INT_MAX) {
+        snprintf(c->diag, c->dlen, "too many points on one rank for MPI's int counts");
+        err = FDT_ETOOBIG;
+    }
     ps = err ? NULL : malloc((nps + 1) * sizeof *ps);
-    if (!err && !ps)
-        err = FDT_ENOMEM;
-    if (err)
-        oom(c, "sending the stars");
+    if (err == FDT_ENOMEM || (!err && !ps))
+        err = oom(c, "sending the stars");
     if ((err = agree(c, err)) != FDT_OK)
         goto done;
     for (size_t i = 0; i < nps; i++) {

@@ -45,7 +45,8 @@ typedef struct fdt_mpi_cells_stats {
  * the failing rank's message in diag: FDT_OK; FDT_EINVAL (a point outside
  * o's box: the least such input id, as frontdt names it); FDT_ERANGE (the
  * cells are beyond doubles, or a Delaunay edge is too short for them: the
- * least such edge over all ranks, frontdt's message); FDT_ENOMEM; FDT_EIO
+ * least such edge over all ranks, frontdt's message); FDT_ENOMEM;
+ * FDT_ETOOBIG (more records for a rank than MPI's int counts); FDT_EIO
  * (a table not written: nothing of it is left); FDT_EINTERNAL.
  */
 int fdt_mpi_cells(MPI_Comm comm, const fdt_mpi_local *L, const fdt_mpi_out *r,
