@@ -67,6 +67,17 @@ static MPI_Datatype record_type(size_t bytes)
     return t;
 }
 
+/* The start of each rank's records in a send buffer: the prefix sums of
+ * the counts c (a counting sort's; each fill moves them on, and a second
+ * call puts them back). */
+static void starts(const int *c, int *d, int size)
+{
+    for (int q = 0, at = 0; q < size; q++) {
+        d[q] = at;
+        at += c[q];
+    }
+}
+
 /* ---- 1. the box ---------------------------------------------------------- */
 
 /* o's box, every point checked inside it (the least input id outside is
@@ -235,15 +246,11 @@ static int send_stars(cells_run *c)
         err = oom(c, "sending the stars");
     if ((err = agree(c, err)) != FDT_OK)
         goto done;
-    for (int q = 0, at = 0; q < size; q++) {
-        td[q] = at;
-        at += tc[q];
-    }
+    starts(tc, td, size);
     for (size_t t = 0; t < nt; t++)
         for (int k = owners(c, r->own_tets + 4 * t, d); k-- > 0;)
             byd[td[d[k]]++] = (uint32_t)t;
-    for (int q = size; q-- > 0;)
-        td[q] -= tc[q];
+    starts(tc, td, size); /* moved on by the fill: back */
     /* each destination's point list and its tets' positions in it */
     for (size_t i = 0; i < np; i++)
         pos[i] = UINT32_MAX;
@@ -367,15 +374,11 @@ static int send_hull(cells_run *c)
     int *sc = cnt, *sd = cnt + size, *rc = cnt + 2 * size, *rd = cnt + 3 * size;
     for (size_t i = 0; i < nh; i++)
         sc[fdt_mpi_block_owner(c->L->n, size, (uint64_t)(uint32_t)r->own_hull[i])]++;
-    for (int q = 0, at = 0; q < size; q++) {
-        sd[q] = at;
-        at += sc[q];
-    }
+    starts(sc, sd, size);
     for (size_t i = 0; i < nh; i++)
         sb[sd[fdt_mpi_block_owner(c->L->n, size, (uint64_t)(uint32_t)r->own_hull[i])]++] =
             (uint32_t)r->own_hull[i];
-    for (int q = size; q-- > 0;)
-        sd[q] -= sc[q];
+    starts(sc, sd, size); /* moved on by the fill: back */
     size_t nr = fdt_mpi_counts(c->comm, sc, sd, rc, rd, sizeof *sb, &c->bytes);
     rb = malloc((nr + 1) * sizeof *rb);
     err = rb ? FDT_OK : oom(c, "receiving the hull");
@@ -423,18 +426,14 @@ static int send_inputs(cells_run *c)
     int *sc = cnt, *sd = cnt + size, *rc = cnt + 2 * size, *rd = cnt + 3 * size;
     for (size_t i = 0; i < L->nin; i++)
         sc[fdt_mpi_block_owner(L->n, size, (uint64_t)(uint32_t)L->in_id[i])]++;
-    for (int q = 0, at = 0; q < size; q++) {
-        sd[q] = at;
-        at += sc[q];
-    }
+    starts(sc, sd, size);
     for (size_t i = 0; i < L->nin; i++) {
         irec *p = &sb[sd[fdt_mpi_block_owner(L->n, size, (uint64_t)(uint32_t)L->in_id[i])]++];
         p->id = (uint64_t)(uint32_t)L->in_id[i];
         p->vertex = (uint64_t)(uint32_t)L->in_vertex[i];
         memcpy(p->x, L->in_xyz + 3 * i, sizeof p->x);
     }
-    for (int q = size; q-- > 0;)
-        sd[q] -= sc[q];
+    starts(sc, sd, size); /* moved on by the fill: back */
     size_t nr = fdt_mpi_counts(c->comm, sc, sd, rc, rd, sizeof *sb, &c->bytes);
     rb = malloc((nr + 1) * sizeof *rb);
     err = rb ? FDT_OK : oom(c, "receiving the points");
