@@ -261,6 +261,17 @@ for fam in lattice dup clusters sphere uniform; do
     fail "CSV cells of $fam beside pieces: differ from frontdt's"
   rm -f "$work"/cp*.fdtb "$work/cp.pfdtb" "$work/c.csv" "$work/c.f.csv"
 done
+# a shuffled input: each point's cell the same bits, its row moved with it
+checks=$((checks + 1))
+awk 'BEGIN {srand(5)} {print rand() "\t" $0}' "$work/uniform.xyz" | sort -k1,1 | cut -f2- \
+  >"$work/shuffled.xyz"
+rowfmt='%x %y %z %v %F %s %c %d %h'
+"$frontdt" -q "$work/uniform.xyz" --voronoi "$work/c.f.txt" --voronoi-format "$rowfmt" &&
+  mpi 3 300 "$fmpi" -q "$work/shuffled.xyz" --voronoi "$work/c.txt" --voronoi-format "$rowfmt" ||
+  fail "cells of a shuffled input: exit $?"
+cmp -s "$work/uniform.xyz" "$work/shuffled.xyz" && fail "the shuffle did not shuffle"
+cmp -s <(sort "$work/c.f.txt") <(sort "$work/c.txt") ||
+  fail "cells of a shuffled input under MPI: other values than frontdt's on the input"
 # errors: frontdt's message and code, no table
 cells_error() {
   local name=$1 f=$2
