@@ -19,7 +19,8 @@ int fdt_cli_dual_wanted(const fdt_cli_dual *d)
     return d->voronoi || d->density;
 }
 
-int fdt_cli_parse_box(const char *s, double box[6])
+/* 0, or -1: not six finite numbers with each min below its max. */
+static int parse_box(const char *s, double box[6])
 {
     const char *p = s;
     for (int k = 0; k < 6; k++) {
@@ -38,6 +39,15 @@ int fdt_cli_parse_box(const char *s, double box[6])
         if (!(box[k] < box[k + 3]))
             return -1;
     return 0;
+}
+
+int fdt_cli_parse_box(const char *s, double box[6], char *err, size_t errlen)
+{
+    if (parse_box(s, box) == 0)
+        return 0;
+    snprintf(err, errlen, "--box wants six finite numbers xmin,ymin,zmin,xmax,ymax,zmax with each "
+             "min below its max, not '%s'", s);
+    return -1;
 }
 
 /* Does path end in ext (".csv", ".vtu")? */

@@ -47,8 +47,9 @@ void fdt_cli_cells_message(const char *what, int r, const char *diag, char *err,
 int fdt_cli_dual_wanted(const fdt_cli_dual *d);
 
 /* --box "xmin,ymin,zmin,xmax,ymax,zmax": 0, or -1 (not six finite numbers
- * with each min below its max). */
-int fdt_cli_parse_box(const char *s, double box[6]);
+ * with each min below its max) with the usage message in err (both
+ * programs'). */
+int fdt_cli_parse_box(const char *s, double box[6], char *err, size_t errlen);
 
 /* Checks the options before the run (input: the input file, or NULL for
  * --demo or standard input): 0, or -1 with the reason in err (a usage

@@ -349,12 +349,13 @@ static int take_dual(fdt_cli_dual *d, int id, const char *v)
     case FDT_OPT_DUAL:
         d->dual = 1;
         break;
-    case FDT_OPT_BOX:
-        if (fdt_cli_parse_box(v, d->box) != 0)
-            return usage_error("--box wants six finite numbers xmin,ymin,zmin,xmax,ymax,zmax "
-                               "with each min below its max, not '%s'", v);
+    case FDT_OPT_BOX: {
+        char err[FDT_IO_PATH + 200];
+        if (fdt_cli_parse_box(v, d->box, err, sizeof err) != 0)
+            return usage_error("%s", err);
         d->box_given = 1;
         break;
+    }
     case FDT_OPT_VALUES:
         d->values = v;
         break;

@@ -164,9 +164,8 @@ static int take_option(opts *o, int id, const char *v, int rank)
         o->cells.density = v;
         return -1;
     case FDT_OPT_BOX:
-        if (fdt_cli_parse_box(v, o->cells.box) != 0) {
-            say0(rank, "--box wants six finite numbers xmin,ymin,zmin,xmax,ymax,zmax with each "
-                       "min below its max, not '%s'", v);
+        if (fdt_cli_parse_box(v, o->cells.box, err, sizeof err) != 0) {
+            say0(rank, "%s", err);
             return CLI_USAGE;
         }
         o->cells.box_given = 1;
