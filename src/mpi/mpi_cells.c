@@ -58,13 +58,29 @@ static int oom(cells_run *c, const char *what)
     return FDT_ENOMEM;
 }
 
-/* An MPI datatype of `bytes` contiguous bytes (a record). */
-static MPI_Datatype record_type(size_t bytes)
+/*
+ * One exchange of records of rec bytes (collective): sb holds sc[q] of
+ * them for rank q, grouped by rank in rank order; cnt's four rows of
+ * size ints are sc itself, then the send starts, the receive counts and
+ * the receive starts (by source), which this fills. *rb: what came, *nr
+ * records (owned by the caller, also on failure). FDT_OK or FDT_ENOMEM
+ * on every rank.
+ */
+static int exchange(cells_run *c, const void *sb, int *cnt, size_t rec, void **rb, size_t *nr,
+                    const char *what)
 {
+    int size = c->size, *sd = cnt + size, *rc = cnt + 2 * size, *rd = cnt + 3 * size;
+    *nr = fdt_mpi_counts(c->comm, cnt, sd, rc, rd, rec, &c->bytes);
+    *rb = malloc((*nr + 1) * rec);
+    int err = *rb ? FDT_OK : oom(c, what);
+    if ((err = agree(c, err)) != FDT_OK)
+        return err;
     MPI_Datatype t;
-    MPI_Type_contiguous((int)bytes, MPI_BYTE, &t);
+    MPI_Type_contiguous((int)rec, MPI_BYTE, &t);
     MPI_Type_commit(&t);
-    return t;
+    MPI_Alltoallv(sb, cnt, sd, t, *rb, rc, rd, t, c->comm);
+    MPI_Type_free(&t);
+    return FDT_OK;
 }
 
 /* The start of each rank's records in a send buffer: the prefix sums of
@@ -227,8 +243,9 @@ static int send_stars(cells_run *c)
     free(tab);
     if ((err = agree(c, err)) != FDT_OK)
         goto done;
+    /* exchange()'s rows: the tets', then the points' */
     int *tc = cnt, *td = cnt + size, *trc = cnt + 2 * size, *trd = cnt + 3 * size;
-    int *pc = cnt + 4 * size, *pd = cnt + 5 * size, *prc = cnt + 6 * size, *prd = cnt + 7 * size;
+    int *pc = cnt + 4 * size, *prc = cnt + 6 * size, *prd = cnt + 7 * size;
     /* the (destination, tet) pairs, grouped by destination */
     int d[4];
     for (size_t t = 0; t < nt; t++)
@@ -287,18 +304,12 @@ static int send_stars(cells_run *c)
         ps[i].id = (uint64_t)(uint32_t)r->own_ids[plist[i]];
         memcpy(ps[i].x, r->own_xyz + 3 * (size_t)plist[i], sizeof ps[i].x);
     }
-    size_t nrt = fdt_mpi_counts(c->comm, tc, td, trc, trd, sizeof *ts, &c->bytes);
-    size_t nrp = fdt_mpi_counts(c->comm, pc, pd, prc, prd, sizeof *ps, &c->bytes);
-    rt = malloc((nrt + 1) * sizeof *rt);
-    rp = malloc((nrp + 1) * sizeof *rp);
-    err = rt && rp ? FDT_OK : oom(c, "receiving the stars");
-    if ((err = agree(c, err)) != FDT_OK)
+    size_t nrt = 0, nrp = 0;
+    if ((err = exchange(c, ts, tc, sizeof *ts, (void **)&rt, &nrt, "receiving the stars")) !=
+            FDT_OK ||
+        (err = exchange(c, ps, pc, sizeof *ps, (void **)&rp, &nrp, "receiving the stars")) !=
+            FDT_OK)
         goto done;
-    MPI_Datatype tt = record_type(sizeof *ts), pt = record_type(sizeof *ps);
-    MPI_Alltoallv(ts, tc, td, tt, rt, trc, trd, tt, c->comm);
-    MPI_Alltoallv(ps, pc, pd, pt, rp, prc, prd, pt, c->comm);
-    MPI_Type_free(&tt);
-    MPI_Type_free(&pt);
     free(ts);
     ts = NULL;
     free(ps);
@@ -371,20 +382,16 @@ static int send_hull(cells_run *c)
     int err = cnt && sb && c->hull ? FDT_OK : oom(c, "sending the hull");
     if ((err = agree(c, err)) != FDT_OK)
         goto done;
-    int *sc = cnt, *sd = cnt + size, *rc = cnt + 2 * size, *rd = cnt + 3 * size;
+    int *sc = cnt, *sd = cnt + size; /* exchange()'s first two rows */
     for (size_t i = 0; i < nh; i++)
         sc[fdt_mpi_block_owner(c->L->n, size, (uint64_t)(uint32_t)r->own_hull[i])]++;
     starts(sc, sd, size);
     for (size_t i = 0; i < nh; i++)
         sb[sd[fdt_mpi_block_owner(c->L->n, size, (uint64_t)(uint32_t)r->own_hull[i])]++] =
             (uint32_t)r->own_hull[i];
-    starts(sc, sd, size); /* moved on by the fill: back */
-    size_t nr = fdt_mpi_counts(c->comm, sc, sd, rc, rd, sizeof *sb, &c->bytes);
-    rb = malloc((nr + 1) * sizeof *rb);
-    err = rb ? FDT_OK : oom(c, "receiving the hull");
-    if ((err = agree(c, err)) != FDT_OK)
+    size_t nr = 0;
+    if ((err = exchange(c, sb, sc, sizeof *sb, (void **)&rb, &nr, "receiving the hull")) != FDT_OK)
         goto done;
-    MPI_Alltoallv(sb, sc, sd, MPI_UINT32_T, rb, rc, rd, MPI_UINT32_T, c->comm);
     for (size_t i = 0; i < nr && !err; i++) {
         size_t k = find_id(c->ids, c->npts, (fdt_vid)rb[i]);
         if (k == c->npts) {
@@ -423,7 +430,7 @@ static int send_inputs(cells_run *c)
     int err = cnt && sb && seen && c->vertex && c->pts ? FDT_OK : oom(c, "sending the points");
     if ((err = agree(c, err)) != FDT_OK)
         goto done;
-    int *sc = cnt, *sd = cnt + size, *rc = cnt + 2 * size, *rd = cnt + 3 * size;
+    int *sc = cnt, *sd = cnt + size; /* exchange()'s first two rows */
     for (size_t i = 0; i < L->nin; i++)
         sc[fdt_mpi_block_owner(L->n, size, (uint64_t)(uint32_t)L->in_id[i])]++;
     starts(sc, sd, size);
@@ -433,15 +440,10 @@ static int send_inputs(cells_run *c)
         p->vertex = (uint64_t)(uint32_t)L->in_vertex[i];
         memcpy(p->x, L->in_xyz + 3 * i, sizeof p->x);
     }
-    starts(sc, sd, size); /* moved on by the fill: back */
-    size_t nr = fdt_mpi_counts(c->comm, sc, sd, rc, rd, sizeof *sb, &c->bytes);
-    rb = malloc((nr + 1) * sizeof *rb);
-    err = rb ? FDT_OK : oom(c, "receiving the points");
-    if ((err = agree(c, err)) != FDT_OK)
+    size_t nr = 0;
+    if ((err = exchange(c, sb, sc, sizeof *sb, (void **)&rb, &nr, "receiving the points")) !=
+        FDT_OK)
         goto done;
-    MPI_Datatype it = record_type(sizeof *sb);
-    MPI_Alltoallv(sb, sc, sd, it, rb, rc, rd, it, c->comm);
-    MPI_Type_free(&it);
     for (size_t i = 0; i < nr && !err; i++) {
         size_t j = (size_t)(rb[i].id - c->lo);
         if (rb[i].id < c->lo || j >= c->nmine || seen[j]) {
