@@ -272,6 +272,9 @@ rowfmt='%x %y %z %v %F %s %c %d %h'
 cmp -s "$work/uniform.xyz" "$work/shuffled.xyz" && fail "the shuffle did not shuffle"
 cmp -s <(sort "$work/c.f.txt") <(sort "$work/c.txt") ||
   fail "cells of a shuffled input under MPI: other values than frontdt's on the input"
+# fewer input points than ranks (empty blocks), a duplicate among them
+printf '0 0 0\n1 0 0\n0 1 0\n0 0 1\n0.3 0.3 0.3\n1 0 0\n' >"$work/tiny.xyz"
+cells_same "cells of 6 points" 7 "$work/tiny.xyz" --voronoi "$work/c.t" --density "$work/c.d"
 # errors: frontdt's message and code, no table
 cells_error() {
   local name=$1 f=$2

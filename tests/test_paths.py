@@ -20,9 +20,9 @@ wall face first, and so which searches it, is timing; 12-18 % apart on
 compared.
 
 Usage: test_paths.py FRONTDT GEN_POINTS DATA_DIR REPS [FAMILY...]
-(the default suite runs it twice on the families that once switched paths
-with the clock, about 30 s; --suite long ten times on every family and the
-larger real sets).
+(the default suite runs it twice on eight families that once switched paths
+with the clock and the bunny, about 15 s; --suite long ten times on every
+family and the larger real sets).
 """
 import json
 import os
