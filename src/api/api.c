@@ -232,19 +232,6 @@ static int run_parallel(fdt_context *ctx, fdt_mode mode, int nthreads, const fdt
     return FDT_OK;
 }
 
-/*
- * Which engine a run takes (issue 31), a function of the settings alone.
- * The insertion engines run where the search's row lets them
- * (src/front/search.c): on one thread, or on several with the default
- * mode and no --pin (which binds the parts' threads). In memory that is
- * the one-part engine (the insertion mesh of every point, built on the
- * run's threads and certified, is the answer: no front re-derives it,
- * bench/NOTES.md entry 91); streamed, whose memory must stay bounded, the
- * parts in sweep order (src/front/sweep.h, entry 104). Every other run
- * takes the fronts: serial, or the parts' engine (src/par/parallel.c).
- */
-typedef enum run_engine { ENGINE_FRONTS, ENGINE_ONE_PART, ENGINE_SWEEP } run_engine;
-
 /* The public names of the engines (fdt_engine, include/frontdt.h). */
 static const struct {
     const char *name, *about;
@@ -270,13 +257,27 @@ const char *fdt_engine_about(int e)
     return e >= FDT_ENGINE_FRONT && e <= FDT_ENGINE_WALLS ? engines[e].about : NULL;
 }
 
-static run_engine pick_engine(const fdt_settings *s, fdt_mode mode, int streamed)
+/*
+ * Which engine a run takes (issue 31), a function of the settings alone.
+ * The insertion engines run where the search's row lets them
+ * (src/front/search.c): on one thread, or on several with the default
+ * mode and no --pin (which binds the parts' threads). In memory that is
+ * the one-part engine (the insertion mesh of every point, built on the
+ * run's threads and certified, is the answer: no front re-derives it,
+ * bench/NOTES.md entry 91); streamed, whose memory must stay bounded, the
+ * parts in sweep order (src/front/sweep.h, entry 104). Every other run
+ * takes the fronts: serial, or the parts' engine (src/par/parallel.c). The
+ * rule's answer is an fdt_engine: FDT_ENGINE_FRONT for the fronts, which
+ * on threads the parts' engine then names (fdt_par_out.engine).
+ */
+
+static fdt_engine pick_engine(const fdt_settings *s, fdt_mode mode, int streamed)
 {
     const fdt_search_row *r = fdt_search_row_of(s->search);
     int insertion = mode == FDT_MODE_SERIAL
                         ? r->one_part_serial
                         : r->one_part_threads && s->mode == FDT_MODE_AUTO && !s->pin;
-    return !insertion ? ENGINE_FRONTS : streamed ? ENGINE_SWEEP : ENGINE_ONE_PART;
+    return !insertion ? FDT_ENGINE_FRONT : streamed ? FDT_ENGINE_SWEEP : FDT_ENGINE_ONE_PART;
 }
 
 /* The Voronoi cells (src/mesh/voronoi.c) on the threads the options ask
@@ -326,21 +327,21 @@ int fdt_engine_one_part(const fdt_settings *s, int streamed)
     fdt_mode mode;
     int nthreads;
     run_mode(s, &mode, &nthreads);
-    return pick_engine(s, mode, streamed) != ENGINE_FRONTS;
+    return pick_engine(s, mode, streamed) != FDT_ENGINE_FRONT;
 }
 
 /* The points put in order (the one-part engine: Morton order, which its
  * BRIO rounds keep and whose ranges are its threads' regions; the sweep:
  * its slabs; the serial front: its kd-tree's), then that engine on
  * nthreads threads (the front: one); *t1: when the preparation ended. */
-static int run_single(fdt_context *ctx, const fdt_sink *user, run_engine eng, int nthreads,
+static int run_single(fdt_context *ctx, const fdt_sink *user, fdt_engine eng, int nthreads,
                       run_state *rs, double *t1)
 {
     fdt_prepared *pr = &rs->pr;
-    if (eng == ENGINE_ONE_PART) {
+    if (eng == FDT_ENGINE_ONE_PART) {
         if (fdt_morton_sort(pr->p, pr->orig, pr->m) != 0)
             return FDT_ENOMEM;
-    } else if (eng == ENGINE_FRONTS) {
+    } else if (eng == FDT_ENGINE_FRONT) {
         if (fdt_kd_build(&rs->tree, pr->p, pr->orig, 0, (uint32_t)pr->m, ctx->s.leaf_size) !=
             FDT_OK)
             return FDT_ENOMEM;
@@ -353,11 +354,11 @@ static int run_single(fdt_context *ctx, const fdt_sink *user, run_engine eng, in
         return FDT_ENOMEM;
     *t1 = fdt_now_s();
     int err;
-    if (eng == ENGINE_ONE_PART) {
+    if (eng == FDT_ENGINE_ONE_PART) {
         err = fdt_partmesh_emit_all(pr->p, (uint32_t)pr->m, nthreads, &rs->em,
                                     ctx->s.progress, ctx->s.progress_user, &rs->pms, ctx->diag,
                                     sizeof ctx->diag);
-    } else if (eng == ENGINE_SWEEP) {
+    } else if (eng == FDT_ENGINE_SWEEP) {
         err = fdt_sweep_emit(pr->p, pr->orig, (uint32_t)pr->m, 0, nthreads, &rs->em, rs->cs,
                              ctx->s.progress, ctx->s.progress_user, &rs->sws, ctx->diag,
                              sizeof ctx->diag);
@@ -483,10 +484,10 @@ static void result_stats(fdt_result *r, run_state *rs, fdt_mode mode, int nthrea
 
 /* The streamed cells' state for the prepared points, when the engine is
  * the sweep (the one whose parts say when a point's last tet is out). */
-static int cells_setup(fdt_context *ctx, fdt_cellstream *cs, run_engine eng,
+static int cells_setup(fdt_context *ctx, fdt_cellstream *cs, fdt_engine eng,
                        const fdt_prepared *pr)
 {
-    if (eng != ENGINE_SWEEP) {
+    if (eng != FDT_ENGINE_SWEEP) {
         snprintf(ctx->diag, sizeof ctx->diag, "streamed Voronoi cells need the parts in sweep "
                  "order: search auto, mode auto or serial, no pin");
         return FDT_EINVAL;
@@ -533,19 +534,16 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
                                         sizeof ctx->diag)) != FDT_OK)
         goto fail;
     double t1 = 0.0;
-    run_engine eng = pick_engine(&ctx->s, mode, user != NULL);
+    fdt_engine eng = pick_engine(&ctx->s, mode, user != NULL);
     if (mode == FDT_MODE_SERIAL)
         nthreads = 1;
     if (cs && (err = cells_setup(ctx, cs, eng, &rs.pr)) != FDT_OK)
         goto fail;
     rs.cs = cs;
-    err = eng != ENGINE_FRONTS || mode == FDT_MODE_SERIAL
+    err = eng != FDT_ENGINE_FRONT || mode == FDT_MODE_SERIAL
               ? run_single(ctx, user, eng, nthreads, &rs, &t1)
               : run_parallel(ctx, mode, nthreads, user, &rs, &t1);
-    rs.engine = eng == ENGINE_ONE_PART ? FDT_ENGINE_ONE_PART
-                : eng == ENGINE_SWEEP  ? FDT_ENGINE_SWEEP
-                : rs.parts             ? rs.par.engine
-                                       : FDT_ENGINE_FRONT;
+    rs.engine = rs.parts ? rs.par.engine : (int)eng;
     if (!err && cs)
         err = cells_done(ctx, cs);
     if (err)

@@ -143,21 +143,29 @@ static int put_density(FILE *f, const void *arg, const double *xyz)
 
 /* The cells' options and tables d asks for (job's format NULL and vtu 0
  * with d->voronoi set: CSV). */
+int fdt_cli_cells_table(const fdt_cli_dual *d, const char **format, int *neighbors)
+{
+    int vtu = d->voronoi && has_ext(d->voronoi, ".vtu");
+    const char *f = d->format;
+    if (d->voronoi && !f && !vtu && !has_ext(d->voronoi, ".csv"))
+        f = FDT_CELLS_DEFAULT_FORMAT;
+    int nb = vtu;
+    char err[256];
+    if (f && !vtu)
+        (void)fdt_cells_format_check(f, &nb, err, sizeof err);
+    *format = vtu ? NULL : f;
+    *neighbors = nb;
+    return vtu;
+}
+
 static void cells_setup(const fdt_cli_dual *d, fdt_voronoi_options *o, cells_job *job)
 {
     fdt_default_voronoi_options(o);
     o->box_given = d->box_given;
     o->threads = d->threads;
     memcpy(o->box, d->box, sizeof o->box);
-    cells_job j = {NULL, d->format, d->voronoi && has_ext(d->voronoi, ".vtu"),
-                   d->threads ? d->threads : fdt_threads_default()};
-    if (d->voronoi && !j.format && !j.vtu && !has_ext(d->voronoi, ".csv"))
-        j.format = FDT_CELLS_DEFAULT_FORMAT;
-    int nb = j.vtu;
-    char err[256];
-    if (j.format && !j.vtu)
-        (void)fdt_cells_format_check(j.format, &nb, err, sizeof err);
-    o->neighbors = nb;
+    cells_job j = {NULL, NULL, 0, d->threads ? d->threads : fdt_threads_default()};
+    j.vtu = fdt_cli_cells_table(d, &j.format, &o->neighbors);
     *job = j;
 }
 
@@ -199,7 +207,9 @@ const char *fdt_cli_dual_stream_refusal(const fdt_cli_dual *d)
 {
     if (fdt_cli_interp_wanted(d))
         return "--interpolate needs the whole mesh";
-    if (d->voronoi && has_ext(d->voronoi, ".vtu"))
+    const char *f;
+    int nb;
+    if (fdt_cli_cells_table(d, &f, &nb))
         return "--voronoi FILE.vtu (the cells as polyhedra) needs the whole mesh";
     return NULL;
 }
@@ -231,11 +241,8 @@ int fdt_cli_cells_open(const fdt_cli_dual *d, size_t n, fdt_cli_cells **out,
     cells_setup(d, &c->o, &c->job);
     /* the spool beside the first table: the same file system, which
      * must hold the tables anyway */
-    const char *path = d->voronoi ? d->voronoi : d->density;
-    const char *slash = strrchr(path, '/');
     char dir[FDT_IO_PATH];
-    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + (slash == path) : 1,
-             slash ? path : ".");
+    fdt_cells_dir(d->voronoi ? d->voronoi : d->density, dir, sizeof dir);
     int e = fdt_cells_spool_open(&c->sp, 0, n, d->voronoi ? c->job.format : NULL,
                                  d->voronoi && !c->job.format, d->density != NULL, dir);
     if (e) {

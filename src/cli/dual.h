@@ -43,6 +43,12 @@ int fdt_cli_dual_mesh(const fdt_cli_dual *d, fdt_result *res, const double *xyz,
  * all (the cells', not a coordinate's range). */
 void fdt_cli_cells_message(const char *what, int r, const char *diag, char *err, size_t errlen);
 
+/* The cells' table d asks for: 1 when --voronoi names a .vtu file (VTK
+ * polyhedra, with neighbours); else 0, *format its text format (NULL:
+ * CSV, for a .csv file; --voronoi-format or FDT_CELLS_DEFAULT_FORMAT
+ * otherwise) and *neighbors whether that format lists neighbours. */
+int fdt_cli_cells_table(const fdt_cli_dual *d, const char **format, int *neighbors);
+
 /* Is anything asked for? */
 int fdt_cli_dual_wanted(const fdt_cli_dual *d);
 

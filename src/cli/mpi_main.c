@@ -32,7 +32,6 @@
 #include "io/read/reader.h"
 #include "mesh/result.h"
 #include "front/seed.h"
-#include "io/write/cells.h"
 #include "io/write/writer.h"
 
 /* ---- SIGINT / SIGTERM / SIGXFSZ ------------------------------------------
@@ -193,9 +192,9 @@ static int check_cells(opts *o, int rank)
         say0(rank, "%s", err);
         return CLI_USAGE;
     }
-    const char *v = o->cells.voronoi;
-    size_t n = v ? strlen(v) : 0;
-    if (v && n >= 4 && strcasecmp(v + n - 4, ".vtu") == 0) {
+    const char *v = o->cells.voronoi, *fmt;
+    int nb;
+    if (fdt_cli_cells_table(&o->cells, &fmt, &nb)) {
         say0(rank, "--voronoi FILE.vtu (the cells as polyhedra) is frontdt's alone; "
                    "frontdt-mpi writes the cells as text or .csv");
         return CLI_USAGE;
@@ -399,16 +398,9 @@ static int cells_step(const opts *o, const fdt_mpi_local *L, const fdt_mpi_out *
                       int size)
 {
     const fdt_cli_dual *d = &o->cells;
-    fdt_mpi_cells_opts co = {d->voronoi, d->format, d->density, d->box_given, {0}, 0};
+    fdt_mpi_cells_opts co = {d->voronoi, NULL, d->density, d->box_given, {0}, 0};
     memcpy(co.box, d->box, sizeof co.box);
-    if (d->voronoi && !d->format) {
-        size_t n = strlen(d->voronoi);
-        if (!(n >= 4 && strcasecmp(d->voronoi + n - 4, ".csv") == 0))
-            co.format = FDT_CELLS_DEFAULT_FORMAT; /* else NULL: CSV */
-    }
-    char err[256];
-    if (co.format)
-        (void)fdt_cells_format_check(co.format, &co.neighbors, err, sizeof err);
+    (void)fdt_cli_cells_table(d, &co.format, &co.neighbors); /* .vtu: refused before */
     fdt_mpi_cells_stats st;
     char diag[512], msg[1024];
     int e = fdt_mpi_cells(MPI_COMM_WORLD, L, r, &co, &st, diag, sizeof diag);

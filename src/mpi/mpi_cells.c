@@ -1,15 +1,13 @@
 /* The Voronoi cells of a distributed run; see mpi_cells.h. */
-#define _DEFAULT_SOURCE /* mkstemp, fseeko, ftello */
+#define _DEFAULT_SOURCE /* fseeko, ftello */
 #include "mpi/mpi_cells.h"
 
 #include <errno.h>
 #include <inttypes.h>
 #include <limits.h>
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "base/clock.h"
 #include "base/mem.h"
@@ -131,14 +129,12 @@ static int the_box(cells_run *c)
         if ((err = agree(c, err)) != FDT_OK)
             return err;
     } else {
-        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (size_t i = 0; i < L->nin; i++)
-            for (int k = 0; k < 3; k++) {
-                lo[k] = fmin(lo[k], L->in_xyz[3 * i + k]);
-                hi[k] = fmax(hi[k], L->in_xyz[3 * i + k]);
-            }
-        MPI_Allreduce(lo, c->box, 3, MPI_DOUBLE, MPI_MIN, c->comm);
-        MPI_Allreduce(hi, c->box + 3, 3, MPI_DOUBLE, MPI_MAX, c->comm);
+        /* each rank's bounding box, as frontdt's rule computes it, then
+         * theirs */
+        double mine[6];
+        (void)fdt_voronoi_box_of(L->in_xyz, NULL, L->nin, &vo, mine, NULL, 0);
+        MPI_Allreduce(mine, c->box, 3, MPI_DOUBLE, MPI_MIN, c->comm);
+        MPI_Allreduce(mine + 3, c->box + 3, 3, MPI_DOUBLE, MPI_MAX, c->comm);
     }
     /* the same box on every rank, so the same answer */
     return fdt_voronoi_scale(c->box, &c->ed, c->diag, c->dlen);
@@ -565,29 +561,13 @@ done:
 
 /* ---- 6. the tables ---------------------------------------------------------- */
 
-/* An unlinked temporary in the directory of path, read and write. */
-static FILE *temp_beside(const char *path)
-{
-    const char *slash = strrchr(path, '/');
-    char t[4200];
-    snprintf(t, sizeof t, "%.*s/.frontdt-cells.XXXXXX",
-             slash ? (int)(slash - path) + (slash == path) : 1, slash ? path : ".");
-    int fd = mkstemp(t);
-    if (fd < 0)
-        return NULL;
-    unlink(t);
-    FILE *f = fdopen(fd, "w+b");
-    if (!f)
-        close(fd);
-    return f;
-}
-
 /* One table (0 the cells', 1 the densities) at path: this rank's block's
  * rows from the spool into a temporary, then the ranks' temporaries into
  * the file together. */
-static int write_table(cells_run *c, fdt_cells_spool *sp, int table, const char *path)
+static int write_table(cells_run *c, fdt_cells_spool *sp, int table, const char *path,
+                       const char *dir)
 {
-    FILE *part = temp_beside(path);
+    FILE *part = fdt_cells_temp(dir);
     int e = part ? fdt_cells_spool_put(sp, table, c->rank == 0, part) : errno ? errno : EIO;
     errno = 0;
     if (!e && fflush(part) != 0)
@@ -612,11 +592,8 @@ static int write_tables(cells_run *c)
 {
     const fdt_mpi_cells_opts *o = c->o;
     fdt_cells_spool *sp = NULL;
-    const char *first = o->voronoi ? o->voronoi : o->density;
-    const char *slash = strrchr(first, '/');
     char dir[4200];
-    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - first) + (slash == first) : 1,
-             slash ? first : ".");
+    fdt_cells_dir(o->voronoi ? o->voronoi : o->density, dir, sizeof dir);
     int e = fdt_cells_spool_open(&sp, c->lo, c->nmine, o->voronoi ? o->format : NULL,
                                  o->voronoi && !o->format, o->density != NULL, dir);
     if (!e)
@@ -629,9 +606,9 @@ static int write_tables(cells_run *c)
         err = e == ENOMEM ? FDT_ENOMEM : FDT_EIO;
     }
     if ((err = agree(c, err)) == FDT_OK && o->voronoi)
-        err = write_table(c, sp, 0, o->voronoi);
+        err = write_table(c, sp, 0, o->voronoi, dir);
     if (!err && o->density)
-        err = write_table(c, sp, 1, o->density);
+        err = write_table(c, sp, 1, o->density, dir);
     fdt_cells_spool_close(&sp);
     return err;
 }

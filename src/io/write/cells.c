@@ -235,6 +235,30 @@ struct fdt_cells_spool {
     uint64_t *off;    /* by input id: its record's offset, UINT64_MAX none */
 };
 
+void fdt_cells_dir(const char *path, char *dir, size_t len)
+{
+    const char *slash = strrchr(path, '/');
+    snprintf(dir, len, "%.*s", slash ? (int)(slash - path) + (slash == path) : 1,
+             slash ? path : ".");
+}
+
+FILE *fdt_cells_temp(const char *dir)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/.frontdt-cells.XXXXXX", dir);
+    int fd = mkstemp(path);
+    if (fd < 0)
+        return NULL;
+    unlink(path); /* gone with the process, whatever happens */
+    FILE *f = fdopen(fd, "w+b");
+    if (!f) {
+        int e = errno;
+        close(fd);
+        errno = e;
+    }
+    return f;
+}
+
 int fdt_cells_spool_open(fdt_cells_spool **sp, size_t base, size_t n, const char *fmt, int csv,
                          int density, const char *dir)
 {
@@ -248,17 +272,8 @@ int fdt_cells_spool_open(fdt_cells_spool **sp, size_t base, size_t n, const char
     s->csv = csv;
     s->density = density;
     s->off = malloc((n ? n : 1) * sizeof *s->off);
-    char path[4200];
-    snprintf(path, sizeof path, "%s/.frontdt-cells.XXXXXX", dir);
-    int fd = s->off ? mkstemp(path) : -1;
-    int e = !s->off ? ENOMEM : fd < 0 ? errno : 0;
-    if (fd >= 0) {
-        unlink(path); /* gone with the process, whatever happens */
-        if (!(s->f = fdopen(fd, "w+b"))) {
-            e = errno;
-            close(fd);
-        }
-    }
+    s->f = s->off ? fdt_cells_temp(dir) : NULL;
+    int e = !s->off ? ENOMEM : !s->f ? (errno ? errno : EIO) : 0;
     if (e) {
         free(s->off);
         free(s);

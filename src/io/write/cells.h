@@ -38,6 +38,14 @@ int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *x
  * fdt_wr_cells does. */
 int fdt_wr_density(FILE *f, const fdt_voronoi *v, int threads);
 
+/* The directory of path into dir ("." for a bare name): where the
+ * temporaries of a table at path go, on the file system that must hold
+ * the table anyway. */
+void fdt_cells_dir(const char *path, char *dir, size_t len);
+/* An unlinked temporary file in dir, open for reading and writing (gone
+ * with the process, whatever happens); NULL with errno. */
+FILE *fdt_cells_temp(const char *dir);
+
 /*
  * The tables of a streamed run (fdt_voronoi_stream's batches, in any
  * order), or of one MPI rank's block of input ids (src/mpi/mpi_cells.c),
