@@ -1,5 +1,4 @@
 /* The Voronoi cells of a distributed run; see mpi_cells.h. */
-#define _DEFAULT_SOURCE /* fseeko, ftello */
 #include "mpi/mpi_cells.h"
 
 #include <errno.h>
@@ -561,31 +560,26 @@ done:
 
 /* ---- 6. the tables ---------------------------------------------------------- */
 
-/* One table (0 the cells', 1 the densities) at path: this rank's block's
- * rows from the spool into a temporary, then the ranks' temporaries into
- * the file together. */
-static int write_table(cells_run *c, fdt_cells_spool *sp, int table, const char *path,
-                       const char *dir)
+/* A table of the block's spool: fdt_mpo_text's writer. */
+typedef struct spooled {
+    fdt_cells_spool *sp;
+    int table, header;
+} spooled;
+
+static int put_spooled(void *user, FILE *f)
 {
-    FILE *part = fdt_cells_temp(dir);
-    int e = part ? fdt_cells_spool_put(sp, table, c->rank == 0, part) : errno ? errno : EIO;
-    errno = 0;
-    if (!e && fflush(part) != 0)
-        e = errno ? errno : EIO;
-    off_t len = e ? 0 : ftello(part);
-    if (!e && len < 0)
-        e = errno ? errno : EIO;
-    int err = FDT_OK;
-    if (e) {
-        snprintf(c->diag, c->dlen, "%s: this rank's rows: %s", path, strerror(e));
-        err = e == ENOMEM ? FDT_ENOMEM : FDT_EIO;
-    }
-    if ((err = agree(c, err)) == FDT_OK)
-        err = fdt_mpo_text(c->comm, path, NULL, part, (uint64_t)len, &c->written, c->diag,
-                           c->dlen);
-    if (part)
-        fclose(part);
-    return err;
+    const spooled *t = user;
+    return fdt_cells_spool_put(t->sp, t->table, t->header, f);
+}
+
+/* One table (0 the cells', 1 the densities) at path: each rank's block's
+ * rows from its spool straight into the file, at its offset. */
+static int write_table(cells_run *c, fdt_cells_spool *sp, int table, const char *path)
+{
+    spooled t = {sp, table, c->rank == 0};
+    return fdt_mpo_text(c->comm, path, put_spooled, &t,
+                        fdt_cells_spool_bytes(sp, table, t.header), &c->written, c->diag,
+                        c->dlen);
 }
 
 static int write_tables(cells_run *c)
@@ -606,9 +600,9 @@ static int write_tables(cells_run *c)
         err = e == ENOMEM ? FDT_ENOMEM : FDT_EIO;
     }
     if ((err = agree(c, err)) == FDT_OK && o->voronoi)
-        err = write_table(c, sp, 0, o->voronoi, dir);
+        err = write_table(c, sp, 0, o->voronoi);
     if (!err && o->density)
-        err = write_table(c, sp, 1, o->density, dir);
+        err = write_table(c, sp, 1, o->density);
     fdt_cells_spool_close(&sp);
     return err;
 }

@@ -198,59 +198,17 @@ static int write_files(char (*names)[FDT_IO_PATH], int k, int kind, uint64_t n_i
  * its points (the setup's in_id/in_xyz, duplicates included) to the rank
  * of its id (one MPI_Alltoallv of 32 bytes a point), formats its lines
  * exactly as the serial writer does, and an MPI_Exscan of the byte counts
- * gives each rank its offset. Rank 0 creates the temporary (src/io/write/writer.c,
- * so the rename and the signal cleanup are the usual ones) and writes the
- * header and its lines through it; the others pwrite theirs into the same
- * file, close it, and only after all have (an MPI_Allreduce) does rank 0
- * commit: the renamed file is complete, or nothing is renamed. */
+ * gives each rank its offset; fdt_mpo_text writes them into rank 0's
+ * temporary (src/io/write/writer.c, so the rename and the signal cleanup
+ * are the usual ones), each rank at its offset, and rank 0 commits only
+ * after all have: the renamed file is complete, or nothing is renamed. */
 typedef struct nrec {
     double x[3];
     uint64_t id;
 } nrec;
 
-static int pwrite_all(int fd, const char *p, size_t n, uint64_t at)
-{
-    while (n > 0) {
-        ssize_t k = pwrite(fd, p, n, (off_t)at);
-        if (k < 0 && errno == EINTR)
-            continue;
-        if (k <= 0)
-            return k < 0 ? errno : EIO;
-        p += k;
-        n -= (size_t)k;
-        at += (uint64_t)k;
-    }
-    return 0;
-}
-
-/* Bytes [0, len) of part (from its start) through o, or at `at` of fd:
- * 0 or an errno. */
-static int copy_part(FILE *part, uint64_t len, out_file *o, int fd, uint64_t at)
-{
-    char buf[1 << 16];
-    errno = 0;
-    if (fseeko(part, 0, SEEK_SET) != 0)
-        return errno ? errno : EIO;
-    for (uint64_t done = 0; done < len;) {
-        size_t want = len - done < sizeof buf ? (size_t)(len - done) : sizeof buf;
-        if (fread(buf, 1, want, part) != want)
-            return errno ? errno : EIO;
-        if (o) {
-            out_bytes(o, buf, want);
-            if (o->err)
-                return o->err;
-        } else {
-            int e = pwrite_all(fd, buf, want, at + done);
-            if (e)
-                return e;
-        }
-        done += want;
-    }
-    return 0;
-}
-
-int fdt_mpo_text(MPI_Comm comm, const char *name, const char *text, FILE *part, uint64_t len,
-                 uint64_t *io, char *diag, size_t dlen)
+int fdt_mpo_text(MPI_Comm comm, const char *name, int (*put)(void *, FILE *), void *user,
+                 uint64_t len, uint64_t *io, char *diag, size_t dlen)
 {
     int rank;
     MPI_Comm_rank(comm, &rank);
@@ -277,27 +235,30 @@ int fdt_mpo_text(MPI_Comm comm, const char *name, const char *text, FILE *part, 
     if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
         goto done;
     MPI_Bcast(tpath, (int)sizeof tpath, MPI_CHAR, 0, comm);
-    if (rank == 0) {
-        int e = 0;
-        if (text)
-            out_bytes(&of, text, (size_t)len);
-        else
-            e = copy_part(part, len, &of, -1, 0);
-        if (e)
-            err = io_code(set_errno_err(diag, dlen, name, e));
-        io[0] += len;
-    } else {
-        /* no O_CREAT: if rank 0's temporary is gone (an interrupt), fail */
-        int fd = open(tpath, O_WRONLY | O_CLOEXEC);
-        int e = fd < 0 ? errno
-                : text ? pwrite_all(fd, text, (size_t)len, off)
-                       : copy_part(part, len, NULL, fd, off);
-        if (fd >= 0 && close(fd) != 0 && !e)
-            e = errno;
-        if (e)
-            err = io_code(set_errno_err(diag, dlen, name, e));
-        io[0] += len;
-    }
+    /* Every rank, rank 0 too, writes its bytes at its offset through a
+     * stream of its own on the temporary (rank 0's out_file stays empty
+     * until the commit); no O_CREAT: if rank 0's temporary is gone (an
+     * interrupt), fail. Exactly len bytes, or the offsets would not add
+     * up. */
+    int fd = open(tpath, O_WRONLY | O_CLOEXEC);
+    FILE *f = fd < 0 ? NULL : fdopen(fd, "wb"); /* no truncation: the fd is open */
+    int e = !f ? errno : 0;
+    if (!f && fd >= 0)
+        close(fd);
+    errno = 0;
+    if (!e && fseeko(f, (off_t)off, SEEK_SET) != 0)
+        e = errno ? errno : EIO;
+    if (!e)
+        e = put(user, f);
+    if (!e && fflush(f) != 0)
+        e = errno ? errno : EIO;
+    if (!e && (uint64_t)ftello(f) != off + len)
+        e = EIO;
+    if (f && fclose(f) != 0 && !e)
+        e = errno ? errno : EIO;
+    if (e)
+        err = io_code(set_errno_err(diag, dlen, name, e));
+    io[0] += len;
     if ((err = fdt_mpi_agree(comm, err, diag, dlen)) == FDT_OK && rank == 0) {
         fdt_write_lock();
         err = io_code(fdt_out_commit(&of, 1, diag, dlen));
@@ -312,6 +273,19 @@ done:
         fdt_write_unlock();
     }
     return err;
+}
+
+/* A text in memory: fdt_mpo_text's writer. */
+typedef struct mem_text {
+    const char *p;
+    size_t len;
+} mem_text;
+
+static int put_mem(void *user, FILE *f)
+{
+    const mem_text *t = user;
+    errno = 0;
+    return fwrite(t->p, 1, t->len, f) == t->len ? 0 : errno ? errno : EIO;
 }
 
 static int write_node(MPI_Comm comm, const char *name, const fdt_mpi_local *L, uint64_t *io,
@@ -390,7 +364,8 @@ static int write_node(MPI_Comm comm, const char *name, const fdt_mpi_local *L, u
     }
     if ((err = fdt_mpi_agree(comm, err, diag, dlen)) != FDT_OK)
         goto done;
-    err = fdt_mpo_text(comm, name, text, NULL, len, io, diag, dlen);
+    mem_text mt = {text, len};
+    err = fdt_mpo_text(comm, name, put_mem, &mt, len, io, diag, dlen);
 done:
     free(c);
     free(sb);

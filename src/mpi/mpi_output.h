@@ -75,16 +75,17 @@ int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
 
 /*
  * One text file written by the ranks together (collective): each rank's
- * len bytes, from text or else from the start of part, at the offset of
- * the ranks' before it (an MPI_Exscan). Rank 0 creates the temporary
- * (src/io/write/writer.c: the usual rename and signal cleanup), the others
- * pwrite into it, and rank 0 renames it to name only once every rank's
- * bytes are in: the file is complete, or nothing is renamed. The same code
- * on every rank (FDT_OK, FDT_EIO, FDT_ENOMEM), the failing rank's message
- * in diag; io[0] gains the bytes this rank wrote. The .node of a .pele,
- * and the Voronoi cells' tables (src/mpi/mpi_cells.h).
+ * len bytes, written by put(user, f) to a stream f already at the offset
+ * of the ranks' before it (an MPI_Exscan; put returns 0 or an errno, and
+ * must write exactly len bytes). Rank 0 creates the temporary
+ * (src/io/write/writer.c: the usual rename and signal cleanup), every
+ * rank writes into it, and rank 0 renames it to name only once every
+ * rank's bytes are in: the file is complete, or nothing is renamed. The
+ * same code on every rank (FDT_OK, FDT_EIO, FDT_ENOMEM), the failing
+ * rank's message in diag; io[0] gains the bytes this rank wrote. The .node
+ * of a .pele, and the Voronoi cells' tables (src/mpi/mpi_cells.h).
  */
-int fdt_mpo_text(MPI_Comm comm, const char *name, const char *text, FILE *part, uint64_t len,
-                 uint64_t *io, char *diag, size_t dlen);
+int fdt_mpo_text(MPI_Comm comm, const char *name, int (*put)(void *, FILE *), void *user,
+                 uint64_t len, uint64_t *io, char *diag, size_t dlen);
 
 #endif

@@ -233,6 +233,7 @@ struct fdt_cells_spool {
     FILE *f;          /* the spool: a record a row (unlinked temporary) */
     uint64_t pos;     /* its length so far */
     uint64_t *off;    /* by input id: its record's offset, UINT64_MAX none */
+    uint64_t text[2]; /* the two tables' bytes so far (no header) */
 };
 
 void fdt_cells_dir(const char *path, char *dir, size_t len)
@@ -347,7 +348,13 @@ static int spool_chunk(fdt_cells_spool *s, const fdt_voronoi *v, size_t lo, size
             e = EINVAL; /* not a row of this spool's ids */
             break;
         }
+        if (s->off[j] != UINT64_MAX) {
+            e = EINVAL; /* a row twice */
+            break;
+        }
         s->off[j] = s->pos;
+        s->text[0] += l[0];
+        s->text[1] += l[1];
         errno = 0;
         if (fwrite(l, sizeof l, 1, s->f) != 1 || fwrite(text + at, 1, end - at, s->f) != end - at)
             e = errno ? errno : EIO;
@@ -366,6 +373,11 @@ int fdt_cells_spool_add(fdt_cells_spool *s, const fdt_voronoi *v)
     for (size_t lo = 0; lo < n && !e; lo += SPOOL_CHUNK)
         e = spool_chunk(s, v, lo, n - lo > SPOOL_CHUNK ? lo + SPOOL_CHUNK : n);
     return e;
+}
+
+uint64_t fdt_cells_spool_bytes(const fdt_cells_spool *s, int table, int header)
+{
+    return s->text[table] + (table == 0 && s->csv && header ? strlen(CSV_HEADER) : 0);
 }
 
 int fdt_cells_spool_put(fdt_cells_spool *s, int table, int header, FILE *f)

@@ -55,7 +55,8 @@ FILE *fdt_cells_temp(const char *dir);
  * each table copied out in input order. The spool holds the rows of the
  * input ids [base, base + n); fmt: the cells' format (NULL: none), csv:
  * CSV instead; density: the density table too. The calls return 0 or an
- * errno; EINVAL when a batch has a row outside [base, base + n) or, from
+ * errno; EINVAL when a batch has a row outside [base, base + n) or one
+ * already spooled, or, from
  * fdt_cells_spool_put, when a point's row never came.
  */
 typedef struct fdt_cells_spool fdt_cells_spool;
@@ -65,6 +66,8 @@ int fdt_cells_spool_add(fdt_cells_spool *sp, const fdt_voronoi *v);
 /* table 0: the cells' (fmt or CSV, its header line first when header is
  * nonzero); 1: the densities. */
 int fdt_cells_spool_put(fdt_cells_spool *sp, int table, int header, FILE *f);
+/* The bytes fdt_cells_spool_put writes of that table (every row come). */
+uint64_t fdt_cells_spool_bytes(const fdt_cells_spool *sp, int table, int header);
 void fdt_cells_spool_close(fdt_cells_spool **sp);
 
 /* The cells as VTK polyhedra (a .vtu file, VTK_POLYHEDRON cells with
