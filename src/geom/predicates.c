@@ -32,6 +32,7 @@
 #include "geom/predicates.h"
 
 #include "base/bits.h"
+#include "geom/exact_gmp.h"
 #include <float.h>
 #include <limits.h>
 #include <gmp.h>
@@ -289,8 +290,8 @@ static uint64_t int_mantissa(double x, int *k)
     return m | (UINT64_C(1) << 52);
 }
 
-/* The exponent k of x = m 2^k with |m| < 2^53 an integer (x != 0). */
-static int int_exponent(double x)
+/* See src/geom/exact_gmp.h. */
+int fdt_int_exponent(double x)
 {
     int k;
     (void)int_mantissa(x, &k);
@@ -306,7 +307,7 @@ static int min_int_exponent(const double *const *pts, int npts)
             double x = pts[i][k];
             if (x == 0.0)
                 continue;
-            int e = int_exponent(x);
+            int e = fdt_int_exponent(x);
             if (!any || e < kmin)
                 kmin = e;
             any = true;
@@ -314,8 +315,8 @@ static int min_int_exponent(const double *const *pts, int npts)
     return kmin;
 }
 
-/* z = x 2^-kmin, an integer because kmin <= int_exponent(x). */
-static void mpz_set_scaled(mpz_t z, double x, int kmin)
+/* See src/geom/exact_gmp.h. */
+void fdt_mpz_set_scaled(mpz_t z, double x, int kmin)
 {
     if (x == 0.0) {
         mpz_set_ui(z, 0);
@@ -335,8 +336,8 @@ static void mpz_set_scaled(mpz_t z, double x, int kmin)
         mpz_neg(z, z);
 }
 
-/* r = det[u; v; w] for integer rows; t is scratch. */
-static void mpz_det3(mpz_t r, mpz_t *const u, mpz_t *const v, mpz_t *const w, mpz_t t)
+/* See src/geom/exact_gmp.h. */
+void fdt_mpz_det3(mpz_t r, mpz_t *const u, mpz_t *const v, mpz_t *const w, mpz_t t)
 {
     mpz_mul(t, v[1], w[2]);
     mpz_submul(t, v[2], w[1]);
@@ -693,6 +694,7 @@ static inline void cross3(const double *x, const double *y, double *z)
 void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double hi[3])
 {
     sf->o3d_inv = sf->isp_inv = 0;
+    sf->img = NULL;
     double M = 0;
     for (int k = 0; k < 3; k++) {
         double d = hi[k] - lo[k];
@@ -965,11 +967,11 @@ static int orient_stage_c(const double *a, const double *b, const double *c, con
     mpz_t *q[4] = {z->q[0], z->q[1], z->q[2], z->q[3]};
     for (int i = 0; i < 4; i++)
         for (int k = 0; k < 3; k++)
-            mpz_set_scaled(q[i][k], pts[i][k], kmin);
+            fdt_mpz_set_scaled(q[i][k], pts[i][k], kmin);
     for (int i = 1; i < 4; i++)
         for (int k = 0; k < 3; k++)
             mpz_sub(q[i][k], q[i][k], q[0][k]);
-    mpz_det3(z->det, q[1], q[2], q[3], z->t);
+    fdt_mpz_det3(z->det, q[1], q[2], q[3], z->t);
     return mpz_sgn(z->det);
 }
 
@@ -1226,7 +1228,7 @@ static int insphere_stage_c(const double *a, const double *b, const double *c,
     gmp_scratch *z = scratch();
     for (int i = 0; i < 5; i++)
         for (int k = 0; k < 3; k++)
-            mpz_set_scaled(z->q[i][k], pts[i][k], kmin);
+            fdt_mpz_set_scaled(z->q[i][k], pts[i][k], kmin);
     for (int i = 0; i < 4; i++)
         for (int k = 0; k < 3; k++)
             mpz_sub(z->q[i][k], z->q[i][k], z->q[4][k]);
@@ -1238,7 +1240,7 @@ static int insphere_stage_c(const double *a, const double *b, const double *c,
         for (int j = 0, r = 0; j < 4; j++)
             if (j != i)
                 rows[r++] = z->q[j];
-        mpz_det3(z->m3, rows[0], rows[1], rows[2], z->t);
+        fdt_mpz_det3(z->m3, rows[0], rows[1], rows[2], z->t);
         mpz_mul(z->lift, z->q[i][0], z->q[i][0]);
         mpz_addmul(z->lift, z->q[i][1], z->q[i][1]);
         mpz_addmul(z->lift, z->q[i][2], z->q[i][2]);
@@ -1319,9 +1321,9 @@ int fdt_compare_dist(const double *q, const double *x, const double *y)
     mpz_init(acc);
     mpz_init(t);
     for (int k = 0; k < 3; k++) {
-        mpz_set_scaled(zq, q[k], kmin);
-        mpz_set_scaled(zx, x[k], kmin);
-        mpz_set_scaled(zy, y[k], kmin);
+        fdt_mpz_set_scaled(zq, q[k], kmin);
+        fdt_mpz_set_scaled(zx, x[k], kmin);
+        fdt_mpz_set_scaled(zy, y[k], kmin);
         mpz_sub(zx, zx, zq);
         mpz_sub(zy, zy, zq);
         mpz_addmul(acc, zx, zx);
@@ -1371,7 +1373,7 @@ int fdt_circumcenter_exact(const double *a, const double *b, const double *c,
     for (int i = 0; i < 4; i++)
         for (int k = 0; k < 3; k++) {
             mpz_init(q[i][k]);
-            mpz_set_scaled(q[i][k], pts[i][k], kmin);
+            fdt_mpz_set_scaled(q[i][k], pts[i][k], kmin);
         }
     for (int i = 1; i < 4; i++)
         for (int k = 0; k < 3; k++)

@@ -218,9 +218,13 @@ int fdt_insphere_adapt(const double *a, const double *b, const double *c,
 typedef struct fdt_pred_static {
     double o3d_inv; /* decide orient3d when fl(|det| o3d_inv) > 1 */
     double isp_inv; /* decide insphere when fl(|det4| isp_inv) > 1 */
+    /* Periodic images (src/geom/images.h), or NULL: the insertion's
+     * points are then rounded images, and its predicates are those of
+     * images.h (src/mesh/insert_impl.h), not these filters. */
+    const struct fdt_images *img;
 } fdt_pred_static;
 
-/* The bounds for points in the box [lo, hi] (componentwise). */
+/* The bounds for points in the box [lo, hi] (componentwise); img NULL. */
 void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double hi[3]);
 
 /*
@@ -314,7 +318,7 @@ static inline int fdt_orient3d_filter_sf(const double *a, const double *b, const
 static inline int fdt_orient3d_filter(const double *a, const double *b,
                                       const double *c, const double *d)
 {
-    return fdt_orient3d_filter_sf(a, b, c, d, &(const fdt_pred_static){0, 0});
+    return fdt_orient3d_filter_sf(a, b, c, d, &(const fdt_pred_static){0, 0, NULL});
 }
 
 /*
@@ -534,7 +538,7 @@ static inline int fdt_insphere_filter(const double *a, const double *b,
                                       const double *c, const double *d,
                                       const double *e)
 {
-    return fdt_insphere_filter_sf(a, b, c, d, e, &(const fdt_pred_static){0, 0});
+    return fdt_insphere_filter_sf(a, b, c, d, e, &(const fdt_pred_static){0, 0, NULL});
 }
 
 #endif

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 
 #include "base/bits.h"
+#include "geom/images.h"
 #include "base/spawn.h"
 
 #define INF FDT_NONE
@@ -26,6 +27,8 @@ static inline int is_freed(const uint32_t *v)
 static inline int orient(const fdt_ins *m, const double *a, const double *b, const double *c,
                          const double *d, fdt_pred_counts *cnt)
 {
+    if (__builtin_expect(m->sf.img != NULL, 0))
+        return fdt_images_orient_call(m->sf.img, a, b, c, d, cnt);
     int s = fdt_orient3d_filter_sf(a, b, c, d, &m->sf);
     return s != FDT_PRED_UNSURE ? s : fdt_orient3d(a, b, c, d, cnt);
 }
@@ -33,6 +36,8 @@ static inline int orient(const fdt_ins *m, const double *a, const double *b, con
 static inline int insphere(const fdt_ins *m, const double *a, const double *b, const double *c,
                            const double *d, const double *e, fdt_pred_counts *cnt)
 {
+    if (__builtin_expect(m->sf.img != NULL, 0))
+        return fdt_images_insphere_call(m->sf.img, a, b, c, d, e, cnt);
     int s = fdt_insphere_filter_sf(a, b, c, d, e, &m->sf);
     return s != FDT_PRED_UNSURE ? s : fdt_insphere_perturbed(a, b, c, d, e, cnt);
 }

@@ -409,7 +409,8 @@ static int start_simplex(build *b, const uint32_t *order, uint32_t n, uint32_t f
     for (uint32_t i = 2; i < n && d == FDT_NONE; i++) {
         if (order[i] == c)
             continue;
-        o = fdt_orient3d(ins_pt(m, a), ins_pt(m, c0), ins_pt(m, c), ins_pt(m, order[i]), b->cnt);
+        o = ins_orient(ins_pt(m, a), ins_pt(m, c0), ins_pt(m, c), ins_pt(m, order[i]), &m->sf,
+                       b->cnt);
         if (o != 0)
             d = order[i];
     }
@@ -478,8 +479,8 @@ static void build_free(build *b)
 
 int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                          const uint32_t *order, uint32_t prefix, uint64_t slots,
-                         uint32_t first[4], fdt_pred_counts *cnt, fdt_progress_fn progress,
-                         void *puser)
+                         uint32_t first[4], const fdt_images *img, fdt_pred_counts *cnt,
+                         fdt_progress_fn progress, void *puser)
 {
     memset(m, 0, sizeof *m);
     m->P = P;
@@ -489,6 +490,7 @@ int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
     if (n < 4)
         return FDT_EDEGENERATE;
     ins_bounds(m);
+    m->sf.img = img;
     build b;
     memset(&b, 0, sizeof b);
     b.m = m;
@@ -598,7 +600,7 @@ int fdt_ins_build_progress(fdt_ins *m, const double *P, uint32_t base, uint32_t 
     /* About 6.5 tets a point on uniform points, plus the hull: growing by
      * realloc stays possible for inputs with more. */
     int err = fdt_ins_build_prefix(m, P, base, n, order, n, (uint64_t)n * 27 / 4 + 64, first,
-                                   cnt, progress, puser);
+                                   NULL, cnt, progress, puser);
     free(order);
     if (err)
         return err;

@@ -19,6 +19,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "frontdt.h"
+#include "geom/images.h"
 #include "geom/kdtree.h"
 #include "geom/predicates.h"
 #include "mesh/insmesh.h"
@@ -61,6 +62,14 @@ int fdt_ins_build_progress(fdt_ins *m, const double *P, uint32_t base, uint32_t 
  */
 int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                            int nthreads, fdt_pred_counts *cnt);
+
+/*
+ * The perturbed DT of the rounded periodic images img->P[0 .. img->n)
+ * (src/geom/images.h; src/mesh/periodic.h makes them), every predicate
+ * decided for the exact images: fdt_ins_build_parallel's build, on
+ * nthreads threads, with its results and errors. img must outlive m.
+ */
+int fdt_ins_build_images(fdt_ins *m, const fdt_images *img, int nthreads, fdt_pred_counts *cnt);
 
 /* The first finite tet in a slot >= t, FDT_NONE if none: iterate with
  * for (t = fdt_ins_next_finite(m, 0); t != FDT_NONE;
@@ -150,12 +159,13 @@ void fdt_ins_brio(const double *P, uint32_t base, uint32_t n, uint32_t *order,
  * the first tetrahedron is found in order[0 .. n) (first[] gets its four
  * ids) and order[0 .. prefix) is inserted, first[] skipped. progress
  * (may be NULL) is called every 64k insertions with the fraction done;
- * nonzero cancels (FDT_ECANCELED). On error m holds nothing.
+ * nonzero cancels (FDT_ECANCELED). img: the points' periodic images
+ * (fdt_ins_build_images), or NULL. On error m holds nothing.
  */
 int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                          const uint32_t *order, uint32_t prefix, uint64_t slots,
-                         uint32_t first[4], fdt_pred_counts *cnt, fdt_progress_fn progress,
-                         void *puser);
+                         uint32_t first[4], const fdt_images *img, fdt_pred_counts *cnt,
+                         fdt_progress_fn progress, void *puser);
 
 /*
  * The end of a build, once every point is in: the incident-tet table, the

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/bits.h"
+#include "geom/images.h"
 #include "mesh/insmesh.h"
 
 /* Neighbour references are 4 * slot + face in 32 bits. */
@@ -37,6 +38,8 @@ static inline const double *ins_pt(const fdt_ins *m, uint32_t v)
 static inline int ins_orient(const double *a, const double *b, const double *c, const double *d,
                              const fdt_pred_static *sf, fdt_pred_counts *cnt)
 {
+    if (__builtin_expect(sf->img != NULL, 0)) /* periodic images (src/geom/images.h) */
+        return fdt_images_orient_call(sf->img, a, b, c, d, cnt);
     int s = fdt_orient3d_filter_sf(a, b, c, d, sf);
     if (s != FDT_PRED_UNSURE)
         return s;
@@ -47,6 +50,8 @@ static inline int ins_insphere(const double *a, const double *b, const double *c
                                const double *d, const double *e, const fdt_pred_static *sf,
                                fdt_pred_counts *cnt)
 {
+    if (__builtin_expect(sf->img != NULL, 0))
+        return fdt_images_insphere_call(sf->img, a, b, c, d, e, cnt);
     int s = fdt_insphere_filter_sf(a, b, c, d, e, sf);
     if (s != FDT_PRED_UNSURE)
         return s;

@@ -1093,8 +1093,8 @@ static void sum_worker_stats(fdt_ins *m, const worker *ws, int nw, fdt_pred_coun
     }
 }
 
-int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
-                                 int nthreads, double slots_a_point, fdt_pred_counts *cnt)
+static int build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t n, int nthreads,
+                          double slots_a_point, const fdt_images *img, fdt_pred_counts *cnt)
 {
     if (nthreads < 1)
         nthreads = 1;
@@ -1127,7 +1127,7 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
     uint64_t slots = slots_a_point > 0.0 ? (uint64_t)(slots_a_point * n) + 64
                                          : (uint64_t)n * 8 + (uint64_t)nw * 2 * CHUNK + 1024;
     double c0 = fdt_thread_cpu_s();
-    err = fdt_ins_build_prefix(m, P, base, n, order, prefix, slots, first, cnt, NULL, NULL);
+    err = fdt_ins_build_prefix(m, P, base, n, order, prefix, slots, first, img, cnt, NULL, NULL);
     if (err)
         goto out;
     double c1 = fdt_thread_cpu_s();
@@ -1171,4 +1171,15 @@ out:
     free(rend);
     free(ws);
     return err;
+}
+
+int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                                 int nthreads, double slots_a_point, fdt_pred_counts *cnt)
+{
+    return build_parallel(m, P, base, n, nthreads, slots_a_point, NULL, cnt);
+}
+
+int fdt_ins_build_images(fdt_ins *m, const fdt_images *img, int nthreads, fdt_pred_counts *cnt)
+{
+    return build_parallel(m, img->P, 0, img->n, nthreads, 0.0, img, cnt);
 }

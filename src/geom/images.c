@@ -1,0 +1,277 @@
+/* Periodic images and exact predicates on them; see images.h. */
+#include "geom/images.h"
+
+#include <float.h>
+#include <gmp.h>
+#include <limits.h>
+#include <string.h>
+
+#include "geom/exact_gmp.h"
+
+/* a + b = s + t exactly (Knuth's TwoSum). */
+static void two_sum(double a, double b, double *s, double *t)
+{
+    *s = a + b;
+    double bv = *s - a, av = *s - bv;
+    *t = (a - av) + (b - bv);
+}
+
+int fdt_images_round(const double x[3], const int8_t off[3], const double lo[3],
+                     const double hi[3], double out[3], double *err)
+{
+    const double eps = 0x1p-53, tiny = 0x1p-1073;
+    int exact = 1;
+    double e = 0;
+    for (int k = 0; k < 3; k++) {
+        if (off[k] == 0) {
+            out[k] = x[k];
+            continue;
+        }
+        /* x + o hi - o lo, o = +-1: two exact sums, then their tails */
+        double o = off[k], s, t1, h, t2;
+        two_sum(x[k], o * hi[k], &s, &t1);
+        two_sum(s, -o * lo[k], &h, &t2);
+        double t = t1 + t2;
+        out[k] = h + t;
+        if (t1 != 0 || t2 != 0) {
+            exact = 0;
+            /* |h + t1 + t2 - out| <= eps |t| (the tails' sum) + eps |out| */
+            double ek = 2 * eps * (fabs(t) + fabs(out[k])) + tiny;
+            e = ek > e ? ek : e;
+        }
+    }
+    if (err)
+        *err = e;
+    return exact;
+}
+
+void fdt_images_init(fdt_images *im, const double blo[3], const double bhi[3], double err)
+{
+    im->o3d_inv = im->isp_inv = 0;
+    double M = 0;
+    for (int k = 0; k < 3; k++) {
+        double d = bhi[k] - blo[k];
+        if (!(d >= 0 && d <= DBL_MAX))
+            return;
+        M = d > M ? d : M;
+    }
+    if (!(M >= 0x1p-100 && M <= 0x1p100) || !(err >= 0 && err <= M))
+        return;
+    /* The evaluation's rounding (twice the plain filters' constants, for
+     * the order of evaluation in images.h), then the inputs' movement by
+     * e = 2 err a difference, expanded so nothing cancels; 1 + 2^-20 for
+     * the roundings of these bounds themselves. */
+    const double safe = 1 + 0x1p-20, e = 2 * err;
+    const double M2 = M * M, M3 = M2 * M, M4 = M3 * M, M5 = M4 * M;
+    double o3d = 2 * FDT_O3D_ERRBOUND * 6 * M3 + 6 * (3 * M2 * e + 3 * M * e * e + e * e * e);
+    double isp = 2 * FDT_ISP_ERRBOUND * 72 * M5 +
+                 72 * (5 * M4 * e + 10 * M3 * e * e + 10 * M2 * e * e * e +
+                       5 * M * e * e * e * e + e * e * e * e * e);
+    o3d *= safe;
+    isp *= safe;
+    if (o3d < 0x1p-790 || isp < 0x1p-790)
+        return;
+    im->o3d_inv = (1 / o3d) * (1 - 0x1p-50);
+    im->isp_inv = (1 / isp) * (1 - 0x1p-50);
+}
+
+/* ---- the exact stage: GMP integers of the exact images --------------- */
+
+/* Up to five points' exact coordinates, as integers in units of 2^kmin. */
+typedef struct exact_pts {
+    mpz_t q[5][3];
+    mpz_t t, r, s;
+    int np;
+} exact_pts;
+
+static void exact_init(exact_pts *z, const fdt_images *im, const uint32_t *i, int np)
+{
+    z->np = np;
+    int kmin = INT_MAX;
+    for (int j = 0; j < np; j++) {
+        const double *x = im->X + 3 * (size_t)im->src[i[j]];
+        const int8_t *o = im->off + 3 * (size_t)i[j];
+        for (int k = 0; k < 3; k++) {
+            const double v[3] = {x[k], o[k] ? im->hi[k] : 0.0, o[k] ? im->lo[k] : 0.0};
+            for (int w = 0; w < 3; w++)
+                if (v[w] != 0.0) {
+                    int e = fdt_int_exponent(v[w]);
+                    kmin = e < kmin ? e : kmin;
+                }
+        }
+    }
+    if (kmin == INT_MAX)
+        kmin = 0;
+    mpz_inits(z->t, z->r, z->s, NULL);
+    for (int j = 0; j < np; j++) {
+        const double *x = im->X + 3 * (size_t)im->src[i[j]];
+        const int8_t *o = im->off + 3 * (size_t)i[j];
+        for (int k = 0; k < 3; k++) {
+            mpz_init(z->q[j][k]);
+            fdt_mpz_set_scaled(z->q[j][k], x[k], kmin);
+            if (o[k]) {
+                fdt_mpz_set_scaled(z->t, im->hi[k], kmin);
+                fdt_mpz_set_scaled(z->r, im->lo[k], kmin);
+                mpz_sub(z->t, z->t, z->r);
+                if (o[k] > 0)
+                    mpz_addmul_ui(z->q[j][k], z->t, (unsigned long)o[k]);
+                else
+                    mpz_submul_ui(z->q[j][k], z->t, (unsigned long)-o[k]);
+            }
+        }
+    }
+}
+
+static void exact_clear(exact_pts *z)
+{
+    for (int j = 0; j < z->np; j++)
+        for (int k = 0; k < 3; k++)
+            mpz_clear(z->q[j][k]);
+    mpz_clears(z->t, z->r, z->s, NULL);
+}
+
+/* sign det[q1 - q0; q2 - q0; q3 - q0] of the points j[0..3] of z. */
+static int orient_z(exact_pts *z, const int j[4])
+{
+    mpz_t d[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++) {
+            mpz_init(d[r][k]);
+            mpz_sub(d[r][k], z->q[j[r + 1]][k], z->q[j[0]][k]);
+        }
+    fdt_mpz_det3(z->s, d[0], d[1], d[2], z->t);
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++)
+            mpz_clear(d[r][k]);
+    return mpz_sgn(z->s);
+}
+
+int fdt_images_orient_exact(const fdt_images *im, const uint32_t i[4], fdt_pred_counts *cnt)
+{
+    if (cnt)
+        cnt->orient_exact++;
+    exact_pts z;
+    exact_init(&z, im, i, 4);
+    static const int j[4] = {0, 1, 2, 3};
+    int s = orient_z(&z, j);
+    exact_clear(&z);
+    return s;
+}
+
+/* Lexicographic comparison of points a and b of z. */
+static int lex_z(const exact_pts *z, int a, int b)
+{
+    for (int k = 0; k < 3; k++) {
+        int c = mpz_cmp(z->q[a][k], z->q[b][k]);
+        if (c)
+            return c < 0 ? -1 : 1;
+    }
+    return 0;
+}
+
+/* CGAL's insphere sign of e = point 4 against (0, 1, 2, 3): minus the
+ * sign of det[p - e, |p - e|^2] (src/geom/predicates.h's filter). */
+static int insphere_z(exact_pts *z)
+{
+    mpz_t d[4][4];
+    for (int r = 0; r < 4; r++) {
+        mpz_init(d[r][3]);
+        for (int k = 0; k < 3; k++) {
+            mpz_init(d[r][k]);
+            mpz_sub(d[r][k], z->q[r][k], z->q[4][k]);
+            mpz_addmul(d[r][3], d[r][k], d[r][k]);
+        }
+    }
+    /* Laplace along the lifted column: sum_r (-1)^(r+3) l_r minor_r. */
+    mpz_t acc;
+    mpz_init(acc);
+    for (int r = 0; r < 4; r++) {
+        mpz_t *rows[3];
+        int w = 0;
+        for (int q = 0; q < 4; q++)
+            if (q != r)
+                rows[w++] = d[q];
+        fdt_mpz_det3(z->s, rows[0], rows[1], rows[2], z->t);
+        mpz_mul(z->s, z->s, d[r][3]);
+        if ((r + 3) % 2 == 0)
+            mpz_add(acc, acc, z->s);
+        else
+            mpz_sub(acc, acc, z->s);
+    }
+    int s = -mpz_sgn(acc);
+    mpz_clear(acc);
+    for (int r = 0; r < 4; r++)
+        for (int k = 0; k < 4; k++)
+            mpz_clear(d[r][k]);
+    return s;
+}
+
+int fdt_images_insphere_exact(const fdt_images *im, const uint32_t i[5], fdt_pred_counts *cnt)
+{
+    if (cnt)
+        cnt->insphere_exact++;
+    exact_pts z;
+    exact_init(&z, im, i, 5);
+    int s = insphere_z(&z);
+    if (s == 0) {
+        /* The tie broken as fdt_insphere_perturbed does (Devillers and
+         * Teillaud): the points in decreasing lexicographic order, the
+         * first whose coefficient is not 0 decides; e's is -1. */
+        int order[5] = {0, 1, 2, 3, 4};
+        for (int a = 1; a < 5; a++) {
+            int x = order[a], b = a;
+            while (b > 0 && lex_z(&z, order[b - 1], x) < 0) {
+                order[b] = order[b - 1];
+                b--;
+            }
+            order[b] = x;
+        }
+        s = -1;
+        for (int r = 0; r < 5; r++) {
+            int v = order[r];
+            if (v == 4)
+                break;
+            int j[4] = {0, 1, 2, 3};
+            j[v] = 4;
+            int o = orient_z(&z, j);
+            if (o != 0) {
+                s = o;
+                break;
+            }
+        }
+    }
+    exact_clear(&z);
+    return s;
+}
+
+int fdt_images_normal_sign(const fdt_images *im, const uint32_t i[3], int k)
+{
+    exact_pts z;
+    exact_init(&z, im, i, 3);
+    int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+    mpz_t u1, u2, v1, v2;
+    mpz_inits(u1, u2, v1, v2, NULL);
+    mpz_sub(u1, z.q[1][k1], z.q[0][k1]);
+    mpz_sub(u2, z.q[1][k2], z.q[0][k2]);
+    mpz_sub(v1, z.q[2][k1], z.q[0][k1]);
+    mpz_sub(v2, z.q[2][k2], z.q[0][k2]);
+    mpz_mul(z.s, u1, v2);
+    mpz_submul(z.s, u2, v1);
+    int s = mpz_sgn(z.s);
+    mpz_clears(u1, u2, v1, v2, NULL);
+    exact_clear(&z);
+    return s;
+}
+
+int fdt_images_orient_call(const fdt_images *im, const double *a, const double *b,
+                           const double *c, const double *d, fdt_pred_counts *cnt)
+{
+    return fdt_images_orient(im, a, b, c, d, cnt);
+}
+
+int fdt_images_insphere_call(const fdt_images *im, const double *a, const double *b,
+                             const double *c, const double *d, const double *e,
+                             fdt_pred_counts *cnt)
+{
+    return fdt_images_insphere(im, a, b, c, d, e, cnt);
+}

@@ -1,0 +1,135 @@
+/*
+ * Periodic images of points, and exact predicates on them (issue 33).
+ *
+ * A periodic run triangulates the input points with some of their images
+ * x + o (hi - lo), o in {-1, 0, 1} on each periodic axis (src/mesh/
+ * periodic.h). That sum is not a double in general (hi - lo need not be
+ * one either), and the issue asks for the exact images, never rounded
+ * first. So the insertion reads P, the images rounded to doubles, through
+ * these predicates, which decide for the exact images:
+ *   - a semi-static filter on P whose bound adds to the evaluation's own
+ *     rounding the images' (fdt_images_init): a sign it gives is the
+ *     exact images' sign;
+ *   - where it cannot decide: the plain exact predicates when every point
+ *     of the call is exact in P (the input points, and images whose sum
+ *     rounded to nothing), otherwise GMP integers of the exact sums, with
+ *     the same symbolic perturbation (fdt_insphere_perturbed's:
+ *     lexicographic order of the exact points, which a translation keeps,
+ *     so every image of a point is perturbed alike and the perturbed
+ *     periodic set stays periodic).
+ * The insertion kernel finds these through its filter bounds
+ * (fdt_pred_static.img, src/mesh/insert_impl.h).
+ */
+#ifndef FDT_IMAGES_H
+#define FDT_IMAGES_H
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+#include "geom/predicates.h"
+
+typedef struct fdt_images {
+    const double *P;         /* n points, 3 doubles each: the rounded images */
+    uint32_t n;
+    const double *X;         /* the input points, 3 doubles each */
+    const uint32_t *src;     /* per point of P: its input point (index into X) */
+    const int8_t *off;       /* per point of P: 3 offsets, in periods */
+    const uint8_t *exact;    /* per point of P: 1 when P holds its exact image */
+    double lo[3], hi[3];     /* the period box: axis k's period is the real hi[k] - lo[k] */
+    double o3d_inv, isp_inv; /* the filters' reciprocal bounds (fdt_images_init); 0: never decide */
+} fdt_images;
+
+/*
+ * The image x + off (hi - lo), rounded to doubles into out; returns 1 when
+ * out is exactly the image, 0 otherwise, and *err (may be NULL) gets a
+ * bound on |image - out| over the three coordinates.
+ */
+int fdt_images_round(const double x[3], const int8_t off[3], const double lo[3],
+                     const double hi[3], double out[3], double *err);
+
+/*
+ * The filters' bounds for points of P in the box [blo, bhi], each
+ * coordinate within err of its exact image (fdt_images_round's, the
+ * largest): the evaluation's own bound (src/geom/predicates.h's, twice)
+ * plus what moving every coordinate of a call by up to err can change its
+ * determinant (6 ((M + 2 err)^3 - M^3) for orient3d, 72 ((M + 2 err)^5 -
+ * M^5) for the lifted insphere determinant, M the box's largest side).
+ * A box outside [2^-100, 2^100] or err above M gives 0 bounds: every call
+ * goes to the exact stages.
+ */
+void fdt_images_init(fdt_images *im, const double blo[3], const double bhi[3], double err);
+
+/* The exact stages (src/geom/images.c): i[] are indices into P. */
+int fdt_images_orient_exact(const fdt_images *im, const uint32_t i[4], fdt_pred_counts *cnt);
+int fdt_images_insphere_exact(const fdt_images *im, const uint32_t i[5], fdt_pred_counts *cnt);
+
+/* The sign of component k of the normal (b - a) x (c - a) of the exact
+ * images of the points i[0..2] of P. */
+int fdt_images_normal_sign(const fdt_images *im, const uint32_t i[3], int k);
+
+static inline uint32_t fdt_images_index(const fdt_images *im, const double *p)
+{
+    return (uint32_t)((size_t)(p - im->P) / 3);
+}
+
+/* orient3d of the exact images of the points of P at a, b, c, d (CGAL's
+ * sign, as fdt_orient3d). */
+static inline int fdt_images_orient(const fdt_images *im, const double *a, const double *b,
+                                    const double *c, const double *d, fdt_pred_counts *cnt)
+{
+    const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+    const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
+    const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
+    const double det = ux * (vy * wz - vz * wy) - uy * (vx * wz - vz * wx) +
+                       uz * (vx * wy - vy * wx);
+    if (fabs(det) * im->o3d_inv > 1)
+        return (det > 0) - (det < 0);
+    const uint32_t i[4] = {fdt_images_index(im, a), fdt_images_index(im, b),
+                           fdt_images_index(im, c), fdt_images_index(im, d)};
+    if (im->exact[i[0]] & im->exact[i[1]] & im->exact[i[2]] & im->exact[i[3]])
+        return fdt_orient3d(a, b, c, d, cnt);
+    return fdt_images_orient_exact(im, i, cnt);
+}
+
+/* The perturbed insphere of the exact images (fdt_insphere_perturbed's
+ * sign and precondition; never 0). */
+static inline int fdt_images_insphere(const fdt_images *im, const double *a, const double *b,
+                                      const double *c, const double *d, const double *e,
+                                      fdt_pred_counts *cnt)
+{
+    const double A[3] = {a[0] - e[0], a[1] - e[1], a[2] - e[2]};
+    const double B[3] = {b[0] - e[0], b[1] - e[1], b[2] - e[2]};
+    const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
+    const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
+    const double ab = A[0] * B[1] - B[0] * A[1], bc = B[0] * C[1] - C[0] * B[1];
+    const double cd = C[0] * D[1] - D[0] * C[1], da = D[0] * A[1] - A[0] * D[1];
+    const double ac = A[0] * C[1] - C[0] * A[1], bd = B[0] * D[1] - D[0] * B[1];
+    const double abc = A[2] * bc - B[2] * ac + C[2] * ab;
+    const double bcd = B[2] * cd - C[2] * bd + D[2] * bc;
+    const double cda = C[2] * da + D[2] * ac + A[2] * cd;
+    const double dab = D[2] * ab + A[2] * bd + B[2] * da;
+    const double al = A[0] * A[0] + A[1] * A[1] + A[2] * A[2];
+    const double bl = B[0] * B[0] + B[1] * B[1] + B[2] * B[2];
+    const double cl = C[0] * C[0] + C[1] * C[1] + C[2] * C[2];
+    const double dl = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+    const double det = (dl * abc - cl * dab) + (bl * cda - al * bcd);
+    if (fabs(det) * im->isp_inv > 1)
+        return (det < 0) - (det > 0);
+    const uint32_t i[5] = {fdt_images_index(im, a), fdt_images_index(im, b),
+                           fdt_images_index(im, c), fdt_images_index(im, d),
+                           fdt_images_index(im, e)};
+    if (im->exact[i[0]] & im->exact[i[1]] & im->exact[i[2]] & im->exact[i[3]] & im->exact[i[4]])
+        return fdt_insphere_perturbed(a, b, c, d, e, cnt);
+    return fdt_images_insphere_exact(im, i, cnt);
+}
+
+/* The two above out of line, for the insertion kernel's rare periodic
+ * branch (inlined there, they cost the plain engine 10 % of its kernel
+ * time: bench/NOTES.md entry 108). */
+int fdt_images_orient_call(const fdt_images *im, const double *a, const double *b,
+                           const double *c, const double *d, fdt_pred_counts *cnt);
+int fdt_images_insphere_call(const fdt_images *im, const double *a, const double *b,
+                             const double *c, const double *d, const double *e,
+                             fdt_pred_counts *cnt);
+
+#endif

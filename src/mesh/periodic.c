@@ -1,0 +1,649 @@
+/* The periodic Delaunay tetrahedralization; see periodic.h. */
+#include "mesh/periodic.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/hash.h"
+#include "geom/images.h"
+#include "geom/morton.h"
+#include "mesh/certify.h"
+#include "mesh/insert.h"
+
+/* ---- step 1: the points and their images within the margin ----------- */
+
+typedef struct ext {
+    double *P;       /* rounded images, 3 each */
+    uint32_t *src;   /* input index */
+    int8_t *off;     /* 3 each */
+    uint8_t *exact;
+    uint32_t n, cap;
+    double err;      /* the largest |exact - rounded| */
+} ext;
+
+static void ext_free(ext *e)
+{
+    free(e->P);
+    free(e->src);
+    free(e->off);
+    free(e->exact);
+    memset(e, 0, sizeof *e);
+}
+
+static int ext_grow(ext *e, size_t need)
+{
+    if (need <= e->cap)
+        return FDT_OK;
+    if (need > UINT32_MAX - 1)
+        return FDT_ETOOBIG;
+    size_t cap = e->cap ? e->cap : 1024;
+    while (cap < need)
+        cap *= 2;
+    if (cap > UINT32_MAX - 1)
+        cap = UINT32_MAX - 1;
+    double *P = realloc(e->P, cap * 3 * sizeof *P);
+    if (P)
+        e->P = P;
+    uint32_t *src = realloc(e->src, cap * sizeof *src);
+    if (src)
+        e->src = src;
+    int8_t *off = realloc(e->off, cap * 3 * sizeof *off);
+    if (off)
+        e->off = off;
+    uint8_t *ex = realloc(e->exact, cap);
+    if (ex)
+        e->exact = ex;
+    if (!P || !src || !off || !ex)
+        return FDT_ENOMEM;
+    e->cap = (uint32_t)cap;
+    return FDT_OK;
+}
+
+/*
+ * The points, then for each the images whose every offset is allowed: on
+ * periodic axis k, +1 when x - lo <= m[k] (the image lands within m above
+ * hi), -1 when hi - x <= m[k]. Every image whose exact coordinate lies in
+ * (lo - m', hi + m') on each periodic axis, m' < m (region(), below), is
+ * then present: x + L < hi + m' means x - lo < m', and rounding is
+ * monotone.
+ */
+static int make_images(ext *e, const double *X, uint32_t n, const fdt_periodic_box *b,
+                       const double m[3])
+{
+    e->n = 0;
+    e->err = 0;
+    int err = ext_grow(e, (size_t)n + n / 4 + 64);
+    if (err)
+        return err;
+    for (uint32_t i = 0; i < n; i++) {
+        memcpy(e->P + 3 * (size_t)i, X + 3 * (size_t)i, 3 * sizeof(double));
+        e->src[i] = i;
+        memset(e->off + 3 * (size_t)i, 0, 3);
+        e->exact[i] = 1;
+    }
+    e->n = n;
+    for (uint32_t i = 0; i < n; i++) {
+        const double *x = X + 3 * (size_t)i;
+        int8_t opts[3][3];
+        int nopt[3];
+        for (int k = 0; k < 3; k++) {
+            nopt[k] = 0;
+            opts[k][nopt[k]++] = 0;
+            if (!(b->axes >> k & 1))
+                continue;
+            if (x[k] - b->lo[k] <= m[k])
+                opts[k][nopt[k]++] = 1;
+            if (b->hi[k] - x[k] <= m[k])
+                opts[k][nopt[k]++] = -1;
+        }
+        for (int a = 0; a < nopt[0]; a++)
+            for (int c = 0; c < nopt[1]; c++)
+                for (int d = 0; d < nopt[2]; d++) {
+                    const int8_t o[3] = {opts[0][a], opts[1][c], opts[2][d]};
+                    if (!o[0] && !o[1] && !o[2])
+                        continue;
+                    if ((err = ext_grow(e, (size_t)e->n + 1)) != FDT_OK)
+                        return err;
+                    uint32_t j = e->n++;
+                    double er;
+                    e->exact[j] = (uint8_t)fdt_images_round(x, o, b->lo, b->hi,
+                                                            e->P + 3 * (size_t)j, &er);
+                    e->err = er > e->err ? er : e->err;
+                    e->src[j] = i;
+                    memcpy(e->off + 3 * (size_t)j, o, 3);
+                }
+    }
+    return FDT_OK;
+}
+
+/* The set in Morton order (the insertion's order, as the one-part
+ * engine's, src/api/api.c), and its box. */
+static int morton(ext *e, double blo[3], double bhi[3])
+{
+    for (int k = 0; k < 3; k++)
+        blo[k] = bhi[k] = e->P[k];
+    for (uint32_t i = 1; i < e->n; i++)
+        for (int k = 0; k < 3; k++) {
+            double v = e->P[3 * (size_t)i + k];
+            blo[k] = v < blo[k] ? v : blo[k];
+            bhi[k] = v > bhi[k] ? v : bhi[k];
+        }
+    const double box[6] = {blo[0], blo[1], blo[2], bhi[0], bhi[1], bhi[2]};
+    uint32_t *order = malloc((size_t)e->n * sizeof *order);
+    ext s = {0};
+    if (!order || ext_grow(&s, e->n) != FDT_OK || fdt_morton_order(e->P, e->n, box, NULL, order) < 0) {
+        free(order);
+        ext_free(&s);
+        return FDT_ENOMEM;
+    }
+    for (uint32_t i = 0; i < e->n; i++) {
+        uint32_t j = order[i];
+        memcpy(s.P + 3 * (size_t)i, e->P + 3 * (size_t)j, 3 * sizeof(double));
+        memcpy(s.off + 3 * (size_t)i, e->off + 3 * (size_t)j, 3);
+        s.src[i] = e->src[j];
+        s.exact[i] = e->exact[j];
+    }
+    s.n = e->n;
+    s.err = e->err;
+    free(order);
+    ext_free(e);
+    *e = s;
+    return FDT_OK;
+}
+
+/* ---- step 3: the kept tets and hull faces, normalised ------------------ */
+
+/* A tet (nv = 4) or hull face (3) as the periodic mesh names it. */
+typedef struct key {
+    uint32_t id[4];
+    int8_t off[4][3];
+} key;
+
+static int vert_cmp(uint32_t ia, const int8_t *oa, uint32_t ib, const int8_t *ob)
+{
+    if (ia != ib)
+        return ia < ib ? -1 : 1;
+    return memcmp(oa, ob, 3);
+}
+
+/*
+ * The key of the vertices v[0 .. nv) of the extended set: the least vertex
+ * (input index, then offsets) taken as the origin, the others' offsets
+ * relative to it, sorted. Returns whether that least vertex is an input
+ * point (offset 0: the copy this mesh keeps); *repeat whether two vertices
+ * are images of one point.
+ */
+static int make_key(const ext *e, const uint32_t *v, int nv, key *k, int *repeat)
+{
+    memset(k, 0, sizeof *k);
+    int lo = 0;
+    for (int j = 1; j < nv; j++)
+        if (vert_cmp(e->src[v[j]], e->off + 3 * (size_t)v[j], e->src[v[lo]],
+                     e->off + 3 * (size_t)v[lo]) < 0)
+            lo = j;
+    const int8_t *o0 = e->off + 3 * (size_t)v[lo];
+    int kept = !o0[0] && !o0[1] && !o0[2];
+    for (int j = 0; j < nv; j++) {
+        k->id[j] = e->src[v[j]];
+        for (int a = 0; a < 3; a++)
+            k->off[j][a] = (int8_t)(e->off[3 * (size_t)v[j] + a] - o0[a]);
+    }
+    for (int a = 1; a < nv; a++) /* insertion sort */
+        for (int j = a; j > 0 && vert_cmp(k->id[j], k->off[j], k->id[j - 1], k->off[j - 1]) < 0;
+             j--) {
+            uint32_t t = k->id[j];
+            k->id[j] = k->id[j - 1];
+            k->id[j - 1] = t;
+            int8_t to[3];
+            memcpy(to, k->off[j], 3);
+            memcpy(k->off[j], k->off[j - 1], 3);
+            memcpy(k->off[j - 1], to, 3);
+        }
+    *repeat = 0;
+    for (int j = 1; j < nv; j++)
+        *repeat |= k->id[j] == k->id[j - 1];
+    return kept;
+}
+
+static uint64_t key_hash(const key *k)
+{
+    uint64_t h = 0;
+    for (int j = 0; j < 4; j++) {
+        uint64_t o = (uint64_t)(uint8_t)k->off[j][0] | (uint64_t)(uint8_t)k->off[j][1] << 8 |
+                     (uint64_t)(uint8_t)k->off[j][2] << 16;
+        h = fdt_mix64(h ^ ((uint64_t)k->id[j] << 24 | o));
+    }
+    return h;
+}
+
+/* An open-addressing set of keys (indices into keys[]). */
+typedef struct keyset {
+    key *keys;
+    size_t n, cap;
+    uint32_t *slot; /* UINT32_MAX empty */
+    size_t mask;
+} keyset;
+
+static void keyset_free(keyset *s)
+{
+    free(s->keys);
+    free(s->slot);
+    memset(s, 0, sizeof *s);
+}
+
+static int keyset_add(keyset *s, const key *k)
+{
+    if (s->n == s->cap) {
+        size_t cap = s->cap ? 2 * s->cap : 1024;
+        key *nk = realloc(s->keys, cap * sizeof *nk);
+        if (!nk)
+            return FDT_ENOMEM;
+        s->keys = nk;
+        s->cap = cap;
+    }
+    s->keys[s->n++] = *k;
+    return FDT_OK;
+}
+
+static int keyset_index(keyset *s)
+{
+    size_t sz = 16;
+    while (sz < 2 * s->n)
+        sz *= 2;
+    free(s->slot);
+    s->slot = malloc(sz * sizeof *s->slot);
+    if (!s->slot)
+        return FDT_ENOMEM;
+    memset(s->slot, 0xff, sz * sizeof *s->slot);
+    s->mask = sz - 1;
+    for (size_t i = 0; i < s->n; i++) {
+        size_t h = (size_t)key_hash(&s->keys[i]) & s->mask;
+        while (s->slot[h] != UINT32_MAX)
+            h = (h + 1) & s->mask;
+        s->slot[h] = (uint32_t)i;
+    }
+    return FDT_OK;
+}
+
+static int keyset_has(const keyset *s, const key *k)
+{
+    size_t h = (size_t)key_hash(k) & s->mask;
+    for (; s->slot[h] != UINT32_MAX; h = (h + 1) & s->mask)
+        if (!memcmp(&s->keys[s->slot[h]], k, sizeof *k))
+            return 1;
+    return 0;
+}
+
+/* ---- step 4: the proofs ------------------------------------------------ */
+
+/* The region where every image is present: (lo - m', hi + m') on each
+ * periodic axis, m' a hair under the margin (or the period) for the
+ * roundings of make_images' tests and of hi - lo. */
+static void region(const fdt_periodic_box *b, const double m[3], double A[3], double B[3])
+{
+    for (int k = 0; k < 3; k++) {
+        double L = b->hi[k] - b->lo[k];
+        double mm = (m[k] < L ? m[k] : L) * (1 - 0x1p-40);
+        A[k] = b->lo[k] - mm;
+        B[k] = b->hi[k] + mm;
+    }
+}
+
+/*
+ * Whether tet v's circumscribed ball, cut to the points' extent [ylo, yhi]
+ * on the axes that are not periodic, lies inside (A, B) on the periodic
+ * ones, with room for the circumcentre's error: fdt_circumcenter's few
+ * ulps of the radius, and the images' rounding err moved through the
+ * tet's condition (edge^3 / |6 volume|).
+ */
+static int ball_inside(const ext *e, const uint32_t *v, const fdt_periodic_box *b,
+                       const double A[3], const double B[3], const double ylo[3],
+                       const double yhi[3])
+{
+    const double *a = e->P + 3 * (size_t)v[0];
+    const double *p[3] = {e->P + 3 * (size_t)v[1], e->P + 3 * (size_t)v[2],
+                          e->P + 3 * (size_t)v[3]};
+    double x[3];
+    if (fdt_circumcenter(a, p[0], p[1], p[2], x) != 0)
+        return 0;
+    double u[3][3], h = 0;
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++) {
+            u[r][k] = p[r][k] - a[k];
+            h = fabs(u[r][k]) > h ? fabs(u[r][k]) : h;
+        }
+    double det = u[0][0] * (u[1][1] * u[2][2] - u[1][2] * u[2][1]) -
+                 u[0][1] * (u[1][0] * u[2][2] - u[1][2] * u[2][0]) +
+                 u[0][2] * (u[1][0] * u[2][1] - u[1][1] * u[2][0]);
+    double R = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    double c[3] = {a[0] + x[0], a[1] + x[1], a[2] + x[2]};
+    double kappa = 64 * h * h * h / fabs(det);
+    double cerr = 0x1p-40 * (R + fabs(c[0]) + fabs(c[1]) + fabs(c[2])) + kappa * 4 * e->err;
+    if (!(cerr < R + h))
+        return 0; /* too flat to place */
+    double D2 = 0;
+    for (int j = 0; j < 3; j++) {
+        if (b->axes >> j & 1)
+            continue;
+        double d = ylo[j] - c[j] > c[j] - yhi[j] ? ylo[j] - c[j] : c[j] - yhi[j];
+        d = d - cerr;
+        if (d > 0)
+            D2 += d * d;
+    }
+    double Rh = R + 2 * cerr, Dl = sqrt(D2);
+    double ext2 = Rh > Dl ? (Rh - Dl) * (Rh + Dl) : 0;
+    double extent = sqrt(ext2) * (1 + 0x1p-40) + cerr;
+    for (int k = 0; k < 3; k++)
+        if (b->axes >> k & 1 && !(c[k] - extent > A[k] && c[k] + extent < B[k]))
+            return 0;
+    return 1;
+}
+
+/* ---- the driver -------------------------------------------------------- */
+
+typedef struct run {
+    const double *X;
+    uint32_t n;
+    const fdt_periodic_box *b;
+    double ylo[3], yhi[3]; /* the points' extent */
+    ext e;
+    fdt_images im;
+    fdt_ins m;
+    keyset tets, hull;
+    char *diag;
+    size_t dsz;
+} run;
+
+enum { ROUND_OK = 0, ROUND_AGAIN = 1 };
+
+/* One round at margin m: ROUND_OK with r->tets and r->hull the periodic
+ * mesh, ROUND_AGAIN when a proof failed, or an error. */
+static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh *out)
+{
+    const fdt_periodic_box *b = r->b;
+    int err;
+    fdt_ins_free(&r->m);
+    keyset_free(&r->tets);
+    keyset_free(&r->hull);
+    if ((err = make_images(&r->e, r->X, r->n, b, m)) != FDT_OK)
+        return err;
+    double blo[3], bhi[3];
+    if ((err = morton(&r->e, blo, bhi)) != FDT_OK)
+        return err;
+    out->images = r->e.n - r->n;
+    fdt_images *im = &r->im;
+    memset(im, 0, sizeof *im);
+    im->P = r->e.P;
+    im->n = r->e.n;
+    im->X = r->X;
+    im->src = r->e.src;
+    im->off = r->e.off;
+    im->exact = r->e.exact;
+    memcpy(im->lo, b->lo, sizeof im->lo);
+    memcpy(im->hi, b->hi, sizeof im->hi);
+    fdt_images_init(im, blo, bhi, r->e.err);
+    err = fdt_ins_build_images(&r->m, im, nthreads, &out->pc);
+    if (err == FDT_EINVAL) {
+        snprintf(r->diag, r->dsz, "two points coincide");
+        return err;
+    }
+    if (err == FDT_EDEGENERATE) {
+        snprintf(r->diag, r->dsz, "the points and their images do not span 3-D space");
+        return err;
+    }
+    if (err == FDT_EINTERNAL) {
+        fdt_certify_fail why;
+        fdt_certify_build_failed(&why);
+        fdt_certify_describe(&why, r->diag, r->dsz);
+        return FDT_ECHECK;
+    }
+    if (err)
+        return err;
+    fdt_certify_fail why;
+    if ((err = fdt_certify_parallel(&r->m, nthreads, &out->pc, &why)) != FDT_OK) {
+        if (err == FDT_ECHECK)
+            fdt_certify_describe(&why, r->diag, r->dsz);
+        return err;
+    }
+    /* the kept tets and hull faces, and the soundness proofs */
+    double A[3], B[3];
+    region(b, m, A, B);
+    int again = 0;
+    long repeat_id = -1;
+    const fdt_ins *M = &r->m;
+    for (uint32_t t = 0; t < M->nslots && !again; t++) {
+        if (fdt_ins_is_free(M, t))
+            continue;
+        const uint32_t *v = fdt_ins_tet(M, t);
+        int inf = fdt_ins_inf_index(v);
+        key k;
+        int rep;
+        if (inf < 0) {
+            if (!make_key(&r->e, v, 4, &k, &rep))
+                continue;
+            if (!ball_inside(&r->e, v, b, A, B, r->ylo, r->yhi)) {
+                again = 1;
+                break;
+            }
+            if (rep && repeat_id < 0)
+                repeat_id = k.id[0];
+            if ((err = keyset_add(&r->tets, &k)) != FDT_OK)
+                return err;
+        } else {
+            uint32_t f[3];
+            fdt_ins_face_inward(v, inf, f);
+            if (!make_key(&r->e, f, 3, &k, &rep))
+                continue;
+            /* nothing lies beyond a hull face of the periodic set: its
+             * normal has no component along a periodic axis */
+            for (int a = 0; a < 3; a++)
+                if (b->axes >> a & 1 && fdt_images_normal_sign(&r->im, f, a) != 0)
+                    again = 1;
+            if (again)
+                break;
+            if (rep && repeat_id < 0)
+                repeat_id = k.id[0];
+            if ((err = keyset_add(&r->hull, &k)) != FDT_OK)
+                return err;
+        }
+    }
+    if (again)
+        return ROUND_AGAIN;
+    if ((err = keyset_index(&r->tets)) != FDT_OK || (err = keyset_index(&r->hull)) != FDT_OK)
+        return err;
+    /* completeness: across every face of a kept tet (and under every kept
+     * hull face) a tet or hull face whose translate is kept */
+    for (uint32_t t = 0; t < M->nslots && !again; t++) {
+        if (fdt_ins_is_free(M, t))
+            continue;
+        const uint32_t *v = fdt_ins_tet(M, t);
+        int inf = fdt_ins_inf_index(v), rep;
+        key k;
+        if (inf < 0 ? !make_key(&r->e, v, 4, &k, &rep) : 0)
+            continue;
+        if (inf >= 0) {
+            uint32_t f[3];
+            fdt_ins_face_inward(v, inf, f);
+            if (!make_key(&r->e, f, 3, &k, &rep))
+                continue;
+        }
+        for (int j = 0; j < 4 && !again; j++) {
+            if (inf >= 0 && j != inf)
+                continue; /* a hull face: the tet under it */
+            uint32_t nt;
+            int nk;
+            (void)fdt_ins_across(M, t, j, &nt, &nk);
+            const uint32_t *w = fdt_ins_tet(M, nt);
+            int ninf = fdt_ins_inf_index(w);
+            key nkey;
+            if (ninf < 0) {
+                (void)make_key(&r->e, w, 4, &nkey, &rep);
+                again = !keyset_has(&r->tets, &nkey);
+            } else {
+                uint32_t f[3];
+                fdt_ins_face_inward(w, ninf, f);
+                (void)make_key(&r->e, f, 3, &nkey, &rep);
+                again = !keyset_has(&r->hull, &nkey);
+            }
+        }
+    }
+    if (again)
+        return ROUND_AGAIN;
+    if (repeat_id >= 0) {
+        snprintf(r->diag, r->dsz,
+                 "no periodic triangulation in one copy of the box: a tet or hull face joins "
+                 "two images of point %ld (the box is too small for the points' spacing: "
+                 "more points, or a smaller box)",
+                 repeat_id);
+        return FDT_EDEGENERATE;
+    }
+    return ROUND_OK;
+}
+
+static int key_cmp(const void *x, const void *y)
+{
+    const key *a = x, *b = y;
+    for (int j = 0; j < 4; j++) {
+        int c = vert_cmp(a->id[j], a->off[j], b->id[j], b->off[j]);
+        if (c)
+            return c;
+    }
+    return 0;
+}
+
+/* out's arrays from a set, sorted. */
+static int emit(keyset *s, int nv, uint32_t **ids, int8_t **offs, size_t *count)
+{
+    qsort(s->keys, s->n, sizeof *s->keys, key_cmp);
+    *ids = malloc((s->n ? s->n : 1) * (size_t)nv * sizeof **ids);
+    *offs = malloc((s->n ? s->n : 1) * (size_t)nv * 3);
+    if (!*ids || !*offs)
+        return FDT_ENOMEM;
+    for (size_t i = 0; i < s->n; i++)
+        for (int j = 0; j < nv; j++) {
+            (*ids)[(size_t)nv * i + (size_t)j] = s->keys[i].id[j];
+            memcpy(*offs + 3 * ((size_t)nv * i + (size_t)j), s->keys[i].off[j], 3);
+        }
+    *count = s->n;
+    return FDT_OK;
+}
+
+/* The box's checks and the points in it; FDT_EINVAL with diag. */
+static int check_box(const double *X, uint32_t n, const fdt_periodic_box *b, char *diag,
+                     size_t dsz)
+{
+    if (!(b->axes & 7) || (b->axes & ~7u)) {
+        snprintf(diag, dsz, "a periodic box needs one to three periodic axes");
+        return FDT_EINVAL;
+    }
+    for (int k = 0; k < 3; k++) {
+        if (!(b->axes >> k & 1))
+            continue;
+        double L = b->hi[k] - b->lo[k];
+        if (!(fabs(b->lo[k]) <= 0x1p500 && fabs(b->hi[k]) <= 0x1p500 && L > 0)) {
+            snprintf(diag, dsz, "the periodic box's %c side [%.17g, %.17g] is empty or beyond "
+                     "2^500", "xyz"[k], b->lo[k], b->hi[k]);
+            return FDT_EINVAL;
+        }
+    }
+    for (uint32_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++)
+            if (b->axes >> k & 1 && !(X[3 * (size_t)i + k] >= b->lo[k] &&
+                                      X[3 * (size_t)i + k] < b->hi[k])) {
+                snprintf(diag, dsz, "point %u has %c = %.17g, outside the periodic box's "
+                         "[%.17g, %.17g)", i, "xyz"[k], X[3 * (size_t)i + k], b->lo[k], b->hi[k]);
+                return FDT_EINVAL;
+            }
+    return FDT_OK;
+}
+
+int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, int nthreads,
+                       fdt_periodic_mesh *out, char *diag, size_t diag_size)
+{
+    memset(out, 0, sizeof *out);
+    char own[8];
+    if (!diag || !diag_size) {
+        diag = own;
+        diag_size = sizeof own;
+    }
+    diag[0] = 0;
+    int err = check_box(X, n, b, diag, diag_size);
+    if (err)
+        return err;
+    if (n < 1) {
+        snprintf(diag, diag_size, "no points");
+        return FDT_EDEGENERATE;
+    }
+    run r;
+    memset(&r, 0, sizeof r);
+    r.X = X;
+    r.n = n;
+    r.b = b;
+    r.diag = diag;
+    r.dsz = diag_size;
+    for (int k = 0; k < 3; k++)
+        r.ylo[k] = r.yhi[k] = X[k];
+    for (uint32_t i = 1; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            double v = X[3 * (size_t)i + k];
+            r.ylo[k] = v < r.ylo[k] ? v : r.ylo[k];
+            r.yhi[k] = v > r.yhi[k] ? v : r.yhi[k];
+        }
+    /* The first margin: three mean spacings, (volume / n)^(1/3). */
+    double vol = 1;
+    for (int k = 0; k < 3; k++) {
+        double s = b->axes >> k & 1 ? b->hi[k] - b->lo[k] : r.yhi[k] - r.ylo[k];
+        vol *= s > 0 ? s : 1;
+    }
+    double m0 = 3 * cbrt(vol / n), m[3] = {0, 0, 0};
+    for (;;) {
+        int last = 1;
+        for (int k = 0; k < 3; k++) {
+            if (!(b->axes >> k & 1))
+                continue;
+            double L = b->hi[k] - b->lo[k];
+            m[k] = m0 < L ? m0 : L;
+            last &= m0 >= L;
+        }
+        out->rounds++;
+        err = one_round(&r, m, nthreads, out);
+        if (err != ROUND_AGAIN)
+            break;
+        if (last) {
+            snprintf(diag, diag_size,
+                     "no periodic triangulation in one copy of the box: with every point's "
+                     "neighbouring images the mesh still reaches past them (the box is too "
+                     "small for the points' spacing, or the points' extent across the axes "
+                     "that are not periodic is not flat at its ends: more points, or walls "
+                     "of points there)");
+            err = FDT_EDEGENERATE;
+            break;
+        }
+        m0 *= 2;
+    }
+    memcpy(out->margin, m, sizeof m);
+    if (err == FDT_OK && ((err = emit(&r.tets, 4, &out->tets, &out->tet_off, &out->ntets)) ||
+                          (err = emit(&r.hull, 3, &out->hull, &out->hull_off, &out->nhull))))
+        snprintf(diag, diag_size, "out of memory");
+    fdt_ins_free(&r.m);
+    keyset_free(&r.tets);
+    keyset_free(&r.hull);
+    ext_free(&r.e);
+    if (err) {
+        fdt_pred_counts pc = out->pc;
+        fdt_periodic_free(out);
+        out->pc = pc;
+    }
+    return err;
+}
+
+void fdt_periodic_free(fdt_periodic_mesh *m)
+{
+    free(m->tets);
+    free(m->tet_off);
+    free(m->hull);
+    free(m->hull_off);
+    memset(m, 0, sizeof *m);
+}

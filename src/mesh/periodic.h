@@ -1,0 +1,80 @@
+/*
+ * The Delaunay tetrahedralization of a point set periodic in any subset of
+ * the three axes (issue 33): the quotient of the DT of the infinite
+ * periodic copy, every tet once, its vertices as input points with an
+ * image offset each, the hull only across the axes that are not periodic.
+ *
+ * How (bench/NOTES.md entry 108): the points and their images within a
+ * margin m of the box (on each periodic axis: x + L for x - lo <= m, x - L
+ * for hi - x <= m, and their combinations on two or three axes) are
+ * triangulated by the insertion engine (src/mesh/insert.h,
+ * fdt_ins_build_images: every predicate exact on the exact images,
+ * src/geom/images.h), and certified. A tet is kept when its
+ * lowest vertex (least input index, then least offset) is an input point
+ * itself; its offsets are then relative to that vertex. The result is
+ * proved, not assumed:
+ *   - sound: a kept tet's circumscribed ball, within the points' extent on
+ *     the axes that are not periodic, lies inside the region where every
+ *     image is present (the box grown by m on each periodic axis), so no
+ *     image of any point is inside its sphere (ties: the images share
+ *     their point's perturbation, images.h); a kept hull face has a
+ *     normal with no periodic component, so nothing lies beyond it;
+ *   - complete: every face of a kept tet has across it a tet (or a hull
+ *     face) whose translate is kept, so the kept set is closed and, the
+ *     quotient being connected, all of the periodic DT.
+ * Where either fails the margin doubles and the run starts again: a
+ * function of the input alone (no clock). At m >= the period (every point
+ * with all its neighbouring images) a failure means the periodic
+ * triangulation is not a simplicial complex in one copy of the box
+ * (CGAL's 1-sheet condition): FDT_EDEGENERATE, with the reason.
+ */
+#ifndef FDT_PERIODIC_H
+#define FDT_PERIODIC_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "geom/predicates.h"
+
+/* The periodic box: bit k of axes set when axis k is periodic, with the
+ * period hi[k] - lo[k] (the real difference, not rounded) and every point
+ * in [lo[k], hi[k]); lo and hi are ignored on the other axes. */
+typedef struct fdt_periodic_box {
+    unsigned axes;
+    double lo[3], hi[3];
+} fdt_periodic_box;
+
+/* The result: ntets tets, 4 input indices each ascending (ties: the
+ * offsets' order), with 3 offsets each (in periods, 0 on an axis that is
+ * not periodic) relative to the first; the hull faces likewise, 3 each;
+ * both sorted. */
+typedef struct fdt_periodic_mesh {
+    uint32_t *tets;
+    int8_t *tet_off;     /* 12 per tet */
+    size_t ntets;
+    uint32_t *hull;
+    int8_t *hull_off;    /* 9 per hull face */
+    size_t nhull;
+    /* How it went, for --stats. */
+    size_t images;       /* images triangulated with the points (last round) */
+    int rounds;          /* margins tried */
+    double margin[3];    /* the last margin on each periodic axis */
+    fdt_pred_counts pc;  /* exact predicate calls, all rounds */
+} fdt_periodic_mesh;
+
+/*
+ * The periodic DT of the n points X (3 doubles each, distinct, finite)
+ * in the box b, on nthreads threads, into *out (free with
+ * fdt_periodic_free). FDT_OK; FDT_EINVAL for a box with no periodic axis,
+ * hi <= lo or a side beyond doubles, a point outside [lo, hi) on a
+ * periodic axis (diag names the first by its index), or two points that
+ * coincide; FDT_EDEGENERATE when no periodic triangulation exists in one
+ * copy of the box (too few points for its size) or the points do not span
+ * 3-D space; FDT_ECHECK if a mesh failed its certificate (a bug);
+ * FDT_ENOMEM; FDT_ETOOBIG. diag gets the reason of any error.
+ */
+int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, int nthreads,
+                       fdt_periodic_mesh *out, char *diag, size_t diag_size);
+
+void fdt_periodic_free(fdt_periodic_mesh *m);
+
+#endif

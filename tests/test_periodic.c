@@ -1,0 +1,404 @@
+/*
+ * The periodic DT (src/mesh/periodic.h, src/geom/images.h; issue 33).
+ *
+ * - Against an independent reference (the issue's): the points replicated
+ *   three times along each periodic axis, triangulated by the public API's
+ *   plain engine, and the tets (and hull faces) whose lowest-index vertex
+ *   lies in the middle copy kept, offsets relative to it. On points whose
+ *   coordinates and box are on a binary grid, so every image is a double
+ *   and the plain engine sees the exact images: uniform points, a lattice
+ *   (every cell's 8 corners cospherical), a channel (walls of points at
+ *   y = 0 and y = 1, a boundary layer between them, periodic in x and z),
+ *   periodic in x y z, in x z and in x alone.
+ * - Where images are not doubles (a box [0.1, 1.3) and random doubles):
+ *   the same mesh at 1 and 3 threads and for a shuffled input, and the
+ *   quotient's Euler characteristic (V - E + T = 0 on the 3-torus: every
+ *   face is in two tets, V - E + F - T = 0 and F = 2T).
+ * - Errors: a point outside the box, a box with no periodic axis, too few
+ *   points for one copy of the box (CGAL's 1-sheet condition).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mesh/periodic.h"
+#include "testutil.h"
+
+typedef struct vtx {
+    uint32_t id;
+    int8_t off[3];
+} vtx;
+
+static int vtx_cmp(const vtx *a, const vtx *b)
+{
+    if (a->id != b->id)
+        return a->id < b->id ? -1 : 1;
+    for (int k = 0; k < 3; k++)
+        if (a->off[k] != b->off[k])
+            return a->off[k] < b->off[k] ? -1 : 1;
+    return 0;
+}
+
+/* A tet or face as a sorted row of vertices (offsets relative to the
+ * first), nv of them, padded. */
+typedef struct row {
+    vtx v[4];
+} row;
+
+static int row_cmp(const void *x, const void *y)
+{
+    const row *a = x, *b = y;
+    for (int j = 0; j < 4; j++) {
+        int c = vtx_cmp(&a->v[j], &b->v[j]);
+        if (c)
+            return c;
+    }
+    return 0;
+}
+
+/* The row of nv vertices: relative to the least id's offset, sorted by
+ * id. Returns whether that vertex has offset 0. */
+static int make_row(vtx *v, int nv, row *r)
+{
+    memset(r, 0, sizeof *r);
+    int lo = 0;
+    for (int j = 1; j < nv; j++)
+        if (v[j].id < v[lo].id)
+            lo = j;
+    int8_t o0[3];
+    memcpy(o0, v[lo].off, 3);
+    for (int j = 0; j < nv; j++) {
+        r->v[j].id = v[j].id;
+        for (int k = 0; k < 3; k++)
+            r->v[j].off[k] = (int8_t)(v[j].off[k] - o0[k]);
+    }
+    for (int a = 1; a < nv; a++)
+        for (int j = a; j > 0 && vtx_cmp(&r->v[j], &r->v[j - 1]) < 0; j--) {
+            vtx t = r->v[j];
+            r->v[j] = r->v[j - 1];
+            r->v[j - 1] = t;
+        }
+    return !o0[0] && !o0[1] && !o0[2];
+}
+
+typedef struct rows {
+    row *r;
+    size_t n;
+} rows;
+
+/* The mesh's tets or hull faces as rows, sorted. */
+static rows mesh_rows(const uint32_t *ids, const int8_t *off, size_t count, int nv)
+{
+    rows s = {malloc((count ? count : 1) * sizeof(row)), count};
+    CHECK(s.r);
+    for (size_t i = 0; i < count; i++) {
+        vtx v[4];
+        memset(v, 0, sizeof v);
+        for (int j = 0; j < nv; j++) {
+            v[j].id = ids[(size_t)nv * i + (size_t)j];
+            memcpy(v[j].off, off + 3 * ((size_t)nv * i + (size_t)j), 3);
+        }
+        make_row(v, nv, &s.r[i]);
+    }
+    qsort(s.r, s.n, sizeof *s.r, row_cmp);
+    return s;
+}
+
+/* The issue's reference: three copies along each periodic axis. */
+static void reference(const double *X, size_t n, const fdt_periodic_box *b, rows *tets,
+                      rows *hull)
+{
+    int cnt[3];
+    for (int k = 0; k < 3; k++)
+        cnt[k] = b->axes >> k & 1 ? 3 : 1;
+    size_t copies = (size_t)cnt[0] * cnt[1] * cnt[2];
+    double *R = malloc(copies * n * 3 * sizeof *R);
+    vtx *who = malloc(copies * n * sizeof *who);
+    CHECK(R && who);
+    size_t m = 0;
+    for (int a = 0; a < cnt[0]; a++)
+        for (int c = 0; c < cnt[1]; c++)
+            for (int d = 0; d < cnt[2]; d++) {
+                int8_t o[3] = {(int8_t)(cnt[0] == 3 ? a - 1 : 0), (int8_t)(cnt[1] == 3 ? c - 1 : 0),
+                               (int8_t)(cnt[2] == 3 ? d - 1 : 0)};
+                for (size_t i = 0; i < n; i++, m++) {
+                    for (int k = 0; k < 3; k++) {
+                        R[3 * m + k] = X[3 * i + k] + o[k] * (b->hi[k] - b->lo[k]);
+                        /* the binary-grid inputs make that exact */
+                        CHECK(R[3 * m + k] - o[k] * (b->hi[k] - b->lo[k]) == X[3 * i + k]);
+                    }
+                    who[m].id = (uint32_t)i;
+                    memcpy(who[m].off, o, 3);
+                }
+            }
+    fdt_result *res = test_triangulate(R, m, 1, 0);
+    size_t nt = fdt_result_num_tets(res), nh = fdt_result_num_hull_faces(res);
+    const fdt_vid *T = fdt_result_tets(res), *H = fdt_result_hull_faces(res);
+    tets->r = malloc((nt ? nt : 1) * sizeof(row));
+    hull->r = malloc((nh ? nh : 1) * sizeof(row));
+    CHECK(tets->r && hull->r);
+    tets->n = hull->n = 0;
+    for (size_t t = 0; t < nt; t++) {
+        vtx v[4];
+        for (int j = 0; j < 4; j++)
+            v[j] = who[T[4 * t + (size_t)j]];
+        if (make_row(v, 4, &tets->r[tets->n]))
+            tets->n++;
+    }
+    for (size_t t = 0; t < nh; t++) {
+        vtx v[4];
+        memset(v, 0, sizeof v);
+        for (int j = 0; j < 3; j++)
+            v[j] = who[H[3 * t + (size_t)j]];
+        if (make_row(v, 3, &hull->r[hull->n]))
+            hull->n++;
+    }
+    qsort(tets->r, tets->n, sizeof(row), row_cmp);
+    qsort(hull->r, hull->n, sizeof(row), row_cmp);
+    fdt_result_free(&res);
+    free(R);
+    free(who);
+}
+
+static int same_rows(const rows *a, const rows *b)
+{
+    return a->n == b->n && (a->n == 0 || !memcmp(a->r, b->r, a->n * sizeof(row)));
+}
+
+static fdt_periodic_mesh build(const double *X, size_t n, const fdt_periodic_box *b, int threads,
+                               const char *name)
+{
+    fdt_periodic_mesh pm;
+    char diag[512];
+    int err = fdt_periodic_build(X, (uint32_t)n, b, threads, &pm, diag, sizeof diag);
+    EXPECTF(err == FDT_OK, "%s: fdt_periodic_build: %d (%s)", name, err, diag);
+    CHECK(err == FDT_OK);
+    return pm;
+}
+
+/* V - E + T over the quotient: the distinct edges, offsets relative to
+ * their lower id. */
+static long euler_vet(const fdt_periodic_mesh *pm, size_t nverts)
+{
+    size_t ne = 0;
+    row *e = malloc(pm->ntets * 6 * sizeof *e);
+    CHECK(e);
+    for (size_t t = 0; t < pm->ntets; t++)
+        for (int a = 0; a < 4; a++)
+            for (int c = a + 1; c < 4; c++) {
+                vtx v[4];
+                memset(v, 0, sizeof v);
+                v[0].id = pm->tets[4 * t + (size_t)a];
+                memcpy(v[0].off, pm->tet_off + 12 * t + 3 * (size_t)a, 3);
+                v[1].id = pm->tets[4 * t + (size_t)c];
+                memcpy(v[1].off, pm->tet_off + 12 * t + 3 * (size_t)c, 3);
+                make_row(v, 2, &e[ne++]);
+            }
+    qsort(e, ne, sizeof *e, row_cmp);
+    size_t edges = ne ? 1 : 0;
+    for (size_t i = 1; i < ne; i++)
+        edges += row_cmp(&e[i], &e[i - 1]) != 0;
+    free(e);
+    return (long)nverts - (long)edges + (long)pm->ntets;
+}
+
+/* Points on the grid of 2^-20 in [0, 1)^3: exact images in a unit box. */
+static double grid_unif(uint64_t *s)
+{
+    return floor(test_unif(s) * 0x1p20) * 0x1p-20;
+}
+
+static double *uniform(size_t n, uint64_t seed)
+{
+    double *X = malloc(n * 3 * sizeof *X);
+    CHECK(X);
+    uint64_t s = seed;
+    for (size_t i = 0; i < 3 * n; i++)
+        X[i] = grid_unif(&s);
+    return X;
+}
+
+static double *lattice(int g, size_t *n)
+{
+    *n = (size_t)g * g * g;
+    double *X = malloc(*n * 3 * sizeof *X);
+    CHECK(X);
+    size_t m = 0;
+    for (int i = 0; i < g; i++)
+        for (int j = 0; j < g; j++)
+            for (int k = 0; k < g; k++, m++) {
+                X[3 * m] = i / 16.0;
+                X[3 * m + 1] = j / 16.0;
+                X[3 * m + 2] = k / 16.0;
+            }
+    return X;
+}
+
+/* A wall-normal coordinate: a wall of points at 0 or 1 (a quarter of
+ * the points), the rest crowded towards the walls (s^2 from the nearer
+ * one); on the 2^-20 grid. */
+static double wall_normal(size_t i, uint64_t *s)
+{
+    double u = test_unif(s);
+    double y = i % 8 == 0 ? 0 : i % 8 == 1 ? 1
+             : u < 0.5    ? 2 * u * 2 * u * 0.5
+                          : 1 - (2 - 2 * u) * (2 - 2 * u) * 0.5;
+    return floor(y * 0x1p20) * 0x1p-20;
+}
+
+/* A channel (walls at y = 0 and 1, x and z uniform), or a duct (walls
+ * in z too). */
+static double *channel(size_t n, uint64_t seed, int duct)
+{
+    double *X = malloc(n * 3 * sizeof *X);
+    CHECK(X);
+    uint64_t s = seed;
+    for (size_t i = 0; i < n; i++) {
+        X[3 * i] = grid_unif(&s);
+        X[3 * i + 1] = wall_normal(i, &s);
+        X[3 * i + 2] = duct ? wall_normal(i / 8 + i, &s) : grid_unif(&s);
+    }
+    return X;
+}
+
+static void against_reference(const char *name, const double *X, size_t n, unsigned axes,
+                              const double lo[3], const double hi[3])
+{
+    fdt_periodic_box b = {axes, {lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
+    fdt_periodic_mesh pm = build(X, n, &b, 1, name);
+    rows got = mesh_rows(pm.tets, pm.tet_off, pm.ntets, 4);
+    rows goth = mesh_rows(pm.hull, pm.hull_off, pm.nhull, 3);
+    rows want, wanth;
+    reference(X, n, &b, &want, &wanth);
+    EXPECTF(same_rows(&got, &want), "%s: %zu tets, the reference %zu", name, got.n, want.n);
+    EXPECTF(same_rows(&goth, &wanth), "%s: %zu hull faces, the reference %zu", name, goth.n,
+            wanth.n);
+    /* the output is sorted and normalised already */
+    EXPECT(got.n == pm.ntets);
+    fdt_periodic_mesh p3 = build(X, n, &b, 3, name);
+    rows got3 = mesh_rows(p3.tets, p3.tet_off, p3.ntets, 4);
+    EXPECTF(same_rows(&got, &got3), "%s: 3 threads differ", name);
+    if (axes == 7)
+        EXPECTF(euler_vet(&pm, n) == 0, "%s: V - E + T = %ld", name, euler_vet(&pm, n));
+    printf("%s (axes %u): %zu tets, %zu hull faces, %zu images, %d round(s): as the reference\n",
+           name, axes, pm.ntets, pm.nhull, pm.images, pm.rounds);
+    free(got.r);
+    free(goth.r);
+    free(want.r);
+    free(wanth.r);
+    free(got3.r);
+    fdt_periodic_free(&pm);
+    fdt_periodic_free(&p3);
+}
+
+/* Random doubles in a box whose images are not doubles: threads and a
+ * shuffle agree, and the Euler characteristic. */
+static void inexact_box(size_t n)
+{
+    const double lo[3] = {0.1, -0.7, 3.3}, hi[3] = {1.3, 0.35, 4.1};
+    double *X = malloc(n * 3 * sizeof *X);
+    CHECK(X);
+    uint64_t s = 99;
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            X[3 * i + k] = lo[k] + test_unif(&s) * (hi[k] - lo[k]);
+            if (X[3 * i + k] >= hi[k])
+                X[3 * i + k] = lo[k];
+        }
+    fdt_periodic_box b = {7, {lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
+    fdt_periodic_mesh p1 = build(X, n, &b, 1, "inexact"), p3 = build(X, n, &b, 3, "inexact t3");
+    rows r1 = mesh_rows(p1.tets, p1.tet_off, p1.ntets, 4);
+    rows r3 = mesh_rows(p3.tets, p3.tet_off, p3.ntets, 4);
+    EXPECT(same_rows(&r1, &r3));
+    EXPECTF(euler_vet(&p1, n) == 0, "inexact: V - E + T = %ld", euler_vet(&p1, n));
+    EXPECT(p1.nhull == 0);
+    /* shuffled: the same tets under the permutation */
+    size_t *perm = malloc(n * sizeof *perm);
+    double *Y = malloc(n * 3 * sizeof *Y);
+    CHECK(perm && Y);
+    for (size_t i = 0; i < n; i++)
+        perm[i] = i;
+    for (size_t i = n - 1; i > 0; i--) {
+        size_t j = (size_t)(test_rand64(&s) % (i + 1)), t = perm[i];
+        perm[i] = perm[j];
+        perm[j] = t;
+    }
+    for (size_t i = 0; i < n; i++)
+        memcpy(Y + 3 * i, X + 3 * perm[i], 3 * sizeof *Y); /* Y[i] = X[perm[i]] */
+    fdt_periodic_mesh ps = build(Y, n, &b, 2, "inexact shuffled");
+    uint32_t *ids = malloc(ps.ntets * 4 * sizeof *ids);
+    CHECK(ids);
+    for (size_t i = 0; i < 4 * ps.ntets; i++)
+        ids[i] = (uint32_t)perm[ps.tets[i]];
+    rows rs = mesh_rows(ids, ps.tet_off, ps.ntets, 4);
+    EXPECT(same_rows(&r1, &rs));
+    printf("inexact box: %zu tets, %zu images (%zu exact calls), shuffled and 3 threads the "
+           "same\n", p1.ntets, p1.images, p1.pc.orient_exact + p1.pc.insphere_exact);
+    free(ids);
+    free(rs.r);
+    free(r1.r);
+    free(r3.r);
+    free(perm);
+    free(Y);
+    free(X);
+    fdt_periodic_free(&p1);
+    fdt_periodic_free(&p3);
+    fdt_periodic_free(&ps);
+}
+
+static void errors(void)
+{
+    double X[3 * 8];
+    uint64_t s = 5;
+    for (int i = 0; i < 24; i++)
+        X[i] = test_unif(&s);
+    fdt_periodic_mesh pm;
+    char diag[512];
+    fdt_periodic_box b = {7, {0, 0, 0}, {1, 1, 1}};
+    X[3 * 5 + 1] = 1.0; /* on the upper wall: outside [0, 1) */
+    EXPECT(fdt_periodic_build(X, 8, &b, 1, &pm, diag, sizeof diag) == FDT_EINVAL);
+    EXPECTF(strstr(diag, "point 5 has y = 1") != NULL, "%s", diag);
+    X[3 * 5 + 1] = 0.5;
+    fdt_periodic_box none = {0, {0, 0, 0}, {1, 1, 1}};
+    EXPECT(fdt_periodic_build(X, 8, &none, 1, &pm, diag, sizeof diag) == FDT_EINVAL);
+    fdt_periodic_box empty = {1, {0, 0, 0}, {0, 1, 1}};
+    EXPECT(fdt_periodic_build(X, 8, &empty, 1, &pm, diag, sizeof diag) == FDT_EINVAL);
+    /* 8 points in a periodic cube: the mesh needs images of one point in
+     * a tet */
+    int err = fdt_periodic_build(X, 8, &b, 1, &pm, diag, sizeof diag);
+    EXPECTF(err == FDT_EDEGENERATE && strstr(diag, "one copy of the box"), "%d %s", err, diag);
+    printf("errors: %s\n", diag);
+}
+
+int main(void)
+{
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    size_t n = 3000;
+    double *U = uniform(n, 1);
+    against_reference("uniform", U, n, 7, lo, hi);
+    /* periodic in x and z only, uniform points have a single lowest
+     * point: the periodic set's hull is the lattice of its images, and
+     * its tets join images of one point (no 1-sheet triangulation) */
+    fdt_periodic_mesh pm;
+    char diag[512];
+    fdt_periodic_box bxz = {5, {0, 0, 0}, {1, 1, 1}};
+    int err = fdt_periodic_build(U, (uint32_t)n, &bxz, 2, &pm, diag, sizeof diag);
+    EXPECTF(err == FDT_EDEGENERATE && strstr(diag, "not flat"), "%d %s", err, diag);
+    free(U);
+    size_t nl;
+    double *L = lattice(8, &nl); /* 8^3 points, spacing 1/16, box [0, 1/2) */
+    const double lhi[3] = {0.5, 0.5, 0.5};
+    against_reference("lattice", L, nl, 7, lo, lhi);
+    against_reference("lattice", L, nl, 5, lo, lhi);
+    free(L);
+    double *C = channel(n, 3, 0);
+    against_reference("channel", C, n, 5, lo, hi);
+    free(C);
+    C = channel(n, 4, 1);
+    against_reference("duct", C, n, 1, lo, hi);
+    free(C);
+    inexact_box(4000);
+    errors();
+    return test_report("periodic");
+}
