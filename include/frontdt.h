@@ -141,12 +141,16 @@ typedef enum fdt_engine {
                                  search (§3-§5) */
     FDT_ENGINE_PARTS_MESH,    /* the same parts reading their apexes from
                                  the mesh of every point */
-    FDT_ENGINE_WALLS          /* each part's own mesh, its final tets at
+    FDT_ENGINE_WALLS,         /* each part's own mesh, its final tets at
                                  once, fronts and messages at the walls */
+    FDT_ENGINE_PERIODIC       /* a periodic run (settings.periodic): the
+                                 insertion mesh of the points and their
+                                 images near the box, the tets of one
+                                 copy kept, proved sound and complete */
 } fdt_engine;
 
 /* The engine's short name ("front", "one-part", "sweep", "parts",
- * "parts-mesh", "walls"; --stats-json's "engine") and a line saying what
+ * "parts-mesh", "walls", "periodic"; --stats-json's "engine") and a line saying what
  * it does (--stats), static; NULL when e is not an fdt_engine. */
 FDT_API const char *fdt_engine_name(int e);
 FDT_API const char *fdt_engine_about(int e);
@@ -183,6 +187,17 @@ typedef struct fdt_settings {
                                 Default 0: xyz is only read. (Added after
                                 the first release in what was padding:
                                 sizeof(fdt_settings) did not change.) */
+    /* Periodic domains (issue 33; added after the first release, whose
+     * smaller struct_size is still accepted). periodic: bit 0, 1, 2 set
+     * when x, y, z is periodic (0, the default: none); periodic_box:
+     * xmin, ymin, zmin, xmax, ymax, zmax, read on the periodic axes only,
+     * where the period is max - min (the real difference) and every
+     * point must lie in [min, max). The result is the Delaunay
+     * tetrahedralization of the periodic point set, every tet once, each
+     * vertex an input point with an image offset
+     * (fdt_result_tet_offsets). In memory only (fdt_triangulate). */
+    unsigned periodic;
+    double periodic_box[6];
 } fdt_settings;
 
 /*
@@ -245,6 +260,20 @@ FDT_API const fdt_tid *fdt_result_neighbors(const fdt_result *r);
  * negative side (outward normals by the right-hand rule). */
 FDT_API size_t fdt_result_num_hull_faces(const fdt_result *r);
 FDT_API const fdt_vid *fdt_result_hull_faces(const fdt_result *r);
+/*
+ * A periodic run's image offsets (settings.periodic), NULL for any other
+ * run: 12 per tet (x, y, z in periods for each of its 4 vertices) and 9
+ * per hull face. A periodic result's tets are not oriented: each is its
+ * 4 input ids ascending (ties by offsets) with offsets relative to the
+ * first, the tets in ascending order (the .tets file's lines), and
+ * likewise the hull faces (only across the axes that are not periodic).
+ * The face list, edges, adjacency, neighbours, set hash, check, cells
+ * and location refuse a periodic result (FDT_EINVAL); fdt_result_hash is
+ * the hash of its .tets text.
+ */
+FDT_API const int8_t *fdt_result_tet_offsets(const fdt_result *r);
+FDT_API const int8_t *fdt_result_hull_offsets(const fdt_result *r);
+
 /* n entries: the vertex each input point was merged into (itself when it
  * is the first of its coordinates). */
 FDT_API const fdt_vid *fdt_result_duplicate_map(const fdt_result *r);
@@ -461,6 +490,10 @@ typedef struct fdt_stats {
                                  triangulation's time (summed over the
                                  sweeps, which run at once) */
     int engine;               /* the fdt_engine that ran (fdt_engine_name) */
+    /* A periodic run (issue 33; added after the engine: a caller with the
+     * size up to it gets the fields above). */
+    size_t periodic_images;   /* images triangulated with the points */
+    size_t periodic_rounds;   /* margins tried (each a doubling) */
 } fdt_stats;
 
 /* Fills the first struct_size bytes of *st (its struct_size included).

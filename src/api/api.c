@@ -20,6 +20,7 @@
 #include "par/threads.h"
 #include "geom/morton.h"
 #include "geom/prepare.h"
+#include "mesh/periodic.h"
 #include "mesh/result.h"
 #include "mesh/locate.h"
 #include "mesh/voronoi.h"
@@ -65,16 +66,17 @@ void fdt_free(void *p) { free(p); }
  * (offsetof the first field it lacks), whose missing fields then take
  * their defaults in fdt_open.
  */
-/* permute_input took what was padding after search: the struct kept its
- * size, so every caller's struct_size is still this one. */
-_Static_assert(sizeof(fdt_settings) ==
+/* permute_input took what was padding after search: the first release's
+ * size, which ends there, did not change. periodic (issue 33) came after
+ * it: a caller of that release gives its size and gets no periodic axis. */
+_Static_assert(offsetof(fdt_settings, periodic) ==
                    (offsetof(fdt_settings, search) + sizeof(fdt_search) +
                     _Alignof(fdt_settings) - 1) / _Alignof(fdt_settings) * _Alignof(fdt_settings),
                "permute_input inside the first release's size");
 
 static int settings_size_known(size_t size)
 {
-    return size == sizeof(fdt_settings);
+    return size == sizeof(fdt_settings) || size == offsetof(fdt_settings, periodic);
 }
 
 int fdt_default_settings_sized(fdt_settings *s, size_t struct_size)
@@ -111,7 +113,8 @@ int fdt_open(fdt_context **ctx, const fdt_settings *s)
     fdt_default_settings_sized(&all, sizeof all);
     memcpy(&all, s, s->struct_size);
     if (all.n_threads < 0 || all.n_threads > 1024 || all.leaf_size < 0 ||
-        all.mode < FDT_MODE_AUTO || all.mode > FDT_MODE_MESSAGE || !fdt_search_row_of(all.search))
+        all.mode < FDT_MODE_AUTO || all.mode > FDT_MODE_MESSAGE || !fdt_search_row_of(all.search) ||
+        (all.periodic & ~7u))
         return FDT_EINVAL;
     fdt_context *c = calloc(1, sizeof *c);
     if (!c)
@@ -245,16 +248,18 @@ static const struct {
                                              "from the mesh of every point"},
     [FDT_ENGINE_WALLS] = {"walls", "each part's own mesh, its final tets at once, fronts and "
                                    "messages at the walls"},
+    [FDT_ENGINE_PERIODIC] = {"periodic", "the insertion mesh of the points and their images "
+                                         "near the box, one copy's tets kept and proved"},
 };
 
 const char *fdt_engine_name(int e)
 {
-    return e >= FDT_ENGINE_FRONT && e <= FDT_ENGINE_WALLS ? engines[e].name : NULL;
+    return e >= FDT_ENGINE_FRONT && e <= FDT_ENGINE_PERIODIC ? engines[e].name : NULL;
 }
 
 const char *fdt_engine_about(int e)
 {
-    return e >= FDT_ENGINE_FRONT && e <= FDT_ENGINE_WALLS ? engines[e].about : NULL;
+    return e >= FDT_ENGINE_FRONT && e <= FDT_ENGINE_PERIODIC ? engines[e].about : NULL;
 }
 
 /*
@@ -292,7 +297,8 @@ int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const 
         fdt_default_voronoi_options(&defaults);
         o = &defaults;
     }
-    if (!r || !xyz || !out || o->struct_size != sizeof *o || o->threads < 0 || o->threads > 1024)
+    if (!r || !xyz || !out || o->struct_size != sizeof *o || o->threads < 0 || o->threads > 1024 ||
+        r->periodic)
         return FDT_EINVAL;
     int threads = o->threads ? o->threads : fdt_threads_default();
     return fdt_voronoi_build(r, xyz, n, o, threads, out, diag, diag_size);
@@ -303,7 +309,7 @@ int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const 
 int fdt_locate(fdt_result *r, const double *xyz, size_t n, const double *q, size_t nq,
                fdt_tid *tet, double *bary, int threads)
 {
-    if (threads < 0 || threads > 1024)
+    if (threads < 0 || threads > 1024 || (r && r->periodic))
         return FDT_EINVAL;
     return fdt_locate_build(r, xyz, n, q, nq, tet, bary,
                             threads ? threads : fdt_threads_default());
@@ -313,7 +319,7 @@ int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *va
                     size_t nv, const double *q, size_t nq, fdt_interp method, int threads,
                     double *out, char *diag, size_t diag_size)
 {
-    if (threads < 0 || threads > 1024)
+    if (threads < 0 || threads > 1024 || (r && r->periodic))
         return FDT_EINVAL;
     return fdt_interpolate_build(r, xyz, n, values, nv, q, nq, method,
                                  threads ? threads : fdt_threads_default(), out, diag,
@@ -504,6 +510,105 @@ static int cells_done(fdt_context *ctx, const fdt_cellstream *cs)
     return fdt_voronoi_too_close(&cs->sh, cs->box, ctx->diag, sizeof ctx->diag);
 }
 
+/* The box of a periodic run scaled as the prepared points were (by a
+ * power of two: exact unless it leaves the doubles' range). */
+static int periodic_box_scaled(fdt_context *ctx, int e, fdt_periodic_box *b)
+{
+    for (int k = 0; k < 3; k++) {
+        if (!(b->axes >> k & 1))
+            continue;
+        double lo = ldexp(b->lo[k], e), hi = ldexp(b->hi[k], e);
+        if (ldexp(lo, -e) != b->lo[k] || ldexp(hi, -e) != b->hi[k] || !isfinite(hi - lo)) {
+            snprintf(ctx->diag, sizeof ctx->diag, "the periodic box's %c side [%.17g, %.17g) "
+                     "is too far from the points' scale", "xyz"[k], b->lo[k], b->hi[k]);
+            return FDT_ERANGE;
+        }
+        b->lo[k] = lo;
+        b->hi[k] = hi;
+    }
+    return FDT_OK;
+}
+
+/*
+ * A periodic run (settings.periodic, src/mesh/periodic.h), as a list of
+ * steps: the box and the points in it (named by input index), the merge
+ * and scaling every run does, the periodic mesh of the distinct points,
+ * renumbered to input indices.
+ */
+static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, fdt_result **out)
+{
+    fdt_mode mode;
+    int nthreads;
+    run_mode(&ctx->s, &mode, &nthreads);
+    if (mode == FDT_MODE_SERIAL)
+        nthreads = 1;
+    double t0 = fdt_now_s();
+    const double *bx = ctx->s.periodic_box;
+    fdt_periodic_box b = {ctx->s.periodic, {bx[0], bx[1], bx[2]}, {bx[3], bx[4], bx[5]}};
+    fdt_prepared pr;
+    memset(&pr, 0, sizeof pr);
+    fdt_periodic_mesh pm;
+    memset(&pm, 0, sizeof pm);
+    fdt_result *r = NULL;
+    int err = fdt_periodic_check(xyz, n, &b, ctx->diag, sizeof ctx->diag);
+    if (!err)
+        err = run_prepare(ctx, xyz, n, mode, nthreads, &pr);
+    if (!err && pr.m > UINT32_MAX / 2)
+        err = FDT_ETOOBIG;
+    if (!err)
+        err = periodic_box_scaled(ctx, pr.scale_exp, &b);
+    double t1 = fdt_now_s();
+    if (!err)
+        err = fdt_periodic_build(pr.p, (uint32_t)pr.m, &b, nthreads, &pm, ctx->diag,
+                                 sizeof ctx->diag);
+    if (!err)
+        err = fdt_periodic_renumber(&pm, pr.orig);
+    double t2 = fdt_now_s();
+    if (!err && !(r = calloc(1, sizeof *r)))
+        err = FDT_ENOMEM;
+    if (err) {
+        if (err == FDT_ENOMEM && !ctx->diag[0])
+            snprintf(ctx->diag, sizeof ctx->diag, "out of memory triangulating %zu points", n);
+        fdt_periodic_free(&pm);
+        fdt_prepared_free(&pr);
+        return err;
+    }
+    r->periodic = 1;
+    r->sorted = 1;
+    r->tets = (fdt_vid *)pm.tets;
+    r->tet_off = pm.tet_off;
+    r->ntets = pm.ntets;
+    r->hull = (fdt_vid *)pm.hull;
+    r->hull_off = pm.hull_off;
+    r->nhull = pm.nhull;
+    r->dupmap = pr.dupmap;
+    pr.dupmap = NULL;
+    r->n = n;
+    r->ndup = pr.ndup;
+    fdt_stats *st = &r->stats;
+    st->points = n;
+    st->vertices = pr.m;
+    st->tets = pm.ntets;
+    st->hull_faces = pm.nhull;
+    st->exact_orient = pm.pc.orient_exact;
+    st->exact_insphere = pm.pc.insphere_exact;
+    st->threads = nthreads;
+    st->mode = mode;
+    st->engine = FDT_ENGINE_PERIODIC;
+    st->periodic_images = pm.images;
+    st->periodic_rounds = (size_t)pm.rounds;
+    st->mem_points = pr.m * (3 * sizeof *pr.p + sizeof *pr.orig) + n * sizeof *pr.dupmap;
+    st->mem_merge = pr.merge_bytes;
+    st->t_prepare = t1 - t0;
+    st->t_front = t2 - t1;
+    st->t_finish = fdt_now_s() - t2;
+    fdt_prepared_free(&pr);
+    if (ctx->s.progress)
+        ctx->s.progress(ctx->s.progress_user, 1.0);
+    *out = r;
+    return FDT_OK;
+}
+
 static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *user,
                fdt_cellstream *cs, fdt_result **out)
 {
@@ -514,6 +619,15 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
     if (user && ctx->s.neighbors) { /* a streamed run keeps no tet to link */
         snprintf(ctx->diag, sizeof ctx->diag, "a streamed run has no neighbours");
         return FDT_EINVAL;
+    }
+    if (ctx->s.periodic) {
+        if (user || ctx->s.neighbors) {
+            snprintf(ctx->diag, sizeof ctx->diag, "a periodic run is in memory, without "
+                     "neighbours (issue 33: streamed and linked periodic meshes are not "
+                     "built yet)");
+            return FDT_EINVAL;
+        }
+        return run_periodic(ctx, xyz, n, out);
     }
     fdt_mode mode;
     int nthreads;

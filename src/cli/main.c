@@ -77,6 +77,7 @@ typedef struct cli {
     int stream;             /* --stream 1, --no-stream -1, else 0: when
                                every output can (stream_refusal) */
     unsigned long long memory_limit; /* --memory-limit bytes; 0: none */
+    unsigned periodic;      /* --periodic: bit k for axis k */
     fdt_cli_dual dual;      /* --voronoi, --voronoi-format, --density, --box,
                                --values, --interpolate, --interpolated, --method */
     int demo;
@@ -441,6 +442,20 @@ static int take_option(cli *c, int id, const char *v)
         return -1;
     case FDT_OPT_MODE:
         return take_mode(c, v);
+    case FDT_OPT_PERIODIC:
+        c->periodic = 0;
+        for (const char *q = v; *q; q++) {
+            const char *ax = strchr("xyz", *q);
+            if (*q == ',' && q != v && q[1])
+                continue;
+            if (!ax || !*q || (c->periodic >> (ax - "xyz") & 1))
+                return usage_error("--periodic takes axes x, y, z, once each (x,z or xyz), "
+                                   "not '%s'", v);
+            c->periodic |= 1u << (ax - "xyz");
+        }
+        if (!c->periodic)
+            return usage_error("--periodic takes axes x, y, z (x,z or xyz), not '%s'", v);
+        return -1;
     case FDT_OPT_SEARCH:
         if (fdt_cli_search(v, &c->search, err, sizeof err) != 0)
             return usage_error("%s", err);
@@ -547,12 +562,34 @@ static int check_args(cli *c, int npos, char **pos)
                     c->decimal_comma))
         return usage_error("--input-format, --columns, --delimiter and --decimal-comma need "
                            "an input file, not --demo");
+    if (c->periodic) {
+        /* issue 33's first step: the periodic mesh in memory, as .tets */
+        if (!c->dual.box_given)
+            return usage_error("--periodic needs --box X0,Y0,Z0,X1,Y1,Z1: the periods");
+        if (fdt_cli_dual_wanted(&c->dual) || c->dual.dual || c->stream > 0 || c->check ||
+            c->set_hash)
+            return usage_error("--periodic writes the mesh (.tets) and its --hash; not yet "
+                               "--voronoi, --density, --dual, --interpolate, --stream, --check "
+                               "or --set-hash");
+        for (int o = 0; o < c->n_outputs; o++) {
+            const char *f = c->out_format[o];
+            const char *dot = strrchr(c->outputs[o], '.');
+            if (f ? strcmp(f, "tets") != 0 : !dot || strcmp(dot, ".tets") != 0)
+                return usage_error("--periodic writes .tets only (-o %s): the other formats "
+                                   "need the image vertices", c->outputs[o]);
+        }
+        c->stream = -1;
+    }
     /* the dual's threads: the run's */
     c->dual.threads = c->mode == FDT_MODE_SERIAL ? 1 : c->threads < 0 ? 0 : c->threads;
     char derr[512];
+    int box_only = c->periodic && c->dual.box_given && !fdt_cli_dual_wanted(&c->dual);
+    if (box_only)
+        c->dual.box_given = 0; /* the periods, not a clipping box: kept in dual.box */
     if (fdt_cli_dual_check(&c->dual, c->input && strcmp(c->input, "-") ? c->input : NULL, derr,
                            sizeof derr) != 0)
         return usage_error("%s", derr);
+    c->dual.box_given |= box_only;
     return -1;
 }
 
@@ -864,6 +901,9 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         fprintf(stderr, "  sweep             %zu parts, %zu points inserted again, at most %zu in "
                         "a part\n",
                 st->sweep_parts, st->sweep_reinserted, st->sweep_max_part);
+    if (st->engine == FDT_ENGINE_PERIODIC)
+        fprintf(stderr, "  periodic          %zu images with the points, %zu margin(s) tried\n",
+                st->periodic_images, st->periodic_rounds);
     if (st->cell_batches)
         fprintf(stderr, "  streamed cells    %zu batches, at most %zu tets held, %.3f s of the "
                         "triangulation\n",
@@ -958,7 +998,7 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         ", \"t_prepare\": %.9g, \"t_front\": %.9g, \"t_finish\": %.9g"
         ", \"t_read\": %.9g, \"t_triangulate\": %.9g, \"t_check\": %.9g"
         ", \"t_canon\": %.9g, \"t_write\": %.9g, \"t_voronoi\": %.9g"
-        ", \"t_interpolate\": %.9g",
+        ", \"t_interpolate\": %.9g, \"periodic_images\": %zu, \"periodic_rounds\": %zu",
         st->points, st->vertices, dups, st->tets, st->hull_faces,
         st->faces_advanced, st->kd_nodes_visited, st->points_tested,
         st->exact_orient, st->exact_insphere, st->adapt_orient, st->adapt_insphere,
@@ -971,7 +1011,8 @@ static void write_stats_json(FILE *f, const cli *c, const fdt_result *res,
         finite_or_zero(st->t_front), finite_or_zero(st->t_finish),
         finite_or_zero(tm->read), finite_or_zero(tm->triangulate),
         finite_or_zero(tm->check), finite_or_zero(tm->canon), finite_or_zero(tm->write),
-        finite_or_zero(tm->voronoi), finite_or_zero(tm->interpolate));
+        finite_or_zero(tm->voronoi), finite_or_zero(tm->interpolate), st->periodic_images,
+        st->periodic_rounds);
     json_msgs(f, "sent", st->sent);
     json_msgs(f, "received", st->received);
     fprintf(f,
@@ -1362,7 +1403,9 @@ static int open_engine(const cli *c, run_state *rs)
     if (c->threads >= 0)
         s.n_threads = c->threads;
     s.pin = c->pin;
-    s.neighbors = !rs->streaming && (c->check || (rs->need & FDT_NEED_NBRS) || fdt_cli_interp_wanted(&c->dual));
+    s.periodic = c->periodic;
+    memcpy(s.periodic_box, c->dual.box, sizeof s.periodic_box);
+    s.neighbors = !c->periodic && !rs->streaming && (c->check || (rs->need & FDT_NEED_NBRS) || fdt_cli_interp_wanted(&c->dual));
     if (rs->prog.enabled) {
         s.progress = progress_engine;
         s.progress_user = &rs->prog;

@@ -113,7 +113,17 @@ const fdt_cli_opt fdt_cli_opts[FDT_OPT_END] = {
         "write each point's DTFE density and flags", NULL},
     [FDT_OPT_BOX] = {"box", 0, required_argument, "X0,Y0,Z0,X1,Y1,Z1", FM, 0,
         "the box that clips the cells (default: the\n"
-        "points' bounding box; must hold them)", NULL},
+        "points' bounding box; must hold them), or the\n"
+        "periodic box of --periodic",
+        "the box that clips the cells (default: the\n"
+        "points' bounding box; must hold them)"},
+    [FDT_OPT_PERIODIC] = {"periodic", 0, required_argument, "AXES", F, 0,
+        "the points are periodic along AXES (x, y, z, or\n"
+        "several: x,z or xyz) with the periods of --box\n"
+        "(every point in [X0, X1) there): the Delaunay\n"
+        "mesh of the periodic set, every tet once; -o\n"
+        "FILE.tets: its 4 ids ascending, then each one's\n"
+        "image offset (3 integers) from the first's", NULL},
     [FDT_OPT_DUAL] = {"dual", 0, no_argument, NULL, F, 0,
         "each OpenFOAM -o (DIR/polyMesh) gets the Voronoi\n"
         "cells clipped by the box instead of the tets:\n"

@@ -49,6 +49,7 @@ typedef enum fdt_cli_opt_id {
     FDT_OPT_VORONOI_FORMAT,
     FDT_OPT_DENSITY,
     FDT_OPT_BOX,
+    FDT_OPT_PERIODIC,
     FDT_OPT_DUAL,
     FDT_OPT_VALUES,
     FDT_OPT_INTERPOLATE,

@@ -182,7 +182,7 @@ fail:
 int fdt_result_faces(fdt_result *r, size_t *n_faces, const fdt_vid **verts,
                      const fdt_tid **tets)
 {
-    if (!r || !n_faces || !verts || !tets)
+    if (!r || !n_faces || !verts || !tets || r->periodic)
         return FDT_EINVAL;
     if (!r->face_verts) {
         int err = build_faces(r);
@@ -277,7 +277,7 @@ fail:
 
 int fdt_result_edges(fdt_result *r, size_t *n_edges, const fdt_vid **verts)
 {
-    if (!r || !n_edges || !verts)
+    if (!r || !n_edges || !verts || r->periodic)
         return FDT_EINVAL;
     if (!r->edges) {
         int err = build_edges(r);
@@ -330,7 +330,7 @@ static int build_adjacency(fdt_result *r)
 int fdt_result_vertex_neighbors(fdt_result *r, fdt_vid v, size_t *count,
                                 const fdt_vid **ids)
 {
-    if (!r || !count || !ids || v < 0 || (size_t)v >= r->n)
+    if (!r || !count || !ids || v < 0 || (size_t)v >= r->n || r->periodic)
         return FDT_EINVAL;
     if (!r->adj) {
         int err = build_adjacency(r);

@@ -530,9 +530,8 @@ static int emit(keyset *s, int nv, uint32_t **ids, int8_t **offs, size_t *count)
     return FDT_OK;
 }
 
-/* The box's checks and the points in it; FDT_EINVAL with diag. */
-static int check_box(const double *X, uint32_t n, const fdt_periodic_box *b, char *diag,
-                     size_t dsz)
+int fdt_periodic_check(const double *X, size_t n, const fdt_periodic_box *b, char *diag,
+                       size_t dsz)
 {
     if (!(b->axes & 7) || (b->axes & ~7u)) {
         snprintf(diag, dsz, "a periodic box needs one to three periodic axes");
@@ -548,15 +547,62 @@ static int check_box(const double *X, uint32_t n, const fdt_periodic_box *b, cha
             return FDT_EINVAL;
         }
     }
-    for (uint32_t i = 0; i < n; i++)
+    for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++)
-            if (b->axes >> k & 1 && !(X[3 * (size_t)i + k] >= b->lo[k] &&
-                                      X[3 * (size_t)i + k] < b->hi[k])) {
-                snprintf(diag, dsz, "point %u has %c = %.17g, outside the periodic box's "
-                         "[%.17g, %.17g)", i, "xyz"[k], X[3 * (size_t)i + k], b->lo[k], b->hi[k]);
+            if (b->axes >> k & 1 && !(X[3 * i + k] >= b->lo[k] && X[3 * i + k] < b->hi[k])) {
+                snprintf(diag, dsz, "point %zu has %c = %.17g, outside the periodic box's "
+                         "[%.17g, %.17g)", i, "xyz"[k], X[3 * i + k], b->lo[k], b->hi[k]);
                 return FDT_EINVAL;
             }
     return FDT_OK;
+}
+
+/* Rows of nv vertices (ids, then offsets) renumbered by orig, made
+ * relative to their least id again and sorted. */
+static int renumber_rows(uint32_t *ids, int8_t *offs, size_t count, int nv, const int32_t *orig)
+{
+    key *k = malloc((count ? count : 1) * sizeof *k);
+    if (!k)
+        return FDT_ENOMEM;
+    for (size_t i = 0; i < count; i++) {
+        memset(&k[i], 0, sizeof k[i]);
+        int lo = 0;
+        uint32_t v[4];
+        for (int j = 0; j < nv; j++) {
+            v[j] = (uint32_t)orig[ids[(size_t)nv * i + (size_t)j]];
+            if (v[j] < v[lo])
+                lo = j;
+        }
+        const int8_t *o0 = offs + 3 * ((size_t)nv * i + (size_t)lo);
+        for (int j = 0; j < nv; j++) {
+            k[i].id[j] = v[j];
+            for (int a = 0; a < 3; a++)
+                k[i].off[j][a] = (int8_t)(offs[3 * ((size_t)nv * i + (size_t)j) + a] - o0[a]);
+        }
+        for (int a = 1; a < nv; a++)
+            for (int j = a; j > 0 && vert_cmp(k[i].id[j], k[i].off[j], k[i].id[j - 1],
+                                              k[i].off[j - 1]) < 0; j--) {
+                key t = k[i];
+                k[i].id[j] = t.id[j - 1];
+                k[i].id[j - 1] = t.id[j];
+                memcpy(k[i].off[j], t.off[j - 1], 3);
+                memcpy(k[i].off[j - 1], t.off[j], 3);
+            }
+    }
+    qsort(k, count, sizeof *k, key_cmp);
+    for (size_t i = 0; i < count; i++)
+        for (int j = 0; j < nv; j++) {
+            ids[(size_t)nv * i + (size_t)j] = k[i].id[j];
+            memcpy(offs + 3 * ((size_t)nv * i + (size_t)j), k[i].off[j], 3);
+        }
+    free(k);
+    return FDT_OK;
+}
+
+int fdt_periodic_renumber(fdt_periodic_mesh *m, const int32_t *orig)
+{
+    int err = renumber_rows(m->tets, m->tet_off, m->ntets, 4, orig);
+    return err ? err : renumber_rows(m->hull, m->hull_off, m->nhull, 3, orig);
 }
 
 int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, int nthreads,
@@ -569,7 +615,7 @@ int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, i
         diag_size = sizeof own;
     }
     diag[0] = 0;
-    int err = check_box(X, n, b, diag, diag_size);
+    int err = fdt_periodic_check(X, n, b, diag, diag_size);
     if (err)
         return err;
     if (n < 1) {
@@ -646,4 +692,15 @@ void fdt_periodic_free(fdt_periodic_mesh *m)
     free(m->hull);
     free(m->hull_off);
     memset(m, 0, sizeof *m);
+}
+
+size_t fdt_periodic_row_text(char *buf, const uint32_t id[4], const int8_t off[12])
+{
+    size_t k = 0;
+    for (int j = 0; j < 4; j++)
+        k += (size_t)snprintf(buf + k, FDT_PERIODIC_ROW_MAX - k, "%s%u", j ? " " : "", id[j]);
+    for (int j = 0; j < 12; j++)
+        k += (size_t)snprintf(buf + k, FDT_PERIODIC_ROW_MAX - k, " %d", off[j]);
+    buf[k++] = '\n';
+    return k;
 }

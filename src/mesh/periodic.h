@@ -77,4 +77,22 @@ int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, i
 
 void fdt_periodic_free(fdt_periodic_mesh *m);
 
+/* The .tets line of a periodic tet (include/frontdt.h): its 4 ids, then
+ * its 12 offsets, separated by spaces, and a newline, into buf (at least
+ * FDT_PERIODIC_ROW_MAX bytes); returns its length. fdt_result_hash hashes
+ * these bytes, the .tets writer writes them. */
+#define FDT_PERIODIC_ROW_MAX 112
+size_t fdt_periodic_row_text(char *buf, const uint32_t id[4], const int8_t off[12]);
+
+/* fdt_periodic_build's checks of the box and of the points in it, alone
+ * (a caller checks its input before it scales or merges it, so that the
+ * message names the input's index and value). FDT_OK or FDT_EINVAL. */
+int fdt_periodic_check(const double *X, size_t n, const fdt_periodic_box *b, char *diag,
+                       size_t diag_size);
+
+/* m's ids renumbered by orig (a merged input's first index of each
+ * point), each row made relative to its least id again and the rows
+ * sorted. FDT_OK or FDT_ENOMEM. */
+int fdt_periodic_renumber(fdt_periodic_mesh *m, const int32_t *orig);
+
 #endif

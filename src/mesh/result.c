@@ -1,5 +1,6 @@
 /* Result accessors, canonical order and the canonical hash. */
 #include "mesh/result.h"
+#include "mesh/periodic.h"
 
 #include <pthread.h>
 #include <sched.h>
@@ -21,6 +22,8 @@ void fdt_result_free(fdt_result **r)
     free((*r)->nbrs);
     free((*r)->hull);
     free((*r)->dupmap);
+    free((*r)->tet_off);
+    free((*r)->hull_off);
     free((*r)->tstats);
     fdt_result_drop_derived(*r);
     free(*r);
@@ -33,6 +36,8 @@ const fdt_tid *fdt_result_neighbors(const fdt_result *r) { return r ? r->nbrs : 
 size_t fdt_result_num_hull_faces(const fdt_result *r) { return r ? r->nhull : 0; }
 const fdt_vid *fdt_result_hull_faces(const fdt_result *r) { return r ? r->hull : NULL; }
 const fdt_vid *fdt_result_duplicate_map(const fdt_result *r) { return r ? r->dupmap : NULL; }
+const int8_t *fdt_result_tet_offsets(const fdt_result *r) { return r ? r->tet_off : NULL; }
+const int8_t *fdt_result_hull_offsets(const fdt_result *r) { return r ? r->hull_off : NULL; }
 size_t fdt_result_num_duplicates(const fdt_result *r) { return r ? r->ndup : 0; }
 
 /* The sizes of fdt_stats and fdt_thread_stats this library fills
@@ -47,7 +52,8 @@ static int stats_size_known(size_t size)
            size == offsetof(fdt_stats, final_tets) ||
            size == offsetof(fdt_stats, ins_conflict_tests) ||
            size == offsetof(fdt_stats, sweep_parts) ||
-           size == offsetof(fdt_stats, cell_batches);
+           size == offsetof(fdt_stats, cell_batches) ||
+           size == offsetof(fdt_stats, periodic_images);
 }
 
 static int thread_stats_size_known(size_t size)
@@ -804,6 +810,14 @@ int fdt_result_hash_threads(fdt_result *r, int threads, uint64_t *hash)
     if (!r || !hash)
         return FDT_EINVAL;
     text_hash th = {14695981039346656037ull};
+    if (r->periodic) { /* sorted as built: the .tets lines' bytes */
+        char buf[FDT_PERIODIC_ROW_MAX];
+        for (size_t i = 0; i < r->ntets; i++)
+            hash_text(&th, buf, fdt_periodic_row_text(buf, (const uint32_t *)r->tets + 4 * i,
+                                                      r->tet_off + 12 * i));
+        *hash = th.h;
+        return FDT_OK;
+    }
     if (!r->sorted) {
         int err = sort_impl(r, &th, threads < 1 ? 1 : (threads > 64 ? 64 : threads));
         if (err)
@@ -817,7 +831,7 @@ int fdt_result_hash_threads(fdt_result *r, int threads, uint64_t *hash)
 
 int fdt_result_set_hash(const fdt_result *r, uint64_t *hash)
 {
-    if (!r || !hash)
+    if (!r || !hash || r->periodic)
         return FDT_EINVAL;
     if (r->streamed) {
         *hash = r->set_hash;

@@ -7,6 +7,7 @@
 #define FDT_MESHVIEW_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include "frontdt.h"
 
 typedef struct fdt_mesh_view {
@@ -23,6 +24,9 @@ typedef struct fdt_mesh_view {
     const fdt_tid *face_tets;/* 2 per face, -1 on the hull */
     size_t n_faces;
     int all_faces;           /* TetGen .face: every face (TetGen -f) */
+    /* A periodic mesh (fdt_result_tet_offsets), or NULL: 12 offsets a
+     * tet, whose rows are then ids ascending, not oriented; .tets only. */
+    const int8_t *tet_off;
 } fdt_mesh_view;
 
 /* The longest path the writer takes (its temporary names live in fixed

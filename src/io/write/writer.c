@@ -1702,6 +1702,11 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
         snprintf(what, sizeof what, "%zu points given for a mesh of %zu", n, r->n);
         return set_err(diag, diag_size, FDT_EINVAL, name, what);
     }
+    if (r->tet_off && strcmp(f->name, "tets") != 0) {
+        snprintf(what, sizeof what, "a periodic mesh is written as .tets (format %s would need "
+                 "the image vertices, issue 33)", f->name);
+        return set_err(diag, diag_size, FDT_EINVAL, name, what);
+    }
     int needs = fdt_format_needs(f, o->all_faces);
     if ((needs & FDT_NEED_NBRS) && !r->nbrs) {
         snprintf(what, sizeof what, "format %s needs tet neighbours (fdt_settings.neighbors)",
@@ -1713,7 +1718,7 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
         return set_err(diag, diag_size, e, name, fdt_strerror(e));
     fdt_mesh_view v = {
         .xyz = xyz, .n_points = n, .tets = r->tets, .n_tets = r->ntets, .nbrs = r->nbrs,
-        .hull = r->hull, .n_hull = r->nhull, .all_faces = o->all_faces,
+        .hull = r->hull, .n_hull = r->nhull, .all_faces = o->all_faces, .tet_off = r->tet_off,
     };
     /* after the sort: the face list names tets by their numbers */
     if ((needs & FDT_NEED_FACES) &&

@@ -1,0 +1,171 @@
+#!/usr/bin/env python3
+"""frontdt --periodic end to end (issue 33).
+
+- Periodic in x, y and z, a cube: the .tets equal CGAL's
+  Periodic_3_Delaunay_triangulation_3 (tests/cgal_periodic.cpp; skipped,
+  exit 77 for that part, where CGAL is not built) byte for byte, on uniform
+  random doubles in [0.1, 1.3)^3 (images that are not doubles), a lattice
+  (every cell's corners cospherical) and clusters; at 1, 2 and 3 threads, in
+  both modes, and for the same points shuffled (ids mapped back).
+- --hash equals the FNV-1a hash of the .tets bytes.
+- Errors, each with its message and exit code and no output: a point
+  outside the box (exit 1, the input's line named by index), too few
+  points for one copy of the box (exit 2), --periodic without --box, with
+  --stream or an output that is not .tets (exit 1).
+
+Usage: periodic_e2e.py FRONTDT CGAL_PERIODIC|none SCRATCH
+"""
+import os
+import random
+import shutil
+import subprocess
+import sys
+
+FRONTDT, CGAL, SCRATCH = sys.argv[1], sys.argv[2], sys.argv[3]
+failures = []
+checks = 0
+
+
+def expect(cond, what):
+    global checks
+    checks += 1
+    if not cond:
+        failures.append(what)
+        print("FAIL:", what)
+
+
+def write_points(path, pts):
+    with open(path, "w") as f:
+        for p in pts:
+            f.write("%.17g %.17g %.17g\n" % p)
+
+
+def frontdt(*args):
+    return subprocess.run([FRONTDT, *args], capture_output=True, text=True, timeout=600)
+
+
+def fnv(data):
+    h = 14695981039346656037
+    for b in data:
+        h = ((h ^ b) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
+    return h
+
+
+def uniform(n, lo, length, seed):
+    r = random.Random(seed)
+    pts = []
+    for _ in range(n):
+        p = tuple(lo + r.random() * length for _ in range(3))
+        pts.append(tuple(c if c < lo + length else lo for c in p))
+    return pts
+
+
+def lattice(g, lo, length):
+    h = length / g
+    return [(lo + i * h, lo + j * h, lo + k * h)
+            for i in range(g) for j in range(g) for k in range(g)]
+
+
+def clusters(n, lo, length, seed):
+    r = random.Random(seed)
+    centres = [tuple(lo + r.random() * length for _ in range(3)) for _ in range(8)]
+    pts = set()
+    while len(pts) < n:
+        c = r.choice(centres)
+        p = []
+        for k in range(3):
+            v = c[k] + r.gauss(0, 0.06 * length)
+            # wrapped into the box: clusters cross its walls
+            v = lo + (v - lo) % length
+            p.append(v if lo <= v < lo + length else lo)
+        pts.add(tuple(p))
+    return sorted(pts, key=lambda p: r.random())
+
+
+def case(name, pts, lo, length):
+    box = ",".join("%.17g" % v for v in (lo, lo, lo, lo + length, lo + length, lo + length))
+    src = os.path.join(SCRATCH, name + ".xyz")
+    write_points(src, pts)
+    out = os.path.join(SCRATCH, name + ".tets")
+    r = frontdt(src, "--periodic", "xyz", "--box", box, "-o", out, "--hash", "-q", "-t", "1")
+    expect(r.returncode == 0, "%s: frontdt exit %d: %s" % (name, r.returncode, r.stderr))
+    if r.returncode:
+        return
+    got = open(out, "rb").read()
+    expect(r.stdout.strip() == "hash: %016x" % fnv(got), "%s: --hash is not the .tets bytes' hash"
+           % name)
+    for extra in (["-t", "2"], ["-t", "3"], ["-t", "2", "--mode", "shared"],
+                  ["-t", "3", "--mode", "message"]):
+        o2 = out + ".t.tets"
+        r2 = frontdt(src, "--periodic", "xyz", "--box", box, "-o", o2, "-q", *extra)
+        expect(r2.returncode == 0 and open(o2, "rb").read() == got,
+               "%s %s: not the same .tets (%s)" % (name, " ".join(extra), r2.stderr))
+    # shuffled: the same tets under the permutation
+    perm = list(range(len(pts)))
+    random.Random(7).shuffle(perm)
+    ssrc = os.path.join(SCRATCH, name + "_shuffled.xyz")
+    write_points(ssrc, [pts[i] for i in perm])
+    so = os.path.join(SCRATCH, name + "_shuffled.tets")
+    r3 = frontdt(ssrc, "--periodic", "xyz", "--box", box, "-o", so, "-q", "-t", "2")
+    expect(r3.returncode == 0, "%s shuffled: exit %d" % (name, r3.returncode))
+    if r3.returncode == 0:
+        rows = []
+        for line in open(so):
+            v = [int(x) for x in line.split()]
+            verts = sorted((perm[v[j]], tuple(v[4 + 3 * j:7 + 3 * j])) for j in range(4))
+            o0 = verts[0][1]
+            verts = sorted((i, tuple(a - b for a, b in zip(o, o0))) for i, o in verts)
+            rows.append(" ".join(str(i) for i, _ in verts) + "".join(
+                " %d %d %d" % o for _, o in verts) + "\n")
+        rows.sort(key=lambda s: [int(x) for x in s.split()])
+        expect("".join(rows).encode() == got, "%s: the shuffled input's tets differ" % name)
+    if CGAL != "none":
+        ref = os.path.join(SCRATCH, name + ".cgal.tets")
+        c = subprocess.run([CGAL, src, "%.17g" % lo, "%.17g" % length, ref], capture_output=True,
+                           text=True, timeout=600)
+        expect(c.returncode == 0, "%s: cgal_periodic exit %d: %s" % (name, c.returncode, c.stderr))
+        if c.returncode == 0:
+            want = open(ref, "rb").read()
+            expect(got == want, "%s: %d tets, CGAL's periodic triangulation %d"
+                   % (name, got.count(b"\n"), want.count(b"\n")))
+    print("%s: %d points, %d tets%s" % (name, len(pts), got.count(b"\n"),
+                                        ", as CGAL's" if CGAL != "none" else ""))
+
+
+def errors():
+    src = os.path.join(SCRATCH, "err.xyz")
+    pts = uniform(200, 0.0, 1.0, 3)
+    pts[17] = (0.5, 1.0, 0.5)
+    write_points(src, pts)
+    out = os.path.join(SCRATCH, "err.tets")
+    r = frontdt(src, "--periodic", "x,y,z", "--box", "0,0,0,1,1,1", "-o", out)
+    expect(r.returncode == 1 and "point 17 has y = 1" in r.stderr and not os.path.exists(out),
+           "outside the box: exit %d, %s" % (r.returncode, r.stderr))
+    write_points(src, uniform(6, 0.0, 1.0, 4))
+    r = frontdt(src, "--periodic", "xyz", "--box", "0,0,0,1,1,1", "-o", out)
+    expect(r.returncode == 2 and "one copy of the box" in r.stderr and not os.path.exists(out),
+           "too few points: exit %d, %s" % (r.returncode, r.stderr))
+    for args, word in ((["--periodic", "xz"], "needs --box"),
+                       (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "--stream"], "--stream"),
+                       (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "-o",
+                         os.path.join(SCRATCH, "m.vtu")], ".tets only"),
+                       (["--periodic", "xq", "--box", "0,0,0,1,1,1"], "axes")):
+        r = frontdt(src, *args)
+        expect(r.returncode == 1 and word in r.stderr, "%s: exit %d, %s"
+               % (" ".join(args), r.returncode, r.stderr))
+    print("errors: outside the box, too few points, usage")
+
+
+def main():
+    shutil.rmtree(SCRATCH, ignore_errors=True)
+    os.makedirs(SCRATCH)
+    case("uniform", uniform(2000, 0.1, 1.2, 1), 0.1, 1.2)
+    case("lattice", lattice(6, 0.1, 1.2), 0.1, 1.2)
+    case("clusters", clusters(1000, -2.0, 3.0, 2), -2.0, 3.0)
+    errors()
+    print("periodic_e2e: %d checks, %d failed" % (checks, len(failures)))
+    shutil.rmtree(SCRATCH, ignore_errors=True)
+    return 1 if failures else 0
+
+
+sys.exit(main())
