@@ -10,6 +10,10 @@
  * the 4 input indices ascending, then the 4 image offsets relative to the
  * first, lines sorted.
  *
+ * cgal_periodic IN.xyz LO L --time: the points inserted as one range (CGAL's
+ * spatial sort, no indices), and "cells N seconds S" printed: for the
+ * speed comparison of bench/NOTES.md entry 108.
+ *
  * Exit status: 0 success, 1 usage or I/O error, 3 when CGAL's
  * triangulation is not in one sheet (too few points for the cube).
  */
@@ -22,6 +26,8 @@
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
 #include <algorithm>
+#include <chrono>
+#include <string>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -74,6 +80,15 @@ int main(int argc, char **argv)
         pts.emplace_back(x, y, z);
     std::fclose(in);
     P3DT3 T(P3DT3::Iso_cuboid(lo, lo, lo, lo + len, lo + len, lo + len));
+    if (std::string(argv[4]) == "--time") {
+        auto t0 = std::chrono::steady_clock::now();
+        T.insert(pts.begin(), pts.end(), true);
+        if (!T.is_1_cover() && T.is_triangulation_in_1_sheet())
+            T.convert_to_1_sheeted_covering();
+        double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        std::printf("cells %zu seconds %.3f\n", (size_t)T.number_of_cells(), s);
+        return T.is_1_cover() ? 0 : 3;
+    }
     /* one at a time, each vertex given its input index (the points are
      * distinct; the perturbed triangulation is unique, so the order does
      * not matter) */

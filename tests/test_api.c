@@ -481,12 +481,12 @@ static void test_abi_stats(void)
  * test_search and tests/test_oracle.c check that the engine that ran is
  * the one it names. */
 /* The engines' names (fdt_engine): each value from FDT_ENGINE_FRONT to
- * FDT_ENGINE_WALLS has a distinct name and a line, the others none. */
+ * FDT_ENGINE_PERIODIC has a distinct name and a line, the others none. */
 static void test_engine_names(void)
 {
     EXPECT(fdt_engine_name(0) == NULL && fdt_engine_about(0) == NULL);
-    EXPECT(fdt_engine_name(FDT_ENGINE_WALLS + 1) == NULL && fdt_engine_name(-1) == NULL);
-    for (int e = FDT_ENGINE_FRONT; e <= FDT_ENGINE_WALLS; e++) {
+    EXPECT(fdt_engine_name(FDT_ENGINE_PERIODIC + 1) == NULL && fdt_engine_name(-1) == NULL);
+    for (int e = FDT_ENGINE_FRONT; e <= FDT_ENGINE_PERIODIC; e++) {
         EXPECTF(fdt_engine_name(e) && fdt_engine_about(e) && *fdt_engine_about(e),
                 "engine %d has no name", e);
         for (int f = FDT_ENGINE_FRONT; f < e; f++)
@@ -525,6 +525,72 @@ static void test_engine_rule(void)
     EXPECT(fdt_engine_one_part(&s, 0) == 1);
 }
 
+static int sink_count(void *user, const fdt_vid *tets, size_t count)
+{
+    (void)user;
+    (void)tets;
+    (void)count;
+    return 0;
+}
+
+/* A periodic run through the API (issue 33; its meshes are tested in
+ * tests/test_periodic.c and tests/periodic_e2e.py): the first release's
+ * settings size runs plain; periodic bits beyond z are refused; the result
+ * has offsets, the engine and its figures; what cannot take a periodic
+ * result refuses it; a point outside the box is named. */
+static void test_periodic_api(void)
+{
+    enum { N = 600 };
+    static double xyz[3 * N];
+    uint64_t seed = 11;
+    for (int i = 0; i < 3 * N; i++)
+        xyz[i] = test_unif(&seed);
+    fdt_settings s;
+    fdt_default_settings(&s);
+    fdt_context *ctx = NULL;
+    fdt_result *r = NULL;
+    s.struct_size = offsetof(fdt_settings, periodic);
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    CHECK_EQ(fdt_triangulate(ctx, xyz, N, &r), FDT_OK);
+    EXPECT(fdt_result_tet_offsets(r) == NULL && fdt_result_hull_offsets(r) == NULL);
+    fdt_result_free(&r);
+    fdt_close(&ctx);
+    fdt_default_settings(&s);
+    s.periodic = 8;
+    EXPECT(fdt_open(&ctx, &s) == FDT_EINVAL && ctx == NULL);
+    s.periodic = 7;
+    const double box[6] = {0, 0, 0, 1, 1, 1};
+    memcpy(s.periodic_box, box, sizeof box);
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    CHECK_EQ(fdt_triangulate(ctx, xyz, N, &r), FDT_OK);
+    fdt_stats st;
+    CHECK_EQ(fdt_result_stats(r, &st), FDT_OK);
+    EXPECT(st.engine == FDT_ENGINE_PERIODIC && st.periodic_images > 0 && st.periodic_rounds >= 1);
+    EXPECT(fdt_result_tet_offsets(r) != NULL && fdt_result_num_tets(r) > 6 * N &&
+           fdt_result_num_hull_faces(r) == 0);
+    uint64_t h;
+    EXPECT(fdt_result_hash(r, &h) == FDT_OK && fdt_result_sort(r) == FDT_OK);
+    EXPECT(fdt_result_set_hash(r, &h) == FDT_EINVAL);
+    size_t cnt;
+    const fdt_vid *fv, *ids;
+    const fdt_tid *ft;
+    EXPECT(fdt_result_faces(r, &cnt, &fv, &ft) == FDT_EINVAL);
+    EXPECT(fdt_result_edges(r, &cnt, &fv) == FDT_EINVAL);
+    EXPECT(fdt_result_vertex_neighbors(r, 0, &cnt, &ids) == FDT_EINVAL);
+    fdt_voronoi *v = NULL;
+    EXPECT(fdt_voronoi_compute(r, xyz, N, NULL, &v, NULL, 0) == FDT_EINVAL);
+    fdt_tid tet;
+    double bary[4];
+    EXPECT(fdt_locate(r, xyz, N, xyz, 1, &tet, bary, 1) == FDT_EINVAL);
+    fdt_result_free(&r);
+    fdt_sink sink = {sizeof sink, sink_count, NULL, NULL};
+    EXPECT(fdt_triangulate_stream(ctx, xyz, N, &sink, &r) == FDT_EINVAL);
+    xyz[3 * 5 + 2] = 1.0;
+    EXPECT(fdt_triangulate(ctx, xyz, N, &r) == FDT_EINVAL &&
+           strstr(fdt_context_diagnostic(ctx), "point 5 has z = 1") != NULL);
+    fdt_close(&ctx);
+}
+
 int main(void)
 {
     test_abi_settings();
@@ -537,5 +603,6 @@ int main(void)
     test_search_names();
     test_engine_rule();
     test_engine_names();
+    test_periodic_api();
     return test_report("test_api");
 }
