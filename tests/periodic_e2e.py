@@ -6,7 +6,8 @@
   exit 77 for that part, where CGAL is not built) byte for byte, on uniform
   random doubles in [0.1, 1.3)^3 (images that are not doubles), a lattice
   (every cell's corners cospherical) and clusters; at 1, 2 and 3 threads, in
-  both modes, and for the same points shuffled (ids mapped back).
+  both modes, for the same points shuffled (ids mapped back) and with
+  duplicates appended (merged: the same file).
 - --hash equals the FNV-1a hash of the .tets bytes.
 - Errors, each with its message and exit code and no output: a point
   outside the box (exit 1, the input's line named by index), too few
@@ -119,6 +120,13 @@ def case(name, pts, lo, length):
                 " %d %d %d" % o for _, o in verts) + "\n")
         rows.sort(key=lambda s: [int(x) for x in s.split()])
         expect("".join(rows).encode() == got, "%s: the shuffled input's tets differ" % name)
+    # duplicates appended (merged into their first occurrences): the same tets
+    dsrc = os.path.join(SCRATCH, name + "_dup.xyz")
+    write_points(dsrc, pts + pts[::97])
+    do = os.path.join(SCRATCH, name + "_dup.tets")
+    r4 = frontdt(dsrc, "--periodic", "xyz", "--box", box, "-o", do, "-q")
+    expect(r4.returncode == 0 and open(do, "rb").read() == got,
+           "%s: duplicates change the tets (%s)" % (name, r4.stderr))
     if CGAL != "none":
         ref = os.path.join(SCRATCH, name + ".cgal.tets")
         c = subprocess.run([CGAL, src, "%.17g" % lo, "%.17g" % length, ref], capture_output=True,

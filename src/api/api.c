@@ -562,7 +562,7 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, fdt_resul
         err = fdt_periodic_build(pr.p, (uint32_t)pr.m, &b, nthreads, &pm, ctx->diag,
                                  sizeof ctx->diag);
     if (!err)
-        err = fdt_periodic_renumber(&pm, pr.orig);
+        err = fdt_periodic_renumber(&pm, pr.orig, pr.m);
     double t2 = fdt_now_s();
     if (!err && !(r = calloc(1, sizeof *r)))
         err = FDT_ENOMEM;

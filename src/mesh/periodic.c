@@ -65,7 +65,7 @@ static int ext_grow(ext *e, size_t need)
  * The points, then for each the images whose every offset is allowed: on
  * periodic axis k, +1 when x - lo <= m[k] (the image lands within m above
  * hi), -1 when hi - x <= m[k]. Every image whose exact coordinate lies in
- * (lo - m', hi + m') on each periodic axis, m' < m (region(), below), is
+ * (lo - m', hi + m') on each periodic axis, m' < m (one_round's mm), is
  * then present: x + L < hi + m' means x - lo < m', and rounding is
  * monotone.
  */
@@ -207,29 +207,15 @@ static int make_key(const ext *e, const uint32_t *v, int nv, key *k, int *repeat
     return kept;
 }
 
-static uint64_t key_hash(const key *k)
-{
-    uint64_t h = 0;
-    for (int j = 0; j < 4; j++) {
-        uint64_t o = (uint64_t)(uint8_t)k->off[j][0] | (uint64_t)(uint8_t)k->off[j][1] << 8 |
-                     (uint64_t)(uint8_t)k->off[j][2] << 16;
-        h = fdt_mix64(h ^ ((uint64_t)k->id[j] << 24 | o));
-    }
-    return h;
-}
-
-/* An open-addressing set of keys (indices into keys[]). */
+/* The kept tets' (or hull faces') keys. */
 typedef struct keyset {
     key *keys;
     size_t n, cap;
-    uint32_t *slot; /* UINT32_MAX empty */
-    size_t mask;
 } keyset;
 
 static void keyset_free(keyset *s)
 {
     free(s->keys);
-    free(s->slot);
     memset(s, 0, sizeof *s);
 }
 
@@ -247,68 +233,23 @@ static int keyset_add(keyset *s, const key *k)
     return FDT_OK;
 }
 
-static int keyset_index(keyset *s)
-{
-    size_t sz = 16;
-    while (sz < 2 * s->n)
-        sz *= 2;
-    free(s->slot);
-    s->slot = malloc(sz * sizeof *s->slot);
-    if (!s->slot)
-        return FDT_ENOMEM;
-    memset(s->slot, 0xff, sz * sizeof *s->slot);
-    s->mask = sz - 1;
-    for (size_t i = 0; i < s->n; i++) {
-        size_t h = (size_t)key_hash(&s->keys[i]) & s->mask;
-        while (s->slot[h] != UINT32_MAX)
-            h = (h + 1) & s->mask;
-        s->slot[h] = (uint32_t)i;
-    }
-    return FDT_OK;
-}
-
-static int keyset_has(const keyset *s, const key *k)
-{
-    size_t h = (size_t)key_hash(k) & s->mask;
-    for (; s->slot[h] != UINT32_MAX; h = (h + 1) & s->mask)
-        if (!memcmp(&s->keys[s->slot[h]], k, sizeof *k))
-            return 1;
-    return 0;
-}
-
 /* ---- step 4: the proofs ------------------------------------------------ */
 
-/* The region where every image is present: (lo - m', hi + m') on each
- * periodic axis, m' a hair under the margin (or the period) for the
- * roundings of make_images' tests and of hi - lo. */
-static void region(const fdt_periodic_box *b, const double m[3], double A[3], double B[3])
-{
-    for (int k = 0; k < 3; k++) {
-        double L = b->hi[k] - b->lo[k];
-        double mm = (m[k] < L ? m[k] : L) * (1 - 0x1p-40);
-        A[k] = b->lo[k] - mm;
-        B[k] = b->hi[k] + mm;
-    }
-}
-
 /*
- * Whether tet v's circumscribed ball, cut to the points' extent [ylo, yhi]
- * on the axes that are not periodic, lies inside (A, B) on the periodic
- * ones, with room for the circumcentre's error: fdt_circumcenter's few
- * ulps of the radius, and the images' rounding err moved through the
- * tet's condition (edge^3 / |6 volume|).
+ * How far beyond the box tet v's circumscribed ball reaches on each
+ * periodic axis (need[k], 0 when it stays inside), the ball cut to the
+ * points' extent [ylo, yhi] on the axes that are not periodic, with room
+ * for the circumcentre's error: fdt_circumcenter's few ulps of the radius,
+ * and the images' rounding err moved through the tet's condition (edge^3
+ * / |6 volume|). A tet too flat to place reaches the whole period.
  */
-static int ball_inside(const ext *e, const uint32_t *v, const fdt_periodic_box *b,
-                       const double A[3], const double B[3], const double ylo[3],
-                       const double yhi[3])
+static void ball_reach(const ext *e, const uint32_t *v, const fdt_periodic_box *b,
+                       const double ylo[3], const double yhi[3], double need[3])
 {
     const double *a = e->P + 3 * (size_t)v[0];
     const double *p[3] = {e->P + 3 * (size_t)v[1], e->P + 3 * (size_t)v[2],
                           e->P + 3 * (size_t)v[3]};
-    double x[3];
-    if (fdt_circumcenter(a, p[0], p[1], p[2], x) != 0)
-        return 0;
-    double u[3][3], h = 0;
+    double x[3], u[3][3], h = 0;
     for (int r = 0; r < 3; r++)
         for (int k = 0; k < 3; k++) {
             u[r][k] = p[r][k] - a[k];
@@ -317,12 +258,16 @@ static int ball_inside(const ext *e, const uint32_t *v, const fdt_periodic_box *
     double det = u[0][0] * (u[1][1] * u[2][2] - u[1][2] * u[2][1]) -
                  u[0][1] * (u[1][0] * u[2][2] - u[1][2] * u[2][0]) +
                  u[0][2] * (u[1][0] * u[2][1] - u[1][1] * u[2][0]);
+    for (int k = 0; k < 3; k++)
+        need[k] = b->axes >> k & 1 ? INFINITY : 0;
+    if (fdt_circumcenter(a, p[0], p[1], p[2], x) != 0)
+        return;
     double R = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
     double c[3] = {a[0] + x[0], a[1] + x[1], a[2] + x[2]};
     double kappa = 64 * h * h * h / fabs(det);
     double cerr = 0x1p-40 * (R + fabs(c[0]) + fabs(c[1]) + fabs(c[2])) + kappa * 4 * e->err;
     if (!(cerr < R + h))
-        return 0; /* too flat to place */
+        return; /* too flat to place */
     double D2 = 0;
     for (int j = 0; j < 3; j++) {
         if (b->axes >> j & 1)
@@ -335,10 +280,13 @@ static int ball_inside(const ext *e, const uint32_t *v, const fdt_periodic_box *
     double Rh = R + 2 * cerr, Dl = sqrt(D2);
     double ext2 = Rh > Dl ? (Rh - Dl) * (Rh + Dl) : 0;
     double extent = sqrt(ext2) * (1 + 0x1p-40) + cerr;
-    for (int k = 0; k < 3; k++)
-        if (b->axes >> k & 1 && !(c[k] - extent > A[k] && c[k] + extent < B[k]))
-            return 0;
-    return 1;
+    for (int k = 0; k < 3; k++) {
+        if (!(b->axes >> k & 1))
+            continue;
+        double over = c[k] + extent - b->hi[k], under = b->lo[k] - (c[k] - extent);
+        double w = over > under ? over : under;
+        need[k] = w > 0 ? w * (1 + 0x1p-40) : 0;
+    }
 }
 
 /* ---- the driver -------------------------------------------------------- */
@@ -352,6 +300,7 @@ typedef struct run {
     fdt_images im;
     fdt_ins m;
     keyset tets, hull;
+    double need[3];        /* a failed round: how far the balls reached */
     char *diag;
     size_t dsz;
 } run;
@@ -407,87 +356,69 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
             fdt_certify_describe(&why, r->diag, r->dsz);
         return err;
     }
-    /* the kept tets and hull faces, and the soundness proofs */
-    double A[3], B[3];
-    region(b, m, A, B);
+    /*
+     * The proofs (periodic.h): every tet with a vertex that is an input
+     * point (offset 0) has its ball inside the region where every image
+     * is present, every such hull face a normal with no periodic
+     * component. Then each input point's star in this mesh is made of
+     * tets of the periodic mesh and, a closed neighbourhood of the point,
+     * is its whole star there; the kept tets (least vertex an input point)
+     * are each star's share, so all of the periodic mesh, once.
+     */
+    double mm[3];
+    for (int k = 0; k < 3; k++) {
+        double L = b->hi[k] - b->lo[k];
+        mm[k] = (m[k] < L ? m[k] : L) * (1 - 0x1p-40);
+    }
     int again = 0;
     long repeat_id = -1;
     const fdt_ins *M = &r->m;
-    for (uint32_t t = 0; t < M->nslots && !again; t++) {
+    for (int k = 0; k < 3; k++)
+        r->need[k] = 0;
+    for (uint32_t t = 0; t < M->nslots; t++) {
         if (fdt_ins_is_free(M, t))
             continue;
         const uint32_t *v = fdt_ins_tet(M, t);
-        int inf = fdt_ins_inf_index(v);
-        key k;
-        int rep;
+        int inf = fdt_ins_inf_index(v), nv = inf < 0 ? 4 : 3;
+        uint32_t w[4];
+        if (inf < 0)
+            memcpy(w, v, sizeof w);
+        else
+            fdt_ins_face_inward(v, inf, w);
+        int touches = 0;
+        for (int j = 0; j < nv; j++) {
+            const int8_t *o = r->e.off + 3 * (size_t)w[j];
+            touches |= !o[0] && !o[1] && !o[2];
+        }
+        if (!touches)
+            continue;
         if (inf < 0) {
-            if (!make_key(&r->e, v, 4, &k, &rep))
-                continue;
-            if (!ball_inside(&r->e, v, b, A, B, r->ylo, r->yhi)) {
-                again = 1;
-                break;
-            }
-            if (rep && repeat_id < 0)
-                repeat_id = k.id[0];
-            if ((err = keyset_add(&r->tets, &k)) != FDT_OK)
-                return err;
+            double need[3];
+            ball_reach(&r->e, w, b, r->ylo, r->yhi, need);
+            for (int k = 0; k < 3; k++)
+                if (b->axes >> k & 1 && need[k] >= mm[k]) {
+                    again = 1;
+                    r->need[k] = need[k] > r->need[k] ? need[k] : r->need[k];
+                }
         } else {
-            uint32_t f[3];
-            fdt_ins_face_inward(v, inf, f);
-            if (!make_key(&r->e, f, 3, &k, &rep))
-                continue;
             /* nothing lies beyond a hull face of the periodic set: its
              * normal has no component along a periodic axis */
             for (int a = 0; a < 3; a++)
-                if (b->axes >> a & 1 && fdt_images_normal_sign(&r->im, f, a) != 0)
+                if (b->axes >> a & 1 && fdt_images_normal_sign(&r->im, w, a) != 0) {
                     again = 1;
-            if (again)
-                break;
-            if (rep && repeat_id < 0)
-                repeat_id = k.id[0];
-            if ((err = keyset_add(&r->hull, &k)) != FDT_OK)
-                return err;
+                    r->need[a] = INFINITY;
+                }
         }
-    }
-    if (again)
-        return ROUND_AGAIN;
-    if ((err = keyset_index(&r->tets)) != FDT_OK || (err = keyset_index(&r->hull)) != FDT_OK)
-        return err;
-    /* completeness: across every face of a kept tet (and under every kept
-     * hull face) a tet or hull face whose translate is kept */
-    for (uint32_t t = 0; t < M->nslots && !again; t++) {
-        if (fdt_ins_is_free(M, t))
-            continue;
-        const uint32_t *v = fdt_ins_tet(M, t);
-        int inf = fdt_ins_inf_index(v), rep;
+        if (again)
+            continue; /* the margin grows: gather what the rest needs */
         key k;
-        if (inf < 0 ? !make_key(&r->e, v, 4, &k, &rep) : 0)
+        int rep;
+        if (!make_key(&r->e, w, nv, &k, &rep))
             continue;
-        if (inf >= 0) {
-            uint32_t f[3];
-            fdt_ins_face_inward(v, inf, f);
-            if (!make_key(&r->e, f, 3, &k, &rep))
-                continue;
-        }
-        for (int j = 0; j < 4 && !again; j++) {
-            if (inf >= 0 && j != inf)
-                continue; /* a hull face: the tet under it */
-            uint32_t nt;
-            int nk;
-            (void)fdt_ins_across(M, t, j, &nt, &nk);
-            const uint32_t *w = fdt_ins_tet(M, nt);
-            int ninf = fdt_ins_inf_index(w);
-            key nkey;
-            if (ninf < 0) {
-                (void)make_key(&r->e, w, 4, &nkey, &rep);
-                again = !keyset_has(&r->tets, &nkey);
-            } else {
-                uint32_t f[3];
-                fdt_ins_face_inward(w, ninf, f);
-                (void)make_key(&r->e, f, 3, &nkey, &rep);
-                again = !keyset_has(&r->hull, &nkey);
-            }
-        }
+        if (rep && repeat_id < 0)
+            repeat_id = k.id[0];
+        if ((err = keyset_add(inf < 0 ? &r->tets : &r->hull, &k)) != FDT_OK)
+            return err;
     }
     if (again)
         return ROUND_AGAIN;
@@ -513,10 +444,54 @@ static int key_cmp(const void *x, const void *y)
     return 0;
 }
 
-/* out's arrays from a set, sorted. */
-static int emit(keyset *s, int nv, uint32_t **ids, int8_t **offs, size_t *count)
+/* keys sorted: counted into buckets by their first id (ids below n),
+ * each bucket (the tets a point is the least vertex of: a few) sorted by
+ * insertion, a large one by qsort. qsort of 6.8M keys took a fifth of a
+ * 1M-point run. */
+static int sort_keys(key *keys, size_t count, size_t n)
 {
-    qsort(s->keys, s->n, sizeof *s->keys, key_cmp);
+    size_t *start = calloc(n + 1, sizeof *start);
+    key *tmp = malloc((count ? count : 1) * sizeof *tmp);
+    if (!start || !tmp) {
+        free(start);
+        free(tmp);
+        return FDT_ENOMEM;
+    }
+    for (size_t i = 0; i < count; i++)
+        start[keys[i].id[0] + 1]++;
+    for (size_t v = 0; v < n; v++)
+        start[v + 1] += start[v];
+    for (size_t i = 0; i < count; i++)
+        tmp[start[keys[i].id[0]]++] = keys[i];
+    for (size_t v = n; v > 0; v--) /* start[v] was the end of bucket v */
+        start[v] = start[v - 1];
+    start[0] = 0;
+    for (size_t v = 0; v < n; v++) {
+        key *a = tmp + start[v];
+        size_t c = start[v + 1] - start[v];
+        if (c > 32) {
+            qsort(a, c, sizeof *a, key_cmp);
+            continue;
+        }
+        for (size_t i = 1; i < c; i++) {
+            key x = a[i];
+            size_t j = i;
+            for (; j > 0 && key_cmp(&x, &a[j - 1]) < 0; j--)
+                a[j] = a[j - 1];
+            a[j] = x;
+        }
+    }
+    memcpy(keys, tmp, count * sizeof *keys);
+    free(tmp);
+    free(start);
+    return FDT_OK;
+}
+
+/* out's arrays from a set of keys with ids below n, sorted. */
+static int emit(keyset *s, int nv, size_t n, uint32_t **ids, int8_t **offs, size_t *count)
+{
+    if (sort_keys(s->keys, s->n, n) != FDT_OK)
+        return FDT_ENOMEM;
     *ids = malloc((s->n ? s->n : 1) * (size_t)nv * sizeof **ids);
     *offs = malloc((s->n ? s->n : 1) * (size_t)nv * 3);
     if (!*ids || !*offs)
@@ -557,52 +532,18 @@ int fdt_periodic_check(const double *X, size_t n, const fdt_periodic_box *b, cha
     return FDT_OK;
 }
 
-/* Rows of nv vertices (ids, then offsets) renumbered by orig, made
- * relative to their least id again and sorted. */
-static int renumber_rows(uint32_t *ids, int8_t *offs, size_t count, int nv, const int32_t *orig)
+int fdt_periodic_renumber(fdt_periodic_mesh *m, const int32_t *orig, size_t n)
 {
-    key *k = malloc((count ? count : 1) * sizeof *k);
-    if (!k)
-        return FDT_ENOMEM;
-    for (size_t i = 0; i < count; i++) {
-        memset(&k[i], 0, sizeof k[i]);
-        int lo = 0;
-        uint32_t v[4];
-        for (int j = 0; j < nv; j++) {
-            v[j] = (uint32_t)orig[ids[(size_t)nv * i + (size_t)j]];
-            if (v[j] < v[lo])
-                lo = j;
-        }
-        const int8_t *o0 = offs + 3 * ((size_t)nv * i + (size_t)lo);
-        for (int j = 0; j < nv; j++) {
-            k[i].id[j] = v[j];
-            for (int a = 0; a < 3; a++)
-                k[i].off[j][a] = (int8_t)(offs[3 * ((size_t)nv * i + (size_t)j) + a] - o0[a]);
-        }
-        for (int a = 1; a < nv; a++)
-            for (int j = a; j > 0 && vert_cmp(k[i].id[j], k[i].off[j], k[i].id[j - 1],
-                                              k[i].off[j - 1]) < 0; j--) {
-                key t = k[i];
-                k[i].id[j] = t.id[j - 1];
-                k[i].id[j - 1] = t.id[j];
-                memcpy(k[i].off[j], t.off[j - 1], 3);
-                memcpy(k[i].off[j - 1], t.off[j], 3);
-            }
-    }
-    qsort(k, count, sizeof *k, key_cmp);
-    for (size_t i = 0; i < count; i++)
-        for (int j = 0; j < nv; j++) {
-            ids[(size_t)nv * i + (size_t)j] = k[i].id[j];
-            memcpy(offs + 3 * ((size_t)nv * i + (size_t)j), k[i].off[j], 3);
-        }
-    free(k);
+    /* orig increasing (src/geom/prepare.h keeps first occurrences in
+     * input order): the rows keep their order and their least vertex */
+    for (size_t i = 1; i < n; i++)
+        if (orig[i] <= orig[i - 1])
+            return FDT_EINTERNAL;
+    for (size_t i = 0; i < 4 * m->ntets; i++)
+        m->tets[i] = (uint32_t)orig[m->tets[i]];
+    for (size_t i = 0; i < 3 * m->nhull; i++)
+        m->hull[i] = (uint32_t)orig[m->hull[i]];
     return FDT_OK;
-}
-
-int fdt_periodic_renumber(fdt_periodic_mesh *m, const int32_t *orig)
-{
-    int err = renumber_rows(m->tets, m->tet_off, m->ntets, 4, orig);
-    return err ? err : renumber_rows(m->hull, m->hull_off, m->nhull, 3, orig);
 }
 
 int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, int nthreads,
@@ -644,20 +585,27 @@ int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, i
         vol *= s > 0 ? s : 1;
     }
     double m0 = 3 * cbrt(vol / n), m[3] = {0, 0, 0};
+    for (int k = 0; k < 3; k++)
+        if (b->axes >> k & 1)
+            m[k] = m0 < b->hi[k] - b->lo[k] ? m0 : b->hi[k] - b->lo[k];
     for (;;) {
-        int last = 1;
-        for (int k = 0; k < 3; k++) {
-            if (!(b->axes >> k & 1))
-                continue;
-            double L = b->hi[k] - b->lo[k];
-            m[k] = m0 < L ? m0 : L;
-            last &= m0 >= L;
-        }
         out->rounds++;
         err = one_round(&r, m, nthreads, out);
         if (err != ROUND_AGAIN)
             break;
-        if (last) {
+        /* The next margin: what the balls reached, and a quarter more (a
+         * face that was not flat: twice the margin), at most the period. */
+        int grew = 0;
+        for (int k = 0; k < 3; k++) {
+            double L = b->hi[k] - b->lo[k];
+            if (!(b->axes >> k & 1) || !(r.need[k] > 0) || m[k] >= L)
+                continue;
+            double w = isfinite(r.need[k]) ? 1.25 * r.need[k] : 2 * m[k];
+            w = w > 1.25 * m[k] ? w : 1.25 * m[k];
+            m[k] = w < L ? w : L;
+            grew = 1;
+        }
+        if (!grew) {
             snprintf(diag, diag_size,
                      "no periodic triangulation in one copy of the box: with every point's "
                      "neighbouring images the mesh still reaches past them (the box is too "
@@ -667,11 +615,10 @@ int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, i
             err = FDT_EDEGENERATE;
             break;
         }
-        m0 *= 2;
     }
     memcpy(out->margin, m, sizeof m);
-    if (err == FDT_OK && ((err = emit(&r.tets, 4, &out->tets, &out->tet_off, &out->ntets)) ||
-                          (err = emit(&r.hull, 3, &out->hull, &out->hull_off, &out->nhull))))
+    if (err == FDT_OK && ((err = emit(&r.tets, 4, n, &out->tets, &out->tet_off, &out->ntets)) ||
+                          (err = emit(&r.hull, 3, n, &out->hull, &out->hull_off, &out->nhull))))
         snprintf(diag, diag_size, "out of memory");
     fdt_ins_free(&r.m);
     keyset_free(&r.tets);

@@ -90,9 +90,10 @@ size_t fdt_periodic_row_text(char *buf, const uint32_t id[4], const int8_t off[1
 int fdt_periodic_check(const double *X, size_t n, const fdt_periodic_box *b, char *diag,
                        size_t diag_size);
 
-/* m's ids renumbered by orig (a merged input's first index of each
- * point), each row made relative to its least id again and the rows
- * sorted. FDT_OK or FDT_ENOMEM. */
-int fdt_periodic_renumber(fdt_periodic_mesh *m, const int32_t *orig);
+/* m's ids (below n) renumbered by orig, a merged input's first index of
+ * each point, increasing (src/geom/prepare.h), so that every row keeps
+ * its order and its least vertex. FDT_OK, or FDT_EINTERNAL when orig is
+ * not increasing. */
+int fdt_periodic_renumber(fdt_periodic_mesh *m, const int32_t *orig, size_t n);
 
 #endif
