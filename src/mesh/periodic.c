@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "base/hash.h"
+#include "base/spawn.h"
 #include "geom/images.h"
 #include "geom/morton.h"
 #include "mesh/certify.h"
@@ -18,16 +18,32 @@ typedef struct ext {
     double *P;       /* rounded images, 3 each */
     uint32_t *src;   /* input index */
     int8_t *off;     /* 3 each */
+    uint64_t *vk;    /* each as one integer (vpack), once in Morton order */
     uint8_t *exact;
     uint32_t n, cap;
     double err;      /* the largest |exact - rounded| */
 } ext;
+
+/*
+ * A vertex (input index, offsets) as one integer: the index, then each
+ * offset plus 128 in a byte, so that integer order is the order by index,
+ * then offsets. VZERO: the offsets of an input point itself.
+ */
+#define VZERO UINT64_C(0x808080)
+#define VOFF UINT64_C(0xffffff)
+
+static inline uint64_t vpack(uint32_t src, const int8_t o[3])
+{
+    return (uint64_t)src << 24 | (uint64_t)(uint8_t)(o[0] + 128) << 16 |
+           (uint64_t)(uint8_t)(o[1] + 128) << 8 | (uint64_t)(uint8_t)(o[2] + 128);
+}
 
 static void ext_free(ext *e)
 {
     free(e->P);
     free(e->src);
     free(e->off);
+    free(e->vk);
     free(e->exact);
     memset(e, 0, sizeof *e);
 }
@@ -55,7 +71,10 @@ static int ext_grow(ext *e, size_t need)
     uint8_t *ex = realloc(e->exact, cap);
     if (ex)
         e->exact = ex;
-    if (!P || !src || !off || !ex)
+    uint64_t *vk = realloc(e->vk, cap * sizeof *vk);
+    if (vk)
+        e->vk = vk;
+    if (!P || !src || !off || !ex || !vk)
         return FDT_ENOMEM;
     e->cap = (uint32_t)cap;
     return FDT_OK;
@@ -143,6 +162,7 @@ static int morton(ext *e, double blo[3], double bhi[3])
         memcpy(s.P + 3 * (size_t)i, e->P + 3 * (size_t)j, 3 * sizeof(double));
         memcpy(s.off + 3 * (size_t)i, e->off + 3 * (size_t)j, 3);
         s.src[i] = e->src[j];
+        s.vk[i] = vpack(e->src[j], e->off + 3 * (size_t)j);
         s.exact[i] = e->exact[j];
     }
     s.n = e->n;
@@ -155,56 +175,48 @@ static int morton(ext *e, double blo[3], double bhi[3])
 
 /* ---- step 3: the kept tets and hull faces, normalised ------------------ */
 
-/* A tet (nv = 4) or hull face (3) as the periodic mesh names it. */
+/* A tet (4 vertices) or hull face (3, then UINT64_MAX) as the periodic
+ * mesh names it: packed vertices ascending, offsets relative to the
+ * first. */
 typedef struct key {
-    uint32_t id[4];
-    int8_t off[4][3];
+    uint64_t v[4];
 } key;
 
-static int vert_cmp(uint32_t ia, const int8_t *oa, uint32_t ib, const int8_t *ob)
+static int key_cmp(const void *x, const void *y)
 {
-    if (ia != ib)
-        return ia < ib ? -1 : 1;
-    return memcmp(oa, ob, 3);
+    const key *a = x, *b = y;
+    for (int j = 0; j < 4; j++)
+        if (a->v[j] != b->v[j])
+            return a->v[j] < b->v[j] ? -1 : 1;
+    return 0;
 }
 
 /*
- * The key of the vertices v[0 .. nv) of the extended set: the least vertex
- * (input index, then offsets) taken as the origin, the others' offsets
- * relative to it, sorted. Returns whether that least vertex is an input
- * point (offset 0: the copy this mesh keeps); *repeat whether two vertices
- * are images of one point.
+ * The key of the vertices w[0 .. nv) of the extended set: sorted, the
+ * least one's offsets subtracted from every one's (a byte at a time
+ * without borrows: offsets are -1..1, so every byte stays in 126..130).
+ * Returns whether the least vertex is an input point (the copy this mesh
+ * keeps); *repeat whether two vertices are images of one point.
  */
-static int make_key(const ext *e, const uint32_t *v, int nv, key *k, int *repeat)
+static int make_key(const ext *e, const uint32_t *w, int nv, key *k, int *repeat)
 {
-    memset(k, 0, sizeof *k);
-    int lo = 0;
-    for (int j = 1; j < nv; j++)
-        if (vert_cmp(e->src[v[j]], e->off + 3 * (size_t)v[j], e->src[v[lo]],
-                     e->off + 3 * (size_t)v[lo]) < 0)
-            lo = j;
-    const int8_t *o0 = e->off + 3 * (size_t)v[lo];
-    int kept = !o0[0] && !o0[1] && !o0[2];
-    for (int j = 0; j < nv; j++) {
-        k->id[j] = e->src[v[j]];
-        for (int a = 0; a < 3; a++)
-            k->off[j][a] = (int8_t)(e->off[3 * (size_t)v[j] + a] - o0[a]);
-    }
-    for (int a = 1; a < nv; a++) /* insertion sort */
-        for (int j = a; j > 0 && vert_cmp(k->id[j], k->off[j], k->id[j - 1], k->off[j - 1]) < 0;
-             j--) {
-            uint32_t t = k->id[j];
-            k->id[j] = k->id[j - 1];
-            k->id[j - 1] = t;
-            int8_t to[3];
-            memcpy(to, k->off[j], 3);
-            memcpy(k->off[j], k->off[j - 1], 3);
-            memcpy(k->off[j - 1], to, 3);
+    uint64_t *a = k->v;
+    for (int j = 0; j < nv; j++)
+        a[j] = e->vk[w[j]];
+    a[3] = nv == 4 ? a[3] : UINT64_MAX;
+    for (int i = 1; i < nv; i++) /* insertion sort of 3 or 4 */
+        for (int j = i; j > 0 && a[j] < a[j - 1]; j--) {
+            uint64_t t = a[j];
+            a[j] = a[j - 1];
+            a[j - 1] = t;
         }
+    uint64_t lo = a[0] & VOFF;
     *repeat = 0;
-    for (int j = 1; j < nv; j++)
-        *repeat |= k->id[j] == k->id[j - 1];
-    return kept;
+    for (int j = 0; j < nv; j++) {
+        a[j] = a[j] + VZERO - lo;
+        *repeat |= j > 0 && a[j] >> 24 == a[j - 1] >> 24;
+    }
+    return lo == VZERO;
 }
 
 /* The kept tets' (or hull faces') keys. */
@@ -230,6 +242,23 @@ static int keyset_add(keyset *s, const key *k)
         s->cap = cap;
     }
     s->keys[s->n++] = *k;
+    return FDT_OK;
+}
+
+/* a += b's keys. */
+static int keyset_cat(keyset *a, const keyset *b)
+{
+    if (a->n + b->n > a->cap) {
+        size_t cap = a->n + b->n;
+        key *nk = realloc(a->keys, (cap ? cap : 1) * sizeof *nk);
+        if (!nk)
+            return FDT_ENOMEM;
+        a->keys = nk;
+        a->cap = cap;
+    }
+    if (b->n)
+        memcpy(a->keys + a->n, b->keys, b->n * sizeof *b->keys);
+    a->n += b->n;
     return FDT_OK;
 }
 
@@ -307,6 +336,86 @@ typedef struct run {
 
 enum { ROUND_OK = 0, ROUND_AGAIN = 1 };
 
+/* One thread's share of a round's proofs: the slots [t0, t1). */
+typedef struct prove_job {
+    run *r;
+    const double *m;     /* the margin */
+    uint32_t t0, t1;
+    keyset tets, hull;   /* the kept ones */
+    double need[3];      /* how far the balls reached, where too far */
+    int again, err;
+    long repeat_id;      /* a kept tet with two images of this point, or -1 */
+} prove_job;
+
+/*
+ * The proofs (periodic.h) over a job's slots: every tet with a vertex that
+ * is an input point (offset 0) has its ball inside the region where every
+ * image is present, (lo - m', hi + m') with m' a hair under the margin (or
+ * the period) for the roundings of make_images' tests and of hi - lo, and
+ * every such hull face a normal with no periodic component. Then each
+ * input point's star in this mesh is made of tets of the periodic mesh
+ * and, a closed neighbourhood of the point, is its whole star there; the
+ * kept tets (least vertex an input point) are each star's share, so all
+ * of the periodic mesh, once. Once a proof fails the job only gathers how
+ * far the balls reach (the next margin).
+ */
+static void *prove_run(void *arg)
+{
+    prove_job *j = arg;
+    const run *r = j->r;
+    const fdt_periodic_box *b = r->b;
+    const fdt_ins *M = &r->m;
+    double mm[3];
+    for (int k = 0; k < 3; k++) {
+        double L = b->hi[k] - b->lo[k];
+        mm[k] = (j->m[k] < L ? j->m[k] : L) * (1 - 0x1p-40);
+    }
+    j->repeat_id = -1;
+    for (uint32_t t = j->t0; t < j->t1 && !j->err; t++) {
+        if (fdt_ins_is_free(M, t))
+            continue;
+        const uint32_t *v = fdt_ins_tet(M, t);
+        int inf = fdt_ins_inf_index(v), nv = inf < 0 ? 4 : 3;
+        uint32_t w[4];
+        if (inf < 0)
+            memcpy(w, v, sizeof w);
+        else
+            fdt_ins_face_inward(v, inf, w);
+        int touches = 0;
+        for (int i = 0; i < nv; i++)
+            touches |= (r->e.vk[w[i]] & VOFF) == VZERO;
+        if (!touches)
+            continue;
+        if (inf < 0) {
+            double need[3];
+            ball_reach(&r->e, w, b, r->ylo, r->yhi, need);
+            for (int k = 0; k < 3; k++)
+                if (b->axes >> k & 1 && need[k] >= mm[k]) {
+                    j->again = 1;
+                    j->need[k] = need[k] > j->need[k] ? need[k] : j->need[k];
+                }
+        } else {
+            /* nothing lies beyond a hull face of the periodic set: its
+             * normal has no component along a periodic axis */
+            for (int a = 0; a < 3; a++)
+                if (b->axes >> a & 1 && fdt_images_normal_sign(&r->im, w, a) != 0) {
+                    j->again = 1;
+                    j->need[a] = INFINITY;
+                }
+        }
+        if (j->again)
+            continue;
+        key k;
+        int rep;
+        if (!make_key(&r->e, w, nv, &k, &rep))
+            continue;
+        if (rep && j->repeat_id < 0)
+            j->repeat_id = (long)(k.v[0] >> 24);
+        j->err = keyset_add(inf < 0 ? &j->tets : &j->hull, &k);
+    }
+    return NULL;
+}
+
 /* One round at margin m: ROUND_OK with r->tets and r->hull the periodic
  * mesh, ROUND_AGAIN when a proof failed, or an error. */
 static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh *out)
@@ -356,70 +465,38 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
             fdt_certify_describe(&why, r->diag, r->dsz);
         return err;
     }
-    /*
-     * The proofs (periodic.h): every tet with a vertex that is an input
-     * point (offset 0) has its ball inside the region where every image
-     * is present, every such hull face a normal with no periodic
-     * component. Then each input point's star in this mesh is made of
-     * tets of the periodic mesh and, a closed neighbourhood of the point,
-     * is its whole star there; the kept tets (least vertex an input point)
-     * are each star's share, so all of the periodic mesh, once.
-     */
-    double mm[3];
-    for (int k = 0; k < 3; k++) {
-        double L = b->hi[k] - b->lo[k];
-        mm[k] = (m[k] < L ? m[k] : L) * (1 - 0x1p-40);
+    /* the proofs and the kept tets, on the run's threads (prove()) */
+    int T = nthreads < 1 ? 1 : nthreads > 64 ? 64 : nthreads;
+    prove_job jobs[64];
+    memset(jobs, 0, sizeof jobs);
+    for (int i = 0; i < T; i++) {
+        jobs[i].r = r;
+        jobs[i].m = m;
+        jobs[i].t0 = (uint32_t)((uint64_t)r->m.nslots * (uint64_t)i / (uint64_t)T);
+        jobs[i].t1 = (uint32_t)((uint64_t)r->m.nslots * (uint64_t)(i + 1) / (uint64_t)T);
     }
+    fdt_fork_join(jobs, sizeof jobs[0], T, prove_run);
     int again = 0;
     long repeat_id = -1;
-    const fdt_ins *M = &r->m;
     for (int k = 0; k < 3; k++)
         r->need[k] = 0;
-    for (uint32_t t = 0; t < M->nslots; t++) {
-        if (fdt_ins_is_free(M, t))
-            continue;
-        const uint32_t *v = fdt_ins_tet(M, t);
-        int inf = fdt_ins_inf_index(v), nv = inf < 0 ? 4 : 3;
-        uint32_t w[4];
-        if (inf < 0)
-            memcpy(w, v, sizeof w);
-        else
-            fdt_ins_face_inward(v, inf, w);
-        int touches = 0;
-        for (int j = 0; j < nv; j++) {
-            const int8_t *o = r->e.off + 3 * (size_t)w[j];
-            touches |= !o[0] && !o[1] && !o[2];
-        }
-        if (!touches)
-            continue;
-        if (inf < 0) {
-            double need[3];
-            ball_reach(&r->e, w, b, r->ylo, r->yhi, need);
-            for (int k = 0; k < 3; k++)
-                if (b->axes >> k & 1 && need[k] >= mm[k]) {
-                    again = 1;
-                    r->need[k] = need[k] > r->need[k] ? need[k] : r->need[k];
-                }
-        } else {
-            /* nothing lies beyond a hull face of the periodic set: its
-             * normal has no component along a periodic axis */
-            for (int a = 0; a < 3; a++)
-                if (b->axes >> a & 1 && fdt_images_normal_sign(&r->im, w, a) != 0) {
-                    again = 1;
-                    r->need[a] = INFINITY;
-                }
-        }
-        if (again)
-            continue; /* the margin grows: gather what the rest needs */
-        key k;
-        int rep;
-        if (!make_key(&r->e, w, nv, &k, &rep))
-            continue;
-        if (rep && repeat_id < 0)
-            repeat_id = k.id[0];
-        if ((err = keyset_add(inf < 0 ? &r->tets : &r->hull, &k)) != FDT_OK)
-            return err;
+    for (int i = 0; i < T; i++) {
+        err = err ? err : jobs[i].err;
+        again |= jobs[i].again;
+        if (jobs[i].repeat_id >= 0 && (repeat_id < 0 || jobs[i].repeat_id < repeat_id))
+            repeat_id = jobs[i].repeat_id;
+        for (int k = 0; k < 3; k++)
+            r->need[k] = jobs[i].need[k] > r->need[k] ? jobs[i].need[k] : r->need[k];
     }
+    for (int i = 0; i < T && !err && !again; i++)
+        if ((err = keyset_cat(&r->tets, &jobs[i].tets)) == FDT_OK)
+            err = keyset_cat(&r->hull, &jobs[i].hull);
+    for (int i = 0; i < T; i++) {
+        keyset_free(&jobs[i].tets);
+        keyset_free(&jobs[i].hull);
+    }
+    if (err)
+        return err;
     if (again)
         return ROUND_AGAIN;
     if (repeat_id >= 0) {
@@ -431,17 +508,6 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
         return FDT_EDEGENERATE;
     }
     return ROUND_OK;
-}
-
-static int key_cmp(const void *x, const void *y)
-{
-    const key *a = x, *b = y;
-    for (int j = 0; j < 4; j++) {
-        int c = vert_cmp(a->id[j], a->off[j], b->id[j], b->off[j]);
-        if (c)
-            return c;
-    }
-    return 0;
 }
 
 /* keys sorted: counted into buckets by their first id (ids below n),
@@ -458,11 +524,11 @@ static int sort_keys(key *keys, size_t count, size_t n)
         return FDT_ENOMEM;
     }
     for (size_t i = 0; i < count; i++)
-        start[keys[i].id[0] + 1]++;
+        start[(keys[i].v[0] >> 24) + 1]++;
     for (size_t v = 0; v < n; v++)
         start[v + 1] += start[v];
     for (size_t i = 0; i < count; i++)
-        tmp[start[keys[i].id[0]]++] = keys[i];
+        tmp[start[keys[i].v[0] >> 24]++] = keys[i];
     for (size_t v = n; v > 0; v--) /* start[v] was the end of bucket v */
         start[v] = start[v - 1];
     start[0] = 0;
@@ -498,8 +564,12 @@ static int emit(keyset *s, int nv, size_t n, uint32_t **ids, int8_t **offs, size
         return FDT_ENOMEM;
     for (size_t i = 0; i < s->n; i++)
         for (int j = 0; j < nv; j++) {
-            (*ids)[(size_t)nv * i + (size_t)j] = s->keys[i].id[j];
-            memcpy(*offs + 3 * ((size_t)nv * i + (size_t)j), s->keys[i].off[j], 3);
+            uint64_t x = s->keys[i].v[j];
+            int8_t *o = *offs + 3 * ((size_t)nv * i + (size_t)j);
+            (*ids)[(size_t)nv * i + (size_t)j] = (uint32_t)(x >> 24);
+            o[0] = (int8_t)((int)(x >> 16 & 255) - 128);
+            o[1] = (int8_t)((int)(x >> 8 & 255) - 128);
+            o[2] = (int8_t)((int)(x & 255) - 128);
         }
     *count = s->n;
     return FDT_OK;
