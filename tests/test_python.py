@@ -451,12 +451,50 @@ def test_interpolation():
     raises(ValueError, t.interpolate, lin[:, 0], q, method="cubic")
 
 
+def test_periodic(tmp):
+    """periodic= and box= (issue 33): the CLI's --periodic .tets, line for
+    line, from simplices and offsets; the same mesh on 1 and 3 threads; what
+    a periodic mesh does not take yet; the argument errors."""
+    rng = np.random.default_rng(8)
+    pts = rng.random((1500, 3)) * [2.0, 1.0, 3.0] - [0.5, 0.0, 1.0]
+    box = (-0.5, 0.0, -1.0, 1.5, 1.0, 2.0)
+    t = frontdt.delaunay(pts, periodic="x,y,z", box=box)
+    off = t.offsets
+    check(off is not None and off.shape == (len(t.simplices), 4, 3) and off.dtype == np.int8,
+          "periodic: offsets (m, 4, 3) int8")
+    check(t.neighbors is None and t.stats["engine"] == "periodic" and
+          t.stats["periodic_images"] > 0, "periodic: no neighbours, the engine and its images")
+    path = os.path.join(tmp, "per.xyz")
+    np.savetxt(path, pts, fmt="%.17g")
+    out = os.path.join(tmp, "per.tets")
+    r = subprocess.run([FRONTDT, path, "--periodic", "xyz", "--box", ",".join(map(repr, box)),
+                        "-o", out, "--hash", "-q"], capture_output=True, text=True, check=True)
+    lines = "".join(" ".join(map(str, list(s) + o.reshape(-1).tolist())) + "\n"
+                    for s, o in zip(t.simplices.tolist(), off))
+    check(lines == open(out).read(), "periodic: the CLI's .tets")
+    check(r.stdout.strip() == "hash: " + t.hash, "periodic: the CLI's hash")
+    t3 = frontdt.delaunay(pts, periodic="xyz", box=box, threads=3)
+    check(np.array_equal(t3.simplices, t.simplices) and np.array_equal(t3.offsets, off),
+          "periodic: 3 threads")
+    check(frontdt.delaunay(pts).offsets is None, "plain: no offsets")
+    check(raises(ValueError, t.check) is not None, "periodic: check() refused")
+    check(raises(Exception, t.voronoi) is not None, "periodic: voronoi() refused")
+    check(raises(ValueError, frontdt.delaunay, pts, periodic="xz") is not None,
+          "periodic without box")
+    check(raises(ValueError, frontdt.delaunay, pts, box=box) is not None, "box without periodic")
+    check(raises(ValueError, frontdt.delaunay, pts, periodic="xq", box=box) is not None,
+          "periodic: a bad axis")
+    m = raises(ValueError, frontdt.delaunay, pts, periodic="xyz", box=(0, 0, 0, 1, 1, 1))
+    check(m is not None and "outside the periodic box" in m, "periodic: a point outside: %s" % m)
+
+
 def main():
     print("frontdt", frontdt.__version__, "from", frontdt._frontdt.__file__)
     with tempfile.TemporaryDirectory() as tmp:
         for test in [test_origin, test_scipy, test_faces, lambda: test_cli_degenerate(tmp),
                      test_errors, test_threads, test_gil_and_interrupt,
-                     test_lifetime_and_memory, test_voronoi, test_interpolation]:
+                     test_lifetime_and_memory, test_voronoi, test_interpolation,
+                     lambda: test_periodic(tmp)]:
             t0 = time.monotonic()
             test()
             print("%s: %.1f s" % (getattr(test, "__name__", "?"), time.monotonic() - t0),

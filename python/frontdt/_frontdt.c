@@ -189,6 +189,8 @@ static PyObject *tri_simplices(TriObject *self, void *closure)
 static PyObject *tri_neighbors(TriObject *self, void *closure)
 {
     (void)closure;
+    if (!fdt_result_neighbors(self->r)) /* a periodic mesh: none yet */
+        Py_RETURN_NONE;
     return view((PyObject *)self, fdt_result_neighbors(self->r),
                 (npy_intp)fdt_result_num_tets(self->r), 4, NPY_INT64);
 }
@@ -198,6 +200,26 @@ static PyObject *tri_hull(TriObject *self, void *closure)
     (void)closure;
     return view((PyObject *)self, fdt_result_hull_faces(self->r),
                 (npy_intp)fdt_result_num_hull_faces(self->r), 3, NPY_INT32);
+}
+
+/* A periodic run's image offsets, int8 (m, 4, 3); None for a plain run. */
+static PyObject *tri_offsets(TriObject *self, void *closure)
+{
+    (void)closure;
+    const int8_t *o = fdt_result_tet_offsets(self->r);
+    if (!o)
+        Py_RETURN_NONE;
+    npy_intp dims[3] = {(npy_intp)fdt_result_num_tets(self->r), 4, 3};
+    PyObject *a = PyArray_SimpleNewFromData(3, dims, NPY_INT8, (void *)o);
+    if (!a)
+        return NULL;
+    PyArray_CLEARFLAGS((PyArrayObject *)a, NPY_ARRAY_WRITEABLE);
+    Py_INCREF(self);
+    if (PyArray_SetBaseObject((PyArrayObject *)a, (PyObject *)self) < 0) {
+        Py_DECREF(a);
+        return NULL;
+    }
+    return a;
 }
 
 static PyObject *tri_duplicates(TriObject *self, void *closure)
@@ -388,6 +410,7 @@ static PyObject *tri_stats(TriObject *self, void *closure)
         PUT_DBL(d, st, t_certify) || PUT_SIZE(d, st, ins_conflict_tests) ||
         PUT_SIZE(d, st, ins_deferred) || PUT_SIZE(d, st, ins_serial) ||
         PUT_SIZE(d, st, sweep_parts) || PUT_SIZE(d, st, sweep_reinserted) ||
+        PUT_SIZE(d, st, periodic_images) || PUT_SIZE(d, st, periodic_rounds) ||
         PUT_SIZE(d, st, sweep_max_part) || PUT_SIZE(d, st, cell_batches) ||
         PUT_SIZE(d, st, cell_held_max) || PUT_DBL(d, st, t_cells) ||
         put(d, "duplicates", PyLong_FromSize_t(fdt_result_num_duplicates(self->r)))) {
@@ -416,6 +439,11 @@ static PyObject *run_check(const double *xyz, size_t n, const fdt_vid *tets,
 static PyObject *tri_check(TriObject *self, PyObject *unused)
 {
     (void)unused;
+    if (fdt_result_tet_offsets(self->r)) {
+        PyErr_SetString(PyExc_ValueError, "check() does not take a periodic mesh yet "
+                        "(its tets have image offsets)");
+        return NULL;
+    }
     return run_check(PyArray_DATA(self->points), (size_t)PyArray_DIM(self->points, 0),
                      fdt_result_tets(self->r), fdt_result_num_tets(self->r),
                      fdt_result_neighbors(self->r));
@@ -440,6 +468,11 @@ static PyGetSetDef tri_getset[] = {
      "opposite simplices[i, k], -1 on the convex hull (as in scipy).", NULL},
     {"convex_hull", (getter)tri_hull, NULL,
      "Hull faces, int32 (h, 3), outward normals by the right-hand rule.", NULL},
+    {"offsets", (getter)tri_offsets, NULL,
+     "A periodic run's image offsets, int8 (m, 4, 3): vertex k of tet i is point "
+     "simplices[i, k] moved by offsets[i, k] periods (relative to the tet's first, "
+     "lowest-id vertex, whose offsets are 0); None for a plain run. A periodic tet's "
+     "ids are ascending, not oriented.", NULL},
     {"duplicates", (getter)tri_duplicates, NULL,
      "int32 (n,): the index each point was merged into (bit-identical "
      "coordinates; itself for the first of its coordinates).", NULL},
@@ -717,14 +750,47 @@ static const char *search_choice(int i)
 static PyObject *py_delaunay(PyObject *mod, PyObject *args, PyObject *kw)
 {
     (void)mod;
-    static char *kwlist[] = {"points", "threads", "mode", "search", NULL};
-    PyObject *obj, *threads_obj = Py_None;
-    const char *mode_s = "auto", *search_s = "auto";
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|Oss:delaunay", kwlist, &obj,
-                                     &threads_obj, &mode_s, &search_s))
+    static char *kwlist[] = {"points", "threads", "mode", "search", "periodic", "box", NULL};
+    PyObject *obj, *threads_obj = Py_None, *box_obj = Py_None;
+    const char *mode_s = "auto", *search_s = "auto", *periodic_s = NULL;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|OsszO:delaunay", kwlist, &obj,
+                                     &threads_obj, &mode_s, &search_s, &periodic_s, &box_obj))
         return NULL;
     fdt_settings s;
     fdt_default_settings(&s);
+    /* periodic="x,z" with box=(xmin, ymin, zmin, xmax, ymax, zmax) */
+    for (const char *q = periodic_s; q && *q; q++) {
+        const char *ax = strchr("xyz", *q);
+        if (*q == ',')
+            continue;
+        if (!ax || (s.periodic >> (ax - "xyz") & 1)) {
+            PyErr_Format(PyExc_ValueError, "periodic takes axes x, y, z once each "
+                         "('x,z', 'xyz'), got '%s'", periodic_s);
+            return NULL;
+        }
+        s.periodic |= 1u << (ax - "xyz");
+    }
+    if ((s.periodic != 0) != (box_obj != Py_None)) {
+        PyErr_SetString(PyExc_ValueError, s.periodic ? "periodic needs box=(xmin, ymin, zmin, "
+                        "xmax, ymax, zmax): the periods" : "box needs periodic (the axes)");
+        return NULL;
+    }
+    if (s.periodic) {
+        PyObject *seq = PySequence_Fast(box_obj, "box must be a sequence of 6 numbers");
+        if (!seq)
+            return NULL;
+        int ok = PySequence_Fast_GET_SIZE(seq) == 6;
+        for (int i = 0; ok && i < 6; i++) {
+            s.periodic_box[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, i));
+            ok = !(s.periodic_box[i] == -1.0 && PyErr_Occurred());
+        }
+        Py_DECREF(seq);
+        if (!ok) {
+            if (!PyErr_Occurred())
+                PyErr_SetString(PyExc_ValueError, "box must be a sequence of 6 numbers");
+            return NULL;
+        }
+    }
     int m = pick("mode", mode_s, mode_choice);
     int se = m < 0 ? -1 : pick("search", search_s, search_choice);
     if (m < 0 || se < 0)
@@ -742,7 +808,7 @@ static PyObject *py_delaunay(PyObject *mod, PyObject *args, PyObject *kw)
         }
         s.n_threads = (int)t;
     }
-    s.neighbors = 1;
+    s.neighbors = !s.periodic; /* a periodic mesh has none yet (issue 33) */
     cancel_state cs = {mono_s() + 0.25};
     s.progress = progress_cb;
     s.progress_user = &cs;
@@ -832,11 +898,14 @@ done:
 
 static PyMethodDef module_methods[] = {
     {"delaunay", (PyCFunction)(void (*)(void))py_delaunay, METH_VARARGS | METH_KEYWORDS,
-     "delaunay(points, threads=None, mode='auto', search='auto')\n--\n\n"
+     "delaunay(points, threads=None, mode='auto', search='auto', periodic=None, box=None)\n--\n\n"
      "The exact Delaunay tetrahedralization of an (n, 3) array-like of points.\n\n"
      "threads: None for one per physical core, or 1 to 1024; mode: 'auto', "
      "'serial', 'shared' or 'message'; search: 'auto', 'kd' or 'mesh' (as the "
-     "CLI's --mode, -t and --search). The GIL is released while it runs. "
+     "CLI's --mode, -t and --search). periodic: the periodic axes ('x,z', 'xyz'), "
+     "with box=(xmin, ymin, zmin, xmax, ymax, zmax) their periods: the mesh of the "
+     "periodic point set, each tet once, its image offsets in .offsets (as the "
+     "CLI's --periodic). The GIL is released while it runs. "
      "Raises ValueError for NaN/Inf, fewer than 4 distinct points or all "
      "coplanar (with the library's diagnostic naming the point), MemoryError, "
      "RuntimeError for other failures."},
