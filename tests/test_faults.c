@@ -408,6 +408,57 @@ static int sc_triangulate(void *arg, const char **bad)
     return rc;
 }
 
+/* A periodic run (issue 33, src/mesh/periodic.c) under injection: the
+ * reference's hash, or a clean FDT_ENOMEM with a diagnostic. The points
+ * wrapped into the unit box, periodic in the axes given. */
+typedef struct periodic_arg {
+    const ptset *ps;
+    unsigned axes;
+    int threads;
+    uint64_t want_hash;
+} periodic_arg;
+
+static int periodic_run(const periodic_arg *a, fdt_result **r)
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.mode = a->threads == 1 ? FDT_MODE_SERIAL : FDT_MODE_AUTO;
+    s.n_threads = a->threads;
+    s.periodic = a->axes;
+    const double box[6] = {0, 0, 0, 1, 1, 1};
+    memcpy(s.periodic_box, box, sizeof box);
+    fdt_context *ctx = NULL;
+    int rc = fdt_open(&ctx, &s);
+    if (rc != FDT_OK)
+        return rc;
+    rc = fdt_triangulate(ctx, a->ps->xyz, a->ps->n, r);
+    if (rc == FDT_ENOMEM && fdt_context_diagnostic(ctx)[0] == '\0')
+        rc = FDT_EINTERNAL;
+    fdt_close(&ctx);
+    return rc;
+}
+
+static int sc_periodic(void *arg, const char **bad)
+{
+    const periodic_arg *a = arg;
+    fdt_result *r = NULL;
+    int rc = periodic_run(a, &r);
+    if (rc != FDT_OK) {
+        if (r != NULL)
+            *bad = "a failed periodic run returned a result";
+        fdt_result_free(&r);
+        return rc;
+    }
+    long at = atomic_load(&fault_at);
+    atomic_store(&fault_at, 0);
+    uint64_t h = 0;
+    if (fdt_result_hash(r, &h) != FDT_OK || h != a->want_hash)
+        *bad = "wrong periodic mesh";
+    atomic_store(&fault_at, at);
+    fdt_result_free(&r);
+    return rc;
+}
+
 /* A streamed run (fdt_triangulate_stream) under injection: it succeeds
  * with the in-memory run's set hash and tet count, or fails with nothing
  * returned; the sink counts what reached it (less than the mesh on a
@@ -1272,6 +1323,39 @@ int main(int argc, char **argv)
                 post_arg pa = {ps, nb, w, h};
                 scenario post = {nm[w + 1], FDT_ENOMEM, sc_post, &pa};
                 inject_all(&post);
+            }
+            /* periodic (the lattice set wrapped into the unit box, its
+             * duplicates merged): x y z, and x z (a wall of points at
+             * y = 0 and y = 1 keeps the ends flat) */
+            for (int pa_i = 0; pa_i < 2 && !nb && si == 0; pa_i++) {
+                ptset w = {"wrapped", alloc_points(ps->n + 32), ps->n + 32};
+                uint64_t wr = 77;
+                for (size_t i = 0; i < ps->n; i++)
+                    for (int k = 0; k < 3; k++) {
+                        double v = ps->xyz[3 * i + k] / 2.0;
+                        w.xyz[3 * i + k] = v - floor(v);
+                    }
+                for (size_t i = ps->n; i < w.n; i++) {
+                    w.xyz[3 * i] = rnd01(&wr);
+                    w.xyz[3 * i + 1] = i % 2 ? 0.0 : 0.9999;
+                    w.xyz[3 * i + 2] = rnd01(&wr);
+                }
+                for (size_t i = 0; i < ps->n; i++) /* the walls bound y */
+                    w.xyz[3 * i + 1] = 0.0001 + 0.999 * w.xyz[3 * i + 1];
+                periodic_arg pa = {&w, pa_i ? 5u : 7u, 1, 0};
+                fdt_result *pr = NULL;
+                CHECK_EQ(periodic_run(&pa, &pr), FDT_OK);
+                EXPECT(fdt_result_hash(pr, &pa.want_hash) == FDT_OK);
+                fdt_result_free(&pr);
+                char pn[96];
+                snprintf(pn, sizeof pn, "periodic %s %s", pa_i ? "x z" : "x y z", ps->name);
+                scenario sp = {pn, FDT_ENOMEM, sc_periodic, &pa};
+                inject_all(&sp);
+                pa.threads = 2;
+                snprintf(pn, sizeof pn, "periodic %s %s 2 threads", pa_i ? "x z" : "x y z",
+                         ps->name);
+                inject_all(&sp);
+                free(w.xyz);
             }
             /* the dual: neighbours derived (the longer path), two sets */
             static const char *const dual_what[4] = {"voronoi", "locate", "interpolate linear",
