@@ -14,7 +14,12 @@
   points for one copy of the box (exit 2), --periodic without --box, with
   --stream or an output that is not .tets (exit 1).
 
-Usage: periodic_e2e.py FRONTDT CGAL_PERIODIC|none SCRATCH
+- The cells (--periodic xyz --voronoi): their volumes sum to the box's to
+  1e-12, and each cell's volume, area and neighbours with their face areas
+  equal voro++'s periodic container's (tests/voro_ref.cpp periodic) to
+  1e-10 (skipped where voro++ is not built).
+
+Usage: periodic_e2e.py FRONTDT CGAL_PERIODIC|none VORO_REF|none SCRATCH
 """
 import os
 import random
@@ -22,7 +27,7 @@ import shutil
 import subprocess
 import sys
 
-FRONTDT, CGAL, SCRATCH = sys.argv[1], sys.argv[2], sys.argv[3]
+FRONTDT, CGAL, VORO, SCRATCH = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
 failures = []
 checks = 0
 
@@ -140,6 +145,51 @@ def case(name, pts, lo, length):
                                         ", as CGAL's" if CGAL != "none" else ""))
 
 
+def cells(name, pts, lo, length):
+    """The periodic cells: the box's volume, and voro++'s periodic cells."""
+    box = ",".join("%.17g" % v for v in (lo, lo, lo, lo + length, lo + length, lo + length))
+    src = os.path.join(SCRATCH, name + "_c.xyz")
+    write_points(src, pts)
+    vt = os.path.join(SCRATCH, name + "_c.txt")
+    r = frontdt(src, "--periodic", "xyz", "--box", box, "--voronoi", vt, "--voronoi-format",
+                "%i %v %F %n %f", "-q", "-t", "2")
+    expect(r.returncode == 0, "%s cells: exit %d: %s" % (name, r.returncode, r.stderr))
+    if r.returncode:
+        return
+    got = {}
+    for line in open(vt):
+        f = line.split()
+        k = (len(f) - 3) // 2
+        got[int(f[0])] = (float(f[1]), float(f[2]),
+                          dict(zip(map(int, f[3:3 + k]), map(float, f[3 + k:]))))
+    total = sum(v[0] for v in got.values())
+    expect(abs(total / length ** 3 - 1) < 1e-12, "%s cells: volumes sum to %.17g, the box %.17g"
+           % (name, total, length ** 3))
+    if VORO == "none":
+        print("%s cells: %d, their volumes the box's" % (name, len(got)))
+        return
+    v = subprocess.run([VORO, box, "periodic"], input="".join(
+        "%.17g %.17g %.17g\n" % p for p in pts), capture_output=True, text=True, timeout=600)
+    expect(v.returncode == 0, "%s: voro_ref exit %d" % (name, v.returncode))
+    bad = 0
+    for line in v.stdout.splitlines():
+        head, rest = line.split("|")
+        h, nb = head.split(), rest.split()
+        i, vol, area = int(h[0]), float(h[1]), float(h[2])
+        faces = {int(nb[2 * j]): float(nb[2 * j + 1]) for j in range(len(nb) // 2)
+                 if float(nb[2 * j + 1]) > 1e-12 * length ** 2}
+        gv, ga, gf = got[i]
+        gf = {j: a for j, a in gf.items() if a > 1e-12 * length ** 2}
+        ok = (abs(gv - vol) <= 1e-10 * vol and abs(ga - area) <= 1e-10 * area and
+              set(gf) == set(faces) and
+              all(abs(gf[j] - faces[j]) <= 1e-10 * area for j in faces))
+        if not ok and bad < 3:
+            print("  cell %d: %r against voro++ %r %r %r" % (i, got[i], vol, area, faces))
+        bad += not ok
+    expect(bad == 0, "%s cells: %d differ from voro++'s" % (name, bad))
+    print("%s cells: %d, their volumes the box's, as voro++'s periodic cells" % (name, len(got)))
+
+
 def errors():
     src = os.path.join(SCRATCH, "err.xyz")
     pts = uniform(200, 0.0, 1.0, 3)
@@ -170,6 +220,9 @@ def main():
     case("uniform", uniform(2000, 0.1, 1.2, 1), 0.1, 1.2)
     case("lattice", lattice(4, 0.1, 1.2), 0.1, 1.2)
     case("clusters", clusters(600, -2.0, 3.0, 2), -2.0, 3.0)
+    cells("uniform", uniform(2000, 0.1, 1.2, 5), 0.1, 1.2)
+    cells("lattice", lattice(5, 0.1, 1.2), 0.1, 1.2)
+    cells("clusters", clusters(800, -2.0, 3.0, 6), -2.0, 3.0)
     errors()
     print("periodic_e2e: %d checks, %d failed" % (checks, len(failures)))
     shutil.rmtree(SCRATCH, ignore_errors=True)

@@ -577,14 +577,35 @@ static void test_periodic_api(void)
     EXPECT(fdt_result_faces(r, &cnt, &fv, &ft) == FDT_EINVAL);
     EXPECT(fdt_result_edges(r, &cnt, &fv) == FDT_EINVAL);
     EXPECT(fdt_result_vertex_neighbors(r, 0, &cnt, &ids) == FDT_EINVAL);
+    /* the cells of a periodic set: its box's volume, no cell clipped */
     fdt_voronoi *v = NULL;
-    EXPECT(fdt_voronoi_compute(r, xyz, N, NULL, &v, NULL, 0) == FDT_EINVAL);
+    EXPECT(fdt_voronoi_compute(r, xyz, N, NULL, &v, NULL, 0) == FDT_OK);
+    double sum = 0;
+    for (size_t i = 0; v && i < N; i++) {
+        sum += fdt_voronoi_volumes(v)[i];
+        EXPECT(fdt_voronoi_flags(v)[i] == 0);
+    }
+    EXPECTF(fabs(sum - 1) < 1e-12, "periodic cells: %.17g", sum);
+    fdt_voronoi_free(&v);
     fdt_tid tet;
     double bary[4];
     EXPECT(fdt_locate(r, xyz, N, xyz, 1, &tet, bary, 1) == FDT_EINVAL);
     fdt_result_free(&r);
     fdt_sink sink = {sizeof sink, sink_count, NULL, NULL};
     EXPECT(fdt_triangulate_stream(ctx, xyz, N, &sink, &r) == FDT_EINVAL);
+    fdt_close(&ctx);
+    /* periodic in x and z only: no cells yet (the hull's would need the
+     * box's clipping) */
+    for (int i = 0; i < N; i++)
+        xyz[3 * i + 1] = i % 4 == 0 ? 0.0 : i % 4 == 1 ? 1.0 : xyz[3 * i + 1];
+    s.periodic = 5;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    CHECK_EQ(fdt_triangulate(ctx, xyz, N, &r), FDT_OK);
+    EXPECT(fdt_result_num_hull_faces(r) > 0 && fdt_result_hull_offsets(r) != NULL);
+    char vd[256];
+    EXPECT(fdt_voronoi_compute(r, xyz, N, NULL, &v, vd, sizeof vd) == FDT_EINVAL &&
+           strstr(vd, "x, y and z") != NULL);
+    fdt_result_free(&r);
     xyz[3 * 5 + 2] = 1.0;
     EXPECT(fdt_triangulate(ctx, xyz, N, &r) == FDT_EINVAL &&
            strstr(fdt_context_diagnostic(ctx), "point 5 has z = 1") != NULL);

@@ -14,17 +14,22 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <cstdlib>
 #include <vector>
 
 int main(int argc, char **argv)
 {
     double b[6];
-    if (argc != 2 || std::sscanf(argv[1], "%lf,%lf,%lf,%lf,%lf,%lf", &b[0], &b[1], &b[2], &b[3],
-                                 &b[4], &b[5]) != 6) {
-        std::fprintf(stderr, "usage: voro_ref XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX < points\n");
+    if (argc < 2 || argc > 3 ||
+        std::sscanf(argv[1], "%lf,%lf,%lf,%lf,%lf,%lf", &b[0], &b[1], &b[2], &b[3], &b[4],
+                    &b[5]) != 6 ||
+        (argc == 3 && std::strcmp(argv[2], "periodic") != 0)) {
+        std::fprintf(stderr, "usage: voro_ref XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX [periodic] < points\n");
         return 1;
     }
+    /* periodic: the container periodic in x, y and z (issue 33's cells) */
+    const bool per = argc == 3;
     std::vector<double> p;
     double x, y, z;
     while (std::scanf("%lf %lf %lf", &x, &y, &z) == 3) {
@@ -38,7 +43,7 @@ int main(int argc, char **argv)
     double side = std::cbrt(vol * 5 / (n ? n : 1));
     int nx = (int)((b[3] - b[0]) / side) + 1, ny = (int)((b[4] - b[1]) / side) + 1,
         nz = (int)((b[5] - b[2]) / side) + 1;
-    voro::container con(b[0], b[3], b[1], b[4], b[2], b[5], nx, ny, nz, false, false, false, 8);
+    voro::container con(b[0], b[3], b[1], b[4], b[2], b[5], nx, ny, nz, per, per, per, 8);
     for (int i = 0; i < n; i++)
         con.put(i, p[3 * i], p[3 * i + 1], p[3 * i + 2]);
     std::vector<std::vector<char>> line(n);

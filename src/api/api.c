@@ -297,10 +297,18 @@ int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const 
         fdt_default_voronoi_options(&defaults);
         o = &defaults;
     }
-    if (!r || !xyz || !out || o->struct_size != sizeof *o || o->threads < 0 || o->threads > 1024 ||
-        r->periodic)
+    if (!r || !xyz || !out || o->struct_size != sizeof *o || o->threads < 0 || o->threads > 1024)
         return FDT_EINVAL;
     int threads = o->threads ? o->threads : fdt_threads_default();
+    if (r->periodic) { /* the cells of the periodic set: its box, no clipping */
+        if (n != r->n)
+            return FDT_EINVAL;
+        fdt_periodic_box b = {r->periodic, {r->pbox[0], r->pbox[1], r->pbox[2]},
+                              {r->pbox[3], r->pbox[4], r->pbox[5]}};
+        return fdt_periodic_cells(r->tets, r->tet_off, r->ntets, xyz, n, r->dupmap, &b, threads,
+                                  o->neighbors, out, diag ? diag : (char[8]){0},
+                                  diag ? diag_size : 8);
+    }
     return fdt_voronoi_build(r, xyz, n, o, threads, out, diag, diag_size);
 }
 
@@ -573,7 +581,8 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, fdt_resul
         fdt_prepared_free(&pr);
         return err;
     }
-    r->periodic = 1;
+    r->periodic = ctx->s.periodic;
+    memcpy(r->pbox, ctx->s.periodic_box, sizeof r->pbox);
     r->sorted = 1;
     r->tets = (fdt_vid *)pm.tets;
     r->tet_off = pm.tet_off;

@@ -6,11 +6,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/hash.h"
 #include "base/spawn.h"
 #include "geom/images.h"
 #include "geom/morton.h"
 #include "mesh/certify.h"
 #include "mesh/insert.h"
+#include "mesh/voronoi.h"
 
 /* ---- step 1: the points and their images within the margin ----------- */
 
@@ -720,4 +722,248 @@ size_t fdt_periodic_row_text(char *buf, const uint32_t id[4], const int8_t off[1
         k += (size_t)snprintf(buf + k, FDT_PERIODIC_ROW_MAX - k, " %d", off[j]);
     buf[k++] = '\n';
     return k;
+}
+
+/* ---- the Voronoi cells of a periodic mesh ------------------------------ */
+
+/* A map from packed vertices (vpack) to their index in a list of
+ * vertices with coordinates: open addressing, grown at half full. */
+typedef struct vmap {
+    uint64_t *key;   /* UINT64_MAX: empty */
+    uint32_t *val;
+    size_t mask, n;
+    uint64_t *vk;    /* the vertices in order, and their rounded images */
+    double *xyz;
+    uint32_t *label;
+    size_t cap;
+} vmap;
+
+static void vmap_free(vmap *m)
+{
+    free(m->key);
+    free(m->val);
+    free(m->vk);
+    free(m->xyz);
+    free(m->label);
+    memset(m, 0, sizeof *m);
+}
+
+static int vmap_rehash(vmap *m, size_t size)
+{
+    uint64_t *keys = malloc(size * sizeof *keys);
+    uint32_t *val = malloc(size * sizeof *val);
+    if (!keys || !val) {
+        free(keys);
+        free(val);
+        return FDT_ENOMEM;
+    }
+    memset(keys, 0xff, size * sizeof *keys);
+    for (size_t i = 0; i < m->n; i++) {
+        size_t h = (size_t)fdt_mix64(m->vk[i]) & (size - 1);
+        while (keys[h] != UINT64_MAX)
+            h = (h + 1) & (size - 1);
+        keys[h] = m->vk[i];
+        val[h] = (uint32_t)i;
+    }
+    free(m->key);
+    free(m->val);
+    m->key = keys;
+    m->val = val;
+    m->mask = size - 1;
+    return FDT_OK;
+}
+
+/* The index of vertex (id, o), added (its image rounded) when new; -1
+ * when out of memory. */
+static long vmap_get(vmap *m, uint32_t id, const int8_t o[3], const double *X,
+                     const fdt_periodic_box *b)
+{
+    uint64_t k = vpack(id, o);
+    if (m->key) {
+        for (size_t h = (size_t)fdt_mix64(k) & m->mask; m->key[h] != UINT64_MAX;
+             h = (h + 1) & m->mask)
+            if (m->key[h] == k)
+                return (long)m->val[h];
+    }
+    if (2 * (m->n + 1) > m->mask + 1 && vmap_rehash(m, m->key ? 2 * (m->mask + 1) : 1024))
+        return -1;
+    if (m->n == m->cap) {
+        size_t cap = m->cap ? 2 * m->cap : 1024;
+        uint64_t *vk = realloc(m->vk, cap * sizeof *vk);
+        if (vk)
+            m->vk = vk;
+        double *xyz = realloc(m->xyz, 3 * cap * sizeof *xyz);
+        if (xyz)
+            m->xyz = xyz;
+        uint32_t *label = realloc(m->label, cap * sizeof *label);
+        if (label)
+            m->label = label;
+        if (!vk || !xyz || !label)
+            return -1;
+        m->cap = cap;
+    }
+    size_t i = m->n++;
+    m->vk[i] = k;
+    m->label[i] = id;
+    (void)fdt_images_round(X + 3 * (size_t)id, o, b->lo, b->hi, m->xyz + 3 * i, NULL);
+    size_t h = (size_t)fdt_mix64(k) & m->mask;
+    while (m->key[h] != UINT64_MAX)
+        h = (h + 1) & m->mask;
+    m->key[h] = k;
+    m->val[h] = (uint32_t)i;
+    return (long)i;
+}
+
+/* The orientation of periodic tet (id[4], off[12]) for its exact images:
+ * the rounded images' determinant where it is clear of their error, else
+ * GMP (src/geom/images.h). */
+static int tet_orient(const double *X, const uint32_t id[4], const int8_t off[12],
+                      const fdt_periodic_box *b)
+{
+    double P[12], err = 0, e;
+    uint8_t exact[4] = {0, 0, 0, 0};
+    for (int j = 0; j < 4; j++) {
+        exact[j] = (uint8_t)fdt_images_round(X + 3 * (size_t)id[j], off + 3 * j, b->lo, b->hi,
+                                             P + 3 * j, &e);
+        err = e > err ? e : err;
+    }
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; k++) {
+        lo[k] = hi[k] = P[k];
+        for (int j = 1; j < 4; j++) {
+            lo[k] = P[3 * j + k] < lo[k] ? P[3 * j + k] : lo[k];
+            hi[k] = P[3 * j + k] > hi[k] ? P[3 * j + k] : hi[k];
+        }
+    }
+    fdt_images im;
+    memset(&im, 0, sizeof im);
+    im.P = P;
+    im.n = 4;
+    im.X = X;
+    im.src = id;
+    im.off = off;
+    im.exact = exact;
+    memcpy(im.lo, b->lo, sizeof im.lo);
+    memcpy(im.hi, b->hi, sizeof im.hi);
+    fdt_images_init(&im, lo, hi, err);
+    return fdt_images_orient(&im, P, P + 3, P + 6, P + 9, NULL);
+}
+
+int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const double *X,
+                       size_t n, const int32_t *dupmap, const fdt_periodic_box *b, int threads,
+                       int neighbors, fdt_voronoi **out, char *diag, size_t ds)
+{
+    *out = NULL;
+    if (b->axes != 7) {
+        snprintf(diag, ds, "the Voronoi cells of a periodic mesh need x, y and z periodic");
+        return FDT_EINVAL;
+    }
+    vmap m;
+    memset(&m, 0, sizeof m);
+    uint32_t *own = NULL, *st = NULL;
+    uint8_t *own_hull = NULL;
+    size_t nst = 0, stcap = 0, nown = 0;
+    int err = FDT_OK;
+    static const int8_t zero[3] = {0, 0, 0};
+    /* the points themselves first: rows 0 .. nown of the batch */
+    for (size_t i = 0; i < n && !err; i++)
+        if (dupmap[i] == (int32_t)i && vmap_get(&m, (uint32_t)i, zero, X, b) < 0)
+            err = FDT_ENOMEM;
+    nown = m.n;
+    /* each tet once for each offset among its vertices, moved so that
+     * vertices with that offset are the points themselves: every star */
+    for (size_t t = 0; t < ntets && !err; t++) {
+        const uint32_t *id = (const uint32_t *)tets + 4 * t;
+        const int8_t *o = off + 12 * t;
+        int pos = tet_orient(X, id, o, b) > 0;
+        for (int j = 0; j < 4 && !err; j++) {
+            int seen = 0;
+            for (int i = 0; i < j; i++)
+                seen |= !memcmp(o + 3 * i, o + 3 * j, 3);
+            if (seen)
+                continue;
+            if (nst + 4 > stcap) {
+                size_t cap = stcap ? 2 * stcap : 4096;
+                uint32_t *ns = realloc(st, cap * sizeof *ns);
+                if (!ns) {
+                    err = FDT_ENOMEM;
+                    break;
+                }
+                st = ns;
+                stcap = cap;
+            }
+            uint32_t w[4];
+            for (int k = 0; k < 4 && !err; k++) {
+                int8_t r[3] = {(int8_t)(o[3 * k] - o[3 * j]), (int8_t)(o[3 * k + 1] - o[3 * j + 1]),
+                               (int8_t)(o[3 * k + 2] - o[3 * j + 2])};
+                long x = vmap_get(&m, id[k], r, X, b);
+                if (x < 0)
+                    err = FDT_ENOMEM;
+                w[k] = (uint32_t)x;
+            }
+            if (!pos) {
+                uint32_t tmp = w[0];
+                w[0] = w[1];
+                w[1] = tmp;
+            }
+            memcpy(st + nst, w, sizeof w);
+            nst += 4;
+        }
+    }
+    if (!err && (!(own = malloc((nown ? nown : 1) * sizeof *own)) ||
+                 !(own_hull = calloc(nown ? nown : 1, 1))))
+        err = FDT_ENOMEM;
+    for (size_t i = 0; !err && i < nown; i++)
+        own[i] = (uint32_t)i;
+    /* the box: the period box with a period on each side, which holds
+     * every image and the circumcentres of the points' stars */
+    fdt_vbatch vb;
+    memset(&vb, 0, sizeof vb);
+    for (int k = 0; k < 3 && !err; k++) {
+        double L = b->hi[k] - b->lo[k];
+        vb.box[k] = b->lo[k] - L;
+        vb.box[k + 3] = b->hi[k] + L;
+        for (size_t i = 0; i < m.n; i++) {
+            double v = m.xyz[3 * i + k];
+            vb.box[k] = v < vb.box[k] ? v : vb.box[k];
+            vb.box[k + 3] = v > vb.box[k + 3] ? v : vb.box[k + 3];
+        }
+    }
+    if (!err)
+        err = fdt_voronoi_scale(vb.box, &vb.ed, diag, ds);
+    fdt_voronoi *v = NULL;
+    if (!err) {
+        vb.xyz = m.xyz;
+        vb.xyz_exp = 0;
+        vb.label = (const fdt_vid *)m.label;
+        vb.own = own;
+        vb.nown = nown;
+        vb.own_hull = own_hull;
+        vb.tets = st;
+        vb.ntets = nst / 4;
+        vb.neighbors = neighbors;
+        fdt_vshort sh = {-1, -1, INFINITY};
+        err = fdt_voronoi_batch(&vb, threads, &v, &sh, diag, ds);
+        if (err == FDT_ERANGE)
+            err = fdt_voronoi_too_close(&sh, vb.box, diag, ds);
+    }
+    /* no cell of a periodic set is clipped: one that is reached past its
+     * neighbouring images (a bug) */
+    const uint8_t *fl = v ? fdt_voronoi_flags(v) : NULL;
+    for (size_t i = 0; !err && i < nown; i++)
+        if (fl[i] & FDT_CELL_CLIPPED) {
+            snprintf(diag, ds, "the periodic cell of point %u reaches past its images",
+                     m.label[own[i]]);
+            err = FDT_EINTERNAL;
+        }
+    if (!err)
+        err = fdt_voronoi_spread(&v, n);
+    if (err)
+        fdt_voronoi_free(&v);
+    *out = v;
+    vmap_free(&m);
+    free(own);
+    free(own_hull);
+    free(st);
+    return err;
 }

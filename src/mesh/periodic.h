@@ -84,6 +84,22 @@ void fdt_periodic_free(fdt_periodic_mesh *m);
 #define FDT_PERIODIC_ROW_MAX 112
 size_t fdt_periodic_row_text(char *buf, const uint32_t id[4], const int8_t off[12]);
 
+/*
+ * The Voronoi cells of a periodic mesh (x, y and z periodic: no cell is
+ * unbounded), as fdt_voronoi_compute gives a plain mesh's: n rows, row i
+ * point i's, merged duplicates (dupmap) FDT_CELL_MERGED. tets, off: the
+ * mesh as fdt_periodic_build gives it, renumbered to input ids; X the
+ * input points. Each point's cell is computed from its star, the tets
+ * around it moved so that it is the point itself (src/mesh/voronoi.h's
+ * batch: a cell has the same bits whichever batch holds it); its
+ * neighbours are input ids (an image's: its point's). FDT_EINVAL when not
+ * every axis is periodic; the batch's errors otherwise, with diag.
+ */
+struct fdt_voronoi;
+int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const double *X,
+                       size_t n, const int32_t *dupmap, const fdt_periodic_box *b, int threads,
+                       int neighbors, struct fdt_voronoi **out, char *diag, size_t ds);
+
 /* fdt_periodic_build's checks of the box and of the points in it, alone
  * (a caller checks its input before it scales or merges it, so that the
  * message names the input's index and value). FDT_OK or FDT_EINVAL. */

@@ -10,9 +10,11 @@ struct fdt_result {
     fdt_tid *nbrs;       /* 4 per tet or NULL (owned) */
     fdt_vid *hull;       /* 3 per hull face, outward (owned) */
     size_t nhull;
-    int periodic;        /* a periodic run: tets and hull faces as rows
-                            of ids ascending with offsets (include/
+    unsigned periodic;   /* a periodic run's axes (bit k: axis k), 0 for
+                            a plain run: tets and hull faces as rows of
+                            ids ascending with offsets (include/
                             frontdt.h's fdt_result_tet_offsets) */
+    double pbox[6];      /* its periodic box, as given */
     int8_t *tet_off;     /* 12 per tet, periodic runs (owned) */
     int8_t *hull_off;    /* 9 per hull face, periodic runs (owned) */
     fdt_vid *dupmap;     /* n (owned) */

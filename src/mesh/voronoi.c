@@ -1417,6 +1417,61 @@ int fdt_voronoi_merged(const fdt_vid *ids, const double *pts, size_t k, const do
     return err;
 }
 
+int fdt_voronoi_spread(fdt_voronoi **vp, size_t n)
+{
+    fdt_voronoi *b = *vp, *v = calloc(1, sizeof *v);
+    if (!v)
+        return FDT_ENOMEM;
+    v->n = n;
+    memcpy(v->box, b->box, sizeof v->box);
+    v->zero_faces = b->zero_faces;
+    int err = alloc_cells(v);
+    size_t *row = err ? NULL : malloc((n ? n : 1) * sizeof *row);
+    if (!err && !row)
+        err = FDT_ENOMEM;
+    for (size_t i = 0; !err && i < n; i++) {
+        row[i] = SIZE_MAX;
+        v->flags[i] = FDT_CELL_MERGED;
+    }
+    for (size_t i = 0; !err && i < b->n; i++) {
+        size_t id = (size_t)b->ids[i];
+        row[id] = i;
+        v->volume[id] = b->volume[i];
+        v->area[id] = b->area[i];
+        memcpy(v->centroid + 3 * id, b->centroid + 3 * i, 3 * sizeof *v->centroid);
+        v->density[id] = b->density[i];
+        v->nfaces[id] = b->nfaces[i];
+        v->flags[id] = b->flags[i];
+    }
+    if (!err && b->nstart) {
+        size_t total = b->nstart[b->n];
+        if (!(v->nstart = malloc((n + 1) * sizeof *v->nstart)) ||
+            !(v->nid = malloc((total ? total : 1) * sizeof *v->nid)) ||
+            !(v->narea = malloc((total ? total : 1) * sizeof *v->narea)))
+            err = FDT_ENOMEM;
+        size_t at = 0;
+        for (size_t id = 0; !err && id < n; id++) {
+            v->nstart[id] = at;
+            if (row[id] == SIZE_MAX)
+                continue;
+            size_t s0 = b->nstart[row[id]], c = b->nstart[row[id] + 1] - s0;
+            memcpy(v->nid + at, b->nid + s0, c * sizeof *v->nid);
+            memcpy(v->narea + at, b->narea + s0, c * sizeof *v->narea);
+            at += c;
+        }
+        if (!err)
+            v->nstart[n] = at;
+    }
+    free(row);
+    if (err) {
+        fdt_voronoi_free(&v);
+        return err;
+    }
+    fdt_voronoi_free(vp);
+    *vp = v;
+    return FDT_OK;
+}
+
 size_t fdt_voronoi_num_points(const fdt_voronoi *v) { return v ? v->n : 0; }
 const fdt_vid *fdt_voronoi_ids(const fdt_voronoi *v) { return v ? v->ids : NULL; }
 const double *fdt_voronoi_points(const fdt_voronoi *v) { return v ? v->pts : NULL; }

@@ -97,6 +97,12 @@ int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_v
 int fdt_voronoi_merged(const fdt_vid *ids, const double *pts, size_t k, const double box[6],
                        int neighbors, fdt_voronoi **out);
 
+/* *v, a batch whose rows' ids are distinct and below n, as n rows, row
+ * i point i's (fdt_voronoi_compute's shape): a row no batch row has is a
+ * merged duplicate's (FDT_CELL_MERGED, no cell). FDT_OK (*v replaced) or
+ * FDT_ENOMEM (*v unchanged). */
+int fdt_voronoi_spread(fdt_voronoi **v, size_t n);
+
 /* The box the cells are clipped by: o's (FDT_EINVAL, with diag, when it is
  * empty, not finite or leaves a point out) or the bounding box of the
  * finite points (a merged duplicate lies on its point). The rule of
