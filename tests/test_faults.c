@@ -361,16 +361,20 @@ typedef struct tri_arg {
     int neighbors;
     uint64_t want_hash; /* the reference, from an uninjected run */
     size_t want_tets;
+    unsigned periodic;  /* periodic axes in the unit box (issue 33), or 0 */
 } tri_arg;
 
-static int triangulate(const ptset *ps, const engine_cfg *cfg, int neighbors,
-                       fdt_result **res)
+static int triangulate_p(const ptset *ps, const engine_cfg *cfg, int neighbors,
+                         unsigned periodic, fdt_result **res)
 {
     fdt_settings s;
     fdt_default_settings(&s);
     s.mode = cfg->mode;
     s.n_threads = cfg->threads;
     s.neighbors = neighbors;
+    s.periodic = periodic;
+    const double unit[6] = {0, 0, 0, 1, 1, 1};
+    memcpy(s.periodic_box, unit, sizeof unit);
     fdt_context *ctx = NULL;
     int rc = fdt_open(&ctx, &s);
     if (rc != FDT_OK)
@@ -382,13 +386,18 @@ static int triangulate(const ptset *ps, const engine_cfg *cfg, int neighbors,
     return rc;
 }
 
+static int triangulate(const ptset *ps, const engine_cfg *cfg, int neighbors, fdt_result **res)
+{
+    return triangulate_p(ps, cfg, neighbors, 0, res);
+}
+
 /* fdt_open + fdt_triangulate; the answer is checked after success (the
  * hash is taken with injection off). */
 static int sc_triangulate(void *arg, const char **bad)
 {
     tri_arg *a = arg;
     fdt_result *r = NULL;
-    int rc = triangulate(a->ps, a->cfg, a->neighbors, &r);
+    int rc = triangulate_p(a->ps, a->cfg, a->neighbors, a->periodic, &r);
     if (rc != FDT_OK) {
         if (r != NULL)
             *bad = "a failed fdt_triangulate returned a result";
@@ -403,57 +412,6 @@ static int sc_triangulate(void *arg, const char **bad)
         *bad = "wrong mesh";
     if (a->neighbors && fdt_result_neighbors(r) == NULL)
         *bad = "no neighbours";
-    atomic_store(&fault_at, at);
-    fdt_result_free(&r);
-    return rc;
-}
-
-/* A periodic run (issue 33, src/mesh/periodic.c) under injection: the
- * reference's hash, or a clean FDT_ENOMEM with a diagnostic. The points
- * wrapped into the unit box, periodic in the axes given. */
-typedef struct periodic_arg {
-    const ptset *ps;
-    unsigned axes;
-    int threads;
-    uint64_t want_hash;
-} periodic_arg;
-
-static int periodic_run(const periodic_arg *a, fdt_result **r)
-{
-    fdt_settings s;
-    fdt_default_settings(&s);
-    s.mode = a->threads == 1 ? FDT_MODE_SERIAL : FDT_MODE_AUTO;
-    s.n_threads = a->threads;
-    s.periodic = a->axes;
-    const double box[6] = {0, 0, 0, 1, 1, 1};
-    memcpy(s.periodic_box, box, sizeof box);
-    fdt_context *ctx = NULL;
-    int rc = fdt_open(&ctx, &s);
-    if (rc != FDT_OK)
-        return rc;
-    rc = fdt_triangulate(ctx, a->ps->xyz, a->ps->n, r);
-    if (rc == FDT_ENOMEM && fdt_context_diagnostic(ctx)[0] == '\0')
-        rc = FDT_EINTERNAL;
-    fdt_close(&ctx);
-    return rc;
-}
-
-static int sc_periodic(void *arg, const char **bad)
-{
-    const periodic_arg *a = arg;
-    fdt_result *r = NULL;
-    int rc = periodic_run(a, &r);
-    if (rc != FDT_OK) {
-        if (r != NULL)
-            *bad = "a failed periodic run returned a result";
-        fdt_result_free(&r);
-        return rc;
-    }
-    long at = atomic_load(&fault_at);
-    atomic_store(&fault_at, 0);
-    uint64_t h = 0;
-    if (fdt_result_hash(r, &h) != FDT_OK || h != a->want_hash)
-        *bad = "wrong periodic mesh";
     atomic_store(&fault_at, at);
     fdt_result_free(&r);
     return rc;
@@ -1101,7 +1059,7 @@ static int run_parallel(void)
                 char nm[96];
                 snprintf(nm, sizeof nm, "triangulate %s %s%s", sets[si].name,
                          cfg_name[c], nb ? " (nbrs)" : "");
-                tri_arg ta = {&sets[si], &cfgs[c], nb, h, nt};
+                tri_arg ta = {&sets[si], &cfgs[c], nb, h, nt, 0};
                 scenario sc = {nm, FDT_ENOMEM, sc_triangulate, &ta};
                 inject_all(&sc);
             }
@@ -1293,7 +1251,7 @@ int main(int argc, char **argv)
             for (int w = 0; w < 5; w++)
                 snprintf(nm[w], sizeof nm[w], "%s %s%s", what[w], ps->name,
                          nb ? " (nbrs)" : "");
-            tri_arg ta = {ps, &serial_cfg, nb, h, nt};
+            tri_arg ta = {ps, &serial_cfg, nb, h, nt, 0};
             scenario sc = {nm[0], FDT_ENOMEM, sc_triangulate, &ta};
             inject_all(&sc);
             if (!nb) {
@@ -1342,16 +1300,18 @@ int main(int argc, char **argv)
                 }
                 for (size_t i = 0; i < ps->n; i++) /* the walls bound y */
                     w.xyz[3 * i + 1] = 0.0001 + 0.999 * w.xyz[3 * i + 1];
-                periodic_arg pa = {&w, pa_i ? 5u : 7u, 1, 0};
+                static const engine_cfg two = {FDT_MODE_AUTO, 2};
+                tri_arg pa = {&w, &serial_cfg, 0, 0, 0, pa_i ? 5u : 7u};
                 fdt_result *pr = NULL;
-                CHECK_EQ(periodic_run(&pa, &pr), FDT_OK);
+                CHECK_EQ(triangulate_p(&w, &serial_cfg, 0, pa.periodic, &pr), FDT_OK);
                 EXPECT(fdt_result_hash(pr, &pa.want_hash) == FDT_OK);
+                pa.want_tets = fdt_result_num_tets(pr);
                 fdt_result_free(&pr);
                 char pn[96];
                 snprintf(pn, sizeof pn, "periodic %s %s", pa_i ? "x z" : "x y z", ps->name);
-                scenario sp = {pn, FDT_ENOMEM, sc_periodic, &pa};
+                scenario sp = {pn, FDT_ENOMEM, sc_triangulate, &pa};
                 inject_all(&sp);
-                pa.threads = 2;
+                pa.cfg = &two;
                 snprintf(pn, sizeof pn, "periodic %s %s 2 threads", pa_i ? "x z" : "x y z",
                          ps->name);
                 inject_all(&sp);

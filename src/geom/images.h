@@ -101,18 +101,7 @@ static inline int fdt_images_insphere(const fdt_images *im, const double *a, con
     const double B[3] = {b[0] - e[0], b[1] - e[1], b[2] - e[2]};
     const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
     const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
-    const double ab = A[0] * B[1] - B[0] * A[1], bc = B[0] * C[1] - C[0] * B[1];
-    const double cd = C[0] * D[1] - D[0] * C[1], da = D[0] * A[1] - A[0] * D[1];
-    const double ac = A[0] * C[1] - C[0] * A[1], bd = B[0] * D[1] - D[0] * B[1];
-    const double abc = A[2] * bc - B[2] * ac + C[2] * ab;
-    const double bcd = B[2] * cd - C[2] * bd + D[2] * bc;
-    const double cda = C[2] * da + D[2] * ac + A[2] * cd;
-    const double dab = D[2] * ab + A[2] * bd + B[2] * da;
-    const double al = A[0] * A[0] + A[1] * A[1] + A[2] * A[2];
-    const double bl = B[0] * B[0] + B[1] * B[1] + B[2] * B[2];
-    const double cl = C[0] * C[0] + C[1] * C[1] + C[2] * C[2];
-    const double dl = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
-    const double det = (dl * abc - cl * dab) + (bl * cda - al * bcd);
+    const double det = fdt_insphere_det4(A, B, C, D);
     if (fabs(det) * im->isp_inv > 1)
         return (det < 0) - (det > 0);
     const uint32_t i[5] = {fdt_images_index(im, a), fdt_images_index(im, b),

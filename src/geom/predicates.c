@@ -445,19 +445,7 @@ static int insphere_stage_g(const double *a, const double *b, const double *c,
     double r[4][3];
     if (!(max_diff(pts, 4, e, r) <= ldexp(0x1p9, k)))
         return FDT_PRED_UNSURE;
-    const double *A = r[0], *B = r[1], *C = r[2], *D = r[3];
-    const double ab = A[0] * B[1] - B[0] * A[1], bc = B[0] * C[1] - C[0] * B[1];
-    const double cd = C[0] * D[1] - D[0] * C[1], da = D[0] * A[1] - A[0] * D[1];
-    const double ac = A[0] * C[1] - C[0] * A[1], bd = B[0] * D[1] - D[0] * B[1];
-    const double abc = A[2] * bc - B[2] * ac + C[2] * ab;
-    const double bcd = B[2] * cd - C[2] * bd + D[2] * bc;
-    const double cda = C[2] * da + D[2] * ac + A[2] * cd;
-    const double dab = D[2] * ab + A[2] * bd + B[2] * da;
-    const double alift = A[0] * A[0] + A[1] * A[1] + A[2] * A[2];
-    const double blift = B[0] * B[0] + B[1] * B[1] + B[2] * B[2];
-    const double clift = C[0] * C[0] + C[1] * C[1] + C[2] * C[2];
-    const double dlift = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
-    const double det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+    const double det = fdt_insphere_det4(r[0], r[1], r[2], r[3]);
     return (det < 0.0) - (det > 0.0);
 }
 

@@ -523,6 +523,26 @@ static inline int fdt_sphere_cof_insphere(const fdt_sphere_cof *s, const double 
 
 /* As for orient3d: the proper filter takes the rounded differences
  * A = a - e, ..., D = d - e; the _sf form tests sf's stage first. */
+/* det4 of the filter above, from the rows A..D alone (no permanent): the
+ * evaluation the grid stage (src/geom/predicates.c, stage G) and the
+ * periodic images' filter (src/geom/images.h) share. */
+static inline double fdt_insphere_det4(const double A[3], const double B[3], const double C[3],
+                                       const double D[3])
+{
+    const double ab = A[0] * B[1] - B[0] * A[1], bc = B[0] * C[1] - C[0] * B[1];
+    const double cd = C[0] * D[1] - D[0] * C[1], da = D[0] * A[1] - A[0] * D[1];
+    const double ac = A[0] * C[1] - C[0] * A[1], bd = B[0] * D[1] - D[0] * B[1];
+    const double abc = A[2] * bc - B[2] * ac + C[2] * ab;
+    const double bcd = B[2] * cd - C[2] * bd + D[2] * bc;
+    const double cda = C[2] * da + D[2] * ac + A[2] * cd;
+    const double dab = D[2] * ab + A[2] * bd + B[2] * da;
+    const double alift = A[0] * A[0] + A[1] * A[1] + A[2] * A[2];
+    const double blift = B[0] * B[0] + B[1] * B[1] + B[2] * B[2];
+    const double clift = C[0] * C[0] + C[1] * C[1] + C[2] * C[2];
+    const double dlift = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+    return (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+}
+
 static inline int fdt_insphere_filter_sf(const double *a, const double *b, const double *c,
                                          const double *d, const double *e,
                                          const fdt_pred_static *sf)
