@@ -314,18 +314,8 @@ static void inexact_box(size_t n)
     EXPECTF(euler_vet(&p1, n) == 0, "inexact: V - E + T = %ld", euler_vet(&p1, n));
     EXPECT(p1.nhull == 0);
     /* shuffled: the same tets under the permutation */
-    size_t *perm = malloc(n * sizeof *perm);
-    double *Y = malloc(n * 3 * sizeof *Y);
-    CHECK(perm && Y);
-    for (size_t i = 0; i < n; i++)
-        perm[i] = i;
-    for (size_t i = n - 1; i > 0; i--) {
-        size_t j = (size_t)(test_rand64(&s) % (i + 1)), t = perm[i];
-        perm[i] = perm[j];
-        perm[j] = t;
-    }
-    for (size_t i = 0; i < n; i++)
-        memcpy(Y + 3 * i, X + 3 * perm[i], 3 * sizeof *Y); /* Y[i] = X[perm[i]] */
+    size_t *perm;
+    double *Y = test_shuffle(X, n, s, &perm); /* Y[i] = X[perm[i]] */
     fdt_periodic_mesh ps = build(Y, n, &b, 2, "inexact shuffled");
     uint32_t *ids = malloc(ps.ntets * 4 * sizeof *ids);
     CHECK(ids);

@@ -212,19 +212,8 @@ static void test_box_sums(size_t n, int clustered, uint64_t seed)
 static void test_same_bits(size_t n)
 {
     double *xyz = test_cloud(n, 1, 7);
-    double *sh = malloc(3 * n * sizeof *sh);
-    size_t *perm = malloc(n * sizeof *perm);
-    CHECK(sh && perm);
-    uint64_t s = 99;
-    for (size_t i = 0; i < n; i++)
-        perm[i] = i;
-    for (size_t i = n - 1; i > 0; i--) {
-        size_t j = (size_t)(test_rand64(&s) % (i + 1)), t = perm[i];
-        perm[i] = perm[j];
-        perm[j] = t;
-    }
-    for (size_t i = 0; i < n; i++)
-        memcpy(sh + 3 * i, xyz + 3 * perm[i], 3 * sizeof *sh);
+    size_t *perm;
+    double *sh = test_shuffle(xyz, n, 99, &perm);
     fdt_result *r1 = test_triangulate(xyz, n, 1, 0), *r3 = test_triangulate(xyz, n, 3, 0);
     fdt_result *rs = test_triangulate(sh, n, 2, 0);
     /* the mesh of 1 and 3 threads, the cells on 1 and 3 threads */

@@ -22,6 +22,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -260,6 +261,26 @@ static inline int test_each_family(const char *gen, size_t n,
     }
     pclose(f);
     return families;
+}
+
+/* A shuffled copy of the n points xyz: row i is point (*perm)[i] (perm
+ * a new array, Fisher-Yates from seed). */
+static inline double *test_shuffle(const double *xyz, size_t n, uint64_t seed, size_t **perm)
+{
+    double *y = malloc(3 * (n ? n : 1) * sizeof *y);
+    size_t *p = malloc((n ? n : 1) * sizeof *p);
+    CHECK(y && p);
+    for (size_t i = 0; i < n; i++)
+        p[i] = i;
+    for (size_t i = n ? n - 1 : 0; i > 0; i--) {
+        size_t j = (size_t)(test_rand64(&seed) % (i + 1)), t = p[i];
+        p[i] = p[j];
+        p[j] = t;
+    }
+    for (size_t i = 0; i < n; i++)
+        memcpy(y + 3 * i, xyz + 3 * p[i], 3 * sizeof *y);
+    *perm = p;
+    return y;
 }
 
 static inline double now_s(void)
