@@ -549,7 +549,8 @@ static int sort_keys(key *keys, size_t count, size_t n)
             a[j] = x;
         }
     }
-    memcpy(keys, tmp, count * sizeof *keys);
+    if (count)
+        memcpy(keys, tmp, count * sizeof *keys);
     free(tmp);
     free(start);
     return FDT_OK;
