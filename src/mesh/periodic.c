@@ -247,23 +247,6 @@ static int keyset_add(keyset *s, const key *k)
     return FDT_OK;
 }
 
-/* a += b's keys. */
-static int keyset_cat(keyset *a, const keyset *b)
-{
-    if (a->n + b->n > a->cap) {
-        size_t cap = a->n + b->n;
-        key *nk = realloc(a->keys, (cap ? cap : 1) * sizeof *nk);
-        if (!nk)
-            return FDT_ENOMEM;
-        a->keys = nk;
-        a->cap = cap;
-    }
-    if (b->n)
-        memcpy(a->keys + a->n, b->keys, b->n * sizeof *b->keys);
-    a->n += b->n;
-    return FDT_OK;
-}
-
 /* ---- step 4: the proofs ------------------------------------------------ */
 
 /*
@@ -330,7 +313,8 @@ typedef struct run {
     ext e;
     fdt_images im;
     fdt_ins m;
-    keyset tets, hull;
+    keyset tets[64], hull[64]; /* the kept ones, a set a thread (prove_run) */
+    int nsets;
     double need[3];        /* a failed round: how far the balls reached */
     char *diag;
     size_t dsz;
@@ -418,15 +402,19 @@ static void *prove_run(void *arg)
     return NULL;
 }
 
-/* One round at margin m: ROUND_OK with r->tets and r->hull the periodic
+/* One round at margin m: ROUND_OK with r->tets and r->hull (a set a
+ * thread) the periodic
  * mesh, ROUND_AGAIN when a proof failed, or an error. */
 static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh *out)
 {
     const fdt_periodic_box *b = r->b;
     int err;
     fdt_ins_free(&r->m);
-    keyset_free(&r->tets);
-    keyset_free(&r->hull);
+    for (int i = 0; i < r->nsets; i++) {
+        keyset_free(&r->tets[i]);
+        keyset_free(&r->hull[i]);
+    }
+    r->nsets = 0;
     if ((err = make_images(&r->e, r->X, r->n, b, m)) != FDT_OK)
         return err;
     double blo[3], bhi[3];
@@ -490,13 +478,11 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
         for (int k = 0; k < 3; k++)
             r->need[k] = jobs[i].need[k] > r->need[k] ? jobs[i].need[k] : r->need[k];
     }
-    for (int i = 0; i < T && !err && !again; i++)
-        if ((err = keyset_cat(&r->tets, &jobs[i].tets)) == FDT_OK)
-            err = keyset_cat(&r->hull, &jobs[i].hull);
-    for (int i = 0; i < T; i++) {
-        keyset_free(&jobs[i].tets);
-        keyset_free(&jobs[i].hull);
+    for (int i = 0; i < T; i++) { /* the run frees them */
+        r->tets[i] = jobs[i].tets;
+        r->hull[i] = jobs[i].hull;
     }
+    r->nsets = T;
     if (err)
         return err;
     if (again)
@@ -512,25 +498,36 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
     return ROUND_OK;
 }
 
-/* keys sorted: counted into buckets by their first id (ids below n),
- * each bucket (the tets a point is the least vertex of: a few) sorted by
- * insertion, a large one by qsort. qsort of 6.8M keys took a fifth of a
- * 1M-point run. */
-static int sort_keys(key *keys, size_t count, size_t n)
+/*
+ * The keys of the sets s[0 .. ns) (ids below n), sorted, into out's
+ * arrays; each set freed once its keys are moved. Counted into buckets by
+ * their first id, each bucket (the tets a point is the least vertex of: a
+ * few) sorted by insertion, a large one by qsort (qsort of 6.8M keys took
+ * a fifth of a 1M-point run).
+ */
+static int emit(keyset *s, int ns, int nv, size_t n, uint32_t **ids, int8_t **offs,
+                size_t *count)
 {
+    size_t total = 0;
+    for (int i = 0; i < ns; i++)
+        total += s[i].n;
     size_t *start = calloc(n + 1, sizeof *start);
-    key *tmp = malloc((count ? count : 1) * sizeof *tmp);
+    key *tmp = malloc((total ? total : 1) * sizeof *tmp);
     if (!start || !tmp) {
         free(start);
         free(tmp);
         return FDT_ENOMEM;
     }
-    for (size_t i = 0; i < count; i++)
-        start[(keys[i].v[0] >> 24) + 1]++;
+    for (int i = 0; i < ns; i++)
+        for (size_t k = 0; k < s[i].n; k++)
+            start[(s[i].keys[k].v[0] >> 24) + 1]++;
     for (size_t v = 0; v < n; v++)
         start[v + 1] += start[v];
-    for (size_t i = 0; i < count; i++)
-        tmp[start[keys[i].v[0] >> 24]++] = keys[i];
+    for (int i = 0; i < ns; i++) {
+        for (size_t k = 0; k < s[i].n; k++)
+            tmp[start[s[i].keys[k].v[0] >> 24]++] = s[i].keys[k];
+        keyset_free(&s[i]);
+    }
     for (size_t v = n; v > 0; v--) /* start[v] was the end of bucket v */
         start[v] = start[v - 1];
     start[0] = 0;
@@ -549,32 +546,24 @@ static int sort_keys(key *keys, size_t count, size_t n)
             a[j] = x;
         }
     }
-    if (count)
-        memcpy(keys, tmp, count * sizeof *keys);
-    free(tmp);
     free(start);
-    return FDT_OK;
-}
-
-/* out's arrays from a set of keys with ids below n, sorted. */
-static int emit(keyset *s, int nv, size_t n, uint32_t **ids, int8_t **offs, size_t *count)
-{
-    if (sort_keys(s->keys, s->n, n) != FDT_OK)
+    *ids = malloc((total ? total : 1) * (size_t)nv * sizeof **ids);
+    *offs = malloc((total ? total : 1) * (size_t)nv * 3);
+    if (!*ids || !*offs) {
+        free(tmp);
         return FDT_ENOMEM;
-    *ids = malloc((s->n ? s->n : 1) * (size_t)nv * sizeof **ids);
-    *offs = malloc((s->n ? s->n : 1) * (size_t)nv * 3);
-    if (!*ids || !*offs)
-        return FDT_ENOMEM;
-    for (size_t i = 0; i < s->n; i++)
+    }
+    for (size_t i = 0; i < total; i++)
         for (int j = 0; j < nv; j++) {
-            uint64_t x = s->keys[i].v[j];
+            uint64_t x = tmp[i].v[j];
             int8_t *o = *offs + 3 * ((size_t)nv * i + (size_t)j);
             (*ids)[(size_t)nv * i + (size_t)j] = (uint32_t)(x >> 24);
             o[0] = (int8_t)((int)(x >> 16 & 255) - 128);
             o[1] = (int8_t)((int)(x >> 8 & 255) - 128);
             o[2] = (int8_t)((int)(x & 255) - 128);
         }
-    *count = s->n;
+    free(tmp);
+    *count = total;
     return FDT_OK;
 }
 
@@ -690,13 +679,17 @@ int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, i
         }
     }
     memcpy(out->margin, m, sizeof m);
-    if (err == FDT_OK && ((err = emit(&r.tets, 4, n, &out->tets, &out->tet_off, &out->ntets)) ||
-                          (err = emit(&r.hull, 3, n, &out->hull, &out->hull_off, &out->nhull))))
-        snprintf(diag, diag_size, "out of memory");
+    /* the mesh and the images go before the output is made */
     fdt_ins_free(&r.m);
-    keyset_free(&r.tets);
-    keyset_free(&r.hull);
     ext_free(&r.e);
+    if (err == FDT_OK &&
+        ((err = emit(r.tets, r.nsets, 4, n, &out->tets, &out->tet_off, &out->ntets)) ||
+         (err = emit(r.hull, r.nsets, 3, n, &out->hull, &out->hull_off, &out->nhull))))
+        snprintf(diag, diag_size, "out of memory");
+    for (int i = 0; i < r.nsets; i++) {
+        keyset_free(&r.tets[i]);
+        keyset_free(&r.hull[i]);
+    }
     if (err) {
         fdt_pred_counts pc = out->pc;
         fdt_periodic_free(out);
