@@ -417,6 +417,37 @@ static int sc_triangulate(void *arg, const char **bad)
     return rc;
 }
 
+/* The cells of a periodic mesh (fdt_voronoi_compute on a result periodic
+ * in x, y and z, src/mesh/periodic.c) under injection: the reference's
+ * volumes, or a clean FDT_ENOMEM. */
+typedef struct pcells_arg {
+    fdt_result *r;
+    const ptset *ps;
+    double want_sum;
+} pcells_arg;
+
+static int sc_pcells(void *arg, const char **bad)
+{
+    pcells_arg *a = arg;
+    fdt_voronoi *v = NULL;
+    char diag[256];
+    int rc = fdt_voronoi_compute(a->r, a->ps->xyz, a->ps->n, NULL, &v, diag, sizeof diag);
+    if (rc != FDT_OK) {
+        if (v != NULL)
+            *bad = "a failed periodic cells call returned cells";
+        fdt_voronoi_free(&v);
+        return rc;
+    }
+    double sum = 0;
+    for (size_t i = 0; i < a->ps->n; i++)
+        sum += fdt_voronoi_volumes(v)[i];
+    if (sum != a->want_sum && a->want_sum == a->want_sum)
+        *bad = "other periodic cells";
+    a->want_sum = sum;
+    fdt_voronoi_free(&v);
+    return rc;
+}
+
 /* A streamed run (fdt_triangulate_stream) under injection: it succeeds
  * with the in-memory run's set hash and tet count, or fails with nothing
  * returned; the sink counts what reached it (less than the mesh on a
@@ -1315,6 +1346,16 @@ int main(int argc, char **argv)
                 snprintf(pn, sizeof pn, "periodic %s %s 2 threads", pa_i ? "x z" : "x y z",
                          ps->name);
                 inject_all(&sp);
+                if (!pa_i) { /* the periodic cells */
+                    CHECK_EQ(triangulate_p(&w, &serial_cfg, 0, 7, &pr), FDT_OK);
+                    pcells_arg ca = {pr, &w, NAN};
+                    const char *cbad = NULL;
+                    EXPECT(sc_pcells(&ca, &cbad) == FDT_OK && !cbad);
+                    snprintf(pn, sizeof pn, "periodic cells %s", ps->name);
+                    scenario sv = {pn, FDT_ENOMEM, sc_pcells, &ca};
+                    inject_all(&sv);
+                    fdt_result_free(&pr);
+                }
                 free(w.xyz);
             }
             /* the dual: neighbours derived (the longer path), two sets */

@@ -359,6 +359,27 @@ static void errors(void)
     int err = fdt_periodic_build(X, 8, &b, 1, &pm, diag, sizeof diag);
     EXPECTF(err == FDT_EDEGENERATE && strstr(diag, "one copy of the box"), "%d %s", err, diag);
     printf("errors: %s\n", diag);
+    /* a flat set periodic in x and y: no 3-D mesh, with its images or not */
+    double F[3 * 40];
+    for (int i = 0; i < 40; i++) {
+        F[3 * i] = test_unif(&s);
+        F[3 * i + 1] = test_unif(&s);
+        F[3 * i + 2] = 0.5;
+    }
+    fdt_periodic_box bxy = {3, {0, 0, 0}, {1, 1, 1}};
+    err = fdt_periodic_build(F, 40, &bxy, 1, &pm, diag, sizeof diag);
+    EXPECTF(err == FDT_EDEGENERATE && strstr(diag, "3-D"), "flat x y: %d %s", err, diag);
+    /* the same periodic in z too: a point's z-images are its neighbours */
+    err = fdt_periodic_build(F, 40, &b, 1, &pm, diag, sizeof diag);
+    EXPECTF(err == FDT_EDEGENERATE && strstr(diag, "one copy of the box"), "flat x y z: %d %s",
+            err, diag);
+    fdt_periodic_box huge = {2, {0, -0x1p600, 0}, {1, 1, 1}};
+    EXPECT(fdt_periodic_build(X, 8, &huge, 1, &pm, diag, sizeof diag) == FDT_EINVAL &&
+           strstr(diag, "2^500"));
+    /* renumbering needs the merge's increasing first indices */
+    fdt_periodic_mesh one = {0};
+    int32_t orig[3] = {0, 2, 1};
+    EXPECT(fdt_periodic_renumber(&one, orig, 3) == FDT_EINTERNAL);
 }
 
 int main(void)

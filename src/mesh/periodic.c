@@ -707,17 +707,6 @@ void fdt_periodic_free(fdt_periodic_mesh *m)
     memset(m, 0, sizeof *m);
 }
 
-size_t fdt_periodic_row_text(char *buf, const uint32_t id[4], const int8_t off[12])
-{
-    size_t k = 0;
-    for (int j = 0; j < 4; j++)
-        k += (size_t)snprintf(buf + k, FDT_PERIODIC_ROW_MAX - k, "%s%u", j ? " " : "", id[j]);
-    for (int j = 0; j < 12; j++)
-        k += (size_t)snprintf(buf + k, FDT_PERIODIC_ROW_MAX - k, " %d", off[j]);
-    buf[k++] = '\n';
-    return k;
-}
-
 /* ---- the Voronoi cells of a periodic mesh ------------------------------ */
 
 /* A map from packed vertices (vpack) to their index in a list of

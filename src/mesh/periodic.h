@@ -77,13 +77,6 @@ int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, i
 
 void fdt_periodic_free(fdt_periodic_mesh *m);
 
-/* The .tets line of a periodic tet (include/frontdt.h): its 4 ids, then
- * its 12 offsets, separated by spaces, and a newline, into buf (at least
- * FDT_PERIODIC_ROW_MAX bytes); returns its length. fdt_result_hash hashes
- * these bytes, the .tets writer writes them. */
-#define FDT_PERIODIC_ROW_MAX 112
-size_t fdt_periodic_row_text(char *buf, const uint32_t id[4], const int8_t off[12]);
-
 /*
  * The Voronoi cells of a periodic mesh (x, y and z periodic: no cell is
  * unbounded), as fdt_voronoi_compute gives a plain mesh's: n rows, row i

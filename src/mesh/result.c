@@ -1,11 +1,11 @@
 /* Result accessors, canonical order and the canonical hash. */
 #include "mesh/result.h"
-#include "mesh/periodic.h"
 
 #include <pthread.h>
 #include <sched.h>
 #include <stdatomic.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -841,4 +841,15 @@ int fdt_result_set_hash(const fdt_result *r, uint64_t *hash)
     fdt_sethash_add_n(&h, (const uint32_t *)r->tets, r->ntets);
     *hash = fdt_sethash_value(&h);
     return FDT_OK;
+}
+
+size_t fdt_periodic_row_text(char *buf, const uint32_t id[4], const int8_t off[12])
+{
+    size_t k = 0;
+    for (int j = 0; j < 4; j++)
+        k += (size_t)snprintf(buf + k, FDT_PERIODIC_ROW_MAX - k, "%s%u", j ? " " : "", id[j]);
+    for (int j = 0; j < 12; j++)
+        k += (size_t)snprintf(buf + k, FDT_PERIODIC_ROW_MAX - k, " %d", off[j]);
+    buf[k++] = '\n';
+    return k;
 }

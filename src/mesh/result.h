@@ -38,6 +38,13 @@ struct fdt_result {
     fdt_vid *adj;        /* each vertex's neighbours, ascending */
 };
 
+/* The .tets line of a periodic tet (include/frontdt.h): its 4 ids, then
+ * its 12 offsets, separated by spaces, and a newline, into buf (at least
+ * FDT_PERIODIC_ROW_MAX bytes); returns its length. fdt_result_hash hashes
+ * these bytes, the .tets writer writes them. */
+#define FDT_PERIODIC_ROW_MAX 112
+size_t fdt_periodic_row_text(char *buf, const uint32_t id[4], const int8_t off[12]);
+
 /* Frees the face list (src/mesh/faces.c): the tets were renumbered. */
 void fdt_result_drop_faces(fdt_result *r);
 /* Frees everything src/mesh/faces.c derived (fdt_result_free). */

@@ -1,7 +1,7 @@
 /* The canonical .tets text (src/io/write/formats.h): one tet per line, its four ids
  * ascending, lines ascending; the bytes fdt_result_hash hashes. */
 #include "io/write/formats.h"
-#include "mesh/periodic.h"
+#include "mesh/result.h"
 
 static inline void sort4(fdt_vid s[4])
 {
@@ -31,7 +31,7 @@ static inline int cmp4(const fdt_vid *a, const fdt_vid *b)
     return 0;
 }
 
-/* A periodic mesh's lines (src/mesh/periodic.h): rows already canonical
+/* A periodic mesh's lines (src/mesh/result.h): rows already canonical
  * (ids ascending, offsets relative to the first, rows ascending). */
 static int put_periodic(out_file *o, const fdt_mesh_view *m)
 {
