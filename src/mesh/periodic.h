@@ -12,18 +12,19 @@
  * src/geom/images.h), and certified. A tet is kept when its
  * lowest vertex (least input index, then least offset) is an input point
  * itself; its offsets are then relative to that vertex. The result is
- * proved, not assumed:
- *   - sound: a kept tet's circumscribed ball, within the points' extent on
- *     the axes that are not periodic, lies inside the region where every
- *     image is present (the box grown by m on each periodic axis), so no
- *     image of any point is inside its sphere (ties: the images share
- *     their point's perturbation, images.h); a kept hull face has a
- *     normal with no periodic component, so nothing lies beyond it;
- *   - complete: every face of a kept tet has across it a tet (or a hull
- *     face) whose translate is kept, so the kept set is closed and, the
- *     quotient being connected, all of the periodic DT.
- * Where either fails the margin doubles and the run starts again: a
- * function of the input alone (no clock). At m >= the period (every point
+ * proved, not assumed: every tet with a vertex that is an input point has
+ * its circumscribed ball, within the points' extent on the axes that are
+ * not periodic, inside the region where every image is present (the box
+ * grown by m on each periodic axis), so no image of any point is inside
+ * its sphere (ties: the images share their point's perturbation,
+ * images.h), and every such hull face a normal with no periodic
+ * component, so nothing lies beyond it. Then each input point's star in
+ * this mesh is its star in the periodic mesh (a closed neighbourhood of
+ * the point made of periodic tets), and the kept tets, the stars' shares,
+ * are all of the periodic mesh, each once (sound and complete).
+ * Where a ball reaches too far the margin grows to what it reached (and a
+ * quarter more) and the run starts again: a function of the input alone
+ * (no clock). At m >= the period (every point
  * with all its neighbouring images) a failure means the periodic
  * triangulation is not a simplicial complex in one copy of the box
  * (CGAL's 1-sheet condition): FDT_EDEGENERATE, with the reason.
