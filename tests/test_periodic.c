@@ -171,7 +171,7 @@ static fdt_periodic_mesh build(const double *X, size_t n, const fdt_periodic_box
 {
     fdt_periodic_mesh pm;
     char diag[512];
-    int err = fdt_periodic_build(X, (uint32_t)n, b, threads, &pm, diag, sizeof diag);
+    int err = fdt_periodic_build(X, (uint32_t)n, NULL, b, threads, &pm, diag, sizeof diag);
     EXPECTF(err == FDT_OK, "%s: fdt_periodic_build: %d (%s)", name, err, diag);
     CHECK(err == FDT_OK);
     return pm;
@@ -347,16 +347,16 @@ static void errors(void)
     char diag[512];
     fdt_periodic_box b = {7, {0, 0, 0}, {1, 1, 1}};
     X[3 * 5 + 1] = 1.0; /* on the upper wall: outside [0, 1) */
-    EXPECT(fdt_periodic_build(X, 8, &b, 1, &pm, diag, sizeof diag) == FDT_EINVAL);
+    EXPECT(fdt_periodic_build(X, 8, NULL, &b, 1, &pm, diag, sizeof diag) == FDT_EINVAL);
     EXPECTF(strstr(diag, "point 5 has y = 1") != NULL, "%s", diag);
     X[3 * 5 + 1] = 0.5;
     fdt_periodic_box none = {0, {0, 0, 0}, {1, 1, 1}};
-    EXPECT(fdt_periodic_build(X, 8, &none, 1, &pm, diag, sizeof diag) == FDT_EINVAL);
+    EXPECT(fdt_periodic_build(X, 8, NULL, &none, 1, &pm, diag, sizeof diag) == FDT_EINVAL);
     fdt_periodic_box empty = {1, {0, 0, 0}, {0, 1, 1}};
-    EXPECT(fdt_periodic_build(X, 8, &empty, 1, &pm, diag, sizeof diag) == FDT_EINVAL);
+    EXPECT(fdt_periodic_build(X, 8, NULL, &empty, 1, &pm, diag, sizeof diag) == FDT_EINVAL);
     /* 8 points in a periodic cube: the mesh needs images of one point in
      * a tet */
-    int err = fdt_periodic_build(X, 8, &b, 1, &pm, diag, sizeof diag);
+    int err = fdt_periodic_build(X, 8, NULL, &b, 1, &pm, diag, sizeof diag);
     EXPECTF(err == FDT_EDEGENERATE && strstr(diag, "one copy of the box"), "%d %s", err, diag);
     printf("errors: %s\n", diag);
     /* a flat set periodic in x and y: no 3-D mesh, with its images or not */
@@ -367,14 +367,14 @@ static void errors(void)
         F[3 * i + 2] = 0.5;
     }
     fdt_periodic_box bxy = {3, {0, 0, 0}, {1, 1, 1}};
-    err = fdt_periodic_build(F, 40, &bxy, 1, &pm, diag, sizeof diag);
+    err = fdt_periodic_build(F, 40, NULL, &bxy, 1, &pm, diag, sizeof diag);
     EXPECTF(err == FDT_EDEGENERATE && strstr(diag, "3-D"), "flat x y: %d %s", err, diag);
     /* the same periodic in z too: a point's z-images are its neighbours */
-    err = fdt_periodic_build(F, 40, &b, 1, &pm, diag, sizeof diag);
+    err = fdt_periodic_build(F, 40, NULL, &b, 1, &pm, diag, sizeof diag);
     EXPECTF(err == FDT_EDEGENERATE && strstr(diag, "one copy of the box"), "flat x y z: %d %s",
             err, diag);
     fdt_periodic_box huge = {2, {0, -0x1p600, 0}, {1, 1, 1}};
-    EXPECT(fdt_periodic_build(X, 8, &huge, 1, &pm, diag, sizeof diag) == FDT_EINVAL &&
+    EXPECT(fdt_periodic_build(X, 8, NULL, &huge, 1, &pm, diag, sizeof diag) == FDT_EINVAL &&
            strstr(diag, "2^500"));
     /* renumbering needs the merge's increasing first indices */
     fdt_periodic_mesh one = {0};
@@ -394,7 +394,7 @@ int main(void)
     fdt_periodic_mesh pm;
     char diag[512];
     fdt_periodic_box bxz = {5, {0, 0, 0}, {1, 1, 1}};
-    int err = fdt_periodic_build(U, (uint32_t)n, &bxz, 2, &pm, diag, sizeof diag);
+    int err = fdt_periodic_build(U, (uint32_t)n, NULL, &bxz, 2, &pm, diag, sizeof diag);
     EXPECTF(err == FDT_EDEGENERATE && strstr(diag, "not flat"), "%d %s", err, diag);
     free(U);
     size_t nl;

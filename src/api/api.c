@@ -567,7 +567,7 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, fdt_resul
         err = periodic_box_scaled(ctx, pr.scale_exp, &b);
     double t1 = fdt_now_s();
     if (!err)
-        err = fdt_periodic_build(pr.p, (uint32_t)pr.m, &b, nthreads, &pm, ctx->diag,
+        err = fdt_periodic_build(pr.p, (uint32_t)pr.m, pr.orig, &b, nthreads, &pm, ctx->diag,
                                  sizeof ctx->diag);
     if (!err)
         err = fdt_periodic_renumber(&pm, pr.orig, pr.m);

@@ -86,7 +86,7 @@ static int ext_grow(ext *e, size_t need)
  * The points, then for each the images whose every offset is allowed: on
  * periodic axis k, +1 when x - lo <= m[k] (the image lands within m above
  * hi), -1 when hi - x <= m[k]. Every image whose exact coordinate lies in
- * (lo - m', hi + m') on each periodic axis, m' < m (one_round's mm), is
+ * (lo - m', hi + m') on each periodic axis, m' < m (prove_run's mm), is
  * then present: x + L < hi + m' means x - lo < m', and rounding is
  * monotone.
  */
@@ -316,6 +316,7 @@ typedef struct run {
     keyset tets[64], hull[64]; /* the kept ones, a set a thread (prove_run) */
     int nsets;
     double need[3];        /* a failed round: how far the balls reached */
+    const int32_t *names;  /* the points' names in messages, or NULL */
     char *diag;
     size_t dsz;
 } run;
@@ -455,7 +456,7 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
             fdt_certify_describe(&why, r->diag, r->dsz);
         return err;
     }
-    /* the proofs and the kept tets, on the run's threads (prove()) */
+    /* the proofs and the kept tets, on the run's threads (prove_run) */
     int T = nthreads < 1 ? 1 : nthreads > 64 ? 64 : nthreads;
     prove_job jobs[64];
     memset(jobs, 0, sizeof jobs);
@@ -492,7 +493,7 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
                  "no periodic triangulation in one copy of the box: a tet or hull face joins "
                  "two images of point %ld (the box is too small for the points' spacing: "
                  "more points, or a smaller box)",
-                 repeat_id);
+                 r->names ? (long)r->names[repeat_id] : repeat_id);
         return FDT_EDEGENERATE;
     }
     return ROUND_OK;
@@ -608,8 +609,9 @@ int fdt_periodic_renumber(fdt_periodic_mesh *m, const int32_t *orig, size_t n)
     return FDT_OK;
 }
 
-int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, int nthreads,
-                       fdt_periodic_mesh *out, char *diag, size_t diag_size)
+int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
+                       const fdt_periodic_box *b, int nthreads, fdt_periodic_mesh *out,
+                       char *diag, size_t diag_size)
 {
     memset(out, 0, sizeof *out);
     char own[8];
@@ -629,6 +631,7 @@ int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, i
     memset(&r, 0, sizeof r);
     r.X = X;
     r.n = n;
+    r.names = names;
     r.b = b;
     r.diag = diag;
     r.dsz = diag_size;

@@ -65,7 +65,8 @@ typedef struct fdt_periodic_mesh {
 /*
  * The periodic DT of the n points X (3 doubles each, distinct, finite)
  * in the box b, on nthreads threads, into *out (free with
- * fdt_periodic_free). FDT_OK; FDT_EINVAL for a box with no periodic axis,
+ * fdt_periodic_free). names (may be NULL): point i's name in messages
+ * (a merged input's index). FDT_OK; FDT_EINVAL for a box with no periodic axis,
  * hi <= lo or a side beyond doubles, a point outside [lo, hi) on a
  * periodic axis (diag names the first by its index), or two points that
  * coincide; FDT_EDEGENERATE when no periodic triangulation exists in one
@@ -73,8 +74,9 @@ typedef struct fdt_periodic_mesh {
  * 3-D space; FDT_ECHECK if a mesh failed its certificate (a bug);
  * FDT_ENOMEM; FDT_ETOOBIG. diag gets the reason of any error.
  */
-int fdt_periodic_build(const double *X, uint32_t n, const fdt_periodic_box *b, int nthreads,
-                       fdt_periodic_mesh *out, char *diag, size_t diag_size);
+int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
+                       const fdt_periodic_box *b, int nthreads, fdt_periodic_mesh *out,
+                       char *diag, size_t diag_size);
 
 void fdt_periodic_free(fdt_periodic_mesh *m);
 
