@@ -12,7 +12,8 @@
 - Errors, each with its message and exit code and no output: a point
   outside the box (exit 1, the input's line named by index), too few
   points for one copy of the box (exit 2), --periodic without --box, with
-  --stream or an output that is not .tets (exit 1).
+  --stream or an output that is not .tets (exit 1), over --memory-limit
+  (exit 4, its estimate counting the images).
 
 - The cells (--periodic xyz --voronoi): their volumes sum to the box's to
   1e-12, and each cell's volume, area and neighbours with their face areas
@@ -211,7 +212,11 @@ def errors():
         r = frontdt(src, *args)
         expect(r.returncode == 1 and word in r.stderr, "%s: exit %d, %s"
                % (" ".join(args), r.returncode, r.stderr))
-    print("errors: outside the box, too few points, usage")
+    write_points(src, uniform(3000, 0.0, 1.0, 5))
+    r = frontdt(src, "--periodic", "xyz", "--box", "0,0,0,1,1,1", "--memory-limit", "2M")
+    expect(r.returncode == 4 and "periodic" in r.stderr,
+           "--memory-limit: exit %d, %s" % (r.returncode, r.stderr))
+    print("errors: outside the box, too few points, usage, --memory-limit")
 
 
 def main():

@@ -1429,10 +1429,17 @@ static int open_engine(const cli *c, run_state *rs)
     unsigned long long dual = c->dual.dual ? 1500ull * rs->n + (16ull << 20) : 0;
     if (dual > rs->estimate)
         rs->estimate = dual;
+    /* a periodic run: the mesh of the points and their images, then the
+     * kept tets' keys and their sort, 605-622 MiB at the peak for 1M
+     * uniform points (bench/NOTES.md entry 108) */
+    unsigned long long periodic = c->periodic ? 700ull * rs->n + (16ull << 20) : 0;
+    if (periodic > rs->estimate)
+        rs->estimate = periodic;
     if (c->memory_limit && rs->estimate > c->memory_limit) {
-        say("%s: %zu points need about %llu MiB (%s%s%s), more than --memory-limit %llu MiB",
+        say("%s: %zu points need about %llu MiB (%s%s%s%s), more than --memory-limit %llu MiB",
             rs->name, rs->n, rs->estimate >> 20, rs->streaming ? "streamed" : "in memory",
             s.neighbors ? ", with neighbours" : "", c->dual.dual ? ", --dual" : "",
+            c->periodic ? ", periodic" : "",
             c->memory_limit >> 20);
         return CLI_RESOURCES;
     }
