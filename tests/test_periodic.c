@@ -409,6 +409,15 @@ int main(void)
     C = channel(n, 4, 1);
     against_reference("duct", C, n, 1, lo, hi);
     free(C);
+    /* walls not quite flat (the wall points moved by up to 2^-30): flat
+     * tets on them with spheres far beyond (periodic.c's ball_reach) */
+    C = channel(n, 5, 0);
+    uint64_t bs = 6;
+    for (size_t i = 0; i < n; i++)
+        if (C[3 * i + 1] == 0.0 || C[3 * i + 1] == 1.0)
+            C[3 * i + 1] += (C[3 * i + 1] == 0.0 ? 1 : -1) * floor(test_unif(&bs) * 4) * 0x1p-30;
+    against_reference("bumpy channel", C, n, 5, lo, hi);
+    free(C);
     inexact_box(4000);
     errors();
     return test_report("periodic");

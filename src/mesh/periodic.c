@@ -282,17 +282,34 @@ static void ball_reach(const ext *e, const uint32_t *v, const fdt_periodic_box *
     double cerr = 0x1p-40 * (R + fabs(c[0]) + fabs(c[1]) + fabs(c[2])) + kappa * 4 * e->err;
     if (!(cerr < R + h))
         return; /* too flat to place */
-    double D2 = 0;
-    for (int j = 0; j < 3; j++) {
-        if (b->axes >> j & 1)
-            continue;
-        double d = ylo[j] - c[j] > c[j] - yhi[j] ? ylo[j] - c[j] : c[j] - yhi[j];
-        d = d - cerr;
-        if (d > 0)
-            D2 += d * d;
+    /*
+     * The squared radius of the ball's widest section inside the points'
+     * extent, R^2 - D^2 (D: the distance from the centre to that extent
+     * on the axes that are not periodic), from each vertex p as the sum
+     * over the axes of (p_k - c_k)^2, but (p_j - w_j) (p_j + w_j - 2 c_j)
+     * on an axis j whose extent's face w_j lies between the points and
+     * the centre: no difference of two huge squares (a flat tet by a wall
+     * that is not quite flat has its centre far beyond it). Each term is
+     * bounded up for the centre's error cerr; an axis within cerr of its
+     * face is not cut (the larger section). The largest over the vertices.
+     */
+    double ext2 = 0;
+    const double *vs[4] = {a, p[0], p[1], p[2]};
+    for (int q = 0; q < 4; q++) {
+        double s2 = 0;
+        for (int j = 0; j < 3; j++) {
+            double pj = vs[q][j], w = c[j];
+            if (!(b->axes >> j & 1) && ylo[j] - c[j] > cerr)
+                w = ylo[j];
+            else if (!(b->axes >> j & 1) && c[j] - yhi[j] > cerr)
+                w = yhi[j];
+            if (w != c[j])
+                s2 += fabs(pj - w) * (fabs(pj + w - 2 * c[j]) + 2 * cerr);
+            else
+                s2 += (fabs(pj - c[j]) + cerr) * (fabs(pj - c[j]) + cerr);
+        }
+        ext2 = s2 > ext2 ? s2 : ext2;
     }
-    double Rh = R + 2 * cerr, Dl = sqrt(D2);
-    double ext2 = Rh > Dl ? (Rh - Dl) * (Rh + Dl) : 0;
     double extent = sqrt(ext2) * (1 + 0x1p-40) + cerr;
     for (int k = 0; k < 3; k++) {
         if (!(b->axes >> k & 1))
