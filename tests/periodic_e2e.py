@@ -200,6 +200,11 @@ def errors():
     r = frontdt(src, "--periodic", "x,y,z", "--box", "0,0,0,1,1,1", "-o", out)
     expect(r.returncode == 1 and "point 17 has y = 1" in r.stderr and not os.path.exists(out),
            "outside the box: exit %d, %s" % (r.returncode, r.stderr))
+    with open(src, "a") as f:
+        f.write("0.5 nan 0.5\n")
+    r = frontdt(src, "--periodic", "xyz", "--box", "0,0,0,1,1,1", "-o", out)
+    expect(r.returncode == 2 and "nan" in r.stderr.lower() and not os.path.exists(out),
+           "NaN: exit %d, %s" % (r.returncode, r.stderr))
     write_points(src, uniform(6, 0.0, 1.0, 4))
     r = frontdt(src, "--periodic", "xyz", "--box", "0,0,0,1,1,1", "-o", out)
     expect(r.returncode == 2 and "one copy of the box" in r.stderr and not os.path.exists(out),

@@ -606,6 +606,8 @@ static void test_periodic_api(void)
     EXPECT(fdt_voronoi_compute(r, xyz, N, NULL, &v, vd, sizeof vd) == FDT_EINVAL &&
            strstr(vd, "x, y and z") != NULL);
     fdt_result_free(&r);
+    xyz[3 * 5 + 2] = NAN; /* the merge names it, as in any run */
+    EXPECT(fdt_triangulate(ctx, xyz, N, &r) == FDT_ERANGE);
     xyz[3 * 5 + 2] = 1.0;
     EXPECT(fdt_triangulate(ctx, xyz, N, &r) == FDT_EINVAL &&
            strstr(fdt_context_diagnostic(ctx), "point 5 has z = 1") != NULL);

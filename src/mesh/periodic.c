@@ -602,9 +602,12 @@ int fdt_periodic_check(const double *X, size_t n, const fdt_periodic_box *b, cha
             return FDT_EINVAL;
         }
     }
+    /* a coordinate that is not finite is the merge's to name (FDT_ERANGE,
+     * as in any run) */
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++)
-            if (b->axes >> k & 1 && !(X[3 * i + k] >= b->lo[k] && X[3 * i + k] < b->hi[k])) {
+            if (b->axes >> k & 1 && isfinite(X[3 * i + k]) &&
+                !(X[3 * i + k] >= b->lo[k] && X[3 * i + k] < b->hi[k])) {
                 snprintf(diag, dsz, "point %zu has %c = %.17g, outside the periodic box's "
                          "[%.17g, %.17g)", i, "xyz"[k], X[3 * i + k], b->lo[k], b->hi[k]);
                 return FDT_EINVAL;
