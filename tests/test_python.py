@@ -481,6 +481,8 @@ def test_periodic(tmp):
     c = t.voronoi()
     check(abs(c["volumes"].sum() / 6.0 - 1) < 1e-12 and not c["flags"].any(),
           "periodic: the cells' volumes are the box's")
+    c2 = frontdt.voronoi(pts, box=box, periodic="xyz")
+    check(np.array_equal(c2["volumes"], c["volumes"]), "frontdt.voronoi(periodic=)")
     check(raises(ValueError, frontdt.delaunay, pts, periodic="xz") is not None,
           "periodic without box")
     check(raises(ValueError, frontdt.delaunay, pts, box=box) is not None, "box without periodic")

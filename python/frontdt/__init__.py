@@ -14,10 +14,14 @@ long as any of them. See help(frontdt.delaunay) and README.md, "Python".
 from ._frontdt import CheckError, Triangulation, __version__, check, delaunay
 
 
-def voronoi(points, box=None, threads=None):
+def voronoi(points, box=None, threads=None, periodic=None):
     """Each point's Voronoi cell, clipped by box (None: the points' bounding
     box): frontdt.delaunay(points, threads).voronoi(box), a dict of arrays
-    (see help(frontdt.Triangulation.voronoi))."""
+    (see help(frontdt.Triangulation.voronoi)). periodic="xyz" with box the
+    periods: the cells of the periodic point set, never clipped, their
+    volumes summing to the box's."""
+    if periodic is not None:
+        return delaunay(points, threads=threads, periodic=periodic, box=box).voronoi()
     return delaunay(points, threads=threads).voronoi(box)
 
 
