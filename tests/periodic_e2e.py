@@ -20,7 +20,13 @@
   equal voro++'s periodic container's (tests/voro_ref.cpp periodic) to
   1e-10 (skipped where voro++ is not built).
 
-Usage: periodic_e2e.py FRONTDT CGAL_PERIODIC|none VORO_REF|none SCRATCH
+- tests/gen_points families scaled into the unit box (a torus, a cubed
+  sphere, near-duplicates, a rotated lattice, mixed scales: flat tets
+  whose spheres the rounded images cannot place, decided exactly): threads,
+  modes, a shuffle; with --long (meson test --suite long: CGAL's periodic
+  triangulation of them takes minutes) CGAL's tets too.
+
+Usage: periodic_e2e.py FRONTDT CGAL_PERIODIC|none VORO_REF|none SCRATCH GEN_POINTS [--long]
 """
 import os
 import random
@@ -28,7 +34,8 @@ import shutil
 import subprocess
 import sys
 
-FRONTDT, CGAL, VORO, SCRATCH = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
+FRONTDT, CGAL, VORO, SCRATCH, GEN = sys.argv[1:6]
+LONG = sys.argv[6:] == ["--long"]
 failures = []
 checks = 0
 
@@ -89,7 +96,8 @@ def clusters(n, lo, length, seed):
     return sorted(pts, key=lambda p: r.random())
 
 
-def case(name, pts, lo, length):
+def case(name, pts, lo, length, cgal=True, settings=(["-t", "2"], ["-t", "3"],
+         ["-t", "2", "--mode", "shared"], ["-t", "3", "--mode", "message"])):
     box = ",".join("%.17g" % v for v in (lo, lo, lo, lo + length, lo + length, lo + length))
     src = os.path.join(SCRATCH, name + ".xyz")
     write_points(src, pts)
@@ -101,8 +109,7 @@ def case(name, pts, lo, length):
     got = open(out, "rb").read()
     expect(r.stdout.strip() == "hash: %016x" % fnv(got), "%s: --hash is not the .tets bytes' hash"
            % name)
-    for extra in (["-t", "2"], ["-t", "3"], ["-t", "2", "--mode", "shared"],
-                  ["-t", "3", "--mode", "message"]):
+    for extra in settings:
         o2 = out + ".t.tets"
         r2 = frontdt(src, "--periodic", "xyz", "--box", box, "-o", o2, "-q", *extra)
         expect(r2.returncode == 0 and open(o2, "rb").read() == got,
@@ -133,7 +140,7 @@ def case(name, pts, lo, length):
     r4 = frontdt(dsrc, "--periodic", "xyz", "--box", box, "-o", do, "-q")
     expect(r4.returncode == 0 and open(do, "rb").read() == got,
            "%s: duplicates change the tets (%s)" % (name, r4.stderr))
-    if CGAL != "none":
+    if CGAL != "none" and cgal:
         ref = os.path.join(SCRATCH, name + ".cgal.tets")
         c = subprocess.run([CGAL, src, "%.17g" % lo, "%.17g" % length, ref], capture_output=True,
                            text=True, timeout=600)
@@ -143,7 +150,7 @@ def case(name, pts, lo, length):
             expect(got == want, "%s: %d tets, CGAL's periodic triangulation %d"
                    % (name, got.count(b"\n"), want.count(b"\n")))
     print("%s: %d points, %d tets%s" % (name, len(pts), got.count(b"\n"),
-                                        ", as CGAL's" if CGAL != "none" else ""))
+                                        ", as CGAL's" if CGAL != "none" and cgal else ""))
 
 
 def cells(name, pts, lo, length):
@@ -191,6 +198,17 @@ def cells(name, pts, lo, length):
     print("%s cells: %d, their volumes the box's, as voro++'s periodic cells" % (name, len(got)))
 
 
+def family(name, n):
+    """A gen_points family scaled into [0, 0.999)^3 (the unit box)."""
+    path = os.path.join(SCRATCH, name + "_raw.xyz")
+    subprocess.run([GEN, name, str(n), "3", path], check=True, capture_output=True)
+    pts = [tuple(map(float, line.split()[:3])) for line in open(path) if line.strip()]
+    lo = [min(p[k] for p in pts) for k in range(3)]
+    hi = [max(p[k] for p in pts) for k in range(3)]
+    return [tuple(((p[k] - lo[k]) / (hi[k] - lo[k]) if hi[k] > lo[k] else 0.5) * 0.999
+                  for k in range(3)) for p in pts]
+
+
 def errors():
     src = os.path.join(SCRATCH, "err.xyz")
     pts = uniform(200, 0.0, 1.0, 3)
@@ -230,6 +248,10 @@ def main():
     case("uniform", uniform(2000, 0.1, 1.2, 1), 0.1, 1.2)
     case("lattice", lattice(4, 0.1, 1.2), 0.1, 1.2)
     case("clusters", clusters(600, -2.0, 3.0, 2), -2.0, 3.0)
+    for fam in ("torus", "cubedsphere", "neardup", "rotlattice", "mixed"):
+        # CGAL's own only in the long suite: its periodic triangulation of
+        # these takes minutes; threads, modes, shuffles always
+        case(fam, family(fam, 1500 if LONG else 500), 0.0, 1.0, LONG, (["-t", "3"],))
     cells("uniform", uniform(2000, 0.1, 1.2, 5), 0.1, 1.2)
     cells("lattice", lattice(5, 0.1, 1.2), 0.1, 1.2)
     cells("clusters", clusters(800, -2.0, 3.0, 6), -2.0, 3.0)

@@ -275,3 +275,98 @@ int fdt_images_insphere_call(const fdt_images *im, const double *a, const double
 {
     return fdt_images_insphere(im, a, b, c, d, e, cnt);
 }
+
+int fdt_images_ball_inside(const fdt_images *im, const uint32_t i[4], const double A[3],
+                           const double B[3], unsigned axes)
+{
+    exact_pts z;
+    exact_init(&z, im, i, 4);
+    /* the bounds on the grid of the points: kmin again, over them too */
+    int kmin = INT_MAX;
+    for (int j = 0; j < 4; j++) {
+        const double *x = im->X + 3 * (size_t)im->src[i[j]];
+        const int8_t *o = im->off + 3 * (size_t)i[j];
+        for (int k = 0; k < 3; k++) {
+            const double v[3] = {x[k], o[k] ? im->hi[k] : 0.0, o[k] ? im->lo[k] : 0.0};
+            for (int w = 0; w < 3; w++)
+                if (v[w] != 0.0) {
+                    int e = fdt_int_exponent(v[w]);
+                    kmin = e < kmin ? e : kmin;
+                }
+        }
+    }
+    if (kmin == INT_MAX)
+        kmin = 0; /* exact_init's grid */
+    int k2 = kmin; /* the bounds' grid too: the points moved onto it */
+    for (int k = 0; k < 3; k++)
+        for (int w = 0; w < 2; w++) {
+            double v = w ? B[k] : A[k];
+            if ((axes >> k & 1) && v != 0.0 && fdt_int_exponent(v) < k2)
+                k2 = fdt_int_exponent(v);
+        }
+    for (int j = 0; j < 4 && k2 < kmin; j++)
+        for (int k = 0; k < 3; k++)
+            mpz_mul_2exp(z.q[j][k], z.q[j][k], (mp_bitcnt_t)(kmin - k2));
+    kmin = k2;
+    /* u_j = p_j - p_0, D = det[u1; u2; u3] (> 0: a positive tet), and
+     * N = |u1|^2 (u2 x u3) + |u2|^2 (u3 x u1) + |u3|^2 (u1 x u2): the
+     * centre is p_0 + N / (2D), the radius |N| / (2D). */
+    mpz_t u[3][3], l[3], N[3], D, t, s, n2, lim;
+    for (int r = 0; r < 3; r++) {
+        mpz_init(l[r]);
+        mpz_init(N[r]);
+        for (int k = 0; k < 3; k++) {
+            mpz_init(u[r][k]);
+            mpz_sub(u[r][k], z.q[r + 1][k], z.q[0][k]);
+            mpz_addmul(l[r], u[r][k], u[r][k]);
+        }
+    }
+    mpz_inits(D, t, s, n2, lim, NULL);
+    fdt_mpz_det3(D, u[0], u[1], u[2], t);
+    int inside = mpz_sgn(D) > 0;
+    for (int r = 0; r < 3 && inside; r++) {
+        const mpz_t *a = u[(r + 1) % 3], *b = u[(r + 2) % 3];
+        for (int k = 0; k < 3; k++) { /* (a x b)_k l_r */
+            int ka = (k + 1) % 3, kb = (k + 2) % 3;
+            mpz_mul(t, a[ka], b[kb]);
+            mpz_submul(t, a[kb], b[ka]);
+            mpz_addmul(N[k], t, l[r]);
+        }
+    }
+    for (int k = 0; k < 3; k++)
+        mpz_addmul(n2, N[k], N[k]);
+    /* c_k + R < B_k: S = 2D (B_k - p0_k) - N_k > 0 and S^2 > |N|^2; and
+     * c_k - R > A_k: S = 2D (p0_k - A_k) + N_k > 0 and S^2 > |N|^2 */
+    for (int k = 0; k < 3 && inside; k++) {
+        if (!(axes >> k & 1))
+            continue;
+        for (int w = 0; w < 2 && inside; w++) {
+            fdt_mpz_set_scaled(lim, w ? B[k] : A[k], kmin);
+            if (w)
+                mpz_sub(s, lim, z.q[0][k]);
+            else
+                mpz_sub(s, z.q[0][k], lim);
+            mpz_mul(s, s, D);
+            mpz_mul_2exp(s, s, 1);
+            if (w)
+                mpz_sub(s, s, N[k]);
+            else
+                mpz_add(s, s, N[k]);
+            if (mpz_sgn(s) <= 0) {
+                inside = 0;
+                break;
+            }
+            mpz_mul(t, s, s);
+            inside = mpz_cmp(t, n2) > 0;
+        }
+    }
+    for (int r = 0; r < 3; r++) {
+        mpz_clear(l[r]);
+        mpz_clear(N[r]);
+        for (int k = 0; k < 3; k++)
+            mpz_clear(u[r][k]);
+    }
+    mpz_clears(D, t, s, n2, lim, NULL);
+    exact_clear(&z);
+    return inside;
+}

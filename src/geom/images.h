@@ -63,6 +63,13 @@ void fdt_images_init(fdt_images *im, const double blo[3], const double bhi[3], d
 int fdt_images_orient_exact(const fdt_images *im, const uint32_t i[4], fdt_pred_counts *cnt);
 int fdt_images_insphere_exact(const fdt_images *im, const uint32_t i[5], fdt_pred_counts *cnt);
 
+/* Whether the closed circumscribed ball of the positive tet of the
+ * points i[0..3] of P (their exact images) lies strictly inside (A[k],
+ * B[k]) on every axis k of axes, exactly (GMP): where the rounded
+ * circumcentre is too uncertain (a flat tet). */
+int fdt_images_ball_inside(const fdt_images *im, const uint32_t i[4], const double A[3],
+                           const double B[3], unsigned axes);
+
 /* The sign of component k of the normal (b - a) x (c - a) of the exact
  * images of the points i[0..2] of P. */
 int fdt_images_normal_sign(const fdt_images *im, const uint32_t i[3], int k);

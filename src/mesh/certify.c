@@ -161,7 +161,7 @@ static inline const char *check_pair_finite(const fdt_ins *m, const uint32_t *v,
 {
     if (q == INF)
         return NULL;
-    int s = fdt_sphere_cof_insphere(cof, pt(m, q));
+    int s = m->sf.img ? FDT_PRED_UNSURE : fdt_sphere_cof_insphere(cof, pt(m, q));
     if (s == FDT_PRED_UNSURE)
         s = insphere(m, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), pt(m, q), cnt);
     return s > 0 ? "a face is not locally Delaunay" : NULL;
@@ -236,7 +236,9 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_co
         fdt_sphere_cof cof = {0}; /* read only where inf < 0 */
         if (inf < 0) {
             fdt_sphere_cof_init(&cof, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]));
-            int o = fdt_sphere_cof_orient(&cof);
+            /* the cofactors' bound holds for the points as stored: not for
+             * rounded periodic images (src/geom/images.h decides those) */
+            int o = m->sf.img ? FDT_PRED_UNSURE : fdt_sphere_cof_orient(&cof);
             if (o == FDT_PRED_UNSURE)
                 o = orient(m, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), cnt);
             if (o <= 0)

@@ -122,6 +122,12 @@ static inline int ins_walk_exit(const fdt_ins *m, const uint32_t *v, const doubl
  * than break the perturbation's precondition, pairwise distinct points. */
 static inline int ins_is_vertex(const fdt_ins *m, const uint32_t *v, const double *p)
 {
+    /* Periodic images (src/geom/images.h): two of them can round to one
+     * double and still be distinct (the input's points are, and an image
+     * never lands on another point: that would lie a period from it, out
+     * of the box), so equal stored coordinates say nothing. */
+    if (m->sf.img)
+        return 0;
     for (int i = 0; i < 4; i++) {
         if (v[i] == INF)
             continue;
