@@ -82,6 +82,7 @@ typedef struct exact_pts {
     mpz_t q[5][3];
     mpz_t t, r, s;
     int np;
+    int kmin; /* the integers' unit: 2^kmin */
 } exact_pts;
 
 static void exact_init(exact_pts *z, const fdt_images *im, const uint32_t *i, int np)
@@ -102,6 +103,7 @@ static void exact_init(exact_pts *z, const fdt_images *im, const uint32_t *i, in
     }
     if (kmin == INT_MAX)
         kmin = 0;
+    z->kmin = kmin;
     mpz_inits(z->t, z->r, z->s, NULL);
     for (int j = 0; j < np; j++) {
         const double *x = im->X + 3 * (size_t)im->src[i[j]];
@@ -281,22 +283,7 @@ int fdt_images_ball_inside(const fdt_images *im, const uint32_t i[4], const doub
 {
     exact_pts z;
     exact_init(&z, im, i, 4);
-    /* the bounds on the grid of the points: kmin again, over them too */
-    int kmin = INT_MAX;
-    for (int j = 0; j < 4; j++) {
-        const double *x = im->X + 3 * (size_t)im->src[i[j]];
-        const int8_t *o = im->off + 3 * (size_t)i[j];
-        for (int k = 0; k < 3; k++) {
-            const double v[3] = {x[k], o[k] ? im->hi[k] : 0.0, o[k] ? im->lo[k] : 0.0};
-            for (int w = 0; w < 3; w++)
-                if (v[w] != 0.0) {
-                    int e = fdt_int_exponent(v[w]);
-                    kmin = e < kmin ? e : kmin;
-                }
-        }
-    }
-    if (kmin == INT_MAX)
-        kmin = 0; /* exact_init's grid */
+    int kmin = z.kmin;
     int k2 = kmin; /* the bounds' grid too: the points moved onto it */
     for (int k = 0; k < 3; k++)
         for (int w = 0; w < 2; w++) {
