@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "base/bits.h"
+#include "base/dtoa.h"
 #include "base/sethash.h"
 #include "base/spawn.h"
 
@@ -846,10 +847,15 @@ int fdt_result_set_hash(const fdt_result *r, uint64_t *hash)
 size_t fdt_periodic_row_text(char *buf, const uint32_t id[4], const int8_t off[12])
 {
     size_t k = 0;
-    for (int j = 0; j < 4; j++)
-        k += (size_t)snprintf(buf + k, FDT_PERIODIC_ROW_MAX - k, "%s%u", j ? " " : "", id[j]);
-    for (int j = 0; j < 12; j++)
-        k += (size_t)snprintf(buf + k, FDT_PERIODIC_ROW_MAX - k, " %d", off[j]);
+    for (int j = 0; j < 4; j++) {
+        if (j)
+            buf[k++] = ' ';
+        k += fdt_utoa(buf + k, id[j]);
+    }
+    for (int j = 0; j < 12; j++) {
+        buf[k++] = ' ';
+        k += fdt_itoa(buf + k, off[j]);
+    }
     buf[k++] = '\n';
     return k;
 }

@@ -350,12 +350,12 @@ static int write_node(MPI_Comm comm, const char *name, const fdt_mpi_local *L, u
     /* the lines, as src/io/write/fmt_tetgen.c's fdt_put_tetgen_node writes them */
     size_t len = 0;
     if (rank == 0) {
-        len += fmt_u64(text, n);
+        len += fdt_utoa(text, n);
         memcpy(text + len, " 3 0 0\n", 7);
         len += 7;
     }
     for (size_t i = 0; i < nmine && !err; i++) {
-        len += fmt_u64(text + len, lo + i);
+        len += fdt_utoa(text + len, lo + i);
         for (int d = 0; d < 3; d++) {
             text[len++] = ' ';
             len += fdt_dtoa17(text + len, rb[i].x[d]);

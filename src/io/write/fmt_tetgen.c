@@ -134,10 +134,10 @@ static void tg_rows(out_file *o, uint64_t first, const fdt_vid *v, size_t count,
 {
     for (size_t r = 0; r < count && !o->err; r++) {
         char *p = out_room(o, 21 + (size_t)k * 12 + 1);
-        char *q = p + fmt_u64(p, first + r);
+        char *q = p + fdt_utoa(p, first + r);
         for (int c = 0; c < k; c++) {
             *q++ = ' ';
-            q += fmt_i64(q, v[(size_t)k * r + (size_t)c]);
+            q += fdt_itoa(q, v[(size_t)k * r + (size_t)c]);
         }
         *q++ = '\n';
         o->len += (size_t)(q - p);

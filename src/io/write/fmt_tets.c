@@ -73,13 +73,13 @@ int fdt_put_tets(out_file *o, const fdt_mesh_view *m, const void *prep, char *er
         memcpy(prev, s, sizeof s);
         /* 4 ids of at most 10 digits, 3 spaces and a newline. */
         char *p = out_room(o, 48);
-        size_t k = fmt_u64(p, (uint64_t)s[0]);
+        size_t k = fdt_utoa(p, (uint64_t)s[0]);
         p[k++] = ' ';
-        k += fmt_u64(p + k, (uint64_t)s[1]);
+        k += fdt_utoa(p + k, (uint64_t)s[1]);
         p[k++] = ' ';
-        k += fmt_u64(p + k, (uint64_t)s[2]);
+        k += fdt_utoa(p + k, (uint64_t)s[2]);
         p[k++] = ' ';
-        k += fmt_u64(p + k, (uint64_t)s[3]);
+        k += fdt_utoa(p + k, (uint64_t)s[3]);
         p[k++] = '\n';
         o->len += k;
     }

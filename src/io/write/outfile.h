@@ -109,47 +109,10 @@ static inline void out_str(out_file *o, const char *s)
     out_bytes(o, s, strlen(s));
 }
 
-/* Two decimal digits per lookup halves the divisions. */
-static const char digit_pairs[201] =
-    "00010203040506070809101112131415161718192021222324252627282930313233"
-    "34353637383940414243444546474849505152535455565758596061626364656667"
-    "68697071727374757677787980818283848586878889909192939495969798990";
-
-/* Writes v in decimal at p, returns the number of chars (at most 20). */
-static inline size_t fmt_u64(char *p, uint64_t v)
-{
-    char tmp[20];
-    char *e = tmp + sizeof tmp, *s = e;
-    while (v >= 100) {
-        unsigned r = (unsigned)(v % 100);
-        v /= 100;
-        s -= 2;
-        memcpy(s, digit_pairs + 2 * r, 2);
-    }
-    if (v >= 10) {
-        s -= 2;
-        memcpy(s, digit_pairs + 2 * v, 2);
-    } else {
-        *--s = (char)('0' + v);
-    }
-    size_t n = (size_t)(e - s);
-    memcpy(p, s, n);
-    return n;
-}
-
-static inline size_t fmt_i64(char *p, int64_t v)
-{
-    if (v < 0) {
-        *p = '-';
-        return 1 + fmt_u64(p + 1, (uint64_t)0 - (uint64_t)v);
-    }
-    return fmt_u64(p, (uint64_t)v);
-}
-
 static inline void out_i64(out_file *o, int64_t v)
 {
     char *p = out_room(o, 21);
-    o->len += fmt_i64(p, v);
+    o->len += fdt_itoa(p, v);
 }
 
 static inline void out_char(out_file *o, char c)
@@ -211,7 +174,7 @@ static inline void out_patch(out_file *o, uint64_t at, const void *p, size_t n)
 static inline void fmt_u64_width(char *p, uint64_t v, size_t w)
 {
     char tmp[24];
-    size_t k = fmt_u64(tmp, v);
+    size_t k = fdt_utoa(tmp, v);
     memset(p, ' ', w - k);
     memcpy(p + w - k, tmp, k);
 }
