@@ -57,8 +57,8 @@ void fdt_images_init(fdt_images *im, const double blo[3], const double bhi[3], d
     }
     if (!(M >= 0x1p-100 && M <= 0x1p100) || !(err >= 0 && err <= M))
         return;
-    /* The evaluation's rounding (twice the plain filters' constants, for
-     * the order of evaluation in images.h), then the inputs' movement by
+    /* The evaluation's rounding (twice the plain filters' constants, a
+     * margin: the evaluation is theirs, predicates.h's _sf filters), then the inputs' movement by
      * e = 2 err a difference, expanded so nothing cancels; 1 + 2^-20 for
      * the roundings of these bounds themselves. */
     const double safe = 1 + 0x1p-20, e = 2 * err;
@@ -265,17 +265,34 @@ int fdt_images_normal_sign(const fdt_images *im, const uint32_t i[3], int k)
     return s;
 }
 
-int fdt_images_orient_call(const fdt_images *im, const double *a, const double *b,
-                           const double *c, const double *d, fdt_pred_counts *cnt)
+int fdt_images_orient_undecided(const fdt_images *im, const double *a, const double *b,
+                                const double *c, const double *d, fdt_pred_counts *cnt)
 {
-    return fdt_images_orient(im, a, b, c, d, cnt);
+    const uint32_t i[4] = {fdt_images_index(im, a), fdt_images_index(im, b),
+                           fdt_images_index(im, c), fdt_images_index(im, d)};
+    if (im->exact[i[0]] & im->exact[i[1]] & im->exact[i[2]] & im->exact[i[3]])
+        return fdt_orient3d(a, b, c, d, cnt);
+    return fdt_images_orient_exact(im, i, cnt);
 }
 
-int fdt_images_insphere_call(const fdt_images *im, const double *a, const double *b,
-                             const double *c, const double *d, const double *e,
-                             fdt_pred_counts *cnt)
+int fdt_images_insphere_undecided(const fdt_images *im, const double *a, const double *b,
+                                  const double *c, const double *d, const double *e,
+                                  fdt_pred_counts *cnt)
 {
-    return fdt_images_insphere(im, a, b, c, d, e, cnt);
+    const uint32_t i[5] = {fdt_images_index(im, a), fdt_images_index(im, b),
+                           fdt_images_index(im, c), fdt_images_index(im, d),
+                           fdt_images_index(im, e)};
+    if (im->exact[i[0]] & im->exact[i[1]] & im->exact[i[2]] & im->exact[i[3]] & im->exact[i[4]])
+        return fdt_insphere_perturbed(a, b, c, d, e, cnt);
+    return fdt_images_insphere_exact(im, i, cnt);
+}
+
+int fdt_images_orient(const fdt_images *im, const double *a, const double *b, const double *c,
+                      const double *d, fdt_pred_counts *cnt)
+{
+    const fdt_pred_static sf = fdt_images_static(im);
+    int s = fdt_orient3d_filter_sf(a, b, c, d, &sf);
+    return s != FDT_PRED_UNSURE ? s : fdt_images_orient_undecided(im, a, b, c, d, cnt);
 }
 
 int fdt_images_ball_inside(const fdt_images *im, const uint32_t i[4], const double A[3],

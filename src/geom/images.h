@@ -79,53 +79,34 @@ static inline uint32_t fdt_images_index(const fdt_images *im, const double *p)
     return (uint32_t)((size_t)(p - im->P) / 3);
 }
 
+/* The semi-static bounds of the filters for the points of P (predicates.h's
+ * fdt_pred_static with img set: its _sf filters then stop after that
+ * stage). */
+static inline fdt_pred_static fdt_images_static(const fdt_images *im)
+{
+    return (fdt_pred_static){im->o3d_inv, im->isp_inv, im};
+}
+
+/*
+ * What the filter fdt_orient3d_filter_sf(..., fdt_images_static(im))
+ * left undecided, for the points of P at a, b, c, d: the plain exact
+ * stages when every one is exact in P, else GMP (fdt_images_orient_exact).
+ * Out of line: the insertion kernel and the certificate call it on that
+ * rare path only, so their filters stay inline and the same as the plain
+ * engine's (bench/NOTES.md entry 109).
+ */
+int fdt_images_orient_undecided(const fdt_images *im, const double *a, const double *b,
+                                const double *c, const double *d, fdt_pred_counts *cnt);
+
+/* The same for fdt_insphere_filter_sf: the perturbed insphere's sign
+ * (fdt_insphere_perturbed's convention; never 0). */
+int fdt_images_insphere_undecided(const fdt_images *im, const double *a, const double *b,
+                                  const double *c, const double *d, const double *e,
+                                  fdt_pred_counts *cnt);
+
 /* orient3d of the exact images of the points of P at a, b, c, d (CGAL's
- * sign, as fdt_orient3d). */
-static inline int fdt_images_orient(const fdt_images *im, const double *a, const double *b,
-                                    const double *c, const double *d, fdt_pred_counts *cnt)
-{
-    const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
-    const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
-    const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
-    const double det = ux * (vy * wz - vz * wy) - uy * (vx * wz - vz * wx) +
-                       uz * (vx * wy - vy * wx);
-    if (fabs(det) * im->o3d_inv > 1)
-        return (det > 0) - (det < 0);
-    const uint32_t i[4] = {fdt_images_index(im, a), fdt_images_index(im, b),
-                           fdt_images_index(im, c), fdt_images_index(im, d)};
-    if (im->exact[i[0]] & im->exact[i[1]] & im->exact[i[2]] & im->exact[i[3]])
-        return fdt_orient3d(a, b, c, d, cnt);
-    return fdt_images_orient_exact(im, i, cnt);
-}
-
-/* The perturbed insphere of the exact images (fdt_insphere_perturbed's
- * sign and precondition; never 0). */
-static inline int fdt_images_insphere(const fdt_images *im, const double *a, const double *b,
-                                      const double *c, const double *d, const double *e,
-                                      fdt_pred_counts *cnt)
-{
-    const double A[3] = {a[0] - e[0], a[1] - e[1], a[2] - e[2]};
-    const double B[3] = {b[0] - e[0], b[1] - e[1], b[2] - e[2]};
-    const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
-    const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
-    const double det = fdt_insphere_det4(A, B, C, D);
-    if (fabs(det) * im->isp_inv > 1)
-        return (det < 0) - (det > 0);
-    const uint32_t i[5] = {fdt_images_index(im, a), fdt_images_index(im, b),
-                           fdt_images_index(im, c), fdt_images_index(im, d),
-                           fdt_images_index(im, e)};
-    if (im->exact[i[0]] & im->exact[i[1]] & im->exact[i[2]] & im->exact[i[3]] & im->exact[i[4]])
-        return fdt_insphere_perturbed(a, b, c, d, e, cnt);
-    return fdt_images_insphere_exact(im, i, cnt);
-}
-
-/* The two above out of line, for the insertion kernel's rare periodic
- * branch (inlined there, they cost the plain engine 10 % of its kernel
- * time: bench/NOTES.md entry 108). */
-int fdt_images_orient_call(const fdt_images *im, const double *a, const double *b,
-                           const double *c, const double *d, fdt_pred_counts *cnt);
-int fdt_images_insphere_call(const fdt_images *im, const double *a, const double *b,
-                             const double *c, const double *d, const double *e,
-                             fdt_pred_counts *cnt);
+ * sign, as fdt_orient3d): the filter, then the stages above. */
+int fdt_images_orient(const fdt_images *im, const double *a, const double *b, const double *c,
+                      const double *d, fdt_pred_counts *cnt);
 
 #endif

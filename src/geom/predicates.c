@@ -1055,7 +1055,7 @@ static int orient3d_filter_rescaled(const double *a, const double *b,
         any |= rescale_diffs(&r[i], 1);
     if (!any)
         return FDT_PRED_UNSURE;
-    return fdt_orient3d_filter_diff(r[0], r[1], r[2], 0);
+    return fdt_orient3d_filter_diff(r[0], r[1], r[2], 0, 1);
 }
 
 static int insphere_filter_rescaled(const double *a, const double *b,
@@ -1071,7 +1071,7 @@ static int insphere_filter_rescaled(const double *a, const double *b,
     }
     if (!rescale_diffs(r, 4))
         return FDT_PRED_UNSURE;
-    return fdt_insphere_filter_diff(r[0], r[1], r[2], r[3], 0);
+    return fdt_insphere_filter_diff(r[0], r[1], r[2], r[3], 0, 1);
 }
 
 int fdt_orient3d(const double *a, const double *b, const double *c,

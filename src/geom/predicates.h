@@ -218,9 +218,12 @@ int fdt_insphere_adapt(const double *a, const double *b, const double *c,
 typedef struct fdt_pred_static {
     double o3d_inv; /* decide orient3d when fl(|det| o3d_inv) > 1 */
     double isp_inv; /* decide insphere when fl(|det4| isp_inv) > 1 */
-    /* Periodic images (src/geom/images.h), or NULL: the insertion's
-     * points are then rounded images, and its predicates are those of
-     * images.h (src/mesh/insert_impl.h), not these filters. */
+    /* Periodic images (src/geom/images.h), or NULL. Set, the points are
+     * rounded images and the two bounds images.h's (fdt_images_init: they
+     * add what the rounding can move a determinant); the _sf filters then
+     * stop after the semi-static stage, whose sign is the exact images',
+     * and the callers take what it leaves to images.h's exact stages
+     * (src/mesh/insert_impl.h, src/mesh/certify.c). */
     const struct fdt_images *img;
 } fdt_pred_static;
 
@@ -231,7 +234,9 @@ void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double 
  * Floating-point filter for orient3d: +1 or -1 when that is certainly the
  * sign of det[b-a; c-a; d-a], FDT_PRED_UNSURE otherwise (never 0). sinv:
  * the semi-static stage's reciprocal bound (fdt_pred_static, above),
- * tested on the determinant before the permanent; 0: none.
+ * tested on the determinant before the permanent; 0: none. dyn: 0 stops
+ * after that stage (the points are rounded images whose bound is sinv's
+ * alone, src/geom/images.h), 1 goes on to the dynamic filter.
  *
  * Error bound. Write eps = 2^-53, eta = 2^-1075 (half the smallest
  * subnormal). Every operation obeys fl(x op y) = (x op y)(1 + delta) + mu,
@@ -273,7 +278,7 @@ void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double 
  * implies det > 0, and det_computed < -bound implies det < 0.
  */
 static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
-                                           const double w[3], double sinv)
+                                           const double w[3], double sinv, int dyn)
 {
     const double ux = u[0], uy = u[1], uz = u[2];
     const double vx = v[0], vy = v[1], vz = v[2];
@@ -284,6 +289,8 @@ static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
     const double det = ux * (vywz - vzwy) + uy * (vzwx - vxwz) + uz * (vxwy - vywx);
     if (fabs(det) * sinv > 1) /* the semi-static stage (fdt_pred_static) */
         return (det > 0) - (det < 0);
+    if (!dyn)
+        return FDT_PRED_UNSURE;
     const double aux = fabs(ux), auy = fabs(uy), auz = fabs(uz);
     const double perm = aux * (fabs(vywz) + fabs(vzwy)) + auy * (fabs(vzwx) + fabs(vxwz)) +
                         auz * (fabs(vxwy) + fabs(vywx));
@@ -312,7 +319,7 @@ static inline int fdt_orient3d_filter_sf(const double *a, const double *b, const
     const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    return fdt_orient3d_filter_diff(u, v, w, sf->o3d_inv);
+    return fdt_orient3d_filter_diff(u, v, w, sf->o3d_inv, sf->img == NULL);
 }
 
 static inline int fdt_orient3d_filter(const double *a, const double *b,
@@ -324,7 +331,7 @@ static inline int fdt_orient3d_filter(const double *a, const double *b,
 /*
  * Floating-point filter for insphere: +1 / -1 when that is certainly the
  * CGAL insphere sign (see the top of this file), FDT_PRED_UNSURE otherwise.
- * sinv as for orient3d.
+ * sinv and dyn as for orient3d.
  *
  * With A = a-e, B = b-e, C = c-e, D = d-e (rows) and |A|^2 etc.,
  *   det4 = det[A |A|^2; B |B|^2; C |C|^2; D |D|^2]
@@ -361,7 +368,7 @@ static inline int fdt_orient3d_filter(const double *a, const double *b,
  */
 static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
                                            const double C[3], const double D[3],
-                                           double sinv)
+                                           double sinv, int dyn)
 {
     const double aex = A[0], aey = A[1], aez = A[2];
     const double bex = B[0], bey = B[1], bez = B[2];
@@ -391,6 +398,8 @@ static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
     const double det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
     if (fabs(det) * sinv > 1) /* the semi-static stage (fdt_pred_static) */
         return (det < 0) - (det > 0);
+    if (!dyn)
+        return FDT_PRED_UNSURE;
 
     const double abP = fabs(aexbey) + fabs(bexaey), bcP = fabs(bexcey) + fabs(cexbey);
     const double cdP = fabs(cexdey) + fabs(dexcey), daP = fabs(dexaey) + fabs(aexdey);
@@ -551,7 +560,7 @@ static inline int fdt_insphere_filter_sf(const double *a, const double *b, const
     const double B[3] = {b[0] - e[0], b[1] - e[1], b[2] - e[2]};
     const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
     const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
-    return fdt_insphere_filter_diff(A, B, C, D, sf->isp_inv);
+    return fdt_insphere_filter_diff(A, B, C, D, sf->isp_inv, sf->img == NULL);
 }
 
 static inline int fdt_insphere_filter(const double *a, const double *b,

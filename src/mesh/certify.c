@@ -27,19 +27,23 @@ static inline int is_freed(const uint32_t *v)
 static inline int orient(const fdt_ins *m, const double *a, const double *b, const double *c,
                          const double *d, fdt_pred_counts *cnt)
 {
-    if (__builtin_expect(m->sf.img != NULL, 0))
-        return fdt_images_orient_call(m->sf.img, a, b, c, d, cnt);
     int s = fdt_orient3d_filter_sf(a, b, c, d, &m->sf);
-    return s != FDT_PRED_UNSURE ? s : fdt_orient3d(a, b, c, d, cnt);
+    if (s != FDT_PRED_UNSURE)
+        return s;
+    if (__builtin_expect(m->sf.img != NULL, 0))
+        return fdt_images_orient_undecided(m->sf.img, a, b, c, d, cnt);
+    return fdt_orient3d(a, b, c, d, cnt);
 }
 
 static inline int insphere(const fdt_ins *m, const double *a, const double *b, const double *c,
                            const double *d, const double *e, fdt_pred_counts *cnt)
 {
-    if (__builtin_expect(m->sf.img != NULL, 0))
-        return fdt_images_insphere_call(m->sf.img, a, b, c, d, e, cnt);
     int s = fdt_insphere_filter_sf(a, b, c, d, e, &m->sf);
-    return s != FDT_PRED_UNSURE ? s : fdt_insphere_perturbed(a, b, c, d, e, cnt);
+    if (s != FDT_PRED_UNSURE)
+        return s;
+    if (__builtin_expect(m->sf.img != NULL, 0))
+        return fdt_images_insphere_undecided(m->sf.img, a, b, c, d, e, cnt);
+    return fdt_insphere_perturbed(a, b, c, d, e, cnt);
 }
 
 static int fail(fdt_certify_fail *why, uint32_t slot, int face, const char *what)

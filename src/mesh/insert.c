@@ -490,7 +490,8 @@ int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
     if (n < 4)
         return FDT_EDEGENERATE;
     ins_bounds(m);
-    m->sf.img = img;
+    if (img) /* the filters' bounds for rounded images (src/geom/images.h) */
+        m->sf = fdt_images_static(img);
     build b;
     memset(&b, 0, sizeof b);
     b.m = m;

@@ -34,15 +34,17 @@ static inline const double *ins_pt(const fdt_ins *m, uint32_t v)
 /* The filters (semi-static stage, then dynamic) inline, the exact stages
  * (and the rescaled filters) out of line: most calls end in the filters.
  * sf: the semi-static bounds of a box that holds every point the test
- * reads (fdt_ins.sf for the mesh's own points). */
+ * reads (fdt_ins.sf for the mesh's own points). Periodic images (sf->img):
+ * the semi-static stage alone, with images.h's bounds, then images.h's
+ * exact stages. */
 static inline int ins_orient(const double *a, const double *b, const double *c, const double *d,
                              const fdt_pred_static *sf, fdt_pred_counts *cnt)
 {
-    if (__builtin_expect(sf->img != NULL, 0)) /* periodic images (src/geom/images.h) */
-        return fdt_images_orient_call(sf->img, a, b, c, d, cnt);
     int s = fdt_orient3d_filter_sf(a, b, c, d, sf);
     if (s != FDT_PRED_UNSURE)
         return s;
+    if (__builtin_expect(sf->img != NULL, 0)) /* periodic images (src/geom/images.h) */
+        return fdt_images_orient_undecided(sf->img, a, b, c, d, cnt);
     return fdt_orient3d(a, b, c, d, cnt);
 }
 
@@ -50,13 +52,13 @@ static inline int ins_insphere(const double *a, const double *b, const double *c
                                const double *d, const double *e, const fdt_pred_static *sf,
                                fdt_pred_counts *cnt)
 {
-    if (__builtin_expect(sf->img != NULL, 0))
-        return fdt_images_insphere_call(sf->img, a, b, c, d, e, cnt);
     int s = fdt_insphere_filter_sf(a, b, c, d, e, sf);
     if (s != FDT_PRED_UNSURE)
         return s;
     if (cnt)
         cnt->insphere_unsure++;
+    if (__builtin_expect(sf->img != NULL, 0))
+        return fdt_images_insphere_undecided(sf->img, a, b, c, d, e, cnt);
 #ifdef FDT_PLANT_INSPHERE
     /* The planted bug of -Dplant=insphere (tests/test_plant.sh; the
      * certificate of src/mesh/certify.h must stop the run): no exact stage
