@@ -267,9 +267,9 @@ FDT_API const fdt_vid *fdt_result_hull_faces(const fdt_result *r);
  * 4 input ids ascending (ties by offsets) with offsets relative to the
  * first, the tets in ascending order (the .tets file's lines), and
  * likewise the hull faces (only across the axes that are not periodic).
- * The face list, edges, adjacency, neighbours, set hash, check, cells
- * and location refuse a periodic result (FDT_EINVAL); fdt_result_hash is
- * the hash of its .tets text.
+ * The face list, edges, adjacency, neighbours, set hash, check and
+ * location refuse a periodic result (FDT_EINVAL); fdt_result_hash is the
+ * hash of its .tets text; fdt_voronoi_compute gives its periodic cells.
  */
 FDT_API const int8_t *fdt_result_tet_offsets(const fdt_result *r);
 FDT_API const int8_t *fdt_result_hull_offsets(const fdt_result *r);
@@ -813,6 +813,11 @@ static inline void fdt_default_voronoi_options(fdt_voronoi_options *o)
  * FDT_ERANGE when two points are closer than 2^-48 of the box (the cells
  * cut from the box could not be; diag names them); FDT_ENOMEM;
  * FDT_EINTERNAL when a cell could not be cut (a bug).
+ * A periodic result (settings.periodic): the cells of the periodic point
+ * set in its own box (o's box, when given, must be that box: FDT_EINVAL
+ * otherwise), wrapped on the periodic axes and cut by the box's sides
+ * across the others, where a point outside the box is FDT_EINVAL; their
+ * volumes sum to the box's.
  */
 FDT_API int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n,
                                 const fdt_voronoi_options *o, fdt_voronoi **out,

@@ -15,10 +15,13 @@
   --stream or an output that is not .tets (exit 1), over --memory-limit
   (exit 4, its estimate counting the images).
 
-- The cells (--periodic xyz --voronoi): their volumes sum to the box's to
+- The cells (--periodic --voronoi): their volumes sum to the box's to
   1e-12, and each cell's volume, area and neighbours with their face areas
   equal voro++'s periodic container's (tests/voro_ref.cpp periodic) to
-  1e-10 (skipped where voro++ is not built).
+  1e-10 (skipped where voro++ is not built): x, y and z periodic in a cube,
+  and a channel (x, z), a duct (x) and a slab (y, z) in a box that is not
+  one, walls of grid points across the other axes, whose cells the box's
+  sides cut, as voro++'s container walls.
 
 - tests/gen_points families scaled into the unit box (a torus, a cubed
   sphere, near-duplicates, a rotated lattice, mixed scales: flat tets
@@ -153,13 +156,16 @@ def case(name, pts, lo, length, cgal=True, settings=(["-t", "2"], ["-t", "3"],
                                         ", as CGAL's" if CGAL != "none" and cgal else ""))
 
 
-def cells(name, pts, lo, length):
-    """The periodic cells: the box's volume, and voro++'s periodic cells."""
-    box = ",".join("%.17g" % v for v in (lo, lo, lo, lo + length, lo + length, lo + length))
+def cells(name, pts, lo, hi, axes="xyz"):
+    """The periodic cells: the box's volume, and voro++'s cells in a
+    container periodic on axes, with walls across the others."""
+    box = ",".join("%.17g" % v for v in (*lo, *hi))
+    vol_box = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2])
+    side = max(h - l for l, h in zip(lo, hi))
     src = os.path.join(SCRATCH, name + "_c.xyz")
     write_points(src, pts)
     vt = os.path.join(SCRATCH, name + "_c.txt")
-    r = frontdt(src, "--periodic", "xyz", "--box", box, "--voronoi", vt, "--voronoi-format",
+    r = frontdt(src, "--periodic", axes, "--box", box, "--voronoi", vt, "--voronoi-format",
                 "%i %v %F %n %f", "-q", "-t", "2")
     expect(r.returncode == 0, "%s cells: exit %d: %s" % (name, r.returncode, r.stderr))
     if r.returncode:
@@ -171,13 +177,19 @@ def cells(name, pts, lo, length):
         got[int(f[0])] = (float(f[1]), float(f[2]),
                           dict(zip(map(int, f[3:3 + k]), map(float, f[3 + k:]))))
     total = sum(v[0] for v in got.values())
-    expect(abs(total / length ** 3 - 1) < 1e-12, "%s cells: volumes sum to %.17g, the box %.17g"
-           % (name, total, length ** 3))
+    expect(abs(total / vol_box - 1) < 1e-12, "%s cells: volumes sum to %.17g, the box %.17g"
+           % (name, total, vol_box))
+    # a wall only across an axis that is not periodic (voro++'s numbers:
+    # -1, -2 for x, -3, -4 for y, -5, -6 for z)
+    walls = {j for c in got.values() for j in c[2] if j < 0}
+    expect(all(axes.find("xyz"[(-j - 1) // 2]) < 0 for j in walls),
+           "%s cells: walls %s across a periodic axis" % (name, sorted(walls)))
     if VORO == "none":
         print("%s cells: %d, their volumes the box's" % (name, len(got)))
         return
-    v = subprocess.run([VORO, box, "periodic"], input="".join(
-        "%.17g %.17g %.17g\n" % p for p in pts), capture_output=True, text=True, timeout=600)
+    v = subprocess.run([VORO, box, "periodic" if axes == "xyz" else "periodic=" + axes],
+                       input="".join("%.17g %.17g %.17g\n" % p for p in pts),
+                       capture_output=True, text=True, timeout=600)
     expect(v.returncode == 0, "%s: voro_ref exit %d" % (name, v.returncode))
     bad = 0
     for line in v.stdout.splitlines():
@@ -185,9 +197,9 @@ def cells(name, pts, lo, length):
         h, nb = head.split(), rest.split()
         i, vol, area = int(h[0]), float(h[1]), float(h[2])
         faces = {int(nb[2 * j]): float(nb[2 * j + 1]) for j in range(len(nb) // 2)
-                 if float(nb[2 * j + 1]) > 1e-12 * length ** 2}
+                 if float(nb[2 * j + 1]) > 1e-12 * side ** 2}
         gv, ga, gf = got[i]
-        gf = {j: a for j, a in gf.items() if a > 1e-12 * length ** 2}
+        gf = {j: a for j, a in gf.items() if a > 1e-12 * side ** 2}
         ok = (abs(gv - vol) <= 1e-10 * vol and abs(ga - area) <= 1e-10 * area and
               set(gf) == set(faces) and
               all(abs(gf[j] - faces[j]) <= 1e-10 * area for j in faces))
@@ -195,7 +207,38 @@ def cells(name, pts, lo, length):
             print("  cell %d: %r against voro++ %r %r %r" % (i, got[i], vol, area, faces))
         bad += not ok
     expect(bad == 0, "%s cells: %d differ from voro++'s" % (name, bad))
-    print("%s cells: %d, their volumes the box's, as voro++'s periodic cells" % (name, len(got)))
+    print("%s cells (%s periodic): %d, their volumes the box's, as voro++'s" % (
+        name, axes, len(got)))
+
+
+def channel(n, g, lo, hi, axes, seed):
+    """Walls of g x g grid points a little inside the box's sides across
+    the axes that are not periodic (flat, as a channel's or a duct's grid:
+    a layer of cells between them and the box's sides; voro++ drops a point
+    on a container's upper wall), n random points between them."""
+    r = random.Random(seed)
+    walls = [k for k in range(3) if "xyz"[k] not in axes]
+    # along a wall: g cells of a period, or g + 1 nodes from side to side
+    near = lambda a: (lo[a] + 1e-3 * (hi[a] - lo[a]), hi[a] - 1e-3 * (hi[a] - lo[a]))
+    pos = lambda a, i: (lo[a] + (hi[a] - lo[a]) * (i + 0.5) / g if a not in walls else
+                        near(a)[0] * (1 - i / g) + near(a)[1] * (i / g))
+    pts = set()
+    for k in walls:
+        a, b = [j for j in range(3) if j != k]
+        for side in near(k):
+            for i in range(g + 1 if a in walls else g):
+                for j in range(g + 1 if b in walls else g):
+                    p = [0.0, 0.0, 0.0]
+                    p[k] = side
+                    p[a] = pos(a, i)
+                    p[b] = pos(b, j)
+                    pts.add(tuple(p))
+    pts = sorted(pts)
+    margin = [0.0 if "xyz"[k] in axes else 0.02 * (hi[k] - lo[k]) for k in range(3)]
+    for _ in range(n):
+        pts.append(tuple(lo[k] + margin[k] + (hi[k] - lo[k] - 2 * margin[k]) * r.random()
+                         for k in range(3)))
+    return pts
 
 
 def family(name, n):
@@ -252,9 +295,14 @@ def main():
         # CGAL's own only in the long suite: its periodic triangulation of
         # these takes minutes; threads, modes, shuffles always
         case(fam, family(fam, 1500 if LONG else 500), 0.0, 1.0, LONG, (["-t", "3"],))
-    cells("uniform", uniform(2000, 0.1, 1.2, 5), 0.1, 1.2)
-    cells("lattice", lattice(5, 0.1, 1.2), 0.1, 1.2)
-    cells("clusters", clusters(800, -2.0, 3.0, 6), -2.0, 3.0)
+    cube = lambda lo, length: ((lo,) * 3, (lo + length,) * 3)
+    cells("uniform", uniform(2000, 0.1, 1.2, 5), *cube(0.1, 1.2))
+    cells("lattice", lattice(5, 0.1, 1.2), *cube(0.1, 1.2))
+    cells("clusters", clusters(800, -2.0, 3.0, 6), *cube(-2.0, 3.0))
+    lo, hi = (0.0, -0.5, 0.25), (2.0, 0.5, 1.25)
+    cells("channel", channel(1500, 8, lo, hi, "xz", 7), lo, hi, "xz")
+    cells("duct", channel(1200, 6, lo, hi, "x", 8), lo, hi, "x")
+    cells("slab", channel(1200, 7, lo, hi, "yz", 9), lo, hi, "yz")
     errors()
     print("periodic_e2e: %d checks, %d failed" % (checks, len(failures)))
     shutil.rmtree(SCRATCH, ignore_errors=True)

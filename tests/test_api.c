@@ -594,8 +594,8 @@ static void test_periodic_api(void)
     fdt_sink sink = {sizeof sink, sink_count, NULL, NULL};
     EXPECT(fdt_triangulate_stream(ctx, xyz, N, &sink, &r) == FDT_EINVAL);
     fdt_close(&ctx);
-    /* periodic in x and z only: no cells yet (the hull's would need the
-     * box's clipping) */
+    /* periodic in x and z only: the walls y = 0 and y = 1 cut the cells
+     * that reach them, the hull's points' among them */
     for (int i = 0; i < N; i++)
         xyz[3 * i + 1] = i % 4 == 0 ? 0.0 : i % 4 == 1 ? 1.0 : xyz[3 * i + 1];
     s.periodic = 5;
@@ -603,8 +603,37 @@ static void test_periodic_api(void)
     CHECK_EQ(fdt_triangulate(ctx, xyz, N, &r), FDT_OK);
     EXPECT(fdt_result_num_hull_faces(r) > 0 && fdt_result_hull_offsets(r) != NULL);
     char vd[256];
+    CHECK_EQ(fdt_voronoi_compute(r, xyz, N, NULL, &v, vd, sizeof vd), FDT_OK);
+    size_t hull_cells = 0;
+    sum = 0;
+    for (size_t i = 0; i < N; i++) {
+        sum += fdt_voronoi_volumes(v)[i];
+        hull_cells += (fdt_voronoi_flags(v)[i] & FDT_CELL_HULL) != 0;
+        /* a wall point's cell is cut by its wall; no other is unbounded */
+        EXPECTF(!(fdt_voronoi_flags(v)[i] & FDT_CELL_HULL) == (i % 4 > 1), "cell %zu", i);
+    }
+    EXPECTF(fabs(sum - 1) < 1e-12 && hull_cells == N / 2, "x-z cells: %.17g, %zu hull",
+            sum, hull_cells);
+    fdt_voronoi_free(&v);
+    /* its own box only */
+    fdt_voronoi_options vo;
+    fdt_default_voronoi_options(&vo);
+    vo.box_given = 1;
+    memcpy(vo.box, box, sizeof vo.box);
+    EXPECT(fdt_voronoi_compute(r, xyz, N, &vo, &v, vd, sizeof vd) == FDT_OK);
+    fdt_voronoi_free(&v);
+    vo.box[4] = 2;
+    EXPECT(fdt_voronoi_compute(r, xyz, N, &vo, &v, vd, sizeof vd) == FDT_EINVAL &&
+           strstr(vd, "its own box") != NULL && v == NULL);
+    fdt_result_free(&r);
+    /* the box's wall below the points (a side that is not periodic: the
+     * mesh does not read it, the cells do) */
+    fdt_close(&ctx);
+    s.periodic_box[4] = 0.75;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    CHECK_EQ(fdt_triangulate(ctx, xyz, N, &r), FDT_OK);
     EXPECT(fdt_voronoi_compute(r, xyz, N, NULL, &v, vd, sizeof vd) == FDT_EINVAL &&
-           strstr(vd, "x, y and z") != NULL);
+           strstr(vd, "point 1 (") != NULL && v == NULL);
     fdt_result_free(&r);
     xyz[3 * 5 + 2] = NAN; /* the merge names it, as in any run */
     EXPECT(fdt_triangulate(ctx, xyz, N, &r) == FDT_ERANGE);

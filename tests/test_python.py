@@ -483,6 +483,17 @@ def test_periodic(tmp):
           "periodic: the cells' volumes are the box's")
     c2 = frontdt.voronoi(pts, box=box, periodic="xyz")
     check(np.array_equal(c2["volumes"], c["volumes"]), "frontdt.voronoi(periodic=)")
+    # periodic in x and z: the walls y = 0 and y = 1 (the box's) cut the cells
+    wy = pts.copy()
+    wy[0::4, 1] = 0.0
+    wy[1::4, 1] = 1.0
+    tw = frontdt.delaunay(wy, periodic="x,z", box=box)
+    cw = tw.voronoi()
+    check(abs(cw["volumes"].sum() / 6.0 - 1) < 1e-12 and
+          np.array_equal(cw["flags"] & 2 != 0, np.arange(len(wy)) % 4 < 2),
+          "periodic x,z: the cells' volumes are the box's, the walls' points on the hull")
+    check(raises(ValueError, tw.voronoi, box=(0, 0, 0, 1, 1, 1)) is not None,
+          "periodic: cells in another box refused")
     check(raises(ValueError, frontdt.delaunay, pts, periodic="xz") is not None,
           "periodic without box")
     check(raises(ValueError, frontdt.delaunay, pts, box=box) is not None, "box without periodic")

@@ -1,5 +1,5 @@
 /*
- * voro_ref XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX < POINTS > CELLS
+ * voro_ref XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX [periodic[=AXES]] < POINTS > CELLS
  *
  * The reference Voronoi cells (issue 32): voro++ (Debian's libvoro++), each
  * point's cell in a box-shaped container, as voro++ computes it: the box
@@ -21,15 +21,30 @@
 int main(int argc, char **argv)
 {
     double b[6];
-    if (argc < 2 || argc > 3 ||
-        std::sscanf(argv[1], "%lf,%lf,%lf,%lf,%lf,%lf", &b[0], &b[1], &b[2], &b[3], &b[4],
-                    &b[5]) != 6 ||
-        (argc == 3 && std::strcmp(argv[2], "periodic") != 0)) {
-        std::fprintf(stderr, "usage: voro_ref XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX [periodic] < points\n");
+    /* periodic: the container periodic in x, y and z; periodic=AXES in
+     * those named (x, y, z), walls across the others (issue 33's cells) */
+    bool per[3] = {false, false, false};
+    bool ok = argc >= 2 && argc <= 3 &&
+              std::sscanf(argv[1], "%lf,%lf,%lf,%lf,%lf,%lf", &b[0], &b[1], &b[2], &b[3],
+                          &b[4], &b[5]) == 6;
+    if (ok && argc == 3) {
+        const char *a = argv[2];
+        if (!std::strcmp(a, "periodic"))
+            per[0] = per[1] = per[2] = true;
+        else if (!std::strncmp(a, "periodic=", 9) && a[9])
+            for (const char *c = a + 9; *c; c++)
+                if (*c >= 'x' && *c <= 'z')
+                    per[*c - 'x'] = true;
+                else
+                    ok = false;
+        else
+            ok = false;
+    }
+    if (!ok) {
+        std::fprintf(stderr, "usage: voro_ref XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX [periodic[=AXES]] "
+                             "< points\n");
         return 1;
     }
-    /* periodic: the container periodic in x, y and z (issue 33's cells) */
-    const bool per = argc == 3;
     std::vector<double> p;
     double x, y, z;
     while (std::scanf("%lf %lf %lf", &x, &y, &z) == 3) {
@@ -43,7 +58,7 @@ int main(int argc, char **argv)
     double side = std::cbrt(vol * 5 / (n ? n : 1));
     int nx = (int)((b[3] - b[0]) / side) + 1, ny = (int)((b[4] - b[1]) / side) + 1,
         nz = (int)((b[5] - b[2]) / side) + 1;
-    voro::container con(b[0], b[3], b[1], b[4], b[2], b[5], nx, ny, nz, per, per, per, 8);
+    voro::container con(b[0], b[3], b[1], b[4], b[2], b[5], nx, ny, nz, per[0], per[1], per[2], 8);
     for (int i = 0; i < n; i++)
         con.put(i, p[3 * i], p[3 * i + 1], p[3 * i + 2]);
     std::vector<std::vector<char>> line(n);

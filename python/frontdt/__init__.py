@@ -17,9 +17,10 @@ from ._frontdt import CheckError, Triangulation, __version__, check, delaunay
 def voronoi(points, box=None, threads=None, periodic=None):
     """Each point's Voronoi cell, clipped by box (None: the points' bounding
     box): frontdt.delaunay(points, threads).voronoi(box), a dict of arrays
-    (see help(frontdt.Triangulation.voronoi)). periodic="xyz" with box the
-    periods: the cells of the periodic point set, never clipped, their
-    volumes summing to the box's."""
+    (see help(frontdt.Triangulation.voronoi)). periodic="xyz" (or "x,z",
+    ...) with box the periods: the cells of the periodic point set, cut by
+    the box's sides across the axes that are not periodic, their volumes
+    summing to the box's."""
     if periodic is not None:
         return delaunay(points, threads=threads, periodic=periodic, box=box).voronoi()
     return delaunay(points, threads=threads).voronoi(box)

@@ -701,7 +701,9 @@ static PyMethodDef tri_methods[] = {
      "volumes, areas, centroids (n, 3), num_faces, densities (DTFE), flags (1 "
      "clipped, 2 hull, 4 merged duplicate), and the neighbours in CSR form: "
      "neighbors[neighbor_ptr[i]:neighbor_ptr[i+1]] (walls -1..-6) with face_areas "
-     "alongside. The same bits for every thread count and input order. The GIL is "
+     "alongside. The same bits for every thread count and input order. A periodic "
+     "triangulation's cells are in its own box (box None, or that box), wrapped on its "
+     "periodic axes and cut by the box's sides across the others. The GIL is "
      "released while it runs."},
     {"find_simplex", (PyCFunction)(void (*)(void))tri_find_simplex, METH_VARARGS | METH_KEYWORDS,
      "find_simplex(q, bary=False)\n--\n\nThe index of a tet holding each query of the (k, 3) "

@@ -10,6 +10,7 @@
 
 #include "frontdt.h"
 #include "base/clock.h"
+#include "base/diag.h"
 #include "front/front.h"
 #include "geom/kdtree.h"
 #include "front/oracle.h"
@@ -300,12 +301,18 @@ int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const 
     if (!r || !xyz || !out || o->struct_size != sizeof *o || o->threads < 0 || o->threads > 1024)
         return FDT_EINVAL;
     int threads = o->threads ? o->threads : fdt_threads_default();
-    if (r->periodic) { /* the cells of the periodic set: its box, no clipping */
+    if (r->periodic) { /* the cells of the periodic set: its box's walls */
         if (n != r->n)
             return FDT_EINVAL;
+        if (o->box_given && memcmp(o->box, r->pbox, sizeof o->box) != 0) {
+            fdt_diag(diag, diag_size, "a periodic mesh's cells take its own box (the "
+                     "periods, and the walls across the axes that are not periodic)");
+            return FDT_EINVAL;
+        }
         fdt_periodic_box b = {r->periodic, {r->pbox[0], r->pbox[1], r->pbox[2]},
                               {r->pbox[3], r->pbox[4], r->pbox[5]}};
-        return fdt_periodic_cells(r->tets, r->tet_off, r->ntets, xyz, n, r->dupmap, &b, threads,
+        return fdt_periodic_cells(r->tets, r->tet_off, r->ntets, r->hull, r->nhull, xyz, n,
+                                  r->dupmap, &b, threads,
                                   o->neighbors, out, diag ? diag : (char[8]){0},
                                   diag ? diag_size : 8);
     }

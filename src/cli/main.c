@@ -568,13 +568,11 @@ static int check_args(cli *c, int npos, char **pos)
             return usage_error("--periodic needs --box X0,Y0,Z0,X1,Y1,Z1: the periods");
         if (c->dual.dual || fdt_cli_interp_wanted(&c->dual) || c->stream > 0 || c->check ||
             c->set_hash)
-            return usage_error("--periodic writes the mesh (.tets), its --hash and, periodic "
-                               "in x, y and z, the cells; not yet --dual, --interpolate, "
-                               "--stream, --check or --set-hash");
+            return usage_error("--periodic writes the mesh (.tets), its --hash and the cells; "
+                               "not yet --dual, --interpolate, --stream, --check or --set-hash");
         const char *vd = c->dual.voronoi ? strrchr(c->dual.voronoi, '.') : NULL;
-        if ((c->dual.voronoi || c->dual.density) && (c->periodic != 7 || (vd && !strcmp(vd, ".vtu"))))
-            return usage_error("--periodic's cells need x, y and z periodic, and a table (not "
-                               ".vtu polyhedra)");
+        if (vd && !strcmp(vd, ".vtu"))
+            return usage_error("--periodic's cells are a table (not .vtu polyhedra)");
         for (int o = 0; o < c->n_outputs; o++) {
             const char *f = c->out_format[o];
             const char *dot = strrchr(c->outputs[o], '.');

@@ -866,14 +866,28 @@ static int tet_orient(const double *X, const uint32_t id[4], const int8_t off[12
     return fdt_images_orient(&im, P, P + 3, P + 6, P + 9, NULL);
 }
 
-int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const double *X,
-                       size_t n, const int32_t *dupmap, const fdt_periodic_box *b, int threads,
-                       int neighbors, fdt_voronoi **out, char *diag, size_t ds)
+int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
+                       size_t nhull, const double *X, size_t n, const int32_t *dupmap,
+                       const fdt_periodic_box *b, int threads, int neighbors, fdt_voronoi **out,
+                       char *diag, size_t ds)
 {
     *out = NULL;
-    if (b->axes != 7) {
-        snprintf(diag, ds, "the Voronoi cells of a periodic mesh need x, y and z periodic");
-        return FDT_EINVAL;
+    /* the walls across the axes that are not periodic: the box's sides,
+     * which hold every point */
+    for (int k = 0; k < 3; k++) {
+        if (b->axes >> k & 1)
+            continue;
+        if (!(b->lo[k] < b->hi[k]) || !isfinite(b->lo[k]) || !isfinite(b->hi[k])) {
+            snprintf(diag, ds, "the box is empty or not finite in %c, which is not periodic: "
+                     "its cells are cut there", "xyz"[k]);
+            return FDT_EINVAL;
+        }
+        for (size_t i = 0; i < n; i++)
+            if (!(X[3 * i + k] >= b->lo[k] && X[3 * i + k] <= b->hi[k])) {
+                snprintf(diag, ds, "point %zu (%.17g %.17g %.17g) lies outside the box",
+                         i, X[3 * i], X[3 * i + 1], X[3 * i + 2]);
+                return FDT_EINVAL;
+            }
     }
     vmap m;
     memset(&m, 0, sizeof m);
@@ -932,11 +946,26 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
         err = FDT_ENOMEM;
     for (size_t i = 0; !err && i < nown; i++)
         own[i] = (uint32_t)i;
-    /* the box: the period box with a period on each side, which holds
-     * every image and the circumcentres of the points' stars */
+    /* the hull's points (across an axis that is not periodic): their
+     * cells are unbounded, cut by the box */
+    for (size_t f = 0; !err && f < 3 * nhull; f++) {
+        long x = vmap_get(&m, (uint32_t)hull[f], zero, X, b);
+        if (x < 0)
+            err = FDT_ENOMEM;
+        else if ((size_t)x < nown)
+            own_hull[x] = 1;
+    }
+    /* the box: on a periodic axis the period box with a period on each
+     * side, which holds every image and the circumcentres of the points'
+     * stars; on the others the box's sides, where cells are cut */
     fdt_vbatch vb;
     memset(&vb, 0, sizeof vb);
     for (int k = 0; k < 3 && !err; k++) {
+        if (!(b->axes >> k & 1)) {
+            vb.box[k] = b->lo[k];
+            vb.box[k + 3] = b->hi[k];
+            continue;
+        }
         double L = b->hi[k] - b->lo[k];
         vb.box[k] = b->lo[k] - L;
         vb.box[k + 3] = b->hi[k] + L;
@@ -964,10 +993,10 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
         if (err == FDT_ERANGE)
             err = fdt_voronoi_too_close(&sh, vb.box, diag, ds);
     }
-    /* no cell of a periodic set is clipped: one that is reached past its
-     * neighbouring images (a bug) */
+    /* no cell of a set periodic on every axis is clipped: one that is
+     * reached past its neighbouring images (a bug) */
     const uint8_t *fl = v ? fdt_voronoi_flags(v) : NULL;
-    for (size_t i = 0; !err && i < nown; i++)
+    for (size_t i = 0; !err && b->axes == 7 && i < nown; i++)
         if (fl[i] & FDT_CELL_CLIPPED) {
             snprintf(diag, ds, "the periodic cell of point %u reaches past its images",
                      m.label[own[i]]);

@@ -81,20 +81,25 @@ int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
 void fdt_periodic_free(fdt_periodic_mesh *m);
 
 /*
- * The Voronoi cells of a periodic mesh (x, y and z periodic: no cell is
- * unbounded), as fdt_voronoi_compute gives a plain mesh's: n rows, row i
- * point i's, merged duplicates (dupmap) FDT_CELL_MERGED. tets, off: the
- * mesh as fdt_periodic_build gives it, renumbered to input ids; X the
- * input points. Each point's cell is computed from its star, the tets
- * around it moved so that it is the point itself (src/mesh/voronoi.h's
- * batch: a cell has the same bits whichever batch holds it); its
- * neighbours are input ids (an image's: its point's). FDT_EINVAL when not
- * every axis is periodic; the batch's errors otherwise, with diag.
+ * The Voronoi cells of a periodic mesh, as fdt_voronoi_compute gives a
+ * plain mesh's: n rows, row i point i's, merged duplicates (dupmap)
+ * FDT_CELL_MERGED. tets, off, hull: the mesh as fdt_periodic_build gives
+ * it, renumbered to input ids; X the input points. Each point's cell is
+ * computed from its star, the tets around it moved so that it is the point
+ * itself (src/mesh/voronoi.h's batch: a cell has the same bits whichever
+ * batch holds it); its neighbours are input ids (an image's: its
+ * point's). Periodic on every axis no cell is clipped; across an axis that
+ * is not periodic the box's sides are walls, which cut the cells that
+ * reach them (the hull's points' cells, unbounded, among them), as
+ * fdt_voronoi_compute's box. FDT_EINVAL when a point lies outside the box
+ * on such an axis or the box is empty there (diag names the point); the
+ * batch's errors otherwise, with diag.
  */
 struct fdt_voronoi;
-int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const double *X,
-                       size_t n, const int32_t *dupmap, const fdt_periodic_box *b, int threads,
-                       int neighbors, struct fdt_voronoi **out, char *diag, size_t ds);
+int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
+                       size_t nhull, const double *X, size_t n, const int32_t *dupmap,
+                       const fdt_periodic_box *b, int threads, int neighbors,
+                       struct fdt_voronoi **out, char *diag, size_t ds);
 
 /* fdt_periodic_build's checks of the box and of the points in it, alone
  * (a caller checks its input before it scales or merges it, so that the
