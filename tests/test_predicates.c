@@ -1291,6 +1291,51 @@ static void test_sphere_cof(tctx *T, double scale)
     EXPECT(out_decided == 0);
     EXPECT(spread > 0 && spread_decided > spread * 9 / 10);
     EXPECT(near_decided > 0);
+    /* Points that stand for others up to dev (rounded periodic images):
+     * each of p moved by up to dev (2^-30 of its magnitude, far above
+     * the move's own rounding: cof.dev twice that), what the cofactors of
+     * the moved points decide is the sign of p's. */
+    long moved = 0, moved_decided = 0;
+    for (long it = 0; it < n / 2; it++) {
+        double p[5][3], q[5][3];
+        int kind = (int)(it % 3);
+        if (kind == 0)
+            for (int i = 0; i < 5; i++)
+                for (int k = 0; k < 3; k++)
+                    p[i][k] = sunif(T);
+        else if (kind == 1)
+            gen_near_coplanar(T, p);
+        else
+            gen_near_cospherical(T, p, 0.0);
+        int e = (int)irand(T, -60, 60);
+        double big = 0;
+        for (int i = 0; i < 5; i++)
+            for (int k = 0; k < 3; k++) {
+                p[i][k] = ldexp(p[i][k], e);
+                big = fmax(big, fabs(p[i][k]));
+            }
+        int ro = ref_of(T, 0, p);
+        if (ro <= 0)
+            continue;
+        const double dev = ldexp(big, -30);
+        for (int i = 0; i < 5; i++)
+            for (int k = 0; k < 3; k++)
+                q[i][k] = p[i][k] + dev * sunif(T);
+        fdt_sphere_cof cof;
+        fdt_sphere_cof_init(&cof, q[0], q[1], q[2], q[3]);
+        cof.dev = 2 * dev;
+        int o = fdt_sphere_cof_orient(&cof);
+        EXPECT(o == FDT_PRED_UNSURE || o == ro);
+        if (o == FDT_PRED_UNSURE)
+            continue;
+        int sq = fdt_sphere_cof_insphere(&cof, q[4]);
+        moved += kind == 0;
+        moved_decided += kind == 0 && sq != FDT_PRED_UNSURE;
+        if (sq != FDT_PRED_UNSURE)
+            EXPECT(sq == ref_of(T, 1, p));
+    }
+    EXPECTF(moved > 0 && moved_decided > moved / 2, "moved: %ld of %ld decided", moved_decided,
+            moved);
     report_section(T, __func__, failures_before);
 }
 

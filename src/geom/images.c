@@ -48,6 +48,7 @@ int fdt_images_round(const double x[3], const int8_t off[3], const double lo[3],
 void fdt_images_init(fdt_images *im, const double blo[3], const double bhi[3], double err)
 {
     im->o3d_inv = im->isp_inv = 0;
+    im->err = err;
     double M = 0;
     for (int k = 0; k < 3; k++) {
         double d = bhi[k] - blo[k];

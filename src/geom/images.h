@@ -37,6 +37,7 @@ typedef struct fdt_images {
     const uint8_t *exact;    /* per point of P: 1 when P holds its exact image */
     double lo[3], hi[3];     /* the period box: axis k's period is the real hi[k] - lo[k] */
     double o3d_inv, isp_inv; /* the filters' reciprocal bounds (fdt_images_init); 0: never decide */
+    double err;              /* the largest |image - P| of a coordinate (fdt_images_init's) */
 } fdt_images;
 
 /*

@@ -433,6 +433,25 @@ static int orient_stage_g(const double *a, const double *b, const double *c, con
     return (det > 0.0) - (det < 0.0);
 }
 
+/* det4 of fdt_insphere_filter_diff, from the rows A..D alone (no
+ * permanent): the grid stage's evaluation. */
+static inline double fdt_insphere_det4(const double A[3], const double B[3], const double C[3],
+                                       const double D[3])
+{
+    const double ab = A[0] * B[1] - B[0] * A[1], bc = B[0] * C[1] - C[0] * B[1];
+    const double cd = C[0] * D[1] - D[0] * C[1], da = D[0] * A[1] - A[0] * D[1];
+    const double ac = A[0] * C[1] - C[0] * A[1], bd = B[0] * D[1] - D[0] * B[1];
+    const double abc = A[2] * bc - B[2] * ac + C[2] * ab;
+    const double bcd = B[2] * cd - C[2] * bd + D[2] * bc;
+    const double cda = C[2] * da + D[2] * ac + A[2] * cd;
+    const double dab = D[2] * ab + A[2] * bd + B[2] * da;
+    const double alift = A[0] * A[0] + A[1] * A[1] + A[2] * A[2];
+    const double blift = B[0] * B[0] + B[1] * B[1] + B[2] * B[2];
+    const double clift = C[0] * C[0] + C[1] * C[1] + C[2] * C[2];
+    const double dlift = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+    return (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+}
+
 /* The exact CGAL insphere sign when stage G applies, else
  * FDT_PRED_UNSURE. The formula is fdt_insphere_filter_diff's. */
 static int insphere_stage_g(const double *a, const double *b, const double *c,

@@ -458,6 +458,10 @@ static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
  * times: under 2^-760, while the bound is at least 2^-500 * 2^-43: the
  * margin above covers it. Overflow: every intermediate is at most
  * 72 mq^5 <= 2^507. Outside that range the calls answer FDT_PRED_UNSURE.
+ * Points that stand for others up to dev (rounded periodic images): the
+ * bounds hold for the determinant of the points as stored, which is within
+ * fdt_sphere_cof_moved of the one they stand for (each difference moves by
+ * at most 2 dev, the permanent grows by at most that), so the calls add it.
  */
 #define FDT_O3D_COF_BOUND 0x1.83p-48
 #define FDT_ISP_COF_BOUND 0x1.34p-43
@@ -467,6 +471,9 @@ typedef struct fdt_sphere_cof {
     double det;      /* orient3d(a, b, c, d) as computed */
     double n[3];     /* N */
     double m;        /* the largest computed |difference| of B, C, D */
+    double dev;      /* how far each point may lie from the one it stands
+                        for (rounded periodic images, src/geom/images.h):
+                        0 from fdt_sphere_cof_init, set by the caller */
 } fdt_sphere_cof;
 
 static inline void fdt_sphere_cof_init(fdt_sphere_cof *s, const double *a, const double *b,
@@ -493,6 +500,21 @@ static inline void fdt_sphere_cof_init(fdt_sphere_cof *s, const double *a, const
     for (int i = 0; i < 9; i++)
         m = fabs(e[i]) > m ? fabs(e[i]) : m;
     s->m = m;
+    s->dev = 0;
+}
+
+/* What moving each point by up to dev can change a determinant of degree
+ * k whose monomials (c of them) multiply differences of magnitude at most
+ * m: c ((M + 2 dev)^k - M^k) <= c k 2 dev (M + 2 dev)^(k-1), M = m over
+ * 1 - 2^-50 (the differences' own rounding), with 2^-20 for this bound's
+ * roundings. 0 when dev is. */
+static inline double fdt_sphere_cof_moved(double dev, double m, double ck, int k)
+{
+    const double d = 2 * dev, M = m * (1 + 0x1p-50) + d;
+    double p = 1;
+    for (int i = 1; i < k; i++)
+        p *= M;
+    return ck * d * p * (1 + 0x1p-20);
 }
 
 /* Whether the magnitude bound x keeps the static bounds above sound. */
@@ -507,7 +529,8 @@ static inline int fdt_sphere_cof_orient(const fdt_sphere_cof *s)
 {
     if (!fdt_sphere_cof_in_range(s->m))
         return FDT_PRED_UNSURE;
-    const double bound = FDT_O3D_COF_BOUND * (s->m * s->m * s->m);
+    const double bound = FDT_O3D_COF_BOUND * (s->m * s->m * s->m) +
+                         fdt_sphere_cof_moved(s->dev, s->m, 6 * 3, 3);
     return s->det > bound ? 1 : s->det < -bound ? -1 : FDT_PRED_UNSURE;
 }
 
@@ -526,32 +549,13 @@ static inline int fdt_sphere_cof_insphere(const fdt_sphere_cof *s, const double 
     mq = fabs(z) > mq ? fabs(z) : mq;
     if (!fdt_sphere_cof_in_range(mq))
         return FDT_PRED_UNSURE;
-    const double m2 = mq * mq, bound = FDT_ISP_COF_BOUND * (m2 * m2 * mq);
+    const double m2 = mq * mq, bound = FDT_ISP_COF_BOUND * (m2 * m2 * mq) +
+                                       fdt_sphere_cof_moved(s->dev, mq, 72 * 5, 5);
     return e > bound ? -1 : e < -bound ? 1 : FDT_PRED_UNSURE;
 }
 
 /* As for orient3d: the proper filter takes the rounded differences
  * A = a - e, ..., D = d - e; the _sf form tests sf's stage first. */
-/* det4 of the filter above, from the rows A..D alone (no permanent): the
- * evaluation the grid stage (src/geom/predicates.c, stage G) and the
- * periodic images' filter (src/geom/images.h) share. */
-static inline double fdt_insphere_det4(const double A[3], const double B[3], const double C[3],
-                                       const double D[3])
-{
-    const double ab = A[0] * B[1] - B[0] * A[1], bc = B[0] * C[1] - C[0] * B[1];
-    const double cd = C[0] * D[1] - D[0] * C[1], da = D[0] * A[1] - A[0] * D[1];
-    const double ac = A[0] * C[1] - C[0] * A[1], bd = B[0] * D[1] - D[0] * B[1];
-    const double abc = A[2] * bc - B[2] * ac + C[2] * ab;
-    const double bcd = B[2] * cd - C[2] * bd + D[2] * bc;
-    const double cda = C[2] * da + D[2] * ac + A[2] * cd;
-    const double dab = D[2] * ab + A[2] * bd + B[2] * da;
-    const double alift = A[0] * A[0] + A[1] * A[1] + A[2] * A[2];
-    const double blift = B[0] * B[0] + B[1] * B[1] + B[2] * B[2];
-    const double clift = C[0] * C[0] + C[1] * C[1] + C[2] * C[2];
-    const double dlift = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
-    return (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
-}
-
 static inline int fdt_insphere_filter_sf(const double *a, const double *b, const double *c,
                                          const double *d, const double *e,
                                          const fdt_pred_static *sf)

@@ -165,7 +165,7 @@ static inline const char *check_pair_finite(const fdt_ins *m, const uint32_t *v,
 {
     if (q == INF)
         return NULL;
-    int s = m->sf.img ? FDT_PRED_UNSURE : fdt_sphere_cof_insphere(cof, pt(m, q));
+    int s = fdt_sphere_cof_insphere(cof, pt(m, q));
     if (s == FDT_PRED_UNSURE)
         s = insphere(m, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), pt(m, q), cnt);
     return s > 0 ? "a face is not locally Delaunay" : NULL;
@@ -211,6 +211,7 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_co
                          fdt_certify_fail *why, size_t *skipped, size_t *pairs)
 {
     size_t used = 0, npairs = 0; /* tets in use, pairs checked */
+    const double dev = m->sf.img ? m->sf.img->err : 0;
     for (uint32_t t = lo; t < hi; t++) {
         if (t + 2 * AHEAD < hi) { /* the neighbours (a freed slot's are any value) */
             const uint32_t *a = m->T + 8 * (size_t)(t + 2 * AHEAD);
@@ -240,9 +241,10 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_co
         fdt_sphere_cof cof = {0}; /* read only where inf < 0 */
         if (inf < 0) {
             fdt_sphere_cof_init(&cof, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]));
-            /* the cofactors' bound holds for the points as stored: not for
-             * rounded periodic images (src/geom/images.h decides those) */
-            int o = m->sf.img ? FDT_PRED_UNSURE : fdt_sphere_cof_orient(&cof);
+            /* rounded periodic images: the bounds widened by their
+             * rounding (src/geom/images.h) */
+            cof.dev = dev;
+            int o = fdt_sphere_cof_orient(&cof);
             if (o == FDT_PRED_UNSURE)
                 o = orient(m, pt(m, v[0]), pt(m, v[1]), pt(m, v[2]), pt(m, v[3]), cnt);
             if (o <= 0)
