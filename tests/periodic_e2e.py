@@ -12,7 +12,7 @@
 - Errors, each with its message and exit code and no output: a point
   outside the box (exit 1, the input's line named by index), too few
   points for one copy of the box (exit 2), --periodic without --box, with
-  --stream or an output that is not .tets (exit 1), over --memory-limit
+  --stream or an output that has no place for the image vertices (exit 1), over --memory-limit
   (exit 4, its estimate counting the images).
 
 - The cells (--periodic --voronoi): their volumes sum to the box's to
@@ -273,7 +273,7 @@ def errors():
     for args, word in ((["--periodic", "xz"], "needs --box"),
                        (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "--stream"], "--stream"),
                        (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "-o",
-                         os.path.join(SCRATCH, "m.vtu")], ".tets only"),
+                         os.path.join(SCRATCH, "m.ele")], "image vertices"),
                        (["--periodic", "xq", "--box", "0,0,0,1,1,1"], "axes")):
         r = frontdt(src, *args)
         expect(r.returncode == 1 and word in r.stderr, "%s: exit %d, %s"

@@ -113,11 +113,12 @@ def readme_reader(name="read_fdtb"):
     text = open(README).read()
     m = re.search(r"<!-- fdtb-reader[^>]*-->\n```python\n(.*?)```", text, re.S)
     mp = re.search(r"<!-- fdtb-pieces-reader[^>]*-->\n```python\n(.*?)```", text, re.S)
-    if not m or not mp:
-        fail(README + " has no fdtb-reader or fdtb-pieces-reader block")
+    mq = re.search(r"<!-- fdtb-periodic-reader[^>]*-->\n```python\n(.*?)```", text, re.S)
+    if not m or not mp or not mq:
+        fail(README + " has no fdtb-reader, fdtb-pieces-reader or fdtb-periodic-reader block")
         return None
-    if len(m.group(1).splitlines()) > 20 or len(mp.group(1).splitlines()) > 20:
-        fail(README + ": the fdtb reader or pieces reader is over 20 lines")
+    if max(len(x.group(1).splitlines()) for x in (m, mp, mq)) > 20:
+        fail(README + ": an fdtb reader is over 20 lines")
     try:
         import numpy  # noqa: F401
     except ImportError:
@@ -126,6 +127,7 @@ def readme_reader(name="read_fdtb"):
     env = {}
     exec(m.group(1), env)
     exec(mp.group(1), env)
+    exec(mq.group(1), env)
     return env[name]
 
 
@@ -215,6 +217,34 @@ def compare(tmp):
     g = reader.GetOutput()
     if g.GetNumberOfCells() != len(ref) or g.GetNumberOfPoints() != len(pts):
         fail("VTK reads %d cells, %d points" % (g.GetNumberOfCells(), g.GetNumberOfPoints()))
+
+
+def periodic(tmp):
+    """A periodic .fdtb (flag 16) read back with doc/reference.md's reader:
+    the .tets rows (ids and offsets), the points, the periods."""
+    reader = readme_reader("read_fdtb_periodic")
+    if reader is None:
+        return
+    rnd = random.Random(33)
+    pts = [(2 * rnd.random(), rnd.random(), 0.5 * rnd.random()) for _ in range(800)]
+    xyz, base = os.path.join(tmp, "per.xyz"), os.path.join(tmp, "per")
+    with open(xyz, "w") as fh:
+        for p in pts:
+            fh.write("%r %r %r\n" % p)
+    r = run([xyz, "--periodic", "xyz", "--box", "0,0,0,2,1,0.5", "-o", base + ".tets",
+             "-o", base + ".fdtb"])
+    if r.returncode:
+        fail("periodic run failed: %s" % r.stderr)
+        return
+    p, tets, hull, toff, hoff, periods = reader(base + ".fdtb")
+    rows = ["%s\n" % " ".join(map(str, list(t) + list(o.reshape(-1))))
+            for t, o in zip(tets.tolist(), toff)]
+    if "".join(rows) != open(base + ".tets").read():
+        fail("periodic .fdtb: its rows are not the .tets lines")
+    if [tuple(x) for x in p.tolist()] != pts or list(periods) != [2.0, 1.0, 0.5]:
+        fail("periodic .fdtb: points or periods %r" % list(periods))
+    if len(hull) or hoff.shape != (0, 3, 3):
+        fail("periodic .fdtb: %d hull faces in a set periodic on every axis" % len(hull))
 
 
 def interrupted(tmp):
@@ -366,6 +396,7 @@ if len(sys.argv) == 6 and sys.argv[3] == "--pieces":
 
 with tempfile.TemporaryDirectory() as tmp:
     compare(tmp)
+    periodic(tmp)
     interrupted(tmp)
     write_fails(tmp)
     refused(tmp)

@@ -448,6 +448,30 @@ static int sc_pcells(void *arg, const char **bad)
     return rc;
 }
 
+/* A periodic mesh written (fdt_write_mesh: .fdtb with its offsets, .vtu
+ * and .msh laid out with its image vertices, src/mesh/periodic.c's
+ * fdt_periodic_unfold) under injection: one file, or FDT_ENOMEM and none. */
+typedef struct pwrite_arg {
+    fdt_result *r;
+    const ptset *ps;
+    const char *dir, *ext;
+} pwrite_arg;
+
+static void empty_dir(const char *dir);
+
+static int sc_pwrite(void *arg, const char **bad)
+{
+    pwrite_arg *a = arg;
+    char path[1024], diag[512];
+    snprintf(path, sizeof path, "%s/per%s", a->dir, a->ext);
+    int rc = fdt_write_mesh(a->r, a->ps->xyz, a->ps->n, path, NULL, diag, sizeof diag);
+    if (count_entries(a->dir) != (rc == FDT_OK))
+        *bad = rc != FDT_OK ? "files left after a failed periodic write"
+                            : "no file after a periodic write";
+    empty_dir(a->dir);
+    return rc;
+}
+
 /* A streamed run (fdt_triangulate_stream) under injection: it succeeds
  * with the in-memory run's set hash and tet count, or fails with nothing
  * returned; the sink counts what reached it (less than the mesh on a
@@ -1346,16 +1370,24 @@ int main(int argc, char **argv)
                 snprintf(pn, sizeof pn, "periodic %s %s 2 threads", pa_i ? "x z" : "x y z",
                          ps->name);
                 inject_all(&sp);
-                if (!pa_i) { /* the periodic cells */
-                    CHECK_EQ(triangulate_p(&w, &serial_cfg, 0, 7, &pr), FDT_OK);
-                    pcells_arg ca = {pr, &w, NAN};
-                    const char *cbad = NULL;
-                    EXPECT(sc_pcells(&ca, &cbad) == FDT_OK && !cbad);
-                    snprintf(pn, sizeof pn, "periodic cells %s", ps->name);
-                    scenario sv = {pn, FDT_ENOMEM, sc_pcells, &ca};
-                    inject_all(&sv);
-                    fdt_result_free(&pr);
+                /* the periodic cells (the walls cut the x z set's) and the
+                 * outputs with offsets or image vertices */
+                CHECK_EQ(triangulate_p(&w, &serial_cfg, 0, pa.periodic, &pr), FDT_OK);
+                pcells_arg ca = {pr, &w, NAN};
+                const char *cbad = NULL;
+                EXPECT(sc_pcells(&ca, &cbad) == FDT_OK && !cbad);
+                snprintf(pn, sizeof pn, "periodic cells %s %s", pa_i ? "x z" : "x y z",
+                         ps->name);
+                scenario sv = {pn, FDT_ENOMEM, sc_pcells, &ca};
+                inject_all(&sv);
+                static const char *const pext[3] = {".fdtb", ".vtu", ".msh"};
+                for (int e = 0; e < 3 && pa_i; e++) {
+                    pwrite_arg wa = {pr, &w, outdir, pext[e]};
+                    snprintf(pn, sizeof pn, "periodic write %s %s", pext[e], ps->name);
+                    scenario sw = {pn, FDT_ENOMEM, sc_pwrite, &wa};
+                    inject_all(&sw);
                 }
+                fdt_result_free(&pr);
                 free(w.xyz);
             }
             /* the dual: neighbours derived (the longer path), two sets */

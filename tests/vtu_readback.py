@@ -20,6 +20,9 @@ duplicate included; the tets are exactly the .tets set, none twice; every
 tet is positively oriented (exact integer arithmetic); VTK's cells are all
 VTK_TETRA. (.fdtb has no outside reader: tests/stream_readback.py reads it
 with README.md's reader; the OpenFOAM polyMesh: tests/formats_readback.sh.)
+A periodic mesh (--periodic x,z) laid out in .vtu, .vtk and both .msh: its
+image vertices after the input points, each with its input_id; the tets
+mapped back equal the .tets rows (periodic(), below).
 Each reader missing is said and skipped; exit 77 (meson's "skipped") when
 neither is installed.
 """
@@ -232,12 +235,122 @@ def main():
                 print("%s: %s" % (what, "FAIL" if new else "ok"))
                 checked.append(what)
 
+        fails += periodic(frontdt, d, checked)
+
     for f in fails:
         print("FAIL:", f)
     if fails:
         return 1
     print("readback ok: %d points, %d tets, %d reads" % (len(pts), len(tets_set), len(checked)))
     return 0
+
+
+def point_src(who, path):
+    """The input id of each point (the periodic formats' map back)."""
+    if who == "vtk":
+        reader = (vtk.vtkXMLUnstructuredGridReader() if path.endswith(".vtu")
+                  else vtk.vtkUnstructuredGridReader())
+        reader.SetFileName(path)
+        reader.Update()
+        a = reader.GetOutput().GetPointData().GetArray("input_id")
+        return None if a is None else [int(a.GetValue(i)) for i in range(a.GetNumberOfTuples())]
+    m = meshio.read(path)
+    a = m.point_data.get("input_id")
+    return None if a is None else [int(v) for v in a.reshape(-1).tolist()]
+
+
+def periodic(frontdt, d, checked):
+    """A channel periodic in x and z (walls of grid points across y) laid
+    out in .vtu, .vtk and .msh: the input points first, bit-exact; each
+    other point an image of the input point its input_id names (that
+    point moved by whole periods along x and z); every tet positively
+    oriented, and mapped back to (input ids, offsets) the .tets rows; the
+    .msh hull triangles outward (their normal along -y on the bottom wall,
+    +y on the top)."""
+    rnd = random.Random(33)
+    g = 6
+    pts = [((i + 0.5) / g, y, (k + 0.5) / g) for y in (0.05, 0.95)
+           for i in range(g) for k in range(g)]
+    pts += [(rnd.random(), rnd.uniform(0.1, 0.9), rnd.random()) for _ in range(700)]
+    pts.append(pts[40])
+    inp = os.path.join(d, "p.xyz")
+    with open(inp, "w") as f:
+        for p in pts:
+            f.write("%r %r %r\n" % p)
+    out = lambda name: os.path.join(d, name)
+    r = subprocess.run([frontdt, inp, "--quiet", "--periodic", "x,z", "--box", "0,0,0,1,1,1",
+                        "-o", out("p.tets"), "-o", out("p.vtu"), "-o", out("p.vtk"),
+                        "-o", out("p.msh"), "--format", "msh2", "-o", out("p2.msh")],
+                       capture_output=True, text=True, timeout=300)
+    if r.returncode != 0:
+        return ["frontdt --periodic: exit %d: %s" % (r.returncode, r.stderr)]
+    rows = set()
+    for line in open(out("p.tets")):
+        v = [int(x) for x in line.split()]
+        rows.add((tuple(v[:4]), tuple(v[4:])))
+    fails = []
+    names = {"vtk": ["p.vtu", "p.vtk"], "meshio": ["p.vtu", "p.vtk", "p.msh", "p2.msh"]}
+    readers = {"vtk": read_vtk if vtk else None, "meshio": read_meshio if meshio else None}
+    for who, files in names.items():
+        if readers[who] is None:
+            continue
+        for name in files:
+            what = "%s reading periodic %s" % (who, name)
+            points, cells, errs = readers[who](out(name))
+            src = point_src(who, out(name))
+            new = ["%s: %s" % (what, e) for e in errs]
+            if src is None or len(src) != len(points):
+                new.append("%s: no input_id for each point" % what)
+            elif points[:len(pts)] != pts or src[:len(pts)] != list(range(len(pts))):
+                new.append("%s: the input points are not the first, in order" % what)
+            else:
+                new += periodic_check(what, pts, points, src, cells, rows)
+                if name.endswith(".msh"):
+                    new += hull_outward(what, points, out(name))
+            fails += new
+            print("%s: %s" % (what, "FAIL" if new else "ok"))
+            checked.append(what)
+    return fails
+
+
+def periodic_check(what, pts, points, src, cells, rows):
+    offs = []
+    for i, p in enumerate(points):
+        x = pts[src[i]]
+        o = tuple(round(p[k] - x[k]) for k in range(3))
+        if o[1] != 0 or any(abs(p[k] - (x[k] + o[k])) > 1e-15 for k in range(3)):
+            return ["%s: point %d %r is no image of input point %d %r" % (what, i, p, src[i], x)]
+        offs.append(o)
+    orient = Orienter(points)
+    got = set()
+    for c, q in enumerate(cells):
+        if not orient.positive(q):
+            return ["%s: cell %d %r is not positively oriented" % (what, c, q)]
+        v = sorted((src[i], offs[i]) for i in q)
+        first = v[0][1]
+        got.add((tuple(a for a, _ in v),
+                 tuple(o[k] - first[k] for _, o in v for k in range(3))))
+    if len(cells) != len(rows) or got != rows:
+        return ["%s: %d cells, %d distinct, %d of the %d .tets rows"
+                % (what, len(cells), len(got), len(got & rows), len(rows))]
+    return []
+
+
+def hull_outward(what, points, path):
+    if meshio is None:
+        return []
+    m = meshio.read(path)
+    tri = [t for b in m.cells if b.type == "triangle" for t in b.data.tolist()]
+    if not tri:
+        return ["%s: no hull triangles" % what]
+    for t in tri:
+        a, b, c = (points[i] for i in t)
+        u = [b[k] - a[k] for k in range(3)]
+        v = [c[k] - a[k] for k in range(3)]
+        ny = u[2] * v[0] - u[0] * v[2]
+        if (ny > 0) != (a[1] > 0.5):
+            return ["%s: hull triangle %r is not outward" % (what, t)]
+    return []
 
 
 if __name__ == "__main__":

@@ -574,11 +574,12 @@ static int check_args(cli *c, int npos, char **pos)
         if (vd && !strcmp(vd, ".vtu"))
             return usage_error("--periodic's cells are a table (not .vtu polyhedra)");
         for (int o = 0; o < c->n_outputs; o++) {
-            const char *f = c->out_format[o];
-            const char *dot = strrchr(c->outputs[o], '.');
-            if (f ? strcmp(f, "tets") != 0 : !dot || strcmp(dot, ".tets") != 0)
-                return usage_error("--periodic writes .tets only (-o %s): the other formats "
-                                   "need the image vertices", c->outputs[o]);
+            const fdt_format *f = c->out_format[o] ? fdt_format_by_name(c->out_format[o])
+                                                   : fdt_format_by_path(c->outputs[o]);
+            if (f && !fdt_format_periodic(f))
+                return usage_error("--periodic writes .tets, .fdtb, .vtu, .vtk or .msh (-o %s: "
+                                   "its format has no place for the image vertices' input "
+                                   "ids)", c->outputs[o]);
         }
         c->stream = -1;
     }

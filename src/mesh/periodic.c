@@ -866,6 +866,163 @@ static int tet_orient(const double *X, const uint32_t id[4], const int8_t off[12
     return fdt_images_orient(&im, P, P + 3, P + 6, P + 9, NULL);
 }
 
+/* The key of a face (3 vertices, ids ascending with their offsets, as
+ * the mesh names a hull face): relative to its first vertex. */
+static void face_key(const uint32_t id[3], const int8_t *o[3], uint64_t k[3])
+{
+    for (int j = 0; j < 3; j++) {
+        const int8_t r[3] = {(int8_t)(o[j][0] - o[0][0]), (int8_t)(o[j][1] - o[0][1]),
+                             (int8_t)(o[j][2] - o[0][2])};
+        k[j] = vpack(id[j], r);
+    }
+}
+
+static size_t face_hash(const uint64_t k[3], size_t mask)
+{
+    return (size_t)fdt_mix64(k[0] ^ fdt_mix64(k[1] ^ fdt_mix64(k[2]))) & mask;
+}
+
+void fdt_periodic_unfolded_free(fdt_periodic_unfolded *u)
+{
+    free(u->xyz);
+    free(u->src);
+    free(u->tets);
+    free(u->hull);
+    memset(u, 0, sizeof *u);
+}
+
+int fdt_periodic_unfold(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
+                        const int8_t *hoff, size_t nhull, const double *X, size_t n,
+                        const fdt_periodic_box *b, fdt_periodic_unfolded *u)
+{
+    memset(u, 0, sizeof *u);
+    if (n > UINT32_MAX / 2)
+        return FDT_ETOOBIG;
+    vmap m;
+    memset(&m, 0, sizeof m);
+    uint64_t *hk = NULL;   /* the hull faces' keys, by hash: 3 each */
+    uint32_t *hslot = NULL, *apex = NULL;
+    int8_t *aoff = NULL;   /* each hull face's apex offsets, from its first vertex */
+    size_t hmask = 0;
+    int err = FDT_OK;
+    static const int8_t zero[3] = {0, 0, 0};
+    for (size_t i = 0; i < n && !err; i++) /* the input points first: their ids */
+        if (vmap_get(&m, (uint32_t)i, zero, X, b) < 0)
+            err = FDT_ENOMEM;
+    if (!err && !(u->tets = malloc((4 * ntets + 1) * sizeof *u->tets)))
+        err = FDT_ENOMEM;
+    /* each tet where its offsets place it, positively oriented */
+    for (size_t t = 0; t < ntets && !err; t++) {
+        const uint32_t *id = (const uint32_t *)tets + 4 * t;
+        const int8_t *o = off + 12 * t;
+        for (int k = 0; k < 4 && !err; k++) {
+            long x = vmap_get(&m, id[k], o + 3 * k, X, b);
+            if (x < 0)
+                err = FDT_ENOMEM;
+            u->tets[4 * t + (size_t)k] = (fdt_vid)x;
+        }
+        if (tet_orient(X, id, o, b) < 0) {
+            fdt_vid tmp = u->tets[4 * t];
+            u->tets[4 * t] = u->tets[4 * t + 1];
+            u->tets[4 * t + 1] = tmp;
+        }
+    }
+    /* each hull face outward: its tet's fourth vertex (the apex) on the
+     * negative side; the tet found by the face's key among its four */
+    if (!err && nhull) {
+        size_t size = 16;
+        while (size < 2 * nhull)
+            size *= 2;
+        hmask = size - 1;
+        if (!(hk = malloc(3 * size * sizeof *hk)) || !(hslot = malloc(size * sizeof *hslot)) ||
+            !(apex = malloc(nhull * sizeof *apex)) || !(aoff = malloc(3 * nhull)))
+            err = FDT_ENOMEM;
+        for (size_t h = 0; !err && h <= hmask; h++)
+            hslot[h] = UINT32_MAX;
+        for (size_t f = 0; !err && f < nhull; f++) {
+            const uint32_t *id = (const uint32_t *)hull + 3 * f;
+            const int8_t *o[3] = {hoff + 9 * f, hoff + 9 * f + 3, hoff + 9 * f + 6};
+            uint64_t k[3];
+            face_key(id, o, k);
+            size_t h = face_hash(k, hmask);
+            while (hslot[h] != UINT32_MAX)
+                h = (h + 1) & hmask;
+            hslot[h] = (uint32_t)f;
+            memcpy(hk + 3 * h, k, sizeof k);
+            apex[f] = UINT32_MAX;
+        }
+        for (size_t t = 0; !err && t < ntets; t++) {
+            const uint32_t *id = (const uint32_t *)tets + 4 * t;
+            const int8_t *o = off + 12 * t;
+            for (int j = 0; j < 4; j++) {
+                uint32_t fid[3];
+                const int8_t *fo[3];
+                for (int i = 0, c = 0; i < 4; i++)
+                    if (i != j) {
+                        fid[c] = id[i];
+                        fo[c++] = o + 3 * i;
+                    }
+                uint64_t k[3];
+                face_key(fid, fo, k);
+                for (size_t h = face_hash(k, hmask); hslot[h] != UINT32_MAX; h = (h + 1) & hmask)
+                    if (!memcmp(hk + 3 * h, k, sizeof k)) {
+                        uint32_t f = hslot[h];
+                        apex[f] = id[j];
+                        for (int a = 0; a < 3; a++)
+                            aoff[3 * f + (size_t)a] = (int8_t)(o[3 * j + a] - fo[0][a]);
+                        break;
+                    }
+            }
+        }
+    }
+    if (!err && !(u->hull = malloc((3 * nhull + 1) * sizeof *u->hull)))
+        err = FDT_ENOMEM;
+    for (size_t f = 0; f < nhull && !err; f++) {
+        const uint32_t *id = (const uint32_t *)hull + 3 * f;
+        const int8_t *o = hoff + 9 * f;
+        if (apex[f] == UINT32_MAX) { /* every hull face is a tet's */
+            err = FDT_EINTERNAL;
+            break;
+        }
+        for (int k = 0; k < 3 && !err; k++) {
+            long x = vmap_get(&m, id[k], o + 3 * k, X, b);
+            if (x < 0)
+                err = FDT_ENOMEM;
+            u->hull[3 * f + (size_t)k] = (fdt_vid)x;
+        }
+        const uint32_t q[4] = {id[0], id[1], id[2], apex[f]};
+        int8_t qo[12];
+        memcpy(qo, o, 9);
+        memcpy(qo + 9, aoff + 3 * f, 3);
+        if (tet_orient(X, q, qo, b) > 0) {
+            fdt_vid tmp = u->hull[3 * f];
+            u->hull[3 * f] = u->hull[3 * f + 1];
+            u->hull[3 * f + 1] = tmp;
+        }
+    }
+    if (!err && m.n > (size_t)INT32_MAX)
+        err = FDT_ETOOBIG;
+    if (!err) {
+        u->n = m.n;
+        u->ntets = ntets;
+        u->nhull = nhull;
+        u->xyz = m.xyz;
+        m.xyz = NULL;
+        if (!(u->src = malloc((m.n ? m.n : 1) * sizeof *u->src)))
+            err = FDT_ENOMEM;
+        for (size_t i = 0; !err && i < m.n; i++)
+            u->src[i] = (fdt_vid)m.label[i];
+    }
+    if (err)
+        fdt_periodic_unfolded_free(u);
+    vmap_free(&m);
+    free(hk);
+    free(hslot);
+    free(apex);
+    free(aoff);
+    return err;
+}
+
 int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
                        size_t nhull, const double *X, size_t n, const int32_t *dupmap,
                        const fdt_periodic_box *b, int threads, int neighbors, fdt_voronoi **out,

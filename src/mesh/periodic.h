@@ -34,6 +34,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include "frontdt.h"
 #include "geom/predicates.h"
 
 /* The periodic box: bit k of axes set when axis k is periodic, with the
@@ -100,6 +101,32 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
                        size_t nhull, const double *X, size_t n, const int32_t *dupmap,
                        const fdt_periodic_box *b, int threads, int neighbors,
                        struct fdt_voronoi **out, char *diag, size_t ds);
+
+/*
+ * A periodic mesh laid out in space for the formats that name points by
+ * their coordinates (.vtu, .msh): the n input points X first (point i is
+ * i), then each image (input id, offsets) a tet or hull face uses,
+ * rounded; each tet where its offsets place it (its lowest-id vertex the
+ * point itself), positively oriented for the exact images; each hull face
+ * likewise, outward (its tet's other vertex on its negative side). src[i]:
+ * point i's input id (i for the first n). FDT_OK, FDT_ENOMEM, FDT_ETOOBIG
+ * past INT32_MAX points, FDT_EINTERNAL for a hull face no tet has (a
+ * bug). Free with fdt_periodic_unfolded_free.
+ */
+typedef struct fdt_periodic_unfolded {
+    double *xyz;     /* 3 each */
+    fdt_vid *src;
+    size_t n;
+    fdt_vid *tets;   /* 4 each */
+    size_t ntets;
+    fdt_vid *hull;   /* 3 each */
+    size_t nhull;
+} fdt_periodic_unfolded;
+
+int fdt_periodic_unfold(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
+                        const int8_t *hoff, size_t nhull, const double *X, size_t n,
+                        const fdt_periodic_box *b, fdt_periodic_unfolded *u);
+void fdt_periodic_unfolded_free(fdt_periodic_unfolded *u);
 
 /* fdt_periodic_build's checks of the box and of the points in it, alone
  * (a caller checks its input before it scales or merges it, so that the

@@ -10,14 +10,20 @@
  *                 (frontdt-mpi -o BASE.pfdtb), no points, the ids number
  *                 the input file's points (in input order, a duplicate's
  *                 tets name its first occurrence), "points" is how many
- *                 the input has
+ *                 the input has; 16 a periodic mesh (--periodic): the
+ *                 tets and hull faces are ids ascending (not oriented),
+ *                 their offsets follow
  *         16..23  uint64 points
  *         24..31  uint64 tets      (a streamed file: patched at the end)
  *         32..39  uint64 hull faces (the same)
- *         40..63  zero (reserved)
+ *         40..63  zero (reserved); with flag 16 the periods, 3 float64
+ *                 (max - min of --box rounded, 0 on an axis that is not
+ *                 periodic)
  *   then the points (3 float64 each) if flag 2, the tets (4 ids each,
  *   positively oriented, input numbering), the hull faces (3 ids each,
- *   outward) if flag 4.
+ *   outward) if flag 4; with flag 16 each tet's 12 offsets (int8: x, y, z
+ *   of each vertex in periods, relative to the first, as in .tets), then
+ *   each hull face's 9.
  * A streamed file keeps the hull faces in memory until the end (a few
  * percent of the tets' bytes) so that each array stays contiguous.
  */
@@ -25,7 +31,7 @@
 
 #define BIN_HEADER 64
 #define BIN_VERSION 1u
-enum { BIN_IDS64 = 1, BIN_POINTS = 2, BIN_HULL = 4, BIN_PIECE = 8 };
+enum { BIN_IDS64 = 1, BIN_POINTS = 2, BIN_HULL = 4, BIN_PIECE = 8, BIN_PERIODIC = 16 };
 
 static void put_le(unsigned char *p, uint64_t v, int bytes)
 {
@@ -90,11 +96,21 @@ int fdt_put_bin(out_file *o, const fdt_mesh_view *m, const void *prep, char *err
     (void)err;
     (void)errlen;
     unsigned char h[BIN_HEADER];
-    bin_header(h, BIN_POINTS | BIN_HULL, m->n_points, m->n_tets, m->n_hull);
+    bin_header(h, BIN_POINTS | BIN_HULL | (m->tet_off ? BIN_PERIODIC : 0), m->n_points,
+               m->n_tets, m->n_hull);
+    for (int k = 0; m->tet_off && k < 3; k++) {
+        uint64_t u;
+        memcpy(&u, &m->period[k], 8);
+        put_le(h + 40 + 8 * k, u, 8);
+    }
     out_bytes(o, h, sizeof h);
     put_points(o, m->xyz, m->n_points);
     put_ids(o, m->tets, 4 * m->n_tets, 0);
     put_ids(o, m->hull, 3 * m->n_hull, 0);
+    if (m->tet_off && m->n_tets) /* (a NULL array of none is not memcpy's) */
+        out_bytes(o, m->tet_off, 12 * m->n_tets);
+    if (m->tet_off && m->n_hull)
+        out_bytes(o, m->hull_off, 9 * m->n_hull);
     return FDT_IO_OK;
 }
 

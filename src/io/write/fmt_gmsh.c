@@ -44,6 +44,24 @@ static void bbox(const fdt_mesh_view *m, double lo[3], double hi[3])
         }
 }
 
+/* A periodic mesh laid out (meshview.h): each node's input id as a
+ * node data view "input_id" (the same section in MSH 2.2 and 4.1). */
+static void put_node_src(out_file *o, const fdt_mesh_view *m)
+{
+    if (!m->point_src)
+        return;
+    out_str(o, "$NodeData\n1\n\"input_id\"\n1\n0\n3\n0\n1\n");
+    out_i64(o, (int64_t)m->n_points);
+    out_char(o, '\n');
+    for (size_t i = 0; i < m->n_points && !o->err; i++) {
+        out_i64(o, (int64_t)i + 1);
+        out_char(o, ' ');
+        out_i64(o, m->point_src[i]);
+        out_char(o, '\n');
+    }
+    out_str(o, "$EndNodeData\n");
+}
+
 int fdt_put_msh41(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
                   size_t errlen)
 {
@@ -101,6 +119,7 @@ int fdt_put_msh41(out_file *o, const fdt_mesh_view *m, const void *prep, char *e
         put_ids(o, m->hull + 3 * f, 3);
     }
     out_str(o, "$EndElements\n");
+    put_node_src(o, m);
     return FDT_IO_OK;
 }
 
@@ -136,5 +155,6 @@ int fdt_put_msh22(out_file *o, const fdt_mesh_view *m, const void *prep, char *e
         put_ids(o, m->hull + 3 * f, 3);
     }
     out_str(o, "$EndElements\n");
+    put_node_src(o, m);
     return FDT_IO_OK;
 }

@@ -29,6 +29,17 @@ int fdt_put_vtu(out_file *o, const fdt_mesh_view *m, const void *prep, char *err
     uint64_t off_conn = off_pts + 8 + sz_pts;
     uint64_t off_off = off_conn + 8 + sz_conn;
     uint64_t off_typ = off_off + 8 + sz_off;
+    /* a periodic mesh laid out: each point's input id (meshview.h) */
+    uint64_t sz_src = m->point_src ? n * sizeof(int64_t) : 0;
+    uint64_t off_src = off_typ + 8 + sz_typ;
+    char pdata[256] = "";
+    if (m->point_src)
+        snprintf(pdata, sizeof pdata,
+                 "      <PointData Scalars=\"input_id\">\n"
+                 "        <DataArray type=\"Int64\" Name=\"input_id\" "
+                 "format=\"appended\" offset=\"%llu\"/>\n"
+                 "      </PointData>\n",
+                 (unsigned long long)off_src);
 
     char head[2048];
     int k = snprintf(head, sizeof head,
@@ -37,6 +48,7 @@ int fdt_put_vtu(out_file *o, const fdt_mesh_view *m, const void *prep, char *err
         "byte_order=\"%s\" header_type=\"UInt64\">\n"
         "  <UnstructuredGrid>\n"
         "    <Piece NumberOfPoints=\"%llu\" NumberOfCells=\"%llu\">\n"
+        "%s"
         "      <Points>\n"
         "        <DataArray type=\"Float64\" Name=\"Points\" "
         "NumberOfComponents=\"3\" format=\"appended\" offset=\"%llu\"/>\n"
@@ -54,7 +66,7 @@ int fdt_put_vtu(out_file *o, const fdt_mesh_view *m, const void *prep, char *err
         "  <AppendedData encoding=\"raw\">\n"
         "   _",
         host_is_little_endian() ? "LittleEndian" : "BigEndian",
-        (unsigned long long)n, (unsigned long long)nt,
+        (unsigned long long)n, (unsigned long long)nt, pdata,
         (unsigned long long)off_pts, (unsigned long long)off_conn,
         (unsigned long long)off_off, (unsigned long long)off_typ);
     if (k < 0 || (size_t)k >= sizeof head) {
@@ -82,6 +94,15 @@ int fdt_put_vtu(out_file *o, const fdt_mesh_view *m, const void *prep, char *err
     out_bytes(o, &sz_typ, 8);
     for (size_t t = 0; t < m->n_tets && !o->err; t++)
         out_char(o, VTK_TETRA);
+    if (m->point_src) {
+        out_bytes(o, &sz_src, 8);
+        for (size_t i = 0; i < m->n_points && !o->err; i++) {
+            int64_t v = m->point_src[i];
+            char *p = out_room(o, 8);
+            memcpy(p, &v, 8);
+            o->len += 8;
+        }
+    }
     out_str(o, "\n  </AppendedData>\n</VTKFile>\n");
     return FDT_IO_OK;
 }
@@ -126,6 +147,15 @@ int fdt_put_vtk(out_file *o, const fdt_mesh_view *m, const void *prep, char *err
     out_char(o, '\n');
     for (size_t t = 0; t < m->n_tets && !o->err; t++)
         out_str(o, "10\n");
+    if (m->point_src) { /* a periodic mesh laid out: each point's input id */
+        out_str(o, "POINT_DATA ");
+        out_i64(o, (int64_t)m->n_points);
+        out_str(o, "\nSCALARS input_id long 1\nLOOKUP_TABLE default\n");
+        for (size_t i = 0; i < m->n_points && !o->err; i++) {
+            out_i64(o, m->point_src[i]);
+            out_char(o, '\n');
+        }
+    }
     return FDT_IO_OK;
 }
 

@@ -25,8 +25,14 @@ typedef struct fdt_mesh_view {
     size_t n_faces;
     int all_faces;           /* TetGen .face: every face (TetGen -f) */
     /* A periodic mesh (fdt_result_tet_offsets), or NULL: 12 offsets a
-     * tet, whose rows are then ids ascending, not oriented; .tets only. */
-    const int8_t *tet_off;
+     * tet and 9 a hull face, whose rows are then ids ascending, not
+     * oriented, and the periods (hi - lo rounded; 0 on an axis that is not
+     * periodic); .tets and .fdtb. */
+    const int8_t *tet_off, *hull_off;
+    double period[3];
+    /* A periodic mesh laid out in space (fdt_periodic_unfold), or NULL:
+     * point i's input id, the formats' map back (.vtu, .vtk, .msh). */
+    const fdt_vid *point_src;
 } fdt_mesh_view;
 
 /* The longest path the writer takes (its temporary names live in fixed

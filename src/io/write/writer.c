@@ -21,6 +21,7 @@
 #include "io/write/writer.h"
 #include "base/abi.h"
 #include "io/write/formats.h"
+#include "mesh/periodic.h"
 #include "mesh/result.h"
 
 #include <errno.h>
@@ -1642,6 +1643,22 @@ int fdt_default_write_options_sized(fdt_write_options *o, size_t struct_size)
     return fdt_abi_reset(o, struct_size, write_options_size_known(struct_size));
 }
 
+/* The formats that write a periodic mesh laid out in space: its image
+ * vertices as points, each with its input id (fdt_periodic_unfold). */
+static int periodic_laid_out(const fdt_format *f)
+{
+    static const char *const names[] = {"vtu", "vtk", "msh", "msh2"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (!strcmp(f->name, names[i]))
+            return 1;
+    return 0;
+}
+
+int fdt_format_periodic(const fdt_format *f)
+{
+    return periodic_laid_out(f) || !strcmp(f->name, "tets") || !strcmp(f->name, "bin");
+}
+
 /* One public write at a time: the temporary-file registry above (and the
  * one temporary directory) are process-wide, and creation_mode() sets the
  * umask for an instant. */
@@ -1702,9 +1719,12 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
         snprintf(what, sizeof what, "%zu points given for a mesh of %zu", n, r->n);
         return set_err(diag, diag_size, FDT_EINVAL, name, what);
     }
-    if (r->tet_off && strcmp(f->name, "tets") != 0) {
-        snprintf(what, sizeof what, "a periodic mesh is written as .tets (format %s would need "
-                 "the image vertices, issue 33)", f->name);
+    /* a periodic mesh: its rows and offsets (.tets, .fdtb), or laid out
+     * with its image vertices and their input ids (periodic_laid_out) */
+    int laid_out = r->tet_off && periodic_laid_out(f);
+    if (r->tet_off && !fdt_format_periodic(f)) {
+        snprintf(what, sizeof what, "a periodic mesh is written as .tets, .fdtb, .vtu, .vtk "
+                 "or .msh (format %s has no place for its image vertices' input ids)", f->name);
         return set_err(diag, diag_size, FDT_EINVAL, name, what);
     }
     int needs = fdt_format_needs(f, o->all_faces);
@@ -1718,8 +1738,23 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
         return set_err(diag, diag_size, e, name, fdt_strerror(e));
     fdt_mesh_view v = {
         .xyz = xyz, .n_points = n, .tets = r->tets, .n_tets = r->ntets, .nbrs = r->nbrs,
-        .hull = r->hull, .n_hull = r->nhull, .all_faces = o->all_faces, .tet_off = r->tet_off,
+        .hull = r->hull, .n_hull = r->nhull, .all_faces = o->all_faces,
     };
+    fdt_periodic_unfolded u = {0};
+    if (laid_out) {
+        const fdt_periodic_box b = {r->periodic, {r->pbox[0], r->pbox[1], r->pbox[2]},
+                                    {r->pbox[3], r->pbox[4], r->pbox[5]}};
+        if ((e = fdt_periodic_unfold(r->tets, r->tet_off, r->ntets, r->hull, r->hull_off,
+                                     r->nhull, xyz, n, &b, &u)) != FDT_OK)
+            return set_err(diag, diag_size, e, name, fdt_strerror(e));
+        v = (fdt_mesh_view){.xyz = u.xyz, .n_points = u.n, .tets = u.tets, .n_tets = u.ntets,
+                            .hull = u.hull, .n_hull = u.nhull, .point_src = u.src};
+    } else if (r->tet_off) {
+        v.tet_off = r->tet_off;
+        v.hull_off = r->hull_off;
+        for (int k = 0; k < 3; k++)
+            v.period[k] = r->periodic >> k & 1 ? r->pbox[k + 3] - r->pbox[k] : 0;
+    }
     /* after the sort: the face list names tets by their numbers */
     if ((needs & FDT_NEED_FACES) &&
         (e = fdt_result_faces(r, &v.n_faces, &v.faces, &v.face_tets)) != FDT_OK)
@@ -1728,6 +1763,7 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
                                                o->progress_user, diag, diag_size)
                        : fdt_wr_mesh_ex(path, f, &v, o->progress, o->progress_user, diag,
                                         diag_size);
+    fdt_periodic_unfolded_free(&u);
     return wr_public_code(io);
 }
 

@@ -41,6 +41,10 @@ int fdt_format_is_text(const fdt_format *f);
 /* Whether writing with f needs tet neighbours, the face list, canonical
  * order (FDT_NEED_* of src/io/write/formats.h, or'ed). */
 int fdt_format_needs(const fdt_format *f, int all_faces);
+/* Whether f writes a periodic mesh: its rows and offsets (.tets, .fdtb),
+ * or laid out in space with its image vertices' input ids (.vtu, .vtk,
+ * .msh); fdt_write_mesh refuses the others. */
+int fdt_format_periodic(const fdt_format *f);
 /* "name (.ext, .ext)" of every row, comma separated, for messages. */
 const char *fdt_format_list(void);
 
