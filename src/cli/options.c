@@ -123,7 +123,9 @@ const fdt_cli_opt fdt_cli_opts[FDT_OPT_END] = {
         "(every point in [X0, X1) there): the Delaunay\n"
         "mesh of the periodic set, every tet once; -o\n"
         "FILE.tets: its 4 ids ascending, then each one's\n"
-        "image offset (3 integers) from the first's", NULL},
+        "image offset (3 integers) from the first's;\n"
+        ".fdtb the same; .vtu, .vtk, .msh with the image\n"
+        "vertices and their input ids", NULL},
     [FDT_OPT_DUAL] = {"dual", 0, no_argument, NULL, F, 0,
         "each OpenFOAM -o (DIR/polyMesh) gets the Voronoi\n"
         "cells clipped by the box instead of the tets:\n"
