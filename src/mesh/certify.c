@@ -207,8 +207,9 @@ static inline unsigned checks_here(uint32_t t, uint32_t nt, uint32_t lo, uint32_
  * someone else. Each neighbour slot is read once a face, where the
  * neighbour reads are most of the time.
  */
-static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_counts *cnt,
-                         fdt_certify_fail *why, size_t *skipped, size_t *pairs)
+static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, const fdt_certify_visit *vis,
+                         int job, fdt_pred_counts *cnt, fdt_certify_fail *why, size_t *skipped,
+                         size_t *pairs)
 {
     size_t used = 0, npairs = 0; /* tets in use, pairs checked */
     const double dev = m->sf.img ? m->sf.img->err : 0;
@@ -281,6 +282,8 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, fdt_pred_co
             if (bad_pair)
                 return fail(why, t, k, bad_pair);
         }
+        if (vis)
+            vis->tet(vis->user, job, t, v, inf, inf < 0 ? &cof : NULL);
     }
     *skipped += 4 * used - npairs;
     *pairs += npairs;
@@ -308,17 +311,26 @@ int fdt_certify_vertices(const fdt_ins *m, fdt_certify_fail *why)
     return FDT_OK;
 }
 
-int fdt_certify(const fdt_ins *m, fdt_pred_counts *cnt, fdt_certify_fail *why)
+/* The whole certificate on the calling thread, with vis's pass. */
+static int certify_serial(const fdt_ins *m, const fdt_certify_visit *vis, fdt_pred_counts *cnt,
+                          fdt_certify_fail *why)
 {
     size_t skipped = 0, pairs = 0;
-    int err = certify_range(m, 0, m->nslots, cnt, why, &skipped, &pairs);
+    int err = certify_range(m, 0, m->nslots, vis, 0, cnt, why, &skipped, &pairs);
     if (!err)
         err = certify_balance(m, skipped, pairs, why);
     return err ? err : fdt_certify_vertices(m, why);
 }
 
+int fdt_certify(const fdt_ins *m, fdt_pred_counts *cnt, fdt_certify_fail *why)
+{
+    return certify_serial(m, NULL, cnt, why);
+}
+
 typedef struct cert_job {
     const fdt_ins *m;
+    const fdt_certify_visit *vis;
+    int index;
     uint32_t lo, hi;
     fdt_pred_counts pc;
     fdt_certify_fail why;
@@ -331,20 +343,34 @@ typedef struct cert_job {
 static void *cert_run(void *arg)
 {
     cert_job *j = arg;
-    j->rc = certify_range(j->m, j->lo, j->hi, &j->pc, &j->why, &j->skipped, &j->pairs);
+    j->rc = certify_range(j->m, j->lo, j->hi, j->vis, j->index, &j->pc, &j->why, &j->skipped,
+                          &j->pairs);
     return NULL;
+}
+
+int fdt_certify_jobs(const fdt_ins *m, int nthreads)
+{
+    return nthreads <= 1 || m->nslots < 4096 ? 1 : nthreads;
 }
 
 int fdt_certify_parallel(const fdt_ins *m, int nthreads, fdt_pred_counts *cnt,
                          fdt_certify_fail *why)
 {
-    if (nthreads <= 1 || m->nslots < 4096)
-        return fdt_certify(m, cnt, why);
+    return fdt_certify_parallel_visit(m, nthreads, NULL, cnt, why);
+}
+
+int fdt_certify_parallel_visit(const fdt_ins *m, int nthreads, const fdt_certify_visit *vis,
+                               fdt_pred_counts *cnt, fdt_certify_fail *why)
+{
+    if (fdt_certify_jobs(m, nthreads) == 1)
+        return certify_serial(m, vis, cnt, why);
     cert_job *j = calloc((size_t)nthreads, sizeof *j);
     if (!j)
         return FDT_ENOMEM;
     for (int i = 0; i < nthreads; i++) {
         j[i].m = m;
+        j[i].vis = vis;
+        j[i].index = i;
         j[i].lo = (uint32_t)((uint64_t)m->nslots * (uint64_t)i / (uint64_t)nthreads);
         j[i].hi = (uint32_t)((uint64_t)m->nslots * (uint64_t)(i + 1) / (uint64_t)nthreads);
     }

@@ -68,6 +68,30 @@ int fdt_certify(const fdt_ins *m, fdt_pred_counts *cnt, fdt_certify_fail *why);
 int fdt_certify_parallel(const fdt_ins *m, int nthreads, fdt_pred_counts *cnt,
                          fdt_certify_fail *why);
 
+/*
+ * A pass of the caller's over the tets, fused with the certificate's, which
+ * has just read their rows and points (the periodic proofs,
+ * src/mesh/periodic.c): tet() for each tet in use, once its own checks
+ * passed, with its lifted cofactors when it is finite (cof NULL and inf
+ * the infinite vertex's index otherwise); job is the range's index, below
+ * fdt_certify_jobs(m, nthreads), each range's calls on one thread in slot
+ * order. A tet's call says nothing of the tets after it: the caller uses
+ * its results only when the certificate passed.
+ */
+typedef struct fdt_certify_visit {
+    void (*tet)(void *user, int job, uint32_t slot, const uint32_t v[4], int inf,
+                const fdt_sphere_cof *cof);
+    void *user;
+} fdt_certify_visit;
+
+/* How many ranges fdt_certify_parallel_visit splits m into (1 for a small
+ * mesh or one thread). */
+int fdt_certify_jobs(const fdt_ins *m, int nthreads);
+
+/* fdt_certify_parallel with vis's pass beside it (vis NULL: none). */
+int fdt_certify_parallel_visit(const fdt_ins *m, int nthreads, const fdt_certify_visit *vis,
+                               fdt_pred_counts *cnt, fdt_certify_fail *why);
+
 /* "mesh certificate failed: tet slot S face F: WHAT" into buf (without
  * the slot when it is FDT_NONE). */
 void fdt_certify_describe(const fdt_certify_fail *why, char *buf, size_t len);

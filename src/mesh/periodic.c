@@ -1,13 +1,13 @@
 /* The periodic Delaunay tetrahedralization; see periodic.h. */
 #include "mesh/periodic.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/hash.h"
-#include "base/spawn.h"
 #include "geom/images.h"
 #include "geom/morton.h"
 #include "mesh/certify.h"
@@ -86,7 +86,7 @@ static int ext_grow(ext *e, size_t need)
  * The points, then for each the images whose every offset is allowed: on
  * periodic axis k, +1 when x - lo <= m[k] (the image lands within m above
  * hi), -1 when hi - x <= m[k]. Every image whose exact coordinate lies in
- * (lo - m', hi + m') on each periodic axis, m' < m (prove_run's mm), is
+ * (lo - m', hi + m') on each periodic axis, m' < m (prove_init's mm), is
  * then present: x + L < hi + m' means x - lo < m', and rounding is
  * monotone.
  */
@@ -140,8 +140,10 @@ static int make_images(ext *e, const double *X, uint32_t n, const fdt_periodic_b
 }
 
 /* The set in Morton order (the insertion's order, as the one-part
- * engine's, src/api/api.c), and its box. */
-static int morton(ext *e, double blo[3], double bhi[3])
+ * engine's, src/api/api.c), and its box: the n input points first, then
+ * the images, each in Morton order, so that a vertex below n is an input
+ * point (the proofs' test, prove_tet, reads no array). */
+static int morton(ext *e, uint32_t n, double blo[3], double bhi[3])
 {
     for (int k = 0; k < 3; k++)
         blo[k] = bhi[k] = e->P[k];
@@ -154,13 +156,14 @@ static int morton(ext *e, double blo[3], double bhi[3])
     const double box[6] = {blo[0], blo[1], blo[2], bhi[0], bhi[1], bhi[2]};
     uint32_t *order = malloc((size_t)e->n * sizeof *order);
     ext s = {0};
-    if (!order || ext_grow(&s, e->n) != FDT_OK || fdt_morton_order(e->P, e->n, box, NULL, order) < 0) {
+    if (!order || ext_grow(&s, e->n) != FDT_OK || fdt_morton_order(e->P, n, box, NULL, order) < 0 ||
+        fdt_morton_order(e->P + 3 * (size_t)n, e->n - n, box, NULL, order + n) < 0) {
         free(order);
         ext_free(&s);
         return FDT_ENOMEM;
     }
     for (uint32_t i = 0; i < e->n; i++) {
-        uint32_t j = order[i];
+        uint32_t j = i < n ? order[i] : n + order[i];
         memcpy(s.P + 3 * (size_t)i, e->P + 3 * (size_t)j, 3 * sizeof(double));
         memcpy(s.off + 3 * (size_t)i, e->off + 3 * (size_t)j, 3);
         s.src[i] = e->src[j];
@@ -253,33 +256,45 @@ static int keyset_add(keyset *s, const key *k)
  * How far beyond the box tet v's circumscribed ball reaches on each
  * periodic axis (need[k], 0 when it stays inside), the ball cut to the
  * points' extent [ylo, yhi] on the axes that are not periodic, with room
- * for the circumcentre's error: fdt_circumcenter's few ulps of the radius,
- * and the images' rounding err moved through the tet's condition (edge^3
- * / |6 volume|). A tet too flat to place reaches the whole period.
+ * for the circumcentre's error and the images' rounding err, both moved
+ * through the tet's condition kappa (edge^3 / |6 volume|). A tet too flat
+ * to place reaches the whole period.
  */
-static void ball_reach(const ext *e, const uint32_t *v, const fdt_periodic_box *b,
-                       const double ylo[3], const double yhi[3], double need[3])
+static void ball_reach(const ext *e, const uint32_t *v, const fdt_sphere_cof *cof,
+                       const fdt_periodic_box *b, const double ylo[3], const double yhi[3],
+                       double need[3])
 {
     const double *a = e->P + 3 * (size_t)v[0];
     const double *p[3] = {e->P + 3 * (size_t)v[1], e->P + 3 * (size_t)v[2],
                           e->P + 3 * (size_t)v[3]};
-    double x[3], u[3][3], h = 0;
-    for (int r = 0; r < 3; r++)
-        for (int k = 0; k < 3; k++) {
-            u[r][k] = p[r][k] - a[k];
-            h = fabs(u[r][k]) > h ? fabs(u[r][k]) : h;
-        }
-    double det = u[0][0] * (u[1][1] * u[2][2] - u[1][2] * u[2][1]) -
-                 u[0][1] * (u[1][0] * u[2][2] - u[1][2] * u[2][0]) +
-                 u[0][2] * (u[1][0] * u[2][1] - u[1][1] * u[2][0]);
     for (int k = 0; k < 3; k++)
         need[k] = b->axes >> k & 1 ? INFINITY : 0;
-    if (fdt_circumcenter(a, p[0], p[1], p[2], x) != 0)
+    /*
+     * The centre a + x, x = N / (2 det) from the lifted cofactors
+     * (predicates.h's fdt_sphere_cof: det = B . (C x D), N = |B|^2 C x D +
+     * ...). Each of N's components is off by at most about 12 eps of its
+     * permanent 6 h^4, det by 8 eps of 6 h^3 (h the largest difference), so
+     * x by about 2^-53 kappa (h + |x|): for kappa up to 2^12 that is within
+     * 2^-40 (h + |x|), which cerr's first term covers with the sums'
+     * roundings. A flatter tet (a wall's, whose section the cut below
+     * needs to a few ulps) takes fdt_circumcenter's double words. (cof:
+     * the certificate's, whose pass this is, src/mesh/certify.h.)
+     */
+    const double det = cof->det, h = cof->m;
+    if (!(fabs(det) > 0) || !(h > 0))
         return;
+    double kappa = 64 * h * h * h / fabs(det), x[3];
+    if (kappa <= 0x1p12) {
+        for (int k = 0; k < 3; k++)
+            x[k] = cof->n[k] / (2 * det);
+    } else if (fdt_circumcenter(a, p[0], p[1], p[2], x) != 0) {
+        return;
+    }
     double R = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
     double c[3] = {a[0] + x[0], a[1] + x[1], a[2] + x[2]};
-    double kappa = 64 * h * h * h / fabs(det);
-    double cerr = 0x1p-40 * (R + fabs(c[0]) + fabs(c[1]) + fabs(c[2])) + kappa * 4 * e->err;
+    double cerr = 0x1p-40 * (R + h + fabs(c[0]) + fabs(c[1]) + fabs(c[2])) + kappa * 4 * e->err;
+    if (!(cerr <= DBL_MAX))
+        return; /* kappa overflowed: too flat to place */
     if (!(cerr < R + h))
         return; /* too flat to place */
     /*
@@ -330,7 +345,7 @@ typedef struct run {
     ext e;
     fdt_images im;
     fdt_ins m;
-    keyset tets[64], hull[64]; /* the kept ones, a set a thread (prove_run) */
+    keyset tets[64], hull[64]; /* the kept ones, a set a job (prove_tet) */
     int nsets;
     double need[3];        /* a failed round: how far the balls reached */
     const int32_t *names;  /* the points' names in messages, or NULL */
@@ -340,22 +355,42 @@ typedef struct run {
 
 enum { ROUND_OK = 0, ROUND_AGAIN = 1 };
 
-/* One thread's share of a round's proofs: the slots [t0, t1). */
+/* One range's share of a round's proofs (a job of the certificate's
+ * pass, src/mesh/certify.h). */
 typedef struct prove_job {
     run *r;
-    const double *m;     /* the margin */
-    uint32_t t0, t1;
+    double mm[3], A[3], B[3]; /* the margin a hair under, the region inside */
     keyset tets, hull;   /* the kept ones */
     double need[3];      /* how far the balls reached, where too far */
     int again, err;
     long repeat_id;      /* a kept tet with two images of this point, or -1 */
 } prove_job;
 
+typedef struct prove_pass {
+    run *r;
+    prove_job job[64];
+} prove_pass;
+
+/* A job's region for the margin m: (lo - m', hi + m') with m' a hair under
+ * the margin (or the period) for the roundings of make_images' tests and
+ * of hi - lo, rounded inwards. */
+static void prove_init(prove_job *j, run *r, const double m[3])
+{
+    memset(j, 0, sizeof *j);
+    j->r = r;
+    j->repeat_id = -1;
+    for (int k = 0; k < 3; k++) {
+        double L = r->b->hi[k] - r->b->lo[k];
+        j->mm[k] = (m[k] < L ? m[k] : L) * (1 - 0x1p-40);
+        j->A[k] = nextafter(r->b->lo[k] - j->mm[k], INFINITY);
+        j->B[k] = nextafter(r->b->hi[k] + j->mm[k], -INFINITY);
+    }
+}
+
 /*
- * The proofs (periodic.h) over a job's slots: every tet with a vertex that
- * is an input point (offset 0) has its ball inside the region where every
- * image is present, (lo - m', hi + m') with m' a hair under the margin (or
- * the period) for the roundings of make_images' tests and of hi - lo, and
+ * The proofs (periodic.h) of one tet, certified, with its cofactors (the
+ * certificate's pass): every tet with a vertex that is an input point has
+ * its ball inside the region where every image is present, (A, B), and
  * every such hull face a normal with no periodic component. Then each
  * input point's star in this mesh is made of tets of the periodic mesh
  * and, a closed neighbourhood of the point, is its whole star there; the
@@ -363,72 +398,59 @@ typedef struct prove_job {
  * of the periodic mesh, once. Once a proof fails the job only gathers how
  * far the balls reach (the next margin).
  */
-static void *prove_run(void *arg)
+static void prove_tet(void *user, int job, uint32_t slot, const uint32_t v[4], int inf,
+                      const fdt_sphere_cof *cof)
 {
-    prove_job *j = arg;
+    (void)slot;
+    prove_job *j = &((prove_pass *)user)->job[job];
     const run *r = j->r;
     const fdt_periodic_box *b = r->b;
-    const fdt_ins *M = &r->m;
-    double mm[3], A[3], B[3];
-    for (int k = 0; k < 3; k++) {
-        double L = b->hi[k] - b->lo[k];
-        mm[k] = (j->m[k] < L ? j->m[k] : L) * (1 - 0x1p-40);
-        A[k] = b->lo[k] - mm[k]; /* the region, rounded inwards */
-        B[k] = b->hi[k] + mm[k];
-        A[k] = nextafter(A[k], INFINITY);
-        B[k] = nextafter(B[k], -INFINITY);
+    if (j->err)
+        return;
+    int nv = inf < 0 ? 4 : 3;
+    uint32_t w[4];
+    if (inf < 0)
+        memcpy(w, v, sizeof w);
+    else
+        fdt_ins_face_inward(v, inf, w);
+    int touches = 0; /* an input point (morton: they come first) */
+    for (int i = 0; i < nv; i++)
+        touches |= w[i] < r->n;
+    if (!touches)
+        return;
+    if (inf < 0) {
+        double need[3];
+        ball_reach(&r->e, w, cof, b, r->ylo, r->yhi, need);
+        /* too far, or too flat to tell from the rounded centre: the
+         * whole ball tested exactly (a fit there is a fit of its cut) */
+        int far = 0;
+        for (int k = 0; k < 3; k++)
+            far |= b->axes >> k & 1 && need[k] >= j->mm[k];
+        if (far && fdt_images_ball_inside(&r->im, w, j->A, j->B, b->axes))
+            need[0] = need[1] = need[2] = 0;
+        for (int k = 0; k < 3; k++)
+            if (b->axes >> k & 1 && need[k] >= j->mm[k]) {
+                j->again = 1;
+                j->need[k] = need[k] > j->need[k] ? need[k] : j->need[k];
+            }
+    } else {
+        /* nothing lies beyond a hull face of the periodic set: its
+         * normal has no component along a periodic axis */
+        for (int a = 0; a < 3; a++)
+            if (b->axes >> a & 1 && fdt_images_normal_sign(&r->im, w, a) != 0) {
+                j->again = 1;
+                j->need[a] = INFINITY;
+            }
     }
-    j->repeat_id = -1;
-    for (uint32_t t = j->t0; t < j->t1 && !j->err; t++) {
-        if (fdt_ins_is_free(M, t))
-            continue;
-        const uint32_t *v = fdt_ins_tet(M, t);
-        int inf = fdt_ins_inf_index(v), nv = inf < 0 ? 4 : 3;
-        uint32_t w[4];
-        if (inf < 0)
-            memcpy(w, v, sizeof w);
-        else
-            fdt_ins_face_inward(v, inf, w);
-        int touches = 0;
-        for (int i = 0; i < nv; i++)
-            touches |= (r->e.vk[w[i]] & VOFF) == VZERO;
-        if (!touches)
-            continue;
-        if (inf < 0) {
-            double need[3];
-            ball_reach(&r->e, w, b, r->ylo, r->yhi, need);
-            /* too far, or too flat to tell from the rounded centre: the
-             * whole ball tested exactly (a fit there is a fit of its cut) */
-            int far = 0;
-            for (int k = 0; k < 3; k++)
-                far |= b->axes >> k & 1 && need[k] >= mm[k];
-            if (far && fdt_images_ball_inside(&r->im, w, A, B, b->axes))
-                need[0] = need[1] = need[2] = 0;
-            for (int k = 0; k < 3; k++)
-                if (b->axes >> k & 1 && need[k] >= mm[k]) {
-                    j->again = 1;
-                    j->need[k] = need[k] > j->need[k] ? need[k] : j->need[k];
-                }
-        } else {
-            /* nothing lies beyond a hull face of the periodic set: its
-             * normal has no component along a periodic axis */
-            for (int a = 0; a < 3; a++)
-                if (b->axes >> a & 1 && fdt_images_normal_sign(&r->im, w, a) != 0) {
-                    j->again = 1;
-                    j->need[a] = INFINITY;
-                }
-        }
-        if (j->again)
-            continue;
-        key k;
-        int rep;
-        if (!make_key(&r->e, w, nv, &k, &rep))
-            continue;
-        if (rep && j->repeat_id < 0)
-            j->repeat_id = (long)(k.v[0] >> 24);
-        j->err = keyset_add(inf < 0 ? &j->tets : &j->hull, &k);
-    }
-    return NULL;
+    if (j->again)
+        return;
+    key k;
+    int rep;
+    if (!make_key(&r->e, w, nv, &k, &rep))
+        return;
+    if (rep && j->repeat_id < 0)
+        j->repeat_id = (long)(k.v[0] >> 24);
+    j->err = keyset_add(inf < 0 ? &j->tets : &j->hull, &k);
 }
 
 /* One round at margin m: ROUND_OK with r->tets and r->hull (a set a
@@ -447,7 +469,7 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
     if ((err = make_images(&r->e, r->X, r->n, b, m)) != FDT_OK)
         return err;
     double blo[3], bhi[3];
-    if ((err = morton(&r->e, blo, bhi)) != FDT_OK)
+    if ((err = morton(&r->e, r->n, blo, bhi)) != FDT_OK)
         return err;
     out->images = r->e.n - r->n;
     fdt_images *im = &r->im;
@@ -478,23 +500,29 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
     }
     if (err)
         return err;
+    /* the certificate, and the proofs and kept tets in its pass (on the
+     * run's threads, prove_tet) */
+    int T = nthreads < 1 ? 1 : nthreads > 64 ? 64 : nthreads;
+    prove_pass *pp = malloc(sizeof *pp);
+    if (!pp)
+        return FDT_ENOMEM;
+    pp->r = r;
+    T = fdt_certify_jobs(&r->m, T);
+    for (int i = 0; i < T; i++)
+        prove_init(&pp->job[i], r, m);
+    prove_job *jobs = pp->job;
+    const fdt_certify_visit vis = {prove_tet, pp};
     fdt_certify_fail why;
-    if ((err = fdt_certify_parallel(&r->m, nthreads, &out->pc, &why)) != FDT_OK) {
+    if ((err = fdt_certify_parallel_visit(&r->m, T, &vis, &out->pc, &why)) != FDT_OK) {
         if (err == FDT_ECHECK)
             fdt_certify_describe(&why, r->diag, r->dsz);
+        for (int i = 0; i < T; i++) {
+            keyset_free(&jobs[i].tets);
+            keyset_free(&jobs[i].hull);
+        }
+        free(pp);
         return err;
     }
-    /* the proofs and the kept tets, on the run's threads (prove_run) */
-    int T = nthreads < 1 ? 1 : nthreads > 64 ? 64 : nthreads;
-    prove_job jobs[64];
-    memset(jobs, 0, sizeof jobs);
-    for (int i = 0; i < T; i++) {
-        jobs[i].r = r;
-        jobs[i].m = m;
-        jobs[i].t0 = (uint32_t)((uint64_t)r->m.nslots * (uint64_t)i / (uint64_t)T);
-        jobs[i].t1 = (uint32_t)((uint64_t)r->m.nslots * (uint64_t)(i + 1) / (uint64_t)T);
-    }
-    fdt_fork_join(jobs, sizeof jobs[0], T, prove_run);
     int again = 0;
     long repeat_id = -1;
     for (int k = 0; k < 3; k++)
@@ -512,6 +540,7 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
         r->hull[i] = jobs[i].hull;
     }
     r->nsets = T;
+    free(pp);
     if (err)
         return err;
     if (again)
