@@ -635,6 +635,13 @@ static void test_periodic_api(void)
     EXPECT(fdt_voronoi_compute(r, xyz, N, NULL, &v, vd, sizeof vd) == FDT_EINVAL &&
            strstr(vd, "point 1 (") != NULL && v == NULL);
     fdt_result_free(&r);
+    fdt_close(&ctx);
+    s.periodic_box[4] = -1; /* empty across y: no walls to cut the cells */
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    CHECK_EQ(fdt_triangulate(ctx, xyz, N, &r), FDT_OK);
+    EXPECT(fdt_voronoi_compute(r, xyz, N, NULL, &v, vd, sizeof vd) == FDT_EINVAL &&
+           strstr(vd, "empty or not finite in y") != NULL && v == NULL);
+    fdt_result_free(&r);
     xyz[3 * 5 + 2] = NAN; /* the merge names it, as in any run */
     EXPECT(fdt_triangulate(ctx, xyz, N, &r) == FDT_ERANGE);
     xyz[3 * 5 + 2] = 1.0;
