@@ -273,6 +273,9 @@ FDT_API const fdt_vid *fdt_result_hull_faces(const fdt_result *r);
  */
 FDT_API const int8_t *fdt_result_tet_offsets(const fdt_result *r);
 FDT_API const int8_t *fdt_result_hull_offsets(const fdt_result *r);
+/* A periodic run's axes (settings.periodic; 0 for any other run) and, when
+ * box is not NULL and the run is periodic, its box (settings.periodic_box). */
+FDT_API unsigned fdt_result_periodic(const fdt_result *r, double box[6]);
 
 /* n entries: the vertex each input point was merged into (itself when it
  * is the first of its coordinates). */
@@ -551,6 +554,23 @@ static inline int fdt_result_thread_stats(const fdt_result *r, int thread,
 FDT_API int fdt_check(const double *xyz, size_t n, const fdt_vid *tets,
                       size_t ntets, const fdt_tid *nbrs, char *msg,
                       size_t len);
+
+/*
+ * The same for a periodic mesh (settings.periodic: fdt_result_tets with
+ * fdt_result_tet_offsets, the hull faces with fdt_result_hull_offsets, in
+ * any vertex order), periodic along the axes of `periodic` (bits 0-2 for x,
+ * y, z) with the box xmin, ymin, zmin, xmax, ymax, zmax: every point a
+ * vertex, no flat tet, every face in two tets on its two sides or on the
+ * hull (normal to no periodic axis, closed, convex), the perturbed
+ * empty-sphere condition across every face on the exact images, and the
+ * tets covering the domain once (their volumes the box's, or what the hull
+ * encloses in one period). 0, FDT_ECHECK with msg, FDT_EINVAL for a bad
+ * axis set or box, FDT_ENOMEM.
+ */
+FDT_API int fdt_check_periodic(const double *xyz, size_t n, const fdt_vid *tets,
+                               const int8_t *offsets, size_t ntets, const fdt_vid *hull,
+                               const int8_t *hull_offsets, size_t nhull, unsigned periodic,
+                               const double box[6], char *msg, size_t len);
 
 /* ------------------------------------------------------------------------ */
 /* File formats: reading point clouds, writing meshes                       */

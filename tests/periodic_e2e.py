@@ -8,7 +8,8 @@
   (every cell's corners cospherical) and clusters; at 1, 2 and 3 threads, in
   both modes, for the same points shuffled (ids mapped back) and with
   duplicates appended (merged: the same file).
-- --hash equals the FNV-1a hash of the .tets bytes.
+- --hash equals the FNV-1a hash of the .tets bytes; --check (the periodic
+  mesh's own exact check) passes on every case and cells' run.
 - Errors, each with its message and exit code and no output: a point
   outside the box (exit 1, the input's line named by index), too few
   points for one copy of the box (exit 2), --periodic without --box, with
@@ -105,8 +106,9 @@ def case(name, pts, lo, length, cgal=True, settings=(["-t", "2"], ["-t", "3"],
     src = os.path.join(SCRATCH, name + ".xyz")
     write_points(src, pts)
     out = os.path.join(SCRATCH, name + ".tets")
-    r = frontdt(src, "--periodic", "xyz", "--box", box, "-o", out, "--hash", "-q", "-t", "1")
-    expect(r.returncode == 0, "%s: frontdt exit %d: %s" % (name, r.returncode, r.stderr))
+    r = frontdt(src, "--periodic", "xyz", "--box", box, "-o", out, "--hash", "--check", "-q",
+                "-t", "1")
+    expect(r.returncode == 0, "%s: frontdt --check exit %d: %s" % (name, r.returncode, r.stderr))
     if r.returncode:
         return
     got = open(out, "rb").read()
@@ -166,7 +168,7 @@ def cells(name, pts, lo, hi, axes="xyz"):
     write_points(src, pts)
     vt = os.path.join(SCRATCH, name + "_c.txt")
     r = frontdt(src, "--periodic", axes, "--box", box, "--voronoi", vt, "--voronoi-format",
-                "%i %v %F %n %f", "-q", "-t", "2")
+                "%i %v %F %n %f", "--check", "-q", "-t", "2")
     expect(r.returncode == 0, "%s cells: exit %d: %s" % (name, r.returncode, r.stderr))
     if r.returncode:
         return

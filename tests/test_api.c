@@ -552,7 +552,8 @@ static void test_periodic_api(void)
     s.struct_size = offsetof(fdt_settings, periodic);
     CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
     CHECK_EQ(fdt_triangulate(ctx, xyz, N, &r), FDT_OK);
-    EXPECT(fdt_result_tet_offsets(r) == NULL && fdt_result_hull_offsets(r) == NULL);
+    EXPECT(fdt_result_tet_offsets(r) == NULL && fdt_result_hull_offsets(r) == NULL &&
+           fdt_result_periodic(r, NULL) == 0);
     fdt_result_free(&r);
     fdt_close(&ctx);
     fdt_default_settings(&s);
@@ -615,6 +616,18 @@ static void test_periodic_api(void)
     EXPECTF(fabs(sum - 1) < 1e-12 && hull_cells == N / 2, "x-z cells: %.17g, %zu hull",
             sum, hull_cells);
     fdt_voronoi_free(&v);
+    /* its own check; a bad axis set or box refused */
+    double pb[6];
+    EXPECT(fdt_result_periodic(r, pb) == 5 && pb[3] == 1);
+    EXPECT(fdt_check_periodic(xyz, N, fdt_result_tets(r), fdt_result_tet_offsets(r),
+                              fdt_result_num_tets(r), fdt_result_hull_faces(r),
+                              fdt_result_hull_offsets(r), fdt_result_num_hull_faces(r), 5, pb,
+                              vd, sizeof vd) == FDT_OK);
+    EXPECT(fdt_check_periodic(xyz, N, fdt_result_tets(r), fdt_result_tet_offsets(r),
+                              fdt_result_num_tets(r), NULL, NULL, 0, 8, pb, vd, sizeof vd) ==
+           FDT_EINVAL);
+    EXPECT(fdt_check_periodic(xyz, N, NULL, NULL, 1, NULL, NULL, 0, 5, pb, vd, sizeof vd) ==
+           FDT_EINVAL);
     /* its own box only */
     fdt_voronoi_options vo;
     fdt_default_voronoi_options(&vo);

@@ -472,6 +472,23 @@ static int sc_pwrite(void *arg, const char **bad)
     return rc;
 }
 
+/* The periodic mesh's check (fdt_check_periodic) under injection: FDT_OK
+ * or FDT_ENOMEM, never a verdict against the mesh. */
+static int sc_pcheck(void *arg, const char **bad)
+{
+    pwrite_arg *a = arg;
+    double box[6];
+    unsigned axes = fdt_result_periodic(a->r, box);
+    char msg[256];
+    int rc = fdt_check_periodic(a->ps->xyz, a->ps->n, fdt_result_tets(a->r),
+                                fdt_result_tet_offsets(a->r), fdt_result_num_tets(a->r),
+                                fdt_result_hull_faces(a->r), fdt_result_hull_offsets(a->r),
+                                fdt_result_num_hull_faces(a->r), axes, box, msg, sizeof msg);
+    if (rc == FDT_ECHECK)
+        *bad = "the check failed a periodic mesh under injection";
+    return rc;
+}
+
 /* A streamed run (fdt_triangulate_stream) under injection: it succeeds
  * with the in-memory run's set hash and tet count, or fails with nothing
  * returned; the sink counts what reached it (less than the mesh on a
@@ -1380,6 +1397,10 @@ int main(int argc, char **argv)
                          ps->name);
                 scenario sv = {pn, FDT_ENOMEM, sc_pcells, &ca};
                 inject_all(&sv);
+                pwrite_arg ka = {pr, &w, outdir, ""};
+                snprintf(pn, sizeof pn, "periodic check %s %s", pa_i ? "x z" : "x y z", ps->name);
+                scenario sk = {pn, FDT_ENOMEM, sc_pcheck, &ka};
+                inject_all(&sk);
                 static const char *const pext[3] = {".fdtb", ".vtu", ".msh"};
                 for (int e = 0; e < 3 && pa_i; e++) {
                     pwrite_arg wa = {pr, &w, outdir, pext[e]};

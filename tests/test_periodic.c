@@ -274,6 +274,11 @@ static void against_reference(const char *name, const double *X, size_t n, unsig
     EXPECTF(same_rows(&got, &want), "%s: %zu tets, the reference %zu", name, got.n, want.n);
     EXPECTF(same_rows(&goth, &wanth), "%s: %zu hull faces, the reference %zu", name, goth.n,
             wanth.n);
+    char msg[256];
+    EXPECTF(fdt_periodic_check_mesh(X, n, (const int32_t *)pm.tets, pm.tet_off, pm.ntets,
+                                    (const int32_t *)pm.hull, pm.hull_off, pm.nhull, &b, msg,
+                                    sizeof msg) == FDT_OK,
+            "%s: the check: %s", name, msg);
     /* the output is sorted and normalised already */
     EXPECT(got.n == pm.ntets);
     fdt_periodic_mesh p3 = build(X, n, &b, 3, name);
@@ -290,6 +295,86 @@ static void against_reference(const char *name, const double *X, size_t n, unsig
     free(got3.r);
     fdt_periodic_free(&pm);
     fdt_periodic_free(&p3);
+}
+
+/* The check of a periodic mesh (fdt_periodic_check_mesh) refuses each
+ * corruption with its reason; a copy of the mesh's arrays a case. */
+static int check_case(const double *X, size_t n, const fdt_periodic_mesh *pm,
+                      const fdt_periodic_box *b, int what, const char *want)
+{
+    size_t nt = pm->ntets, nh = pm->nhull;
+    int32_t *T = malloc((4 * nt + 4) * sizeof *T), *H = malloc((3 * nh + 3) * sizeof *H);
+    int8_t *O = malloc(12 * nt + 12), *HO = malloc(9 * nh + 9);
+    CHECK(T && H && O && HO);
+    memcpy(T, pm->tets, 4 * nt * sizeof *T);
+    memcpy(O, pm->tet_off, 12 * nt);
+    if (nh) {
+        memcpy(H, pm->hull, 3 * nh * sizeof *H);
+        memcpy(HO, pm->hull_off, 9 * nh);
+    }
+    switch (what) {
+    case 1: nt--; break;                                    /* a tet dropped */
+    case 2: memcpy(T, T + 4, 4 * sizeof *T);                /* a tet twice */
+            memcpy(O, O + 12, 12); break;
+    case 3: O[3 * 1] = (int8_t)(O[3 * 1] + 1); break;       /* an offset off */
+    case 4: T[1] = T[0]; break;                             /* two images of a point */
+    case 5: T[2] = (int32_t)n; break;                       /* past the points */
+    case 6: nh--; break;                                    /* a hull face dropped */
+    case 7: memcpy(H + 3 * nh, T, 3 * sizeof *T);           /* an inner face on the hull */
+            memcpy(HO + 9 * nh, O, 9); nh++; break;
+    case 8: n++; break;                                     /* a point in no tet */
+    case 9: memcpy(T + 4 * nt, T, 4 * sizeof *T);           /* a tet listed twice */
+            memcpy(O + 12 * nt, O, 12); nt++; break;
+    case 10: memcpy(H + 3 * nh, H, 3 * sizeof *H);          /* a hull face twice */
+             memcpy(HO + 9 * nh, HO, 9); nh++; break;
+    default: break;
+    }
+    char msg[256] = "";
+    int rc = fdt_periodic_check_mesh(X, n, T, O, nt, H, HO, nh, b, msg, sizeof msg);
+    int ok = want ? rc == FDT_ECHECK && strstr(msg, want) != NULL : rc == FDT_OK;
+    EXPECTF(ok, "check case %d: %d, \"%s\" (want %s)", what, rc, msg, want ? want : "OK");
+    free(T);
+    free(H);
+    free(O);
+    free(HO);
+    return ok;
+}
+
+static void check_corruptions(void)
+{
+    size_t n = 800;
+    double *U = uniform(n + 2, 9);
+    memcpy(U + 3 * n, U, 3 * sizeof *U); /* a duplicate of point 0, then one more point */
+    fdt_periodic_box b = {7, {0, 0, 0}, {1, 1, 1}};
+    fdt_periodic_mesh pm = build(U, n, &b, 1, "check uniform");
+    check_case(U, n + 1, &pm, &b, 0, NULL); /* the duplicate, merged: fine */
+    check_case(U, n, &pm, &b, 1, "no other tet");
+    check_case(U, n, &pm, &b, 2, "same side");
+    check_case(U, n, &pm, &b, 3, "");
+    check_case(U, n, &pm, &b, 4, "two images of point");
+    check_case(U, n, &pm, &b, 9, "in 3 tets");
+    check_case(U, n, &pm, &b, 5, "not one of the");
+    check_case(U, n + 1, &pm, &b, 8, "point 801 is in no tet");
+    /* a point moved by half the spacing: the old tets are no longer its
+     * Delaunay mesh (or fold over) */
+    U[3 * 5] += 0.05;
+    U[3 * 5 + 1] += 0.03;
+    char msg[256];
+    EXPECT(fdt_periodic_check_mesh(U, n, (const int32_t *)pm.tets, pm.tet_off, pm.ntets, NULL,
+                                   NULL, 0, &b, msg, sizeof msg) == FDT_ECHECK);
+    fdt_periodic_free(&pm);
+    free(U);
+    /* x and z periodic: the hull */
+    double *C = channel(n, 7, 0);
+    b.axes = 5;
+    pm = build(C, n, &b, 1, "check channel");
+    check_case(C, n, &pm, &b, 0, NULL);
+    check_case(C, n, &pm, &b, 6, "no other tet");
+    check_case(C, n, &pm, &b, 7, "crosses periodic axis");
+    check_case(C, n, &pm, &b, 10, "listed twice");
+    fdt_periodic_free(&pm);
+    free(C);
+    printf("check: a valid mesh passes, each corruption refused with its reason\n");
 }
 
 /* Random doubles in a box whose images are not doubles: threads and a
@@ -419,6 +504,7 @@ int main(void)
     against_reference("bumpy channel", C, n, 5, lo, hi);
     free(C);
     inexact_box(4000);
+    check_corruptions();
     errors();
     return test_report("periodic");
 }

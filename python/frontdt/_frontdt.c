@@ -439,10 +439,23 @@ static PyObject *run_check(const double *xyz, size_t n, const fdt_vid *tets,
 static PyObject *tri_check(TriObject *self, PyObject *unused)
 {
     (void)unused;
-    if (fdt_result_tet_offsets(self->r)) {
-        PyErr_SetString(PyExc_ValueError, "check() does not take a periodic mesh yet "
-                        "(its tets have image offsets)");
-        return NULL;
+    double box[6];
+    unsigned axes = fdt_result_periodic(self->r, box);
+    if (axes) { /* the periodic mesh's own check */
+        char msg[1024];
+        int err;
+        const fdt_result *r = self->r;
+        size_t n = (size_t)PyArray_DIM(self->points, 0);
+        const double *xyz = PyArray_DATA(self->points);
+        Py_BEGIN_ALLOW_THREADS
+        err = fdt_check_periodic(xyz, n, fdt_result_tets(r), fdt_result_tet_offsets(r),
+                                 fdt_result_num_tets(r), fdt_result_hull_faces(r),
+                                 fdt_result_hull_offsets(r), fdt_result_num_hull_faces(r), axes,
+                                 box, msg, sizeof msg);
+        Py_END_ALLOW_THREADS
+        if (err)
+            return raise_fdt(err, msg);
+        Py_RETURN_NONE;
     }
     return run_check(PyArray_DATA(self->points), (size_t)PyArray_DIM(self->points, 0),
                      fdt_result_tets(self->r), fdt_result_num_tets(self->r),
@@ -694,7 +707,8 @@ static PyObject *tri_interpolate(TriObject *self, PyObject *args, PyObject *kw)
 static PyMethodDef tri_methods[] = {
     {"check", (PyCFunction)tri_check, METH_NOARGS,
      "check()\n--\n\nVerifies exactly that the mesh is the Delaunay "
-     "tetrahedralization of the points (fdt_check); raises CheckError if not."},
+     "tetrahedralization of the points (fdt_check; a periodic one's: fdt_check_periodic); "
+     "raises CheckError if not."},
     {"voronoi", (PyCFunction)(void (*)(void))tri_voronoi, METH_VARARGS | METH_KEYWORDS,
      "voronoi(box=None)\n--\n\nEach point's Voronoi cell clipped by box (xmin, ymin, "
      "zmin, xmax, ymax, zmax; None: the points' bounding box), as a dict of arrays: "

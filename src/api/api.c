@@ -319,6 +319,20 @@ int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const 
     return fdt_voronoi_build(r, xyz, n, o, threads, out, diag, diag_size);
 }
 
+int fdt_check_periodic(const double *xyz, size_t n, const fdt_vid *tets, const int8_t *offsets,
+                       size_t ntets, const fdt_vid *hull, const int8_t *hull_offsets,
+                       size_t nhull, unsigned periodic, const double box[6], char *msg,
+                       size_t len)
+{
+    const fdt_periodic_box b = {periodic, {box ? box[0] : 0, box ? box[1] : 0, box ? box[2] : 0},
+                                {box ? box[3] : 0, box ? box[4] : 0, box ? box[5] : 0}};
+    if (!xyz || !box || (ntets && (!tets || !offsets)) || (nhull && (!hull || !hull_offsets)) ||
+        fdt_periodic_check(NULL, 0, &b, msg, len) != FDT_OK)
+        return FDT_EINVAL;
+    return fdt_periodic_check_mesh(xyz, n, tets, offsets, ntets, hull, hull_offsets, nhull, &b,
+                                   msg, len);
+}
+
 /* Point location and interpolation (src/mesh/locate.c, interpolate.c) on
  * the threads asked for. */
 int fdt_locate(fdt_result *r, const double *xyz, size_t n, const double *q, size_t nq,

@@ -566,10 +566,9 @@ static int check_args(cli *c, int npos, char **pos)
         /* issue 33's first step: the periodic mesh in memory, as .tets */
         if (!c->dual.box_given)
             return usage_error("--periodic needs --box X0,Y0,Z0,X1,Y1,Z1: the periods");
-        if (c->dual.dual || fdt_cli_interp_wanted(&c->dual) || c->stream > 0 || c->check ||
-            c->set_hash)
-            return usage_error("--periodic writes the mesh (.tets), its --hash and the cells; "
-                               "not yet --dual, --interpolate, --stream, --check or --set-hash");
+        if (c->dual.dual || fdt_cli_interp_wanted(&c->dual) || c->stream > 0 || c->set_hash)
+            return usage_error("--periodic writes the mesh, its --hash, --check and the cells; "
+                               "not yet --dual, --interpolate, --stream or --set-hash");
         const char *vd = c->dual.voronoi ? strrchr(c->dual.voronoi, '.') : NULL;
         if (vd && !strcmp(vd, ".vtu"))
             return usage_error("--periodic's cells are a table (not .vtu polyhedra)");
@@ -1545,8 +1544,16 @@ static int check_mesh(const cli *c, run_state *rs)
     char msg[1024];
     double t0 = fdt_now_s();
     progress_phase(&rs->prog, "check");
-    int r = fdt_check(rs->xyz, rs->n, fdt_result_tets(rs->res), rs->nt,
-                      fdt_result_neighbors(rs->res), msg, sizeof msg);
+    double box[6];
+    unsigned axes = fdt_result_periodic(rs->res, box);
+    int r = axes ? fdt_check_periodic(rs->xyz, rs->n, fdt_result_tets(rs->res),
+                                      fdt_result_tet_offsets(rs->res), rs->nt,
+                                      fdt_result_hull_faces(rs->res),
+                                      fdt_result_hull_offsets(rs->res),
+                                      fdt_result_num_hull_faces(rs->res), axes, box, msg,
+                                      sizeof msg)
+                 : fdt_check(rs->xyz, rs->n, fdt_result_tets(rs->res), rs->nt,
+                             fdt_result_neighbors(rs->res), msg, sizeof msg);
     progress_clear(&rs->prog);
     rs->tm.check = fdt_now_s() - t0;
     if (r != FDT_OK) {

@@ -296,6 +296,14 @@ int fdt_images_orient(const fdt_images *im, const double *a, const double *b, co
     return s != FDT_PRED_UNSURE ? s : fdt_images_orient_undecided(im, a, b, c, d, cnt);
 }
 
+int fdt_images_insphere(const fdt_images *im, const double *a, const double *b, const double *c,
+                        const double *d, const double *e, fdt_pred_counts *cnt)
+{
+    const fdt_pred_static sf = fdt_images_static(im);
+    int s = fdt_insphere_filter_sf(a, b, c, d, e, &sf);
+    return s != FDT_PRED_UNSURE ? s : fdt_images_insphere_undecided(im, a, b, c, d, e, cnt);
+}
+
 int fdt_images_ball_inside(const fdt_images *im, const uint32_t i[4], const double A[3],
                            const double B[3], unsigned axes)
 {

@@ -110,4 +110,10 @@ int fdt_images_insphere_undecided(const fdt_images *im, const double *a, const d
 int fdt_images_orient(const fdt_images *im, const double *a, const double *b, const double *c,
                       const double *d, fdt_pred_counts *cnt);
 
+/* The perturbed insphere of the exact images of the points of P at a..e
+ * (fdt_insphere_perturbed's sign and precondition; never 0): the filter,
+ * then the stages above. */
+int fdt_images_insphere(const fdt_images *im, const double *a, const double *b, const double *c,
+                        const double *d, const double *e, fdt_pred_counts *cnt);
+
 #endif

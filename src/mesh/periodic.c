@@ -3,6 +3,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -860,39 +861,56 @@ static long vmap_get(vmap *m, uint32_t id, const int8_t o[3], const double *X,
     return (long)i;
 }
 
+/* Up to five vertices (input id, offsets) as rounded images with their
+ * exact flags, for images.h's exact predicates on them (im points into
+ * the struct: use it in place). */
+typedef struct few {
+    double P[15];
+    uint32_t id[5];
+    int8_t off[15];
+    uint8_t exact[5];
+    fdt_images im;
+} few;
+
+static void few_init(few *f, int k, const uint32_t *id, const int8_t *off, const double *X,
+                     const fdt_periodic_box *b)
+{
+    double err = 0, e, lo[3], hi[3];
+    for (int j = 0; j < k; j++) {
+        f->id[j] = id[j];
+        memcpy(f->off + 3 * j, off + 3 * j, 3);
+        f->exact[j] = (uint8_t)fdt_images_round(X + 3 * (size_t)id[j], off + 3 * j, b->lo, b->hi,
+                                                f->P + 3 * j, &e);
+        err = e > err ? e : err;
+    }
+    for (int c = 0; c < 3; c++) {
+        lo[c] = hi[c] = f->P[c];
+        for (int j = 1; j < k; j++) {
+            lo[c] = f->P[3 * j + c] < lo[c] ? f->P[3 * j + c] : lo[c];
+            hi[c] = f->P[3 * j + c] > hi[c] ? f->P[3 * j + c] : hi[c];
+        }
+    }
+    memset(&f->im, 0, sizeof f->im);
+    f->im.P = f->P;
+    f->im.n = (uint32_t)k;
+    f->im.X = X;
+    f->im.src = f->id;
+    f->im.off = f->off;
+    f->im.exact = f->exact;
+    memcpy(f->im.lo, b->lo, sizeof f->im.lo);
+    memcpy(f->im.hi, b->hi, sizeof f->im.hi);
+    fdt_images_init(&f->im, lo, hi, err);
+}
+
 /* The orientation of periodic tet (id[4], off[12]) for its exact images:
  * the rounded images' determinant where it is clear of their error, else
  * GMP (src/geom/images.h). */
 static int tet_orient(const double *X, const uint32_t id[4], const int8_t off[12],
                       const fdt_periodic_box *b)
 {
-    double P[12], err = 0, e;
-    uint8_t exact[4] = {0, 0, 0, 0};
-    for (int j = 0; j < 4; j++) {
-        exact[j] = (uint8_t)fdt_images_round(X + 3 * (size_t)id[j], off + 3 * j, b->lo, b->hi,
-                                             P + 3 * j, &e);
-        err = e > err ? e : err;
-    }
-    double lo[3], hi[3];
-    for (int k = 0; k < 3; k++) {
-        lo[k] = hi[k] = P[k];
-        for (int j = 1; j < 4; j++) {
-            lo[k] = P[3 * j + k] < lo[k] ? P[3 * j + k] : lo[k];
-            hi[k] = P[3 * j + k] > hi[k] ? P[3 * j + k] : hi[k];
-        }
-    }
-    fdt_images im;
-    memset(&im, 0, sizeof im);
-    im.P = P;
-    im.n = 4;
-    im.X = X;
-    im.src = id;
-    im.off = off;
-    im.exact = exact;
-    memcpy(im.lo, b->lo, sizeof im.lo);
-    memcpy(im.hi, b->hi, sizeof im.hi);
-    fdt_images_init(&im, lo, hi, err);
-    return fdt_images_orient(&im, P, P + 3, P + 6, P + 9, NULL);
+    few f;
+    few_init(&f, 4, id, off, X, b);
+    return fdt_images_orient(&f.im, f.P, f.P + 3, f.P + 6, f.P + 9, NULL);
 }
 
 /* The key of a face (3 vertices, ids ascending with their offsets, as
@@ -1049,6 +1067,504 @@ int fdt_periodic_unfold(const int32_t *tets, const int8_t *off, size_t ntets, co
     free(hslot);
     free(apex);
     free(aoff);
+    return err;
+}
+
+/* ---- the independent check of a periodic mesh --------------------------- */
+
+
+static int chk_fail(char *msg, size_t len, const char *fmt, ...)
+{
+    if (msg && len) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, len, fmt, ap);
+        va_end(ap);
+    }
+    return FDT_ECHECK;
+}
+
+/* A row's k vertices (ids distinct) sorted by id, offsets with them. */
+static void chk_sort(int k, const int32_t *ids, const int8_t *off, uint32_t *id, int8_t *o)
+{
+    for (int j = 0; j < k; j++) {
+        int m = j;
+        uint32_t x = (uint32_t)ids[j];
+        for (; m > 0 && id[m - 1] > x; m--) {
+            id[m] = id[m - 1];
+            memcpy(o + 3 * m, o + 3 * (m - 1), 3);
+        }
+        id[m] = x;
+        memcpy(o + 3 * m, off + 3 * j, 3);
+    }
+}
+
+/* The hull edges of the check: key, then up to two hull faces, each with
+ * its third vertex (id, offsets relative to the key's first). */
+typedef struct cslot {
+    uint64_t k[3];
+    uint32_t who[2], apex[2];
+    int8_t aoff[2][3];
+    uint8_t cnt;
+} cslot;
+
+typedef struct ctab {
+    cslot *s;
+    size_t mask;
+} ctab;
+
+static int ctab_init(ctab *t, size_t n)
+{
+    size_t size = 16;
+    while (size < 2 * n)
+        size *= 2;
+    t->mask = size - 1;
+    t->s = calloc(size, sizeof *t->s);
+    return t->s ? FDT_OK : FDT_ENOMEM;
+}
+
+/* The slot of key k, claimed when new. */
+static cslot *ctab_get(ctab *t, const uint64_t k[3])
+{
+    size_t h = face_hash(k, t->mask);
+    while (t->s[h].cnt && memcmp(t->s[h].k, k, sizeof t->s[h].k))
+        h = (h + 1) & t->mask;
+    if (!t->s[h].cnt)
+        memcpy(t->s[h].k, k, sizeof t->s[h].k);
+    return &t->s[h];
+}
+
+/* A face of a tet or of the hull, filed under its least vertex: the other
+ * two ids ascending, their offsets relative to the least (3 bits a
+ * component, plus 2: a face's vertices are at most two periods apart), and
+ * who holds it (tet << 2 | the vertex it leaves out, or the hull face). */
+typedef struct finc {
+    uint32_t id1, id2, offs, who;
+} finc;
+
+static int finc_cmp(const finc *a, const finc *b)
+{
+    if (a->id1 != b->id1)
+        return a->id1 < b->id1 ? -1 : 1;
+    if (a->id2 != b->id2)
+        return a->id2 < b->id2 ? -1 : 1;
+    return a->offs < b->offs ? -1 : a->offs > b->offs;
+}
+
+/* Row k (nv vertices, ids distinct after the range check) sorted by id;
+ * face j's incidence (the vertex j left out; j = 3 for a hull row) and its
+ * least vertex. 0 when two vertices are more than two periods apart. */
+static int finc_make(const uint32_t *id, const int8_t *o, int nv, int j, uint32_t who,
+                     finc *f, uint32_t *least)
+{
+    uint32_t fid[3];
+    const int8_t *fo[3];
+    for (int i = 0, c = 0; i < nv; i++)
+        if (i != j || nv == 3) {
+            fid[c] = id[i];
+            fo[c++] = o + 3 * i;
+        }
+    *least = fid[0];
+    f->id1 = fid[1];
+    f->id2 = fid[2];
+    f->offs = 0;
+    for (int c = 1; c < 3; c++)
+        for (int a = 0; a < 3; a++) {
+            int r = fo[c][a] - fo[0][a] + 2;
+            if (r < 0 || r > 4)
+                return 0;
+            f->offs |= (uint32_t)r << (3 * (3 * (c - 1) + a));
+        }
+    f->who = who;
+    return 1;
+}
+
+/* The face's vertices (least, then f's two) with their offsets in the
+ * face's frame. */
+static void finc_face(uint32_t least, const finc *f, uint32_t id[3], int8_t o[9])
+{
+    id[0] = least;
+    id[1] = f->id1;
+    id[2] = f->id2;
+    memset(o, 0, 3);
+    for (int c = 1; c < 3; c++)
+        for (int a = 0; a < 3; a++)
+            o[3 * c + a] = (int8_t)((int)(f->offs >> (3 * (3 * (c - 1) + a)) & 7) - 2);
+}
+
+/* The exact orient3d / perturbed insphere of k vertices (id, offsets):
+ * the input points' own predicates when no vertex is an image. */
+static int chk_pred(const double *X, const fdt_periodic_box *b, int k, const uint32_t *id,
+                    const int8_t *o)
+{
+    int moved = 0;
+    for (int j = 0; j < 3 * k; j++)
+        moved |= o[j];
+    if (!moved) {
+        const double *p[5];
+        for (int j = 0; j < k; j++)
+            p[j] = X + 3 * (size_t)id[j];
+        return k == 4 ? fdt_orient3d(p[0], p[1], p[2], p[3], NULL)
+                      : fdt_insphere_perturbed(p[0], p[1], p[2], p[3], p[4], NULL);
+    }
+    few f;
+    few_init(&f, k, id, o, X, b);
+    const double *P = f.P;
+    return k == 4 ? fdt_images_orient(&f.im, P, P + 3, P + 6, P + 9, NULL)
+                  : fdt_images_insphere(&f.im, P, P + 3, P + 6, P + 9, P + 12, NULL);
+}
+
+/* The sorted vertices of tet t (or hull face h, nv 3); nonzero when an id
+ * is out of range or repeated (msg written). */
+static int chk_row(const int32_t *rows, const int8_t *offs, size_t r, int nv, size_t n,
+                   uint32_t *id, int8_t *o, char *msg, size_t len)
+{
+    const char *what = nv == 4 ? "tet" : "hull face";
+    for (int j = 0; j < nv; j++)
+        if (rows[(size_t)nv * r + (size_t)j] < 0 || (size_t)rows[(size_t)nv * r + (size_t)j] >= n)
+            return chk_fail(msg, len, "%s %zu names point %ld, not one of the %zu", what, r,
+                            (long)rows[(size_t)nv * r + (size_t)j], n);
+    chk_sort(nv, rows + (size_t)nv * r, offs + 3 * (size_t)nv * r, id, o);
+    for (int j = 1; j < nv; j++)
+        if (id[j] == id[j - 1])
+            return chk_fail(msg, len, "%s %zu joins two images of point %u", what, r, id[j]);
+    return FDT_OK;
+}
+
+int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, const int8_t *off,
+                            size_t ntets, const int32_t *hull, const int8_t *hoff, size_t nhull,
+                            const fdt_periodic_box *b, char *msg, size_t len)
+{
+    if (msg && len)
+        msg[0] = 0;
+    if (ntets > (SIZE_MAX >> 3) / sizeof(finc) || n > UINT32_MAX || ntets > UINT32_MAX / 4)
+        return FDT_ENOMEM;
+    ctab et = {0};
+    uint8_t *used = calloc(n ? n : 1, 1);
+    size_t *start = calloc(n + 2, sizeof *start), *hstart = calloc(n + 2, sizeof *hstart);
+    finc *inc = malloc((4 * ntets + 1) * sizeof *inc), *hinc = malloc((nhull + 1) * sizeof *hinc);
+    uint32_t *hapex = malloc((nhull + 1) * sizeof *hapex); /* a hull face's tet's other vertex */
+    int8_t *haoff = malloc(3 * nhull + 3);                   /* its offsets in the face's frame */
+    int err = !used || !start || !hstart || !inc || !hinc || !hapex || !haoff ||
+                      ctab_init(&et, 3 * nhull)
+                  ? FDT_ENOMEM : FDT_OK;
+    double vol = 0;
+    /* every tet: ids in range and distinct, not flat, its volume; its
+     * faces counted under their least vertices (then filed, below) */
+    for (int pass = 0; pass < 2 && !err; pass++) {
+        for (size_t t = 0; t < ntets && !err; t++) {
+            uint32_t id[4];
+            int8_t o[12];
+            if ((err = chk_row(tets, off, t, 4, n, id, o, msg, len)) != FDT_OK)
+                break;
+            if (pass == 0) {
+                if (chk_pred(X, b, 4, id, o) == 0) {
+                    err = chk_fail(msg, len, "tet %zu is flat", t);
+                    break;
+                }
+                double P[12];
+                for (int j = 0; j < 4; j++)
+                    (void)fdt_images_round(X + 3 * (size_t)id[j], o + 3 * j, b->lo, b->hi,
+                                           P + 3 * j, NULL);
+                double u[3][3];
+                for (int r = 0; r < 3; r++)
+                    for (int a = 0; a < 3; a++)
+                        u[r][a] = P[3 * (r + 1) + a] - P[a];
+                vol += fabs(u[0][0] * (u[1][1] * u[2][2] - u[1][2] * u[2][1]) -
+                            u[0][1] * (u[1][0] * u[2][2] - u[1][2] * u[2][0]) +
+                            u[0][2] * (u[1][0] * u[2][1] - u[1][1] * u[2][0])) / 6;
+            }
+            for (int j = 0; j < 4 && !err; j++) {
+                finc f;
+                uint32_t least;
+                used[id[j]] = 1;
+                if (!finc_make(id, o, 4, j, (uint32_t)(t << 2 | (size_t)j), &f, &least))
+                    err = chk_fail(msg, len, "tet %zu spans more than two periods", t);
+                else if (pass == 0)
+                    start[least + 1]++;
+                else
+                    inc[start[least]++] = f;
+            }
+        }
+        if (pass == 0) /* start[v]: where bucket v begins */
+            for (size_t v = 0; v < n; v++)
+                start[v + 1] += start[v];
+        else /* start[v] moved to the end of bucket v: back by one */
+            for (size_t v = n; v > 0; v--)
+                start[v] = start[v - 1];
+        start[0] = 0;
+    }
+    /* the hull faces likewise, each normal to no periodic axis */
+    for (int pass = 0; pass < 2 && !err; pass++) {
+        for (size_t h = 0; h < nhull && !err; h++) {
+            uint32_t id[3];
+            int8_t o[9];
+            finc f;
+            uint32_t least;
+            if ((err = chk_row(hull, hoff, h, 3, n, id, o, msg, len)) != FDT_OK)
+                break;
+            if (!finc_make(id, o, 3, 3, (uint32_t)h, &f, &least))
+                err = chk_fail(msg, len, "hull face %zu spans more than two periods", h);
+            else if (pass == 0)
+                hstart[least + 1]++;
+            else
+                hinc[hstart[least]++] = f;
+            if (pass || err)
+                continue;
+            few q;
+            int8_t ro[9];
+            for (int j = 0; j < 9; j++)
+                ro[j] = (int8_t)(o[j] - o[j % 3]);
+            few_init(&q, 3, id, ro, X, b);
+            const uint32_t i3[3] = {0, 1, 2};
+            for (int a = 0; a < 3 && !err; a++)
+                if (b->axes >> a & 1 && fdt_images_normal_sign(&q.im, i3, a) != 0)
+                    err = chk_fail(msg, len, "hull face %zu crosses periodic axis %c", h,
+                                   "xyz"[a]);
+        }
+        if (pass == 0)
+            for (size_t v = 0; v < n; v++)
+                hstart[v + 1] += hstart[v];
+        else
+            for (size_t v = n; v > 0; v--)
+                hstart[v] = hstart[v - 1];
+        hstart[0] = 0;
+    }
+    /* every point a vertex, but a duplicate of an earlier one (which the
+     * tets must name instead): each point's first occurrence by a hash of
+     * its coordinates' bits */
+    size_t pmask = 15;
+    while (pmask + 1 < 2 * n)
+        pmask = 2 * pmask + 1;
+    uint32_t *first = err ? NULL : malloc((pmask + 1) * sizeof *first);
+    if (!err && !first)
+        err = FDT_ENOMEM;
+    for (size_t h = 0; first && h <= pmask; h++)
+        first[h] = UINT32_MAX;
+    for (size_t i = 0; i < n && !err; i++) {
+        uint64_t w[3];
+        memcpy(w, X + 3 * i, sizeof w);
+        size_t h = (size_t)fdt_mix64(w[0] ^ fdt_mix64(w[1] ^ fdt_mix64(w[2]))) & pmask;
+        while (first[h] != UINT32_MAX && memcmp(X + 3 * (size_t)first[h], X + 3 * i, sizeof w))
+            h = (h + 1) & pmask;
+        if (first[h] == UINT32_MAX) {
+            first[h] = (uint32_t)i;
+            if (!used[i])
+                err = chk_fail(msg, len, "point %zu is in no tet", i);
+        } else if (used[i]) {
+            err = chk_fail(msg, len, "point %zu is a duplicate of point %u, which the tets "
+                           "must name instead", i, first[h]);
+        }
+    }
+    free(first);
+    /* each least vertex's faces: two tets on the two sides of each, the
+     * one's apex outside the other's sphere, or one tet and a hull face */
+    for (size_t v = 0; v < n && !err; v++) {
+        finc *a = inc + start[v], *ha = hinc + hstart[v];
+        size_t m = start[v + 1] - start[v], hm = hstart[v + 1] - hstart[v], hk = 0;
+        for (size_t i = 1; i < m; i++) /* a few dozen: insertion */
+            for (size_t k = i; k > 0 && finc_cmp(&a[k], &a[k - 1]) < 0; k--) {
+                finc x = a[k];
+                a[k] = a[k - 1];
+                a[k - 1] = x;
+            }
+        for (size_t i = 1; i < hm; i++)
+            for (size_t k = i; k > 0 && finc_cmp(&ha[k], &ha[k - 1]) < 0; k--) {
+                finc x = ha[k];
+                ha[k] = ha[k - 1];
+                ha[k - 1] = x;
+            }
+        for (size_t i = 0; i < m && !err;) {
+            size_t r = 1;
+            while (i + r < m && !finc_cmp(&a[i + r], &a[i]))
+                r++;
+            /* the face, and each holder's other vertex in its frame */
+            uint32_t id[5];
+            int8_t o[15];
+            finc_face((uint32_t)v, &a[i], id, o);
+            for (size_t q = 0; q < r && q < 2; q++) {
+                uint32_t t = a[i + q].who >> 2, tid[4];
+                int j = (int)(a[i + q].who & 3), l = 0;
+                int8_t to[12];
+                (void)chk_row(tets, off, t, 4, n, tid, to, NULL, 0);
+                while (tid[l] != (uint32_t)v)
+                    l++;
+                id[3 + q] = tid[j];
+                for (int c = 0; c < 3; c++)
+                    o[3 * (3 + q) + c] = (int8_t)(to[3 * j + c] - to[3 * l + c]);
+            }
+            while (hk < hm && finc_cmp(&ha[hk], &a[i]) < 0)
+                hk++;
+            int on_hull = hk < hm && !finc_cmp(&ha[hk], &a[i]);
+            if (r > 2) {
+                err = chk_fail(msg, len, "a face (points %u %u %u) is in %zu tets", id[0], id[1],
+                               id[2], r);
+            } else if (r == 1 && !on_hull) {
+                err = chk_fail(msg, len, "a face of tet %u (points %u %u %u) is in no other tet "
+                               "and no hull face", a[i].who >> 2, id[0], id[1], id[2]);
+            } else if (r == 2 && on_hull) {
+                err = chk_fail(msg, len, "hull face %u (points %u %u %u) is not the face of one "
+                               "tet alone", ha[hk].who, id[0], id[1], id[2]);
+            } else if (r == 1) { /* a hull face: its tet's other vertex, for the checks below */
+                hapex[ha[hk].who] = id[3];
+                memcpy(haoff + 3 * (size_t)ha[hk].who, o + 9, 3);
+                ha[hk].who |= 0x80000000u; /* matched */
+            } else {
+                int s0 = chk_pred(X, b, 4, id, o);
+                uint32_t id1[4] = {id[0], id[1], id[2], id[4]};
+                int8_t o1[12];
+                memcpy(o1, o, 9);
+                memcpy(o1 + 9, o + 12, 3);
+                int s1 = chk_pred(X, b, 4, id1, o1);
+                if (s0 == s1) {
+                    err = chk_fail(msg, len, "tets %u and %u lie on the same side of their face "
+                                   "(points %u %u %u)", a[i].who >> 2, a[i + 1].who >> 2, id[0],
+                                   id[1], id[2]);
+                } else {
+                    if (s0 < 0) { /* the first tet positive: swap its face's first two */
+                        uint32_t x = id[0];
+                        id[0] = id[1];
+                        id[1] = x;
+                        int8_t y[3];
+                        memcpy(y, o, 3);
+                        memcpy(o, o + 3, 3);
+                        memcpy(o + 3, y, 3);
+                    }
+                    if (chk_pred(X, b, 5, id, o) > 0)
+                        err = chk_fail(msg, len, "tets %u and %u are not locally Delaunay: "
+                                       "point %u's image is in the other's sphere",
+                                       a[i].who >> 2, a[i + 1].who >> 2, id[4]);
+                }
+            }
+            i += r;
+        }
+        for (size_t k = 0; k < hm && !err; k++)
+            if (!(ha[k].who & 0x80000000u))
+                err = chk_fail(msg, len, "hull face %u is the face of no tet, or listed twice",
+                               ha[k].who);
+    }
+    /* the hull closed and convex: each edge in two hull faces, the one's
+     * third vertex not outside the other; and what it encloses */
+    double flux = 0;
+    for (size_t h = 0; h < nhull && !err; h++) {
+        uint32_t id[3];
+        int8_t o[9];
+        (void)chk_row(hull, hoff, h, 3, n, id, o, NULL, 0);
+        for (int j = 0; j < 9; j++)
+            o[j] = (int8_t)(o[j] - o[j % 3]);
+        for (int j = 0; j < 3 && !err; j++) {
+            uint64_t ek[3];
+            int e0 = j == 0 ? 1 : 0, e1 = j == 2 ? 1 : 2;
+            ek[0] = vpack(id[e0], (const int8_t[3]){0, 0, 0});
+            const int8_t r1[3] = {(int8_t)(o[3 * e1] - o[3 * e0]),
+                                  (int8_t)(o[3 * e1 + 1] - o[3 * e0 + 1]),
+                                  (int8_t)(o[3 * e1 + 2] - o[3 * e0 + 2])};
+            ek[1] = vpack(id[e1], r1);
+            const int8_t ao[3] = {(int8_t)(o[3 * j] - o[3 * e0]), (int8_t)(o[3 * j + 1] - o[3 * e0 + 1]),
+                                  (int8_t)(o[3 * j + 2] - o[3 * e0 + 2])};
+            ek[2] = UINT64_MAX;
+            cslot *c = ctab_get(&et, ek);
+            if (c->cnt >= 2) {
+                err = chk_fail(msg, len, "a hull edge (points %u %u) is in three hull faces",
+                               id[e0], id[e1]);
+                break;
+            }
+            c->who[c->cnt] = (uint32_t)h;
+            c->apex[c->cnt] = id[j];
+            memcpy(c->aoff[c->cnt], ao, 3);
+            c->cnt++;
+        }
+        if (err)
+            break;
+        /* the flux of (x_a - lo_a) over the axes a that are not periodic:
+         * the outward area vector is -+N / 2, N = (p1 - p0) x (p2 - p0),
+         * outward away from the tet's other vertex */
+        uint32_t q[4] = {id[0], id[1], id[2], hapex[h]};
+        int8_t qo[12];
+        memcpy(qo, o, 9);
+        memcpy(qo + 9, haoff + 3 * h, 3);
+        int s = chk_pred(X, b, 4, q, qo);
+        double P[9], u[3], w[3];
+        for (int k = 0; k < 3; k++)
+            (void)fdt_images_round(X + 3 * (size_t)id[k], o + 3 * k, b->lo, b->hi, P + 3 * k,
+                                   NULL);
+        for (int a = 0; a < 3; a++) {
+            u[a] = P[3 + a] - P[a];
+            w[a] = P[6 + a] - P[a];
+        }
+        const double nrm[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                               u[0] * w[1] - u[1] * w[0]};
+        for (int a = 0; a < 3; a++)
+            if (!(b->axes >> a & 1))
+                flux += (s > 0 ? -1 : 1) * ((P[a] + P[3 + a] + P[6 + a]) / 3 - b->lo[a]) *
+                        nrm[a] / 2;
+    }
+    for (size_t h = 0; h <= et.mask && !err; h++) {
+        cslot *c = &et.s[h];
+        if (!c->cnt)
+            continue;
+        uint32_t e0 = (uint32_t)(c->k[0] >> 24), e1 = (uint32_t)(c->k[1] >> 24);
+        if (c->cnt != 2) {
+            err = chk_fail(msg, len, "the hull is not closed at the edge of points %u %u", e0,
+                           e1);
+            break;
+        }
+        /* in the edge's frame: the edge, face who[0]'s third vertex, its
+         * tet's other vertex (the inside), face who[1]'s third vertex */
+        uint32_t f = c->who[0], fid[3];
+        int8_t fo[9];
+        (void)chk_row(hull, hoff, f, 3, n, fid, fo, NULL, 0);
+        int l = 0;
+        while (fid[l] != e0)
+            l++;
+        uint32_t id[5] = {e0, e1, c->apex[0], hapex[f], c->apex[1]};
+        int8_t o[15] = {0};
+        for (int a = 0; a < 3; a++) {
+            o[3 + a] = (int8_t)((int)(c->k[1] >> (16 - 8 * a) & 255) - 128);
+            o[6 + a] = c->aoff[0][a];
+            /* haoff is relative to face f's least vertex, fid[0] */
+            o[9 + a] = (int8_t)(haoff[3 * (size_t)f + (size_t)a] - (fo[3 * l + a] - fo[a]));
+            o[12 + a] = c->aoff[1][a];
+        }
+        int si = chk_pred(X, b, 4, id, o);
+        uint32_t id2[4] = {e0, e1, c->apex[0], c->apex[1]};
+        int8_t o2[12];
+        memcpy(o2, o, 9);
+        memcpy(o2 + 9, o + 12, 3);
+        int sv = chk_pred(X, b, 4, id2, o2);
+        if (sv != 0 && sv != si)
+            err = chk_fail(msg, len, "the hull is not convex at the edge of points %u %u", e0,
+                           e1);
+    }
+    /* the tets cover the domain once: their volumes sum to the box's (x,
+     * y and z periodic), or to what the hull encloses in one period: by
+     * the divergence theorem, the flux of the field (x_a - lo_a) over the
+     * d axes a that are not periodic, through the hull faces (none
+     * crosses the periods' cuts), over d */
+    if (!err && ntets) {
+        double want = 1;
+        int d = 0;
+        for (int a = 0; a < 3; a++)
+            if (b->axes >> a & 1)
+                want *= b->hi[a] - b->lo[a];
+            else
+                d++;
+        if (d)
+            want = flux / d;
+        if (!(fabs(vol - want) <= 1e-9 * fabs(want)))
+            err = chk_fail(msg, len, "the tets' volumes sum to %.17g, the domain's is %.17g: "
+                           "they do not cover it once", vol, want);
+    }
+    if (!err && !ntets)
+        err = chk_fail(msg, len, "no tets");
+    free(used);
+    free(start);
+    free(hstart);
+    free(inc);
+    free(hinc);
+    free(hapex);
+    free(haoff);
+    free(et.s);
     return err;
 }
 

@@ -128,6 +128,22 @@ int fdt_periodic_unfold(const int32_t *tets, const int8_t *off, size_t ntets, co
                         const fdt_periodic_box *b, fdt_periodic_unfolded *u);
 void fdt_periodic_unfolded_free(fdt_periodic_unfolded *u);
 
+/*
+ * An independent exact check that tets (4 ids and 12 offsets each, in any
+ * vertex order) and hull faces (3 and 9) are the periodic Delaunay mesh of
+ * the n points X in box b: ids in range and distinct in a row, every point
+ * a vertex (a duplicate's first occurrence named instead), no flat tet,
+ * every face in two tets on its two sides, the one's apex outside the
+ * other's sphere (the perturbed test, on the exact images), or in one tet
+ * and the hull; the hull faces normal to no periodic axis, closed and
+ * convex; and the tets' volumes the domain's (the box's, or the hull's
+ * flux over one period), so that they cover it once. FDT_OK, FDT_ECHECK
+ * with msg saying what and where, FDT_ENOMEM.
+ */
+int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, const int8_t *off,
+                            size_t ntets, const int32_t *hull, const int8_t *hoff, size_t nhull,
+                            const fdt_periodic_box *b, char *msg, size_t len);
+
 /* fdt_periodic_build's checks of the box and of the points in it, alone
  * (a caller checks its input before it scales or merges it, so that the
  * message names the input's index and value). FDT_OK or FDT_EINVAL. */

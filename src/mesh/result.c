@@ -39,6 +39,15 @@ const fdt_vid *fdt_result_hull_faces(const fdt_result *r) { return r ? r->hull :
 const fdt_vid *fdt_result_duplicate_map(const fdt_result *r) { return r ? r->dupmap : NULL; }
 const int8_t *fdt_result_tet_offsets(const fdt_result *r) { return r ? r->tet_off : NULL; }
 const int8_t *fdt_result_hull_offsets(const fdt_result *r) { return r ? r->hull_off : NULL; }
+
+unsigned fdt_result_periodic(const fdt_result *r, double box[6])
+{
+    if (!r || !r->periodic)
+        return 0;
+    if (box)
+        memcpy(box, r->pbox, sizeof r->pbox);
+    return r->periodic;
+}
 size_t fdt_result_num_duplicates(const fdt_result *r) { return r ? r->ndup : 0; }
 
 /* The sizes of fdt_stats and fdt_thread_stats this library fills
