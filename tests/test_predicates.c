@@ -352,6 +352,20 @@ static void gen_near_cospherical(tctx *T, double (*p)[3], double offset)
         p[4][k] = nudge(p[4][k], (int)irand(T, -3, 3));
 }
 
+/* Five points: uniform in the cube (kind 0), nearly coplanar (1) or
+ * nearly cospherical (2). */
+static void gen_kind(tctx *T, double (*p)[3], int kind)
+{
+    if (kind == 0)
+        for (int i = 0; i < 5; i++)
+            for (int k = 0; k < 3; k++)
+                p[i][k] = sunif(T);
+    else if (kind == 1)
+        gen_near_coplanar(T, p);
+    else
+        gen_near_cospherical(T, p, 0.0);
+}
+
 static void gen_lattice(tctx *T, double (*p)[3], long n)
 {
     for (int i = 0; i < 5; i++)
@@ -1159,14 +1173,7 @@ static void test_static_filter(tctx *T, double scale)
     for (long it = 0; it < n; it++) {
         double p[5][3];
         int kind = (int)(it % 3);
-        if (kind == 0)
-            for (int i = 0; i < 5; i++)
-                for (int k = 0; k < 3; k++)
-                    p[i][k] = sunif(T);
-        else if (kind == 1)
-            gen_near_coplanar(T, p);
-        else
-            gen_near_cospherical(T, p, 0.0);
+        gen_kind(T, p, kind);
         int e = (int)irand(T, -130, 130);
         for (int i = 0; i < 5; i++)
             for (int k = 0; k < 3; k++)
@@ -1299,14 +1306,7 @@ static void test_sphere_cof(tctx *T, double scale)
     for (long it = 0; it < n / 2; it++) {
         double p[5][3], q[5][3];
         int kind = (int)(it % 3);
-        if (kind == 0)
-            for (int i = 0; i < 5; i++)
-                for (int k = 0; k < 3; k++)
-                    p[i][k] = sunif(T);
-        else if (kind == 1)
-            gen_near_coplanar(T, p);
-        else
-            gen_near_cospherical(T, p, 0.0);
+        gen_kind(T, p, kind);
         int e = (int)irand(T, -60, 60);
         double big = 0;
         for (int i = 0; i < 5; i++)
