@@ -510,6 +510,8 @@ static inline void fdt_sphere_cof_init(fdt_sphere_cof *s, const double *a, const
  * roundings. 0 when dev is. */
 static inline double fdt_sphere_cof_moved(double dev, double m, double ck, int k)
 {
+    if (dev == 0) /* the plain engines' points: a predictable branch */
+        return 0;
     const double d = 2 * dev, M = m * (1 + 0x1p-50) + d;
     double p = 1;
     for (int i = 1; i < k; i++)
