@@ -902,15 +902,28 @@ static void few_init(few *f, int k, const uint32_t *id, const int8_t *off, const
     fdt_images_init(&f->im, lo, hi, err);
 }
 
-/* The orientation of periodic tet (id[4], off[12]) for its exact images:
- * the rounded images' determinant where it is clear of their error, else
- * GMP (src/geom/images.h). */
-static int tet_orient(const double *X, const uint32_t id[4], const int8_t off[12],
-                      const fdt_periodic_box *b)
+/* The exact orient3d (k 4: CGAL's sign, as fdt_orient3d) or perturbed
+ * insphere (k 5) of k vertices (id, offsets) for their exact images: the
+ * input points' own predicates when no vertex is an image, else the
+ * rounded images' filters and images.h's exact stages. */
+static int exact_sign(const double *X, const fdt_periodic_box *b, int k, const uint32_t *id,
+                    const int8_t *o)
 {
+    int moved = 0;
+    for (int j = 0; j < 3 * k; j++)
+        moved |= o[j];
+    if (!moved) {
+        const double *p[5];
+        for (int j = 0; j < k; j++)
+            p[j] = X + 3 * (size_t)id[j];
+        return k == 4 ? fdt_orient3d(p[0], p[1], p[2], p[3], NULL)
+                      : fdt_insphere_perturbed(p[0], p[1], p[2], p[3], p[4], NULL);
+    }
     few f;
-    few_init(&f, 4, id, off, X, b);
-    return fdt_images_orient(&f.im, f.P, f.P + 3, f.P + 6, f.P + 9, NULL);
+    few_init(&f, k, id, o, X, b);
+    const double *P = f.P;
+    return k == 4 ? fdt_images_orient(&f.im, P, P + 3, P + 6, P + 9, NULL)
+                  : fdt_images_insphere(&f.im, P, P + 3, P + 6, P + 9, P + 12, NULL);
 }
 
 /* The key of a face (3 vertices, ids ascending with their offsets, as
@@ -968,7 +981,7 @@ int fdt_periodic_unfold(const int32_t *tets, const int8_t *off, size_t ntets, co
                 err = FDT_ENOMEM;
             u->tets[4 * t + (size_t)k] = (fdt_vid)x;
         }
-        if (tet_orient(X, id, o, b) < 0) {
+        if (exact_sign(X, b, 4, id, o) < 0) {
             fdt_vid tmp = u->tets[4 * t];
             u->tets[4 * t] = u->tets[4 * t + 1];
             u->tets[4 * t + 1] = tmp;
@@ -1041,7 +1054,7 @@ int fdt_periodic_unfold(const int32_t *tets, const int8_t *off, size_t ntets, co
         int8_t qo[12];
         memcpy(qo, o, 9);
         memcpy(qo + 9, aoff + 3 * f, 3);
-        if (tet_orient(X, q, qo, b) > 0) {
+        if (exact_sign(X, b, 4, q, qo) > 0) {
             fdt_vid tmp = u->hull[3 * f];
             u->hull[3 * f] = u->hull[3 * f + 1];
             u->hull[3 * f + 1] = tmp;
@@ -1192,28 +1205,6 @@ static void finc_face(uint32_t least, const finc *f, uint32_t id[3], int8_t o[9]
             o[3 * c + a] = (int8_t)((int)(f->offs >> (3 * (3 * (c - 1) + a)) & 7) - 2);
 }
 
-/* The exact orient3d / perturbed insphere of k vertices (id, offsets):
- * the input points' own predicates when no vertex is an image. */
-static int chk_pred(const double *X, const fdt_periodic_box *b, int k, const uint32_t *id,
-                    const int8_t *o)
-{
-    int moved = 0;
-    for (int j = 0; j < 3 * k; j++)
-        moved |= o[j];
-    if (!moved) {
-        const double *p[5];
-        for (int j = 0; j < k; j++)
-            p[j] = X + 3 * (size_t)id[j];
-        return k == 4 ? fdt_orient3d(p[0], p[1], p[2], p[3], NULL)
-                      : fdt_insphere_perturbed(p[0], p[1], p[2], p[3], p[4], NULL);
-    }
-    few f;
-    few_init(&f, k, id, o, X, b);
-    const double *P = f.P;
-    return k == 4 ? fdt_images_orient(&f.im, P, P + 3, P + 6, P + 9, NULL)
-                  : fdt_images_insphere(&f.im, P, P + 3, P + 6, P + 9, P + 12, NULL);
-}
-
 /* The sorted vertices of tet t (or hull face h, nv 3); nonzero when an id
  * is out of range or repeated (msg written). */
 static int chk_row(const int32_t *rows, const int8_t *offs, size_t r, int nv, size_t n,
@@ -1258,7 +1249,7 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
             if ((err = chk_row(tets, off, t, 4, n, id, o, msg, len)) != FDT_OK)
                 break;
             if (pass == 0) {
-                if (chk_pred(X, b, 4, id, o) == 0) {
+                if (exact_sign(X, b, 4, id, o) == 0) {
                     err = chk_fail(msg, len, "tet %zu is flat", t);
                     break;
                 }
@@ -1410,12 +1401,12 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
                 memcpy(haoff + 3 * (size_t)ha[hk].who, o + 9, 3);
                 ha[hk].who |= 0x80000000u; /* matched */
             } else {
-                int s0 = chk_pred(X, b, 4, id, o);
+                int s0 = exact_sign(X, b, 4, id, o);
                 uint32_t id1[4] = {id[0], id[1], id[2], id[4]};
                 int8_t o1[12];
                 memcpy(o1, o, 9);
                 memcpy(o1 + 9, o + 12, 3);
-                int s1 = chk_pred(X, b, 4, id1, o1);
+                int s1 = exact_sign(X, b, 4, id1, o1);
                 if (s0 == s1) {
                     err = chk_fail(msg, len, "tets %u and %u lie on the same side of their face "
                                    "(points %u %u %u)", a[i].who >> 2, a[i + 1].who >> 2, id[0],
@@ -1430,7 +1421,7 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
                         memcpy(o, o + 3, 3);
                         memcpy(o + 3, y, 3);
                     }
-                    if (chk_pred(X, b, 5, id, o) > 0)
+                    if (exact_sign(X, b, 5, id, o) > 0)
                         err = chk_fail(msg, len, "tets %u and %u are not locally Delaunay: "
                                        "point %u's image is in the other's sphere",
                                        a[i].who >> 2, a[i + 1].who >> 2, id[4]);
@@ -1483,7 +1474,7 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
         int8_t qo[12];
         memcpy(qo, o, 9);
         memcpy(qo + 9, haoff + 3 * h, 3);
-        int s = chk_pred(X, b, 4, q, qo);
+        int s = exact_sign(X, b, 4, q, qo);
         double P[9], u[3], w[3];
         for (int k = 0; k < 3; k++)
             (void)fdt_images_round(X + 3 * (size_t)id[k], o + 3 * k, b->lo, b->hi, P + 3 * k,
@@ -1526,12 +1517,12 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
             o[9 + a] = (int8_t)(haoff[3 * (size_t)f + (size_t)a] - (fo[3 * l + a] - fo[a]));
             o[12 + a] = c->aoff[1][a];
         }
-        int si = chk_pred(X, b, 4, id, o);
+        int si = exact_sign(X, b, 4, id, o);
         uint32_t id2[4] = {e0, e1, c->apex[0], c->apex[1]};
         int8_t o2[12];
         memcpy(o2, o, 9);
         memcpy(o2 + 9, o + 12, 3);
-        int sv = chk_pred(X, b, 4, id2, o2);
+        int sv = exact_sign(X, b, 4, id2, o2);
         if (sv != 0 && sv != si)
             err = chk_fail(msg, len, "the hull is not convex at the edge of points %u %u", e0,
                            e1);
@@ -1608,7 +1599,7 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
     for (size_t t = 0; t < ntets && !err; t++) {
         const uint32_t *id = (const uint32_t *)tets + 4 * t;
         const int8_t *o = off + 12 * t;
-        int pos = tet_orient(X, id, o, b) > 0;
+        int pos = exact_sign(X, b, 4, id, o) > 0;
         for (int j = 0; j < 4 && !err; j++) {
             int seen = 0;
             for (int i = 0; i < j; i++)
