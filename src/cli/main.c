@@ -1429,8 +1429,10 @@ static int open_engine(const cli *c, run_state *rs)
         rs->estimate = dual;
     /* a periodic run: the mesh of the points and their images, then the
      * kept tets' keys and their sort, 605-622 MiB at the peak for 1M
-     * uniform points (bench/NOTES.md entry 108) */
-    unsigned long long periodic = c->periodic ? 700ull * rs->n + (16ull << 20) : 0;
+     * uniform points (bench/NOTES.md entry 108); --check's faces after it,
+     * 790 MiB (entry 109) */
+    unsigned long long periodic =
+        c->periodic ? (c->check ? 850ull : 700ull) * rs->n + (16ull << 20) : 0;
     if (periodic > rs->estimate)
         rs->estimate = periodic;
     if (c->memory_limit && rs->estimate > c->memory_limit) {

@@ -1149,11 +1149,14 @@ static cslot *ctab_get(ctab *t, const uint64_t k[3])
 
 /* A face of a tet or of the hull, filed under its least vertex: the other
  * two ids ascending, their offsets relative to the least (3 bits a
- * component, plus 2: a face's vertices are at most two periods apart), and
- * who holds it (tet << 2 | the vertex it leaves out, or the hull face). */
+ * component, plus 2: a face's vertices are at most two periods apart; bits
+ * 0-17 of offs), who holds it (tet << 2 | the vertex it leaves out, or the
+ * hull face) and, for a tet, that vertex (apex, its offsets in bits 18-26). */
 typedef struct finc {
-    uint32_t id1, id2, offs, who;
+    uint32_t id1, id2, offs, who, apex;
 } finc;
+
+#define FINC_KEY 0x3ffffu /* the face's own bits of offs */
 
 static int finc_cmp(const finc *a, const finc *b)
 {
@@ -1161,7 +1164,8 @@ static int finc_cmp(const finc *a, const finc *b)
         return a->id1 < b->id1 ? -1 : 1;
     if (a->id2 != b->id2)
         return a->id2 < b->id2 ? -1 : 1;
-    return a->offs < b->offs ? -1 : a->offs > b->offs;
+    uint32_t x = a->offs & FINC_KEY, y = b->offs & FINC_KEY;
+    return x < y ? -1 : x > y;
 }
 
 /* Row k (nv vertices, ids distinct after the range check) sorted by id;
@@ -1181,26 +1185,28 @@ static int finc_make(const uint32_t *id, const int8_t *o, int nv, int j, uint32_
     f->id1 = fid[1];
     f->id2 = fid[2];
     f->offs = 0;
-    for (int c = 1; c < 3; c++)
-        for (int a = 0; a < 3; a++) {
-            int r = fo[c][a] - fo[0][a] + 2;
+    for (int c = 1; c < 4; c++) /* c = 3: the apex */
+        for (int a = 0; a < 3 && (c < 3 || nv == 4); a++) {
+            int r = (c < 3 ? fo[c][a] : o[3 * j + a]) - fo[0][a] + 2;
             if (r < 0 || r > 4)
                 return 0;
             f->offs |= (uint32_t)r << (3 * (3 * (c - 1) + a));
         }
     f->who = who;
+    f->apex = nv == 4 ? id[j] : UINT32_MAX;
     return 1;
 }
 
-/* The face's vertices (least, then f's two) with their offsets in the
- * face's frame. */
-static void finc_face(uint32_t least, const finc *f, uint32_t id[3], int8_t o[9])
+/* The face's vertices (least, then f's two, then its tet's apex) with
+ * their offsets in the face's frame. */
+static void finc_face(uint32_t least, const finc *f, uint32_t id[4], int8_t o[12])
 {
     id[0] = least;
     id[1] = f->id1;
     id[2] = f->id2;
+    id[3] = f->apex;
     memset(o, 0, 3);
-    for (int c = 1; c < 3; c++)
+    for (int c = 1; c < 4; c++)
         for (int a = 0; a < 3; a++)
             o[3 * c + a] = (int8_t)((int)(f->offs >> (3 * (3 * (c - 1) + a)) & 7) - 2);
 }
@@ -1370,19 +1376,13 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
             while (i + r < m && !finc_cmp(&a[i + r], &a[i]))
                 r++;
             /* the face, and each holder's other vertex in its frame */
-            uint32_t id[5];
-            int8_t o[15];
+            uint32_t id[5], id2[4];
+            int8_t o[15], o2[12];
             finc_face((uint32_t)v, &a[i], id, o);
-            for (size_t q = 0; q < r && q < 2; q++) {
-                uint32_t t = a[i + q].who >> 2, tid[4];
-                int j = (int)(a[i + q].who & 3), l = 0;
-                int8_t to[12];
-                (void)chk_row(tets, off, t, 4, n, tid, to, NULL, 0);
-                while (tid[l] != (uint32_t)v)
-                    l++;
-                id[3 + q] = tid[j];
-                for (int c = 0; c < 3; c++)
-                    o[3 * (3 + q) + c] = (int8_t)(to[3 * j + c] - to[3 * l + c]);
+            if (r > 1) {
+                finc_face((uint32_t)v, &a[i + 1], id2, o2);
+                id[4] = id2[3];
+                memcpy(o + 12, o2 + 9, 3);
             }
             while (hk < hm && finc_cmp(&ha[hk], &a[i]) < 0)
                 hk++;
