@@ -1239,14 +1239,8 @@ static void test_sphere_cof(tctx *T, double scale)
     for (long it = 0; it < n; it++) {
         double p[5][3];
         int kind = (int)(it % 4);
-        if (kind == 0)
-            for (int i = 0; i < 5; i++)
-                for (int k = 0; k < 3; k++)
-                    p[i][k] = sunif(T);
-        else if (kind == 1)
-            gen_near_coplanar(T, p);
-        else if (kind == 2)
-            gen_near_cospherical(T, p, 0.0);
+        if (kind < 3)
+            gen_kind(T, p, kind);
         else {
             for (int i = 0; i < 4; i++)
                 for (int k = 0; k < 3; k++)
