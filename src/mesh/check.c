@@ -46,6 +46,8 @@
  * grouped by their smallest vertex with a counting sort (O(n + ntets)),
  * then each small bucket is sorted by the other two vertices.
  */
+#include "mesh/check.h"
+
 #include "frontdt.h"
 #include "base/bits.h"
 #include "geom/predicates.h"
@@ -289,37 +291,41 @@ static int chk_points(chk *c)
             return chk_fail(c, FDT_ECHECK,
                             "point %zu has a non-finite coordinate", i / 3);
     }
-    if (c->n == 0)
+    return fdt_check_first_points(c->xyz, c->n, c->flags); /* PT_FIRST is 1 */
+}
+
+int fdt_check_first_points(const double *xyz, size_t n, uint8_t *first)
+{
+    if (n == 0)
         return 0;
-    fdt_vid *idx = malloc(c->n * sizeof *idx);
-    fdt_vid *tmp = malloc(c->n * sizeof *tmp);
+    fdt_vid *idx = malloc(n * sizeof *idx);
+    fdt_vid *tmp = malloc(n * sizeof *tmp);
     if (!idx || !tmp) {
         free(idx);
         free(tmp);
         return FDT_ENOMEM;
     }
-    for (size_t i = 0; i < c->n; i++)
+    for (size_t i = 0; i < n; i++)
         idx[i] = (fdt_vid)i;
-    chk_sort_points(c->xyz, idx, tmp, c->n);
+    chk_sort_points(xyz, idx, tmp, n);
     /* fdt_lex_compare compares values, so -0 and +0 fall in one run. */
-    c->flags[idx[0]] = PT_FIRST;
-    for (size_t k = 1; k < c->n; k++) {
-        if (fdt_lex_compare(chk_pt(c, idx[k - 1]), chk_pt(c, idx[k])) != 0)
-            c->flags[idx[k]] = PT_FIRST;
+    first[idx[0]] = 1;
+    for (size_t k = 1; k < n; k++) {
+        if (fdt_lex_compare(xyz + 3 * (size_t)idx[k - 1], xyz + 3 * (size_t)idx[k]) != 0)
+            first[idx[k]] = 1;
     }
     free(idx);
     free(tmp);
     return 0;
 }
 
-/* The first index with the coordinates of point v (for messages only). */
-static size_t chk_first_of(const chk *c, fdt_vid v)
+size_t fdt_check_first_of(const double *xyz, size_t n, size_t v)
 {
-    for (size_t i = 0; i < c->n; i++) {
-        if (fdt_lex_compare(chk_pt(c, (fdt_vid)i), chk_pt(c, v)) == 0)
+    for (size_t i = 0; i < n; i++) {
+        if (fdt_lex_compare(xyz + 3 * i, xyz + 3 * v) == 0)
             return i;
     }
-    return (size_t)v;
+    return v;
 }
 
 #define TET_FMT "tet %zu (%ld %ld %ld %ld)"
@@ -351,7 +357,7 @@ static int chk_tets(chk *c)
                                 TET_FMT " uses vertex %ld, a duplicate of "
                                 "point %zu (tets must use the first index "
                                 "of each coordinate)", TET_ARGS(c, t),
-                                (long)v[i], chk_first_of(c, v[i]));
+                                (long)v[i], fdt_check_first_of(c->xyz, c->n, (size_t)v[i]));
         }
         int o = fdt_orient3d(chk_pt(c, v[0]), chk_pt(c, v[1]),
                              chk_pt(c, v[2]), chk_pt(c, v[3]), NULL);

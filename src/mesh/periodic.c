@@ -12,6 +12,7 @@
 #include "geom/images.h"
 #include "geom/morton.h"
 #include "mesh/certify.h"
+#include "mesh/check.h"
 #include "mesh/insert.h"
 #include "mesh/voronoi.h"
 
@@ -1328,30 +1329,16 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
         hstart[0] = 0;
     }
     /* every point a vertex, but a duplicate of an earlier one (which the
-     * tets must name instead): each point's first occurrence by a hash of
-     * its coordinates' bits */
-    size_t pmask = 15;
-    while (pmask + 1 < 2 * n)
-        pmask = 2 * pmask + 1;
-    uint32_t *first = err ? NULL : malloc((pmask + 1) * sizeof *first);
-    if (!err && !first)
+     * tets must name instead): fdt_check's first occurrences */
+    uint8_t *first = err ? NULL : calloc(n ? n : 1, 1);
+    if (!err && (!first || fdt_check_first_points(X, n, first) != 0))
         err = FDT_ENOMEM;
-    for (size_t h = 0; first && h <= pmask; h++)
-        first[h] = UINT32_MAX;
     for (size_t i = 0; i < n && !err; i++) {
-        uint64_t w[3];
-        memcpy(w, X + 3 * i, sizeof w);
-        size_t h = (size_t)fdt_mix64(w[0] ^ fdt_mix64(w[1] ^ fdt_mix64(w[2]))) & pmask;
-        while (first[h] != UINT32_MAX && memcmp(X + 3 * (size_t)first[h], X + 3 * i, sizeof w))
-            h = (h + 1) & pmask;
-        if (first[h] == UINT32_MAX) {
-            first[h] = (uint32_t)i;
-            if (!used[i])
-                err = chk_fail(msg, len, "point %zu is in no tet", i);
-        } else if (used[i]) {
-            err = chk_fail(msg, len, "point %zu is a duplicate of point %u, which the tets "
-                           "must name instead", i, first[h]);
-        }
+        if (first[i] && !used[i])
+            err = chk_fail(msg, len, "point %zu is in no tet", i);
+        else if (!first[i] && used[i])
+            err = chk_fail(msg, len, "point %zu is a duplicate of point %zu, which the tets "
+                           "must name instead", i, fdt_check_first_of(X, n, i));
     }
     free(first);
     /* each least vertex's faces: two tets on the two sides of each, the
