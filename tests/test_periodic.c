@@ -262,6 +262,69 @@ static double *channel(size_t n, uint64_t seed, int duct)
     return X;
 }
 
+/*
+ * The mesh in parts (fdt_periodic_parts_make with part_points a part, each
+ * part built on threads): every part's rows sorted and each part's least
+ * vertices its own points; all of them together, sorted, equal want's
+ * (the one-part build's rows, tets then hull faces).
+ */
+static void parts_equal(const char *name, const double *X, size_t n, const fdt_periodic_box *b,
+                        uint32_t part_points, int threads, const rows *want,
+                        const rows *wanth)
+{
+    fdt_periodic_parts p;
+    CHECK(fdt_periodic_parts_make(X, (uint32_t)n, b, part_points, &p) == FDT_OK);
+    size_t cap = 1024, nt = 0, nh = 0, owned = 0;
+    uint32_t *ids = malloc(cap * 4 * sizeof *ids), *hids = malloc(cap * 3 * sizeof *hids);
+    int8_t *off = malloc(cap * 12), *hoff = malloc(cap * 9);
+    CHECK(ids && hids && off && hoff);
+    for (uint32_t k = 0; k < p.nparts; k++) {
+        fdt_periodic_mesh pm;
+        char diag[512];
+        int err = fdt_periodic_build_part(X, (uint32_t)n, NULL, b, &p, k, threads, &pm, diag,
+                                          sizeof diag);
+        EXPECTF(err == FDT_OK, "%s: part %u of %u: %d (%s)", name, k, p.nparts, err, diag);
+        CHECK(err == FDT_OK);
+        owned += fdt_periodic_part_points(&p, k, (uint32_t)n);
+        size_t bad = 0;
+        for (size_t i = 0; i < pm.ntets; i++) {
+            const uint32_t *t = pm.tets + 4 * i;
+            bad += i && t[-4] > t[0]; /* sorted by least vertex */
+            if (p.nparts > 1) {
+                double x = X[3 * (size_t)t[0] + p.axis];
+                bad += !(x >= p.cut[k] && x < p.cut[k + 1]); /* its own */
+            }
+        }
+        EXPECTF(!bad, "%s: part %u of %u: %zu tets unsorted or not its own", name, k, p.nparts,
+                bad);
+        while (nt + pm.ntets > cap || nh + pm.nhull > cap) {
+            cap *= 2;
+            CHECK((ids = realloc(ids, cap * 4 * sizeof *ids)) &&
+                  (hids = realloc(hids, cap * 3 * sizeof *hids)) &&
+                  (off = realloc(off, cap * 12)) && (hoff = realloc(hoff, cap * 9)));
+        }
+        memcpy(ids + 4 * nt, pm.tets, pm.ntets * 4 * sizeof *ids);
+        memcpy(off + 12 * nt, pm.tet_off, pm.ntets * 12);
+        memcpy(hids + 3 * nh, pm.hull, pm.nhull * 3 * sizeof *hids);
+        memcpy(hoff + 9 * nh, pm.hull_off, pm.nhull * 9);
+        nt += pm.ntets;
+        nh += pm.nhull;
+        fdt_periodic_free(&pm);
+    }
+    EXPECTF(owned == n, "%s: the parts own %zu of %zu points", name, owned, n);
+    rows got = mesh_rows(ids, off, nt, 4), goth = mesh_rows(hids, hoff, nh, 3);
+    EXPECTF(same_rows(&got, want) && same_rows(&goth, wanth),
+            "%s: %u parts of %u points, %d threads: %zu tets, %zu hull faces, one part %zu, %zu",
+            name, p.nparts, part_points, threads, got.n, goth.n, want->n, wanth->n);
+    free(got.r);
+    free(goth.r);
+    free(ids);
+    free(off);
+    free(hids);
+    free(hoff);
+    fdt_periodic_parts_free(&p);
+}
+
 static void against_reference(const char *name, const double *X, size_t n, unsigned axes,
                               const double lo[3], const double hi[3])
 {
@@ -286,6 +349,11 @@ static void against_reference(const char *name, const double *X, size_t n, unsig
     EXPECTF(same_rows(&got, &got3), "%s: 3 threads differ", name);
     if (axes == 7)
         EXPECTF(euler_vet(&pm, n) == 0, "%s: V - E + T = %ld", name, euler_vet(&pm, n));
+    /* in parts (streamed, MPI): slabs of a fifth, a seventeenth and 97
+     * points (the margin of a thin slab reaching over many of them) */
+    const uint32_t sizes[3] = {(uint32_t)(n / 5), (uint32_t)(n / 17), 97};
+    for (int t = 0; t < 3; t++)
+        parts_equal(name, X, n, &b, sizes[t], 1 + 2 * (t == 1), &got, &goth);
     printf("%s (axes %u): %zu tets, %zu hull faces, %zu images, %d round(s): as the reference\n",
            name, axes, pm.ntets, pm.nhull, pm.images, pm.rounds);
     free(got.r);

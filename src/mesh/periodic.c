@@ -24,6 +24,7 @@ typedef struct ext {
     int8_t *off;     /* 3 each */
     uint64_t *vk;    /* each as one integer (vpack), once in Morton order */
     uint8_t *exact;
+    uint32_t *rank;  /* an owned point's place in the owned list (morton) */
     uint32_t n, cap;
     double err;      /* the largest |exact - rounded| */
 } ext;
@@ -49,6 +50,7 @@ static void ext_free(ext *e)
     free(e->off);
     free(e->vk);
     free(e->exact);
+    free(e->rank);
     memset(e, 0, sizeof *e);
 }
 
@@ -85,47 +87,62 @@ static int ext_grow(ext *e, size_t need)
 }
 
 /*
- * The points, then for each the images whose every offset is allowed: on
- * periodic axis k, +1 when x - lo <= m[k] (the image lands within m above
- * hi), -1 when hi - x <= m[k]. Every image whose exact coordinate lies in
- * (lo - m', hi + m') on each periodic axis, m' < m (prove_init's mm), is
- * then present: x + L < hi + m' means x - lo < m', and rounding is
- * monotone.
+ * A part's points and images (fdt_periodic_parts): the points it owns
+ * (own[0 .. nown), ascending; all n when own is NULL), then for each of
+ * them and of the candidates near it (near[0 .. nnear)) the copies whose
+ * every offset is allowed. On periodic axis k, with the part's core
+ * [c0, c1) (the box's [lo, hi) on every axis but the slab's): offset 0
+ * for an owned point, or a candidate with c0 - m <= x <= c1 + m; +1 when
+ * (x - lo) + (hi - c1) <= m[k] (the image lands within m above c1), -1
+ * when (hi - x) + (c0 - lo) <= m[k]. Every copy whose exact coordinate
+ * lies in (c0 - m', c1 + m') on each periodic axis, m' < m (prove_init's
+ * mm), is then present: x + L < c1 + m' means the two nonnegative terms
+ * sum below m', and rounding is monotone. With the whole box as the core
+ * the tests are the box's: x - lo <= m, hi - x <= m.
  */
-static int make_images(ext *e, const double *X, uint32_t n, const fdt_periodic_box *b,
-                       const double m[3])
+static int make_images(ext *e, const double *X, uint32_t n, const uint32_t *own, uint32_t nown,
+                       const uint32_t *near, uint32_t nnear, const fdt_periodic_box *b,
+                       const double c0[3], const double c1[3], const double m[3])
 {
+    if (!own)
+        nown = n;
     e->n = 0;
     e->err = 0;
-    int err = ext_grow(e, (size_t)n + n / 4 + 64);
+    int err = ext_grow(e, (size_t)nown + nown / 4 + 64);
     if (err)
         return err;
-    for (uint32_t i = 0; i < n; i++) {
-        memcpy(e->P + 3 * (size_t)i, X + 3 * (size_t)i, 3 * sizeof(double));
-        e->src[i] = i;
-        memset(e->off + 3 * (size_t)i, 0, 3);
-        e->exact[i] = 1;
+    for (uint32_t q = 0; q < nown; q++) {
+        uint32_t i = own ? own[q] : q;
+        memcpy(e->P + 3 * (size_t)q, X + 3 * (size_t)i, 3 * sizeof(double));
+        e->src[q] = i;
+        memset(e->off + 3 * (size_t)q, 0, 3);
+        e->exact[q] = 1;
     }
-    e->n = n;
-    for (uint32_t i = 0; i < n; i++) {
+    e->n = nown;
+    for (uint32_t q = 0; q < nown + nnear; q++) {
+        int owned = q < nown;
+        uint32_t i = owned ? (own ? own[q] : q) : near[q - nown];
         const double *x = X + 3 * (size_t)i;
         int8_t opts[3][3];
         int nopt[3];
         for (int k = 0; k < 3; k++) {
             nopt[k] = 0;
-            opts[k][nopt[k]++] = 0;
-            if (!(b->axes >> k & 1))
+            if (!(b->axes >> k & 1)) {
+                opts[k][nopt[k]++] = 0;
                 continue;
-            if (x[k] - b->lo[k] <= m[k])
+            }
+            if (owned || (x[k] - c1[k] <= m[k] && c0[k] - x[k] <= m[k]))
+                opts[k][nopt[k]++] = 0;
+            if ((x[k] - b->lo[k]) + (b->hi[k] - c1[k]) <= m[k])
                 opts[k][nopt[k]++] = 1;
-            if (b->hi[k] - x[k] <= m[k])
+            if ((b->hi[k] - x[k]) + (c0[k] - b->lo[k]) <= m[k])
                 opts[k][nopt[k]++] = -1;
         }
         for (int a = 0; a < nopt[0]; a++)
             for (int c = 0; c < nopt[1]; c++)
                 for (int d = 0; d < nopt[2]; d++) {
                     const int8_t o[3] = {opts[0][a], opts[1][c], opts[2][d]};
-                    if (!o[0] && !o[1] && !o[2])
+                    if (owned && !o[0] && !o[1] && !o[2])
                         continue;
                     if ((err = ext_grow(e, (size_t)e->n + 1)) != FDT_OK)
                         return err;
@@ -142,9 +159,9 @@ static int make_images(ext *e, const double *X, uint32_t n, const fdt_periodic_b
 }
 
 /* The set in Morton order (the insertion's order, as the one-part
- * engine's, src/api/api.c), and its box: the n input points first, then
- * the images, each in Morton order, so that a vertex below n is an input
- * point (the proofs' test, prove_tet, reads no array). */
+ * engine's, src/api/api.c), and its box: the n owned points first, then
+ * the other copies, each in Morton order, so that a vertex below n is an
+ * owned point (the proofs' test, prove_tet, reads no array). */
 static int morton(ext *e, uint32_t n, double blo[3], double bhi[3])
 {
     for (int k = 0; k < 3; k++)
@@ -174,7 +191,14 @@ static int morton(ext *e, uint32_t n, double blo[3], double bhi[3])
     }
     s.n = e->n;
     s.err = e->err;
-    free(order);
+    /* order[i] for i < n: the place in the owned list of the point now
+     * at i (the kept tets' buckets, emit) */
+    s.rank = realloc(order, (n ? n : 1) * sizeof *order);
+    if (!s.rank) {
+        free(order);
+        ext_free(&s);
+        return FDT_ENOMEM;
+    }
     ext_free(e);
     *e = s;
     return FDT_OK;
@@ -202,14 +226,18 @@ static int key_cmp(const void *x, const void *y)
  * The key of the vertices w[0 .. nv) of the extended set: sorted, the
  * least one's offsets subtracted from every one's (a byte at a time
  * without borrows: offsets are -1..1, so every byte stays in 126..130).
- * Returns whether the least vertex is an input point (the copy this mesh
- * keeps); *repeat whether two vertices are images of one point.
+ * Returns the least vertex's index in the set (the copy a part keeps is
+ * the one whose least vertex is an owned point: an index below its owned
+ * count); *repeat whether two vertices are images of one point.
  */
-static int make_key(const ext *e, const uint32_t *w, int nv, key *k, int *repeat)
+static uint32_t make_key(const ext *e, const uint32_t *w, int nv, key *k, int *repeat)
 {
     uint64_t *a = k->v;
-    for (int j = 0; j < nv; j++)
+    uint32_t least = w[0];
+    for (int j = 0; j < nv; j++) {
         a[j] = e->vk[w[j]];
+        least = a[j] < e->vk[least] ? w[j] : least;
+    }
     a[3] = nv == 4 ? a[3] : UINT64_MAX;
     for (int i = 1; i < nv; i++) /* insertion sort of 3 or 4 */
         for (int j = i; j > 0 && a[j] < a[j - 1]; j--) {
@@ -223,32 +251,40 @@ static int make_key(const ext *e, const uint32_t *w, int nv, key *k, int *repeat
         a[j] = a[j] + VZERO - lo;
         *repeat |= j > 0 && a[j] >> 24 == a[j - 1] >> 24;
     }
-    return lo == VZERO;
+    return least;
 }
 
-/* The kept tets' (or hull faces') keys. */
+/* The kept tets' (or hull faces') keys, each with its least vertex's
+ * place in the owned list (emit's bucket). */
 typedef struct keyset {
     key *keys;
+    uint32_t *rank;
     size_t n, cap;
 } keyset;
 
 static void keyset_free(keyset *s)
 {
     free(s->keys);
+    free(s->rank);
     memset(s, 0, sizeof *s);
 }
 
-static int keyset_add(keyset *s, const key *k)
+static int keyset_add(keyset *s, const key *k, uint32_t rank)
 {
     if (s->n == s->cap) {
         size_t cap = s->cap ? 2 * s->cap : 1024;
         key *nk = realloc(s->keys, cap * sizeof *nk);
-        if (!nk)
+        if (nk)
+            s->keys = nk;
+        uint32_t *nr = realloc(s->rank, cap * sizeof *nr);
+        if (nr)
+            s->rank = nr;
+        if (!nk || !nr)
             return FDT_ENOMEM;
-        s->keys = nk;
         s->cap = cap;
     }
-    s->keys[s->n++] = *k;
+    s->keys[s->n] = *k;
+    s->rank[s->n++] = rank;
     return FDT_OK;
 }
 
@@ -343,6 +379,13 @@ typedef struct run {
     const double *X;
     uint32_t n;
     const fdt_periodic_box *b;
+    const fdt_periodic_parts *parts;
+    uint32_t part;         /* the part built */
+    fdt_periodic_box core; /* its core: the box, its slab on the slabs' axis */
+    const uint32_t *own;   /* the points it owns, ascending (NULL: all n) */
+    uint32_t nown;
+    uint32_t *near;        /* the other points the round's margin may need */
+    uint32_t nnear;
     double ylo[3], yhi[3]; /* the points' extent */
     ext e;
     fdt_images im;
@@ -373,9 +416,9 @@ typedef struct prove_pass {
     prove_job job[64];
 } prove_pass;
 
-/* A job's region for the margin m: (lo - m', hi + m') with m' a hair under
- * the margin (or the period) for the roundings of make_images' tests and
- * of hi - lo, rounded inwards. */
+/* A job's region for the margin m: (c0 - m', c1 + m') around the part's
+ * core with m' a hair under the margin (or the period) for the roundings
+ * of make_images' tests and of hi - lo, rounded inwards. */
 static void prove_init(prove_job *j, run *r, const double m[3])
 {
     memset(j, 0, sizeof *j);
@@ -384,8 +427,8 @@ static void prove_init(prove_job *j, run *r, const double m[3])
     for (int k = 0; k < 3; k++) {
         double L = r->b->hi[k] - r->b->lo[k];
         j->mm[k] = (m[k] < L ? m[k] : L) * (1 - 0x1p-40);
-        j->A[k] = nextafter(r->b->lo[k] - j->mm[k], INFINITY);
-        j->B[k] = nextafter(r->b->hi[k] + j->mm[k], -INFINITY);
+        j->A[k] = nextafter(r->core.lo[k] - j->mm[k], INFINITY);
+        j->B[k] = nextafter(r->core.hi[k] + j->mm[k], -INFINITY);
     }
 }
 
@@ -415,14 +458,14 @@ static void prove_tet(void *user, int job, uint32_t slot, const uint32_t v[4], i
         memcpy(w, v, sizeof w);
     else
         fdt_ins_face_inward(v, inf, w);
-    int touches = 0; /* an input point (morton: they come first) */
+    int touches = 0; /* an owned point (morton: they come first) */
     for (int i = 0; i < nv; i++)
-        touches |= w[i] < r->n;
+        touches |= w[i] < r->nown;
     if (!touches)
         return;
     if (inf < 0) {
         double need[3];
-        ball_reach(&r->e, w, cof, b, r->ylo, r->yhi, need);
+        ball_reach(&r->e, w, cof, &r->core, r->ylo, r->yhi, need);
         /* too far, or too flat to tell from the rounded centre: the
          * whole ball tested exactly (a fit there is a fit of its cut) */
         int far = 0;
@@ -448,11 +491,65 @@ static void prove_tet(void *user, int job, uint32_t slot, const uint32_t v[4], i
         return;
     key k;
     int rep;
-    if (!make_key(&r->e, w, nv, &k, &rep))
+    uint32_t least = make_key(&r->e, w, nv, &k, &rep);
+    if (least >= r->nown)
         return;
     if (rep && j->repeat_id < 0)
         j->repeat_id = (long)(k.v[0] >> 24);
-    j->err = keyset_add(inf < 0 ? &j->tets : &j->hull, &k);
+    j->err = keyset_add(inf < 0 ? &j->tets : &j->hull, &k, r->e.rank[least]);
+}
+
+/*
+ * The other points a round at margin m may need (make_images tests each
+ * copy): those of every part whose slab lies within m of this part's core
+ * on the slabs' axis, going up and down from it (wrapping round the
+ * period), with a hair of room for the roundings of the slabs' bounds;
+ * every other part's once the core is the whole box there.
+ */
+static int part_near(run *r, const double m[3])
+{
+    const fdt_periodic_parts *p = r->parts;
+    r->nnear = 0;
+    if (!p || p->nparts < 2)
+        return FDT_OK;
+    const int a = p->axis;
+    const uint32_t K = p->nparts, j = r->part;
+    const double L = r->b->hi[a] - r->b->lo[a];
+    const int whole = r->core.lo[a] == r->b->lo[a] && r->core.hi[a] == r->b->hi[a];
+    const double reach = m[a] * (1 + 0x1p-30) + 0x1p-50 * L;
+    uint8_t *take = calloc(K, 1);
+    if (!take)
+        return FDT_ENOMEM;
+    for (uint32_t d = 1; d < K; d++) { /* upwards: part j + d's lower side */
+        uint32_t q = (j + d) % K;
+        double low = j + d < K ? p->cut[j + d] : p->cut[j + d - K] + L;
+        if (!whole && low - r->core.hi[a] > reach)
+            break;
+        take[q] = 1;
+    }
+    for (uint32_t d = 1; d < K; d++) { /* downwards: part j - d's upper side */
+        uint32_t q = (j + K - d) % K;
+        double up = d <= j ? p->cut[j - d + 1] : p->cut[q + 1] - L;
+        if (!whole && r->core.lo[a] - up > reach)
+            break;
+        take[q] = 1;
+    }
+    take[j] = 0;
+    size_t c = 0;
+    for (uint32_t q = 0; q < K; q++)
+        c += take[q] ? p->start[q + 1] - p->start[q] : 0;
+    free(r->near);
+    r->near = malloc((c ? c : 1) * sizeof *r->near);
+    if (!r->near) {
+        free(take);
+        return FDT_ENOMEM;
+    }
+    for (uint32_t q = 0; q < K; q++)
+        if (take[q])
+            for (uint32_t i = p->start[q]; i < p->start[q + 1]; i++)
+                r->near[r->nnear++] = p->idx[i];
+    free(take);
+    return FDT_OK;
 }
 
 /* One round at margin m: ROUND_OK with r->tets and r->hull (a set a
@@ -468,12 +565,14 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
         keyset_free(&r->hull[i]);
     }
     r->nsets = 0;
-    if ((err = make_images(&r->e, r->X, r->n, b, m)) != FDT_OK)
+    if ((err = part_near(r, m)) != FDT_OK ||
+        (err = make_images(&r->e, r->X, r->n, r->own, r->nown, r->near, r->nnear, b, r->core.lo,
+                           r->core.hi, m)) != FDT_OK)
         return err;
     double blo[3], bhi[3];
-    if ((err = morton(&r->e, r->n, blo, bhi)) != FDT_OK)
+    if ((err = morton(&r->e, r->nown, blo, bhi)) != FDT_OK)
         return err;
-    out->images = r->e.n - r->n;
+    out->images = r->e.n - r->nown;
     fdt_images *im = &r->im;
     memset(im, 0, sizeof *im);
     im->P = r->e.P;
@@ -559,11 +658,12 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
 }
 
 /*
- * The keys of the sets s[0 .. ns) (ids below n), sorted, into out's
- * arrays; each set freed once its keys are moved. Counted into buckets by
- * their first id, each bucket (the tets a point is the least vertex of: a
- * few) sorted by insertion, a large one by qsort (qsort of 6.8M keys took
- * a fifth of a 1M-point run).
+ * The keys of the sets s[0 .. ns), sorted, into out's arrays; each set
+ * freed once its keys are moved. Counted into buckets by their least
+ * vertex's place among the n owned points (ascending ids, so the buckets'
+ * order is the ids'), each bucket (the tets a point is the least vertex
+ * of: a few) sorted by insertion, a large one by qsort (qsort of 6.8M
+ * keys took a fifth of a 1M-point run).
  */
 static int emit(keyset *s, int ns, int nv, size_t n, uint32_t **ids, int8_t **offs,
                 size_t *count)
@@ -580,12 +680,12 @@ static int emit(keyset *s, int ns, int nv, size_t n, uint32_t **ids, int8_t **of
     }
     for (int i = 0; i < ns; i++)
         for (size_t k = 0; k < s[i].n; k++)
-            start[(s[i].keys[k].v[0] >> 24) + 1]++;
+            start[s[i].rank[k] + 1]++;
     for (size_t v = 0; v < n; v++)
         start[v + 1] += start[v];
     for (int i = 0; i < ns; i++) {
         for (size_t k = 0; k < s[i].n; k++)
-            tmp[start[s[i].keys[k].v[0] >> 24]++] = s[i].keys[k];
+            tmp[start[s[i].rank[k]]++] = s[i].keys[k];
         keyset_free(&s[i]);
     }
     for (size_t v = n; v > 0; v--) /* start[v] was the end of bucket v */
@@ -671,20 +771,128 @@ int fdt_periodic_renumber(fdt_periodic_mesh *m, const int32_t *orig, size_t n)
     return FDT_OK;
 }
 
-int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
-                       const fdt_periodic_box *b, int nthreads, fdt_periodic_mesh *out,
-                       char *diag, size_t diag_size)
+/* The points' extent (every axis; the proofs read the axes that are not
+ * periodic). */
+static void extent(const double *X, uint32_t n, double lo[3], double hi[3])
+{
+    for (int k = 0; k < 3; k++)
+        lo[k] = hi[k] = n ? X[k] : 0;
+    for (uint32_t i = 1; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            double v = X[3 * (size_t)i + k];
+            lo[k] = v < lo[k] ? v : lo[k];
+            hi[k] = v > hi[k] ? v : hi[k];
+        }
+}
+
+/* Part of x on the slabs' axis: the number of inner cuts at or below it. */
+static uint32_t part_of(const fdt_periodic_parts *p, double x)
+{
+    uint32_t lo = 1, hi = p->nparts; /* the answer is in [lo - 1, hi - 1] */
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (p->cut[mid] <= x)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo - 1;
+}
+
+int fdt_periodic_parts_make(const double *X, uint32_t n, const fdt_periodic_box *b,
+                            uint32_t part_points, fdt_periodic_parts *p)
+{
+    memset(p, 0, sizeof *p);
+    p->axis = -1;
+    p->nparts = 1;
+    extent(X, n, p->ylo, p->yhi);
+    uint64_t want = part_points ? ((uint64_t)n + part_points - 1) / part_points : 1;
+    int a = -1;
+    for (int k = 0; k < 3; k++)
+        if (b->axes >> k & 1 && (a < 0 || b->hi[k] - b->lo[k] > b->hi[a] - b->lo[a]))
+            a = k;
+    enum { NB = 1 << 16 };
+    if (want > NB / 4)
+        want = NB / 4;
+    p->cut = malloc((size_t)(want + 1) * sizeof *p->cut);
+    if (!p->cut)
+        return FDT_ENOMEM;
+    p->cut[0] = a >= 0 ? b->lo[a] : 0;
+    if (want > 1 && a >= 0) {
+        /* the cuts at bins' edges where the running count passes t n / K:
+         * about n / K points a slab, by a histogram rather than a sort */
+        const double lo = b->lo[a], hi = b->hi[a], L = hi - lo;
+        uint32_t *bin = calloc(NB, sizeof *bin);
+        if (!bin)
+            return FDT_ENOMEM;
+        for (uint32_t i = 0; i < n; i++) {
+            double t = (X[3 * (size_t)i + a] - lo) / L * NB;
+            bin[t < 0 ? 0 : t >= NB ? NB - 1 : (uint32_t)t]++;
+        }
+        uint64_t seen = 0;
+        uint32_t K = 1;
+        for (uint32_t q = 0; q + 1 < NB && K < want; q++) {
+            seen += bin[q];
+            if (seen * want < (uint64_t)K * n)
+                continue;
+            double c = lo + L * (double)(q + 1) / NB;
+            if (c > p->cut[K - 1] && c < hi) /* one cut a bin at most */
+                p->cut[K++] = c;
+        }
+        free(bin);
+        p->nparts = K;
+    }
+    if (p->nparts > 1) {
+        p->axis = a;
+        p->cut[p->nparts] = b->hi[a];
+        p->start = calloc((size_t)p->nparts + 1, sizeof *p->start);
+        p->idx = malloc((n ? n : 1) * sizeof *p->idx);
+        if (!p->start || !p->idx) {
+            fdt_periodic_parts_free(p);
+            return FDT_ENOMEM;
+        }
+        for (uint32_t i = 0; i < n; i++)
+            p->start[part_of(p, X[3 * (size_t)i + a]) + 1]++;
+        for (uint32_t q = 0; q < p->nparts; q++)
+            p->start[q + 1] += p->start[q];
+        uint32_t *fill = malloc((size_t)p->nparts * sizeof *fill);
+        if (!fill) {
+            fdt_periodic_parts_free(p);
+            return FDT_ENOMEM;
+        }
+        memcpy(fill, p->start, (size_t)p->nparts * sizeof *fill);
+        for (uint32_t i = 0; i < n; i++) /* ascending within each part */
+            p->idx[fill[part_of(p, X[3 * (size_t)i + a])]++] = i;
+        free(fill);
+    }
+    return FDT_OK;
+}
+
+void fdt_periodic_parts_free(fdt_periodic_parts *p)
+{
+    free(p->cut);
+    free(p->start);
+    free(p->idx);
+    memset(p, 0, sizeof *p);
+}
+
+uint32_t fdt_periodic_part_points(const fdt_periodic_parts *p, uint32_t k, uint32_t n)
+{
+    return p->nparts < 2 ? n : p->start[k + 1] - p->start[k];
+}
+
+int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
+                            const fdt_periodic_box *b, const fdt_periodic_parts *parts,
+                            uint32_t part, int nthreads, fdt_periodic_mesh *out, char *diag,
+                            size_t diag_size)
 {
     memset(out, 0, sizeof *out);
-    char own[8];
+    char owndiag[8];
     if (!diag || !diag_size) {
-        diag = own;
-        diag_size = sizeof own;
+        diag = owndiag;
+        diag_size = sizeof owndiag;
     }
     diag[0] = 0;
-    int err = fdt_periodic_check(X, n, b, diag, diag_size);
-    if (err)
-        return err;
     if (n < 1) {
         snprintf(diag, diag_size, "no points");
         return FDT_EDEGENERATE;
@@ -697,14 +905,21 @@ int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
     r.b = b;
     r.diag = diag;
     r.dsz = diag_size;
-    for (int k = 0; k < 3; k++)
-        r.ylo[k] = r.yhi[k] = X[k];
-    for (uint32_t i = 1; i < n; i++)
-        for (int k = 0; k < 3; k++) {
-            double v = X[3 * (size_t)i + k];
-            r.ylo[k] = v < r.ylo[k] ? v : r.ylo[k];
-            r.yhi[k] = v > r.yhi[k] ? v : r.yhi[k];
-        }
+    r.parts = parts;
+    r.part = part;
+    r.core = *b;
+    r.nown = n;
+    int a = parts->nparts > 1 ? parts->axis : -1;
+    if (a >= 0) {
+        r.core.lo[a] = parts->cut[part];
+        r.core.hi[a] = parts->cut[part + 1];
+        r.own = parts->idx + parts->start[part];
+        r.nown = parts->start[part + 1] - parts->start[part];
+        if (!r.nown)
+            return FDT_OK; /* an empty slab owns no tet */
+    }
+    memcpy(r.ylo, parts->ylo, sizeof r.ylo);
+    memcpy(r.yhi, parts->yhi, sizeof r.yhi);
     /* The first margin: three mean spacings, (volume / n)^(1/3). */
     double vol = 1;
     for (int k = 0; k < 3; k++) {
@@ -715,6 +930,7 @@ int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
     for (int k = 0; k < 3; k++)
         if (b->axes >> k & 1)
             m[k] = m0 < b->hi[k] - b->lo[k] ? m0 : b->hi[k] - b->lo[k];
+    int err;
     for (;;) {
         out->rounds++;
         err = one_round(&r, m, nthreads, out);
@@ -732,6 +948,16 @@ int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
             m[k] = w < L ? w : L;
             grew = 1;
         }
+        /* A slab whose balls reach half a period away: its core becomes the
+         * whole box on that axis (the region, and so the proofs, of the
+         * one-part build; its own points still the slab's), so that a part
+         * fails only where the whole box would. */
+        if (a >= 0 && r.core.hi[a] - r.core.lo[a] < b->hi[a] - b->lo[a] &&
+            m[a] >= 0.5 * (b->hi[a] - b->lo[a])) {
+            r.core.lo[a] = b->lo[a];
+            r.core.hi[a] = b->hi[a];
+            grew = 1;
+        }
         if (!grew) {
             snprintf(diag, diag_size,
                      "no periodic triangulation in one copy of the box: with every point's "
@@ -747,9 +973,10 @@ int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
     /* the mesh and the images go before the output is made */
     fdt_ins_free(&r.m);
     ext_free(&r.e);
+    free(r.near);
     if (err == FDT_OK &&
-        ((err = emit(r.tets, r.nsets, 4, n, &out->tets, &out->tet_off, &out->ntets)) ||
-         (err = emit(r.hull, r.nsets, 3, n, &out->hull, &out->hull_off, &out->nhull))))
+        ((err = emit(r.tets, r.nsets, 4, r.nown, &out->tets, &out->tet_off, &out->ntets)) ||
+         (err = emit(r.hull, r.nsets, 3, r.nown, &out->hull, &out->hull_off, &out->nhull))))
         snprintf(diag, diag_size, "out of memory");
     for (int i = 0; i < r.nsets; i++) {
         keyset_free(&r.tets[i]);
@@ -760,6 +987,30 @@ int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
         fdt_periodic_free(out);
         out->pc = pc;
     }
+    return err;
+}
+
+int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
+                       const fdt_periodic_box *b, int nthreads, fdt_periodic_mesh *out,
+                       char *diag, size_t diag_size)
+{
+    memset(out, 0, sizeof *out);
+    char own[8];
+    if (!diag || !diag_size) {
+        diag = own;
+        diag_size = sizeof own;
+    }
+    diag[0] = 0;
+    int err = fdt_periodic_check(X, n, b, diag, diag_size);
+    if (err)
+        return err;
+    fdt_periodic_parts p;
+    if ((err = fdt_periodic_parts_make(X, n, b, 0, &p)) != FDT_OK) {
+        snprintf(diag, diag_size, "out of memory");
+        return err;
+    }
+    err = fdt_periodic_build_part(X, n, names, b, &p, 0, nthreads, out, diag, diag_size);
+    fdt_periodic_parts_free(&p);
     return err;
 }
 

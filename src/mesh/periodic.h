@@ -82,6 +82,47 @@ int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
 void fdt_periodic_free(fdt_periodic_mesh *m);
 
 /*
+ * A periodic run in parts (streamed, MPI; bench/NOTES.md entry 110): the
+ * box cut into slabs along its longest periodic axis, about part_points
+ * points a slab (counted by a histogram of 2^16 bins), each slab a part
+ * that owns its points. Part k's build (fdt_periodic_build_part) is the
+ * one-part build with the slab as its core on that axis: the owned points,
+ * then every copy of any point within the margin of the slab (the other
+ * parts' points included), its proofs for the tets with an owned vertex
+ * and its balls inside the slab grown by the margin, and it keeps the
+ * tets whose least vertex is an owned point. Each periodic tet has one
+ * least vertex, so the parts' rows are the one-part build's, each once.
+ * A slab whose balls reach half a period away takes the whole box as its
+ * core on that axis (the one-part proofs, its own points still the
+ * slab's), so a part fails only where the one-part build would. With
+ * part_points 0, or n at most part_points: one part, the whole box.
+ */
+typedef struct fdt_periodic_parts {
+    int axis;            /* the slabs' axis (-1: one part) */
+    uint32_t nparts;
+    double *cut;         /* nparts + 1: part k owns [cut[k], cut[k + 1]) */
+    uint32_t *start;     /* nparts + 1 (NULL for one part) */
+    uint32_t *idx;       /* the points by part, ascending in each */
+    double ylo[3], yhi[3]; /* the points' extent */
+} fdt_periodic_parts;
+
+/* FDT_OK or FDT_ENOMEM; X and b as fdt_periodic_build's, checked. */
+int fdt_periodic_parts_make(const double *X, uint32_t n, const fdt_periodic_box *b,
+                            uint32_t part_points, fdt_periodic_parts *p);
+void fdt_periodic_parts_free(fdt_periodic_parts *p);
+/* The points part k owns. */
+uint32_t fdt_periodic_part_points(const fdt_periodic_parts *p, uint32_t k, uint32_t n);
+
+/* Part k's tets and hull faces (those whose least vertex it owns), sorted,
+ * as fdt_periodic_build gives the whole mesh's; the errors of
+ * fdt_periodic_build but the box's and points' checks, which are the
+ * caller's (fdt_periodic_check). */
+int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
+                            const fdt_periodic_box *b, const fdt_periodic_parts *parts,
+                            uint32_t part, int nthreads, fdt_periodic_mesh *out, char *diag,
+                            size_t diag_size);
+
+/*
  * The Voronoi cells of a periodic mesh, as fdt_voronoi_compute gives a
  * plain mesh's: n rows, row i point i's, merged duplicates (dupmap)
  * FDT_CELL_MERGED. tets, off, hull: the mesh as fdt_periodic_build gives
