@@ -195,7 +195,10 @@ typedef struct fdt_settings {
      * point must lie in [min, max). The result is the Delaunay
      * tetrahedralization of the periodic point set, every tet once, each
      * vertex an input point with an image offset
-     * (fdt_result_tet_offsets). In memory only (fdt_triangulate). */
+     * (fdt_result_tet_offsets). In memory (fdt_triangulate), or streamed
+     * (fdt_triangulate_stream with fdt_sink's periodic_tets: the box in
+     * slabs along its longest periodic axis, a slab's mesh at a time,
+     * the same rows), never with neighbours. */
     unsigned periodic;
     double periodic_box[6];
 } fdt_settings;
@@ -340,7 +343,9 @@ FDT_API int fdt_result_hash(fdt_result *r, uint64_t *hash);
  * hash of the tet set, the same for every mode, thread count and order of
  * emission, with no sort (r is not changed). It differs from
  * fdt_result_hash's value. A streamed result (fdt_triangulate_stream),
- * which holds no tets, gives the set hash of the tets it emitted. */
+ * which holds no tets, gives the set hash of the tets it emitted. A
+ * periodic run's rows hash with their offsets (src/base/sethash.h), in
+ * memory and streamed alike. */
 FDT_API int fdt_result_set_hash(const fdt_result *r, uint64_t *hash);
 
 /*
@@ -363,6 +368,17 @@ typedef struct fdt_sink {
     int (*tets)(void *user, const fdt_vid *tets, size_t count);
     int (*hull)(void *user, const fdt_vid *faces, size_t count);
     void *user;
+    /* A periodic run's rows (settings.periodic, issue 33; added after
+     * user: a caller compiled before passes the smaller size, still
+     * accepted, and cannot stream a periodic run). Called instead of tets
+     * and hull: each batch rows as fdt_result_tets and
+     * fdt_result_tet_offsets give them (4 input ids ascending, 12
+     * offsets relative to the first; hull faces 3 and 9), the rows of a
+     * batch in ascending order, each row of the periodic mesh in exactly
+     * one batch; batches come in no particular order. periodic_tets must
+     * be set to stream a periodic run, periodic_hull may be NULL. */
+    int (*periodic_tets)(void *user, const fdt_vid *tets, const int8_t *offsets, size_t count);
+    int (*periodic_hull)(void *user, const fdt_vid *faces, const int8_t *offsets, size_t count);
 } fdt_sink;
 
 /*
@@ -479,8 +495,9 @@ typedef struct fdt_stats {
      * 0.4: an older caller passes a shorter size and gets the fields
      * above. */
     size_t sweep_parts;       /* parts: slabs of the points in sweep order,
-                                 each meshed, certified and freed (0: the
-                                 run took another engine) */
+                                 each meshed, certified and freed (a
+                                 streamed periodic run's too; 0: the run
+                                 took another engine) */
     size_t sweep_reinserted;  /* live vertices a part carried into the next
                                  (inserted again) */
     size_t sweep_max_part;    /* the most points in one part's mesh */
@@ -495,8 +512,10 @@ typedef struct fdt_stats {
     int engine;               /* the fdt_engine that ran (fdt_engine_name) */
     /* A periodic run (issue 33; added after the engine: a caller with the
      * size up to it gets the fields above). */
-    size_t periodic_images;   /* images triangulated with the points */
-    size_t periodic_rounds;   /* margins tried (each a doubling) */
+    size_t periodic_images;   /* images triangulated with the points
+                                 (streamed: summed over the parts) */
+    size_t periodic_rounds;   /* margins tried (streamed: the most a part
+                                 tried) */
 } fdt_stats;
 
 /* Fills the first struct_size bytes of *st (its struct_size included).
@@ -747,13 +766,19 @@ FDT_API void fdt_write_cleanup(void);
  *   bin      .fdtb   frontdt's compact binary mesh (README, "Binary mesh")
  * The tets are in the order they were given, which a streamed run does
  * not fix: compare two files by their tet sets (fdt_result_set_hash).
+ * A periodic run's rows (FDT_STREAM_PERIODIC, fdt_sink's periodic_tets)
+ * stream to .tets alone: each batch's rows (ascending) go to a spool of
+ * 28 bytes a row, an unlinked temporary beside the target, and the
+ * canonical text (all rows ascending, the bytes of fdt_write_mesh's .tets
+ * of the same mesh) is merged from it at the commit.
  * Every file goes to a temporary beside its target, renamed over it at
  * the commit (all or none); fdt_write_cleanup removes them too.
  */
 typedef struct fdt_stream_writer fdt_stream_writer;
 enum {
     FDT_STREAM_IDS64 = 1,     /* bin: 64-bit vertex ids (default 32-bit) */
-    FDT_STREAM_NO_POINTS = 2  /* bin: leave the points out */
+    FDT_STREAM_NO_POINTS = 2, /* bin: leave the points out */
+    FDT_STREAM_PERIODIC = 4   /* a periodic run's rows (tets only) */
 };
 /* Whether the format named (NULL: chosen by path's extension) can stream:
  * 1, 0, or FDT_EINVAL for an unknown format. */

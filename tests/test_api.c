@@ -592,7 +592,7 @@ static void test_periodic_api(void)
     double bary[4];
     EXPECT(fdt_locate(r, xyz, N, xyz, 1, &tet, bary, 1) == FDT_EINVAL);
     fdt_result_free(&r);
-    fdt_sink sink = {sizeof sink, sink_count, NULL, NULL};
+    fdt_sink sink = {sizeof sink, sink_count, NULL, NULL, NULL, NULL};
     EXPECT(fdt_triangulate_stream(ctx, xyz, N, &sink, &r) == FDT_EINVAL);
     fdt_close(&ctx);
     /* periodic in x and z only: the walls y = 0 and y = 1 cut the cells

@@ -257,7 +257,7 @@ static void test_api(void)
         CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
         fdt_cell_sink good = {sizeof good, collect, &g}, small = {1, collect, &g},
                       none = {sizeof none, NULL, &g};
-        fdt_sink notets = {sizeof notets, NULL, NULL, NULL};
+        fdt_sink notets = {sizeof notets, NULL, NULL, NULL, NULL, NULL};
         fdt_voronoi_options osz = o;
         osz.struct_size = 1;
         EXPECT_IS(fdt_voronoi_stream(NULL, xyz, n, &o, NULL, &good, &sr), FDT_EINVAL);

@@ -536,7 +536,7 @@ static int sc_stream(void *arg, const char **bad)
     if (rc != FDT_OK)
         return rc;
     size_t got = 0;
-    fdt_sink sink = {sizeof sink, count_sink, NULL, &got};
+    fdt_sink sink = {sizeof sink, count_sink, NULL, &got, NULL, NULL};
     fdt_result *r = NULL;
     rc = fdt_triangulate_stream(ctx, a->ps->xyz, a->ps->n, &sink, &r);
     if (stream_status(&ctx, rc, &r, "a failed fdt_triangulate_stream returned a result", bad))

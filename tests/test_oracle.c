@@ -208,7 +208,7 @@ static fdt_result *run_stream(const pts *p, fdt_stats *st)
     s.mode = FDT_MODE_SERIAL;
     fdt_context *ctx = NULL;
     CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
-    fdt_sink sink = {sizeof sink, drop_tets, NULL, NULL};
+    fdt_sink sink = {sizeof sink, drop_tets, NULL, NULL, NULL, NULL};
     fdt_result *r = NULL;
     int err = fdt_triangulate_stream(ctx, p->xyz, p->n, &sink, &r);
     if (err != FDT_OK)

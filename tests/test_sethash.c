@@ -273,7 +273,7 @@ static void test_stream(void)
         CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
         keep k;
         memset(&k, 0, sizeof k);
-        fdt_sink sink = {sizeof sink, keep_tets, keep_hull, &k};
+        fdt_sink sink = {sizeof sink, keep_tets, keep_hull, &k, NULL, NULL};
         fdt_result *r = NULL;
         CHECK_EQ(fdt_triangulate_stream(ctx, p, n, &sink, &r), FDT_OK);
         EXPECT(fdt_result_num_tets(r) == 0 && fdt_result_num_hull_faces(r) == 0);
@@ -308,7 +308,7 @@ static void test_stream(void)
         memset(&k, 0, sizeof k);
         k.stop_after = 1;
         k.stop_rc = rcs[i];
-        fdt_sink sink = {sizeof sink, keep_tets, NULL, &k};
+        fdt_sink sink = {sizeof sink, keep_tets, NULL, &k, NULL, NULL};
         fdt_result *r = (fdt_result *)&k;
         EXPECTF(fdt_triangulate_stream(ctx, p, n, &sink, &r) == want[i], "stop %d", rcs[i]);
         EXPECT(r == NULL);
@@ -319,7 +319,7 @@ static void test_stream(void)
     fdt_result *r = NULL;
     keep k;
     memset(&k, 0, sizeof k);
-    fdt_sink bad = {sizeof bad, NULL, NULL, &k};
+    fdt_sink bad = {sizeof bad, NULL, NULL, &k, NULL, NULL};
     EXPECT(fdt_triangulate_stream(ctx, p, n, NULL, &r) == FDT_EINVAL);
     EXPECT(fdt_triangulate_stream(ctx, p, n, &bad, &r) == FDT_EINVAL);
     bad.tets = keep_tets;

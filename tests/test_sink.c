@@ -103,7 +103,7 @@ static void test_emit(void)
         orig[i] = 100 + 9 - i;
     tally k;
     tally_init(&k);
-    fdt_sink us = {sizeof us, tally_tets, tally_hull, &k};
+    fdt_sink us = {sizeof us, tally_tets, tally_hull, &k, NULL, NULL};
     fdt_tsink s;
     CHECK_EQ(fdt_tsink_init(&s, orig, &us), FDT_OK);
     s.batch = 3;
@@ -170,7 +170,7 @@ static void test_emit(void)
      * freeing a sink twice is harmless. */
     for (int c = 0; c < 2; c++) {
         tally_init(&k);
-        fdt_sink hs = {sizeof hs, tally_tets, c ? hull_enomem : hull_stop, &k};
+        fdt_sink hs = {sizeof hs, tally_tets, c ? hull_enomem : hull_stop, &k, NULL, NULL};
         CHECK_EQ(fdt_tsink_init(&s, orig, &us), FDT_OK);
         s.user = &hs;
         s.hbatch = 2;
@@ -278,7 +278,7 @@ static void test_threads(void)
         orig[i] = (fdt_vid)i;
     tally k;
     tally_init(&k);
-    fdt_sink us = {sizeof us, tally_tets, tally_hull, &k};
+    fdt_sink us = {sizeof us, tally_tets, tally_hull, &k, NULL, NULL};
     fdt_tsink s;
     CHECK_EQ(fdt_tsink_init(&s, orig, &us), FDT_OK);
     s.batch = 37;
@@ -318,7 +318,7 @@ static int stream_run(const double *xyz, size_t n, fdt_mode mode, int threads, t
     fdt_prepared pr;
     char diag[256];
     CHECK_EQ(fdt_prepare(xyz, n, 1, &pr, diag, sizeof diag), FDT_OK);
-    fdt_sink us = {sizeof us, tally_tets, tally_hull, k};
+    fdt_sink us = {sizeof us, tally_tets, tally_hull, k, NULL, NULL};
     fdt_tsink s;
     CHECK_EQ(fdt_tsink_init(&s, pr.orig, &us), FDT_OK);
     s.batch = batch;
@@ -426,7 +426,7 @@ static void test_engine(void)
         memcpy(own, p, sizeof *own * 3 * n);
         tally k;
         tally_init(&k);
-        fdt_sink us = {sizeof us, tally_tets, tally_hull, &k};
+        fdt_sink us = {sizeof us, tally_tets, tally_hull, &k, NULL, NULL};
         fdt_result *r = NULL;
         CHECK_EQ(fdt_triangulate_stream(ctx, own, n, &us, &r), FDT_OK);
         uint64_t h;
@@ -485,7 +485,7 @@ static void test_engine(void)
         CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
         tally k;
         tally_init(&k);
-        fdt_sink us = {sizeof us, tally_tets, tally_hull, &k};
+        fdt_sink us = {sizeof us, tally_tets, tally_hull, &k, NULL, NULL};
         fdt_result *r = NULL;
         int err = fdt_triangulate_stream(ctx, q, n2, &us, &r);
         /* a parallel run may finish before its second report */

@@ -346,7 +346,7 @@ static void test_refusals(void)
     fdt_context *ctx = NULL;
     CHECK(fdt_open(&ctx, &st) == FDT_OK);
     fdt_result *sr = NULL;
-    fdt_sink sink = {sizeof sink, count_tets, NULL, NULL};
+    fdt_sink sink = {sizeof sink, count_tets, NULL, NULL, NULL, NULL};
     CHECK(fdt_triangulate_stream(ctx, xyz, n, &sink, &sr) == FDT_OK);
     fdt_close(&ctx);
     EXPECT(fdt_voronoi_compute(sr, xyz, n, NULL, &v, diag, sizeof diag) == FDT_EINVAL);

@@ -538,7 +538,7 @@ int main(void)
                                      sizeof diag) == FDT_OK);
         poison p = {.k = 0};
         CHECK(fdt_stream_writer_sink(w, &p.inner) == FDT_OK);
-        fdt_sink ps = {sizeof ps, poison_tets, poison_hull, &p};
+        fdt_sink ps = {sizeof ps, poison_tets, poison_hull, &p, NULL, NULL};
         fdt_result *sr = NULL;
         EXPECT(fdt_triangulate_stream(ctx, xyz, n, &ps, &sr) == FDT_EINVAL && sr == NULL);
         EXPECT(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_EINVAL &&

@@ -559,12 +559,59 @@ static int periodic_box_scaled(fdt_context *ctx, int e, fdt_periodic_box *b)
 }
 
 /*
+ * A periodic run streamed: the slabs of fdt_periodic_parts, the sweep's
+ * points a slab (fdt_sweep_slab), each part's rows renumbered to input
+ * ids, hashed and handed to the sink, then freed; the progress after each
+ * part. *sum gets the counts (images summed, the most rounds, rows).
+ */
+static int periodic_stream(fdt_context *ctx, const fdt_prepared *pr, const fdt_periodic_box *b,
+                           int nthreads, const fdt_sink *user, fdt_periodic_mesh *sum,
+                           fdt_sethash *h, size_t *nparts)
+{
+    fdt_periodic_parts parts;
+    int err = fdt_periodic_parts_make(pr->p, (uint32_t)pr->m, b, fdt_sweep_slab(pr->m), &parts);
+    if (err)
+        return err;
+    *nparts = parts.nparts;
+    for (uint32_t k = 0; k < parts.nparts && !err; k++) {
+        fdt_periodic_mesh pm;
+        err = fdt_periodic_build_part(pr->p, (uint32_t)pr->m, pr->orig, b, &parts, k, nthreads,
+                                      &pm, ctx->diag, sizeof ctx->diag);
+        if (!err)
+            err = fdt_periodic_renumber(&pm, pr->orig, pr->m);
+        if (!err) {
+            fdt_sethash_add_periodic(h, pm.tets, pm.tet_off, pm.ntets);
+            int u = pm.ntets ? user->periodic_tets(user->user, (const fdt_vid *)pm.tets,
+                                                   pm.tet_off, pm.ntets)
+                             : 0;
+            if (!u && pm.nhull && user->periodic_hull)
+                u = user->periodic_hull(user->user, (const fdt_vid *)pm.hull, pm.hull_off,
+                                        pm.nhull);
+            err = u ? fdt_sink_code(u) : FDT_OK;
+        }
+        sum->images += pm.images;
+        sum->rounds = pm.rounds > sum->rounds ? pm.rounds : sum->rounds;
+        sum->ntets += pm.ntets;
+        sum->nhull += pm.nhull;
+        fdt_pred_counts_add(&sum->pc, &pm.pc);
+        fdt_periodic_free(&pm);
+        if (!err && ctx->s.progress &&
+            ctx->s.progress(ctx->s.progress_user, (double)(k + 1) / parts.nparts))
+            err = FDT_ECANCELED;
+    }
+    fdt_periodic_parts_free(&parts);
+    return err;
+}
+
+/*
  * A periodic run (settings.periodic, src/mesh/periodic.h), as a list of
  * steps: the box and the points in it (named by input index), the merge
- * and scaling every run does, the periodic mesh of the distinct points,
- * renumbered to input indices.
+ * and scaling every run does, the periodic mesh of the distinct points
+ * (in memory: one part, renumbered to input indices; streamed: slab after
+ * slab to the sink).
  */
-static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, fdt_result **out)
+static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *user,
+                        fdt_result **out)
 {
     fdt_mode mode;
     int nthreads;
@@ -578,6 +625,8 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, fdt_resul
     memset(&pr, 0, sizeof pr);
     fdt_periodic_mesh pm;
     memset(&pm, 0, sizeof pm);
+    fdt_sethash h = {0, 0};
+    size_t nparts = 1;
     fdt_result *r = NULL;
     int err = fdt_periodic_check(xyz, n, &b, ctx->diag, sizeof ctx->diag);
     if (!err)
@@ -587,17 +636,22 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, fdt_resul
     if (!err)
         err = periodic_box_scaled(ctx, pr.scale_exp, &b);
     double t1 = fdt_now_s();
-    if (!err)
+    if (!err && user) {
+        err = periodic_stream(ctx, &pr, &b, nthreads, user, &pm, &h, &nparts);
+    } else if (!err) {
         err = fdt_periodic_build(pr.p, (uint32_t)pr.m, pr.orig, &b, nthreads, &pm, ctx->diag,
                                  sizeof ctx->diag);
-    if (!err)
-        err = fdt_periodic_renumber(&pm, pr.orig, pr.m);
+        if (!err)
+            err = fdt_periodic_renumber(&pm, pr.orig, pr.m);
+    }
     double t2 = fdt_now_s();
     if (!err && !(r = calloc(1, sizeof *r)))
         err = FDT_ENOMEM;
     if (err) {
         if (err == FDT_ENOMEM && !ctx->diag[0])
             snprintf(ctx->diag, sizeof ctx->diag, "out of memory triangulating %zu points", n);
+        if (err == FDT_ECANCELED && !ctx->diag[0])
+            snprintf(ctx->diag, sizeof ctx->diag, "canceled");
         fdt_periodic_free(&pm);
         fdt_prepared_free(&pr);
         return err;
@@ -605,12 +659,14 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, fdt_resul
     r->periodic = ctx->s.periodic;
     memcpy(r->pbox, ctx->s.periodic_box, sizeof r->pbox);
     r->sorted = 1;
+    r->streamed = user != NULL;
+    r->set_hash = fdt_sethash_value(&h);
     r->tets = (fdt_vid *)pm.tets;
     r->tet_off = pm.tet_off;
-    r->ntets = pm.ntets;
+    r->ntets = user ? 0 : pm.ntets;
     r->hull = (fdt_vid *)pm.hull;
     r->hull_off = pm.hull_off;
-    r->nhull = pm.nhull;
+    r->nhull = user ? 0 : pm.nhull;
     r->dupmap = pr.dupmap;
     pr.dupmap = NULL;
     r->n = n;
@@ -627,6 +683,7 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, fdt_resul
     st->engine = FDT_ENGINE_PERIODIC;
     st->periodic_images = pm.images;
     st->periodic_rounds = (size_t)pm.rounds;
+    st->sweep_parts = user ? nparts : 0;
     st->mem_points = pr.m * (3 * sizeof *pr.p + sizeof *pr.orig) + n * sizeof *pr.dupmap;
     st->mem_merge = pr.merge_bytes;
     st->t_prepare = t1 - t0;
@@ -637,6 +694,12 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, fdt_resul
         ctx->s.progress(ctx->s.progress_user, 1.0);
     *out = r;
     return FDT_OK;
+}
+
+/* A sink that takes a periodic run's rows. */
+static int periodic_sink_ok(const fdt_sink *sink)
+{
+    return sink->struct_size >= sizeof(fdt_sink) && sink->periodic_tets;
 }
 
 static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *user,
@@ -651,13 +714,18 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
         return FDT_EINVAL;
     }
     if (ctx->s.periodic) {
-        if (user || ctx->s.neighbors) {
-            snprintf(ctx->diag, sizeof ctx->diag, "a periodic run is in memory, without "
-                     "neighbours (issue 33: streamed and linked periodic meshes are not "
-                     "built yet)");
+        if (ctx->s.neighbors || cs || (user && !periodic_sink_ok(user))) {
+            snprintf(ctx->diag, sizeof ctx->diag, "%s",
+                     ctx->s.neighbors ? "a periodic run has no neighbours"
+                     : cs ? "a periodic run's cells are in memory (fdt_voronoi_compute)"
+                          : "a periodic run streams to a sink with periodic_tets set");
             return FDT_EINVAL;
         }
-        return run_periodic(ctx, xyz, n, out);
+        return run_periodic(ctx, xyz, n, user, out);
+    }
+    if (user && !user->tets) {
+        snprintf(ctx->diag, sizeof ctx->diag, "the sink has no tets callback");
+        return FDT_EINVAL;
     }
     fdt_mode mode;
     int nthreads;
@@ -730,10 +798,13 @@ int fdt_triangulate(fdt_context *ctx, const double *xyz, size_t n, fdt_result **
     return run(ctx, xyz, n, NULL, NULL, out);
 }
 
-/* A caller's tet sink as compiled against this header or a later one. */
+/* A caller's tet sink as compiled against this header or a later one, or
+ * against the release before periodic_tets (ABI: the smaller size): tets
+ * set, or periodic_tets (run refuses what does not fit the settings). */
 static int sink_ok(const fdt_sink *sink)
 {
-    return sink->struct_size >= sizeof(fdt_sink) && sink->tets;
+    return sink->struct_size >= offsetof(fdt_sink, periodic_tets) &&
+           (sink->tets || periodic_sink_ok(sink));
 }
 
 int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
@@ -769,7 +840,7 @@ int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
         return FDT_EINVAL;
     *out = NULL;
     ctx->diag[0] = '\0';
-    fdt_sink dropped = {sizeof dropped, drop_tets, NULL, NULL};
+    fdt_sink dropped = {sizeof dropped, drop_tets, NULL, NULL, NULL, NULL};
     fdt_cellstream cs;
     memset(&cs, 0, sizeof cs);
     cs.neighbors = o->neighbors;

@@ -16,6 +16,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "base/hash.h"
 
@@ -61,6 +62,29 @@ static inline void fdt_sethash_add_n(fdt_sethash *h, const uint32_t *tets, size_
     uint64_t s = 0;
     for (size_t i = 0; i < ntets; i++)
         s += fdt_sethash_tet(tets + 4 * i);
+    h->sum += s;
+    h->count += ntets;
+}
+
+/* A periodic mesh's rows (issue 33), canonical (4 ids ascending, 12
+ * offsets relative to the first: the row names the periodic tet): the
+ * tet's mix chained with the offsets' 96 bits, so two rows of the same
+ * four points in different images differ. */
+static inline uint64_t fdt_sethash_periodic(const uint32_t t[4], const int8_t off[12])
+{
+    uint64_t a;
+    uint32_t c;
+    memcpy(&a, off, 8);
+    memcpy(&c, off + 8, 4);
+    return fdt_mix64(fdt_mix64(fdt_sethash_tet(t) ^ a) + c);
+}
+
+static inline void fdt_sethash_add_periodic(fdt_sethash *h, const uint32_t *tets,
+                                            const int8_t *off, size_t ntets)
+{
+    uint64_t s = 0;
+    for (size_t i = 0; i < ntets; i++)
+        s += fdt_sethash_periodic(tets + 4 * i, off + 12 * i);
     h->sum += s;
     h->count += ntets;
 }

@@ -566,9 +566,9 @@ static int check_args(cli *c, int npos, char **pos)
         /* issue 33's first step: the periodic mesh in memory, as .tets */
         if (!c->dual.box_given)
             return usage_error("--periodic needs --box X0,Y0,Z0,X1,Y1,Z1: the periods");
-        if (c->dual.dual || fdt_cli_interp_wanted(&c->dual) || c->stream > 0 || c->set_hash)
-            return usage_error("--periodic writes the mesh, its --hash, --check and the cells; "
-                               "not yet --dual, --interpolate, --stream or --set-hash");
+        if (c->dual.dual || fdt_cli_interp_wanted(&c->dual))
+            return usage_error("--periodic writes the mesh, its hashes, --check and the cells; "
+                               "not yet --dual or --interpolate");
         const char *vd = c->dual.voronoi ? strrchr(c->dual.voronoi, '.') : NULL;
         if (vd && !strcmp(vd, ".vtu"))
             return usage_error("--periodic's cells are a table (not .vtu polyhedra)");
@@ -580,7 +580,8 @@ static int check_args(cli *c, int npos, char **pos)
                                    "its format has no place for the image vertices' input "
                                    "ids)", c->outputs[o]);
         }
-        c->stream = -1;
+        if (c->stream <= 0) /* in memory unless asked (its slabs: --stream) */
+            c->stream = -1;
     }
     /* the dual's threads: the run's */
     c->dual.threads = c->mode == FDT_MODE_SERIAL ? 1 : c->threads < 0 ? 0 : c->threads;
@@ -903,7 +904,11 @@ static void print_stats(const fdt_result *res, const fdt_stats *st, size_t dups,
         fprintf(stderr, "  sweep             %zu parts, %zu points inserted again, at most %zu in "
                         "a part\n",
                 st->sweep_parts, st->sweep_reinserted, st->sweep_max_part);
-    if (st->engine == FDT_ENGINE_PERIODIC)
+    if (st->engine == FDT_ENGINE_PERIODIC && st->sweep_parts)
+        fprintf(stderr, "  periodic          %zu slabs streamed, %zu images with the points, "
+                        "at most %zu margin(s) tried in a slab\n",
+                st->sweep_parts, st->periodic_images, st->periodic_rounds);
+    else if (st->engine == FDT_ENGINE_PERIODIC)
         fprintf(stderr, "  periodic          %zu images with the points, %zu margin(s) tried\n",
                 st->periodic_images, st->periodic_rounds);
     if (st->cell_batches)
@@ -1072,6 +1077,8 @@ static const char *stream_refusal(const cli *c, const fdt_format *const *fmts, i
     const char *dual = fdt_cli_dual_stream_refusal(&c->dual);
     if (dual)
         return dual;
+    if (c->periodic && fdt_cli_dual_wanted(&c->dual))
+        return "a periodic run's cells need the whole mesh";
     /* the cells stream where asked to; else they take the whole mesh */
     if (fdt_cli_dual_wanted(&c->dual) && !forced)
         return "--voronoi and --density stream with --stream only";
@@ -1081,6 +1088,13 @@ static const char *stream_refusal(const cli *c, const fdt_format *const *fmts, i
         if (!strcmp(c->outputs[o], "-"))
             return "-o - (standard output) cannot stream";
         const char *name = fdt_format_name(fmts[o]);
+        if (c->periodic && !fdt_format_periodic_stream(fmts[o])) {
+            snprintf(why, len, "-o %s: a periodic run streams its rows to .tets only (format "
+                     "%s needs the whole mesh)", c->outputs[o], name);
+            return why;
+        }
+        if (c->periodic)
+            continue;
         if (fdt_stream_format_ok(c->outputs[o], name) != 1 ||
             (!forced && !strcmp(name, "tetgen"))) {
             snprintf(why, len, "-o %s: format %s needs the whole mesh (tetgen, vtu and bin "
@@ -1120,6 +1134,35 @@ static int fanout_hull(void *user, const fdt_vid *f, size_t count)
     fanout *fo = user;
     for (int i = 0; i < fo->n; i++) {
         int r = fo->sink[i].hull(fo->sink[i].user, f, count);
+        if (r) {
+            fo->failed = i;
+            return r;
+        }
+    }
+    fo->hull += count;
+    return 0;
+}
+
+/* A periodic run's rows, as fanout_tets and fanout_hull. */
+static int fanout_periodic_tets(void *user, const fdt_vid *t, const int8_t *off, size_t count)
+{
+    fanout *fo = user;
+    for (int i = 0; i < fo->n; i++) {
+        int r = fo->sink[i].periodic_tets(fo->sink[i].user, t, off, count);
+        if (r) {
+            fo->failed = i;
+            return r;
+        }
+    }
+    fo->tets += count;
+    return 0;
+}
+
+static int fanout_periodic_hull(void *user, const fdt_vid *f, const int8_t *off, size_t count)
+{
+    fanout *fo = user;
+    for (int i = 0; i < fo->n; i++) {
+        int r = fo->sink[i].periodic_hull(fo->sink[i].user, f, off, count);
         if (r) {
             fo->failed = i;
             return r;
@@ -1432,7 +1475,9 @@ static int open_engine(const cli *c, run_state *rs)
      * uniform points (bench/NOTES.md entry 108); --check's faces after it,
      * 790 MiB (entry 109) */
     unsigned long long periodic =
-        c->periodic ? (c->check ? 850ull : 700ull) * rs->n + (16ull << 20) : 0;
+        !c->periodic    ? 0
+        : rs->streaming ? 64ull * rs->n + 900ull * fdt_sweep_slab(rs->n) + (16ull << 20)
+                        : (c->check ? 850ull : 700ull) * rs->n + (16ull << 20);
     if (periodic > rs->estimate)
         rs->estimate = periodic;
     if (c->memory_limit && rs->estimate > c->memory_limit) {
@@ -1458,7 +1503,8 @@ static int open_stream_writers(const cli *c, run_state *rs)
     for (int o = 0; o < c->n_outputs; o++) {
         char err[1024];
         int r = fdt_stream_writer_open(&fo->w[o], c->outputs[o], fdt_format_name(rs->fmts[o]),
-                                       rs->xyz, rs->n, 0, err, sizeof err);
+                                       rs->xyz, rs->n, c->periodic ? FDT_STREAM_PERIODIC : 0,
+                                       err, sizeof err);
         if (r != FDT_OK) {
             say("%s", err);
             (void)fanout_close(fo, 0);
@@ -1483,7 +1529,8 @@ static int triangulate(const cli *c, run_state *rs)
     progress_phase(&rs->prog, "merge"); /* "triangulate" at the library's first report */
     int r;
     char derr[FDT_IO_PATH + 600];
-    fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &rs->fo};
+    fdt_sink sink = {sizeof sink, fanout_tets, fanout_hull, &rs->fo, fanout_periodic_tets,
+                     fanout_periodic_hull};
     if (rs->streaming && fdt_cli_dual_wanted(&c->dual)) {
         /* the cells as their points' last tets leave, spooled */
         fdt_voronoi_options o;

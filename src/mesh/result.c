@@ -841,14 +841,17 @@ int fdt_result_hash_threads(fdt_result *r, int threads, uint64_t *hash)
 
 int fdt_result_set_hash(const fdt_result *r, uint64_t *hash)
 {
-    if (!r || !hash || r->periodic)
+    if (!r || !hash)
         return FDT_EINVAL;
     if (r->streamed) {
         *hash = r->set_hash;
         return FDT_OK;
     }
     fdt_sethash h = {0, 0};
-    fdt_sethash_add_n(&h, (const uint32_t *)r->tets, r->ntets);
+    if (r->periodic)
+        fdt_sethash_add_periodic(&h, (const uint32_t *)r->tets, r->tet_off, r->ntets);
+    else
+        fdt_sethash_add_n(&h, (const uint32_t *)r->tets, r->ntets);
     *hash = fdt_sethash_value(&h);
     return FDT_OK;
 }

@@ -189,4 +189,4 @@ static int bin_finish(fdt_stream_out *s, char *err, size_t errlen)
     return FDT_IO_OK;
 }
 
-const fdt_stream_fmt fdt_stream_bin = {1, bin_begin, bin_tets, bin_hull, bin_finish};
+const fdt_stream_fmt fdt_stream_bin = {1, bin_begin, bin_tets, bin_hull, bin_finish, NULL};

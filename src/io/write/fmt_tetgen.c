@@ -166,4 +166,4 @@ static int tg_finish(fdt_stream_out *s, char *err, size_t errlen)
     return FDT_IO_OK;
 }
 
-const fdt_stream_fmt fdt_stream_tetgen = {3, tg_begin, tg_tets, tg_hull, tg_finish};
+const fdt_stream_fmt fdt_stream_tetgen = {3, tg_begin, tg_tets, tg_hull, tg_finish, NULL};

@@ -293,4 +293,4 @@ static int vtu_finish(fdt_stream_out *s, char *err, size_t errlen)
     return FDT_IO_OK;
 }
 
-const fdt_stream_fmt fdt_stream_vtu = {1, vtu_begin, vtu_tets, NULL, vtu_finish};
+const fdt_stream_fmt fdt_stream_vtu = {1, vtu_begin, vtu_tets, NULL, vtu_finish, NULL};

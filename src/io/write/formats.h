@@ -45,6 +45,13 @@ typedef struct fdt_stream_out {
     fdt_vid *hull;           /* a format that writes the hull after the
                                 tets (binary) keeps it here, 3 a face */
     size_t hull_cap;
+    /* A periodic run's rows spooled (.tets, src/io/write/fmt_tets.c):
+     * ascending runs of 28-byte records, where each run starts, and the
+     * last record's key. */
+    FILE *spool;
+    uint64_t *runs;
+    size_t nruns, runs_cap;
+    uint64_t last[4];
 } fdt_stream_out;
 
 typedef struct fdt_stream_fmt {
@@ -58,6 +65,9 @@ typedef struct fdt_stream_fmt {
     /* Writes what follows and patches the counts; the caller closes and
      * renames. FDT_IO_OK or a code with err. */
     int (*finish)(fdt_stream_out *s, char *err, size_t errlen);
+    /* A periodic run's rows (FDT_STREAM_PERIODIC): NULL where the format
+     * takes none; tets NULL where it takes nothing else. */
+    void (*periodic_tets)(fdt_stream_out *s, const fdt_vid *t, const int8_t *off, size_t count);
 } fdt_stream_fmt;
 
 typedef struct fdt_format {
@@ -120,6 +130,8 @@ int fdt_put_tetgen_neigh(out_file *o, const fdt_mesh_view *m, const void *prep, 
 int fdt_put_vtu(out_file *o, const fdt_mesh_view *m, const void *prep, char *err, size_t errlen);
 int fdt_put_vtk(out_file *o, const fdt_mesh_view *m, const void *prep, char *err, size_t errlen);
 extern const fdt_stream_fmt fdt_stream_vtu;
+/* src/io/write/fmt_tets.c: a periodic run's rows, merged at the end */
+extern const fdt_stream_fmt fdt_stream_tets;
 /* src/io/write/fmt_tetgen.c: .node, .ele, .face (no .neigh: no neighbours) */
 extern const fdt_stream_fmt fdt_stream_tetgen;
 /* src/io/write/fmt_bin.c: the compact binary format (README, "Binary mesh") */

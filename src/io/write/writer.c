@@ -1293,7 +1293,7 @@ int fdt_same_file(const char *a, const char *b)
 
 const fdt_format fdt_formats[] = {
     {"tets", {".tets"}, "canonical sorted text, one tet a line (the hash's bytes)", 0,
-     FDT_LAYOUT_FILE, FDT_NEED_SORTED, 1, {NULL}, {fdt_put_tets}, NULL, NULL},
+     FDT_LAYOUT_FILE, FDT_NEED_SORTED, 1, {NULL}, {fdt_put_tets}, NULL, &fdt_stream_tets},
     {"tetgen", {".ele"}, "TetGen .node/.ele/.face/.neigh, 0-based", 0, FDT_LAYOUT_FAMILY,
      FDT_NEED_NBRS, 4, {".node", ".ele", ".face", ".neigh"},
      {fdt_put_tetgen_node, fdt_put_tetgen_ele, fdt_put_tetgen_face, fdt_put_tetgen_neigh},
@@ -1657,6 +1657,11 @@ static int periodic_laid_out(const fdt_format *f)
 int fdt_format_periodic(const fdt_format *f)
 {
     return periodic_laid_out(f) || !strcmp(f->name, "tets") || !strcmp(f->name, "bin");
+}
+
+int fdt_format_periodic_stream(const fdt_format *f)
+{
+    return f->stream && f->stream->periodic_tets;
 }
 
 /* One public write at a time: the temporary-file registry above (and the

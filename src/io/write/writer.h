@@ -45,6 +45,8 @@ int fdt_format_needs(const fdt_format *f, int all_faces);
  * or laid out in space with its image vertices' input ids (.vtu, .vtk,
  * .msh); fdt_write_mesh refuses the others. */
 int fdt_format_periodic(const fdt_format *f);
+/* Whether f streams a periodic run's rows (FDT_STREAM_PERIODIC: .tets). */
+int fdt_format_periodic_stream(const fdt_format *f);
 /* "name (.ext, .ext)" of every row, comma separated, for messages. */
 const char *fdt_format_list(void);
 

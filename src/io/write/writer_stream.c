@@ -54,7 +54,7 @@ int fdt_stream_format_ok(const char *path, const char *format)
     const fdt_format *f = pick(path, format);
     if (!f)
         return FDT_EINVAL;
-    return f->stream != NULL && f->layout != FDT_LAYOUT_DIR;
+    return f->stream != NULL && f->stream->tets && f->layout != FDT_LAYOUT_DIR;
 }
 
 static void abandon_all(fdt_stream_writer *w)
@@ -67,6 +67,9 @@ static void abandon_all(fdt_stream_writer *w)
 static void writer_free(fdt_stream_writer *w)
 {
     free(w->s.hull);
+    free(w->s.runs);
+    if (w->s.spool)
+        fclose(w->s.spool);
     free(w);
 }
 
@@ -85,13 +88,14 @@ int fdt_stream_writer_open(fdt_stream_writer **wp, const char *path, const char 
         snprintf(what, sizeof what, "unknown output format (use %s)", fdt_format_list());
         return set_err(diag, diag_size, FDT_EINVAL, path, what);
     }
-    if (!f->stream) {
+    int periodic = (flags & FDT_STREAM_PERIODIC) != 0;
+    if (!f->stream || !(periodic ? f->stream->periodic_tets != NULL : f->stream->tets != NULL)) {
         char what[160];
-        snprintf(what, sizeof what, "format %s cannot be streamed (tetgen, vtu and bin can)",
-                 f->name);
+        snprintf(what, sizeof what, "format %s cannot be streamed (%s)", f->name,
+                 periodic ? "a periodic run's rows stream to tets" : "tetgen, vtu and bin can");
         return set_err(diag, diag_size, FDT_EINVAL, path, what);
     }
-    if (flags & ~(FDT_STREAM_IDS64 | FDT_STREAM_NO_POINTS))
+    if (flags & ~(FDT_STREAM_IDS64 | FDT_STREAM_NO_POINTS | FDT_STREAM_PERIODIC))
         return set_err(diag, diag_size, FDT_EINVAL, path, "unknown stream flags");
     fdt_stream_writer *w = calloc(1, sizeof *w);
     if (!w)
@@ -176,22 +180,66 @@ static int ids_ok(fdt_stream_writer *w, const fdt_vid *v, size_t count, const ch
     return 1;
 }
 
+/* A batch the writer cannot take: NULL, or rows of the other kind (a
+ * periodic run's to a plain writer, or the reverse). */
+static int batch_ok(fdt_stream_writer *w, const void *rows, size_t count, int periodic,
+                    const char *what)
+{
+    const char *why = count > 0 && !rows ? "is NULL"
+                      : periodic != ((w->s.flags & FDT_STREAM_PERIODIC) != 0)
+                          ? (periodic ? "of a periodic run, to a writer opened without "
+                                        "FDT_STREAM_PERIODIC"
+                                      : "without offsets, to a writer opened with "
+                                        "FDT_STREAM_PERIODIC")
+                          : NULL;
+    if (!why)
+        return 1;
+    char m[160];
+    snprintf(m, sizeof m, "a batch of %s %s", what, why);
+    w->failed = 1;
+    w->code = FDT_EINVAL;
+    set_err(w->diag, sizeof w->diag, 0, w->s.files[0].path, m);
+    return 0;
+}
+
 static int sink_tets(void *user, const fdt_vid *tets, size_t count)
 {
     fdt_stream_writer *w = user;
     if (w->failed)
         return w->code;
-    if (count > 0 && !tets) {
-        w->failed = 1;
-        w->code = FDT_EINVAL;
-        set_err(w->diag, sizeof w->diag, 0, w->s.files[0].path, "a batch of tets is NULL");
-        return w->code;
-    }
-    if (!ids_ok(w, tets, 4 * count, "a tet"))
+    if (!batch_ok(w, tets, count, 0, "tets") || !ids_ok(w, tets, 4 * count, "a tet"))
         return w->code;
     w->f->stream->tets(&w->s, tets, count);
     w->s.n_tets += count;
     return check_files(w);
+}
+
+static int sink_periodic_tets(void *user, const fdt_vid *tets, const int8_t *offsets,
+                              size_t count)
+{
+    fdt_stream_writer *w = user;
+    if (w->failed)
+        return w->code;
+    if (!batch_ok(w, tets, count, 1, "tets") || !batch_ok(w, offsets, count, 1, "offsets") ||
+        !ids_ok(w, tets, 4 * count, "a tet"))
+        return w->code;
+    w->f->stream->periodic_tets(&w->s, tets, offsets, count);
+    w->s.n_tets += count;
+    return check_files(w);
+}
+
+/* A periodic run's hull faces: counted (.tets has no place for them). */
+static int sink_periodic_hull(void *user, const fdt_vid *faces, const int8_t *offsets,
+                              size_t count)
+{
+    fdt_stream_writer *w = user;
+    if (w->failed)
+        return w->code;
+    if (!batch_ok(w, faces, count, 1, "hull faces") ||
+        !batch_ok(w, offsets, count, 1, "offsets") || !ids_ok(w, faces, 3 * count, "a hull face"))
+        return w->code;
+    w->s.n_hull += count;
+    return FDT_OK;
 }
 
 static int sink_hull(void *user, const fdt_vid *faces, size_t count)
@@ -199,14 +247,7 @@ static int sink_hull(void *user, const fdt_vid *faces, size_t count)
     fdt_stream_writer *w = user;
     if (w->failed)
         return w->code;
-    if (count > 0 && !faces) {
-        w->failed = 1;
-        w->code = FDT_EINVAL;
-        set_err(w->diag, sizeof w->diag, 0, w->s.files[0].path,
-                "a batch of hull faces is NULL");
-        return w->code;
-    }
-    if (!ids_ok(w, faces, 3 * count, "a hull face"))
+    if (!batch_ok(w, faces, count, 0, "hull faces") || !ids_ok(w, faces, 3 * count, "a hull face"))
         return w->code;
     if (w->f->stream->hull)
         w->f->stream->hull(&w->s, faces, count);
@@ -223,6 +264,8 @@ int fdt_stream_writer_sink(fdt_stream_writer *w, fdt_sink *sink)
     sink->tets = sink_tets;
     sink->hull = sink_hull;
     sink->user = w;
+    sink->periodic_tets = sink_periodic_tets;
+    sink->periodic_hull = sink_periodic_hull;
     return FDT_OK;
 }
 
