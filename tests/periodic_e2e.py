@@ -101,7 +101,8 @@ def clusters(n, lo, length, seed):
 
 
 def case(name, pts, lo, length, cgal=True, settings=(["-t", "2"], ["-t", "3"],
-         ["-t", "2", "--mode", "shared"], ["-t", "3", "--mode", "message"])):
+         ["-t", "2", "--mode", "shared"], ["-t", "3", "--mode", "message"],
+         ["-t", "2", "--stream"])):
     box = ",".join("%.17g" % v for v in (lo, lo, lo, lo + length, lo + length, lo + length))
     src = os.path.join(SCRATCH, name + ".xyz")
     write_points(src, pts)
@@ -254,6 +255,36 @@ def family(name, n):
                   for k in range(3)) for p in pts]
 
 
+def stream():
+    """Streamed in slabs (2^18 points a slab at most: 273,200 points make
+    two) on a channel periodic in x and z (slabs along x, the longest
+    period): the .tets is the in-memory run's byte for byte and the set
+    hashes equal (case() streams every case in one slab; test_periodic.c
+    has parts of every size)."""
+    for name, pts, axes in (("channel", channel(270000, 40, (0.0, -0.5, 0.0), (2.0, 0.5, 1.0),
+                                                "xz", 12), "xz"),):
+        box = "0,-0.5,0,2,0.5,1"
+        src = os.path.join(SCRATCH, "s_" + name + ".xyz")
+        write_points(src, pts)
+        mem, st = os.path.join(SCRATCH, "s_mem.tets"), os.path.join(SCRATCH, "s_st.tets")
+        r1 = frontdt(src, "--periodic", axes, "--box", box, "-o", mem, "--set-hash", "-q",
+                     "-t", "2")
+        r2 = frontdt(src, "--periodic", axes, "--box", box, "-o", st, "--stream", "--set-hash",
+                     "-t", "3", "--stats")
+        expect(r1.returncode == 0 and r2.returncode == 0, "stream %s: exit %d, %d: %s"
+               % (name, r1.returncode, r2.returncode, r2.stderr))
+        if r1.returncode or r2.returncode:
+            continue
+        expect("2 slabs streamed" in r2.stderr, "stream %s: not two slabs: %s" % (name, r2.stderr))
+        expect(open(mem, "rb").read() == open(st, "rb").read(),
+               "stream %s: the streamed .tets differs" % name)
+        sh = lambda out: [x for x in out.splitlines() if x.startswith("set-hash: ")]
+        expect(sh(r1.stdout) == sh(r2.stdout) and len(sh(r1.stdout)) == 1,
+               "stream %s: set hashes %s, %s" % (name, r1.stdout, r2.stdout))
+        print("stream %s: %d points in two slabs, the in-memory .tets and set hash" %
+              (name, len(pts)))
+
+
 def errors():
     src = os.path.join(SCRATCH, "err.xyz")
     pts = uniform(200, 0.0, 1.0, 3)
@@ -273,7 +304,10 @@ def errors():
     expect(r.returncode == 2 and "one copy of the box" in r.stderr and not os.path.exists(out),
            "too few points: exit %d, %s" % (r.returncode, r.stderr))
     for args, word in ((["--periodic", "xz"], "needs --box"),
-                       (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "--stream"], "--stream"),
+                       (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "--stream", "-o",
+                         os.path.join(SCRATCH, "m.vtu")], ".tets only"),
+                       (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "--stream", "--voronoi",
+                         os.path.join(SCRATCH, "m.vor")], "whole mesh"),
                        (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "-o",
                          os.path.join(SCRATCH, "m.ele")], "image vertices"),
                        (["--periodic", "xq", "--box", "0,0,0,1,1,1"], "axes")):
@@ -305,6 +339,7 @@ def main():
     cells("channel", channel(1500, 8, lo, hi, "xz", 7), lo, hi, "xz")
     cells("duct", channel(1200, 6, lo, hi, "x", 8), lo, hi, "x")
     cells("slab", channel(1200, 7, lo, hi, "yz", 9), lo, hi, "yz")
+    stream()
     errors()
     print("periodic_e2e: %d checks, %d failed" % (checks, len(failures)))
     shutil.rmtree(SCRATCH, ignore_errors=True)

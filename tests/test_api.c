@@ -533,6 +533,22 @@ static int sink_count(void *user, const fdt_vid *tets, size_t count)
     return 0;
 }
 
+/* A periodic run's rows streamed: counted, each batch checked ascending
+ * by least vertex; stop_after batches, then a stop. */
+typedef struct periodic_rows {
+    size_t rows, unsorted, stop_after;
+} periodic_rows;
+
+static int periodic_count(void *user, const fdt_vid *t, const int8_t *off, size_t count)
+{
+    periodic_rows *p = user;
+    (void)off;
+    for (size_t i = 1; i < count; i++)
+        p->unsorted += t[4 * i - 4] > t[4 * i];
+    p->rows += count;
+    return p->stop_after && p->rows ? 1 : 0;
+}
+
 /* A periodic run through the API (issue 33; its meshes are tested in
  * tests/test_periodic.c and tests/periodic_e2e.py): the first release's
  * settings size runs plain; periodic bits beyond z are refused; the result
@@ -571,7 +587,9 @@ static void test_periodic_api(void)
            fdt_result_num_hull_faces(r) == 0);
     uint64_t h;
     EXPECT(fdt_result_hash(r, &h) == FDT_OK && fdt_result_sort(r) == FDT_OK);
-    EXPECT(fdt_result_set_hash(r, &h) == FDT_EINVAL);
+    uint64_t set_hash = 0;
+    EXPECT(fdt_result_set_hash(r, &set_hash) == FDT_OK);
+    size_t ntets = fdt_result_num_tets(r);
     size_t cnt;
     const fdt_vid *fv, *ids;
     const fdt_tid *ft;
@@ -592,8 +610,20 @@ static void test_periodic_api(void)
     double bary[4];
     EXPECT(fdt_locate(r, xyz, N, xyz, 1, &tet, bary, 1) == FDT_EINVAL);
     fdt_result_free(&r);
+    /* streamed: a sink without periodic_tets is refused; with it, the
+     * rows come ascending in each batch, the set hash is the in-memory
+     * run's; a nonzero return stops the run */
     fdt_sink sink = {sizeof sink, sink_count, NULL, NULL, NULL, NULL};
-    EXPECT(fdt_triangulate_stream(ctx, xyz, N, &sink, &r) == FDT_EINVAL);
+    EXPECT(fdt_triangulate_stream(ctx, xyz, N, &sink, &r) == FDT_EINVAL && !r);
+    periodic_rows pr = {0, 0, 0};
+    fdt_sink ps = {sizeof ps, NULL, NULL, &pr, periodic_count, NULL};
+    EXPECT(fdt_triangulate_stream(ctx, xyz, N, &ps, &r) == FDT_OK);
+    uint64_t sh = 0;
+    EXPECT(pr.rows == ntets && !pr.unsorted && fdt_result_set_hash(r, &sh) == FDT_OK &&
+           sh == set_hash && fdt_result_num_tets(r) == 0);
+    fdt_result_free(&r);
+    pr.stop_after = 1;
+    EXPECT(fdt_triangulate_stream(ctx, xyz, N, &ps, &r) == FDT_ECANCELED && !r);
     fdt_close(&ctx);
     /* periodic in x and z only: the walls y = 0 and y = 1 cut the cells
      * that reach them, the hull's points' among them */

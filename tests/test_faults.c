@@ -489,6 +489,62 @@ static int sc_pcheck(void *arg, const char **bad)
     return rc;
 }
 
+/* A periodic run streamed to a .tets (FDT_STREAM_PERIODIC: the rows
+ * spooled, merged at the commit) under injection: one file with the
+ * in-memory .tets's bytes (want_hash, fdt_result_hash's FNV-1a of them),
+ * or an error and no file. */
+typedef struct pstream_arg {
+    const ptset *ps;
+    unsigned periodic;
+    const char *dir;
+    uint64_t want_hash;
+} pstream_arg;
+
+static int sc_pstream(void *arg, const char **bad)
+{
+    pstream_arg *a = arg;
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.n_threads = 1;
+    s.periodic = a->periodic;
+    const double unit[6] = {0, 0, 0, 1, 1, 1};
+    memcpy(s.periodic_box, unit, sizeof unit);
+    char path[1024], diag[1024] = "";
+    snprintf(path, sizeof path, "%s/per.tets", a->dir);
+    fdt_context *ctx = NULL;
+    int rc = fdt_open(&ctx, &s);
+    fdt_stream_writer *w = NULL;
+    if (rc == FDT_OK)
+        rc = fdt_stream_writer_open(&w, path, NULL, a->ps->xyz, a->ps->n, FDT_STREAM_PERIODIC,
+                                    diag, sizeof diag);
+    if (rc == FDT_OK) {
+        fdt_sink sink;
+        fdt_result *r = NULL;
+        int e = fdt_stream_writer_sink(w, &sink);
+        if (e == FDT_OK)
+            e = fdt_triangulate_stream(ctx, a->ps->xyz, a->ps->n, &sink, &r);
+        fdt_result_free(&r);
+        rc = fdt_stream_writer_close(&w, e == FDT_OK, diag, sizeof diag);
+        rc = e != FDT_OK ? e : rc;
+    }
+    fdt_close(&ctx);
+    if (count_entries(a->dir) != (rc == FDT_OK))
+        *bad = rc != FDT_OK ? "files left after a failed periodic stream"
+                            : "no file after a periodic stream";
+    if (rc == FDT_OK) {
+        FILE *f = fopen(path, "rb");
+        uint64_t h = 14695981039346656037ull;
+        for (int c; f && (c = getc(f)) != EOF;)
+            h = (h ^ (uint64_t)(unsigned char)c) * 1099511628211ull;
+        if (f)
+            fclose(f);
+        if (h != a->want_hash)
+            *bad = "the streamed periodic .tets is not the in-memory one";
+    }
+    empty_dir(a->dir);
+    return rc;
+}
+
 /* A streamed run (fdt_triangulate_stream) under injection: it succeeds
  * with the in-memory run's set hash and tet count, or fails with nothing
  * returned; the sink counts what reached it (less than the mesh on a
@@ -1401,6 +1457,11 @@ int main(int argc, char **argv)
                 snprintf(pn, sizeof pn, "periodic check %s %s", pa_i ? "x z" : "x y z", ps->name);
                 scenario sk = {pn, FDT_ENOMEM, sc_pcheck, &ka};
                 inject_all(&sk);
+                pstream_arg sa = {&w, pa.periodic, outdir, pa.want_hash};
+                snprintf(pn, sizeof pn, "periodic stream %s %s", pa_i ? "x z" : "x y z",
+                         ps->name);
+                scenario ss = {pn, FDT_ENOMEM, sc_pstream, &sa};
+                inject_all(&ss);
                 static const char *const pext[3] = {".fdtb", ".vtu", ".msh"};
                 for (int e = 0; e < 3 && pa_i; e++) {
                     pwrite_arg wa = {pr, &w, outdir, pext[e]};

@@ -224,7 +224,7 @@ static void test_refusals(const double *xyz, size_t n, const fdt_result *mem)
     EXPECT(fdt_stream_writer_open(&w, path_in("r.fdtb"), "nope", xyz, n, 0, diag,
                                   sizeof diag) == FDT_EINVAL && w == NULL &&
            strstr(diag, "unknown output format") && strstr(diag, "bin"));
-    EXPECT(fdt_stream_writer_open(&w, path_in("r.fdtb"), NULL, xyz, n, 4, diag,
+    EXPECT(fdt_stream_writer_open(&w, path_in("r.fdtb"), NULL, xyz, n, 8, diag,
                                   sizeof diag) == FDT_EINVAL && strstr(diag, "flags"));
     /* a path whose temporary name cannot fit */
     static char longp[5000];
@@ -452,6 +452,106 @@ static void test_write_errors(const double *xyz, size_t n, const fdt_result *mem
         unlink(path_in(outs[o]));
 }
 
+/*
+ * A periodic run's rows (FDT_STREAM_PERIODIC): streamed in memory-sized
+ * runs (rows dealt to five runs, each ascending, the runs in turn, so the
+ * merge has five cursors), and through fdt_triangulate_stream, the .tets
+ * is fdt_write_mesh's byte for byte; the kinds do not mix.
+ */
+static void test_periodic(const double *xyz, size_t n)
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.periodic = 7;
+    const double box[6] = {0, 0, 0, 1, 1, 1};
+    memcpy(s.periodic_box, box, sizeof box);
+    fdt_context *ctx = NULL;
+    CHECK(fdt_open(&ctx, &s) == FDT_OK);
+    fdt_result *mem = NULL;
+    CHECK(fdt_triangulate(ctx, xyz, n, &mem) == FDT_OK);
+    char diag[1024];
+    CHECK(fdt_write_mesh(mem, xyz, n, path_in("p_mem.tets"), NULL, diag, sizeof diag) == FDT_OK);
+    size_t want_len, got_len;
+    unsigned char *want = slurp(path_in("p_mem.tets"), &want_len);
+    const fdt_vid *t = fdt_result_tets(mem);
+    const int8_t *off = fdt_result_tet_offsets(mem);
+    size_t nt = fdt_result_num_tets(mem);
+    CHECK(want && t && off && nt > 100);
+
+    fdt_stream_writer *w = NULL;
+    EXPECT(fdt_stream_writer_open(&w, path_in("p.vtu"), NULL, xyz, n, FDT_STREAM_PERIODIC, diag,
+                                  sizeof diag) == FDT_EINVAL && !w && strstr(diag, "periodic"));
+    CHECK(fdt_stream_writer_open(&w, path_in("p.tets"), NULL, xyz, n, FDT_STREAM_PERIODIC, diag,
+                                 sizeof diag) == FDT_OK);
+    fdt_sink sink;
+    CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+    fdt_vid *rt = malloc(nt * 4 * sizeof *rt);
+    int8_t *ro = malloc(nt * 12);
+    CHECK(rt && ro);
+    for (int run = 0; run < 5; run++) {
+        size_t k = 0;
+        for (size_t i = run; i < nt; i += 5, k++) {
+            memcpy(rt + 4 * k, t + 4 * i, 4 * sizeof *rt);
+            memcpy(ro + 12 * k, off + 12 * i, 12);
+        }
+        /* each run in two batches */
+        EXPECT(sink.periodic_tets(sink.user, rt, ro, k / 2) == 0);
+        EXPECT(sink.periodic_tets(sink.user, rt + 4 * (k / 2), ro + 12 * (k / 2), k - k / 2) ==
+               0);
+    }
+    EXPECTF(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_OK, "%s", diag);
+    unsigned char *got = slurp(path_in("p.tets"), &got_len);
+    EXPECTF(got && got_len == want_len && !memcmp(got, want, want_len),
+            "the merged rows: %zu bytes, fdt_write_mesh %zu", got_len, want_len);
+    free(got);
+
+    /* the run streamed (one slab at this size: test_periodic.c has parts) */
+    CHECK(fdt_stream_writer_open(&w, path_in("p2.tets"), NULL, xyz, n, FDT_STREAM_PERIODIC,
+                                 diag, sizeof diag) == FDT_OK);
+    CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+    fdt_result *sr = NULL;
+    EXPECT(fdt_triangulate_stream(ctx, xyz, n, &sink, &sr) == FDT_OK);
+    uint64_t h1 = 0, h2 = 1;
+    EXPECT(fdt_result_set_hash(mem, &h1) == FDT_OK && fdt_result_set_hash(sr, &h2) == FDT_OK &&
+           h1 == h2);
+    fdt_stats st;
+    EXPECT(fdt_result_num_tets(sr) == 0 && fdt_result_stats(sr, &st) == FDT_OK && st.tets == nt);
+    EXPECTF(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_OK, "%s", diag);
+    got = slurp(path_in("p2.tets"), &got_len);
+    EXPECT(got && got_len == want_len && !memcmp(got, want, want_len));
+    free(got);
+    fdt_result_free(&sr);
+
+    /* the kinds do not mix: a plain batch to a periodic writer, a periodic
+     * one to a plain writer, a plain sink to a periodic run */
+    CHECK(fdt_stream_writer_open(&w, path_in("p3.tets"), NULL, xyz, n, FDT_STREAM_PERIODIC,
+                                 diag, sizeof diag) == FDT_OK);
+    CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+    EXPECT(sink.tets(sink.user, t, 1) == FDT_EINVAL);
+    EXPECT(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_EINVAL &&
+           strstr(diag, "without offsets"));
+    EXPECT(access(path_in("p3.tets"), F_OK) != 0);
+    CHECK(fdt_stream_writer_open(&w, path_in("p3.vtu"), NULL, xyz, n, 0, diag, sizeof diag) ==
+          FDT_OK);
+    CHECK(fdt_stream_writer_sink(w, &sink) == FDT_OK);
+    EXPECT(sink.periodic_tets(sink.user, t, off, 1) == FDT_EINVAL);
+    EXPECT(fdt_stream_writer_close(&w, 1, diag, sizeof diag) == FDT_EINVAL &&
+           strstr(diag, "periodic"));
+    fdt_sink plain = sink;
+    plain.periodic_tets = NULL;
+    EXPECT(fdt_triangulate_stream(ctx, xyz, n, &plain, &sr) == FDT_EINVAL && !sr);
+    plain.periodic_tets = sink.periodic_tets;
+    plain.struct_size = offsetof(fdt_sink, periodic_tets); /* an older caller */
+    EXPECT(fdt_triangulate_stream(ctx, xyz, n, &plain, &sr) == FDT_EINVAL && !sr);
+    free(rt);
+    free(ro);
+    free(want);
+    fdt_result_free(&mem);
+    fdt_close(&ctx);
+    EXPECT(unlink(path_in("p_mem.tets")) == 0 && unlink(path_in("p.tets")) == 0 &&
+           unlink(path_in("p2.tets")) == 0);
+}
+
 int main(void)
 {
     CHECK(mkdtemp(dir));
@@ -560,6 +660,7 @@ int main(void)
     test_bin_flags(xyz, n, mem);
     test_refusals(xyz, n, mem);
     test_write_errors(xyz, n, mem);
+    test_periodic(xyz, n);
 
     fdt_result_free(&mem);
     fdt_close(&ctx);
