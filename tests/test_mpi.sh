@@ -125,7 +125,8 @@ grep -q -- "--hash gathers the mesh to rank 0" "$work/q.err" || fail "--hash wit
 declare -A optval=([--input-format]=xyz [--search]=kd [--leaf]=7
   [--voronoi]="$work/o.cells" [--density]="$work/o.dens"
   [--voronoi-format]="%i;%v;%n;%f --voronoi $work/o.cells"
-  [--box]="-1,-1,-1,2,2,2 --density $work/o.dens")
+  [--box]="-1,-1,-1,2,2,2 --density $work/o.dens"
+  [--periodic]="xyz --box -0.01,-0.01,-0.01,1.01,1.01,1.01")
 # "-x VALUE" and "--name VALUE" of each option line of a --help
 help_opts() {
   sed -nE 's/^  (-(.), |    )--([a-z-]+)( ([^ ]+))?.*/-\2 \5\n--\3 \5/p' | grep -v '^- \|^-$' |
@@ -620,6 +621,41 @@ if [[ ${#oversub[@]} -gt 0 ]]; then
 else
   echo "skip: SIGINT (not Open MPI's launcher)"
 fi
+
+# Periodic domains (issue 33): every rank reads the input and builds its
+# share of the box's slabs; the rows gathered to rank 0 are frontdt's .tets
+# byte for byte, with its --hash and --set-hash, at 1-4 ranks, periodic
+# on three axes and on two (x and z, walls of points across y); a point
+# outside the box gives frontdt's message and code and no file.
+"$gen" uniform 3000 41 "$work/pu.xyz" >/dev/null
+awk '{ print $1, 0.02 + 0.96 * $2, $3 }
+     END { for (i = 0; i < 20; i++) for (j = 0; j < 20; j++)
+             print (i + 0.5) / 20, 0.001, (j + 0.5) / 20 "\n" (i + 0.5) / 20, 0.999, (j + 0.5) / 20 }' \
+  "$work/pu.xyz" >"$work/pch.xyz"
+for spec in "pu xyz" "pch x,z"; do
+  set -- $spec
+  ref=$("$frontdt" "$work/$1.xyz" --periodic "$2" --box 0,0,0,1,1,1 -o "$work/$1.ref.tets" \
+    --hash --set-hash -q | sort)
+  [[ -n $ref ]] || fail "periodic $1: frontdt gave no hashes"
+  for np in 1 2 3 4; do
+    checks=$((checks + 1))
+    got=$(mpi "$np" 300 "$fmpi" "$work/$1.xyz" --periodic "$2" --box 0,0,0,1,1,1 \
+      -o "$work/$1.$np.tets" --hash --set-hash -q | sort)
+    [[ $got == "$ref" ]] && cmp -s "$work/$1.ref.tets" "$work/$1.$np.tets" ||
+      fail "periodic $1 on $np ranks: '$got', frontdt '$ref'"
+  done
+done
+checks=$((checks + 1))
+printf '0.5 1.5 0.5\n' >>"$work/pu.xyz"
+want=$("$frontdt" "$work/pu.xyz" --periodic xyz --box 0,0,0,1,1,1 -q 2>&1)
+wcode=$?
+mpi 3 300 "$fmpi" "$work/pu.xyz" --periodic xyz --box 0,0,0,1,1,1 -o "$work/pbad.tets" \
+  2>"$work/pbad.err"
+gcode=$?
+got=$(head -1 "$work/pbad.err") # then mpirun's own lines
+[[ $gcode -eq $wcode && $wcode -ne 0 && ${got#frontdt-mpi: } == "${want#frontdt: }" &&
+   ! -e $work/pbad.tets ]] ||
+  fail "periodic, a point outside the box: exit $gcode '$got', frontdt $wcode '$want'"
 
 echo "$checks checks, $fails failures"
 [[ $fails -eq 0 ]]

@@ -28,6 +28,7 @@
 #include "front/seed.h"
 #include "base/sethash.h"
 #include "front/sink.h"
+#include "api/parts.h"
 
 struct fdt_context {
     fdt_settings s;
@@ -565,15 +566,18 @@ static int periodic_box_scaled(fdt_context *ctx, int e, fdt_periodic_box *b)
  * part. *sum gets the counts (images summed, the most rounds, rows).
  */
 static int periodic_stream(fdt_context *ctx, const fdt_prepared *pr, const fdt_periodic_box *b,
-                           int nthreads, const fdt_sink *user, fdt_periodic_mesh *sum,
-                           fdt_sethash *h, size_t *nparts)
+                           int nthreads, const fdt_sink *user, const unsigned share[2],
+                           fdt_periodic_mesh *sum, fdt_sethash *h, size_t *nparts)
 {
     fdt_periodic_parts parts;
-    int err = fdt_periodic_parts_make(pr->p, (uint32_t)pr->m, b, fdt_sweep_slab(pr->m), &parts);
+    /* a share of the parts (frontdt-mpi): at least a part a sharer */
+    uint64_t slab = fdt_sweep_slab(pr->m), each = (pr->m + share[1] - 1) / share[1];
+    int err = fdt_periodic_parts_make(pr->p, (uint32_t)pr->m, b,
+                                      (uint32_t)(each && each < slab ? each : slab), &parts);
     if (err)
         return err;
     *nparts = parts.nparts;
-    for (uint32_t k = 0; k < parts.nparts && !err; k++) {
+    for (uint32_t k = share[0]; k < parts.nparts && !err; k += share[1]) {
         fdt_periodic_mesh pm;
         err = fdt_periodic_build_part(pr->p, (uint32_t)pr->m, pr->orig, b, &parts, k, nthreads,
                                       &pm, ctx->diag, sizeof ctx->diag);
@@ -611,7 +615,7 @@ static int periodic_stream(fdt_context *ctx, const fdt_prepared *pr, const fdt_p
  * slab to the sink).
  */
 static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *user,
-                        fdt_result **out)
+                        const unsigned share[2], fdt_result **out)
 {
     fdt_mode mode;
     int nthreads;
@@ -637,7 +641,7 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, const fdt
         err = periodic_box_scaled(ctx, pr.scale_exp, &b);
     double t1 = fdt_now_s();
     if (!err && user) {
-        err = periodic_stream(ctx, &pr, &b, nthreads, user, &pm, &h, &nparts);
+        err = periodic_stream(ctx, &pr, &b, nthreads, user, share, &pm, &h, &nparts);
     } else if (!err) {
         err = fdt_periodic_build(pr.p, (uint32_t)pr.m, pr.orig, &b, nthreads, &pm, ctx->diag,
                                  sizeof ctx->diag);
@@ -721,7 +725,8 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
                           : "a periodic run streams to a sink with periodic_tets set");
             return FDT_EINVAL;
         }
-        return run_periodic(ctx, xyz, n, user, out);
+        static const unsigned all[2] = {0, 1};
+        return run_periodic(ctx, xyz, n, user, all, out);
     }
     if (user && !user->tets) {
         snprintf(ctx->diag, sizeof ctx->diag, "the sink has no tets callback");
@@ -814,6 +819,23 @@ int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
         return FDT_EINVAL;
     *out = NULL;
     return run(ctx, xyz, n, sink, NULL, out);
+}
+
+int fdt_triangulate_stream_parts(fdt_context *ctx, const double *xyz, size_t n,
+                                 const fdt_sink *sink, unsigned first, unsigned stride,
+                                 fdt_result **out)
+{
+    if (!ctx || !out || !sink || (!xyz && n) || !stride || first >= stride)
+        return FDT_EINVAL;
+    *out = NULL;
+    ctx->diag[0] = '\0';
+    if (!ctx->s.periodic || ctx->s.neighbors || !periodic_sink_ok(sink)) {
+        snprintf(ctx->diag, sizeof ctx->diag, "a share of the parts is a periodic run's, "
+                 "streamed to periodic_tets");
+        return FDT_EINVAL;
+    }
+    const unsigned share[2] = {first, stride};
+    return run_periodic(ctx, xyz, n, sink, share, out);
 }
 
 /* The tets of a cells-only stream: counted and hashed by the sink, then

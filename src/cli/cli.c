@@ -66,3 +66,24 @@ int fdt_cli_signals(const char *prog, void (*cleanup)(void), int exit_code)
     }
     return 0;
 }
+
+int fdt_cli_engine_exit(int err)
+{
+    switch (err) {
+    case FDT_OK:
+        return CLI_OK;
+    case FDT_EINVAL:
+        return CLI_USAGE;
+    case FDT_EDEGENERATE:
+    case FDT_ERANGE:
+        return CLI_INPUT;
+    case FDT_ENOMEM:
+    case FDT_ETOOBIG:
+    case FDT_ETHREAD:
+        return CLI_RESOURCES;
+    case FDT_ECHECK:
+        return CLI_CHECK;
+    default: /* FDT_EINTERNAL, and FDT_ECANCELED which we never ask for */
+        return CLI_INTERNAL;
+    }
+}

@@ -35,4 +35,10 @@ enum {
  */
 int fdt_cli_signals(const char *prog, void (*cleanup)(void), int exit_code);
 
+/* The exit code of a library error from the engine (an FDT_E* code), the
+ * same in frontdt and frontdt-mpi: a refused argument or box is usage,
+ * input that has no mesh is input, memory and size are resources, a
+ * failed certificate is a check, the rest internal. */
+int fdt_cli_engine_exit(int err);
+
 #endif

@@ -443,18 +443,8 @@ static int take_option(cli *c, int id, const char *v)
     case FDT_OPT_MODE:
         return take_mode(c, v);
     case FDT_OPT_PERIODIC:
-        c->periodic = 0;
-        for (const char *q = v; *q; q++) {
-            const char *ax = strchr("xyz", *q);
-            if (*q == ',' && q != v && q[1])
-                continue;
-            if (!ax || !*q || (c->periodic >> (ax - "xyz") & 1))
-                return usage_error("--periodic takes axes x, y, z, once each (x,z or xyz), "
-                                   "not '%s'", v);
-            c->periodic |= 1u << (ax - "xyz");
-        }
-        if (!c->periodic)
-            return usage_error("--periodic takes axes x, y, z (x,z or xyz), not '%s'", v);
+        if (fdt_cli_periodic(v, &c->periodic, err, sizeof err) != 0)
+            return usage_error("%s", err);
         return -1;
     case FDT_OPT_SEARCH:
         if (fdt_cli_search(v, &c->search, err, sizeof err) != 0)
@@ -727,32 +717,11 @@ static double *demo_points(size_t n)
 /* Error mapping                                                             */
 /* ------------------------------------------------------------------------ */
 
-static int exit_for_engine(int err)
-{
-    switch (err) {
-    case FDT_OK:
-        return CLI_OK;
-    case FDT_EINVAL:
-        return CLI_USAGE;
-    case FDT_EDEGENERATE:
-    case FDT_ERANGE:
-        return CLI_INPUT;
-    case FDT_ENOMEM:
-    case FDT_ETOOBIG:
-    case FDT_ETHREAD:
-        return CLI_RESOURCES;
-    case FDT_ECHECK:
-        return CLI_CHECK;
-    default: /* FDT_EINTERNAL, and FDT_ECANCELED which we never ask for */
-        return CLI_INTERNAL;
-    }
-}
-
 /* The exit code of the dual's step (src/cli/dual.h): a file it could not
  * write, a malformed file it read, else as the engine's. */
 static int exit_for_dual(int err)
 {
-    return err == FDT_EIO ? CLI_WRITE : err == FDT_EFORMAT ? CLI_INPUT : exit_for_engine(err);
+    return err == FDT_EIO ? CLI_WRITE : err == FDT_EFORMAT ? CLI_INPUT : fdt_cli_engine_exit(err);
 }
 
 /* Threads for reading a text file: those of the triangulation, at most
@@ -1491,7 +1460,7 @@ static int open_engine(const cli *c, run_state *rs)
     int r = fdt_open(&rs->ctx, &s);
     if (r != FDT_OK) {
         say("cannot use these settings: %s", fdt_strerror(r));
-        return exit_for_engine(r);
+        return fdt_cli_engine_exit(r);
     }
     return CLI_OK;
 }
@@ -1567,7 +1536,7 @@ static int triangulate(const cli *c, run_state *rs)
     if (r != FDT_OK) {
         const char *diag = fdt_context_diagnostic(rs->ctx);
         say("%s: %s", rs->name, diag && *diag ? diag : fdt_strerror(r));
-        return exit_for_engine(r);
+        return fdt_cli_engine_exit(r);
     }
     /* No engine threads may outlive this point: the signal handler then
      * runs on the thread that is writing, never beside it. */
@@ -1610,7 +1579,7 @@ static int check_mesh(const cli *c, run_state *rs)
             say("%s: check failed: %s", rs->name, msg);
         else
             say("%s: check could not run: %s", rs->name, fdt_strerror(r));
-        return exit_for_engine(r);
+        return fdt_cli_engine_exit(r);
     }
     return CLI_OK;
 }
@@ -1631,14 +1600,14 @@ static int canonical_order(const cli *c, run_state *rs)
         progress_clear(&rs->prog);
         if (r != FDT_OK) {
             say("%s: sorting and hashing the tets failed: %s", rs->name, fdt_strerror(r));
-            return exit_for_engine(r);
+            return fdt_cli_engine_exit(r);
         }
     } else if (rs->need & FDT_NEED_SORTED) {
         int r = fdt_result_sort(rs->res);
         progress_clear(&rs->prog);
         if (r != FDT_OK) {
             say("%s: sorting the tets failed: %s", rs->name, fdt_strerror(r));
-            return exit_for_engine(r);
+            return fdt_cli_engine_exit(r);
         }
     }
     progress_clear(&rs->prog);
@@ -1773,7 +1742,7 @@ static int write_stats(const cli *c, run_state *rs)
     int r = fdt_result_stats(rs->res, &st);
     if (r != FDT_OK && (c->stats || c->stats_json)) {
         say("%s: no statistics: %s", rs->name, fdt_strerror(r));
-        return exit_for_engine(r);
+        return fdt_cli_engine_exit(r);
     }
     if (c->stats) {
         print_stats(rs->res, &st, rs->dups, &rs->tm);

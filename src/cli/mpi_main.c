@@ -30,7 +30,9 @@
 #include "mpi/mpi_run.h"
 #include "geom/prepare.h"
 #include "io/read/reader.h"
+#include "mesh/periodic.h"
 #include "mesh/result.h"
+#include "api/parts.h"
 #include "front/seed.h"
 #include "io/write/writer.h"
 
@@ -61,6 +63,7 @@ typedef struct opts {
     int fail_write;      /* --inject-write-failure RANK, -1: none */
     int kind;            /* FDT_MPO_* of -o */
     fdt_cli_dual cells;  /* --voronoi, --voronoi-format, --density, --box */
+    unsigned periodic;   /* --periodic AXES (the periods: --box) */
 } opts;
 
 static void usage(FILE *f)
@@ -168,6 +171,12 @@ static int take_option(opts *o, int id, const char *v, int rank)
             return CLI_USAGE;
         }
         o->cells.box_given = 1;
+        return -1;
+    case FDT_OPT_PERIODIC:
+        if (fdt_cli_periodic(v, &o->periodic, err, sizeof err) != 0) {
+            say0(rank, "%s", err);
+            return CLI_USAGE;
+        }
         return -1;
     case FDT_OPT_INJECT_WRITE_FAILURE:
         r = strtol(v, &end, 10);
@@ -293,8 +302,205 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
             usage(stderr);
         return CLI_USAGE;
     }
+    if (o->periodic) {
+        /* the rows gathered to rank 0 and written by frontdt's writers */
+        const fdt_format *f = o->output ? fdt_format_by_path(o->output) : NULL;
+        if (!o->cells.box_given) {
+            say0(rank, "--periodic needs --box X0,Y0,Z0,X1,Y1,Z1: the periods");
+            return CLI_USAGE;
+        }
+        if (fdt_cli_dual_wanted(&o->cells) || (o->output && (!f || !fdt_format_periodic(f)))) {
+            say0(rank, "--periodic under MPI writes -o .tets, .fdtb, .vtu, .vtk or .msh "
+                       "(gathered to rank 0) and the hashes; not the cells nor pieces");
+            return CLI_USAGE;
+        }
+        return -1;
+    }
     int rc = check_cells(o, rank);
     return rc >= 0 ? rc : check_output(o, rank, size);
+}
+
+/* A share's rows (src/api/parts.h's sink): nv ids and 3 nv offsets each. */
+typedef struct rowbuf {
+    int nv;
+    fdt_vid *ids;
+    int8_t *off;
+    size_t n, cap;
+} rowbuf;
+
+static int setup_exit_code(int err);
+
+/* Room for want rows. */
+static int rows_reserve(rowbuf *b, size_t want)
+{
+    if (want <= b->cap)
+        return FDT_OK;
+    size_t cap = b->cap ? b->cap : 4096;
+    while (cap < want)
+        cap *= 2;
+    fdt_vid *i2 = realloc(b->ids, cap * (size_t)b->nv * sizeof *i2);
+    if (i2)
+        b->ids = i2;
+    int8_t *o2 = realloc(b->off, cap * 3 * (size_t)b->nv);
+    if (o2)
+        b->off = o2;
+    if (!i2 || !o2)
+        return FDT_ENOMEM;
+    b->cap = cap;
+    return FDT_OK;
+}
+
+static int rows_put(rowbuf *b, const fdt_vid *ids, const int8_t *off, size_t count)
+{
+    if (rows_reserve(b, b->n + count) != FDT_OK)
+        return FDT_ENOMEM;
+    memcpy(b->ids + (size_t)b->nv * b->n, ids, count * (size_t)b->nv * sizeof *ids);
+    memcpy(b->off + 3 * (size_t)b->nv * b->n, off, count * 3 * (size_t)b->nv);
+    b->n += count;
+    return FDT_OK;
+}
+
+static int put_tets(void *user, const fdt_vid *t, const int8_t *off, size_t count)
+{
+    return rows_put(&((rowbuf *)user)[0], t, off, count);
+}
+
+static int put_hull(void *user, const fdt_vid *f, const int8_t *off, size_t count)
+{
+    return rows_put(&((rowbuf *)user)[1], f, off, count);
+}
+
+/* Every rank's rows into rank 0's b (its own first; others': appended);
+ * FDT_ETOOBIG when a count passes MPI's int. Collective. */
+static int gather_rows(rowbuf *b, int rank, int size)
+{
+    unsigned long long mine = b->n, *all = rank == 0 ? calloc((size_t)size, sizeof *all) : NULL;
+    MPI_Gather(&mine, 1, MPI_UNSIGNED_LONG_LONG, all, 1, MPI_UNSIGNED_LONG_LONG, 0,
+               MPI_COMM_WORLD);
+    int err = FDT_OK;
+    int *cnt = NULL, *dsp = NULL;
+    size_t total = 0;
+    if (rank == 0) {
+        cnt = calloc((size_t)size, sizeof *cnt);
+        dsp = calloc((size_t)size, sizeof *dsp);
+        err = all && cnt && dsp ? FDT_OK : FDT_ENOMEM;
+        for (int q = 0; q < size && !err; q++)
+            total += all[q];
+        if (!err && total * 3 * (size_t)b->nv > INT_MAX)
+            err = FDT_ETOOBIG;
+        if (!err)
+            err = rows_reserve(b, total ? total : 1);
+    }
+    MPI_Bcast(&err, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!err) {
+        for (int pass = 0; pass < 2; pass++) {
+            int w = pass ? 3 * b->nv : b->nv, at = 0;
+            for (int q = 0; rank == 0 && q < size; q++) {
+                cnt[q] = (int)all[q] * w;
+                dsp[q] = at;
+                at += cnt[q];
+            }
+            if (pass == 0)
+                MPI_Gatherv(rank ? b->ids : MPI_IN_PLACE, (int)b->n * w, MPI_INT32_T, b->ids,
+                            cnt, dsp, MPI_INT32_T, 0, MPI_COMM_WORLD);
+            else
+                MPI_Gatherv(rank ? b->off : MPI_IN_PLACE, (int)b->n * w, MPI_INT8_T, b->off,
+                            cnt, dsp, MPI_INT8_T, 0, MPI_COMM_WORLD);
+        }
+        if (rank == 0)
+            b->n = total;
+    }
+    free(all);
+    free(cnt);
+    free(dsp);
+    return err;
+}
+
+/*
+ * A periodic run (--periodic; issue 33, src/api/parts.h): every rank reads
+ * the whole input and builds its share of the box's slabs (slab k on rank
+ * k mod size) with the library's periodic engine on one thread; the rows
+ * go to rank 0, which sorts them into the one mesh (the same rows for any
+ * rank count) and hashes and writes it as frontdt does. The first rank
+ * that failed says why; every rank leaves with its code.
+ */
+static int periodic_run(const opts *o, int rank, int size)
+{
+    char diag[1024] = "";
+    double *xyz = NULL;
+    size_t n = 0;
+    fdt_context *ctx = NULL;
+    fdt_result *res = NULL;
+    rowbuf rows[2] = {{4, NULL, NULL, 0, 0}, {3, NULL, NULL, 0, 0}};
+    int err = fdt_read_points(o->input, o->format, &xyz, &n, diag, sizeof diag), rc;
+    rc = err ? setup_exit_code(err) : CLI_OK;
+    if (!err) {
+        fdt_settings s;
+        fdt_default_settings(&s);
+        s.n_threads = 1;
+        s.periodic = o->periodic;
+        memcpy(s.periodic_box, o->cells.box, sizeof s.periodic_box);
+        fdt_sink sink = {sizeof sink, NULL, NULL, rows, put_tets, put_hull};
+        err = fdt_open(&ctx, &s);
+        if (!err)
+            err = fdt_triangulate_stream_parts(ctx, xyz, n, &sink, (unsigned)rank,
+                                               (unsigned)size, &res);
+        if (err)
+            snprintf(diag, sizeof diag, "%s", ctx ? fdt_context_diagnostic(ctx) : "");
+        rc = fdt_cli_engine_exit(err);
+    }
+    /* the first rank that failed names it */
+    int first, me = rc ? rank : size;
+    MPI_Allreduce(&me, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    if (first < size) {
+        if (rank == first)
+            fprintf(stderr, "frontdt-mpi: %s: %s\n", o->input, diag[0] ? diag : fdt_strerror(err));
+        MPI_Bcast(&rc, 1, MPI_INT, first, MPI_COMM_WORLD);
+        goto out;
+    }
+    for (int k = 0; k < 2 && !err; k++)
+        err = gather_rows(&rows[k], rank, size);
+    if (rank == 0 && !err)
+        for (int k = 0; k < 2 && !err; k++)
+            err = fdt_periodic_sort_rows((uint32_t *)rows[k].ids, rows[k].off, rows[k].n,
+                                         rows[k].nv);
+    rc = err ? fdt_cli_engine_exit(err) : CLI_OK;
+    if (rank == 0 && !err) {
+        /* rank 0's result, the gathered rows in it: one periodic mesh */
+        res->streamed = 0;
+        res->sorted = 1;
+        res->tets = rows[0].ids;
+        res->tet_off = rows[0].off;
+        res->ntets = rows[0].n;
+        res->hull = rows[1].ids;
+        res->hull_off = rows[1].off;
+        res->nhull = rows[1].n;
+        memset(rows, 0, sizeof rows);
+        uint64_t h;
+        if (o->set_hash && fdt_result_set_hash(res, &h) == FDT_OK)
+            printf("set-hash: %016" PRIx64 "\n", h);
+        if (o->hash && fdt_result_hash(res, &h) == FDT_OK)
+            printf("hash: %016" PRIx64 "\n", h);
+        if (o->output &&
+            (err = fdt_write_mesh(res, xyz, n, o->output, NULL, diag, sizeof diag)) != FDT_OK) {
+            fprintf(stderr, "frontdt-mpi: %s\n", diag);
+            rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
+        }
+        if (!o->quiet)
+            fprintf(stderr, "frontdt-mpi: %zu points, %zu periodic tets on %d ranks\n", n,
+                    res->ntets, size);
+        fflush(stdout);
+    }
+    MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
+out:
+    for (int k = 0; k < 2; k++) {
+        free(rows[k].ids);
+        free(rows[k].off);
+    }
+    fdt_result_free(&res);
+    fdt_close(&ctx);
+    free(xyz);
+    return rc;
 }
 
 static int exit_code(int err)
@@ -443,6 +649,8 @@ static int run(int argc, char **argv, int rank, int size)
     int rc = parse(argc, argv, &o, rank, size);
     if (rc >= 0)
         return rc;
+    if (o.periodic)
+        return periodic_run(&o, rank, size);
     char diag[512] = "";
     double t0 = MPI_Wtime();
     fdt_mpi_local L;

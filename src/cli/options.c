@@ -117,7 +117,7 @@ const fdt_cli_opt fdt_cli_opts[FDT_OPT_END] = {
         "periodic box of --periodic",
         "the box that clips the cells (default: the\n"
         "points' bounding box; must hold them)"},
-    [FDT_OPT_PERIODIC] = {"periodic", 0, required_argument, "AXES", F, 0,
+    [FDT_OPT_PERIODIC] = {"periodic", 0, required_argument, "AXES", FM, 0,
         "the points are periodic along AXES (x, y, z, or\n"
         "several: x,z or xyz) with the periods of --box\n"
         "(every point in [X0, X1) there): the Delaunay\n"
@@ -314,6 +314,28 @@ int fdt_cli_leaf(const char *s, int *out, char *err, size_t len)
         return -1;
     }
     *out = (int)x;
+    return 0;
+}
+
+int fdt_cli_periodic(const char *v, unsigned *axes, char *err, size_t len)
+{
+    unsigned a = 0;
+    for (const char *q = v; *q; q++) {
+        const char *ax = strchr("xyz", *q);
+        if (*q == ',' && q != v && q[1])
+            continue;
+        if (!ax || (a >> (ax - "xyz") & 1)) {
+            snprintf(err, len, "--periodic takes axes x, y, z, once each (x,z or xyz), not '%s'",
+                     v);
+            return -1;
+        }
+        a |= 1u << (ax - "xyz");
+    }
+    if (!a) {
+        snprintf(err, len, "--periodic takes axes x, y, z (x,z or xyz), not '%s'", v);
+        return -1;
+    }
+    *axes = a;
     return 0;
 }
 

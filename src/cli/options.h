@@ -103,10 +103,13 @@ int fdt_cli_find(const char *word, unsigned prog);
  * The values both programs check, with one message each (in err, without
  * the program's name): 0, or -1. --search NAME (fdt_search_from_name), --leaf
  * N (1 .. 1000000), --input-format NAME (an FDT_RD_* of
- * src/io/read/reader.h, not FDT_RD_AUTO).
+ * src/io/read/reader.h, not FDT_RD_AUTO), --periodic AXES.
  */
 int fdt_cli_search(const char *name, fdt_search *out, char *err, size_t len);
 int fdt_cli_leaf(const char *s, int *out, char *err, size_t len);
 int fdt_cli_input_format(const char *name, int *out, char *err, size_t len);
+/* --periodic AXES: x, y, z, once each, optionally comma separated (x,z,
+ * xyz); *axes gets bit k for axis k. */
+int fdt_cli_periodic(const char *v, unsigned *axes, char *err, size_t len);
 
 #endif

@@ -657,6 +657,20 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
     return ROUND_OK;
 }
 
+/* count keys of nv vertices each back into rows: ids, 3 offsets a vertex. */
+static void unpack(const key *k, size_t count, int nv, uint32_t *ids, int8_t *off)
+{
+    for (size_t i = 0; i < count; i++)
+        for (int j = 0; j < nv; j++) {
+            uint64_t x = k[i].v[j];
+            int8_t *o = off + 3 * ((size_t)nv * i + (size_t)j);
+            ids[(size_t)nv * i + (size_t)j] = (uint32_t)(x >> 24);
+            o[0] = (int8_t)((int)(x >> 16 & 255) - 128);
+            o[1] = (int8_t)((int)(x >> 8 & 255) - 128);
+            o[2] = (int8_t)((int)(x & 255) - 128);
+        }
+}
+
 /*
  * The keys of the sets s[0 .. ns), sorted, into out's arrays; each set
  * freed once its keys are moved. Counted into buckets by their least
@@ -713,17 +727,26 @@ static int emit(keyset *s, int ns, int nv, size_t n, uint32_t **ids, int8_t **of
         free(tmp);
         return FDT_ENOMEM;
     }
-    for (size_t i = 0; i < total; i++)
-        for (int j = 0; j < nv; j++) {
-            uint64_t x = tmp[i].v[j];
-            int8_t *o = *offs + 3 * ((size_t)nv * i + (size_t)j);
-            (*ids)[(size_t)nv * i + (size_t)j] = (uint32_t)(x >> 24);
-            o[0] = (int8_t)((int)(x >> 16 & 255) - 128);
-            o[1] = (int8_t)((int)(x >> 8 & 255) - 128);
-            o[2] = (int8_t)((int)(x & 255) - 128);
-        }
+    unpack(tmp, total, nv, *ids, *offs);
     free(tmp);
     *count = total;
+    return FDT_OK;
+}
+
+int fdt_periodic_sort_rows(uint32_t *ids, int8_t *off, size_t count, int nv)
+{
+    key *k = malloc((count ? count : 1) * sizeof *k);
+    if (!k)
+        return FDT_ENOMEM;
+    for (size_t i = 0; i < count; i++) {
+        for (int j = 0; j < 4; j++)
+            k[i].v[j] = j < nv ? vpack(ids[(size_t)nv * i + (size_t)j],
+                                       off + 3 * ((size_t)nv * i + (size_t)j))
+                               : UINT64_MAX;
+    }
+    qsort(k, count, sizeof *k, key_cmp);
+    unpack(k, count, nv, ids, off);
+    free(k);
     return FDT_OK;
 }
 
