@@ -303,10 +303,14 @@ static void parts_equal(const char *name, const double *X, size_t n, const fdt_p
                   (hids = realloc(hids, cap * 3 * sizeof *hids)) &&
                   (off = realloc(off, cap * 12)) && (hoff = realloc(hoff, cap * 9)));
         }
-        memcpy(ids + 4 * nt, pm.tets, pm.ntets * 4 * sizeof *ids);
-        memcpy(off + 12 * nt, pm.tet_off, pm.ntets * 12);
-        memcpy(hids + 3 * nh, pm.hull, pm.nhull * 3 * sizeof *hids);
-        memcpy(hoff + 9 * nh, pm.hull_off, pm.nhull * 9);
+        if (pm.ntets) { /* an empty slab's arrays are NULL */
+            memcpy(ids + 4 * nt, pm.tets, pm.ntets * 4 * sizeof *ids);
+            memcpy(off + 12 * nt, pm.tet_off, pm.ntets * 12);
+        }
+        if (pm.nhull) {
+            memcpy(hids + 3 * nh, pm.hull, pm.nhull * 3 * sizeof *hids);
+            memcpy(hoff + 9 * nh, pm.hull_off, pm.nhull * 9);
+        }
         nt += pm.ntets;
         nh += pm.nhull;
         fdt_periodic_free(&pm);
