@@ -1064,7 +1064,7 @@ done
 run stv_csv_m "$FRONTDT" stv.xyz -q --voronoi stv_m.csv
 run stv_csv_s "$FRONTDT" stv.xyz -q --stream --voronoi stv_s.csv
 cmp -s stv_m.csv stv_s.csv || fail "--stream --voronoi F.csv: not the in-memory table"
-ls -a | grep -q frontdt-cells && fail "--stream --voronoi left its spool"
+ls -a | grep -q frontdt-spool && fail "--stream --voronoi left its spool"
 usage_case u_stream_vtu "polyhedra) needs the whole mesh" st.xyz --stream --voronoi st.vtu
 run stv_kd "$FRONTDT" stv.xyz -q --stream --search kd --voronoi stv_kd.txt
 expect_rc stv_kd 1 && expect_in stv_kd err "sweep order"

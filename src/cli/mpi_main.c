@@ -458,6 +458,25 @@ static int periodic_run(const opts *o, int rank, int size)
         MPI_Bcast(&rc, 1, MPI_INT, first, MPI_COMM_WORLD);
         goto out;
     }
+    if (o->stats) {
+        /* each rank's share: its slabs' rows, images and seconds */
+        fdt_stats st;
+        double mine[3] = {0, 0, 0}, *all = rank == 0 ? malloc(3 * (size_t)size * sizeof *all)
+                                                     : NULL;
+        if (fdt_result_stats(res, &st) == FDT_OK) {
+            mine[0] = (double)st.tets;
+            mine[1] = (double)st.periodic_images;
+            mine[2] = st.t_front;
+        }
+        MPI_Gather(mine, 3, MPI_DOUBLE, all, 3, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+        if (rank == 0 && all) {
+            fprintf(stderr, "  rank         rows       images   slabs s\n");
+            for (int q = 0; q < size; q++)
+                fprintf(stderr, "  %4d %12.0f %12.0f %9.3f\n", q, all[3 * q], all[3 * q + 1],
+                        all[3 * q + 2]);
+        }
+        free(all);
+    }
     for (int k = 0; k < 2 && !err; k++)
         err = gather_rows(&rows[k], rank, size);
     if (rank == 0 && !err)

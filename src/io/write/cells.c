@@ -246,7 +246,7 @@ void fdt_cells_dir(const char *path, char *dir, size_t len)
 FILE *fdt_cells_temp(const char *dir)
 {
     char path[4200];
-    snprintf(path, sizeof path, "%s/.frontdt-cells.XXXXXX", dir);
+    snprintf(path, sizeof path, "%s/.frontdt-spool.XXXXXX", dir);
     int fd = mkstemp(path);
     if (fd < 0)
         return NULL;

@@ -43,7 +43,8 @@ int fdt_wr_density(FILE *f, const fdt_voronoi *v, int threads);
  * the table anyway. */
 void fdt_cells_dir(const char *path, char *dir, size_t len);
 /* An unlinked temporary file in dir, open for reading and writing (gone
- * with the process, whatever happens); NULL with errno. */
+ * with the process, whatever happens): the tables' spools, and a periodic
+ * stream's .tets rows (src/io/write/fmt_tets.c); NULL with errno. */
 FILE *fdt_cells_temp(const char *dir);
 
 /*
