@@ -463,8 +463,10 @@ typedef struct fdt_stats {
     size_t mem_points;        /* the points in tree order (24 a vertex:
                                  in the caller's array with
                                  settings.permute_input), their input
-                                 indices (4) and the duplicate map (4 an
-                                 input point) */
+                                 indices (4) and, when there are
+                                 duplicates, the duplicate map (4 an input
+                                 point; without, the identity is made for
+                                 the result after the run) */
     size_t mem_merge;         /* the duplicate merge's hash table (freed
                                  before the front starts) */
     size_t mem_tree;          /* the kd-trees: nodes, cells, leaf maps,

@@ -32,6 +32,7 @@
 #include "cli/progress.h"
 #include "front/partmesh.h"
 #include "front/sweep.h"
+#include "geom/prepare.h"
 #include "io/read/reader.h"
 #include "io/write/writer.h"
 
@@ -1163,8 +1164,8 @@ static int fanout_close(fanout *fo, int commit)
  * points as read (24 a point, the CLI's array; a streamed run prepares
  * them in it, fdt_settings.permute_input), the library's own copy (24
  * otherwise), input indices and duplicate map (8), the merge's table
- * (4 bytes a slot, slots the power of two >= 2n, freed before the
- * trees), the kd-trees (about 26 a point with leaves of 30: 24.5
+ * (4 bytes a slot, src/geom/prepare.h's fdt_prepare_merge_slots, freed
+ * before the trees), the kd-trees (about 26 a point with leaves of 30: 24.5
  * measured on 1M uniform points), the front (the queue's buckets, 1 a
  * point, and 110 bytes a front face, for 8 n^(2/3) faces: a front is a
  * surface; 1M uniform points measured 34k faces serial, 50k on two
@@ -1181,10 +1182,7 @@ static unsigned long long memory_estimate(size_t n, int stream, int threads, int
     double pts = 24.0 * (double)n;
     double own = stream ? 0.0 : 24.0 * (double)n;
     double idx = 8.0 * (double)n;
-    double merge = 16.0;
-    while (merge < 2.0 * (double)n)
-        merge *= 2.0;
-    merge *= 4.0;
+    double merge = 4.0 * (double)fdt_prepare_merge_slots(n);
     double tree = 26.0 * (double)n;
     double front = 1.0 * (double)n + 110.0 * 8.0 * cbrt((double)n) * cbrt((double)n);
     double mesh = 0.0;

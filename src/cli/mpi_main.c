@@ -433,6 +433,7 @@ static int periodic_run(const opts *o, int rank, int size)
     fdt_result *res = NULL;
     rowbuf rows[2] = {{4, NULL, NULL, 0, 0}, {3, NULL, NULL, 0, 0}};
     int err = fdt_read_points(o->input, o->format, &xyz, &n, diag, sizeof diag), rc;
+    int read_failed = err != FDT_OK; /* its message names the file */
     rc = err ? setup_exit_code(err) : CLI_OK;
     if (!err) {
         fdt_settings s;
@@ -453,7 +454,9 @@ static int periodic_run(const opts *o, int rank, int size)
     int first, me = rc ? rank : size;
     MPI_Allreduce(&me, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
     if (first < size) {
-        if (rank == first)
+        if (rank == first && read_failed)
+            fprintf(stderr, "frontdt-mpi: %s\n", diag);
+        else if (rank == first)
             fprintf(stderr, "frontdt-mpi: %s: %s\n", o->input, diag[0] ? diag : fdt_strerror(err));
         MPI_Bcast(&rc, 1, MPI_INT, first, MPI_COMM_WORLD);
         goto out;

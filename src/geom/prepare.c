@@ -267,9 +267,17 @@ static int prepare_threads(const double *xyz, size_t n, int T, fdt_prepared *pr,
     return FDT_OK;
 }
 
+size_t fdt_prepare_merge_slots(size_t n)
+{
+    size_t cap = 16;
+    while (3 * cap < 4 * n)
+        cap <<= 1;
+    return cap;
+}
+
 /* pr's arrays for n points and the merge's table of *cap empty slots
- * (all bits set), open addressing at load <= 1/2. On failure the caller
- * frees what was allocated (fdt_prepared_free, free(*slots)). */
+ * (all bits set), open addressing (fdt_prepare_merge_slots). On failure
+ * the caller frees what was allocated (fdt_prepared_free, free(*slots)). */
 static int prep_alloc(fdt_prepared *pr, size_t n, uint32_t **slots, size_t *cap)
 {
     size_t n1 = n ? n : 1;
@@ -279,9 +287,7 @@ static int prep_alloc(fdt_prepared *pr, size_t n, uint32_t **slots, size_t *cap)
         fdt_mem_advise_huge(pr->p, n1 * 3 * sizeof *pr->p);
     }
     pr->orig = malloc(n1 * sizeof *pr->orig);
-    *cap = 16;
-    while (*cap < 2 * n)
-        *cap <<= 1;
+    *cap = fdt_prepare_merge_slots(n);
     pr->merge_bytes = *cap * sizeof **slots;
     *slots = malloc(*cap * sizeof **slots);
     if (!pr->dupmap || !pr->p || !pr->orig || !*slots)

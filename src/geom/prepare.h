@@ -27,6 +27,12 @@ typedef struct fdt_prepared {
     size_t merge_bytes; /* the merge's hash table (freed on return) */
 } fdt_prepared;
 
+/* The merge's hash table for n points: its slots (4 bytes each), the
+ * power of two >= 4n/3 (load at most 3/4: 5.4 bytes a point at 100M
+ * points, where >= 2n took 10.7 and made the merge a streamed run's peak,
+ * bench/NOTES.md entry 111), at least 16. */
+size_t fdt_prepare_merge_slots(size_t n);
+
 /* Fills pr from n input points, on `threads` threads (one below 64k
  * points, at most 64): the same result for every count.
  * Errors: FDT_ERANGE (NaN/Inf, the first such point named in diag),
