@@ -798,6 +798,16 @@ int fdt_periodic_renumber(fdt_periodic_mesh *m, const int32_t *orig, size_t n)
     return FDT_OK;
 }
 
+/* The caller's diagnostic buffer, or own when it gave none; emptied. */
+static void diag_init(char **diag, size_t *ds, char *own, size_t osz)
+{
+    if (!*diag || !*ds) {
+        *diag = own;
+        *ds = osz;
+    }
+    (*diag)[0] = 0;
+}
+
 /* The points' extent (every axis; the proofs read the axes that are not
  * periodic). */
 static void extent(const double *X, uint32_t n, double lo[3], double hi[3])
@@ -915,11 +925,7 @@ int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
 {
     memset(out, 0, sizeof *out);
     char owndiag[8];
-    if (!diag || !diag_size) {
-        diag = owndiag;
-        diag_size = sizeof owndiag;
-    }
-    diag[0] = 0;
+    diag_init(&diag, &diag_size, owndiag, sizeof owndiag);
     if (n < 1) {
         snprintf(diag, diag_size, "no points");
         return FDT_EDEGENERATE;
@@ -1023,11 +1029,7 @@ int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
 {
     memset(out, 0, sizeof *out);
     char own[8];
-    if (!diag || !diag_size) {
-        diag = own;
-        diag_size = sizeof own;
-    }
-    diag[0] = 0;
+    diag_init(&diag, &diag_size, own, sizeof own);
     int err = fdt_periodic_check(X, n, b, diag, diag_size);
     if (err)
         return err;
