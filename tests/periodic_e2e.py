@@ -318,6 +318,16 @@ def errors():
     r = frontdt(src, "--periodic", "xyz", "--box", "0,0,0,1,1,1", "--memory-limit", "2M")
     expect(r.returncode == 4 and "periodic" in r.stderr,
            "--memory-limit: exit %d, %s" % (r.returncode, r.stderr))
+    # streamed: the points and one slab's build (3,000 points: 16 MiB and a little)
+    out = os.path.join(SCRATCH, "lim.tets")
+    r = frontdt(src, "--periodic", "xyz", "--box", "0,0,0,1,1,1", "--stream", "-o", out,
+                "--memory-limit", "16M")
+    expect(r.returncode == 4 and "streamed, periodic" in r.stderr and not os.path.exists(out),
+           "--stream --memory-limit: exit %d, %s" % (r.returncode, r.stderr))
+    r = frontdt(src, "--periodic", "xyz", "--box", "0,0,0,1,1,1", "--stream", "-o", out,
+                "--memory-limit", "40M", "-q")
+    expect(r.returncode == 0 and os.path.exists(out),
+           "--stream --memory-limit 40M: exit %d, %s" % (r.returncode, r.stderr))
     print("errors: outside the box, too few points, usage, --memory-limit")
 
 

@@ -1440,10 +1440,14 @@ static int open_engine(const cli *c, run_state *rs)
     /* a periodic run: the mesh of the points and their images, then the
      * kept tets' keys and their sort, 605-622 MiB at the peak for 1M
      * uniform points (bench/NOTES.md entry 108); --check's faces after it,
-     * 790 MiB (entry 109) */
+     * 790 MiB (entry 109); streamed, the points and one slab's build
+     * (222 MiB for 1M in slabs of 320k, entry 110) */
     unsigned long long periodic =
         !c->periodic    ? 0
-        : rs->streaming ? 64ull * rs->n + 900ull * fdt_sweep_slab(rs->n) + (16ull << 20)
+        : rs->streaming ? 64ull * rs->n +
+                              900ull * (rs->n < fdt_sweep_slab(rs->n) ? rs->n
+                                                                      : fdt_sweep_slab(rs->n)) +
+                              (16ull << 20)
                         : (c->check ? 850ull : 700ull) * rs->n + (16ull << 20);
     if (periodic > rs->estimate)
         rs->estimate = periodic;
