@@ -348,6 +348,23 @@ static void against_reference(const char *name, const double *X, size_t n, unsig
             "%s: the check: %s", name, msg);
     /* the output is sorted and normalised already */
     EXPECT(got.n == pm.ntets);
+    /* the rows shuffled and sorted again (frontdt-mpi's gather) */
+    uint32_t *sid = malloc(pm.ntets * 4 * sizeof *sid);
+    int8_t *soff = malloc(pm.ntets * 12);
+    CHECK(sid && soff);
+    for (size_t i = 0; i < pm.ntets; i++) {
+        size_t from = (i * 7919) % pm.ntets; /* a permutation: 7919 is prime, above n */
+        memcpy(sid + 4 * i, pm.tets + 4 * from, 4 * sizeof *sid);
+        memcpy(soff + 12 * i, pm.tet_off + 12 * from, 12);
+    }
+    EXPECT(pm.ntets % 7919 != 0);
+    EXPECT(fdt_periodic_sort_rows(&sid, &soff, pm.ntets, 4, n) == FDT_OK);
+    EXPECTF(!memcmp(sid, pm.tets, pm.ntets * 4 * sizeof *sid) &&
+            !memcmp(soff, pm.tet_off, pm.ntets * 12), "%s: the rows sorted again differ", name);
+    EXPECT(fdt_periodic_sort_rows(&sid, &soff, pm.ntets, 4, pm.tets[4 * (pm.ntets - 1)]) ==
+           FDT_EINVAL);
+    free(sid);
+    free(soff);
     fdt_periodic_mesh p3 = build(X, n, &b, 3, name);
     rows got3 = mesh_rows(p3.tets, p3.tet_off, p3.ntets, 4);
     EXPECTF(same_rows(&got, &got3), "%s: 3 threads differ", name);

@@ -482,10 +482,12 @@ static int periodic_run(const opts *o, int rank, int size)
     }
     for (int k = 0; k < 2 && !err; k++)
         err = gather_rows(&rows[k], rank, size);
-    if (rank == 0 && !err)
-        for (int k = 0; k < 2 && !err; k++)
-            err = fdt_periodic_sort_rows((uint32_t *)rows[k].ids, rows[k].off, rows[k].n,
-                                         rows[k].nv);
+    for (int k = 0; rank == 0 && k < 2 && !err; k++) {
+        uint32_t *ids = (uint32_t *)rows[k].ids; /* replaced by the sort */
+        err = fdt_periodic_sort_rows(&ids, &rows[k].off, rows[k].n, rows[k].nv, n);
+        rows[k].ids = (fdt_vid *)ids;
+        rows[k].cap = rows[k].n;
+    }
     rc = err ? fdt_cli_engine_exit(err) : CLI_OK;
     if (rank == 0 && !err) {
         /* rank 0's result, the gathered rows in it: one periodic mesh */

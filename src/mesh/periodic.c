@@ -737,20 +737,40 @@ static int emit(keyset *s, int ns, int nv, size_t n, uint32_t **ids, int8_t **of
     return FDT_OK;
 }
 
-int fdt_periodic_sort_rows(uint32_t *ids, int8_t *off, size_t count, int nv)
+int fdt_periodic_sort_rows(uint32_t **ids, int8_t **off, size_t count, int nv, size_t n)
 {
-    key *k = malloc((count ? count : 1) * sizeof *k);
-    if (!k)
+    /* emit's buckets, each row's least id its bucket */
+    keyset s = {malloc((count ? count : 1) * sizeof(key)),
+                malloc((count ? count : 1) * sizeof(uint32_t)), count, count};
+    if (!s.keys || !s.rank) {
+        keyset_free(&s);
         return FDT_ENOMEM;
+    }
     for (size_t i = 0; i < count; i++) {
         for (int j = 0; j < 4; j++)
-            k[i].v[j] = j < nv ? vpack(ids[(size_t)nv * i + (size_t)j],
-                                       off + 3 * ((size_t)nv * i + (size_t)j))
-                               : UINT64_MAX;
+            s.keys[i].v[j] = j < nv ? vpack((*ids)[(size_t)nv * i + (size_t)j],
+                                            *off + 3 * ((size_t)nv * i + (size_t)j))
+                                    : UINT64_MAX;
+        s.rank[i] = (*ids)[(size_t)nv * i];
+        if (s.rank[i] >= n) {
+            keyset_free(&s);
+            return FDT_EINVAL;
+        }
     }
-    qsort(k, count, sizeof *k, key_cmp);
-    unpack(k, count, nv, ids, off);
-    free(k);
+    uint32_t *ni = NULL;
+    int8_t *no = NULL;
+    size_t got;
+    int err = emit(&s, 1, nv, n, &ni, &no, &got);
+    if (err) {
+        keyset_free(&s);
+        free(ni);
+        free(no);
+        return err;
+    }
+    free(*ids);
+    free(*off);
+    *ids = ni;
+    *off = no;
     return FDT_OK;
 }
 
