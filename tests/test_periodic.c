@@ -556,8 +556,82 @@ static void errors(void)
     EXPECT(fdt_periodic_renumber(&one, orig, 3) == FDT_EINTERNAL);
 }
 
-int main(void)
+/* Coordinates, then index: the order that puts a point's copies side by
+ * side, its first occurrence first. */
+static const double *dedup_pts;
+static int dedup_cmp(const void *x, const void *y)
 {
+    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
+    int c = 0;
+    for (int k = 0; k < 3 && !c; k++) {
+        double u = dedup_pts[3 * (size_t)a + k], v = dedup_pts[3 * (size_t)b + k];
+        c = u < v ? -1 : u > v;
+    }
+    return c ? c : a < b ? -1 : a > b;
+}
+
+/* A gen_points family scaled into [0, 0.999)^3 (distinct points, first
+ * occurrences in input order), periodic in x, y and z: the parts of 300
+ * points on 3 threads and of 40 on one give the one-part build's rows. */
+static void family_parts(const char *gen, const char *fam, size_t n)
+{
+    size_t got;
+    double *X = test_gen_family(gen, fam, n, 3, &got);
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; k++)
+        lo[k] = hi[k] = X[k];
+    for (size_t i = 0; i < 3 * got; i++) {
+        lo[i % 3] = X[i] < lo[i % 3] ? X[i] : lo[i % 3];
+        hi[i % 3] = X[i] > hi[i % 3] ? X[i] : hi[i % 3];
+    }
+    for (size_t i = 0; i < 3 * got; i++) {
+        double w = hi[i % 3] - lo[i % 3];
+        X[i] = w > 0 ? (X[i] - lo[i % 3]) / w * 0.999 : 0.5;
+    }
+    uint32_t *ord = malloc((got ? got : 1) * sizeof *ord);
+    uint8_t *keep = calloc(got ? got : 1, 1);
+    CHECK(ord && keep);
+    for (size_t i = 0; i < got; i++)
+        ord[i] = (uint32_t)i;
+    dedup_pts = X;
+    qsort(ord, got, sizeof *ord, dedup_cmp);
+    for (size_t i = 0; i < got; i++)
+        keep[ord[i]] = i == 0 || X[3 * (size_t)ord[i]] != X[3 * (size_t)ord[i - 1]] ||
+                       X[3 * (size_t)ord[i] + 1] != X[3 * (size_t)ord[i - 1] + 1] ||
+                       X[3 * (size_t)ord[i] + 2] != X[3 * (size_t)ord[i - 1] + 2];
+    size_t m = 0;
+    for (size_t i = 0; i < got; i++)
+        if (keep[i])
+            memmove(X + 3 * m++, X + 3 * i, 3 * sizeof *X);
+    free(ord);
+    free(keep);
+    fdt_periodic_box b = {7, {0, 0, 0}, {1, 1, 1}};
+    fdt_periodic_mesh pm;
+    char diag[512];
+    int err = fdt_periodic_build(X, (uint32_t)m, NULL, &b, 2, &pm, diag, sizeof diag);
+    EXPECTF(err == FDT_OK, "%s: the one-part build: %d (%s)", fam, err, diag);
+    if (err == FDT_OK) {
+        rows want = mesh_rows(pm.tets, pm.tet_off, pm.ntets, 4);
+        rows wanth = mesh_rows(pm.hull, pm.hull_off, pm.nhull, 3);
+        parts_equal(fam, X, m, &b, 300, 3, &want, &wanth);
+        parts_equal(fam, X, m, &b, 40, 1, &want, &wanth);
+        printf("%s: %zu points, %zu tets: the same in parts of 300 and 40\n", fam, m,
+               pm.ntets);
+        free(want.r);
+        free(wanth.r);
+        fdt_periodic_free(&pm);
+    }
+    free(X);
+}
+
+int main(int argc, char **argv)
+{
+    /* suite long: every gen_points family in parts (argv[1]: gen_points) */
+    if (argc > 1) {
+        int families = test_each_family(argv[1], 3000, family_parts);
+        EXPECTF(families > 30, "%d families", families);
+        return test_report("periodic families");
+    }
     const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
     size_t n = 3000;
     double *U = uniform(n, 1);
