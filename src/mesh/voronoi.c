@@ -105,13 +105,27 @@ typedef struct vwork {
     int njobs;
     double *vmax;         /* per point: its largest tet's volume, then (DTFE_FINE)
                            * the step of its own DTFE grid (owned) */
+    struct vcell *cells;  /* the own points' cells, by local id, in the
+                             computation's frame (owned by cells_run) */
 } vwork;
 
-/* One thread's share: the points [lo, hi) of the local numbering. */
+/* A cell as cell_pass computes it, in local order: the rows are then
+ * written in their own order (rows_pass), one sequential write a row and
+ * a read that can be prefetched, where writing each row as its cell was
+ * computed wrote six arrays at random (bench/NOTES.md entry 112). */
+typedef struct vcell {
+    double volume, area, centroid[3], density;
+    int32_t nfaces;
+    uint8_t flags;
+} vcell;
+
+/* One thread's share: the points [lo, hi) of the local numbering, and
+ * the rows [rlo, rhi) of the output. */
 typedef struct vjob {
     vwork *w;
     fdt_voronoi *v;
     uint32_t lo, hi;
+    size_t rlo, rhi;
     /* point l's neighbours, ascending, adj[adj_start[l - lo] ..
      * adj_start[l - lo + 1]), and the area of the face to each (owned) */
     size_t *adj_start;
@@ -222,17 +236,10 @@ int fdt_voronoi_scale(const double box[6], int *ed, char *diag, size_t ds)
     return FDT_ERANGE;
 }
 
-/* Local point l's row in the answer: its input id, or in a batch its
- * place among the batch's own points. */
-static inline uint32_t row(const vwork *w, uint32_t l)
-{
-    return w->batch ? l : w->perm[l];
-}
-
 /* The computation's frame: the local coordinates and the box times
  * 2^-ed, so that the box's largest side lies in [1/2, 1). Every operation
  * of the cells commutes with a power of two, so the results scaled back
- * (scale_back) are the same bits as in the points' own frame wherever
+ * (rows_pass) are the same bits as in the points' own frame wherever
  * that frame kept clear of underflow and overflow, and the same bits at
  * every scale. */
 static void scale_frame(vwork *w)
@@ -241,35 +248,6 @@ static void scale_frame(vwork *w)
         w->xyz[c] = ldexp(w->xyz[c], -w->ed);
     for (int k = 0; k < 6; k++)
         w->box[k] = ldexp(w->box[k], -w->ed);
-}
-
-/* The job's cells in the points' frame: volumes times 2^(3 ed), areas
- * 2^(2 ed), centroids 2^ed, densities 2^(-3 ed), face areas 2^(2 ed). */
-static void *scale_back(void *arg)
-{
-    vjob *j = arg;
-    const vwork *w = j->w;
-    fdt_voronoi *v = j->v;
-    /* Products with powers of two, not ldexp calls (4 % of a 300k
-     * --voronoi run): ed is in [VORONOI_MIN_EXP, VORONOI_MAX_EXP], so
-     * each factor, 2^(3 ed) to 2^(-3 ed), is a normal double, and x 2^k
-     * rounds once, as ldexp does, underflow and overflow included: the
-     * same bits. */
-    int e = w->ed;
-    const double f1 = ldexp(1, e), f2 = ldexp(1, 2 * e), f3 = ldexp(1, 3 * e),
-                 fm3 = ldexp(1, -3 * e);
-    for (uint32_t l = j->lo; l < j->hi; l++) {
-        uint32_t g = row(w, l);
-        v->volume[g] *= f3;
-        v->area[g] *= f2;
-        v->density[g] *= fm3;
-        for (int k = 0; k < 3; k++)
-            v->centroid[3 * (size_t)g + k] *= f1;
-        if (v->nstart)
-            for (size_t f = v->nstart[g]; f < v->nstart[g + 1]; f++)
-                v->narea[f] *= f2;
-    }
-    return NULL;
 }
 
 /* The grids: terms up to about 16 D^k for the box's largest side D land
@@ -666,7 +644,6 @@ static int cut_order(vjob *j, uint32_t l)
 static int cut_cell(vjob *j, uint32_t l)
 {
     const vwork *w = j->w;
-    fdt_voronoi *v = j->v;
     const double *p = w->xyz + 3 * (size_t)l;
     double lo[3], hi[3];
     for (int k = 0; k < 3; k++) {
@@ -696,15 +673,15 @@ static int cut_cell(vjob *j, uint32_t l)
         j->face = q;
         j->capface = nc;
     }
-    uint32_t g = row(w, l);
+    vcell *c = &w->cells[l];
     double cen[3];
     fdt_cell_face *fc = j->face + j->nface;
-    fdt_cell_measure(&j->cell, &v->volume[g], &v->area[g], cen, fc);
+    fdt_cell_measure(&j->cell, &c->volume, &c->area, cen, fc);
     for (int k = 0; k < 3; k++)
-        v->centroid[3 * (size_t)g + k] = p[k] + cen[k];
+        c->centroid[k] = p[k] + cen[k];
     size_t m = 0;
     for (int f = 0; f < j->cell.nf; f++) {
-        if (!real_face(fc[f].area, v->area[g])) {
+        if (!real_face(fc[f].area, c->area)) {
             j->zero_faces++;
             continue;
         }
@@ -716,7 +693,7 @@ static int cut_cell(vjob *j, uint32_t l)
     }
     j->first[l - j->lo] = j->nface;
     j->nface += m;
-    v->nfaces[g] = (int32_t)m;
+    c->nfaces = (int32_t)m;
     return FDT_OK;
 }
 
@@ -724,8 +701,7 @@ static int cut_cell(vjob *j, uint32_t l)
 static void sum_cell(vjob *j, uint32_t l)
 {
     const vwork *w = j->w;
-    fdt_voronoi *v = j->v;
-    uint32_t g = row(w, l);
+    vcell *c = &w->cells[l];
     size_t e0 = j->adj_start[l - j->lo], e1 = j->adj_start[l - j->lo + 1];
     fdt_fix total = {0, 0};
     for (size_t e = e0; e < e1; e++)
@@ -739,11 +715,11 @@ static void sum_cell(vjob *j, uint32_t l)
             j->zero_faces++;
     }
     double vol = fdt_fix_value(w->vol[l], w->g_vol);
-    v->volume[g] = vol;
-    v->area[g] = area;
-    v->nfaces[g] = m;
+    c->volume = vol;
+    c->area = area;
+    c->nfaces = m;
     for (int k = 0; k < 3; k++)
-        v->centroid[3 * (size_t)g + k] =
+        c->centroid[k] =
             w->xyz[3 * (size_t)l + k] + fdt_fix_value(w->mom[3 * (size_t)l + k], w->g_mom) / vol;
 }
 
@@ -899,12 +875,12 @@ static void *cell_pass(void *arg)
             j->fsum[e] = oj->fsum[slot(oj, nb, l)];
         }
     for (uint32_t l = j->lo; l < j->hi && !j->err; l++) {
-        uint32_t g = row(w, l);
-        j->v->flags[g] = w->flags[l] & (FDT_CELL_CLIPPED | FDT_CELL_HULL);
+        vcell *c = &w->cells[l];
+        c->flags = w->flags[l] & (FDT_CELL_CLIPPED | FDT_CELL_HULL);
         double dt = w->flags[l] & DTFE_FINE
                         ? fdt_fix_value(w->dtfe[l], fdt_fix_grid_of(ilogb(w->vmax[l])))
                         : fdt_fix_value(w->dtfe[l], w->g_vol);
-        j->v->density[g] = dt > 0 ? 4 / dt : 0;
+        c->density = dt > 0 ? 4 / dt : 0;
         /* A cell whose shares' rounding scale exceeds its volume 2^8 times
          * (a needle: its Voronoi vertices far from its point for its
          * volume) would keep 8 bits less than the shares' precision: cut
@@ -930,32 +906,127 @@ static void *cell_pass(void *arg)
 
 /* ---------------------------------------------------------------- results */
 
-/* The neighbour lists in input order, the job's points' part: a summed
- * cell's from its list's entries, a cut cell's from its faces (both by
- * input id, walls first). v->nstart is set; the lists of different jobs'
- * points are disjoint. */
-static void *fill_neighbors(void *arg)
+/* The local point of output row g: the row itself in a batch, else the
+ * row's point's local id (UINT32_MAX: a merged duplicate, whose row
+ * stays zero). */
+static inline uint32_t local_of(const vwork *w, size_t g)
+{
+    return w->batch ? (uint32_t)g : w->loc[g];
+}
+
+/* How many rows ahead the row passes prefetch what a row reads (its
+ * local point's data lie anywhere: input order is not the local order). */
+#define ROW_AHEAD 16
+
+/* The factors that take the computation's frame back to the points'
+ * (scale_frame): volumes times 2^(3 ed), areas 2^(2 ed), centroids 2^ed,
+ * densities 2^(-3 ed). Products with powers of two, not ldexp calls (4 %
+ * of a 300k --voronoi run): ed is in [VORONOI_MIN_EXP, VORONOI_MAX_EXP],
+ * so each factor is a normal double, and x 2^k rounds once, as ldexp
+ * does, underflow and overflow included: the same bits. */
+typedef struct vscale {
+    double f1, f2, f3, fm3;
+} vscale;
+
+static vscale scale_of(const vwork *w)
+{
+    vscale s = {ldexp(1, w->ed), ldexp(1, 2 * w->ed), ldexp(1, 3 * w->ed), ldexp(1, -3 * w->ed)};
+    return s;
+}
+
+/* A thread's rows [rlo, rhi): each its point's cell (cell_pass), in the
+ * points' frame. Writes only its rows; pthread_join orders them before
+ * the caller. */
+static void *rows_pass(void *arg)
 {
     vjob *j = arg;
     const vwork *w = j->w;
     fdt_voronoi *v = j->v;
-    for (uint32_t l = j->lo; l < j->hi; l++) {
-        uint32_t g = row(w, l);
+    const vscale f = scale_of(w);
+    for (size_t g = j->rlo; g < j->rhi; g++) {
+        if (g + ROW_AHEAD < j->rhi) {
+            uint32_t la = local_of(w, g + ROW_AHEAD);
+            if (la != UINT32_MAX) { /* 56 bytes: one or two lines */
+                __builtin_prefetch(&w->cells[la]);
+                __builtin_prefetch((const char *)&w->cells[la] + sizeof(vcell) - 1);
+            }
+        }
+        uint32_t l = local_of(w, g);
+        if (l == UINT32_MAX)
+            continue;
+        const vcell *c = &w->cells[l];
+        v->volume[g] = c->volume * f.f3;
+        v->area[g] = c->area * f.f2;
+        v->density[g] = c->density * f.fm3;
+        for (int k = 0; k < 3; k++)
+            v->centroid[3 * g + k] = c->centroid[k] * f.f1;
+        v->nfaces[g] = c->nfaces;
+        v->flags[g] = c->flags;
+    }
+    return NULL;
+}
+
+/* A thread's rows' neighbour lists (v->nstart set): a summed cell's from
+ * its list's entries (which its job keeps), a cut cell's from its faces
+ * (both by input id, walls first), the areas in the points' frame. */
+static void *neighbors_pass(void *arg)
+{
+    vjob *j = arg;
+    const vwork *w = j->w;
+    fdt_voronoi *v = j->v;
+    const double f2 = scale_of(w).f2;
+    for (size_t g = j->rlo; g < j->rhi; g++) {
+        /* three reads deep, a stage a distance: the list's place, then
+         * the list, then its points' input ids */
+        if (g + 2 * ROW_AHEAD < j->rhi) {
+            uint32_t la = local_of(w, g + 2 * ROW_AHEAD);
+            if (la != UINT32_MAX) {
+                const vjob *oa = owner(w, la);
+                __builtin_prefetch(&oa->adj_start[la - oa->lo]);
+                __builtin_prefetch(&w->flags[la]);
+                __builtin_prefetch(&w->cells[la].area);
+            }
+        }
+        if (g + ROW_AHEAD < j->rhi) {
+            uint32_t la = local_of(w, g + ROW_AHEAD);
+            if (la != UINT32_MAX) {
+                const vjob *oa = owner(w, la);
+                size_t b = oa->adj_start[la - oa->lo];
+                __builtin_prefetch(&oa->adj[b]);
+                __builtin_prefetch(&oa->fsum[b]);
+                __builtin_prefetch(&oa->fsum[b] + 4);
+            }
+        }
+        if (g + ROW_AHEAD / 2 < j->rhi) {
+            uint32_t la = local_of(w, g + ROW_AHEAD / 2);
+            if (la != UINT32_MAX) {
+                const vjob *oa = owner(w, la);
+                size_t b = oa->adj_start[la - oa->lo], e1 = oa->adj_start[la - oa->lo + 1];
+                for (size_t e = b; e < e1; e++)
+                    __builtin_prefetch(&w->perm[oa->adj[e]]);
+            }
+        }
+        uint32_t l = local_of(w, g);
+        if (l == UINT32_MAX)
+            continue;
+        const vjob *oj = owner(w, l);
         size_t o = v->nstart[g], k = (size_t)v->nfaces[g];
         if (w->flags[l] & (FDT_CELL_CLIPPED | CELL_CUT)) {
-            const fdt_cell_face *fc = j->face + j->first[l - j->lo];
+            const fdt_cell_face *fc = oj->face + oj->first[l - oj->lo];
             for (size_t f = 0; f < k; f++) {
                 v->nid[o + f] = (fdt_vid)fc[f].label;
-                v->narea[o + f] = fc[f].area;
+                v->narea[o + f] = fc[f].area * f2;
             }
             continue;
         }
+        double total = w->cells[l].area;
         size_t m = 0;
-        for (size_t e = j->adj_start[l - j->lo]; e < j->adj_start[l - j->lo + 1]; e++) {
-            double ar = fdt_fix_value(j->fsum[e], w->g_area);
-            if (!real_face(ar, v->area[g]))
+        for (size_t e = oj->adj_start[l - oj->lo]; e < oj->adj_start[l - oj->lo + 1]; e++) {
+            double ar = fdt_fix_value(oj->fsum[e], w->g_area);
+            if (!real_face(ar, total))
                 continue;
-            fdt_vid id = (fdt_vid)w->perm[j->adj[e]];
+            fdt_vid id = (fdt_vid)w->perm[oj->adj[e]];
+            ar *= f2;
             size_t y = o + m++; /* ascending input ids: insertion, a dozen */
             for (; y > o && v->nid[y - 1] > id; y--) {
                 v->nid[y] = v->nid[y - 1];
@@ -997,6 +1068,20 @@ static int alloc_work(vwork *w)
     return FDT_OK;
 }
 
+/* The accumulators (104 bytes a point), freed once every cell is out of
+ * them (cell_pass), before the rows and the neighbour lists (12 bytes a
+ * face) are written. */
+static void free_sums(vwork *w)
+{
+    free(w->vol);
+    free(w->vabs);
+    free(w->mom);
+    free(w->dtfe);
+    free(w->vmax);
+    w->vol = w->vabs = w->mom = w->dtfe = NULL;
+    w->vmax = NULL;
+}
+
 static void free_work(vwork *w)
 {
     free(w->perm);
@@ -1004,11 +1089,7 @@ static void free_work(vwork *w)
     free(w->xyz);
     free(w->tets);
     free(w->flags);
-    free(w->vol);
-    free(w->vabs);
-    free(w->mom);
-    free(w->dtfe);
-    free(w->vmax);
+    free_sums(w);
 }
 
 /* The jobs over the own points, in equal ranges of the local numbering. */
@@ -1022,6 +1103,8 @@ static int make_jobs(vwork *w, fdt_voronoi *v, vjob *jobs, int threads)
         j->v = v;
         j->lo = (uint32_t)(w->nown * (size_t)t / (size_t)threads);
         j->hi = (uint32_t)(w->nown * (size_t)(t + 1) / (size_t)threads);
+        j->rlo = v->n * (size_t)t / (size_t)threads;
+        j->rhi = v->n * (size_t)(t + 1) / (size_t)threads;
         j->short_a = j->short_b = UINT32_MAX;
         fdt_cell_init(&j->cell);
         j->first = malloc(((size_t)(j->hi - j->lo) + 1) * sizeof *j->first);
@@ -1056,7 +1139,7 @@ static int list_neighbors(fdt_voronoi *v, vjob *jobs, int threads)
     v->narea = malloc((tot ? tot : 1) * sizeof *v->narea);
     if (!v->nid || !v->narea)
         return FDT_ENOMEM;
-    return fork_join(jobs, threads, fill_neighbors);
+    return fork_join(jobs, threads, neighbors_pass);
 }
 
 int fdt_voronoi_resolution(const fdt_result *r, const double *xyz, const double box[6],
@@ -1119,8 +1202,13 @@ static int cells_run(vwork *w, fdt_voronoi *v, int threads, int neighbors, fdt_v
                      char *diag, size_t ds)
 {
     vjob *jobs = calloc((size_t)threads, sizeof *jobs);
-    if (!jobs)
+    w->cells = malloc((w->nown ? w->nown : 1) * sizeof *w->cells);
+    if (!jobs || !w->cells) {
+        free(jobs);
+        free(w->cells);
+        w->cells = NULL;
         return FDT_ENOMEM;
+    }
     int err = make_jobs(w, v, jobs, threads);
     if (!err)
         err = fork_join(jobs, threads, tet_pass);
@@ -1154,10 +1242,11 @@ static int cells_run(vwork *w, fdt_voronoi *v, int threads, int neighbors, fdt_v
             }
     for (int t = 0; !err && t < threads; t++)
         v->zero_faces += jobs[t].zero_faces;
+    free_sums(w);
+    if (!err)
+        err = fork_join(jobs, threads, rows_pass);
     if (!err && neighbors)
         err = list_neighbors(v, jobs, threads);
-    if (!err)
-        err = fork_join(jobs, threads, scale_back);
     for (int t = 0; t < threads; t++) {
         fdt_cell_free(&jobs[t].cell);
         free(jobs[t].face);
@@ -1168,6 +1257,8 @@ static int cells_run(vwork *w, fdt_voronoi *v, int threads, int neighbors, fdt_v
         free(jobs[t].fsum);
     }
     free(jobs);
+    free(w->cells);
+    w->cells = NULL;
     return err;
 }
 
