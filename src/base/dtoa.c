@@ -70,13 +70,35 @@ static uint64_t scaled(uint64_t m, int e, int k)
     return q >> 64 ? UINT64_MAX : (uint64_t)q;
 }
 
-/* D's 17 digits at p. */
+/* "00" to "99". */
+static const char pairs[201] =
+    "0001020304050607080910111213141516171819"
+    "2021222324252627282930313233343536373839"
+    "4041424344454647484950515253545556575859"
+    "6061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
+/* v < 10^8 as 8 digits at p: two digits a step from pairs, in two
+ * independent halves (digit by digit, D's 17 divisions by ten were one
+ * chain: 5 % of a --voronoi run's samples at 1M points, bench/NOTES.md
+ * entry 112). */
+static void digits8(char *p, uint32_t v)
+{
+    uint32_t a = v / 10000, b = v % 10000;
+    memcpy(p, pairs + 2 * (a / 100), 2);
+    memcpy(p + 2, pairs + 2 * (a % 100), 2);
+    memcpy(p + 4, pairs + 2 * (b / 100), 2);
+    memcpy(p + 6, pairs + 2 * (b % 100), 2);
+}
+
+/* D's 17 digits at p (D < 10^17). */
 static void digits17(char *p, uint64_t d)
 {
-    for (int i = 16; i >= 0; i--) {
-        p[i] = (char)('0' + d % 10);
-        d /= 10;
-    }
+    uint64_t hi = d / 100000000;
+    uint32_t lo = (uint32_t)(d % 100000000);
+    p[0] = (char)('0' + hi / 100000000);
+    digits8(p + 1, (uint32_t)(hi % 100000000));
+    digits8(p + 9, lo);
 }
 
 /* The digits of D = dig (17 of them) times 10^(X - 16), laid out by %g. */

@@ -135,6 +135,7 @@ typedef struct vjob {
     fdt_cell_face *face; /* its cut cells' real faces, by label (owned) */
     size_t nface, capface;
     uint32_t *order;     /* scratch: a cell's neighbours in cutting order */
+    double *dist;        /* scratch: their squared distances */
     size_t cap_order;
     size_t *first;       /* cut cell lo + k: its faces from face[first[k]] */
     size_t zero_faces;
@@ -615,26 +616,48 @@ static int real_face(double area, double total)
     return area > FDT_CELL_TOL * total;
 }
 
-/* Point l's neighbours in the points' lexicographic order: the cuts, and
- * so the cell's bits, do not depend on how the input was numbered. */
+/* Whether neighbour a of a point (da: its squared distance) is cut
+ * before neighbour b: nearer first (its
+ * bisector cuts the most off the box, so the later cuts mostly find the
+ * cell on their inner side and change nothing), ties in the points'
+ * lexicographic order. A function of the coordinates alone: the cuts,
+ * and so the cell's bits, do not depend on how the input was numbered. */
+static int cut_before(const double *a, double da, const double *b, double db)
+{
+    return da < db || (da == db && fdt_lex_compare(a, b) < 0);
+}
+
+/* Point l's neighbours in cutting order (cut_before). */
 static int cut_order(vjob *j, uint32_t l)
 {
     const vwork *w = j->w;
     size_t b = j->adj_start[l - j->lo], m = j->adj_start[l - j->lo + 1] - b;
     if (m > j->cap_order) {
         uint32_t *q = realloc(j->order, m * sizeof *q);
-        if (!q)
+        double *d = realloc(j->dist, m * sizeof *d);
+        if (q)
+            j->order = q;
+        if (d)
+            j->dist = d;
+        if (!q || !d)
             return FDT_ENOMEM;
-        j->order = q;
         j->cap_order = m;
     }
+    const double *p = w->xyz + 3 * (size_t)l;
     for (size_t e = 0; e < m; e++) {
         uint32_t nb = j->adj[b + e];
+        const double *q = w->xyz + 3 * (size_t)nb;
+        double d[3];
+        sub3(q, p, d);
+        double dn = dot3(d, d);
         size_t y = e;
-        for (; y > 0 && fdt_lex_compare(w->xyz + 3 * (size_t)j->order[y - 1],
-                                        w->xyz + 3 * (size_t)nb) > 0; y--)
+        for (; y > 0 && cut_before(q, dn, w->xyz + 3 * (size_t)j->order[y - 1], j->dist[y - 1]);
+             y--) {
             j->order[y] = j->order[y - 1];
+            j->dist[y] = j->dist[y - 1];
+        }
         j->order[y] = nb;
+        j->dist[y] = dn;
     }
     return FDT_OK;
 }
@@ -1251,6 +1274,7 @@ static int cells_run(vwork *w, fdt_voronoi *v, int threads, int neighbors, fdt_v
         fdt_cell_free(&jobs[t].cell);
         free(jobs[t].face);
         free(jobs[t].order);
+        free(jobs[t].dist);
         free(jobs[t].first);
         free(jobs[t].adj_start);
         free(jobs[t].adj);
