@@ -920,7 +920,9 @@ FDT_API int fdt_voronoi_polyhedron(fdt_voronoi *v, const double *xyz, fdt_vid i,
  * point's last tet is out, so that no more cells are held than a part's
  * points (the run's parts in sweep order: settings.search FDT_SEARCH_AUTO,
  * FDT_MODE_AUTO or serial, no pin; else FDT_EINVAL, ctx's diagnostic
- * says why). Each batch is an fdt_voronoi of some points' cells, as
+ * says why). A periodic run (settings.periodic) hands on each slab's
+ * points' cells after the slab, as fdt_voronoi_compute computes them on
+ * its result (o->box, when given, must be settings.periodic_box). Each batch is an fdt_voronoi of some points' cells, as
  * fdt_voronoi_compute computes them (the same bits, whatever the threads,
  * the parts or the input's order): fdt_voronoi_ids gives each row's input
  * id, and the accessors take rows (fdt_voronoi_neighbors too, with

@@ -173,6 +173,14 @@ def cells(name, pts, lo, hi, axes="xyz"):
     expect(r.returncode == 0, "%s cells: exit %d: %s" % (name, r.returncode, r.stderr))
     if r.returncode:
         return
+    # streamed (one slab: stream() has two), from the stars of the slab's
+    # mesh: the same table
+    vs = os.path.join(SCRATCH, name + "_cs.txt")
+    r = frontdt(src, "--periodic", axes, "--box", box, "--voronoi", vs, "--voronoi-format",
+                "%i %v %F %n %f", "--stream", "-q", "-t", "3")
+    expect(r.returncode == 0 and open(vs, "rb").read() == open(vt, "rb").read(),
+           "%s cells streamed: exit %d, %s, not the in-memory table" % (name, r.returncode,
+                                                                        r.stderr))
     got = {}
     for line in open(vt):
         f = line.split()
@@ -258,19 +266,21 @@ def family(name, n):
 def stream():
     """Streamed in slabs (2^18 points a slab at most: 273,200 points make
     two) on a channel periodic in x and z (slabs along x, the longest
-    period): the .tets is the in-memory run's byte for byte and the set
-    hashes equal (case() streams every case in one slab; test_periodic.c
-    has parts of every size)."""
+    period): the .tets and the cells' tables are the in-memory run's byte
+    for byte and the set hashes equal (case() and cells() stream in one
+    slab; test_periodic.c has parts of every size)."""
     for name, pts, axes in (("channel", channel(270000, 40, (0.0, -0.5, 0.0), (2.0, 0.5, 1.0),
                                                 "xz", 12), "xz"),):
         box = "0,-0.5,0,2,0.5,1"
         src = os.path.join(SCRATCH, "s_" + name + ".xyz")
         write_points(src, pts)
         mem, st = os.path.join(SCRATCH, "s_mem.tets"), os.path.join(SCRATCH, "s_st.tets")
+        tables = lambda tag: ["--voronoi", os.path.join(SCRATCH, "s_%s.vor" % tag),
+                              "--density", os.path.join(SCRATCH, "s_%s.den" % tag)]
         r1 = frontdt(src, "--periodic", axes, "--box", box, "-o", mem, "--set-hash", "-q",
-                     "-t", "2")
+                     "-t", "2", *tables("mem"))
         r2 = frontdt(src, "--periodic", axes, "--box", box, "-o", st, "--stream", "--set-hash",
-                     "-t", "3", "--stats")
+                     "-t", "3", "--stats", *tables("st"))
         expect(r1.returncode == 0 and r2.returncode == 0, "stream %s: exit %d, %d: %s"
                % (name, r1.returncode, r2.returncode, r2.stderr))
         if r1.returncode or r2.returncode:
@@ -278,11 +288,15 @@ def stream():
         expect("2 slabs streamed" in r2.stderr, "stream %s: not two slabs: %s" % (name, r2.stderr))
         expect(open(mem, "rb").read() == open(st, "rb").read(),
                "stream %s: the streamed .tets differs" % name)
+        for ext in ("vor", "den"):
+            expect(open(os.path.join(SCRATCH, "s_mem." + ext), "rb").read() ==
+                   open(os.path.join(SCRATCH, "s_st." + ext), "rb").read(),
+                   "stream %s: the streamed .%s table differs" % (name, ext))
         sh = lambda out: [x for x in out.splitlines() if x.startswith("set-hash: ")]
         expect(sh(r1.stdout) == sh(r2.stdout) and len(sh(r1.stdout)) == 1,
                "stream %s: set hashes %s, %s" % (name, r1.stdout, r2.stdout))
-        print("stream %s: %d points in two slabs, the in-memory .tets and set hash" %
-              (name, len(pts)))
+        print("stream %s: %d points in two slabs, the in-memory .tets, cells, densities and "
+              "set hash" % (name, len(pts)))
 
 
 def errors():
@@ -306,14 +320,28 @@ def errors():
     for args, word in ((["--periodic", "xz"], "needs --box"),
                        (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "--stream", "-o",
                          os.path.join(SCRATCH, "m.vtu")], ".tets only"),
-                       (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "--stream", "--voronoi",
-                         os.path.join(SCRATCH, "m.vor")], "whole mesh"),
                        (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "-o",
                          os.path.join(SCRATCH, "m.ele")], "image vertices"),
                        (["--periodic", "xq", "--box", "0,0,0,1,1,1"], "axes")):
         r = frontdt(src, *args)
         expect(r.returncode == 1 and word in r.stderr, "%s: exit %d, %s"
                % (" ".join(args), r.returncode, r.stderr))
+    # points outside a wall (y is not periodic: a channel's walls, the box
+    # a little lower than its upper one): the mesh is made, its cells are
+    # not, in memory or streamed (refused before any work), in the same
+    # words, naming the first such point
+    lo, hi = (0.0, -0.5, 0.25), (2.0, 0.5, 1.25)
+    write_points(src, channel(300, 4, lo, hi, "xz", 6))
+    said = []
+    for extra in ([], ["--stream"]):
+        vor = os.path.join(SCRATCH, "wall.vor")
+        r = frontdt(src, "--periodic", "xz", "--box", "0,-0.5,0.25,2,0.498,1.25", "--voronoi",
+                    vor, *extra)
+        expect(r.returncode != 0 and "lies outside the box" in r.stderr and
+               not os.path.exists(vor),
+               "points outside a wall %s: exit %d, %s" % (extra, r.returncode, r.stderr))
+        said.append((r.returncode, r.stderr[r.stderr.find("point "):]))
+    expect(said[0] == said[1], "points outside a wall: %r in memory, %r streamed" % tuple(said))
     write_points(src, uniform(3000, 0.0, 1.0, 5))
     r = frontdt(src, "--periodic", "xyz", "--box", "0,0,0,1,1,1", "--memory-limit", "2M")
     expect(r.returncode == 4 and "periodic" in r.stderr,

@@ -549,6 +549,29 @@ static int periodic_count(void *user, const fdt_vid *t, const int8_t *off, size_
     return p->stop_after && p->rows ? 1 : 0;
 }
 
+/* Streamed cells gathered by id: volumes and densities, each id once. */
+typedef struct cells_by_id {
+    double *vol, *dens;
+    size_t n, seen, twice;
+} cells_by_id;
+
+static int take_cells(void *user, const fdt_voronoi *b)
+{
+    cells_by_id *c = user;
+    const fdt_vid *ids = fdt_voronoi_ids(b);
+    for (size_t i = 0; i < fdt_voronoi_num_points(b); i++) {
+        size_t id = (size_t)ids[i];
+        if (id >= c->n || c->vol[id] != -1) {
+            c->twice++;
+            continue;
+        }
+        c->vol[id] = fdt_voronoi_volumes(b)[i];
+        c->dens[id] = fdt_voronoi_densities(b)[i];
+        c->seen++;
+    }
+    return 0;
+}
+
 /* A periodic run through the API (issue 33; its meshes are tested in
  * tests/test_periodic.c and tests/periodic_e2e.py): the first release's
  * settings size runs plain; periodic bits beyond z are refused; the result
@@ -645,6 +668,18 @@ static void test_periodic_api(void)
     }
     EXPECTF(fabs(sum - 1) < 1e-12 && hull_cells == N / 2, "x-z cells: %.17g, %zu hull",
             sum, hull_cells);
+    /* streamed (fdt_voronoi_stream): every point's cell once, to the bit */
+    double cv[N], cd[N];
+    for (size_t i = 0; i < N; i++)
+        cv[i] = cd[i] = -1;
+    cells_by_id cb = {cv, cd, N, 0, 0};
+    fdt_cell_sink csink = {sizeof csink, take_cells, &cb};
+    fdt_result *rs = NULL;
+    CHECK_EQ(fdt_voronoi_stream(ctx, xyz, N, NULL, NULL, &csink, &rs), FDT_OK);
+    EXPECT(cb.seen == N && !cb.twice && fdt_result_num_tets(rs) == 0);
+    EXPECT(!memcmp(cv, fdt_voronoi_volumes(v), sizeof cv) &&
+           !memcmp(cd, fdt_voronoi_densities(v), sizeof cd));
+    fdt_result_free(&rs);
     fdt_voronoi_free(&v);
     /* its own check; a bad axis set or box refused */
     double pb[6];
@@ -668,6 +703,8 @@ static void test_periodic_api(void)
     vo.box[4] = 2;
     EXPECT(fdt_voronoi_compute(r, xyz, N, &vo, &v, vd, sizeof vd) == FDT_EINVAL &&
            strstr(vd, "its own box") != NULL && v == NULL);
+    EXPECT(fdt_voronoi_stream(ctx, xyz, N, &vo, NULL, &csink, &rs) == FDT_EINVAL && !rs &&
+           strstr(fdt_context_diagnostic(ctx), "its own box") != NULL);
     fdt_result_free(&r);
     /* the box's wall below the points (a side that is not periodic: the
      * mesh does not read it, the cells do) */
@@ -677,6 +714,9 @@ static void test_periodic_api(void)
     CHECK_EQ(fdt_triangulate(ctx, xyz, N, &r), FDT_OK);
     EXPECT(fdt_voronoi_compute(r, xyz, N, NULL, &v, vd, sizeof vd) == FDT_EINVAL &&
            strstr(vd, "point 1 (") != NULL && v == NULL);
+    cb.seen = 0;
+    EXPECT(fdt_voronoi_stream(ctx, xyz, N, NULL, NULL, &csink, &rs) == FDT_EINVAL && !rs &&
+           !cb.seen && strstr(fdt_context_diagnostic(ctx), "point 1 (") != NULL);
     fdt_result_free(&r);
     fdt_close(&ctx);
     s.periodic_box[4] = -1; /* empty across y: no walls to cut the cells */

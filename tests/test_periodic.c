@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "mesh/periodic.h"
+#include "mesh/voronoi.h"
 #include "testutil.h"
 
 typedef struct vtx {
@@ -262,29 +263,93 @@ static double *channel(size_t n, uint64_t seed, int duct)
     return X;
 }
 
+/* Whether row r of batch a (a part's cells) is row want_row of w (the
+ * whole set's): every quantity to the bit, the neighbours and their face
+ * areas too. */
+static int same_cell(const fdt_voronoi *a, size_t r, const fdt_voronoi *w, size_t want_row)
+{
+    int same = !memcmp(&fdt_voronoi_volumes(a)[r], &fdt_voronoi_volumes(w)[want_row], 8) &&
+               !memcmp(&fdt_voronoi_areas(a)[r], &fdt_voronoi_areas(w)[want_row], 8) &&
+               !memcmp(&fdt_voronoi_centroids(a)[3 * r], &fdt_voronoi_centroids(w)[3 * want_row],
+                       24) &&
+               !memcmp(&fdt_voronoi_densities(a)[r], &fdt_voronoi_densities(w)[want_row], 8) &&
+               fdt_voronoi_num_faces(a)[r] == fdt_voronoi_num_faces(w)[want_row] &&
+               fdt_voronoi_flags(a)[r] == fdt_voronoi_flags(w)[want_row];
+    size_t ca, cw;
+    const fdt_vid *ia, *iw;
+    const double *aa, *aw;
+    CHECK(fdt_voronoi_neighbors(a, (fdt_vid)r, &ca, &ia, &aa) == FDT_OK);
+    CHECK(fdt_voronoi_neighbors(w, (fdt_vid)want_row, &cw, &iw, &aw) == FDT_OK);
+    return same && ca == cw && (!ca || (!memcmp(ia, iw, ca * sizeof *ia) &&
+                                        !memcmp(aa, aw, ca * sizeof *aa)));
+}
+
 /*
  * The mesh in parts (fdt_periodic_parts_make with part_points a part, each
  * part built on threads): every part's rows sorted and each part's least
  * vertices its own points; all of them together, sorted, equal want's
- * (the one-part build's rows, tets then hull faces).
+ * (the one-part build's rows, tets then hull faces). Where the points'
+ * cells can be cut by the box (fdt_periodic_cells accepts it), each part's
+ * cells from its stars (fdt_periodic_part_cells, a streamed run's) are
+ * the whole set's to the bit, and every point is in one part's.
  */
-static void parts_equal(const char *name, const double *X, size_t n, const fdt_periodic_box *b,
+static void parts_equal(const char *name, const double *X, size_t n, const fdt_periodic_box *pb,
                         uint32_t part_points, int threads, const rows *want,
                         const rows *wanth)
 {
     fdt_periodic_parts p;
-    CHECK(fdt_periodic_parts_make(X, (uint32_t)n, b, part_points, &p) == FDT_OK);
+    CHECK(fdt_periodic_parts_make(X, (uint32_t)n, pb, part_points, &p) == FDT_OK);
+    /* the box's walls across the axes that are not periodic (which the
+     * mesh ignores) at the points' extent, so that the cells are cut there */
+    fdt_periodic_box wb = *pb;
+    const fdt_periodic_box *b = &wb;
+    for (int k = 0; k < 3; k++)
+        if (!(pb->axes >> k & 1)) {
+            wb.lo[k] = p.ylo[k];
+            wb.hi[k] = p.yhi[k];
+        }
     size_t cap = 1024, nt = 0, nh = 0, owned = 0;
     uint32_t *ids = malloc(cap * 4 * sizeof *ids), *hids = malloc(cap * 3 * sizeof *hids);
     int8_t *off = malloc(cap * 12), *hoff = malloc(cap * 9);
     CHECK(ids && hids && off && hoff);
+    /* the whole set's cells, where the box holds them */
+    fdt_voronoi *whole = NULL;
+    {
+        fdt_periodic_mesh one;
+        char d[512];
+        CHECK(fdt_periodic_build(X, (uint32_t)n, NULL, b, threads, &one, d, sizeof d) == FDT_OK);
+        int32_t *dup = malloc(n * sizeof *dup);
+        CHECK(dup);
+        for (size_t i = 0; i < n; i++)
+            dup[i] = (int32_t)i;
+        if (fdt_periodic_cells((const int32_t *)one.tets, one.tet_off, one.ntets,
+                               (const int32_t *)one.hull, one.nhull, X, n, dup, b, threads, 1,
+                               &whole, d, sizeof d) != FDT_OK)
+            whole = NULL; /* a point outside a wall's box: no cells to compare */
+        free(dup);
+        fdt_periodic_free(&one);
+    }
+    size_t celled = 0, cells_off = 0;
     for (uint32_t k = 0; k < p.nparts; k++) {
         fdt_periodic_mesh pm;
         char diag[512];
-        int err = fdt_periodic_build_part(X, (uint32_t)n, NULL, b, &p, k, threads, &pm, diag,
-                                          sizeof diag);
+        int err = fdt_periodic_build_part(X, (uint32_t)n, NULL, b, &p, k, threads, whole != NULL,
+                                          &pm, diag, sizeof diag);
         EXPECTF(err == FDT_OK, "%s: part %u of %u: %d (%s)", name, k, p.nparts, err, diag);
         CHECK(err == FDT_OK);
+        if (whole) {
+            fdt_voronoi *c = NULL;
+            fdt_vshort sh = {-1, -1, INFINITY};
+            err = fdt_periodic_part_cells(&pm, X, (uint32_t)n, 0, NULL, &p, k, b, threads, 1, &c,
+                                          &sh, diag, sizeof diag);
+            EXPECTF(err == FDT_OK, "%s: part %u's cells: %d (%s)", name, k, err, diag);
+            CHECK(err == FDT_OK);
+            const fdt_vid *cid = fdt_voronoi_ids(c);
+            for (size_t r = 0; r < fdt_voronoi_num_points(c); r++)
+                cells_off += !same_cell(c, r, whole, (size_t)cid[r]);
+            celled += fdt_voronoi_num_points(c);
+            fdt_voronoi_free(&c);
+        }
         owned += fdt_periodic_part_points(&p, k, (uint32_t)n);
         size_t bad = 0;
         for (size_t i = 0; i < pm.ntets; i++) {
@@ -316,6 +381,12 @@ static void parts_equal(const char *name, const double *X, size_t n, const fdt_p
         fdt_periodic_free(&pm);
     }
     EXPECTF(owned == n, "%s: the parts own %zu of %zu points", name, owned, n);
+    if (whole) {
+        EXPECTF(celled == n && !cells_off,
+                "%s: %u parts: %zu cells of %zu points, %zu not the whole set's", name, p.nparts,
+                celled, n, cells_off);
+        fdt_voronoi_free(&whole);
+    }
     rows got = mesh_rows(ids, off, nt, 4), goth = mesh_rows(hids, hoff, nh, 3);
     EXPECTF(same_rows(&got, want) && same_rows(&goth, wanth),
             "%s: %u parts of %u points, %d threads: %zu tets, %zu hull faces, one part %zu, %zu",

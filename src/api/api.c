@@ -567,8 +567,14 @@ static int cells_done(fdt_context *ctx, const fdt_cellstream *cs)
 static int periodic_box_scaled(fdt_context *ctx, int e, fdt_periodic_box *b)
 {
     for (int k = 0; k < 3; k++) {
-        if (!(b->axes >> k & 1))
+        if (!(b->axes >> k & 1)) {
+            /* a wall of the cells (the mesh has none there): the points'
+             * scale, exactly where it holds (else the cells' box is out
+             * of range and refused) */
+            b->lo[k] = ldexp(b->lo[k], e);
+            b->hi[k] = ldexp(b->hi[k], e);
             continue;
+        }
         double lo = ldexp(b->lo[k], e), hi = ldexp(b->hi[k], e);
         if (ldexp(lo, -e) != b->lo[k] || ldexp(hi, -e) != b->hi[k] || !isfinite(hi - lo)) {
             snprintf(ctx->diag, sizeof ctx->diag, "the periodic box's %c side [%.17g, %.17g) "
@@ -584,12 +590,15 @@ static int periodic_box_scaled(fdt_context *ctx, int e, fdt_periodic_box *b)
 /*
  * A periodic run streamed: the slabs of fdt_periodic_parts, the sweep's
  * points a slab (fdt_sweep_slab), each part's rows renumbered to input
- * ids, hashed and handed to the sink, then freed; the progress after each
- * part. *sum gets the counts (images summed, the most rounds, rows).
+ * ids, hashed and handed to the sink, and with cells (cs) its points'
+ * cells from their stars in its mesh (fdt_periodic_part_cells) handed to
+ * cs's sink, then freed; the progress after each part. *sum gets the
+ * counts (images summed, the most rounds, rows).
  */
 static int periodic_stream(fdt_context *ctx, const fdt_prepared *pr, const fdt_periodic_box *b,
-                           int nthreads, const fdt_sink *user, const unsigned share[2],
-                           fdt_periodic_mesh *sum, fdt_sethash *h, size_t *nparts)
+                           int nthreads, const fdt_sink *user, fdt_cellstream *cs,
+                           const unsigned share[2], fdt_periodic_mesh *sum, fdt_sethash *h,
+                           size_t *nparts)
 {
     fdt_periodic_parts parts;
     /* a share of the parts (frontdt-mpi): at least a part a sharer */
@@ -602,7 +611,16 @@ static int periodic_stream(fdt_context *ctx, const fdt_prepared *pr, const fdt_p
     for (uint32_t k = share[0]; k < parts.nparts && !err; k += share[1]) {
         fdt_periodic_mesh pm;
         err = fdt_periodic_build_part(pr->p, (uint32_t)pr->m, pr->orig, b, &parts, k, nthreads,
-                                      &pm, ctx->diag, sizeof ctx->diag);
+                                      cs != NULL, &pm, ctx->diag, sizeof ctx->diag);
+        if (!err && cs) {
+            fdt_voronoi *v = NULL;
+            fdt_vshort sh = {-1, -1, 0};
+            err = fdt_periodic_part_cells(&pm, pr->p, (uint32_t)pr->m, pr->scale_exp, pr->orig,
+                                          &parts, k, b, nthreads, cs->neighbors, &v, &sh,
+                                          ctx->diag, sizeof ctx->diag);
+            err = fdt_cellstream_give(cs, err, v, &sh);
+            fdt_voronoi_free(&v);
+        }
         if (!err)
             err = fdt_periodic_renumber(&pm, pr->orig, pr->m);
         if (!err) {
@@ -637,7 +655,7 @@ static int periodic_stream(fdt_context *ctx, const fdt_prepared *pr, const fdt_p
  * slab to the sink).
  */
 static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *user,
-                        const unsigned share[2], fdt_result **out)
+                        fdt_cellstream *cs, const unsigned share[2], fdt_result **out)
 {
     fdt_mode mode;
     int nthreads;
@@ -662,14 +680,22 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, const fdt
     if (!err)
         err = periodic_box_scaled(ctx, pr.scale_exp, &b);
     double t1 = fdt_now_s();
+    if (!err && cs && !(err = fdt_cellstream_init(cs, pr.m)))
+        cs->p_exp = pr.scale_exp;
     if (!err && user) {
-        err = periodic_stream(ctx, &pr, &b, nthreads, user, share, &pm, &h, &nparts);
+        err = periodic_stream(ctx, &pr, &b, nthreads, user, cs, share, &pm, &h, &nparts);
     } else if (!err) {
         err = fdt_periodic_build(pr.p, (uint32_t)pr.m, pr.orig, &b, nthreads, &pm, ctx->diag,
                                  sizeof ctx->diag);
         if (!err)
             err = fdt_periodic_renumber(&pm, pr.orig, pr.m);
     }
+    /* the cells' end: the least edge too short for them, if any, then the
+     * merged duplicates' rows, the last batch */
+    if (!err && cs)
+        err = cells_done(ctx, cs);
+    if (!err && cs && pr.dupmap)
+        err = fdt_cellstream_merged(cs, pr.dupmap, n, pr.p, pr.orig, pr.m);
     double t2 = fdt_now_s();
     if (!err)
         err = result_dupmap(&pr, n);
@@ -743,15 +769,14 @@ static int run(fdt_context *ctx, const double *xyz, size_t n, const fdt_sink *us
         return FDT_EINVAL;
     }
     if (ctx->s.periodic) {
-        if (ctx->s.neighbors || cs || (user && !periodic_sink_ok(user))) {
+        if (ctx->s.neighbors || (user && !periodic_sink_ok(user))) {
             snprintf(ctx->diag, sizeof ctx->diag, "%s",
                      ctx->s.neighbors ? "a periodic run has no neighbours"
-                     : cs ? "a periodic run's cells are in memory (fdt_voronoi_compute)"
-                          : "a periodic run streams to a sink with periodic_tets set");
+                                      : "a periodic run streams to a sink with periodic_tets set");
             return FDT_EINVAL;
         }
         static const unsigned all[2] = {0, 1};
-        return run_periodic(ctx, xyz, n, user, all, out);
+        return run_periodic(ctx, xyz, n, user, cs, all, out);
     }
     if (user && !user->tets) {
         snprintf(ctx->diag, sizeof ctx->diag, "the sink has no tets callback");
@@ -863,7 +888,7 @@ int fdt_triangulate_stream_parts(fdt_context *ctx, const double *xyz, size_t n,
         return FDT_EINVAL;
     }
     const unsigned share[2] = {first, stride};
-    return run_periodic(ctx, xyz, n, sink, share, out);
+    return run_periodic(ctx, xyz, n, sink, NULL, share, out);
 }
 
 /* The tets of a cells-only stream: counted and hashed by the sink, then
@@ -874,6 +899,35 @@ static int drop_tets(void *user, const fdt_vid *tets, size_t count)
     (void)tets;
     (void)count;
     return 0;
+}
+
+static int drop_rows(void *user, const fdt_vid *rows, const int8_t *offsets, size_t count)
+{
+    (void)offsets;
+    return drop_tets(user, rows, count);
+}
+
+/* A periodic run's cells' box (fdt_periodic_cells_box of its periods) into
+ * cs, after the points' checks (the run's against the periods first, then
+ * the walls'); o's box, when given, must be the periodic box (as
+ * fdt_voronoi_compute asks). */
+static int periodic_cells_box(fdt_context *ctx, const double *xyz, size_t n,
+                              const fdt_voronoi_options *o, fdt_cellstream *cs)
+{
+    const double *bx = ctx->s.periodic_box;
+    if (o->box_given && memcmp(o->box, bx, sizeof o->box) != 0) {
+        snprintf(ctx->diag, sizeof ctx->diag, "a periodic mesh's cells take its own box (the "
+                 "periods, and the walls across the axes that are not periodic)");
+        return FDT_EINVAL;
+    }
+    fdt_periodic_box b = {ctx->s.periodic, {bx[0], bx[1], bx[2]}, {bx[3], bx[4], bx[5]}};
+    int err = fdt_periodic_check(xyz, n, &b, ctx->diag, sizeof ctx->diag);
+    if (!err)
+        err = fdt_periodic_cells_check(xyz, n, &b, ctx->diag, sizeof ctx->diag);
+    if (err)
+        return err;
+    fdt_periodic_cells_box(&b, cs->box);
+    return fdt_voronoi_scale(cs->box, &cs->ed, ctx->diag, sizeof ctx->diag);
 }
 
 int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
@@ -890,7 +944,7 @@ int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
         return FDT_EINVAL;
     *out = NULL;
     ctx->diag[0] = '\0';
-    fdt_sink dropped = {sizeof dropped, drop_tets, NULL, NULL, NULL, NULL};
+    fdt_sink dropped = {sizeof dropped, drop_tets, NULL, NULL, drop_rows, NULL};
     fdt_cellstream cs;
     memset(&cs, 0, sizeof cs);
     cs.neighbors = o->neighbors;
@@ -898,10 +952,15 @@ int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
     /* The box and its scale before any work (xyz is the caller's still:
      * a permuted input is moved by the run). The bounding box of the
      * distinct points is that of all of them. */
-    int err = fdt_voronoi_box_of(xyz, NULL, n, o, cs.box, ctx->diag, sizeof ctx->diag);
-    /* no finite point: the run refuses the input, with its own message */
-    if (!err && cs.box[0] <= cs.box[3])
-        err = fdt_voronoi_scale(cs.box, &cs.ed, ctx->diag, sizeof ctx->diag);
+    int err = FDT_OK;
+    if (ctx->s.periodic) {
+        err = periodic_cells_box(ctx, xyz, n, o, &cs);
+    } else {
+        err = fdt_voronoi_box_of(xyz, NULL, n, o, cs.box, ctx->diag, sizeof ctx->diag);
+        /* no finite point: the run refuses the input, with its own message */
+        if (!err && cs.box[0] <= cs.box[3])
+            err = fdt_voronoi_scale(cs.box, &cs.ed, ctx->diag, sizeof ctx->diag);
+    }
     if (!err)
         err = run(ctx, xyz, n, sink ? sink : &dropped, &cs, out);
     fdt_cellstream_free(&cs);

@@ -1047,8 +1047,6 @@ static const char *stream_refusal(const cli *c, const fdt_format *const *fmts, i
     const char *dual = fdt_cli_dual_stream_refusal(&c->dual);
     if (dual)
         return dual;
-    if (c->periodic && fdt_cli_dual_wanted(&c->dual))
-        return "a periodic run's cells need the whole mesh";
     /* the cells stream where asked to; else they take the whole mesh */
     if (fdt_cli_dual_wanted(&c->dual) && !forced)
         return "--voronoi and --density stream with --stream only";

@@ -132,6 +132,18 @@ static int hand_on(fdt_cellstream *cs, const fdt_voronoi *v)
     return rc;
 }
 
+int fdt_cellstream_give(fdt_cellstream *cs, int err, const fdt_voronoi *v, const fdt_vshort *sh)
+{
+    if (err == FDT_ERANGE && sh->a >= 0) {
+        pthread_mutex_lock(&cs->lock);
+        if (cs->sh.a < 0 || fdt_edge_less(sh->a, sh->b, cs->sh.a, cs->sh.b))
+            cs->sh = *sh;
+        pthread_mutex_unlock(&cs->lock);
+        return FDT_OK; /* the run goes on to find the least */
+    }
+    return err ? err : hand_on(cs, v);
+}
+
 int fdt_cellstream_part(fdt_cellstream *cs, fdt_cellheld *h, const fdt_vid *part, size_t npart,
                         const uint32_t *live, size_t nlive, const uint32_t *hull, size_t nhull,
                         int threads, char *diag, size_t dlen)
@@ -197,14 +209,7 @@ int fdt_cellstream_part(fdt_cellstream *cs, fdt_cellheld *h, const fdt_vid *part
         fdt_voronoi *v = NULL;
         fdt_vshort sh = {-1, -1, 0};
         err = fdt_voronoi_batch(&b, threads, &v, &sh, diag, dlen);
-        if (err == FDT_ERANGE && sh.a >= 0) {
-            pthread_mutex_lock(&cs->lock);
-            if (cs->sh.a < 0 || fdt_edge_less(sh.a, sh.b, cs->sh.a, cs->sh.b))
-                cs->sh = sh;
-            pthread_mutex_unlock(&cs->lock);
-            err = FDT_OK; /* the run goes on to find the least */
-        } else if (!err)
-            err = hand_on(cs, v);
+        err = fdt_cellstream_give(cs, err, v, &sh);
         fdt_voronoi_free(&v);
     }
     for (size_t i = 0; i < nown; i++)

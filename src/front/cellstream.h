@@ -93,6 +93,13 @@ int fdt_cellstream_part(fdt_cellstream *cs, fdt_cellheld *h, const fdt_vid *part
                         const uint32_t *live, size_t nlive, const uint32_t *hull, size_t nhull,
                         int threads, char *diag, size_t dlen);
 
+/* A batch's end (err: fdt_voronoi_batch's, or a call that gives its
+ * errors): a tet too short for the cells kept in cs->sh when it is the
+ * least yet (FDT_OK: the run goes on), another error returned, else v
+ * handed to the sink under the lock unless the run is stopping (the
+ * sink's stop code). The periodic parts' batches come this way too
+ * (src/api/api.c). */
+int fdt_cellstream_give(fdt_cellstream *cs, int err, const fdt_voronoi *v, const fdt_vshort *sh);
 /* The run is over: the merged duplicates (dupmap: input id -> the input
  * id it was merged into; n input points) as the last batch, their points
  * found through the sweep's points P and ids orig (m of them). FDT_OK,

@@ -391,6 +391,9 @@ typedef struct run {
     fdt_images im;
     fdt_ins m;
     keyset tets[64], hull[64]; /* the kept ones, a set a job (prove_tet) */
+    int stars;             /* also gather every tet and hull face with an owned
+                              vertex (the owned points' stars: their cells) */
+    keyset star[64], star_hull[64];
     int nsets;
     double need[3];        /* a failed round: how far the balls reached */
     const int32_t *names;  /* the points' names in messages, or NULL */
@@ -406,6 +409,7 @@ typedef struct prove_job {
     run *r;
     double mm[3], A[3], B[3]; /* the margin a hair under, the region inside */
     keyset tets, hull;   /* the kept ones */
+    keyset star, star_hull; /* those with an owned vertex (run.stars) */
     double need[3];      /* how far the balls reached, where too far */
     int again, err;
     long repeat_id;      /* a kept tet with two images of this point, or -1 */
@@ -430,6 +434,47 @@ static void prove_init(prove_job *j, run *r, const double m[3])
         j->A[k] = nextafter(r->core.lo[k] - j->mm[k], INFINITY);
         j->B[k] = nextafter(r->core.hi[k] + j->mm[k], -INFINITY);
     }
+}
+
+/* Part of x on the slabs' axis: the number of inner cuts at or below it. */
+static uint32_t part_of(const fdt_periodic_parts *p, double x)
+{
+    uint32_t lo = 1, hi = p->nparts; /* the answer is in [lo - 1, hi - 1] */
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (p->cut[mid] <= x)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo - 1;
+}
+
+/* Whether the run's part owns input point i (its slab's). */
+static int owns(const run *r, uint32_t i)
+{
+    const fdt_periodic_parts *p = r->parts;
+    return !r->own || part_of(p, r->X[3 * (size_t)i + (size_t)p->axis]) == r->part;
+}
+
+/*
+ * Whether this copy of a tet (or hull face) with an owned vertex is the one
+ * the stars keep: the copy in which the least of its owned points (by id)
+ * is the point itself, not an image. A periodic tet has copies in the
+ * part's mesh around each of its owned points (the same key, make_key's),
+ * and exactly one of them holds that point itself: the point's star is
+ * whole in the mesh (the proofs) and holds the tet once.
+ */
+static int star_copy(const run *r, const uint32_t *w, int nv)
+{
+    uint32_t self = UINT32_MAX;
+    for (int i = 0; i < nv; i++)
+        if (w[i] < r->nown && r->e.src[w[i]] < self)
+            self = r->e.src[w[i]];
+    for (int i = 0; i < nv; i++)
+        if (w[i] >= r->nown && r->e.src[w[i]] < self && owns(r, r->e.src[w[i]]))
+            return 0;
+    return 1;
 }
 
 /*
@@ -492,6 +537,11 @@ static void prove_tet(void *user, int job, uint32_t slot, const uint32_t v[4], i
     key k;
     int rep;
     uint32_t least = make_key(&r->e, w, nv, &k, &rep);
+    /* the owned points' stars, for their cells: every tet and hull face
+     * with an owned vertex, proved like the kept ones, once */
+    if (r->stars && star_copy(r, w, nv) &&
+        (j->err = keyset_add(inf < 0 ? &j->star : &j->star_hull, &k, 0)) != FDT_OK)
+        return;
     if (least >= r->nown)
         return;
     if (rep && j->repeat_id < 0)
@@ -567,6 +617,8 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
     for (int i = 0; i < r->nsets; i++) {
         keyset_free(&r->tets[i]);
         keyset_free(&r->hull[i]);
+        keyset_free(&r->star[i]);
+        keyset_free(&r->star_hull[i]);
     }
     r->nsets = 0;
     if ((err = part_near(r, m)) != FDT_OK ||
@@ -624,6 +676,8 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
         for (int i = 0; i < T; i++) {
             keyset_free(&jobs[i].tets);
             keyset_free(&jobs[i].hull);
+            keyset_free(&jobs[i].star);
+            keyset_free(&jobs[i].star_hull);
         }
         free(pp);
         return err;
@@ -643,6 +697,8 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
     for (int i = 0; i < T; i++) { /* the run frees them */
         r->tets[i] = jobs[i].tets;
         r->hull[i] = jobs[i].hull;
+        r->star[i] = jobs[i].star;
+        r->star_hull[i] = jobs[i].star_hull;
     }
     r->nsets = T;
     free(pp);
@@ -733,6 +789,27 @@ static int emit(keyset *s, int ns, int nv, size_t n, uint32_t **ids, int8_t **of
     }
     unpack(tmp, total, nv, *ids, *offs);
     free(tmp);
+    *count = total;
+    return FDT_OK;
+}
+
+/* The keys of the sets s[0 .. ns) into rows, in no order (the stars),
+ * each set freed once its keys are moved. */
+static int gather(keyset *s, int ns, int nv, uint32_t **ids, int8_t **offs, size_t *count)
+{
+    size_t total = 0;
+    for (int i = 0; i < ns; i++)
+        total += s[i].n;
+    *ids = malloc((total ? total : 1) * (size_t)nv * sizeof **ids);
+    *offs = malloc((total ? total : 1) * (size_t)nv * 3);
+    if (!*ids || !*offs)
+        return FDT_ENOMEM;
+    size_t at = 0;
+    for (int i = 0; i < ns; i++) {
+        unpack(s[i].keys, s[i].n, nv, *ids + (size_t)nv * at, *offs + 3 * (size_t)nv * at);
+        at += s[i].n;
+        keyset_free(&s[i]);
+    }
     *count = total;
     return FDT_OK;
 }
@@ -842,19 +919,6 @@ static void extent(const double *X, uint32_t n, double lo[3], double hi[3])
         }
 }
 
-/* Part of x on the slabs' axis: the number of inner cuts at or below it. */
-static uint32_t part_of(const fdt_periodic_parts *p, double x)
-{
-    uint32_t lo = 1, hi = p->nparts; /* the answer is in [lo - 1, hi - 1] */
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (p->cut[mid] <= x)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo - 1;
-}
 
 int fdt_periodic_parts_make(const double *X, uint32_t n, const fdt_periodic_box *b,
                             uint32_t part_points, fdt_periodic_parts *p)
@@ -940,8 +1004,8 @@ uint32_t fdt_periodic_part_points(const fdt_periodic_parts *p, uint32_t k, uint3
 
 int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
                             const fdt_periodic_box *b, const fdt_periodic_parts *parts,
-                            uint32_t part, int nthreads, fdt_periodic_mesh *out, char *diag,
-                            size_t diag_size)
+                            uint32_t part, int nthreads, int stars, fdt_periodic_mesh *out,
+                            char *diag, size_t diag_size)
 {
     memset(out, 0, sizeof *out);
     char owndiag[8];
@@ -960,6 +1024,7 @@ int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
     r.dsz = diag_size;
     r.parts = parts;
     r.part = part;
+    r.stars = stars;
     r.core = *b;
     r.nown = n;
     int a = parts->nparts > 1 ? parts->axis : -1;
@@ -1029,11 +1094,17 @@ int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
     free(r.near);
     if (err == FDT_OK &&
         ((err = emit(r.tets, r.nsets, 4, r.nown, &out->tets, &out->tet_off, &out->ntets)) ||
-         (err = emit(r.hull, r.nsets, 3, r.nown, &out->hull, &out->hull_off, &out->nhull))))
+         (err = emit(r.hull, r.nsets, 3, r.nown, &out->hull, &out->hull_off, &out->nhull)) ||
+         (stars && ((err = gather(r.star, r.nsets, 4, &out->star_tets, &out->star_off,
+                                  &out->nstar)) ||
+                    (err = gather(r.star_hull, r.nsets, 3, &out->star_hull,
+                                  &out->star_hull_off, &out->nstar_hull))))))
         snprintf(diag, diag_size, "out of memory");
     for (int i = 0; i < r.nsets; i++) {
         keyset_free(&r.tets[i]);
         keyset_free(&r.hull[i]);
+        keyset_free(&r.star[i]);
+        keyset_free(&r.star_hull[i]);
     }
     if (err) {
         fdt_pred_counts pc = out->pc;
@@ -1058,7 +1129,7 @@ int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
         snprintf(diag, diag_size, "out of memory");
         return err;
     }
-    err = fdt_periodic_build_part(X, n, names, b, &p, 0, nthreads, out, diag, diag_size);
+    err = fdt_periodic_build_part(X, n, names, b, &p, 0, nthreads, 0, out, diag, diag_size);
     fdt_periodic_parts_free(&p);
     return err;
 }
@@ -1069,6 +1140,10 @@ void fdt_periodic_free(fdt_periodic_mesh *m)
     free(m->tet_off);
     free(m->hull);
     free(m->hull_off);
+    free(m->star_tets);
+    free(m->star_off);
+    free(m->star_hull);
+    free(m->star_hull_off);
     memset(m, 0, sizeof *m);
 }
 
@@ -1846,29 +1921,25 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
     return err;
 }
 
-int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
-                       size_t nhull, const double *X, size_t n, const int32_t *dupmap,
-                       const fdt_periodic_box *b, int threads, int neighbors, fdt_voronoi **out,
-                       char *diag, size_t ds)
+/*
+ * The cells of the points own[0 .. nown) (X's ids, distinct) from tets
+ * (ids in X, 12 offsets each relative to any vertex) that hold every tet
+ * of their stars, and the hull faces' points hull[0 .. 3 nhull): a batch
+ * (src/mesh/voronoi.h), row i own[i]'s cell, its id names[own[i]] (names
+ * NULL: the ids themselves). X is the input's points times 2^x_exp, and b
+ * its box likewise. Each tet is taken once for each offset among its
+ * vertices, moved so that the vertices with that offset are the points
+ * themselves: every star around its point. FDT_ERANGE for an edge too
+ * short for the cells (*sh, the least one, diag not written); else the
+ * batch's errors with diag.
+ */
+static int star_batch(const uint32_t *tets, const int8_t *off, size_t ntets, const uint32_t *hull,
+                      size_t nhull, const double *X, int x_exp, const int32_t *names,
+                      const uint32_t *own_ids, size_t nown_ids, const fdt_periodic_box *b,
+                      int threads, int neighbors, struct fdt_voronoi **out, fdt_vshort *sh,
+                      double box[6], char *diag, size_t ds)
 {
     *out = NULL;
-    /* the walls across the axes that are not periodic: the box's sides,
-     * which hold every point */
-    for (int k = 0; k < 3; k++) {
-        if (b->axes >> k & 1)
-            continue;
-        if (!(b->lo[k] < b->hi[k]) || !isfinite(b->lo[k]) || !isfinite(b->hi[k])) {
-            snprintf(diag, ds, "the box is empty or not finite in %c, which is not periodic: "
-                     "its cells are cut there", "xyz"[k]);
-            return FDT_EINVAL;
-        }
-        for (size_t i = 0; i < n; i++)
-            if (!(X[3 * i + k] >= b->lo[k] && X[3 * i + k] <= b->hi[k])) {
-                snprintf(diag, ds, "point %zu (%.17g %.17g %.17g) lies outside the box",
-                         i, X[3 * i], X[3 * i + 1], X[3 * i + 2]);
-                return FDT_EINVAL;
-            }
-    }
     vmap m;
     memset(&m, 0, sizeof m);
     uint32_t *own = NULL, *st = NULL;
@@ -1876,15 +1947,35 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
     size_t nst = 0, stcap = 0, nown = 0;
     int err = FDT_OK;
     static const int8_t zero[3] = {0, 0, 0};
-    /* the points themselves first: rows 0 .. nown of the batch */
-    for (size_t i = 0; i < n && !err; i++)
-        if (dupmap[i] == (int32_t)i && vmap_get(&m, (uint32_t)i, zero, X, b) < 0)
+    /* the points themselves first, rows 0 .. nown of the batch, in Morton
+     * order: the cells' passes then meet a tet's points near the last
+     * one's (in input order, add_tet read points all over the batch:
+     * bench/NOTES.md entry 112) */
+    double *pts = malloc(3 * (nown_ids ? nown_ids : 1) * sizeof *pts);
+    uint32_t *order = malloc((nown_ids ? nown_ids : 1) * sizeof *order);
+    if (!pts || !order)
+        err = FDT_ENOMEM;
+    double ob[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < nown_ids && !err; i++) {
+        const double *x = X + 3 * (size_t)(own_ids ? own_ids[i] : i);
+        for (int k = 0; k < 3; k++) {
+            pts[3 * i + (size_t)k] = x[k];
+            ob[k] = x[k] < ob[k] ? x[k] : ob[k];
+            ob[k + 3] = x[k] > ob[k + 3] ? x[k] : ob[k + 3];
+        }
+    }
+    if (!err && nown_ids && fdt_morton_order(pts, nown_ids, ob, NULL, order) < 0)
+        err = FDT_ENOMEM;
+    for (size_t i = 0; i < nown_ids && !err; i++) {
+        uint32_t q = order[i];
+        if (vmap_get(&m, own_ids ? own_ids[q] : q, zero, X, b) < 0)
             err = FDT_ENOMEM;
+    }
+    free(pts);
+    free(order);
     nown = m.n;
-    /* each tet once for each offset among its vertices, moved so that
-     * vertices with that offset are the points themselves: every star */
     for (size_t t = 0; t < ntets && !err; t++) {
-        const uint32_t *id = (const uint32_t *)tets + 4 * t;
+        const uint32_t *id = tets + 4 * t;
         const int8_t *o = off + 12 * t;
         int pos = exact_sign(X, b, 4, id, o) > 0;
         for (int j = 0; j < 4 && !err; j++) {
@@ -1929,7 +2020,7 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
     /* the hull's points (across an axis that is not periodic): their
      * cells are unbounded, cut by the box */
     for (size_t f = 0; !err && f < 3 * nhull; f++) {
-        long x = vmap_get(&m, (uint32_t)hull[f], zero, X, b);
+        long x = vmap_get(&m, hull[f], zero, X, b);
         if (x < 0)
             err = FDT_ENOMEM;
         else if ((size_t)x < nown)
@@ -1940,27 +2031,26 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
      * stars; on the others the box's sides, where cells are cut */
     fdt_vbatch vb;
     memset(&vb, 0, sizeof vb);
+    fdt_periodic_cells_box(b, vb.box);
     for (int k = 0; k < 3 && !err; k++) {
-        if (!(b->axes >> k & 1)) {
-            vb.box[k] = b->lo[k];
-            vb.box[k + 3] = b->hi[k];
+        if (!(b->axes >> k & 1))
             continue;
-        }
-        double L = b->hi[k] - b->lo[k];
-        vb.box[k] = b->lo[k] - L;
-        vb.box[k + 3] = b->hi[k] + L;
         for (size_t i = 0; i < m.n; i++) {
             double v = m.xyz[3 * i + k];
             vb.box[k] = v < vb.box[k] ? v : vb.box[k];
             vb.box[k + 3] = v > vb.box[k + 3] ? v : vb.box[k + 3];
         }
     }
+    for (int k = 0; k < 6; k++) /* the input's frame, exactly */
+        box[k] = vb.box[k] = ldexp(vb.box[k], -x_exp);
+    for (size_t i = 0; names && i < m.n; i++) /* the rows' and neighbours' ids */
+        m.label[i] = (uint32_t)names[m.label[i]];
     if (!err)
         err = fdt_voronoi_scale(vb.box, &vb.ed, diag, ds);
-    fdt_voronoi *v = NULL;
+    struct fdt_voronoi *v = NULL;
     if (!err) {
         vb.xyz = m.xyz;
-        vb.xyz_exp = 0;
+        vb.xyz_exp = x_exp;
         vb.label = (const fdt_vid *)m.label;
         vb.own = own;
         vb.nown = nown;
@@ -1968,10 +2058,7 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
         vb.tets = st;
         vb.ntets = nst / 4;
         vb.neighbors = neighbors;
-        fdt_vshort sh = {-1, -1, INFINITY};
-        err = fdt_voronoi_batch(&vb, threads, &v, &sh, diag, ds);
-        if (err == FDT_ERANGE)
-            err = fdt_voronoi_too_close(&sh, vb.box, diag, ds);
+        err = fdt_voronoi_batch(&vb, threads, &v, sh, diag, ds);
     }
     /* no cell of a set periodic on every axis is clipped: one that is
      * reached past its neighbouring images (a bug) */
@@ -1982,8 +2069,6 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
                      m.label[own[i]]);
             err = FDT_EINTERNAL;
         }
-    if (!err)
-        err = fdt_voronoi_spread(&v, n);
     if (err)
         fdt_voronoi_free(&v);
     *out = v;
@@ -1992,4 +2077,81 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
     free(own_hull);
     free(st);
     return err;
+}
+
+int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
+                       size_t nhull, const double *X, size_t n, const int32_t *dupmap,
+                       const fdt_periodic_box *b, int threads, int neighbors, fdt_voronoi **out,
+                       char *diag, size_t ds)
+{
+    *out = NULL;
+    int err = fdt_periodic_cells_check(X, n, b, diag, ds);
+    if (err)
+        return err;
+    uint32_t *own = malloc((n ? n : 1) * sizeof *own);
+    if (!own)
+        return FDT_ENOMEM;
+    size_t nown = 0;
+    for (size_t i = 0; i < n; i++)
+        if (dupmap[i] == (int32_t)i)
+            own[nown++] = (uint32_t)i;
+    fdt_vshort sh = {-1, -1, INFINITY};
+    fdt_voronoi *v = NULL;
+    double box[6];
+    err = star_batch((const uint32_t *)tets, off, ntets, (const uint32_t *)hull, nhull, X, 0, NULL,
+                     own, nown, b, threads, neighbors, &v, &sh, box, diag, ds);
+    free(own);
+    if (err == FDT_ERANGE && sh.a >= 0)
+        err = fdt_voronoi_too_close(&sh, box, diag, ds);
+    if (!err)
+        err = fdt_voronoi_spread(&v, n);
+    if (err)
+        fdt_voronoi_free(&v);
+    *out = v;
+    return err;
+}
+
+int fdt_periodic_cells_check(const double *X, size_t n, const fdt_periodic_box *b, char *diag,
+                             size_t ds)
+{
+    /* the walls across the axes that are not periodic: the box's sides,
+     * which hold every point */
+    for (int k = 0; k < 3; k++) {
+        if (b->axes >> k & 1)
+            continue;
+        if (!(b->lo[k] < b->hi[k]) || !isfinite(b->lo[k]) || !isfinite(b->hi[k])) {
+            snprintf(diag, ds, "the box is empty or not finite in %c, which is not periodic: "
+                     "its cells are cut there", "xyz"[k]);
+            return FDT_EINVAL;
+        }
+        for (size_t i = 0; i < n; i++)
+            if (!(X[3 * i + k] >= b->lo[k] && X[3 * i + k] <= b->hi[k])) {
+                snprintf(diag, ds, "point %zu (%.17g %.17g %.17g) lies outside the box",
+                         i, X[3 * i], X[3 * i + 1], X[3 * i + 2]);
+                return FDT_EINVAL;
+            }
+    }
+    return FDT_OK;
+}
+
+void fdt_periodic_cells_box(const fdt_periodic_box *b, double box[6])
+{
+    for (int k = 0; k < 3; k++) {
+        double L = b->axes >> k & 1 ? b->hi[k] - b->lo[k] : 0;
+        box[k] = b->lo[k] - L;
+        box[k + 3] = b->hi[k] + L;
+    }
+}
+
+int fdt_periodic_part_cells(const fdt_periodic_mesh *pm, const double *X, uint32_t n, int x_exp,
+                            const int32_t *names, const fdt_periodic_parts *parts, uint32_t part,
+                            const fdt_periodic_box *b, int threads, int neighbors,
+                            fdt_voronoi **out, fdt_vshort *sh, char *diag, size_t ds)
+{
+    int one = parts->nparts < 2;
+    const uint32_t *own = one ? NULL : parts->idx + parts->start[part];
+    size_t nown = one ? n : parts->start[part + 1] - parts->start[part];
+    double box[6];
+    return star_batch(pm->star_tets, pm->star_off, pm->nstar, pm->star_hull, pm->nstar_hull, X,
+                      x_exp, names, own, nown, b, threads, neighbors, out, sh, box, diag, ds);
 }

@@ -56,6 +56,15 @@ typedef struct fdt_periodic_mesh {
     uint32_t *hull;
     int8_t *hull_off;    /* 9 per hull face */
     size_t nhull;
+    /* fdt_periodic_build_part with stars: every tet and hull face with a
+     * vertex the part owns, in no order, in the build's numbering (the
+     * owned points' stars, for their cells: fdt_periodic_part_cells). */
+    uint32_t *star_tets;
+    int8_t *star_off;
+    size_t nstar;
+    uint32_t *star_hull;
+    int8_t *star_hull_off;
+    size_t nstar_hull;
     /* How it went, for --stats. */
     size_t images;       /* images triangulated with the points (last round) */
     int rounds;          /* margins tried */
@@ -121,13 +130,14 @@ void fdt_periodic_parts_free(fdt_periodic_parts *p);
 uint32_t fdt_periodic_part_points(const fdt_periodic_parts *p, uint32_t k, uint32_t n);
 
 /* Part k's tets and hull faces (those whose least vertex it owns), sorted,
- * as fdt_periodic_build gives the whole mesh's; the errors of
- * fdt_periodic_build but the box's and points' checks, which are the
- * caller's (fdt_periodic_check). */
+ * as fdt_periodic_build gives the whole mesh's, and with stars nonzero its
+ * points' stars (fdt_periodic_mesh); the errors of fdt_periodic_build but
+ * the box's and points' checks, which are the caller's
+ * (fdt_periodic_check). */
 int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
                             const fdt_periodic_box *b, const fdt_periodic_parts *parts,
-                            uint32_t part, int nthreads, fdt_periodic_mesh *out, char *diag,
-                            size_t diag_size);
+                            uint32_t part, int nthreads, int stars, fdt_periodic_mesh *out,
+                            char *diag, size_t diag_size);
 
 /*
  * The Voronoi cells of a periodic mesh, as fdt_voronoi_compute gives a
@@ -145,10 +155,36 @@ int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
  * batch's errors otherwise, with diag.
  */
 struct fdt_voronoi;
+struct fdt_vshort;
 int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
                        size_t nhull, const double *X, size_t n, const int32_t *dupmap,
                        const fdt_periodic_box *b, int threads, int neighbors,
                        struct fdt_voronoi **out, char *diag, size_t ds);
+/* fdt_periodic_cells' checks of the box and the points X (n, as given)
+ * across the axes that are not periodic, whose sides are walls: FDT_OK, or
+ * FDT_EINVAL with diag naming the side or the first point outside. */
+int fdt_periodic_cells_check(const double *X, size_t n, const fdt_periodic_box *b, char *diag,
+                             size_t ds);
+/* The cells' box of a periodic set in box b: b's sides on the axes that
+ * are not periodic (the walls), a period on each side of it on the
+ * periodic ones (every image of a star and its circumcentres; a batch
+ * grows it where an image lies beyond). fdt_voronoi_box of its cells. */
+void fdt_periodic_cells_box(const fdt_periodic_box *b, double box[6]);
+/*
+ * The cells of the points part k owns (a streamed periodic run's batch,
+ * src/mesh/voronoi.h: row i the i-th owned point's, ids names[] of them)
+ * from the part's stars (fdt_periodic_build_part with stars), the same
+ * bits as fdt_periodic_cells gives them. X: the n points the part was
+ * built from, the input's times 2^x_exp (b likewise); names: X's ids to
+ * input ids. FDT_ERANGE for an edge too short for the cells (the least
+ * kept in *sh, diag not written); else FDT_ENOMEM or FDT_EINTERNAL with
+ * diag.
+ */
+int fdt_periodic_part_cells(const fdt_periodic_mesh *pm, const double *X, uint32_t n, int x_exp,
+                            const int32_t *names, const fdt_periodic_parts *parts, uint32_t part,
+                            const fdt_periodic_box *b, int threads, int neighbors,
+                            struct fdt_voronoi **out, struct fdt_vshort *sh, char *diag,
+                            size_t ds);
 
 /*
  * A periodic mesh laid out in space for the formats that name points by
