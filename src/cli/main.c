@@ -1439,14 +1439,18 @@ static int open_engine(const cli *c, run_state *rs)
      * kept tets' keys and their sort, 605-622 MiB at the peak for 1M
      * uniform points (bench/NOTES.md entry 108); --check's faces after it,
      * 790 MiB (entry 109); streamed, the points and one slab's build
-     * (222 MiB for 1M in slabs of 320k, entry 110) */
+     * (222 MiB for 1M in slabs of 320k, entry 110). With the cells: 1,210
+     * MiB in memory, and streamed the spool's index and a slab's stars and
+     * cells besides, 685 MiB on two threads, 395 on one (entry 112) */
+    int pcells = fdt_cli_dual_wanted(&c->dual);
+    unsigned long long slab = rs->n < fdt_sweep_slab(rs->n) ? rs->n : fdt_sweep_slab(rs->n);
     unsigned long long periodic =
         !c->periodic    ? 0
-        : rs->streaming ? 64ull * rs->n +
-                              900ull * (rs->n < fdt_sweep_slab(rs->n) ? rs->n
-                                                                      : fdt_sweep_slab(rs->n)) +
+        : rs->streaming ? (pcells ? 72ull : 64ull) * rs->n +
+                              (pcells ? (run_threads > 1 ? 2200ull : 1100ull) : 900ull) * slab +
                               (16ull << 20)
-                        : (c->check ? 850ull : 700ull) * rs->n + (16ull << 20);
+                        : (pcells ? 1300ull : c->check ? 850ull : 700ull) * rs->n +
+                              (16ull << 20);
     if (periodic > rs->estimate)
         rs->estimate = periodic;
     if (c->memory_limit && rs->estimate > c->memory_limit) {
