@@ -1439,9 +1439,9 @@ static int open_engine(const cli *c, run_state *rs)
      * kept tets' keys and their sort, 605-622 MiB at the peak for 1M
      * uniform points (bench/NOTES.md entry 108); --check's faces after it,
      * 790 MiB (entry 109); streamed, the points and one slab's build
-     * (222 MiB for 1M in slabs of 320k, entry 110). With the cells: 1,210
+     * (222 MiB for 1M in slabs of 320k, entry 110). With the cells: 1,239
      * MiB in memory, and streamed the spool's index and a slab's stars and
-     * cells besides, 685 MiB on two threads, 395 on one (entry 112) */
+     * cells besides, 701 MiB on two threads, 395 on one (entry 112) */
     int pcells = fdt_cli_dual_wanted(&c->dual);
     unsigned long long slab = rs->n < fdt_sweep_slab(rs->n) ? rs->n : fdt_sweep_slab(rs->n);
     unsigned long long periodic =
