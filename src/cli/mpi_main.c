@@ -311,7 +311,8 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
         }
         if (fdt_cli_dual_wanted(&o->cells) || (o->output && (!f || !fdt_format_periodic(f)))) {
             say0(rank, "--periodic under MPI writes -o .tets, .fdtb, .vtu, .vtk or .msh "
-                       "(gathered to rank 0) and the hashes; not the cells nor pieces");
+                       "(gathered to rank 0) and the hashes; not the cells (frontdt --periodic "
+                       "--stream --voronoi computes them a slab at a time) nor pieces");
             return CLI_USAGE;
         }
         return -1;
