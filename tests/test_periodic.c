@@ -400,6 +400,48 @@ static void parts_equal(const char *name, const double *X, size_t n, const fdt_p
     fdt_periodic_parts_free(&p);
 }
 
+/*
+ * A shell as wide as the periodic cube: a point's neighbour across
+ * the shell's inside and the same point's image across the box's side are
+ * both its neighbours, so its list holds one input id twice; in parts, the
+ * cells' neighbour lists must still be the whole set's (ties in the
+ * images' coordinates, not the batch's numbering).
+ */
+static void shell_parts(size_t n)
+{
+    double *X = malloc(n * 3 * sizeof *X);
+    CHECK(X);
+    uint64_t s = 11;
+    for (size_t i = 0; i < n; i++) {
+        double z = 2 * test_unif(&s) - 1, phi = 6.283185307179586 * test_unif(&s),
+               r = sqrt(1 - z * z);
+        X[3 * i] = r * cos(phi);
+        X[3 * i + 1] = r * sin(phi);
+        X[3 * i + 2] = z;
+    }
+    /* each axis's extent onto [0, 0.999): the extreme points 0.001 apart
+     * across the box's side */
+    for (int k = 0; k < 3; k++) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < n; i++) {
+            lo = X[3 * i + k] < lo ? X[3 * i + k] : lo;
+            hi = X[3 * i + k] > hi ? X[3 * i + k] : hi;
+        }
+        for (size_t i = 0; i < n; i++)
+            X[3 * i + k] = (X[3 * i + k] - lo) / (hi - lo) * 0.999;
+    }
+    fdt_periodic_box b = {7, {0, 0, 0}, {1, 1, 1}};
+    fdt_periodic_mesh pm = build(X, n, &b, 1, "shell");
+    rows want = mesh_rows(pm.tets, pm.tet_off, pm.ntets, 4);
+    rows wanth = mesh_rows(pm.hull, pm.hull_off, pm.nhull, 3);
+    parts_equal("shell", X, n, &b, (uint32_t)(n / 6), 2, &want, &wanth);
+    printf("shell: %zu points, %zu tets: the same cells in parts of %zu\n", n, pm.ntets, n / 6);
+    free(want.r);
+    free(wanth.r);
+    fdt_periodic_free(&pm);
+    free(X);
+}
+
 static void against_reference(const char *name, const double *X, size_t n, unsigned axes,
                               const double lo[3], const double hi[3])
 {
@@ -737,6 +779,7 @@ int main(int argc, char **argv)
             C[3 * i + 1] += (C[3 * i + 1] == 0.0 ? 1 : -1) * floor(test_unif(&bs) * 4) * 0x1p-30;
     against_reference("bumpy channel", C, n, 5, lo, hi);
     free(C);
+    shell_parts(1500);
     inexact_box(4000);
     check_corruptions();
     errors();

@@ -2026,9 +2026,14 @@ static int star_batch(const uint32_t *tets, const int8_t *off, size_t ntets, con
         else if ((size_t)x < nown)
             own_hull[x] = 1;
     }
-    /* the box: on a periodic axis the period box with a period on each
-     * side, which holds every image and the circumcentres of the points'
-     * stars; on the others the box's sides, where cells are cut */
+    /* the box (fdt_periodic_cells_box): on a periodic axis the period box
+     * with three periods on each side, which holds every image and
+     * circumcentre of the points' stars, whichever stars a batch has (so
+     * the cells' frame and grids, and their bits, are the same in every
+     * batch: with one period, the sphere family's tets a period wide put
+     * images beyond it in some batches and not others); on the others the
+     * box's sides, where cells are cut. Grown where an image lies beyond
+     * (the proofs keep every star inside it). */
     fdt_vbatch vb;
     memset(&vb, 0, sizeof vb);
     fdt_periodic_cells_box(b, vb.box);
@@ -2136,8 +2141,12 @@ int fdt_periodic_cells_check(const double *X, size_t n, const fdt_periodic_box *
 
 void fdt_periodic_cells_box(const fdt_periodic_box *b, double box[6])
 {
+    /* A star's tets have their balls inside the proofs' region, the core
+     * grown by a margin of at most a period (so at most three periods
+     * wide): moved so that one vertex is the point itself, in the box, the
+     * others and the centre lie within three periods of it. */
     for (int k = 0; k < 3; k++) {
-        double L = b->axes >> k & 1 ? b->hi[k] - b->lo[k] : 0;
+        double L = b->axes >> k & 1 ? 3 * (b->hi[k] - b->lo[k]) : 0;
         box[k] = b->lo[k] - L;
         box[k + 3] = b->hi[k] + L;
     }

@@ -166,9 +166,10 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
 int fdt_periodic_cells_check(const double *X, size_t n, const fdt_periodic_box *b, char *diag,
                              size_t ds);
 /* The cells' box of a periodic set in box b: b's sides on the axes that
- * are not periodic (the walls), a period on each side of it on the
- * periodic ones (every image of a star and its circumcentres; a batch
- * grows it where an image lies beyond). fdt_voronoi_box of its cells. */
+ * are not periodic (the walls), three periods on each side of it on the
+ * periodic ones (every image of a star and its circumcentres, whichever
+ * stars a batch holds; a batch grows it where an image lies beyond).
+ * fdt_voronoi_box of its cells. */
 void fdt_periodic_cells_box(const fdt_periodic_box *b, double box[6]);
 /*
  * The cells of the points part k owns (a streamed periodic run's batch,

@@ -137,6 +137,8 @@ typedef struct vjob {
     uint32_t *order;     /* scratch: a cell's neighbours in cutting order */
     double *dist;        /* scratch: their squared distances */
     size_t cap_order;
+    uint32_t *nloc;      /* scratch: a row's neighbours' local points (neighbors_pass) */
+    size_t cap_nloc;
     size_t *first;       /* cut cell lo + k: its faces from face[first[k]] */
     size_t zero_faces;
     uint32_t short_a, short_b; /* the least edge too short (fdt_edge_less), local ids, or
@@ -1043,20 +1045,39 @@ static void *neighbors_pass(void *arg)
             continue;
         }
         double total = w->cells[l].area;
+        if (k > j->cap_nloc) {
+            uint32_t *q = realloc(j->nloc, k * sizeof *q);
+            if (!q) {
+                j->err = FDT_ENOMEM;
+                return NULL;
+            }
+            j->nloc = q;
+            j->cap_nloc = k;
+        }
         size_t m = 0;
         for (size_t e = oj->adj_start[l - oj->lo]; e < oj->adj_start[l - oj->lo + 1]; e++) {
             double ar = fdt_fix_value(oj->fsum[e], w->g_area);
             if (!real_face(ar, total))
                 continue;
-            fdt_vid id = (fdt_vid)w->perm[oj->adj[e]];
+            uint32_t nb = oj->adj[e];
+            fdt_vid id = (fdt_vid)w->perm[nb];
             ar *= f2;
-            size_t y = o + m++; /* ascending input ids: insertion, a dozen */
-            for (; y > o && v->nid[y - 1] > id; y--) {
-                v->nid[y] = v->nid[y - 1];
-                v->narea[y] = v->narea[y - 1];
+            /* ascending input ids (insertion, a dozen); two images of one
+             * point (a periodic set's) in their coordinates' order, not
+             * the numbering's, which differs from batch to batch */
+            size_t y = m++;
+            for (; y > 0 && (v->nid[o + y - 1] > id ||
+                             (v->nid[o + y - 1] == id &&
+                              fdt_lex_compare(w->xyz + 3 * (size_t)j->nloc[y - 1],
+                                              w->xyz + 3 * (size_t)nb) > 0));
+                 y--) {
+                v->nid[o + y] = v->nid[o + y - 1];
+                v->narea[o + y] = v->narea[o + y - 1];
+                j->nloc[y] = j->nloc[y - 1];
             }
-            v->nid[y] = id;
-            v->narea[y] = ar;
+            v->nid[o + y] = id;
+            v->narea[o + y] = ar;
+            j->nloc[y] = nb;
         }
     }
     return NULL;
@@ -1275,6 +1296,7 @@ static int cells_run(vwork *w, fdt_voronoi *v, int threads, int neighbors, fdt_v
         free(jobs[t].face);
         free(jobs[t].order);
         free(jobs[t].dist);
+        free(jobs[t].nloc);
         free(jobs[t].first);
         free(jobs[t].adj_start);
         free(jobs[t].adj);
