@@ -919,7 +919,6 @@ static void extent(const double *X, uint32_t n, double lo[3], double hi[3])
         }
 }
 
-
 int fdt_periodic_parts_make(const double *X, uint32_t n, const fdt_periodic_box *b,
                             uint32_t part_points, fdt_periodic_parts *p)
 {
@@ -2028,12 +2027,11 @@ static int star_batch(const uint32_t *tets, const int8_t *off, size_t ntets, con
     }
     /* the box (fdt_periodic_cells_box): on a periodic axis the period box
      * with three periods on each side, which holds every image and
-     * circumcentre of the points' stars, whichever stars a batch has (so
-     * the cells' frame and grids, and their bits, are the same in every
-     * batch: with one period, the sphere family's tets a period wide put
-     * images beyond it in some batches and not others); on the others the
-     * box's sides, where cells are cut. Grown where an image lies beyond
-     * (the proofs keep every star inside it). */
+     * circumcentre of the points' stars, whichever stars a batch has, so
+     * that the cells' frame and grids, and their bits, are the same in
+     * every batch (a box grown to each batch's farthest image would not
+     * be); on the others the box's sides, where cells are cut. Grown
+     * where an image lies beyond (the proofs keep every star inside). */
     fdt_vbatch vb;
     memset(&vb, 0, sizeof vb);
     fdt_periodic_cells_box(b, vb.box);
