@@ -477,6 +477,18 @@ static int star_copy(const run *r, const uint32_t *w, int nv)
     return 1;
 }
 
+/* Whether a tet of the mesh (positive, certified on the exact images), its
+ * vertices w, is positive with them in its key's order (make_key's sort):
+ * an even permutation. A star's tets then need no orientation test. */
+static uint32_t key_positive(const ext *e, const uint32_t w[4])
+{
+    int inv = 0;
+    for (int a = 0; a < 4; a++)
+        for (int b = a + 1; b < 4; b++)
+            inv += e->vk[w[a]] > e->vk[w[b]];
+    return !(inv & 1);
+}
+
 /*
  * The proofs (periodic.h) of one tet, certified, with its cofactors (the
  * certificate's pass): every tet with a vertex that is an input point has
@@ -540,7 +552,8 @@ static void prove_tet(void *user, int job, uint32_t slot, const uint32_t v[4], i
     /* the owned points' stars, for their cells: every tet and hull face
      * with an owned vertex, proved like the kept ones, once */
     if (r->stars && star_copy(r, w, nv) &&
-        (j->err = keyset_add(inf < 0 ? &j->star : &j->star_hull, &k, 0)) != FDT_OK)
+        (j->err = keyset_add(inf < 0 ? &j->star : &j->star_hull, &k,
+                             inf < 0 ? key_positive(&r->e, w) : 0)) != FDT_OK)
         return;
     if (least >= r->nown)
         return;
@@ -794,19 +807,25 @@ static int emit(keyset *s, int ns, int nv, size_t n, uint32_t **ids, int8_t **of
 }
 
 /* The keys of the sets s[0 .. ns) into rows, in no order (the stars),
- * each set freed once its keys are moved. */
-static int gather(keyset *s, int ns, int nv, uint32_t **ids, int8_t **offs, size_t *count)
+ * and with pos each one's rank (key_positive's), each set freed once its
+ * keys are moved. */
+static int gather(keyset *s, int ns, int nv, uint32_t **ids, int8_t **offs, uint8_t **pos,
+                  size_t *count)
 {
     size_t total = 0;
     for (int i = 0; i < ns; i++)
         total += s[i].n;
     *ids = malloc((total ? total : 1) * (size_t)nv * sizeof **ids);
     *offs = malloc((total ? total : 1) * (size_t)nv * 3);
-    if (!*ids || !*offs)
+    if (pos)
+        *pos = malloc(total ? total : 1);
+    if (!*ids || !*offs || (pos && !*pos))
         return FDT_ENOMEM;
     size_t at = 0;
     for (int i = 0; i < ns; i++) {
         unpack(s[i].keys, s[i].n, nv, *ids + (size_t)nv * at, *offs + 3 * (size_t)nv * at);
+        for (size_t k = 0; pos && k < s[i].n; k++)
+            (*pos)[at + k] = (uint8_t)s[i].rank[k];
         at += s[i].n;
         keyset_free(&s[i]);
     }
@@ -1095,9 +1114,9 @@ int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
         ((err = emit(r.tets, r.nsets, 4, r.nown, &out->tets, &out->tet_off, &out->ntets)) ||
          (err = emit(r.hull, r.nsets, 3, r.nown, &out->hull, &out->hull_off, &out->nhull)) ||
          (stars && ((err = gather(r.star, r.nsets, 4, &out->star_tets, &out->star_off,
-                                  &out->nstar)) ||
+                                  &out->star_pos, &out->nstar)) ||
                     (err = gather(r.star_hull, r.nsets, 3, &out->star_hull,
-                                  &out->star_hull_off, &out->nstar_hull))))))
+                                  &out->star_hull_off, NULL, &out->nstar_hull))))))
         snprintf(diag, diag_size, "out of memory");
     for (int i = 0; i < r.nsets; i++) {
         keyset_free(&r.tets[i]);
@@ -1141,6 +1160,7 @@ void fdt_periodic_free(fdt_periodic_mesh *m)
     free(m->hull_off);
     free(m->star_tets);
     free(m->star_off);
+    free(m->star_pos);
     free(m->star_hull);
     free(m->star_hull_off);
     memset(m, 0, sizeof *m);
@@ -1922,8 +1942,10 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
 
 /*
  * The cells of the points own[0 .. nown) (X's ids, distinct) from tets
- * (ids in X, 12 offsets each relative to any vertex) that hold every tet
- * of their stars, and the hull faces' points hull[0 .. 3 nhull): a batch
+ * (ids in X, 12 offsets each relative to any vertex; positive[t], when
+ * given, whether tet t is positive in that order, else an exact test
+ * says) that hold every tet of their stars, and the hull faces' points
+ * hull[0 .. 3 nhull): a batch
  * (src/mesh/voronoi.h), row i own[i]'s cell, its id names[own[i]] (names
  * NULL: the ids themselves). X is the input's points times 2^x_exp, and b
  * its box likewise. Each tet is taken once for each offset among its
@@ -1932,7 +1954,8 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
  * short for the cells (*sh, the least one, diag not written); else the
  * batch's errors with diag.
  */
-static int star_batch(const uint32_t *tets, const int8_t *off, size_t ntets, const uint32_t *hull,
+static int star_batch(const uint32_t *tets, const int8_t *off, const uint8_t *positive,
+                      size_t ntets, const uint32_t *hull,
                       size_t nhull, const double *X, int x_exp, const int32_t *names,
                       const uint32_t *own_ids, size_t nown_ids, const fdt_periodic_box *b,
                       int threads, int neighbors, struct fdt_voronoi **out, fdt_vshort *sh,
@@ -1976,7 +1999,7 @@ static int star_batch(const uint32_t *tets, const int8_t *off, size_t ntets, con
     for (size_t t = 0; t < ntets && !err; t++) {
         const uint32_t *id = tets + 4 * t;
         const int8_t *o = off + 12 * t;
-        int pos = exact_sign(X, b, 4, id, o) > 0;
+        int pos = positive ? positive[t] : exact_sign(X, b, 4, id, o) > 0;
         for (int j = 0; j < 4 && !err; j++) {
             int seen = 0;
             for (int i = 0; i < j; i++)
@@ -2101,8 +2124,8 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
     fdt_vshort sh = {-1, -1, INFINITY};
     fdt_voronoi *v = NULL;
     double box[6];
-    err = star_batch((const uint32_t *)tets, off, ntets, (const uint32_t *)hull, nhull, X, 0, NULL,
-                     own, nown, b, threads, neighbors, &v, &sh, box, diag, ds);
+    err = star_batch((const uint32_t *)tets, off, NULL, ntets, (const uint32_t *)hull, nhull, X, 0,
+                     NULL, own, nown, b, threads, neighbors, &v, &sh, box, diag, ds);
     free(own);
     if (err == FDT_ERANGE && sh.a >= 0)
         err = fdt_voronoi_too_close(&sh, box, diag, ds);
@@ -2159,6 +2182,7 @@ int fdt_periodic_part_cells(const fdt_periodic_mesh *pm, const double *X, uint32
     const uint32_t *own = one ? NULL : parts->idx + parts->start[part];
     size_t nown = one ? n : parts->start[part + 1] - parts->start[part];
     double box[6];
-    return star_batch(pm->star_tets, pm->star_off, pm->nstar, pm->star_hull, pm->nstar_hull, X,
-                      x_exp, names, own, nown, b, threads, neighbors, out, sh, box, diag, ds);
+    return star_batch(pm->star_tets, pm->star_off, pm->star_pos, pm->nstar, pm->star_hull,
+                      pm->nstar_hull, X, x_exp, names, own, nown, b, threads, neighbors, out, sh,
+                      box, diag, ds);
 }

@@ -61,6 +61,7 @@ typedef struct fdt_periodic_mesh {
      * owned points' stars, for their cells: fdt_periodic_part_cells). */
     uint32_t *star_tets;
     int8_t *star_off;
+    uint8_t *star_pos;   /* 1 where a star tet is positive in its rows' order */
     size_t nstar;
     uint32_t *star_hull;
     int8_t *star_hull_off;
