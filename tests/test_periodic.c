@@ -294,8 +294,8 @@ static int same_cell(const fdt_voronoi *a, size_t r, const fdt_voronoi *w, size_
  * the whole set's to the bit, and every point is in one part's.
  */
 static void parts_equal(const char *name, const double *X, size_t n, const fdt_periodic_box *pb,
-                        uint32_t part_points, int threads, const rows *want,
-                        const rows *wanth)
+                        uint32_t part_points, int threads, const fdt_periodic_mesh *one,
+                        const rows *want, const rows *wanth)
 {
     fdt_periodic_parts p;
     CHECK(fdt_periodic_parts_make(X, (uint32_t)n, pb, part_points, &p) == FDT_OK);
@@ -312,22 +312,20 @@ static void parts_equal(const char *name, const double *X, size_t n, const fdt_p
     uint32_t *ids = malloc(cap * 4 * sizeof *ids), *hids = malloc(cap * 3 * sizeof *hids);
     int8_t *off = malloc(cap * 12), *hoff = malloc(cap * 9);
     CHECK(ids && hids && off && hoff);
-    /* the whole set's cells, where the box holds them */
+    /* the whole set's cells (one: the one-part build's mesh), where the
+     * box holds them */
     fdt_voronoi *whole = NULL;
     {
-        fdt_periodic_mesh one;
         char d[512];
-        CHECK(fdt_periodic_build(X, (uint32_t)n, NULL, b, threads, &one, d, sizeof d) == FDT_OK);
         int32_t *dup = malloc(n * sizeof *dup);
         CHECK(dup);
         for (size_t i = 0; i < n; i++)
             dup[i] = (int32_t)i;
-        if (fdt_periodic_cells((const int32_t *)one.tets, one.tet_off, one.ntets,
-                               (const int32_t *)one.hull, one.nhull, X, n, dup, b, threads, 1,
+        if (fdt_periodic_cells((const int32_t *)one->tets, one->tet_off, one->ntets,
+                               (const int32_t *)one->hull, one->nhull, X, n, dup, b, threads, 1,
                                &whole, d, sizeof d) != FDT_OK)
             whole = NULL; /* a point outside a wall's box: no cells to compare */
         free(dup);
-        fdt_periodic_free(&one);
     }
     size_t celled = 0, cells_off = 0;
     for (uint32_t k = 0; k < p.nparts; k++) {
@@ -400,6 +398,24 @@ static void parts_equal(const char *name, const double *X, size_t n, const fdt_p
     fdt_periodic_parts_free(&p);
 }
 
+/* Each axis's extent of the n points X onto [0, 0.999) (a flat one to
+ * 0.5): inside the unit periodic box, its extreme points 0.001 apart
+ * across the box's sides. */
+static void to_unit_box(double *X, size_t n)
+{
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; k++)
+        lo[k] = hi[k] = X[k];
+    for (size_t i = 0; i < 3 * n; i++) {
+        lo[i % 3] = X[i] < lo[i % 3] ? X[i] : lo[i % 3];
+        hi[i % 3] = X[i] > hi[i % 3] ? X[i] : hi[i % 3];
+    }
+    for (size_t i = 0; i < 3 * n; i++) {
+        double w = hi[i % 3] - lo[i % 3];
+        X[i] = w > 0 ? (X[i] - lo[i % 3]) / w * 0.999 : 0.5;
+    }
+}
+
 /*
  * A shell as wide as the periodic cube: a point's neighbour across
  * the shell's inside and the same point's image across the box's side are
@@ -419,22 +435,12 @@ static void shell_parts(size_t n)
         X[3 * i + 1] = r * sin(phi);
         X[3 * i + 2] = z;
     }
-    /* each axis's extent onto [0, 0.999): the extreme points 0.001 apart
-     * across the box's side */
-    for (int k = 0; k < 3; k++) {
-        double lo = INFINITY, hi = -INFINITY;
-        for (size_t i = 0; i < n; i++) {
-            lo = X[3 * i + k] < lo ? X[3 * i + k] : lo;
-            hi = X[3 * i + k] > hi ? X[3 * i + k] : hi;
-        }
-        for (size_t i = 0; i < n; i++)
-            X[3 * i + k] = (X[3 * i + k] - lo) / (hi - lo) * 0.999;
-    }
+    to_unit_box(X, n); /* the extreme points 0.001 apart across the box's sides */
     fdt_periodic_box b = {7, {0, 0, 0}, {1, 1, 1}};
     fdt_periodic_mesh pm = build(X, n, &b, 1, "shell");
     rows want = mesh_rows(pm.tets, pm.tet_off, pm.ntets, 4);
     rows wanth = mesh_rows(pm.hull, pm.hull_off, pm.nhull, 3);
-    parts_equal("shell", X, n, &b, (uint32_t)(n / 6), 2, &want, &wanth);
+    parts_equal("shell", X, n, &b, (uint32_t)(n / 6), 2, &pm, &want, &wanth);
     printf("shell: %zu points, %zu tets: the same cells in parts of %zu\n", n, pm.ntets, n / 6);
     free(want.r);
     free(wanth.r);
@@ -487,7 +493,7 @@ static void against_reference(const char *name, const double *X, size_t n, unsig
      * points (the margin of a thin slab reaching over many of them) */
     const uint32_t sizes[3] = {(uint32_t)(n / 5), (uint32_t)(n / 17), 97};
     for (int t = 0; t < 3; t++)
-        parts_equal(name, X, n, &b, sizes[t], 1 + 2 * (t == 1), &got, &goth);
+        parts_equal(name, X, n, &b, sizes[t], 1 + 2 * (t == 1), &pm, &got, &goth);
     printf("%s (axes %u): %zu tets, %zu hull faces, %zu images, %d round(s): as the reference\n",
            name, axes, pm.ntets, pm.nhull, pm.images, pm.rounds);
     free(got.r);
@@ -690,17 +696,7 @@ static void family_parts(const char *gen, const char *fam, size_t n)
 {
     size_t got;
     double *X = test_gen_family(gen, fam, n, 3, &got);
-    double lo[3], hi[3];
-    for (int k = 0; k < 3; k++)
-        lo[k] = hi[k] = X[k];
-    for (size_t i = 0; i < 3 * got; i++) {
-        lo[i % 3] = X[i] < lo[i % 3] ? X[i] : lo[i % 3];
-        hi[i % 3] = X[i] > hi[i % 3] ? X[i] : hi[i % 3];
-    }
-    for (size_t i = 0; i < 3 * got; i++) {
-        double w = hi[i % 3] - lo[i % 3];
-        X[i] = w > 0 ? (X[i] - lo[i % 3]) / w * 0.999 : 0.5;
-    }
+    to_unit_box(X, got);
     uint32_t *ord = malloc((got ? got : 1) * sizeof *ord);
     uint8_t *keep = calloc(got ? got : 1, 1);
     CHECK(ord && keep);
@@ -726,8 +722,8 @@ static void family_parts(const char *gen, const char *fam, size_t n)
     if (err == FDT_OK) {
         rows want = mesh_rows(pm.tets, pm.tet_off, pm.ntets, 4);
         rows wanth = mesh_rows(pm.hull, pm.hull_off, pm.nhull, 3);
-        parts_equal(fam, X, m, &b, 300, 3, &want, &wanth);
-        parts_equal(fam, X, m, &b, 40, 1, &want, &wanth);
+        parts_equal(fam, X, m, &b, 300, 3, &pm, &want, &wanth);
+        parts_equal(fam, X, m, &b, 40, 1, &pm, &want, &wanth);
         printf("%s: %zu points, %zu tets: the same in parts of 300 and 40\n", fam, m,
                pm.ntets);
         free(want.r);

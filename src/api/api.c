@@ -310,6 +310,18 @@ static fdt_engine pick_engine(const fdt_settings *s, fdt_mode mode, int streamed
 
 /* The Voronoi cells (src/mesh/voronoi.c) on the threads the options ask
  * for. */
+/* Whether o asks for a box other than the periodic run's pbox, whose own
+ * cells take its box alone (in memory and streamed); diag says so. */
+static int periodic_box_other(const fdt_voronoi_options *o, const double pbox[6], char *diag,
+                              size_t ds)
+{
+    if (!o->box_given || !memcmp(o->box, pbox, sizeof o->box))
+        return 0;
+    fdt_diag(diag, ds, "a periodic mesh's cells take its own box (the periods, and the walls "
+             "across the axes that are not periodic)");
+    return 1;
+}
+
 int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
                         fdt_voronoi **out, char *diag, size_t diag_size)
 {
@@ -326,11 +338,8 @@ int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const 
     if (r->periodic) { /* the cells of the periodic set: its box's walls */
         if (n != r->n)
             return FDT_EINVAL;
-        if (o->box_given && memcmp(o->box, r->pbox, sizeof o->box) != 0) {
-            fdt_diag(diag, diag_size, "a periodic mesh's cells take its own box (the "
-                     "periods, and the walls across the axes that are not periodic)");
+        if (periodic_box_other(o, r->pbox, diag, diag_size))
             return FDT_EINVAL;
-        }
         fdt_periodic_box b = {r->periodic, {r->pbox[0], r->pbox[1], r->pbox[2]},
                               {r->pbox[3], r->pbox[4], r->pbox[5]}};
         return fdt_periodic_cells(r->tets, r->tet_off, r->ntets, r->hull, r->nhull, xyz, n,
@@ -915,11 +924,8 @@ static int periodic_cells_box(fdt_context *ctx, const double *xyz, size_t n,
                               const fdt_voronoi_options *o, fdt_cellstream *cs)
 {
     const double *bx = ctx->s.periodic_box;
-    if (o->box_given && memcmp(o->box, bx, sizeof o->box) != 0) {
-        snprintf(ctx->diag, sizeof ctx->diag, "a periodic mesh's cells take its own box (the "
-                 "periods, and the walls across the axes that are not periodic)");
+    if (periodic_box_other(o, bx, ctx->diag, sizeof ctx->diag))
         return FDT_EINVAL;
-    }
     fdt_periodic_box b = {ctx->s.periodic, {bx[0], bx[1], bx[2]}, {bx[3], bx[4], bx[5]}};
     int err = fdt_periodic_check(xyz, n, &b, ctx->diag, sizeof ctx->diag);
     if (!err)

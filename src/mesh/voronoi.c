@@ -619,11 +619,11 @@ static int real_face(double area, double total)
 }
 
 /* Whether neighbour a of a point (da: its squared distance) is cut
- * before neighbour b: nearer first (its
- * bisector cuts the most off the box, so the later cuts mostly find the
- * cell on their inner side and change nothing), ties in the points'
- * lexicographic order. A function of the coordinates alone: the cuts,
- * and so the cell's bits, do not depend on how the input was numbered. */
+ * before neighbour b: nearer first (its bisector cuts the most off the
+ * box, so the later cuts mostly find the cell on their inner side and
+ * change nothing), ties in the points' lexicographic order. A function of
+ * the coordinates alone: the cuts, and so the cell's bits, do not depend
+ * on how the input was numbered. */
 static int cut_before(const double *a, double da, const double *b, double db)
 {
     return da < db || (da == db && fdt_lex_compare(a, b) < 0);
