@@ -1531,19 +1531,17 @@ int fdt_circumcenter(const double *a, const double *b, const double *c, const do
 }
 
 /* The circumcentre of the triangle (0, e1, e2):
- * (|e1|^2 e2 - |e2|^2 e1) x (e1 x e2) / (2 |e1 x e2|^2). */
-static void tri_centre(const double *e1, const double *e2, double *x)
+ * (|e1|^2 e2 - |e2|^2 e1) x (e1 x e2) / (2 |e1 x e2|^2), given n = e1 x e2,
+ * nn = |n|^2, aa = |e1|^2 and bb = |e2|^2 as the caller computed them. */
+static void tri_centre(const double *e1, const double *e2, const double *n, double nn, double aa,
+                       double bb, double *x)
 {
-    double n[3], t[3];
-    cross3(e1, e2, n);
-    double aa = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
-    double bb = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+    double t[3];
     for (int k = 0; k < 3; k++)
         t[k] = aa * e2[k] - bb * e1[k];
     cross3(t, n, x);
-    double nn = 2 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     for (int k = 0; k < 3; k++)
-        x[k] /= nn;
+        x[k] /= 2 * nn;
 }
 
 /* predicates.h: without the exact fallback the Voronoi cells next to a
@@ -1561,7 +1559,7 @@ void fdt_circumcenter_tri(const double *a, const double *b, const double *c, dou
     double l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
     double l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
     if (nn >= 0x1p-20 * l1 * l2) {
-        tri_centre(e1, e2, x);
+        tri_centre(e1, e2, n, nn, l1, l2, x);
         return;
     }
     double d[3] = {a[0] + n[0], a[1] + n[1], a[2] + n[2]}, X[3];
@@ -1574,7 +1572,7 @@ void fdt_circumcenter_tri(const double *a, const double *b, const double *c, dou
         got = fdt_circumcenter_exact(a, b, c, d, X);
     }
     if (got != 0) {
-        tri_centre(e1, e2, x); /* collinear to the last bit: nothing better */
+        tri_centre(e1, e2, n, nn, l1, l2, x); /* collinear to the last bit: nothing better */
         return;
     }
     double t = (X[0] * n[0] + X[1] * n[1] + X[2] * n[2]) / nn;

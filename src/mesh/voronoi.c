@@ -91,6 +91,10 @@ typedef struct vwork {
     double *xyz;        /* 3m local coordinates (owned) */
     uint32_t *tets;     /* 4 local ids a tet, by lowest id (owned) */
     size_t ntets;
+    const fdt_vid *rtets; /* the result's tets, in input ids, that tets maps
+                             (NULL in a batch: tets are local already) */
+    size_t *bcnt;       /* bucket_tets's: each key's next entry */
+    uint32_t *btets;    /* and the tets it fills */
     uint8_t *flags;     /* local (owned) */
     double box[6];
     /* the accumulators: per point its volume, the scale of its volume
@@ -140,6 +144,8 @@ typedef struct vjob {
     uint32_t *nloc;      /* scratch: a row's neighbours' local points (neighbors_pass) */
     size_t cap_nloc;
     size_t *first;       /* cut cell lo + k: its faces from face[first[k]] */
+    size_t nbucket, bbase; /* the tets whose key is in [lo, hi): how many; where
+                              they start */
     size_t zero_faces;
     uint32_t short_a, short_b; /* the least edge too short (fdt_edge_less), local ids, or
                                   UINT32_MAX */
@@ -296,47 +302,14 @@ static int number_points(vwork *w, const fdt_result *r, const double *xyz)
     return FDT_OK;
 }
 
-/* w's tets (local ids) bucketed by their lowest id, so that the tet pass
- * meets the points' accumulators in order (a streamed batch's tets in the
- * insertion's slot order took 2.4 times the tet pass's samples of a 700k
- * run, bench/NOTES.md entry 105). */
-static int bucket_tets(vwork *w)
-{
-    size_t *cnt = calloc(w->m + 1, sizeof *cnt);
-    uint32_t *out = malloc((w->ntets ? 4 * w->ntets : 1) * sizeof *out);
-    if (!cnt || !out) {
-        free(cnt);
-        free(out);
-        return FDT_ENOMEM;
-    }
-    for (size_t t = 0; t < w->ntets; t++) {
-        const uint32_t *x = w->tets + 4 * t;
-        uint32_t lo = x[0] < x[1] ? x[0] : x[1], lo2 = x[2] < x[3] ? x[2] : x[3];
-        cnt[(lo < lo2 ? lo : lo2) + 1]++;
-    }
-    for (size_t l = 0; l < w->m; l++)
-        cnt[l + 1] += cnt[l];
-    for (size_t t = 0; t < w->ntets; t++) {
-        const uint32_t *x = w->tets + 4 * t;
-        uint32_t lo = x[0] < x[1] ? x[0] : x[1], lo2 = x[2] < x[3] ? x[2] : x[3];
-        memcpy(out + 4 * cnt[lo < lo2 ? lo : lo2]++, x, 4 * sizeof *x);
-    }
-    free(cnt);
-    free(w->tets);
-    w->tets = out;
-    return FDT_OK;
-}
-
-/* The result's tets in local ids, bucketed. */
+/* The result's tets in local ids: room for them and their source (the
+ * jobs map and bucket them, bucket_tets). */
 static int local_tets(vwork *w, const fdt_result *r)
 {
     w->ntets = r->ntets;
+    w->rtets = r->tets;
     w->tets = malloc((w->ntets ? 4 * w->ntets : 1) * sizeof *w->tets);
-    if (!w->tets)
-        return FDT_ENOMEM;
-    for (size_t c = 0; c < 4 * w->ntets; c++)
-        w->tets[c] = w->loc[r->tets[c]];
-    return bucket_tets(w);
+    return w->tets ? FDT_OK : FDT_ENOMEM;
 }
 
 /* ---------------------------------------------------------------- tet pass */
@@ -1168,6 +1141,101 @@ static int fork_join(vjob *jobs, int threads, void *(*fn)(void *))
     return err;
 }
 
+/* ---------------------------------------------------------------- buckets */
+
+/* A tet's bucket: its lowest local id, which is an own point's (every
+ * tet has one), so the jobs' ranges [lo, hi) cover every key. */
+static inline uint32_t tet_key(const uint32_t *x)
+{
+    uint32_t a = x[0] < x[1] ? x[0] : x[1], b = x[2] < x[3] ? x[2] : x[3];
+    return a < b ? a : b;
+}
+
+/* A job's slice of the result's tets, [t ntets / T, (t + 1) ntets / T),
+ * in local ids. */
+static void *map_pass(void *arg)
+{
+    vjob *j = arg;
+    vwork *w = j->w;
+    size_t t = (size_t)(j - w->jobs), T = (size_t)w->njobs;
+    size_t end = 4 * (w->ntets * (t + 1) / T);
+    for (size_t c = 4 * (w->ntets * t / T); c < end; c++)
+        w->tets[c] = w->loc[w->rtets[c]];
+    return NULL;
+}
+
+/* The job's keys counted, then each key's first entry relative to the
+ * job's first (a prefix sum over [lo, hi)). */
+static void *count_pass(void *arg)
+{
+    vjob *j = arg;
+    vwork *w = j->w;
+    size_t *cnt = w->bcnt, run = 0;
+    for (size_t t = 0; t < w->ntets; t++) {
+        uint32_t k = tet_key(w->tets + 4 * t);
+        if (mine(j, k))
+            cnt[k]++;
+    }
+    for (uint32_t k = j->lo; k < j->hi; k++) {
+        size_t c = cnt[k];
+        cnt[k] = run;
+        run += c;
+    }
+    j->nbucket = run;
+    return NULL;
+}
+
+/* The job's tets into their buckets, in their order. */
+static void *scatter_pass(void *arg)
+{
+    vjob *j = arg;
+    vwork *w = j->w;
+    for (size_t t = 0; t < w->ntets; t++) {
+        const uint32_t *x = w->tets + 4 * t;
+        uint32_t k = tet_key(x);
+        if (mine(j, k))
+            memcpy(w->btets + 4 * (j->bbase + w->bcnt[k]++), x, 4 * sizeof *x);
+    }
+    return NULL;
+}
+
+/* w's tets (local ids) bucketed by their lowest id, so that the tet pass
+ * meets the points' accumulators in order (a streamed batch's tets in the
+ * insertion's slot order took 2.4 times the tet pass's samples of a 700k
+ * run, bench/NOTES.md entry 105): a counting sort on the jobs' threads,
+ * each job the keys of its own points (each reads all the tets, twice;
+ * the buckets come out as one thread's sort would make them). The
+ * result's tets are first mapped to local ids, a slice a job. Each pass
+ * writes only its job's entries of tets, bcnt and btets; pthread_join
+ * (fork_join) orders them before the next pass reads them. */
+static int bucket_tets(vwork *w, vjob *jobs, int threads)
+{
+    int err = w->rtets ? fork_join(jobs, threads, map_pass) : FDT_OK;
+    w->bcnt = calloc(w->m + 1, sizeof *w->bcnt);
+    w->btets = malloc((w->ntets ? 4 * w->ntets : 1) * sizeof *w->btets);
+    if (!err && (!w->bcnt || !w->btets))
+        err = FDT_ENOMEM;
+    if (!err)
+        err = fork_join(jobs, threads, count_pass);
+    for (size_t t = 0, base = 0; !err && t < (size_t)threads; t++) {
+        jobs[t].bbase = base;
+        base += jobs[t].nbucket;
+    }
+    if (!err)
+        err = fork_join(jobs, threads, scatter_pass);
+    free(w->bcnt);
+    w->bcnt = NULL;
+    if (!err) {
+        free(w->tets);
+        w->tets = w->btets;
+    } else {
+        free(w->btets);
+    }
+    w->btets = NULL;
+    return err;
+}
+
+
 /* The neighbour lists' offsets (by row), then their entries on the
  * threads. */
 static int list_neighbors(fdt_voronoi *v, vjob *jobs, int threads)
@@ -1254,6 +1322,8 @@ static int cells_run(vwork *w, fdt_voronoi *v, int threads, int neighbors, fdt_v
         return FDT_ENOMEM;
     }
     int err = make_jobs(w, v, jobs, threads);
+    if (!err)
+        err = bucket_tets(w, jobs, threads);
     if (!err)
         err = fork_join(jobs, threads, tet_pass);
     int too_short = 0;
@@ -1448,7 +1518,7 @@ static uint32_t batch_local(vwork *w, btab *bt, const fdt_vbatch *b, uint32_t id
 
 /* The batch's points numbered (its own first, in their order; then the
  * other points of its tets as met) and its tets in those numbers, those
- * with no own point left out, bucketed. */
+ * with no own point left out (cells_run buckets them). */
 static int batch_number(vwork *w, const fdt_vbatch *b)
 {
     btab bt = {NULL, 32, 0};
@@ -1479,7 +1549,7 @@ static int batch_number(vwork *w, const fdt_vbatch *b)
             memcpy(w->tets + 4 * w->ntets++, x, sizeof x);
     }
     free(bt.t);
-    return err ? err : bucket_tets(w);
+    return err;
 }
 
 int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_vshort *sh,
