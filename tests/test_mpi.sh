@@ -624,25 +624,32 @@ fi
 
 # Periodic domains (issue 33): every rank reads the input and builds its
 # share of the box's slabs; the rows gathered to rank 0 are frontdt's .tets
-# byte for byte, with its --hash and --set-hash, at 1-4 ranks, periodic
-# on three axes and on two (x and z, walls of points across y); a point
-# outside the box gives frontdt's message and code and no file.
+# byte for byte, with its --hash and --set-hash, and the cells' and
+# densities' tables (each rank its slabs' cells) frontdt's, at 1-4 ranks,
+# periodic on three axes (with a duplicate point: its row once) and on two
+# (x and z, walls of points across y); a point outside the box gives
+# frontdt's message and code and no file.
 "$gen" uniform 3000 41 "$work/pu.xyz" >/dev/null
 awk '{ print $1, 0.02 + 0.96 * $2, $3 }
      END { for (i = 0; i < 20; i++) for (j = 0; j < 20; j++)
              print (i + 0.5) / 20, 0.001, (j + 0.5) / 20 "\n" (i + 0.5) / 20, 0.999, (j + 0.5) / 20 }' \
   "$work/pu.xyz" >"$work/pch.xyz"
+sed -n 7p "$work/pu.xyz" >>"$work/pu.xyz"
 for spec in "pu xyz" "pch x,z"; do
   set -- $spec
   ref=$("$frontdt" "$work/$1.xyz" --periodic "$2" --box 0,0,0,1,1,1 -o "$work/$1.ref.tets" \
-    --hash --set-hash -q | sort)
-  [[ -n $ref ]] || fail "periodic $1: frontdt gave no hashes"
+    --hash --set-hash -q --voronoi "$work/$1.ref.cells" --voronoi-format '%i %v %F %n %f %c %h' \
+    --density "$work/$1.ref.dens" | sort)
+  [[ -n $ref && -s $work/$1.ref.cells ]] || fail "periodic $1: frontdt gave no hashes or cells"
   for np in 1 2 3 4; do
     checks=$((checks + 1))
     got=$(mpi "$np" 300 "$fmpi" "$work/$1.xyz" --periodic "$2" --box 0,0,0,1,1,1 \
-      -o "$work/$1.$np.tets" --hash --set-hash -q | sort)
-    [[ $got == "$ref" ]] && cmp -s "$work/$1.ref.tets" "$work/$1.$np.tets" ||
-      fail "periodic $1 on $np ranks: '$got', frontdt '$ref'"
+      -o "$work/$1.$np.tets" --hash --set-hash -q --voronoi "$work/$1.$np.cells" \
+      --voronoi-format '%i %v %F %n %f %c %h' --density "$work/$1.$np.dens" | sort)
+    [[ $got == "$ref" ]] && cmp -s "$work/$1.ref.tets" "$work/$1.$np.tets" &&
+      cmp -s "$work/$1.ref.cells" "$work/$1.$np.cells" &&
+      cmp -s "$work/$1.ref.dens" "$work/$1.$np.dens" ||
+      fail "periodic $1 on $np ranks: '$got', frontdt '$ref' (or the tables differ)"
   done
 done
 checks=$((checks + 1))

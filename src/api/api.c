@@ -703,7 +703,7 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, const fdt
      * merged duplicates' rows, the last batch */
     if (!err && cs)
         err = cells_done(ctx, cs);
-    if (!err && cs && pr.dupmap)
+    if (!err && cs && pr.dupmap && (!share || share[0] == 0))
         err = fdt_cellstream_merged(cs, pr.dupmap, n, pr.p, pr.orig, pr.m);
     double t2 = fdt_now_s();
     if (!err)
@@ -883,22 +883,6 @@ int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
     return run(ctx, xyz, n, sink, NULL, out);
 }
 
-int fdt_triangulate_stream_parts(fdt_context *ctx, const double *xyz, size_t n,
-                                 const fdt_sink *sink, unsigned first, unsigned stride,
-                                 fdt_result **out)
-{
-    if (!ctx || !out || !sink || (!xyz && n) || !stride || first >= stride)
-        return FDT_EINVAL;
-    *out = NULL;
-    ctx->diag[0] = '\0';
-    if (!ctx->s.periodic || ctx->s.neighbors || !periodic_sink_ok(sink)) {
-        snprintf(ctx->diag, sizeof ctx->diag, "a share of the parts is a periodic run's, "
-                 "streamed to periodic_tets");
-        return FDT_EINVAL;
-    }
-    const unsigned share[2] = {first, stride};
-    return run_periodic(ctx, xyz, n, sink, NULL, share, out);
-}
 
 /* The tets of a cells-only stream: counted and hashed by the sink, then
  * dropped. */
@@ -936,6 +920,65 @@ static int periodic_cells_box(fdt_context *ctx, const double *xyz, size_t n,
     return fdt_voronoi_scale(cs->box, &cs->ed, ctx->diag, sizeof ctx->diag);
 }
 
+/* A cells stream's state for o and cells (checked), its box and scale
+ * before any work (xyz is the caller's still: a permuted input is moved
+ * by the run). The bounding box of the distinct points is that of all of
+ * them. */
+static int cells_open(fdt_context *ctx, const double *xyz, size_t n, const fdt_voronoi_options *o,
+                      const fdt_cell_sink *cells, fdt_cellstream *cs)
+{
+    memset(cs, 0, sizeof *cs);
+    cs->neighbors = o->neighbors;
+    cs->sink = cells;
+    int err = FDT_OK;
+    if (ctx->s.periodic) {
+        err = periodic_cells_box(ctx, xyz, n, o, cs);
+    } else {
+        err = fdt_voronoi_box_of(xyz, NULL, n, o, cs->box, ctx->diag, sizeof ctx->diag);
+        /* no finite point: the run refuses the input, with its own message */
+        if (!err && cs->box[0] <= cs->box[3])
+            err = fdt_voronoi_scale(cs->box, &cs->ed, ctx->diag, sizeof ctx->diag);
+    }
+    return err;
+}
+
+/* o and cells as fdt_voronoi_stream takes them: usable. */
+static int cells_ok(const fdt_voronoi_options *o, const fdt_cell_sink *cells)
+{
+    return cells->struct_size >= sizeof(fdt_cell_sink) && cells->cells &&
+           o->struct_size == sizeof *o;
+}
+
+int fdt_triangulate_stream_parts(fdt_context *ctx, const double *xyz, size_t n,
+                                 const fdt_sink *sink, const fdt_voronoi_options *o,
+                                 const fdt_cell_sink *cells, unsigned first, unsigned stride,
+                                 fdt_result **out)
+{
+    fdt_voronoi_options defaults;
+    if (!o) {
+        fdt_default_voronoi_options(&defaults);
+        o = &defaults;
+    }
+    if (!ctx || !out || !sink || (!xyz && n) || !stride || first >= stride ||
+        (cells && !cells_ok(o, cells)))
+        return FDT_EINVAL;
+    *out = NULL;
+    ctx->diag[0] = '\0';
+    if (!ctx->s.periodic || ctx->s.neighbors || !periodic_sink_ok(sink)) {
+        snprintf(ctx->diag, sizeof ctx->diag, "a share of the parts is a periodic run's, "
+                 "streamed to periodic_tets");
+        return FDT_EINVAL;
+    }
+    const unsigned share[2] = {first, stride};
+    fdt_cellstream cs;
+    int err = cells ? cells_open(ctx, xyz, n, o, cells, &cs) : FDT_OK;
+    if (!err)
+        err = run_periodic(ctx, xyz, n, sink, cells ? &cs : NULL, share, out);
+    if (cells)
+        fdt_cellstream_free(&cs);
+    return err;
+}
+
 int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
                        const fdt_voronoi_options *o, const fdt_sink *sink,
                        const fdt_cell_sink *cells, fdt_result **out)
@@ -945,28 +988,13 @@ int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
         fdt_default_voronoi_options(&defaults);
         o = &defaults;
     }
-    if (!ctx || !out || (!xyz && n) || !cells || cells->struct_size < sizeof(fdt_cell_sink) ||
-        !cells->cells || o->struct_size != sizeof *o || (sink && !sink_ok(sink)))
+    if (!ctx || !out || (!xyz && n) || !cells || !cells_ok(o, cells) || (sink && !sink_ok(sink)))
         return FDT_EINVAL;
     *out = NULL;
     ctx->diag[0] = '\0';
     fdt_sink dropped = {sizeof dropped, drop_tets, NULL, NULL, drop_rows, NULL};
     fdt_cellstream cs;
-    memset(&cs, 0, sizeof cs);
-    cs.neighbors = o->neighbors;
-    cs.sink = cells;
-    /* The box and its scale before any work (xyz is the caller's still:
-     * a permuted input is moved by the run). The bounding box of the
-     * distinct points is that of all of them. */
-    int err = FDT_OK;
-    if (ctx->s.periodic) {
-        err = periodic_cells_box(ctx, xyz, n, o, &cs);
-    } else {
-        err = fdt_voronoi_box_of(xyz, NULL, n, o, cs.box, ctx->diag, sizeof ctx->diag);
-        /* no finite point: the run refuses the input, with its own message */
-        if (!err && cs.box[0] <= cs.box[3])
-            err = fdt_voronoi_scale(cs.box, &cs.ed, ctx->diag, sizeof ctx->diag);
-    }
+    int err = cells_open(ctx, xyz, n, o, cells, &cs);
     if (!err)
         err = run(ctx, xyz, n, sink ? sink : &dropped, &cs, out);
     fdt_cellstream_free(&cs);

@@ -257,6 +257,11 @@ int fdt_cli_cells_open(const fdt_cli_dual *d, size_t n, fdt_cli_cells **out,
     return FDT_OK;
 }
 
+fdt_cells_spool *fdt_cli_cells_spool(fdt_cli_cells *c)
+{
+    return c->sp;
+}
+
 int fdt_cli_cells_failed(const fdt_cli_cells *c, char *err, size_t errlen)
 {
     if (!c->err)

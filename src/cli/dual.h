@@ -82,6 +82,9 @@ const char *fdt_cli_dual_stream_refusal(const fdt_cli_dual *d);
 int fdt_cli_cells_open(const fdt_cli_dual *d, size_t n, fdt_cli_cells **out,
                        fdt_voronoi_options *o, fdt_cell_sink *sink, char *err, size_t errlen);
 int fdt_cli_cells_failed(const fdt_cli_cells *c, char *err, size_t errlen);
+/* The spool itself (src/io/write/cells.h): frontdt-mpi's periodic cells
+ * add the other ranks' rows to rank 0's. */
+struct fdt_cells_spool *fdt_cli_cells_spool(fdt_cli_cells *c);
 int fdt_cli_cells_write(const fdt_cli_dual *d, fdt_cli_cells *c, char *err, size_t errlen);
 void fdt_cli_cells_close(fdt_cli_cells **c);
 

@@ -11,6 +11,7 @@
  * together (src/mpi/mpi_cells.h) and write the tables, each rank its
  * block of rows.
  */
+#include <errno.h>
 #include <inttypes.h>
 #include <limits.h>
 #include <mpi.h>
@@ -30,6 +31,7 @@
 #include "mpi/mpi_run.h"
 #include "geom/prepare.h"
 #include "io/read/reader.h"
+#include "io/write/cells.h"
 #include "mesh/periodic.h"
 #include "mesh/result.h"
 #include "api/parts.h"
@@ -309,13 +311,13 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
             say0(rank, "--periodic needs --box X0,Y0,Z0,X1,Y1,Z1: the periods");
             return CLI_USAGE;
         }
-        if (fdt_cli_dual_wanted(&o->cells) || (o->output && (!f || !fdt_format_periodic(f)))) {
+        if (o->output && (!f || !fdt_format_periodic(f))) {
             say0(rank, "--periodic under MPI writes -o .tets, .fdtb, .vtu, .vtk or .msh "
-                       "(gathered to rank 0) and the hashes; not the cells (frontdt --periodic "
-                       "--stream --voronoi computes them a slab at a time) nor pieces");
+                       "(gathered to rank 0), the hashes and the cells' tables; not pieces");
             return CLI_USAGE;
         }
-        return -1;
+        /* --box is the periods: the cells' options checked when asked */
+        return fdt_cli_dual_wanted(&o->cells) ? check_cells(o, rank) : -1;
     }
     int rc = check_cells(o, rank);
     return rc >= 0 ? rc : check_output(o, rank, size);
@@ -417,13 +419,120 @@ static int gather_rows(rowbuf *b, int rank, int size)
     return err;
 }
 
+/* A periodic run's cells' rows on their way to rank 0: records of an
+ * input id (8 bytes), the two tables' lengths (4 bytes each) and their
+ * text, a message at most CELLS_CHUNK bytes (or one record), an empty
+ * message the last. */
+#define CELLS_CHUNK (16u << 20)
+#define CELLS_TAG 33
+
+typedef struct cells_msg {
+    char *b;
+    size_t len, cap;
+} cells_msg;
+
+static int cells_send(cells_msg *m)
+{
+    MPI_Send(m->b, (int)m->len, MPI_BYTE, 0, CELLS_TAG, MPI_COMM_WORLD);
+    m->len = 0;
+    return 0;
+}
+
+/* One spooled row into the message (fdt_cells_spool_each's call), which
+ * goes when the row would not fit. */
+static int cells_pack(void *user, size_t id, const uint32_t l[2], const char *text)
+{
+    cells_msg *m = user;
+    size_t need = 16 + (size_t)l[0] + l[1];
+    if (m->len && m->len + need > CELLS_CHUNK)
+        cells_send(m);
+    if (m->len + need > m->cap) {
+        size_t cap = need > CELLS_CHUNK ? need : CELLS_CHUNK;
+        char *b = realloc(m->b, cap);
+        if (!b)
+            return ENOMEM;
+        m->b = b;
+        m->cap = cap;
+    }
+    uint64_t id64 = id;
+    memcpy(m->b + m->len, &id64, 8);
+    memcpy(m->b + m->len + 8, l, 8);
+    memcpy(m->b + m->len + 16, text, need - 16);
+    m->len += need;
+    return 0;
+}
+
+/* A message's records into rank 0's spool: 0 or an errno (EINVAL for a
+ * record cut short). */
+static int cells_unpack(fdt_cells_spool *sp, const char *b, size_t len)
+{
+    int e = 0;
+    for (size_t at = 0; at < len && !e; ) {
+        uint64_t id;
+        uint32_t l[2];
+        if (len - at < 16)
+            return EINVAL;
+        memcpy(&id, b + at, 8);
+        memcpy(l, b + at + 8, 8);
+        size_t text = (size_t)l[0] + l[1];
+        if (len - at - 16 < text)
+            return EINVAL;
+        e = fdt_cells_spool_add_row(sp, (size_t)id, l, b + at + 16);
+        at += 16 + text;
+    }
+    return e;
+}
+
+/* Every rank's cells' rows into rank 0's spool (collective): each rank
+ * other than 0 sends its own in messages, rank 0 takes them rank by rank
+ * (every message taken, whatever failed). The same code on every rank:
+ * FDT_OK, FDT_ENOMEM, or FDT_EIO with the message in diag. */
+static int cells_to_root(fdt_cli_cells *cells, int rank, int size, char *diag, size_t dlen)
+{
+    fdt_cells_spool *sp = fdt_cli_cells_spool(cells);
+    cells_msg m = {NULL, 0, 0};
+    int e = 0;
+    if (rank != 0) {
+        e = fdt_cells_spool_each(sp, cells_pack, &m);
+        if (m.len)
+            cells_send(&m);
+        cells_send(&m); /* the end */
+    } else {
+        for (int q = 1; q < size; q++)
+            for (;;) {
+                MPI_Status st;
+                int count;
+                MPI_Probe(q, CELLS_TAG, MPI_COMM_WORLD, &st);
+                MPI_Get_count(&st, MPI_BYTE, &count);
+                char *b = malloc(count ? (size_t)count : 1);
+                MPI_Recv(b ? b : m.b, b ? count : 0, MPI_BYTE, q, CELLS_TAG, MPI_COMM_WORLD,
+                         MPI_STATUS_IGNORE);
+                if (!b && !e)
+                    e = ENOMEM;
+                if (b && !e)
+                    e = cells_unpack(sp, b, (size_t)count);
+                free(b);
+                if (!count)
+                    break;
+            }
+    }
+    free(m.b);
+    int err = e == 0 ? FDT_OK : e == ENOMEM ? FDT_ENOMEM : FDT_EIO;
+    if (e)
+        snprintf(diag, dlen, "the cells' rows to rank 0: %s", strerror(e));
+    return fdt_mpi_agree(MPI_COMM_WORLD, err, diag, dlen);
+}
+
 /*
  * A periodic run (--periodic; issue 33, src/api/parts.h): every rank reads
  * the whole input and builds its share of the box's slabs (slab k on rank
  * k mod size) with the library's periodic engine on one thread; the rows
  * go to rank 0, which sorts them into the one mesh (the same rows for any
- * rank count) and hashes and writes it as frontdt does. The first rank
- * that failed says why; every rank leaves with its code.
+ * rank count) and hashes and writes it as frontdt does. With --voronoi or
+ * --density each rank computes its slabs' points' cells as they are built
+ * (frontdt --stream's batches, spooled as text), and rank 0 gathers the
+ * rows into its spool and writes the tables: the same bytes as frontdt's.
+ * The first rank that failed says why; every rank leaves with its code.
  */
 static int periodic_run(const opts *o, int rank, int size)
 {
@@ -433,9 +542,17 @@ static int periodic_run(const opts *o, int rank, int size)
     fdt_context *ctx = NULL;
     fdt_result *res = NULL;
     rowbuf rows[2] = {{4, NULL, NULL, 0, 0}, {3, NULL, NULL, 0, 0}};
+    fdt_cli_cells *cells = NULL;
     int err = fdt_read_points(o->input, o->format, &xyz, &n, diag, sizeof diag), rc;
     int read_failed = err != FDT_OK; /* its message names the file */
     rc = err ? setup_exit_code(err) : CLI_OK;
+    fdt_voronoi_options vo;
+    fdt_cell_sink cs;
+    if (!err && fdt_cli_dual_wanted(&o->cells) &&
+        (err = fdt_cli_cells_open(&o->cells, n, &cells, &vo, &cs, diag, sizeof diag)) != FDT_OK) {
+        read_failed = 1; /* the message names the spool's folder */
+        rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
+    }
     if (!err) {
         fdt_settings s;
         fdt_default_settings(&s);
@@ -445,11 +562,14 @@ static int periodic_run(const opts *o, int rank, int size)
         fdt_sink sink = {sizeof sink, NULL, NULL, rows, put_tets, put_hull};
         err = fdt_open(&ctx, &s);
         if (!err)
-            err = fdt_triangulate_stream_parts(ctx, xyz, n, &sink, (unsigned)rank,
+            err = fdt_triangulate_stream_parts(ctx, xyz, n, &sink, cells ? &vo : NULL,
+                                               cells ? &cs : NULL, (unsigned)rank,
                                                (unsigned)size, &res);
         if (err)
             snprintf(diag, sizeof diag, "%s", ctx ? fdt_context_diagnostic(ctx) : "");
         rc = fdt_cli_engine_exit(err);
+        if (err && cells && fdt_cli_cells_failed(cells, diag, sizeof diag))
+            rc = CLI_WRITE;
     }
     /* the first rank that failed names it */
     int first, me = rc ? rank : size;
@@ -483,6 +603,12 @@ static int periodic_run(const opts *o, int rank, int size)
     }
     for (int k = 0; k < 2 && !err; k++)
         err = gather_rows(&rows[k], rank, size);
+    if (!err && cells && (err = cells_to_root(cells, rank, size, diag, sizeof diag)) != FDT_OK) {
+        if (rank == 0)
+            fprintf(stderr, "frontdt-mpi: %s\n", diag);
+        rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
+        goto out;
+    }
     for (int k = 0; rank == 0 && k < 2 && !err; k++) {
         uint32_t *ids = (uint32_t *)rows[k].ids; /* replaced by the sort */
         err = fdt_periodic_sort_rows(&ids, &rows[k].off, rows[k].n, rows[k].nv, n);
@@ -511,6 +637,11 @@ static int periodic_run(const opts *o, int rank, int size)
             fprintf(stderr, "frontdt-mpi: %s\n", diag);
             rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
         }
+        if (rc == CLI_OK && cells &&
+            (err = fdt_cli_cells_write(&o->cells, cells, diag, sizeof diag)) != FDT_OK) {
+            fprintf(stderr, "frontdt-mpi: %s\n", diag);
+            rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
+        }
         if (!o->quiet)
             fprintf(stderr, "frontdt-mpi: %zu points, %zu periodic tets on %d ranks\n", n,
                     res->ntets, size);
@@ -522,6 +653,7 @@ out:
         free(rows[k].ids);
         free(rows[k].off);
     }
+    fdt_cli_cells_close(&cells);
     fdt_result_free(&res);
     fdt_close(&ctx);
     free(xyz);

@@ -305,6 +305,27 @@ static void no_report(void *user, int stage, uint64_t done, uint64_t total)
     (void)total;
 }
 
+/* Input id's row, its two tables' text (l[0] and l[1] bytes at text),
+ * appended to the spool as a record: the lengths, then the text. 0 or an
+ * errno: EINVAL for an id outside the spool's or one spooled already. */
+static int spool_row(fdt_cells_spool *s, size_t id, const uint32_t l[2], const char *text)
+{
+    size_t j = id - s->base;
+    if (id < s->base || j >= s->n)
+        return EINVAL; /* not a row of this spool's ids */
+    if (s->off[j] != UINT64_MAX)
+        return EINVAL; /* a row twice */
+    s->off[j] = s->pos;
+    s->text[0] += l[0];
+    s->text[1] += l[1];
+    size_t len = (size_t)l[0] + l[1];
+    errno = 0;
+    if (fwrite(l, 2 * sizeof *l, 1, s->f) != 1 || fwrite(text, 1, len, s->f) != len)
+        return errno ? errno : EIO;
+    s->pos += 2 * sizeof *l + len;
+    return 0;
+}
+
 /* Rows a chunk of a batch formatted in memory before it is spooled. */
 #define SPOOL_CHUNK 4096
 
@@ -339,26 +360,8 @@ static int spool_chunk(fdt_cells_spool *s, const fdt_voronoi *v, size_t lo, size
     for (size_t r = lo, at = 0; !e && r < hi; r++) {
         size_t mid = cut[2 * (r - lo)], end = cut[2 * (r - lo) + 1];
         uint32_t l[2] = {(uint32_t)(mid - at), (uint32_t)(end - mid)};
-        if (mid - at > UINT32_MAX || end - mid > UINT32_MAX) {
-            e = EFBIG;
-            break;
-        }
-        size_t j = (size_t)ids[r] - s->base;
-        if ((size_t)ids[r] < s->base || j >= s->n) {
-            e = EINVAL; /* not a row of this spool's ids */
-            break;
-        }
-        if (s->off[j] != UINT64_MAX) {
-            e = EINVAL; /* a row twice */
-            break;
-        }
-        s->off[j] = s->pos;
-        s->text[0] += l[0];
-        s->text[1] += l[1];
-        errno = 0;
-        if (fwrite(l, sizeof l, 1, s->f) != 1 || fwrite(text + at, 1, end - at, s->f) != end - at)
-            e = errno ? errno : EIO;
-        s->pos += sizeof l + (end - at);
+        e = mid - at > UINT32_MAX || end - mid > UINT32_MAX ? EFBIG
+                                                            : spool_row(s, (size_t)ids[r], l, text + at);
         at = end;
     }
     free(text);
@@ -375,6 +378,52 @@ int fdt_cells_spool_add(fdt_cells_spool *s, const fdt_voronoi *v)
     return e;
 }
 
+int fdt_cells_spool_add_row(fdt_cells_spool *s, size_t id, const uint32_t l[2], const char *text)
+{
+    return spool_row(s, id, l, text);
+}
+
+/* The spool's records readable at *base (NULL when it is empty): its
+ * stream flushed and the file mapped. 0 or an errno. */
+static int spool_map(fdt_cells_spool *s, const char **base)
+{
+    *base = NULL;
+    errno = 0;
+    if (fflush(s->f) != 0)
+        return errno ? errno : EIO;
+    if (!s->pos)
+        return 0;
+    void *mp = mmap(NULL, (size_t)s->pos, PROT_READ, MAP_PRIVATE, fileno(s->f), 0);
+    if (mp == MAP_FAILED)
+        return errno;
+    *base = mp;
+    return 0;
+}
+
+static void spool_unmap(const fdt_cells_spool *s, const char *base)
+{
+    if (base)
+        munmap((void *)(uintptr_t)base, (size_t)s->pos);
+}
+
+int fdt_cells_spool_each(fdt_cells_spool *s,
+                         int (*fn)(void *user, size_t id, const uint32_t l[2], const char *text),
+                         void *user)
+{
+    const char *base;
+    int e = spool_map(s, &base);
+    for (size_t i = 0; i < s->n && !e; i++) {
+        if (s->off[i] == UINT64_MAX)
+            continue;
+        const char *rec = base + s->off[i];
+        uint32_t l[2];
+        memcpy(l, rec, sizeof l);
+        e = fn(user, s->base + i, l, rec + sizeof l);
+    }
+    spool_unmap(s, base);
+    return e;
+}
+
 uint64_t fdt_cells_spool_bytes(const fdt_cells_spool *s, int table, int header)
 {
     return s->text[table] + (table == 0 && s->csv && header ? strlen(CSV_HEADER) : 0);
@@ -382,21 +431,15 @@ uint64_t fdt_cells_spool_bytes(const fdt_cells_spool *s, int table, int header)
 
 int fdt_cells_spool_put(fdt_cells_spool *s, int table, int header, FILE *f)
 {
-    errno = 0;
-    if (fflush(s->f) != 0)
-        return errno ? errno : EIO;
     for (size_t i = 0; i < s->n; i++)
         if (s->off[i] == UINT64_MAX)
             return EINVAL; /* a row never came: the run was not whole */
-    const char *base = NULL;
-    if (s->pos) {
-        void *mp = mmap(NULL, (size_t)s->pos, PROT_READ, MAP_PRIVATE, fileno(s->f), 0);
-        if (mp == MAP_FAILED)
-            return errno;
-        base = mp;
-    }
+    const char *base;
+    int e = spool_map(s, &base);
+    if (e)
+        return e;
     out_file o;
-    int e = open_out(&o, f);
+    e = open_out(&o, f);
     if (!e && table == 0 && s->csv && header)
         out_str(&o, CSV_HEADER);
     for (size_t i = 0; i < s->n && !e && !o.err; i++) {
@@ -407,8 +450,7 @@ int fdt_cells_spool_put(fdt_cells_spool *s, int table, int header, FILE *f)
     }
     if (!e)
         e = close_out(&o);
-    if (base)
-        munmap((void *)(uintptr_t)base, (size_t)s->pos);
+    spool_unmap(s, base);
     return e;
 }
 

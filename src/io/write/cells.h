@@ -16,6 +16,7 @@
 #define FDT_CELLS_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include "frontdt.h"
@@ -67,6 +68,17 @@ int fdt_cells_spool_add(fdt_cells_spool *sp, const fdt_voronoi *v);
 /* table 0: the cells' (fmt or CSV, its header line first when header is
  * nonzero); 1: the densities. */
 int fdt_cells_spool_put(fdt_cells_spool *sp, int table, int header, FILE *f);
+/* The spooled rows in input order, each handed to fn as a record: its
+ * input id and its two tables' text, l[0] and l[1] bytes one after the
+ * other at text (valid during the call). Stops at fn's first nonzero
+ * return, which it returns; else 0, or an errno. For frontdt-mpi's
+ * periodic cells, whose ranks send their rows to rank 0. */
+int fdt_cells_spool_each(fdt_cells_spool *sp,
+                         int (*fn)(void *user, size_t id, const uint32_t l[2], const char *text),
+                         void *user);
+/* A record as fdt_cells_spool_each hands it, spooled: 0 or an errno
+ * (EINVAL as fdt_cells_spool_add's). */
+int fdt_cells_spool_add_row(fdt_cells_spool *sp, size_t id, const uint32_t l[2], const char *text);
 /* The bytes fdt_cells_spool_put writes of that table (every row come). */
 uint64_t fdt_cells_spool_bytes(const fdt_cells_spool *sp, int table, int header);
 void fdt_cells_spool_close(fdt_cells_spool **sp);
