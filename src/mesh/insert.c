@@ -590,6 +590,13 @@ int fdt_ins_build(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
 int fdt_ins_build_progress(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                            fdt_pred_counts *cnt, fdt_progress_fn progress, void *puser)
 {
+    return fdt_ins_build_serial(m, P, base, n, NULL, cnt, progress, puser);
+}
+
+int fdt_ins_build_serial(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                         const fdt_images *img, fdt_pred_counts *cnt, fdt_progress_fn progress,
+                         void *puser)
+{
     if (ins_begin(m, P, base, n) != FDT_OK)
         return FDT_EDEGENERATE;
     uint32_t *order = malloc((size_t)n * sizeof *order);
@@ -601,7 +608,7 @@ int fdt_ins_build_progress(fdt_ins *m, const double *P, uint32_t base, uint32_t 
     /* About 6.5 tets a point on uniform points, plus the hull: growing by
      * realloc stays possible for inputs with more. */
     int err = fdt_ins_build_prefix(m, P, base, n, order, n, (uint64_t)n * 27 / 4 + 64, first,
-                                   NULL, cnt, progress, puser);
+                                   img, cnt, progress, puser);
     free(order);
     if (err)
         return err;

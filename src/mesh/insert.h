@@ -66,8 +66,9 @@ int fdt_ins_build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t 
 /*
  * The perturbed DT of the rounded periodic images img->P[0 .. img->n)
  * (src/geom/images.h; src/mesh/periodic.h makes them), every predicate
- * decided for the exact images: fdt_ins_build_parallel's build, on
- * nthreads threads, with its results and errors. img must outlive m.
+ * decided for the exact images: fdt_ins_build_parallel's build on
+ * nthreads threads, fdt_ins_build's on one, with their results and
+ * errors. img must outlive m.
  */
 int fdt_ins_build_images(fdt_ins *m, const fdt_images *img, int nthreads, fdt_pred_counts *cnt);
 
@@ -166,6 +167,14 @@ int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
                          const uint32_t *order, uint32_t prefix, uint64_t slots,
                          uint32_t first[4], const fdt_images *img, fdt_pred_counts *cnt,
                          fdt_progress_fn progress, void *puser);
+
+/*
+ * fdt_ins_build_progress's build, with img the points' periodic images
+ * (fdt_ins_build_images on one thread) or NULL.
+ */
+int fdt_ins_build_serial(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
+                         const fdt_images *img, fdt_pred_counts *cnt, fdt_progress_fn progress,
+                         void *puser);
 
 /*
  * The end of a build, once every point is in: the incident-tet table, the

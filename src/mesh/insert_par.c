@@ -1181,5 +1181,10 @@ int fdt_ins_build_parallel_slots(fdt_ins *m, const double *P, uint32_t base, uin
 
 int fdt_ins_build_images(fdt_ins *m, const fdt_images *img, int nthreads, fdt_pred_counts *cnt)
 {
+    /* one thread: the serial kernel, as the plain engine's (src/front/
+     * partmesh.c), not the workers' with their locks and hints (bench/
+     * NOTES.md entry 113) */
+    if (nthreads <= 1)
+        return fdt_ins_build_serial(m, img->P, 0, img->n, img, cnt, NULL, NULL);
     return build_parallel(m, img->P, 0, img->n, nthreads, 0.0, img, cnt);
 }
