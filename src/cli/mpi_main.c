@@ -421,21 +421,21 @@ static int gather_rows(rowbuf *b, int rank, int size)
 
 /* A periodic run's cells' rows on their way to rank 0: records of an
  * input id (8 bytes), the two tables' lengths (4 bytes each) and their
- * text, a message at most CELLS_CHUNK bytes (or one record), an empty
- * message the last. */
+ * text, a message at most CELLS_CHUNK bytes (a record longer than that,
+ * a cell of some 400,000 faces, is refused: EFBIG), an empty message the
+ * last. */
 #define CELLS_CHUNK (16u << 20)
 #define CELLS_TAG 33
 
 typedef struct cells_msg {
-    char *b;
-    size_t len, cap;
+    char *b; /* CELLS_CHUNK bytes, or NULL */
+    size_t len;
 } cells_msg;
 
-static int cells_send(cells_msg *m)
+static void cells_send(cells_msg *m)
 {
     MPI_Send(m->b, (int)m->len, MPI_BYTE, 0, CELLS_TAG, MPI_COMM_WORLD);
     m->len = 0;
-    return 0;
 }
 
 /* One spooled row into the message (fdt_cells_spool_each's call), which
@@ -444,16 +444,12 @@ static int cells_pack(void *user, size_t id, const uint32_t l[2], const char *te
 {
     cells_msg *m = user;
     size_t need = 16 + (size_t)l[0] + l[1];
-    if (m->len && m->len + need > CELLS_CHUNK)
+    if (need > CELLS_CHUNK)
+        return EFBIG;
+    if (m->len + need > CELLS_CHUNK)
         cells_send(m);
-    if (m->len + need > m->cap) {
-        size_t cap = need > CELLS_CHUNK ? need : CELLS_CHUNK;
-        char *b = realloc(m->b, cap);
-        if (!b)
-            return ENOMEM;
-        m->b = b;
-        m->cap = cap;
-    }
+    if (!m->b && !(m->b = malloc(CELLS_CHUNK)))
+        return ENOMEM;
     uint64_t id64 = id;
     memcpy(m->b + m->len, &id64, 8);
     memcpy(m->b + m->len + 8, l, 8);
@@ -483,15 +479,22 @@ static int cells_unpack(fdt_cells_spool *sp, const char *b, size_t len)
     return e;
 }
 
-/* Every rank's cells' rows into rank 0's spool (collective): each rank
- * other than 0 sends its own in messages, rank 0 takes them rank by rank
- * (every message taken, whatever failed). The same code on every rank:
- * FDT_OK, FDT_ENOMEM, or FDT_EIO with the message in diag. */
+/* Every rank's cells' rows into rank 0's spool (collective): rank 0's
+ * buffer first (every rank told if it failed, before anything is sent),
+ * then each other rank sends its rows in messages and rank 0 takes them
+ * rank by rank, every message taken whatever failed. The same code on
+ * every rank: FDT_OK, FDT_ENOMEM, or FDT_EIO with the message in diag. */
 static int cells_to_root(fdt_cli_cells *cells, int rank, int size, char *diag, size_t dlen)
 {
     fdt_cells_spool *sp = fdt_cli_cells_spool(cells);
-    cells_msg m = {NULL, 0, 0};
-    int e = 0;
+    cells_msg m = {rank == 0 && size > 1 ? malloc(CELLS_CHUNK) : NULL, 0};
+    int e = rank == 0 && size > 1 && !m.b ? ENOMEM : 0;
+    if (e)
+        snprintf(diag, dlen, "out of memory for the cells' rows");
+    if (fdt_mpi_agree(MPI_COMM_WORLD, e ? FDT_ENOMEM : FDT_OK, diag, dlen) != FDT_OK) {
+        free(m.b);
+        return FDT_ENOMEM;
+    }
     if (rank != 0) {
         e = fdt_cells_spool_each(sp, cells_pack, &m);
         if (m.len)
@@ -502,18 +505,12 @@ static int cells_to_root(fdt_cli_cells *cells, int rank, int size, char *diag, s
             for (;;) {
                 MPI_Status st;
                 int count;
-                MPI_Probe(q, CELLS_TAG, MPI_COMM_WORLD, &st);
+                MPI_Recv(m.b, (int)CELLS_CHUNK, MPI_BYTE, q, CELLS_TAG, MPI_COMM_WORLD, &st);
                 MPI_Get_count(&st, MPI_BYTE, &count);
-                char *b = malloc(count ? (size_t)count : 1);
-                MPI_Recv(b ? b : m.b, b ? count : 0, MPI_BYTE, q, CELLS_TAG, MPI_COMM_WORLD,
-                         MPI_STATUS_IGNORE);
-                if (!b && !e)
-                    e = ENOMEM;
-                if (b && !e)
-                    e = cells_unpack(sp, b, (size_t)count);
-                free(b);
                 if (!count)
                     break;
+                if (!e)
+                    e = cells_unpack(sp, m.b, (size_t)count);
             }
     }
     free(m.b);
@@ -544,13 +541,13 @@ static int periodic_run(const opts *o, int rank, int size)
     rowbuf rows[2] = {{4, NULL, NULL, 0, 0}, {3, NULL, NULL, 0, 0}};
     fdt_cli_cells *cells = NULL;
     int err = fdt_read_points(o->input, o->format, &xyz, &n, diag, sizeof diag), rc;
-    int read_failed = err != FDT_OK; /* its message names the file */
+    int named = err != FDT_OK; /* a read's message names the file */
     rc = err ? setup_exit_code(err) : CLI_OK;
     fdt_voronoi_options vo;
     fdt_cell_sink cs;
     if (!err && fdt_cli_dual_wanted(&o->cells) &&
         (err = fdt_cli_cells_open(&o->cells, n, &cells, &vo, &cs, diag, sizeof diag)) != FDT_OK) {
-        read_failed = 1; /* the message names the spool's folder */
+        named = 1; /* the message names the spool's folder */
         rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
     }
     if (!err) {
@@ -575,7 +572,7 @@ static int periodic_run(const opts *o, int rank, int size)
     int first, me = rc ? rank : size;
     MPI_Allreduce(&me, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
     if (first < size) {
-        if (rank == first && read_failed)
+        if (rank == first && named)
             fprintf(stderr, "frontdt-mpi: %s\n", diag);
         else if (rank == first)
             fprintf(stderr, "frontdt-mpi: %s: %s\n", o->input, diag[0] ? diag : fdt_strerror(err));
