@@ -883,7 +883,6 @@ int fdt_triangulate_stream(fdt_context *ctx, const double *xyz, size_t n,
     return run(ctx, xyz, n, sink, NULL, out);
 }
 
-
 /* The tets of a cells-only stream: counted and hashed by the sink, then
  * dropped. */
 static int drop_tets(void *user, const fdt_vid *tets, size_t count)
