@@ -22,21 +22,6 @@
 
 #define FMT "%i %v %F %s %n %f %c"
 
-/* The whole of f into a new string (*len bytes). */
-static char *slurp(FILE *f, size_t *len)
-{
-    CHECK(fflush(f) == 0 && fseek(f, 0, SEEK_END) == 0);
-    long end = ftell(f);
-    CHECK(end >= 0);
-    rewind(f);
-    char *s = malloc((size_t)end + 1);
-    CHECK(s != NULL);
-    CHECK(fread(s, 1, (size_t)end, f) == (size_t)end);
-    s[end] = 0;
-    *len = (size_t)end;
-    return s;
-}
-
 /* Table `table` of sp (0 the cells', 1 the densities) as a string; its
  * length checked against fdt_cells_spool_bytes. */
 static char *put(fdt_cells_spool *sp, int table, size_t *len)
@@ -44,7 +29,9 @@ static char *put(fdt_cells_spool *sp, int table, size_t *len)
     FILE *f = tmpfile();
     CHECK(f != NULL);
     CHECK_EQ(fdt_cells_spool_put(sp, table, 1, f), 0);
-    char *s = slurp(f, len);
+    CHECK(fflush(f) == 0);
+    rewind(f);
+    char *s = test_slurp_stream(f, len);
     fclose(f);
     EXPECT(*len == fdt_cells_spool_bytes(sp, table, 1));
     return s;
@@ -58,7 +45,9 @@ static char *whole(const fdt_voronoi *v, const double *xyz, int density, const c
     FILE *f = tmpfile();
     CHECK(f != NULL);
     CHECK_EQ(density ? fdt_wr_density(f, v, 1) : fdt_wr_cells(f, fmt, v, xyz, 2), 0);
-    char *s = slurp(f, len);
+    CHECK(fflush(f) == 0);
+    rewind(f);
+    char *s = test_slurp_stream(f, len);
     fclose(f);
     return s;
 }
@@ -110,14 +99,9 @@ int main(void)
     memcpy(xyz + 3 * 17, xyz + 3 * 5, 3 * sizeof *xyz); /* a merged duplicate */
 
     /* the whole set's cells and tables */
-    fdt_result *r = test_triangulate(xyz, n, 1, 0);
-    fdt_voronoi_options o;
-    fdt_default_voronoi_options(&o);
-    o.neighbors = 1;
-    o.threads = 1;
-    fdt_voronoi *v = NULL;
-    char diag[256];
-    CHECK_EQ(fdt_voronoi_compute(r, xyz, n, &o, &v, diag, sizeof diag), FDT_OK);
+    fdt_result *r = NULL;
+    fdt_voronoi *v = test_whole_cells(xyz, n, &r);
+    CHECK(v != NULL);
     size_t lc, lv, ld;
     char *want_cells = whole(v, xyz, 0, FMT, &lc), *want_csv = whole(v, xyz, 0, NULL, &lv),
          *want_dens = whole(v, xyz, 1, NULL, &ld);
@@ -126,6 +110,10 @@ int main(void)
     two t = {NULL, NULL, 0};
     CHECK_EQ(fdt_cells_spool_open(&t.text, 0, n, FMT, 0, 1, "."), 0);
     CHECK_EQ(fdt_cells_spool_open(&t.csv, 0, n, NULL, 1, 0, "."), 0);
+    fdt_voronoi_options o; /* as test_whole_cells's */
+    fdt_default_voronoi_options(&o);
+    o.neighbors = 1;
+    o.threads = 1;
     fdt_settings s;
     fdt_default_settings(&s);
     s.n_threads = 2;

@@ -90,24 +90,6 @@ static void got_init(got *g, const fdt_voronoi *ref, const double *xyz, size_t n
     CHECK(g->seen != NULL);
 }
 
-/* The whole mesh's cells, neighbours kept, in the points' bounding box. */
-static fdt_voronoi *whole_cells(const double *xyz, size_t n, fdt_result **r)
-{
-    *r = test_triangulate(xyz, n, 1, 0);
-    fdt_voronoi_options o;
-    fdt_default_voronoi_options(&o);
-    o.neighbors = 1;
-    o.threads = 1;
-    fdt_voronoi *v = NULL;
-    char diag[512];
-    int err = fdt_voronoi_compute(*r, xyz, n, &o, &v, diag, sizeof diag);
-    if (err != FDT_OK) {
-        fdt_result_free(r);
-        return NULL;
-    }
-    return v;
-}
-
 static int run_stream(const double *xyz, size_t n, const fdt_settings *s,
                       const fdt_voronoi_options *o, got *g, fdt_result **r, char *diag,
                       size_t ds)
@@ -128,7 +110,7 @@ static void test_family(const char *gen, const char *fam, size_t n)
     size_t m;
     double *xyz = test_gen_family(gen, fam, n, 3, &m);
     fdt_result *r = NULL;
-    fdt_voronoi *ref = whole_cells(xyz, m, &r);
+    fdt_voronoi *ref = test_whole_cells(xyz, m, &r);
     if (!ref) {
         /* the cells refused (a box beyond doubles, points too close): the
          * stream refuses them alike */
@@ -212,7 +194,7 @@ static void test_api(void)
     for (size_t i = 3000; i < n; i += 7) /* duplicates of earlier points */
         memcpy(xyz + 3 * i, xyz + 3 * (i - 2000), 3 * sizeof *xyz);
     fdt_result *r = NULL;
-    fdt_voronoi *ref = whole_cells(xyz, n, &r);
+    fdt_voronoi *ref = test_whole_cells(xyz, n, &r);
     CHECK(ref != NULL);
     fdt_voronoi_options o;
     fdt_default_voronoi_options(&o);

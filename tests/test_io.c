@@ -45,25 +45,6 @@ static void put_file(const char *path, const char *text)
     CHECK(fclose(f) == 0);
 }
 
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    CHECK(fseek(f, 0, SEEK_END) == 0);
-    long sz = ftell(f);
-    CHECK(sz >= 0);
-    rewind(f);
-    char *buf = malloc((size_t)sz + 1);
-    CHECK(buf != NULL);
-    CHECK(fread(buf, 1, (size_t)sz, f) == (size_t)sz);
-    fclose(f);
-    buf[sz] = '\0';
-    if (len)
-        *len = (size_t)sz;
-    return buf;
-}
-
 /* The text after the first line equal to key (key without its newline). */
 static const char *after_line(const char *text, const char *key)
 {
@@ -308,7 +289,7 @@ static void test_write_formats(void)
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("m.tets"), NULL, diag, sizeof diag), FDT_OK);
     CHECK(diag[0] == '\0');
     size_t len;
-    char *text = slurp(at("m.tets"), &len);
+    char *text = test_slurp(at("m.tets"), &len);
     CHECK(text != NULL);
     uint64_t h;
     CHECK_EQ(fdt_result_hash(r, &h), FDT_OK);
@@ -328,7 +309,7 @@ static void test_write_formats(void)
     CHECK_EQ(n, CUBE_N);
     CHECK(memcmp(xyz, cube, sizeof cube) == 0);
     fdt_free(xyz);
-    text = slurp(at("m.ele"), NULL);
+    text = test_slurp(at("m.ele"), NULL);
     CHECK(text != NULL);
     const char *p = text;
     while (*p == '#')
@@ -350,7 +331,7 @@ static void test_write_formats(void)
     /* gmsh 4.1: nodes 1..n (every input point), tets then hull triangles,
      * ids + 1. */
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("m.msh"), NULL, diag, sizeof diag), FDT_OK);
-    text = slurp(at("m.msh"), NULL);
+    text = test_slurp(at("m.msh"), NULL);
     CHECK(strncmp(text, "$MeshFormat\n4.1 0 8\n", 20) == 0);
     p = after_line(text, "$Nodes");
     CHECK(p != NULL);
@@ -385,7 +366,7 @@ static void test_write_formats(void)
 
     /* gmsh 2.2 (by name only): "i x y z" nodes, "id type 2 phys elem ids". */
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("m2.msh"), "msh2", diag, sizeof diag), FDT_OK);
-    text = slurp(at("m2.msh"), NULL);
+    text = test_slurp(at("m2.msh"), NULL);
     CHECK(strncmp(text, "$MeshFormat\n2.2 0 8\n", 20) == 0);
     p = after_line(text, "$Nodes");
     long long cnt;
@@ -415,7 +396,7 @@ static void test_write_formats(void)
 
     /* Medit: counts, 1-based tets. */
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("m.mesh"), NULL, diag, sizeof diag), FDT_OK);
-    text = slurp(at("m.mesh"), NULL);
+    text = test_slurp(at("m.mesh"), NULL);
     p = after_line(text, "Vertices");
     CHECK(p != NULL);
     ints(&p, &cnt, 1);
@@ -440,7 +421,7 @@ static void test_write_formats(void)
 
     /* VTK legacy and XML: the counts in their headers. */
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("m.vtk"), NULL, diag, sizeof diag), FDT_OK);
-    text = slurp(at("m.vtk"), NULL);
+    text = test_slurp(at("m.vtk"), NULL);
     char want[128];
     snprintf(want, sizeof want, "POINTS %d double", CUBE_N);
     CHECK(strstr(text, want) != NULL);
@@ -448,7 +429,7 @@ static void test_write_formats(void)
     CHECK(strstr(text, want) != NULL);
     free(text);
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("m.vtu"), NULL, diag, sizeof diag), FDT_OK);
-    text = slurp(at("m.vtu"), NULL);
+    text = test_slurp(at("m.vtu"), NULL);
     snprintf(want, sizeof want, "NumberOfPoints=\"%d\" NumberOfCells=\"%zu\"", CUBE_N, T);
     CHECK(strstr(text, want) != NULL);
     free(text);
@@ -463,19 +444,19 @@ static void test_write_formats(void)
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("case/polyMesh"), NULL, diag, sizeof diag),
              FDT_OK);
     size_t F = (4 * T + H) / 2, I = F - H;
-    text = slurp(at("case/polyMesh/points"), NULL);
+    text = test_slurp(at("case/polyMesh/points"), NULL);
     p = strstr(text, "}\n");
     CHECK(p != NULL);
     ints(&p, &cnt, 1);
     CHECK_EQ(cnt, CUBE_N - 1);
     free(text);
-    text = slurp(at("case/polyMesh/faces"), NULL);
+    text = test_slurp(at("case/polyMesh/faces"), NULL);
     p = strstr(text, "}\n");
     ints(&p, &cnt, 1);
     CHECK_EQ(cnt, F);
     free(text);
-    char *own = slurp(at("case/polyMesh/owner"), NULL);
-    char *nei = slurp(at("case/polyMesh/neighbour"), NULL);
+    char *own = test_slurp(at("case/polyMesh/owner"), NULL);
+    char *nei = test_slurp(at("case/polyMesh/neighbour"), NULL);
     CHECK(own != NULL && nei != NULL);
     const char *po = strstr(own, "}\n"), *pn = strstr(nei, "}\n");
     ints(&po, &cnt, 1);
@@ -499,7 +480,7 @@ static void test_write_formats(void)
     }
     free(own);
     free(nei);
-    text = slurp(at("case/polyMesh/boundary"), NULL);
+    text = test_slurp(at("case/polyMesh/boundary"), NULL);
     snprintf(want, sizeof want, "nFaces          %zu;", H);
     CHECK(strstr(text, want) != NULL);
     snprintf(want, sizeof want, "startFace       %zu;", I);
@@ -512,7 +493,7 @@ static void test_write_formats(void)
     CHECK_EQ(wo.struct_size, sizeof wo);
     wo.all_faces = 1;
     CHECK_EQ(fdt_write_mesh_opts(r, cube, CUBE_N, at("f.ele"), &wo, diag, sizeof diag), FDT_OK);
-    text = slurp(at("f.face"), NULL);
+    text = test_slurp(at("f.face"), NULL);
     p = text;
     while (*p == '#')
         p = skip_lines(p, 1);
@@ -540,7 +521,7 @@ static void test_write_sorts(void)
     CHECK(strstr(diag, "neighbours") != NULL);
     CHECK(access(at("nn.node"), F_OK) != 0 && access(at("nn.ele"), F_OK) != 0);
     CHECK_EQ(fdt_write_mesh(r, pts, N, at("s.tets"), NULL, diag, sizeof diag), FDT_OK);
-    char *text = slurp(at("s.tets"), NULL);
+    char *text = test_slurp(at("s.tets"), NULL);
     const char *p = text;
     long long prev[4] = {-1, -1, -1, -1};
     const fdt_vid *t = fdt_result_tets(r); /* again: the write sorted r */
@@ -641,10 +622,10 @@ static void test_write_errors(void)
     CHECK(symlink("keep.txt", at("link.vtk")) == 0);
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("old.vtk"), NULL, diag, sizeof diag), FDT_OK);
     CHECK_EQ(fdt_write_mesh(r, cube, CUBE_N, at("link.vtk"), NULL, diag, sizeof diag), FDT_OK);
-    char *text = slurp(at("keep.txt"), NULL);
+    char *text = test_slurp(at("keep.txt"), NULL);
     CHECK(strcmp(text, "keep") == 0);
     free(text);
-    text = slurp(at("old.vtk"), NULL);
+    text = test_slurp(at("old.vtk"), NULL);
     CHECK(strncmp(text, "# vtk DataFile", 14) == 0);
     free(text);
     struct stat st;

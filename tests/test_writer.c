@@ -44,29 +44,6 @@
 /* Helpers                                                                   */
 /* ------------------------------------------------------------------------ */
 
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap + 1);
-    for (;;) {
-        if (n == cap) {
-            cap *= 2;
-            buf = realloc(buf, cap + 1);
-        }
-        size_t k = fread(buf + n, 1, cap - n, f);
-        n += k;
-        if (k == 0)
-            break;
-    }
-    fclose(f);
-    buf[n] = '\0';
-    *len = n;
-    return buf;
-}
-
 static int file_exists(const char *path)
 {
     struct stat st;
@@ -298,7 +275,7 @@ static char *canonical_text(const fdt_vid *tets, size_t nt)
 static void check_tets_file(const char *path, const fdt_vid *tets, size_t nt)
 {
     size_t len;
-    char *got = slurp(path, &len);
+    char *got = test_slurp(path, &len);
     char *want = canonical_text(tets, nt);
     EXPECT(got != NULL);
     if (got) {
@@ -312,7 +289,7 @@ static void check_tets_file(const char *path, const fdt_vid *tets, size_t nt)
 static void check_node_file(const char *path, const double *xyz, size_t n)
 {
     size_t len;
-    char *s = slurp(path, &len);
+    char *s = test_slurp(path, &len);
     EXPECT(s != NULL);
     if (!s)
         return;
@@ -342,7 +319,7 @@ static void check_table_file(const char *path, const long long *hdr,
                              const fdt_vid *want32, const fdt_tid *want64)
 {
     size_t len;
-    char *s = slurp(path, &len);
+    char *s = test_slurp(path, &len);
     EXPECT(s != NULL);
     if (!s)
         return;
@@ -369,7 +346,7 @@ static void check_vtk_file(const char *path, const double *xyz, size_t n,
                            const fdt_vid *tets, size_t nt)
 {
     size_t len;
-    char *s = slurp(path, &len);
+    char *s = test_slurp(path, &len);
     EXPECT(s != NULL);
     if (!s)
         return;
@@ -420,7 +397,7 @@ static void check_vtu_file(const char *path, const double *xyz, size_t n,
                            const fdt_vid *tets, size_t nt)
 {
     size_t len;
-    char *s = slurp(path, &len);
+    char *s = test_slurp(path, &len);
     EXPECT(s != NULL);
     if (!s)
         return;
@@ -772,7 +749,7 @@ static void test_refusals(const char *dir)
     signal(SIGXFSZ, old_h);
     size_t len;
     snprintf(p, sizeof p, "%s/keep.vtk", dir);
-    char *s = slurp(p, &len);
+    char *s = test_slurp(p, &len);
     EXPECT(s && strcmp(s, "old content\n") == 0);
     free(s);
 }
@@ -1110,7 +1087,7 @@ static void test_misc(const char *dir)
     fputs("{}\n", f);
     EXPECT(fdt_wr_side_commit(side, err, sizeof err) == FDT_IO_OK);
     size_t len;
-    char *back = slurp(p, &len);
+    char *back = test_slurp(p, &len);
     EXPECT(back && strcmp(back, "{}\n") == 0 && count_temps(dir) == 0);
     free(back);
     unlink(p);
@@ -1315,7 +1292,7 @@ static void test_outfile(const char *dir)
     fclose(o.f);
     free(o.buf);
     size_t len;
-    char *back = slurp(path, &len);
+    char *back = test_slurp(path, &len);
     EXPECTF(back && strcmp(back, "01ab456789!") == 0, "[%s]", back ? back : "");
     free(back);
     unlink(path);
@@ -1339,7 +1316,7 @@ static void test_outfile(const char *dir)
 static int same_bytes(const char *path, const char *want, size_t wlen)
 {
     size_t len;
-    char *got = slurp(path, &len);
+    char *got = test_slurp(path, &len);
     int same = got && len == wlen && memcmp(got, want, len) == 0;
     free(got);
     return same;
@@ -1360,12 +1337,12 @@ static void test_commit_set(const char *dir)
     /* the new and the old bytes */
     EXPECT(fdt_wr_mesh(a, &v, err, sizeof err) == FDT_IO_OK);
     EXPECT(fdt_wr_mesh(b, &v, err, sizeof err) == FDT_IO_OK);
-    newa = slurp(a, &na);
-    newb = slurp(b, &nb);
+    newa = test_slurp(a, &na);
+    newb = test_slurp(b, &nb);
     EXPECT(fdt_wr_mesh(a, &old, err, sizeof err) == FDT_IO_OK);
     EXPECT(fdt_wr_mesh(b, &old, err, sizeof err) == FDT_IO_OK);
-    olda = slurp(a, &la);
-    oldb = slurp(b, &lb);
+    olda = test_slurp(a, &la);
+    oldb = test_slurp(b, &lb);
     CHECK(newa && newb && olda && oldb);
     EXPECT(la != na || memcmp(olda, newa, la) != 0);
 

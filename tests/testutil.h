@@ -11,9 +11,11 @@
  * - test_note_failure() counts a failure a test prints itself (a point
  *   set, a matrix) and says whether it is still within the print limit.
  * - test_triangulate is fdt_triangulate with the settings a test names
- *   (threads, neighbours), any failure ending the test.
+ *   (threads, neighbours), any failure ending the test; test_whole_cells
+ *   the cells of its mesh.
  * - now_s is a monotonic clock for watchdogs and timings; test_rand64 and
  *   test_unif a deterministic random stream for inputs.
+ * - test_slurp_stream and test_slurp read a stream or a file whole.
  */
 #ifndef FDT_TESTUTIL_H
 #define FDT_TESTUTIL_H
@@ -185,6 +187,26 @@ static inline fdt_result *test_triangulate(const double *xyz, size_t n, int thre
     return r;
 }
 
+/* The Voronoi cells of xyz (fdt_voronoi_compute, neighbours kept, one
+ * thread, in the points' bounding box) from *r, their mesh on one thread;
+ * NULL, with *r freed, when the cells are refused. */
+static inline fdt_voronoi *test_whole_cells(const double *xyz, size_t n, fdt_result **r)
+{
+    *r = test_triangulate(xyz, n, 1, 0);
+    fdt_voronoi_options o;
+    fdt_default_voronoi_options(&o);
+    o.neighbors = 1;
+    o.threads = 1;
+    fdt_voronoi *v = NULL;
+    char diag[512];
+    int err = fdt_voronoi_compute(*r, xyz, n, &o, &v, diag, sizeof diag);
+    if (err != FDT_OK) {
+        fdt_result_free(r);
+        return NULL;
+    }
+    return v;
+}
+
 /* Reads "x y z" lines (what tests/gen_points writes, %.17g: exact) into
  * a new array; *n the points. */
 static inline double *test_read_xyz(const char *path, size_t *n)
@@ -281,6 +303,39 @@ static inline double *test_shuffle(const double *xyz, size_t n, uint64_t seed, s
         memcpy(y + 3 * i, xyz + 3 * p[i], 3 * sizeof *y);
     *perm = p;
     return y;
+}
+
+/* The rest of stream f, from where it stands to its end, in a new
+ * NUL-terminated string; *len (when len is not NULL) its bytes. */
+static inline char *test_slurp_stream(FILE *f, size_t *len)
+{
+    size_t cap = 1 << 16, n = 0;
+    char *buf = malloc(cap + 1);
+    CHECK(buf != NULL);
+    for (size_t k = 1; k > 0; n += k) {
+        if (n == cap) {
+            cap *= 2;
+            buf = realloc(buf, cap + 1);
+            CHECK(buf != NULL);
+        }
+        k = fread(buf + n, 1, cap - n, f);
+    }
+    buf[n] = '\0';
+    if (len)
+        *len = n;
+    return buf;
+}
+
+/* The file at path whole (test_slurp_stream), or NULL when it cannot be
+ * opened. */
+static inline char *test_slurp(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    char *buf = test_slurp_stream(f, len);
+    fclose(f);
+    return buf;
 }
 
 static inline double now_s(void)

@@ -1235,7 +1235,6 @@ static int bucket_tets(vwork *w, vjob *jobs, int threads)
     return err;
 }
 
-
 /* The neighbour lists' offsets (by row), then their entries on the
  * threads. */
 static int list_neighbors(fdt_voronoi *v, vjob *jobs, int threads)
