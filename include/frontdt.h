@@ -834,7 +834,15 @@ typedef struct fdt_voronoi_options {
     int neighbors;      /* nonzero: keep each cell's neighbours and face areas */
     int threads;        /* 0: one per physical core (as fdt_settings.n_threads);
                            the values do not depend on it */
+    /* Added after the cells (a caller compiled before passes the smaller
+     * struct_size, still accepted: nothing skipped). FDT_CELLS_NO_* bits:
+     * quantities not computed, whose accessors then return NULL; the others
+     * are the same bits either way (0, the default: every one). */
+    unsigned skip;
 } fdt_voronoi_options;
+
+#define FDT_CELLS_NO_CENTROIDS 1u /* fdt_voronoi_centroids */
+#define FDT_CELLS_NO_DENSITIES 2u /* fdt_voronoi_densities */
 
 FDT_API int fdt_default_voronoi_options_sized(fdt_voronoi_options *o, size_t struct_size);
 static inline void fdt_default_voronoi_options(fdt_voronoi_options *o)
@@ -874,7 +882,8 @@ FDT_API void fdt_voronoi_free(fdt_voronoi **v);
 /* n entries each (3n for the centroids, absolute coordinates), owned by
  * v. A merged duplicate's entries are 0 (density too). Faces are counted
  * without the faces of zero area (fdt_voronoi_zero_faces). The DTFE
- * density is 4 / (the sum of the volumes of the point's tets). */
+ * density is 4 / (the sum of the volumes of the point's tets). The
+ * centroids and densities are NULL where options.skip left them out. */
 FDT_API size_t fdt_voronoi_num_points(const fdt_voronoi *v);
 /* The rows' points: NULL for fdt_voronoi_compute's cells (row i is point
  * i); for a batch of fdt_voronoi_stream, each row's input id, and its

@@ -11,7 +11,11 @@
  *    send theirs to rank 0, put the same bytes; each hands the rows in
  *    input order and stops at its callback's first nonzero return;
  *  - a row twice and a row outside the spool's ids are refused (EINVAL),
- *    and so is a table put before every row came.
+ *    and so is a table put before every row came;
+ *  - cells computed without the centroids and densities (options.skip, as
+ *    fdt_cells_table_skip gives it for a table) write the tables that do
+ *    not read them byte for byte, and the writers and the spool refuse
+ *    (EINVAL) those that do.
  */
 #include <errno.h>
 #include <stdlib.h>
@@ -164,6 +168,35 @@ int main(void)
     fclose(f);
     copier one = {NULL, -1, 0, 0};
     EXPECT(fdt_cells_spool_each(part, copy_row, &one) == 0 && one.calls == 1 && one.last == 120);
+
+    /* what the tables read, and cells without the rest */
+    EXPECT(fdt_cells_table_skip("%i %v %F %n", 0, 0) ==
+           (FDT_CELLS_NO_CENTROIDS | FDT_CELLS_NO_DENSITIES));
+    EXPECT(fdt_cells_table_skip("%i %c", 0, 0) == FDT_CELLS_NO_DENSITIES);
+    EXPECT(fdt_cells_table_skip("%C %d", 0, 0) == 0);
+    EXPECT(fdt_cells_table_skip("%v %%c", 0, 1) == FDT_CELLS_NO_CENTROIDS);
+    EXPECT(fdt_cells_table_skip(NULL, 1, 0) == 0);
+    EXPECT(fdt_cells_table_skip(NULL, 0, 1) == FDT_CELLS_NO_CENTROIDS);
+    o.skip = fdt_cells_table_skip("%i %v %F %s %n %f", 0, 0);
+    fdt_voronoi *lean = NULL;
+    CHECK_EQ(fdt_voronoi_compute(r, xyz, n, &o, &lean, NULL, 0), FDT_OK);
+    size_t ll, lw;
+    char *a = whole(lean, xyz, 0, "%i %v %F %s %n %f %h", &ll);
+    char *b = whole(v, xyz, 0, "%i %v %F %s %n %f %h", &lw);
+    expect_same(a, ll, b, lw, "the cells without centroids and densities");
+    free(a);
+    free(b);
+    f = tmpfile();
+    CHECK(f != NULL);
+    EXPECT(fdt_wr_cells(f, FMT, lean, xyz, 1) == EINVAL);
+    EXPECT(fdt_wr_cells(f, NULL, lean, xyz, 1) == EINVAL);
+    EXPECT(fdt_wr_density(f, lean, 1) == EINVAL);
+    fclose(f);
+    fdt_cells_spool *wants = NULL;
+    CHECK_EQ(fdt_cells_spool_open(&wants, 0, n, FMT, 0, 0, "."), 0);
+    EXPECT(fdt_cells_spool_add(wants, lean) == EINVAL);
+    fdt_cells_spool_close(&wants);
+    fdt_voronoi_free(&lean);
 
     fdt_cells_spool_close(&part);
     fdt_cells_spool_close(&copy);

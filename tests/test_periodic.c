@@ -323,7 +323,7 @@ static void parts_equal(const char *name, const double *X, size_t n, const fdt_p
             dup[i] = (int32_t)i;
         if (fdt_periodic_cells((const int32_t *)one->tets, one->tet_off, one->ntets,
                                (const int32_t *)one->hull, one->nhull, X, n, dup, b, threads, 1,
-                               &whole, d, sizeof d) != FDT_OK)
+                               0, &whole, d, sizeof d) != FDT_OK)
             whole = NULL; /* a point outside a wall's box: no cells to compare */
         free(dup);
     }
@@ -338,8 +338,8 @@ static void parts_equal(const char *name, const double *X, size_t n, const fdt_p
         if (whole) {
             fdt_voronoi *c = NULL;
             fdt_vshort sh = {-1, -1, INFINITY};
-            err = fdt_periodic_part_cells(&pm, X, (uint32_t)n, 0, NULL, &p, k, b, threads, 1, &c,
-                                          &sh, diag, sizeof diag);
+            err = fdt_periodic_part_cells(&pm, X, (uint32_t)n, 0, NULL, &p, k, b, threads, 1, 0,
+                                          &c, &sh, diag, sizeof diag);
             EXPECTF(err == FDT_OK, "%s: part %u's cells: %d (%s)", name, k, err, diag);
             CHECK(err == FDT_OK);
             const fdt_vid *cid = fdt_voronoi_ids(c);

@@ -16,6 +16,7 @@
  * voro++ itself is compared in tests/voronoi_voro.py (CLI, end to end).
  */
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #include <gmp.h>
@@ -504,6 +505,71 @@ static void test_tiny_cells(double w)
     free(xyz);
 }
 
+/* options.skip: the centroids and densities left out (NULL), every other
+ * value the same bits as the whole computation's, at 1 and 3 threads;
+ * the options' size before skip accepted (nothing skipped), unknown bits
+ * refused. A clustered cloud with a duplicate: summed, cut and clipped
+ * cells, and a merged row. */
+static void test_skip(size_t n)
+{
+    double *xyz = test_cloud(n, 1, 11);
+    memcpy(xyz + 3 * (n - 1), xyz + 3, 3 * sizeof *xyz);
+    fdt_result *r = test_triangulate(xyz, n, 2, 0);
+    fdt_voronoi *all = cells(r, xyz, n, NULL);
+    for (unsigned skip = 1; skip <= 3; skip++)
+        for (int threads = 1; threads <= 3; threads += 2) {
+            fdt_voronoi_options o;
+            fdt_default_voronoi_options(&o);
+            o.neighbors = 1;
+            o.threads = threads;
+            o.skip = skip;
+            fdt_voronoi *v = NULL;
+            CHECK(fdt_voronoi_compute(r, xyz, n, &o, &v, NULL, 0) == FDT_OK);
+            EXPECT(!fdt_voronoi_centroids(v) == !!(skip & FDT_CELLS_NO_CENTROIDS));
+            EXPECT(!fdt_voronoi_densities(v) == !!(skip & FDT_CELLS_NO_DENSITIES));
+            size_t diff = 0;
+            for (size_t i = 0; i < n; i++) {
+                diff += memcmp(&fdt_voronoi_volumes(v)[i], &fdt_voronoi_volumes(all)[i], 8) != 0;
+                diff += memcmp(&fdt_voronoi_areas(v)[i], &fdt_voronoi_areas(all)[i], 8) != 0;
+                diff += fdt_voronoi_num_faces(v)[i] != fdt_voronoi_num_faces(all)[i];
+                diff += fdt_voronoi_flags(v)[i] != fdt_voronoi_flags(all)[i];
+                if (fdt_voronoi_centroids(v))
+                    diff += memcmp(&fdt_voronoi_centroids(v)[3 * i],
+                                   &fdt_voronoi_centroids(all)[3 * i], 24) != 0;
+                if (fdt_voronoi_densities(v))
+                    diff += memcmp(&fdt_voronoi_densities(v)[i],
+                                   &fdt_voronoi_densities(all)[i], 8) != 0;
+                size_t c1, c2;
+                const fdt_vid *i1, *i2;
+                const double *a1, *a2;
+                CHECK(fdt_voronoi_neighbors(v, (fdt_vid)i, &c1, &i1, &a1) == FDT_OK);
+                CHECK(fdt_voronoi_neighbors(all, (fdt_vid)i, &c2, &i2, &a2) == FDT_OK);
+                diff += c1 != c2 || memcmp(i1, i2, c1 * sizeof *i1) ||
+                        memcmp(a1, a2, c1 * sizeof *a1);
+            }
+            EXPECTF(diff == 0, "skip %u, %d threads: %zu values differ", skip, threads, diff);
+            fdt_voronoi_free(&v);
+        }
+    EXPECT(fdt_voronoi_flags(all)[n - 1] == FDT_CELL_MERGED);
+    fdt_voronoi_options o;
+    /* a caller compiled before skip */
+    size_t old = offsetof(fdt_voronoi_options, skip);
+    CHECK(fdt_default_voronoi_options_sized(&o, old) == FDT_OK && o.struct_size == old);
+    o.neighbors = 1;
+    o.skip = 3; /* past the caller's struct: not read */
+    fdt_voronoi *v = NULL;
+    CHECK(fdt_voronoi_compute(r, xyz, n, &o, &v, NULL, 0) == FDT_OK);
+    EXPECT(fdt_voronoi_centroids(v) && fdt_voronoi_densities(v) &&
+           !memcmp(fdt_voronoi_densities(v), fdt_voronoi_densities(all), n * sizeof(double)));
+    fdt_voronoi_free(&v);
+    fdt_default_voronoi_options(&o);
+    o.skip = 4;
+    EXPECT(fdt_voronoi_compute(r, xyz, n, &o, &v, NULL, 0) == FDT_EINVAL && !v);
+    fdt_voronoi_free(&all);
+    fdt_result_free(&r);
+    free(xyz);
+}
+
 int main(void)
 {
     test_tiny_cells(1e-8);
@@ -519,5 +585,6 @@ int main(void)
     test_same_bits(4000);
     test_scales();
     test_refusals();
+    test_skip(3000);
     return test_report("voronoi");
 }

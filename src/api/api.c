@@ -325,14 +325,17 @@ static int periodic_box_other(const fdt_voronoi_options *o, const double pbox[6]
 int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
                         fdt_voronoi **out, char *diag, size_t diag_size)
 {
-    fdt_voronoi_options defaults;
+    fdt_voronoi_options full;
     if (diag && diag_size)
         diag[0] = 0;
     if (!o) {
-        fdt_default_voronoi_options(&defaults);
-        o = &defaults;
+        fdt_default_voronoi_options(&full);
+        o = &full;
     }
-    if (!r || !xyz || !out || o->struct_size != sizeof *o || o->threads < 0 || o->threads > 1024)
+    if (!r || !xyz || !out || fdt_voronoi_options_read(o, &full) != FDT_OK)
+        return FDT_EINVAL;
+    o = &full;
+    if (o->threads < 0 || o->threads > 1024)
         return FDT_EINVAL;
     int threads = o->threads ? o->threads : fdt_threads_default();
     if (r->periodic) { /* the cells of the periodic set: its box's walls */
@@ -343,8 +346,8 @@ int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const 
         fdt_periodic_box b = {r->periodic, {r->pbox[0], r->pbox[1], r->pbox[2]},
                               {r->pbox[3], r->pbox[4], r->pbox[5]}};
         return fdt_periodic_cells(r->tets, r->tet_off, r->ntets, r->hull, r->nhull, xyz, n,
-                                  r->dupmap, &b, threads,
-                                  o->neighbors, out, diag ? diag : (char[8]){0},
+                                  r->dupmap, &b, threads, o->neighbors, o->skip, out,
+                                  diag ? diag : (char[8]){0},
                                   diag ? diag_size : 8);
     }
     return fdt_voronoi_build(r, xyz, n, o, threads, out, diag, diag_size);
@@ -625,7 +628,7 @@ static int periodic_stream(fdt_context *ctx, const fdt_prepared *pr, const fdt_p
             fdt_voronoi *v = NULL;
             fdt_vshort sh = {-1, -1, 0};
             err = fdt_periodic_part_cells(&pm, pr->p, (uint32_t)pr->m, pr->scale_exp, pr->orig,
-                                          &parts, k, b, nthreads, cs->neighbors, &v, &sh,
+                                          &parts, k, b, nthreads, cs->neighbors, cs->skip, &v, &sh,
                                           ctx->diag, sizeof ctx->diag);
             err = fdt_cellstream_give(cs, err, v, &sh);
             fdt_voronoi_free(&v);
@@ -928,6 +931,7 @@ static int cells_open(fdt_context *ctx, const double *xyz, size_t n, const fdt_v
 {
     memset(cs, 0, sizeof *cs);
     cs->neighbors = o->neighbors;
+    cs->skip = o->skip;
     cs->sink = cells;
     int err = FDT_OK;
     if (ctx->s.periodic) {
@@ -941,11 +945,17 @@ static int cells_open(fdt_context *ctx, const double *xyz, size_t n, const fdt_v
     return err;
 }
 
-/* o and cells as fdt_voronoi_stream takes them: usable. */
-static int cells_ok(const fdt_voronoi_options *o, const fdt_cell_sink *cells)
+/* o (NULL: the defaults) and cells as fdt_voronoi_stream takes them:
+ * usable, with *o then full, this library's whole struct. */
+static int cells_ok(const fdt_voronoi_options **o, fdt_voronoi_options *full,
+                    const fdt_cell_sink *cells)
 {
-    return cells->struct_size >= sizeof(fdt_cell_sink) && cells->cells &&
-           o->struct_size == sizeof *o;
+    if (!*o)
+        fdt_default_voronoi_options(full);
+    else if (fdt_voronoi_options_read(*o, full) != FDT_OK)
+        return 0;
+    *o = full;
+    return cells->struct_size >= sizeof(fdt_cell_sink) && cells->cells;
 }
 
 int fdt_triangulate_stream_parts(fdt_context *ctx, const double *xyz, size_t n,
@@ -953,13 +963,9 @@ int fdt_triangulate_stream_parts(fdt_context *ctx, const double *xyz, size_t n,
                                  const fdt_cell_sink *cells, unsigned first, unsigned stride,
                                  fdt_result **out)
 {
-    fdt_voronoi_options defaults;
-    if (!o) {
-        fdt_default_voronoi_options(&defaults);
-        o = &defaults;
-    }
+    fdt_voronoi_options full;
     if (!ctx || !out || !sink || (!xyz && n) || !stride || first >= stride ||
-        (cells && !cells_ok(o, cells)))
+        (cells && !cells_ok(&o, &full, cells)))
         return FDT_EINVAL;
     *out = NULL;
     ctx->diag[0] = '\0';
@@ -982,12 +988,9 @@ int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
                        const fdt_voronoi_options *o, const fdt_sink *sink,
                        const fdt_cell_sink *cells, fdt_result **out)
 {
-    fdt_voronoi_options defaults;
-    if (!o) {
-        fdt_default_voronoi_options(&defaults);
-        o = &defaults;
-    }
-    if (!ctx || !out || (!xyz && n) || !cells || !cells_ok(o, cells) || (sink && !sink_ok(sink)))
+    fdt_voronoi_options full;
+    if (!ctx || !out || (!xyz && n) || !cells || !cells_ok(&o, &full, cells) ||
+        (sink && !sink_ok(sink)))
         return FDT_EINVAL;
     *out = NULL;
     ctx->diag[0] = '\0';

@@ -143,7 +143,8 @@ static int put_density(FILE *f, const void *arg, const double *xyz)
 
 /* The cells' options and tables d asks for (job's format NULL and vtu 0
  * with d->voronoi set: CSV). */
-int fdt_cli_cells_table(const fdt_cli_dual *d, const char **format, int *neighbors)
+int fdt_cli_cells_table(const fdt_cli_dual *d, const char **format, int *neighbors,
+                        unsigned *skip)
 {
     int vtu = d->voronoi && has_ext(d->voronoi, ".vtu");
     const char *f = d->format;
@@ -155,6 +156,8 @@ int fdt_cli_cells_table(const fdt_cli_dual *d, const char **format, int *neighbo
         (void)fdt_cells_format_check(f, &nb, err, sizeof err);
     *format = vtu ? NULL : f;
     *neighbors = nb;
+    /* the polyhedra read their volumes alone */
+    *skip = fdt_cells_table_skip(vtu ? "" : f, d->voronoi && !vtu && !f, d->density != NULL);
     return vtu;
 }
 
@@ -165,7 +168,7 @@ static void cells_setup(const fdt_cli_dual *d, fdt_voronoi_options *o, cells_job
     o->threads = d->threads;
     memcpy(o->box, d->box, sizeof o->box);
     cells_job j = {NULL, NULL, 0, d->threads ? d->threads : fdt_threads_default()};
-    j.vtu = fdt_cli_cells_table(d, &j.format, &o->neighbors);
+    j.vtu = fdt_cli_cells_table(d, &j.format, &o->neighbors, &o->skip);
     *job = j;
 }
 
@@ -209,7 +212,8 @@ const char *fdt_cli_dual_stream_refusal(const fdt_cli_dual *d)
         return "--interpolate needs the whole mesh";
     const char *f;
     int nb;
-    if (fdt_cli_cells_table(d, &f, &nb))
+    unsigned skip;
+    if (fdt_cli_cells_table(d, &f, &nb, &skip))
         return "--voronoi FILE.vtu (the cells as polyhedra) needs the whole mesh";
     return NULL;
 }

@@ -46,8 +46,10 @@ void fdt_cli_cells_message(const char *what, int r, const char *diag, char *err,
 /* The cells' table d asks for: 1 when --voronoi names a .vtu file (VTK
  * polyhedra, with neighbours); else 0, *format its text format (NULL:
  * CSV, for a .csv file; --voronoi-format or FDT_CELLS_DEFAULT_FORMAT
- * otherwise) and *neighbors whether that format lists neighbours. */
-int fdt_cli_cells_table(const fdt_cli_dual *d, const char **format, int *neighbors);
+ * otherwise) and *neighbors whether that format lists neighbours. *skip:
+ * what neither that table nor --density reads (fdt_voronoi_options.skip). */
+int fdt_cli_cells_table(const fdt_cli_dual *d, const char **format, int *neighbors,
+                        unsigned *skip);
 
 /* Is anything asked for? */
 int fdt_cli_dual_wanted(const fdt_cli_dual *d);

@@ -205,7 +205,8 @@ static int check_cells(opts *o, int rank)
     }
     const char *v = o->cells.voronoi, *fmt;
     int nb;
-    if (fdt_cli_cells_table(&o->cells, &fmt, &nb)) {
+    unsigned skip;
+    if (fdt_cli_cells_table(&o->cells, &fmt, &nb, &skip)) {
         say0(rank, "--voronoi FILE.vtu (the cells as polyhedra) is frontdt's alone; "
                    "frontdt-mpi writes the cells as text or .csv");
         return CLI_USAGE;
@@ -758,9 +759,10 @@ static int cells_step(const opts *o, const fdt_mpi_local *L, const fdt_mpi_out *
                       int size)
 {
     const fdt_cli_dual *d = &o->cells;
-    fdt_mpi_cells_opts co = {d->voronoi, NULL, d->density, d->box_given, {0}, 0};
+    fdt_mpi_cells_opts co = {d->voronoi, NULL, d->density, d->box_given, {0}, 0, 0};
     memcpy(co.box, d->box, sizeof co.box);
-    (void)fdt_cli_cells_table(d, &co.format, &co.neighbors); /* .vtu: refused before */
+    /* .vtu: refused before */
+    (void)fdt_cli_cells_table(d, &co.format, &co.neighbors, &co.skip);
     fdt_mpi_cells_stats st;
     char diag[512], msg[1024];
     int e = fdt_mpi_cells(MPI_COMM_WORLD, L, r, &co, &st, diag, sizeof diag);

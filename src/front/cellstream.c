@@ -204,7 +204,7 @@ int fdt_cellstream_part(fdt_cellstream *cs, fdt_cellheld *h, const fdt_vid *part
         fdt_vbatch b = {.xyz = cs->P, .xyz_exp = cs->p_exp, .label = cs->orig,
                         .own = h->own + c0, .nown = c1 - c0, .own_hull = h->own_hull + c0,
                         .tets = h->pool, .ntets = nt, .pick = pick, .ed = cs->ed,
-                        .neighbors = cs->neighbors};
+                        .neighbors = cs->neighbors, .skip = cs->skip};
         memcpy(b.box, cs->box, sizeof b.box);
         fdt_voronoi *v = NULL;
         fdt_vshort sh = {-1, -1, 0};
@@ -263,7 +263,7 @@ int fdt_cellstream_merged(fdt_cellstream *cs, const fdt_vid *dupmap, size_t n, c
         ids[j] = d[j].id;
     fdt_voronoi *v = NULL;
     if (!err)
-        err = fdt_voronoi_merged(ids, pts, k, cs->box, cs->neighbors, &v);
+        err = fdt_voronoi_merged(ids, pts, k, cs->box, cs->neighbors, cs->skip, &v);
     if (!err)
         err = hand_on(cs, v);
     fdt_voronoi_free(&v);

@@ -36,6 +36,7 @@ typedef struct fdt_cellstream {
     double box[6];            /* the cells' box, the input's frame */
     int ed;                   /* fdt_voronoi_scale of box */
     int neighbors;            /* keep neighbours and face areas */
+    unsigned skip;            /* fdt_voronoi_options.skip */
     size_t chunk;             /* closing points a batch at most (0: 2^18;
                                  tests make it small) */
     const fdt_cell_sink *sink;/* the caller's (borrowed) */

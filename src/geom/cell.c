@@ -114,20 +114,29 @@ static int crossing(fdt_cell *c, int a, int b)
     return x;
 }
 
-static int push_ring(fdt_cell *c, int v)
+/* The scratch faces' entries and faces, in the room cut_tol made for a
+ * cut's most (room_for_cut): one entry or face a call, with no test. */
+static inline void push_ring(fdt_cell *c, int v)
 {
-    if (grow(&c->tring, &c->captring, c->ntring + 1, sizeof(int)))
-        return -1;
     c->tring[c->ntring++] = v;
-    return 0;
 }
 
-static int push_face(fdt_cell *c, int start, long label)
+static inline void push_face(fdt_cell *c, int start, long label)
 {
-    if (grow(&c->tf, &c->captf, c->ntf + 1, sizeof *c->tf))
-        return -1;
     c->tf[c->ntf++] = (fdt_cell_ring){start, c->ntring - start, label};
-    return 0;
+}
+
+/* Room for a cut's scratch faces: a face's entries are at most its
+ * vertices and a crossing an edge (a convex face keeps at most one more
+ * than it had, but a cut among vertices closer than their rounding can
+ * cross a face's edges several times before cut_tol finds it not convex),
+ * the cap's one a face, and the faces at most one more. 0 or -1. */
+static int room_for_cut(fdt_cell *c)
+{
+    return grow(&c->tring, &c->captring, 2 * c->nring + c->nf, sizeof(int)) ||
+                   grow(&c->tf, &c->captf, c->nf + 1, sizeof *c->tf)
+               ? -1
+               : 0;
 }
 
 /* Face f cut by the plane: its kept part goes to the scratch faces, and
@@ -140,22 +149,28 @@ static int cut_face(fdt_cell *c, const fdt_cell_ring *f)
     const int *r = c->ring + f->start;
     int k = f->count, start = c->ntring, entry = -1, exitp = -1;
     for (int j = 0; j < k; j++) {
-        int a = r[j], b = r[(j + 1) % k];
+        int a = r[j], b = j + 1 < k ? r[j + 1] : r[0];
         int sa = c->v[a].side, sb = c->v[b].side;
-        if (sa != OUT && push_ring(c, a))
-            return -2;
+        if (sa != OUT)
+            push_ring(c, a);
         if (sa != OUT && sb == OUT) {
             exitp = a;
-            if (sa == IN && ((exitp = crossing(c, a, b)) < 0 || push_ring(c, exitp)))
-                return -2;
+            if (sa == IN) {
+                if ((exitp = crossing(c, a, b)) < 0)
+                    return -2;
+                push_ring(c, exitp);
+            }
         } else if (sa == OUT && sb != OUT) {
             entry = b;
-            if (sb == IN && ((entry = crossing(c, b, a)) < 0 || push_ring(c, entry)))
-                return -2;
+            if (sb == IN) {
+                if ((entry = crossing(c, b, a)) < 0)
+                    return -2;
+                push_ring(c, entry);
+            }
         }
     }
-    if (c->ntring - start >= 3 && push_face(c, start, f->label))
-        return -2;
+    if (c->ntring - start >= 3)
+        push_face(c, start, f->label);
     if (c->ntring - start < 3) /* nothing of the face is left */
         c->ntring = start;
     if (entry < 0 || exitp < 0 || entry == exitp)
@@ -227,6 +242,8 @@ static int cut_tol(fdt_cell *c, const double n[3], double h, long label, double 
         return -2;
 
     c->ne = c->ntring = c->ntf = 0;
+    if (room_for_cut(c))
+        return -1;
     int first = -1, edges = 0;
     for (int f = 0; f < c->nf; f++) {
         int e = cut_face(c, &c->f[f]);
@@ -244,14 +261,12 @@ static int cut_tol(fdt_cell *c, const double n[3], double h, long label, double 
     if (edges >= 3) {
         int start = c->ntring, v = first, steps = 0;
         do {
-            if (push_ring(c, v))
-                return -1;
+            push_ring(c, v);
             v = c->v[v].next;
             if (v < 0 || ++steps > edges)
                 return -3; /* an open chain: not a convex cell */
         } while (v != first);
-        if (push_face(c, start, label))
-            return -1;
+        push_face(c, start, label);
     }
     return compact(c) ? -1 : 1;
 }

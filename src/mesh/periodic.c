@@ -1958,8 +1958,8 @@ static int star_batch(const uint32_t *tets, const int8_t *off, const uint8_t *po
                       size_t ntets, const uint32_t *hull,
                       size_t nhull, const double *X, int x_exp, const int32_t *names,
                       const uint32_t *own_ids, size_t nown_ids, const fdt_periodic_box *b,
-                      int threads, int neighbors, struct fdt_voronoi **out, fdt_vshort *sh,
-                      double box[6], char *diag, size_t ds)
+                      int threads, int neighbors, unsigned skip, struct fdt_voronoi **out,
+                      fdt_vshort *sh, double box[6], char *diag, size_t ds)
 {
     *out = NULL;
     vmap m;
@@ -2084,6 +2084,7 @@ static int star_batch(const uint32_t *tets, const int8_t *off, const uint8_t *po
         vb.tets = st;
         vb.ntets = nst / 4;
         vb.neighbors = neighbors;
+        vb.skip = skip;
         err = fdt_voronoi_batch(&vb, threads, &v, sh, diag, ds);
     }
     /* no cell of a set periodic on every axis is clipped: one that is
@@ -2107,8 +2108,8 @@ static int star_batch(const uint32_t *tets, const int8_t *off, const uint8_t *po
 
 int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
                        size_t nhull, const double *X, size_t n, const int32_t *dupmap,
-                       const fdt_periodic_box *b, int threads, int neighbors, fdt_voronoi **out,
-                       char *diag, size_t ds)
+                       const fdt_periodic_box *b, int threads, int neighbors, unsigned skip,
+                       fdt_voronoi **out, char *diag, size_t ds)
 {
     *out = NULL;
     int err = fdt_periodic_cells_check(X, n, b, diag, ds);
@@ -2125,7 +2126,7 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
     fdt_voronoi *v = NULL;
     double box[6];
     err = star_batch((const uint32_t *)tets, off, NULL, ntets, (const uint32_t *)hull, nhull, X, 0,
-                     NULL, own, nown, b, threads, neighbors, &v, &sh, box, diag, ds);
+                     NULL, own, nown, b, threads, neighbors, skip, &v, &sh, box, diag, ds);
     free(own);
     if (err == FDT_ERANGE && sh.a >= 0)
         err = fdt_voronoi_too_close(&sh, box, diag, ds);
@@ -2175,7 +2176,7 @@ void fdt_periodic_cells_box(const fdt_periodic_box *b, double box[6])
 
 int fdt_periodic_part_cells(const fdt_periodic_mesh *pm, const double *X, uint32_t n, int x_exp,
                             const int32_t *names, const fdt_periodic_parts *parts, uint32_t part,
-                            const fdt_periodic_box *b, int threads, int neighbors,
+                            const fdt_periodic_box *b, int threads, int neighbors, unsigned skip,
                             fdt_voronoi **out, fdt_vshort *sh, char *diag, size_t ds)
 {
     int one = parts->nparts < 2;
@@ -2183,6 +2184,6 @@ int fdt_periodic_part_cells(const fdt_periodic_mesh *pm, const double *X, uint32
     size_t nown = one ? n : parts->start[part + 1] - parts->start[part];
     double box[6];
     return star_batch(pm->star_tets, pm->star_off, pm->star_pos, pm->nstar, pm->star_hull,
-                      pm->nstar_hull, X, x_exp, names, own, nown, b, threads, neighbors, out, sh,
-                      box, diag, ds);
+                      pm->nstar_hull, X, x_exp, names, own, nown, b, threads, neighbors, skip,
+                      out, sh, box, diag, ds);
 }

@@ -151,7 +151,8 @@ int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
  * point's). Periodic on every axis no cell is clipped; across an axis that
  * is not periodic the box's sides are walls, which cut the cells that
  * reach them (the hull's points' cells, unbounded, among them), as
- * fdt_voronoi_compute's box. FDT_EINVAL when a point lies outside the box
+ * fdt_voronoi_compute's box; neighbors and skip as fdt_voronoi_options'
+ * fields. FDT_EINVAL when a point lies outside the box
  * on such an axis or the box is empty there (diag names the point); the
  * batch's errors otherwise, with diag.
  */
@@ -159,7 +160,7 @@ struct fdt_voronoi;
 struct fdt_vshort;
 int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
                        size_t nhull, const double *X, size_t n, const int32_t *dupmap,
-                       const fdt_periodic_box *b, int threads, int neighbors,
+                       const fdt_periodic_box *b, int threads, int neighbors, unsigned skip,
                        struct fdt_voronoi **out, char *diag, size_t ds);
 /* fdt_periodic_cells' checks of the box and the points X (n, as given)
  * across the axes that are not periodic, whose sides are walls: FDT_OK, or
@@ -184,7 +185,7 @@ void fdt_periodic_cells_box(const fdt_periodic_box *b, double box[6]);
  */
 int fdt_periodic_part_cells(const fdt_periodic_mesh *pm, const double *X, uint32_t n, int x_exp,
                             const int32_t *names, const fdt_periodic_parts *parts, uint32_t part,
-                            const fdt_periodic_box *b, int threads, int neighbors,
+                            const fdt_periodic_box *b, int threads, int neighbors, unsigned skip,
                             struct fdt_voronoi **out, struct fdt_vshort *sh, char *diag,
                             size_t ds);
 

@@ -46,6 +46,7 @@ struct fdt_voronoi {
     int32_t *nfaces;                            /* owned */
     uint8_t *flags;                             /* owned */
     size_t zero_faces;
+    unsigned skip;      /* FDT_CELLS_NO_*: centroid, density NULL */
     size_t *nstart; /* n + 1 offsets, or NULL (owned) */
     fdt_vid *nid;   /* owned */
     double *narea;  /* owned */
@@ -93,6 +94,7 @@ typedef struct vwork {
     size_t ntets;
     const fdt_vid *rtets; /* the result's tets, in input ids, that tets maps
                              (NULL in a batch: tets are local already) */
+    unsigned skip;      /* FDT_CELLS_NO_*: the moments, the DTFE sums left out */
     size_t *bcnt;       /* bucket_tets's: each key's next entry */
     uint32_t *btets;    /* and the tets it fills */
     uint8_t *flags;     /* local (owned) */
@@ -152,9 +154,26 @@ typedef struct vjob {
     int err;
 } vjob;
 
+/* The sizes fdt_voronoi_options has had: this header's, and the one
+ * before skip. */
+static int options_size_known(size_t size)
+{
+    return size == sizeof(fdt_voronoi_options) || size == offsetof(fdt_voronoi_options, skip);
+}
+
 int fdt_default_voronoi_options_sized(fdt_voronoi_options *o, size_t struct_size)
 {
-    return fdt_abi_reset(o, struct_size, struct_size == sizeof(fdt_voronoi_options));
+    return fdt_abi_reset(o, struct_size, options_size_known(struct_size));
+}
+
+int fdt_voronoi_options_read(const fdt_voronoi_options *o, fdt_voronoi_options *full)
+{
+    if (!options_size_known(o->struct_size))
+        return FDT_EINVAL;
+    memset(full, 0, sizeof *full);
+    memcpy(full, o, o->struct_size);
+    full->struct_size = sizeof *full;
+    return full->skip & ~(FDT_CELLS_NO_CENTROIDS | FDT_CELLS_NO_DENSITIES) ? FDT_EINVAL : FDT_OK;
 }
 
 void fdt_voronoi_free(fdt_voronoi **pv)
@@ -370,9 +389,6 @@ static int mine(const vjob *j, uint32_t x)
     return x >= j->lo && x < j->hi;
 }
 
-/* One tet's shares to the job's points (the file's comment). A tet whose
- * circumcentre lies outside the box adds no share: it marks its points,
- * whose cells are then cut from the box. */
 /* Tet tv's points in canonical order, the points' lexicographic order
  * (not their ids, which change with the input's order) into s, their
  * differences from s[0] into q[1 .. 3]: the same bits whichever way round
@@ -459,7 +475,11 @@ static double tet_volume(const double *X, const uint32_t *tv)
     return fabs(triple(q[0], q[1], q[2])) / 6;
 }
 
-static void add_tet(vjob *j, const uint32_t *tv)
+/* add_tet's body for the quantities asked for (moments: the centroids',
+ * dtfe: the densities'), constants where add_tet calls it, so that each
+ * case compiles without the others' work or tests. */
+__attribute__((always_inline)) static inline void add_tet_for(vjob *j, const uint32_t *tv,
+                                                              const int moments, const int dtfe)
 {
     vwork *w = j->w;
     const double *X = w->xyz;
@@ -484,15 +504,21 @@ static void add_tet(vjob *j, const uint32_t *tv)
     uint32_t s[4];
     double q[4][3];
     int sigma = canon_tet(X, tv, s, q);
+    /* which of the canonical points are the job's (bit m: s[m]) */
+    unsigned own = 0;
+    for (int m = 0; m < 4; m++)
+        own |= (unsigned)mine(j, s[m]) << m;
     /* the DTFE share from the canonical differences (tet_volume, more
      * careful and slower, for the sums too small for the box's grid) */
-    double dv = fabs(triple(q[1], q[2], q[3])) / 6;
+    if (dtfe) {
+        double dv = fabs(triple(q[1], q[2], q[3])) / 6;
+        for (int m = 0; m < 4; m++)
+            if (own >> m & 1) {
+                fdt_fix_add(&w->dtfe[s[m]], dv, w->g_vol);
+                w->vmax[s[m]] = max2(w->vmax[s[m]], dv);
+            }
+    }
     const double *p0 = X + 3 * (size_t)s[0];
-    for (int m = 0; m < 4; m++)
-        if (mine(j, s[m])) {
-            fdt_fix_add(&w->dtfe[s[m]], dv, w->g_vol);
-            w->vmax[s[m]] = max2(w->vmax[s[m]], dv);
-        }
     double c[3];
     int outside = fdt_circumcenter(p0, X + 3 * (size_t)s[1], X + 3 * (size_t)s[2],
                                    X + 3 * (size_t)s[3], c) != 0;
@@ -505,7 +531,7 @@ static void add_tet(vjob *j, const uint32_t *tv)
             outside = 1;
     if (outside) {
         for (int m = 0; m < 4; m++)
-            if (mine(j, s[m]))
+            if (own >> m & 1)
                 w->flags[s[m]] |= FDT_CELL_CLIPPED;
         return;
     }
@@ -533,7 +559,7 @@ static void add_tet(vjob *j, const uint32_t *tv)
     for (int e = 0; e < 6; e++) {
         const int *te = fdt_tet_edge[e];
         int i = te[0], jj = te[1], k = te[2], l = te[3];
-        int mi = mine(j, s[i]), mj = mine(j, s[jj]);
+        int mi = own >> i & 1, mj = own >> jj & 1;
         if (!mi && !mj)
             continue;
         double o = sigma * te[4];
@@ -561,7 +587,7 @@ static void add_tet(vjob *j, const uint32_t *tv)
         double scale = (fabs(u[0]) + fabs(u[1]) + fabs(u[2])) * (fabs(cm[0]) + fabs(cm[1]) + fabs(cm[2])) *
                        (fabs(fp[0]) + fabs(fp[1]) + fabs(fp[2]) + fabs(fn[0]) + fabs(fn[1]) + fabs(fn[2])) / 12;
         double g[3];
-        for (int d = 0; d < 3; d++)
+        for (int d = 0; moments && d < 3; d++)
             g[d] = cone * (2 * mid[d] + c[d]) + vp * fp[d] - vn * fn[d];
         for (int end = 0; end < 2; end++) {
             int at = end ? jj : i;
@@ -569,18 +595,36 @@ static void add_tet(vjob *j, const uint32_t *tv)
                 continue;
             vsum[at] += cone;
             vabs[at] += scale;
-            for (int d = 0; d < 3; d++)
+            for (int d = 0; moments && d < 3; d++)
                 gm[at][d] += g[d];
         }
     }
     for (int m = 0; m < 4; m++)
-        if (mine(j, s[m])) {
+        if (own >> m & 1) {
             fdt_fix_add(&w->vol[s[m]], vsum[m], w->g_vol);
             fdt_fix_add(&w->vabs[s[m]], vabs[m], w->g_vol);
-            for (int d = 0; d < 3; d++)
+            for (int d = 0; moments && d < 3; d++)
                 fdt_fix_add(&w->mom[3 * (size_t)s[m] + d], (gm[m][d] - 3 * q[m][d] * vsum[m]) / 4,
                             w->g_mom);
         }
+}
+
+/* One tet's shares to the job's points (the file's comment), those of the
+ * quantities asked for: the moments (w->mom) and DTFE sums (w->dtfe) are
+ * allocated only then (alloc_work). A tet whose circumcentre lies outside
+ * the box adds no share: it marks its points, whose cells are then cut
+ * from the box. */
+static void add_tet(vjob *j, const uint32_t *tv)
+{
+    const vwork *w = j->w;
+    if (w->mom && w->dtfe)
+        add_tet_for(j, tv, 1, 1);
+    else if (w->mom)
+        add_tet_for(j, tv, 1, 0);
+    else if (w->dtfe)
+        add_tet_for(j, tv, 0, 1);
+    else
+        add_tet_for(j, tv, 0, 0);
 }
 
 /* ---------------------------------------------------------------- cells */
@@ -716,7 +760,7 @@ static void sum_cell(vjob *j, uint32_t l)
     c->volume = vol;
     c->area = area;
     c->nfaces = m;
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; w->mom && k < 3; k++)
         c->centroid[k] =
             w->xyz[3 * (size_t)l + k] + fdt_fix_value(w->mom[3 * (size_t)l + k], w->g_mom) / vol;
 }
@@ -813,7 +857,7 @@ static void *tet_pass(void *arg)
      * tet_volume. Uniform points have none, so this second pass over the
      * tets rarely runs. */
     size_t fine = 0;
-    for (uint32_t l = j->lo; l < j->hi; l++) {
+    for (uint32_t l = j->lo; w->dtfe && l < j->hi; l++) {
         if (fabs(fdt_fix_value(w->dtfe[l], w->g_vol)) >= 0x1p40 * w->g_vol.step ||
             !(w->vmax[l] > 0))
             continue;
@@ -875,7 +919,8 @@ static void *cell_pass(void *arg)
     for (uint32_t l = j->lo; l < j->hi && !j->err; l++) {
         vcell *c = &w->cells[l];
         c->flags = w->flags[l] & (FDT_CELL_CLIPPED | FDT_CELL_HULL);
-        double dt = w->flags[l] & DTFE_FINE
+        double dt = !w->dtfe                 ? 0
+                    : w->flags[l] & DTFE_FINE
                         ? fdt_fix_value(w->dtfe[l], fdt_fix_grid_of(ilogb(w->vmax[l])))
                         : fdt_fix_value(w->dtfe[l], w->g_vol);
         c->density = dt > 0 ? 4 / dt : 0;
@@ -955,8 +1000,9 @@ static void *rows_pass(void *arg)
         const vcell *c = &w->cells[l];
         v->volume[g] = c->volume * f.f3;
         v->area[g] = c->area * f.f2;
-        v->density[g] = c->density * f.fm3;
-        for (int k = 0; k < 3; k++)
+        if (v->density)
+            v->density[g] = c->density * f.fm3;
+        for (int k = 0; v->centroid && k < 3; k++)
             v->centroid[3 * g + k] = c->centroid[k] * f.f1;
         v->nfaces[g] = c->nfaces;
         v->flags[g] = c->flags;
@@ -1056,31 +1102,38 @@ static void *neighbors_pass(void *arg)
     return NULL;
 }
 
-static int alloc_cells(fdt_voronoi *v)
+/* The rows, but those skip leaves out (v->skip). */
+static int alloc_cells(fdt_voronoi *v, unsigned skip)
 {
     size_t n = v->n ? v->n : 1;
+    int cen = !(skip & FDT_CELLS_NO_CENTROIDS), dens = !(skip & FDT_CELLS_NO_DENSITIES);
+    v->skip = skip;
     v->volume = calloc(n, sizeof *v->volume);
     v->area = calloc(n, sizeof *v->area);
-    v->centroid = calloc(3 * n, sizeof *v->centroid);
-    v->density = calloc(n, sizeof *v->density);
+    v->centroid = cen ? calloc(3 * n, sizeof *v->centroid) : NULL;
+    v->density = dens ? calloc(n, sizeof *v->density) : NULL;
     v->nfaces = calloc(n, sizeof *v->nfaces);
     v->flags = calloc(n, sizeof *v->flags);
-    return v->volume && v->area && v->centroid && v->density && v->nfaces && v->flags
+    return v->volume && v->area && (v->centroid || !cen) && (v->density || !dens) && v->nfaces &&
+                   v->flags
                ? FDT_OK
                : FDT_ENOMEM;
 }
 
-/* The local flags and accumulators (the callers mark the hull points). */
+/* The local flags and accumulators (the callers mark the hull points):
+ * the moments only for the centroids, the DTFE sums and largest tets only
+ * for the densities (w->skip); the passes test the pointers. */
 static int alloc_work(vwork *w)
 {
     size_t m = w->m ? w->m : 1;
+    int cen = !(w->skip & FDT_CELLS_NO_CENTROIDS), dens = !(w->skip & FDT_CELLS_NO_DENSITIES);
     w->flags = calloc(m, sizeof *w->flags);
     w->vol = calloc(m, sizeof *w->vol);
     w->vabs = calloc(m, sizeof *w->vabs);
-    w->mom = calloc(3 * m, sizeof *w->mom);
-    w->dtfe = calloc(m, sizeof *w->dtfe);
-    w->vmax = calloc(m, sizeof *w->vmax);
-    if (!w->flags || !w->vol || !w->vabs || !w->mom || !w->dtfe || !w->vmax)
+    w->mom = cen ? calloc(3 * m, sizeof *w->mom) : NULL;
+    w->dtfe = dens ? calloc(m, sizeof *w->dtfe) : NULL;
+    w->vmax = dens ? calloc(m, sizeof *w->vmax) : NULL;
+    if (!w->flags || !w->vol || !w->vabs || (cen && !w->mom) || (dens && (!w->dtfe || !w->vmax)))
         return FDT_ENOMEM;
     return FDT_OK;
 }
@@ -1410,7 +1463,8 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
     if (!v)
         return FDT_ENOMEM;
     v->n = n;
-    err = alloc_cells(v);
+    w.skip = o->skip;
+    err = alloc_cells(v, o->skip);
     if (!err)
         err = fdt_voronoi_box_of(xyz, NULL, n, o, v->box, diag, diag_size);
     if (!err)
@@ -1562,6 +1616,7 @@ int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_v
         return FDT_ENOMEM;
     w.batch = 1;
     w.ed = b->ed;
+    w.skip = b->skip;
     memcpy(w.box, b->box, sizeof w.box);
     memcpy(v->box, b->box, sizeof v->box);
     /* The steps: number the batch's points and tets, in the computation's
@@ -1570,7 +1625,7 @@ int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_v
     v->n = w.nown;
     w.n = w.m;
     if (!err)
-        err = alloc_cells(v);
+        err = alloc_cells(v, b->skip);
     if (!err && !(v->pts = malloc(3 * (w.nown ? w.nown : 1) * sizeof *v->pts)))
         err = FDT_ENOMEM;
     if (!err)
@@ -1595,7 +1650,7 @@ int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_v
     return err;
 }
 int fdt_voronoi_merged(const fdt_vid *ids, const double *pts, size_t k, const double box[6],
-                       int neighbors, fdt_voronoi **out)
+                       int neighbors, unsigned skip, fdt_voronoi **out)
 {
     fdt_voronoi *v = calloc(1, sizeof *v);
     *out = NULL;
@@ -1603,7 +1658,7 @@ int fdt_voronoi_merged(const fdt_vid *ids, const double *pts, size_t k, const do
         return FDT_ENOMEM;
     v->n = k;
     memcpy(v->box, box, sizeof v->box);
-    int err = alloc_cells(v);
+    int err = alloc_cells(v, skip);
     if (!err && (!(v->ids = malloc((k ? k : 1) * sizeof *v->ids)) ||
                  !(v->pts = malloc(3 * (k ? k : 1) * sizeof *v->pts))))
         err = FDT_ENOMEM;
@@ -1631,7 +1686,7 @@ int fdt_voronoi_spread(fdt_voronoi **vp, size_t n)
     v->n = n;
     memcpy(v->box, b->box, sizeof v->box);
     v->zero_faces = b->zero_faces;
-    int err = alloc_cells(v);
+    int err = alloc_cells(v, b->skip);
     size_t *row = err ? NULL : malloc((n ? n : 1) * sizeof *row);
     if (!err && !row)
         err = FDT_ENOMEM;
@@ -1644,8 +1699,10 @@ int fdt_voronoi_spread(fdt_voronoi **vp, size_t n)
         row[id] = i;
         v->volume[id] = b->volume[i];
         v->area[id] = b->area[i];
-        memcpy(v->centroid + 3 * id, b->centroid + 3 * i, 3 * sizeof *v->centroid);
-        v->density[id] = b->density[i];
+        if (v->centroid)
+            memcpy(v->centroid + 3 * id, b->centroid + 3 * i, 3 * sizeof *v->centroid);
+        if (v->density)
+            v->density[id] = b->density[i];
         v->nfaces[id] = b->nfaces[i];
         v->flags[id] = b->flags[i];
     }

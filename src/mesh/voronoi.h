@@ -42,6 +42,11 @@ static inline double fdt_box_side(const double box[6])
     return side;
 }
 
+/* o, a caller's fdt_voronoi_options of any size include/frontdt.h accepts,
+ * as this library's whole struct in *full (the fields o lacks at their
+ * defaults): FDT_OK, or FDT_EINVAL for a size it does not know or skip
+ * bits it has no name for. */
+int fdt_voronoi_options_read(const fdt_voronoi_options *o, fdt_voronoi_options *full);
 /* fdt_voronoi_compute on `threads` threads (at least 1; the caller's is
  * one of them), o not NULL and of this library's size. */
 int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
@@ -82,6 +87,7 @@ typedef struct fdt_vbatch {
     double box[6];           /* holds every point (the caller checked) */
     int ed;                  /* fdt_voronoi_scale's exponent of box */
     int neighbors;           /* keep each cell's neighbours and face areas */
+    unsigned skip;           /* fdt_voronoi_options.skip */
 } fdt_vbatch;
 
 /* The batch's cells into *out, row i the cell of own[i] (fdt_voronoi_ids:
@@ -93,9 +99,9 @@ int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_v
 
 /* A batch of the k merged duplicates ids (input ids; pts their points, 3
  * each): no cells, flag FDT_CELL_MERGED, as fdt_voronoi_compute gives
- * them. */
+ * them; neighbors and skip as the other batches'. */
 int fdt_voronoi_merged(const fdt_vid *ids, const double *pts, size_t k, const double box[6],
-                       int neighbors, fdt_voronoi **out);
+                       int neighbors, unsigned skip, fdt_voronoi **out);
 
 /* *v, a batch whose rows' ids are distinct and below n, as n rows, row
  * i point i's (fdt_voronoi_compute's shape): a row no batch row has is a

@@ -532,15 +532,16 @@ static int block_cells(cells_run *c)
     if ((err = agree(c, err)) != FDT_OK)
         goto done;
     fdt_vbatch b = {c->xyz, 0, c->ids, own, nown, own_hull, c->tets, c->ntets, NULL,
-                    {0}, c->ed, c->o->neighbors};
+                    {0}, c->ed, c->o->neighbors, c->o->skip};
     memcpy(b.box, c->box, sizeof b.box);
     fdt_vshort sh = {-1, -1, 0};
     err = fdt_voronoi_batch(&b, 1, &c->cells, &sh, c->diag, c->dlen);
     int short_edge = err == FDT_ERANGE && sh.a >= 0;
     if (short_edge)
         err = FDT_OK; /* the least edge of all ranks decides, below */
-    if (!err && !short_edge && (err = fdt_voronoi_merged(dup_ids, dup_pts, ndup, c->box, c->o->neighbors,
-                                          &c->merged)) != FDT_OK)
+    if (!err && !short_edge &&
+        (err = fdt_voronoi_merged(dup_ids, dup_pts, ndup, c->box, c->o->neighbors, c->o->skip,
+                                  &c->merged)) != FDT_OK)
         oom(c, "for the cells");
     if ((err = agree(c, err)) != FDT_OK)
         goto done;

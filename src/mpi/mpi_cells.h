@@ -29,6 +29,7 @@ typedef struct fdt_mpi_cells_opts {
     int box_given;       /* clip by box, not the points' bounding box */
     double box[6];
     int neighbors;       /* the format lists neighbours (%n, %f) */
+    unsigned skip;       /* what the tables do not read (fdt_voronoi_options.skip) */
 } fdt_mpi_cells_opts;
 
 typedef struct fdt_mpi_cells_stats {

@@ -39,6 +39,28 @@ int fdt_cells_format_check(const char *fmt, int *needs_nbrs, char *err, size_t e
     return 0;
 }
 
+unsigned fdt_cells_table_skip(const char *fmt, int csv, int density)
+{
+    unsigned skip = csv ? 0 : FDT_CELLS_NO_CENTROIDS | FDT_CELLS_NO_DENSITIES;
+    for (const char *p = csv ? NULL : fmt; p && *p; p++) {
+        if (*p != '%' || !*++p)
+            continue;
+        if (*p == 'c' || *p == 'C')
+            skip &= ~FDT_CELLS_NO_CENTROIDS;
+        if (*p == 'd')
+            skip &= ~FDT_CELLS_NO_DENSITIES;
+    }
+    return density ? skip & ~FDT_CELLS_NO_DENSITIES : skip;
+}
+
+/* Whether those tables read only what v holds. */
+static int tables_fit(const char *fmt, int csv, int density, const fdt_voronoi *v)
+{
+    unsigned missing = (fdt_voronoi_centroids(v) ? 0 : FDT_CELLS_NO_CENTROIDS) |
+                       (fdt_voronoi_densities(v) ? 0 : FDT_CELLS_NO_DENSITIES);
+    return !(missing & ~fdt_cells_table_skip(fmt, csv, density));
+}
+
 /* Point i's neighbours (%n) or face areas (%f), separated by blanks. */
 static void list(out_file *o, const fdt_voronoi *v, size_t i, int areas)
 {
@@ -75,7 +97,7 @@ static void code(out_file *o, char c, const fdt_voronoi *v, const double *xyz, s
     const double *p = ids  ? fdt_voronoi_points(v) + 3 * i
                       : xyz ? xyz + 3 * i
                             : NULL; /* NULL: no code reads it */
-    const double *cen = fdt_voronoi_centroids(v) + 3 * i;
+    const double *cen = fdt_voronoi_centroids(v); /* NULL: no code reads it */
     int merged = (fdt_voronoi_flags(v)[i] & FDT_CELL_MERGED) != 0;
     double rel[3];
     switch (c) {
@@ -91,10 +113,10 @@ static void code(out_file *o, char c, const fdt_voronoi *v, const double *xyz, s
     case 'f': list(o, v, i, 1); break;
     case 'c':
         for (int k = 0; k < 3; k++)
-            rel[k] = merged ? 0 : cen[k] - p[k];
+            rel[k] = merged ? 0 : cen[3 * i + k] - p[k];
         three(o, rel, sep);
         break;
-    case 'C': three(o, merged ? p : cen, sep); break;
+    case 'C': three(o, merged ? p : cen + 3 * i, sep); break;
     case 'd': out_double(o, fdt_voronoi_densities(v)[i]); break;
     case 'h': out_i64(o, fdt_voronoi_flags(v)[i]); break;
     default: out_char(o, '%'); break;
@@ -215,11 +237,15 @@ static int put_rows(FILE *f, const char *fmt, const fdt_voronoi *v, const double
 
 int fdt_wr_cells(FILE *f, const char *fmt, const fdt_voronoi *v, const double *xyz, int threads)
 {
+    if (!tables_fit(fmt, !fmt, 0, v))
+        return EINVAL;
     return fmt ? put_rows(f, fmt, v, xyz, 0, threads) : put_rows(f, CSV_CODES, v, xyz, 1, threads);
 }
 
 int fdt_wr_density(FILE *f, const fdt_voronoi *v, int threads)
 {
+    if (!tables_fit(NULL, 0, 1, v))
+        return EINVAL;
     return put_rows(f, DENSITY_FORMAT, v, NULL, 0, threads);
 }
 
@@ -372,7 +398,7 @@ static int spool_chunk(fdt_cells_spool *s, const fdt_voronoi *v, size_t lo, size
 int fdt_cells_spool_add(fdt_cells_spool *s, const fdt_voronoi *v)
 {
     size_t n = fdt_voronoi_num_points(v);
-    int e = 0;
+    int e = tables_fit(s->csv ? NULL : s->fmt, s->csv, s->density, v) ? 0 : EINVAL;
     for (size_t lo = 0; lo < n && !e; lo += SPOOL_CHUNK)
         e = spool_chunk(s, v, lo, n - lo > SPOOL_CHUNK ? lo + SPOOL_CHUNK : n);
     return e;

@@ -28,6 +28,14 @@
  * (may be NULL) says whether it lists neighbours (%n, %f). */
 int fdt_cells_format_check(const char *fmt, int *needs_nbrs, char *err, size_t errlen);
 
+/* The quantities the tables do not read, as fdt_voronoi_options.skip
+ * bits: FDT_CELLS_NO_CENTROIDS unless the cells' table is CSV (csv) or its
+ * format fmt (NULL: no cells' table) has %c or %C; FDT_CELLS_NO_DENSITIES
+ * unless it is CSV, fmt has %d, or the densities' table is written too
+ * (density). The writers refuse (EINVAL) a table that reads what the
+ * cells left out. */
+unsigned fdt_cells_table_skip(const char *fmt, int csv, int density);
+
 /* Writes the cells in format fmt (checked), or as CSV (fmt NULL: a header
  * line, then id,x,y,z,volume,area,faces,cx,cy,cz,density,flags), the
  * text formatted on `threads` threads (1: the caller's alone). Returns 0,
@@ -58,7 +66,7 @@ FILE *fdt_cells_temp(const char *dir);
  * input ids [base, base + n); fmt: the cells' format (NULL: none), csv:
  * CSV instead; density: the density table too. The calls return 0 or an
  * errno; EINVAL when a batch has a row outside [base, base + n) or one
- * already spooled, or, from
+ * already spooled, or lacks what the tables read (fdt_cells_table_skip), or, from
  * fdt_cells_spool_put, when a point's row never came.
  */
 typedef struct fdt_cells_spool fdt_cells_spool;
