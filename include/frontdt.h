@@ -914,8 +914,11 @@ FDT_API int fdt_voronoi_neighbors(const fdt_voronoi *v, fdt_vid i, size_t *count
  * faces, each as its vertex count then its vertex indices, counter-
  * clockwise seen from outside. Cut from the box by the neighbours'
  * bisectors, as the cut cells are (so a summed cell's polyhedron agrees
- * with its volume to rounding). Owned by v, valid until the next call on
- * v (not from two threads at once). A merged duplicate has none (0, 0).
+ * with its volume to rounding); a periodic set's cell from its point's
+ * period box (the point at its centre) on the periodic axes, by the
+ * neighbours' images, so that its vertices may lie outside the box.
+ * Owned by v, valid until the next call on v (not from two threads at
+ * once). A merged duplicate has none (0, 0).
  * FDT_ERANGE when the cell has a neighbour closer than 2^-40 of their
  * coordinates: its vertices, absolute coordinates, would round by as much
  * as the cell is wide. */

@@ -22,7 +22,10 @@
   1e-10 (skipped where voro++ is not built): x, y and z periodic in a cube,
   and a channel (x, z), a duct (x) and a slab (y, z) in a box that is not
   one, walls of grid points across the other axes, whose cells the box's
-  sides cut, as voro++'s container walls.
+  sides cut, as voro++'s container walls. As VTK polyhedra (--voronoi
+  cells.vtu, read back with python3-vtk9 where it is installed): a cell a
+  point, each one's volume from its faces and its volume array its cell's
+  to 1e-9.
 
 - tests/gen_points families scaled into the unit box (a torus, a cubed
   sphere, near-duplicates, a rotated lattice, mixed scales: flat tets
@@ -195,6 +198,7 @@ def cells(name, pts, lo, hi, axes="xyz"):
     walls = {j for c in got.values() for j in c[2] if j < 0}
     expect(all(axes.find("xyz"[(-j - 1) // 2]) < 0 for j in walls),
            "%s cells: walls %s across a periodic axis" % (name, sorted(walls)))
+    polyhedra(name, src, axes, box, {i: c[0] for i, c in got.items()})
     if VORO == "none":
         print("%s cells: %d, their volumes the box's" % (name, len(got)))
         return
@@ -220,6 +224,50 @@ def cells(name, pts, lo, hi, axes="xyz"):
     expect(bad == 0, "%s cells: %d differ from voro++'s" % (name, bad))
     print("%s cells (%s periodic): %d, their volumes the box's, as voro++'s" % (
         name, axes, len(got)))
+
+
+def polyhedra(name, src, axes, box, want):
+    """--voronoi cells.vtu of a periodic set: a VTK polyhedron a point,
+    its volume from its faces (fans from its first vertex) and its volume
+    array want's (the table's %v) to 1e-9."""
+    vtu = os.path.join(SCRATCH, name + "_c.vtu")
+    r = frontdt(src, "--periodic", axes, "--box", box, "--voronoi", vtu, "-q", "-t", "2")
+    expect(r.returncode == 0, "%s polyhedra: exit %d: %s" % (name, r.returncode, r.stderr))
+    try:
+        import vtk
+        from vtk.util.numpy_support import vtk_to_numpy
+    except ImportError:
+        print("%s polyhedra: no VTK Python module, not read back" % name)
+        return
+    if r.returncode:
+        return
+    rd = vtk.vtkXMLUnstructuredGridReader()
+    rd.SetFileName(vtu)
+    rd.Update()
+    g = rd.GetOutput()
+    pts = vtk_to_numpy(g.GetPoints().GetData())
+    site = vtk_to_numpy(g.GetCellData().GetArray("point"))
+    vol = vtk_to_numpy(g.GetCellData().GetArray("volume"))
+    expect(g.GetNumberOfCells() == len(want), "%s polyhedra: %d cells for %d points" % (
+        name, g.GetNumberOfCells(), len(want)))
+    worst = 0.0
+    for c in range(g.GetNumberOfCells()):
+        cell = g.GetCell(c)
+        v, base = 0.0, None
+        for k in range(cell.GetNumberOfFaces()):
+            f = cell.GetFace(k)
+            q = [pts[f.GetPointId(j)] for j in range(f.GetNumberOfPoints())]
+            base = q[0] if base is None else base
+            q = [x - base for x in q]
+            for j in range(1, len(q) - 1):
+                a, b, d = q[0], q[j], q[j + 1]
+                v += (a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) +
+                      a[2] * (b[0] * d[1] - b[1] * d[0])) / 6
+        w = want[int(site[c])]
+        worst = max(worst, abs(v - w) / w, abs(vol[c] - w) / w)
+    expect(worst < 1e-9, "%s polyhedra: a volume %.3g off its cell's" % (name, worst))
+    print("%s polyhedra: %d read back, volumes from their faces within %.1e" % (
+        name, g.GetNumberOfCells(), worst))
 
 
 def channel(n, g, lo, hi, axes, seed):

@@ -570,6 +570,97 @@ static void test_skip(size_t n)
     free(xyz);
 }
 
+/* A periodic set's cells as polyhedra (fdt_voronoi_polyhedron): each
+ * one's volume from its faces (fans from its point) its cell's to 1e-9,
+ * and together the box's. Uniform points periodic on every axis in a box
+ * of unequal sides, a channel (periodic in x and z, walls of points at
+ * y = 0 and 1) and a sparse set, whose cells reach across the box and
+ * meet two images of one point. */
+static void periodic_polyhedra(const char *name, const double *xyz, size_t n, unsigned axes,
+                               const double box[6])
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.n_threads = 2;
+    s.periodic = axes;
+    memcpy(s.periodic_box, box, sizeof s.periodic_box);
+    fdt_context *ctx = NULL;
+    fdt_result *r = NULL;
+    CHECK_EQ(fdt_open(&ctx, &s), FDT_OK);
+    int err = fdt_triangulate(ctx, xyz, n, &r);
+    EXPECTF(err == FDT_OK, "%s: %s", name, fdt_context_diagnostic(ctx));
+    fdt_close(&ctx);
+    if (err)
+        return;
+    fdt_voronoi *v = cells(r, xyz, n, box);
+    double sum = 0, worst = 0;
+    size_t two_images = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t nv, nf, cnt;
+        const double *vs, *fa;
+        const int32_t *fs;
+        const fdt_vid *ids;
+        CHECK_EQ(fdt_voronoi_polyhedron(v, xyz, (fdt_vid)i, &nv, &vs, &nf, &fs), FDT_OK);
+        CHECK_EQ(fdt_voronoi_neighbors(v, (fdt_vid)i, &cnt, &ids, &fa), FDT_OK);
+        for (size_t e = 1; e < cnt; e++)
+            two_images += ids[e] == ids[e - 1];
+        const double *p = xyz + 3 * i;
+        double vol = 0;
+        for (size_t f = 0, o = 0; f < nf; f++) {
+            int32_t k = fs[o++];
+            const double *a = vs + 3 * (size_t)fs[o];
+            for (int32_t j = 1; j + 1 < k; j++) {
+                const double *b = vs + 3 * (size_t)fs[o + j], *c = vs + 3 * (size_t)fs[o + j + 1];
+                double u[3], w[3], x[3];
+                for (int d = 0; d < 3; d++) {
+                    u[d] = a[d] - p[d];
+                    w[d] = b[d] - p[d];
+                    x[d] = c[d] - p[d];
+                }
+                vol += (u[0] * (w[1] * x[2] - w[2] * x[1]) - u[1] * (w[0] * x[2] - w[2] * x[0]) +
+                        u[2] * (w[0] * x[1] - w[1] * x[0])) / 6;
+            }
+            o += (size_t)k;
+        }
+        double want = fdt_voronoi_volumes(v)[i];
+        worst = fmax(worst, fabs(vol - want) / want);
+        sum += vol;
+    }
+    double bv = (box[3] - box[0]) * (box[4] - box[1]) * (box[5] - box[2]);
+    EXPECTF(worst < 1e-9, "%s: a polyhedron's volume is %.3g off its cell's", name, worst);
+    EXPECTF(fabs(sum - bv) < 1e-9 * bv, "%s: the polyhedra sum to %.17g, the box %.17g", name,
+            sum, bv);
+    if (n < 50)
+        EXPECTF(two_images > 0, "%s: no cell meets two images of one point", name);
+    fdt_voronoi_free(&v);
+    fdt_result_free(&r);
+}
+
+static void test_periodic_polyhedra(void)
+{
+    const double unequal[6] = {0, 0, 0, 2, 1, 0.5}, unit[6] = {0, 0, 0, 1, 1, 1};
+    size_t n = 600;
+    double *xyz = test_cloud(n, 0, 5);
+    for (size_t i = 0; i < n; i++) {
+        xyz[3 * i] *= 2;
+        xyz[3 * i + 2] *= 0.5;
+    }
+    periodic_polyhedra("uniform xyz", xyz, n, 7, unequal);
+    uint64_t seed = 9;
+    for (size_t i = 0; i < n; i++) /* a channel: an eighth of the points on each wall */
+        xyz[3 * i + 1] = i % 8 == 0 ? 0 : i % 8 == 1 ? 1 : test_unif(&seed);
+    for (size_t i = 0; i < n; i++)
+        xyz[3 * i] *= 0.5;
+    for (size_t i = 0; i < n; i++)
+        xyz[3 * i + 2] *= 2;
+    periodic_polyhedra("channel xz", xyz, n, 5, unit);
+    free(xyz);
+    n = 12;
+    xyz = test_cloud(n, 0, 21);
+    periodic_polyhedra("sparse xyz", xyz, n, 7, unit);
+    free(xyz);
+}
+
 int main(void)
 {
     test_tiny_cells(1e-8);
@@ -586,5 +677,6 @@ int main(void)
     test_scales();
     test_refusals();
     test_skip(3000);
+    test_periodic_polyhedra();
     return test_report("voronoi");
 }

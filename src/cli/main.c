@@ -560,9 +560,6 @@ static int check_args(cli *c, int npos, char **pos)
         if (c->dual.dual || fdt_cli_interp_wanted(&c->dual))
             return usage_error("--periodic writes the mesh, its hashes, --check and the cells; "
                                "not yet --dual or --interpolate");
-        const char *vd = c->dual.voronoi ? strrchr(c->dual.voronoi, '.') : NULL;
-        if (vd && !strcmp(vd, ".vtu"))
-            return usage_error("--periodic's cells are a table (not .vtu polyhedra)");
         for (int o = 0; o < c->n_outputs; o++) {
             const fdt_format *f = c->out_format[o] ? fdt_format_by_name(c->out_format[o])
                                                    : fdt_format_by_path(c->outputs[o]);

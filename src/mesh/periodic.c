@@ -2132,6 +2132,8 @@ int fdt_periodic_cells(const int32_t *tets, const int8_t *off, size_t ntets, con
         err = fdt_voronoi_too_close(&sh, box, diag, ds);
     if (!err)
         err = fdt_voronoi_spread(&v, n);
+    if (!err)
+        fdt_voronoi_set_periodic(v, b->axes, b->lo, b->hi);
     if (err)
         fdt_voronoi_free(&v);
     *out = v;

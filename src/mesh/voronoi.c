@@ -47,6 +47,9 @@ struct fdt_voronoi {
     uint8_t *flags;                             /* owned */
     size_t zero_faces;
     unsigned skip;      /* FDT_CELLS_NO_*: centroid, density NULL */
+    unsigned periodic;  /* a periodic set's cells: bits 0-2 the periodic
+                           axes (fdt_voronoi_set_periodic), else 0 */
+    double period[3];   /* the periods on those axes */
     size_t *nstart; /* n + 1 offsets, or NULL (owned) */
     fdt_vid *nid;   /* owned */
     double *narea;  /* owned */
@@ -1763,6 +1766,21 @@ int fdt_voronoi_neighbors(const fdt_voronoi *v, fdt_vid i, size_t *count, const 
     return FDT_OK;
 }
 
+/* q - p, moved by whole periods along v's periodic axes into [-L/2, L/2]
+ * (the nearest image of q; q - p itself for a set that is not periodic).
+ * Both points lie in the box, so one period at most. */
+static void nearest_image(const fdt_voronoi *v, const double *p, const double *q, double d[3])
+{
+    for (int k = 0; k < 3; k++) {
+        d[k] = q[k] - p[k];
+        double L = v->period[k];
+        if (L > 0 && d[k] > 0.5 * L)
+            d[k] -= L;
+        else if (L > 0 && d[k] < -0.5 * L)
+            d[k] += L;
+    }
+}
+
 /* The least neighbour pair (input ids) of cell i closer than 2^-40 of
  * their coordinates (fdt_voronoi_resolution's coords rule) into *a, *b,
  * kept when less than theirs (*a < 0: none yet); its length and
@@ -1776,6 +1794,13 @@ static void near_pair(const fdt_voronoi *v, const double *xyz, fdt_vid i, fdt_vi
         if (nb < 0)
             continue; /* a wall */
         const double *q = xyz + 3 * (size_t)nb;
+        double img[3]; /* a periodic set's: the image nearest p */
+        if (v->periodic) {
+            nearest_image(v, p, q, img);
+            for (int k = 0; k < 3; k++)
+                img[k] += p[k];
+            q = img;
+        }
         double l = fdt_cheb(p, q), m = coord_mag(p, q);
         if (l < ldexp(m, VORONOI_COORD_EXP) && (*a < 0 || fdt_edge_less(i, nb, *a, *b))) {
             *a = i < nb ? i : nb;
@@ -1784,6 +1809,14 @@ static void near_pair(const fdt_voronoi *v, const double *xyz, fdt_vid i, fdt_vi
             *mag = m;
         }
     }
+}
+
+void fdt_voronoi_set_periodic(fdt_voronoi *v, unsigned axes, const double lo[3],
+                              const double hi[3])
+{
+    v->periodic = axes;
+    for (int k = 0; k < 3; k++)
+        v->period[k] = axes >> k & 1 ? hi[k] - lo[k] : 0;
 }
 
 int fdt_voronoi_vertices_check(const fdt_voronoi *v, const double *xyz, char *diag, size_t ds)
@@ -1796,6 +1829,58 @@ int fdt_voronoi_vertices_check(const fdt_voronoi *v, const double *xyz, char *di
     if (a < 0)
         return FDT_OK;
     return too_close(a, b, len, mag, 1, FDT_VORONOI_BOX_EXP, 1, diag, ds);
+}
+
+/*
+ * A periodic cell's cuts by its neighbours' other images: the neighbour
+ * lists name points, not which image of a point is the neighbour, and a
+ * cell may have two images of one point among its neighbours (a sparse
+ * set) or a neighbour that is not the nearest image. The nearest images
+ * made the cell (fdt_voronoi_polyhedron); every other image whose
+ * bisector could still cut it, nearer p than twice the cell's farthest
+ * vertex, cuts it too. A bisector of any image of any point of the set
+ * keeps the whole Voronoi cell on p's side, so these cuts take off only
+ * what is not the cell, and the cell's own faces' images are among them.
+ */
+static int other_images(fdt_voronoi *v, const double *xyz, fdt_vid i)
+{
+    const double *p = xyz + 3 * (size_t)i;
+    for (size_t e = v->nstart[i]; e < v->nstart[i + 1]; e++) {
+        if (v->nid[e] < 0)
+            continue;
+        double r2 = 0; /* the cell's farthest vertex from p, squared */
+        for (int j = 0; j < v->poly.np; j++)
+            r2 = max2(r2, dot3(v->poly.p[j], v->poly.p[j]));
+        double d0[3];
+        nearest_image(v, p, xyz + 3 * (size_t)v->nid[e], d0);
+        /* the shifts, a period at a time, that keep each axis within 2r */
+        int s0[3], s1[3];
+        double r = 2 * sqrt(r2);
+        for (int k = 0; k < 3; k++) {
+            s0[k] = s1[k] = 0;
+            if (v->period[k] > 0) {
+                s0[k] = (int)ceil((-r - d0[k]) / v->period[k]);
+                s1[k] = (int)floor((r - d0[k]) / v->period[k]);
+            }
+        }
+        for (int a = s0[0]; a <= s1[0]; a++)
+            for (int b = s0[1]; b <= s1[1]; b++)
+                for (int c = s0[2]; c <= s1[2]; c++) {
+                    if (!a && !b && !c)
+                        continue; /* the nearest image, cut already */
+                    double nrm[3] = {d0[0] + a * v->period[0], d0[1] + b * v->period[1],
+                                     d0[2] + c * v->period[2]};
+                    double h2 = dot3(nrm, nrm);
+                    if (h2 >= 4 * r2)
+                        continue; /* its bisector lies beyond every vertex */
+                    int got = fdt_cell_cut(&v->poly, nrm, 0.5 * h2, v->nid[e]);
+                    if (got == -1)
+                        return FDT_ENOMEM;
+                    if (got < 0)
+                        return FDT_EINTERNAL;
+                }
+    }
+    return FDT_OK;
 }
 
 int fdt_voronoi_polyhedron(fdt_voronoi *v, const double *xyz, fdt_vid i, size_t *nverts,
@@ -1822,19 +1907,31 @@ int fdt_voronoi_polyhedron(fdt_voronoi *v, const double *xyz, fdt_vid i, size_t 
         lo[k] = v->box[k] - p[k];
         hi[k] = v->box[k + 3] - p[k];
     }
+    if (v->periodic) /* the cell of p among its own images, on those axes */
+        for (int k = 0; k < 3; k++)
+            if (v->period[k] > 0) {
+                lo[k] = -0.5 * v->period[k];
+                hi[k] = 0.5 * v->period[k];
+            }
     if (fdt_cell_box(&v->poly, lo, hi))
         return FDT_ENOMEM;
     for (size_t e = v->nstart[i]; e < v->nstart[i + 1]; e++) {
         if (v->nid[e] < 0)
             continue; /* a wall: the box has it */
         double nrm[3];
-        sub3(xyz + 3 * (size_t)v->nid[e], p, nrm);
+        if (v->periodic)
+            nearest_image(v, p, xyz + 3 * (size_t)v->nid[e], nrm);
+        else
+            sub3(xyz + 3 * (size_t)v->nid[e], p, nrm);
         int got = fdt_cell_cut(&v->poly, nrm, 0.5 * dot3(nrm, nrm), v->nid[e]);
         if (got == -1)
             return FDT_ENOMEM;
         if (got < 0)
             return FDT_EINTERNAL;
     }
+    int err = v->periodic ? other_images(v, xyz, i) : FDT_OK;
+    if (err)
+        return err;
     const fdt_cell *c = &v->poly;
     size_t need_v = 3 * (size_t)c->np, need_f = (size_t)c->nf + (size_t)c->nring;
     if (need_v > v->cap_pverts) {

@@ -128,6 +128,12 @@ int fdt_voronoi_box_of(const double *xyz, const fdt_vid *ids, size_t n,
  */
 int fdt_voronoi_scale(const double box[6], int *ed, char *diag, size_t ds);
 
+/* v's cells are a periodic set's, periodic along axes (bits 0-2) with
+ * the periods hi - lo there: fdt_voronoi_polyhedron then cuts each cell
+ * from its point's own period box on those axes by its neighbours'
+ * images, and the checks below measure a neighbour at its nearest image. */
+void fdt_voronoi_set_periodic(fdt_voronoi *v, unsigned axes, const double lo[3],
+                              const double hi[3]);
 /*
  * Whether the cells' vertices can be written as absolute coordinates
  * (fdt_voronoi_polyhedron, the .vtu polyhedra): FDT_ERANGE with diag
