@@ -404,6 +404,12 @@ def test_voronoi():
     check(np.array_equal(cs["volumes"], c["volumes"][perm]) and
           np.array_equal(cs["centroids"], c["centroids"][perm]),
           "voronoi: same bits for a shuffled input")
+    lean = frontdt.voronoi(pts, box, threads=2, centroids=False, densities=False)
+    check(lean["centroids"] is None and lean["densities"] is None and
+          all(np.array_equal(lean[k], c[k]) for k in ("volumes", "areas", "num_faces", "flags",
+                                                       "neighbor_ptr", "neighbors",
+                                                       "face_areas")),
+          "voronoi: without centroids and densities, the rest the same bits")
     raises(ValueError, t.voronoi, (0, 0, 0, 1, 1, 0.5))
     raises(ValueError, t.voronoi, (0, 0, 0, 1, 1))
 

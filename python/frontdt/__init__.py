@@ -14,16 +14,19 @@ long as any of them. See help(frontdt.delaunay) and README.md, "Python".
 from ._frontdt import CheckError, Triangulation, __version__, check, delaunay
 
 
-def voronoi(points, box=None, threads=None, periodic=None):
+def voronoi(points, box=None, threads=None, periodic=None, centroids=True, densities=True):
     """Each point's Voronoi cell, clipped by box (None: the points' bounding
-    box): frontdt.delaunay(points, threads).voronoi(box), a dict of arrays
-    (see help(frontdt.Triangulation.voronoi)). periodic="xyz" (or "x,z",
-    ...) with box the periods: the cells of the periodic point set, cut by
-    the box's sides across the axes that are not periodic, their volumes
-    summing to the box's."""
+    box): frontdt.delaunay(points, threads).voronoi(box, centroids,
+    densities), a dict of arrays (see help(frontdt.Triangulation.voronoi));
+    centroids=False or densities=False leave those out (None), and the
+    time they take. periodic="xyz" (or "x,z", ...) with box the periods: the
+    cells of the periodic point set, cut by the box's sides across the axes
+    that are not periodic, their volumes summing to the box's."""
     if periodic is not None:
-        return delaunay(points, threads=threads, periodic=periodic, box=box).voronoi()
-    return delaunay(points, threads=threads).voronoi(box)
+        return delaunay(points, threads=threads, periodic=periodic,
+                        box=box).voronoi(centroids=centroids, densities=densities)
+    return delaunay(points, threads=threads).voronoi(box, centroids=centroids,
+                                                     densities=densities)
 
 
 def interpolate(points, values, queries, method="natural", threads=None):

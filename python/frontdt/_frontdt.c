@@ -518,17 +518,33 @@ static PyObject *copy_array(const void *data, npy_intp rows, npy_intp cols, int 
     return a;
 }
 
-/* Triangulation.voronoi(box=None): the cells (fdt_voronoi_compute) as a
- * dict of new arrays; the neighbours in CSR form. */
+/* An array of what the cells computed, or None for what they left out
+ * (fdt_voronoi_options.skip: data NULL). */
+static PyObject *copy_or_none(const void *data, npy_intp rows, npy_intp cols, int type,
+                              size_t item)
+{
+    if (data)
+        return copy_array(data, rows, cols, type, item);
+    Py_INCREF(Py_None);
+    return Py_None;
+}
+
+/* Triangulation.voronoi(box=None, centroids=True, densities=True): the
+ * cells (fdt_voronoi_compute) as a dict of new arrays; the neighbours in
+ * CSR form; centroids and densities None where not asked for (they are
+ * then not computed). */
 static PyObject *tri_voronoi(TriObject *self, PyObject *args, PyObject *kw)
 {
-    static char *kwlist[] = {"box", NULL};
+    static char *kwlist[] = {"box", "centroids", "densities", NULL};
     PyObject *box_obj = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "|O:voronoi", kwlist, &box_obj))
+    int centroids = 1, densities = 1;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|Opp:voronoi", kwlist, &box_obj, &centroids,
+                                     &densities))
         return NULL;
     fdt_voronoi_options o;
     fdt_default_voronoi_options(&o);
     o.neighbors = 1;
+    o.skip = (centroids ? 0 : FDT_CELLS_NO_CENTROIDS) | (densities ? 0 : FDT_CELLS_NO_DENSITIES);
     if (box_obj != Py_None) {
         PyArrayObject *b = (PyArrayObject *)PyArray_FROMANY(
             box_obj, NPY_DOUBLE, 1, 1, NPY_ARRAY_C_CONTIGUOUS | NPY_ARRAY_ALIGNED);
@@ -576,9 +592,9 @@ static PyObject *tri_voronoi(TriObject *self, PyObject *args, PyObject *kw)
     struct { const char *key; PyObject *val; } items[] = {
         {"volumes", copy_array(fdt_voronoi_volumes(v), nn, 0, NPY_DOUBLE, sizeof(double))},
         {"areas", copy_array(fdt_voronoi_areas(v), nn, 0, NPY_DOUBLE, sizeof(double))},
-        {"centroids", copy_array(fdt_voronoi_centroids(v), nn, 3, NPY_DOUBLE, sizeof(double))},
+        {"centroids", copy_or_none(fdt_voronoi_centroids(v), nn, 3, NPY_DOUBLE, sizeof(double))},
         {"num_faces", copy_array(fdt_voronoi_num_faces(v), nn, 0, NPY_INT32, sizeof(int32_t))},
-        {"densities", copy_array(fdt_voronoi_densities(v), nn, 0, NPY_DOUBLE, sizeof(double))},
+        {"densities", copy_or_none(fdt_voronoi_densities(v), nn, 0, NPY_DOUBLE, sizeof(double))},
         {"flags", copy_array(fdt_voronoi_flags(v), nn, 0, NPY_UINT8, 1)},
         {"neighbor_ptr", copy_array(ptr, nn + 1, 0, NPY_INTP, sizeof(npy_intp))},
         {"neighbors", nb},
@@ -710,9 +726,11 @@ static PyMethodDef tri_methods[] = {
      "tetrahedralization of the points (fdt_check; a periodic one's: fdt_check_periodic); "
      "raises CheckError if not."},
     {"voronoi", (PyCFunction)(void (*)(void))tri_voronoi, METH_VARARGS | METH_KEYWORDS,
-     "voronoi(box=None)\n--\n\nEach point's Voronoi cell clipped by box (xmin, ymin, "
-     "zmin, xmax, ymax, zmax; None: the points' bounding box), as a dict of arrays: "
-     "volumes, areas, centroids (n, 3), num_faces, densities (DTFE), flags (1 "
+     "voronoi(box=None, centroids=True, densities=True)\n--\n\nEach point's Voronoi cell "
+     "clipped by box (xmin, ymin, zmin, xmax, ymax, zmax; None: the points' bounding box), "
+     "as a dict of arrays: volumes, areas, centroids (n, 3; None with centroids=False, "
+     "which also leaves them uncomputed: faster), num_faces, densities (DTFE; None with "
+     "densities=False), flags (1 "
      "clipped, 2 hull, 4 merged duplicate), and the neighbours in CSR form: "
      "neighbors[neighbor_ptr[i]:neighbor_ptr[i+1]] (walls -1..-6) with face_areas "
      "alongside. The same bits for every thread count and input order. A periodic "
