@@ -27,6 +27,10 @@
   point, each one's volume from its faces and its volume array its cell's
   to 1e-9.
 
+- The cells of gen_points torus and cone scaled into the unit box (random
+  doubles: images rounded, flat tets whose centres the rounding throws
+  periods away), as voro++'s too.
+
 - tests/gen_points families scaled into the unit box (a torus, a cubed
   sphere, near-duplicates, a rotated lattice, mixed scales: flat tets
   whose spheres the rounded images cannot place, decided exactly): threads,
@@ -421,6 +425,10 @@ def main():
     cells("uniform", uniform(2000, 0.1, 1.2, 5), *cube(0.1, 1.2))
     cells("lattice", lattice(5, 0.1, 1.2), *cube(0.1, 1.2))
     cells("clusters", clusters(800, -2.0, 3.0, 6), *cube(-2.0, 3.0))
+    for fam in ("torus", "cone"):
+        # surfaces of revolution: nearly flat tets among the rounded
+        # images, whose centres land periods away (were refused, exit 7)
+        cells(fam, family(fam, 2000), *cube(0.0, 1.0))
     lo, hi = (0.0, -0.5, 0.25), (2.0, 0.5, 1.25)
     cells("channel", channel(1500, 8, lo, hi, "xz", 7), lo, hi, "xz")
     cells("duct", channel(1200, 6, lo, hi, "x", 8), lo, hi, "x")

@@ -2085,6 +2085,7 @@ static int star_batch(const uint32_t *tets, const int8_t *off, const uint8_t *po
         vb.ntets = nst / 4;
         vb.neighbors = neighbors;
         vb.skip = skip;
+        vb.periodic = b->axes;
         err = fdt_voronoi_batch(&vb, threads, &v, sh, diag, ds);
     }
     /* no cell of a set periodic on every axis is clipped: one that is

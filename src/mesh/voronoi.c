@@ -98,6 +98,7 @@ typedef struct vwork {
     const fdt_vid *rtets; /* the result's tets, in input ids, that tets maps
                              (NULL in a batch: tets are local already) */
     unsigned skip;      /* FDT_CELLS_NO_*: the moments, the DTFE sums left out */
+    unsigned periodic;  /* a periodic set's batch: its periodic axes (add_tet) */
     size_t *bcnt;       /* bucket_tets's: each key's next entry */
     uint32_t *btets;    /* and the tets it fills */
     uint8_t *flags;     /* local (owned) */
@@ -523,19 +524,40 @@ __attribute__((always_inline)) static inline void add_tet_for(vjob *j, const uin
     }
     const double *p0 = X + 3 * (size_t)s[0];
     double c[3];
-    int outside = fdt_circumcenter(p0, X + 3 * (size_t)s[1], X + 3 * (size_t)s[2],
-                                   X + 3 * (size_t)s[3], c) != 0;
+    if (fdt_circumcenter(p0, X + 3 * (size_t)s[1], X + 3 * (size_t)s[2], X + 3 * (size_t)s[3],
+                         c) != 0) {
+        /* Four coplanar points (a flat tet of the perturbed mesh: four
+         * cocircular points of a plane, as scans and surfaces of
+         * revolution have) have no centre to share out: their cells are
+         * cut instead, which the box need not have done (a periodic set's
+         * cells never meet it: gen_points torus and cone in a periodic
+         * box were refused as cells reaching past their images). */
+        for (int m = 0; m < 4; m++)
+            if (own >> m & 1)
+                w->flags[s[m]] |= CELL_CUT;
+        return;
+    }
     /* Against the walls relative to p0, as c is: p0 + c rounds at the
      * coordinates' scale (points at 2^40 on a 2^-12 grid: a centre a
      * half step outside rounded onto the wall, and its cells were summed
      * past the box, 3e-6 off), box - p0 at the cell's. */
+    unsigned outside = 0; /* the axes along which c leaves the box */
     for (int k = 0; k < 3; k++)
         if (!(c[k] >= w->box[k] - p0[k] && c[k] <= w->box[k + 3] - p0[k]))
-            outside = 1;
+            outside |= 1u << k;
     if (outside) {
+        /* Along a periodic axis a batch's box is three periods each side
+         * (src/mesh/periodic.c), which no true centre leaves (an empty
+         * ball is less than a period's diagonal across): one out there is
+         * a nearly flat tet's among rounded images (gen_points torus: a
+         * tet 2e-20 thick whose centre, 0.1 from its points, came out 9
+         * periods away from images rounded by 1e-17). Its cells are cut
+         * from the box by their neighbours' bisectors, which rounding
+         * moves by as little; only a wall clips them. */
+        unsigned flag = outside & ~w->periodic ? FDT_CELL_CLIPPED : CELL_CUT;
         for (int m = 0; m < 4; m++)
             if (own >> m & 1)
-                w->flags[s[m]] |= FDT_CELL_CLIPPED;
+                w->flags[s[m]] |= flag;
         return;
     }
     /* f[m]: the circumcentre of the face opposite m, relative to p0. It
@@ -1620,6 +1642,7 @@ int fdt_voronoi_batch(const fdt_vbatch *b, int threads, fdt_voronoi **out, fdt_v
     w.batch = 1;
     w.ed = b->ed;
     w.skip = b->skip;
+    w.periodic = b->periodic;
     memcpy(w.box, b->box, sizeof w.box);
     memcpy(v->box, b->box, sizeof v->box);
     /* The steps: number the batch's points and tets, in the computation's

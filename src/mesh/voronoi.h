@@ -88,6 +88,9 @@ typedef struct fdt_vbatch {
     int ed;                  /* fdt_voronoi_scale's exponent of box */
     int neighbors;           /* keep each cell's neighbours and face areas */
     unsigned skip;           /* fdt_voronoi_options.skip */
+    unsigned periodic;       /* a periodic set's star: its periodic axes
+                                (bits 0-2), along which box is three
+                                periods each side; else 0 */
 } fdt_vbatch;
 
 /* The batch's cells into *out, row i the cell of own[i] (fdt_voronoi_ids:

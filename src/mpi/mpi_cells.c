@@ -532,7 +532,7 @@ static int block_cells(cells_run *c)
     if ((err = agree(c, err)) != FDT_OK)
         goto done;
     fdt_vbatch b = {c->xyz, 0, c->ids, own, nown, own_hull, c->tets, c->ntets, NULL,
-                    {0}, c->ed, c->o->neighbors, c->o->skip};
+                    {0}, c->ed, c->o->neighbors, c->o->skip, 0};
     memcpy(b.box, c->box, sizeof b.box);
     fdt_vshort sh = {-1, -1, 0};
     err = fdt_voronoi_batch(&b, 1, &c->cells, &sh, c->diag, c->dlen);
