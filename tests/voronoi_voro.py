@@ -32,6 +32,8 @@ import random
 import subprocess
 import sys
 
+from vtk_cells import read_polyhedra
+
 FRONTDT, GEN, VORO, SCRATCH = sys.argv[1:5]
 os.makedirs(SCRATCH, exist_ok=True)
 FMT = "%i %v %F %s %C %h|%n|%f"
@@ -321,12 +323,6 @@ def formats_and_refusals():
 
 
 def polyhedra():
-    try:
-        import vtk
-        from vtk.util.numpy_support import vtk_to_numpy
-    except ImportError:
-        print("polyhedra: no VTK Python module, not read back")
-        return
     path = os.path.join(SCRATCH, "poly.xyz")
     subprocess.run([GEN, "gaussian", "1500", "3", path], check=True)
     vtu = os.path.join(SCRATCH, "cells.vtu")
@@ -336,40 +332,23 @@ def polyhedra():
     if r.returncode or r2.returncode:
         fail("--voronoi .vtu: exit %d / %d: %s" % (r.returncode, r2.returncode, r.stderr))
         return
+    got = read_polyhedra(vtu)
+    if got is None:
+        print("polyhedra: no VTK Python module, not read back")
+        return
     rows = [line.split() for line in open(txt)]
     want = {int(i): float(v) for i, v, h in rows if not int(h) & 4}
-    rd = vtk.vtkXMLUnstructuredGridReader()
-    rd.SetFileName(vtu)
-    rd.Update()
-    g = rd.GetOutput()
-    pts = vtk_to_numpy(g.GetPoints().GetData())
-    site = vtk_to_numpy(g.GetCellData().GetArray("point"))
-    vol = vtk_to_numpy(g.GetCellData().GetArray("volume"))
-    if g.GetNumberOfCells() != len(want):
-        fail("cells.vtu: %d cells for %d distinct points" % (g.GetNumberOfCells(), len(want)))
+    if len(got) != len(want):
+        fail("cells.vtu: %d cells for %d distinct points" % (len(got), len(want)))
         return
     worst = 0.0
-    for c in range(g.GetNumberOfCells()):
-        cell = g.GetCell(c)
-        if cell.GetCellType() != 42:
-            fail("cells.vtu: cell %d has type %d" % (c, cell.GetCellType()))
+    for s, va, v, kind in got:
+        if kind != 42:
+            fail("cells.vtu: the cell of point %d has type %d" % (s, kind))
             return
-        v = 0.0
-        base = None
-        for k in range(cell.GetNumberOfFaces()):
-            f = cell.GetFace(k)
-            p = [pts[f.GetPointId(j)] for j in range(f.GetNumberOfPoints())]
-            if base is None:
-                base = p[0]
-            q = [x - base for x in p]
-            for j in range(1, len(q) - 1):
-                a, b, d = q[0], q[j], q[j + 1]
-                v += (a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) +
-                      a[2] * (b[0] * d[1] - b[1] * d[0])) / 6
-        s = int(site[c])
-        worst = max(worst, abs(v - want[s]) / want[s], abs(vol[c] - want[s]) / want[s])
+        worst = max(worst, abs(v - want[s]) / want[s], abs(va - want[s]) / want[s])
     print("polyhedra: %d VTK polyhedra read back; volumes from their faces against %%v: worst "
-          "%.1e" % (g.GetNumberOfCells(), worst))
+          "%.1e" % (len(got), worst))
     if worst > 1e-10:
         fail("cells.vtu: a polyhedron's volume is off by %.3g" % worst)
 
