@@ -130,10 +130,11 @@ static inline void push_face(fdt_cell *c, int start, long label)
  * vertices and a crossing an edge (a convex face keeps at most one more
  * than it had, but a cut among vertices closer than their rounding can
  * cross a face's edges several times before cut_tol finds it not convex),
- * the cap's one a face, and the faces at most one more. 0 or -1. */
+ * the cap's one a face and one more before an open chain stops it, and
+ * the faces at most one more. 0 or -1. */
 static int room_for_cut(fdt_cell *c)
 {
-    return grow(&c->tring, &c->captring, 2 * c->nring + c->nf, sizeof(int)) ||
+    return grow(&c->tring, &c->captring, 2 * c->nring + c->nf + 1, sizeof(int)) ||
                    grow(&c->tf, &c->captf, c->nf + 1, sizeof *c->tf)
                ? -1
                : 0;
