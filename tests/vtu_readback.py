@@ -20,8 +20,9 @@ duplicate included; the tets are exactly the .tets set, none twice; every
 tet is positively oriented (exact integer arithmetic); VTK's cells are all
 VTK_TETRA. (.fdtb has no outside reader: tests/stream_readback.py reads it
 with README.md's reader; the OpenFOAM polyMesh: tests/formats_readback.sh.)
-A periodic mesh (--periodic x,z) laid out in .vtu, .vtk and both .msh: its
-image vertices after the input points, each with its input_id; the tets
+A periodic mesh (--periodic x,z) laid out in .vtu, .vtk, both .msh and .mesh:
+its image vertices after the input points, each with its input_id (Medit's
+vertex reference); the tets
 mapped back equal the .tets rows (periodic(), below).
 Each reader missing is said and skipped; exit 77 (meson's "skipped") when
 neither is installed.
@@ -255,13 +256,13 @@ def point_src(who, path):
         a = reader.GetOutput().GetPointData().GetArray("input_id")
         return None if a is None else [int(a.GetValue(i)) for i in range(a.GetNumberOfTuples())]
     m = meshio.read(path)
-    a = m.point_data.get("input_id")
+    a = m.point_data.get("medit:ref" if path.endswith(".mesh") else "input_id")
     return None if a is None else [int(v) for v in a.reshape(-1).tolist()]
 
 
 def periodic(frontdt, d, checked):
     """A channel periodic in x and z (walls of grid points across y) laid
-    out in .vtu, .vtk and .msh: the input points first, bit-exact; each
+    out in .vtu, .vtk, .msh and .mesh: the input points first, bit-exact; each
     other point an image of the input point its input_id names (that
     point moved by whole periods along x and z); every tet positively
     oriented, and mapped back to (input ids, offsets) the .tets rows; the
@@ -280,7 +281,8 @@ def periodic(frontdt, d, checked):
     out = lambda name: os.path.join(d, name)
     r = subprocess.run([frontdt, inp, "--quiet", "--periodic", "x,z", "--box", "0,0,0,1,1,1",
                         "-o", out("p.tets"), "-o", out("p.vtu"), "-o", out("p.vtk"),
-                        "-o", out("p.msh"), "--format", "msh2", "-o", out("p2.msh")],
+                        "-o", out("p.msh"), "--format", "msh2", "-o", out("p2.msh"),
+                        "-o", out("p.mesh")],
                        capture_output=True, text=True, timeout=300)
     if r.returncode != 0:
         return ["frontdt --periodic: exit %d: %s" % (r.returncode, r.stderr)]
@@ -289,7 +291,8 @@ def periodic(frontdt, d, checked):
         v = [int(x) for x in line.split()]
         rows.add((tuple(v[:4]), tuple(v[4:])))
     fails = []
-    names = {"vtk": ["p.vtu", "p.vtk"], "meshio": ["p.vtu", "p.vtk", "p.msh", "p2.msh"]}
+    names = {"vtk": ["p.vtu", "p.vtk"],
+             "meshio": ["p.vtu", "p.vtk", "p.msh", "p2.msh", "p.mesh"]}
     readers = {"vtk": read_vtk if vtk else None, "meshio": read_meshio if meshio else None}
     for who, files in names.items():
         if readers[who] is None:

@@ -1,7 +1,9 @@
 /*
  * Medit .mesh (src/io/write/formats.h), ASCII, as MMG and meshio read it: every
  * input point (reference 0), the tets (reference 1) and the outward hull
- * triangles (reference 1), 1-based.
+ * triangles (reference 1), 1-based. A periodic mesh laid out in space
+ * (writer.c): each point's reference is its input id (an image vertex's,
+ * the point it is an image of), as the other laid-out formats' input_id.
  */
 #include "io/write/formats.h"
 
@@ -34,7 +36,8 @@ int fdt_put_medit(out_file *o, const fdt_mesh_view *m, const void *prep, char *e
             out_double(o, m->xyz[3 * i + (size_t)c]);
             out_char(o, ' ');
         }
-        out_str(o, "0\n");
+        out_i64(o, m->point_src ? (int64_t)m->point_src[i] : 0);
+        out_char(o, '\n');
     }
     put_block(o, "\nTetrahedra\n", m->tets, m->n_tets, 4);
     put_block(o, "\nTriangles\n", m->hull, m->n_hull, 3);

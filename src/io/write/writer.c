@@ -1647,7 +1647,7 @@ int fdt_default_write_options_sized(fdt_write_options *o, size_t struct_size)
  * vertices as points, each with its input id (fdt_periodic_unfold). */
 static int periodic_laid_out(const fdt_format *f)
 {
-    static const char *const names[] = {"vtu", "vtk", "msh", "msh2"};
+    static const char *const names[] = {"vtu", "vtk", "msh", "msh2", "medit"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (!strcmp(f->name, names[i]))
             return 1;
@@ -1728,8 +1728,8 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
      * with its image vertices and their input ids (periodic_laid_out) */
     int laid_out = r->tet_off && periodic_laid_out(f);
     if (r->tet_off && !fdt_format_periodic(f)) {
-        snprintf(what, sizeof what, "a periodic mesh is written as .tets, .fdtb, .vtu, .vtk "
-                 "or .msh (format %s has no place for its image vertices' input ids)", f->name);
+        snprintf(what, sizeof what, "a periodic mesh is written as .tets, .fdtb, .vtu, .vtk, "
+                 ".msh or .mesh (format %s has no place for its image vertices' input ids)", f->name);
         return set_err(diag, diag_size, FDT_EINVAL, name, what);
     }
     int needs = fdt_format_needs(f, o->all_faces);
