@@ -826,32 +826,39 @@ static int job_adjacency(vjob *j)
     j->adj = malloc(cap * sizeof *j->adj);
     for (size_t x = 0; x < k && j->adj; x++) {
         uint32_t l = j->lo + (uint32_t)x;
-        size_t b = j->adj_start[x] = o;
-        for (size_t c = x ? ts[x - 1] : 0; c < ts[x] && j->adj; c++) {
+        size_t b = j->adj_start[x] = o, c0 = x ? ts[x - 1] : 0;
+        /* room for every other point of its tets first: no test an entry */
+        size_t most = o + 3 * (ts[x] - c0);
+        if (most > cap) {
+            while (cap < most)
+                cap *= 2;
+            uint32_t *nq = realloc(j->adj, cap * sizeof *nq);
+            if (!nq) {
+                free(j->adj);
+                j->adj = NULL;
+                break;
+            }
+            j->adj = nq;
+        }
+        uint32_t *adj = j->adj;
+        /* the point itself marked seen: its tets' other points only */
+        seen[l / 64] |= UINT64_C(1) << (l % 64);
+        for (size_t c = c0; c < ts[x]; c++) {
             const uint32_t *tv = w->tets + 4 * (size_t)inc[c];
             for (int q = 0; q < 4; q++) {
                 uint32_t u = tv[q];
-                if (u == l || (seen[u / 64] >> (u % 64) & 1))
+                if (seen[u / 64] >> (u % 64) & 1)
                     continue;
                 seen[u / 64] |= UINT64_C(1) << (u % 64);
-                if (o == cap) {
-                    uint32_t *nq = realloc(j->adj, 2 * cap * sizeof *nq);
-                    if (!nq) {
-                        free(j->adj);
-                        j->adj = NULL;
-                        break;
-                    }
-                    j->adj = nq;
-                    cap *= 2;
-                }
                 size_t y = o++; /* ascending: insertion, about 15 */
-                for (; y > b && j->adj[y - 1] > u; y--)
-                    j->adj[y] = j->adj[y - 1];
-                j->adj[y] = u;
+                for (; y > b && adj[y - 1] > u; y--)
+                    adj[y] = adj[y - 1];
+                adj[y] = u;
             }
         }
-        for (size_t e = b; e < o && j->adj; e++)
-            seen[j->adj[e] / 64] = 0;
+        seen[l / 64] = 0;
+        for (size_t e = b; e < o; e++)
+            seen[adj[e] / 64] = 0;
     }
     j->adj_start[k] = o;
     free(ts);
