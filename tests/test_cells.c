@@ -177,6 +177,7 @@ int main(void)
     EXPECT(fdt_cells_table_skip("%v %%c", 0, 1) == FDT_CELLS_NO_CENTROIDS);
     EXPECT(fdt_cells_table_skip(NULL, 1, 0) == 0);
     EXPECT(fdt_cells_table_skip(NULL, 0, 1) == FDT_CELLS_NO_CENTROIDS);
+    EXPECT(fdt_cells_table_skip("%c %", 0, 0) == FDT_CELLS_NO_DENSITIES);
     o.skip = fdt_cells_table_skip("%i %v %F %s %n %f", 0, 0);
     fdt_voronoi *lean = NULL;
     CHECK_EQ(fdt_voronoi_compute(r, xyz, n, &o, &lean, NULL, 0), FDT_OK);

@@ -43,8 +43,10 @@ unsigned fdt_cells_table_skip(const char *fmt, int csv, int density)
 {
     unsigned skip = csv ? 0 : FDT_CELLS_NO_CENTROIDS | FDT_CELLS_NO_DENSITIES;
     for (const char *p = csv ? NULL : fmt; p && *p; p++) {
-        if (*p != '%' || !*++p)
+        if (*p != '%')
             continue;
+        if (!*++p)
+            break; /* a '%' that ends the format (fdt_cells_format_check refuses it) */
         if (*p == 'c' || *p == 'C')
             skip &= ~FDT_CELLS_NO_CENTROIDS;
         if (*p == 'd')
