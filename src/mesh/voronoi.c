@@ -1937,22 +1937,18 @@ int fdt_voronoi_polyhedron(fdt_voronoi *v, const double *xyz, fdt_vid i, size_t 
         lo[k] = v->box[k] - p[k];
         hi[k] = v->box[k + 3] - p[k];
     }
-    if (v->periodic) /* the cell of p among its own images, on those axes */
-        for (int k = 0; k < 3; k++)
-            if (v->period[k] > 0) {
-                lo[k] = -0.5 * v->period[k];
-                hi[k] = 0.5 * v->period[k];
-            }
+    for (int k = 0; k < 3; k++) /* on a periodic axis: the cell of p among its own images */
+        if (v->period[k] > 0) {
+            lo[k] = -0.5 * v->period[k];
+            hi[k] = 0.5 * v->period[k];
+        }
     if (fdt_cell_box(&v->poly, lo, hi))
         return FDT_ENOMEM;
     for (size_t e = v->nstart[i]; e < v->nstart[i + 1]; e++) {
         if (v->nid[e] < 0)
             continue; /* a wall: the box has it */
-        double nrm[3];
-        if (v->periodic)
-            nearest_image(v, p, xyz + 3 * (size_t)v->nid[e], nrm);
-        else
-            sub3(xyz + 3 * (size_t)v->nid[e], p, nrm);
+        double nrm[3]; /* q - p itself where no axis is periodic */
+        nearest_image(v, p, xyz + 3 * (size_t)v->nid[e], nrm);
         int got = fdt_cell_cut(&v->poly, nrm, 0.5 * dot3(nrm, nrm), v->nid[e]);
         if (got == -1)
             return FDT_ENOMEM;
