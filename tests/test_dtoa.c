@@ -3,7 +3,7 @@
  * for byte:
  *  - zeros of both signs, infinities, NaN, the extremes (subnormals, the
  *    largest double);
- *  - powers of ten and their neighbours one ulp either side, where the
+ *  - powers of ten and their neighbours three ulps either side, where the
  *    decimal exponent and the %g layout change (1e-5 / 1e-4, 1e16 / 1e17)
  *    and where rounding carries into a new digit (0.99999999999999999...);
  *  - a million doubles of random significands at every exponent of the
@@ -55,11 +55,17 @@ int main(void)
         same(-specials[i]);
     }
     for (int p = -30; p <= 50; p++) {
-        double x = pow(10, p);
+        /* three ulps either side: dtoa.c's first guess of the exponent
+         * compares with the nearest double of each power */
+        double x = pow(10, p), lo = x, hi = x;
         same(x);
-        same(nextafter(x, 0));
-        same(nextafter(x, INFINITY));
-        same(-nextafter(x, INFINITY));
+        for (int u = 0; u < 3; u++) {
+            lo = nextafter(lo, 0);
+            hi = nextafter(hi, INFINITY);
+            same(lo);
+            same(hi);
+            same(-hi);
+        }
     }
     for (int i = 0; i < 1000000; i++) {
         int ex = (int)(next() % 200) - 100; /* 2^-100 .. 2^100 */

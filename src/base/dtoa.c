@@ -35,6 +35,15 @@ static const uint64_t pow5[28] = {
     UINT64_C(59604644775390625), UINT64_C(298023223876953125),
     UINT64_C(1490116119384765625), UINT64_C(7450580596923828125)};
 
+/* 10^j for j in [POW10_LOW, 44], as doubles (rounded outside [0, 22]):
+ * the next power above every x the exact path takes, [1e-11, 1e43). */
+#define POW10_LOW 11
+static const double tens[] = {
+    1e-11, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1e0, 1e1, 1e2, 1e3,
+    1e4,   1e5,   1e6,  1e7,  1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18,
+    1e19,  1e20,  1e21, 1e22, 1e23, 1e24, 1e25, 1e26, 1e27, 1e28, 1e29, 1e30, 1e31, 1e32, 1e33,
+    1e34,  1e35,  1e36, 1e37, 1e38, 1e39, 1e40, 1e41, 1e42, 1e43, 1e44};
+
 #define TEN16 UINT64_C(10000000000000000)
 #define TEN17 UINT64_C(100000000000000000)
 
@@ -82,7 +91,7 @@ static const char pairs[201] =
  * independent halves (digit by digit, D's 17 divisions by ten were one
  * chain: 5 % of a --voronoi run's samples at 1M points, bench/NOTES.md
  * entry 112). */
-static void digits8(char *p, uint32_t v)
+static inline void digits8(char *p, uint32_t v)
 {
     uint32_t a = v / 10000, b = v % 10000;
     memcpy(p, pairs + 2 * (a / 100), 2);
@@ -92,7 +101,7 @@ static void digits8(char *p, uint32_t v)
 }
 
 /* D's 17 digits at p (D < 10^17). */
-static void digits17(char *p, uint64_t d)
+static inline void digits17(char *p, uint64_t d)
 {
     uint64_t hi = d / 100000000;
     uint32_t lo = (uint32_t)(d % 100000000);
@@ -160,8 +169,16 @@ static size_t fast(char *p, double x)
         return 0;
     uint64_t m = (b & ((UINT64_C(1) << 52) - 1)) | UINT64_C(1) << 52;
     int e = (int)((b >> 52) & 0x7ff) - 1075;
-    /* floor((e + 52) log10 2): low by at most one */
-    int est = (int)floor((e + 52) * 0.30102999566398120);
+    /* floor((e + 52) log10 2) as 78913 / 2^18 (exact for |e + 52| < 1650;
+     * baseline x86-64 has no rounding instruction, so floor() was a dozen
+     * SSE2 operations), low by at most one; then raised where x is above
+     * the next power of ten's nearest double, so above the power itself
+     * (the next double up from a rounded power is past it): never too
+     * high, which the correction below could not see (a D rounded up to
+     * 10^16 from a lower exponent reads as a valid D). One computation of
+     * D instead of two on about a third of the numbers. */
+    int est = ((e + 52) * 78913) >> 18;
+    est += ax > tens[est + 1 + POW10_LOW];
     int k = 16 - est;
     if (k < -27 || k > 27)
         return 0;
