@@ -386,7 +386,18 @@ def errors():
                 "--memory-limit", "40M", "-q")
     expect(r.returncode == 0 and os.path.exists(out),
            "--stream --memory-limit 40M: exit %d, %s" % (r.returncode, r.stderr))
-    print("errors: outside the box, too few points, usage, --memory-limit")
+    # a torus periodic in x and z has tets that join two images of a point:
+    # the error names the same one (the least) on any threads, streamed too
+    write_points(src, family("torus", 3000))
+    said = set()
+    for extra in (["-t", "1"], ["-t", "3"], ["-t", "3"], ["-t", "2", "--stream"]):
+        r = frontdt(src, "--periodic", "xz", "--box", "0,0,0,1,1,1", "--set-hash", *extra)
+        expect(r.returncode == 2 and "two images of point" in r.stderr,
+               "torus x z %s: exit %d, %s" % (extra, r.returncode, r.stderr))
+        said.add(r.stderr)
+    expect(len(said) == 1, "torus x z: the errors differ: %r" % sorted(said))
+    print("errors: outside the box, too few points, usage, --memory-limit, the same repeated "
+          "point on any threads")
 
 
 def main():
