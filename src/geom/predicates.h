@@ -265,8 +265,8 @@ void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double 
  * (and, likewise, the amount by which perm may fall short) is at most
  *   U = 2 eta (1+eps)^4 su' + 3 eta (1+eps)^2,  su' = |ux|+|uy|+|uz|
  * (exact sum of the computed magnitudes; su' <= (1+3eps) su). We require
- * perm >= 2^-800 and fl(su 2^-980) <= perm. Scaling by 2^-980 is exact
- * unless su < 2^-42 (and then U < 2^-1070 anyway); otherwise
+ * perm >= 2^-800 and su < 2^-42 or fl(su 2^-980) <= perm. If su < 2^-42
+ * then U < 2^-1070 anyway; otherwise scaling by 2^-980 is exact and
  * su <= 2^980 perm and U <= 2^-93 perm + 2^-1071 <= 2^-92 perm.
  *
  * Together: |det_computed - det| <= gamma8 P + U and
@@ -295,7 +295,9 @@ static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
     const double perm = aux * (fabs(vywz) + fabs(vzwy)) + auy * (fabs(vzwx) + fabs(vxwz)) +
                         auz * (fabs(vxwy) + fabs(vywx));
     const double su = aux + auy + auz;
-    if (perm >= 0x1p-800 && perm <= DBL_MAX && su * 0x1p-980 <= perm) {
+    /* su < 2^-42 passes without the product, which would be subnormal
+     * (a microcode assist of about a hundred cycles) and at most perm */
+    if (perm >= 0x1p-800 && perm <= DBL_MAX && (su < 0x1p-42 || su * 0x1p-980 <= perm)) {
         const double bound = FDT_O3D_ERRBOUND * perm;
         /* Branch-free: the sign itself is a coin flip on typical input,
          * whether it is certain is nearly always yes. */
@@ -357,7 +359,7 @@ static inline int fdt_orient3d_filter(const double *a, const double *b,
  * 10M^3 (their 3x3 minor); 4 outer products times 1; with (1+eps)^8 of
  * rounding: U <= 1.01 eta (216 M^3 + 48 M^2 + 4) <= 2^-1066 (M^4 + 1).
  * L = sum of the four computed lifts has M^2 <= 1.01 L + 2^-1070, and we
- * require perm >= 2^-800 and fl(L fl(L 2^-960)) <= perm: an overflow gives
+ * require perm >= 2^-800 and L < 2^-31 or fl(L fl(L 2^-960)) <= perm: an overflow gives
  * inf and fails; if L < 2^-31 then M < 1 and U <= 2^-1065; otherwise
  * L 2^-960 is exact, the product is not subnormal, and
  * L^2 <= (1+eps) 2^960 perm. So U <= 2^-1066 (1.03 * 2^960 perm + 2)
@@ -412,7 +414,12 @@ static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
     const double perm = (dlift * abcP + clift * dabP) + (blift * cdaP + alift * bcdP);
 
     const double lsum = (alift + blift) + (clift + dlift);
-    if (perm >= 0x1p-800 && perm <= DBL_MAX && lsum * (lsum * 0x1p-960) <= perm) {
+    /* L < 2^-31 passes without the products, whose result would be
+     * subnormal and at most perm: on a dense scan (points 1e-5 apart) that
+     * assist, about a hundred cycles a test, was 46 % of the insertion's
+     * conflict tests (bench/NOTES.md entry 116) */
+    if (perm >= 0x1p-800 && perm <= DBL_MAX &&
+        (lsum < 0x1p-31 || lsum * (lsum * 0x1p-960) <= perm)) {
         const double bound = FDT_ISP_ERRBOUND * perm;
         const int s = (det < -bound) - (det > bound);
         if (s != 0)
