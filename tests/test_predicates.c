@@ -592,6 +592,30 @@ static void fam_cospherical(tctx *T, double (*p)[3])
     const double *shift = e == -12 ? big : (irand(T, 0, 1) ? none : small);
     gen_cospherical(T, &S, p, shift, e);
 }
+/* The same spheres scaled by up to 2^19 and shifted by up to 2^22 (still
+ * integers): differences up to about 2^23, past stage G's doubles and
+ * within stage I's 128-bit integers; a third of the cases one coordinate
+ * moved by 1 (near-cospherical, exact nonzero), and a few 2^12 times
+ * coarser (past stage I: stage B). */
+static void fam_cospherical_wide(tctx *T, double (*p)[3])
+{
+    static const int r2[] = {50, 75};
+    sphere_set S;
+    make_sphere(&S, r2[irand(T, 0, 1)]);
+    const double none[3] = {0, 0, 0};
+    gen_cospherical(T, &S, p, none, 0);
+    double lambda = (double)irand(T, 1L << 10, 1L << 19);
+    if (irand(T, 0, 9) == 0)
+        lambda *= 4096;
+    double shift[3];
+    for (int k = 0; k < 3; k++)
+        shift[k] = (double)irand(T, -(1L << 22), 1L << 22);
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            p[i][k] = p[i][k] * lambda + shift[k];
+    if (irand(T, 0, 2) == 0)
+        p[irand(T, 0, 4)][irand(T, 0, 2)] += irand(T, 0, 1) ? 1 : -1;
+}
 /* Magnitudes near 1e-150 and 1e150, rounded and exact scalings. */
 static void fam_near_coplanar_scaled(tctx *T, double (*p)[3])
 {
@@ -632,6 +656,7 @@ static const family families[] = {
     {"offset-lattice", fam_offset_lattice, 6000},
     {"offset", fam_offset, 6000},
     {"cospherical", fam_cospherical, 3000},
+    {"cospherical-wide", fam_cospherical_wide, 3000},
     {"near-coplanar-scaled", fam_near_coplanar_scaled, 2000},
     {"near-cospherical-scaled", fam_near_cospherical_scaled, 2000},
     {"lattice-scaled", fam_lattice_scaled, 2000},

@@ -383,8 +383,10 @@ void fdt_mpz_det3(mpz_t r, mpz_t *const u, mpz_t *const v, mpz_t *const w, mpz_t
  */
 
 /* The exponent of the lowest set bit over the nonzero coordinates, or
- * INT_MAX if all are 0. */
-static int grid_exponent(const double *const *pts, int npts)
+ * INT_MAX if all are 0; INT_MIN as soon as one is below floor (no grid
+ * stage can take the call: most calls on data off any coarse grid end
+ * at the first coordinate). */
+static int grid_exponent(const double *const *pts, int npts, int floor)
 {
     int k = INT_MAX;
     for (int i = 0; i < npts; i++)
@@ -395,6 +397,8 @@ static int grid_exponent(const double *const *pts, int npts)
             int e;
             uint64_t m = int_mantissa(x, &e);
             e += fdt_ctz64(m);
+            if (e < floor)
+                return INT_MIN;
             if (e < k)
                 k = e;
         }
@@ -414,19 +418,118 @@ static double max_diff(const double *const *p, int n, const double *q, double (*
     return mx;
 }
 
+/* ------------------------------------------------------------------ */
+/* Stage I: the same grid in 128-bit integers, for the coarser grids that
+ * stage G's doubles cannot hold.
+ *
+ * With 2^k and the differences as in stage G, and M = the largest rounded
+ * difference / 2^k at most L (below 2^53), every exact difference is an
+ * integer multiple of 2^k below 2^53 2^k, so the rounded differences are
+ * exact and r 2^-k are integers of at most L (the scaling by a power of
+ * two is exact: its result is that integer). The determinants are then
+ * evaluated exactly in integers, bounded as in stage G:
+ *   orient3d: products M^2, minors 2M^2, terms 2M^3, det 6M^3; L = 2^40
+ *     gives 6 2^120 < 2^123.
+ *   insphere: minors 2M^2 (int64 for M <= 2^24), 3x3 minors 6M^3, lifts
+ *     3M^2, lift * minor 18M^5, det 72M^5; L = 2^24 gives 72 2^120 <
+ *     2^127.
+ * Integer data on a coarse grid (a sphere of integer points, whose every
+ * insphere test of five of its points is an exact 0: bench/NOTES.md entry
+ * 116) then costs a few dozen integer products instead of stage B's
+ * expansions. Without a 128-bit type the call goes on to stage B or C. */
+#if defined(__SIZEOF_INT128__)
+typedef __int128 i128;
+
+/* The n rows of r in units of 2^k as integers, when each is at most L:
+ * 1, else 0 (2^-k not a normal double, or a row too long). */
+static int grid_ints(const double (*r)[3], int n, int k, double mx, double L, int64_t (*z)[3])
+{
+    if (k < -1022 || k > 1022 || !(mx <= ldexp(L, k)))
+        return 0;
+    const double s = ldexp(1.0, -k);
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < 3; j++)
+            z[i][j] = (int64_t)(r[i][j] * s);
+    return 1;
+}
+
+static int orient_stage_i(const double (*r)[3], int k, double mx)
+{
+    int64_t z[3][3];
+    if (!grid_ints(r, 3, k, mx, 0x1p40, z))
+        return FDT_PRED_UNSURE;
+    const int64_t *u = z[0], *v = z[1], *w = z[2];
+    const i128 det = u[0] * ((i128)v[1] * w[2] - (i128)v[2] * w[1]) +
+                     u[1] * ((i128)v[2] * w[0] - (i128)v[0] * w[2]) +
+                     u[2] * ((i128)v[0] * w[1] - (i128)v[1] * w[0]);
+    return (det > 0) - (det < 0);
+}
+
+static int insphere_stage_i(const double (*r)[3], int k, double mx)
+{
+    int64_t z[4][3];
+    if (!grid_ints(r, 4, k, mx, 0x1p24, z))
+        return FDT_PRED_UNSURE;
+    const int64_t *A = z[0], *B = z[1], *C = z[2], *D = z[3];
+    const int64_t ab = A[0] * B[1] - B[0] * A[1], bc = B[0] * C[1] - C[0] * B[1];
+    const int64_t cd = C[0] * D[1] - D[0] * C[1], da = D[0] * A[1] - A[0] * D[1];
+    const int64_t ac = A[0] * C[1] - C[0] * A[1], bd = B[0] * D[1] - D[0] * B[1];
+    const i128 abc = (i128)A[2] * bc - (i128)B[2] * ac + (i128)C[2] * ab;
+    const i128 bcd = (i128)B[2] * cd - (i128)C[2] * bd + (i128)D[2] * bc;
+    const i128 cda = (i128)C[2] * da + (i128)D[2] * ac + (i128)A[2] * cd;
+    const i128 dab = (i128)D[2] * ab + (i128)A[2] * bd + (i128)B[2] * da;
+    const int64_t al = A[0] * A[0] + A[1] * A[1] + A[2] * A[2];
+    const int64_t bl = B[0] * B[0] + B[1] * B[1] + B[2] * B[2];
+    const int64_t cl = C[0] * C[0] + C[1] * C[1] + C[2] * C[2];
+    const int64_t dl = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+    const i128 det = (dl * abc - cl * dab) + (bl * cda - al * bcd);
+    return (det < 0) - (det > 0);
+}
+#else
+static int orient_stage_i(const double (*r)[3], int k, double mx)
+{
+    (void)r, (void)k, (void)mx;
+    return FDT_PRED_UNSURE;
+}
+
+static int insphere_stage_i(const double (*r)[3], int k, double mx)
+{
+    (void)r, (void)k, (void)mx;
+    return FDT_PRED_UNSURE;
+}
+#endif
+
+/* Whether p's coordinates could lie on a grid stage I can take: each
+ * nonzero one with at most 41 significant bits (its integer mantissa's
+ * lowest 12 bits 0). A gate, not a proof: the stages check for
+ * themselves. Data off any coarse grid (random doubles, decimal scans)
+ * fails at the first coordinate, where the stages' differences and
+ * exponents cost 3 % of a pipe scan's instructions (bench/NOTES.md
+ * entry 116). */
+static inline bool grid_likely(const double *p)
+{
+    for (int k = 0; k < 3; k++) {
+        int e;
+        if (p[k] != 0.0 && (int_mantissa(p[k], &e) & 0xfff) != 0)
+            return false;
+    }
+    return true;
+}
+
 /* The exact orient3d sign when stage G applies (see above), else
  * FDT_PRED_UNSURE. */
 static int orient_stage_g(const double *a, const double *b, const double *c, const double *d)
 {
     const double *const pts[4] = {a, b, c, d};
-    int k = grid_exponent(pts, 4);
-    if (k == INT_MAX)
-        return 0; /* four times the origin */
-    if (k < -358 || k > 307)
-        return FDT_PRED_UNSURE;
     double r[3][3];
-    if (!(max_diff(pts + 1, 3, a, r) <= ldexp(0x1p16, k)))
+    const double mx = max_diff(pts + 1, 3, a, r);
+    if (!(mx > 0.0 && mx <= DBL_MAX))
+        return FDT_PRED_UNSURE; /* four equal points (stage B: 0), or past doubles */
+    int k = grid_exponent(pts, 4, ilogb(mx) - 40);
+    if (k == INT_MIN || k == INT_MAX)
         return FDT_PRED_UNSURE;
+    if (k < -358 || k > 307 || !(mx <= ldexp(0x1p16, k)))
+        return orient_stage_i(r, k, mx);
     const double *u = r[0], *v = r[1], *w = r[2];
     double det = u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2]) +
                  u[2] * (v[0] * w[1] - v[1] * w[0]);
@@ -458,12 +561,15 @@ static int insphere_stage_g(const double *a, const double *b, const double *c,
                             const double *d, const double *e)
 {
     const double *const pts[5] = {a, b, c, d, e};
-    int k = grid_exponent(pts, 5);
-    if (k == INT_MAX || k < -214 || k > 183)
-        return FDT_PRED_UNSURE; /* all zero: distinctness is broken; let B decide */
     double r[4][3];
-    if (!(max_diff(pts, 4, e, r) <= ldexp(0x1p9, k)))
+    const double mx = max_diff(pts, 4, e, r);
+    if (!(mx > 0.0 && mx <= DBL_MAX))
+        return FDT_PRED_UNSURE; /* five equal points: distinctness is broken; let B decide */
+    int k = grid_exponent(pts, 5, ilogb(mx) - 24);
+    if (k == INT_MIN || k == INT_MAX)
         return FDT_PRED_UNSURE;
+    if (k < -214 || k > 183 || !(mx <= ldexp(0x1p9, k)))
+        return insphere_stage_i(r, k, mx);
     const double det = fdt_insphere_det4(r[0], r[1], r[2], r[3]);
     return (det < 0.0) - (det > 0.0);
 }
@@ -1102,6 +1208,14 @@ int fdt_orient3d(const double *a, const double *b, const double *c,
     s = orient3d_filter_rescaled(a, b, c, d);
     if (s != FDT_PRED_UNSURE)
         return s;
+    /* On a binary grid the exact sign is a few products away: before the
+     * adaptive stage, which can only defer an exact 0 */
+    s = grid_likely(a) ? orient_stage_g(a, b, c, d) : FDT_PRED_UNSURE;
+    if (s != FDT_PRED_UNSURE) {
+        if (cnt)
+            cnt->orient_exact++;
+        return s;
+    }
     s = fdt_orient3d_adapt(a, b, c, d);
     if (s != FDT_PRED_UNSURE) {
         if (cnt)
@@ -1292,6 +1406,15 @@ int fdt_insphere(const double *a, const double *b, const double *c,
     s = insphere_filter_rescaled(a, b, c, d, e);
     if (s != FDT_PRED_UNSURE)
         return s;
+    /* On a binary grid the exact sign is a few products away: before the
+     * adaptive stage, which can only defer an exact 0 (a sphere of integer
+     * points: every test of five of its points; bench/NOTES.md entry 116) */
+    s = grid_likely(e) ? insphere_stage_g(a, b, c, d, e) : FDT_PRED_UNSURE;
+    if (s != FDT_PRED_UNSURE) {
+        if (cnt)
+            cnt->insphere_exact++;
+        return s;
+    }
     s = fdt_insphere_adapt(a, b, c, d, e);
     if (s != FDT_PRED_UNSURE) {
         if (cnt)
