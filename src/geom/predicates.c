@@ -453,11 +453,162 @@ static int grid_ints(const double (*r)[3], int n, int k, double mx, double L, in
     return 1;
 }
 
+/*
+ * Stage W: the same integers up to 2^52 grid units, the most for which
+ * stage G's argument makes the rounded differences exact (computed CFD
+ * grid nodes, decimal scans: most data stage B would take), in five
+ * 64-bit limbs. Bounds: 2x2 minors below 2^105 (i128), 3x3 minors below
+ * 3 2^157, lifts below 3 2^104, lift * minor below 2^265, insphere's det
+ * below 2^267 and orient3d's below 2^160: all within 320 bits, two's
+ * complement (the products below allow more). Stage B's expansions took
+ * 41 % of a wind-tunnel grid's run (bench/NOTES.md entry 116).
+ */
+#define WL 5
+typedef struct wide {
+    uint64_t w[WL]; /* little-endian limbs, two's complement */
+} wide;
+typedef unsigned __int128 u128w;
+
+static int wide_neg_p(const wide *x)
+{
+    return (x->w[WL - 1] >> 63) != 0;
+}
+
+static void wide_negate(wide *x)
+{
+    uint64_t carry = 1;
+    for (int i = 0; i < WL; i++) {
+        const uint64_t v = ~x->w[i];
+        x->w[i] = v + carry;
+        carry = carry && x->w[i] == 0;
+    }
+}
+
+/* a + b (sub: a - b), modulo 2^320: exact within the bounds above. */
+static wide wide_add(const wide *a, const wide *b, int sub)
+{
+    wide r;
+    u128w c = sub;
+    for (int i = 0; i < WL; i++) {
+        c += (u128w)a->w[i] + (sub ? ~b->w[i] : b->w[i]);
+        r.w[i] = (uint64_t)c;
+        c >>= 64;
+    }
+    return r;
+}
+
+/* |x| for x within the bounds above (never -2^319). */
+static wide wide_abs(wide x, int *neg)
+{
+    *neg = wide_neg_p(&x);
+    if (*neg)
+        wide_negate(&x);
+    return x;
+}
+
+/* a b for |a| < 2^63, |b| < 2^127: two products of limbs. */
+static wide wide_mul_64(int64_t a, i128 b)
+{
+    const int neg = (a < 0) != (b < 0);
+    const uint64_t ma = a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a;
+    const u128w mb = b < 0 ? (u128w)0 - (u128w)b : (u128w)b;
+    const u128w p0 = (u128w)ma * (uint64_t)mb, p1 = (u128w)ma * (uint64_t)(mb >> 64);
+    const u128w mid = (p0 >> 64) + (uint64_t)p1;
+    wide r = {{(uint64_t)p0, (uint64_t)mid, (uint64_t)((p1 >> 64) + (mid >> 64)), 0, 0}};
+    if (neg)
+        wide_negate(&r);
+    return r;
+}
+
+/* a b for 0 <= a < 2^127 and |b| < 2^192 (its top two limbs the sign's):
+ * six products of limbs, the sum below 2^319 by the bounds above. */
+static wide wide_mul_128(i128 a, wide b)
+{
+    int neg;
+    b = wide_abs(b, &neg);
+    const uint64_t a0 = (uint64_t)a, a1 = (uint64_t)((u128w)a >> 64);
+    wide r = {{0}};
+    for (int i = 0; i < 2; i++) {
+        const uint64_t ai = i ? a1 : a0;
+        u128w c = 0;
+        for (int j = 0; j < 3; j++) {
+            c += (u128w)ai * b.w[j] + r.w[i + j];
+            r.w[i + j] = (uint64_t)c;
+            c >>= 64;
+        }
+        r.w[i + 3] += (uint64_t)c;
+    }
+    if (neg)
+        wide_negate(&r);
+    return r;
+}
+
+static int wide_sign(const wide *x)
+{
+    if (wide_neg_p(x))
+        return -1;
+    for (int i = 0; i < WL; i++)
+        if (x->w[i])
+            return 1;
+    return 0;
+}
+
+static int orient_stage_w(const double (*r)[3], int k, double mx)
+{
+    int64_t z[3][3];
+    if (!grid_ints(r, 3, k, mx, 0x1p52, z))
+        return FDT_PRED_UNSURE;
+    const int64_t *u = z[0], *v = z[1], *w = z[2];
+    const i128 m0 = (i128)v[1] * w[2] - (i128)v[2] * w[1];
+    const i128 m1 = (i128)v[2] * w[0] - (i128)v[0] * w[2];
+    const i128 m2 = (i128)v[0] * w[1] - (i128)v[1] * w[0];
+    const wide t0 = wide_mul_64(u[0], m0), t1 = wide_mul_64(u[1], m1), t2 = wide_mul_64(u[2], m2);
+    const wide s01 = wide_add(&t0, &t1, 0), det = wide_add(&s01, &t2, 0);
+    return wide_sign(&det);
+}
+
+/* The 3x3 minor x2 yz - y2 xz + z2 xy of insphere (x, y, z the rows'
+ * third coordinates, yz ... their 2x2 minors). */
+static wide minor3(int64_t x2, i128 yz, int64_t y2, i128 xz, int64_t z2, i128 xy)
+{
+    const wide a = wide_mul_64(x2, yz), b = wide_mul_64(y2, xz), c = wide_mul_64(z2, xy);
+    const wide ab = wide_add(&a, &b, 1);
+    return wide_add(&ab, &c, 0);
+}
+
+static int insphere_stage_w(const double (*r)[3], int k, double mx)
+{
+    int64_t z[4][3];
+    if (!grid_ints(r, 4, k, mx, 0x1p52, z))
+        return FDT_PRED_UNSURE;
+    const int64_t *A = z[0], *B = z[1], *C = z[2], *D = z[3];
+    const i128 ab = (i128)A[0] * B[1] - (i128)B[0] * A[1];
+    const i128 bc = (i128)B[0] * C[1] - (i128)C[0] * B[1];
+    const i128 cd = (i128)C[0] * D[1] - (i128)D[0] * C[1];
+    const i128 da = (i128)D[0] * A[1] - (i128)A[0] * D[1];
+    const i128 ac = (i128)A[0] * C[1] - (i128)C[0] * A[1];
+    const i128 bd = (i128)B[0] * D[1] - (i128)D[0] * B[1];
+    /* as insphere_stage_i: abc, bcd, cda (+ + +), dab (+ + +) */
+    const wide abc = minor3(A[2], bc, B[2], ac, C[2], ab);
+    const wide bcd = minor3(B[2], cd, C[2], bd, D[2], bc);
+    const wide cda0 = minor3(C[2], da, -D[2], ac, A[2], cd);
+    const wide dab0 = minor3(D[2], ab, -A[2], bd, B[2], da);
+    const i128 al = (i128)A[0] * A[0] + (i128)A[1] * A[1] + (i128)A[2] * A[2];
+    const i128 bl = (i128)B[0] * B[0] + (i128)B[1] * B[1] + (i128)B[2] * B[2];
+    const i128 cl = (i128)C[0] * C[0] + (i128)C[1] * C[1] + (i128)C[2] * C[2];
+    const i128 dl = (i128)D[0] * D[0] + (i128)D[1] * D[1] + (i128)D[2] * D[2];
+    const wide t0 = wide_mul_128(dl, abc), t1 = wide_mul_128(cl, dab0);
+    const wide t2 = wide_mul_128(bl, cda0), t3 = wide_mul_128(al, bcd);
+    const wide s01 = wide_add(&t0, &t1, 1), s23 = wide_add(&t2, &t3, 1);
+    const wide det = wide_add(&s01, &s23, 0);
+    return -wide_sign(&det);
+}
+
 static int orient_stage_i(const double (*r)[3], int k, double mx)
 {
     int64_t z[3][3];
     if (!grid_ints(r, 3, k, mx, 0x1p40, z))
-        return FDT_PRED_UNSURE;
+        return orient_stage_w(r, k, mx);
     const int64_t *u = z[0], *v = z[1], *w = z[2];
     const i128 det = u[0] * ((i128)v[1] * w[2] - (i128)v[2] * w[1]) +
                      u[1] * ((i128)v[2] * w[0] - (i128)v[0] * w[2]) +
@@ -469,7 +620,7 @@ static int insphere_stage_i(const double (*r)[3], int k, double mx)
 {
     int64_t z[4][3];
     if (!grid_ints(r, 4, k, mx, 0x1p24, z))
-        return FDT_PRED_UNSURE;
+        return insphere_stage_w(r, k, mx);
     const int64_t *A = z[0], *B = z[1], *C = z[2], *D = z[3];
     const int64_t ab = A[0] * B[1] - B[0] * A[1], bc = B[0] * C[1] - C[0] * B[1];
     const int64_t cd = C[0] * D[1] - D[0] * C[1], da = D[0] * A[1] - A[0] * D[1];
@@ -525,7 +676,7 @@ static int orient_stage_g(const double *a, const double *b, const double *c, con
     const double mx = max_diff(pts + 1, 3, a, r);
     if (!(mx > 0.0 && mx <= DBL_MAX))
         return FDT_PRED_UNSURE; /* four equal points (stage B: 0), or past doubles */
-    int k = grid_exponent(pts, 4, ilogb(mx) - 40);
+    int k = grid_exponent(pts, 4, ilogb(mx) - 52);
     if (k == INT_MIN || k == INT_MAX)
         return FDT_PRED_UNSURE;
     if (k < -358 || k > 307 || !(mx <= ldexp(0x1p16, k)))
@@ -565,7 +716,7 @@ static int insphere_stage_g(const double *a, const double *b, const double *c,
     const double mx = max_diff(pts, 4, e, r);
     if (!(mx > 0.0 && mx <= DBL_MAX))
         return FDT_PRED_UNSURE; /* five equal points: distinctness is broken; let B decide */
-    int k = grid_exponent(pts, 5, ilogb(mx) - 24);
+    int k = grid_exponent(pts, 5, ilogb(mx) - 52);
     if (k == INT_MIN || k == INT_MAX)
         return FDT_PRED_UNSURE;
     if (k < -214 || k > 183 || !(mx <= ldexp(0x1p9, k)))
