@@ -2,9 +2,15 @@
  * Exact orient3d / insphere for all finite doubles, and the symbolic
  * perturbation of Devillers & Teillaud. Sign conventions and the
  * floating-point filters (stage A, with their error bounds) are in
- * src/geom/predicates.h. This file holds an adaptive stage and the two exact
- * stages:
+ * src/geom/predicates.h. This file holds an adaptive stage and the exact
+ * stages, tried in this order after the filters:
  *
+ *   grid (G, I, W): every coordinate a multiple of 2^k and the differences
+ *            at most 2^52 of those units (lattices, integer data, computed
+ *            grid nodes): the determinant in doubles (G, while it is
+ *            exact), 128-bit integers (I) or five 64-bit limbs (W). Tried
+ *            before the adaptive stage where the point's coordinates have
+ *            few significant bits, and first in the exact stages.
  *   adaptive: coordinates in stage B's range, differences exact or not:
  *            the determinant of the rounded differences in double-word
  *            arithmetic plus the first-order terms of the differences'
@@ -26,7 +32,7 @@
  *            |m| < 2^53, so scaling all coordinates by 2^-kmin makes them
  *            integers, and the determinant is evaluated in GMP integers.
  *
- * All three compute the same polynomial as the filters, so the sign
+ * All compute the same polynomial as the filters, so the sign
  * conventions carry over unchanged.
  */
 #include "geom/predicates.h"
@@ -650,12 +656,13 @@ static int insphere_stage_i(const double (*r)[3], int k, double mx)
 }
 #endif
 
-/* Whether p's coordinates could lie on a grid stage I can take: each
- * nonzero one with at most 41 significant bits (its integer mantissa's
- * lowest 12 bits 0). A gate, not a proof: the stages check for
- * themselves. Data off any coarse grid (random doubles, decimal scans)
- * fails at the first coordinate, where the stages' differences and
- * exponents cost 3 % of a pipe scan's instructions (bench/NOTES.md
+/* Whether p's coordinates look like a coarse grid's: each nonzero one
+ * with at most 41 significant bits (its integer mantissa's lowest 12 bits
+ * 0). The gate of the grid stages' early call, before the adaptive stage;
+ * not a proof (the stages check for themselves), and the exact stages try
+ * them whatever it says. Data off any coarse grid (random doubles, decimal
+ * scans) fails at the first coordinate: the stages' differences and
+ * exponents there cost 3 % of a pipe scan's instructions (bench/NOTES.md
  * entry 116). */
 static inline bool grid_likely(const double *p)
 {
