@@ -616,6 +616,26 @@ static void fam_cospherical_wide(tctx *T, double (*p)[3])
     if (irand(T, 0, 2) == 0)
         p[irand(T, 0, 4)][irand(T, 0, 2)] += irand(T, 0, 1) ? 1 : -1;
 }
+/* The same spheres scaled by an odd integer of 49 bits and by 2^-60:
+ * coordinates up to 2^52 units of 2^-60 (exact doubles), differences up to
+ * 2^53 units: past stage W's 2^52, within stage X (the coordinates as
+ * integers); a third moved by one unit. */
+static void fam_cospherical_fine(tctx *T, double (*p)[3])
+{
+    static const int r2[] = {50, 75};
+    sphere_set S;
+    make_sphere(&S, r2[irand(T, 0, 1)]);
+    const double none[3] = {0, 0, 0};
+    gen_cospherical(T, &S, p, none, 0);
+    const double lambda = (double)(irand(T, 1L << 48, 1L << 49) | 1) * 0x1p-60;
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            p[i][k] *= lambda;
+    if (irand(T, 0, 2) == 0) {
+        double *x = &p[irand(T, 0, 4)][irand(T, 0, 2)];
+        *x += irand(T, 0, 1) ? 0x1p-60 : -0x1p-60;
+    }
+}
 /* Magnitudes near 1e-150 and 1e150, rounded and exact scalings. */
 static void fam_near_coplanar_scaled(tctx *T, double (*p)[3])
 {
@@ -657,6 +677,7 @@ static const family families[] = {
     {"offset", fam_offset, 6000},
     {"cospherical", fam_cospherical, 3000},
     {"cospherical-wide", fam_cospherical_wide, 3000},
+    {"cospherical-fine", fam_cospherical_fine, 3000},
     {"near-coplanar-scaled", fam_near_coplanar_scaled, 2000},
     {"near-cospherical-scaled", fam_near_cospherical_scaled, 2000},
     {"lattice-scaled", fam_lattice_scaled, 2000},

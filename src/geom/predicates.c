@@ -11,6 +11,9 @@
  *            exact), 128-bit integers (I) or five 64-bit limbs (W). Tried
  *            before the adaptive stage where the point's coordinates have
  *            few significant bits, and first in the exact stages.
+ *   stage X: the coordinates themselves as integers below 2^63 units,
+ *            their differences exact in 128 bits, W's limbs: stretched
+ *            grids from 0, differences that are not doubles.
  *   adaptive: coordinates in stage B's range, differences exact or not:
  *            the determinant of the rounded differences in double-word
  *            arithmetic plus the first-order terms of the differences'
@@ -559,11 +562,10 @@ static int wide_sign(const wide *x)
     return 0;
 }
 
-static int orient_stage_w(const double (*r)[3], int k, double mx)
+/* orient3d's sign from integer rows of at most 2^62 (the bounds above
+ * hold for that too: minors below 2^126, det below 2^189). */
+static int orient_w_sign(const int64_t (*z)[3])
 {
-    int64_t z[3][3];
-    if (!grid_ints(r, 3, k, mx, 0x1p52, z))
-        return FDT_PRED_UNSURE;
     const int64_t *u = z[0], *v = z[1], *w = z[2];
     const i128 m0 = (i128)v[1] * w[2] - (i128)v[2] * w[1];
     const i128 m1 = (i128)v[2] * w[0] - (i128)v[0] * w[2];
@@ -571,6 +573,14 @@ static int orient_stage_w(const double (*r)[3], int k, double mx)
     const wide t0 = wide_mul_64(u[0], m0), t1 = wide_mul_64(u[1], m1), t2 = wide_mul_64(u[2], m2);
     const wide s01 = wide_add(&t0, &t1, 0), det = wide_add(&s01, &t2, 0);
     return wide_sign(&det);
+}
+
+static int orient_stage_w(const double (*r)[3], int k, double mx)
+{
+    int64_t z[3][3];
+    if (!grid_ints(r, 3, k, mx, 0x1p52, z))
+        return FDT_PRED_UNSURE;
+    return orient_w_sign((const int64_t(*)[3])z);
 }
 
 /* The 3x3 minor x2 yz - y2 xz + z2 xy of insphere (x, y, z the rows'
@@ -582,11 +592,11 @@ static wide minor3(int64_t x2, i128 yz, int64_t y2, i128 xz, int64_t z2, i128 xy
     return wide_add(&ab, &c, 0);
 }
 
-static int insphere_stage_w(const double (*r)[3], int k, double mx)
+/* insphere's CGAL sign from integer rows of at most 2^62 (minors below
+ * 2^126, 3x3 minors below 3 2^187, lifts below 3 2^124, det below
+ * 2^317). */
+static int insphere_w_sign(const int64_t (*z)[3])
 {
-    int64_t z[4][3];
-    if (!grid_ints(r, 4, k, mx, 0x1p52, z))
-        return FDT_PRED_UNSURE;
     const int64_t *A = z[0], *B = z[1], *C = z[2], *D = z[3];
     const i128 ab = (i128)A[0] * B[1] - (i128)B[0] * A[1];
     const i128 bc = (i128)B[0] * C[1] - (i128)C[0] * B[1];
@@ -608,6 +618,63 @@ static int insphere_stage_w(const double (*r)[3], int k, double mx)
     const wide s01 = wide_add(&t0, &t1, 1), s23 = wide_add(&t2, &t3, 1);
     const wide det = wide_add(&s01, &s23, 0);
     return -wide_sign(&det);
+}
+
+static int insphere_stage_w(const double (*r)[3], int k, double mx)
+{
+    int64_t z[4][3];
+    if (!grid_ints(r, 4, k, mx, 0x1p52, z))
+        return FDT_PRED_UNSURE;
+    return insphere_w_sign((const int64_t(*)[3])z);
+}
+
+/*
+ * Stage X: the coordinates themselves as integers, for differences that
+ * are not exact doubles or span more than 2^52 units. With 2^k the lowest
+ * set bit over the points' coordinates and every coordinate below 2^63
+ * units (k at least ilogb(largest) - 62), x 2^-k is an integer that a
+ * double and an int64 hold exactly; the differences to the last point,
+ * in i128, are exact, and at most 2^62 of them take the limbs of stage W.
+ * A stretched grid from 0 (cfdgrid: steps of 2^-62 beside coordinates
+ * near 1) lands here instead of stage B's expansions (bench/NOTES.md
+ * entry 116).
+ */
+static int coord_rows(const double *const *p, int n, int64_t (*z)[3])
+{
+    double cm = 0;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < 3; j++)
+            cm = fabs(p[i][j]) > cm ? fabs(p[i][j]) : cm;
+    if (!(cm > 0 && cm <= DBL_MAX))
+        return 0;
+    const int k = grid_exponent(p, n, ilogb(cm) - 62);
+    if (k == INT_MIN || k == INT_MAX || k < -1022 || k > 1022)
+        return 0;
+    const double s = ldexp(1.0, -k);
+    const double *last = p[n - 1];
+    for (int i = 0; i + 1 < n; i++)
+        for (int j = 0; j < 3; j++) {
+            const i128 d = (i128)(int64_t)(p[i][j] * s) - (i128)(int64_t)(last[j] * s);
+            if (d > ((i128)1 << 62) || d < -((i128)1 << 62))
+                return 0;
+            z[i][j] = (int64_t)d;
+        }
+    return 1;
+}
+
+static int orient_stage_x(const double *a, const double *b, const double *c, const double *d)
+{
+    const double *const p[4] = {b, c, d, a}; /* rows b - a, c - a, d - a */
+    int64_t z[3][3];
+    return coord_rows(p, 4, z) ? orient_w_sign((const int64_t(*)[3])z) : FDT_PRED_UNSURE;
+}
+
+static int insphere_stage_x(const double *a, const double *b, const double *c,
+                            const double *d, const double *e)
+{
+    const double *const p[5] = {a, b, c, d, e};
+    int64_t z[4][3];
+    return coord_rows(p, 5, z) ? insphere_w_sign((const int64_t(*)[3])z) : FDT_PRED_UNSURE;
 }
 
 static int orient_stage_i(const double (*r)[3], int k, double mx)
@@ -652,6 +719,19 @@ static int orient_stage_i(const double (*r)[3], int k, double mx)
 static int insphere_stage_i(const double (*r)[3], int k, double mx)
 {
     (void)r, (void)k, (void)mx;
+    return FDT_PRED_UNSURE;
+}
+
+static int orient_stage_x(const double *a, const double *b, const double *c, const double *d)
+{
+    (void)a, (void)b, (void)c, (void)d;
+    return FDT_PRED_UNSURE;
+}
+
+static int insphere_stage_x(const double *a, const double *b, const double *c,
+                            const double *d, const double *e)
+{
+    (void)a, (void)b, (void)c, (void)d, (void)e;
     return FDT_PRED_UNSURE;
 }
 #endif
@@ -1276,6 +1356,8 @@ int fdt_orient3d_exact(const double *a, const double *b, const double *c,
     if (share_axis_plane(pts, 4))
         return 0;
     int g = orient_stage_g(a, b, c, d);
+    if (g == FDT_PRED_UNSURE)
+        g = orient_stage_x(a, b, c, d);
     if (g != FDT_PRED_UNSURE)
         return g;
     double u[3], v[3], w[3];
@@ -1540,6 +1622,8 @@ int fdt_insphere_exact(const double *a, const double *b, const double *c,
     if (share_axis_plane(pts, 5))
         return 0;
     int g = insphere_stage_g(a, b, c, d, e);
+    if (g == FDT_PRED_UNSURE)
+        g = insphere_stage_x(a, b, c, d, e);
     if (g != FDT_PRED_UNSURE)
         return g;
     double A[3], B[3], C[3], D[3];
