@@ -447,11 +447,11 @@ static double max_diff(const double *const *p, int n, const double *q, double (*
  * 116) then costs a few dozen integer products instead of stage B's
  * expansions. Without a 128-bit type the call goes on to stage B or C. */
 #if defined(__SIZEOF_INT128__)
-typedef __int128 i128;
+__extension__ typedef __int128 i128; /* GCC and Clang on 64-bit targets */
 
 /* The n rows of r in units of 2^k as integers, when each is at most L:
  * 1, else 0 (2^-k not a normal double, or a row too long). */
-static int grid_ints(const double (*r)[3], int n, int k, double mx, double L, int64_t (*z)[3])
+static int grid_ints(double (*r)[3], int n, int k, double mx, double L, int64_t (*z)[3])
 {
     if (k < -1022 || k > 1022 || !(mx <= ldexp(L, k)))
         return 0;
@@ -476,7 +476,7 @@ static int grid_ints(const double (*r)[3], int n, int k, double mx, double L, in
 typedef struct wide {
     uint64_t w[WL]; /* little-endian limbs, two's complement */
 } wide;
-typedef unsigned __int128 u128w;
+__extension__ typedef unsigned __int128 u128w;
 
 static int wide_neg_p(const wide *x)
 {
@@ -564,7 +564,7 @@ static int wide_sign(const wide *x)
 
 /* orient3d's sign from integer rows of at most 2^62 (the bounds above
  * hold for that too: minors below 2^126, det below 2^189). */
-static int orient_w_sign(const int64_t (*z)[3])
+static int orient_w_sign(int64_t (*z)[3])
 {
     const int64_t *u = z[0], *v = z[1], *w = z[2];
     const i128 m0 = (i128)v[1] * w[2] - (i128)v[2] * w[1];
@@ -575,12 +575,12 @@ static int orient_w_sign(const int64_t (*z)[3])
     return wide_sign(&det);
 }
 
-static int orient_stage_w(const double (*r)[3], int k, double mx)
+static int orient_stage_w(double (*r)[3], int k, double mx)
 {
     int64_t z[3][3];
     if (!grid_ints(r, 3, k, mx, 0x1p52, z))
         return FDT_PRED_UNSURE;
-    return orient_w_sign((const int64_t(*)[3])z);
+    return orient_w_sign(z);
 }
 
 /* The 3x3 minor x2 yz - y2 xz + z2 xy of insphere (x, y, z the rows'
@@ -595,7 +595,7 @@ static wide minor3(int64_t x2, i128 yz, int64_t y2, i128 xz, int64_t z2, i128 xy
 /* insphere's CGAL sign from integer rows of at most 2^62 (minors below
  * 2^126, 3x3 minors below 3 2^187, lifts below 3 2^124, det below
  * 2^317). */
-static int insphere_w_sign(const int64_t (*z)[3])
+static int insphere_w_sign(int64_t (*z)[3])
 {
     const int64_t *A = z[0], *B = z[1], *C = z[2], *D = z[3];
     const i128 ab = (i128)A[0] * B[1] - (i128)B[0] * A[1];
@@ -620,12 +620,12 @@ static int insphere_w_sign(const int64_t (*z)[3])
     return -wide_sign(&det);
 }
 
-static int insphere_stage_w(const double (*r)[3], int k, double mx)
+static int insphere_stage_w(double (*r)[3], int k, double mx)
 {
     int64_t z[4][3];
     if (!grid_ints(r, 4, k, mx, 0x1p52, z))
         return FDT_PRED_UNSURE;
-    return insphere_w_sign((const int64_t(*)[3])z);
+    return insphere_w_sign(z);
 }
 
 /*
@@ -666,7 +666,7 @@ static int orient_stage_x(const double *a, const double *b, const double *c, con
 {
     const double *const p[4] = {b, c, d, a}; /* rows b - a, c - a, d - a */
     int64_t z[3][3];
-    return coord_rows(p, 4, z) ? orient_w_sign((const int64_t(*)[3])z) : FDT_PRED_UNSURE;
+    return coord_rows(p, 4, z) ? orient_w_sign(z) : FDT_PRED_UNSURE;
 }
 
 static int insphere_stage_x(const double *a, const double *b, const double *c,
@@ -674,10 +674,10 @@ static int insphere_stage_x(const double *a, const double *b, const double *c,
 {
     const double *const p[5] = {a, b, c, d, e};
     int64_t z[4][3];
-    return coord_rows(p, 5, z) ? insphere_w_sign((const int64_t(*)[3])z) : FDT_PRED_UNSURE;
+    return coord_rows(p, 5, z) ? insphere_w_sign(z) : FDT_PRED_UNSURE;
 }
 
-static int orient_stage_i(const double (*r)[3], int k, double mx)
+static int orient_stage_i(double (*r)[3], int k, double mx)
 {
     int64_t z[3][3];
     if (!grid_ints(r, 3, k, mx, 0x1p40, z))
@@ -689,7 +689,7 @@ static int orient_stage_i(const double (*r)[3], int k, double mx)
     return (det > 0) - (det < 0);
 }
 
-static int insphere_stage_i(const double (*r)[3], int k, double mx)
+static int insphere_stage_i(double (*r)[3], int k, double mx)
 {
     int64_t z[4][3];
     if (!grid_ints(r, 4, k, mx, 0x1p24, z))
@@ -710,13 +710,13 @@ static int insphere_stage_i(const double (*r)[3], int k, double mx)
     return (det < 0) - (det > 0);
 }
 #else
-static int orient_stage_i(const double (*r)[3], int k, double mx)
+static int orient_stage_i(double (*r)[3], int k, double mx)
 {
     (void)r, (void)k, (void)mx;
     return FDT_PRED_UNSURE;
 }
 
-static int insphere_stage_i(const double (*r)[3], int k, double mx)
+static int insphere_stage_i(double (*r)[3], int k, double mx)
 {
     (void)r, (void)k, (void)mx;
     return FDT_PRED_UNSURE;
