@@ -1445,17 +1445,18 @@ int fdt_orient3d(const double *a, const double *b, const double *c,
     int s = fdt_orient3d_filter(a, b, c, d);
     if (s != FDT_PRED_UNSURE)
         return s;
-    s = orient3d_filter_rescaled(a, b, c, d);
-    if (s != FDT_PRED_UNSURE)
-        return s;
     /* On a binary grid the exact sign is a few products away: before the
-     * adaptive stage, which can only defer an exact 0 */
+     * rescaled filter and the adaptive stage, which can only defer an
+     * exact 0 */
     s = grid_likely(a) ? orient_stage_g(a, b, c, d) : FDT_PRED_UNSURE;
     if (s != FDT_PRED_UNSURE) {
         if (cnt)
             cnt->orient_exact++;
         return s;
     }
+    s = orient3d_filter_rescaled(a, b, c, d);
+    if (s != FDT_PRED_UNSURE)
+        return s;
     s = fdt_orient3d_adapt(a, b, c, d);
     if (s != FDT_PRED_UNSURE) {
         if (cnt)
@@ -1645,18 +1646,19 @@ int fdt_insphere(const double *a, const double *b, const double *c,
     int s = fdt_insphere_filter(a, b, c, d, e);
     if (s != FDT_PRED_UNSURE)
         return s;
-    s = insphere_filter_rescaled(a, b, c, d, e);
-    if (s != FDT_PRED_UNSURE)
-        return s;
     /* On a binary grid the exact sign is a few products away: before the
-     * adaptive stage, which can only defer an exact 0 (a sphere of integer
-     * points: every test of five of its points; bench/NOTES.md entry 116) */
+     * rescaled filter and the adaptive stage, which can only defer an exact
+     * 0 (a sphere of integer points: every test of five of its points;
+     * bench/NOTES.md entry 116) */
     s = grid_likely(e) ? insphere_stage_g(a, b, c, d, e) : FDT_PRED_UNSURE;
     if (s != FDT_PRED_UNSURE) {
         if (cnt)
             cnt->insphere_exact++;
         return s;
     }
+    s = insphere_filter_rescaled(a, b, c, d, e);
+    if (s != FDT_PRED_UNSURE)
+        return s;
     s = fdt_insphere_adapt(a, b, c, d, e);
     if (s != FDT_PRED_UNSURE) {
         if (cnt)
