@@ -592,49 +592,43 @@ static void fam_cospherical(tctx *T, double (*p)[3])
     const double *shift = e == -12 ? big : (irand(T, 0, 1) ? none : small);
     gen_cospherical(T, &S, p, shift, e);
 }
-/* The same spheres scaled by up to 2^19 and shifted by up to 2^22 (still
- * integers): differences up to about 2^23, past stage G's doubles and
- * within stage I's 128-bit integers; a third of the cases one coordinate
- * moved by 1 (near-cospherical, exact nonzero), and a few 2^12 times
- * coarser (past stage I: stage B). */
-static void fam_cospherical_wide(tctx *T, double (*p)[3])
+/* Five points of one of those spheres, times lambda plus shift; a third
+ * of the time one coordinate moved by unit (near-cospherical: an exact
+ * nonzero). */
+static void sphere_scaled(tctx *T, double (*p)[3], double lambda, const double shift[3],
+                          double unit)
 {
     static const int r2[] = {50, 75};
     sphere_set S;
     make_sphere(&S, r2[irand(T, 0, 1)]);
     const double none[3] = {0, 0, 0};
     gen_cospherical(T, &S, p, none, 0);
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k < 3; k++)
+            p[i][k] = p[i][k] * lambda + shift[k];
+    if (irand(T, 0, 2) == 0)
+        p[irand(T, 0, 4)][irand(T, 0, 2)] += irand(T, 0, 1) ? unit : -unit;
+}
+/* Scaled by up to 2^19 and shifted by up to 2^22 (still integers):
+ * differences up to about 2^23, past stage G's doubles and within stage
+ * I's 128-bit integers; a tenth 2^12 times coarser (stage W's limbs). */
+static void fam_cospherical_wide(tctx *T, double (*p)[3])
+{
     double lambda = (double)irand(T, 1L << 10, 1L << 19);
     if (irand(T, 0, 9) == 0)
         lambda *= 4096;
     double shift[3];
     for (int k = 0; k < 3; k++)
         shift[k] = (double)irand(T, -(1L << 22), 1L << 22);
-    for (int i = 0; i < 5; i++)
-        for (int k = 0; k < 3; k++)
-            p[i][k] = p[i][k] * lambda + shift[k];
-    if (irand(T, 0, 2) == 0)
-        p[irand(T, 0, 4)][irand(T, 0, 2)] += irand(T, 0, 1) ? 1 : -1;
+    sphere_scaled(T, p, lambda, shift, 1);
 }
-/* The same spheres scaled by an odd integer of 49 bits and by 2^-60:
- * coordinates up to 2^52 units of 2^-60 (exact doubles), differences up to
- * 2^53 units: past stage W's 2^52, within stage X (the coordinates as
- * integers); a third moved by one unit. */
+/* Scaled by an odd integer of 49 bits and by 2^-60: coordinates up to
+ * 2^52 units of 2^-60 (exact doubles), differences up to 2^53 units: past
+ * stage W's 2^52, within stage X (the coordinates as integers). */
 static void fam_cospherical_fine(tctx *T, double (*p)[3])
 {
-    static const int r2[] = {50, 75};
-    sphere_set S;
-    make_sphere(&S, r2[irand(T, 0, 1)]);
     const double none[3] = {0, 0, 0};
-    gen_cospherical(T, &S, p, none, 0);
-    const double lambda = (double)(irand(T, 1L << 48, 1L << 49) | 1) * 0x1p-60;
-    for (int i = 0; i < 5; i++)
-        for (int k = 0; k < 3; k++)
-            p[i][k] *= lambda;
-    if (irand(T, 0, 2) == 0) {
-        double *x = &p[irand(T, 0, 4)][irand(T, 0, 2)];
-        *x += irand(T, 0, 1) ? 0x1p-60 : -0x1p-60;
-    }
+    sphere_scaled(T, p, (double)(irand(T, 1L << 48, 1L << 49) | 1) * 0x1p-60, none, 0x1p-60);
 }
 /* Magnitudes near 1e-150 and 1e150, rounded and exact scalings. */
 static void fam_near_coplanar_scaled(tctx *T, double (*p)[3])
