@@ -478,12 +478,12 @@ typedef struct wide {
 } wide;
 __extension__ typedef unsigned __int128 u128w;
 
-static int wide_neg_p(const wide *x)
+static inline int wide_neg_p(const wide *x)
 {
     return (x->w[WL - 1] >> 63) != 0;
 }
 
-static void wide_negate(wide *x)
+static inline void wide_negate(wide *x)
 {
     uint64_t carry = 1;
     for (int i = 0; i < WL; i++) {
@@ -494,7 +494,7 @@ static void wide_negate(wide *x)
 }
 
 /* a + b (sub: a - b), modulo 2^320: exact within the bounds above. */
-static wide wide_add(const wide *a, const wide *b, int sub)
+static inline wide wide_add(const wide *a, const wide *b, int sub)
 {
     wide r;
     u128w c = sub;
@@ -516,7 +516,7 @@ static wide wide_abs(wide x, int *neg)
 }
 
 /* a b for |a| < 2^63, |b| < 2^127: two products of limbs. */
-static wide wide_mul_64(int64_t a, i128 b)
+static inline wide wide_mul_64(int64_t a, i128 b)
 {
     const int neg = (a < 0) != (b < 0);
     const uint64_t ma = a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a;
@@ -585,7 +585,7 @@ static int orient_stage_w(double (*r)[3], int k, double mx)
 
 /* The 3x3 minor x2 yz - y2 xz + z2 xy of insphere (x, y, z the rows'
  * third coordinates, yz ... their 2x2 minors). */
-static wide minor3(int64_t x2, i128 yz, int64_t y2, i128 xz, int64_t z2, i128 xy)
+static inline wide minor3(int64_t x2, i128 yz, int64_t y2, i128 xz, int64_t z2, i128 xy)
 {
     const wide a = wide_mul_64(x2, yz), b = wide_mul_64(y2, xz), c = wide_mul_64(z2, xy);
     const wide ab = wide_add(&a, &b, 1);
