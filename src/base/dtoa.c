@@ -35,14 +35,14 @@ static const uint64_t pow5[28] = {
     UINT64_C(59604644775390625), UINT64_C(298023223876953125),
     UINT64_C(1490116119384765625), UINT64_C(7450580596923828125)};
 
-/* 10^j for j in [POW10_LOW, 44], as doubles (rounded outside [0, 22]):
+/* 10^j for j in [-POW10_LOW, 43], as doubles (rounded outside [0, 22]):
  * the next power above every x the exact path takes, [1e-11, 1e43). */
 #define POW10_LOW 11
 static const double tens[] = {
     1e-11, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1e0, 1e1, 1e2, 1e3,
     1e4,   1e5,   1e6,  1e7,  1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18,
     1e19,  1e20,  1e21, 1e22, 1e23, 1e24, 1e25, 1e26, 1e27, 1e28, 1e29, 1e30, 1e31, 1e32, 1e33,
-    1e34,  1e35,  1e36, 1e37, 1e38, 1e39, 1e40, 1e41, 1e42, 1e43, 1e44};
+    1e34,  1e35,  1e36, 1e37, 1e38, 1e39, 1e40, 1e41, 1e42, 1e43};
 
 #define TEN16 UINT64_C(10000000000000000)
 #define TEN17 UINT64_C(100000000000000000)
