@@ -696,6 +696,38 @@ static void test_set(pts p, int extra)
     free(p.xyz);
 }
 
+/* ---- the tets array's size ----------------------------------------------- */
+
+/*
+ * A serial build sizes its tets array once, after the first 1/128 of its
+ * points (src/mesh/insert.c, size_for_all), for the tets a point the
+ * family has: a uniform cloud (6.7 slots a point), a pipe's scan (15) and
+ * a cylinder's rings move it once and never grow it late, where a late
+ * growth holds the old block and the new one at once (bench/NOTES.md
+ * entry 117). Without the sizing the pipe's first block (6.75 slots a
+ * point) grew by half again three times at 2^17 points, each move a copy
+ * of everything built so far.
+ */
+static void test_slot_sizing(const char *gen)
+{
+    static const char *fams[] = {"uniform", "cylscan", "cylinder"};
+    for (size_t f = 0; f < sizeof fams / sizeof fams[0]; f++) {
+        pts p = gen_family(gen, fams[f], (size_t)1 << 17, 1);
+        prepped pp;
+        prep(&p, &pp);
+        fdt_ins m;
+        CHECK_EQ(fdt_ins_build(&m, pp.pr.p, 0, pp.m, NULL), FDT_OK);
+        printf("%-22s %6u points %8u slots, capacity %8u, moved %zu time(s)\n", p.name, pp.m,
+               m.nslots, m.cap, m.stats.moves);
+        if (pp.m >= 65536)
+            CHECK(m.stats.moves <= 1);
+        CHECK(m.nslots <= m.cap);
+        fdt_ins_free(&m);
+        prep_free(&pp);
+        free(p.xyz);
+    }
+}
+
 /* ---- refusals ---------------------------------------------------------- */
 
 static void expect_refusal(const double *xyz, uint32_t n, int want, const char *what)
@@ -1182,6 +1214,7 @@ int main(int argc, char **argv)
     test_brio_order();
     test_star_edges();
     test_star_links();
+    test_slot_sizing(gen);
 
     /* Every family of gen_points; sizes keep the reference (the front,
      * quadratic on cospherical sets) within a few seconds. */

@@ -88,6 +88,22 @@ typedef struct build {
 /* ------------------------------------------------------------------ */
 /* Slots and scratch. */
 
+/* The conflict marks grown to the tets array's new capacity nc: a zeroed
+ * block (its pages first touched where a slot is used, as the tets'
+ * are), the marks of the slots in use copied. */
+static int set_capacity(build *b, uint64_t nc)
+{
+    fdt_ins *m = b->m;
+    uint8_t *mk = calloc((size_t)nc, 1);
+    if (!mk)
+        return FDT_ENOMEM;
+    memcpy(mk, b->mark, m->nslots);
+    free(b->mark);
+    b->mark = mk;
+    m->cap = (uint32_t)nc;
+    return FDT_OK;
+}
+
 /* Makes room for `extra` more tets (free list plus unused capacity). */
 static int reserve_slots(build *b, uint32_t extra)
 {
@@ -95,16 +111,26 @@ static int reserve_slots(build *b, uint32_t extra)
     if ((uint64_t)b->nfree + (m->cap - m->nslots) >= extra)
         return FDT_OK;
     uint64_t need = (uint64_t)m->nslots + extra - b->nfree, nc;
-    int err = ins_grow_tets(m, need, &nc);
-    if (err)
-        return err;
-    uint8_t *mk = realloc(b->mark, (size_t)nc);
-    if (!mk)
-        return FDT_ENOMEM;
-    memset(mk + m->cap, 0, (size_t)(nc - m->cap));
-    b->mark = mk;
-    m->cap = (uint32_t)nc;
-    return FDT_OK;
+    int err = ins_grow_tets(m, need, m->nslots, &nc);
+    return err ? err : set_capacity(b, nc);
+}
+
+/*
+ * The whole build's slots, sized once its first `done` points are in
+ * (ins_slots_wanted): the first block holds 6.75 slots a point, which
+ * uniform points pass past about a million (6.77 tets a point and the
+ * hull), and a growth late in the build holds two blocks at once
+ * (bench/NOTES.md entry 117: 497 bytes a point at the peak on 2M uniform
+ * points, 283 on 1M). Here the copy is of the few slots in use.
+ */
+static int size_for_all(build *b, uint32_t done, uint32_t n)
+{
+    fdt_ins *m = b->m;
+    uint64_t want = ins_slots_wanted(m, done, b->nfree, n, 1024);
+    if (want <= m->cap)
+        return FDT_OK;
+    int err = ins_move_tets(m, want, m->nslots);
+    return err ? err : set_capacity(b, want);
 }
 
 /* A slot for a new tet (reserve_slots first). Freed slots first: they
@@ -519,7 +545,13 @@ int fdt_ins_build_prefix(fdt_ins *m, const double *P, uint32_t base, uint32_t n,
     if ((err = start_simplex(&b, order, n, first)) != FDT_OK)
         goto fail;
     uint32_t last = 0;
+    /* The whole build sizes its slots once, after the first 1/128 of its
+     * points (size_for_all); the parallel build sizes for its workers
+     * after its prefix instead (src/mesh/insert_par.c). */
+    uint32_t size_at = prefix == n && n >= 65536 ? n / 128 : UINT32_MAX;
     for (uint32_t i = 0; i < prefix; i++) {
+        if (i == size_at && (err = size_for_all(&b, i, n)) != FDT_OK)
+            goto fail;
         uint32_t id = order[i];
         if (id == first[0] || id == first[1] || id == first[2] || id == first[3])
             continue;

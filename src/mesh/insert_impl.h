@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/bits.h"
+#include "base/mem.h"
 #include "geom/images.h"
 #include "mesh/insmesh.h"
 
@@ -71,13 +72,37 @@ static inline int ins_insphere(const double *a, const double *b, const double *c
 }
 
 /*
- * The tets array grown for `need` slots (a build's reserve): the capacity
- * half as much again plus 64, at least need, at most INS_MAX_SLOTS; m->T
- * is reallocated to *nc slots, and the caller grows its own per-slot array
- * to match and then sets m->cap. FDT_ETOOBIG beyond INS_MAX_SLOTS,
- * FDT_ENOMEM (m->T unchanged).
+ * The tets array moved to a new block of nc slots, huge pages asked for
+ * before its first write, its first `used` rows copied (used <= nc: the
+ * slots below nslots, or, where other slots were handed out, the whole
+ * capacity);
+ * the caller grows its own per-slot arrays and then sets m->cap.
+ * FDT_ENOMEM (m->T unchanged). Not realloc: the huge-page advice covers a
+ * block's 2 MB-aligned interior only (fdt_mem_advise_huge), so the kernel
+ * holds the block as three mappings, glibc's mremap of them fails, and
+ * realloc then copied into a fresh block without the advice: the rest of
+ * the build and the certificate on 4 KB pages (bench/NOTES.md entry 117).
  */
-static inline int ins_grow_tets(fdt_ins *m, uint64_t need, uint64_t *nc_out)
+static inline int ins_move_tets(fdt_ins *m, uint64_t nc, uint64_t used)
+{
+    uint32_t *t = malloc((size_t)nc * 8 * sizeof *t);
+    if (!t)
+        return FDT_ENOMEM;
+    fdt_mem_advise_huge(t, (size_t)nc * 8 * sizeof *t);
+    memcpy(t, m->T, (size_t)used * 8 * sizeof *t);
+    free(m->T);
+    m->T = t;
+    m->stats.moves++;
+    return FDT_OK;
+}
+
+/*
+ * The tets array grown for `need` slots (a build's reserve): the capacity
+ * half as much again plus 64, at least need, at most INS_MAX_SLOTS
+ * (ins_move_tets, its first `used` rows kept). *nc_out gets the new
+ * capacity. FDT_ETOOBIG beyond INS_MAX_SLOTS, FDT_ENOMEM (m->T unchanged).
+ */
+static inline int ins_grow_tets(fdt_ins *m, uint64_t need, uint64_t used, uint64_t *nc_out)
 {
     if (need > INS_MAX_SLOTS)
         return FDT_ETOOBIG;
@@ -86,12 +111,26 @@ static inline int ins_grow_tets(fdt_ins *m, uint64_t need, uint64_t *nc_out)
         nc = need;
     if (nc > INS_MAX_SLOTS)
         nc = INS_MAX_SLOTS;
-    uint32_t *t = realloc(m->T, (size_t)nc * 8 * sizeof *t);
-    if (!t)
-        return FDT_ENOMEM;
-    m->T = t;
+    int err = ins_move_tets(m, nc, used);
+    if (err)
+        return err;
     *nc_out = nc;
     return FDT_OK;
+}
+
+/*
+ * The slots the whole build of n points will want, from the done points
+ * in so far and the slots in use (nslots less the nfree freed ones): the
+ * slots a point so far, with a third more (later rounds are denser, and
+ * the parallel build's chunks), plus `extra`. Sized once, early, so that
+ * the array rarely grows later: its untouched pages cost no memory, and a
+ * growth holds the old and new blocks at once.
+ */
+static inline uint64_t ins_slots_wanted(const fdt_ins *m, uint32_t done, uint32_t nfree,
+                                        uint32_t n, uint64_t extra)
+{
+    uint64_t want = (uint64_t)((double)(m->nslots - nfree) / (double)done * 1.35 * n) + extra;
+    return want > INS_MAX_SLOTS ? INS_MAX_SLOTS : want;
 }
 
 /*

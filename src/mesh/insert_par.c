@@ -289,7 +289,9 @@ static int grow_arrays(shared *sh, uint64_t need)
 {
     fdt_ins *m = sh->m;
     uint64_t nc;
-    int err = ins_grow_tets(m, need, &nc);
+    /* every slot below the capacity: the workers' chunks of phase 3 lie
+     * past nslots, which is set at its end */
+    int err = ins_grow_tets(m, need, m->cap, &nc);
     if (err)
         return err;
     atomic_uchar *lk = malloc((size_t)nc * sizeof *lk);
@@ -869,30 +871,17 @@ static int grow_for_workers(fdt_ins *m, uint32_t prefix, uint32_t n, int nw,
     uint32_t nfree = 0;
     for (uint32_t t = m->free_head; t != FDT_NONE; t = m->T[8 * (size_t)t + 4])
         nfree++;
-    uint64_t want = (uint64_t)((double)(m->nslots - nfree) / (double)prefix * 1.35 * n) +
-                    (uint64_t)nw * 2 * CHUNK + 1024;
-    if (want > INS_MAX_SLOTS)
-        want = INS_MAX_SLOTS;
+    uint64_t want = ins_slots_wanted(m, prefix, nfree, n, (uint64_t)nw * 2 * CHUNK + 1024);
     if (want > m->cap && slots_a_point <= 0.0) {
-        /* A new block with only the slots in use copied, not a
-         * realloc: the prefix used ~2.5 % of its capacity (statue
-         * 100k: 19,921 of 762,224 slots), and realloc (a copy inside
-         * glibc's heap by then, not an mremap) read all of it and
-         * faulted in the whole new block on this one thread while
-         * the other waited: 0.009-0.012 s at statue, cylscan and
-         * autzen 100k. Now the workers fault in the pages they use,
-         * both at once (bench/NOTES.md entry 56). Every slot the
-         * prefix used, its free list included, is below nslots. */
-        uint32_t *t = malloc((size_t)want * 8 * sizeof *t);
-        if (!t)
-            return FDT_ENOMEM;
-        /* Huge pages, as src/mesh/insert.c's first block has: without
-         * them each worker took a fault a 4 KB page it first wrote
-         * (bench/NOTES.md entry 69). */
-        fdt_mem_advise_huge(t, (size_t)want * 8 * sizeof *t);
-        memcpy(t, m->T, (size_t)m->nslots * 8 * sizeof *t);
-        free(m->T);
-        m->T = t;
+        /* Only the slots in use copied (ins_move_tets), not the whole
+         * capacity: the prefix used ~2.5 % of it (statue 100k: 19,921 of
+         * 762,224 slots), and the workers fault in the pages they use,
+         * both at once (bench/NOTES.md entry 56), on huge pages (without
+         * them a fault a 4 KB page first written, entry 69). Every slot
+         * the prefix used, its free list included, is below nslots. */
+        int err = ins_move_tets(m, want, m->nslots);
+        if (err)
+            return err;
         m->cap = (uint32_t)want;
     }
     return FDT_OK;

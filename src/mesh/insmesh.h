@@ -40,6 +40,8 @@ typedef struct fdt_ins_stats {
     size_t cavity_tets;   /* tets destroyed (sum of the cavity sizes) */
     size_t created_tets;  /* tets created */
     size_t max_cavity;    /* largest cavity */
+    size_t moves;         /* times the tets array moved to a bigger block
+                           * (src/mesh/insert_impl.h, ins_move_tets) */
     size_t conflict_tests;/* conflict (insphere / hull side) tests */
     size_t deferred;      /* fdt_ins_build_parallel: insertions put off (a tet held
                            * by another thread, or the slots spent) */
