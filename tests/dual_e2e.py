@@ -32,6 +32,9 @@ import shutil
 import subprocess
 import sys
 
+import foam_mesh
+from foam_mesh import cell_volumes, checkmesh_cmd, make_case, read_polymesh
+
 FRONTDT, GEN, SCRATCH = sys.argv[1:4]
 CHECKMESH = "--checkmesh" in sys.argv[4:]
 os.makedirs(SCRATCH, exist_ok=True)
@@ -41,50 +44,6 @@ failures = []
 def fail(msg):
     failures.append(msg)
     print("FAIL:", msg)
-
-
-def foam_body(path):
-    text = open(path).read()
-    text = text[text.index("FoamFile"):]
-    return text[text.index("}") + 1:]
-
-
-def read_polymesh(d):
-    pts = foam_body(os.path.join(d, "points"))
-    points = [tuple(map(float, m.split())) for m in re.findall(r"\(([^()]*)\)",
-                                                                 pts[pts.index("(") + 1:])]
-    fc = foam_body(os.path.join(d, "faces"))
-    faces = [list(map(int, m.split())) for m in re.findall(r"\d+\(([^()]*)\)",
-                                                             fc[fc.index("(") + 1:])]
-
-    def labels(name):
-        b = foam_body(os.path.join(d, name))
-        b = b[b.index("(") + 1:b.rindex(")")]
-        return [int(x) for x in b.split()]
-    owner, neighbour = labels("owner"), labels("neighbour")
-    bd = foam_body(os.path.join(d, "boundary"))
-    patches = re.findall(r"(\w+)\s*\{\s*type\s+(\w+);\s*nFaces\s+(\d+);\s*startFace\s+(\d+);", bd)
-    return points, faces, owner, neighbour, [(p[0], p[1], int(p[2]), int(p[3])) for p in patches]
-
-
-def cell_volumes(points, faces, owner, neighbour, ncells):
-    vol = [0.0] * ncells
-    ref = [None] * ncells
-    for f, fv in enumerate(faces):
-        sides = [(owner[f], 1.0)] + ([(neighbour[f], -1.0)] if f < len(neighbour) else [])
-        for c, sg in sides:
-            if ref[c] is None:
-                ref[c] = points[fv[0]]
-            r = ref[c]
-            a = [points[fv[0]][k] - r[k] for k in range(3)]
-            s = 0.0
-            for i in range(1, len(fv) - 1):
-                b = [points[fv[i]][k] - r[k] for k in range(3)]
-                e = [points[fv[i + 1]][k] - r[k] for k in range(3)]
-                s += (a[0] * (b[1] * e[2] - b[2] * e[1]) + a[1] * (b[2] * e[0] - b[0] * e[2]) +
-                      a[2] * (b[0] * e[1] - b[1] * e[0]))
-            vol[c] += sg * s / 6
-    return vol
 
 
 def check_topology(name, points, faces, owner, neighbour, patches):
@@ -105,15 +64,15 @@ def check_topology(name, points, faces, owner, neighbour, patches):
         if f and (owner[f - 1], neighbour[f - 1]) >= (owner[f], neighbour[f]):
             fail(f"{name}: face {f} out of upper-triangular order")
             break
-    names = [p[0] for p in patches]
+    names = [p["name"] for p in patches]
     if names != ["xmin", "xmax", "ymin", "ymax", "zmin", "zmax"] or \
-            any(p[1] != "patch" for p in patches):
+            any(p["type"] != "patch" for p in patches):
         fail(f"{name}: patches {patches}")
     at = nint
     for p in patches:
-        if p[3] != at:
-            fail(f"{name}: patch {p[0]} starts at {p[3]}, not {at}")
-        at += p[2]
+        if p["startFace"] != at:
+            fail(f"{name}: patch {p['name']} starts at {p['startFace']}, not {at}")
+        at += p["nFaces"]
     if at != len(faces):
         fail(f"{name}: the patches end at {at} of {len(faces)} faces")
     edges = {}
@@ -135,31 +94,6 @@ def run(args, want=0):
     if p.returncode != want:
         fail(f"frontdt {' '.join(args)}: exit {p.returncode}, want {want}: {p.stderr.strip()}")
     return p
-
-
-def make_case(case):
-    shutil.rmtree(case, ignore_errors=True)
-    os.makedirs(os.path.join(case, "system"))
-    os.makedirs(os.path.join(case, "constant"))
-    for d in ("controlDict", "fvSchemes", "fvSolution"):
-        with open(os.path.join(case, "system", d), "w") as f:
-            f.write("FoamFile { version 2.0; format ascii; class dictionary; object %s; }\n" % d)
-            if d == "controlDict":
-                f.write("application checkMesh; startFrom startTime; startTime 0; "
-                        "stopAt endTime; endTime 1; deltaT 1; writeControl timeStep; "
-                        "writeInterval 1;\n")
-            if d == "fvSchemes":
-                f.write("ddtSchemes { default Euler; } gradSchemes { default Gauss linear; }\n"
-                        "divSchemes { default none; } laplacianSchemes { default Gauss linear "
-                        "corrected; }\ninterpolationSchemes { default linear; } "
-                        "snGradSchemes { default corrected; }\n")
-
-
-def checkmesh_cmd():
-    for rc in ("/usr/share/openfoam/etc/bashrc",):
-        if os.path.exists(rc):
-            return rc
-    return "" if shutil.which("checkMesh") else None
 
 
 def one_case(name, xyz, box=None):
@@ -195,10 +129,7 @@ def one_case(name, xyz, box=None):
 
 
 def checkmesh(name, case, rc):
-    src = f". '{rc}' >/dev/null 2>&1; " if rc else ""
-    p = subprocess.run(["bash", "-c", src + f"checkMesh -allTopology -case '{case}'"],
-                       capture_output=True, text=True)
-    out = p.stdout + p.stderr
+    out = foam_mesh.checkmesh(case, rc, "-allTopology")
     for ok in ("Boundary definition OK", "Cell to face addressing OK", "Point usage OK",
                "Upper triangular ordering OK", "Face vertices OK", "Number of regions: 1 (OK)",
                "Topological cell zip-up check OK", "Face-face connectivity OK",

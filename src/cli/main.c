@@ -564,7 +564,7 @@ static int check_args(cli *c, int npos, char **pos)
             const fdt_format *f = c->out_format[o] ? fdt_format_by_name(c->out_format[o])
                                                    : fdt_format_by_path(c->outputs[o]);
             if (f && !fdt_format_periodic(f))
-                return usage_error("--periodic writes .tets, .fdtb, .vtu, .vtk, .msh or .mesh (-o %s: "
+                return usage_error("--periodic writes " FDT_PERIODIC_FORMATS " (-o %s: "
                                    "its format has no place for the image vertices' input "
                                    "ids)", c->outputs[o]);
         }

@@ -313,8 +313,8 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
             return CLI_USAGE;
         }
         if (o->output && (!f || !fdt_format_periodic(f))) {
-            say0(rank, "--periodic under MPI writes -o .tets, .fdtb, .vtu, .vtk, .msh or .mesh "
-                       "(gathered to rank 0), the hashes and the cells' tables; not pieces");
+            say0(rank, "--periodic under MPI writes -o " FDT_PERIODIC_FORMATS
+                       " (gathered to rank 0), the hashes and the cells' tables; not pieces");
             return CLI_USAGE;
         }
         /* --box is the periods: the cells' options checked when asked */

@@ -1367,6 +1367,7 @@ void fdt_periodic_unfolded_free(fdt_periodic_unfolded *u)
 {
     free(u->xyz);
     free(u->src);
+    free(u->off);
     free(u->tets);
     free(u->hull);
     memset(u, 0, sizeof *u);
@@ -1489,10 +1490,14 @@ int fdt_periodic_unfold(const int32_t *tets, const int8_t *off, size_t ntets, co
         u->nhull = nhull;
         u->xyz = m.xyz;
         m.xyz = NULL;
-        if (!(u->src = malloc((m.n ? m.n : 1) * sizeof *u->src)))
+        if (!(u->src = malloc((m.n ? m.n : 1) * sizeof *u->src)) ||
+            !(u->off = malloc((m.n ? m.n : 1) * 3)))
             err = FDT_ENOMEM;
-        for (size_t i = 0; !err && i < m.n; i++)
+        for (size_t i = 0; !err && i < m.n; i++) {
             u->src[i] = (fdt_vid)m.label[i];
+            for (int a = 0; a < 3; a++) /* vpack's bytes, 128 up */
+                u->off[3 * i + (size_t)a] = (int8_t)((int)(m.vk[i] >> (16 - 8 * a) & 0xff) - 128);
+        }
     }
     if (err)
         fdt_periodic_unfolded_free(u);

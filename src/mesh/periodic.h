@@ -198,11 +198,14 @@ int fdt_periodic_part_cells(const fdt_periodic_mesh *pm, const double *X, uint32
  * likewise, outward (its tet's other vertex on its negative side). src[i]:
  * point i's input id (i for the first n). FDT_OK, FDT_ENOMEM, FDT_ETOOBIG
  * past INT32_MAX points, FDT_EINTERNAL for a hull face no tet has (a
- * bug). Free with fdt_periodic_unfolded_free.
+ * bug). off[3i..3i+2]: point i's image offsets, which name the cyclic
+ * pairs of faces exactly (src/io/write/fmt_foam.c). Free with
+ * fdt_periodic_unfolded_free.
  */
 typedef struct fdt_periodic_unfolded {
     double *xyz;     /* 3 each */
     fdt_vid *src;
+    int8_t *off;     /* 3 each: the image's offsets (0 0 0 for the first n) */
     size_t n;
     fdt_vid *tets;   /* 4 each */
     size_t ntets;

@@ -13,19 +13,49 @@
  * Our face list has owner = tets[2i] (the lower tet for an interior face)
  * on the positive side, i.e. the normal points into the owner: each face
  * is written reversed. The hull is one patch, "hull", of type patch.
+ *
+ * A periodic mesh comes laid out (meshview.h: each tet where its offsets
+ * place it, image vertices as points of their own). A face of the
+ * periodic mesh whose two tets lie in different copies is then two faces,
+ * translates of each other: a pair of cyclic patches (OpenFOAM's
+ * translational cyclic), one pair a translation (up to 13: the axes and,
+ * where an edge or a corner of the box is crossed, the diagonals). The
+ * faces are paired by their input ids and image offsets, exactly, never by
+ * coordinates; face i of one patch is the partner of face i of the other,
+ * listed from the same point.
  */
 #include "io/write/formats.h"
 #include "mesh/dualmesh.h"
+
+/* A boundary patch: the hull, or one side of a cyclic pair (partner: the
+ * other side's index in the list, its faces' translates at +sep). */
+typedef struct foam_patch {
+    char name[64];
+    size_t n_faces, start;
+    int partner;
+    double sep[3];
+} foam_patch;
 
 typedef struct foam_prep {
     size_t n_internal, n_faces, n_points, n_cells;
     size_t *order;   /* n_faces: face list indices in OpenFOAM order */
     fdt_vid *map;    /* n_points of the input: the new number, -1 unused */
+    /* a periodic mesh laid out (fdt_foam_prepare_periodic), else NULL:
+     * each face's three points (mapped, the normal out of its owner) and
+     * owner in OpenFOAM order, the internal faces' neighbours, the patches */
+    int32_t *fv, *own, *nbr;
+    foam_patch *patch;
+    size_t n_patches;
 } foam_prep;
+
+static int foam_prepare_periodic(const fdt_mesh_view *m, void **prep, const char *path,
+                                 char *err, size_t errlen);
 
 int fdt_foam_prepare(const fdt_mesh_view *m, void **prep, const char *path, char *err,
                      size_t errlen)
 {
+    if (m->point_src)
+        return foam_prepare_periodic(m, prep, path, err, errlen);
     size_t T = m->n_tets, F = m->n_faces, N = m->n_points;
     if (T > (size_t)INT32_MAX || F > (size_t)INT32_MAX)
         return set_err(err, errlen, FDT_IO_EFORMAT, path,
@@ -38,6 +68,7 @@ int fdt_foam_prepare(const fdt_mesh_view *m, void **prep, const char *path, char
         free(start);
         return set_errno_err(err, errlen, path, ENOMEM);
     }
+    memset(p, 0, sizeof *p);
     p->order = (size_t *)(p + 1);
     p->map = (fdt_vid *)(p->order + F);
     p->n_faces = F;
@@ -90,6 +121,321 @@ int fdt_foam_prepare(const fdt_mesh_view *m, void **prep, const char *path, char
     p->n_internal = n_int;
     *prep = p;
     return FDT_IO_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* A periodic mesh laid out: the faces paired by input ids and offsets. */
+
+/* The faces of a positive tet (fdt_orient3d > 0, the sign convention of
+ * include/frontdt.h) opposite each vertex, the normal pointing out. */
+static const int out_face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+/* Face r = 4 t + k of the laid-out tets: its points, outward. */
+static void pface_points(const fdt_mesh_view *m, uint64_t r, fdt_vid v[3])
+{
+    const fdt_vid *t = m->tets + 4 * (size_t)(r >> 2);
+    for (int i = 0; i < 3; i++)
+        v[i] = t[out_face[r & 3][i]];
+}
+
+/* The lowest input id of face r's points: its bucket. */
+static uint32_t pface_low(const fdt_mesh_view *m, uint64_t r)
+{
+    fdt_vid v[3];
+    pface_points(m, r, v);
+    fdt_vid a = m->point_src[v[0]], b = m->point_src[v[1]], c = m->point_src[v[2]];
+    return (uint32_t)(a < b ? (a < c ? a : c) : (b < c ? b : c));
+}
+
+/*
+ * Face r as the periodic mesh names it, wherever this copy lies, in four
+ * words: its input ids ascending (key[0] the first two, key[1] the third
+ * and the top of the rest), the offsets of the second and third point from
+ * the first's (6 bytes: the top of key[1], then key[2]'s top 16 bits), the
+ * first's offsets (where this copy lies: key[2]'s next 24 bits) and r
+ * itself (key[3], for ties). Sorting by key brings the two copies of a
+ * face together (KEY_SAME), in an order the mesh alone decides.
+ */
+static void pface_key(const fdt_mesh_view *m, uint64_t r, uint64_t key[4])
+{
+    fdt_vid v[3];
+    pface_points(m, r, v);
+    int o[3] = {0, 1, 2};
+    for (int i = 1; i < 3; i++)
+        for (int j = i; j > 0 && m->point_src[v[o[j]]] < m->point_src[v[o[j - 1]]]; j--) {
+            int x = o[j];
+            o[j] = o[j - 1];
+            o[j - 1] = x;
+        }
+    const int8_t *a = m->point_off + 3 * (size_t)v[o[0]];
+    uint64_t rel = 0, at = 0;
+    for (int i = 1; i < 3; i++)
+        for (int c = 0; c < 3; c++)
+            rel = rel << 8 | (uint8_t)(m->point_off[3 * (size_t)v[o[i]] + (size_t)c] - a[c]);
+    for (int c = 0; c < 3; c++)
+        at = at << 8 | (uint8_t)(a[c] + 128);
+    key[0] = (uint64_t)m->point_src[v[o[0]]] << 32 | (uint32_t)m->point_src[v[o[1]]];
+    key[1] = (uint64_t)m->point_src[v[o[2]]] << 32 | rel >> 16;
+    key[2] = (rel & 0xffff) << 48 | at << 24;
+    key[3] = r;
+}
+
+/* Whether keys a and b name the same face of the periodic mesh. */
+#define KEY_SAME(a, b) ((a)[0] == (b)[0] && (a)[1] == (b)[1] && (a)[2] >> 48 == (b)[2] >> 48)
+/* Where a key's copy lies: its first point's offsets, 128 up a byte each. */
+#define KEY_AT(a) ((a)[2] >> 24 & 0xffffff)
+
+static int key_cmp(const void *x, const void *y)
+{
+    const uint64_t *a = x, *b = y;
+    for (int i = 0; i < 4; i++)
+        if (a[i] != b[i])
+            return a[i] < b[i] ? -1 : 1;
+    return 0;
+}
+
+/* The translation from a face's copy at a (KEY_AT) to its partner at b,
+ * in periods: b - a per axis. */
+static void pface_shift(uint64_t a, uint64_t b, int s[3])
+{
+    for (int c = 0; c < 3; c++)
+        s[c] = (int)(b >> (16 - 8 * c) & 0xff) - (int)(a >> (16 - 8 * c) & 0xff);
+}
+
+/* A cyclic pair of faces: r on the side whose partner lies at +shift
+ * (the shift's first nonzero component positive), q the partner. */
+typedef struct cyc {
+    uint64_t r, q;
+    int s[3];
+} cyc;
+
+/* An internal face: its owner's face r, owner below neighbour. */
+typedef struct intf {
+    int32_t own, nbr;
+    uint64_t r;
+} intf;
+
+static int intf_cmp(const void *x, const void *y)
+{
+    const intf *a = x, *b = y;
+    if (a->own != b->own)
+        return a->own < b->own ? -1 : 1;
+    return (a->nbr > b->nbr) - (a->nbr < b->nbr);
+}
+
+static int shift_cmp(const int a[3], const int b[3])
+{
+    for (int c = 0; c < 3; c++)
+        if (a[c] != b[c])
+            return a[c] < b[c] ? -1 : 1;
+    return 0;
+}
+
+/* "periodic_p1_0_m1": the translation to the partner, p for plus, m for
+ * minus (OpenFOAM's words take neither sign). */
+static void shift_name(const int s[3], char *buf, size_t len)
+{
+    snprintf(buf, len, "periodic_%s%d_%s%d_%s%d", s[0] > 0 ? "p" : s[0] < 0 ? "m" : "",
+             abs(s[0]), s[1] > 0 ? "p" : s[1] < 0 ? "m" : "", abs(s[1]),
+             s[2] > 0 ? "p" : s[2] < 0 ? "m" : "", abs(s[2]));
+}
+
+/* Face f of the output: laid-out face r (outward of its tet, which owns
+ * it), turned (an even permutation: the orientation kept) to start at the
+ * point whose input id is first_src (-1: as it is). */
+static void put_face(foam_prep *p, size_t f, const fdt_mesh_view *m, uint64_t r,
+                     long first_src)
+{
+    fdt_vid v[3];
+    pface_points(m, r, v);
+    int z = 0;
+    while (first_src >= 0 && z < 2 && (long)m->point_src[v[z]] != first_src)
+        z++;
+    for (int c = 0; c < 3; c++)
+        p->fv[3 * f + (size_t)c] = (int32_t)p->map[v[(z + c) % 3]];
+    p->own[f] = (int32_t)(r >> 2);
+}
+
+static int foam_prepare_periodic(const fdt_mesh_view *m, void **prep, const char *path,
+                                 char *err, size_t errlen)
+{
+    size_t T = m->n_tets, N = m->n_points, R = 4 * T;
+    if (T > (size_t)INT32_MAX / 3 || N > (size_t)INT32_MAX)
+        return set_err(err, errlen, FDT_IO_EFORMAT, path,
+                       "too many cells or faces for OpenFOAM's 32-bit labels");
+    int rc = FDT_IO_OK;
+    uint64_t *key = malloc((R ? R : 1) * 4 * sizeof *key);
+    size_t *start = calloc(N + 2, sizeof *start);
+    intf *in = NULL;
+    cyc *cy = NULL;
+    uint64_t *hull = NULL;
+    int (*shifts)[3] = NULL;
+    foam_prep *p = NULL;
+    size_t n_in = 0, n_cy = 0, n_hull = 0, n_sh = 0;
+    if (!key || !start) {
+        rc = set_errno_err(err, errlen, path, ENOMEM);
+        goto done;
+    }
+    /* the keys, by their lowest input id (a counting sort), each bucket
+     * sorted: the copies of a face are then side by side */
+    for (uint64_t r = 0; r < R; r++)
+        start[pface_low(m, r) + 1]++;
+    for (size_t i = 0; i < N; i++)
+        start[i + 1] += start[i];
+    for (uint64_t r = 0; r < R; r++) {
+        uint64_t k[4];
+        pface_key(m, r, k);
+        memcpy(key + 4 * start[k[0] >> 32]++, k, sizeof k);
+    }
+    for (size_t i = N; i > 0; i--) /* start[i] was the end of bucket i */
+        start[i] = start[i - 1];
+    start[0] = 0;
+    for (size_t i = 0; i < N; i++)
+        qsort(key + 4 * start[i], start[i + 1] - start[i], 4 * sizeof *key, key_cmp);
+    /* pairs: one copy (the hull), two in one place (an internal face) or
+     * two copies (a cyclic pair); counted, then listed */
+    for (int pass = 0; pass < 2; pass++) {
+        if (pass && (!(in = malloc((n_in + 1) * sizeof *in)) ||
+                     !(cy = malloc((n_cy + 1) * sizeof *cy)) ||
+                     !(hull = malloc((n_hull + 1) * sizeof *hull)))) {
+            rc = set_errno_err(err, errlen, path, ENOMEM);
+            goto done;
+        }
+        n_in = n_cy = n_hull = 0;
+        for (uint64_t i = 0; i < R;) {
+            const uint64_t *a = key + 4 * i;
+            uint64_t j = i + 1;
+            while (j < R && KEY_SAME(key + 4 * j, a))
+                j++;
+            if (j - i > 2) {
+                rc = set_err(err, errlen, FDT_IO_EFORMAT, path,
+                             "the periodic mesh's faces do not pair (a face in more than two "
+                             "tets)");
+                goto done;
+            }
+            const uint64_t *b = a + 4;
+            if (j - i == 1) {
+                if (pass)
+                    hull[n_hull] = a[3];
+                n_hull++;
+            } else if (KEY_AT(a) == KEY_AT(b)) {
+                int32_t ta = (int32_t)(a[3] >> 2), tb = (int32_t)(b[3] >> 2);
+                if (pass)
+                    in[n_in] = ta < tb ? (intf){ta, tb, a[3]} : (intf){tb, ta, b[3]};
+                n_in++;
+            } else {
+                cyc c;
+                pface_shift(KEY_AT(a), KEY_AT(b), c.s);
+                int neg = c.s[0] < 0 || (c.s[0] == 0 && (c.s[1] < 0 || (c.s[1] == 0 && c.s[2] < 0)));
+                c.r = neg ? b[3] : a[3];
+                c.q = neg ? a[3] : b[3];
+                for (int k = 0; neg && k < 3; k++)
+                    c.s[k] = -c.s[k];
+                if (pass)
+                    cy[n_cy] = c;
+                n_cy++;
+            }
+            i = j;
+        }
+    }
+    free(key); /* the largest array: 32 bytes a face of a tet */
+    key = NULL;
+    qsort(in, n_in, sizeof *in, intf_cmp);
+    /* the translations, ascending: a pair of patches each */
+    if (!(shifts = malloc((n_cy + 1) * sizeof *shifts))) {
+        rc = set_errno_err(err, errlen, path, ENOMEM);
+        goto done;
+    }
+    for (size_t i = 0; i < n_cy; i++) {
+        size_t k = 0;
+        while (k < n_sh && shift_cmp(shifts[k], cy[i].s))
+            k++;
+        if (k == n_sh)
+            memcpy(shifts[n_sh++], cy[i].s, sizeof shifts[0]);
+    }
+    for (size_t i = 1; i < n_sh; i++) /* at most 13: insertion */
+        for (size_t k = i; k > 0 && shift_cmp(shifts[k], shifts[k - 1]) < 0; k--) {
+            int x[3];
+            memcpy(x, shifts[k], sizeof x);
+            memcpy(shifts[k], shifts[k - 1], sizeof x);
+            memcpy(shifts[k - 1], x, sizeof x);
+        }
+    size_t F = n_in + 2 * n_cy + n_hull, P = 2 * n_sh + (n_hull > 0);
+    size_t bytes = sizeof(foam_prep) + N * sizeof(fdt_vid) + P * sizeof(foam_patch) +
+                   (3 * F + F + n_in) * sizeof(int32_t);
+    if (!(p = malloc(bytes))) {
+        rc = set_errno_err(err, errlen, path, ENOMEM);
+        goto done;
+    }
+    memset(p, 0, sizeof *p);
+    p->patch = (foam_patch *)(p + 1); /* the 8-byte members first */
+    p->map = (fdt_vid *)(p->patch + P);
+    p->fv = (int32_t *)(p->map + N);
+    p->own = p->fv + 3 * F;
+    p->nbr = p->own + F;
+    p->n_faces = F;
+    p->n_internal = n_in;
+    p->n_cells = T;
+    p->n_patches = P;
+    /* points: the used ones, in the laid-out order (input points first) */
+    for (size_t i = 0; i < N; i++)
+        p->map[i] = -1;
+    for (size_t i = 0; i < 4 * T; i++)
+        p->map[m->tets[i]] = 0;
+    size_t np = 0;
+    for (size_t i = 0; i < N; i++)
+        if (p->map[i] == 0)
+            p->map[i] = (fdt_vid)np++;
+    p->n_points = np;
+    size_t f = 0;
+    for (size_t i = 0; i < n_in; i++) {
+        put_face(p, f++, m, in[i].r, -1);
+        p->nbr[i] = in[i].nbr;
+    }
+    for (size_t k = 0; k < n_sh; k++) {
+        int neg[3] = {-shifts[k][0], -shifts[k][1], -shifts[k][2]};
+        for (int side = 0; side < 2; side++) {
+            foam_patch *pa = &p->patch[2 * k + (size_t)side];
+            shift_name(side ? neg : shifts[k], pa->name, sizeof pa->name);
+            pa->start = f;
+            pa->partner = (int)(2 * k + (size_t)!side);
+            for (int c = 0; c < 3; c++)
+                pa->sep[c] = (side ? -1 : 1) * shifts[k][c] * m->period[c];
+            for (size_t i = 0; i < n_cy; i++) {
+                if (shift_cmp(cy[i].s, shifts[k]))
+                    continue;
+                /* both sides from the same input point: the first of the
+                 * r side's face */
+                fdt_vid v0[3];
+                pface_points(m, cy[i].r, v0);
+                if (!side)
+                    put_face(p, f++, m, cy[i].r, -1);
+                else
+                    put_face(p, f++, m, cy[i].q, (long)m->point_src[v0[0]]);
+            }
+            pa->n_faces = f - pa->start;
+        }
+    }
+    if (n_hull) {
+        foam_patch *pa = &p->patch[P - 1];
+        snprintf(pa->name, sizeof pa->name, "hull");
+        pa->start = f;
+        pa->partner = -1;
+        for (size_t i = 0; i < n_hull; i++)
+            put_face(p, f++, m, hull[i], -1);
+        pa->n_faces = f - pa->start;
+    }
+    *prep = p;
+    p = NULL;
+done:
+    free(p);
+    free(key);
+    free(start);
+    free(in);
+    free(cy);
+    free(hull);
+    free(shifts);
+    return rc;
 }
 
 /* The FoamFile header of one file; counts (points, cells, faces, internal
@@ -164,7 +510,17 @@ int fdt_put_foam_faces(out_file *o, const fdt_mesh_view *m, const void *prep, ch
     header(o, "faceList", "faces", p);
     out_i64(o, (int64_t)p->n_faces);
     out_str(o, "\n(\n");
-    for (size_t i = 0; i < p->n_faces && !o->err; i++) {
+    for (size_t i = 0; p->fv && i < p->n_faces && !o->err; i++) {
+        const int32_t *v = p->fv + 3 * i; /* turned already */
+        out_str(o, "3(");
+        for (int c = 0; c < 3; c++) {
+            if (c)
+                out_char(o, ' ');
+            out_i64(o, v[c]);
+        }
+        out_str(o, ")\n");
+    }
+    for (size_t i = 0; !p->fv && i < p->n_faces && !o->err; i++) {
         const fdt_vid *v = m->faces + 3 * p->order[i];
         /* reversed: the normal out of the owner */
         out_str(o, "3(");
@@ -184,8 +540,9 @@ static void put_labels(out_file *o, const fdt_mesh_view *m, const foam_prep *p, 
 {
     out_i64(o, (int64_t)count);
     out_str(o, "\n(\n");
+    const int32_t *laid = side ? p->nbr : p->own; /* a periodic mesh's */
     for (size_t i = 0; i < count && !o->err; i++) {
-        out_i64(o, (int64_t)m->face_tets[2 * p->order[i] + (size_t)side]);
+        out_i64(o, p->fv ? (int64_t)laid[i] : (int64_t)m->face_tets[2 * p->order[i] + (size_t)side]);
         out_char(o, '\n');
     }
     out_str(o, ")\n");
@@ -233,8 +590,38 @@ int fdt_put_foam_boundary(out_file *o, const fdt_mesh_view *m, const void *prep,
     (void)errlen;
     const foam_prep *p = prep;
     header(o, "polyBoundaryMesh", "boundary", p);
-    out_str(o, "1\n(\n");
-    put_patch(o, "hull", p->n_faces - p->n_internal, p->n_internal);
+    if (!p->fv) {
+        out_str(o, "1\n(\n");
+        put_patch(o, "hull", p->n_faces - p->n_internal, p->n_internal);
+        out_str(o, ")\n");
+        return FDT_IO_OK;
+    }
+    out_i64(o, (int64_t)p->n_patches);
+    out_str(o, "\n(\n");
+    for (size_t i = 0; i < p->n_patches; i++) {
+        const foam_patch *pa = &p->patch[i];
+        if (pa->partner < 0) {
+            put_patch(o, pa->name, pa->n_faces, pa->start);
+            continue;
+        }
+        out_str(o, "    ");
+        out_str(o, pa->name);
+        out_str(o, "\n    {\n        type            cyclic;\n        inGroups        "
+                   "List<word> 1(cyclic);\n        nFaces          ");
+        out_i64(o, (int64_t)pa->n_faces);
+        out_str(o, ";\n        startFace       ");
+        out_i64(o, (int64_t)pa->start);
+        out_str(o, ";\n        matchTolerance  0.0001;\n        transform       translational;\n"
+                   "        neighbourPatch  ");
+        out_str(o, p->patch[pa->partner].name);
+        out_str(o, ";\n        separationVector (");
+        for (int c = 0; c < 3; c++) {
+            if (c)
+                out_char(o, ' ');
+            out_double(o, pa->sep[c]);
+        }
+        out_str(o, ");\n    }\n");
+    }
     out_str(o, ")\n");
     return FDT_IO_OK;
 }

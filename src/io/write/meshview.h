@@ -31,8 +31,11 @@ typedef struct fdt_mesh_view {
     const int8_t *tet_off, *hull_off;
     double period[3];
     /* A periodic mesh laid out in space (fdt_periodic_unfold), or NULL:
-     * point i's input id, the formats' map back (.vtu, .vtk, .msh). */
+     * point i's input id, the formats' map back (.vtu, .vtk, .msh), and
+     * its image offsets (3 a point), which pair an OpenFOAM mesh's cyclic
+     * faces; period as above. */
     const fdt_vid *point_src;
+    const int8_t *point_off;
 } fdt_mesh_view;
 
 /* The longest path the writer takes (its temporary names live in fixed

@@ -1329,7 +1329,9 @@ static const char *missing(const fdt_format *f, const fdt_mesh_view *m)
     int needs = fdt_format_needs(f, m->all_faces);
     if ((needs & FDT_NEED_NBRS) && !m->nbrs)
         return "this format needs tet neighbours (settings.neighbors)";
-    if ((needs & FDT_NEED_FACES) && !m->faces && (m->n_tets > 0))
+    /* a periodic mesh laid out (point_src): the OpenFOAM writer pairs its
+     * faces itself */
+    if ((needs & FDT_NEED_FACES) && !m->faces && m->n_tets > 0 && !m->point_src)
         return "this format needs the face list (fdt_result_faces)";
     return NULL;
 }
@@ -1647,7 +1649,7 @@ int fdt_default_write_options_sized(fdt_write_options *o, size_t struct_size)
  * vertices as points, each with its input id (fdt_periodic_unfold). */
 static int periodic_laid_out(const fdt_format *f)
 {
-    static const char *const names[] = {"vtu", "vtk", "msh", "msh2", "medit"};
+    static const char *const names[] = {"vtu", "vtk", "msh", "msh2", "medit", "openfoam"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (!strcmp(f->name, names[i]))
             return 1;
@@ -1728,8 +1730,8 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
      * with its image vertices and their input ids (periodic_laid_out) */
     int laid_out = r->tet_off && periodic_laid_out(f);
     if (r->tet_off && !fdt_format_periodic(f)) {
-        snprintf(what, sizeof what, "a periodic mesh is written as .tets, .fdtb, .vtu, .vtk, "
-                 ".msh or .mesh (format %s has no place for its image vertices' input ids)", f->name);
+        snprintf(what, sizeof what, "a periodic mesh is written as " FDT_PERIODIC_FORMATS
+                 " (format %s has no place for its image vertices' input ids)", f->name);
         return set_err(diag, diag_size, FDT_EINVAL, name, what);
     }
     int needs = fdt_format_needs(f, o->all_faces);
@@ -1753,15 +1755,17 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
                                      r->nhull, xyz, n, &b, &u)) != FDT_OK)
             return set_err(diag, diag_size, e, name, fdt_strerror(e));
         v = (fdt_mesh_view){.xyz = u.xyz, .n_points = u.n, .tets = u.tets, .n_tets = u.ntets,
-                            .hull = u.hull, .n_hull = u.nhull, .point_src = u.src};
+                            .hull = u.hull, .n_hull = u.nhull, .point_src = u.src,
+                            .point_off = u.off};
     } else if (r->tet_off) {
         v.tet_off = r->tet_off;
         v.hull_off = r->hull_off;
-        for (int k = 0; k < 3; k++)
-            v.period[k] = r->periodic >> k & 1 ? r->pbox[k + 3] - r->pbox[k] : 0;
     }
-    /* after the sort: the face list names tets by their numbers */
-    if ((needs & FDT_NEED_FACES) &&
+    for (int k = 0; r->tet_off && k < 3; k++)
+        v.period[k] = r->periodic >> k & 1 ? r->pbox[k + 3] - r->pbox[k] : 0;
+    /* after the sort: the face list names tets by their numbers (a
+     * periodic OpenFOAM mesh pairs its laid-out faces itself) */
+    if ((needs & FDT_NEED_FACES) && !laid_out &&
         (e = fdt_result_faces(r, &v.n_faces, &v.faces, &v.face_tets)) != FDT_OK)
         return set_err(diag, diag_size, e, name, fdt_strerror(e));
     int io = to_stdout ? fdt_wr_mesh_stream_ex(stdout, name, f, &v, o->progress,
