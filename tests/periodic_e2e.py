@@ -13,7 +13,7 @@
 - Errors, each with its message and exit code and no output: a point
   outside the box (exit 1, the input's line named by index), too few
   points for one copy of the box (exit 2), --periodic without --box, with
-  --stream or an output that has no place for the image vertices (exit 1), over --memory-limit
+  --stream and an output that is not .tets, or with --all-faces (exit 1), over --memory-limit
   (exit 4, its estimate counting the images).
 
 - The cells (--periodic --voronoi): their volumes sum to the box's to
@@ -35,7 +35,9 @@
   faces across periodic sides as cyclic patch pairs, checked here (cells
   closed, volumes the domain's, each pair's faces translates of each
   other by whole periods) and by OpenFOAM's checkMesh where it is
-  installed; uniform and a lattice in a cube, a channel and a duct.
+  installed; uniform and a lattice in a cube, a channel and a duct. TetGen's
+  set of the same meshes: each point's input id and offsets as attributes,
+  the periodic neighbours in .neigh.
 
 - tests/gen_points families scaled into the unit box (a torus, a cubed
   sphere, near-duplicates, a rotated lattice, mixed scales: flat tets
@@ -290,6 +292,71 @@ def channel(n, g, lo, hi, axes, seed):
     return pts
 
 
+def tetgen(name, src, box, axes, ntets, want, period):
+    """-o X.ele (TetGen's set) of the same mesh laid out: a point's four
+    attributes its input id and image offsets (the input points first, as
+    themselves); a tet a row, positive, their volumes the domain's; .neigh
+    symmetric, the tet across a face holding the same input ids, its face
+    the translate of this one by whole periods (the offsets' difference),
+    -1 exactly on the .face's hull faces."""
+    base = os.path.join(SCRATCH, name + "_tg")
+    r = frontdt(src, "--periodic", ",".join(axes), "--box", box, "-q", "-o", base + ".ele")
+    expect(r.returncode == 0, "TetGen %s: exit %d, %s" % (name, r.returncode, r.stderr))
+    if r.returncode:
+        return
+
+    def rows(ext):
+        lines = [line.split() for line in open(base + ext) if line.strip()]
+        return lines[0], lines[1:]
+    head, node = rows(".node")
+    expect(head[1:] == ["3", "4", "0"], "TetGen %s: .node header %s" % (name, head))
+    xyz = [tuple(map(float, r[1:4])) for r in node]
+    src_id = [int(r[4]) for r in node]
+    off = [tuple(map(int, r[5:8])) for r in node]
+    n_in = sum(1 for line in open(src) if line.strip())
+    expect(all(src_id[i] == i and off[i] == (0, 0, 0) for i in range(n_in)),
+           "TetGen %s: the input points are not the first, as themselves" % name)
+    expect(all(period[k] or o[k] == 0 for o in off for k in range(3)),
+           "TetGen %s: an offset across an axis that is not periodic" % name)
+    _, ele = rows(".ele")
+    tets = [list(map(int, r[1:5])) for r in ele]
+    _, neigh = rows(".neigh")
+    nb = [list(map(int, r[1:5])) for r in neigh]
+    _, face = rows(".face")
+    expect(len(tets) == ntets and len(nb) == ntets,
+           "TetGen %s: %d tets, %d .neigh rows, the .tets %d" % (name, len(tets), len(nb), ntets))
+
+    def vol(t):
+        a, b, c, d = (xyz[v] for v in t)
+        u = [b[k] - a[k] for k in range(3)]
+        v = [c[k] - a[k] for k in range(3)]
+        w = [d[k] - a[k] for k in range(3)]
+        return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                u[2] * (v[0] * w[1] - v[1] * w[0])) / 6
+    vols = [vol(t) for t in tets]
+    expect(min(vols) > 0 and abs(sum(vols) - want) <= 1e-12 * want,
+           "TetGen %s: volumes %g .. sum %.17g, the domain %.17g"
+           % (name, min(vols), sum(vols), want))
+    bad, hull = 0, 0
+    for t, row in enumerate(nb):
+        for k, u in enumerate(row):
+            if u < 0:
+                hull += 1
+                continue
+            mine = [tets[t][i] for i in range(4) if i != k]
+            ids = {src_id[v]: v for v in tets[u]}
+            theirs = [ids.get(src_id[v]) for v in mine]
+            if t not in nb[u] or None in theirs:
+                bad += 1
+                continue
+            shift = [off[theirs[0]][c] - off[mine[0]][c] for c in range(3)]
+            bad += any(off[b][c] - off[a][c] != shift[c] for a, b in zip(mine, theirs)
+                       for c in range(3))
+    expect(bad == 0 and hull == len(face),
+           "TetGen %s: %d neighbours wrong, %d hull sides for %d .face rows"
+           % (name, bad, hull, len(face)))
+
+
 def polymesh(name, pts, lo, hi, axes):
     """-o CASE/constant/polyMesh: the mesh laid out, its faces across the
     periodic sides as cyclic patch pairs. The same files at 1 and 3
@@ -299,7 +366,8 @@ def polymesh(name, pts, lo, hi, axes):
     each cyclic patch's faces, moved by its separationVector, its
     neighbour's face for face, from the same point in the opposite turn;
     the separations whole periods; a hull patch only where an axis is not
-    periodic. Then OpenFOAM's checkMesh where it is installed: its
+    periodic; TetGen's set of the same mesh (tetgen()). Then OpenFOAM's
+    checkMesh where it is installed: its
     topology, openness, pyramids and volumes OK, and the coupled points
     matched (a separation with the wrong sign fails there, and here)."""
     src = os.path.join(SCRATCH, name + "_foam.xyz")
@@ -386,6 +454,7 @@ def polymesh(name, pts, lo, hi, axes):
                        for j, v in enumerate(fb) for k in range(3))
         expect(bad == 0, "polyMesh %s: %d faces of %s not their partners in %s"
                % (name, bad, p["name"], q["name"]))
+    tetgen(name, src, box, axes, ntets, want, period)
     rc = foam_mesh.checkmesh_cmd()
     said = "checkMesh not installed"
     if rc is not None:
@@ -473,8 +542,8 @@ def errors():
     for args, word in ((["--periodic", "xz"], "needs --box"),
                        (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "--stream", "-o",
                          os.path.join(SCRATCH, "m.vtu")], ".tets only"),
-                       (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "-o",
-                         os.path.join(SCRATCH, "m.ele")], "image vertices"),
+                       (["--periodic", "xyz", "--box", "0,0,0,1,1,1", "--all-faces", "-o",
+                         os.path.join(SCRATCH, "m.ele")], "--all-faces"),
                        (["--periodic", "xq", "--box", "0,0,0,1,1,1"], "axes")):
         r = frontdt(src, *args)
         expect(r.returncode == 1 and word in r.stderr, "%s: exit %d, %s"

@@ -448,13 +448,16 @@ static int sc_pcells(void *arg, const char **bad)
     return rc;
 }
 
-/* A periodic mesh written (fdt_write_mesh: .fdtb with its offsets, .vtu
- * and .msh laid out with its image vertices, src/mesh/periodic.c's
- * fdt_periodic_unfold) under injection: one file, or FDT_ENOMEM and none. */
+/* A periodic mesh written (fdt_write_mesh: .fdtb with its offsets, .vtu,
+ * .msh, TetGen's set and an OpenFOAM polyMesh laid out with its image
+ * vertices, src/mesh/periodic.c's fdt_periodic_unfold, the last two with
+ * the periodic neighbours) under injection: its files (a TetGen set's
+ * four, a polyMesh's directory), or FDT_ENOMEM and none. */
 typedef struct pwrite_arg {
     fdt_result *r;
     const ptset *ps;
     const char *dir, *ext;
+    int files;
 } pwrite_arg;
 
 static void empty_dir(const char *dir);
@@ -463,9 +466,10 @@ static int sc_pwrite(void *arg, const char **bad)
 {
     pwrite_arg *a = arg;
     char path[1024], diag[512];
-    snprintf(path, sizeof path, "%s/per%s", a->dir, a->ext);
+    snprintf(path, sizeof path, "%s/%s%s", a->dir, strcmp(a->ext, "polyMesh") ? "per" : "",
+             a->ext);
     int rc = fdt_write_mesh(a->r, a->ps->xyz, a->ps->n, path, NULL, diag, sizeof diag);
-    if (count_entries(a->dir) != (rc == FDT_OK))
+    if (count_entries(a->dir) != (rc == FDT_OK ? a->files : 0))
         *bad = rc != FDT_OK ? "files left after a failed periodic write"
                             : "no file after a periodic write";
     empty_dir(a->dir);
@@ -1036,7 +1040,10 @@ static void empty_dir(const char *dir)
         if (strcmp(de->d_name, ".") == 0 || strcmp(de->d_name, "..") == 0)
             continue;
         snprintf(p, sizeof p, "%s/%s", dir, de->d_name);
-        unlink(p);
+        if (unlink(p) != 0) { /* a directory (a polyMesh): its files, then it */
+            empty_dir(p);
+            rmdir(p);
+        }
     }
     closedir(d);
 }
@@ -1453,7 +1460,7 @@ int main(int argc, char **argv)
                          ps->name);
                 scenario sv = {pn, FDT_ENOMEM, sc_pcells, &ca};
                 inject_all(&sv);
-                pwrite_arg ka = {pr, &w, outdir, ""};
+                pwrite_arg ka = {pr, &w, outdir, "", 1};
                 snprintf(pn, sizeof pn, "periodic check %s %s", pa_i ? "x z" : "x y z", ps->name);
                 scenario sk = {pn, FDT_ENOMEM, sc_pcheck, &ka};
                 inject_all(&sk);
@@ -1462,9 +1469,10 @@ int main(int argc, char **argv)
                          ps->name);
                 scenario ss = {pn, FDT_ENOMEM, sc_pstream, &sa};
                 inject_all(&ss);
-                static const char *const pext[3] = {".fdtb", ".vtu", ".msh"};
-                for (int e = 0; e < 3 && pa_i; e++) {
-                    pwrite_arg wa = {pr, &w, outdir, pext[e]};
+                static const char *const pext[5] = {".fdtb", ".vtu", ".msh", ".ele", "polyMesh"};
+                static const int pfiles[5] = {1, 1, 1, 4, 1};
+                for (int e = 0; e < 5 && pa_i; e++) {
+                    pwrite_arg wa = {pr, &w, outdir, pext[e], pfiles[e]};
                     snprintf(pn, sizeof pn, "periodic write %s %s", pext[e], ps->name);
                     scenario sw = {pn, FDT_ENOMEM, sc_pwrite, &wa};
                     inject_all(&sw);

@@ -554,20 +554,16 @@ static int check_args(cli *c, int npos, char **pos)
         return usage_error("--input-format, --columns, --delimiter and --decimal-comma need "
                            "an input file, not --demo");
     if (c->periodic) {
-        /* issue 33's first step: the periodic mesh in memory, as .tets */
+        /* the periodic mesh, in memory unless --stream; every output
+         * format (laid out in space but .tets and .fdtb) */
         if (!c->dual.box_given)
             return usage_error("--periodic needs --box X0,Y0,Z0,X1,Y1,Z1: the periods");
+        if (c->all_faces)
+            return usage_error("--periodic: TetGen's .face lists the hull, not every face "
+                               "(--all-faces)");
         if (c->dual.dual || fdt_cli_interp_wanted(&c->dual))
             return usage_error("--periodic writes the mesh, its hashes, --check and the cells; "
                                "not yet --dual or --interpolate");
-        for (int o = 0; o < c->n_outputs; o++) {
-            const fdt_format *f = c->out_format[o] ? fdt_format_by_name(c->out_format[o])
-                                                   : fdt_format_by_path(c->outputs[o]);
-            if (f && !fdt_format_periodic(f))
-                return usage_error("--periodic writes " FDT_PERIODIC_FORMATS " (-o %s: "
-                                   "its format has no place for the image vertices' input "
-                                   "ids)", c->outputs[o]);
-        }
         if (c->stream <= 0) /* in memory unless asked (its slabs: --stream) */
             c->stream = -1;
     }

@@ -1373,6 +1373,110 @@ void fdt_periodic_unfolded_free(fdt_periodic_unfolded *u)
     memset(u, 0, sizeof *u);
 }
 
+/*
+ * Face k of laid-out tet t as the periodic mesh names it, wherever this
+ * copy lies, in three words: its input ids ascending (key[0] the first
+ * two, key[1] the third and the top of the rest), the offsets of the
+ * second and third point from the first's (6 bytes: the top of key[1],
+ * then key[2]'s top 16 bits), and 4 t + k (key[2]'s low 32 bits: 4
+ * ntets < 2^32, checked). Sorting the keys brings a face's two tets
+ * together.
+ */
+static void unfolded_face_key(const fdt_periodic_unfolded *u, uint64_t r, uint64_t fk[3])
+{
+    const fdt_vid *t = u->tets + 4 * (size_t)(r >> 2);
+    const int *f = fdt_tet_face[r & 3]; /* out of the tet: any order would do */
+    fdt_vid v[3] = {t[f[0]], t[f[1]], t[f[2]]};
+    for (int i = 1; i < 3; i++) /* by input id */
+        for (int j = i; j > 0 && u->src[v[j]] < u->src[v[j - 1]]; j--) {
+            fdt_vid x = v[j];
+            v[j] = v[j - 1];
+            v[j - 1] = x;
+        }
+    uint64_t rel = 0;
+    for (int i = 1; i < 3; i++)
+        for (int c = 0; c < 3; c++)
+            rel = rel << 8 | (uint8_t)(u->off[3 * (size_t)v[i] + (size_t)c] -
+                                       u->off[3 * (size_t)v[0] + (size_t)c]);
+    fk[0] = (uint64_t)(uint32_t)u->src[v[0]] << 32 | (uint32_t)u->src[v[1]];
+    fk[1] = (uint64_t)(uint32_t)u->src[v[2]] << 32 | rel >> 16;
+    fk[2] = (rel & 0xffff) << 48 | r;
+}
+
+static int key3_cmp(const void *x, const void *y)
+{
+    const uint64_t *a = x, *b = y;
+    for (int i = 0; i < 3; i++)
+        if (a[i] != b[i])
+            return a[i] < b[i] ? -1 : 1;
+    return 0;
+}
+
+int fdt_periodic_unfolded_neighbors(const fdt_periodic_unfolded *u, fdt_tid **nbrs)
+{
+    *nbrs = NULL;
+    size_t R = 4 * u->ntets, N = u->n;
+    if (R >= (UINT64_C(1) << 32))
+        return FDT_ETOOBIG;
+    uint64_t *fk = malloc((R ? R : 1) * 3 * sizeof *fk);
+    size_t *start = calloc(N + 2, sizeof *start);
+    fdt_tid *nb = malloc((R ? R : 1) * sizeof *nb);
+    int err = FDT_OK;
+    if (!fk || !start || !nb) {
+        err = FDT_ENOMEM;
+        goto done;
+    }
+    /* the keys by their lowest input id (a counting sort), then each
+     * bucket sorted */
+    for (uint64_t r = 0; r < R; r++) {
+        const fdt_vid *t = u->tets + 4 * (size_t)(r >> 2);
+        fdt_vid lo = INT32_MAX;
+        for (int i = 0; i < 3; i++) {
+            fdt_vid s = u->src[t[fdt_tet_face[r & 3][i]]];
+            lo = s < lo ? s : lo;
+        }
+        start[(size_t)lo + 1]++;
+    }
+    for (size_t i = 0; i < N; i++)
+        start[i + 1] += start[i];
+    for (uint64_t r = 0; r < R; r++) {
+        uint64_t k[3];
+        unfolded_face_key(u, r, k);
+        memcpy(fk + 3 * start[k[0] >> 32]++, k, sizeof k);
+    }
+    for (size_t i = N; i > 0; i--) /* start[i] was the end of bucket i */
+        start[i] = start[i - 1];
+    start[0] = 0;
+    for (size_t i = 0; i < N; i++)
+        qsort(fk + 3 * start[i], start[i + 1] - start[i], 3 * sizeof *fk, key3_cmp);
+    for (size_t i = 0; i < R;) {
+        const uint64_t *a = fk + 3 * i;
+        size_t j = i + 1;
+        while (j < R && fk[3 * j] == a[0] && fk[3 * j + 1] == a[1] &&
+               fk[3 * j + 2] >> 48 == a[2] >> 48)
+            j++;
+        uint32_t ra = (uint32_t)a[2];
+        if (j - i == 1) {
+            nb[ra] = -1;
+        } else if (j - i == 2) {
+            uint32_t rb = (uint32_t)a[5];
+            nb[ra] = (fdt_tid)(rb >> 2);
+            nb[rb] = (fdt_tid)(ra >> 2);
+        } else {
+            err = FDT_EINTERNAL;
+            goto done;
+        }
+        i = j;
+    }
+    *nbrs = nb;
+    nb = NULL;
+done:
+    free(fk);
+    free(start);
+    free(nb);
+    return err;
+}
+
 int fdt_periodic_unfold(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
                         const int8_t *hoff, size_t nhull, const double *X, size_t n,
                         const fdt_periodic_box *b, fdt_periodic_unfolded *u)

@@ -216,6 +216,17 @@ typedef struct fdt_periodic_unfolded {
 int fdt_periodic_unfold(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
                         const int8_t *hoff, size_t nhull, const double *X, size_t n,
                         const fdt_periodic_box *b, fdt_periodic_unfolded *u);
+
+/*
+ * The neighbours of u's tets in the periodic mesh, for the formats that
+ * write them (TetGen's .neigh) or pair faces (OpenFOAM's cyclic patches):
+ * nbrs[4 t + k] the tet across tet t's face opposite its vertex k, which
+ * may lie in another copy (the face is then a translate of t's), -1 on
+ * the hull. Faces are paired by their input ids and the offsets between
+ * their points, never by coordinates. FDT_OK, FDT_ENOMEM, FDT_EINTERNAL
+ * (a face in more than two tets: a bug). *nbrs is the caller's to free.
+ */
+int fdt_periodic_unfolded_neighbors(const fdt_periodic_unfolded *u, fdt_tid **nbrs);
 void fdt_periodic_unfolded_free(fdt_periodic_unfolded *u);
 
 /*

@@ -25,6 +25,7 @@
  * listed from the same point.
  */
 #include "io/write/formats.h"
+#include "geom/predicates.h"
 #include "mesh/dualmesh.h"
 
 /* A boundary patch: the hull, or one side of a cyclic pair (partner: the
@@ -126,84 +127,16 @@ int fdt_foam_prepare(const fdt_mesh_view *m, void **prep, const char *path, char
 /* ------------------------------------------------------------------ */
 /* A periodic mesh laid out: the faces paired by input ids and offsets. */
 
-/* The faces of a positive tet (fdt_orient3d > 0, the sign convention of
- * include/frontdt.h) opposite each vertex, the normal pointing out. */
-static const int out_face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-
-/* Face r = 4 t + k of the laid-out tets: its points, outward. */
+/* Face r = 4 t + k of the laid-out tets: its points, out of tet t. */
 static void pface_points(const fdt_mesh_view *m, uint64_t r, fdt_vid v[3])
 {
     const fdt_vid *t = m->tets + 4 * (size_t)(r >> 2);
     for (int i = 0; i < 3; i++)
-        v[i] = t[out_face[r & 3][i]];
+        v[i] = t[fdt_tet_face[r & 3][i]];
 }
 
-/* The lowest input id of face r's points: its bucket. */
-static uint32_t pface_low(const fdt_mesh_view *m, uint64_t r)
-{
-    fdt_vid v[3];
-    pface_points(m, r, v);
-    fdt_vid a = m->point_src[v[0]], b = m->point_src[v[1]], c = m->point_src[v[2]];
-    return (uint32_t)(a < b ? (a < c ? a : c) : (b < c ? b : c));
-}
-
-/*
- * Face r as the periodic mesh names it, wherever this copy lies, in four
- * words: its input ids ascending (key[0] the first two, key[1] the third
- * and the top of the rest), the offsets of the second and third point from
- * the first's (6 bytes: the top of key[1], then key[2]'s top 16 bits), the
- * first's offsets (where this copy lies: key[2]'s next 24 bits) and r
- * itself (key[3], for ties). Sorting by key brings the two copies of a
- * face together (KEY_SAME), in an order the mesh alone decides.
- */
-static void pface_key(const fdt_mesh_view *m, uint64_t r, uint64_t key[4])
-{
-    fdt_vid v[3];
-    pface_points(m, r, v);
-    int o[3] = {0, 1, 2};
-    for (int i = 1; i < 3; i++)
-        for (int j = i; j > 0 && m->point_src[v[o[j]]] < m->point_src[v[o[j - 1]]]; j--) {
-            int x = o[j];
-            o[j] = o[j - 1];
-            o[j - 1] = x;
-        }
-    const int8_t *a = m->point_off + 3 * (size_t)v[o[0]];
-    uint64_t rel = 0, at = 0;
-    for (int i = 1; i < 3; i++)
-        for (int c = 0; c < 3; c++)
-            rel = rel << 8 | (uint8_t)(m->point_off[3 * (size_t)v[o[i]] + (size_t)c] - a[c]);
-    for (int c = 0; c < 3; c++)
-        at = at << 8 | (uint8_t)(a[c] + 128);
-    key[0] = (uint64_t)m->point_src[v[o[0]]] << 32 | (uint32_t)m->point_src[v[o[1]]];
-    key[1] = (uint64_t)m->point_src[v[o[2]]] << 32 | rel >> 16;
-    key[2] = (rel & 0xffff) << 48 | at << 24;
-    key[3] = r;
-}
-
-/* Whether keys a and b name the same face of the periodic mesh. */
-#define KEY_SAME(a, b) ((a)[0] == (b)[0] && (a)[1] == (b)[1] && (a)[2] >> 48 == (b)[2] >> 48)
-/* Where a key's copy lies: its first point's offsets, 128 up a byte each. */
-#define KEY_AT(a) ((a)[2] >> 24 & 0xffffff)
-
-static int key_cmp(const void *x, const void *y)
-{
-    const uint64_t *a = x, *b = y;
-    for (int i = 0; i < 4; i++)
-        if (a[i] != b[i])
-            return a[i] < b[i] ? -1 : 1;
-    return 0;
-}
-
-/* The translation from a face's copy at a (KEY_AT) to its partner at b,
- * in periods: b - a per axis. */
-static void pface_shift(uint64_t a, uint64_t b, int s[3])
-{
-    for (int c = 0; c < 3; c++)
-        s[c] = (int)(b >> (16 - 8 * c) & 0xff) - (int)(a >> (16 - 8 * c) & 0xff);
-}
-
-/* A cyclic pair of faces: r on the side whose partner lies at +shift
- * (the shift's first nonzero component positive), q the partner. */
+/* A cyclic pair of faces: r on the side whose partner q lies at +s
+ * periods (the shift's first nonzero component positive). */
 typedef struct cyc {
     uint64_t r, q;
     int s[3];
@@ -240,9 +173,9 @@ static void shift_name(const int s[3], char *buf, size_t len)
              s[2] > 0 ? "p" : s[2] < 0 ? "m" : "", abs(s[2]));
 }
 
-/* Face f of the output: laid-out face r (outward of its tet, which owns
- * it), turned (an even permutation: the orientation kept) to start at the
- * point whose input id is first_src (-1: as it is). */
+/* Face f of the output: laid-out face r (out of its tet, which owns it),
+ * turned (an even permutation: the orientation kept) to start at the point
+ * whose input id is first_src (-1: as it is). */
 static void put_face(foam_prep *p, size_t f, const fdt_mesh_view *m, uint64_t r,
                      long first_src)
 {
@@ -256,44 +189,51 @@ static void put_face(foam_prep *p, size_t f, const fdt_mesh_view *m, uint64_t r,
     p->own[f] = (int32_t)(r >> 2);
 }
 
+/*
+ * Where face r of the laid-out tets is across its neighbour m->nbrs[r]
+ * (the periodic mesh's: fdt_periodic_unfolded_neighbors): *q the
+ * neighbour's face (its vertex with the input id that r's face lacks is
+ * the one opposite), and whether the two lie in one copy (the same
+ * points), else *s the translation from r's copy to q's, in periods.
+ */
+static int across(const fdt_mesh_view *m, uint64_t r, uint64_t *q, int s[3])
+{
+    fdt_vid v[3], w[3];
+    pface_points(m, r, v);
+    uint64_t t2 = (uint64_t)m->nbrs[r];
+    const fdt_vid *u = m->tets + 4 * (size_t)t2;
+    int k2 = 0;
+    for (int i = 0; i < 4; i++)
+        if (m->point_src[u[i]] != m->point_src[v[0]] && m->point_src[u[i]] != m->point_src[v[1]] &&
+            m->point_src[u[i]] != m->point_src[v[2]])
+            k2 = i;
+    *q = 4 * t2 + (uint64_t)k2;
+    pface_points(m, *q, w);
+    int z = 0;
+    while (z < 2 && m->point_src[w[z]] != m->point_src[v[0]])
+        z++;
+    for (int c = 0; c < 3; c++)
+        s[c] = m->point_off[3 * (size_t)w[z] + (size_t)c] - m->point_off[3 * (size_t)v[0] + (size_t)c];
+    return w[z] == v[0];
+}
+
 static int foam_prepare_periodic(const fdt_mesh_view *m, void **prep, const char *path,
                                  char *err, size_t errlen)
 {
-    size_t T = m->n_tets, N = m->n_points, R = 4 * T;
+    size_t T = m->n_tets, N = m->n_points;
+    uint64_t R = 4 * (uint64_t)T;
     if (T > (size_t)INT32_MAX / 3 || N > (size_t)INT32_MAX)
         return set_err(err, errlen, FDT_IO_EFORMAT, path,
                        "too many cells or faces for OpenFOAM's 32-bit labels");
     int rc = FDT_IO_OK;
-    uint64_t *key = malloc((R ? R : 1) * 4 * sizeof *key);
-    size_t *start = calloc(N + 2, sizeof *start);
     intf *in = NULL;
     cyc *cy = NULL;
     uint64_t *hull = NULL;
     int (*shifts)[3] = NULL;
     foam_prep *p = NULL;
     size_t n_in = 0, n_cy = 0, n_hull = 0, n_sh = 0;
-    if (!key || !start) {
-        rc = set_errno_err(err, errlen, path, ENOMEM);
-        goto done;
-    }
-    /* the keys, by their lowest input id (a counting sort), each bucket
-     * sorted: the copies of a face are then side by side */
-    for (uint64_t r = 0; r < R; r++)
-        start[pface_low(m, r) + 1]++;
-    for (size_t i = 0; i < N; i++)
-        start[i + 1] += start[i];
-    for (uint64_t r = 0; r < R; r++) {
-        uint64_t k[4];
-        pface_key(m, r, k);
-        memcpy(key + 4 * start[k[0] >> 32]++, k, sizeof k);
-    }
-    for (size_t i = N; i > 0; i--) /* start[i] was the end of bucket i */
-        start[i] = start[i - 1];
-    start[0] = 0;
-    for (size_t i = 0; i < N; i++)
-        qsort(key + 4 * start[i], start[i + 1] - start[i], 4 * sizeof *key, key_cmp);
-    /* pairs: one copy (the hull), two in one place (an internal face) or
-     * two copies (a cyclic pair); counted, then listed */
+    /* each face once, from the lower tet (an internal one, or a cyclic
+     * pair's two copies), or the hull: counted, then listed */
     for (int pass = 0; pass < 2; pass++) {
         if (pass && (!(in = malloc((n_in + 1) * sizeof *in)) ||
                      !(cy = malloc((n_cy + 1) * sizeof *cy)) ||
@@ -302,44 +242,34 @@ static int foam_prepare_periodic(const fdt_mesh_view *m, void **prep, const char
             goto done;
         }
         n_in = n_cy = n_hull = 0;
-        for (uint64_t i = 0; i < R;) {
-            const uint64_t *a = key + 4 * i;
-            uint64_t j = i + 1;
-            while (j < R && KEY_SAME(key + 4 * j, a))
-                j++;
-            if (j - i > 2) {
-                rc = set_err(err, errlen, FDT_IO_EFORMAT, path,
-                             "the periodic mesh's faces do not pair (a face in more than two "
-                             "tets)");
-                goto done;
-            }
-            const uint64_t *b = a + 4;
-            if (j - i == 1) {
+        for (uint64_t r = 0; r < R; r++) {
+            if (m->nbrs[r] < 0) {
                 if (pass)
-                    hull[n_hull] = a[3];
+                    hull[n_hull] = r;
                 n_hull++;
-            } else if (KEY_AT(a) == KEY_AT(b)) {
-                int32_t ta = (int32_t)(a[3] >> 2), tb = (int32_t)(b[3] >> 2);
+                continue;
+            }
+            uint64_t q;
+            int sh[3];
+            int same = across(m, r, &q, sh);
+            if (q < r) /* listed from the lower one */
+                continue;
+            if (same) {
                 if (pass)
-                    in[n_in] = ta < tb ? (intf){ta, tb, a[3]} : (intf){tb, ta, b[3]};
+                    in[n_in] = (intf){(int32_t)(r >> 2), (int32_t)(q >> 2), r};
                 n_in++;
-            } else {
-                cyc c;
-                pface_shift(KEY_AT(a), KEY_AT(b), c.s);
-                int neg = c.s[0] < 0 || (c.s[0] == 0 && (c.s[1] < 0 || (c.s[1] == 0 && c.s[2] < 0)));
-                c.r = neg ? b[3] : a[3];
-                c.q = neg ? a[3] : b[3];
+                continue;
+            }
+            if (pass) {
+                int neg = sh[0] < 0 || (sh[0] == 0 && (sh[1] < 0 || (sh[1] == 0 && sh[2] < 0)));
+                cyc c = {neg ? q : r, neg ? r : q, {sh[0], sh[1], sh[2]}};
                 for (int k = 0; neg && k < 3; k++)
                     c.s[k] = -c.s[k];
-                if (pass)
-                    cy[n_cy] = c;
-                n_cy++;
+                cy[n_cy] = c;
             }
-            i = j;
+            n_cy++;
         }
     }
-    free(key); /* the largest array: 32 bytes a face of a tet */
-    key = NULL;
     qsort(in, n_in, sizeof *in, intf_cmp);
     /* the translations, ascending: a pair of patches each */
     if (!(shifts = malloc((n_cy + 1) * sizeof *shifts))) {
@@ -429,8 +359,6 @@ static int foam_prepare_periodic(const fdt_mesh_view *m, void **prep, const char
     p = NULL;
 done:
     free(p);
-    free(key);
-    free(start);
     free(in);
     free(cy);
     free(hull);

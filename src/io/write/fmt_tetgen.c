@@ -9,14 +9,26 @@ int fdt_put_tetgen_node(out_file *o, const fdt_mesh_view *m, const void *prep, c
     (void)errlen;
     /* "<points> <dimension> <attributes> <boundary markers>", then
      * "<index> <x> <y> <z>", first index 0 (TetGen accepts either base
-     * and follows the first index it reads). */
+     * and follows the first index it reads). A periodic mesh laid out
+     * (meshview.h) gives each point four attributes: its input id and
+     * its image's offsets in periods (0 0 0 for the input points, the
+     * first ones), the map back that .vtu's input_id is. */
+    int laid = m->point_src != NULL;
     out_i64(o, (int64_t)m->n_points);
-    out_str(o, " 3 0 0\n");
+    out_str(o, laid ? " 3 4 0\n" : " 3 0 0\n");
     for (size_t i = 0; i < m->n_points && !o->err; i++) {
         out_i64(o, (int64_t)i);
         for (int c = 0; c < 3; c++) {
             out_char(o, ' ');
             out_double(o, m->xyz[3 * i + (size_t)c]);
+        }
+        if (laid) {
+            out_char(o, ' ');
+            out_i64(o, m->point_src[i]);
+            for (int c = 0; c < 3; c++) {
+                out_char(o, ' ');
+                out_i64(o, m->point_off[3 * i + (size_t)c]);
+            }
         }
         out_char(o, '\n');
     }
@@ -95,7 +107,10 @@ int fdt_put_tetgen_neigh(out_file *o, const fdt_mesh_view *m, const void *prep, 
     (void)err;
     (void)errlen;
     /* "<tets> 4", then "<index> <n0> <n1> <n2> <n3>": neighbour i is
-     * opposite vertex i (TetGen's convention and ours), -1 on the hull. */
+     * opposite vertex i (TetGen's convention and ours), -1 on the hull.
+     * A periodic mesh's: across a periodic side, the tet on the other
+     * side, which lies in another copy (its face a translate of this
+     * one's). */
     put_rows(o, m->n_tets, " 4\n", 4, NULL, m->nbrs);
     return FDT_IO_OK;
 }

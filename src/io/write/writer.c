@@ -1645,20 +1645,12 @@ int fdt_default_write_options_sized(fdt_write_options *o, size_t struct_size)
     return fdt_abi_reset(o, struct_size, write_options_size_known(struct_size));
 }
 
-/* The formats that write a periodic mesh laid out in space: its image
- * vertices as points, each with its input id (fdt_periodic_unfold). */
+/* How a format writes a periodic mesh: its rows and offsets (.tets,
+ * .fdtb), or, every other one, laid out in space with its image vertices
+ * and their input ids (fdt_periodic_unfold). */
 static int periodic_laid_out(const fdt_format *f)
 {
-    static const char *const names[] = {"vtu", "vtk", "msh", "msh2", "medit", "openfoam"};
-    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
-        if (!strcmp(f->name, names[i]))
-            return 1;
-    return 0;
-}
-
-int fdt_format_periodic(const fdt_format *f)
-{
-    return periodic_laid_out(f) || !strcmp(f->name, "tets") || !strcmp(f->name, "bin");
+    return strcmp(f->name, "tets") && strcmp(f->name, "bin");
 }
 
 int fdt_format_periodic_stream(const fdt_format *f)
@@ -1729,13 +1721,13 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
     /* a periodic mesh: its rows and offsets (.tets, .fdtb), or laid out
      * with its image vertices and their input ids (periodic_laid_out) */
     int laid_out = r->tet_off && periodic_laid_out(f);
-    if (r->tet_off && !fdt_format_periodic(f)) {
-        snprintf(what, sizeof what, "a periodic mesh is written as " FDT_PERIODIC_FORMATS
-                 " (format %s has no place for its image vertices' input ids)", f->name);
+    int needs = fdt_format_needs(f, o->all_faces);
+    if (laid_out && o->all_faces) {
+        snprintf(what, sizeof what, "a periodic mesh's TetGen .face lists its hull, not every "
+                 "face (--all-faces)");
         return set_err(diag, diag_size, FDT_EINVAL, name, what);
     }
-    int needs = fdt_format_needs(f, o->all_faces);
-    if ((needs & FDT_NEED_NBRS) && !r->nbrs) {
+    if ((needs & FDT_NEED_NBRS) && !r->nbrs && !laid_out) {
         snprintf(what, sizeof what, "format %s needs tet neighbours (fdt_settings.neighbors)",
                  f->name);
         return set_err(diag, diag_size, FDT_EINVAL, name, what);
@@ -1748,15 +1740,22 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
         .hull = r->hull, .n_hull = r->nhull, .all_faces = o->all_faces,
     };
     fdt_periodic_unfolded u = {0};
+    fdt_tid *laid_nbrs = NULL; /* the laid-out tets' periodic neighbours */
     if (laid_out) {
         const fdt_periodic_box b = {r->periodic, {r->pbox[0], r->pbox[1], r->pbox[2]},
                                     {r->pbox[3], r->pbox[4], r->pbox[5]}};
         if ((e = fdt_periodic_unfold(r->tets, r->tet_off, r->ntets, r->hull, r->hull_off,
                                      r->nhull, xyz, n, &b, &u)) != FDT_OK)
             return set_err(diag, diag_size, e, name, fdt_strerror(e));
+        /* TetGen's .neigh lists them, OpenFOAM's cyclic pairs come from them */
+        if ((needs & (FDT_NEED_NBRS | FDT_NEED_FACES)) &&
+            (e = fdt_periodic_unfolded_neighbors(&u, &laid_nbrs)) != FDT_OK) {
+            fdt_periodic_unfolded_free(&u);
+            return set_err(diag, diag_size, e, name, fdt_strerror(e));
+        }
         v = (fdt_mesh_view){.xyz = u.xyz, .n_points = u.n, .tets = u.tets, .n_tets = u.ntets,
-                            .hull = u.hull, .n_hull = u.nhull, .point_src = u.src,
-                            .point_off = u.off};
+                            .nbrs = laid_nbrs, .hull = u.hull, .n_hull = u.nhull,
+                            .point_src = u.src, .point_off = u.off};
     } else if (r->tet_off) {
         v.tet_off = r->tet_off;
         v.hull_off = r->hull_off;
@@ -1764,7 +1763,8 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
     for (int k = 0; r->tet_off && k < 3; k++)
         v.period[k] = r->periodic >> k & 1 ? r->pbox[k + 3] - r->pbox[k] : 0;
     /* after the sort: the face list names tets by their numbers (a
-     * periodic OpenFOAM mesh pairs its laid-out faces itself) */
+     * periodic OpenFOAM mesh pairs its faces from the laid-out tets'
+     * periodic neighbours instead) */
     if ((needs & FDT_NEED_FACES) && !laid_out &&
         (e = fdt_result_faces(r, &v.n_faces, &v.faces, &v.face_tets)) != FDT_OK)
         return set_err(diag, diag_size, e, name, fdt_strerror(e));
@@ -1773,6 +1773,7 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
                        : fdt_wr_mesh_ex(path, f, &v, o->progress, o->progress_user, diag,
                                         diag_size);
     fdt_periodic_unfolded_free(&u);
+    free(laid_nbrs);
     return wr_public_code(io);
 }
 

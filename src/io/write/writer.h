@@ -41,12 +41,6 @@ int fdt_format_is_text(const fdt_format *f);
 /* Whether writing with f needs tet neighbours, the face list, canonical
  * order (FDT_NEED_* of src/io/write/formats.h, or'ed). */
 int fdt_format_needs(const fdt_format *f, int all_faces);
-/* Whether f writes a periodic mesh: its rows and offsets (.tets, .fdtb),
- * or laid out in space with its image vertices' input ids (.vtu, .vtk,
- * .msh, .mesh; an OpenFOAM polyMesh with cyclic patches); fdt_write_mesh
- * refuses the others. FDT_PERIODIC_FORMATS names them for messages. */
-int fdt_format_periodic(const fdt_format *f);
-#define FDT_PERIODIC_FORMATS ".tets, .fdtb, .vtu, .vtk, .msh, .mesh or an OpenFOAM polyMesh"
 /* Whether f streams a periodic run's rows (FDT_STREAM_PERIODIC: .tets). */
 int fdt_format_periodic_stream(const fdt_format *f);
 /* "name (.ext, .ext)" of every row, comma separated, for messages. */
