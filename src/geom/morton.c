@@ -36,19 +36,14 @@ static uint64_t morton(const double *p, const double box[6])
     return spread3(c[0]) << 2 | spread3(c[1]) << 1 | spread3(c[2]);
 }
 
-/*
- * a[0 .. n) sorted by key, ties in the order they come (ids ascending
- * when they came so): least significant digit first, 11 bits a pass, so
- * six passes over 63 bits, a pass skipped where every key has the same
- * digit. tmp: n entries. The sorted array is a or tmp: returned.
- */
-static keyed *radix_sort(keyed *a, keyed *tmp, size_t n)
+/* a[0 .. n) sorted by key on the bits below `bits`, ties in the order
+ * they come: least significant digit first, 11 bits a pass, a pass
+ * skipped where every key has the same digit; count: 2^11 entries. tmp:
+ * n entries. The sorted array is a or tmp: returned. */
+static keyed *lsd_sort(keyed *a, keyed *tmp, size_t n, int bits, size_t *count)
 {
     enum { BITS = 11, B = 1 << BITS };
-    size_t *count = malloc(B * sizeof *count);
-    if (!count)
-        return NULL;
-    for (int shift = 0; shift < 63; shift += BITS) {
+    for (int shift = 0; shift < bits; shift += BITS) {
         memset(count, 0, B * sizeof *count);
         for (size_t i = 0; i < n; i++)
             count[a[i].key >> shift & (B - 1)]++;
@@ -66,8 +61,56 @@ static keyed *radix_sort(keyed *a, keyed *tmp, size_t n)
         a = tmp;
         tmp = t;
     }
-    free(count);
     return a;
+}
+
+/*
+ * a[0 .. n) sorted by its 63-bit keys, ties in the order they come (ids
+ * ascending when they came so). The top 11 bits first (one pass of a
+ * counting sort: each bucket a cell of the box, n / 2048 points on
+ * uniform ones), then each bucket on the 52 bits below, least significant
+ * digit first, inside the cache: six passes of the whole array through
+ * memory were the sort's time (bench/NOTES.md entry 118). A bucket of a
+ * few points is sorted by insertion. tmp: n entries. The sorted array is
+ * a or tmp: returned.
+ */
+static keyed *radix_sort(keyed *a, keyed *tmp, size_t n)
+{
+    enum { BITS = 11, B = 1 << BITS, TOP = 52, SMALL = 48 };
+    size_t *count = malloc(2 * B * sizeof *count), *start = count + B;
+    if (!count)
+        return NULL;
+    memset(start, 0, B * sizeof *start);
+    for (size_t i = 0; i < n; i++)
+        start[a[i].key >> TOP]++;
+    size_t acc = 0;
+    for (size_t d = 0; d < B; d++) {
+        size_t c = start[d];
+        start[d] = acc;
+        acc += c;
+    }
+    for (size_t i = 0; i < n; i++)
+        tmp[start[a[i].key >> TOP]++] = a[i];
+    /* start[d] is now bucket d's end; tmp holds the buckets */
+    for (size_t d = 0, lo = 0; d < B; lo = start[d], d++) {
+        size_t m = start[d] - lo;
+        keyed *b = tmp + lo;
+        if (m <= SMALL) {
+            for (size_t i = 1; i < m; i++) {
+                keyed x = b[i];
+                size_t j = i;
+                for (; j > 0 && b[j - 1].key > x.key; j--)
+                    b[j] = b[j - 1];
+                b[j] = x;
+            }
+            continue;
+        }
+        keyed *got = lsd_sort(b, a + lo, m, TOP, count);
+        if (got != b)
+            memcpy(b, got, m * sizeof *b);
+    }
+    free(count);
+    return tmp;
 }
 
 /* The keys of the points not skipped, sorted (ids ascending within a key);
