@@ -66,16 +66,13 @@ static int orient_with(const fdt_ins *m, const uint32_t *v, int k, const double 
     return orient(m, p[0], p[1], p[2], p[3], cnt);
 }
 
-/* Whether point q is in conflict with infinite tet v (infinite vertex at
- * index inf): the insertion's rule (src/mesh/insert.c, "Hull"), strictly
- * outside the hull face's plane, or on it and inside the sphere of the
+/* Whether point q, on the plane of infinite tet v's hull face (infinite
+ * vertex at index inf), is in conflict with v: the insertion's rule
+ * (src/mesh/insert.c, "Hull") for such a point, inside the sphere of the
  * finite tet under the face. */
-static int conflicts_infinite(const fdt_ins *m, const uint32_t *v, int inf, const double *q,
+static int conflicts_coplanar(const fdt_ins *m, const uint32_t *v, int inf, const double *q,
                               fdt_pred_counts *cnt)
 {
-    int o = orient_with(m, v, inf, q, cnt);
-    if (o != 0)
-        return o > 0;
     const uint32_t *w = m->T + 8 * (size_t)(v[4 + inf] >> 2);
     return insphere(m, pt(m, w[0]), pt(m, w[1]), pt(m, w[2]), pt(m, w[3]), q, cnt) > 0;
 }
@@ -146,10 +143,24 @@ static const char *check_pair_infinite(const fdt_ins *m, const uint32_t *v, int 
         return NULL;
     if (winf < 0)
         return "a finite face between a finite and an infinite tet";
-    /* Two hull faces through an edge: convex, or coplanar and locally
-     * Delaunay in their plane; both sides checked. */
-    if (conflicts_infinite(m, v, inf, pt(m, q), cnt) ||
-        conflicts_infinite(m, w, winf, pt(m, p), cnt))
+    /*
+     * Two hull faces through an edge: convex, or coplanar and locally
+     * Delaunay in their plane. In the insertion's rule (src/mesh/insert.c,
+     * "Hull") q conflicts with v when strictly outside v's hull face, or on
+     * its plane and inside the sphere of the finite tet under it; likewise
+     * p with w. The two outside tests are one: v with q for its infinite
+     * vertex and w with p for its are the same four points, and their
+     * orders differ by an even permutation. (v is an even permutation of
+     * (f0, f2, f1, p) for f its face k in outward order, w of (g0, g2,
+     * g1, q) for g a rotation of f reversed, as glued_opposite checked;
+     * with the infinite vertex at f2, they read (f0, q, f1, p) and (f0,
+     * f1, p, q): a 3-cycle.) So one exact orient3d decides both sides,
+     * which halves the tests of a hull-heavy set's certificate (every
+     * point on a sphere); on the plane each side's sphere still decides.
+     */
+    int o = orient_with(m, v, inf, pt(m, q), cnt);
+    if (o > 0 || (o == 0 && (conflicts_coplanar(m, v, inf, pt(m, q), cnt) ||
+                             conflicts_coplanar(m, w, winf, pt(m, p), cnt))))
         return "the hull is not convex (or not Delaunay in a plane)";
     return NULL;
 }
