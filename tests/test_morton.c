@@ -5,7 +5,8 @@
  *    (equal points, a cell shared) by index;
  *  - fdt_morton_sort: each point keeps its input index, in the order of
  *    fdt_morton_order over the points' own bounding box;
- *  - no point, one point, all points equal (a box of width 0).
+ *  - no point, one point, all points equal (a box of width 0);
+ *  - past 2^21 points, where the sort splits on the top bits first.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -136,7 +137,9 @@ static void test_equal_points(void)
 
 int main(void)
 {
-    const size_t sizes[] = {0, 1, 2, 17, 1000, 50000};
+    /* 2^21 + 5: past the sort's split (the top bits first, then each
+     * bucket; src/geom/morton.c's radix_sort) */
+    const size_t sizes[] = {0, 1, 2, 17, 1000, 50000, ((size_t)1 << 21) + 5};
     for (size_t i = 0; i < sizeof sizes / sizeof *sizes; i++) {
         test_order(sizes[i]);
         test_sort(sizes[i]);

@@ -66,25 +66,32 @@ static keyed *lsd_sort(keyed *a, keyed *tmp, size_t n, int bits, size_t *count)
 
 /*
  * a[0 .. n) sorted by its 63-bit keys, ties in the order they come (ids
- * ascending when they came so). The top 11 bits first (one pass of a
- * counting sort: each bucket a cell of the box, n / 2048 points on
- * uniform ones), then each bucket on the 52 bits below, least significant
- * digit first, inside the cache: six passes of the whole array through
- * memory were the sort's time (bench/NOTES.md entry 118). A bucket of a
- * few points is sorted by insertion. tmp: n entries. The sorted array is
- * a or tmp: returned.
+ * ascending when they came so). Up to SPLIT points, least significant
+ * digit first over the whole array (lsd_sort). Past it the top 8 bits
+ * first (one pass of a counting sort: each bucket a cell of the box,
+ * 39k points a bucket at 10M uniform), then each bucket on the 55 bits
+ * below, five passes inside the cache: six passes of the whole array
+ * through memory were the sort's time there, while on fewer points the
+ * buckets' own counts would cost more than they save (bench/NOTES.md
+ * entry 118). tmp: n entries. The sorted array is a or tmp: returned.
  */
 static keyed *radix_sort(keyed *a, keyed *tmp, size_t n)
 {
-    enum { BITS = 11, B = 1 << BITS, TOP = 52, SMALL = 48 };
-    size_t *count = malloc(2 * B * sizeof *count), *start = count + B;
+    enum { BITS = 11, B = 1 << BITS, TOP = 55, NTOP = 1 << (63 - TOP), SMALL = 32 };
+    const size_t SPLIT = (size_t)1 << 21;
+    size_t *count = malloc((B + NTOP) * sizeof *count), *start = count + B;
     if (!count)
         return NULL;
-    memset(start, 0, B * sizeof *start);
+    if (n < SPLIT) {
+        keyed *r = lsd_sort(a, tmp, n, 63, count);
+        free(count);
+        return r;
+    }
+    memset(start, 0, NTOP * sizeof *start);
     for (size_t i = 0; i < n; i++)
         start[a[i].key >> TOP]++;
     size_t acc = 0;
-    for (size_t d = 0; d < B; d++) {
+    for (size_t d = 0; d < NTOP; d++) {
         size_t c = start[d];
         start[d] = acc;
         acc += c;
@@ -92,7 +99,7 @@ static keyed *radix_sort(keyed *a, keyed *tmp, size_t n)
     for (size_t i = 0; i < n; i++)
         tmp[start[a[i].key >> TOP]++] = a[i];
     /* start[d] is now bucket d's end; tmp holds the buckets */
-    for (size_t d = 0, lo = 0; d < B; lo = start[d], d++) {
+    for (size_t d = 0, lo = 0; d < NTOP; lo = start[d], d++) {
         size_t m = start[d] - lo;
         keyed *b = tmp + lo;
         if (m <= SMALL) {
