@@ -75,9 +75,8 @@ static inline int ins_insphere(const double *a, const double *b, const double *c
  * The tets array moved to a new block of nc slots, huge pages asked for
  * before its first write, its first `used` rows copied (used <= nc: the
  * slots below nslots, or, where other slots were handed out, the whole
- * capacity);
- * the caller grows its own per-slot arrays and then sets m->cap.
- * FDT_ENOMEM (m->T unchanged). Not realloc: the huge-page advice covers a
+ * capacity); the caller grows its own per-slot arrays and then sets
+ * m->cap. FDT_ENOMEM (m->T unchanged). Not realloc: the huge-page advice covers a
  * block's 2 MB-aligned interior only (fdt_mem_advise_huge), so the kernel
  * holds the block as three mappings, glibc's mremap of them fails, and
  * realloc then copied into a fresh block without the advice: the rest of

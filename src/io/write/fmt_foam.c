@@ -20,9 +20,10 @@
  * translates of each other: a pair of cyclic patches (OpenFOAM's
  * translational cyclic), one pair a translation (up to 13: the axes and,
  * where an edge or a corner of the box is crossed, the diagonals). The
- * faces are paired by their input ids and image offsets, exactly, never by
- * coordinates; face i of one patch is the partner of face i of the other,
- * listed from the same point.
+ * faces are paired by the periodic neighbours of the laid-out tets
+ * (src/mesh/periodic.h, fdt_periodic_unfolded_neighbors: input ids and
+ * image offsets, exactly, never coordinates); face i of one patch is the
+ * partner of face i of the other, listed from the same point.
  */
 #include "io/write/formats.h"
 #include "geom/predicates.h"
@@ -41,7 +42,7 @@ typedef struct foam_prep {
     size_t n_internal, n_faces, n_points, n_cells;
     size_t *order;   /* n_faces: face list indices in OpenFOAM order */
     fdt_vid *map;    /* n_points of the input: the new number, -1 unused */
-    /* a periodic mesh laid out (fdt_foam_prepare_periodic), else NULL:
+    /* a periodic mesh laid out (foam_prepare_periodic), else NULL:
      * each face's three points (mapped, the normal out of its owner) and
      * owner in OpenFOAM order, the internal faces' neighbours, the patches */
     int32_t *fv, *own, *nbr;
