@@ -1375,11 +1375,11 @@ void fdt_periodic_unfolded_free(fdt_periodic_unfolded *u)
 
 /*
  * Face k of laid-out tet t as the periodic mesh names it, wherever this
- * copy lies, in three words: its input ids ascending (key[0] the first
- * two, key[1] the third and the top of the rest), the offsets of the
- * second and third point from the first's (6 bytes: the top of key[1],
- * then key[2]'s top 16 bits), and 4 t + k (key[2]'s low 32 bits: 4
- * ntets < 2^32, checked). Sorting the keys brings a face's two tets
+ * copy lies, in three words: its input ids ascending (fk[0] the first
+ * two, fk[1] the third and the top of the rest), the offsets of the
+ * second and third point from the first's (6 bytes: the low half of
+ * fk[1], then fk[2]'s top 16 bits), and 4 t + k (fk[2]'s low 32 bits:
+ * 4 ntets < 2^32, checked). Sorting the keys brings a face's two tets
  * together.
  */
 static void unfolded_face_key(const fdt_periodic_unfolded *u, uint64_t r, uint64_t fk[3])
