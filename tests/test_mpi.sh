@@ -627,7 +627,8 @@ fi
 # byte for byte, with its --hash and --set-hash, and the cells' and
 # densities' tables (each rank its slabs' cells) frontdt's, at 1-4 ranks,
 # periodic on three axes (with a duplicate point: its row once) and on two
-# (x and z, walls of points across y); a point outside the box gives
+# (x and z, walls of points across y); TetGen's set and an OpenFOAM
+# polyMesh on 2 ranks are frontdt's; a point outside the box gives
 # frontdt's message and code and no file.
 "$gen" uniform 3000 41 "$work/pu.xyz" >/dev/null
 awk '{ print $1, 0.02 + 0.96 * $2, $3 }
@@ -651,6 +652,20 @@ for spec in "pu xyz" "pch x,z"; do
       cmp -s "$work/$1.ref.dens" "$work/$1.$np.dens" ||
       fail "periodic $1 on $np ranks: '$got', frontdt '$ref' (or the tables differ)"
   done
+done
+# the laid-out formats on rank 0 (TetGen's set with its periodic .neigh, an
+# OpenFOAM polyMesh with cyclic patches): frontdt's files byte for byte
+mkdir -p "$work/pf1" "$work/pf2"
+"$frontdt" "$work/pch.xyz" --periodic x,z --box 0,0,0,1,1,1 -q -o "$work/pf1/m.ele" \
+  -o "$work/pf1/polyMesh" || fail "periodic x,z: frontdt -o .ele -o polyMesh"
+for out in m.ele polyMesh; do
+  checks=$((checks + 1))
+  mpi 2 300 "$fmpi" "$work/pch.xyz" --periodic x,z --box 0,0,0,1,1,1 -q -o "$work/pf2/$out" ||
+    fail "periodic x,z on 2 ranks: -o $out"
+done
+for f in m.node m.ele m.face m.neigh polyMesh/points polyMesh/faces polyMesh/owner \
+  polyMesh/neighbour polyMesh/boundary; do
+  cmp -s "$work/pf1/$f" "$work/pf2/$f" || fail "periodic x,z on 2 ranks: $f differs"
 done
 checks=$((checks + 1))
 printf '0.5 1.5 0.5\n' >>"$work/pu.xyz"
