@@ -36,31 +36,42 @@ static uint64_t morton(const double *p, const double box[6])
     return spread3(c[0]) << 2 | spread3(c[1]) << 1 | spread3(c[2]);
 }
 
+/* One stable counting-sort pass of a[0 .. n) into tmp on the digit
+ * key >> shift & (nb - 1), count holding nb entries: 1, with count[d] the
+ * end of digit d's run in tmp; or 0, nothing moved, when every key has
+ * the same digit. */
+static int digit_pass(const keyed *a, keyed *tmp, size_t n, int shift, size_t nb,
+                      size_t *count)
+{
+    memset(count, 0, nb * sizeof *count);
+    for (size_t i = 0; i < n; i++)
+        count[a[i].key >> shift & (nb - 1)]++;
+    if (n == 0 || count[a[0].key >> shift & (nb - 1)] == n)
+        return 0;
+    size_t acc = 0;
+    for (size_t d = 0; d < nb; d++) {
+        size_t c = count[d];
+        count[d] = acc;
+        acc += c;
+    }
+    for (size_t i = 0; i < n; i++)
+        tmp[count[a[i].key >> shift & (nb - 1)]++] = a[i];
+    return 1;
+}
+
 /* a[0 .. n) sorted by key on the bits below `bits`, ties in the order
- * they come: least significant digit first, 11 bits a pass, a pass
- * skipped where every key has the same digit; count: 2^11 entries. tmp:
- * n entries. The sorted array is a or tmp: returned. */
+ * they come: least significant digit first, 11 bits a pass (digit_pass),
+ * a pass skipped where every key has the same digit; count: 2^11
+ * entries. tmp: n entries. The sorted array is a or tmp: returned. */
 static keyed *lsd_sort(keyed *a, keyed *tmp, size_t n, int bits, size_t *count)
 {
-    enum { BITS = 11, B = 1 << BITS };
-    for (int shift = 0; shift < bits; shift += BITS) {
-        memset(count, 0, B * sizeof *count);
-        for (size_t i = 0; i < n; i++)
-            count[a[i].key >> shift & (B - 1)]++;
-        if (n == 0 || count[a[0].key >> shift & (B - 1)] == n)
-            continue; /* one digit everywhere: the pass would not move anything */
-        size_t acc = 0;
-        for (size_t d = 0; d < B; d++) {
-            size_t c = count[d];
-            count[d] = acc;
-            acc += c;
+    enum { BITS = 11 };
+    for (int shift = 0; shift < bits; shift += BITS)
+        if (digit_pass(a, tmp, n, shift, (size_t)1 << BITS, count)) {
+            keyed *t = a;
+            a = tmp;
+            tmp = t;
         }
-        for (size_t i = 0; i < n; i++)
-            tmp[count[a[i].key >> shift & (B - 1)]++] = a[i];
-        keyed *t = a;
-        a = tmp;
-        tmp = t;
-    }
     return a;
 }
 
@@ -82,22 +93,11 @@ static keyed *radix_sort(keyed *a, keyed *tmp, size_t n)
     size_t *count = malloc((B + NTOP) * sizeof *count), *start = count + B;
     if (!count)
         return NULL;
-    if (n < SPLIT) {
-        keyed *r = lsd_sort(a, tmp, n, 63, count);
+    if (n < SPLIT || !digit_pass(a, tmp, n, TOP, NTOP, start)) {
+        keyed *r = lsd_sort(a, tmp, n, n < SPLIT ? 63 : TOP, count);
         free(count);
         return r;
     }
-    memset(start, 0, NTOP * sizeof *start);
-    for (size_t i = 0; i < n; i++)
-        start[a[i].key >> TOP]++;
-    size_t acc = 0;
-    for (size_t d = 0; d < NTOP; d++) {
-        size_t c = start[d];
-        start[d] = acc;
-        acc += c;
-    }
-    for (size_t i = 0; i < n; i++)
-        tmp[start[a[i].key >> TOP]++] = a[i];
     /* start[d] is now bucket d's end; tmp holds the buckets */
     for (size_t d = 0, lo = 0; d < NTOP; lo = start[d], d++) {
         size_t m = start[d] - lo;

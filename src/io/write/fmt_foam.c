@@ -53,6 +53,22 @@ typedef struct foam_prep {
 static int foam_prepare_periodic(const fdt_mesh_view *m, void **prep, const char *path,
                                  char *err, size_t errlen);
 
+/* The points the tets use, numbered in their order into map (n_points
+ * entries; -1 for one no tet uses: a merged duplicate), as OpenFOAM wants
+ * every point used. Returns how many. */
+static size_t used_points(const fdt_mesh_view *m, fdt_vid *map)
+{
+    for (size_t i = 0; i < m->n_points; i++)
+        map[i] = -1;
+    for (size_t i = 0; i < 4 * m->n_tets; i++)
+        map[m->tets[i]] = 0;
+    size_t k = 0;
+    for (size_t i = 0; i < m->n_points; i++)
+        if (map[i] == 0)
+            map[i] = (fdt_vid)k++;
+    return k;
+}
+
 int fdt_foam_prepare(const fdt_mesh_view *m, void **prep, const char *path, char *err,
                      size_t errlen)
 {
@@ -75,16 +91,7 @@ int fdt_foam_prepare(const fdt_mesh_view *m, void **prep, const char *path, char
     p->map = (fdt_vid *)(p->order + F);
     p->n_faces = F;
     p->n_cells = T;
-    /* points: the used ones, in input order */
-    for (size_t i = 0; i < N; i++)
-        p->map[i] = -1;
-    for (size_t i = 0; i < 4 * T; i++)
-        p->map[m->tets[i]] = 0;
-    size_t k = 0;
-    for (size_t i = 0; i < N; i++)
-        if (p->map[i] == 0)
-            p->map[i] = (fdt_vid)k++;
-    p->n_points = k;
+    p->n_points = used_points(m, p->map); /* in input order */
     /* faces: a counting sort by owner, internal faces first (keys 0..T-1)
      * then boundary ones (keys T..2T-1, by owner too): start[] holds the
      * counts of the internal faces per owner, and the boundary faces
@@ -308,16 +315,7 @@ static int foam_prepare_periodic(const fdt_mesh_view *m, void **prep, const char
     p->n_internal = n_in;
     p->n_cells = T;
     p->n_patches = P;
-    /* points: the used ones, in the laid-out order (input points first) */
-    for (size_t i = 0; i < N; i++)
-        p->map[i] = -1;
-    for (size_t i = 0; i < 4 * T; i++)
-        p->map[m->tets[i]] = 0;
-    size_t np = 0;
-    for (size_t i = 0; i < N; i++)
-        if (p->map[i] == 0)
-            p->map[i] = (fdt_vid)np++;
-    p->n_points = np;
+    p->n_points = used_points(m, p->map); /* in the laid-out order: input points first */
     size_t f = 0;
     for (size_t i = 0; i < n_in; i++) {
         put_face(p, f++, m, in[i].r, -1);
@@ -400,8 +398,8 @@ static void header(out_file *o, const char *cls, const char *object, const foam_
     header_of(o, "Delaunay tetrahedralization", cls, object, counts);
 }
 
-/* One point of a vectorField: "(x y z)" on a line. */
-static void put_point(out_file *o, const double *x)
+/* A vector: "(x y z)". */
+static void put_vector(out_file *o, const double *x)
 {
     out_char(o, '(');
     for (int c = 0; c < 3; c++) {
@@ -409,7 +407,14 @@ static void put_point(out_file *o, const double *x)
             out_char(o, ' ');
         out_double(o, x[c]);
     }
-    out_str(o, ")\n");
+    out_char(o, ')');
+}
+
+/* One point of a vectorField: "(x y z)" on a line. */
+static void put_point(out_file *o, const double *x)
+{
+    put_vector(o, x);
+    out_char(o, '\n');
 }
 
 int fdt_put_foam_points(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
@@ -543,13 +548,9 @@ int fdt_put_foam_boundary(out_file *o, const fdt_mesh_view *m, const void *prep,
         out_str(o, ";\n        matchTolerance  0.0001;\n        transform       translational;\n"
                    "        neighbourPatch  ");
         out_str(o, p->patch[pa->partner].name);
-        out_str(o, ";\n        separationVector (");
-        for (int c = 0; c < 3; c++) {
-            if (c)
-                out_char(o, ' ');
-            out_double(o, pa->sep[c]);
-        }
-        out_str(o, ");\n    }\n");
+        out_str(o, ";\n        separationVector ");
+        put_vector(o, pa->sep);
+        out_str(o, ";\n    }\n");
     }
     out_str(o, ")\n");
     return FDT_IO_OK;
