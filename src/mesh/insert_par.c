@@ -56,7 +56,7 @@
  * point the serial rounds used, times 1.35, times n: 9-10 a point on
  * uniform points, 15-19 on a pipe scan; untouched pages cost no memory)
  * and never moved while they run. Fresh slots come in
- * chunks of CHUNK from one atomic counter; freed slots go to the freeing
+ * chunks (chunk_of) from one atomic counter; freed slots go to the freeing
  * worker's own list. A worker that finds the capacity spent stops every
  * worker cleanly (before writing anything); phase 3 grows the arrays.
  *
@@ -85,13 +85,28 @@
 #include "base/bits.h"
 
 enum {
-    CHUNK = 256,       /* fresh slots a worker takes at a time */
     MAX_WORKERS = 63,  /* owner ids are six bits, 0 meaning free */
     OWNER = 63,        /* the owner's bits of a state byte */
     MARK_SHIFT = 6,    /* the mark's */
     RECENT = 8,        /* recent new tets kept as walk starts */
     HINT_REACH = 16,   /* ids tried each side for a neighbour's hint */
 };
+
+/*
+ * The fresh slots a worker takes at a time from the shared counter, for n
+ * points: n / 64 as a power of two, from 256 to 65536 (16384 at 1M
+ * points, 512 KB of tets). Chunks of 256 at every size interleaved the
+ * workers' new tets in every huge page, and the two-thread build took
+ * about 3 % more CPU (bench/NOTES.md entry 118); a chunk's unused rest is
+ * freed slots every later pass reads, so small builds keep small chunks.
+ */
+static uint32_t chunk_of(uint32_t n)
+{
+    uint32_t c = 256;
+    while (c < 65536 && 2 * (uint64_t)c <= n / 64)
+        c *= 2;
+    return c;
+}
 
 /* What an insertion attempt returns besides FDT_OK and the errors:
  * BUSY, another thread holds a tet it needs; FULL, the slots are spent
@@ -127,6 +142,7 @@ typedef struct shared {
     int nw;
     atomic_uchar *lock;        /* cap entries: owner | mark << MARK_SHIFT, 0 free */
     atomic_uint_fast64_t next; /* the next fresh slot */
+    uint32_t chunk;            /* fresh slots taken at a time (chunk_of) */
     _Atomic uint32_t *hint;    /* n entries: a tet that held point base + i */
     int single;                /* phase 3: one thread, the arrays may grow */
     atomic_int stop;           /* an error or spent slots: every worker stops */
@@ -327,21 +343,21 @@ static int reserve(worker *w, size_t need)
         }
         /* Relaxed: the counter only hands out distinct ranges; the slots'
          * contents are published through their locks. */
-        uint64_t x = atomic_fetch_add_explicit(&sh->next, CHUNK, memory_order_relaxed);
+        uint64_t x = atomic_fetch_add_explicit(&sh->next, sh->chunk, memory_order_relaxed);
         uint32_t cap = sh->m->cap;
         /* Phase 2 takes a chunk's part below the capacity (the counter
          * then ends past it, and nslots is cut back to it); phase 3 grows
          * to fit the whole chunk, so no slot below nslots is left out. */
         if (x >= cap && !sh->single)
             return FULL;
-        if (x + CHUNK > cap && sh->single) {
-            int err = grow_arrays(sh, x + CHUNK);
+        if (x + sh->chunk > cap && sh->single) {
+            int err = grow_arrays(sh, x + sh->chunk);
             if (err)
                 return err;
             cap = sh->m->cap;
         }
         w->fresh = (uint32_t)x;
-        w->fresh_end = x + CHUNK < cap ? (uint32_t)(x + CHUNK) : cap;
+        w->fresh_end = x + sh->chunk < cap ? (uint32_t)(x + sh->chunk) : cap;
     }
     return FDT_OK;
 }
@@ -871,7 +887,7 @@ static int grow_for_workers(fdt_ins *m, uint32_t prefix, uint32_t n, int nw,
     uint32_t nfree = 0;
     for (uint32_t t = m->free_head; t != FDT_NONE; t = m->T[8 * (size_t)t + 4])
         nfree++;
-    uint64_t want = ins_slots_wanted(m, prefix, nfree, n, (uint64_t)nw * 2 * CHUNK + 1024);
+    uint64_t want = ins_slots_wanted(m, prefix, nfree, n, (uint64_t)nw * 2 * chunk_of(n) + 1024);
     if (want > m->cap && slots_a_point <= 0.0) {
         /* Only the slots in use copied (ins_move_tets), not the whole
          * capacity: the prefix used ~2.5 % of it (statue 100k: 19,921 of
@@ -896,6 +912,7 @@ static int shared_init(shared *sh, worker *ws, int nw, uint32_t base, uint32_t n
      * bits). calloc leaves the zeroing to the pages' first touch, in the
      * workers, where atomic_init a byte took 2.9 ms at 440k points on
      * this thread (bench/NOTES.md entry 76). */
+    sh->chunk = chunk_of(n);
     sh->lock = calloc((size_t)m->cap, sizeof *sh->lock);
     sh->hint = malloc((size_t)n * sizeof *sh->hint);
     sh->spans = aligned_alloc(alignof(span), (size_t)nw * sizeof *sh->spans);
@@ -1114,7 +1131,7 @@ static int build_parallel(fdt_ins *m, const double *P, uint32_t base, uint32_t n
         r0++;
     uint32_t prefix = round_end[r0 - 1];
     uint64_t slots = slots_a_point > 0.0 ? (uint64_t)(slots_a_point * n) + 64
-                                         : (uint64_t)n * 8 + (uint64_t)nw * 2 * CHUNK + 1024;
+                                         : (uint64_t)n * 8 + (uint64_t)nw * 2 * chunk_of(n) + 1024;
     double c0 = fdt_thread_cpu_s();
     err = fdt_ins_build_prefix(m, P, base, n, order, prefix, slots, first, img, cnt, NULL, NULL);
     if (err)
