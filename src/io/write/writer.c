@@ -1331,8 +1331,8 @@ static const char *missing(const fdt_format *f, const fdt_mesh_view *m)
     if ((needs & FDT_NEED_NBRS) && !m->nbrs)
         return "this format needs tet neighbours (settings.neighbors)";
     /* a periodic mesh laid out (point_src): the OpenFOAM writer pairs its
-     * faces itself */
-    if ((needs & FDT_NEED_FACES) && !m->faces && m->n_tets > 0 && !m->point_src)
+     * faces from the periodic neighbours instead */
+    if ((needs & FDT_NEED_FACES) && !m->faces && m->n_tets > 0 && !(m->point_src && m->nbrs))
         return "this format needs the face list (fdt_result_faces)";
     return NULL;
 }
