@@ -6,7 +6,8 @@
  *  - fdt_morton_sort: each point keeps its input index, in the order of
  *    fdt_morton_order over the points' own bounding box;
  *  - no point, one point, all points equal (a box of width 0);
- *  - past 2^21 points, where the sort splits on the top bits first.
+ *  - past 2^21 points, where the sort splits on the top bits first, with
+ *    large buckets and with small ones (sorted by insertion).
  */
 #include <stdlib.h>
 #include <string.h>
@@ -120,6 +121,28 @@ static void test_sort(size_t n)
     free(p);
 }
 
+/* Past the split with small buckets: 2^21 points in one corner cell and
+ * ten groups of 20 far apart, each group its own bucket (the insertion
+ * sort of a bucket of up to 32 points, src/geom/morton.c). */
+static void test_small_buckets(void)
+{
+    size_t big = (size_t)1 << 21, n = big + 200;
+    double *p = malloc(3 * n * sizeof *p);
+    uint32_t *order = malloc(n * sizeof *order);
+    CHECK(p && order);
+    for (size_t i = 0; i < 3 * big; i++)
+        p[i] = 1e-3 * unif();
+    for (size_t g = 0; g < 10; g++)
+        for (size_t j = 0; j < 20; j++)
+            for (int k = 0; k < 3; k++)
+                p[3 * (big + 20 * g + j) + (size_t)k] =
+                    0.1 + 0.09 * (double)g + 1e-4 * unif() + (k == 1 ? 0.05 * (double)(g % 3) : 0);
+    const double box[6] = {0, 0, 0, 1, 1, 1};
+    check_order(p, n, box, NULL, order, fdt_morton_order(p, n, box, NULL, order));
+    free(order);
+    free(p);
+}
+
 static void test_equal_points(void)
 {
     double p[3 * 5];
@@ -145,5 +168,6 @@ int main(void)
         test_sort(sizes[i]);
     }
     test_equal_points();
+    test_small_buckets();
     return test_report("morton");
 }
