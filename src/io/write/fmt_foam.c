@@ -257,10 +257,15 @@ static int foam_prepare_periodic(const fdt_mesh_view *m, void **prep, const char
                 n_hull++;
                 continue;
             }
+            /* each face listed from its lower record: one whose neighbour
+             * is a lower tet was listed there, so across() runs only from
+             * the lower tet (or, the same tet on both sides, from both) */
+            if ((uint64_t)m->nbrs[r] < (r >> 2))
+                continue;
             uint64_t q;
             int sh[3];
             int same = across(m, r, &q, sh);
-            if (q < r) /* listed from the lower one */
+            if (q < r)
                 continue;
             if (same) {
                 if (pass)
@@ -333,14 +338,14 @@ static int foam_prepare_periodic(const fdt_mesh_view *m, void **prep, const char
             for (size_t i = 0; i < n_cy; i++) {
                 if (shift_cmp(cy[i].s, shifts[k]))
                     continue;
-                /* both sides from the same input point: the first of the
-                 * r side's face */
+                if (!side) {
+                    put_face(p, f++, m, cy[i].r, -1);
+                    continue;
+                }
+                /* from the same input point as the r side's face: its first */
                 fdt_vid v0[3];
                 pface_points(m, cy[i].r, v0);
-                if (!side)
-                    put_face(p, f++, m, cy[i].r, -1);
-                else
-                    put_face(p, f++, m, cy[i].q, (long)m->point_src[v0[0]]);
+                put_face(p, f++, m, cy[i].q, (long)m->point_src[v0[0]]);
             }
             pa->n_faces = f - pa->start;
         }
