@@ -166,7 +166,7 @@ static int ball_before(const sweep *sw, const uint32_t *v, double next, fdt_kdq 
     const double *a = Q + 3 * (size_t)v[0];
     fdt_sphere_cof c;
     fdt_sphere_cof_init(&c, a, Q + 3 * (size_t)v[1], Q + 3 * (size_t)v[2], Q + 3 * (size_t)v[3]);
-    if (fdt_sphere_cof_in_range(c.m)) {
+    if (fdt_pred_in_range(c.m)) {
         const double m3 = c.m * c.m * c.m, bd = FDT_O3D_COF_BOUND * m3, bn = 0x1p-45 * (m3 * c.m);
         if (c.det > 4.0 * bd) {
             double nmax = fabs(c.n[0]);

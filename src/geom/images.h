@@ -7,9 +7,13 @@
  * one either), and the issue asks for the exact images, never rounded
  * first. So the insertion reads P, the images rounded to doubles, through
  * these predicates, which decide for the exact images:
- *   - a semi-static filter on P whose bound adds to the evaluation's own
- *     rounding the images' (fdt_images_init): a sign it gives is the
- *     exact images' sign;
+ *   - the filters on P, semi-static and dynamic, whose bounds add to the
+ *     evaluation's own rounding what the images' rounding can move the
+ *     determinant (fdt_images_init for the box, predicates.h's
+ *     fdt_pred_moved for a call's own differences): a sign they give is
+ *     the exact images' sign (the dynamic stage decides inside clusters,
+ *     whose tets are too small for the box's bound: bench/NOTES.md entry
+ *     119);
  *   - where it cannot decide: the plain exact predicates when every point
  *     of the call is exact in P (the input points, and images whose sum
  *     rounded to nothing), otherwise GMP integers of the exact sums, with
@@ -42,8 +46,9 @@ typedef struct fdt_images {
 
 /*
  * The image x + off (hi - lo), rounded to doubles into out; returns 1 when
- * out is exactly the image, 0 otherwise, and *err (may be NULL) gets a
- * bound on |image - out| over the three coordinates.
+ * out is exactly the image (every sum exact), 0 otherwise (which it may
+ * still be, by tails that cancel), and *err (may be NULL) gets a bound on
+ * |image - out| over the three coordinates.
  */
 int fdt_images_round(const double x[3], const int8_t off[3], const double lo[3],
                      const double hi[3], double out[3], double *err);
@@ -80,12 +85,12 @@ static inline uint32_t fdt_images_index(const fdt_images *im, const double *p)
     return (uint32_t)((size_t)(p - im->P) / 3);
 }
 
-/* The semi-static bounds of the filters for the points of P (predicates.h's
- * fdt_pred_static with img set: its _sf filters then stop after that
- * stage). */
+/* The filters' bounds for the points of P (predicates.h's fdt_pred_static
+ * with img set: the semi-static stage's, and the rounding err that widens
+ * the dynamic stage's). */
 static inline fdt_pred_static fdt_images_static(const fdt_images *im)
 {
-    return (fdt_pred_static){im->o3d_inv, im->isp_inv, im};
+    return (fdt_pred_static){im->o3d_inv, im->isp_inv, im, im->err};
 }
 
 /*

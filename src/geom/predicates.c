@@ -1046,6 +1046,7 @@ void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double 
 {
     sf->o3d_inv = sf->isp_inv = 0;
     sf->img = NULL;
+    sf->dev = 0;
     double M = 0;
     for (int k = 0; k < 3; k++) {
         double d = hi[k] - lo[k];
@@ -1420,7 +1421,7 @@ static int orient3d_filter_rescaled(const double *a, const double *b,
         any |= rescale_diffs(&r[i], 1);
     if (!any)
         return FDT_PRED_UNSURE;
-    return fdt_orient3d_filter_diff(r[0], r[1], r[2], 0, 1);
+    return fdt_orient3d_filter_diff(r[0], r[1], r[2], 0, 0);
 }
 
 static int insphere_filter_rescaled(const double *a, const double *b,
@@ -1436,7 +1437,7 @@ static int insphere_filter_rescaled(const double *a, const double *b,
     }
     if (!rescale_diffs(r, 4))
         return FDT_PRED_UNSURE;
-    return fdt_insphere_filter_diff(r[0], r[1], r[2], r[3], 0, 1);
+    return fdt_insphere_filter_diff(r[0], r[1], r[2], r[3], 0, 0);
 }
 
 int fdt_orient3d(const double *a, const double *b, const double *c,

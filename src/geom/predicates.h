@@ -180,6 +180,42 @@ int fdt_insphere_adapt(const double *a, const double *b, const double *c,
 #define FDT_O3D_ADAPT_ERRBOUND 0x1.48p-101
 #define FDT_ISP_ADAPT_ERRBOUND 0x1.b4p-100
 
+/* What moving each point by up to dev can change a determinant of degree
+ * k whose monomials (c of them) multiply differences of magnitude at most
+ * m: c ((M + 2 dev)^k - M^k) <= c k 2 dev (M + 2 dev)^(k-1), M = m over
+ * 1 - 2^-50 (the differences' own rounding), with 2^-20 for this bound's
+ * roundings. 0 when dev is. Sound for m in fdt_pred_in_range: a product
+ * that underflows there loses under 2^-1070, which the filters' margins
+ * (2^-62 of a permanent of at least 2^-800) and the cofactors' (below)
+ * cover. */
+static inline double fdt_pred_moved(double dev, double m, double ck, int k)
+{
+    if (dev == 0) /* the plain engines' points: a predictable branch */
+        return 0;
+    const double d = 2 * dev, M = m * (1 + 0x1p-50) + d;
+    double p = 1;
+    for (int i = 1; i < k; i++)
+        p *= M;
+    return ck * d * p * (1 + 0x1p-20);
+}
+
+/* Whether the magnitude bound x keeps fdt_pred_moved and the cofactors'
+ * static bounds (below) sound. */
+static inline int fdt_pred_in_range(double x)
+{
+    return x >= 0x1p-100 && x <= 0x1p100;
+}
+
+/* The largest of the k magnitudes |x[i]|, branch-free (fmax would be a
+ * call). */
+static inline double fdt_pred_maxabs(const double *x, int k)
+{
+    double m = 0;
+    for (int i = 0; i < k; i++)
+        m = fabs(x[i]) > m ? fabs(x[i]) : m;
+    return m;
+}
+
 /*
  * Semi-static filters (the insertion kernel's and the certificate's
  * tests, src/mesh/insert_impl.h, src/mesh/certify.c): for points whose
@@ -220,11 +256,15 @@ typedef struct fdt_pred_static {
     double isp_inv; /* decide insphere when fl(|det4| isp_inv) > 1 */
     /* Periodic images (src/geom/images.h), or NULL. Set, the points are
      * rounded images and the two bounds images.h's (fdt_images_init: they
-     * add what the rounding can move a determinant); the _sf filters then
-     * stop after the semi-static stage, whose sign is the exact images',
-     * and the callers take what it leaves to images.h's exact stages
-     * (src/mesh/insert_impl.h, src/mesh/certify.c). */
+     * add what the rounding can move a determinant); the _sf filters'
+     * dynamic stage adds that too (dev), so the signs of both stages are
+     * the exact images', and the callers take what they leave to
+     * images.h's exact stages (src/mesh/insert_impl.h,
+     * src/mesh/certify.c). */
     const struct fdt_images *img;
+    /* How far each point may lie from the one it stands for: img's
+     * rounding (fdt_images.err), 0 for plain points. */
+    double dev;
 } fdt_pred_static;
 
 /* The bounds for points in the box [lo, hi] (componentwise); img NULL. */
@@ -234,9 +274,13 @@ void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double 
  * Floating-point filter for orient3d: +1 or -1 when that is certainly the
  * sign of det[b-a; c-a; d-a], FDT_PRED_UNSURE otherwise (never 0). sinv:
  * the semi-static stage's reciprocal bound (fdt_pred_static, above),
- * tested on the determinant before the permanent; 0: none. dyn: 0 stops
- * after that stage (the points are rounded images whose bound is sinv's
- * alone, src/geom/images.h), 1 goes on to the dynamic filter.
+ * tested on the determinant before the permanent; 0: none. dev: how far
+ * each point may lie from the one whose sign is asked (rounded periodic
+ * images, src/geom/images.h; 0 for plain points): the dynamic stage's
+ * bound then adds fdt_pred_moved over the call's largest difference
+ * (each exact difference of the stored points moves by at most 2 dev, so
+ * the exact determinant by at most that), or leaves the call undecided
+ * where that bound is not sound.
  *
  * Error bound. Write eps = 2^-53, eta = 2^-1075 (half the smallest
  * subnormal). Every operation obeys fl(x op y) = (x op y)(1 + delta) + mu,
@@ -278,7 +322,7 @@ void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double 
  * implies det > 0, and det_computed < -bound implies det < 0.
  */
 static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
-                                           const double w[3], double sinv, int dyn)
+                                           const double w[3], double sinv, double dev)
 {
     const double ux = u[0], uy = u[1], uz = u[2];
     const double vx = v[0], vy = v[1], vz = v[2];
@@ -289,8 +333,14 @@ static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
     const double det = ux * (vywz - vzwy) + uy * (vzwx - vxwz) + uz * (vxwy - vywx);
     if (fabs(det) * sinv > 1) /* the semi-static stage (fdt_pred_static) */
         return (det > 0) - (det < 0);
-    if (!dyn)
-        return FDT_PRED_UNSURE;
+    double moved = 0;
+    if (dev != 0) { /* rounded images: rare, a predictable branch */
+        const double m3[3] = {fdt_pred_maxabs(u, 3), fdt_pred_maxabs(v, 3), fdt_pred_maxabs(w, 3)};
+        const double m = fdt_pred_maxabs(m3, 3);
+        if (!fdt_pred_in_range(m))
+            return FDT_PRED_UNSURE;
+        moved = fdt_pred_moved(dev, m, 6 * 3, 3);
+    }
     const double aux = fabs(ux), auy = fabs(uy), auz = fabs(uz);
     const double perm = aux * (fabs(vywz) + fabs(vzwy)) + auy * (fabs(vzwx) + fabs(vxwz)) +
                         auz * (fabs(vxwy) + fabs(vywx));
@@ -298,7 +348,7 @@ static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
     /* su < 2^-42 passes without the product, which would be subnormal
      * (a microcode assist of about a hundred cycles) and at most perm */
     if (perm >= 0x1p-800 && perm <= DBL_MAX && (su < 0x1p-42 || su * 0x1p-980 <= perm)) {
-        const double bound = FDT_O3D_ERRBOUND * perm;
+        const double bound = FDT_O3D_ERRBOUND * perm + moved;
         /* Branch-free: the sign itself is a coin flip on typical input,
          * whether it is certain is nearly always yes. */
         const int s = (det > bound) - (det < -bound);
@@ -321,19 +371,20 @@ static inline int fdt_orient3d_filter_sf(const double *a, const double *b, const
     const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    return fdt_orient3d_filter_diff(u, v, w, sf->o3d_inv, sf->img == NULL);
+    return fdt_orient3d_filter_diff(u, v, w, sf->o3d_inv, sf->dev);
 }
 
 static inline int fdt_orient3d_filter(const double *a, const double *b,
                                       const double *c, const double *d)
 {
-    return fdt_orient3d_filter_sf(a, b, c, d, &(const fdt_pred_static){0, 0, NULL});
+    return fdt_orient3d_filter_sf(a, b, c, d, &(const fdt_pred_static){0, 0, NULL, 0});
 }
 
 /*
  * Floating-point filter for insphere: +1 / -1 when that is certainly the
  * CGAL insphere sign (see the top of this file), FDT_PRED_UNSURE otherwise.
- * sinv and dyn as for orient3d.
+ * sinv and dev as for orient3d (72 x 5 for fdt_pred_moved: the lifted
+ * determinant's monomials, five differences each).
  *
  * With A = a-e, B = b-e, C = c-e, D = d-e (rows) and |A|^2 etc.,
  *   det4 = det[A |A|^2; B |B|^2; C |C|^2; D |D|^2]
@@ -370,7 +421,7 @@ static inline int fdt_orient3d_filter(const double *a, const double *b,
  */
 static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
                                            const double C[3], const double D[3],
-                                           double sinv, int dyn)
+                                           double sinv, double dev)
 {
     const double aex = A[0], aey = A[1], aez = A[2];
     const double bex = B[0], bey = B[1], bez = B[2];
@@ -400,8 +451,15 @@ static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
     const double det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
     if (fabs(det) * sinv > 1) /* the semi-static stage (fdt_pred_static) */
         return (det < 0) - (det > 0);
-    if (!dyn)
-        return FDT_PRED_UNSURE;
+    double moved = 0;
+    if (dev != 0) { /* rounded images: rare, a predictable branch */
+        const double m4[4] = {fdt_pred_maxabs(A, 3), fdt_pred_maxabs(B, 3), fdt_pred_maxabs(C, 3),
+                              fdt_pred_maxabs(D, 3)};
+        const double m = fdt_pred_maxabs(m4, 4);
+        if (!fdt_pred_in_range(m))
+            return FDT_PRED_UNSURE;
+        moved = fdt_pred_moved(dev, m, 72 * 5, 5);
+    }
 
     const double abP = fabs(aexbey) + fabs(bexaey), bcP = fabs(bexcey) + fabs(cexbey);
     const double cdP = fabs(cexdey) + fabs(dexcey), daP = fabs(dexaey) + fabs(aexdey);
@@ -420,7 +478,7 @@ static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
      * conflict tests (bench/NOTES.md entry 116) */
     if (perm >= 0x1p-800 && perm <= DBL_MAX &&
         (lsum < 0x1p-31 || lsum * (lsum * 0x1p-960) <= perm)) {
-        const double bound = FDT_ISP_ERRBOUND * perm;
+        const double bound = FDT_ISP_ERRBOUND * perm + moved;
         const int s = (det < -bound) - (det > bound);
         if (s != 0)
             return s;
@@ -467,7 +525,7 @@ static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
  * 72 mq^5 <= 2^507. Outside that range the calls answer FDT_PRED_UNSURE.
  * Points that stand for others up to dev (rounded periodic images): the
  * bounds hold for the determinant of the points as stored, which is within
- * fdt_sphere_cof_moved of the one they stand for (each difference moves by
+ * fdt_pred_moved of the one they stand for (each difference moves by
  * at most 2 dev, the permanent grows by at most that), so the calls add it.
  */
 #define FDT_O3D_COF_BOUND 0x1.83p-48
@@ -501,45 +559,19 @@ static inline void fdt_sphere_cof_init(fdt_sphere_cof *s, const double *a, const
     s->n[0] = lb * cdx + lc * dbx + ld * bcx;
     s->n[1] = lb * cdy + lc * dby + ld * bcy;
     s->n[2] = lb * cdz + lc * dbz + ld * bcz;
-    /* the largest magnitude as maxsd, branch-free (fmax would be a call) */
     const double e[9] = {ux, uy, uz, vx, vy, vz, wx, wy, wz};
-    double m = 0;
-    for (int i = 0; i < 9; i++)
-        m = fabs(e[i]) > m ? fabs(e[i]) : m;
-    s->m = m;
+    s->m = fdt_pred_maxabs(e, 9);
     s->dev = 0;
-}
-
-/* What moving each point by up to dev can change a determinant of degree
- * k whose monomials (c of them) multiply differences of magnitude at most
- * m: c ((M + 2 dev)^k - M^k) <= c k 2 dev (M + 2 dev)^(k-1), M = m over
- * 1 - 2^-50 (the differences' own rounding), with 2^-20 for this bound's
- * roundings. 0 when dev is. */
-static inline double fdt_sphere_cof_moved(double dev, double m, double ck, int k)
-{
-    if (dev == 0) /* the plain engines' points: a predictable branch */
-        return 0;
-    const double d = 2 * dev, M = m * (1 + 0x1p-50) + d;
-    double p = 1;
-    for (int i = 1; i < k; i++)
-        p *= M;
-    return ck * d * p * (1 + 0x1p-20);
-}
-
-/* Whether the magnitude bound x keeps the static bounds above sound. */
-static inline int fdt_sphere_cof_in_range(double x)
-{
-    return x >= 0x1p-100 && x <= 0x1p100;
 }
 
 /* orient3d(a, b, c, d) of the cofactors' tet: +1 / -1 when certain,
  * FDT_PRED_UNSURE otherwise. */
 static inline int fdt_sphere_cof_orient(const fdt_sphere_cof *s)
 {
-    if (!fdt_sphere_cof_in_range(s->m))
+    if (!fdt_pred_in_range(s->m))
         return FDT_PRED_UNSURE;
     const double bound = FDT_O3D_COF_BOUND * (s->m * s->m * s->m) +
-                         fdt_sphere_cof_moved(s->dev, s->m, 6 * 3, 3);
+                         fdt_pred_moved(s->dev, s->m, 6 * 3, 3);
     return s->det > bound ? 1 : s->det < -bound ? -1 : FDT_PRED_UNSURE;
 }
 
@@ -556,10 +588,10 @@ static inline int fdt_sphere_cof_insphere(const fdt_sphere_cof *s, const double 
     mq = fabs(x) > mq ? fabs(x) : mq;
     mq = fabs(y) > mq ? fabs(y) : mq;
     mq = fabs(z) > mq ? fabs(z) : mq;
-    if (!fdt_sphere_cof_in_range(mq))
+    if (!fdt_pred_in_range(mq))
         return FDT_PRED_UNSURE;
     const double m2 = mq * mq, bound = FDT_ISP_COF_BOUND * (m2 * m2 * mq) +
-                                       fdt_sphere_cof_moved(s->dev, mq, 72 * 5, 5);
+                                       fdt_pred_moved(s->dev, mq, 72 * 5, 5);
     return e > bound ? -1 : e < -bound ? 1 : FDT_PRED_UNSURE;
 }
 
@@ -573,14 +605,14 @@ static inline int fdt_insphere_filter_sf(const double *a, const double *b, const
     const double B[3] = {b[0] - e[0], b[1] - e[1], b[2] - e[2]};
     const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
     const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
-    return fdt_insphere_filter_diff(A, B, C, D, sf->isp_inv, sf->img == NULL);
+    return fdt_insphere_filter_diff(A, B, C, D, sf->isp_inv, sf->dev);
 }
 
 static inline int fdt_insphere_filter(const double *a, const double *b,
                                       const double *c, const double *d,
                                       const double *e)
 {
-    return fdt_insphere_filter_sf(a, b, c, d, e, &(const fdt_pred_static){0, 0, NULL});
+    return fdt_insphere_filter_sf(a, b, c, d, e, &(const fdt_pred_static){0, 0, NULL, 0});
 }
 
 #endif
