@@ -1208,7 +1208,7 @@ static void test_static_filter(tctx *T, double scale)
 {
     const long failures_before = test_failures();
     const long n = (long)fmax(20000 * scale, 500);
-    const fdt_pred_static zero = {0, 0, NULL, 0};
+    const fdt_pred_static zero = {0, 0, NULL};
     long spread = 0, spread_decided = 0, near_decided = 0, out_decided = 0;
     for (long it = 0; it < n; it++) {
         double p[5][3];

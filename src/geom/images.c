@@ -269,6 +269,13 @@ int fdt_images_normal_sign(const fdt_images *im, const uint32_t i[3], int k)
 int fdt_images_orient_undecided(const fdt_images *im, const double *a, const double *b,
                                 const double *c, const double *d, fdt_pred_counts *cnt)
 {
+    /* the dynamic stage, widened by the images' rounding */
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    int s = fdt_orient3d_filter_diff(u, v, w, 0, 1, fdt_orient3d_moved(u, v, w, im->err));
+    if (s != FDT_PRED_UNSURE)
+        return s;
     const uint32_t i[4] = {fdt_images_index(im, a), fdt_images_index(im, b),
                            fdt_images_index(im, c), fdt_images_index(im, d)};
     if (im->exact[i[0]] & im->exact[i[1]] & im->exact[i[2]] & im->exact[i[3]])
@@ -280,6 +287,14 @@ int fdt_images_insphere_undecided(const fdt_images *im, const double *a, const d
                                   const double *c, const double *d, const double *e,
                                   fdt_pred_counts *cnt)
 {
+    /* the dynamic stage, as for orient3d */
+    const double A[3] = {a[0] - e[0], a[1] - e[1], a[2] - e[2]};
+    const double B[3] = {b[0] - e[0], b[1] - e[1], b[2] - e[2]};
+    const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
+    const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
+    int s = fdt_insphere_filter_diff(A, B, C, D, 0, 1, fdt_insphere_moved(A, B, C, D, im->err));
+    if (s != FDT_PRED_UNSURE)
+        return s;
     const uint32_t i[5] = {fdt_images_index(im, a), fdt_images_index(im, b),
                            fdt_images_index(im, c), fdt_images_index(im, d),
                            fdt_images_index(im, e)};

@@ -7,13 +7,14 @@
  * one either), and the issue asks for the exact images, never rounded
  * first. So the insertion reads P, the images rounded to doubles, through
  * these predicates, which decide for the exact images:
- *   - the filters on P, semi-static and dynamic, whose bounds add to the
- *     evaluation's own rounding what the images' rounding can move the
- *     determinant (fdt_images_init for the box, predicates.h's
- *     fdt_pred_moved for a call's own differences): a sign they give is
- *     the exact images' sign (the dynamic stage decides inside clusters,
- *     whose tets are too small for the box's bound: bench/NOTES.md entry
- *     119);
+ *   - the filters on P, semi-static (inline in the kernel) and dynamic
+ *     (here, out of line), whose bounds add to the evaluation's own
+ *     rounding what the images' rounding can move the determinant
+ *     (fdt_images_init for the box, predicates.h's fdt_orient3d_moved and
+ *     fdt_insphere_moved for a call's own differences): a sign they give
+ *     is the exact images' sign (the dynamic stage decides inside
+ *     clusters, whose tets are too small for the box's bound:
+ *     bench/NOTES.md entry 119);
  *   - where it cannot decide: the plain exact predicates when every point
  *     of the call is exact in P (the input points, and images whose sum
  *     rounded to nothing), otherwise GMP integers of the exact sums, with
@@ -85,18 +86,19 @@ static inline uint32_t fdt_images_index(const fdt_images *im, const double *p)
     return (uint32_t)((size_t)(p - im->P) / 3);
 }
 
-/* The filters' bounds for the points of P (predicates.h's fdt_pred_static
- * with img set: the semi-static stage's, and the rounding err that widens
- * the dynamic stage's). */
+/* The semi-static bounds of the filters for the points of P (predicates.h's
+ * fdt_pred_static with img set: its _sf filters then stop after that
+ * stage). */
 static inline fdt_pred_static fdt_images_static(const fdt_images *im)
 {
-    return (fdt_pred_static){im->o3d_inv, im->isp_inv, im, im->err};
+    return (fdt_pred_static){im->o3d_inv, im->isp_inv, im};
 }
 
 /*
  * What the filter fdt_orient3d_filter_sf(..., fdt_images_static(im))
- * left undecided, for the points of P at a, b, c, d: the plain exact
- * stages when every one is exact in P, else GMP (fdt_images_orient_exact).
+ * left undecided, for the points of P at a, b, c, d: the dynamic filter
+ * widened by the images' rounding, then the plain exact stages when every
+ * one is exact in P, else GMP (fdt_images_orient_exact).
  * Out of line: the insertion kernel and the certificate call it on that
  * rare path only, so their filters stay inline and the same as the plain
  * engine's (bench/NOTES.md entry 109).

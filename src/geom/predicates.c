@@ -1041,12 +1041,27 @@ static inline void cross3(const double *x, const double *y, double *z)
     z[2] = x[0] * y[1] - x[1] * y[0];
 }
 
+double fdt_orient3d_moved(const double u[3], const double v[3], const double w[3], double dev)
+{
+    const double m3[3] = {fdt_pred_maxabs(u, 3), fdt_pred_maxabs(v, 3), fdt_pred_maxabs(w, 3)};
+    const double m = fdt_pred_maxabs(m3, 3);
+    return fdt_pred_in_range(m) ? fdt_pred_moved(dev, m, 6 * 3, 3) : INFINITY;
+}
+
+double fdt_insphere_moved(const double A[3], const double B[3], const double C[3],
+                          const double D[3], double dev)
+{
+    const double m4[4] = {fdt_pred_maxabs(A, 3), fdt_pred_maxabs(B, 3), fdt_pred_maxabs(C, 3),
+                          fdt_pred_maxabs(D, 3)};
+    const double m = fdt_pred_maxabs(m4, 4);
+    return fdt_pred_in_range(m) ? fdt_pred_moved(dev, m, 72 * 5, 5) : INFINITY;
+}
+
 /* The semi-static bounds (predicates.h, fdt_pred_static). */
 void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double hi[3])
 {
     sf->o3d_inv = sf->isp_inv = 0;
     sf->img = NULL;
-    sf->dev = 0;
     double M = 0;
     for (int k = 0; k < 3; k++) {
         double d = hi[k] - lo[k];
@@ -1421,7 +1436,7 @@ static int orient3d_filter_rescaled(const double *a, const double *b,
         any |= rescale_diffs(&r[i], 1);
     if (!any)
         return FDT_PRED_UNSURE;
-    return fdt_orient3d_filter_diff(r[0], r[1], r[2], 0, 0);
+    return fdt_orient3d_filter_diff(r[0], r[1], r[2], 0, 1, 0);
 }
 
 static int insphere_filter_rescaled(const double *a, const double *b,
@@ -1437,7 +1452,7 @@ static int insphere_filter_rescaled(const double *a, const double *b,
     }
     if (!rescale_diffs(r, 4))
         return FDT_PRED_UNSURE;
-    return fdt_insphere_filter_diff(r[0], r[1], r[2], r[3], 0, 0);
+    return fdt_insphere_filter_diff(r[0], r[1], r[2], r[3], 0, 1, 0);
 }
 
 int fdt_orient3d(const double *a, const double *b, const double *c,

@@ -216,6 +216,15 @@ static inline double fdt_pred_maxabs(const double *x, int k)
     return m;
 }
 
+/* fdt_pred_moved for orient3d of the rounded differences u, v, w (6
+ * monomials of 3 differences) and for the lifted insphere of A, B, C, D
+ * (72 of 5), over their largest; +infinity (no sign then) where that is
+ * out of fdt_pred_in_range. The filters' moved argument, for points that
+ * stand for others up to dev (src/geom/images.h). */
+double fdt_orient3d_moved(const double u[3], const double v[3], const double w[3], double dev);
+double fdt_insphere_moved(const double A[3], const double B[3], const double C[3],
+                          const double D[3], double dev);
+
 /*
  * Semi-static filters (the insertion kernel's and the certificate's
  * tests, src/mesh/insert_impl.h, src/mesh/certify.c): for points whose
@@ -256,15 +265,12 @@ typedef struct fdt_pred_static {
     double isp_inv; /* decide insphere when fl(|det4| isp_inv) > 1 */
     /* Periodic images (src/geom/images.h), or NULL. Set, the points are
      * rounded images and the two bounds images.h's (fdt_images_init: they
-     * add what the rounding can move a determinant); the _sf filters'
-     * dynamic stage adds that too (dev), so the signs of both stages are
-     * the exact images', and the callers take what they leave to
-     * images.h's exact stages (src/mesh/insert_impl.h,
-     * src/mesh/certify.c). */
+     * add what the rounding can move a determinant); the _sf filters then
+     * stop after the semi-static stage, whose sign is the exact images',
+     * and the callers take what it leaves to images.h's stages (the
+     * dynamic one widened likewise, then the exact ones; src/mesh/
+     * insert_impl.h, src/mesh/certify.c). */
     const struct fdt_images *img;
-    /* How far each point may lie from the one it stands for: img's
-     * rounding (fdt_images.err), 0 for plain points. */
-    double dev;
 } fdt_pred_static;
 
 /* The bounds for points in the box [lo, hi] (componentwise); img NULL. */
@@ -274,13 +280,13 @@ void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double 
  * Floating-point filter for orient3d: +1 or -1 when that is certainly the
  * sign of det[b-a; c-a; d-a], FDT_PRED_UNSURE otherwise (never 0). sinv:
  * the semi-static stage's reciprocal bound (fdt_pred_static, above),
- * tested on the determinant before the permanent; 0: none. dev: how far
- * each point may lie from the one whose sign is asked (rounded periodic
- * images, src/geom/images.h; 0 for plain points): the dynamic stage's
- * bound then adds fdt_pred_moved over the call's largest difference
- * (each exact difference of the stored points moves by at most 2 dev, so
- * the exact determinant by at most that), or leaves the call undecided
- * where that bound is not sound.
+ * tested on the determinant before the permanent; 0: none. dyn: 0 stops
+ * after that stage (the points are rounded images whose bound is sinv's
+ * alone, src/geom/images.h), 1 goes on to the dynamic filter. moved: what
+ * the dynamic stage adds to its bound, 0 for plain points; for points
+ * that stand for others (rounded periodic images) what that can move the
+ * determinant, fdt_orient3d_moved (images.h's stages pass it: the
+ * kernel's inline calls pass 0, a constant that keeps them small).
  *
  * Error bound. Write eps = 2^-53, eta = 2^-1075 (half the smallest
  * subnormal). Every operation obeys fl(x op y) = (x op y)(1 + delta) + mu,
@@ -322,7 +328,8 @@ void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double 
  * implies det > 0, and det_computed < -bound implies det < 0.
  */
 static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
-                                           const double w[3], double sinv, double dev)
+                                           const double w[3], double sinv, int dyn,
+                                           double moved)
 {
     const double ux = u[0], uy = u[1], uz = u[2];
     const double vx = v[0], vy = v[1], vz = v[2];
@@ -333,14 +340,8 @@ static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
     const double det = ux * (vywz - vzwy) + uy * (vzwx - vxwz) + uz * (vxwy - vywx);
     if (fabs(det) * sinv > 1) /* the semi-static stage (fdt_pred_static) */
         return (det > 0) - (det < 0);
-    double moved = 0;
-    if (dev != 0) { /* rounded images: rare, a predictable branch */
-        const double m3[3] = {fdt_pred_maxabs(u, 3), fdt_pred_maxabs(v, 3), fdt_pred_maxabs(w, 3)};
-        const double m = fdt_pred_maxabs(m3, 3);
-        if (!fdt_pred_in_range(m))
-            return FDT_PRED_UNSURE;
-        moved = fdt_pred_moved(dev, m, 6 * 3, 3);
-    }
+    if (!dyn)
+        return FDT_PRED_UNSURE;
     const double aux = fabs(ux), auy = fabs(uy), auz = fabs(uz);
     const double perm = aux * (fabs(vywz) + fabs(vzwy)) + auy * (fabs(vzwx) + fabs(vxwz)) +
                         auz * (fabs(vxwy) + fabs(vywx));
@@ -371,20 +372,19 @@ static inline int fdt_orient3d_filter_sf(const double *a, const double *b, const
     const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    return fdt_orient3d_filter_diff(u, v, w, sf->o3d_inv, sf->dev);
+    return fdt_orient3d_filter_diff(u, v, w, sf->o3d_inv, sf->img == NULL, 0);
 }
 
 static inline int fdt_orient3d_filter(const double *a, const double *b,
                                       const double *c, const double *d)
 {
-    return fdt_orient3d_filter_sf(a, b, c, d, &(const fdt_pred_static){0, 0, NULL, 0});
+    return fdt_orient3d_filter_sf(a, b, c, d, &(const fdt_pred_static){0, 0, NULL});
 }
 
 /*
  * Floating-point filter for insphere: +1 / -1 when that is certainly the
  * CGAL insphere sign (see the top of this file), FDT_PRED_UNSURE otherwise.
- * sinv and dev as for orient3d (72 x 5 for fdt_pred_moved: the lifted
- * determinant's monomials, five differences each).
+ * sinv, dyn and moved as for orient3d (fdt_insphere_moved).
  *
  * With A = a-e, B = b-e, C = c-e, D = d-e (rows) and |A|^2 etc.,
  *   det4 = det[A |A|^2; B |B|^2; C |C|^2; D |D|^2]
@@ -421,7 +421,7 @@ static inline int fdt_orient3d_filter(const double *a, const double *b,
  */
 static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
                                            const double C[3], const double D[3],
-                                           double sinv, double dev)
+                                           double sinv, int dyn, double moved)
 {
     const double aex = A[0], aey = A[1], aez = A[2];
     const double bex = B[0], bey = B[1], bez = B[2];
@@ -451,15 +451,8 @@ static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
     const double det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
     if (fabs(det) * sinv > 1) /* the semi-static stage (fdt_pred_static) */
         return (det < 0) - (det > 0);
-    double moved = 0;
-    if (dev != 0) { /* rounded images: rare, a predictable branch */
-        const double m4[4] = {fdt_pred_maxabs(A, 3), fdt_pred_maxabs(B, 3), fdt_pred_maxabs(C, 3),
-                              fdt_pred_maxabs(D, 3)};
-        const double m = fdt_pred_maxabs(m4, 4);
-        if (!fdt_pred_in_range(m))
-            return FDT_PRED_UNSURE;
-        moved = fdt_pred_moved(dev, m, 72 * 5, 5);
-    }
+    if (!dyn)
+        return FDT_PRED_UNSURE;
 
     const double abP = fabs(aexbey) + fabs(bexaey), bcP = fabs(bexcey) + fabs(cexbey);
     const double cdP = fabs(cexdey) + fabs(dexcey), daP = fabs(dexaey) + fabs(aexdey);
@@ -605,14 +598,14 @@ static inline int fdt_insphere_filter_sf(const double *a, const double *b, const
     const double B[3] = {b[0] - e[0], b[1] - e[1], b[2] - e[2]};
     const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
     const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
-    return fdt_insphere_filter_diff(A, B, C, D, sf->isp_inv, sf->dev);
+    return fdt_insphere_filter_diff(A, B, C, D, sf->isp_inv, sf->img == NULL, 0);
 }
 
 static inline int fdt_insphere_filter(const double *a, const double *b,
                                       const double *c, const double *d,
                                       const double *e)
 {
-    return fdt_insphere_filter_sf(a, b, c, d, e, &(const fdt_pred_static){0, 0, NULL, 0});
+    return fdt_insphere_filter_sf(a, b, c, d, e, &(const fdt_pred_static){0, 0, NULL});
 }
 
 #endif

@@ -223,7 +223,7 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, const fdt_c
                          size_t *pairs)
 {
     size_t used = 0, npairs = 0; /* tets in use, pairs checked */
-    const double dev = m->sf.dev;
+    const double dev = m->sf.img ? m->sf.img->err : 0;
     for (uint32_t t = lo; t < hi; t++) {
         if (t + 2 * AHEAD < hi) { /* the neighbours (a freed slot's are any value) */
             const uint32_t *a = m->T + 8 * (size_t)(t + 2 * AHEAD);

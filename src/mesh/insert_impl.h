@@ -36,8 +36,9 @@ static inline const double *ins_pt(const fdt_ins *m, uint32_t v)
  * (and the rescaled filters) out of line: most calls end in the filters.
  * sf: the semi-static bounds of a box that holds every point the test
  * reads (fdt_ins.sf for the mesh's own points). Periodic images (sf->img):
- * both stages with bounds widened by the images' rounding (sf->dev), then
- * images.h's exact stages. */
+ * the semi-static stage alone, with images.h's bounds, then images.h's
+ * stages (the dynamic one widened by the images' rounding, out of line,
+ * then the exact ones). */
 static inline int ins_orient(const double *a, const double *b, const double *c, const double *d,
                              const fdt_pred_static *sf, fdt_pred_counts *cnt)
 {
