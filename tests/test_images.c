@@ -9,7 +9,7 @@
  *    bounds): a sign it gives is the exact images' sign;
  *  - fdt_images_orient and fdt_images_insphere (that stage, then the
  *    dynamic one widened by the images' rounding, predicates.h's
- *    fdt_orient3d_moved and fdt_insphere_moved, then the exact stages): the
+ *    fdt_pred_moved, then the exact stages): the
  *    exact sign wherever it is not 0, and inside clusters without the
  *    exact stages on most calls (the box's bounds, a run's, decide none).
  * Inputs: small clusters (1e-3 to 1e-12 of the box) at the box's walls,

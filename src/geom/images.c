@@ -273,7 +273,7 @@ int fdt_images_orient_undecided(const fdt_images *im, const double *a, const dou
     const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    int s = fdt_orient3d_filter_diff(u, v, w, 0, 1, fdt_orient3d_moved(u, v, w, im->err));
+    int s = fdt_orient3d_filter_diff(u, v, w, 0, 1, im->err);
     if (s != FDT_PRED_UNSURE)
         return s;
     const uint32_t i[4] = {fdt_images_index(im, a), fdt_images_index(im, b),
@@ -292,7 +292,7 @@ int fdt_images_insphere_undecided(const fdt_images *im, const double *a, const d
     const double B[3] = {b[0] - e[0], b[1] - e[1], b[2] - e[2]};
     const double C[3] = {c[0] - e[0], c[1] - e[1], c[2] - e[2]};
     const double D[3] = {d[0] - e[0], d[1] - e[1], d[2] - e[2]};
-    int s = fdt_insphere_filter_diff(A, B, C, D, 0, 1, fdt_insphere_moved(A, B, C, D, im->err));
+    int s = fdt_insphere_filter_diff(A, B, C, D, 0, 1, im->err);
     if (s != FDT_PRED_UNSURE)
         return s;
     const uint32_t i[5] = {fdt_images_index(im, a), fdt_images_index(im, b),

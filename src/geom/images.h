@@ -10,8 +10,8 @@
  *   - the filters on P, semi-static (inline in the kernel) and dynamic
  *     (here, out of line), whose bounds add to the evaluation's own
  *     rounding what the images' rounding can move the determinant
- *     (fdt_images_init for the box, predicates.h's fdt_orient3d_moved and
- *     fdt_insphere_moved for a call's own differences): a sign they give
+ *     (fdt_images_init for the box, predicates.h's fdt_pred_moved for a
+ *     call's own differences): a sign they give
  *     is the exact images' sign (the dynamic stage decides inside
  *     clusters, whose tets are too small for the box's bound:
  *     bench/NOTES.md entry 119);

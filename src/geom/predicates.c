@@ -1041,22 +1041,6 @@ static inline void cross3(const double *x, const double *y, double *z)
     z[2] = x[0] * y[1] - x[1] * y[0];
 }
 
-double fdt_orient3d_moved(const double u[3], const double v[3], const double w[3], double dev)
-{
-    const double m3[3] = {fdt_pred_maxabs(u, 3), fdt_pred_maxabs(v, 3), fdt_pred_maxabs(w, 3)};
-    const double m = fdt_pred_maxabs(m3, 3);
-    return fdt_pred_in_range(m) ? fdt_pred_moved(dev, m, 6 * 3, 3) : INFINITY;
-}
-
-double fdt_insphere_moved(const double A[3], const double B[3], const double C[3],
-                          const double D[3], double dev)
-{
-    const double m4[4] = {fdt_pred_maxabs(A, 3), fdt_pred_maxabs(B, 3), fdt_pred_maxabs(C, 3),
-                          fdt_pred_maxabs(D, 3)};
-    const double m = fdt_pred_maxabs(m4, 4);
-    return fdt_pred_in_range(m) ? fdt_pred_moved(dev, m, 72 * 5, 5) : INFINITY;
-}
-
 /* The semi-static bounds (predicates.h, fdt_pred_static). */
 void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double hi[3])
 {

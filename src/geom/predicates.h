@@ -206,24 +206,20 @@ static inline int fdt_pred_in_range(double x)
     return x >= 0x1p-100 && x <= 0x1p100;
 }
 
-/* The largest of the k magnitudes |x[i]|, branch-free (fmax would be a
- * call). */
+/* The larger of a and b, branch-free (maxsd; fmax would be a call). */
+static inline double fdt_pred_max(double a, double b)
+{
+    return a > b ? a : b;
+}
+
+/* The largest of the k magnitudes |x[i]|. */
 static inline double fdt_pred_maxabs(const double *x, int k)
 {
     double m = 0;
     for (int i = 0; i < k; i++)
-        m = fabs(x[i]) > m ? fabs(x[i]) : m;
+        m = fdt_pred_max(fabs(x[i]), m);
     return m;
 }
-
-/* fdt_pred_moved for orient3d of the rounded differences u, v, w (6
- * monomials of 3 differences) and for the lifted insphere of A, B, C, D
- * (72 of 5), over their largest; +infinity (no sign then) where that is
- * out of fdt_pred_in_range. The filters' moved argument, for points that
- * stand for others up to dev (src/geom/images.h). */
-double fdt_orient3d_moved(const double u[3], const double v[3], const double w[3], double dev);
-double fdt_insphere_moved(const double A[3], const double B[3], const double C[3],
-                          const double D[3], double dev);
 
 /*
  * Semi-static filters (the insertion kernel's and the certificate's
@@ -282,11 +278,14 @@ void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double 
  * the semi-static stage's reciprocal bound (fdt_pred_static, above),
  * tested on the determinant before the permanent; 0: none. dyn: 0 stops
  * after that stage (the points are rounded images whose bound is sinv's
- * alone, src/geom/images.h), 1 goes on to the dynamic filter. moved: what
- * the dynamic stage adds to its bound, 0 for plain points; for points
- * that stand for others (rounded periodic images) what that can move the
- * determinant, fdt_orient3d_moved (images.h's stages pass it: the
- * kernel's inline calls pass 0, a constant that keeps them small).
+ * alone, src/geom/images.h), 1 goes on to the dynamic filter. dev: how
+ * far each point may lie from the one whose sign is asked (rounded
+ * periodic images), 0 for plain points: the dynamic stage's bound adds
+ * what that can move the determinant, fdt_pred_moved over the call's
+ * largest difference (6 monomials of 3 differences), or the call stays
+ * undecided where that is out of fdt_pred_in_range. images.h's stages
+ * pass it; the _sf forms pass the constant 0, which keeps the kernel's
+ * inline calls as small as without it.
  *
  * Error bound. Write eps = 2^-53, eta = 2^-1075 (half the smallest
  * subnormal). Every operation obeys fl(x op y) = (x op y)(1 + delta) + mu,
@@ -329,7 +328,7 @@ void fdt_pred_static_init(fdt_pred_static *sf, const double lo[3], const double 
  */
 static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
                                            const double w[3], double sinv, int dyn,
-                                           double moved)
+                                           double dev)
 {
     const double ux = u[0], uy = u[1], uz = u[2];
     const double vx = v[0], vy = v[1], vz = v[2];
@@ -349,7 +348,13 @@ static inline int fdt_orient3d_filter_diff(const double u[3], const double v[3],
     /* su < 2^-42 passes without the product, which would be subnormal
      * (a microcode assist of about a hundred cycles) and at most perm */
     if (perm >= 0x1p-800 && perm <= DBL_MAX && (su < 0x1p-42 || su * 0x1p-980 <= perm)) {
-        const double bound = FDT_O3D_ERRBOUND * perm + moved;
+        double bound = FDT_O3D_ERRBOUND * perm;
+        if (dev != 0) {
+            const double w3[6] = {vx, vy, vz, wx, wy, wz};
+            const double m = fdt_pred_max(fdt_pred_max(aux, auy),
+                                          fdt_pred_max(auz, fdt_pred_maxabs(w3, 6)));
+            bound = fdt_pred_in_range(m) ? bound + fdt_pred_moved(dev, m, 6 * 3, 3) : INFINITY;
+        }
         /* Branch-free: the sign itself is a coin flip on typical input,
          * whether it is certain is nearly always yes. */
         const int s = (det > bound) - (det < -bound);
@@ -384,7 +389,10 @@ static inline int fdt_orient3d_filter(const double *a, const double *b,
 /*
  * Floating-point filter for insphere: +1 / -1 when that is certainly the
  * CGAL insphere sign (see the top of this file), FDT_PRED_UNSURE otherwise.
- * sinv, dyn and moved as for orient3d (fdt_insphere_moved).
+ * sinv, dyn and dev as for orient3d (72 monomials of 5 differences; the
+ * largest difference from the largest lift: a component's square is at
+ * most its row's |.|^2, computed within 3 eps, and so is its square
+ * root).
  *
  * With A = a-e, B = b-e, C = c-e, D = d-e (rows) and |A|^2 etc.,
  *   det4 = det[A |A|^2; B |B|^2; C |C|^2; D |D|^2]
@@ -421,7 +429,7 @@ static inline int fdt_orient3d_filter(const double *a, const double *b,
  */
 static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
                                            const double C[3], const double D[3],
-                                           double sinv, int dyn, double moved)
+                                           double sinv, int dyn, double dev)
 {
     const double aex = A[0], aey = A[1], aez = A[2];
     const double bex = B[0], bey = B[1], bez = B[2];
@@ -471,7 +479,13 @@ static inline int fdt_insphere_filter_diff(const double A[3], const double B[3],
      * conflict tests (bench/NOTES.md entry 116) */
     if (perm >= 0x1p-800 && perm <= DBL_MAX &&
         (lsum < 0x1p-31 || lsum * (lsum * 0x1p-960) <= perm)) {
-        const double bound = FDT_ISP_ERRBOUND * perm + moved;
+        double bound = FDT_ISP_ERRBOUND * perm;
+        if (dev != 0) {
+            const double m = sqrt(fdt_pred_max(fdt_pred_max(alift, blift),
+                                               fdt_pred_max(clift, dlift))) *
+                             (1 + 0x1p-50);
+            bound = fdt_pred_in_range(m) ? bound + fdt_pred_moved(dev, m, 72 * 5, 5) : INFINITY;
+        }
         const int s = (det < -bound) - (det > bound);
         if (s != 0)
             return s;
