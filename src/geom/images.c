@@ -266,6 +266,28 @@ int fdt_images_normal_sign(const fdt_images *im, const uint32_t i[3], int k)
     return s;
 }
 
+/*
+ * The input points of P's points i[0 .. k) into x, when they are all
+ * images in one copy (the same offsets): 1 then, 0 otherwise. Both
+ * predicates are invariant under a translation, and so is the
+ * perturbation's lexicographic order (images.h), so those input points,
+ * doubles, decide for the images with the plain stages: no GMP where the
+ * images are rounded (points of a sphere in a copy of the box ran 18M
+ * tests through GMP, bench/NOTES.md entry 119).
+ */
+static int one_copy(const fdt_images *im, const uint32_t *i, int k, const double *x[5])
+{
+    const int8_t *o = im->off + 3 * (size_t)i[0];
+    for (int j = 1; j < k; j++) {
+        const int8_t *q = im->off + 3 * (size_t)i[j];
+        if (q[0] != o[0] || q[1] != o[1] || q[2] != o[2])
+            return 0;
+    }
+    for (int j = 0; j < k; j++)
+        x[j] = im->X + 3 * (size_t)im->src[i[j]];
+    return 1;
+}
+
 int fdt_images_orient_undecided(const fdt_images *im, const double *a, const double *b,
                                 const double *c, const double *d, fdt_pred_counts *cnt)
 {
@@ -280,6 +302,9 @@ int fdt_images_orient_undecided(const fdt_images *im, const double *a, const dou
                            fdt_images_index(im, c), fdt_images_index(im, d)};
     if (im->exact[i[0]] & im->exact[i[1]] & im->exact[i[2]] & im->exact[i[3]])
         return fdt_orient3d(a, b, c, d, cnt);
+    const double *x[5];
+    if (one_copy(im, i, 4, x))
+        return fdt_orient3d(x[0], x[1], x[2], x[3], cnt);
     return fdt_images_orient_exact(im, i, cnt);
 }
 
@@ -300,6 +325,9 @@ int fdt_images_insphere_undecided(const fdt_images *im, const double *a, const d
                            fdt_images_index(im, e)};
     if (im->exact[i[0]] & im->exact[i[1]] & im->exact[i[2]] & im->exact[i[3]] & im->exact[i[4]])
         return fdt_insphere_perturbed(a, b, c, d, e, cnt);
+    const double *x[5];
+    if (one_copy(im, i, 5, x))
+        return fdt_insphere_perturbed(x[0], x[1], x[2], x[3], x[4], cnt);
     return fdt_images_insphere_exact(im, i, cnt);
 }
 

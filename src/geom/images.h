@@ -17,7 +17,9 @@
  *     bench/NOTES.md entry 119);
  *   - where it cannot decide: the plain exact predicates when every point
  *     of the call is exact in P (the input points, and images whose sum
- *     rounded to nothing), otherwise GMP integers of the exact sums, with
+ *     rounded to nothing), or on the input points when all are images in
+ *     one copy (a translation changes neither sign), otherwise GMP
+ *     integers of the exact sums, with
  *     the same symbolic perturbation (fdt_insphere_perturbed's:
  *     lexicographic order of the exact points, which a translation keeps,
  *     so every image of a point is perturbed alike and the perturbed
@@ -98,7 +100,9 @@ static inline fdt_pred_static fdt_images_static(const fdt_images *im)
  * What the filter fdt_orient3d_filter_sf(..., fdt_images_static(im))
  * left undecided, for the points of P at a, b, c, d: the dynamic filter
  * widened by the images' rounding, then the plain exact stages when every
- * one is exact in P, else GMP (fdt_images_orient_exact).
+ * one is exact in P or all are images in one copy (on their input
+ * points: the predicates and the perturbation are invariant under the
+ * translation), else GMP (fdt_images_orient_exact).
  * Out of line: the insertion kernel and the certificate call it on that
  * rare path only, so their filters stay inline and the same as the plain
  * engine's (bench/NOTES.md entry 109).
