@@ -3,6 +3,7 @@
 
 usage: stream_readback.py FRONTDT REFERENCE_MD
        stream_readback.py FRONTDT REFERENCE_MD --pieces INDEX REF
+       stream_readback.py FRONTDT REFERENCE_MD --periodic-pieces INDEX INPUT REF BOX AXES
 
 --pieces (tests/test_mpi.sh): the pieces of frontdt-mpi's -o INDEX (.pfdtb,
 read with doc/reference.md's read_pieces, or .pele: the .ele/.face pieces beside
@@ -10,6 +11,14 @@ their .node) hold, all together, the tets and hull faces of the serial
 run's REF.ele / REF.face, each the same way round; the index's counts and
 names are those of the files; each .fdtb piece's header says piece (flag 8),
 no points, the input's point count.
+
+--periodic-pieces (tests/test_mpi.sh, issue 33): the pieces of a periodic
+frontdt-mpi run hold, all together, the rows of frontdt's REF.tets of the
+same INPUT, each once, normalised as .tets's are: .pfdtb pieces (flags 8 |
+4 | 16) read with doc/reference.md's read_fdtb_periodic, the index's set
+hash the one on stdin ("set-hash: HEX", frontdt's); a .pvtu through VTK's
+own reader as ParaView reads it, each cell's points mapped to rows by their
+input_id and by how many periods (BOX, AXES) they lie from that point.
 
 1. A random point set (one duplicate point) is written by the CLI twice: in
    memory (--no-stream: .ele with .node/.face/.neigh, .vtu, .fdtb) and
@@ -386,6 +395,81 @@ def pieces(index, ref):
     if sorted(canon_face(f) for f in hull) != sorted(canon_face(f) for f in ref_hull):
         fail("%s: the pieces' hull faces are not the serial run's" % index)
 
+
+def row_line(ids, offs):
+    """A periodic row as a .tets line: ids ascending, then the offsets
+    relative to the least one's."""
+    order = sorted(range(len(ids)), key=lambda i: ids[i])
+    parts = [str(ids[i]) for i in order]
+    for i in order:
+        parts += [str(offs[i][k] - offs[order[0]][k]) for k in range(3)]
+    return " ".join(parts)
+
+
+def periodic_pieces(index, inp, ref, box, axes):
+    """--periodic-pieces: a periodic run's pieces against frontdt's rows."""
+    rows = []
+    if index.endswith(".pfdtb"):
+        keys, plist = index_lines(index)
+        reader = readme_reader("read_fdtb_periodic")
+        if reader is None:
+            return
+        for name, nt, nh in plist:
+            path = os.path.join(os.path.dirname(index), name)
+            flags = struct.unpack_from("<I", open(path, "rb").read(16), 12)[0]
+            _, tets, hull, toff, _, _ = reader(path)
+            if flags != 28 or (len(tets), len(hull)) != (nt, nh):
+                fail("%s: flags %d, %d tets %d hull faces" % (name, flags, len(tets), len(hull)))
+            for t, o in zip(tets.tolist(), toff.tolist()):
+                line = row_line(t, o)
+                if line.split()[:4] != [str(x) for x in t] or line.split()[4:7] != ["0"] * 3:
+                    fail("%s: a row not normalised as .tets's: %r" % (name, line))
+                rows.append(line)
+        if sum(p[1] for p in plist) != int(keys.get("total", "-1 -1").split()[0]):
+            fail("%s: the total is not the pieces' sum" % index)
+        m = re.search(r"set-hash: ([0-9a-f]{16})", sys.stdin.read())
+        if not m or keys.get("set-hash") != m.group(1):
+            fail("%s: set-hash %r, frontdt's %r" % (index, keys.get("set-hash"),
+                                                    m and m.group(1)))
+    else:
+        try:
+            from vtkmodules.vtkIOXML import vtkXMLPUnstructuredGridReader
+        except ImportError:
+            print("no python3 VTK: the .pvtu is not read")
+            return
+        pts = [tuple(float(v) for v in line.split()[:3]) for line in open(inp)]
+        period = [box[k + 3] - box[k] if k in axes else 0 for k in range(3)]
+        r = vtkXMLPUnstructuredGridReader()
+        r.SetFileName(index)
+        r.Update()
+        g = r.GetOutput()
+        src = g.GetPointData().GetArray("input_id")
+        if src is None:
+            fail("%s: no input_id point data" % index)
+            return
+        for c in range(g.GetNumberOfCells()):
+            ids, offs = [], []
+            for k in range(4):
+                p = g.GetCell(c).GetPointIds().GetId(k)
+                i, x = int(src.GetValue(p)), g.GetPoint(p)
+                ids.append(i)
+                offs.append([round((x[a] - pts[i][a]) / period[a]) if period[a] else 0
+                             for a in range(3)])
+            rows.append(row_line(ids, offs))
+    want = open(ref).read().splitlines()
+    if sorted(rows, key=lambda l: [int(x) for x in l.split()]) != want:
+        fail("%s: %d rows, %d of frontdt's %d" % (index, len(rows), len(set(rows) & set(want)),
+                                                    len(want)))
+
+
+if len(sys.argv) == 9 and sys.argv[3] == "--periodic-pieces":
+    periodic_pieces(sys.argv[4], sys.argv[5], sys.argv[6],
+                    [float(v) for v in sys.argv[7].split(",")],
+                    {"xyz".index(a) for a in sys.argv[8] if a in "xyz"})
+    if failures:
+        sys.exit(1)
+    print("stream_readback --periodic-pieces: all checks passed")
+    sys.exit(0)
 
 if len(sys.argv) == 6 and sys.argv[3] == "--pieces":
     pieces(sys.argv[4], sys.argv[5])

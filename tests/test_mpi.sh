@@ -653,6 +653,37 @@ for spec in "pu xyz" "pch x,z"; do
       fail "periodic $1 on $np ranks: '$got', frontdt '$ref' (or the tables differ)"
   done
 done
+# pieces of a periodic run (no row gathered): each rank's sorted rows as a
+# .pfdtb piece (flags 8 | 4 | 16) or a laid-out .vtu piece (its images,
+# each point's input id), the index's set hash frontdt's; every row of
+# frontdt's .tets once over the pieces (stream_readback.py
+# --periodic-pieces; the .pvtu through VTK where python3 has it). .pele
+# and --hash with pieces refused.
+for spec in "pu xyz" "pch x,z"; do
+  set -- $spec
+  "$frontdt" "$work/$1.xyz" --periodic "$2" --box 0,0,0,1,1,1 -q --set-hash \
+    >"$work/$1.ref.sh"
+  for np in 1 2 3; do
+    for ext in pfdtb pvtu; do
+      checks=$((checks + 1))
+      rm -rf "$work/pp" && mkdir -p "$work/pp"
+      got=$(mpi "$np" 300 "$fmpi" "$work/$1.xyz" --periodic "$2" --box 0,0,0,1,1,1 -q \
+        --set-hash -o "$work/pp/m.$ext") || { fail "periodic $1 on $np ranks: -o .$ext"; continue; }
+      [[ $got == "$(cat "$work/$1.ref.sh")" ]] ||
+        fail "periodic $1 on $np ranks, .$ext: '$got', frontdt '$(cat "$work/$1.ref.sh")'"
+      "$python" "$readback" "$frontdt" "$readme" --periodic-pieces "$work/pp/m.$ext" \
+        "$work/$1.xyz" "$work/$1.ref.tets" 0,0,0,1,1,1 "$2" <"$work/$1.ref.sh" >/dev/null ||
+        fail "periodic $1 on $np ranks: the .$ext pieces are not frontdt's rows"
+    done
+  done
+done
+for bad in "-o $work/pp/x.pele" "--hash -o $work/pp/x.pvtu"; do
+  checks=$((checks + 1))
+  mpi 2 60 "$fmpi" "$work/pu.xyz" --periodic xyz --box 0,0,0,1,1,1 -q $bad 2>/dev/null
+  rc=$?
+  [[ $rc -eq 1 && ! -e $work/pp/x.pele && ! -e $work/pp/x.pvtu ]] ||
+    fail "periodic with $bad: exit $rc"
+done
 # the laid-out formats on rank 0 (TetGen's set with its periodic .neigh, an
 # OpenFOAM polyMesh with cyclic patches): frontdt's files byte for byte
 mkdir -p "$work/pf1" "$work/pf2"

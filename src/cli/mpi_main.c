@@ -306,19 +306,23 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
         return CLI_USAGE;
     }
     if (o->periodic) {
-        /* the rows gathered to rank 0 and written by frontdt's writers */
+        /* the rows gathered to rank 0 and written by frontdt's writers, or
+         * a piece a rank (.pvtu, .pfdtb: periodic_pieces) */
         const fdt_format *f = o->output ? fdt_format_by_path(o->output) : NULL;
+        int kind = o->output ? fdt_mpo_kind(o->output) : FDT_MPO_GATHER;
         if (!o->cells.box_given) {
             say0(rank, "--periodic needs --box X0,Y0,Z0,X1,Y1,Z1: the periods");
             return CLI_USAGE;
         }
-        if (o->output && !f) {
+        if (kind == FDT_MPO_ELE || (kind == FDT_MPO_GATHER && o->output && !f)) {
             say0(rank, "--periodic under MPI writes -o in one of frontdt's formats (gathered "
-                       "to rank 0), the hashes and the cells' tables; not pieces");
+                       "to rank 0) or pieces as BASE.pvtu or BASE.pfdtb; not .pele (a periodic "
+                       "TetGen set's .node holds its images: -o BASE.ele gathers it)");
             return CLI_USAGE;
         }
+        int rc = kind == FDT_MPO_GATHER ? -1 : check_output(o, rank, size);
         /* --box is the periods: the cells' options checked when asked */
-        return fdt_cli_dual_wanted(&o->cells) ? check_cells(o, rank) : -1;
+        return rc >= 0 ? rc : fdt_cli_dual_wanted(&o->cells) ? check_cells(o, rank) : -1;
     }
     int rc = check_cells(o, rank);
     return rc >= 0 ? rc : check_output(o, rank, size);
@@ -333,6 +337,90 @@ typedef struct rowbuf {
 } rowbuf;
 
 static int setup_exit_code(int err);
+
+/* The rows sorted as .tets sorts them (tets, then hull faces), ids below
+ * n: FDT_OK or FDT_ENOMEM. */
+static int sort_rows(rowbuf rows[2], size_t n)
+{
+    int err = FDT_OK;
+    for (int k = 0; k < 2 && !err; k++) {
+        uint32_t *ids = (uint32_t *)rows[k].ids; /* replaced by the sort */
+        err = fdt_periodic_sort_rows(&ids, &rows[k].off, rows[k].n, rows[k].nv, n);
+        rows[k].ids = (fdt_vid *)ids;
+        rows[k].cap = rows[k].n;
+    }
+    return err;
+}
+
+/* A periodic run's pieces: the rank's rows and what its .vtu piece is
+ * written from (periodic_piece). */
+typedef struct periodic_share {
+    int kind;              /* FDT_MPO_VTU or FDT_MPO_BIN */
+    fdt_result *res;       /* the rank's result: its box, duplicates */
+    const rowbuf *rows;    /* tets, hull faces: sorted */
+    const double *xyz;     /* every input point (each rank read them) */
+    size_t n;
+} periodic_share;
+
+/* One rank's piece of a periodic mesh (src/mpi/mpi_output.h): its rows laid
+ * out as frontdt lays out a periodic .vtu (the points and images its tets
+ * use, each point's input id), or as a periodic .fdtb piece (flags 8 |
+ * 16). */
+static int periodic_piece(void *user, char (*names)[FDT_IO_PATH], int k, char *diag,
+                          size_t dlen)
+{
+    (void)k;
+    const periodic_share *p = user;
+    fdt_result *r = p->res;
+    const rowbuf *t = &p->rows[0], *h = &p->rows[1];
+    if (p->kind == FDT_MPO_BIN) {
+        fdt_bin_periodic per = {t->off, h->off, {0, 0, 0}};
+        for (int a = 0; a < 3; a++) /* as src/io/write/writer.c's mesh view */
+            per.period[a] = r->periodic >> a & 1 ? r->pbox[a + 3] - r->pbox[a] : 0;
+        return fdt_mpo_bin_piece(names[0], p->n, t->ids, t->n, h->ids, h->n, &per, diag, dlen);
+    }
+    const fdt_periodic_box b = {r->periodic, {r->pbox[0], r->pbox[1], r->pbox[2]},
+                                {r->pbox[3], r->pbox[4], r->pbox[5]}};
+    return fdt_mpo_periodic_vtu(names[0], t->ids, t->off, t->n, p->xyz, p->n, &b, diag, dlen);
+}
+
+/*
+ * A periodic run's pieces (-o BASE.pvtu or BASE.pfdtb): each rank sorts
+ * its slabs' rows and writes them as its piece, rank 0 the index, with
+ * the set hash of the ranks' partial sums (the same as the gathered
+ * mesh's). No row goes to rank 0. *hash: rank 0's set hash. A code
+ * (CLI_) the same on every rank.
+ */
+static int periodic_pieces(const opts *o, int rank, fdt_result *res, rowbuf rows[2],
+                           const double *xyz, size_t n, uint64_t *hash)
+{
+    char diag[1024] = "";
+    int err = sort_rows(rows, n);
+    int bad = err != FDT_OK, worst;
+    MPI_Allreduce(&bad, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (worst) {
+        if (rank == 0)
+            fprintf(stderr, "frontdt-mpi: out of memory sorting a piece's rows\n");
+        return CLI_RESOURCES;
+    }
+    fdt_sethash h = {0, 0};
+    fdt_sethash_add_periodic(&h, (const uint32_t *)rows[0].ids, rows[0].off, rows[0].n);
+    uint64_t mine[2] = {h.sum, h.count}, all[2] = {0, 0};
+    MPI_Reduce(mine, all, 2, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
+    h.sum = all[0];
+    h.count = all[1];
+    *hash = fdt_sethash_value(&h);
+    periodic_share ps = {fdt_mpo_kind(o->output), res, rows, xyz, n};
+    const fdt_mpo_share s = {n,    res->ndup,      rows[0].n, rows[1].n, h, 1,
+                             periodic_piece, NULL, &ps};
+    fdt_mpo_args oa = {o->output, o->input, o->fail_write};
+    int me = FDT_OK;
+    uint64_t io[2];
+    err = fdt_mpo_write_share(MPI_COMM_WORLD, &oa, &s, &me, io, diag, sizeof diag);
+    if (me)
+        fprintf(stderr, "frontdt-mpi: rank %d: %s\n", rank, diag);
+    return err == FDT_OK ? CLI_OK : err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
+}
 
 /* Room for want rows. */
 static int rows_reserve(rowbuf *b, size_t want)
@@ -599,7 +687,12 @@ static int periodic_run(const opts *o, int rank, int size)
         }
         free(all);
     }
-    for (int k = 0; k < 2 && !err; k++)
+    /* the rows: a piece a rank (no gather), or gathered to rank 0 */
+    int pieces = o->output && fdt_mpo_kind(o->output) != FDT_MPO_GATHER;
+    uint64_t piece_hash = 0;
+    if (pieces && (rc = periodic_pieces(o, rank, res, rows, xyz, n, &piece_hash)) != CLI_OK)
+        goto out;
+    for (int k = 0; k < 2 && !err && !pieces; k++)
         err = gather_rows(&rows[k], rank, size);
     if (!err && cells && (err = cells_to_root(cells, rank, size, diag, sizeof diag)) != FDT_OK) {
         if (rank == 0)
@@ -607,14 +700,12 @@ static int periodic_run(const opts *o, int rank, int size)
         rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
         goto out;
     }
-    for (int k = 0; rank == 0 && k < 2 && !err; k++) {
-        uint32_t *ids = (uint32_t *)rows[k].ids; /* replaced by the sort */
-        err = fdt_periodic_sort_rows(&ids, &rows[k].off, rows[k].n, rows[k].nv, n);
-        rows[k].ids = (fdt_vid *)ids;
-        rows[k].cap = rows[k].n;
-    }
+    if (rank == 0 && !err && !pieces)
+        err = sort_rows(rows, n);
     rc = err ? fdt_cli_engine_exit(err) : CLI_OK;
-    if (rank == 0 && !err) {
+    if (rank == 0 && !err && pieces && o->set_hash) /* the pieces are written */
+        printf("set-hash: %016" PRIx64 "\n", piece_hash);
+    if (rank == 0 && !err && !pieces) {
         /* rank 0's result, the gathered rows in it: one periodic mesh */
         res->streamed = 0;
         res->sorted = 1;
@@ -635,12 +726,16 @@ static int periodic_run(const opts *o, int rank, int size)
             fprintf(stderr, "frontdt-mpi: %s\n", diag);
             rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
         }
+    }
+    if (rank == 0 && !err) {
         if (rc == CLI_OK && cells &&
             (err = fdt_cli_cells_write(&o->cells, cells, diag, sizeof diag)) != FDT_OK) {
             fprintf(stderr, "frontdt-mpi: %s\n", diag);
             rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
         }
-        if (!o->quiet)
+        if (!o->quiet && pieces)
+            fprintf(stderr, "frontdt-mpi: %zu points, periodic pieces on %d ranks\n", n, size);
+        else if (!o->quiet)
             fprintf(stderr, "frontdt-mpi: %zu points, %zu periodic tets on %d ranks\n", n,
                     res->ntets, size);
         fflush(stdout);

@@ -20,6 +20,7 @@
 #include "io/write/outfile.h"
 #include "base/sethash.h"
 #include "io/write/writer.h"
+#include "mesh/periodic.h"
 
 /* ---- names ---------------------------------------------------------------- */
 
@@ -152,9 +153,78 @@ static int write_vtu(const char *name, const fdt_mpi_out *r, char *diag, size_t 
     return err;
 }
 
-/* Opens k temporaries, puts the piece, commits all or none (src/io/write/writer.c). */
-static int write_files(char (*names)[FDT_IO_PATH], int k, int kind, uint64_t n_input,
-                       const fdt_mpi_out *r, char *diag, size_t dlen)
+int fdt_mpo_periodic_vtu(const char *name, const fdt_vid *tets, const int8_t *off, size_t nt,
+                         const double *xyz, size_t n, const fdt_periodic_box *b, char *diag,
+                         size_t dlen)
+{
+    /* laid out without the hull faces (a .vtu has none; a piece's hull
+     * faces may lie on another piece's tets), then only the points its
+     * tets use, in the order laid out (the input points, then images) */
+    fdt_periodic_unfolded u;
+    int err = fdt_periodic_unfold((const int32_t *)tets, off, nt, NULL, NULL, 0, xyz, n, b, &u);
+    uint32_t *at = NULL;
+    double *px = NULL;
+    fdt_vid *src = NULL;
+    int8_t *po = NULL;
+    if (!err && (!(at = malloc((u.n + 1) * sizeof *at)) || !(px = malloc((3 * u.n + 1) * sizeof *px)) ||
+                 !(src = malloc((u.n + 1) * sizeof *src)) || !(po = malloc(3 * u.n + 1))))
+        err = FDT_ENOMEM;
+    if (err) {
+        snprintf(diag, dlen, "%s: %s", name, fdt_strerror(err));
+    } else {
+        for (size_t i = 0; i < u.n; i++)
+            at[i] = UINT32_MAX;
+        for (size_t i = 0; i < 4 * u.ntets; i++)
+            at[u.tets[i]] = 0;
+        size_t m = 0;
+        for (size_t i = 0; i < u.n; i++)
+            if (at[i] == 0) {
+                at[i] = (uint32_t)m;
+                memcpy(px + 3 * m, u.xyz + 3 * i, 3 * sizeof *px);
+                memcpy(po + 3 * m, u.off + 3 * i, 3);
+                src[m++] = u.src[i];
+            }
+        for (size_t i = 0; i < 4 * u.ntets; i++)
+            u.tets[i] = (fdt_vid)at[u.tets[i]];
+        fdt_mesh_view v;
+        memset(&v, 0, sizeof v);
+        v.xyz = px;
+        v.n_points = m;
+        v.tets = u.tets;
+        v.n_tets = u.ntets;
+        v.point_src = src;
+        v.point_off = po;
+        err = io_code(fdt_wr_mesh_as(name, fdt_format_by_name("vtu"), &v, diag, dlen));
+    }
+    free(at);
+    free(px);
+    free(src);
+    free(po);
+    fdt_periodic_unfolded_free(&u);
+    return err;
+}
+
+int fdt_mpo_bin_piece(const char *name, uint64_t n_input, const fdt_vid *tets, size_t nt,
+                      const fdt_vid *hull, size_t nh, const fdt_bin_periodic *per, char *diag,
+                      size_t dlen)
+{
+    out_file f;
+    fdt_write_lock();
+    int e = fdt_out_open(&f, name);
+    fdt_write_unlock();
+    if (e)
+        return io_code(fdt_create_err(diag, dlen, "output", name, e));
+    fdt_put_bin_piece(&f, n_input, tets, nt, hull, nh, per);
+    fdt_write_lock();
+    int rc = io_code(fdt_out_commit(&f, 1, diag, dlen));
+    fdt_write_unlock();
+    return rc;
+}
+
+/* A .pele piece: opens the .ele's and the .face's temporaries, puts them,
+ * commits both or none (src/io/write/writer.c). */
+static int write_ele(char (*names)[FDT_IO_PATH], int k, uint64_t n_input, const fdt_mpi_out *r,
+                     char *diag, size_t dlen)
 {
     out_file f[2];
     int nopen = 0, e = 0;
@@ -171,19 +241,15 @@ static int write_files(char (*names)[FDT_IO_PATH], int k, int kind, uint64_t n_i
         fdt_write_unlock();
         return code;
     }
-    if (kind == FDT_MPO_BIN) {
-        fdt_put_bin_piece(&f[0], n_input, r->own_tets, r->own_ntets, r->own_hull, r->own_nhull);
-    } else {
-        fdt_mesh_view v;
-        memset(&v, 0, sizeof v);
-        v.n_points = n_input;
-        v.tets = r->own_tets;
-        v.n_tets = r->own_ntets;
-        v.hull = r->own_hull;
-        v.n_hull = r->own_nhull;
-        fdt_put_tetgen_ele(&f[0], &v, NULL, diag, dlen);
-        fdt_put_tetgen_face(&f[1], &v, NULL, diag, dlen);
-    }
+    fdt_mesh_view v;
+    memset(&v, 0, sizeof v);
+    v.n_points = n_input;
+    v.tets = r->own_tets;
+    v.n_tets = r->own_ntets;
+    v.hull = r->own_hull;
+    v.n_hull = r->own_nhull;
+    fdt_put_tetgen_ele(&f[0], &v, NULL, diag, dlen);
+    fdt_put_tetgen_face(&f[1], &v, NULL, diag, dlen);
     fdt_write_lock();
     int rc = io_code(fdt_out_commit(f, k, diag, dlen));
     fdt_write_unlock();
@@ -398,17 +464,23 @@ static void put_xml(FILE *f, const char *s)
         }
 }
 
-/* The ParaView index: it reads the pieces it names. */
-static void put_pvtu(FILE *f, const char *path, int size)
+/* The ParaView index: it reads the pieces it names (and a periodic
+ * mesh's input ids, src/io/write/fmt_vtk.c). */
+static void put_pvtu(FILE *f, const char *path, int size, int periodic)
 {
     fprintf(f, "<?xml version=\"1.0\"?>\n"
                "<VTKFile type=\"PUnstructuredGrid\" version=\"0.1\" byte_order=\"%s\" "
                "header_type=\"UInt64\">\n"
                "  <PUnstructuredGrid GhostLevel=\"0\">\n"
+               "%s"
                "    <PPoints>\n"
                "      <PDataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"/>\n"
                "    </PPoints>\n",
-            little_endian() ? "LittleEndian" : "BigEndian");
+            little_endian() ? "LittleEndian" : "BigEndian",
+            periodic ? "    <PPointData Scalars=\"input_id\">\n"
+                       "      <PDataArray type=\"Int64\" Name=\"input_id\"/>\n"
+                       "    </PPointData>\n"
+                     : "");
     char name[FDT_IO_PATH];
     for (int q = 0; q < size; q++) {
         piece_name(path, FDT_MPO_VTU, q, 0, name, sizeof name); /* checked by the caller */
@@ -421,13 +493,14 @@ static void put_pvtu(FILE *f, const char *path, int size)
 
 /* The text index of .pfdtb and .pele (src/mpi/mpi_output.h, README). A control
  * character in the input's name would break its line: written as '?'. */
-static void put_text_index(FILE *f, const fdt_mpo_args *a, int kind, const fdt_mpi_local *L,
-                           const fdt_mpi_out *r, int size, const uint64_t *counts)
+static void put_text_index(FILE *f, const fdt_mpo_args *a, int kind, const fdt_mpo_share *sh,
+                           int size, const uint64_t *counts)
 {
     fprintf(f, "frontdt-pieces 1\nformat %s\ninput ", format_word[kind]);
     for (const char *s = a->input; *s; s++)
         fputc((unsigned char)*s < 32 || *s == 127 ? '?' : *s, f);
-    fprintf(f, "\npoints %zu\nduplicates %zu\nranks %d\n", L->n, L->ndup, size);
+    fprintf(f, "\npoints %" PRIu64 "\nduplicates %" PRIu64 "\nranks %d\n", sh->n_input, sh->ndup,
+            size);
     char name[FDT_IO_PATH];
     if (kind == FDT_MPO_ELE) {
         sibling(a->path, kind, "", ".node", name, sizeof name);
@@ -442,13 +515,48 @@ static void put_text_index(FILE *f, const fdt_mpo_args *a, int kind, const fdt_m
         th += counts[2 * q + 1];
     }
     fprintf(f, "total %" PRIu64 " %" PRIu64 "\nset-hash %016" PRIx64 "\n", tt, th,
-            fdt_sethash_value(&r->hash));
+            fdt_sethash_value(&sh->hash));
 }
 
 /* ---- the whole output ------------------------------------------------------ */
 
+/* The plain engine's share (fdt_mpo_write): its pieces from the run's
+ * output r, the .node from the setup's L. */
+typedef struct plain_share {
+    const fdt_mpi_local *L;
+    const fdt_mpi_out *r;
+    int kind;
+} plain_share;
+
+static int plain_piece(void *user, char (*names)[FDT_IO_PATH], int k, char *diag, size_t dlen)
+{
+    const plain_share *p = user;
+    const fdt_mpi_out *r = p->r;
+    if (p->kind == FDT_MPO_VTU)
+        return write_vtu(names[0], r, diag, dlen);
+    if (p->kind == FDT_MPO_BIN)
+        return fdt_mpo_bin_piece(names[0], p->L->n, r->own_tets, r->own_ntets, r->own_hull,
+                                 r->own_nhull, NULL, diag, dlen);
+    return write_ele(names, k, p->L->n, r, diag, dlen);
+}
+
+static int plain_node(MPI_Comm comm, const char *name, void *user, uint64_t *io, char *diag,
+                      size_t dlen)
+{
+    return write_node(comm, name, ((const plain_share *)user)->L, io, diag, dlen);
+}
+
 int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
                   const fdt_mpi_out *r, int *mine, uint64_t io[2], char *diag, size_t dlen)
+{
+    plain_share p = {L, r, fdt_mpo_kind(a->path)};
+    const fdt_mpo_share s = {L->n,       L->ndup,    r->own_ntets, r->own_nhull, r->hash, 0,
+                             plain_piece, plain_node, &p};
+    return fdt_mpo_write_share(comm, a, &s, mine, io, diag, dlen);
+}
+
+int fdt_mpo_write_share(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpo_share *s, int *mine,
+                        uint64_t io[2], char *diag, size_t dlen)
 {
     io[0] = io[1] = 0;
     int rank, size;
@@ -457,6 +565,11 @@ int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
     int kind = fdt_mpo_kind(a->path);
     *mine = FDT_OK;
     diag[0] = '\0';
+    if (kind == FDT_MPO_ELE && !s->node) {
+        snprintf(diag, dlen, "this run writes no .pele pieces");
+        *mine = FDT_EINVAL;
+        return FDT_EINVAL; /* the same answer on every rank, nothing written */
+    }
     /* The names: this rank's piece (and .face), the .node, the index. The
      * CLI checked every name fits (fdt_mpo_file). */
     char names[2][FDT_IO_PATH], node[FDT_IO_PATH] = "";
@@ -476,14 +589,13 @@ int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
 
     int err = FDT_OK;
     if (kind == FDT_MPO_ELE) {
-        err = write_node(comm, node, L, io, diag, dlen);
+        err = s->node(comm, node, s->user, io, diag, dlen);
         if (err && rank == 0)
             *mine = err; /* the agreed message: rank 0 says it */
     }
     int wrote = 0;
     if (!err) {
-        int e = kind == FDT_MPO_VTU ? write_vtu(names[0], r, diag, dlen)
-                                    : write_files(names, k, kind, L->n, r, diag, dlen);
+        int e = s->piece(s->user, names, k, diag, dlen);
         wrote = e == FDT_OK;
         struct stat st;
         for (int i = 0; wrote && i < k; i++)
@@ -500,7 +612,7 @@ int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
     if (err)
         bad = err == FDT_ENOMEM ? 1 : 2;
     MPI_Allreduce(&bad, &worst, 1, MPI_INT, MPI_MAX, comm);
-    uint64_t cnt[2] = {r->own_ntets, r->own_nhull}, *all = NULL;
+    uint64_t cnt[2] = {s->ntets, s->nhull}, *all = NULL;
     if (rank == 0 && !(all = malloc(2 * (size_t)size * sizeof *all)))
         worst = worst ? worst : 1;
     MPI_Gather(cnt, 2, MPI_UINT64_T, all, 2, MPI_UINT64_T, 0, comm);
@@ -512,9 +624,9 @@ int fdt_mpo_write(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpi_local *L,
             worst = 2;
         } else {
             if (kind == FDT_MPO_VTU)
-                put_pvtu(f, a->path, size);
+                put_pvtu(f, a->path, size, s->periodic);
             else
-                put_text_index(f, a, kind, L, r, size, all);
+                put_text_index(f, a, kind, s, size, all);
             if (fdt_wr_side_commit(side, diag, dlen) != FDT_IO_OK)
                 worst = 2;
         }

@@ -33,6 +33,10 @@
 #include <stdio.h>
 #include <stdint.h>
 
+#include "base/sethash.h"
+#include "io/write/formats.h"
+#include "io/write/writer.h"
+#include "mesh/periodic.h"
 #include "mpi/mpi_run.h"
 #include "mpi/mpi_setup.h"
 
@@ -59,6 +63,49 @@ typedef struct fdt_mpo_args {
                                piece write fails after its temporary is
                                written; -1: none */
 } fdt_mpo_args;
+
+/*
+ * A rank's share of a piece output, whatever run made it (the plain
+ * engine's below; a periodic run's, src/cli/mpi_main.c): what the index
+ * says of the input and of this rank, and how this rank's piece is
+ * written.
+ */
+typedef struct fdt_mpo_share {
+    uint64_t n_input, ndup; /* the input's points and merged duplicates */
+    uint64_t ntets, nhull;  /* this rank's rows */
+    fdt_sethash hash;       /* rank 0: the run's set hash (the index's) */
+    int periodic;           /* the rows are a periodic mesh's: the .vtu
+                               pieces carry each point's input id */
+    /* Writes this rank's k files (names: the piece, then .pele's .face),
+     * each through a temporary renamed at its end; an FDT_ code, the
+     * message in diag. */
+    int (*piece)(void *user, char (*names)[FDT_IO_PATH], int k, char *diag, size_t dlen);
+    /* .pele: the collective .node into name (every rank); NULL refuses
+     * .pele (FDT_EINVAL before anything is written). */
+    int (*node)(MPI_Comm comm, const char *name, void *user, uint64_t *io, char *diag,
+                size_t dlen);
+    void *user;
+} fdt_mpo_share;
+
+/* A .pfdtb piece into name (src/io/write/formats.h's fdt_put_bin_piece),
+ * through a temporary renamed at its end: an FDT_ code, the message in
+ * diag. */
+int fdt_mpo_bin_piece(const char *name, uint64_t n_input, const fdt_vid *tets, size_t nt,
+                      const fdt_vid *hull, size_t nh, const fdt_bin_periodic *per, char *diag,
+                      size_t dlen);
+
+/* A periodic run's .vtu piece into name: its nt rows (input ids, offsets)
+ * laid out as frontdt lays out a periodic .vtu (src/mesh/periodic.h's
+ * fdt_periodic_unfold over the n input points xyz and the box b), with only
+ * the points they use, each with its input_id. An FDT_ code, the message
+ * in diag. */
+int fdt_mpo_periodic_vtu(const char *name, const fdt_vid *tets, const int8_t *off, size_t nt,
+                         const double *xyz, size_t n, const fdt_periodic_box *b, char *diag,
+                         size_t dlen);
+
+/* The pieces and the index of share s (collective), as fdt_mpo_write. */
+int fdt_mpo_write_share(MPI_Comm comm, const fdt_mpo_args *a, const fdt_mpo_share *s, int *mine,
+                        uint64_t io[2], char *diag, size_t dlen);
 
 /*
  * Writes the pieces and the index (collective). r: the run's output with

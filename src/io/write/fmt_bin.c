@@ -12,7 +12,7 @@
  *                 tets name its first occurrence), "points" is how many
  *                 the input has; 16 a periodic mesh (--periodic): the
  *                 tets and hull faces are ids ascending (not oriented),
- *                 their offsets follow
+ *                 their offsets follow (a piece may have both: 8 | 16)
  *         16..23  uint64 points
  *         24..31  uint64 tets      (a streamed file: patched at the end)
  *         32..39  uint64 hull faces (the same)
@@ -89,6 +89,27 @@ static void put_ids(out_file *o, const fdt_vid *v, size_t count, int ids64)
     }
 }
 
+/* The periods in the header's reserved bytes (flag 16). */
+static void put_periods(unsigned char h[BIN_HEADER], const double period[3])
+{
+    for (int k = 0; k < 3; k++) {
+        uint64_t u;
+        memcpy(&u, &period[k], 8);
+        put_le(h + 40 + 8 * k, u, 8);
+    }
+}
+
+/* A periodic mesh's offsets after its ids: each tet's 12, each hull face's
+ * 9 (a NULL array of none is not memcpy's). */
+static void put_offsets(out_file *o, const int8_t *tet_off, size_t nt, const int8_t *hull_off,
+                        size_t nh)
+{
+    if (nt)
+        out_bytes(o, tet_off, 12 * nt);
+    if (nh)
+        out_bytes(o, hull_off, 9 * nh);
+}
+
 int fdt_put_bin(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
                 size_t errlen)
 {
@@ -98,32 +119,32 @@ int fdt_put_bin(out_file *o, const fdt_mesh_view *m, const void *prep, char *err
     unsigned char h[BIN_HEADER];
     bin_header(h, BIN_POINTS | BIN_HULL | (m->tet_off ? BIN_PERIODIC : 0), m->n_points,
                m->n_tets, m->n_hull);
-    for (int k = 0; m->tet_off && k < 3; k++) {
-        uint64_t u;
-        memcpy(&u, &m->period[k], 8);
-        put_le(h + 40 + 8 * k, u, 8);
-    }
+    if (m->tet_off)
+        put_periods(h, m->period);
     out_bytes(o, h, sizeof h);
     put_points(o, m->xyz, m->n_points);
     put_ids(o, m->tets, 4 * m->n_tets, 0);
     put_ids(o, m->hull, 3 * m->n_hull, 0);
-    if (m->tet_off && m->n_tets) /* (a NULL array of none is not memcpy's) */
-        out_bytes(o, m->tet_off, 12 * m->n_tets);
-    if (m->tet_off && m->n_hull)
-        out_bytes(o, m->hull_off, 9 * m->n_hull);
+    if (m->tet_off)
+        put_offsets(o, m->tet_off, m->n_tets, m->hull_off, m->n_hull);
     return FDT_IO_OK;
 }
 
 int fdt_put_bin_piece(out_file *o, uint64_t n_input, const fdt_vid *tets, size_t nt,
-                      const fdt_vid *hull, size_t nh)
+                      const fdt_vid *hull, size_t nh, const fdt_bin_periodic *per)
 {
     /* int64 ids only when int32 cannot number the input */
     int ids64 = n_input > (uint64_t)INT32_MAX;
     unsigned char h[BIN_HEADER];
-    bin_header(h, BIN_PIECE | BIN_HULL | (ids64 ? BIN_IDS64 : 0), n_input, nt, nh);
+    bin_header(h, BIN_PIECE | BIN_HULL | (ids64 ? BIN_IDS64 : 0) | (per ? BIN_PERIODIC : 0),
+               n_input, nt, nh);
+    if (per)
+        put_periods(h, per->period);
     out_bytes(o, h, sizeof h);
     put_ids(o, tets, 4 * nt, ids64);
     put_ids(o, hull, 3 * nh, ids64);
+    if (per)
+        put_offsets(o, per->tet_off, nt, per->hull_off, nh);
     return FDT_IO_OK;
 }
 

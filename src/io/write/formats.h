@@ -137,11 +137,18 @@ extern const fdt_stream_fmt fdt_stream_tetgen;
 /* src/io/write/fmt_bin.c: the compact binary format (README, "Binary mesh") */
 int fdt_put_bin(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
                 size_t errlen);
-/* One rank's piece of a distributed mesh (src/mpi/mpi_output.c): the header
- * with flag 8 (a piece, no points: ids number the n_input input points),
- * its nt tets and nh hull faces; int64 ids when n_input needs them. */
+/* A periodic piece's offsets (12 a tet, 9 a hull face) and periods. */
+typedef struct fdt_bin_periodic {
+    const int8_t *tet_off, *hull_off;
+    double period[3];
+} fdt_bin_periodic;
+/* One rank's piece of a distributed mesh (src/mpi/mpi_output.c,
+ * src/cli/mpi_main.c): the header with flag 8 (a piece, no points: ids
+ * number the n_input input points), its nt tets and nh hull faces; int64
+ * ids when n_input needs them; per (or NULL): a periodic mesh's rows, flag
+ * 16, the periods and offsets as in a whole periodic .fdtb. */
 int fdt_put_bin_piece(out_file *o, uint64_t n_input, const fdt_vid *tets, size_t nt,
-                      const fdt_vid *hull, size_t nh);
+                      const fdt_vid *hull, size_t nh, const fdt_bin_periodic *per);
 extern const fdt_stream_fmt fdt_stream_bin;
 /* src/io/write/fmt_gmsh.c */
 int fdt_put_msh41(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
