@@ -54,19 +54,31 @@ static void exact_image(mpq_t out[3], const double x[3], const int8_t o[3], cons
     mpq_clear(t);
 }
 
+/* The permutations of three columns, the even ones first. */
+static const int perm3[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
+
+/* s = the 3x3 determinant of rows r[0..2] (s initialised). */
+static void det3(mpq_t s, mpq_t r[3][3])
+{
+    mpq_t a;
+    mpq_init(a);
+    mpq_set_ui(s, 0, 1);
+    for (int i = 0; i < 6; i++) {
+        mpq_mul(a, r[0][perm3[i][0]], r[1][perm3[i][1]]);
+        mpq_mul(a, a, r[2][perm3[i][2]]);
+        (i < 3 ? mpq_add : mpq_sub)(s, s, a);
+    }
+    mpq_clear(a);
+}
+
 /* The sign of the 3x3 determinant of rows r[0..2]. */
 static int det3_sign(mpq_t r[3][3])
 {
-    mpq_t a, b, s;
-    mpq_inits(a, b, s, NULL);
-    static const int p[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
-    for (int i = 0; i < 6; i++) {
-        mpq_mul(a, r[0][p[i][0]], r[1][p[i][1]]);
-        mpq_mul(a, a, r[2][p[i][2]]);
-        (i < 3 ? mpq_add : mpq_sub)(s, s, a);
-    }
+    mpq_t s;
+    mpq_init(s);
+    det3(s, r);
     int sg = mpq_sgn(s);
-    mpq_clears(a, b, s, NULL);
+    mpq_clear(s);
     return sg;
 }
 
@@ -115,18 +127,12 @@ static int exact_insphere(mpq_t q[5][3])
             }
             w++;
         }
-        /* the minor's value, not only its sign */
-        mpq_t a, s;
-        mpq_inits(a, s, NULL);
-        static const int p[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
-        for (int i = 0; i < 6; i++) {
-            mpq_mul(a, m[0][p[i][0]], m[1][p[i][1]]);
-            mpq_mul(a, a, m[2][p[i][2]]);
-            (i < 3 ? mpq_add : mpq_sub)(s, s, a);
-        }
+        mpq_t s; /* the minor's value, not only its sign */
+        mpq_init(s);
+        det3(s, m);
         mpq_mul(s, s, d[r][3]);
         ((r + 3) % 2 == 0 ? mpq_add : mpq_sub)(acc, acc, s);
-        mpq_clears(a, s, NULL);
+        mpq_clear(s);
         for (int i = 0; i < 3; i++)
             for (int k = 0; k < 3; k++)
                 mpq_clear(m[i][k]);

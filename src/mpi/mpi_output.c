@@ -166,9 +166,14 @@ int fdt_mpo_periodic_vtu(const char *name, const fdt_vid *tets, const int8_t *of
     double *px = NULL;
     fdt_vid *src = NULL;
     int8_t *po = NULL;
-    if (!err && (!(at = malloc((u.n + 1) * sizeof *at)) || !(px = malloc((3 * u.n + 1) * sizeof *px)) ||
-                 !(src = malloc((u.n + 1) * sizeof *src)) || !(po = malloc(3 * u.n + 1))))
-        err = FDT_ENOMEM;
+    if (!err) {
+        at = malloc((u.n + 1) * sizeof *at);
+        px = malloc((3 * u.n + 1) * sizeof *px);
+        src = malloc((u.n + 1) * sizeof *src);
+        po = malloc(3 * u.n + 1);
+        if (!at || !px || !src || !po)
+            err = FDT_ENOMEM;
+    }
     if (err) {
         snprintf(diag, dlen, "%s: %s", name, fdt_strerror(err));
     } else {
