@@ -30,13 +30,6 @@ fails=0
 for ((i = 0; i < count; i++)); do
   fam=${families[RANDOM % ${#families[@]}]}
   n=$((500 + (RANDOM * 32768 + RANDOM) % 19501))
-  # Every point on one sphere: no rank's probe votes for the replica mesh,
-  # and the kd searches across ranks test every point a face (5,000 points
-  # of intsphere on 2 ranks: 12 s, also before issue 34; 19,453 on 6
-  # ranks: over 600 s; every other family at 15,000 points on 4 ranks took
-  # under 12 s). The one engine's walls answered from the owner's mesh
-  # (issue 31) are the cure; until then it stays small here.
-  [[ $fam == intsphere ]] && n=$((500 + n % 2500))
   pseed=$((RANDOM + 1))
   np=$((1 + RANDOM % 8))
   what="$fam $n (seed $pseed) on $np ranks"
