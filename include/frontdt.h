@@ -990,6 +990,10 @@ typedef enum fdt_interp {
  * query. Both methods reproduce linear functions; a query outside the hull
  * gets NaN (natural: on the hull too), one at a point that point's values. FDT_EINVAL, FDT_ENOMEM,
  * FDT_EINTERNAL (diag, when not NULL, names the query).
+ * A periodic r (settings.periodic): FDT_INTERP_LINEAR only (natural:
+ * FDT_EINVAL, diag says so), each query wrapped into the box along the
+ * periodic axes and found in the periodic mesh, on one thread; NaN beyond
+ * the hull across an axis that is not periodic.
  */
 FDT_API int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
                             size_t nv, const double *q, size_t nq, fdt_interp method,

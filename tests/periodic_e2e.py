@@ -31,6 +31,12 @@
   doubles: images rounded, flat tets whose centres the rounding throws
   periods away), as voro++'s too.
 
+- --interpolate --method linear: the values at queries anywhere in space
+  equal plain frontdt's over the points replicated in the 27 copies
+  around the box (queries wrapped) to 1e-9; a channel (x, z) reproduces a
+  linear function of y and gives NaN past its walls; natural neighbours
+  and --stream with it are refused (exit 1).
+
 - An OpenFOAM polyMesh (-o CASE/constant/polyMesh): the mesh laid out, the
   faces across periodic sides as cyclic patch pairs, checked here (cells
   closed, volumes the domain's, each pair's faces translates of each
@@ -47,12 +53,14 @@
 
 Usage: periodic_e2e.py FRONTDT CGAL_PERIODIC|none VORO_REF|none SCRATCH GEN_POINTS [--long]
 """
+import math
 import os
 import random
 import re
 import shutil
 import subprocess
 import sys
+from fractions import Fraction
 
 import foam_mesh
 from vtk_cells import read_polyhedra
@@ -592,6 +600,82 @@ def errors():
           "point on any threads")
 
 
+def interpolation():
+    """--interpolate --method linear on a periodic mesh: at queries
+    anywhere in space (wrapped), the values of plain frontdt's linear
+    interpolation over the points replicated in the 27 copies around the
+    box (each image the rounded exact sum, Fraction's) at the queries
+    wrapped into the box; in a channel (x, z) a linear function of y
+    reproduced, and NaN past the walls; natural neighbours and --stream
+    refused (exit 1)."""
+    lo, length = 0.1, 1.2
+    pts = uniform(1500, lo, length, 21)
+    r = random.Random(22)
+    vals = [(r.random(), r.random() - 0.5) for _ in pts]
+    qs = [tuple(-1.5 + 4.5 * r.random() for _ in range(3)) for _ in range(300)]
+    src, vf, qf, out = (os.path.join(SCRATCH, "i." + x) for x in ("xyz", "vals", "q.xyz", "out"))
+    write_points(src, pts)
+    write_points(qf, qs)
+    with open(vf, "w") as f:
+        f.writelines("%.17g %.17g\n" % v for v in vals)
+    box = ",".join("%.17g" % v for v in (lo,) * 3 + (lo + length,) * 3)
+    r1 = frontdt(src, "--periodic", "xyz", "--box", box, "--values", vf, "--interpolate", qf,
+                 "--interpolated", out, "--method", "linear", "-q")
+    expect(r1.returncode == 0, "periodic --interpolate: exit %d %s" % (r1.returncode, r1.stderr))
+    if r1.returncode:
+        return
+    got = [tuple(float(x) for x in line.split()) for line in open(out)]
+    period = Fraction(lo + length) - Fraction(lo)
+    rep, rvals = [], []
+    for o in range(27):
+        shift = (o % 3 - 1, o // 3 % 3 - 1, o // 9 - 1)
+        rep += [tuple(float(Fraction(p[k]) + shift[k] * period) for k in range(3)) for p in pts]
+        rvals += vals
+    wrapped = [tuple(float(Fraction(lo) + (Fraction(c) - Fraction(lo)) % period) for c in q)
+               for q in qs]
+    rsrc, rvf, rqf, rout = (os.path.join(SCRATCH, "r." + x) for x in ("xyz", "vals", "q.xyz", "out"))
+    write_points(rsrc, rep)
+    write_points(rqf, wrapped)
+    with open(rvf, "w") as f:
+        f.writelines("%.17g %.17g\n" % v for v in rvals)
+    r2 = frontdt(rsrc, "--values", rvf, "--interpolate", rqf, "--interpolated", rout, "--method",
+                 "linear", "-q")
+    expect(r2.returncode == 0, "replicated --interpolate: exit %d %s" % (r2.returncode, r2.stderr))
+    if r2.returncode:
+        return
+    want = [tuple(float(x) for x in line.split()) for line in open(rout)]
+    # periodic on every axis: no hull, so no NaN (which max() would skip)
+    worst = max(abs(a - b) if a == a and b == b else math.inf
+                for g, w in zip(got, want) for a, b in zip(g, w))
+    expect(len(got) == len(qs) and worst < 1e-9,
+           "periodic --interpolate: %d values, %.3g off the replicated mesh's" % (len(got), worst))
+    # a channel: y's walls are not periodic; the values a linear function of y
+    clo, chi = (0.0, -0.5, 0.25), (2.0, 0.5, 1.25)
+    cp = channel(1200, 6, clo, chi, "xz", 23)
+    write_points(src, cp)
+    with open(vf, "w") as f:
+        f.writelines("%.17g\n" % (3 * p[1] - 0.25) for p in cp)
+    inside = [(4 * r.random() - 1, -0.45 + 0.9 * r.random(), 3 * r.random() - 1) for _ in range(100)]
+    beyond = [(0.5, 0.7, 0.5), (1.0, -0.9, 3.0)]
+    write_points(qf, inside + beyond)
+    cbox = ",".join("%.17g" % v for v in clo + chi)
+    r3 = frontdt(src, "--periodic", "x,z", "--box", cbox, "--values", vf, "--interpolate", qf,
+                 "--interpolated", out, "--method", "linear", "-q")
+    expect(r3.returncode == 0, "channel --interpolate: exit %d %s" % (r3.returncode, r3.stderr))
+    if r3.returncode == 0:
+        cv = [float(line) for line in open(out)]
+        worst = max(abs(v - (3 * q[1] - 0.25)) if v == v else math.inf
+                    for v, q in zip(cv, inside))
+        expect(worst < 1e-12, "channel --interpolate: a linear function %.3g off" % worst)
+        expect(all(math.isnan(v) for v in cv[len(inside):]), "channel --interpolate: past the "
+               "walls %r, not NaN" % cv[len(inside):])
+    for extra in (["--method", "natural"], ["--method", "linear", "--stream"]):
+        r4 = frontdt(src, "--periodic", "x,z", "--box", cbox, "--values", vf, "--interpolate", qf,
+                     "--interpolated", out + "2", *extra, "-q")
+        expect(r4.returncode == 1 and not os.path.exists(out + "2"),
+               "periodic --interpolate %s: exit %d" % (" ".join(extra), r4.returncode))
+
+
 def main():
     shutil.rmtree(SCRATCH, ignore_errors=True)
     os.makedirs(SCRATCH)
@@ -620,6 +704,7 @@ def main():
     polymesh("duct", channel(800, 5, lo, hi, "x", 12), lo, hi, "x")
     stream()
     errors()
+    interpolation()
     print("periodic_e2e: %d checks, %d failed" % (checks, len(failures)))
     shutil.rmtree(SCRATCH, ignore_errors=True)
     return 1 if failures else 0

@@ -22,6 +22,7 @@
 #include "geom/morton.h"
 #include "geom/prepare.h"
 #include "mesh/periodic.h"
+#include "mesh/periodic_interp.h"
 #include "mesh/result.h"
 #include "mesh/locate.h"
 #include "mesh/voronoi.h"
@@ -382,8 +383,23 @@ int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *va
                     size_t nv, const double *q, size_t nq, fdt_interp method, int threads,
                     double *out, char *diag, size_t diag_size)
 {
-    if (threads < 0 || threads > 1024 || (r && r->periodic))
+    if (threads < 0 || threads > 1024)
         return FDT_EINVAL;
+    if (r && r->periodic) { /* src/mesh/periodic_interp.h */
+        if (diag && diag_size)
+            diag[0] = 0;
+        if (method != FDT_INTERP_LINEAR) {
+            fdt_diag(diag, diag_size, "a periodic mesh interpolates linearly only (natural "
+                     "neighbours: not yet)");
+            return FDT_EINVAL;
+        }
+        if (!xyz || !values || nv == 0 || (nq && (!q || !out)) || r->streamed)
+            return FDT_EINVAL;
+        const fdt_periodic_box b = {r->periodic, {r->pbox[0], r->pbox[1], r->pbox[2]},
+                                    {r->pbox[3], r->pbox[4], r->pbox[5]}};
+        return fdt_periodic_interpolate_linear(r->tets, r->tet_off, r->ntets, xyz, n, &b, values,
+                                               nv, q, nq, out);
+    }
     return fdt_interpolate_build(r, xyz, n, values, nv, q, nq, method,
                                  threads ? threads : fdt_threads_default(), out, diag,
                                  diag_size);

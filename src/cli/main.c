@@ -561,9 +561,15 @@ static int check_args(cli *c, int npos, char **pos)
         if (c->all_faces)
             return usage_error("--periodic: TetGen's .face lists the hull, not every face "
                                "(--all-faces)");
-        if (c->dual.dual || fdt_cli_interp_wanted(&c->dual))
-            return usage_error("--periodic writes the mesh, its hashes, --check and the cells; "
-                               "not yet --dual or --interpolate");
+        if (c->dual.dual)
+            return usage_error("--periodic writes the mesh, its hashes, --check, the cells "
+                               "and --interpolate --method linear; not yet --dual");
+        if (fdt_cli_interp_wanted(&c->dual) && c->dual.natural)
+            return usage_error("--periodic interpolates linearly only: --method linear "
+                               "(natural neighbours: not yet)");
+        if (fdt_cli_interp_wanted(&c->dual) && c->stream > 0)
+            return usage_error("--periodic --interpolate needs the mesh in memory (no "
+                               "--stream)");
         if (c->stream <= 0) /* in memory unless asked (its slabs: --stream) */
             c->stream = -1;
     }
