@@ -656,8 +656,8 @@ for spec in "pu xyz" "pch x,z"; do
   done
 done
 # pieces of a periodic run (no row gathered): each rank's sorted rows as a
-# .pfdtb piece (flags 8 | 4 | 16) or a laid-out .vtu piece (its images,
-# each point's input id), the index's set hash frontdt's; every row of
+# .pfdtb piece (flags 8 | 4 | 16) or a laid-out .vtu piece (the points and
+# images its tets use, each one's input id), the index's set hash frontdt's; every row of
 # frontdt's .tets once over the pieces (stream_readback.py
 # --periodic-pieces; the .pvtu through VTK where python3 has it). .pele
 # and --hash with pieces refused.
