@@ -975,6 +975,9 @@ FDT_API int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
  * either), or -1 outside the hull (or not finite); when bary is not NULL,
  * its 4 barycentric coordinates in the order of that tet's vertices (0
  * outside). The walk decides with exact orient3d. FDT_EINVAL, FDT_ENOMEM.
+ * A periodic r: the row (fdt_result_tets, with its offsets) holding the
+ * query wrapped into the box along the periodic axes, the coordinates in
+ * the order of that row's ids, on one thread.
  */
 FDT_API int fdt_locate(fdt_result *r, const double *xyz, size_t n, const double *q, size_t nq,
                        fdt_tid *tet, double *bary, int threads);

@@ -629,9 +629,15 @@ static void test_periodic_api(void)
     }
     EXPECTF(fabs(sum - 1) < 1e-12, "periodic cells: %.17g", sum);
     fdt_voronoi_free(&v);
-    fdt_tid tet;
-    double bary[4];
-    EXPECT(fdt_locate(r, xyz, N, xyz, 1, &tet, bary, 1) == FDT_EINVAL);
+    /* located in the periodic mesh (tests/test_periodic_interp.c): a
+     * point's own coordinate 1 in a row that holds it */
+    fdt_tid tet = -1;
+    double bary[4] = {0, 0, 0, 0};
+    EXPECT(fdt_locate(r, xyz, N, xyz, 1, &tet, bary, 1) == FDT_OK && tet >= 0 &&
+           (size_t)tet < ntets);
+    for (int i = 0; tet >= 0 && (size_t)tet < ntets && i < 4; i++)
+        if (fdt_result_tets(r)[4 * tet + i] == 0)
+            EXPECTF(fabs(bary[i] - 1) < 1e-12, "point 0's coordinate %.17g", bary[i]);
     fdt_result_free(&r);
     /* streamed: a sink without periodic_tets is refused; with it, the
      * rows come ascending in each batch, the set hash is the in-memory
@@ -644,6 +650,7 @@ static void test_periodic_api(void)
     uint64_t sh = 0;
     EXPECT(pr.rows == ntets && !pr.unsorted && fdt_result_set_hash(r, &sh) == FDT_OK &&
            sh == set_hash && fdt_result_num_tets(r) == 0);
+    EXPECT(fdt_locate(r, xyz, N, xyz, 1, &tet, bary, 1) == FDT_EINVAL); /* no mesh kept */
     fdt_result_free(&r);
     pr.stop_after = 1;
     EXPECT(fdt_triangulate_stream(ctx, xyz, N, &ps, &r) == FDT_ECANCELED && !r);

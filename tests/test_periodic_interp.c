@@ -1,6 +1,6 @@
 /*
- * Tests for src/mesh/periodic_interp.c (fdt_interpolate on a periodic
- * mesh, linear):
+ * Tests for src/mesh/periodic_interp.c (fdt_interpolate, linear, and
+ * fdt_locate on a periodic mesh):
  *  - periodic on x, y, z: a query and its translates by whole periods get
  *    the same values (to rounding), a query at a point (or an image of it)
  *    that point's values, a constant function the constant, every value
@@ -9,6 +9,9 @@
  *  - periodic on x and z with walls of points across y: a linear function
  *    of y reproduced to 1e-12, NaN past the walls and for a query with a
  *    NaN coordinate;
+ *  - fdt_locate: a row of the mesh holding each query, its barycentric
+ *    coordinates in the row's order (summing to 1, none negative), which
+ *    weigh the points' values into fdt_interpolate's;
  *  - natural neighbours refused (FDT_EINVAL, with a message).
  * tests/periodic_e2e.py compares the values with a plain mesh of the
  * points replicated around the box.
@@ -75,6 +78,29 @@ static void test_cube(void)
         if (k % 20 == 0)
             EXPECTF(fabs(o[0] - val[2 * k]) < 1e-12, "query %zu at point %zu: %.17g, not %.17g",
                     k, k, o[0], val[2 * k]);
+    }
+    /* fdt_locate: a row holding each query, its coordinates in the row's
+     * order, which weigh the first values into fdt_interpolate's */
+    static fdt_tid tet[4 * 200];
+    static double bary[4 * 4 * 200];
+    CHECK(fdt_locate(r, xyz, n, q, 4 * nq, tet, bary, 1) == FDT_OK);
+    const fdt_vid *rows = fdt_result_tets(r);
+    size_t nt = fdt_result_num_tets(r);
+    for (size_t k = 0; k < 4 * nq; k++) {
+        EXPECTF(tet[k] >= 0 && (size_t)tet[k] < nt, "query %zu: row %lld", k, (long long)tet[k]);
+        if (tet[k] < 0 || (size_t)tet[k] >= nt)
+            continue;
+        double sum = 0, v = 0, least = 1;
+        for (int i = 0; i < 4; i++) {
+            double c = bary[4 * k + (size_t)i];
+            sum += c;
+            least = c < least ? c : least;
+            v += c * val[2 * (size_t)rows[4 * (size_t)tet[k] + (size_t)i]];
+        }
+        EXPECTF(fabs(sum - 1) < 1e-12 && least > -1e-12, "query %zu: coordinates sum %.17g, "
+                "least %.17g", k, sum, least);
+        EXPECTF(fabs(v - out[2 * k]) < 1e-12, "query %zu: %.17g by fdt_locate's coordinates, "
+                "%.17g by fdt_interpolate", k, v, out[2 * k]);
     }
     /* natural neighbours: not for a periodic mesh */
     diag[0] = 0;

@@ -344,8 +344,7 @@ int fdt_voronoi_compute(const fdt_result *r, const double *xyz, size_t n, const 
             return FDT_EINVAL;
         if (periodic_box_other(o, r->pbox, diag, diag_size))
             return FDT_EINVAL;
-        fdt_periodic_box b = {r->periodic, {r->pbox[0], r->pbox[1], r->pbox[2]},
-                              {r->pbox[3], r->pbox[4], r->pbox[5]}};
+        fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
         return fdt_periodic_cells(r->tets, r->tet_off, r->ntets, r->hull, r->nhull, xyz, n,
                                   r->dupmap, &b, threads, o->neighbors, o->skip, out,
                                   diag ? diag : (char[8]){0},
@@ -373,8 +372,14 @@ int fdt_check_periodic(const double *xyz, size_t n, const fdt_vid *tets, const i
 int fdt_locate(fdt_result *r, const double *xyz, size_t n, const double *q, size_t nq,
                fdt_tid *tet, double *bary, int threads)
 {
-    if (threads < 0 || threads > 1024 || (r && r->periodic))
+    if (threads < 0 || threads > 1024)
         return FDT_EINVAL;
+    if (r && r->periodic) { /* src/mesh/periodic_interp.h */
+        if (!xyz || (nq && (!q || !tet)) || r->streamed)
+            return FDT_EINVAL;
+        const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
+        return fdt_periodic_locate(r->tets, r->tet_off, r->ntets, xyz, n, &b, q, nq, tet, bary);
+    }
     return fdt_locate_build(r, xyz, n, q, nq, tet, bary,
                             threads ? threads : fdt_threads_default());
 }
@@ -395,8 +400,7 @@ int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *va
         }
         if (!xyz || !values || nv == 0 || (nq && (!q || !out)) || r->streamed)
             return FDT_EINVAL;
-        const fdt_periodic_box b = {r->periodic, {r->pbox[0], r->pbox[1], r->pbox[2]},
-                                    {r->pbox[3], r->pbox[4], r->pbox[5]}};
+        const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
         return fdt_periodic_interpolate_linear(r->tets, r->tet_off, r->ntets, xyz, n, &b, values,
                                                nv, q, nq, out);
     }
@@ -692,7 +696,7 @@ static int run_periodic(fdt_context *ctx, const double *xyz, size_t n, const fdt
         nthreads = 1;
     double t0 = fdt_now_s();
     const double *bx = ctx->s.periodic_box;
-    fdt_periodic_box b = {ctx->s.periodic, {bx[0], bx[1], bx[2]}, {bx[3], bx[4], bx[5]}};
+    fdt_periodic_box b = fdt_periodic_box_of(ctx->s.periodic, bx);
     fdt_prepared pr;
     memset(&pr, 0, sizeof pr);
     fdt_periodic_mesh pm;
@@ -928,7 +932,7 @@ static int periodic_cells_box(fdt_context *ctx, const double *xyz, size_t n,
     const double *bx = ctx->s.periodic_box;
     if (periodic_box_other(o, bx, ctx->diag, sizeof ctx->diag))
         return FDT_EINVAL;
-    fdt_periodic_box b = {ctx->s.periodic, {bx[0], bx[1], bx[2]}, {bx[3], bx[4], bx[5]}};
+    fdt_periodic_box b = fdt_periodic_box_of(ctx->s.periodic, bx);
     int err = fdt_periodic_check(xyz, n, &b, ctx->diag, sizeof ctx->diag);
     if (!err)
         err = fdt_periodic_cells_check(xyz, n, &b, ctx->diag, sizeof ctx->diag);

@@ -379,8 +379,7 @@ static int periodic_piece(void *user, char (*names)[FDT_IO_PATH], int k, char *d
             per.period[a] = r->periodic >> a & 1 ? r->pbox[a + 3] - r->pbox[a] : 0;
         return fdt_mpo_bin_piece(names[0], p->n, t->ids, t->n, h->ids, h->n, &per, diag, dlen);
     }
-    const fdt_periodic_box b = {r->periodic, {r->pbox[0], r->pbox[1], r->pbox[2]},
-                                {r->pbox[3], r->pbox[4], r->pbox[5]}};
+    const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
     return fdt_mpo_periodic_vtu(names[0], t->ids, t->off, t->n, p->xyz, p->n, &b, diag, dlen);
 }
 

@@ -45,6 +45,13 @@ typedef struct fdt_periodic_box {
     double lo[3], hi[3];
 } fdt_periodic_box;
 
+/* The box of the periodic axes axes and box (xmin, ymin, zmin, xmax, ymax,
+ * zmax: fdt_settings.periodic_box, a result's pbox). */
+static inline fdt_periodic_box fdt_periodic_box_of(unsigned axes, const double box[6])
+{
+    return (fdt_periodic_box){axes, {box[0], box[1], box[2]}, {box[3], box[4], box[5]}};
+}
+
 /* The result: ntets tets, 4 input indices each ascending (ties: the
  * offsets' order), with 3 offsets each (in periods, 0 on an axis that is
  * not periodic) relative to the first; the hull faces likewise, 3 each;

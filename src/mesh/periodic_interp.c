@@ -126,10 +126,9 @@ static int search_all(const pwalk *w, size_t *t, double p[3])
     return 1;
 }
 
-int fdt_periodic_interpolate_linear(const int32_t *tets, const int8_t *off, size_t ntets,
-                                    const double *X, size_t n, const fdt_periodic_box *b,
-                                    const double *values, size_t nv, const double *q,
-                                    size_t nq, double *out)
+int fdt_periodic_locate(const int32_t *tets, const int8_t *off, size_t ntets, const double *X,
+                        size_t n, const fdt_periodic_box *b, const double *q, size_t nq,
+                        fdt_tid *tet, double *bary)
 {
     fdt_periodic_unfolded u;
     fdt_tid *nb = NULL;
@@ -155,12 +154,13 @@ int fdt_periodic_interpolate_linear(const int32_t *tets, const int8_t *off, size
     for (int d = 0; d < 3; d++)
         w.L[d] = b->axes >> d & 1 ? b->hi[d] - b->lo[d] : 0;
     for (size_t k = 0; k < nq; k++) {
+        tet[k] = -1;
+        for (int i = 0; bary && i < 4; i++)
+            bary[4 * k + (size_t)i] = 0;
         for (int d = 0; d < 3; d++) {
             double x = q[3 * k + (size_t)d];
             if (!isfinite(x)) {
                 bad[k] = 1;
-                for (size_t c = 0; c < nv; c++)
-                    out[nv * k + c] = NAN;
                 break;
             }
             if (w.L[d] > 0) {
@@ -183,22 +183,21 @@ int fdt_periodic_interpolate_linear(const int32_t *tets, const int8_t *off, size
     for (size_t i = 0; i < (size_t)ordered; i++) {
         const size_t k = order[i];
         double p[3] = {wq[3 * k], wq[3 * k + 1], wq[3 * k + 2]}, wt[4];
-        double *o = out + nv * k;
         int got = u.ntets ? walk(&w, &t, p, max) : 0;
         if (got < 0)
             got = search_all(&w, &t, p);
-        if (got <= 0) {
-            for (size_t c = 0; c < nv; c++)
-                o[c] = NAN;
+        if (got <= 0)
             continue;
-        }
+        tet[k] = (fdt_tid)t;
+        if (!bary)
+            continue;
+        /* the weights in the row's order (the layout may have swapped two
+         * vertices to orient the tet): by input id, distinct in a tet */
         weights(&w, t, p, wt);
-        for (size_t c = 0; c < nv; c++) {
-            double s = 0;
+        for (int r = 0; r < 4; r++)
             for (int v = 0; v < 4; v++)
-                s += wt[v] * values[nv * (size_t)u.src[u.tets[4 * t + (size_t)v]] + c];
-            o[c] = s;
-        }
+                if ((int32_t)u.src[u.tets[4 * t + (size_t)v]] == tets[4 * t + (size_t)r])
+                    bary[4 * k + (size_t)r] = wt[v];
     }
 done:
     free(order);
@@ -206,5 +205,27 @@ done:
     free(bad);
     free(nb);
     fdt_periodic_unfolded_free(&u);
+    return err;
+}
+
+int fdt_periodic_interpolate_linear(const int32_t *tets, const int8_t *off, size_t ntets,
+                                    const double *X, size_t n, const fdt_periodic_box *b,
+                                    const double *values, size_t nv, const double *q,
+                                    size_t nq, double *out)
+{
+    fdt_tid *tet = malloc((nq ? nq : 1) * sizeof *tet);
+    double *bary = malloc((nq ? 4 * nq : 1) * sizeof *bary);
+    int err = tet && bary ? fdt_periodic_locate(tets, off, ntets, X, n, b, q, nq, tet, bary)
+                          : FDT_ENOMEM;
+    for (size_t k = 0; !err && k < nq; k++)
+        for (size_t c = 0; c < nv; c++) {
+            double s = tet[k] < 0 ? NAN : 0;
+            for (int r = 0; tet[k] >= 0 && r < 4; r++)
+                s += bary[4 * k + (size_t)r] *
+                     values[nv * (size_t)tets[4 * (size_t)tet[k] + (size_t)r] + c];
+            out[nv * k + c] = s;
+        }
+    free(tet);
+    free(bary);
     return err;
 }

@@ -1,5 +1,6 @@
 /*
- * Linear interpolation in a periodic mesh (issue 33; src/mesh/periodic.h):
+ * Point location and linear interpolation in a periodic mesh (issue 33;
+ * src/mesh/periodic.h):
  * values given at the input points, at query points anywhere in space,
  * barycentric in the periodic tet that holds the query (the DTFE's
  * interpolation in a periodic box). The tets are laid out as the writers
@@ -17,7 +18,18 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "frontdt.h"
 #include "mesh/periodic.h"
+
+/*
+ * tet[k]: the row (of tets) holding query k, wrapped into the box along
+ * the periodic axes, or -1 past the hull across an axis that is not
+ * periodic (or not finite); bary (or NULL): its 4 barycentric coordinates
+ * in the order of that row's ids (0 for -1). The errors below.
+ */
+int fdt_periodic_locate(const int32_t *tets, const int8_t *off, size_t ntets, const double *X,
+                        size_t n, const fdt_periodic_box *b, const double *q, size_t nq,
+                        fdt_tid *tet, double *bary);
 
 /*
  * out[nv k + c]: value c at query k, from values[nv i + c] at input point
