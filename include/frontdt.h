@@ -270,9 +270,11 @@ FDT_API const fdt_vid *fdt_result_hull_faces(const fdt_result *r);
  * 4 input ids ascending (ties by offsets) with offsets relative to the
  * first, the tets in ascending order (the .tets file's lines), and
  * likewise the hull faces (only across the axes that are not periodic).
- * The face list, edges, adjacency, neighbours, set hash, check and
- * location refuse a periodic result (FDT_EINVAL); fdt_result_hash is the
- * hash of its .tets text; fdt_voronoi_compute gives its periodic cells.
+ * The face list, edges, adjacency, neighbours and check refuse a
+ * periodic result (FDT_EINVAL); fdt_locate and fdt_interpolate (linear)
+ * find queries in it; fdt_result_hash is the hash of its .tets text,
+ * fdt_result_set_hash that of its rows with their offsets;
+ * fdt_voronoi_compute gives its periodic cells.
  */
 FDT_API const int8_t *fdt_result_tet_offsets(const fdt_result *r);
 FDT_API const int8_t *fdt_result_hull_offsets(const fdt_result *r);

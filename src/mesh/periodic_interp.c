@@ -1,4 +1,4 @@
-/* Linear interpolation in a periodic mesh; see periodic_interp.h. */
+/* Point location and linear interpolation in a periodic mesh; see periodic_interp.h. */
 #include "mesh/periodic_interp.h"
 
 #include <math.h>

@@ -1,9 +1,8 @@
 /*
  * Point location and linear interpolation in a periodic mesh (issue 33;
- * src/mesh/periodic.h):
- * values given at the input points, at query points anywhere in space,
- * barycentric in the periodic tet that holds the query (the DTFE's
- * interpolation in a periodic box). The tets are laid out as the writers
+ * src/mesh/periodic.h): the periodic tet that holds a query anywhere in
+ * space, and values given at the input points interpolated there,
+ * barycentric in that tet (the DTFE's interpolation in a periodic box). The tets are laid out as the writers
  * lay them out (fdt_periodic_unfold) with their periodic neighbours, and
  * each query, wrapped into the box along the periodic axes, is found by a
  * visibility walk that crosses periodic faces by moving the query by
