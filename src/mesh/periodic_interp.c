@@ -96,9 +96,10 @@ static double weights(const pwalk *w, size_t t, const double *p, double wt[4])
     return least;
 }
 
-/* The walk's last resort: every tet in every copy next to p's, the one p
- * lies deepest in (its least barycentric weight the largest); p moved
- * into its frame. 0 when none holds p (past the hull). */
+/* The walk's last resort: every tet in every copy next to p's (p in the
+ * box: the laid-out tets lie within a tet's reach of it), the one p lies
+ * deepest in (its least barycentric weight the largest); p moved into its
+ * frame. 0 when none holds p (past the hull). */
 static int search_all(const pwalk *w, size_t *t, double p[3])
 {
     double best = -INFINITY, bp[3] = {0, 0, 0};
@@ -184,8 +185,10 @@ int fdt_periodic_locate(const int32_t *tets, const int8_t *off, size_t ntets, co
         const size_t k = order[i];
         double p[3] = {wq[3 * k], wq[3 * k + 1], wq[3 * k + 2]}, wt[4];
         int got = u.ntets ? walk(&w, &t, p, max) : 0;
-        if (got < 0)
+        if (got < 0) { /* from the wrapped query: the walk moved p by periods */
+            memcpy(p, wq + 3 * k, sizeof p);
             got = search_all(&w, &t, p);
+        }
         if (got <= 0)
             continue;
         tet[k] = (fdt_tid)t;
