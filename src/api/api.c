@@ -22,7 +22,6 @@
 #include "geom/morton.h"
 #include "geom/prepare.h"
 #include "mesh/periodic.h"
-#include "mesh/periodic_interp.h"
 #include "mesh/result.h"
 #include "mesh/locate.h"
 #include "mesh/voronoi.h"
@@ -374,12 +373,6 @@ int fdt_locate(fdt_result *r, const double *xyz, size_t n, const double *q, size
 {
     if (threads < 0 || threads > 1024)
         return FDT_EINVAL;
-    if (r && r->periodic) { /* src/mesh/periodic_interp.h */
-        if (!xyz || (nq && (!q || !tet)) || r->streamed)
-            return FDT_EINVAL;
-        const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
-        return fdt_periodic_locate(r->tets, r->tet_off, r->ntets, xyz, n, &b, q, nq, tet, bary);
-    }
     return fdt_locate_build(r, xyz, n, q, nq, tet, bary,
                             threads ? threads : fdt_threads_default());
 }
@@ -390,20 +383,6 @@ int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *va
 {
     if (threads < 0 || threads > 1024)
         return FDT_EINVAL;
-    if (r && r->periodic) { /* src/mesh/periodic_interp.h */
-        if (diag && diag_size)
-            diag[0] = 0;
-        if (method != FDT_INTERP_LINEAR) {
-            fdt_diag(diag, diag_size, "a periodic mesh interpolates linearly only (natural "
-                     "neighbours: not yet)");
-            return FDT_EINVAL;
-        }
-        if (!xyz || !values || nv == 0 || (nq && (!q || !out)) || r->streamed)
-            return FDT_EINVAL;
-        const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
-        return fdt_periodic_interpolate_linear(r->tets, r->tet_off, r->ntets, xyz, n, &b, values,
-                                               nv, q, nq, out);
-    }
     return fdt_interpolate_build(r, xyz, n, values, nv, q, nq, method,
                                  threads ? threads : fdt_threads_default(), out, diag,
                                  diag_size);

@@ -373,13 +373,13 @@ static int periodic_piece(void *user, char (*names)[FDT_IO_PATH], int k, char *d
     const periodic_share *p = user;
     fdt_result *r = p->res;
     const rowbuf *t = &p->rows[0], *h = &p->rows[1];
+    const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
     if (p->kind == FDT_MPO_BIN) {
         fdt_bin_periodic per = {t->off, h->off, {0, 0, 0}};
-        for (int a = 0; a < 3; a++) /* as src/io/write/writer.c's mesh view */
-            per.period[a] = r->periodic >> a & 1 ? r->pbox[a + 3] - r->pbox[a] : 0;
+        for (int a = 0; a < 3; a++)
+            per.period[a] = fdt_periodic_period(&b, a);
         return fdt_mpo_bin_piece(names[0], p->n, t->ids, t->n, h->ids, h->n, &per, diag, dlen);
     }
-    const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
     return fdt_mpo_periodic_vtu(names[0], t->ids, t->off, t->n, p->xyz, p->n, &b, diag, dlen);
 }
 

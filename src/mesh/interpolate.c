@@ -69,6 +69,7 @@
 #include "base/spawn.h"
 #include "geom/predicates.h"
 #include "mesh/locate.h"
+#include "mesh/periodic_interp.h"
 #include "mesh/result.h"
 #include "mesh/voronoi.h"
 
@@ -638,6 +639,19 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
     if (!r || !xyz || !values || nv == 0 || (nq && (!q || !out)) ||
         (method != FDT_INTERP_LINEAR && method != FDT_INTERP_NATURAL))
         return FDT_EINVAL;
+    if (r->periodic) { /* src/mesh/periodic_interp.h */
+        if (method != FDT_INTERP_LINEAR) {
+            if (diag && diag_size)
+                snprintf(diag, diag_size, "a periodic mesh interpolates linearly only "
+                         "(natural neighbours: not yet)");
+            return FDT_EINVAL;
+        }
+        if (r->streamed)
+            return FDT_EINVAL; /* no mesh kept */
+        const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
+        return fdt_periodic_interpolate_linear(r->tets, r->tet_off, r->ntets, xyz, n, &b, values,
+                                               nv, q, nq, out);
+    }
     /* Sibson's coordinates are ratios of volumes, products of up to six
      * coordinate differences in the circumcentres: for points whose box
      * is outside 2^-100 .. 2^100 (1e-151 and 1e149 apart: an internal

@@ -19,6 +19,7 @@
 #include "geom/morton.h"
 #include "geom/predicates.h"
 #include "mesh/locate.h"
+#include "mesh/periodic_interp.h"
 #include "mesh/result.h"
 
 int fdt_locator_init(fdt_locator *L, fdt_result *r, const double *xyz, size_t n)
@@ -228,6 +229,12 @@ int fdt_locate_build(fdt_result *r, const double *xyz, size_t n, const double *q
 {
     if (!r || !xyz || (nq && (!q || !tet)))
         return FDT_EINVAL;
+    if (r->periodic) { /* its own walk, across the periodic sides */
+        if (r->streamed)
+            return FDT_EINVAL; /* no mesh kept */
+        const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
+        return fdt_periodic_locate(r->tets, r->tet_off, r->ntets, xyz, n, &b, q, nq, tet, bary);
+    }
     fdt_locator L;
     uint32_t *order;
     void *jp;

@@ -52,6 +52,13 @@ static inline fdt_periodic_box fdt_periodic_box_of(unsigned axes, const double b
     return (fdt_periodic_box){axes, {box[0], box[1], box[2]}, {box[3], box[4], box[5]}};
 }
 
+/* The period along axis k (hi - lo rounded), 0 on an axis that is not
+ * periodic: the .fdtb header's, the laid-out writers' and walks'. */
+static inline double fdt_periodic_period(const fdt_periodic_box *b, int k)
+{
+    return b->axes >> k & 1 ? b->hi[k] - b->lo[k] : 0;
+}
+
 /* The result: ntets tets, 4 input indices each ascending (ties: the
  * offsets' order), with 3 offsets each (in periods, 0 on an axis that is
  * not periodic) relative to the first; the hull faces likewise, 3 each;

@@ -153,7 +153,7 @@ int fdt_periodic_locate(const int32_t *tets, const int8_t *off, size_t ntets, co
     pwalk w = {&u, nb, {0, 0, 0}, 0x9e3779b97f4a7c15u};
     double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     for (int d = 0; d < 3; d++)
-        w.L[d] = b->axes >> d & 1 ? b->hi[d] - b->lo[d] : 0;
+        w.L[d] = fdt_periodic_period(b, d);
     for (size_t k = 0; k < nq; k++) {
         tet[k] = -1;
         for (int i = 0; bary && i < 4; i++)

@@ -1761,8 +1761,9 @@ static int wr_write_locked(fdt_result *r, const double *xyz, size_t n, const cha
         v.tet_off = r->tet_off;
         v.hull_off = r->hull_off;
     }
+    const fdt_periodic_box pb = fdt_periodic_box_of(r->periodic, r->pbox);
     for (int k = 0; r->tet_off && k < 3; k++)
-        v.period[k] = r->periodic >> k & 1 ? r->pbox[k + 3] - r->pbox[k] : 0;
+        v.period[k] = fdt_periodic_period(&pb, k);
     /* after the sort: the face list names tets by their numbers (a
      * periodic OpenFOAM mesh pairs its faces from the laid-out tets'
      * periodic neighbours instead) */
