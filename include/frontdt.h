@@ -271,8 +271,8 @@ FDT_API const fdt_vid *fdt_result_hull_faces(const fdt_result *r);
  * first, the tets in ascending order (the .tets file's lines), and
  * likewise the hull faces (only across the axes that are not periodic).
  * The face list, edges, adjacency, neighbours and check refuse a
- * periodic result (FDT_EINVAL); fdt_locate and fdt_interpolate (linear)
- * find queries in it; fdt_result_hash is the hash of its .tets text,
+ * periodic result (FDT_EINVAL); fdt_locate and fdt_interpolate (both
+ * methods) find queries in it; fdt_result_hash is the hash of its .tets text,
  * fdt_result_set_hash that of its rows with their offsets;
  * fdt_voronoi_compute gives its periodic cells.
  */
@@ -979,7 +979,7 @@ FDT_API int fdt_voronoi_stream(fdt_context *ctx, const double *xyz, size_t n,
  * outside). The walk decides with exact orient3d. FDT_EINVAL, FDT_ENOMEM.
  * A periodic r: the row (fdt_result_tets, with its offsets) holding the
  * query wrapped into the box along the periodic axes, the coordinates in
- * the order of that row's ids, on one thread.
+ * the order of that row's ids.
  */
 FDT_API int fdt_locate(fdt_result *r, const double *xyz, size_t n, const double *q, size_t nq,
                        fdt_tid *tet, double *bary, int threads);
@@ -995,10 +995,11 @@ typedef enum fdt_interp {
  * query. Both methods reproduce linear functions; a query outside the hull
  * gets NaN (natural: on the hull too), one at a point that point's values. FDT_EINVAL, FDT_ENOMEM,
  * FDT_EINTERNAL (diag, when not NULL, names the query).
- * A periodic r (settings.periodic): FDT_INTERP_LINEAR only (natural:
- * FDT_EINVAL, diag says so), each query wrapped into the box along the
- * periodic axes and found in the periodic mesh, on one thread; NaN beyond
- * the hull across an axis that is not periodic.
+ * A periodic r (settings.periodic): each query wrapped into the box along
+ * the periodic axes and answered in the periodic mesh (the natural
+ * neighbours of a query near a side among the images across it); NaN
+ * beyond the hull across an axis that is not periodic (natural: on it
+ * too).
  */
 FDT_API int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
                             size_t nv, const double *q, size_t nq, fdt_interp method,

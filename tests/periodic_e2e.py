@@ -601,13 +601,12 @@ def errors():
 
 
 def interpolation():
-    """--interpolate --method linear on a periodic mesh: at queries
-    anywhere in space (wrapped), the values of plain frontdt's linear
-    interpolation over the points replicated in the 27 copies around the
-    box (each image the rounded exact sum, Fraction's) at the queries
-    wrapped into the box; in a channel (x, z) a linear function of y
-    reproduced, and NaN past the walls; natural neighbours and --stream
-    refused (exit 1)."""
+    """--interpolate on a periodic mesh, both methods: at queries anywhere
+    in space (wrapped), the values of plain frontdt's interpolation over
+    the points replicated in the 27 copies around the box (each image the
+    rounded exact sum, Fraction's) at the queries wrapped into the box; in
+    a channel (x, z) a linear function of y reproduced, and NaN past the
+    walls; --stream refused (exit 1)."""
     lo, length = 0.1, 1.2
     pts = uniform(1500, lo, length, 21)
     r = random.Random(22)
@@ -619,12 +618,6 @@ def interpolation():
     with open(vf, "w") as f:
         f.writelines("%.17g %.17g\n" % v for v in vals)
     box = ",".join("%.17g" % v for v in (lo,) * 3 + (lo + length,) * 3)
-    r1 = frontdt(src, "--periodic", "xyz", "--box", box, "--values", vf, "--interpolate", qf,
-                 "--interpolated", out, "--method", "linear", "-q")
-    expect(r1.returncode == 0, "periodic --interpolate: exit %d %s" % (r1.returncode, r1.stderr))
-    if r1.returncode:
-        return
-    got = [tuple(float(x) for x in line.split()) for line in open(out)]
     period = Fraction(lo + length) - Fraction(lo)
     rep, rvals = [], []
     for o in range(27):
@@ -638,17 +631,24 @@ def interpolation():
     write_points(rqf, wrapped)
     with open(rvf, "w") as f:
         f.writelines("%.17g %.17g\n" % v for v in rvals)
-    r2 = frontdt(rsrc, "--values", rvf, "--interpolate", rqf, "--interpolated", rout, "--method",
-                 "linear", "-q")
-    expect(r2.returncode == 0, "replicated --interpolate: exit %d %s" % (r2.returncode, r2.stderr))
-    if r2.returncode:
-        return
-    want = [tuple(float(x) for x in line.split()) for line in open(rout)]
-    # periodic on every axis: no hull, so no NaN (which max() would skip)
-    worst = max(abs(a - b) if a == a and b == b else math.inf
-                for g, w in zip(got, want) for a, b in zip(g, w))
-    expect(len(got) == len(qs) and worst < 1e-9,
-           "periodic --interpolate: %d values, %.3g off the replicated mesh's" % (len(got), worst))
+    for method in ("linear", "natural"):
+        r1 = frontdt(src, "--periodic", "xyz", "--box", box, "--values", vf, "--interpolate", qf,
+                     "--interpolated", out, "--method", method, "-q")
+        expect(r1.returncode == 0, "periodic --interpolate --method %s: exit %d %s"
+               % (method, r1.returncode, r1.stderr))
+        r2 = frontdt(rsrc, "--values", rvf, "--interpolate", rqf, "--interpolated", rout,
+                     "--method", method, "-q")
+        expect(r2.returncode == 0, "replicated --interpolate --method %s: exit %d %s"
+               % (method, r2.returncode, r2.stderr))
+        if r1.returncode or r2.returncode:
+            continue
+        got = [tuple(float(x) for x in line.split()) for line in open(out)]
+        want = [tuple(float(x) for x in line.split()) for line in open(rout)]
+        # periodic on every axis: no hull, so no NaN (which max() would skip)
+        worst = max(abs(a - b) if a == a and b == b else math.inf
+                    for g, w in zip(got, want) for a, b in zip(g, w))
+        expect(len(got) == len(qs) and worst < 1e-9, "periodic --interpolate --method %s: %d "
+               "values, %.3g off the replicated mesh's" % (method, len(got), worst))
     # a channel: y's walls are not periodic; the values a linear function of y
     clo, chi = (0.0, -0.5, 0.25), (2.0, 0.5, 1.25)
     cp = channel(1200, 6, clo, chi, "xz", 23)
@@ -659,21 +659,23 @@ def interpolation():
     beyond = [(0.5, 0.7, 0.5), (1.0, -0.9, 3.0)]
     write_points(qf, inside + beyond)
     cbox = ",".join("%.17g" % v for v in clo + chi)
-    r3 = frontdt(src, "--periodic", "x,z", "--box", cbox, "--values", vf, "--interpolate", qf,
-                 "--interpolated", out, "--method", "linear", "-q")
-    expect(r3.returncode == 0, "channel --interpolate: exit %d %s" % (r3.returncode, r3.stderr))
-    if r3.returncode == 0:
-        cv = [float(line) for line in open(out)]
-        worst = max(abs(v - (3 * q[1] - 0.25)) if v == v else math.inf
-                    for v, q in zip(cv, inside))
-        expect(worst < 1e-12, "channel --interpolate: a linear function %.3g off" % worst)
-        expect(all(math.isnan(v) for v in cv[len(inside):]), "channel --interpolate: past the "
-               "walls %r, not NaN" % cv[len(inside):])
-    for extra in (["--method", "natural"], ["--method", "linear", "--stream"]):
-        r4 = frontdt(src, "--periodic", "x,z", "--box", cbox, "--values", vf, "--interpolate", qf,
-                     "--interpolated", out + "2", *extra, "-q")
-        expect(r4.returncode == 1 and not os.path.exists(out + "2"),
-               "periodic --interpolate %s: exit %d" % (" ".join(extra), r4.returncode))
+    for method in ("linear", "natural"):
+        r3 = frontdt(src, "--periodic", "x,z", "--box", cbox, "--values", vf, "--interpolate",
+                     qf, "--interpolated", out, "--method", method, "-q")
+        expect(r3.returncode == 0, "channel --interpolate --method %s: exit %d %s"
+               % (method, r3.returncode, r3.stderr))
+        if r3.returncode == 0:
+            cv = [float(line) for line in open(out)]
+            worst = max(abs(v - (3 * q[1] - 0.25)) if v == v else math.inf
+                        for v, q in zip(cv, inside))
+            expect(worst < 1e-12, "channel --interpolate --method %s: a linear function %.3g "
+                   "off" % (method, worst))
+            expect(all(math.isnan(v) for v in cv[len(inside):]), "channel --interpolate "
+                   "--method %s: past the walls %r, not NaN" % (method, cv[len(inside):]))
+    r4 = frontdt(src, "--periodic", "x,z", "--box", cbox, "--values", vf, "--interpolate", qf,
+                 "--interpolated", out + "2", "--stream", "-q")
+    expect(r4.returncode == 1 and not os.path.exists(out + "2"),
+           "periodic --interpolate --stream: exit %d" % r4.returncode)
 
 
 def main():

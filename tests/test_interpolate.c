@@ -231,7 +231,6 @@ static int ref_has_tet(const fdt_tid *a, size_t n, fdt_tid t)
  * out of memory. */
 static long ref_cavity(ref_sibson *S, fdt_tid t0, const double *q)
 {
-    const fdt_result *r = S->L->r;
     const double *X = S->L->xyz;
     size_t nc = 0, ns = 0;
     if (ref_push(&S->cavity, &S->cap_cavity, 0, sizeof *S->cavity) ||
@@ -245,7 +244,7 @@ static long ref_cavity(ref_sibson *S, fdt_tid t0, const double *q)
             fdt_tid u = S->L->nbrs[4 * (size_t)t + (size_t)i];
             if (u < 0 || ref_has_tet(S->cavity, nc, u))
                 continue;
-            const fdt_vid *tv = r->tets + 4 * (size_t)u;
+            const fdt_vid *tv = S->L->tets + 4 * (size_t)u;
             if (fdt_insphere(X + 3 * (size_t)tv[0], X + 3 * (size_t)tv[1], X + 3 * (size_t)tv[2],
                              X + 3 * (size_t)tv[3], q, NULL) <= 0)
                 continue;
@@ -263,7 +262,7 @@ static long ref_cavity(ref_sibson *S, fdt_tid t0, const double *q)
 static int ref_add_ball(const ref_sibson *S, fdt_tid t, const double *q, double lo[3], double hi[3])
 {
     const double *X = S->L->xyz;
-    const fdt_vid *tv = S->L->r->tets + 4 * (size_t)t;
+    const fdt_vid *tv = S->L->tets + 4 * (size_t)t;
     const double *a = X + 3 * (size_t)tv[0];
     double cc[3];
     if (fdt_circumcenter_exact(a, X + 3 * (size_t)tv[1], X + 3 * (size_t)tv[2],
@@ -284,7 +283,6 @@ static int ref_add_ball(const ref_sibson *S, fdt_tid t, const double *q, double 
  * either side: spheres of one pencil). */
 static long ref_neighbours(ref_sibson *S, size_t nc, const double *q, double lo[3], double hi[3])
 {
-    const fdt_result *r = S->L->r;
     const double *X = S->L->xyz;
     size_t m = 0;
     for (int k = 0; k < 3; k++) {
@@ -293,7 +291,7 @@ static long ref_neighbours(ref_sibson *S, size_t nc, const double *q, double lo[
     }
     for (size_t c = 0; c < nc; c++) {
         fdt_tid t = S->cavity[c];
-        const fdt_vid *tv = r->tets + 4 * (size_t)t;
+        const fdt_vid *tv = S->L->tets + 4 * (size_t)t;
         for (int i = 0; i < 4; i++) {
             size_t y = m;
             while (y > 0 && S->nn[y - 1] > tv[i])
@@ -332,9 +330,8 @@ static long ref_neighbours(ref_sibson *S, size_t nc, const double *q, double lo[
  * of memory, -2 a cut that failed (a bug). */
 static long ref_coordinates(ref_sibson *S, fdt_tid t0, const double *q)
 {
-    const fdt_result *r = S->L->r;
     const double *X = S->L->xyz;
-    const fdt_vid *tv = r->tets + 4 * (size_t)t0;
+    const fdt_vid *tv = S->L->tets + 4 * (size_t)t0;
     for (int i = 0; i < 4; i++) /* q at a point: that point alone */
         if (X[3 * (size_t)tv[i]] == q[0] && X[3 * (size_t)tv[i] + 1] == q[1] &&
             X[3 * (size_t)tv[i] + 2] == q[2]) {

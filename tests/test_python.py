@@ -459,8 +459,8 @@ def test_interpolation():
 
 def test_periodic(tmp):
     """periodic= and box= (issue 33): the CLI's --periodic .tets, line for
-    line, from simplices and offsets; the same mesh on 1 and 3 threads; what
-    a periodic mesh does not take yet; the argument errors."""
+    line, from simplices and offsets; the same mesh on 1 and 3 threads; its
+    cells, interpolation and point location; the argument errors."""
     rng = np.random.default_rng(8)
     pts = rng.random((1500, 3)) * [2.0, 1.0, 3.0] - [0.5, 0.0, 1.0]
     box = (-0.5, 0.0, -1.0, 1.5, 1.0, 2.0)
@@ -501,6 +501,19 @@ def test_periodic(tmp):
     check(raises(ValueError, tw.voronoi, box=(0, 0, 0, 1, 1, 1)) is not None,
           "periodic: cells in another box refused")
     check(tw.check() is None, "periodic x,z: check() passes")
+    # interpolation, both methods: a query and its translate by whole
+    # periods alike, the same bits on 1 and 3 threads, a constant kept
+    vals = np.stack([rng.random(len(pts)), np.full(len(pts), 2.5)], axis=1)
+    q = rng.random((200, 3)) * [2.0, 1.0, 3.0] - [0.5, 0.0, 1.0]
+    shifted = q + [2.0, -1.0, 6.0]
+    for method in ("natural", "linear"):
+        a = t.interpolate(vals, q, method=method)
+        check(np.allclose(a, t.interpolate(vals, shifted, method=method), rtol=0, atol=1e-12) and
+              np.array_equal(a, t3.interpolate(vals, q, method=method)) and
+              np.allclose(a[:, 1], 2.5, rtol=0, atol=1e-12),
+              "periodic interpolate(%s): translates, threads, a constant" % method)
+    s = t.find_simplex(shifted)
+    check(s.min() >= 0 and s.max() < len(t.simplices), "periodic find_simplex: a row each")
     check(raises(ValueError, frontdt.delaunay, pts, periodic="xz") is not None,
           "periodic without box")
     check(raises(ValueError, frontdt.delaunay, pts, box=box) is not None, "box without periodic")

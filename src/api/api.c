@@ -23,7 +23,7 @@
 #include "geom/prepare.h"
 #include "mesh/periodic.h"
 #include "mesh/result.h"
-#include "mesh/locate.h"
+#include "mesh/query.h"
 #include "mesh/voronoi.h"
 #include "front/seed.h"
 #include "base/sethash.h"

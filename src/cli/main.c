@@ -563,10 +563,7 @@ static int check_args(cli *c, int npos, char **pos)
                                "(--all-faces)");
         if (c->dual.dual)
             return usage_error("--periodic writes the mesh, its hashes, --check, the cells "
-                               "and --interpolate --method linear; not yet --dual");
-        if (fdt_cli_interp_wanted(&c->dual) && c->dual.natural)
-            return usage_error("--periodic interpolates linearly only: --method linear "
-                               "(natural neighbours: not yet)");
+                               "and --interpolate; not yet --dual");
         if (fdt_cli_interp_wanted(&c->dual) && c->stream > 0)
             return usage_error("--periodic --interpolate needs the mesh in memory (no "
                                "--stream)");

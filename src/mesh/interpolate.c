@@ -59,6 +59,10 @@
  * points' ids and coordinates in a canonical order (each tet's points by
  * id, the cavity's tets by those ids), so the values are the same bits for
  * any thread count, query order and numbering of the mesh's tets.
+ *
+ * The same code answers on a patch of a periodic mesh
+ * (src/mesh/periodic_interp.c): a cavity that reaches the patch's edge
+ * (FDT_NB_CUT) is reported, not summed, and asked again of a larger one.
  */
 #include <math.h>
 #include <stdint.h>
@@ -69,7 +73,6 @@
 #include "base/spawn.h"
 #include "geom/predicates.h"
 #include "mesh/locate.h"
-#include "mesh/periodic_interp.h"
 #include "mesh/result.h"
 #include "mesh/voronoi.h"
 
@@ -172,27 +175,31 @@ static int tab_begin(sibson *S)
     return 0;
 }
 
+/* What coordinates() and the steps under it return besides a count. */
+enum { COORD_NOMEM = -1, COORD_BUG = -2, COORD_CUT = -3 };
+
 /* The cavity of q from tet t0 (which holds q): every tet reached across
- * faces whose circumsphere holds q strictly. Returns its size, or -1 when
- * out of memory. */
+ * faces whose circumsphere holds q strictly. Returns its size, or
+ * COORD_NOMEM, or COORD_CUT when it meets a patch's edge. */
 static long cavity(sibson *S, fdt_tid t0, const double *q)
 {
-    const fdt_result *r = S->L->r;
     const double *X = S->L->xyz;
     size_t nc = 0, ns = 0;
     if (tab_begin(S) || tab_put(S, t0, 0) ||
         push(&S->cavity, &S->cap_cavity, 0, sizeof *S->cavity) ||
         push(&S->stack, &S->cap_stack, 0, sizeof *S->stack))
-        return -1;
+        return COORD_NOMEM;
     S->cavity[nc++] = t0;
     S->stack[ns++] = t0;
     while (ns) {
         fdt_tid t = S->stack[--ns];
         for (int i = 0; i < 4; i++) {
             fdt_tid u = S->L->nbrs[4 * (size_t)t + (size_t)i];
+            if (u == FDT_NB_CUT)
+                return COORD_CUT;
             if (u < 0 || tab_find(S, u)->stamp == S->stamp)
                 continue; /* the hull, or met before */
-            const fdt_vid *tv = r->tets + 4 * (size_t)u;
+            const fdt_vid *tv = S->L->tets + 4 * (size_t)u;
             int in = fdt_insphere(X + 3 * (size_t)tv[0], X + 3 * (size_t)tv[1],
                                   X + 3 * (size_t)tv[2], X + 3 * (size_t)tv[3], q, NULL) > 0;
             if (tab_put(S, u, in ? (int)nc : -1))
@@ -304,7 +311,7 @@ static long canonical_cavity(sibson *S, size_t nc, const double *q)
     for (size_t a = 0; a < nc; a++) {
         ctet T;
         T.t = S->cavity[a];
-        const fdt_vid *tv = S->L->r->tets + 4 * (size_t)T.t;
+        const fdt_vid *tv = S->L->tets + 4 * (size_t)T.t;
         T.sigma = 1;
         for (int x = 0; x < 4; x++) {
             int y = x;
@@ -493,26 +500,25 @@ static void sibson_shares(sibson *S, size_t nc, size_t nb, long m, const double 
 }
 
 /* Sibson's coordinates of q (held by tet t0) into S->w over S->nn[0..m).
- * Returns m, 0 when q lies on the hull (its new cell is unbounded), -1 out
- * of memory, -2 a computation that failed (a bug). */
+ * Returns m, 0 when q lies on the hull (its new cell is unbounded),
+ * COORD_NOMEM, COORD_BUG (a computation that failed), COORD_CUT. */
 static long coordinates(sibson *S, fdt_tid t0, const double *q)
 {
-    const fdt_result *r = S->L->r;
     const double *X = S->L->xyz;
-    const fdt_vid *tv = r->tets + 4 * (size_t)t0;
+    const fdt_vid *tv = S->L->tets + 4 * (size_t)t0;
     for (int i = 0; i < 4; i++) /* q at a point: that point alone */
         if (X[3 * (size_t)tv[i]] == q[0] && X[3 * (size_t)tv[i] + 1] == q[1] &&
             X[3 * (size_t)tv[i] + 2] == q[2]) {
             if (push(&S->nn, &S->cap_nn, 0, sizeof *S->nn) ||
                 push(&S->w, &S->cap_w, 0, sizeof *S->w))
-                return -1;
+                return COORD_NOMEM;
             S->nn[0] = tv[i];
             S->w[0] = 1;
             return 1;
         }
     long nc = cavity(S, t0, q);
     if (nc < 0)
-        return -1;
+        return nc;
     S->nc = (size_t)nc; /* canonical_cavity fills ct before it can fail */
     long m = canonical_cavity(S, (size_t)nc, q);
     if (m < 0)
@@ -527,13 +533,13 @@ static long coordinates(sibson *S, fdt_tid t0, const double *q)
         return got;
     while (S->cap_w < (size_t)m)
         if (push(&S->w, &S->cap_w, S->cap_w, sizeof *S->w))
-            return -1;
+            return COORD_NOMEM;
     sibson_shares(S, (size_t)nc, (size_t)nb, m, q);
     double total = 0;
     for (long k = 0; k < m; k++)
         total += S->w[k];
     if (!(total > 0))
-        return -2;
+        return COORD_BUG;
     for (long k = 0; k < m; k++)
         S->w[k] /= total;
     return m;
@@ -564,20 +570,27 @@ static int too_close(const sibson *S, fdt_vid *a, fdt_vid *b)
 typedef struct ijob {
     fdt_query_run run; /* first: fdt_queries_begin fills it */
     sibson S;
+    const fdt_vid *src;       /* each point's row of values (NULL: its own) */
     const double *values;
     size_t nv;
     fdt_interp method;
     double *out;
+    uint8_t *cut;             /* the queries whose cavity met a patch's edge */
     int err;
     size_t bad;               /* the query that failed */
     fdt_vid short_a, short_b; /* FDT_ERANGE: the edge too short (too_close) */
 } ijob;
 
+/* Point v's row of values. */
+static size_t row_of(const ijob *j, fdt_vid v)
+{
+    return j->src ? (size_t)j->src[v] : (size_t)v;
+}
+
 static void *interpolate_run(void *arg)
 {
     ijob *j = arg;
     sibson *S = &j->S;
-    const fdt_result *r = S->L->r;
     size_t hint = 0, nv = j->nv;
     for (size_t i = 0; i < j->run.count && !j->err; i++) {
         size_t k = j->run.order[i];
@@ -588,76 +601,44 @@ static void *interpolate_run(void *arg)
         fdt_tid t = fdt_locate_one(S->L, &hint, qk);
         if (t < 0)
             continue;
-        const fdt_vid *tv = r->tets + 4 * (size_t)t;
+        const fdt_vid *tv = S->L->tets + 4 * (size_t)t;
         if (j->method == FDT_INTERP_LINEAR) {
             double b[4];
             fdt_barycentric(S->L, t, qk, b);
             for (size_t c = 0; c < nv; c++) {
                 o[c] = 0;
                 for (int v = 0; v < 4; v++)
-                    o[c] += b[v] * j->values[nv * (size_t)tv[v] + c];
+                    o[c] += b[v] * j->values[nv * row_of(j, tv[v]) + c];
             }
             continue;
         }
         long m = coordinates(S, t, qk);
         if (m == 0)
             continue; /* on the hull: NaN */
+        if (m == COORD_CUT && j->cut) {
+            j->cut[k] = 1;
+            continue;
+        }
         if (m < 0) {
-            j->err = m == -1 ? FDT_ENOMEM : too_close(S, &j->short_a, &j->short_b);
+            j->err = m == COORD_NOMEM ? FDT_ENOMEM : too_close(S, &j->short_a, &j->short_b);
             j->bad = k;
             break;
         }
         for (size_t c = 0; c < nv; c++) {
             o[c] = 0;
             for (long v = 0; v < m; v++)
-                o[c] += S->w[v] * j->values[nv * (size_t)S->nn[v] + c];
+                o[c] += S->w[v] * j->values[nv * row_of(j, S->nn[v]) + c];
         }
     }
     return NULL;
 }
 
-static int interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
-                       size_t nv, const double *q, size_t nq, fdt_interp method, int threads,
-                       double *out, double min_edge, const double *q_named, char *diag,
-                       size_t diag_size);
-
-/* a copy of the k points p times 2^-e, or NULL */
-static double *scaled(const double *p, size_t k, int e)
+int fdt_interpolate_frame(const double *xyz, size_t n, fdt_interp method, double *min_edge)
 {
-    double *c = malloc((k > 0 ? 3 * k : 1) * sizeof *c);
-    for (size_t i = 0; c && i < 3 * k; i++)
-        c[i] = ldexp(p[i], -e);
-    return c;
-}
-
-int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const double *values,
-                          size_t nv, const double *q, size_t nq, fdt_interp method,
-                          int threads, double *out, char *diag, size_t diag_size)
-{
-    if (diag && diag_size)
-        diag[0] = 0;
-    if (!r || !xyz || !values || nv == 0 || (nq && (!q || !out)) ||
-        (method != FDT_INTERP_LINEAR && method != FDT_INTERP_NATURAL))
-        return FDT_EINVAL;
-    if (r->periodic) { /* src/mesh/periodic_interp.h */
-        if (method != FDT_INTERP_LINEAR) {
-            if (diag && diag_size)
-                snprintf(diag, diag_size, "a periodic mesh interpolates linearly only "
-                         "(natural neighbours: not yet)");
-            return FDT_EINVAL;
-        }
-        if (r->streamed)
-            return FDT_EINVAL; /* no mesh kept */
-        const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
-        return fdt_periodic_interpolate_linear(r->tets, r->tet_off, r->ntets, xyz, n, &b, values,
-                                               nv, q, nq, out);
-    }
     /* Sibson's coordinates are ratios of volumes, products of up to six
      * coordinate differences in the circumcentres: for points whose box
      * is outside 2^-100 .. 2^100 (1e-151 and 1e149 apart: an internal
-     * error) they are computed on the points and queries scaled by a
-     * power of two (exact: the coordinates are a function of the points'
-     * shape). */
+     * error) they are computed on the points and queries scaled. */
     fdt_voronoi_options vo;
     fdt_default_voronoi_options(&vo);
     double box[6], side = 0;
@@ -667,38 +648,31 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
     if (side > 0)
         (void)frexp(side, &e);
     if (e >= -100 && e <= 100)
-        return interpolate(r, xyz, n, values, nv, q, nq, method, threads, out,
-                           ldexp(side, FDT_VORONOI_BOX_EXP), q, diag, diag_size);
-    double *xs = scaled(xyz, n, e), *qs = scaled(q, nq, e);
-    int err = xs && qs ? interpolate(r, xs, n, values, nv, qs, nq, method, threads, out,
-                                     ldexp(side, FDT_VORONOI_BOX_EXP - e), q, diag, diag_size)
-                       : FDT_ENOMEM;
-    free(xs);
-    free(qs);
-    return err;
+        e = 0;
+    *min_edge = ldexp(side, FDT_VORONOI_BOX_EXP - e);
+    return e;
 }
 
-/* fdt_interpolate_build on xyz and q (perhaps scaled); min_edge in their
- * frame; q_named: the queries as given, for the messages. */
-static int interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
-                       size_t nv, const double *q, size_t nq, fdt_interp method, int threads,
-                       double *out, double min_edge, const double *q_named, char *diag,
-                       size_t diag_size)
+int fdt_interpolate_with(const fdt_locator *L, const fdt_vid *src, const double *values,
+                         size_t nv, const double *q, size_t nq, fdt_interp method, int threads,
+                         double *out, uint8_t *cut, double min_edge, const double *q_named,
+                         char *diag, size_t diag_size)
 {
-    fdt_locator L;
     uint32_t *order;
     void *jp;
-    int err = fdt_queries_begin(&L, r, xyz, n, q, nq, &threads, &order, sizeof(ijob), &jp);
+    int err = fdt_queries_begin(L, q, nq, &threads, &order, sizeof(ijob), &jp);
     if (err)
         return err;
     ijob *jobs = jp;
     for (int t = 0; t < threads; t++) {
         ijob *j = &jobs[t];
-        j->S.L = &L;
+        j->S.L = L;
+        j->src = src;
         j->values = values;
         j->nv = nv;
         j->method = method;
         j->out = out;
+        j->cut = cut;
         j->S.min_edge = min_edge;
     }
     fdt_fork_join(jobs, sizeof *jobs, threads, interpolate_run);
@@ -713,10 +687,10 @@ static int interpolate(fdt_result *r, const double *xyz, size_t n, const double 
                          j->bad, qk[0], qk[1], qk[2]);
             if (err == FDT_ERANGE && diag && diag_size)
                 snprintf(diag, diag_size, "natural-neighbour coordinates of query %zu "
-                         "(%.17g %.17g %.17g) need the Voronoi cells of points %lld and %lld, "
+                         "(%.17g %.17g %.17g) need the Voronoi cells of points %zu and %zu, "
                          "closer than doubles can hold the cells between (a Delaunay edge must "
                          "be at least 2^%d of the box)", j->bad, qk[0], qk[1], qk[2],
-                         (long long)j->short_a, (long long)j->short_b, FDT_VORONOI_BOX_EXP);
+                         row_of(j, j->short_a), row_of(j, j->short_b), FDT_VORONOI_BOX_EXP);
         }
         free(j->S.ct);
         free(j->S.nt);
@@ -726,6 +700,6 @@ static int interpolate(fdt_result *r, const double *xyz, size_t n, const double 
         free(j->S.nn);
         free(j->S.w);
     }
-    fdt_queries_end(&L, order, jobs);
+    fdt_queries_end(order, jobs);
     return err;
 }

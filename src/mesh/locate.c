@@ -9,7 +9,8 @@
  * cannot cycle (Edelsbrunner 1990, the acyclic "in front of" relation);
  * a cap of steps and a scan of every tet back that up, so a walk always
  * ends. Each query starts at the previous query's tet: a run of nearby
- * queries walks a few steps each.
+ * queries walks a few steps each. On a patch (FDT_NB_CUT), which need not
+ * be convex, a walk that reaches the patch's edge scans too.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -19,7 +20,6 @@
 #include "geom/morton.h"
 #include "geom/predicates.h"
 #include "mesh/locate.h"
-#include "mesh/periodic_interp.h"
 #include "mesh/result.h"
 
 int fdt_locator_init(fdt_locator *L, fdt_result *r, const double *xyz, size_t n)
@@ -27,11 +27,8 @@ int fdt_locator_init(fdt_locator *L, fdt_result *r, const double *xyz, size_t n)
     memset(L, 0, sizeof *L);
     if (!r || !xyz || r->streamed || n != r->n || r->ntets == 0)
         return FDT_EINVAL;
-    L->r = r;
-    L->xyz = xyz;
-    L->cap = 64 + 4 * r->ntets;
     if (r->nbrs) {
-        L->nbrs = r->nbrs;
+        fdt_locator_patch(L, r->tets, r->nbrs, r->ntets, xyz);
         return FDT_OK;
     }
     /* No neighbours kept (settings.neighbors 0): from the face list. */
@@ -55,8 +52,15 @@ int fdt_locator_init(fdt_locator *L, fdt_result *r, const double *xyz, size_t n)
                 if (tv[i] != fv[3 * f] && tv[i] != fv[3 * f + 1] && tv[i] != fv[3 * f + 2])
                     nb[4 * (size_t)t + (size_t)i] = ft[2 * f + 1 - side];
         }
-    L->nbrs = L->owned = nb;
+    fdt_locator_patch(L, r->tets, nb, r->ntets, xyz);
+    L->owned = nb;
     return FDT_OK;
+}
+
+void fdt_locator_patch(fdt_locator *L, const fdt_vid *tets, const fdt_tid *nbrs, size_t ntets,
+                       const double *xyz)
+{
+    *L = (fdt_locator){tets, ntets, xyz, nbrs, NULL, 64 + 4 * ntets};
 }
 
 void fdt_locator_free(fdt_locator *L)
@@ -68,7 +72,7 @@ void fdt_locator_free(fdt_locator *L)
 /* Face i of tet t has q strictly on its outer side. */
 static int beyond(const fdt_locator *L, size_t t, int i, const double *q)
 {
-    const fdt_vid *tv = L->r->tets + 4 * t;
+    const fdt_vid *tv = L->tets + 4 * t;
     const double *X = L->xyz;
     return fdt_orient3d(X + 3 * (size_t)tv[fdt_tet_face[i][0]],
                         X + 3 * (size_t)tv[fdt_tet_face[i][1]],
@@ -78,7 +82,7 @@ static int beyond(const fdt_locator *L, size_t t, int i, const double *q)
 /* The tet holding q, by scanning them all (the walk's backstop). */
 static fdt_tid scan(const fdt_locator *L, const double *q)
 {
-    for (size_t t = 0; t < L->r->ntets; t++) {
+    for (size_t t = 0; t < L->ntets; t++) {
         int in = 1;
         for (int i = 0; i < 4 && in; i++)
             in = !beyond(L, t, i, q);
@@ -93,7 +97,9 @@ fdt_tid fdt_locate_one(const fdt_locator *L, size_t *hint, const double *q)
     for (int k = 0; k < 3; k++)
         if (!isfinite(q[k]))
             return -1;
-    size_t t = *hint < L->r->ntets ? *hint : 0;
+    if (L->ntets == 0)
+        return -1;
+    size_t t = *hint < L->ntets ? *hint : 0;
     /* The faces are tried from a rotating start, so that a walk does not
      * favour one direction. */
     for (size_t step = 0; step < L->cap; step++) {
@@ -103,6 +109,8 @@ fdt_tid fdt_locate_one(const fdt_locator *L, size_t *hint, const double *q)
             if (!beyond(L, t, i, q))
                 continue;
             fdt_tid next = L->nbrs[4 * t + (size_t)i];
+            if (next == FDT_NB_CUT)
+                goto scan;
             if (next < 0) {
                 *hint = t;
                 return -1; /* beyond a hull face: outside the hull */
@@ -115,18 +123,16 @@ fdt_tid fdt_locate_one(const fdt_locator *L, size_t *hint, const double *q)
             return (fdt_tid)t;
         }
     }
+scan:;
     fdt_tid s = scan(L, q);
     if (s >= 0)
         *hint = (size_t)s;
     return s;
 }
 
-int fdt_queries_begin(fdt_locator *L, fdt_result *r, const double *xyz, size_t n, const double *q,
-                      size_t nq, int *threads, uint32_t **order, size_t job_size, void **jobs)
+int fdt_queries_begin(const fdt_locator *L, const double *q, size_t nq, int *threads,
+                      uint32_t **order, size_t job_size, void **jobs)
 {
-    int err = fdt_locator_init(L, r, xyz, n);
-    if (err)
-        return err;
     if (*threads < 1)
         *threads = 1;
     if ((size_t)*threads > nq / 64 + 1)
@@ -141,7 +147,7 @@ int fdt_queries_begin(fdt_locator *L, fdt_result *r, const double *xyz, size_t n
     *order = malloc((nq ? nq : 1) * sizeof **order);
     *jobs = calloc((size_t)*threads, job_size);
     if (!*order || !*jobs || fdt_morton_order(q, nq, box, NULL, *order) < 0) {
-        fdt_queries_end(L, *order, *jobs);
+        fdt_queries_end(*order, *jobs);
         *order = NULL;
         *jobs = NULL;
         return FDT_ENOMEM;
@@ -154,16 +160,15 @@ int fdt_queries_begin(fdt_locator *L, fdt_result *r, const double *xyz, size_t n
     return FDT_OK;
 }
 
-void fdt_queries_end(fdt_locator *L, uint32_t *order, void *jobs)
+void fdt_queries_end(uint32_t *order, void *jobs)
 {
     free(jobs);
     free(order);
-    fdt_locator_free(L);
 }
 
 void fdt_barycentric(const fdt_locator *L, fdt_tid t, const double *q, double b[4])
 {
-    const fdt_vid *tv = L->r->tets + 4 * (size_t)t;
+    const fdt_vid *tv = L->tets + 4 * (size_t)t;
     const double *X = L->xyz;
     /* b[i]: the volume of the tet with vertex i replaced by q, over the
      * tet's, each relative to q (differences first, for accuracy). */
@@ -224,21 +229,12 @@ static void *locate_run(void *arg)
     return NULL;
 }
 
-int fdt_locate_build(fdt_result *r, const double *xyz, size_t n, const double *q, size_t nq,
-                     fdt_tid *tet, double *bary, int threads)
+int fdt_locate_with(const fdt_locator *L, const double *q, size_t nq, fdt_tid *tet,
+                    double *bary, int threads)
 {
-    if (!r || !xyz || (nq && (!q || !tet)))
-        return FDT_EINVAL;
-    if (r->periodic) { /* its own walk, across the periodic sides */
-        if (r->streamed)
-            return FDT_EINVAL; /* no mesh kept */
-        const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
-        return fdt_periodic_locate(r->tets, r->tet_off, r->ntets, xyz, n, &b, q, nq, tet, bary);
-    }
-    fdt_locator L;
     uint32_t *order;
     void *jp;
-    int err = fdt_queries_begin(&L, r, xyz, n, q, nq, &threads, &order, sizeof(ljob), &jp);
+    int err = fdt_queries_begin(L, q, nq, &threads, &order, sizeof(ljob), &jp);
     if (err)
         return err;
     ljob *jobs = jp;
@@ -247,6 +243,6 @@ int fdt_locate_build(fdt_result *r, const double *xyz, size_t n, const double *q
         jobs[t].bary = bary;
     }
     fdt_fork_join(jobs, sizeof *jobs, threads, locate_run);
-    fdt_queries_end(&L, order, jobs);
+    fdt_queries_end(order, jobs);
     return FDT_OK;
 }

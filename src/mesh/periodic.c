@@ -10,11 +10,13 @@
 
 #include "base/hash.h"
 #include "base/mem.h"
+#include "base/sortu64.h"
 #include "geom/images.h"
 #include "geom/morton.h"
 #include "mesh/certify.h"
 #include "mesh/check.h"
 #include "mesh/insert.h"
+#include "mesh/locate.h"
 #include "mesh/voronoi.h"
 
 /* ---- step 1: the points and their images within the margin ----------- */
@@ -1610,6 +1612,189 @@ int fdt_periodic_unfold(const int32_t *tets, const int8_t *off, size_t ntets, co
     free(hslot);
     free(apex);
     free(aoff);
+    return err;
+}
+
+/* ---- a patch: the laid-out tets and their translates around the box ---- */
+
+void fdt_periodic_patch_free(fdt_periodic_patch *p)
+{
+    free(p->xyz);
+    free(p->src);
+    free(p->tets);
+    free(p->nbrs);
+    free(p->row);
+    memset(p, 0, sizeof *p);
+}
+
+/* The translates of one laid-out tet in a patch: k[d] from kmin[d], kn[d]
+ * of them along axis d (1 on an axis that is not periodic), the first of
+ * them the patch's tet base. */
+typedef struct pcopies {
+    size_t base;
+    int8_t kmin[3];
+    uint8_t kn[3];
+} pcopies;
+
+/* The patch's tet of c's translate k, or FDT_NB_CUT when k is not one of
+ * them. */
+static fdt_tid patch_tet(const pcopies *c, const int k[3])
+{
+    size_t at = 0;
+    for (int d = 0; d < 3; d++) {
+        int i = k[d] - c->kmin[d];
+        if (i < 0 || i >= c->kn[d])
+            return FDT_NB_CUT;
+        at = at * c->kn[d] + (size_t)i;
+    }
+    return (fdt_tid)(c->base + at);
+}
+
+/* The i-th translate of c (in patch_tet's order). */
+static void patch_k(const pcopies *c, size_t i, int k[3])
+{
+    for (int d = 2; d >= 0; d--) {
+        k[d] = c->kmin[d] + (int)(i % c->kn[d]);
+        i /= c->kn[d];
+    }
+}
+
+static int u64_lower(const uint64_t *a, size_t n, uint64_t x)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (a[mid] < x)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return (int)lo;
+}
+
+int fdt_periodic_patch_make(const fdt_periodic_unfolded *u, const fdt_tid *unb, const double *X,
+                            const fdt_periodic_box *b, const double margin[3],
+                            fdt_periodic_patch *p)
+{
+    memset(p, 0, sizeof *p);
+    vmap m;
+    memset(&m, 0, sizeof m);
+    uint64_t *keys = NULL;
+    uint32_t *rank = NULL;
+    pcopies *cp = malloc((u->ntets + 1) * sizeof *cp);
+    int err = cp ? FDT_OK : FDT_ENOMEM;
+    /* which translates of each tet: those whose box meets the box grown by
+     * the margin (rounding may add one more: harmless) */
+    size_t total = 0;
+    for (size_t t = 0; t < u->ntets && !err; t++) {
+        size_t cnt = 1;
+        for (int d = 0; d < 3; d++) {
+            const double L = fdt_periodic_period(b, d);
+            cp[t].kmin[d] = 0;
+            cp[t].kn[d] = 1;
+            if (L == 0)
+                continue;
+            double lo = INFINITY, hi = -INFINITY;
+            for (int i = 0; i < 4; i++) {
+                double x = u->xyz[3 * (size_t)u->tets[4 * t + (size_t)i] + (size_t)d];
+                lo = x < lo ? x : lo;
+                hi = x > hi ? x : hi;
+            }
+            double a = ceil((b->lo[d] - margin[d] - hi) / L), z = floor((b->hi[d] + margin[d] - lo) / L);
+            if (!(a >= -64 && z <= 64)) {
+                err = FDT_ETOOBIG;
+                break;
+            }
+            cp[t].kmin[d] = (int8_t)a;
+            cp[t].kn[d] = (uint8_t)(z >= a ? z - a + 1 : 0);
+            cnt *= cp[t].kn[d];
+        }
+        cp[t].base = total;
+        total += cnt;
+    }
+    if (!err && total > (size_t)INT32_MAX)
+        err = FDT_ETOOBIG;
+    if (!err && (!(p->tets = malloc((4 * total + 1) * sizeof *p->tets)) ||
+                 !(p->nbrs = malloc((4 * total + 1) * sizeof *p->nbrs)) ||
+                 !(p->row = malloc((total + 1) * sizeof *p->row))))
+        err = FDT_ENOMEM;
+    /* the translates' points (each image once: u's points first, so that
+     * the untranslated copies, most of the patch, take theirs as they
+     * are) and neighbours */
+    for (size_t i = 0; i < u->n && !err; i++)
+        if (vmap_get(&m, (uint32_t)u->src[i], u->off + 3 * i, X, b) < 0)
+            err = FDT_ENOMEM;
+    for (size_t t = 0; t < u->ntets && !err; t++) {
+        const fdt_vid *tv = u->tets + 4 * t;
+        const size_t cnt = (size_t)cp[t].kn[0] * cp[t].kn[1] * cp[t].kn[2];
+        for (size_t i = 0; i < cnt && !err; i++) {
+            int k[3];
+            patch_k(&cp[t], i, k);
+            const size_t pt = cp[t].base + i;
+            p->row[pt] = (uint32_t)t;
+            for (int v = 0; v < 4 && !err; v++) {
+                if (!k[0] && !k[1] && !k[2]) {
+                    p->tets[4 * pt + (size_t)v] = tv[v];
+                    continue;
+                }
+                int8_t o[3];
+                for (int d = 0; d < 3; d++)
+                    o[d] = (int8_t)(u->off[3 * (size_t)tv[v] + (size_t)d] + k[d]);
+                long x = vmap_get(&m, (uint32_t)u->src[tv[v]], o, X, b);
+                if (x < 0)
+                    err = FDT_ENOMEM;
+                p->tets[4 * pt + (size_t)v] = (fdt_vid)x;
+            }
+            for (int f = 0; f < 4; f++) {
+                const fdt_tid nt = unb[4 * t + (size_t)f];
+                if (nt < 0) {
+                    p->nbrs[4 * pt + (size_t)f] = -1;
+                    continue;
+                }
+                /* the frames of t and nt differ by what the offsets of one
+                 * point of the face differ by (the faces of a 1-sheet
+                 * mesh's tets name distinct points) */
+                const fdt_vid a = tv[f == 0];
+                int kn[3] = {k[0], k[1], k[2]};
+                for (int j = 0; j < 4; j++) {
+                    const fdt_vid c = u->tets[4 * (size_t)nt + (size_t)j];
+                    if (u->src[c] != u->src[a])
+                        continue;
+                    for (int d = 0; d < 3; d++)
+                        kn[d] += u->off[3 * (size_t)a + (size_t)d] - u->off[3 * (size_t)c + (size_t)d];
+                }
+                p->nbrs[4 * pt + (size_t)f] = patch_tet(&cp[nt], kn);
+            }
+        }
+    }
+    if (!err && m.n > (size_t)INT32_MAX)
+        err = FDT_ETOOBIG;
+    /* the points numbered in the order of their (id, offsets) */
+    if (!err && (!(keys = malloc((m.n + 1) * sizeof *keys)) ||
+                 !(rank = malloc((m.n + 1) * sizeof *rank)) ||
+                 !(p->xyz = malloc((3 * m.n + 1) * sizeof *p->xyz)) ||
+                 !(p->src = malloc((m.n + 1) * sizeof *p->src))))
+        err = FDT_ENOMEM;
+    if (!err) {
+        memcpy(keys, m.vk, m.n * sizeof *keys);
+        fdt_sort_u64(keys, m.n);
+        for (size_t i = 0; i < m.n; i++) {
+            const int r = u64_lower(keys, m.n, m.vk[i]);
+            rank[i] = (uint32_t)r;
+            memcpy(p->xyz + 3 * (size_t)r, m.xyz + 3 * i, 3 * sizeof *p->xyz);
+            p->src[r] = (fdt_vid)m.label[i];
+        }
+        for (size_t i = 0; i < 4 * total; i++)
+            p->tets[i] = (fdt_vid)rank[p->tets[i]];
+        p->n = m.n;
+        p->ntets = total;
+    }
+    if (err)
+        fdt_periodic_patch_free(p);
+    vmap_free(&m);
+    free(keys);
+    free(rank);
+    free(cp);
     return err;
 }
 

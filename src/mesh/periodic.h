@@ -244,6 +244,36 @@ int fdt_periodic_unfolded_neighbors(const fdt_periodic_unfolded *u, fdt_tid **nb
 void fdt_periodic_unfolded_free(fdt_periodic_unfolded *u);
 
 /*
+ * A patch of a periodic mesh: u's laid-out tets and their translates by
+ * whole periods whose boxes come within margin[k] of the box b along each
+ * periodic axis k, as one plain mesh, for the walks and cavities of
+ * src/mesh/locate.c and src/mesh/interpolate.c (src/mesh/periodic_interp.c).
+ * Its points are the images (input id, offsets) the tets use, rounded as
+ * fdt_periodic_unfold rounds them, numbered in the order of (id, offsets):
+ * the same numbers in any order of the mesh's rows, and in the same order
+ * in a larger patch. nbrs: -1 across a hull face, FDT_NB_CUT
+ * (src/mesh/locate.h) across a face whose other tet lies beyond the
+ * patch. row[t]: the row (of u) tet t is a translate of, its vertices in
+ * u's order. unb: fdt_periodic_unfolded_neighbors'. FDT_OK, FDT_ENOMEM,
+ * FDT_ETOOBIG (a margin of more than 64 periods, or past INT32_MAX
+ * points). Free with fdt_periodic_patch_free.
+ */
+typedef struct fdt_periodic_patch {
+    double *xyz;    /* 3 each */
+    fdt_vid *src;   /* each point's input id */
+    size_t n;
+    fdt_vid *tets;  /* 4 each */
+    fdt_tid *nbrs;  /* 4 each */
+    uint32_t *row;
+    size_t ntets;
+} fdt_periodic_patch;
+
+int fdt_periodic_patch_make(const fdt_periodic_unfolded *u, const fdt_tid *unb, const double *X,
+                            const fdt_periodic_box *b, const double margin[3],
+                            fdt_periodic_patch *p);
+void fdt_periodic_patch_free(fdt_periodic_patch *p);
+
+/*
  * An independent exact check that tets (4 ids and 12 offsets each, in any
  * vertex order) and hull faces (3 and 9) are the periodic Delaunay mesh of
  * the n points X in box b: ids in range and distinct in a row, every point
