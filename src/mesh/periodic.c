@@ -296,6 +296,29 @@ static int keyset_add(keyset *s, const key *k, uint32_t rank)
     return FDT_OK;
 }
 
+/*
+ * An empty set with room for cap keys, on huge pages: the kept tets' sets
+ * are some hundreds of MB on 1M points, written once. Grown by doubling
+ * from nothing they took a page fault every 4 KB and, where the kernel
+ * could not move a block (advised blocks are several mappings), a copy
+ * each time (bench/NOTES.md entry 123). FDT_OK or FDT_ENOMEM.
+ */
+static int keyset_reserve(keyset *s, size_t cap)
+{
+    if (cap < 1024)
+        return FDT_OK; /* keyset_add's first room */
+    s->keys = malloc(cap * sizeof *s->keys);
+    s->rank = malloc(cap * sizeof *s->rank);
+    if (!s->keys || !s->rank) {
+        keyset_free(s);
+        return FDT_ENOMEM;
+    }
+    fdt_mem_advise_huge(s->keys, cap * sizeof *s->keys);
+    fdt_mem_advise_huge(s->rank, cap * sizeof *s->rank);
+    s->cap = cap;
+    return FDT_OK;
+}
+
 /* ---- step 4: the proofs ------------------------------------------------ */
 
 /*
@@ -706,12 +729,19 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
         return FDT_ENOMEM;
     pp->r = r;
     T = fdt_certify_jobs(&r->m, T);
-    for (int i = 0; i < T; i++)
+    /* each job's kept tets: about its share of the finite tets, times the
+     * owned points' share of the points (a tet a point, about), and a
+     * tenth more */
+    const size_t keep = (size_t)((double)r->m.nfinite / T * r->nown / r->e.n * 1.1) + 1024;
+    for (int i = 0; i < T; i++) {
         prove_init(&pp->job[i], r, m);
+        if (!err)
+            err = keyset_reserve(&pp->job[i].tets, keep);
+    }
     prove_job *jobs = pp->job;
     const fdt_certify_visit vis = {prove_tet, pp};
     fdt_certify_fail why;
-    if ((err = fdt_certify_parallel_visit(&r->m, T, &vis, &out->pc, &why)) != FDT_OK) {
+    if (err || (err = fdt_certify_parallel_visit(&r->m, T, &vis, &out->pc, &why)) != FDT_OK) {
         if (err == FDT_ECHECK)
             fdt_certify_describe(&why, r->diag, r->dsz);
         for (int i = 0; i < T; i++) {
@@ -778,19 +808,27 @@ static void unpack(const key *k, size_t count, int nv, uint32_t *ids, int8_t *of
  * vertex's place among the n owned points (ascending ids, so the buckets'
  * order is the ids'), each bucket (the tets a point is the least vertex
  * of: a few) sorted by insertion, a large one by qsort (qsort of 6.8M
- * keys took a fifth of a 1M-point run).
+ * keys took a fifth of a 1M-point run). The buckets go in scratch
+ * (scratch_bytes; NULL: a new array) and the rows' ids in the first set's
+ * keys when they fit: memory every page of which is already mapped (a
+ * fresh array's first touch, a page fault every 4 KB, was half of what
+ * this took on 1M points; bench/NOTES.md entry 123).
  */
-static int emit(keyset *s, int ns, int nv, size_t n, uint32_t **ids, int8_t **offs,
-                size_t *count)
+static int emit(keyset *s, int ns, int nv, size_t n, void *scratch, size_t scratch_bytes,
+                uint32_t **ids, int8_t **offs, size_t *count)
 {
     size_t total = 0;
     for (int i = 0; i < ns; i++)
         total += s[i].n;
+    const size_t id_bytes = (total ? total : 1) * (size_t)nv * sizeof **ids;
     size_t *start = calloc(n + 1, sizeof *start);
-    key *tmp = malloc((total ? total : 1) * sizeof *tmp);
+    key *tmp = scratch && total * sizeof *tmp <= scratch_bytes
+                   ? scratch
+                   : malloc((total ? total : 1) * sizeof *tmp);
     if (!start || !tmp) {
         free(start);
-        free(tmp);
+        if (tmp != scratch)
+            free(tmp);
         return FDT_ENOMEM;
     }
     for (int i = 0; i < ns; i++)
@@ -798,9 +836,14 @@ static int emit(keyset *s, int ns, int nv, size_t n, uint32_t **ids, int8_t **of
             start[s[i].rank[k] + 1]++;
     for (size_t v = 0; v < n; v++)
         start[v + 1] += start[v];
+    void *reuse = NULL;
     for (int i = 0; i < ns; i++) {
         for (size_t k = 0; k < s[i].n; k++)
             tmp[start[s[i].rank[k]]++] = s[i].keys[k];
+        if (!reuse && s[i].cap * sizeof *s[i].keys >= id_bytes) {
+            reuse = s[i].keys;
+            s[i].keys = NULL;
+        }
         keyset_free(&s[i]);
     }
     for (size_t v = n; v > 0; v--) /* start[v] was the end of bucket v */
@@ -822,16 +865,21 @@ static int emit(keyset *s, int ns, int nv, size_t n, uint32_t **ids, int8_t **of
         }
     }
     free(start);
-    *ids = malloc((total ? total : 1) * (size_t)nv * sizeof **ids);
-    *offs = malloc((total ? total : 1) * (size_t)nv * 3);
-    if (!*ids || !*offs) {
-        free(tmp);
-        return FDT_ENOMEM;
+    if (reuse) { /* shrunk where it is */
+        void *shrunk = realloc(reuse, id_bytes);
+        *ids = shrunk ? shrunk : reuse;
+    } else {
+        *ids = malloc(id_bytes);
     }
-    unpack(tmp, total, nv, *ids, *offs);
-    free(tmp);
+    *offs = malloc((total ? total : 1) * (size_t)nv * 3);
+    fdt_mem_advise_huge(*offs, total * (size_t)nv * 3);
+    int err = *ids && *offs ? FDT_OK : FDT_ENOMEM;
+    if (!err)
+        unpack(tmp, total, nv, *ids, *offs);
+    if (tmp != scratch)
+        free(tmp);
     *count = total;
-    return FDT_OK;
+    return err;
 }
 
 /* The keys of the sets s[0 .. ns) into rows, in no order (the stars),
@@ -884,7 +932,7 @@ int fdt_periodic_sort_rows(uint32_t **ids, int8_t **off, size_t count, int nv, s
     uint32_t *ni = NULL;
     int8_t *no = NULL;
     size_t got;
-    int err = emit(&s, 1, nv, n, &ni, &no, &got);
+    int err = emit(&s, 1, nv, n, NULL, 0, &ni, &no, &got);
     if (err) {
         keyset_free(&s);
         free(ni);
@@ -1134,18 +1182,25 @@ int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
         }
     }
     memcpy(out->margin, m, sizeof m);
-    /* the mesh and the images go before the output is made */
+    /* the mesh and the images go before the output is made; the mesh's
+     * slots, every page of them written, are emit's scratch */
+    void *scratch = r.m.T;
+    const size_t scratch_bytes = (size_t)r.m.nslots * 8 * sizeof *r.m.T;
+    r.m.T = NULL;
     fdt_ins_free(&r.m);
     ext_free(&r.e);
     free(r.near);
     if (err == FDT_OK &&
-        ((err = emit(r.tets, r.nsets, 4, r.nown, &out->tets, &out->tet_off, &out->ntets)) ||
-         (err = emit(r.hull, r.nsets, 3, r.nown, &out->hull, &out->hull_off, &out->nhull)) ||
+        ((err = emit(r.tets, r.nsets, 4, r.nown, scratch, scratch_bytes, &out->tets,
+                     &out->tet_off, &out->ntets)) ||
+         (err = emit(r.hull, r.nsets, 3, r.nown, scratch, scratch_bytes, &out->hull,
+                     &out->hull_off, &out->nhull)) ||
          (stars && ((err = gather(r.star, r.nsets, 4, &out->star_tets, &out->star_off,
                                   &out->star_pos, &out->nstar)) ||
                     (err = gather(r.star_hull, r.nsets, 3, &out->star_hull,
                                   &out->star_hull_off, NULL, &out->nstar_hull))))))
         snprintf(diag, diag_size, "out of memory");
+    free(scratch);
     for (int i = 0; i < r.nsets; i++) {
         keyset_free(&r.tets[i]);
         keyset_free(&r.hull[i]);
