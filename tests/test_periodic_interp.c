@@ -16,7 +16,8 @@
  *    a query with a NaN coordinate;
  *  - fdt_locate: a row of the mesh holding each query, its barycentric
  *    coordinates in the row's order (summing to 1, none negative), which
- *    weigh the points' values into fdt_interpolate's;
+ *    weigh the points' values into fdt_interpolate's; a point count
+ *    other than the mesh's refused;
  *  - fdt_periodic_patch_make: each tet a translate of its row, neighbours
  *    mutual, points numbered by (id, offsets); on a patch without margin
  *    the cavities that reach its edge are reported (cut, NaN) and the
@@ -122,6 +123,10 @@ static void test_cube(void)
         EXPECTF(fabs(v - out[2 * k]) < 1e-12, "query %zu: %.17g by fdt_locate's coordinates, "
                 "%.17g by fdt_interpolate", k, v, out[2 * k]);
     }
+    /* other points than the mesh's: refused, not read past their end */
+    EXPECT(fdt_interpolate(r, xyz, n - 1, val, 2, q, 1, FDT_INTERP_LINEAR, 1, out, NULL, 0) ==
+           FDT_EINVAL);
+    EXPECT(fdt_locate(r, xyz, n - 1, q, 1, tet, NULL, 1) == FDT_EINVAL);
     fdt_result_free(&r);
 }
 

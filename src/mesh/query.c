@@ -14,8 +14,8 @@ int fdt_locate_build(fdt_result *r, const double *xyz, size_t n, const double *q
     if (!r || !xyz || (nq && (!q || !tet)))
         return FDT_EINVAL;
     if (r->periodic) { /* on a patch of its tets laid out around the box */
-        if (r->streamed)
-            return FDT_EINVAL; /* no mesh kept */
+        if (r->streamed || n != r->n)
+            return FDT_EINVAL; /* no mesh kept, or other points */
         const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
         return fdt_periodic_locate(r->tets, r->tet_off, r->ntets, xyz, n, &b, q, nq, tet, bary,
                                    threads);
@@ -47,8 +47,8 @@ int fdt_interpolate_build(fdt_result *r, const double *xyz, size_t n, const doub
         (method != FDT_INTERP_LINEAR && method != FDT_INTERP_NATURAL))
         return FDT_EINVAL;
     if (r->periodic) { /* src/mesh/periodic_interp.h */
-        if (r->streamed)
-            return FDT_EINVAL; /* no mesh kept */
+        if (r->streamed || n != r->n)
+            return FDT_EINVAL; /* no mesh kept, or other points */
         const fdt_periodic_box b = fdt_periodic_box_of(r->periodic, r->pbox);
         return fdt_periodic_interpolate(r->tets, r->tet_off, r->ntets, xyz, n, &b, values, nv, q,
                                         nq, method, threads, out, diag, diag_size);
