@@ -512,6 +512,8 @@ def test_periodic(tmp):
               np.array_equal(a, t3.interpolate(vals, q, method=method)) and
               np.allclose(a[:, 1], 2.5, rtol=0, atol=1e-12),
               "periodic interpolate(%s): translates, threads, a constant" % method)
+    check(np.array_equal(frontdt.interpolate(pts, vals, q, periodic="xyz", box=box),
+                         t.interpolate(vals, q)), "frontdt.interpolate(periodic=, box=)")
     s = t.find_simplex(shifted)
     check(s.min() >= 0 and s.max() < len(t.simplices), "periodic find_simplex: a row each")
     check(raises(ValueError, frontdt.delaunay, pts, periodic="xz") is not None,

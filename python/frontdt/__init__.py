@@ -29,11 +29,18 @@ def voronoi(points, box=None, threads=None, periodic=None, centroids=True, densi
                                                      densities=densities)
 
 
-def interpolate(points, values, queries, method="natural", threads=None):
+def interpolate(points, values, queries, method="natural", threads=None, periodic=None,
+                box=None):
     """Interpolates values given at points (shape (n,) or (n, k)) at the
-    queries: frontdt.delaunay(points, threads).interpolate(values, queries,
-    method), method "natural" (Sibson) or "linear"."""
-    return delaunay(points, threads=threads).interpolate(values, queries, method)
+    queries: frontdt.delaunay(points, threads, periodic=, box=).interpolate(
+    values, queries, method), method "natural" (Sibson) or "linear".
+    periodic="xyz" (or "x,z", ...) with box the periods: the points as a
+    periodic set, each query wrapped into the box along those axes."""
+    if periodic is not None:
+        t = delaunay(points, threads=threads, periodic=periodic, box=box)
+    else:
+        t = delaunay(points, threads=threads)
+    return t.interpolate(values, queries, method)
 
 
 __all__ = ["CheckError", "Triangulation", "check", "delaunay", "interpolate", "voronoi",

@@ -741,13 +741,15 @@ static PyMethodDef tri_methods[] = {
      "find_simplex(q, bary=False)\n--\n\nThe index of a tet holding each query of the (k, 3) "
      "array-like q (int64, -1 outside the hull), by a walk with exact predicates; with "
      "bary=True a tuple (indices, (k, 4) barycentric coordinates in the order of the tet's "
-     "vertices). The GIL is released while it runs."},
+     "vertices). A periodic triangulation's queries may lie anywhere: each is wrapped into "
+     "the box first. The GIL is released while it runs."},
     {"interpolate", (PyCFunction)(void (*)(void))tri_interpolate, METH_VARARGS | METH_KEYWORDS,
      "interpolate(values, q, method='natural')\n--\n\nInterpolates values given at the points "
      "(shape (n,) or (n, k)) at the queries q: 'natural' (Sibson's natural-neighbour "
      "coordinates) or 'linear' (barycentric in the tet holding the query). NaN outside the "
-     "hull ('natural': on it too); a query at a point gets that point's values. The GIL is "
-     "released while it runs."},
+     "hull ('natural': on it too); a query at a point gets that point's values. A periodic "
+     "triangulation's queries may lie anywhere: each is wrapped into the box first. The GIL "
+     "is released while it runs."},
     {"vertex_neighbors", (PyCFunction)tri_vertex_neighbors, METH_O,
      "vertex_neighbors(v)\n--\n\nThe Delaunay neighbours of point v, int32, "
      "ascending (a new array; empty for a duplicate merged into another)."},
