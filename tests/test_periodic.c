@@ -563,6 +563,19 @@ static void check_corruptions(void)
     check_case(U, n, &pm, &b, 9, "in 3 tets");
     check_case(U, n, &pm, &b, 5, "not one of the");
     check_case(U, n + 1, &pm, &b, 8, "point 801 is in no tet");
+    /* the same points and box times 2^500 and 2^-500 (the same mesh: every
+     * predicate's sign is the same): the volumes' sum neither overflows
+     * (it was inf, nan: the mesh refused) nor underflows */
+    for (int e = -500; e <= 500; e += 1000) {
+        double *S = malloc(3 * (n + 2) * sizeof *S);
+        CHECK(S);
+        for (size_t i = 0; i < 3 * (n + 2); i++)
+            S[i] = ldexp(U[i], e);
+        fdt_periodic_box bs = {7, {0, 0, 0}, {ldexp(1, e), ldexp(1, e), ldexp(1, e)}};
+        check_case(S, n, &pm, &bs, 0, NULL);
+        check_case(S, n, &pm, &bs, 1, "no other tet");
+        free(S);
+    }
     /* a point moved by half the spacing: the old tets are no longer its
      * Delaunay mesh (or fold over) */
     U[3 * 5] += 0.05;

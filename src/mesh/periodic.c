@@ -2015,6 +2015,24 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
     int err = !used || !start || !hstart || !inc || !hinc || !hapex || !haoff ||
                       ctab_init(&et, 3 * nhull)
                   ? FDT_ENOMEM : FDT_OK;
+    /* The volumes below in units of a power of two an axis near its
+     * extent (the period, or the points' extent across an axis that is
+     * not periodic): exact, and a box of 1e150 (gen_points mixed) neither
+     * overflows (the volumes inf and nan: a sound mesh reported broken)
+     * nor, at 1e-150, underflows to a sum of zeros that any tets match. */
+    double sc[3];
+    for (int a = 0; a < 3; a++) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; !(b->axes >> a & 1) && i < n; i++) {
+            lo = X[3 * i + (size_t)a] < lo ? X[3 * i + (size_t)a] : lo;
+            hi = X[3 * i + (size_t)a] > hi ? X[3 * i + (size_t)a] : hi;
+        }
+        double side = b->axes >> a & 1 ? b->hi[a] - b->lo[a] : hi - lo;
+        int e = 0;
+        if (side > 0 && isfinite(side))
+            (void)frexp(side, &e);
+        sc[a] = ldexp(1, -e);
+    }
     double vol = 0;
     /* every tet: ids in range and distinct, not flat, its volume; its
      * faces counted under their least vertices (then filed, below) */
@@ -2036,7 +2054,7 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
                 double u[3][3];
                 for (int r = 0; r < 3; r++)
                     for (int a = 0; a < 3; a++)
-                        u[r][a] = P[3 * (r + 1) + a] - P[a];
+                        u[r][a] = (P[3 * (r + 1) + a] - P[a]) * sc[a];
                 vol += fabs(u[0][0] * (u[1][1] * u[2][2] - u[1][2] * u[2][1]) -
                             u[0][1] * (u[1][0] * u[2][2] - u[1][2] * u[2][0]) +
                             u[0][2] * (u[1][0] * u[2][1] - u[1][1] * u[2][0])) / 6;
@@ -2236,15 +2254,15 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
             (void)fdt_images_round(X + 3 * (size_t)id[k], o + 3 * k, b->lo, b->hi, P + 3 * k,
                                    NULL);
         for (int a = 0; a < 3; a++) {
-            u[a] = P[3 + a] - P[a];
-            w[a] = P[6 + a] - P[a];
+            u[a] = (P[3 + a] - P[a]) * sc[a];
+            w[a] = (P[6 + a] - P[a]) * sc[a];
         }
         const double nrm[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
                                u[0] * w[1] - u[1] * w[0]};
         for (int a = 0; a < 3; a++)
             if (!(b->axes >> a & 1))
-                flux += (s > 0 ? -1 : 1) * ((P[a] + P[3 + a] + P[6 + a]) / 3 - b->lo[a]) *
-                        nrm[a] / 2;
+                flux += (s > 0 ? -1 : 1) *
+                        ((P[a] + P[3 + a] + P[6 + a]) / 3 - b->lo[a]) * sc[a] * nrm[a] / 2;
     }
     for (size_t h = 0; h <= et.mask && !err; h++) {
         cslot *c = &et.s[h];
@@ -2293,7 +2311,7 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
         int d = 0;
         for (int a = 0; a < 3; a++)
             if (b->axes >> a & 1)
-                want *= b->hi[a] - b->lo[a];
+                want *= (b->hi[a] - b->lo[a]) * sc[a];
             else
                 d++;
         if (d)
