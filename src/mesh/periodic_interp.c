@@ -117,6 +117,16 @@ int fdt_periodic_interpolate(const int32_t *tets, const int8_t *off, size_t ntet
                              fdt_interp method, int threads, double *out, char *diag,
                              size_t diag_size)
 {
+    return fdt_periodic_interpolate_from(tets, off, ntets, X, n, b, values, nv, q, nq, method,
+                                         threads, out, diag, diag_size, 1);
+}
+
+int fdt_periodic_interpolate_from(const int32_t *tets, const int8_t *off, size_t ntets,
+                                  const double *X, size_t n, const fdt_periodic_box *b,
+                                  const double *values, size_t nv, const double *q, size_t nq,
+                                  fdt_interp method, int threads, double *out, char *diag,
+                                  size_t diag_size, double first)
+{
     pview v;
     uint8_t *cut = calloc(nq + 1, 1);
     int err = cut ? view_open(&v, tets, off, ntets, X, n, b, q, nq) : FDT_ENOMEM;
@@ -124,6 +134,8 @@ int fdt_periodic_interpolate(const int32_t *tets, const int8_t *off, size_t ntet
         free(cut);
         return err;
     }
+    for (int d = 0; d < 3; d++)
+        v.margin[d] *= first;
     double min_edge;
     const int e = fdt_interpolate_frame(X, n, method, &min_edge);
     for (size_t k = 0; e && k < 3 * nq; k++)
@@ -143,10 +155,10 @@ int fdt_periodic_interpolate(const int32_t *tets, const int8_t *off, size_t ntet
         err = fdt_interpolate_with(&L, p.src, values, nv, v.wq, nq, method, threads, out, cut,
                                    min_edge, q, diag, diag_size);
         fdt_periodic_patch_free(&p);
-        size_t first = 0;
-        while (first < nq && !cut[first])
-            first++;
-        if (err || first == nq)
+        size_t k = 0; /* the first query cut */
+        while (k < nq && !cut[k])
+            k++;
+        if (err || k == nq)
             break;
         int past = 0;
         for (int d = 0; d < 3; d++) {
@@ -157,8 +169,8 @@ int fdt_periodic_interpolate(const int32_t *tets, const int8_t *off, size_t ntet
             err = FDT_EINTERNAL;
             if (diag && diag_size)
                 snprintf(diag, diag_size, "the natural neighbours of query %zu (%.17g %.17g "
-                         "%.17g) reach over %d periods from it (a bug: please report)", first,
-                         q[3 * first], q[3 * first + 1], q[3 * first + 2], MAX_PERIODS);
+                         "%.17g) reach over %d periods from it (a bug: please report)", k, q[3 * k],
+                         q[3 * k + 1], q[3 * k + 2], MAX_PERIODS);
             break;
         }
     }

@@ -48,4 +48,13 @@ int fdt_periodic_interpolate(const int32_t *tets, const int8_t *off, size_t ntet
                              fdt_interp method, int threads, double *out, char *diag,
                              size_t diag_size);
 
+/* fdt_periodic_interpolate with the first patch's margin times first (1
+ * there: the laid-out tets' largest extent; tests give 0, so that the
+ * cavities near the sides are asked again of patches of growing margins). */
+int fdt_periodic_interpolate_from(const int32_t *tets, const int8_t *off, size_t ntets,
+                                  const double *X, size_t n, const fdt_periodic_box *b,
+                                  const double *values, size_t nv, const double *q, size_t nq,
+                                  fdt_interp method, int threads, double *out, char *diag,
+                                  size_t diag_size, double first);
+
 #endif
