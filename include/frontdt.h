@@ -999,7 +999,9 @@ typedef enum fdt_interp {
  * the periodic axes and answered in the periodic mesh (the natural
  * neighbours of a query near a side among the images across it); NaN
  * beyond the hull across an axis that is not periodic (natural: on it
- * too).
+ * too); FDT_ERANGE (diag names the query) where the images' rounding to
+ * doubles leaves the part of the mesh a query's natural neighbours need
+ * not Delaunay (points on a grid or circles across the periods).
  */
 FDT_API int fdt_interpolate(fdt_result *r, const double *xyz, size_t n, const double *values,
                             size_t nv, const double *q, size_t nq, fdt_interp method,

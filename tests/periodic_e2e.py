@@ -606,7 +606,9 @@ def interpolation():
     the points replicated in the 27 copies around the box (each image the
     rounded exact sum, Fraction's) at the queries wrapped into the box; in
     a channel (x, z) a linear function of y reproduced, and NaN past the
-    walls; --stream refused (exit 1)."""
+    walls; --stream refused (exit 1); natural neighbours refused (exit 2)
+    where the rounded images are not Delaunay in the periodic tets (a
+    polar grid), linear answering there."""
     lo, length = 0.1, 1.2
     pts = uniform(1500, lo, length, 21)
     r = random.Random(22)
@@ -676,6 +678,23 @@ def interpolation():
                  "--interpolated", out + "2", "--stream", "-q")
     expect(r4.returncode == 1 and not os.path.exists(out + "2"),
            "periodic --interpolate --stream: exit %d" % r4.returncode)
+    # a polar grid in the unit box: its images, rounded, are not Delaunay in
+    # the periodic mesh's tets; natural neighbours refused there (exit 2,
+    # no output), not 4 % off; linear answers
+    og = family("ogrid", 300)
+    write_points(src, og)
+    with open(vf, "w") as f:
+        f.writelines("%d\n" % (i % 7) for i in range(len(og)))
+    write_points(qf, [tuple(3 * r.random() - 1 for _ in range(3)) for _ in range(200)])
+    for method, want in (("natural", 2), ("linear", 0)):
+        if os.path.exists(out):
+            os.remove(out)
+        r5 = frontdt(src, "--periodic", "xyz", "--box", "0,0,0,1,1,1", "--values", vf,
+                     "--interpolate", qf, "--interpolated", out, "--method", method, "-q")
+        expect(r5.returncode == want and os.path.exists(out) == (want == 0) and
+               (want == 0 or "not Delaunay in the images rounded" in r5.stderr),
+               "ogrid --interpolate --method %s: exit %d %s" % (method, r5.returncode,
+                                                               r5.stderr))
 
 
 def main():

@@ -175,12 +175,37 @@ static int tab_begin(sibson *S)
     return 0;
 }
 
-/* What coordinates() and the steps under it return besides a count. */
-enum { COORD_NOMEM = -1, COORD_BUG = -2, COORD_CUT = -3 };
+/* What coordinates() and the steps under it return besides a count:
+ * COORD_ROUNDING, a tet of points that stand for others (a patch's rounded
+ * images: the locator's rounded) flat in them, where the points they stand
+ * for are not (gen_points cone periodic on x and y: four points on two
+ * circles across the periods, 2e-20 thick with the exact images). */
+enum { COORD_NOMEM = -1, COORD_BUG = -2, COORD_CUT = -3, COORD_ROUNDING = -4 };
+
+/* Whether the face of cavity tet t opposite its vertex i, shared with tet
+ * u, is Delaunay in the locator's points: u's other vertex not strictly
+ * inside t's sphere. A periodic patch's tets are the Delaunay mesh of the
+ * exact images; where rounding them breaks that (points on circles or a
+ * grid across the periods), a cavity found in the rounded ones is not the
+ * Delaunay one of either (gen_points ogrid periodic in x, y, z: values 4 %
+ * off the replicated mesh's). */
+static int face_delaunay(const sibson *S, fdt_tid t, fdt_tid u)
+{
+    const double *X = S->L->xyz;
+    const fdt_vid *tv = S->L->tets + 4 * (size_t)t, *uv = S->L->tets + 4 * (size_t)u;
+    for (int k = 0; k < 4; k++)
+        if (uv[k] != tv[0] && uv[k] != tv[1] && uv[k] != tv[2] && uv[k] != tv[3])
+            return fdt_insphere(X + 3 * (size_t)tv[0], X + 3 * (size_t)tv[1],
+                                X + 3 * (size_t)tv[2], X + 3 * (size_t)tv[3],
+                                X + 3 * (size_t)uv[k], NULL) <= 0;
+    return 0;
+}
 
 /* The cavity of q from tet t0 (which holds q): every tet reached across
  * faces whose circumsphere holds q strictly. Returns its size, or
- * COORD_NOMEM, or COORD_CUT when it meets a patch's edge. */
+ * COORD_NOMEM, or COORD_CUT when it meets a patch's edge, or (rounded
+ * points) COORD_ROUNDING when a face of a cavity tet is not Delaunay in
+ * them. */
 static long cavity(sibson *S, fdt_tid t0, const double *q)
 {
     const double *X = S->L->xyz;
@@ -197,6 +222,8 @@ static long cavity(sibson *S, fdt_tid t0, const double *q)
             fdt_tid u = S->L->nbrs[4 * (size_t)t + (size_t)i];
             if (u == FDT_NB_CUT)
                 return COORD_CUT;
+            if (u >= 0 && S->L->rounded && !face_delaunay(S, t, u))
+                return COORD_ROUNDING;
             if (u < 0 || tab_find(S, u)->stamp == S->stamp)
                 continue; /* the hull, or met before */
             const fdt_vid *tv = S->L->tets + 4 * (size_t)u;
@@ -301,7 +328,7 @@ static int nn_at(const fdt_vid *nn, long m, fdt_vid id)
 /* The cavity's tets in canonical order (their ids ascending, the tets by
  * those ids), their circumcentres, and the natural neighbours (their
  * points, ascending) into S->nn. Returns m, or -1 out of memory, -2 a flat
- * tet (a bug). */
+ * tet (a bug; COORD_ROUNDING where the points stand for others). */
 static long canonical_cavity(sibson *S, size_t nc, const double *q)
 {
     const double *X = S->L->xyz;
@@ -350,7 +377,7 @@ static long canonical_cavity(sibson *S, size_t nc, const double *q)
         }
         double cc[3];
         if (fdt_circumcenter(p[0], p[1], p[2], p[3], cc))
-            return -2;
+            return S->L->rounded ? COORD_ROUNDING : -2;
         for (int k = 0; k < 3; k++)
             T->c[k] = (p[0][k] - q[k]) + cc[k];
     }
@@ -362,8 +389,9 @@ static long canonical_cavity(sibson *S, size_t nc, const double *q)
  * of them in canonical order (that one's own share along it is then
  * nothing), a face of the boundary at the centre of its new tet, which is
  * made here (split -1 - its index). Returns the number of new tets, or -1
- * out of memory, -2 a flat new tet inside the hull (a bug), -3 q on the
- * hull (in the plane of a hull face). */
+ * out of memory, -2 a flat new tet inside the hull (a bug; COORD_ROUNDING
+ * where the points stand for others), -3 q on the hull (in the plane of a
+ * hull face). */
 static long boundary(sibson *S, size_t nc, const double *q)
 {
     const double *X = S->L->xyz;
@@ -394,7 +422,7 @@ static long boundary(sibson *S, size_t nc, const double *q)
             N->sigma = m % 2 ? -T->sigma : T->sigma;
             if (fdt_circumcenter(q, X + 3 * (size_t)N->v[0], X + 3 * (size_t)N->v[1],
                                  X + 3 * (size_t)N->v[2], N->c))
-                return u < 0 ? -3 : -2;
+                return u < 0 ? -3 : S->L->rounded ? COORD_ROUNDING : -2;
             T->split[m] = -1 - (int)nb;
             nb++;
         }
@@ -579,6 +607,7 @@ typedef struct ijob {
     int err;
     size_t bad;               /* the query that failed */
     fdt_vid short_a, short_b; /* FDT_ERANGE: the edge too short (too_close) */
+    int rounding;             /* FDT_ERANGE: a tet flat by rounding (COORD_ROUNDING) */
 } ijob;
 
 /* Point v's row of values. */
@@ -620,7 +649,10 @@ static void *interpolate_run(void *arg)
             continue;
         }
         if (m < 0) {
-            j->err = m == COORD_NOMEM ? FDT_ENOMEM : too_close(S, &j->short_a, &j->short_b);
+            j->rounding = m == COORD_ROUNDING;
+            j->err = m == COORD_NOMEM  ? FDT_ENOMEM
+                     : j->rounding ? FDT_ERANGE
+                                   : too_close(S, &j->short_a, &j->short_b);
             j->bad = k;
             break;
         }
@@ -685,7 +717,14 @@ int fdt_interpolate_with(const fdt_locator *L, const fdt_vid *src, const double 
                 snprintf(diag, diag_size, "natural-neighbour coordinates of query %zu "
                          "(%.17g %.17g %.17g) could not be computed (a bug: please report)",
                          j->bad, qk[0], qk[1], qk[2]);
-            if (err == FDT_ERANGE && diag && diag_size)
+            if (err == FDT_ERANGE && j->rounding && diag && diag_size)
+                snprintf(diag, diag_size, "natural-neighbour coordinates of query %zu "
+                         "(%.17g %.17g %.17g) need a part of the periodic mesh that is not "
+                         "Delaunay in the images rounded to doubles (points on a grid, circles "
+                         "or spheres across the periods; exact images, and so no such part, "
+                         "where the box's sides and the points are binary fractions of the "
+                         "periods): --method linear answers there", j->bad, qk[0], qk[1], qk[2]);
+            else if (err == FDT_ERANGE && diag && diag_size)
                 snprintf(diag, diag_size, "natural-neighbour coordinates of query %zu "
                          "(%.17g %.17g %.17g) need the Voronoi cells of points %zu and %zu, "
                          "closer than doubles can hold the cells between (a Delaunay edge must "

@@ -60,7 +60,7 @@ int fdt_locator_init(fdt_locator *L, fdt_result *r, const double *xyz, size_t n)
 void fdt_locator_patch(fdt_locator *L, const fdt_vid *tets, const fdt_tid *nbrs, size_t ntets,
                        const double *xyz)
 {
-    *L = (fdt_locator){tets, ntets, xyz, nbrs, NULL, 64 + 4 * ntets};
+    *L = (fdt_locator){tets, ntets, xyz, nbrs, NULL, 64 + 4 * ntets, 0};
 }
 
 void fdt_locator_free(fdt_locator *L)

@@ -17,6 +17,9 @@ typedef struct fdt_locator {
     fdt_tid *owned;       /* derived from the face list when r has none */
     size_t cap;           /* steps before a walk gives way to the scan
                              (64 + 4 a tet; tests lower it) */
+    int rounded;          /* the points are rounded images of exact ones
+                             (a periodic patch's): a tet flat in them is
+                             refused, not a bug (src/mesh/interpolate.c) */
 } fdt_locator;
 
 /* A neighbour past the edge of a patch (a mesh that is part of a larger

@@ -1841,6 +1841,7 @@ int fdt_periodic_patch_make(const fdt_periodic_unfolded *u, const fdt_tid *unb, 
         }
         for (size_t i = 0; i < 4 * total; i++)
             p->tets[i] = (fdt_vid)rank[p->tets[i]];
+
         p->n = m.n;
         p->ntets = total;
     }

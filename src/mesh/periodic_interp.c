@@ -151,6 +151,7 @@ int fdt_periodic_interpolate_from(const int32_t *tets, const int8_t *off, size_t
             p.xyz[i] = ldexp(p.xyz[i], -e);
         fdt_locator L;
         fdt_locator_patch(&L, p.tets, p.nbrs, p.ntets, p.xyz);
+        L.rounded = 1;
         memset(cut, 0, nq);
         err = fdt_interpolate_with(&L, p.src, values, nv, v.wq, nq, method, threads, out, cut,
                                    min_edge, q, diag, diag_size);
