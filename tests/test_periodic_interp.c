@@ -291,7 +291,8 @@ static void test_patch(void)
                 bad += o == -1 || (o >= 0 && !back);
                 int named = 0; /* the row's ids, each once */
                 for (int i = 0; i < 4; i++)
-                    named += p.src[p.tets[4 * t + (size_t)f]] == rows[4 * (size_t)p.row[t] + (size_t)i];
+                    named += p.src[p.tets[4 * t + (size_t)f]] ==
+                             rows[4 * (size_t)p.row[t] + (size_t)i];
                 bad += named != 1;
             }
         for (size_t i = 1; i < p.n; i++)
@@ -307,7 +308,8 @@ static void test_patch(void)
         for (size_t k = 0; k < NQ; k++) {
             ncut += cut[k];
             if (!w)
-                diff += cut[k] ? !isnan(narrow[k]) : memcmp(&narrow[k], &wide[k], sizeof *wide) != 0;
+                diff += cut[k] ? !isnan(narrow[k])
+                               : memcmp(&narrow[k], &wide[k], sizeof *wide) != 0;
         }
         if (w)
             EXPECTF(ncut == 0, "the wide patch cut %zu cavities", ncut);

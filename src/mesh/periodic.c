@@ -1755,7 +1755,8 @@ int fdt_periodic_patch_make(const fdt_periodic_unfolded *u, const fdt_tid *unb, 
                 lo = x < lo ? x : lo;
                 hi = x > hi ? x : hi;
             }
-            double a = ceil((b->lo[d] - margin[d] - hi) / L), z = floor((b->hi[d] + margin[d] - lo) / L);
+            const double a = ceil((b->lo[d] - margin[d] - hi) / L),
+                         z = floor((b->hi[d] + margin[d] - lo) / L);
             if (!(a >= -64 && z <= 64)) {
                 err = FDT_ETOOBIG;
                 break;
@@ -1816,7 +1817,8 @@ int fdt_periodic_patch_make(const fdt_periodic_unfolded *u, const fdt_tid *unb, 
                     if (u->src[c] != u->src[a])
                         continue;
                     for (int d = 0; d < 3; d++)
-                        kn[d] += u->off[3 * (size_t)a + (size_t)d] - u->off[3 * (size_t)c + (size_t)d];
+                        kn[d] += u->off[3 * (size_t)a + (size_t)d] -
+                                 u->off[3 * (size_t)c + (size_t)d];
                 }
                 p->nbrs[4 * pt + (size_t)f] = patch_tet(&cp[nt], kn);
             }

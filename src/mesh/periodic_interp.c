@@ -94,7 +94,8 @@ int fdt_periodic_locate(const int32_t *tets, const int8_t *off, size_t ntets, co
              * two vertices to orient the tet): by input id, distinct in a
              * tet */
             for (int i = 0; pt[k] >= 0 && i < 4; i++)
-                if (p.src[p.tets[4 * (size_t)pt[k] + (size_t)i]] == tets[4 * (size_t)tet[k] + (size_t)r])
+                if (p.src[p.tets[4 * (size_t)pt[k] + (size_t)i]] ==
+                    tets[4 * (size_t)tet[k] + (size_t)r])
                     bary[4 * k + (size_t)r] = pb[4 * k + (size_t)i];
         }
     }
