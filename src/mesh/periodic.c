@@ -1843,7 +1843,6 @@ int fdt_periodic_patch_make(const fdt_periodic_unfolded *u, const fdt_tid *unb, 
         }
         for (size_t i = 0; i < 4 * total; i++)
             p->tets[i] = (fdt_vid)rank[p->tets[i]];
-
         p->n = m.n;
         p->ntets = total;
     }
@@ -2023,14 +2022,10 @@ int fdt_periodic_check_mesh(const double *X, size_t n, const int32_t *tets, cons
      * not periodic): exact, and a box of 1e150 (gen_points mixed) neither
      * overflows (the volumes inf and nan: a sound mesh reported broken)
      * nor, at 1e-150, underflows to a sum of zeros that any tets match. */
-    double sc[3];
+    double sc[3], lo[3], hi[3];
+    extent(X, (uint32_t)n, lo, hi);
     for (int a = 0; a < 3; a++) {
-        double lo = INFINITY, hi = -INFINITY;
-        for (size_t i = 0; !(b->axes >> a & 1) && i < n; i++) {
-            lo = X[3 * i + (size_t)a] < lo ? X[3 * i + (size_t)a] : lo;
-            hi = X[3 * i + (size_t)a] > hi ? X[3 * i + (size_t)a] : hi;
-        }
-        double side = b->axes >> a & 1 ? b->hi[a] - b->lo[a] : hi - lo;
+        double side = b->axes >> a & 1 ? b->hi[a] - b->lo[a] : hi[a] - lo[a];
         int e = 0;
         if (side > 0 && isfinite(side))
             (void)frexp(side, &e);
