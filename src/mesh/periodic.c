@@ -1749,12 +1749,8 @@ int fdt_periodic_patch_make(const fdt_periodic_unfolded *u, const fdt_tid *unb, 
             cp[t].kn[d] = 1;
             if (L == 0)
                 continue;
-            double lo = INFINITY, hi = -INFINITY;
-            for (int i = 0; i < 4; i++) {
-                double x = u->xyz[3 * (size_t)u->tets[4 * t + (size_t)i] + (size_t)d];
-                lo = x < lo ? x : lo;
-                hi = x > hi ? x : hi;
-            }
+            double lo, hi;
+            fdt_periodic_unfolded_span(u, t, d, &lo, &hi);
             const double a = ceil((b->lo[d] - margin[d] - hi) / L),
                          z = floor((b->hi[d] + margin[d] - lo) / L);
             if (!(a >= -64 && z <= 64)) {

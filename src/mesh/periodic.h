@@ -32,6 +32,7 @@
 #ifndef FDT_PERIODIC_H
 #define FDT_PERIODIC_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include "frontdt.h"
@@ -226,6 +227,20 @@ typedef struct fdt_periodic_unfolded {
     fdt_vid *hull;   /* 3 each */
     size_t nhull;
 } fdt_periodic_unfolded;
+
+/* The coordinates along axis d of laid-out tet t's points: their least
+ * in *lo, their largest in *hi. */
+static inline void fdt_periodic_unfolded_span(const fdt_periodic_unfolded *u, size_t t, int d,
+                                              double *lo, double *hi)
+{
+    *lo = INFINITY;
+    *hi = -INFINITY;
+    for (int i = 0; i < 4; i++) {
+        const double x = u->xyz[3 * (size_t)u->tets[4 * t + (size_t)i] + (size_t)d];
+        *lo = x < *lo ? x : *lo;
+        *hi = x > *hi ? x : *hi;
+    }
+}
 
 int fdt_periodic_unfold(const int32_t *tets, const int8_t *off, size_t ntets, const int32_t *hull,
                         const int8_t *hoff, size_t nhull, const double *X, size_t n,

@@ -54,12 +54,8 @@ static int view_open(pview *v, const int32_t *tets, const int8_t *off, size_t nt
             v->wq[3 * k + (size_t)d] = x;
         }
         for (size_t t = 0; L > 0 && t < v->u.ntets; t++) {
-            double lo = INFINITY, hi = -INFINITY;
-            for (int i = 0; i < 4; i++) {
-                double x = v->u.xyz[3 * (size_t)v->u.tets[4 * t + (size_t)i] + (size_t)d];
-                lo = x < lo ? x : lo;
-                hi = x > hi ? x : hi;
-            }
+            double lo, hi;
+            fdt_periodic_unfolded_span(&v->u, t, d, &lo, &hi);
             v->margin[d] = hi - lo > v->margin[d] ? hi - lo : v->margin[d];
         }
     }
