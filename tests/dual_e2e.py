@@ -27,6 +27,7 @@ every topology check OK ("Boundary definition OK" .. "Number of regions: 1
 volumes OK; exit 77 (skipped) when OpenFOAM is not installed.
 """
 import os
+import random
 import re
 import shutil
 import subprocess
@@ -46,7 +47,37 @@ def fail(msg):
     print("FAIL:", msg)
 
 
-def check_topology(name, points, faces, owner, neighbour, patches):
+WALLS = ["xmin", "xmax", "ymin", "ymax", "zmin", "zmax"]
+
+
+def check_cyclic(name, points, faces, patches, periodic):
+    """The cyclic pairs of a periodic dual: partners side by side, each
+    other's neighbourPatch with opposite separation vectors along the
+    periodic axes only, as many faces; face i of one moved by its
+    separation vector is face i of the other from the same point, turned
+    the other way (to 1e-9 of the box)."""
+    cyc = [p for p in patches if p["type"] == "cyclic"]
+    if len(cyc) % 2 or not cyc:
+        fail(f"{name}: {len(cyc)} cyclic patches")
+        return
+    span = max(max(p[k] for p in points) - min(p[k] for p in points) for k in range(3))
+    for a, b in zip(cyc[0::2], cyc[1::2]):
+        sa, sb = a["separationVector"], b["separationVector"]
+        if a["neighbourPatch"] != b["name"] or b["neighbourPatch"] != a["name"] or \
+                a["nFaces"] != b["nFaces"] or any(x != -y for x, y in zip(sa, sb)) or \
+                any(sa[k] and "xyz"[k] not in periodic for k in range(3)):
+            fail(f"{name}: cyclic pair {a} / {b}")
+            continue
+        for i in range(a["nFaces"]):
+            f, g = faces[a["startFace"] + i], faces[b["startFace"] + i]
+            moved = [tuple(points[v][k] + sa[k] for k in range(3)) for v in [f[0]] + f[:0:-1]]
+            if len(f) != len(g) or any(abs(x[k] - points[v][k]) > 1e-9 * span
+                                       for x, v in zip(moved, g) for k in range(3)):
+                fail(f"{name}: face {i} of {b['name']} is not face {i} of {a['name']} moved")
+                break
+
+
+def check_topology(name, points, faces, owner, neighbour, patches, periodic=""):
     nint = len(neighbour)
     ncells = max(owner + neighbour) + 1
     used = [False] * len(points)
@@ -65,9 +96,12 @@ def check_topology(name, points, faces, owner, neighbour, patches):
             fail(f"{name}: face {f} out of upper-triangular order")
             break
     names = [p["name"] for p in patches]
-    if names != ["xmin", "xmax", "ymin", "ymax", "zmin", "zmax"] or \
-            any(p["type"] != "patch" for p in patches):
+    walls = [w for w in WALLS if w[0] not in periodic]
+    if names[:len(walls)] != walls or any(p["type"] != "patch" for p in patches[:len(walls)]) \
+            or (not periodic and len(names) != 6):
         fail(f"{name}: patches {patches}")
+    if periodic:
+        check_cyclic(name, points, faces, patches[len(walls):], periodic)
     at = nint
     for p in patches:
         if p["startFace"] != at:
@@ -96,19 +130,20 @@ def run(args, want=0):
     return p
 
 
-def one_case(name, xyz, box=None):
+def one_case(name, xyz, box=None, periodic=""):
     case = os.path.join(SCRATCH, name)
     make_case(case)
     poly = os.path.join(case, "constant", "polyMesh")
     cells = os.path.join(SCRATCH, name + ".cells")
     extra = ["--box", ",".join(repr(x) for x in box)] if box else []
+    extra += ["--periodic", periodic] if periodic else []
     run([xyz, "-q", "-o", poly, "--dual", "--voronoi", cells, "--voronoi-format", "%i %v %h"]
         + extra)
     if not os.path.exists(os.path.join(poly, "boundary")):
         fail(f"{name}: no polyMesh written")
         return case
     points, faces, owner, neighbour, patches = read_polymesh(poly)
-    ncells = check_topology(name, points, faces, owner, neighbour, patches)
+    ncells = check_topology(name, points, faces, owner, neighbour, patches, periodic)
     rows = [line.split() for line in open(cells)]
     kept = [float(r[1]) for r in rows if not int(r[2]) & 4]
     if len(kept) != ncells:
@@ -118,8 +153,10 @@ def one_case(name, xyz, box=None):
     worst = max(abs(v - w) / max(abs(w), 1e-300) for v, w in zip(vol, kept))
     if worst > 1e-10:
         fail(f"{name}: a cell's volume differs from --voronoi's by {worst:.3g} relative")
-    lo = [min(p[k] for p in points) for k in range(3)]
-    hi = [max(p[k] for p in points) for k in range(3)]
+    # the cells fill the box (a periodic one's: the cells laid out around
+    # their points reach past it on its periodic axes)
+    lo = box[:3] if periodic else [min(p[k] for p in points) for k in range(3)]
+    hi = box[3:] if periodic else [max(p[k] for p in points) for k in range(3)]
     bvol = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2])
     if abs(sum(vol) - bvol) > 1e-12 * bvol:
         fail(f"{name}: volumes add up to {sum(vol):.17g}, the box's {bvol:.17g}")
@@ -130,10 +167,13 @@ def one_case(name, xyz, box=None):
 
 def checkmesh(name, case, rc):
     out = foam_mesh.checkmesh(case, rc, "-allTopology")
-    for ok in ("Boundary definition OK", "Cell to face addressing OK", "Point usage OK",
-               "Upper triangular ordering OK", "Face vertices OK", "Number of regions: 1 (OK)",
-               "Topological cell zip-up check OK", "Face-face connectivity OK",
-               "Face pyramids OK", "Cell volumes OK", "Boundary openness", "Max cell openness"):
+    want = ["Boundary definition OK", "Cell to face addressing OK", "Point usage OK",
+            "Upper triangular ordering OK", "Face vertices OK", "Number of regions: 1 (OK)",
+            "Topological cell zip-up check OK", "Face-face connectivity OK",
+            "Face pyramids OK", "Cell volumes OK", "Boundary openness", "Max cell openness"]
+    if "periodic" in name:  # the cyclic pairs matched by OpenFOAM
+        want.append("Coupled point location match")
+    for ok in want:
         if ok not in out:
             fail(f"checkMesh {name}: no '{ok}'\n{out}")
             return
@@ -142,6 +182,48 @@ def checkmesh(name, case, rc):
     print(f"checkMesh {name}: topology OK; " +
           ("mesh OK" if "Mesh OK" in out else
            "; ".join(l.strip() for l in out.splitlines() if l.lstrip().startswith("***"))))
+
+
+def periodic_sets():
+    """Periodic duals (issue 33 item 5): uniform points periodic in x, y, z;
+    an integer lattice in a box of its period (every cell a cube of
+    cospherical points); a channel (x, z: walls of grid points a little
+    inside the y sides, random points between) and a duct (x), in boxes
+    whose periods are not powers of two, so the images are rounded."""
+    sets = []
+    uni = os.path.join(SCRATCH, "uniform.xyz")  # main's set, made first
+    sets.append(("uniform-periodic-xyz", uni, (0, 0, 0, 1, 1, 1), "x,y,z"))
+    lat = os.path.join(SCRATCH, "lattice.xyz")  # 8^3 points, 0 .. 7
+    sets.append(("lattice-periodic-xyz", lat, (0, 0, 0, 8, 8, 8), "x,y,z"))
+    r = random.Random(5)
+    for name, box, axes in (("channel-periodic-xz", (0, -0.5, 0, 2.1, 0.5, 1.3), "x,z"),
+                            ("duct-periodic-x", (0, 0, 0, 3.3, 1, 1), "x")):
+        lo, hi = box[:3], box[3:]
+        pts = set()
+        g = 7
+        for k in range(3):
+            if "xyz"[k] in axes:
+                continue
+            a, b = [j for j in range(3) if j != k]
+            for side in (lo[k] + 1e-3, hi[k] - 1e-3):
+                for i in range(g + 1):
+                    for j in range(g + 1):
+                        q = [0.0] * 3
+                        q[k] = side
+                        for ax, t in ((a, i), (b, j)):
+                            q[ax] = (lo[ax] + (hi[ax] - lo[ax]) * (t + 0.5) / (g + 1)
+                                     if "xyz"[ax] in axes else
+                                     lo[ax] + 1e-3 + (hi[ax] - lo[ax] - 2e-3) * t / g)
+                        pts.add(tuple(q))
+        pts = sorted(pts)
+        pad = [0 if "xyz"[k] in axes else 0.02 * (hi[k] - lo[k]) for k in range(3)]
+        pts += [tuple(lo[k] + pad[k] + (hi[k] - lo[k] - 2 * pad[k]) * r.random()
+                      for k in range(3)) for _ in range(1500)]
+        xyz = os.path.join(SCRATCH, name + ".xyz")
+        with open(xyz, "w") as f:
+            f.writelines("%r %r %r\n" % q for q in pts)
+        sets.append((name, xyz, box, axes))
+    return sets
 
 
 def main():
@@ -159,7 +241,8 @@ def main():
     sets.append(("five", five, None))
     sets.append(("five-box", five, (-0.5, 0, 0, 1, 1, 2.5)))
     sets.append(("uniform-box", sets[0][1], (-0.25, 0, -0.5, 1, 1.5, 1)))
-    cases = [(name, one_case(name, xyz, box)) for name, xyz, box in sets]
+    sets = [s + ("",) for s in sets] + periodic_sets()
+    cases = [(name, one_case(name, xyz, box, per)) for name, xyz, box, per in sets]
     if CHECKMESH:
         rc = checkmesh_cmd()
         if rc is None:
@@ -196,6 +279,21 @@ def main():
                 fail(f"--dual on {fam}: {p.stderr.strip()}")
             if os.path.exists(os.path.join(SCRATCH, "b", "polyMesh")):
                 fail(f"a refused --dual ({fam}) left a polyMesh")
+        # a periodic dual whose faces across a period do not survive the
+        # images' rounding (a cylinder's cocircular rings in a box whose
+        # period is no power of two): refused as input (exit 2), nothing left
+        cyl = os.path.join(SCRATCH, "cylinder.xyz")
+        subprocess.run([GEN, "cylinder", "3000", "1", cyl], check=True, capture_output=True)
+        pts = [tuple(map(float, line.split())) for line in open(cyl)]
+        lo = [min(q[k] for q in pts) for k in range(3)]
+        hi = [max(q[k] for q in pts) * 15 / 14 - min(q[k] for q in pts) / 14 for k in range(3)]
+        p = run([cyl, "-q", "--dual", "--periodic", "x,y,z", "--box",
+                 ",".join(repr(x) for x in lo + hi), "-o", os.path.join(SCRATCH, "b", "polyMesh")],
+                want=2)
+        if "cannot be matched with its copy on the other side" not in p.stderr:
+            fail(f"--dual --periodic on a cylinder: {p.stderr.strip()}")
+        if os.path.exists(os.path.join(SCRATCH, "b", "polyMesh")):
+            fail("a refused periodic --dual left a polyMesh")
         # over an existing polyMesh (its five files replaced), beside a
         # Delaunay output of the same run (the tets as ever)
         case = dict(cases)["uniform"]
@@ -210,19 +308,23 @@ def main():
         if any(".tmp." in x for x in os.listdir(os.path.join(case, "constant"))):
             fail("--dual left a temporary beside the polyMesh")
         # the same bytes in every mode and thread count (the tets sorted first)
-        ref = None
-        for mode in (["--mode", "serial"], ["--mode", "shared", "-t", "2"],
-                     ["--mode", "message", "-t", "3"]):
-            d = os.path.join(SCRATCH, "mode-" + mode[1])
-            shutil.rmtree(d, ignore_errors=True)
-            os.makedirs(d)
-            run([uni, "-q", "-o", os.path.join(d, "polyMesh"), "--dual"] + mode)
-            got = [open(os.path.join(d, "polyMesh", f), "rb").read()
-                   for f in ("points", "faces", "owner", "neighbour", "boundary")]
-            if ref is None:
-                ref = got
-            elif got != ref:
-                fail(f"--dual {' '.join(mode)}: not the serial mode's bytes")
+        chan = [s for s in periodic_sets() if s[0].startswith("channel")][0]
+        for what, args in (("", [uni]),
+                           (" --periodic", [chan[1], "--periodic", chan[3], "--box",
+                                           ",".join(repr(x) for x in chan[2])])):
+            ref = None
+            for mode in (["--mode", "serial"], ["--mode", "shared", "-t", "2"],
+                         ["--mode", "message", "-t", "3"], ["-t", "3"]):
+                d = os.path.join(SCRATCH, "mode-" + "".join(mode))
+                shutil.rmtree(d, ignore_errors=True)
+                os.makedirs(d)
+                run(args + ["-q", "-o", os.path.join(d, "polyMesh"), "--dual"] + mode)
+                got = [open(os.path.join(d, "polyMesh", f), "rb").read()
+                       for f in ("points", "faces", "owner", "neighbour", "boundary")]
+                if ref is None:
+                    ref = got
+                elif got != ref:
+                    fail(f"--dual{what} {' '.join(mode)}: not the serial mode's bytes")
     if failures:
         print(f"{len(failures)} failures")
         sys.exit(1)

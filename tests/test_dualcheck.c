@@ -7,9 +7,16 @@
  * upper-triangular order, a vertex in no face, a face naming a vertex that
  * is not there or one vertex twice, an owner that is no cell, patches that
  * do not end at the last face, every cell turned inward (mirrored), a face
- * missing, a wall face off its wall, wall faces overlapping. (tests/test_dualmesh.c checks the meshes src/mesh/dualmesh.c
- * builds; this one that the check can fail.)
+ * missing, a wall face off its wall, wall faces overlapping. The same
+ * cubes periodic along x (cell 0's face at x = 0 and cell 2's at x = 3 a
+ * cyclic pair), which it must pass, and broken: the pair off its
+ * translate, listed from another point, shifts that do not mirror, the
+ * axis's walls left uncovered, a patch without partner. The check scaled
+ * (fdt_dualmesh_check_scaled) on cubes of 2^-500, whose volumes underflow
+ * in their own frame. (tests/test_dualmesh.c checks the meshes
+ * src/mesh/dualmesh.c builds; this one that the check can fail.)
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -99,6 +106,41 @@ static void build(built *b)
     memcpy(d->box, box, sizeof box);
 }
 
+/* The cubes periodic along x (a period of 3): cell 0's face at x = 0 and
+ * cell 2's at x = 3 become a cyclic pair, the first (its partner at +3)
+ * as it was, the second turned to start at the first's first point moved;
+ * the walls of x empty, the other walls as before. */
+static fdt_dual_cyclic cyc[2];
+
+static void build_periodic(built *b)
+{
+    build(b);
+    size_t f0 = b->d.patch_start[0], f1 = b->d.patch_start[1]; /* 2 and 3 */
+    int32_t a[4], c[4];
+    memcpy(a, b->fverts + 4 * f0, sizeof a);
+    memcpy(c, b->fverts + 4 * f1, sizeof c);
+    int32_t oa = b->owner[f0], oc = b->owner[f1];
+    /* the y and z walls' faces two places up */
+    memmove(b->fverts + 4 * f0, b->fverts + 4 * (f0 + 2), 4 * (NF - f0 - 2) * sizeof *b->fverts);
+    memmove(b->owner + f0, b->owner + f0 + 2, (NF - f0 - 2) * sizeof *b->owner);
+    for (int p = 2; p < 6; p++)
+        b->d.patch_start[p] -= 2;
+    b->d.patch_start[0] = b->d.patch_start[1] = f0;
+    b->d.patch_size[0] = b->d.patch_size[1] = 0;
+    /* a's first point (0, 0, 1) moved by 3 is c's last: c from there on */
+    CHECK(c[3] == vid(3, 0, 1) && a[0] == vid(0, 0, 1));
+    int32_t turned[4] = {c[3], c[0], c[1], c[2]};
+    memcpy(b->fverts + 4 * (NF - 2), a, sizeof a);
+    memcpy(b->fverts + 4 * (NF - 1), turned, sizeof turned);
+    b->owner[NF - 2] = oa;
+    b->owner[NF - 1] = oc;
+    cyc[0] = (fdt_dual_cyclic){{1, 0, 0}, {3, 0, 0}, NF - 2, 1};
+    cyc[1] = (fdt_dual_cyclic){{-1, 0, 0}, {-3, 0, 0}, NF - 1, 1};
+    b->d.periodic = 1;
+    b->d.n_cyclic = 2;
+    b->d.cyclic = cyc;
+}
+
 /* The check on b refuses it with a message holding want. */
 static void refused(const built *b, const char *want, const char *what)
 {
@@ -177,5 +219,39 @@ int main(void)
     b.xyz[3 * vid(1, 1, 1)] = -0.5;
     refused(&b, "cover", "wall faces overlapping");
 
+    /* periodic along x: passes; then a cyclic pair broken each way */
+    build_periodic(&b);
+    EXPECTF(fdt_dualmesh_check(&b.d, diag, sizeof diag) == 0, "the periodic cubes: %s", diag);
+    build_periodic(&b);
+    cyc[0].sep[0] = 2.9; /* the partner not at the translate */
+    refused(&b, "is not face", "a cyclic face off its partner");
+    build_periodic(&b); /* the partner from another point */
+    int32_t *g = b.fverts + 4 * (NF - 1), g0 = g[0];
+    memmove(g, g + 1, 3 * sizeof *g);
+    g[3] = g0;
+    refused(&b, "is not face", "a cyclic face listed from another point");
+    build_periodic(&b);
+    cyc[1].shift[0] = 1;
+    refused(&b, "mirror its partner", "partners whose shifts do not mirror");
+    build_periodic(&b);
+    b.d.periodic = 0; /* x not periodic: its walls uncovered */
+    refused(&b, "cover", "the walls of an axis that is not periodic left empty");
+    build_periodic(&b);
+    b.d.n_cyclic = 1;
+    b.d.n_faces = NF - 1;
+    refused(&b, "no partner", "a cyclic patch alone");
+
+    /* 2^-500 of the cubes: their volumes underflow, which the scaled check
+     * does not see; the mesh the same bits after it */
+    build(&b);
+    for (int i = 0; i < 3 * NV; i++)
+        b.xyz[i] = ldexp(b.xyz[i], -500);
+    for (int k = 0; k < 6; k++)
+        b.d.box[k] = ldexp(b.d.box[k], -500);
+    double keep[3 * NV];
+    memcpy(keep, b.xyz, sizeof keep);
+    refused(&b, "volume", "cubes of 2^-500 in their own frame");
+    EXPECTF(fdt_dualmesh_check_scaled(&b.d, diag, sizeof diag) == 0, "scaled: %s", diag);
+    EXPECT(!memcmp(keep, b.xyz, sizeof keep) && b.d.box[3] == ldexp(3, -500));
     return test_report("dualcheck");
 }

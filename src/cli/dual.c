@@ -1,5 +1,6 @@
 /* The CLI's Voronoi outputs: see dual.h. */
 #include "cli/dual.h"
+#include "api/dual.h"
 
 #include <errno.h>
 #include <math.h>
@@ -364,7 +365,7 @@ int fdt_cli_dual_mesh(const fdt_cli_dual *d, fdt_result *res, const double *xyz,
     memcpy(o.box, d->box, sizeof o.box);
     fdt_dualmesh dm;
     char diag[512];
-    int r = fdt_dualmesh_build(res, xyz, n, &o, &dm, diag, sizeof diag);
+    int r = fdt_dual_build(res, xyz, n, &o, d->threads, &dm, diag, sizeof diag);
     if (r != FDT_OK) {
         char what[FDT_IO_PATH + 64];
         snprintf(what, sizeof what, "%s: the Voronoi cells as a polyMesh (--dual)", path);

@@ -561,9 +561,6 @@ static int check_args(cli *c, int npos, char **pos)
         if (c->all_faces)
             return usage_error("--periodic: TetGen's .face lists the hull, not every face "
                                "(--all-faces)");
-        if (c->dual.dual)
-            return usage_error("--periodic writes the mesh, its hashes, --check, the cells "
-                               "and --interpolate; not yet --dual");
         if (fdt_cli_interp_wanted(&c->dual) && c->stream > 0)
             return usage_error("--periodic --interpolate needs the mesh in memory (no "
                                "--stream)");
@@ -1427,8 +1424,10 @@ static int open_engine(const cli *c, run_state *rs)
                                    fdt_engine_one_part(&s, rs->streaming));
     /* --dual's polyhedral mesh, built after the tets beside them: 1,425
      * bytes a point at the peak for 1M uniform points (bench/NOTES.md
-     * entry 97) */
-    unsigned long long dual = c->dual.dual ? 1500ull * rs->n + (16ull << 20) : 0;
+     * entry 97); a periodic one's from the points and their images beside
+     * the periodic mesh, 1,743 (entry 124) */
+    unsigned long long dual =
+        c->dual.dual ? (c->periodic ? 1800ull : 1500ull) * rs->n + (16ull << 20) : 0;
     if (dual > rs->estimate)
         rs->estimate = dual;
     /* a periodic run: the mesh of the points and their images, then the

@@ -131,7 +131,8 @@ const fdt_cli_opt fdt_cli_opts[FDT_OPT_END] = {
         "cells clipped by the box instead of the tets:\n"
         "a polyhedral cell a point (duplicates none),\n"
         "the walls patches xmin, xmax, ymin, ymax, zmin,\n"
-        "zmax", NULL},
+        "zmax; with --periodic each cell whole, the faces\n"
+        "across a period cyclic patch pairs", NULL},
     [FDT_OPT_VALUES] = {"values", 0, required_argument, "FILE", F, 0,
         "values at the points (a line a point, k numbers)", NULL},
     [FDT_OPT_INTERPOLATE] = {"interpolate", 0, required_argument, "Q", F, 0,

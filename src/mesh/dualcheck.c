@@ -12,6 +12,7 @@
 #include "base/sortu64.h"
 #include "base/diag.h"
 #include "mesh/dualmesh.h"
+#include "mesh/voronoi.h"
 
 static int u64_cmp(const void *x, const void *y)
 {
@@ -100,7 +101,28 @@ static int check_faces(const fdt_dualmesh *d, char *diag, size_t ds)
                 d->patch_start[p], at);
             return -1;
         }
+        if (d->periodic >> (p / 2) & 1 && d->patch_size[p]) {
+            fdt_diag(diag, ds, "wall %s of a periodic axis has %zu faces", fdt_dualmesh_patch[p],
+                d->patch_size[p]);
+            return -1;
+        }
         at += d->patch_size[p];
+    }
+    for (size_t c = 0; c < d->n_cyclic; c++) {
+        const fdt_dual_cyclic *y = &d->cyclic[c];
+        if (y->start != at || (c & 1 && y->size != d->cyclic[c - 1].size) ||
+            (c & 1 && (y->shift[0] != -d->cyclic[c - 1].shift[0] ||
+                       y->shift[1] != -d->cyclic[c - 1].shift[1] ||
+                       y->shift[2] != -d->cyclic[c - 1].shift[2]))) {
+            fdt_diag(diag, ds, "cyclic patch %zu (faces %zu to %zu) does not follow on, or does "
+                "not mirror its partner", c, y->start, y->start + y->size);
+            return -1;
+        }
+        at += y->size;
+    }
+    if (d->n_cyclic & 1) {
+        fdt_diag(diag, ds, "cyclic patch %zu has no partner", d->n_cyclic - 1);
+        return -1;
     }
     if (at != d->n_faces) {
         fdt_diag(diag, ds, "the patches end at face %zu of %zu", at, d->n_faces);
@@ -210,6 +232,8 @@ static int check_cell(const fdt_dualmesh *d, const size_t *cs, const size_t *cf,
 static int check_walls(const fdt_dualmesh *d, char *diag, size_t ds)
 {
     for (int p = 0; p < 6; p++) {
+        if (d->periodic >> (p / 2) & 1)
+            continue; /* no wall: its patch is empty (check_faces) */
         int k = p / 2, u = (k + 1) % 3, t = (k + 2) % 3;
         double bnd = d->box[k + 3 * (p & 1)], out = 0, all = 0;
         for (size_t f = d->patch_start[p]; f < d->patch_start[p] + d->patch_size[p]; f++) {
@@ -242,6 +266,98 @@ static int check_walls(const fdt_dualmesh *d, char *diag, size_t ds)
     return 0;
 }
 
+/* Twice the area vector of the polygon v[0 .. m) read from position z on,
+ * fanned from its first vertex, in units of size (no square of a 1e-150
+ * or 1e150 wide face under- or overflows). */
+static void area2(const double *xyz, const int32_t *v, size_t m, size_t z, double size,
+                  double a[3])
+{
+    const double *o = xyz + 3 * (size_t)v[z % m];
+    a[0] = a[1] = a[2] = 0;
+    for (size_t i = 1; i + 1 < m; i++) {
+        const double *p = xyz + 3 * (size_t)v[(z + i) % m], *q = xyz + 3 * (size_t)v[(z + i + 1) % m];
+        double u[3] = {(p[0] - o[0]) / size, (p[1] - o[1]) / size, (p[2] - o[2]) / size};
+        double w[3] = {(q[0] - o[0]) / size, (q[1] - o[1]) / size, (q[2] - o[2]) / size};
+        a[0] += u[1] * w[2] - u[2] * w[1];
+        a[1] += u[2] * w[0] - u[0] * w[2];
+        a[2] += u[0] * w[1] - u[1] * w[0];
+    }
+}
+
+int fdt_dual_faces_match(const double *xyz, const int32_t *fv, size_t m, const int32_t *gv,
+                         size_t gm, size_t z, const double sep[3])
+{
+    if (gm != m || m < 3)
+        return 0;
+    double size = 0;
+    for (size_t j = 1; j < m; j++)
+        for (int k = 0; k < 3; k++)
+            size = fmax(size, fabs(xyz[3 * (size_t)fv[j] + (size_t)k] - xyz[3 * (size_t)fv[0] + (size_t)k]));
+    for (size_t j = 0; j < m; j++) {
+        const double *x = xyz + 3 * (size_t)fv[(m - j) % m];
+        const double *y = xyz + 3 * (size_t)gv[(z + j) % m];
+        for (int k = 0; k < 3; k++)
+            if (!(fabs(x[k] + sep[k] - y[k]) <= 1e-6 * size))
+                return 0;
+    }
+    if (!(size > 0))
+        return 0;
+    double a[3], b[3];
+    area2(xyz, fv, m, 0, size, a);
+    area2(xyz, gv, m, z, size, b);
+    double na = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    double nb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    return fabs(na - nb) <= 1e-5 * (na + nb) / 2;
+}
+
+/* The cyclic pairs: face i of patch 2k and face i of patch 2k + 1 match
+ * (fdt_dual_faces_match, from their first points). */
+static int check_cyclic(const fdt_dualmesh *d, char *diag, size_t ds)
+{
+    for (size_t c = 0; c + 1 < d->n_cyclic; c += 2) {
+        const fdt_dual_cyclic *a = &d->cyclic[c], *b = &d->cyclic[c + 1];
+        for (size_t i = 0; i < a->size; i++) {
+            size_t f = a->start + i, g = b->start + i;
+            if (!fdt_dual_faces_match(d->xyz, d->fverts + d->fstart[f], d->fstart[f + 1] - d->fstart[f],
+                                      d->fverts + d->fstart[g], d->fstart[g + 1] - d->fstart[g], 0,
+                                      a->sep)) {
+                fdt_diag(diag, ds, "cyclic face %zu is not face %zu moved by (%g, %g, %g)", g, f,
+                    a->sep[0], a->sep[1], a->sep[2]);
+                return -1;
+            }
+        }
+    }
+    return 0;
+}
+
+/* d moved to a frame scaled by 2^-e, sep too, or back (e negated):
+ * exact, a power of two. */
+static void scale_dual(fdt_dualmesh *d, int e)
+{
+    for (size_t i = 0; i < 3 * d->n_verts; i++)
+        d->xyz[i] = ldexp(d->xyz[i], -e);
+    for (int k = 0; k < 6; k++)
+        d->box[k] = ldexp(d->box[k], -e);
+    for (size_t c = 0; c < d->n_cyclic; c++)
+        for (int k = 0; k < 3; k++)
+            d->cyclic[c].sep[k] = ldexp(d->cyclic[c].sep[k], -e);
+}
+
+int fdt_dualmesh_check_scaled(fdt_dualmesh *d, char *diag, size_t ds)
+{
+    int e;
+    (void)frexp(fdt_box_side(d->box), &e);
+    for (size_t i = 0; i < 3 * d->n_verts && e; i++)
+        if (ldexp(ldexp(d->xyz[i], -e), e) != d->xyz[i])
+            e = 0; /* a vertex would lose bits: checked as it is */
+    if (e)
+        scale_dual(d, e);
+    int rc = fdt_dualmesh_check(d, diag, ds);
+    if (e)
+        scale_dual(d, -e);
+    return rc;
+}
+
 int fdt_dualmesh_check(const fdt_dualmesh *d, char *diag, size_t ds)
 {
     fdt_diag(diag, ds, "%s", "");
@@ -259,6 +375,8 @@ int fdt_dualmesh_check(const fdt_dualmesh *d, char *diag, size_t ds)
         bad = check_cell(d, cs, cf, c, &buf, &cap, diag, ds) != 0;
     if (!bad)
         bad = check_walls(d, diag, ds) != 0;
+    if (!bad)
+        bad = check_cyclic(d, diag, ds) != 0;
     free(buf);
     free(cs);
     free(cf);

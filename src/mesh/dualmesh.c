@@ -1385,6 +1385,7 @@ void fdt_dualmesh_free(fdt_dualmesh *d)
     free(d->owner);
     free(d->neighbour);
     free(d->cell_of);
+    free(d->cyclic);
     memset(d, 0, sizeof *d);
 }
 
@@ -1460,9 +1461,8 @@ static int scale_points(dwork *w)
     return e;
 }
 
-int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
-                       const fdt_voronoi_options *o, fdt_dualmesh *d, char *diag,
-                       size_t diag_size)
+static int build(fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
+                 fdt_dualmesh *d, int check, char *diag, size_t diag_size)
 {
     char own[256];
     if (!diag || !diag_size) {
@@ -1545,7 +1545,7 @@ int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
     double box[6];
     memcpy(box, d->box, sizeof box);
     memcpy(d->box, w.box, sizeof box);
-    if (!err && fdt_dualmesh_check(d, diag, diag_size) != 0)
+    if (!err && check && fdt_dualmesh_check(d, diag, diag_size) != 0)
         err = FDT_EINTERNAL;
     memcpy(d->box, box, sizeof box);
     for (size_t i = 0; !err && ex && i < 3 * d->n_verts; i++)
@@ -1561,4 +1561,18 @@ done:
         fdt_diag(diag, diag_size, "%s", keep);
     }
     return err;
+}
+
+int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
+                       const fdt_voronoi_options *o, fdt_dualmesh *d, char *diag,
+                       size_t diag_size)
+{
+    return build(r, xyz, n, o, d, 1, diag, diag_size);
+}
+
+int fdt_dualmesh_build_unchecked(fdt_result *r, const double *xyz, size_t n,
+                                 const fdt_voronoi_options *o, fdt_dualmesh *d, char *diag,
+                                 size_t diag_size)
+{
+    return build(r, xyz, n, o, d, 0, diag, diag_size);
 }

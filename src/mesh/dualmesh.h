@@ -22,6 +22,15 @@
 
 #include "frontdt.h"
 
+/* A cyclic patch of a periodic dual (src/mesh/dualperiodic.h): its faces'
+ * translates by sep (shift periods) are its partner's faces, face i of one
+ * the partner of face i of the other, listed from the same point. */
+typedef struct fdt_dual_cyclic {
+    int shift[3];         /* periods to the partner */
+    double sep[3];        /* the translation to the partner */
+    size_t start, size;   /* its faces */
+} fdt_dual_cyclic;
+
 typedef struct fdt_dualmesh {
     size_t n_verts;
     double *xyz;          /* 3 a vertex (owned) */
@@ -36,6 +45,13 @@ typedef struct fdt_dualmesh {
     int32_t *cell_of;     /* n_input: a point's cell, -1 for a merged
                              duplicate (owned) */
     double box[6];        /* xmin, ymin, zmin, xmax, ymax, zmax */
+    /* A periodic dual: the axes without walls (bit k: axis k; their two
+     * walls' patches are empty and not written), and after the walls'
+     * faces the cyclic patches, partners in pairs (2k, 2k + 1). 0 and
+     * none for a dual clipped by a box. */
+    unsigned periodic;
+    size_t n_cyclic;
+    fdt_dual_cyclic *cyclic; /* owned */
 } fdt_dualmesh;
 
 /* The patches' names, in the order of the walls: xmin, xmax, ymin, ... */
@@ -59,6 +75,12 @@ extern const char *const fdt_dualmesh_patch[6];
 int fdt_dualmesh_build(fdt_result *r, const double *xyz, size_t n,
                        const fdt_voronoi_options *o, fdt_dualmesh *d, char *diag,
                        size_t diag_size);
+/* The same without the check, for a dual that is checked once folded
+ * (fdt_dualmesh_fold, src/mesh/dualperiodic.h: the check was a quarter of
+ * a periodic --dual's time, bench/NOTES.md entry 124). */
+int fdt_dualmesh_build_unchecked(fdt_result *r, const double *xyz, size_t n,
+                                 const fdt_voronoi_options *o, fdt_dualmesh *d, char *diag,
+                                 size_t diag_size);
 void fdt_dualmesh_free(fdt_dualmesh *d);
 
 /*
@@ -70,9 +92,25 @@ void fdt_dualmesh_free(fdt_dualmesh *d);
  * two of its faces, once each way round when the faces are turned out of
  * the cell) and of positive volume, every wall face on its wall and each
  * wall's faces covering it once (their areas, turned out of the box, add
- * up to the wall's to 1e-9). 0, or -1 with the first fault in diag.
+ * up to the wall's to 1e-9); in a periodic dual, the walls of its periodic
+ * axes empty and each cyclic pair's faces translates of each other, from
+ * the same point, turned the other way (to 1e-6 of the face's size). 0, or
+ * -1 with the first fault in diag.
  */
 int fdt_dualmesh_check(const fdt_dualmesh *d, char *diag, size_t diag_size);
+
+/* fdt_dualmesh_check in a frame scaled by a power of two in which the
+ * box's largest side is about 1 (cells of 1e-150 wide sets have volumes
+ * beyond doubles in their own), d moved back after it exactly. */
+int fdt_dualmesh_check_scaled(fdt_dualmesh *d, char *diag, size_t diag_size);
+
+/* Whether face g (gv[0 .. gm), read from position z) is face f (fv[0 ..
+ * m)) moved by sep, from the same point and turned the other way (each a
+ * face turned out of its own cell), its vertices within 1e-6 of f's size
+ * and the two areas within 1e-5 of each other: what OpenFOAM's
+ * translational cyclic patches need (they match to 1e-4). */
+int fdt_dual_faces_match(const double *xyz, const int32_t *fv, size_t m, const int32_t *gv,
+                         size_t gm, size_t z, const double sep[3]);
 
 /* Cell c's volume from its faces (the divergence theorem on the faces'
  * fans), for checks. */

@@ -521,6 +521,26 @@ static void put_patch(out_file *o, const char *name, size_t n_faces, size_t star
     out_str(o, ";\n    }\n");
 }
 
+/* One side of a cyclic pair: its faces' translates by sep are its partner
+ * patch's (OpenFOAM's translational cyclic). */
+static void put_cyclic(out_file *o, const char *name, size_t n_faces, size_t start,
+                       const char *partner, const double sep[3])
+{
+    out_str(o, "    ");
+    out_str(o, name);
+    out_str(o, "\n    {\n        type            cyclic;\n        inGroups        "
+               "List<word> 1(cyclic);\n        nFaces          ");
+    out_i64(o, (int64_t)n_faces);
+    out_str(o, ";\n        startFace       ");
+    out_i64(o, (int64_t)start);
+    out_str(o, ";\n        matchTolerance  0.0001;\n        transform       translational;\n"
+               "        neighbourPatch  ");
+    out_str(o, partner);
+    out_str(o, ";\n        separationVector ");
+    put_vector(o, sep);
+    out_str(o, ";\n    }\n");
+}
+
 int fdt_put_foam_boundary(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
                           size_t errlen)
 {
@@ -543,19 +563,7 @@ int fdt_put_foam_boundary(out_file *o, const fdt_mesh_view *m, const void *prep,
             put_patch(o, pa->name, pa->n_faces, pa->start);
             continue;
         }
-        out_str(o, "    ");
-        out_str(o, pa->name);
-        out_str(o, "\n    {\n        type            cyclic;\n        inGroups        "
-                   "List<word> 1(cyclic);\n        nFaces          ");
-        out_i64(o, (int64_t)pa->n_faces);
-        out_str(o, ";\n        startFace       ");
-        out_i64(o, (int64_t)pa->start);
-        out_str(o, ";\n        matchTolerance  0.0001;\n        transform       translational;\n"
-                   "        neighbourPatch  ");
-        out_str(o, p->patch[pa->partner].name);
-        out_str(o, ";\n        separationVector ");
-        put_vector(o, pa->sep);
-        out_str(o, ";\n    }\n");
+        put_cyclic(o, pa->name, pa->n_faces, pa->start, p->patch[pa->partner].name, pa->sep);
     }
     out_str(o, ")\n");
     return FDT_IO_OK;
@@ -566,12 +574,13 @@ int fdt_put_foam_boundary(out_file *o, const fdt_mesh_view *m, const void *prep,
  * view unused. Its faces are in OpenFOAM's order and turned already. */
 
 #define DUAL_WHAT "Voronoi cells clipped by a box, a cell a point"
+#define DUAL_WHAT_PERIODIC "periodic Voronoi cells, whole, across cyclic patches, a cell a point"
 
 static void dual_header(out_file *o, const char *cls, const char *object,
                         const fdt_dualmesh *d)
 {
     size_t counts[4] = {d->n_verts, d->n_cells, d->n_faces, d->n_internal};
-    header_of(o, DUAL_WHAT, cls, object, counts);
+    header_of(o, d->periodic ? DUAL_WHAT_PERIODIC : DUAL_WHAT, cls, object, counts);
 }
 
 int fdt_put_foam_dual_points(out_file *o, const fdt_mesh_view *m, const void *prep, char *err,
@@ -658,9 +667,22 @@ int fdt_put_foam_dual_boundary(out_file *o, const fdt_mesh_view *m, const void *
     (void)errlen;
     const fdt_dualmesh *d = prep;
     dual_header(o, "polyBoundaryMesh", "boundary", d);
-    out_str(o, "6\n(\n");
+    /* the walls of the axes that are not periodic, then the cyclic pairs */
+    int walls = 0;
     for (int p = 0; p < 6; p++)
-        put_patch(o, fdt_dualmesh_patch[p], d->patch_size[p], d->patch_start[p]);
+        walls += !(d->periodic >> (p / 2) & 1);
+    out_i64(o, (int64_t)(walls + (int)d->n_cyclic));
+    out_str(o, "\n(\n");
+    for (int p = 0; p < 6; p++)
+        if (!(d->periodic >> (p / 2) & 1))
+            put_patch(o, fdt_dualmesh_patch[p], d->patch_size[p], d->patch_start[p]);
+    for (size_t c = 0; c < d->n_cyclic; c++) {
+        const fdt_dual_cyclic *y = &d->cyclic[c];
+        char name[64], partner[64];
+        shift_name(y->shift, name, sizeof name);
+        shift_name(d->cyclic[c ^ 1].shift, partner, sizeof partner);
+        put_cyclic(o, name, y->size, y->start, partner, y->sep);
+    }
     out_str(o, ")\n");
     return FDT_IO_OK;
 }
