@@ -36,20 +36,6 @@
 #include "mesh/periodic_interp.h"
 #include "testutil.h"
 
-static fdt_result *periodic_mesh(const double *xyz, size_t n, unsigned axes, const double box[6])
-{
-    fdt_settings s;
-    fdt_default_settings(&s);
-    s.periodic = axes;
-    memcpy(s.periodic_box, box, sizeof s.periodic_box);
-    fdt_context *ctx = NULL;
-    fdt_result *r = NULL;
-    CHECK(fdt_open(&ctx, &s) == FDT_OK);
-    CHECK(fdt_triangulate(ctx, xyz, n, &r) == FDT_OK);
-    fdt_close(&ctx);
-    return r;
-}
-
 static void test_cube(void)
 {
     const size_t n = 800, nq = 200;
@@ -65,7 +51,7 @@ static void test_cube(void)
         lo = val[2 * i] < lo ? val[2 * i] : lo;
         hi = val[2 * i] > hi ? val[2 * i] : hi;
     }
-    fdt_result *r = periodic_mesh(xyz, n, 7, box);
+    fdt_result *r = test_periodic_mesh(xyz, n, 7, box);
     /* each query, then three translates of it by whole periods */
     for (size_t k = 0; k < nq; k++) {
         double *a = q + 12 * k;
@@ -161,7 +147,7 @@ static void replicated(const char *what, const double *xyz, size_t n, const doub
             q[3 * k + d] = box[d] - 2 * L + 5 * L * test_unif(&seed);
             wq[3 * k + d] = box[d] + fmod(q[3 * k + d] - box[d] + 2 * L, L); /* exact */
         }
-    fdt_result *r = periodic_mesh(xyz, n, 7, box);
+    fdt_result *r = test_periodic_mesh(xyz, n, 7, box);
     fdt_settings s;
     fdt_default_settings(&s);
     fdt_context *ctx = NULL;
@@ -231,7 +217,7 @@ static void test_channel(void)
                                            : box[d] + (box[d + 3] - box[d]) * test_unif(&s);
     for (size_t i = 0; i < n; i++)
         val[i] = 3 * xyz[3 * i + 1] - 0.25;
-    fdt_result *r = periodic_mesh(xyz, n, 5, box);
+    fdt_result *r = test_periodic_mesh(xyz, n, 5, box);
     double q[3 * (NQ + 3)], out[NQ + 3];
     for (int k = 0; k < NQ; k++) {
         q[3 * k] = -3 + 8 * test_unif(&s);
@@ -268,7 +254,7 @@ static void test_patch(void)
     for (size_t k = 0; k < NQ; k++)
         for (int d = 0; d < 3; d++)
             q[3 * k + (size_t)d] = box[d + 3] * test_unif(&s);
-    fdt_result *r = periodic_mesh(xyz, N, 7, box);
+    fdt_result *r = test_periodic_mesh(xyz, N, 7, box);
     const fdt_periodic_box b = fdt_periodic_box_of(7, box);
     const fdt_vid *rows = fdt_result_tets(r);
     fdt_periodic_unfolded u;

@@ -169,6 +169,23 @@ static inline double *test_cloud(size_t n, int clustered, uint64_t seed)
     return xyz;
 }
 
+/* The periodic mesh of xyz (settings.periodic axes, periodic_box box), by
+ * default settings; any failure ends the test. */
+static inline fdt_result *test_periodic_mesh(const double *xyz, size_t n, unsigned axes,
+                                             const double box[6])
+{
+    fdt_settings s;
+    fdt_default_settings(&s);
+    s.periodic = axes;
+    memcpy(s.periodic_box, box, sizeof s.periodic_box);
+    fdt_context *ctx = NULL;
+    fdt_result *r = NULL;
+    CHECK(fdt_open(&ctx, &s) == FDT_OK);
+    CHECK(fdt_triangulate(ctx, xyz, n, &r) == FDT_OK);
+    fdt_close(&ctx);
+    return r;
+}
+
 /* The mesh of xyz on `threads` threads (1: serial mode), with the tets'
  * neighbours when `neighbors`; any failure ends the test. */
 static inline fdt_result *test_triangulate(const double *xyz, size_t n, int threads,

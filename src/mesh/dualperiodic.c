@@ -235,14 +235,6 @@ static int first_sign(const int8_t d[3])
     return 0;
 }
 
-static int shift_cmp(const int a[3], const int b[3])
-{
-    for (int k = 0; k < 3; k++)
-        if (a[k] != b[k])
-            return a[k] < b[k] ? -1 : 1;
-    return 0;
-}
-
 typedef struct fold {
     const fdt_dualmesh *P;
     fdt_dualmesh *d;
@@ -373,24 +365,13 @@ int fdt_dualmesh_fold(const fdt_dualmesh *P, const fdt_dual_images *im, const do
             err = FDT_ERANGE;
             break;
         }
-        size_t k = 0;
-        while (k < nsh && shift_cmp(shifts[k], s))
-            k++;
-        if (k == nsh)
-            memcpy(shifts[nsh++], s, sizeof s);
+        fdt_shift_add(shifts, &nsh, s);
     }
     if (!err && 2 * npos != ncf) {
         fdt_diag(diag, ds, "%zu faces across a period have no copy on the other side",
             ncf - 2 * npos);
         err = FDT_ERANGE;
     }
-    for (size_t i = 1; !err && i < nsh; i++) /* a few dozen at most: insertion */
-        for (size_t k = i; k > 0 && shift_cmp(shifts[k], shifts[k - 1]) < 0; k--) {
-            int x[3];
-            memcpy(x, shifts[k], sizeof x);
-            memcpy(shifts[k], shifts[k - 1], sizeof x);
-            memcpy(shifts[k - 1], x, sizeof x);
-        }
     size_t nf = nint + nwall + ncf;
     if (!err && (nf > (size_t)INT32_MAX || nfv > (size_t)INT32_MAX)) {
         fdt_diag(diag, ds, "too many faces for OpenFOAM's 32-bit labels");
@@ -430,7 +411,7 @@ int fdt_dualmesh_fold(const fdt_dualmesh *P, const fdt_dual_images *im, const do
                 }
                 for (size_t j = 0; j < ncf; j++) {
                     int s[3] = {-cf[j].d[0], -cf[j].d[1], -cf[j].d[2]};
-                    if (first_sign(cf[j].d) > 0 || shift_cmp(s, shifts[k]))
+                    if (first_sign(cf[j].d) > 0 || fdt_shift_cmp(s, shifts[k]))
                         continue;
                     if (!side) {
                         put_face(&w, i++, cf[j].f, 0, (int32_t)cf[j].a);

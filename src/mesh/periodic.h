@@ -35,6 +35,7 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 #include "frontdt.h"
 #include "geom/predicates.h"
 
@@ -58,6 +59,31 @@ static inline fdt_periodic_box fdt_periodic_box_of(unsigned axes, const double b
 static inline double fdt_periodic_period(const fdt_periodic_box *b, int k)
 {
     return b->axes >> k & 1 ? b->hi[k] - b->lo[k] : 0;
+}
+
+/* Translations by whole periods, in lexicographic order (the cyclic patch
+ * pairs of the laid-out polyMesh writers, src/io/write/fmt_foam.c and
+ * src/mesh/dualperiodic.c, come in it). */
+static inline int fdt_shift_cmp(const int a[3], const int b[3])
+{
+    for (int k = 0; k < 3; k++)
+        if (a[k] != b[k])
+            return a[k] < b[k] ? -1 : 1;
+    return 0;
+}
+
+/* s into the *n distinct shifts sh[] (ascending, room for one more) unless
+ * there: a few dozen at most, so a linear insertion. */
+static inline void fdt_shift_add(int (*sh)[3], size_t *n, const int s[3])
+{
+    size_t k = 0;
+    while (k < *n && fdt_shift_cmp(sh[k], s) < 0)
+        k++;
+    if (k < *n && !fdt_shift_cmp(sh[k], s))
+        return;
+    memmove(sh + k + 1, sh + k, (*n - k) * sizeof *sh);
+    memcpy(sh[k], s, sizeof sh[k]);
+    (*n)++;
 }
 
 /* The result: ntets tets, 4 input indices each ascending (ties: the

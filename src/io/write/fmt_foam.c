@@ -28,6 +28,7 @@
 #include "io/write/formats.h"
 #include "geom/predicates.h"
 #include "mesh/dualmesh.h"
+#include "mesh/periodic.h"
 
 /* A boundary patch: the hull, or one side of a cyclic pair (partner: the
  * other side's index in the list, its faces' translates at +sep). */
@@ -164,14 +165,6 @@ static int intf_cmp(const void *x, const void *y)
     return (a->nbr > b->nbr) - (a->nbr < b->nbr);
 }
 
-static int shift_cmp(const int a[3], const int b[3])
-{
-    for (int c = 0; c < 3; c++)
-        if (a[c] != b[c])
-            return a[c] < b[c] ? -1 : 1;
-    return 0;
-}
-
 /* "periodic_p1_0_m1": the translation to the partner, p for plus, m for
  * minus (OpenFOAM's words take neither sign). */
 static void shift_name(const int s[3], char *buf, size_t len)
@@ -289,20 +282,8 @@ static int foam_prepare_periodic(const fdt_mesh_view *m, void **prep, const char
         rc = set_errno_err(err, errlen, path, ENOMEM);
         goto done;
     }
-    for (size_t i = 0; i < n_cy; i++) {
-        size_t k = 0;
-        while (k < n_sh && shift_cmp(shifts[k], cy[i].s))
-            k++;
-        if (k == n_sh)
-            memcpy(shifts[n_sh++], cy[i].s, sizeof shifts[0]);
-    }
-    for (size_t i = 1; i < n_sh; i++) /* at most 13: insertion */
-        for (size_t k = i; k > 0 && shift_cmp(shifts[k], shifts[k - 1]) < 0; k--) {
-            int x[3];
-            memcpy(x, shifts[k], sizeof x);
-            memcpy(shifts[k], shifts[k - 1], sizeof x);
-            memcpy(shifts[k - 1], x, sizeof x);
-        }
+    for (size_t i = 0; i < n_cy; i++) /* at most 13 */
+        fdt_shift_add(shifts, &n_sh, cy[i].s);
     size_t F = n_in + 2 * n_cy + n_hull, P = 2 * n_sh + (n_hull > 0);
     size_t bytes = sizeof(foam_prep) + N * sizeof(fdt_vid) + P * sizeof(foam_patch) +
                    (3 * F + F + n_in) * sizeof(int32_t);
@@ -336,7 +317,7 @@ static int foam_prepare_periodic(const fdt_mesh_view *m, void **prep, const char
             for (int c = 0; c < 3; c++)
                 pa->sep[c] = (side ? -1 : 1) * shifts[k][c] * m->period[c];
             for (size_t i = 0; i < n_cy; i++) {
-                if (shift_cmp(cy[i].s, shifts[k]))
+                if (fdt_shift_cmp(cy[i].s, shifts[k]))
                     continue;
                 if (!side) {
                     put_face(p, f++, m, cy[i].r, -1);
