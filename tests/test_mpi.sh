@@ -150,6 +150,10 @@ while read -r opt value <&3; do
   af=("$opt") am=("$opt")
   if [[ $opt == -o || $opt == --output ]]; then
     af+=("$work/o.f.tets") am+=("$work/o.m.tets")
+  elif [[ $opt == --dual ]]; then # it needs a polyMesh output
+    rm -rf "$work/odf" "$work/odm"
+    mkdir -p "$work/odf" "$work/odm"
+    af+=(-o "$work/odf/polyMesh") am+=(-o "$work/odm/polyMesh")
   elif [[ -n $value ]]; then
     [[ -n ${optval[$opt]:-} ]] || { fail "$opt $value: no value to test it with"; continue; }
     read -ra words <<<"${optval[$opt]}"
@@ -166,6 +170,9 @@ while read -r opt value <&3; do
   if [[ $opt == -o || $opt == --output ]]; then
     cmp -s "$work/o.f.tets" "$work/o.m.tets" || fail "$opt: the two programs' files differ"
     rm -f "$work/o.f.tets" "$work/o.m.tets"
+  fi
+  if [[ $opt == --dual ]]; then
+    diff -r "$work/odf" "$work/odm" >/dev/null || fail "$opt: the two programs' files differ"
   fi
   for t in cells dens; do
     if [[ -e $work/o.$t.f ]]; then
@@ -699,6 +706,37 @@ done
 for f in m.node m.ele m.face m.neigh polyMesh/points polyMesh/faces polyMesh/owner \
   polyMesh/neighbour polyMesh/boundary; do
   cmp -s "$work/pf1/$f" "$work/pf2/$f" || fail "periodic x,z on 2 ranks: $f differs"
+done
+# --dual (the Voronoi cells as a polyMesh, written on rank 0 from the
+# gathered mesh): frontdt's files byte for byte, plain and periodic, at 1-3
+# ranks; without a gathered polyMesh output it is a usage error
+mkdir -p "$work/pd0" "$work/pdp0"
+"$frontdt" "$work/uniform.xyz" -q -o "$work/pd0/polyMesh" --dual 2>"$work/pd.err" ||
+  fail "frontdt --dual: $(cat "$work/pd.err")"
+"$frontdt" "$work/pch.xyz" --periodic x,z --box 0,0,0,1,1,1 -q -o "$work/pdp0/polyMesh" --dual \
+  2>"$work/pd.err" || fail "frontdt --periodic --dual: $(cat "$work/pd.err")"
+for np in 1 2 3; do
+  checks=$((checks + 1))
+  rm -rf "$work/pd$np" "$work/pdp$np"
+  mkdir -p "$work/pd$np" "$work/pdp$np"
+  mpi "$np" 300 "$fmpi" "$work/uniform.xyz" -q -o "$work/pd$np/polyMesh" --dual ||
+    fail "--dual on $np ranks"
+  mpi "$np" 300 "$fmpi" "$work/pch.xyz" --periodic x,z --box 0,0,0,1,1,1 -q \
+    -o "$work/pdp$np/polyMesh" --dual || fail "--periodic --dual on $np ranks"
+  for f in points faces owner neighbour boundary; do
+    cmp -s "$work/pd0/polyMesh/$f" "$work/pd$np/polyMesh/$f" ||
+      fail "--dual on $np ranks: $f differs from frontdt's"
+    cmp -s "$work/pdp0/polyMesh/$f" "$work/pdp$np/polyMesh/$f" ||
+      fail "--periodic --dual on $np ranks: $f differs from frontdt's"
+  done
+done
+for bad in "" "-o $work/pdx.vtu" "-o $work/pdx.pvtu"; do
+  checks=$((checks + 1))
+  # shellcheck disable=SC2086 # $bad is the options, split on purpose
+  mpi 2 60 "$fmpi" "$work/uniform.xyz" -q --dual $bad 2>"$work/pd.err"
+  rc=$?
+  [[ $rc -eq 1 ]] && grep -q "needs an -o CASE/constant/polyMesh" "$work/pd.err" &&
+    [[ ! -e $work/pdx.vtu && ! -e $work/pdx.pvtu ]] || fail "--dual $bad under MPI: exit $rc"
 done
 checks=$((checks + 1))
 printf '0.5 1.5 0.5\n' >>"$work/pu.xyz"

@@ -1,6 +1,7 @@
 /* The CLI's Voronoi outputs: see dual.h. */
 #include "cli/dual.h"
 #include "api/dual.h"
+#include "cli/cli.h"
 
 #include <errno.h>
 #include <math.h>
@@ -354,6 +355,11 @@ int fdt_cli_interp_write(const fdt_cli_dual *d, fdt_result *res, const double *x
     free(q);
     free(out);
     return r;
+}
+
+int fdt_cli_dual_exit(int err)
+{
+    return err == FDT_EIO ? CLI_WRITE : err == FDT_EFORMAT ? CLI_INPUT : fdt_cli_engine_exit(err);
 }
 
 int fdt_cli_dual_mesh(const fdt_cli_dual *d, fdt_result *res, const double *xyz, size_t n,

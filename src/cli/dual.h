@@ -38,6 +38,11 @@ typedef struct fdt_cli_dual {
 int fdt_cli_dual_mesh(const fdt_cli_dual *d, fdt_result *res, const double *xyz, size_t n,
                       const char *path, char *err, size_t errlen);
 
+/* The exit code (src/cli/cli.h) of an error of the cells' or the dual's
+ * steps: a file they could not write, a malformed file they read, else as
+ * the engine's. */
+int fdt_cli_dual_exit(int err);
+
 /* The message of the cells' error r (diag: the library's) into err:
  * "WHAT: the error: diag", or "WHAT: diag" for FDT_ERANGE, where diag says
  * all (the cells', not a coordinate's range). */

@@ -711,12 +711,6 @@ static double *demo_points(size_t n)
 /* Error mapping                                                             */
 /* ------------------------------------------------------------------------ */
 
-/* The exit code of the dual's step (src/cli/dual.h): a file it could not
- * write, a malformed file it read, else as the engine's. */
-static int exit_for_dual(int err)
-{
-    return err == FDT_EIO ? CLI_WRITE : err == FDT_EFORMAT ? CLI_INPUT : fdt_cli_engine_exit(err);
-}
 
 /* Threads for reading a text file: those of the triangulation, at most
  * one an online CPU (more only take turns); one in serial mode, so that
@@ -1507,7 +1501,7 @@ static int triangulate(const cli *c, run_state *rs)
                                     sizeof derr)) != FDT_OK) {
             say("%s", derr);
             (void)fanout_close(&rs->fo, 0);
-            return exit_for_dual(r);
+            return fdt_cli_dual_exit(r);
         }
         r = fdt_voronoi_stream(rs->ctx, rs->xyz, rs->n, &o, &sink, &cells, &rs->res);
     } else if (rs->streaming) {
@@ -1641,7 +1635,7 @@ static int write_meshes(const cli *c, run_state *rs)
             if (r != FDT_OK) {
                 progress_clear(&rs->prog);
                 say("%s", err);
-                code = exit_for_dual(r);
+                code = fdt_cli_dual_exit(r);
             }
             continue;
         }
@@ -1673,7 +1667,7 @@ static int dual_steps(const cli *c, run_state *rs)
         rs->tm.voronoi = fdt_now_s() - t0;
         if (r != FDT_OK) {
             say("%s: %s", rs->name, derr);
-            return exit_for_dual(r);
+            return fdt_cli_dual_exit(r);
         }
     }
     if (fdt_cli_interp_wanted(&c->dual)) {
@@ -1684,7 +1678,7 @@ static int dual_steps(const cli *c, run_state *rs)
         rs->tm.interpolate = fdt_now_s() - t0;
         if (r != FDT_OK) {
             say("%s", derr);
-            return exit_for_dual(r);
+            return fdt_cli_dual_exit(r);
         }
     }
     return CLI_OK;

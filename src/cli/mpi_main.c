@@ -167,6 +167,9 @@ static int take_option(opts *o, int id, const char *v, int rank)
     case FDT_OPT_DENSITY:
         o->cells.density = v;
         return -1;
+    case FDT_OPT_DUAL:
+        o->cells.dual = 1;
+        return -1;
     case FDT_OPT_BOX:
         if (fdt_cli_parse_box(v, o->cells.box, err, sizeof err) != 0) {
             say0(rank, "%s", err);
@@ -192,6 +195,26 @@ static int take_option(opts *o, int id, const char *v, int rank)
         say0(rank, "internal error: option row %d has no parser", id);
         return CLI_INTERNAL;
     }
+}
+
+/* --dual on rank 0: the gathered mesh res's Voronoi cells as frontdt
+ * writes them (src/cli/dual.h), its tets sorted first so that the files are
+ * frontdt's bytes whatever the ranks; the triangulation a periodic dual
+ * runs takes one thread, as a rank's work does. An exit code. */
+static int write_dual(const opts *o, fdt_result *res, const double *xyz, size_t n)
+{
+    char err[FDT_IO_PATH + 600];
+    fdt_cli_dual d = o->cells;
+    d.threads = 1;
+    int r = fdt_result_sort(res);
+    if (r == FDT_OK)
+        r = fdt_cli_dual_mesh(&d, res, xyz, n, o->output, err, sizeof err);
+    else
+        snprintf(err, sizeof err, "%s: out of memory sorting the tets", o->output);
+    if (r == FDT_OK)
+        return CLI_OK;
+    fprintf(stderr, "frontdt-mpi: %s\n", err);
+    return fdt_cli_dual_exit(r);
 }
 
 /* The cells' options (frontdt's rules, src/cli/dual.h), and what only
@@ -303,6 +326,14 @@ static int parse(int argc, char **argv, opts *o, int rank, int size)
         say0(rank, "no input file");
         if (rank == 0)
             usage(stderr);
+        return CLI_USAGE;
+    }
+    /* --dual: the gathered mesh's cells, written on rank 0 as frontdt
+     * writes them */
+    if (o->cells.dual && (!o->output || fdt_mpo_kind(o->output) != FDT_MPO_GATHER ||
+                          fdt_format_by_path(o->output) != fdt_format_by_name("openfoam"))) {
+        say0(rank, "--dual writes the Voronoi cells as an OpenFOAM polyMesh: it needs an -o "
+                   "CASE/constant/polyMesh (gathered to rank 0)");
         return CLI_USAGE;
     }
     if (o->periodic) {
@@ -720,8 +751,11 @@ static int periodic_run(const opts *o, int rank, int size)
             printf("set-hash: %016" PRIx64 "\n", h);
         if (o->hash && fdt_result_hash(res, &h) == FDT_OK)
             printf("hash: %016" PRIx64 "\n", h);
-        if (o->output &&
-            (err = fdt_write_mesh(res, xyz, n, o->output, NULL, diag, sizeof diag)) != FDT_OK) {
+        if (o->output && o->cells.dual)
+            rc = write_dual(o, res, xyz, n);
+        else if (o->output &&
+                 (err = fdt_write_mesh(res, xyz, n, o->output, NULL, diag, sizeof diag)) !=
+                     FDT_OK) {
             fprintf(stderr, "frontdt-mpi: %s\n", diag);
             rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
         }
@@ -980,12 +1014,16 @@ static int run(int argc, char **argv, int rank, int size)
                     else
                         rc = CLI_RESOURCES;
                 }
-                err = rc || !o.output ? FDT_OK
-                                      : fdt_write_mesh(res, r.all_xyz, r.n_input, o.output,
-                                                       NULL, diag, sizeof diag);
-                if (err) {
-                    fprintf(stderr, "frontdt-mpi: %s\n", diag);
-                    rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
+                if (!rc && o.output && o.cells.dual) {
+                    rc = write_dual(&o, res, r.all_xyz, r.n_input);
+                } else {
+                    err = rc || !o.output ? FDT_OK
+                                          : fdt_write_mesh(res, r.all_xyz, r.n_input, o.output,
+                                                           NULL, diag, sizeof diag);
+                    if (err) {
+                        fprintf(stderr, "frontdt-mpi: %s\n", diag);
+                        rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
+                    }
                 }
             }
         }

@@ -126,7 +126,7 @@ const fdt_cli_opt fdt_cli_opts[FDT_OPT_END] = {
         "image offset (3 integers) from the first's;\n"
         ".fdtb the same; .vtu, .vtk, .msh with the image\n"
         "vertices and their input ids", NULL},
-    [FDT_OPT_DUAL] = {"dual", 0, no_argument, NULL, F, 0,
+    [FDT_OPT_DUAL] = {"dual", 0, no_argument, NULL, FM, 0,
         "each OpenFOAM -o (DIR/polyMesh) gets the Voronoi\n"
         "cells clipped by the box instead of the tets:\n"
         "a polyhedral cell a point (duplicates none),\n"
