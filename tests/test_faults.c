@@ -54,6 +54,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "testdir.h"
+#include "api/dual.h"
 #include "testutil.h"
 
 /* ------------------------------------------------------------------ */
@@ -445,6 +446,35 @@ static int sc_pcells(void *arg, const char **bad)
         *bad = "other periodic cells";
     a->want_sum = sum;
     fdt_voronoi_free(&v);
+    return rc;
+}
+
+/* The polyhedral dual (src/api/dual.c) under injection: a plain result's
+ * clipped by the box, or a periodic one's (the images, their
+ * triangulation, the plain dual, the fold): the reference's counts, or a
+ * clean FDT_ENOMEM and nothing held. */
+typedef struct pdual_arg {
+    fdt_result *r;
+    const ptset *ps;
+    size_t want[3]; /* cells, faces, vertices (0: not yet known) */
+} pdual_arg;
+
+static int sc_pdual(void *arg, const char **bad)
+{
+    pdual_arg *a = arg;
+    fdt_dualmesh d;
+    char diag[512];
+    int rc = fdt_dual_build(a->r, a->ps->xyz, a->ps->n, NULL, 1, &d, diag, sizeof diag);
+    if (rc != FDT_OK) {
+        if (d.xyz || d.fstart || d.cyclic || d.cell_of)
+            *bad = "a failed periodic dual kept arrays";
+        return rc;
+    }
+    size_t got[3] = {d.n_cells, d.n_faces, d.n_verts};
+    if (a->want[0] && memcmp(got, a->want, sizeof got))
+        *bad = "another periodic dual";
+    memcpy(a->want, got, sizeof got);
+    fdt_dualmesh_free(&d);
     return rc;
 }
 
@@ -1477,6 +1507,12 @@ int main(int argc, char **argv)
                     scenario sw = {pn, FDT_ENOMEM, sc_pwrite, &wa};
                     inject_all(&sw);
                 }
+                CHECK_EQ(fdt_result_sort(pr), FDT_OK);
+                pdual_arg pda = {pr, &w, {0, 0, 0}};
+                EXPECT(sc_pdual(&pda, &cbad) == FDT_OK && !cbad);
+                snprintf(pn, sizeof pn, "periodic dual %s %s", pa_i ? "x z" : "x y z", ps->name);
+                scenario sdu = {pn, FDT_ENOMEM, sc_pdual, &pda};
+                inject_all(&sdu);
                 fdt_result_free(&pr);
                 free(w.xyz);
             }
@@ -1493,6 +1529,18 @@ int main(int argc, char **argv)
                 snprintf(dn, sizeof dn, "%s %s", dual_what[w], ps->name);
                 scenario sd = {dn, FDT_ENOMEM, sc_dual, &da};
                 inject_all(&sd);
+            }
+            if (!nb && si != 1) { /* the polyhedral dual (--dual), clipped by the box */
+                char dn[96];
+                CHECK_EQ(triangulate(ps, &serial_cfg, 0, &r), FDT_OK);
+                CHECK_EQ(fdt_result_sort(r), FDT_OK);
+                pdual_arg pda = {r, ps, {0, 0, 0}};
+                const char *dbad = NULL;
+                EXPECT(sc_pdual(&pda, &dbad) == FDT_OK && !dbad);
+                snprintf(dn, sizeof dn, "dual polyMesh %s", ps->name);
+                scenario sd = {dn, FDT_ENOMEM, sc_pdual, &pda};
+                inject_all(&sd);
+                fdt_result_free(&r);
             }
         }
     }

@@ -51,7 +51,13 @@ static int periodic_dual(fdt_result *r, const double *xyz, size_t n, int threads
 int fdt_dual_build(fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_options *o,
                    int threads, fdt_dualmesh *d, char *diag, size_t ds)
 {
+    memset(d, 0, sizeof *d); /* zeroed on every error, as the builders leave it */
     if (r && fdt_result_periodic(r, NULL))
         return periodic_dual(r, xyz, n, threads, d, diag, ds);
+    fdt_voronoi_options whole; /* NULL: the points' bounding box */
+    if (!o) {
+        fdt_default_voronoi_options(&whole);
+        o = &whole;
+    }
     return fdt_dualmesh_build(r, xyz, n, o, d, diag, ds);
 }

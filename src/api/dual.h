@@ -16,8 +16,10 @@
 /*
  * The dual of r (the result of triangulating the n points xyz, its tets
  * sorted: the vertices and faces are numbered in their order) into *d
- * (owned by the caller: fdt_dualmesh_free), checked (fdt_dualmesh_check).
- * A plain result's cells are clipped by o's box; a periodic result's
+ * (owned by the caller: fdt_dualmesh_free; zeroed on an error), checked
+ * (fdt_dualmesh_check).
+ * A plain result's cells are clipped by o's box (o NULL: the points'
+ * bounding box); a periodic result's
  * take its own box, and the triangulation of its points and images runs on
  * `threads` threads (0: one per physical core). The errors of
  * fdt_dualmesh_build and fdt_dualmesh_fold, and the triangulation's, with

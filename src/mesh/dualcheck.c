@@ -131,7 +131,7 @@ static int check_faces(const fdt_dualmesh *d, char *diag, size_t ds)
     uint8_t *used = calloc(d->n_verts + 1, 1);
     if (!used) {
         fdt_diag(diag, ds, "out of memory");
-        return -1;
+        return FDT_ENOMEM;
     }
     int bad = 0;
     for (size_t f = 0; f < d->n_faces && !bad; f++) {
@@ -191,7 +191,7 @@ static int check_cell(const fdt_dualmesh *d, const size_t *cs, const size_t *cf,
         int out = d->owner[f] == (int32_t)c;
         if (grow(buf, cap, m + k) != 0) {
             fdt_diag(diag, ds, "out of memory");
-            return -1;
+            return FDT_ENOMEM;
         }
         for (size_t i = 0; i < k; i++) {
             uint64_t a = (uint32_t)v[i], b = (uint32_t)v[(i + 1) % k];
@@ -361,24 +361,24 @@ int fdt_dualmesh_check_scaled(fdt_dualmesh *d, char *diag, size_t ds)
 int fdt_dualmesh_check(const fdt_dualmesh *d, char *diag, size_t ds)
 {
     fdt_diag(diag, ds, "%s", "");
-    if (check_faces(d, diag, ds) != 0)
-        return -1;
+    int rc = check_faces(d, diag, ds);
+    if (rc != 0)
+        return rc;
     size_t *cs = NULL, *cf = NULL;
     if (fdt_dualmesh_cell_faces(d, &cs, &cf) != FDT_OK) {
         fdt_diag(diag, ds, "out of memory");
-        return -1;
+        return FDT_ENOMEM;
     }
     uint64_t *buf = NULL;
     size_t cap = 0;
-    int bad = 0;
-    for (size_t c = 0; c < d->n_cells && !bad; c++)
-        bad = check_cell(d, cs, cf, c, &buf, &cap, diag, ds) != 0;
-    if (!bad)
-        bad = check_walls(d, diag, ds) != 0;
-    if (!bad)
-        bad = check_cyclic(d, diag, ds) != 0;
+    for (size_t c = 0; c < d->n_cells && !rc; c++)
+        rc = check_cell(d, cs, cf, c, &buf, &cap, diag, ds);
+    if (!rc)
+        rc = check_walls(d, diag, ds);
+    if (!rc)
+        rc = check_cyclic(d, diag, ds);
     free(buf);
     free(cs);
     free(cf);
-    return bad ? -1 : 0;
+    return rc;
 }

@@ -1545,8 +1545,9 @@ static int build(fdt_result *r, const double *xyz, size_t n, const fdt_voronoi_o
     double box[6];
     memcpy(box, d->box, sizeof box);
     memcpy(d->box, w.box, sizeof box);
-    if (!err && check && fdt_dualmesh_check(d, diag, diag_size) != 0)
-        err = FDT_EINTERNAL;
+    int bad = !err && check ? fdt_dualmesh_check(d, diag, diag_size) : 0;
+    if (bad)
+        err = bad == FDT_ENOMEM ? FDT_ENOMEM : FDT_EINTERNAL;
     memcpy(d->box, box, sizeof box);
     for (size_t i = 0; !err && ex && i < 3 * d->n_verts; i++)
         d->xyz[i] = ldexp(d->xyz[i], ex);

@@ -94,8 +94,8 @@ void fdt_dualmesh_free(fdt_dualmesh *d);
  * wall's faces covering it once (their areas, turned out of the box, add
  * up to the wall's to 1e-9); in a periodic dual, the walls of its periodic
  * axes empty and each cyclic pair's faces translates of each other, from
- * the same point, turned the other way (to 1e-6 of the face's size). 0, or
- * -1 with the first fault in diag.
+ * the same point, turned the other way (to 1e-6 of the face's size). 0,
+ * -1 with the first fault in diag, or FDT_ENOMEM (nothing was checked).
  */
 int fdt_dualmesh_check(const fdt_dualmesh *d, char *diag, size_t diag_size);
 

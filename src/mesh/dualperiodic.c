@@ -442,8 +442,9 @@ int fdt_dualmesh_fold(const fdt_dualmesh *P, const fdt_dual_images *im, const do
         d->n_input = im->n;
         memcpy(d->box, pbox, sizeof d->box);
         d->periodic = periodic;
-        if (fdt_dualmesh_check_scaled(d, diag, ds) != 0)
-            err = FDT_EINTERNAL;
+        int bad = fdt_dualmesh_check_scaled(d, diag, ds);
+        if (bad)
+            err = bad == FDT_ENOMEM ? FDT_ENOMEM : FDT_EINTERNAL;
     }
     if (err == FDT_ENOMEM)
         fdt_diag(diag, ds, "out of memory");
