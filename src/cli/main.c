@@ -707,11 +707,6 @@ static double *demo_points(size_t n)
     return xyz;
 }
 
-/* ------------------------------------------------------------------------ */
-/* Error mapping                                                             */
-/* ------------------------------------------------------------------------ */
-
-
 /* Threads for reading a text file: those of the triangulation, at most
  * one an online CPU (more only take turns); one in serial mode, so that
  * mode stays sequential from end to end. */

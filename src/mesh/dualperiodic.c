@@ -119,7 +119,8 @@ static int dual_box(const fdt_result *r, const double *xyz, const fdt_periodic_b
             fdt_images_round(xyz + 3 * (size_t)v[i], o + 3 * i, b->lo, b->hi, p[i], NULL);
         if (fdt_circumcenter(p[0], p[1], p[2], p[3], c) != 0) {
             fdt_diag(diag, ds, "tet %zu of the periodic mesh (points %u, %u, %u, %u) is flat "
-                "in doubles: its Voronoi vertex cannot be placed", t, (unsigned)v[0],
+                "in doubles, or its circumcentre beyond them: its Voronoi vertex cannot be "
+                "placed", t, (unsigned)v[0],
                 (unsigned)v[1], (unsigned)v[2], (unsigned)v[3]);
             return FDT_ERANGE;
         }
@@ -235,6 +236,15 @@ static int first_sign(const int8_t d[3])
     return 0;
 }
 
+/* The input id of cell c, for the messages (a scan: errors only). */
+static size_t input_of(const fdt_dual_images *im, size_t c)
+{
+    for (size_t i = 0; i < im->n; i++)
+        if (im->cell_of[i] == (int32_t)c)
+            return i;
+    return c;
+}
+
 typedef struct fold {
     const fdt_dualmesh *P;
     fdt_dualmesh *d;
@@ -258,7 +268,8 @@ static void put_face(fold *w, size_t i, size_t f, size_t z, int32_t own)
 }
 
 /* Where face g of P starts to be listed from the point of face f's first
- * moved by sep: its vertex nearest there. */
+ * moved by sep: its vertex nearest there (in the largest coordinate
+ * difference: no square of a 1e-160 wide set's underflows). */
 static size_t nearest_start(const fdt_dualmesh *P, size_t f, size_t g, const double sep[3])
 {
     const double *x = P->xyz + 3 * (size_t)P->fverts[P->fstart[f]];
@@ -268,7 +279,7 @@ static size_t nearest_start(const fdt_dualmesh *P, size_t f, size_t g, const dou
         const double *y = P->xyz + 3 * (size_t)P->fverts[P->fstart[g] + j];
         double dd = 0;
         for (int k = 0; k < 3; k++)
-            dd += (x[k] + sep[k] - y[k]) * (x[k] + sep[k] - y[k]);
+            dd = fmax(dd, fabs(x[k] + sep[k] - y[k]));
         if (dd < bd) {
             bd = dd;
             best = j;
@@ -301,8 +312,8 @@ int fdt_dualmesh_fold(const fdt_dualmesh *P, const fdt_dual_images *im, const do
     for (size_t s = 0; !err && s < im->m; s++) {
         int32_t c = P->cell_of[s];
         if (c < 0 || (s < C && (size_t)c != s)) {
-            fdt_diag(diag, ds, "an image of point %u rounds onto another point: the periodic "
-                "cells cannot be told apart in doubles", (unsigned)im->src[s]);
+            fdt_diag(diag, ds, "an image of point %zu rounds onto another point: the periodic "
+                "cells cannot be told apart in doubles", input_of(im, im->src[s]));
             err = FDT_ERANGE;
         } else if (s >= C)
             img_of[(size_t)c - C] = s;
@@ -327,8 +338,8 @@ int fdt_dualmesh_fold(const fdt_dualmesh *P, const fdt_dual_images *im, const do
             if ((size_t)P->owner[f] >= C)
                 continue;
             if (periodic >> (p / 2) & 1) {
-                fdt_diag(diag, ds, "the cell of point %d reaches the images' box",
-                    P->owner[f]);
+                fdt_diag(diag, ds, "the cell of point %zu reaches the images' box",
+                    input_of(im, (size_t)P->owner[f]));
                 err = FDT_EINTERNAL;
             }
             nwall++;
@@ -356,12 +367,12 @@ int fdt_dualmesh_fold(const fdt_dualmesh *P, const fdt_dual_images *im, const do
                                         P->fverts + P->fstart[g->f],
                                         P->fstart[g->f + 1] - P->fstart[g->f],
                                         nearest_start(P, f, g->f, sep), sep)) {
-            fdt_diag(diag, ds, "the Voronoi face of points %u and %u across a period cannot be "
+            fdt_diag(diag, ds, "the Voronoi face of points %zu and %zu across a period cannot be "
                 "matched with its copy on the other side in doubles: the images of the points "
                 "are rounded (their coordinates plus a period are not doubles) and the face is "
                 "too small or too near a cospherical tie to survive it (a period that adds "
                 "exactly to the coordinates, e.g. a power of two on a grid of its ulp, keeps "
-                "the copies exact)", (unsigned)cf[i].a, (unsigned)cf[i].j);
+                "the copies exact)", input_of(im, cf[i].a), input_of(im, cf[i].j));
             err = FDT_ERANGE;
             break;
         }
