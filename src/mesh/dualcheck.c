@@ -350,6 +350,12 @@ int fdt_dualmesh_check_scaled(fdt_dualmesh *d, char *diag, size_t ds)
     for (size_t i = 0; i < 3 * d->n_verts && e; i++)
         if (ldexp(ldexp(d->xyz[i], -e), e) != d->xyz[i])
             e = 0; /* a vertex would lose bits: checked as it is */
+    for (int k = 0; k < 6 && e; k++)
+        if (ldexp(ldexp(d->box[k], -e), e) != d->box[k])
+            e = 0;
+    for (size_t i = 0; i < 3 * d->n_cyclic && e; i++)
+        if (ldexp(ldexp(d->cyclic[i / 3].sep[i % 3], -e), e) != d->cyclic[i / 3].sep[i % 3])
+            e = 0;
     if (e)
         scale_dual(d, e);
     int rc = fdt_dualmesh_check(d, diag, ds);
