@@ -306,10 +306,23 @@ cells_error "a point outside --box" "$work/lattice.xyz" --box 0,0,0,1,1,1
 awk '{print} NR == 101 {printf "%.17g %.17g %.17g\n", $1, $2 + 2e-16, $3}' \
   "$work/uniform.xyz" >"$work/close.xyz"
 cells_error "two points too close for the cells" "$work/close.xyz"
+# --voronoi FILE.vtu: the polyhedra made on rank 0 from the gathered mesh,
+# frontdt's bytes (beside the ranks' --density table); refused beside pieces
+"$frontdt" -q "$work/uniform.xyz" --voronoi "$work/c.f.vtu" --density "$work/c.f.d" ||
+  fail "frontdt --voronoi FILE.vtu"
+for np in 1 3; do
+  checks=$((checks + 1))
+  rm -f "$work/c.vtu" "$work/c.d"
+  mpi "$np" 300 "$fmpi" -q "$work/uniform.xyz" --voronoi "$work/c.vtu" --density "$work/c.d" ||
+    fail "--voronoi FILE.vtu on $np ranks: exit $?"
+  cmp -s "$work/c.f.vtu" "$work/c.vtu" && cmp -s "$work/c.f.d" "$work/c.d" ||
+    fail "--voronoi FILE.vtu on $np ranks: not frontdt's files"
+done
 checks=$((checks + 1))
-mpi 2 60 "$fmpi" -q "$work/uniform.xyz" --voronoi "$work/c.vtu" 2>"$work/c.err"
-[[ $? -eq 1 ]] && grep -q "frontdt's alone" "$work/c.err" && [[ ! -e $work/c.vtu ]] ||
-  fail "--voronoi FILE.vtu under MPI: not refused as a usage error"
+rm -f "$work/c.vtu"
+mpi 2 60 "$fmpi" -q "$work/uniform.xyz" --voronoi "$work/c.vtu" -o "$work/cv.pvtu" 2>"$work/c.err"
+[[ $? -eq 1 ]] && grep -q "not beside an -o of pieces" "$work/c.err" && [[ ! -e $work/c.vtu ]] ||
+  fail "--voronoi FILE.vtu beside pieces under MPI: not refused as a usage error"
 # A face waiting for each answer (--no-park, message mode's loop) gives the
 # same mesh as parked faces.
 extra=(--no-park)
@@ -730,6 +743,12 @@ for np in 1 2 3; do
       fail "--periodic --dual on $np ranks: $f differs from frontdt's"
   done
 done
+checks=$((checks + 1))
+"$frontdt" "$work/pch.xyz" --periodic x,z --box 0,0,0,1,1,1 -q --voronoi "$work/pv0.vtu" ||
+  fail "frontdt --periodic --voronoi FILE.vtu"
+mpi 2 300 "$fmpi" "$work/pch.xyz" --periodic x,z --box 0,0,0,1,1,1 -q --voronoi "$work/pv2.vtu" &&
+  cmp -s "$work/pv0.vtu" "$work/pv2.vtu" ||
+  fail "--periodic --voronoi FILE.vtu on 2 ranks: not frontdt's file"
 for bad in "" "-o $work/pdx.vtu" "-o $work/pdx.pvtu"; do
   checks=$((checks + 1))
   # shellcheck disable=SC2086 # $bad is the options, split on purpose

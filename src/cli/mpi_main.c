@@ -65,6 +65,8 @@ typedef struct opts {
     int fail_write;      /* --inject-write-failure RANK, -1: none */
     int kind;            /* FDT_MPO_* of -o */
     fdt_cli_dual cells;  /* --voronoi, --voronoi-format, --density, --box */
+    const char *vtu;     /* --voronoi FILE.vtu: the polyhedra, made on rank 0
+                            from the gathered mesh (cells.voronoi is then NULL) */
     unsigned periodic;   /* --periodic AXES (the periods: --box) */
 } opts;
 
@@ -217,6 +219,22 @@ static int write_dual(const opts *o, fdt_result *res, const double *xyz, size_t 
     return fdt_cli_dual_exit(r);
 }
 
+/* --voronoi FILE.vtu on rank 0: the gathered mesh res's cells as VTK
+ * polyhedra, as frontdt writes them (src/cli/dual.h). An exit code. */
+static int write_vtu_cells(const opts *o, const fdt_result *res, const double *xyz, size_t n)
+{
+    char err[FDT_IO_PATH + 600];
+    fdt_cli_dual d = o->cells;
+    d.voronoi = o->vtu;
+    d.density = NULL; /* the ranks' table */
+    d.threads = 1;
+    int r = fdt_cli_dual_write(&d, res, xyz, n, err, sizeof err);
+    if (r == FDT_OK)
+        return CLI_OK;
+    fprintf(stderr, "frontdt-mpi: %s\n", err);
+    return fdt_cli_dual_exit(r);
+}
+
 /* The cells' options (frontdt's rules, src/cli/dual.h), and what only
  * frontdt does: -1 to go on, or an exit code. */
 static int check_cells(opts *o, int rank)
@@ -230,9 +248,15 @@ static int check_cells(opts *o, int rank)
     int nb;
     unsigned skip;
     if (fdt_cli_cells_table(&o->cells, &fmt, &nb, &skip)) {
-        say0(rank, "--voronoi FILE.vtu (the cells as polyhedra) is frontdt's alone; "
-                   "frontdt-mpi writes the cells as text or .csv");
-        return CLI_USAGE;
+        /* the polyhedra need every cell's neighbours' points: made on rank
+         * 0 from the gathered mesh, as frontdt makes them */
+        if (o->output && fdt_mpo_kind(o->output) != FDT_MPO_GATHER) {
+            say0(rank, "--voronoi FILE.vtu (the cells as polyhedra) is made on rank 0 from the "
+                       "gathered mesh: not beside an -o of pieces");
+            return CLI_USAGE;
+        }
+        o->vtu = v;
+        o->cells.voronoi = NULL; /* the ranks' tables: --density alone */
     }
     if (o->output && fdt_cli_dual_wanted(&o->cells))
         for (int k = 0; k < 2; k++) {
@@ -759,6 +783,8 @@ static int periodic_run(const opts *o, int rank, int size)
             fprintf(stderr, "frontdt-mpi: %s\n", diag);
             rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
         }
+        if (rc == CLI_OK && o->vtu)
+            rc = write_vtu_cells(o, res, xyz, n);
     }
     if (rank == 0 && !err) {
         if (rc == CLI_OK && cells &&
@@ -948,7 +974,8 @@ static int run(int argc, char **argv, int rank, int size)
     /* the gather (-o to rank 0, --hash) takes the points along */
     int cells = fdt_cli_dual_wanted(&o.cells);
     fdt_mpi_setup_opts so = {o.input, o.format, o.leaf,
-                             (o.output && !pieces) || o.hash || o.kind == FDT_MPO_ELE || cells};
+                             (o.output && !pieces) || o.hash || o.kind == FDT_MPO_ELE || cells ||
+                                 o.vtu};
     int err = fdt_mpi_setup(MPI_COMM_WORLD, &so, &L, diag, sizeof diag);
     double t_read = MPI_Wtime() - t0;
     if (err) {
@@ -961,7 +988,7 @@ static int run(int argc, char **argv, int rank, int size)
     int own = !pieces ? 0 : o.kind == FDT_MPO_VTU ? FDT_MPI_OWN_POINTS : FDT_MPI_OWN_HULL;
     if (cells) /* a star's tets with their points, and the hull */
         own |= FDT_MPI_OWN_POINTS | FDT_MPI_OWN_HULL;
-    int gather = (o.output && !pieces) || o.hash;
+    int gather = (o.output && !pieces) || o.hash || o.vtu;
     fdt_mpi_opts mo = {o.leaf, o.search, gather, own, o.fail_rank, o.fail_after, o.no_park};
     err = fdt_mpi_run(MPI_COMM_WORLD, &L, &mo, &r, diag, sizeof diag);
     if (err) {
@@ -1025,6 +1052,8 @@ static int run(int argc, char **argv, int rank, int size)
                         rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
                     }
                 }
+                if (!rc && o.vtu)
+                    rc = write_vtu_cells(&o, res, r.all_xyz, r.n_input);
             }
         }
         fflush(stdout);
