@@ -351,6 +351,33 @@ static void test_rings(size_t m)
     free(xyz);
 }
 
+/* A torus (R 3, r 1) on its nu x nv parameter grid (gen_points `torus`):
+ * every point on the box's walls and corners 7e-16 off where they would
+ * be. At 4 x 3 the box corner (4, -4, z) is 4 from two points but for
+ * a rounding: it came as a vertex of the face between their cells and as
+ * a corner of its own (cell 0 not closed); at 4 x 4 two Voronoi edges'
+ * crossings snapped onto one corner as two vertices (an edge twice). */
+static void test_torus(size_t nu, size_t nv)
+{
+    double *xyz = malloc(nu * nv * 3 * sizeof *xyz);
+    CHECK(xyz);
+    size_t n = 0;
+    for (size_t i = 0; i < nu; i++)
+        for (size_t j = 0; j < nv; j++) {
+            double u = 6.283185307179586 * (double)i / (double)nu;
+            double v = 6.283185307179586 * (double)j / (double)nv, w = 3.0 + cos(v);
+            xyz[3 * n] = w * cos(u);
+            xyz[3 * n + 1] = w * sin(u);
+            xyz[3 * n + 2] = sin(v);
+            n++;
+        }
+    char what[64];
+    snprintf(what, sizeof what, "a %zu x %zu torus", nu, nv);
+    fdt_dualmesh d = check_dual(what, xyz, n, NULL);
+    fdt_dualmesh_free(&d);
+    free(xyz);
+}
+
 /* Points closer than doubles can hold the cells between: refused with
  * FDT_ERANGE naming them, nothing handed out. */
 static void expect_beyond_doubles(const char *what, const double *xyz, size_t n)
@@ -392,6 +419,9 @@ int main(void)
 {
     test_rings(10);
     test_rings(45);
+    test_torus(4, 3);
+    test_torus(4, 4);
+    test_torus(5, 4);
     test_beyond_doubles();
     test_small_and_flat();
     test_lattice(2);
