@@ -15,17 +15,27 @@
 #include "geom/morton.h"
 #include "testutil.h"
 
-/* 21 bits a coordinate in the box, x's bit above y's above z's. */
-static uint64_t ref_key(const double *p, const double box[6])
+/* The bits a coordinate for n points: 21, or what a 64-bit record leaves
+ * beside an index of n - 1 (src/geom/morton.c). */
+static int key_bits(size_t n)
+{
+    int idbits = 1;
+    while (((uint64_t)(n ? n - 1 : 0) >> idbits) != 0)
+        idbits++;
+    return (64 - idbits) / 3 < 21 ? (64 - idbits) / 3 : 21;
+}
+
+/* `bits` bits a coordinate in the box, x's bit above y's above z's. */
+static uint64_t ref_key(const double *p, const double box[6], int bits)
 {
     uint64_t key = 0;
     uint32_t c[3];
     for (int k = 0; k < 3; k++) {
         double w = box[k + 3] - box[k], t = w > 0 ? (p[k] - box[k]) / w : 0;
         t = t > 0 ? (t < 1 ? t : 1) : 0;
-        c[k] = (uint32_t)(t * 2097151.0);
+        c[k] = (uint32_t)(t * (double)((1u << bits) - 1));
     }
-    for (int b = 20; b >= 0; b--)
+    for (int b = bits - 1; b >= 0; b--)
         for (int k = 0; k < 3; k++)
             key = key << 1 | ((c[k] >> b) & 1);
     return key;
@@ -69,8 +79,8 @@ static void check_order(const double *p, size_t n, const double box[6], const ui
         CHECK(order[i] < n && !seen[order[i]] && (!skip || !skip[order[i]]));
         seen[order[i]] = 1;
         if (i > 0) {
-            uint64_t a = ref_key(p + 3 * (size_t)order[i - 1], box);
-            uint64_t b = ref_key(p + 3 * (size_t)order[i], box);
+            uint64_t a = ref_key(p + 3 * (size_t)order[i - 1], box, key_bits(n));
+            uint64_t b = ref_key(p + 3 * (size_t)order[i], box, key_bits(n));
             CHECK(a < b || (a == b && order[i - 1] < order[i]));
         }
     }

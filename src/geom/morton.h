@@ -10,9 +10,11 @@
 #include "frontdt.h"
 
 /* Writes to order[] the indices i < n of the points pts (3 doubles each)
- * with skip[i] 0 (skip NULL: every point), sorted by the Morton key of 21
- * bits a coordinate in box (xmin, ymin, zmin, xmax, ymax, zmax; points
- * outside count as on its walls), ties by index. Returns how many, or -1
+ * with skip[i] 0 (skip NULL: every point), sorted by their Morton key in
+ * box (xmin, ymin, zmin, xmax, ymax, zmax; points outside count as on its
+ * walls), ties by index. The key has 21 bits a coordinate, or fewer where
+ * an index of n - 1 and the key must share 64 bits: (64 - b) / 3 for b
+ * the bits of n - 1 (14 at a million points). Returns how many, or -1
  * when out of memory. */
 long fdt_morton_order(const double *pts, size_t n, const double box[6], const uint8_t *skip,
                       uint32_t *order);

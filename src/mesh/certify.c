@@ -3,6 +3,7 @@
 #include "mesh/certify.h"
 
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -347,21 +348,44 @@ typedef struct cert_job {
     fdt_certify_fail why;
     size_t skipped, pairs;
     int rc;
-    pthread_t th;
-    int started;
 } cert_job;
 
-static void *cert_run(void *arg)
+/* The ranges of a parallel certificate and the next one to take. */
+typedef struct cert_pool {
+    cert_job *jobs;
+    int njobs;
+    /* relaxed: a taker only needs a range no other taker got (the
+     * counter's own modification order); what a range's check wrote is
+     * published to the caller by pthread_join. */
+    atomic_int next;
+    pthread_t th;
+    int started;
+} cert_pool;
+
+static void *cert_take(void *arg)
 {
-    cert_job *j = arg;
-    j->rc = certify_range(j->m, j->lo, j->hi, j->vis, j->index, &j->pc, &j->why, &j->skipped,
-                          &j->pairs);
+    cert_pool *p = arg;
+    int i;
+    while ((i = atomic_fetch_add_explicit(&p->next, 1, memory_order_relaxed)) < p->njobs) {
+        cert_job *j = &p->jobs[i];
+        j->rc = certify_range(j->m, j->lo, j->hi, j->vis, j->index, &j->pc, &j->why, &j->skipped,
+                              &j->pairs);
+    }
     return NULL;
 }
 
+/* Ranges a thread: the lower slots, reused through the whole build, cost
+ * more a slot than the upper ones (their neighbours far apart), so halves
+ * left one thread idle a third of the time (bench/NOTES.md entry 126);
+ * threads take the next range as they finish one. */
+#define RANGES_A_THREAD 4
+
 int fdt_certify_jobs(const fdt_ins *m, int nthreads)
 {
-    return nthreads <= 1 || m->nslots < 4096 ? 1 : nthreads;
+    if (nthreads <= 1 || m->nslots < 4096)
+        return 1;
+    int r = nthreads * RANGES_A_THREAD;
+    return r > FDT_CERTIFY_MAX_JOBS ? FDT_CERTIFY_MAX_JOBS : r;
 }
 
 int fdt_certify_parallel(const fdt_ins *m, int nthreads, fdt_pred_counts *cnt,
@@ -373,29 +397,41 @@ int fdt_certify_parallel(const fdt_ins *m, int nthreads, fdt_pred_counts *cnt,
 int fdt_certify_parallel_visit(const fdt_ins *m, int nthreads, const fdt_certify_visit *vis,
                                fdt_pred_counts *cnt, fdt_certify_fail *why)
 {
-    if (fdt_certify_jobs(m, nthreads) == 1)
+    int nj = fdt_certify_jobs(m, nthreads);
+    if (nj == 1)
         return certify_serial(m, vis, cnt, why);
-    cert_job *j = calloc((size_t)nthreads, sizeof *j);
-    if (!j)
+    if (nthreads > nj)
+        nthreads = nj;
+    cert_job *j = calloc((size_t)nj, sizeof *j);
+    cert_pool *p = calloc((size_t)nthreads, sizeof *p);
+    if (!j || !p) {
+        free(j);
+        free(p);
         return FDT_ENOMEM;
-    for (int i = 0; i < nthreads; i++) {
+    }
+    for (int i = 0; i < nj; i++) {
         j[i].m = m;
         j[i].vis = vis;
         j[i].index = i;
-        j[i].lo = (uint32_t)((uint64_t)m->nslots * (uint64_t)i / (uint64_t)nthreads);
-        j[i].hi = (uint32_t)((uint64_t)m->nslots * (uint64_t)(i + 1) / (uint64_t)nthreads);
+        j[i].lo = (uint32_t)((uint64_t)m->nslots * (uint64_t)i / (uint64_t)nj);
+        j[i].hi = (uint32_t)((uint64_t)m->nslots * (uint64_t)(i + 1) / (uint64_t)nj);
     }
+    /* one counter, shared: p[0]'s */
+    atomic_init(&p[0].next, 0);
+    p[0].jobs = j;
+    p[0].njobs = nj;
     int err = FDT_OK;
     for (int i = 1; i < nthreads; i++)
-        if (!(j[i].started = fdt_spawn(&j[i].th, 0, cert_run, &j[i]) == 0))
+        if (!(p[i].started = fdt_spawn(&p[i].th, 0, cert_take, &p[0]) == 0))
             err = FDT_ETHREAD;
-    cert_run(&j[0]);
+    cert_take(&p[0]); /* takes every range the others did not */
     for (int i = 1; i < nthreads; i++)
-        if (j[i].started)
-            pthread_join(j[i].th, NULL);
-    /* The joins publish each job's fields to this thread. */
+        if (p[i].started)
+            pthread_join(p[i].th, NULL);
+    /* The joins publish each range's fields to this thread; the lowest
+     * failing range is the one reported, whoever checked it. */
     size_t skipped = 0, pairs = 0;
-    for (int i = 0; i < nthreads && !err; i++) {
+    for (int i = 0; i < nj && !err; i++) {
         if (j[i].rc) {
             err = j[i].rc;
             if (why)
@@ -407,9 +443,10 @@ int fdt_certify_parallel_visit(const fdt_ins *m, int nthreads, const fdt_certify
     if (!err)
         err = certify_balance(m, skipped, pairs, why);
     if (cnt)
-        for (int i = 0; i < nthreads; i++)
+        for (int i = 0; i < nj; i++)
             fdt_pred_counts_add(cnt, &j[i].pc);
     free(j);
+    free(p);
     return err ? err : fdt_certify_vertices(m, why);
 }
 

@@ -60,8 +60,9 @@ int fdt_certify_vertices(const fdt_ins *m, fdt_certify_fail *why);
  * the exact predicate calls. */
 int fdt_certify(const fdt_ins *m, fdt_pred_counts *cnt, fdt_certify_fail *why);
 
-/* The same on nthreads threads (the caller's one of them; slot ranges of
- * equal size, each face checked in the range of one of its slots): FDT_OK,
+/* The same on nthreads threads (the caller's one of them; fdt_certify_jobs
+ * slot ranges of equal size, each taken by the next thread free, each face
+ * checked in the range of one of its slots): FDT_OK,
  * FDT_ECHECK (*why: the failure of the lowest range that failed), or
  * FDT_ETHREAD / FDT_ENOMEM when the helpers could not start. cnt gets the
  * sum of the threads' counts. */
@@ -85,7 +86,9 @@ typedef struct fdt_certify_visit {
 } fdt_certify_visit;
 
 /* How many ranges fdt_certify_parallel_visit splits m into (1 for a small
- * mesh or one thread). */
+ * mesh or one thread; at most FDT_CERTIFY_MAX_JOBS): a function of the
+ * slots and the thread count alone. */
+#define FDT_CERTIFY_MAX_JOBS 64
 int fdt_certify_jobs(const fdt_ins *m, int nthreads);
 
 /* fdt_certify_parallel with vis's pass beside it (vis NULL: none). */

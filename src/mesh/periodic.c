@@ -438,10 +438,11 @@ typedef struct run {
     ext e;
     fdt_images im;
     fdt_ins m;
-    keyset tets[64], hull[64]; /* the kept ones, a set a job (prove_tet) */
+    /* the kept ones, a set a job (prove_tet) */
+    keyset tets[FDT_CERTIFY_MAX_JOBS], hull[FDT_CERTIFY_MAX_JOBS];
     int stars;             /* also gather every tet and hull face with an owned
                               vertex (the owned points' stars: their cells) */
-    keyset star[64], star_hull[64];
+    keyset star[FDT_CERTIFY_MAX_JOBS], star_hull[FDT_CERTIFY_MAX_JOBS];
     int nsets;
     double need[3];        /* a failed round: how far the balls reached */
     const int32_t *names;  /* the points' names in messages, or NULL */
@@ -468,7 +469,7 @@ typedef struct prove_job {
 
 typedef struct prove_pass {
     run *r;
-    prove_job job[64];
+    prove_job job[FDT_CERTIFY_MAX_JOBS];
 } prove_pass;
 
 /* A job's region for the margin m: (c0 - m', c1 + m') around the part's
@@ -723,17 +724,17 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
         return err;
     /* the certificate, and the proofs and kept tets in its pass (on the
      * run's threads, prove_tet) */
-    int T = nthreads < 1 ? 1 : nthreads > 64 ? 64 : nthreads;
+    int T = nthreads < 1 ? 1 : nthreads;
     prove_pass *pp = malloc(sizeof *pp);
     if (!pp)
         return FDT_ENOMEM;
     pp->r = r;
-    T = fdt_certify_jobs(&r->m, T);
+    int nj = fdt_certify_jobs(&r->m, T); /* its ranges: a set each */
     /* each job's kept tets: about its share of the finite tets, times the
      * owned points' share of the points (a tet a point, about), and a
      * tenth more */
-    const size_t keep = (size_t)((double)r->m.nfinite / T * r->nown / r->e.n * 1.1) + 1024;
-    for (int i = 0; i < T; i++) {
+    const size_t keep = (size_t)((double)r->m.nfinite / nj * r->nown / r->e.n * 1.1) + 1024;
+    for (int i = 0; i < nj; i++) {
         prove_init(&pp->job[i], r, m);
         if (!err)
             err = keyset_reserve(&pp->job[i].tets, keep);
@@ -744,7 +745,7 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
     if (err || (err = fdt_certify_parallel_visit(&r->m, T, &vis, &out->pc, &why)) != FDT_OK) {
         if (err == FDT_ECHECK)
             fdt_certify_describe(&why, r->diag, r->dsz);
-        for (int i = 0; i < T; i++) {
+        for (int i = 0; i < nj; i++) {
             keyset_free(&jobs[i].tets);
             keyset_free(&jobs[i].hull);
             keyset_free(&jobs[i].star);
@@ -757,7 +758,7 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
     long repeat_id = -1;
     for (int k = 0; k < 3; k++)
         r->need[k] = 0;
-    for (int i = 0; i < T; i++) {
+    for (int i = 0; i < nj; i++) {
         err = err ? err : jobs[i].err;
         again |= jobs[i].again;
         if (jobs[i].repeat_id >= 0 && (repeat_id < 0 || jobs[i].repeat_id < repeat_id))
@@ -765,13 +766,13 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
         for (int k = 0; k < 3; k++)
             r->need[k] = jobs[i].need[k] > r->need[k] ? jobs[i].need[k] : r->need[k];
     }
-    for (int i = 0; i < T; i++) { /* the run frees them */
+    for (int i = 0; i < nj; i++) { /* the run frees them */
         r->tets[i] = jobs[i].tets;
         r->hull[i] = jobs[i].hull;
         r->star[i] = jobs[i].star;
         r->star_hull[i] = jobs[i].star_hull;
     }
-    r->nsets = T;
+    r->nsets = nj;
     free(pp);
     if (err)
         return err;
