@@ -4,7 +4,8 @@
  *  - fdt_morton_order: every point not skipped once, keys ascending, ties
  *    (equal points, a cell shared) by index;
  *  - fdt_morton_sort: each point keeps its input index, in the order of
- *    fdt_morton_order over the points' own bounding box;
+ *    fdt_morton_order over the points' own bounding box, on 1, 2 and 3
+ *    threads (slices of the records, of the buckets past 2^21);
  *  - no point, one point, all points equal (a box of width 0);
  *  - past 2^21 points, where the sort splits on the top bits first, with
  *    large buckets and with small ones (sorted by insertion).
@@ -103,7 +104,7 @@ static void test_order(size_t n)
     free(p);
 }
 
-static void test_sort(size_t n)
+static void test_sort(size_t n, int threads)
 {
     double *p = points(n), *q = malloc((3 * n + 1) * sizeof *q);
     fdt_vid *orig = malloc((n + 1) * sizeof *orig);
@@ -120,7 +121,7 @@ static void test_sort(size_t n)
             box[k + 3] = i == 0 || x > box[k + 3] ? x : box[k + 3];
         }
     CHECK(fdt_morton_order(p, n, box, NULL, order) == (long)n);
-    CHECK(fdt_morton_sort(q, orig, n) == 0);
+    CHECK(fdt_morton_sort(q, orig, n, threads) == 0);
     for (size_t i = 0; i < n; i++) {
         CHECK(orig[i] == (fdt_vid)(1000 + order[i])); /* the order, ties by index */
         CHECK(memcmp(q + 3 * i, p + 3 * (size_t)order[i], 3 * sizeof *q) == 0);
@@ -163,19 +164,21 @@ static void test_equal_points(void)
         p[3 * i + 2] = 0.25;
         orig[i] = (fdt_vid)(4 - i);
     }
-    CHECK(fdt_morton_sort(p, orig, 5) == 0);
+    CHECK(fdt_morton_sort(p, orig, 5, 2) == 0);
     for (int i = 0; i < 5; i++)
         CHECK(orig[i] == (fdt_vid)(4 - i)); /* one key: the order as it was */
 }
 
 int main(void)
 {
-    /* 2^21 + 5: past the sort's split (the top bits first, then each
-     * bucket; src/geom/morton.c's radix_sort) */
-    const size_t sizes[] = {0, 1, 2, 17, 1000, 50000, ((size_t)1 << 21) + 5};
+    /* 300000: the whole-array passes on 2 and 3 threads; 2^21 + 5: past
+     * the sort's split (the top bits first, then each bucket;
+     * src/geom/morton.c's msort_radix) */
+    const size_t sizes[] = {0, 1, 2, 17, 1000, 50000, 300000, ((size_t)1 << 21) + 5};
     for (size_t i = 0; i < sizeof sizes / sizeof *sizes; i++) {
         test_order(sizes[i]);
-        test_sort(sizes[i]);
+        for (int t = 1; t <= 3; t++) /* the same order on any threads */
+            test_sort(sizes[i], t);
     }
     test_equal_points();
     test_small_buckets();

@@ -92,19 +92,20 @@ static void test_prepare(void)
 
 /* fdt_prepare_inplace (settings.permute_input): the same result as the
  * copying merge, with the points compacted into the caller's array (every
- * family, duplicates across the range, -0 against +0); the array left as
- * it was when a point is refused. */
-static void test_prepare_inplace(void)
+ * family, duplicates across the range or none, -0 against +0), on one
+ * thread and, past 64k points, on two and three (the slices write their
+ * own points when there is no duplicate, else in order); the array left
+ * as it was when a point is refused. */
+static void inplace_case(size_t want, int threads, int dups)
 {
-    const size_t want = 30000;
     double *xyz = malloc(want * 3 * sizeof *xyz);
     double *work = malloc(want * 3 * sizeof *work);
     CHECK(xyz && work);
     for (int fam = 0; fam < NFAMILIES; fam++) {
         size_t n = make_points(fam, want, xyz);
-        for (size_t i = 0; i + 7 < n && n >= 1000; i += 97)
+        for (size_t i = 0; dups && i + 7 < n && n >= 1000; i += 97)
             memcpy(xyz + 3 * i, xyz + 3 * ((i * 7919 + 13) % n), 3 * sizeof *xyz);
-        if (n > 10) {
+        if (dups && n > 10) {
             xyz[3 * 5] = 0.0;
             xyz[3 * 9] = -0.0;
             memcpy(xyz + 3 * 9 + 1, xyz + 3 * 5 + 1, 2 * sizeof *xyz);
@@ -113,25 +114,51 @@ static void test_prepare_inplace(void)
         fdt_prepared ref, in;
         char diag[256];
         CHECK_EQ(fdt_prepare(xyz, n, 1, &ref, diag, sizeof diag), FDT_OK);
-        EXPECTF(fdt_prepare_inplace(work, n, &in, diag, sizeof diag) == FDT_OK, "%s",
+        EXPECTF(fdt_prepare_inplace(work, n, threads, &in, diag, sizeof diag) == FDT_OK, "%s",
                 family_name[fam]);
         EXPECTF(in.p == work && in.p_borrowed && in.m == ref.m && in.ndup == ref.ndup &&
                     in.scale_exp == ref.scale_exp &&
                     !memcmp(in.p, ref.p, 3 * ref.m * sizeof *ref.p) &&
                     !memcmp(in.orig, ref.orig, ref.m * sizeof *ref.orig) &&
                     !memcmp(in.dupmap, ref.dupmap, n * sizeof *ref.dupmap),
-                "%s (%zu points, %zu distinct): in place differs", family_name[fam], n, ref.m);
+                "%s (%zu points, %zu distinct, %d threads): in place differs", family_name[fam],
+                n, ref.m, threads);
         fdt_prepared_free(&in); /* frees the library's arrays, not work */
         EXPECT(in.p == NULL);
         fdt_prepared_free(&ref);
     }
+    free(work);
+    free(xyz);
+}
+
+static void test_prepare_inplace(void)
+{
+    inplace_case(30000, 1, 1);
+    inplace_case(140000, 2, 1);
+    inplace_case(140000, 3, 0);
+    inplace_case(140000, 3, 1);
+    double *xyz = malloc(100 * 3 * sizeof *xyz), *work = malloc(100 * 3 * sizeof *work);
+    CHECK(xyz && work);
+    make_points(0, 100, xyz);
     memcpy(work, xyz, 3 * 100 * sizeof *xyz);
     work[3 * 60 + 1] = NAN;
     memcpy(xyz, work, 3 * 100 * sizeof *xyz);
     fdt_prepared pr;
     char diag[256];
-    EXPECT(fdt_prepare_inplace(work, 100, &pr, diag, sizeof diag) == FDT_ERANGE &&
+    EXPECT(fdt_prepare_inplace(work, 100, 1, &pr, diag, sizeof diag) == FDT_ERANGE &&
            strstr(diag, "point 60") && !memcmp(work, xyz, 3 * 60 * sizeof *xyz));
+    free(work);
+    free(xyz);
+    /* on three threads, the bad point in the last slice: nothing written */
+    const size_t big = 140000;
+    xyz = malloc(big * 3 * sizeof *xyz);
+    work = malloc(big * 3 * sizeof *work);
+    CHECK(xyz && work);
+    make_points(0, big, xyz);
+    xyz[3 * 130000 + 2] = INFINITY;
+    memcpy(work, xyz, 3 * big * sizeof *xyz);
+    EXPECT(fdt_prepare_inplace(work, big, 3, &pr, diag, sizeof diag) == FDT_ERANGE &&
+           strstr(diag, "point 130000") && !memcmp(work, xyz, 3 * big * sizeof *xyz));
     free(work);
     free(xyz);
 }

@@ -203,14 +203,13 @@ static int run_prepare(fdt_context *ctx, const double *xyz, size_t n, fdt_mode m
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
     /* permute_input: the caller's array becomes the point store (the
      * const was the caller's to give up, include/frontdt.h). */
+    int threads = mode == FDT_MODE_SERIAL          ? 1
+                  : cpus >= 1 && nthreads > cpus ? (int)cpus
+                                                 : nthreads;
     int err = ctx->s.permute_input
-                  ? fdt_prepare_inplace((double *)(uintptr_t)xyz, n, pr, ctx->diag,
+                  ? fdt_prepare_inplace((double *)(uintptr_t)xyz, n, threads, pr, ctx->diag,
                                         sizeof ctx->diag)
-                  : fdt_prepare(xyz, n,
-                                mode == FDT_MODE_SERIAL          ? 1
-                                : cpus >= 1 && nthreads > cpus ? (int)cpus
-                                                               : nthreads,
-                                pr, ctx->diag, sizeof ctx->diag);
+                  : fdt_prepare(xyz, n, threads, pr, ctx->diag, sizeof ctx->diag);
     if (!err && pr->ndup == 0) {
         free(pr->dupmap);
         pr->dupmap = NULL;
@@ -407,7 +406,7 @@ static int run_single(fdt_context *ctx, const fdt_sink *user, fdt_engine eng, in
 {
     fdt_prepared *pr = &rs->pr;
     if (eng == FDT_ENGINE_ONE_PART) {
-        if (fdt_morton_sort(pr->p, pr->orig, pr->m) != 0)
+        if (fdt_morton_sort(pr->p, pr->orig, pr->m, nthreads) != 0)
             return FDT_ENOMEM;
     } else if (eng == FDT_ENGINE_FRONT) {
         if (fdt_kd_build(&rs->tree, pr->p, pr->orig, 0, (uint32_t)pr->m, ctx->s.leaf_size) !=

@@ -222,7 +222,7 @@ static int gather(sweep *sw, uint32_t begin, uint32_t end, size_t *nq_out)
         memcpy(sw->Q + 3 * i, sw->P + 3 * (size_t)gid, 3 * sizeof *sw->Q);
     }
     *nq_out = nq;
-    if (fdt_morton_sort(sw->Q, sw->g, nq))
+    if (fdt_morton_sort(sw->Q, sw->g, nq, sw->nthreads))
         return FDT_ENOMEM;
     for (size_t i = 0; i < nq; i++)
         sw->gin[i] = sw->orig[sw->g[i]];

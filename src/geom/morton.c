@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/spawn.h"
+
 /*
  * A point's record: its key in the high bits, its index in the low
  * `idbits` (the fewest that hold n - 1), so that a record is 8 bytes
@@ -100,56 +102,204 @@ static uint64_t *lsd_sort(uint64_t *a, uint64_t *tmp, size_t n, int lo, int hi, 
     return a;
 }
 
-/*
- * a[0 .. n) sorted on its bits [lo, hi), ties in the order they come. Up
- * to SPLIT records, least significant digit first over the whole array
- * (lsd_sort). Past it the top 8 of those bits first (one pass of a
- * counting sort: each bucket a cell of the box, 39k points a bucket at
- * 10M uniform), then each bucket on the bits below, the passes inside the
- * cache: the passes of the whole array through memory were the sort's
- * time there, while on fewer points the buckets' own counts would cost
- * more than they save (bench/NOTES.md entry 118). tmp: n entries. The
- * sorted array is a or tmp: returned; NULL when out of memory.
- */
-static uint64_t *radix_sort(uint64_t *a, uint64_t *tmp, size_t n, int lo, int hi)
+/* The sort's threads: each a slice of the records (or of the buckets),
+ * run phase by phase with fdt_fork_join. */
+enum { BITS = 11, NB = 1 << BITS, NTOP = 1 << 8, SMALL = 32, MAX_T = 16 };
+enum { PH_BOX, PH_KEYS, PH_COUNT, PH_SCATTER, PH_BUCKETS, PH_GATHER };
+
+typedef struct msort msort;
+typedef struct mjob {
+    msort *s;
+    int t;
+    size_t lo, hi;       /* its records (PH_BUCKETS: its buckets) */
+    double box[6];       /* PH_BOX: its points' */
+    size_t count[NB];    /* PH_COUNT: its digits; then where each goes */
+    int err;
+} mjob;
+
+struct msort {
+    const double *pts;
+    const fdt_vid *orig;
+    double *p2;
+    fdt_vid *o2;
+    uint64_t *a, *tmp;  /* the records, and as many more */
+    size_t n;
+    layout l;
+    double box[6];
+    int phase, shift;
+    size_t nb;          /* this pass's digits */
+    size_t start[NTOP]; /* the top pass's buckets' ends (in tmp) */
+    int lo, top;        /* the buckets' bits [lo, top) */
+    int T;
+    mjob job[MAX_T];
+};
+
+/* Sorts tmp's buckets [j->lo, j->hi) (of the top pass) on the bits below
+ * the top, each back into tmp (a's same rows as scratch). */
+static int sort_buckets(msort *s, mjob *j)
 {
-    enum { BITS = 11, B = 1 << BITS, NTOP = 1 << 8, SMALL = 32 };
-    const size_t SPLIT = (size_t)1 << 21;
-    int top = hi - 8;
-    size_t *count = malloc((B + NTOP) * sizeof *count), *start = count + B;
-    if (!count)
-        return NULL;
-    if (n < SPLIT || top <= lo || !digit_pass(a, tmp, n, top, NTOP, start)) {
-        uint64_t *r = lsd_sort(a, tmp, n, lo, n < SPLIT || top <= lo ? hi : top, count);
-        free(count);
-        return r;
-    }
-    /* start[d] is now bucket d's end; tmp holds the buckets */
-    uint64_t kmask = ~((UINT64_C(1) << lo) - 1);
-    for (size_t d = 0, b0 = 0; d < NTOP; b0 = start[d], d++) {
-        size_t m = start[d] - b0;
-        uint64_t *b = tmp + b0;
+    uint64_t kmask = ~((UINT64_C(1) << s->lo) - 1);
+    size_t *count = j->count;
+    for (size_t d = j->lo; d < j->hi; d++) {
+        size_t b0 = d ? s->start[d - 1] : 0, m = s->start[d] - b0;
+        uint64_t *b = s->tmp + b0;
         if (m <= SMALL) {
             for (size_t i = 1; i < m; i++) {
                 uint64_t x = b[i];
-                size_t j = i;
-                for (; j > 0 && (b[j - 1] & kmask) > (x & kmask); j--)
-                    b[j] = b[j - 1];
-                b[j] = x;
+                size_t k = i;
+                for (; k > 0 && (b[k - 1] & kmask) > (x & kmask); k--)
+                    b[k] = b[k - 1];
+                b[k] = x;
             }
             continue;
         }
-        uint64_t *got = lsd_sort(b, a + b0, m, lo, top, count);
+        uint64_t *got = lsd_sort(b, s->a + b0, m, s->lo, s->top, count);
         if (got != b)
             memcpy(b, got, m * sizeof *b);
     }
-    free(count);
-    return tmp;
+    return 0;
+}
+
+static void *msort_run(void *arg)
+{
+    mjob *j = arg;
+    msort *s = j->s;
+    switch (s->phase) {
+    case PH_BOX:
+        for (size_t i = j->lo; i < j->hi; i++)
+            for (int k = 0; k < 3; k++) {
+                double x = s->pts[3 * i + (size_t)k];
+                if (i == j->lo || x < j->box[k])
+                    j->box[k] = x;
+                if (i == j->lo || x > j->box[k + 3])
+                    j->box[k + 3] = x;
+            }
+        break;
+    case PH_KEYS:
+        for (size_t i = j->lo; i < j->hi; i++)
+            s->a[i] = morton(s->pts + 3 * i, s->box, s->l.bits) << s->l.idbits | (uint64_t)i;
+        break;
+    case PH_COUNT:
+        memset(j->count, 0, s->nb * sizeof *j->count);
+        for (size_t i = j->lo; i < j->hi; i++)
+            j->count[s->a[i] >> s->shift & (s->nb - 1)]++;
+        break;
+    case PH_SCATTER:
+        for (size_t i = j->lo; i < j->hi; i++)
+            s->tmp[j->count[s->a[i] >> s->shift & (s->nb - 1)]++] = s->a[i];
+        break;
+    case PH_BUCKETS:
+        j->err = sort_buckets(s, j);
+        break;
+    case PH_GATHER:
+        for (size_t i = j->lo; i < j->hi; i++) {
+            size_t k = (size_t)(s->a[i] & s->l.idmask);
+            const double *q = s->pts + 3 * k;
+            s->p2[3 * i] = q[0];
+            s->p2[3 * i + 1] = q[1];
+            s->p2[3 * i + 2] = q[2];
+            s->o2[i] = s->orig[k];
+        }
+        break;
+    }
+    return NULL;
+}
+
+static void msort_phase(msort *s, int phase)
+{
+    s->phase = phase;
+    fdt_fork_join(s->job, sizeof *s->job, s->T, msort_run);
+}
+
+/*
+ * One stable counting-sort pass of s->a into s->tmp on the digit of nb
+ * values at `shift`, the threads' slices in order (thread t's records of
+ * a digit after thread t - 1's): 1 and swapped, or 0, nothing moved, when
+ * every record has the same digit. With the top pass (nb NTOP), s->start
+ * gets the buckets' ends.
+ */
+static int msort_pass(msort *s, int shift, size_t nb)
+{
+    s->shift = shift;
+    s->nb = nb;
+    msort_phase(s, PH_COUNT);
+    size_t acc = 0, full = 0;
+    for (size_t d = 0; d < nb; d++) {
+        size_t before = acc;
+        for (int t = 0; t < s->T; t++) {
+            size_t c = s->job[t].count[d];
+            s->job[t].count[d] = acc;
+            acc += c;
+        }
+        full |= acc - before == s->n;
+        if (nb == NTOP)
+            s->start[d] = acc;
+    }
+    if (full)
+        return 0;
+    msort_phase(s, PH_SCATTER);
+    uint64_t *x = s->a;
+    s->a = s->tmp;
+    s->tmp = x;
+    return 1;
+}
+
+/* The threads' slices of n records (or buckets), in order. */
+static void msort_slices(msort *s, size_t n)
+{
+    for (int t = 0; t < s->T; t++) {
+        s->job[t].s = s;
+        s->job[t].t = t;
+        s->job[t].lo = n * (size_t)t / (size_t)s->T;
+        s->job[t].hi = n * (size_t)(t + 1) / (size_t)s->T;
+    }
+}
+
+/*
+ * s->a sorted on its bits [lo, hi), ties in the order they come (s->a
+ * then holds them). Up to SPLIT records, least significant digit first
+ * over the whole array, 11 bits a pass, a pass skipped where every record
+ * has the same digit. Past it the top 8 of those bits first (one pass of
+ * a counting sort: each bucket a cell of the box, 39k points a bucket at
+ * 10M uniform), then each bucket on the bits below, the passes inside the
+ * cache, the buckets shared among the threads by their records: the
+ * passes of the whole array through memory were the sort's time there,
+ * while on fewer points the buckets' own counts would cost more than they
+ * save (bench/NOTES.md entry 118).
+ */
+static void msort_radix(msort *s, int lo, int hi)
+{
+    const size_t SPLIT = (size_t)1 << 21;
+    s->lo = lo;
+    s->top = hi - 8;
+    if (s->n >= SPLIT && s->top > lo && msort_pass(s, s->top, NTOP)) {
+        /* s->a holds the buckets: sort them in place, each thread a run
+         * of buckets holding about its share of the records */
+        uint64_t *x = s->a;
+        s->a = s->tmp;
+        s->tmp = x;
+        size_t d = 0;
+        for (int t = 0; t < s->T; t++) {
+            size_t want = s->n * (size_t)(t + 1) / (size_t)s->T;
+            s->job[t].lo = d;
+            while (d < NTOP && (t == s->T - 1 || s->start[d] <= want))
+                d++;
+            s->job[t].hi = d;
+        }
+        msort_phase(s, PH_BUCKETS);
+        x = s->a;
+        s->a = s->tmp;
+        s->tmp = x;
+        msort_slices(s, s->n);
+        return;
+    }
+    for (int shift = lo; shift < hi; shift += BITS)
+        msort_pass(s, shift, (size_t)1 << (hi - shift < BITS ? hi - shift : BITS));
 }
 
 /* The records of the points not skipped, sorted by key (index ascending
  * within a key); *m: how many. NULL when out of memory; the caller frees
- * *block. */
+ * *block. One thread (the cells' and queries' orders). */
 static uint64_t *sorted_records(const double *pts, size_t n, const double box[6],
                                 const uint8_t *skip, layout l, size_t *m, uint64_t **block)
 {
@@ -162,7 +312,18 @@ static uint64_t *sorted_records(const double *pts, size_t n, const double box[6]
         if (!skip || !skip[i])
             r[k++] = morton(pts + 3 * i, box, l.bits) << l.idbits | (uint64_t)i;
     *m = k;
-    return radix_sort(r, r + (n ? n : 1), k, l.idbits, l.idbits + 3 * l.bits);
+    msort *s = calloc(1, sizeof *s);
+    if (!s)
+        return NULL;
+    s->a = r;
+    s->tmp = r + (n ? n : 1);
+    s->n = k;
+    s->T = 1;
+    msort_slices(s, k);
+    msort_radix(s, l.idbits, l.idbits + 3 * l.bits);
+    uint64_t *sorted = s->a;
+    free(s);
+    return sorted;
 }
 
 long fdt_morton_order(const double *pts, size_t n, const double box[6], const uint8_t *skip,
@@ -178,45 +339,50 @@ long fdt_morton_order(const double *pts, size_t n, const double box[6], const ui
     return s ? (long)m : -1;
 }
 
-int fdt_morton_sort(double *pts, fdt_vid *orig, size_t n)
+int fdt_morton_sort(double *pts, fdt_vid *orig, size_t n, int threads)
 {
-    double box[6] = {0, 0, 0, 0, 0, 0};
-    for (size_t i = 0; i < n; i++)
-        for (int k = 0; k < 3; k++) {
-            double x = pts[3 * i + k];
-            if (i == 0 || x < box[k])
-                box[k] = x;
-            if (i == 0 || x > box[k + 3])
-                box[k + 3] = x;
-        }
-    size_t m;
-    layout l = layout_of(n);
-    uint64_t *block, *s = sorted_records(pts, n, box, NULL, l, &m, &block);
-    if (!s) {
-        free(block);
-        return -1;
-    }
-    /* The points gathered into a new array (independent loads: an
-     * in-place walk of the permutation's cycles, each load waiting for
-     * the last, took twice as long: entry 126); their indices into the
-     * records' other half, free now (4 bytes of its 8 a point). */
+    msort *s = calloc(1, sizeof *s);
+    uint64_t *block = malloc(2 * (n ? n : 1) * sizeof *block);
+    /* The points gathered into a new array (independent loads: an in-place
+     * walk of the permutation's cycles, each load waiting for the last,
+     * took twice as long: entry 126); their indices into the records'
+     * other half, free by then (4 bytes of its 8 a point). */
     double *p2 = malloc((n ? n : 1) * 3 * sizeof *p2);
-    if (!p2) {
+    if (!s || !block || !p2) {
+        free(s);
         free(block);
+        free(p2);
         return -1;
     }
-    fdt_vid *o2 = (fdt_vid *)(s == block ? block + (n ? n : 1) : block);
-    for (size_t i = 0; i < n; i++) {
-        size_t k = (size_t)(s[i] & l.idmask);
-        const double *q = pts + 3 * k;
-        p2[3 * i] = q[0];
-        p2[3 * i + 1] = q[1];
-        p2[3 * i + 2] = q[2];
-        o2[i] = orig[k];
-    }
+    s->pts = pts;
+    s->orig = orig;
+    s->n = n;
+    s->l = layout_of(n);
+    s->a = block;
+    s->tmp = block + (n ? n : 1);
+    s->p2 = p2;
+    /* a thread for every 64k points at least: below, starting one costs
+     * more than its share */
+    s->T = threads < 1 ? 1 : threads > MAX_T ? MAX_T : threads;
+    while (s->T > 1 && n / (size_t)s->T < ((size_t)1 << 16))
+        s->T--;
+    msort_slices(s, n);
+    msort_phase(s, PH_BOX);
+    for (int t = 0; t < s->T; t++)
+        for (int k = 0; k < 3; k++)
+            if (s->job[t].hi > s->job[t].lo) {
+                const double *b = s->job[t].box;
+                s->box[k] = t == 0 || b[k] < s->box[k] ? b[k] : s->box[k];
+                s->box[k + 3] = t == 0 || b[k + 3] > s->box[k + 3] ? b[k + 3] : s->box[k + 3];
+            }
+    msort_phase(s, PH_KEYS);
+    msort_radix(s, s->l.idbits, s->l.idbits + 3 * s->l.bits);
+    s->o2 = (fdt_vid *)s->tmp;
+    msort_phase(s, PH_GATHER);
     memcpy(pts, p2, n * 3 * sizeof *pts);
-    memcpy(orig, o2, n * sizeof *orig);
+    memcpy(orig, s->o2, n * sizeof *orig);
     free(p2);
     free(block);
+    free(s);
     return 0;
 }

@@ -260,7 +260,16 @@ static int prepare_threads(const double *xyz, size_t n, int T, fdt_prepared *pr,
     }
     j.k = choose_scale(maxabs, minabs);
     j.p2k = j.k >= -1022 && j.k <= 1023 ? fdt_pow2i(j.k) : 0.0;
-    prep_phase(&j, 2, args);
+    if (pr->p_borrowed && m != n) {
+        /* In place with duplicates: slice t writes from its m0, below its
+         * own points, over slice t - 1's, which must be read first: the
+         * slices in order, on this thread, as the serial merge would. */
+        j.phase = 2;
+        for (int t = 0; t < T; t++)
+            prep_worker(&args[t]);
+    } else {
+        prep_phase(&j, 2, args); /* in place, each slice writes its own points */
+    }
     pr->scale_exp = j.k;
     pr->m = m;
     pr->ndup = n - m;
@@ -313,7 +322,6 @@ static int prepare_any(const double *xyz, double *into, size_t n, int threads,
     if (into) {
         pr->p = into;
         pr->p_borrowed = 1;
-        threads = 1; /* the parallel merge writes slices out of order */
     }
     if (n > (size_t)FDT_VID_MAX) {
         snprintf(diag, dlen, "%zu points: more than the %d a vertex id holds",
@@ -409,9 +417,10 @@ int fdt_prepare(const double *xyz, size_t n, int threads, fdt_prepared *pr, char
     return prepare_any(xyz, NULL, n, threads, pr, diag, dlen);
 }
 
-int fdt_prepare_inplace(double *xyz, size_t n, fdt_prepared *pr, char *diag, size_t dlen)
+int fdt_prepare_inplace(double *xyz, size_t n, int threads, fdt_prepared *pr, char *diag,
+                        size_t dlen)
 {
-    return prepare_any(xyz, xyz, n, 1, pr, diag, dlen);
+    return prepare_any(xyz, xyz, n, threads, pr, diag, dlen);
 }
 
 int fdt_prepare_scale_exp(double maxabs, double minabs)

@@ -39,11 +39,13 @@ size_t fdt_prepare_merge_slots(size_t n);
  * FDT_ETOOBIG, FDT_ENOMEM. */
 int fdt_prepare(const double *xyz, size_t n, int threads, fdt_prepared *pr, char *diag,
                 size_t dlen);
-/* The same on one thread, with xyz itself as pr->p: the distinct points
- * are compacted to its front (first occurrence order) and scaled there,
- * so the points are stored once (settings.permute_input). On failure xyz
- * is unchanged. */
-int fdt_prepare_inplace(double *xyz, size_t n, fdt_prepared *pr, char *diag, size_t dlen);
+/* The same with xyz itself as pr->p: the distinct points are compacted
+ * to its front (first occurrence order) and scaled there, so the points
+ * are stored once (settings.permute_input); with duplicates the slices
+ * are compacted in order on the calling thread (each writes over the
+ * one before). On failure xyz is unchanged. */
+int fdt_prepare_inplace(double *xyz, size_t n, int threads, fdt_prepared *pr, char *diag,
+                        size_t dlen);
 void fdt_prepared_free(fdt_prepared *pr);
 /* The scale exponent fdt_prepare chooses for points whose largest |x| is
  * maxabs and smallest nonzero |x| minabs (INFINITY: none), for callers
