@@ -114,7 +114,6 @@ typedef struct mjob {
     size_t lo, hi;       /* its records (PH_BUCKETS: its buckets) */
     double box[6];       /* PH_BOX: its points' */
     size_t count[NB];    /* PH_COUNT: its digits; then where each goes */
-    int err;
 } mjob;
 
 struct msort {
@@ -136,7 +135,7 @@ struct msort {
 
 /* Sorts tmp's buckets [j->lo, j->hi) (of the top pass) on the bits below
  * the top, each back into tmp (a's same rows as scratch). */
-static int sort_buckets(msort *s, mjob *j)
+static void sort_buckets(msort *s, mjob *j)
 {
     uint64_t kmask = ~((UINT64_C(1) << s->lo) - 1);
     size_t *count = j->count;
@@ -157,7 +156,6 @@ static int sort_buckets(msort *s, mjob *j)
         if (got != b)
             memcpy(b, got, m * sizeof *b);
     }
-    return 0;
 }
 
 static void *msort_run(void *arg)
@@ -189,7 +187,7 @@ static void *msort_run(void *arg)
             s->tmp[j->count[s->a[i] >> s->shift & (s->nb - 1)]++] = s->a[i];
         break;
     case PH_BUCKETS:
-        j->err = sort_buckets(s, j);
+        sort_buckets(s, j);
         break;
     case PH_GATHER:
         for (size_t i = j->lo; i < j->hi; i++) {
