@@ -2,7 +2,6 @@
  * checked and why it proves the mesh is the perturbed DT. */
 #include "mesh/certify.h"
 
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -356,15 +355,15 @@ typedef struct cert_pool {
     int njobs;
     /* relaxed: a taker only needs a range no other taker got (the
      * counter's own modification order); what a range's check wrote is
-     * published to the caller by pthread_join. */
+     * published to the caller by fdt_fork_join's joins. */
     atomic_int next;
-    pthread_t th;
-    int started;
 } cert_pool;
 
+/* A thread's loop (arg: a cert_pool * of fdt_fork_join's array, every one
+ * the same pool): the next range, until none is left. */
 static void *cert_take(void *arg)
 {
-    cert_pool *p = arg;
+    cert_pool *p = *(cert_pool **)arg;
     int i;
     while ((i = atomic_fetch_add_explicit(&p->next, 1, memory_order_relaxed)) < p->njobs) {
         cert_job *j = &p->jobs[i];
@@ -403,10 +402,10 @@ int fdt_certify_parallel_visit(const fdt_ins *m, int nthreads, const fdt_certify
     if (nthreads > nj)
         nthreads = nj;
     cert_job *j = calloc((size_t)nj, sizeof *j);
-    cert_pool *p = calloc((size_t)nthreads, sizeof *p);
-    if (!j || !p) {
+    cert_pool **take = malloc((size_t)nthreads * sizeof *take);
+    if (!j || !take) {
         free(j);
-        free(p);
+        free(take);
         return FDT_ENOMEM;
     }
     for (int i = 0; i < nj; i++) {
@@ -416,18 +415,14 @@ int fdt_certify_parallel_visit(const fdt_ins *m, int nthreads, const fdt_certify
         j[i].lo = (uint32_t)((uint64_t)m->nslots * (uint64_t)i / (uint64_t)nj);
         j[i].hi = (uint32_t)((uint64_t)m->nslots * (uint64_t)(i + 1) / (uint64_t)nj);
     }
-    /* one counter, shared: p[0]'s */
-    atomic_init(&p[0].next, 0);
-    p[0].jobs = j;
-    p[0].njobs = nj;
+    cert_pool pool = {.jobs = j, .njobs = nj};
+    atomic_init(&pool.next, 0);
+    for (int i = 0; i < nthreads; i++)
+        take[i] = &pool;
+    /* a thread that cannot start leaves its ranges to the others */
+    fdt_fork_join(take, sizeof *take, nthreads, cert_take);
+    free(take);
     int err = FDT_OK;
-    for (int i = 1; i < nthreads; i++)
-        if (!(p[i].started = fdt_spawn(&p[i].th, 0, cert_take, &p[0]) == 0))
-            err = FDT_ETHREAD;
-    cert_take(&p[0]); /* takes every range the others did not */
-    for (int i = 1; i < nthreads; i++)
-        if (p[i].started)
-            pthread_join(p[i].th, NULL);
     /* The joins publish each range's fields to this thread; the lowest
      * failing range is the one reported, whoever checked it. */
     size_t skipped = 0, pairs = 0;
@@ -446,7 +441,6 @@ int fdt_certify_parallel_visit(const fdt_ins *m, int nthreads, const fdt_certify
         for (int i = 0; i < nj; i++)
             fdt_pred_counts_add(cnt, &j[i].pc);
     free(j);
-    free(p);
     return err ? err : fdt_certify_vertices(m, why);
 }
 

@@ -62,10 +62,10 @@ int fdt_certify(const fdt_ins *m, fdt_pred_counts *cnt, fdt_certify_fail *why);
 
 /* The same on nthreads threads (the caller's one of them; fdt_certify_jobs
  * slot ranges of equal size, each taken by the next thread free, each face
- * checked in the range of one of its slots): FDT_OK,
- * FDT_ECHECK (*why: the failure of the lowest range that failed), or
- * FDT_ETHREAD / FDT_ENOMEM when the helpers could not start. cnt gets the
- * sum of the threads' counts. */
+ * checked in the range of one of its slots; a helper that cannot start
+ * leaves its ranges to the others): FDT_OK, FDT_ECHECK (*why: the failure
+ * of the lowest range that failed), or FDT_ENOMEM. cnt gets the sum of
+ * the threads' counts. */
 int fdt_certify_parallel(const fdt_ins *m, int nthreads, fdt_pred_counts *cnt,
                          fdt_certify_fail *why);
 
