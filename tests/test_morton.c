@@ -1,8 +1,9 @@
 /*
  * Tests for src/geom/morton.c: Morton order by radix sort, against keys
  * interleaved here bit by bit (an independent spelling of the same key).
- *  - fdt_morton_order: every point not skipped once, keys ascending, ties
- *    (equal points, a cell shared) by index;
+ *  - fdt_morton_order: every point not skipped once, keys ascending, the
+ *    runs of one key longer than 32 ordered again in their own box, down
+ *    to equal points, and ties by index;
  *  - fdt_morton_sort: each point keeps its input index, in the order of
  *    fdt_morton_order over the points' own bounding box, on 1, 2 and 3
  *    threads (slices of the records, of the buckets past 2^21);
@@ -67,6 +68,34 @@ static double *points(size_t n)
     return p;
 }
 
+/* order[lo .. hi) by keys in box, ascending; each run of one key longer
+ * than 32 by keys in its own points' box, the same way down, unless its
+ * points are all one; shorter runs, and runs of one point, by index. */
+static void check_run(const double *p, const uint32_t *order, size_t lo, size_t hi,
+                      const double box[6], int bits)
+{
+    for (size_t i = lo, j; i < hi; i = j) {
+        uint64_t a = ref_key(p + 3 * (size_t)order[i], box, bits);
+        for (j = i + 1; j < hi && ref_key(p + 3 * (size_t)order[j], box, bits) == a; j++)
+            ;
+        if (j < hi)
+            CHECK(ref_key(p + 3 * (size_t)order[j], box, bits) > a);
+        double sub[6];
+        for (size_t k = i; k < j; k++)
+            for (int c = 0; c < 3; c++) {
+                double x = p[3 * (size_t)order[k] + (size_t)c];
+                sub[c] = k == i || x < sub[c] ? x : sub[c];
+                sub[c + 3] = k == i || x > sub[c + 3] ? x : sub[c + 3];
+            }
+        if (j - i > 32 && (sub[0] != sub[3] || sub[1] != sub[4] || sub[2] != sub[5])) {
+            check_run(p, order, i, j, sub, bits);
+            continue;
+        }
+        for (size_t k = i + 1; k < j; k++)
+            CHECK(order[k - 1] < order[k]);
+    }
+}
+
 static void check_order(const double *p, size_t n, const double box[6], const uint8_t *skip,
                         const uint32_t *order, long m)
 {
@@ -79,12 +108,8 @@ static void check_order(const double *p, size_t n, const double box[6], const ui
     for (long i = 0; i < m; i++) {
         CHECK(order[i] < n && !seen[order[i]] && (!skip || !skip[order[i]]));
         seen[order[i]] = 1;
-        if (i > 0) {
-            uint64_t a = ref_key(p + 3 * (size_t)order[i - 1], box, key_bits(n));
-            uint64_t b = ref_key(p + 3 * (size_t)order[i], box, key_bits(n));
-            CHECK(a < b || (a == b && order[i - 1] < order[i]));
-        }
     }
+    check_run(p, order, 0, (size_t)m, box, key_bits(n));
     free(seen);
 }
 

@@ -295,6 +295,63 @@ static void msort_radix(msort *s, int lo, int hi)
         msort_pass(s, shift, (size_t)1 << (hi - shift < BITS ? hi - shift : BITS));
 }
 
+/*
+ * Runs of more than REFINE records with one key, each sorted again on keys
+ * of its own points' box, and so on down (ties by index in the end): the
+ * order of a Morton curve refined where the points are dense. A fixed grid
+ * puts a cluster 1e-6 wide of a unit box (gen_points `clusters`) in one
+ * cell of 2^-15, and its 18k points then came in input order: the
+ * insertion's walks crossed the cluster each time, its mesh took twice as
+ * long as with 21 bits a coordinate and three times a uniform set's
+ * (bench/NOTES.md entry 126). Each level's box lies in one cell of the
+ * level above, 2^bits times smaller on every axis, so a run of points
+ * that are not all equal comes apart within a few hundred levels, and
+ * equal points (possible in fdt_morton_order's inputs) end it at once.
+ */
+enum { REFINE = 32 };
+
+static void refine(const double *pts, uint64_t *a, uint64_t *tmp, size_t n, layout l,
+                   size_t *count);
+
+static void refine_run(const double *pts, uint64_t *r, uint64_t *tmp, size_t m, layout l,
+                       size_t *count)
+{
+    double box[6];
+    for (size_t i = 0; i < m; i++) {
+        const double *q = pts + 3 * (size_t)(r[i] & l.idmask);
+        for (int k = 0; k < 3; k++) {
+            if (i == 0 || q[k] < box[k])
+                box[k] = q[k];
+            if (i == 0 || q[k] > box[k + 3])
+                box[k + 3] = q[k];
+        }
+    }
+    if (box[0] == box[3] && box[1] == box[4] && box[2] == box[5])
+        return; /* one point, repeated: the index order stays */
+    for (size_t i = 0; i < m; i++) {
+        uint64_t id = r[i] & l.idmask;
+        r[i] = morton(pts + 3 * (size_t)id, box, l.bits) << l.idbits | id;
+    }
+    uint64_t *got = lsd_sort(r, tmp, m, l.idbits, l.idbits + 3 * l.bits, count);
+    if (got != r)
+        memcpy(r, got, m * sizeof *r);
+    refine(pts, r, tmp, m, l, count);
+}
+
+/* a[0 .. n) sorted by key, ties by index: its long runs refined. tmp: n
+ * records of scratch; count: 2^11 entries. */
+static void refine(const double *pts, uint64_t *a, uint64_t *tmp, size_t n, layout l,
+                   size_t *count)
+{
+    uint64_t kmask = ~l.idmask;
+    for (size_t i = 0, j; i < n; i = j) {
+        for (j = i + 1; j < n && (a[j] & kmask) == (a[i] & kmask); j++)
+            ;
+        if (j - i > REFINE)
+            refine_run(pts, a + i, tmp + i, j - i, l, count);
+    }
+}
+
 /* The records of the points not skipped, sorted by key (index ascending
  * within a key); *m: how many. NULL when out of memory; the caller frees
  * *block. One thread (the cells' and queries' orders). */
@@ -319,6 +376,7 @@ static uint64_t *sorted_records(const double *pts, size_t n, const double box[6]
     s->T = 1;
     msort_slices(s, k);
     msort_radix(s, l.idbits, l.idbits + 3 * l.bits);
+    refine(pts, s->a, s->tmp, k, l, s->job[0].count);
     uint64_t *sorted = s->a;
     free(s);
     return sorted;
@@ -375,6 +433,7 @@ int fdt_morton_sort(double *pts, fdt_vid *orig, size_t n, int threads)
             }
     msort_phase(s, PH_KEYS);
     msort_radix(s, s->l.idbits, s->l.idbits + 3 * s->l.bits);
+    refine(pts, s->a, s->tmp, n, s->l, s->job[0].count);
     s->o2 = (fdt_vid *)s->tmp;
     msort_phase(s, PH_GATHER);
     memcpy(pts, p2, n * 3 * sizeof *pts);
