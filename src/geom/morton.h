@@ -12,7 +12,9 @@
 /* Writes to order[] the indices i < n of the points pts (3 doubles each)
  * with skip[i] 0 (skip NULL: every point), sorted by their Morton key in
  * box (xmin, ymin, zmin, xmax, ymax, zmax; points outside count as on its
- * walls), ties by index. The key has 21 bits a coordinate, or fewer where
+ * walls); each run of more than 32 points with one key sorted again by
+ * their keys in their own bounding box, and so on down to runs of equal
+ * points; ties by index. The key has 21 bits a coordinate, or fewer where
  * an index of n - 1 and the key must share 64 bits: (64 - b) / 3 for b
  * the bits of n - 1 (14 at a million points). Returns how many, or -1
  * when out of memory. */
