@@ -268,7 +268,7 @@ static int prepare_threads(const double *xyz, size_t n, int T, fdt_prepared *pr,
         for (int t = 0; t < T; t++)
             prep_worker(&args[t]);
     } else {
-        prep_phase(&j, 2, args); /* in place, each slice writes its own points */
+        prep_phase(&j, 2, args); /* in place with no duplicate: each over its own points */
     }
     pr->scale_exp = j.k;
     pr->m = m;
