@@ -417,10 +417,10 @@ int fdt_morton_sort(double *pts, fdt_vid *orig, size_t n, int threads)
     s->a = block;
     s->tmp = block + (n ? n : 1);
     s->p2 = p2;
-    /* a thread for every 64k points at least: below, starting one costs
+    /* a thread for every 32k points at least: below, starting one costs
      * more than its share */
     s->T = threads < 1 ? 1 : threads > MAX_T ? MAX_T : threads;
-    while (s->T > 1 && n / (size_t)s->T < ((size_t)1 << 16))
+    while (s->T > 1 && n / (size_t)s->T < ((size_t)1 << 15))
         s->T--;
     msort_slices(s, n);
     msort_phase(s, PH_BOX);

@@ -25,7 +25,7 @@ long fdt_morton_order(const double *pts, size_t n, const double box[6], const ui
  * the Morton order of their bounding box (the key as fdt_morton_order's),
  * ties by their current index: the insertion order of the one-part engine
  * (src/api/api.c), whose BRIO rounds keep it. On up to `threads` threads
- * (one for every 64k points at least); the same order for any count. 0,
+ * (one for every 32k points at least); the same order for any count. 0,
  * or -1 when out of memory (nothing moved then). */
 int fdt_morton_sort(double *pts, fdt_vid *orig, size_t n, int threads);
 
