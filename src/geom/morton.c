@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/mem.h"
 #include "base/spawn.h"
 
 /*
@@ -402,8 +403,12 @@ int fdt_morton_sort(double *pts, fdt_vid *orig, size_t n, int threads)
     /* The points gathered into a new array (independent loads: an in-place
      * walk of the permutation's cycles, each load waiting for the last,
      * took twice as long: entry 126); their indices into the records'
-     * other half, free by then (4 bytes of its 8 a point). */
+     * other half, free by then (4 bytes of its 8 a point). Both arrays
+     * fresh, on huge pages (a 4 KB fault is a trap on some hosts: entry
+     * 128). */
     double *p2 = malloc((n ? n : 1) * 3 * sizeof *p2);
+    fdt_mem_advise_huge(block, 2 * (n ? n : 1) * sizeof *block);
+    fdt_mem_advise_huge(p2, (n ? n : 1) * 3 * sizeof *p2);
     if (!s || !block || !p2) {
         free(s);
         free(block);
