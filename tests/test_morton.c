@@ -11,6 +11,7 @@
  *  - past 2^21 points, where the sort splits on the top bits first, with
  *    large buckets and with small ones (sorted by insertion).
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -194,6 +195,33 @@ static void test_equal_points(void)
         CHECK(orig[i] == (fdt_vid)(4 - i)); /* one key: the order as it was */
 }
 
+/* Queries are ordered too (src/mesh/locate.c), and may be NaN or
+ * infinite: a run of them with one key ends (a level that splits nothing
+ * stops), each index once. */
+static void test_not_finite(void)
+{
+    size_t n = 300;
+    double *p = malloc(3 * n * sizeof *p);
+    uint32_t *order = malloc(n * sizeof *order);
+    CHECK(p && order);
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++)
+            p[3 * i + (size_t)k] = i % 3 == 0   ? NAN
+                                   : i % 3 == 1 ? (k == 1 ? INFINITY : 0.25)
+                                                : 0.25 + 1e-12 * unif();
+    const double box[6] = {0, 0, 0, 1, 1, 1};
+    CHECK(fdt_morton_order(p, n, box, NULL, order) == (long)n);
+    uint8_t *seen = calloc(n, 1);
+    CHECK(seen != NULL);
+    for (size_t i = 0; i < n; i++) {
+        CHECK(order[i] < n && !seen[order[i]]);
+        seen[order[i]] = 1;
+    }
+    free(seen);
+    free(order);
+    free(p);
+}
+
 int main(void)
 {
     /* 300000: the whole-array passes on 2 and 3 threads; 2^21 + 5: past
@@ -207,5 +235,6 @@ int main(void)
     }
     test_equal_points();
     test_small_buckets();
+    test_not_finite();
     return test_report("morton");
 }

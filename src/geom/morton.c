@@ -302,9 +302,8 @@ static void msort_radix(msort *s, int lo, int hi)
  * order of a Morton curve refined where the points are dense. A fixed grid
  * puts a cluster 1e-6 wide of a unit box (gen_points `clusters`) in one
  * cell of 2^-15, and its 18k points then came in input order: the
- * insertion's walks crossed the cluster each time, its mesh took twice as
- * long as with 21 bits a coordinate and three times a uniform set's
- * (bench/NOTES.md entry 126). Each level's box lies in one cell of the
+ * insertion's walks crossed the cluster each time, and its mesh took
+ * twice as long as with 21 bits a coordinate (bench/NOTES.md entry 126). Each level's box lies in one cell of the
  * level above, 2^bits times smaller on every axis, so a run of points
  * that are not all equal comes apart within a few hundred levels, and
  * equal points (possible in fdt_morton_order's inputs) end it at once.
@@ -317,16 +316,20 @@ static void refine(const double *pts, uint64_t *a, uint64_t *tmp, size_t n, layo
 static void refine_run(const double *pts, uint64_t *r, uint64_t *tmp, size_t m, layout l,
                        size_t *count)
 {
-    double box[6];
+    /* the box of the finite coordinates (queries may be NaN or infinite:
+     * fdt_queries_begin orders them too) */
+    double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i < m; i++) {
         const double *q = pts + 3 * (size_t)(r[i] & l.idmask);
-        for (int k = 0; k < 3; k++) {
-            if (i == 0 || q[k] < box[k])
-                box[k] = q[k];
-            if (i == 0 || q[k] > box[k + 3])
-                box[k + 3] = q[k];
-        }
+        for (int k = 0; k < 3; k++)
+            if (isfinite(q[k])) {
+                box[k] = fmin(box[k], q[k]);
+                box[k + 3] = fmax(box[k + 3], q[k]);
+            }
     }
+    for (int k = 0; k < 3; k++)
+        if (box[k] > box[k + 3])
+            box[k] = box[k + 3] = 0;
     if (box[0] == box[3] && box[1] == box[4] && box[2] == box[5])
         return; /* one point, repeated: the index order stays */
     for (size_t i = 0; i < m; i++) {
@@ -336,7 +339,12 @@ static void refine_run(const double *pts, uint64_t *r, uint64_t *tmp, size_t m, 
     uint64_t *got = lsd_sort(r, tmp, m, l.idbits, l.idbits + 3 * l.bits, count);
     if (got != r)
         memcpy(r, got, m * sizeof *r);
-    refine(pts, r, tmp, m, l, count);
+    /* Down only where this level split the run: every level then works
+     * on fewer records, whatever the coordinates (finite ones always
+     * split: the box's lowest and highest points take the first and last
+     * cell of an axis). */
+    if ((r[0] & ~l.idmask) != (r[m - 1] & ~l.idmask))
+        refine(pts, r, tmp, m, l, count);
 }
 
 /* a[0 .. n) sorted by key, ties by index: its long runs refined. tmp: n
