@@ -30,6 +30,15 @@ void fdt_mem_advise_huge(void *p, size_t bytes)
 #endif
 }
 
+void *fdt_mem_alloc_huge(size_t n, size_t size, int zero)
+{
+    if (size && n > SIZE_MAX / size)
+        return NULL;
+    void *p = zero ? calloc(n, size) : malloc(n * size);
+    fdt_mem_advise_huge(p, n * size);
+    return p;
+}
+
 size_t fdt_mem_available(void)
 {
     return fdt_mem_available_at("/proc/meminfo");

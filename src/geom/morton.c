@@ -303,10 +303,11 @@ static void msort_radix(msort *s, int lo, int hi)
  * puts a cluster 1e-6 wide of a unit box (gen_points `clusters`) in one
  * cell of 2^-15, and its 18k points then came in input order: the
  * insertion's walks crossed the cluster each time, and its mesh took
- * twice as long as with 21 bits a coordinate (bench/NOTES.md entry 126). Each level's box lies in one cell of the
- * level above, 2^bits times smaller on every axis, so a run of points
- * that are not all equal comes apart within a few hundred levels, and
- * equal points (possible in fdt_morton_order's inputs) end it at once.
+ * twice as long as with 21 bits a coordinate (bench/NOTES.md entry 126).
+ * Each level's box lies in one cell of the level above, 2^bits times
+ * smaller on every axis, so a run of points that are not all equal comes
+ * apart within a few hundred levels, and equal points (possible in
+ * fdt_morton_order's inputs) end it at once.
  */
 enum { REFINE = 32 };
 
@@ -407,16 +408,14 @@ long fdt_morton_order(const double *pts, size_t n, const double box[6], const ui
 int fdt_morton_sort(double *pts, fdt_vid *orig, size_t n, int threads)
 {
     msort *s = calloc(1, sizeof *s);
-    uint64_t *block = malloc(2 * (n ? n : 1) * sizeof *block);
+    uint64_t *block = fdt_mem_alloc_huge(2 * (n ? n : 1), sizeof *block, 0);
     /* The points gathered into a new array (independent loads: an in-place
      * walk of the permutation's cycles, each load waiting for the last,
      * took twice as long: entry 126); their indices into the records'
      * other half, free by then (4 bytes of its 8 a point). Both arrays
      * fresh, on huge pages (a 4 KB fault is a trap on some hosts: entry
      * 128). */
-    double *p2 = malloc((n ? n : 1) * 3 * sizeof *p2);
-    fdt_mem_advise_huge(block, 2 * (n ? n : 1) * sizeof *block);
-    fdt_mem_advise_huge(p2, (n ? n : 1) * 3 * sizeof *p2);
+    double *p2 = fdt_mem_alloc_huge((n ? n : 1) * 3, sizeof *p2, 0);
     if (!s || !block || !p2) {
         free(s);
         free(block);

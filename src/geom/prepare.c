@@ -292,18 +292,13 @@ static int prep_alloc(fdt_prepared *pr, size_t n, uint32_t **slots, size_t *cap)
     size_t n1 = n ? n : 1;
     /* every array fresh and written at once: huge pages (a 4 KB fault is
      * a trap on some hosts, bench/NOTES.md entry 128) */
-    pr->dupmap = malloc(n1 * sizeof *pr->dupmap);
-    fdt_mem_advise_huge(pr->dupmap, n1 * sizeof *pr->dupmap);
-    if (!pr->p_borrowed) {
-        pr->p = malloc(n1 * 3 * sizeof *pr->p);
-        fdt_mem_advise_huge(pr->p, n1 * 3 * sizeof *pr->p);
-    }
-    pr->orig = malloc(n1 * sizeof *pr->orig);
-    fdt_mem_advise_huge(pr->orig, n1 * sizeof *pr->orig);
+    pr->dupmap = fdt_mem_alloc_huge(n1, sizeof *pr->dupmap, 0);
+    if (!pr->p_borrowed)
+        pr->p = fdt_mem_alloc_huge(n1 * 3, sizeof *pr->p, 0);
+    pr->orig = fdt_mem_alloc_huge(n1, sizeof *pr->orig, 0);
     *cap = fdt_prepare_merge_slots(n);
     pr->merge_bytes = *cap * sizeof **slots;
-    *slots = malloc(*cap * sizeof **slots);
-    fdt_mem_advise_huge(*slots, *cap * sizeof **slots);
+    *slots = fdt_mem_alloc_huge(*cap, sizeof **slots, 0);
     if (!pr->dupmap || !pr->p || !pr->orig || !*slots)
         return FDT_ENOMEM;
     memset(*slots, 0xff, *cap * sizeof **slots);

@@ -947,6 +947,15 @@ static int all_faces(dwork *w)
 
 /* ------------------------------------------------------------ walls */
 
+/* Whether point x lies on one of the box's walls. */
+static int on_wall(const dwork *w, const double x[3])
+{
+    for (int p = 0; p < 6; p++)
+        if (x[p >> 1] == bound(w, p))
+            return 1;
+    return 0;
+}
+
 /* A vertex on a wall, sorted by place. */
 typedef struct wallvx {
     double x[3];
@@ -977,11 +986,7 @@ static int merge_wall_vertices(dwork *w)
 {
     size_t m = 0;
     for (size_t v = 0; v < w->nv; v++)
-        for (int p = 0; p < 6; p++)
-            if (w->vx[3 * v + (size_t)(p >> 1)] == bound(w, p)) {
-                m++;
-                break;
-            }
+        m += (size_t)on_wall(w, w->vx + 3 * v);
     wallvx *s = malloc((m + 1) * sizeof *s);
     int64_t *to = malloc((w->nv + 1) * sizeof *to);
     if (!s || !to) {
@@ -992,12 +997,10 @@ static int merge_wall_vertices(dwork *w)
     m = 0;
     for (size_t v = 0; v < w->nv; v++) {
         to[v] = (int64_t)v;
-        for (int p = 0; p < 6; p++)
-            if (w->vx[3 * v + (size_t)(p >> 1)] == bound(w, p)) {
-                memcpy(s[m].x, w->vx + 3 * v, sizeof s[m].x);
-                s[m++].id = (int64_t)v;
-                break;
-            }
+        if (on_wall(w, w->vx + 3 * v)) {
+            memcpy(s[m].x, w->vx + 3 * v, sizeof s[m].x);
+            s[m++].id = (int64_t)v;
+        }
     }
     qsort(s, m, sizeof *s, wallvx_cmp);
     size_t same = 0;
@@ -1036,8 +1039,6 @@ static int merge_wall_vertices(dwork *w)
     free(to);
     return FDT_OK;
 }
-
-
 
 /* The box corner c (bit k: the upper bound in axis k) and the cell of the
  * point nearest to it, -1 on a tie (then the corner lies on a face, which
@@ -1305,12 +1306,8 @@ static int touching_cells(const dwork *w, const int32_t corner_of[8], uint8_t *t
     uint8_t *on = malloc(w->nv + 1);
     if (!on)
         return FDT_ENOMEM;
-    for (size_t v = 0; v < w->nv; v++) {
-        const double *x = w->vx + 3 * v;
-        on[v] = 0;
-        for (int p = 0; p < 6; p++)
-            on[v] |= x[p >> 1] == bound(w, p);
-    }
+    for (size_t v = 0; v < w->nv; v++)
+        on[v] = (uint8_t)on_wall(w, w->vx + 3 * v);
     memset(touch, 0, w->ncells);
     for (size_t f = 0; f < w->nf; f++)
         for (size_t i = w->fs[f]; i < w->fs[f + 1]; i++)

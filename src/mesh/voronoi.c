@@ -294,26 +294,14 @@ static void set_grids(vwork *w)
     w->g_mom = fdt_fix_grid_of(4 * ed - 98);
 }
 
-/* A large array of n elements of `size` bytes, its pages asked as huge
- * ones before the first write: the passes read and add into the points'
- * rows at random (a TLB miss a row on 4 KB pages), and on a host that
- * hands pages over late each 4 KB fault is a trap (bench/NOTES.md entry
- * 128). malloc's result, or calloc's when zero. */
-static void *big_alloc(size_t n, size_t size, int zero)
-{
-    void *p = zero ? calloc(n, size) : malloc(n * size);
-    fdt_mem_advise_huge(p, n * size);
-    return p;
-}
-
 /* ---------------------------------------------------------------- numbering */
 
 /* perm, loc and the local coordinates. */
 static int number_points(vwork *w, const fdt_result *r, const double *xyz)
 {
     uint8_t *merged = malloc(w->n ? w->n : 1);
-    w->loc = big_alloc(w->n ? w->n : 1, sizeof *w->loc, 0);
-    w->perm = big_alloc(w->n ? w->n : 1, sizeof *w->perm, 0);
+    w->loc = fdt_mem_alloc_huge(w->n ? w->n : 1, sizeof *w->loc, 0);
+    w->perm = fdt_mem_alloc_huge(w->n ? w->n : 1, sizeof *w->perm, 0);
     if (!merged || !w->loc || !w->perm) {
         free(merged);
         return FDT_ENOMEM;
@@ -327,7 +315,7 @@ static int number_points(vwork *w, const fdt_result *r, const double *xyz)
     if (m < 0)
         return FDT_ENOMEM;
     w->m = (size_t)m;
-    w->xyz = big_alloc(3 * (w->m ? w->m : 1), sizeof *w->xyz, 0);
+    w->xyz = fdt_mem_alloc_huge(3 * (w->m ? w->m : 1), sizeof *w->xyz, 0);
     if (!w->xyz)
         return FDT_ENOMEM;
     for (size_t l = 0; l < w->m; l++) {
@@ -344,7 +332,7 @@ static int local_tets(vwork *w, const fdt_result *r)
 {
     w->ntets = r->ntets;
     w->rtets = r->tets;
-    w->tets = big_alloc(w->ntets ? 4 * w->ntets : 1, sizeof *w->tets, 0);
+    w->tets = fdt_mem_alloc_huge(w->ntets ? 4 * w->ntets : 1, sizeof *w->tets, 0);
     return w->tets ? FDT_OK : FDT_ENOMEM;
 }
 
@@ -812,9 +800,9 @@ static int job_adjacency(vjob *j)
 {
     const vwork *w = j->w;
     size_t k = j->hi - j->lo;
-    size_t *ts = big_alloc(k + 1, sizeof *ts, 1);
+    size_t *ts = fdt_mem_alloc_huge(k + 1, sizeof *ts, 1);
     uint64_t *seen = calloc(w->m / 64 + 1, sizeof *seen);
-    j->adj_start = big_alloc(k + 1, sizeof *j->adj_start, 0);
+    j->adj_start = fdt_mem_alloc_huge(k + 1, sizeof *j->adj_start, 0);
     if (!ts || !seen || !j->adj_start) {
         free(ts);
         free(seen);
@@ -825,7 +813,7 @@ static int job_adjacency(vjob *j)
             ts[w->tets[c] - j->lo + 1]++;
     for (size_t l = 0; l < k; l++)
         ts[l + 1] += ts[l];
-    uint32_t *inc = big_alloc(ts[k] ? ts[k] : 1, sizeof *inc, 0);
+    uint32_t *inc = fdt_mem_alloc_huge(ts[k] ? ts[k] : 1, sizeof *inc, 0);
     if (!inc) {
         free(ts);
         free(seen);
@@ -836,7 +824,7 @@ static int job_adjacency(vjob *j)
             inc[ts[w->tets[c] - j->lo]++] = (uint32_t)(c / 4);
     /* ts[x] is now the end of point lo + x's tets, ts[x - 1] their start */
     size_t cap = 16 * (k ? k : 1), o = 0;
-    j->adj = big_alloc(cap, sizeof *j->adj, 0);
+    j->adj = fdt_mem_alloc_huge(cap, sizeof *j->adj, 0);
     for (size_t x = 0; x < k && j->adj; x++) {
         uint32_t l = j->lo + (uint32_t)x;
         size_t b = j->adj_start[x] = o, c0 = x ? ts[x - 1] : 0;
@@ -877,7 +865,7 @@ static int job_adjacency(vjob *j)
     free(ts);
     free(seen);
     free(inc);
-    j->fsum = j->adj ? big_alloc(o ? o : 1, sizeof *j->fsum, 1) : NULL;
+    j->fsum = j->adj ? fdt_mem_alloc_huge(o ? o : 1, sizeof *j->fsum, 1) : NULL;
     return j->fsum ? FDT_OK : FDT_ENOMEM;
 }
 
@@ -1153,12 +1141,12 @@ static int alloc_cells(fdt_voronoi *v, unsigned skip)
     size_t n = v->n ? v->n : 1;
     int cen = !(skip & FDT_CELLS_NO_CENTROIDS), dens = !(skip & FDT_CELLS_NO_DENSITIES);
     v->skip = skip;
-    v->volume = big_alloc(n, sizeof *v->volume, 1);
-    v->area = big_alloc(n, sizeof *v->area, 1);
-    v->centroid = cen ? big_alloc(3 * n, sizeof *v->centroid, 1) : NULL;
-    v->density = dens ? big_alloc(n, sizeof *v->density, 1) : NULL;
-    v->nfaces = big_alloc(n, sizeof *v->nfaces, 1);
-    v->flags = big_alloc(n, sizeof *v->flags, 1);
+    v->volume = fdt_mem_alloc_huge(n, sizeof *v->volume, 1);
+    v->area = fdt_mem_alloc_huge(n, sizeof *v->area, 1);
+    v->centroid = cen ? fdt_mem_alloc_huge(3 * n, sizeof *v->centroid, 1) : NULL;
+    v->density = dens ? fdt_mem_alloc_huge(n, sizeof *v->density, 1) : NULL;
+    v->nfaces = fdt_mem_alloc_huge(n, sizeof *v->nfaces, 1);
+    v->flags = fdt_mem_alloc_huge(n, sizeof *v->flags, 1);
     return v->volume && v->area && (v->centroid || !cen) && (v->density || !dens) && v->nfaces &&
                    v->flags
                ? FDT_OK
@@ -1172,12 +1160,12 @@ static int alloc_work(vwork *w)
 {
     size_t m = w->m ? w->m : 1;
     int cen = !(w->skip & FDT_CELLS_NO_CENTROIDS), dens = !(w->skip & FDT_CELLS_NO_DENSITIES);
-    w->flags = big_alloc(m, sizeof *w->flags, 1);
-    w->vol = big_alloc(m, sizeof *w->vol, 1);
-    w->vabs = big_alloc(m, sizeof *w->vabs, 1);
-    w->mom = cen ? big_alloc(3 * m, sizeof *w->mom, 1) : NULL;
-    w->dtfe = dens ? big_alloc(m, sizeof *w->dtfe, 1) : NULL;
-    w->vmax = dens ? big_alloc(m, sizeof *w->vmax, 1) : NULL;
+    w->flags = fdt_mem_alloc_huge(m, sizeof *w->flags, 1);
+    w->vol = fdt_mem_alloc_huge(m, sizeof *w->vol, 1);
+    w->vabs = fdt_mem_alloc_huge(m, sizeof *w->vabs, 1);
+    w->mom = cen ? fdt_mem_alloc_huge(3 * m, sizeof *w->mom, 1) : NULL;
+    w->dtfe = dens ? fdt_mem_alloc_huge(m, sizeof *w->dtfe, 1) : NULL;
+    w->vmax = dens ? fdt_mem_alloc_huge(m, sizeof *w->vmax, 1) : NULL;
     if (!w->flags || !w->vol || !w->vabs || (cen && !w->mom) || (dens && (!w->dtfe || !w->vmax)))
         return FDT_ENOMEM;
     return FDT_OK;
@@ -1309,8 +1297,8 @@ static void *scatter_pass(void *arg)
 static int bucket_tets(vwork *w, vjob *jobs, int threads)
 {
     int err = w->rtets ? fork_join(jobs, threads, map_pass) : FDT_OK;
-    w->bcnt = big_alloc(w->m + 1, sizeof *w->bcnt, 1);
-    w->btets = big_alloc(w->ntets ? 4 * w->ntets : 1, sizeof *w->btets, 0);
+    w->bcnt = fdt_mem_alloc_huge(w->m + 1, sizeof *w->bcnt, 1);
+    w->btets = fdt_mem_alloc_huge(w->ntets ? 4 * w->ntets : 1, sizeof *w->btets, 0);
     if (!err && (!w->bcnt || !w->btets))
         err = FDT_ENOMEM;
     if (!err)
@@ -1337,15 +1325,15 @@ static int bucket_tets(vwork *w, vjob *jobs, int threads)
  * threads. */
 static int list_neighbors(fdt_voronoi *v, vjob *jobs, int threads)
 {
-    v->nstart = big_alloc(v->n + 1, sizeof *v->nstart, 0);
+    v->nstart = fdt_mem_alloc_huge(v->n + 1, sizeof *v->nstart, 0);
     if (!v->nstart)
         return FDT_ENOMEM;
     v->nstart[0] = 0;
     for (size_t i = 0; i < v->n; i++)
         v->nstart[i + 1] = v->nstart[i] + (size_t)v->nfaces[i];
     size_t tot = v->nstart[v->n];
-    v->nid = big_alloc(tot ? tot : 1, sizeof *v->nid, 0);
-    v->narea = big_alloc(tot ? tot : 1, sizeof *v->narea, 0);
+    v->nid = fdt_mem_alloc_huge(tot ? tot : 1, sizeof *v->nid, 0);
+    v->narea = fdt_mem_alloc_huge(tot ? tot : 1, sizeof *v->narea, 0);
     if (!v->nid || !v->narea)
         return FDT_ENOMEM;
     return fork_join(jobs, threads, neighbors_pass);
