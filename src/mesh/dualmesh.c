@@ -1004,8 +1004,9 @@ static int merge_wall_vertices(dwork *w)
     }
     qsort(s, m, sizeof *s, wallvx_cmp);
     size_t same = 0;
-    for (size_t i = 1; i < m; i++)
-        if (!memcmp(s[i].x, s[i - 1].x, sizeof s[i].x)) {
+    for (size_t i = 1; i < m; i++) /* as the sort compares: -0 and +0 one place */
+        if (s[i].x[0] == s[i - 1].x[0] && s[i].x[1] == s[i - 1].x[1] &&
+            s[i].x[2] == s[i - 1].x[2]) {
             to[s[i].id] = to[s[i - 1].id];
             same++;
         }
