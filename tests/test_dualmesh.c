@@ -378,6 +378,35 @@ static void test_torus(size_t nu, size_t nv)
     free(xyz);
 }
 
+/*
+ * An HCP crystal (hexagonal layers, every other one shifted; irrational
+ * coordinates: sqrt(3) / 2, sqrt(2 / 3)) in its bounding box: Voronoi
+ * vertices within rounding of the walls and of each other. 5 x 5 x 6 left
+ * a face running out to a vertex 2 ulps under zmax and back (a spike
+ * after two crossings merged); 3 x 3 x 7 a loop of three wall edges
+ * 4e-16 across beside the cell's wall face; both were refused as
+ * internal errors ("has vertex twice", "does not chain").
+ */
+static void test_hcp(int ni, int nl)
+{
+    double *xyz = malloc((size_t)ni * (size_t)ni * (size_t)nl * 3 * sizeof *xyz);
+    CHECK(xyz);
+    size_t n = 0;
+    for (int l = 0; l < nl; l++)
+        for (int i = 0; i < ni; i++)
+            for (int j = 0; j < ni; j++) {
+                xyz[3 * n] = i + 0.5 * (j % 2) + (l % 2 ? 0.5 : 0);
+                xyz[3 * n + 1] = j * sqrt(3.0) / 2 + (l % 2 ? sqrt(3.0) / 6 : 0);
+                xyz[3 * n + 2] = l * sqrt(2.0 / 3.0);
+                n++;
+            }
+    char what[64];
+    snprintf(what, sizeof what, "an HCP crystal %d x %d x %d", ni, ni, nl);
+    fdt_dualmesh d = check_dual(what, xyz, n, NULL);
+    fdt_dualmesh_free(&d);
+    free(xyz);
+}
+
 /* Points closer than doubles can hold the cells between: refused with
  * FDT_ERANGE naming them, nothing handed out. */
 static void expect_beyond_doubles(const char *what, const double *xyz, size_t n)
@@ -422,6 +451,8 @@ int main(void)
     test_torus(4, 3);
     test_torus(4, 4);
     test_torus(5, 4);
+    test_hcp(5, 6);
+    test_hcp(3, 7);
     test_beyond_doubles();
     test_small_and_flat();
     test_lattice(2);

@@ -972,6 +972,39 @@ static int wallvx_cmp(const void *p, const void *q)
 }
 
 /*
+ * A face's cycle of m vertex ids after wall vertices were merged, cleaned
+ * in place: a vertex repeated next to itself kept once, and a spike (A,
+ * B, A in cyclic order: the face runs out to B and back) cut to A, until
+ * neither is left. Returns the ids left. A spike comes from a vertex
+ * within rounding of a box edge between two crossings of that edge that
+ * merged (an HCP lattice's bounding box: a Voronoi vertex 2 ulps below
+ * zmax beside the crossings at x = 0, z = zmax). Cutting it takes the
+ * edge A-B out of the face once each way, so both cells of the face stay
+ * closed; a wall face never gets it (walls are chained after the merge).
+ */
+static size_t drop_spikes(int64_t *f, size_t m)
+{
+    for (int changed = 1; changed && m >= 2;) {
+        changed = 0;
+        for (size_t i = 0; i < m && m >= 2; i++) {
+            size_t nx = (i + 1) % m, pv = (i + m - 1) % m;
+            if (f[i] == f[nx]) { /* A, A: drop the second */
+                memmove(f + nx, f + nx + 1, (m - nx - 1) * sizeof *f);
+                m--;
+                changed = 1;
+            } else if (m >= 3 && f[pv] == f[nx]) { /* A, B, A: drop B and an A */
+                size_t hi = i > nx ? i : nx, lo = i > nx ? nx : i;
+                memmove(f + hi, f + hi + 1, (m - hi - 1) * sizeof *f);
+                memmove(f + lo, f + lo + 1, (m - 2 - lo) * sizeof *f);
+                m -= 2;
+                changed = 1;
+            }
+        }
+    }
+    return m;
+}
+
+/*
  * Vertices on the walls at the same place made one (the lowest), and
  * the faces left without an area dropped. Crossings of different
  * Voronoi edges snapped onto a box edge or corner (snap_to_walls) land
@@ -1019,13 +1052,9 @@ static int merge_wall_vertices(dwork *w)
     size_t nf = 0, nfv = 0;
     for (size_t f = 0; f < w->nf; f++) {
         size_t a = w->fs[f], b = w->fs[f + 1], k0 = nfv;
-        for (size_t i = a; i < b; i++) {
-            int64_t id = to[w->fv[i]];
-            if (nfv == k0 || w->fv[nfv - 1] != id)
-                w->fv[nfv++] = id;
-        }
-        while (nfv - k0 > 1 && w->fv[nfv - 1] == w->fv[k0])
-            nfv--;
+        for (size_t i = a; i < b; i++)
+            w->fv[nfv++] = to[w->fv[i]];
+        nfv = k0 + drop_spikes(w->fv + k0, nfv - k0);
         if (nfv - k0 < 3) {
             nfv = k0;
             continue;
@@ -1144,65 +1173,135 @@ typedef struct wallwork {
     size_t capit;
     uint64_t *to;    /* one wall's edges' ends, sorted */
     size_t capto;
+    uint8_t *done;   /* which of the wall's edges a chain took */
+    size_t capdone;
+    int64_t *ids;    /* the face from the rim's chains and corners */
+    size_t capids;
+    int64_t *path;   /* walk_edges' path */
+    size_t cappath;
 } wallwork;
+
+/* The first of the wall's edges e[0 .. m) (sorted) from vertex v that no
+ * chain took yet, or SIZE_MAX. */
+static size_t unused_from(const wallwork *ww, size_t m, uint64_t v)
+{
+    const uint64_t *e = ww->we;
+    for (size_t at = edge_from(e, m, v); at < m && (e[at] >> 32) == v; at++)
+        if (!ww->done[at])
+            return at;
+    return SIZE_MAX;
+}
+
+/*
+ * The walk along cell c's unused edges on wall p from vertex v until none
+ * leaves the vertex reached. A vertex met again closes a loop, cut out at
+ * once as a face of its own (one of two vertices, an edge there and back,
+ * adds nothing: the cell's other faces use the edge both ways); so the
+ * walk's path stays simple, and is appended to ids[*k ...] when `open`
+ * (a chain from the rim to the rim), else must have come back to v.
+ */
+static int walk_edges(dwork *w, wallwork *ww, int32_t c, int p, size_t m, uint64_t v, int open,
+                      int64_t *ids, size_t *k)
+{
+    const uint64_t *e = ww->we;
+    int64_t *path = ww->path;
+    size_t np = 0, at;
+    path[np++] = (int64_t)v;
+    while ((at = unused_from(ww, m, v)) != SIZE_MAX) {
+        ww->done[at] = 1;
+        v = e[at] & 0xffffffffu;
+        size_t q = np;
+        while (q > 0 && path[q - 1] != (int64_t)v)
+            q--;
+        if (q == 0) {
+            path[np++] = (int64_t)v;
+            continue;
+        }
+        if (np - (q - 1) >= 3) { /* the loop path[q - 1 .. np) */
+            int err = append_face(w, path + q - 1, np - (q - 1), c, -1 - p);
+            if (err)
+                return err;
+        }
+        np = q;
+    }
+    if (!open)
+        return np == 1 ? FDT_OK : FDT_EINTERNAL;
+    memcpy(ids + *k, path, np * sizeof *path);
+    *k += np;
+    return FDT_OK;
+}
 
 /* Cell c's face on wall p: its edges e[0 .. m) on the wall (each the
  * reverse of an edge its other faces use once), chained, and the box
  * corners it holds there, put in the order of their chains' starts round
- * the rim (the face is convex: its rim points come in the rim's order). */
+ * the rim (the face is convex: its rim points come in the rim's order).
+ * Where rounding leaves slivers (an HCP lattice in its bounding box:
+ * vertices within 4e-16 of each other, where nearly cospherical Voronoi
+ * vertices meet the wall), a chain can meet a vertex twice or edges
+ * can close a loop inside the wall: each such loop is a face of its own
+ * (walk_edges), as is a whole face inside the wall. The cell's other
+ * faces use those edges, so without them it would not close. */
 static int wall_face(dwork *w, wallwork *ww, int32_t c, int p, size_t m, const int64_t *corners,
                      int nc)
 {
     uint64_t *e = ww->we;
     fdt_sort_u64(e, m);
     if (fdt_grow(&ww->it, &ww->capit, m + (size_t)nc + 1, sizeof *ww->it) != 0 ||
-        fdt_grow(&w->fv, &w->capfv, w->nfv + 2 * m + (size_t)nc + 1, sizeof *w->fv) != 0)
+        fdt_grow(&ww->ids, &ww->capids, 2 * m + (size_t)nc + 1, sizeof *ww->ids) != 0 ||
+        fdt_grow(&ww->path, &ww->cappath, m + 1, sizeof *ww->path) != 0 ||
+        fdt_grow(&ww->to, &ww->capto, m + 1, sizeof *ww->to) != 0 ||
+        fdt_grow(&ww->done, &ww->capdone, m + 1, sizeof *ww->done) != 0)
         return FDT_ENOMEM;
-    if (fdt_grow(&ww->to, &ww->capto, m + 1, sizeof *ww->to) != 0)
-        return FDT_ENOMEM;
-    for (size_t i = 0; i < m; i++)
-        ww->to[i] = e[i] & 0xffffffffu;
-    fdt_sort_u64(ww->to, m);
-    size_t ni = 0;
     for (size_t i = 0; i < m; i++) {
-        if (i > 0 && (e[i] >> 32) == (e[i - 1] >> 32))
-            goto bad;
+        ww->to[i] = e[i] & 0xffffffffu;
+        ww->done[i] = 0;
+    }
+    fdt_sort_u64(ww->to, m);
+    /* the chains' starts: a vertex with more edges out than in, once for
+     * each more, on the rim */
+    size_t ni = 0;
+    for (size_t i = 0, j; i < m; i = j) {
         uint64_t from = e[i] >> 32;
-        if (bsearch(&from, ww->to, m, sizeof *ww->to, u64_cmp))
-            continue; /* not a chain's start */
-        ww->it[ni] = (wallitem){rim_key(w, p, w->vx + 3 * (e[i] >> 32)), i, -1};
-        if (ww->it[ni++].key.side < 0)
-            goto bad;
+        for (j = i + 1; j < m && (e[j] >> 32) == from; j++)
+            ;
+        size_t lo = 0, hi = m;
+        while (lo < hi) { /* the first end >= from */
+            size_t mid = lo + (hi - lo) / 2;
+            if (ww->to[mid] < from)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        size_t in = 0;
+        while (lo + in < m && ww->to[lo + in] == from)
+            in++;
+        for (size_t r = in; r < j - i; r++) {
+            ww->it[ni] = (wallitem){rim_key(w, p, w->vx + 3 * from), i, -1};
+            if (ww->it[ni++].key.side < 0)
+                goto bad;
+        }
     }
     for (int k = 0; k < nc; k++)
         ww->it[ni++] = (wallitem){rim_key(w, p, w->vx + 3 * (size_t)corners[k]), SIZE_MAX,
                                   corners[k]};
-    if (ni == 0 && m > 0)
-        ww->it[ni++] = (wallitem){{0, 0}, 0, -1}; /* one closed chain inside the wall */
     qsort(ww->it, ni, sizeof *ww->it, item_cmp);
-    int64_t *ids = w->fv + w->nfv;
-    size_t k = 0, used = 0;
-    for (size_t a = 0; a < ni; a++) {
+    int64_t *ids = ww->ids;
+    size_t k = 0;
+    int err = FDT_OK;
+    for (size_t a = 0; a < ni && !err; a++) {
         const wallitem *x = &ww->it[(p & 1) ? a : ni - 1 - a];
-        if (x->at == SIZE_MAX) {
+        if (x->at == SIZE_MAX)
             ids[k++] = x->corner;
-            continue;
-        }
-        uint64_t v = e[x->at] >> 32, first = v;
-        size_t at = x->at;
-        do {
-            ids[k++] = (int64_t)v;
-            v = e[at] & 0xffffffffu;
-            if (++used > m)
-                goto bad;
-            at = edge_from(e, m, v);
-        } while (at != SIZE_MAX && v != first);
-        if (v != first)
-            ids[k++] = (int64_t)v;
+        else
+            err = walk_edges(w, ww, c, p, m, e[x->at] >> 32, 1, ids, &k);
     }
-    if (used != m)
-        goto bad;
-    return k < 3 ? FDT_OK : append_face(w, ids, k, c, -1 - p);
+    if (!err && k >= 3)
+        err = append_face(w, ids, k, c, -1 - p);
+    for (size_t i = 0; i < m && !err; i++) /* the loops left */
+        if (!ww->done[i])
+            err = walk_edges(w, ww, c, p, m, e[i] >> 32, 0, NULL, NULL);
+    if (err != FDT_EINTERNAL)
+        return err;
 bad:
     fdt_diag(w->diag, w->ds, "the face of cell %d on wall %s does not chain (%zu edges)", c,
         fdt_dualmesh_patch[p], m);
@@ -1392,6 +1491,9 @@ static int all_walls(dwork *w)
     free(ww.to);
     free(ww.we);
     free(ww.it);
+    free(ww.done);
+    free(ww.ids);
+    free(ww.path);
     free(cs);
     free(cf);
     return err;
