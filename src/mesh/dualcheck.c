@@ -165,7 +165,7 @@ static int check_faces(const fdt_dualmesh *d, char *diag, size_t ds)
                 fdt_diag(diag, ds, "face %zu: owner %d, neighbour %d", f, o, nb);
                 bad = 1;
             } else if (f > 0 && (d->owner[f - 1] > o ||
-                                 (d->owner[f - 1] == o && d->neighbour[f - 1] >= nb))) {
+                                 (d->owner[f - 1] == o && d->neighbour[f - 1] > nb))) {
                 fdt_diag(diag, ds, "face %zu (%d, %d) is out of upper-triangular order", f, o, nb);
                 bad = 1;
             }

@@ -971,37 +971,61 @@ static int wallvx_cmp(const void *p, const void *q)
     return (a->id > b->id) - (a->id < b->id);
 }
 
+/* Faces cut out of others (split_loops), to be appended. */
+typedef struct loops {
+    int64_t *v;       /* their vertices */
+    size_t nv, capv;
+    size_t *at;       /* face i: v[at[2i] .. at[2i] + at[2i + 1]) */
+    size_t n, capat;
+    int32_t *cells;   /* face i's owner and neighbour: 2i, 2i + 1 */
+    size_t capcells;
+} loops;
+
 /*
- * A face's cycle of m vertex ids after wall vertices were merged, cleaned
- * in place: a vertex repeated next to itself kept once, and a spike (A,
- * B, A in cyclic order: the face runs out to B and back) cut to A, until
- * neither is left. Returns the ids left. A spike comes from a vertex
- * within rounding of a box edge between two crossings of that edge that
- * merged (an HCP lattice's bounding box: a Voronoi vertex 2 ulps below
- * zmax beside the crossings at x = 0, z = zmax). Cutting it takes the
- * edge A-B out of the face once each way, so both cells of the face stay
- * closed; a wall face never gets it (walls are chained after the merge).
+ * A face's cycle of m vertex ids after wall vertices were merged, made
+ * simple in place: walking it, a vertex met again closes a loop, which
+ * is cut out (kept in *lp as a face of its own, between the face's cells
+ * own and nbr, when it
+ * has 3 vertices or more; one of 1 or 2 is a repeat or a spike, A, B, A,
+ * which runs out and back and has no area). Returns the ids left.
+ * Merging makes them: crossings of two Voronoi edges with a box edge
+ * that round to one place become one vertex, and a face through both,
+ * with a vertex within rounding of the wall between them, runs out to it
+ * and back, or pinches into two loops there (HCP crystals in their
+ * bounding box: Voronoi vertices 2e-16 from a wall). Cutting a spike
+ * takes its edge out once each way; a loop cut out keeps its edges: both
+ * cells of the face stay closed.
  */
-static size_t drop_spikes(int64_t *f, size_t m)
+static int split_loops(int64_t *f, size_t *m, loops *lp, int32_t own, int32_t nbr)
 {
-    for (int changed = 1; changed && m >= 2;) {
-        changed = 0;
-        for (size_t i = 0; i < m && m >= 2; i++) {
-            size_t nx = (i + 1) % m, pv = (i + m - 1) % m;
-            if (f[i] == f[nx]) { /* A, A: drop the second */
-                memmove(f + nx, f + nx + 1, (m - nx - 1) * sizeof *f);
-                m--;
-                changed = 1;
-            } else if (m >= 3 && f[pv] == f[nx]) { /* A, B, A: drop B and an A */
-                size_t hi = i > nx ? i : nx, lo = i > nx ? nx : i;
-                memmove(f + hi, f + hi + 1, (m - hi - 1) * sizeof *f);
-                memmove(f + lo, f + lo + 1, (m - 2 - lo) * sizeof *f);
-                m -= 2;
-                changed = 1;
-            }
+    size_t np = 0;
+    for (size_t i = 0; i < *m; i++) {
+        int64_t v = f[i];
+        size_t q = np;
+        while (q > 0 && f[q - 1] != v)
+            q--;
+        if (q == 0) {
+            f[np++] = v; /* np <= i: in place */
+            continue;
         }
+        size_t k = np - (q - 1); /* the loop f[q - 1 .. np) */
+        if (k >= 3) {
+            if (fdt_grow(&lp->v, &lp->capv, lp->nv + k, sizeof *lp->v) != 0 ||
+                fdt_grow(&lp->at, &lp->capat, 2 * lp->n + 2, sizeof *lp->at) != 0 ||
+                fdt_grow(&lp->cells, &lp->capcells, 2 * lp->n + 2, sizeof *lp->cells) != 0)
+                return FDT_ENOMEM;
+            memcpy(lp->v + lp->nv, f + q - 1, k * sizeof *f);
+            lp->at[2 * lp->n] = lp->nv;
+            lp->at[2 * lp->n + 1] = k;
+            lp->cells[2 * lp->n] = own;
+            lp->cells[2 * lp->n + 1] = nbr;
+            lp->n++;
+            lp->nv += k;
+        }
+        np = q;
     }
-    return m;
+    *m = np;
+    return FDT_OK;
 }
 
 /*
@@ -1048,14 +1072,18 @@ static int merge_wall_vertices(dwork *w)
         free(to);
         return FDT_OK;
     }
-    /* in place: a face's entries only move down */
+    /* in place: a face's entries only move down; the loops cut out
+     * appended after */
     size_t nf = 0, nfv = 0;
-    for (size_t f = 0; f < w->nf; f++) {
-        size_t a = w->fs[f], b = w->fs[f + 1], k0 = nfv;
+    loops lp = {0};
+    int err = FDT_OK;
+    for (size_t f = 0; f < w->nf && !err; f++) {
+        size_t a = w->fs[f], b = w->fs[f + 1], k0 = nfv, k = b - a;
         for (size_t i = a; i < b; i++)
             w->fv[nfv++] = to[w->fv[i]];
-        nfv = k0 + drop_spikes(w->fv + k0, nfv - k0);
-        if (nfv - k0 < 3) {
+        err = split_loops(w->fv + k0, &k, &lp, w->fown[f], w->fnbr[f]);
+        nfv = k0 + k;
+        if (k < 3) {
             nfv = k0;
             continue;
         }
@@ -1066,8 +1094,14 @@ static int merge_wall_vertices(dwork *w)
     w->fs[nf] = nfv;
     w->nf = nf;
     w->nfv = nfv;
+    for (size_t i = 0; i < lp.n && !err; i++)
+        err = append_face(w, lp.v + lp.at[2 * i], lp.at[2 * i + 1], lp.cells[2 * i],
+                          lp.cells[2 * i + 1]);
+    free(lp.v);
+    free(lp.at);
+    free(lp.cells);
     free(to);
-    return FDT_OK;
+    return err;
 }
 
 /* The box corner c (bit k: the upper bound in axis k) and the cell of the
@@ -1360,14 +1394,31 @@ static int cell_walls(dwork *w, wallwork *ww, int32_t c, const size_t *cs, const
         }
     }
     qsort(ww->he, m, sizeof *ww->he, hedge_cmp);
-    /* the unmatched ones, reversed, after the first m */
+    /* the unmatched ones, reversed, after the first m: as many as an edge
+     * is used more one way than the other (a face pinched or collapsed
+     * by rounding can use it more than once: three faces of one cell of
+     * an HCP crystal between two wall vertices 4e-16 apart, twice one way
+     * and once the other) */
     size_t nw = 0;
     if (fdt_grow(&ww->he, &ww->caphe, 2 * m + 1, sizeof *ww->he) != 0)
         return FDT_ENOMEM;
-    for (size_t i = 0; i < m; i++) {
+    for (size_t i = 0, j; i < m; i = j) {
+        for (j = i + 1; j < m && ww->he[j].key == ww->he[i].key; j++)
+            ;
         hedge r = ww->he[i];
         r.key = (r.key << 32) | (r.key >> 32);
-        if (bsearch(&r, ww->he, m, sizeof *ww->he, hedge_cmp))
+        size_t lo = 0, hi = m; /* the reverse's run: from the first key >= r's */
+        while (lo < hi) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (ww->he[mid].key < r.key)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        size_t back = 0;
+        while (lo + back < m && ww->he[lo + back].key == r.key)
+            back++;
+        if (j - i <= back)
             continue;
         r.wall = hedge_wall(w, c, &r);
         if (r.wall < 0) {
@@ -1375,7 +1426,8 @@ static int cell_walls(dwork *w, wallwork *ww, int32_t c, const size_t *cs, const
                 (unsigned long long)(r.key >> 32), (unsigned long long)(r.key & 0xffffffffu));
             return FDT_EINTERNAL;
         }
-        ww->he[m + nw++] = r;
+        for (size_t x = back; x < j - i; x++)
+            ww->he[m + nw++] = r;
     }
     for (int p = 0; p < 6; p++) {
         int64_t corners[4];

@@ -87,7 +87,9 @@ void fdt_dualmesh_free(fdt_dualmesh *d);
  * The check (src/mesh/dualcheck.c, sharing nothing with the construction):
  * an independent check of a dual's numbering: every vertex used and every
  * index in range, no face with fewer than 3 or repeated vertices, owner <
- * neighbour, the internal faces in upper-triangular order, the patches
+ * neighbour, the internal faces in upper-triangular order (two faces of
+ * one pair of cells side by side, as OpenFOAM allows: a face pinched by
+ * rounding is cut in two, src/mesh/dualmesh.c's split_loops), the patches
  * contiguous after them by owner, every cell closed (each of its edges in
  * two of its faces, once each way round when the faces are turned out of
  * the cell) and of positive volume, every wall face on its wall and each
