@@ -1337,6 +1337,48 @@ static int fam_boxsurf(pts *p, size_t n, rng *r)
     return 0;
 }
 
+/* ~N: a face-centred cubic crystal, s^3 unit cells of 4 atoms (corners
+ * and face centres at halves: exact in binary), a metal's or a molecular
+ * dynamics cell's atoms: every octahedral hole has 6 exactly cospherical
+ * atoms around it, every tetrahedral one 4, and each is shared by
+ * neighbouring holes' spheres. */
+static int fam_fcc(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    size_t s = round_cbrt(n / 4 ? n / 4 : 1);
+    static const double basis[4][3] = {{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}};
+    for (size_t i = 0; i < s; i++)
+        for (size_t j = 0; j < s; j++)
+            for (size_t k = 0; k < s; k++)
+                for (int b = 0; b < 4; b++)
+                    if (pts_add(p, (double)i + basis[b][0], (double)j + basis[b][1],
+                                (double)k + basis[b][2]))
+                        return -1;
+    return 0;
+}
+
+/* ~N: a hexagonal close-packed crystal, s layers of s x s atoms (unit
+ * spacing; rows sqrt(3)/2 apart, every other layer shifted by (1/2,
+ * sqrt(3)/6) and sqrt(2/3) higher): the coordinates are rounded
+ * irrationals, so its many cospherical groups are cospherical only to
+ * rounding (their spheres differ in the last bits), and in its bounding
+ * box Voronoi vertices fall within ulps of the walls (the `--dual` of
+ * 5 x 5 x 6 and 3 x 3 x 7 once failed there). */
+static int fam_hcp(pts *p, size_t n, rng *r)
+{
+    (void)r;
+    size_t s = round_cbrt(n);
+    for (size_t l = 0; l < s; l++)
+        for (size_t i = 0; i < s; i++)
+            for (size_t j = 0; j < s; j++) {
+                double x = (double)i + 0.5 * (double)(j % 2) + (l % 2 ? 0.5 : 0);
+                double y = (double)j * sqrt(3.0) / 2 + (l % 2 ? sqrt(3.0) / 6 : 0);
+                if (pts_add(p, x, y, (double)l * sqrt(2.0 / 3.0)))
+                    return -1;
+            }
+    return 0;
+}
+
 /* How a family's coordinates are printed: most as %.17g, which round-trips
  * every double; a few the way their real files are written. */
 enum { FMT_17G, FMT_12G, FMT_2F, FMT_6F };
@@ -1395,6 +1437,8 @@ static const struct family {
     {"helix", fam_helix, FMT_17G, "points along a helix (a curve in 3-D)"},
     {"twoshells", fam_twoshells, FMT_17G, "two Fibonacci spheres, radii 1 and 50"},
     {"boxsurf", fam_boxsurf, FMT_17G, "~N: every integer point of a box's surface"},
+    {"fcc", fam_fcc, FMT_17G, "~N: face-centred cubic crystal, s^3 cells of 4 atoms"},
+    {"hcp", fam_hcp, FMT_17G, "~N: hexagonal close-packed crystal, s^3 atoms, irrational rows"},
 };
 #define N_FAMILIES (sizeof families / sizeof families[0])
 
