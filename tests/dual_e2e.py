@@ -173,6 +173,16 @@ def checkmesh(name, case, rc):
             "Face pyramids OK", "Cell volumes OK", "Boundary openness", "Max cell openness"]
     if "periodic" in name:  # the cyclic pairs matched by OpenFOAM
         want.append("Coupled point location match")
+    if name == "hcp":
+        # crossings of distinct Voronoi edges that round to one place inside
+        # a wall stay distinct vertices (merged, the cells did not close:
+        # bench/NOTES.md entry 129), so faces there meet at coincident
+        # points: checkMesh warns of "non-consecutive shared points" (no
+        # failed check); every other topology check must pass
+        want.remove("Face-face connectivity OK")
+        if not re.search(r"Number of faces with non-consecutive shared points: \d+", out):
+            fail(f"checkMesh {name}: neither face-face connectivity nor its warning\n{out}")
+            return
     for ok in want:
         if ok not in out:
             fail(f"checkMesh {name}: no '{ok}'\n{out}")
@@ -229,9 +239,12 @@ def periodic_sets():
 def main():
     sets = []
     # cone and torus: rings of cocircular points, whose Voronoi edges meet
-    # the walls at box edges and corners (cells were left open there)
+    # the walls at box edges and corners (cells were left open there); fcc
+    # and hcp crystals in their bounding boxes (hcp: Voronoi vertices
+    # within ulps of the walls and of each other, an internal error until
+    # bench/NOTES.md entry 129)
     for fam, n in (("uniform", 2000), ("gaussian", 2000), ("lattice", 512), ("dup", 500),
-                   ("cone", 1000), ("torus", 4000)):
+                   ("cone", 1000), ("torus", 4000), ("fcc", 500), ("hcp", 729)):
         xyz = os.path.join(SCRATCH, fam + ".xyz")
         subprocess.run([GEN, fam, str(n), "1", xyz], check=True, capture_output=True)
         sets.append((fam, xyz, None))

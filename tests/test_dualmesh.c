@@ -391,7 +391,8 @@ static void test_torus(size_t nu, size_t nv)
  * 4e-16 across beside the cell's wall face; 20 x 20 x 3 an internal face
  * pinched at a merged wall vertex, and a wall face through one vertex
  * twice: all were refused as internal errors ("has vertex twice", "does
- * not chain").
+ * not chain"). (tests/dual_e2e.py has `gen_points hcp 729`, whose cells
+ * did not close while crossings inside a wall were merged.)
  */
 static void test_hcp(int ni, int nl)
 {

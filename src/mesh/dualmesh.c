@@ -956,6 +956,15 @@ static int on_wall(const dwork *w, const double x[3])
     return 0;
 }
 
+/* Whether point x lies on two walls or more: a box edge or corner. */
+static int on_box_edge(const dwork *w, const double x[3])
+{
+    int n = 0;
+    for (int p = 0; p < 6; p++)
+        n += x[p >> 1] == bound(w, p);
+    return n >= 2;
+}
+
 /* A vertex on a wall, sorted by place. */
 typedef struct wallvx {
     double x[3];
@@ -1029,21 +1038,26 @@ static int split_loops(int64_t *f, size_t *m, loops *lp, int32_t own, int32_t nb
 }
 
 /*
- * Vertices on the walls at the same place made one (the lowest), and
- * the faces left without an area dropped. Crossings of different
- * Voronoi edges snapped onto a box edge or corner (snap_to_walls) land
- * on the same doubles: two vertices there, and the cells meeting at the
- * place would each use one of them and not close (gen_points `torus` 16:
- * two crossings at the corner (4, -4, 1), one in each of two faces of
- * one cell). Only wall vertices: the Voronoi vertices inside are one a
- * sphere (merge_tets), and equal roundings of two spheres' centres keep
- * their edge, as every cell on it sees it.
+ * Vertices on the box's edges and corners at the same place made one
+ * (the lowest), and the faces made simple (split_loops). Crossings of
+ * different Voronoi edges snapped onto a box edge or corner
+ * (snap_to_walls), and a face's own edge along one wall crossing the
+ * next (crossing: computed for each face), land on the same doubles: two
+ * vertices there, and the cells meeting at the place would each use one
+ * of them and not close (gen_points `torus` 16: two crossings at the
+ * corner (4, -4, 1), one in each of two faces of one cell). Only there:
+ * a crossing inside one wall is a Voronoi edge's, made once under its
+ * key for every face that has it, and two edges' crossings that round to
+ * one place are two vertices as two spheres' centres are (merge_tets).
+ * Merging those too (as this did at first) joined faces that share no
+ * edge: an HCP crystal's cell then used one edge twice each way
+ * (bench/NOTES.md entry 129).
  */
 static int merge_wall_vertices(dwork *w)
 {
     size_t m = 0;
     for (size_t v = 0; v < w->nv; v++)
-        m += (size_t)on_wall(w, w->vx + 3 * v);
+        m += (size_t)on_box_edge(w, w->vx + 3 * v);
     wallvx *s = malloc((m + 1) * sizeof *s);
     int64_t *to = malloc((w->nv + 1) * sizeof *to);
     if (!s || !to) {
@@ -1054,7 +1068,7 @@ static int merge_wall_vertices(dwork *w)
     m = 0;
     for (size_t v = 0; v < w->nv; v++) {
         to[v] = (int64_t)v;
-        if (on_wall(w, w->vx + 3 * v)) {
+        if (on_box_edge(w, w->vx + 3 * v)) {
             memcpy(s[m].x, w->vx + 3 * v, sizeof s[m].x);
             s[m++].id = (int64_t)v;
         }
