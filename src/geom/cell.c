@@ -39,6 +39,7 @@ void fdt_cell_free(fdt_cell *c)
     free(c->tring);
     free(c->tf);
     free(c->tp);
+    free(c->touched);
     fdt_cell_init(c);
 }
 
@@ -71,7 +72,8 @@ int fdt_cell_box(fdt_cell *c, const double lo[3], const double hi[3])
         memcpy(c->ring + 4 * f, faces[f], sizeof faces[f]);
     }
     c->nf = 6;
-    c->nring = 24;
+    c->nring = c->live_ring = 24;
+    c->ndead = 0;
     return 0;
 }
 
@@ -87,6 +89,8 @@ int fdt_cell_copy(fdt_cell *dst, const fdt_cell *src)
     dst->np = src->np;
     dst->nring = src->nring;
     dst->nf = src->nf;
+    dst->live_ring = src->live_ring;
+    dst->ndead = src->ndead;
     return 0;
 }
 
@@ -216,7 +220,94 @@ static int compact(fdt_cell *c)
     return 0;
 }
 
-/* fdt_cell_cut with the ON tolerance tol (FDT_CELL_TOL, or coarser). */
+/* The live faces' rings copied to the scratch, then compact: the
+ * vertices and entries no face uses dropped. */
+int fdt_cell_compact(fdt_cell *c)
+{
+    if (c->ndead == 0 && c->live_ring == c->nring)
+        return 0;
+    c->ntring = c->ntf = 0;
+    if (grow(&c->tring, &c->captring, c->live_ring, sizeof(int)) ||
+        grow(&c->tf, &c->captf, c->nf, sizeof *c->tf) ||
+        grow(&c->v, &c->capv, c->np, sizeof *c->v))
+        return -1;
+    for (int f = 0; f < c->nf; f++) {
+        int start = c->ntring;
+        for (int j = 0; j < c->f[f].count; j++)
+            push_ring(c, c->ring[c->f[f].start + j]);
+        push_face(c, start, c->f[f].label);
+    }
+    if (compact(c))
+        return -1;
+    c->live_ring = c->nring;
+    c->ndead = 0;
+    return 0;
+}
+
+/* A cut's faces made the cell's (cut_tol, once it has them all in the
+ * scratch): each kept face reached by the cut gets its new ring at the
+ * end of ring[] (its old one left there unused), a face cut away goes
+ * (the others keep their order), the cap (if any: the scratch's last
+ * face) comes last, and the vertices cut off become NaN. np0: the
+ * vertices before the cut's crossings. 0, or -1 when out of memory (the
+ * cell is then as before the cut but for unused room). */
+static int apply_cut(fdt_cell *c, int nt, int np0)
+{
+    if (grow(&c->ring, &c->capring, c->nring + c->ntring, sizeof(int)) ||
+        grow(&c->f, &c->capf, c->nf + 1, sizeof *c->f))
+        return -1;
+    int t = 0, gone = 0;
+    for (int i = 0; i < nt; i++) {
+        int f = c->touched[i];
+        if (f < 0) {
+            f = -1 - f;
+            c->live_ring -= c->f[f].count;
+            c->f[f].count = 0;
+            gone++;
+            continue;
+        }
+        const fdt_cell_ring *src = &c->tf[t++];
+        memcpy(c->ring + c->nring, c->tring + src->start, (size_t)src->count * sizeof(int));
+        c->live_ring += src->count - c->f[f].count;
+        c->f[f].start = c->nring;
+        c->f[f].count = src->count;
+        c->nring += src->count;
+    }
+    if (gone) {
+        int m = 0;
+        for (int f = 0; f < c->nf; f++)
+            if (c->f[f].count > 0)
+                c->f[m++] = c->f[f];
+        c->nf = m;
+    }
+    if (t < c->ntf) { /* the cap */
+        const fdt_cell_ring *src = &c->tf[t];
+        memcpy(c->ring + c->nring, c->tring + src->start, (size_t)src->count * sizeof(int));
+        c->f[c->nf++] = (fdt_cell_ring){c->nring, src->count, src->label};
+        c->nring += src->count;
+        c->live_ring += src->count;
+    }
+    for (int i = 0; i < np0; i++)
+        if (c->v[i].side == OUT) {
+            c->p[i][0] = c->p[i][1] = c->p[i][2] = NAN;
+            c->ndead++;
+        }
+    /* the space left unused, once it is as large as what is used (out
+     * of memory there leaves it for later: the cell is whole either way) */
+    if (c->nring > 2 * c->live_ring + 256 || 2 * c->ndead > c->np + 256)
+        (void)fdt_cell_compact(c);
+    return 0;
+}
+
+/*
+ * fdt_cell_cut with the ON tolerance tol (FDT_CELL_TOL, or coarser).
+ * Every vertex is classed (one pass of a few operations each; a vertex
+ * cut off earlier is NaN, which classes as ON and no face uses), but
+ * only the faces that have a vertex outside are cut and rewritten: a
+ * cell of k faces, each cut adding one (a point with thousands of
+ * Delaunay neighbours: a scan's outlier above it), took k^2 / 2 ring
+ * copies when every cut rebuilt every face (bench/NOTES.md entry 129).
+ */
 static int cut_tol(fdt_cell *c, const double n[3], double h, long label, double tol)
 {
     /* Each vertex classed once; a crossing point is ON by construction. */
@@ -242,16 +333,25 @@ static int cut_tol(fdt_cell *c, const double n[3], double h, long label, double 
     if (nin == 0)
         return -2;
 
+    int np0 = c->np, nt = 0;
     c->ne = c->ntring = c->ntf = 0;
-    if (room_for_cut(c))
+    if (room_for_cut(c) || grow(&c->touched, &c->captouched, c->nf, sizeof(int)))
         return -1;
     int first = -1, edges = 0;
     for (int f = 0; f < c->nf; f++) {
+        const int *r = c->ring + c->f[f].start;
+        int out = 0;
+        for (int j = 0; j < c->f[f].count; j++)
+            out |= c->v[r[j]].side == OUT;
+        if (!out)
+            continue; /* wholly kept: left as it is */
+        int tf0 = c->ntf;
         int e = cut_face(c, &c->f[f]);
-        if (e == -2)
-            return -1;
-        if (e == -3)
-            return -3;
+        if (e == -2 || e == -3) {
+            c->np = np0; /* the crossings made so far unmade */
+            return e == -2 ? -1 : -3;
+        }
+        c->touched[nt++] = c->ntf > tf0 ? f : -1 - f;
         if (e >= 0) {
             edges++;
             if (first < 0)
@@ -264,12 +364,14 @@ static int cut_tol(fdt_cell *c, const double n[3], double h, long label, double 
         do {
             push_ring(c, v);
             v = c->v[v].next;
-            if (v < 0 || ++steps > edges)
+            if (v < 0 || ++steps > edges) {
+                c->np = np0;
                 return -3; /* an open chain: not a convex cell */
+            }
         } while (v != first);
         push_face(c, start, label);
     }
-    return compact(c) ? -1 : 1;
+    return apply_cut(c, nt, np0) ? -1 : 1;
 }
 
 /* A cut that finds the cell not convex has met vertices closer together

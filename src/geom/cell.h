@@ -56,6 +56,14 @@ typedef struct fdt_cell {
     int ntf, captf;
     double (*tp)[3];    /* vertices being compacted */
     int captp;
+    /* A cut rewrites only the faces it reaches (cut_tol): the rings it
+     * replaces stay in ring[] unreferenced, and the vertices it cuts off
+     * in p[] as NaN, until they are as many as the live ones (then one
+     * compaction, fdt_cell_compact). */
+    int live_ring;      /* ring entries the faces use */
+    int ndead;          /* vertices cut off, still in p[] */
+    int *touched;       /* this cut's faces: f kept, -1 - f gone */
+    int captouched;
 } fdt_cell;
 
 /* One face of a measured cell. */
@@ -83,6 +91,12 @@ int fdt_cell_box(fdt_cell *c, const double lo[3], const double hi[3]);
  * c not convex with FDT_CELL_TOL, the coarser ones up to FDT_CELL_TOL_MAX
  * and none (rounding gone wrong: a bug; c keeps its shape). */
 int fdt_cell_cut(fdt_cell *c, const double n[3], double h, long label);
+
+/* Drops the vertices and ring entries no face uses (cuts leave them for
+ * later), so that p[0 .. np) are the cell's vertices. For readers of the
+ * vertices; the faces and fdt_cell_measure never need it. 0, or -1 when
+ * out of memory (c unchanged). */
+int fdt_cell_compact(fdt_cell *c);
 
 /* The cell's volume, surface area, centroid (relative to the site), and
  * its faces (labels and areas, faces of zero area included) into

@@ -1880,6 +1880,8 @@ static int other_images(fdt_voronoi *v, const double *xyz, fdt_vid i)
         if (v->nid[e] < 0)
             continue;
         double r2 = 0; /* the cell's farthest vertex from p, squared */
+        if (fdt_cell_compact(&v->poly))
+            return FDT_ENOMEM;
         for (int j = 0; j < v->poly.np; j++)
             r2 = max2(r2, dot3(v->poly.p[j], v->poly.p[j]));
         double d0[3];
@@ -1959,6 +1961,8 @@ int fdt_voronoi_polyhedron(fdt_voronoi *v, const double *xyz, fdt_vid i, size_t 
     int err = v->periodic ? other_images(v, xyz, i) : FDT_OK;
     if (err)
         return err;
+    if (fdt_cell_compact(&v->poly))
+        return FDT_ENOMEM;
     const fdt_cell *c = &v->poly;
     size_t need_v = 3 * (size_t)c->np, need_f = (size_t)c->nf + (size_t)c->nring;
     if (need_v > v->cap_pverts) {
