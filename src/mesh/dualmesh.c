@@ -991,19 +991,18 @@ typedef struct loops {
 } loops;
 
 /*
- * A face's cycle of m vertex ids after wall vertices were merged, made
- * simple in place: walking it, a vertex met again closes a loop, which
- * is cut out (kept in *lp as a face of its own, between the face's cells
- * own and nbr, when it
- * has 3 vertices or more; one of 1 or 2 is a repeat or a spike, A, B, A,
- * which runs out and back and has no area). Returns the ids left.
- * Merging makes them: crossings of two Voronoi edges with a box edge
- * that round to one place become one vertex, and a face through both,
- * with a vertex within rounding of the wall between them, runs out to it
- * and back, or pinches into two loops there (HCP crystals in their
- * bounding box: Voronoi vertices 2e-16 from a wall). Cutting a spike
- * takes its edge out once each way; a loop cut out keeps its edges: both
- * cells of the face stay closed.
+ * A face's cycle of *m vertex ids after the box edges' vertices were
+ * merged, made simple in place: walking it, a vertex met again closes a
+ * loop, which is cut out: kept in *lp as a face of its own between the
+ * same cells own and nbr when it has 3 vertices or more; dropped when it
+ * has 1 or 2 (a repeat, or a spike A, B, A that runs out and back and
+ * has no area). *m becomes the count left. Merging makes them: crossings
+ * of two Voronoi edges with a box edge that round to one place become
+ * one vertex, and a face through both, with a vertex within rounding of
+ * the wall between them, runs out to it and back, or pinches into two
+ * loops there (HCP crystals in their bounding box: Voronoi vertices
+ * 2e-16 from a wall). Cutting a spike takes its edge out once each way;
+ * a loop cut out keeps its edges: both cells of the face stay closed.
  */
 static int split_loops(int64_t *f, size_t *m, loops *lp, int32_t own, int32_t nbr)
 {
