@@ -12,9 +12,10 @@
  *  - random cuts: the faces stay closed (the vector areas add up to 0)
  *    and the volume equals the divergence-theorem one;
  *  - a cell of thousands of faces (a point above a plane of points): the
- *    cuts that rewrite only what they reach give the bits of a cell
- *    compacted after every cut, and fdt_cell_compact leaves every
- *    vertex used.
+ *    cuts that climb to the vertices outside and rewrite only what they
+ *    reach give the bits of a cell that classes every vertex and is
+ *    compacted after every cut, and fdt_cell_compact leaves every vertex
+ *    used.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -150,13 +151,14 @@ static void test_random_cuts(fdt_cell *c)
  * A cell of many faces, every cut leaving one: the site 1 above a plane
  * of 3,000 random points (a scan's outlier above it), cut by their
  * bisectors nearest first, as src/mesh/voronoi.c cuts a hull point's cell.
- * The cuts rewrite only the faces they reach and leave the rest of the
- * arrays for a later compaction (bench/NOTES.md entry 129); a twin cell
- * compacted after every cut (the rebuild of every cut before) must
- * measure the same to the last bit, have the same faces in the same
- * order, and, compacted, the same vertices. Then every vertex of the
- * compacted cell is used, none is NaN, and each face's vertices lie on
- * its plane.
+ * The cuts find the vertices outside by climbing and rewrite only the
+ * faces they reach, leaving the rest of the arrays for a later
+ * compaction (bench/NOTES.md entry 129); a twin that classes every
+ * vertex at every cut and is compacted after each (what every cut did
+ * before) must measure the same to the last bit, have the same faces in
+ * the same order, and, compacted, the same vertices. Then every vertex
+ * of the compacted cell is used, none is NaN, and each face's vertices
+ * lie on its plane.
  */
 static void test_many_faces(void)
 {
@@ -185,6 +187,7 @@ static void test_many_faces(void)
     fdt_cell_init(&eager);
     const double lo[3] = {-3, -3, -2}, hi[3] = {3, 3, 1};
     CHECK(fdt_cell_box(&lazy, lo, hi) == 0 && fdt_cell_box(&eager, lo, hi) == 0);
+    eager.classify_all = 1;
     int cut = 0;
     for (int i = 0; i < NPTS; i++) {
         double h = 0.5 * d2[i];

@@ -40,6 +40,11 @@ void fdt_cell_free(fdt_cell *c)
     free(c->tf);
     free(c->tp);
     free(c->touched);
+    free(c->inc_head);
+    free(c->inc);
+    free(c->stamp);
+    free(c->fstamp);
+    free(c->queue);
     fdt_cell_init(c);
 }
 
@@ -74,6 +79,16 @@ int fdt_cell_box(fdt_cell *c, const double lo[3], const double hi[3])
     c->nf = 6;
     c->nring = c->live_ring = 24;
     c->ndead = 0;
+    c->inc_ok = 0;
+    c->hint = 0;
+    /* Cuts only shrink the cell, and a crossing lies between two
+     * vertices up to a rounding: 2^-20 of slack covers any drift. */
+    c->l1max = 0;
+    for (int i = 0; i < 8; i++) {
+        double l1 = fabs(c->p[i][0]) + fabs(c->p[i][1]) + fabs(c->p[i][2]);
+        c->l1max = l1 > c->l1max ? l1 : c->l1max;
+    }
+    c->l1max *= 1 + 0x1p-20;
     return 0;
 }
 
@@ -91,6 +106,9 @@ int fdt_cell_copy(fdt_cell *dst, const fdt_cell *src)
     dst->nf = src->nf;
     dst->live_ring = src->live_ring;
     dst->ndead = src->ndead;
+    dst->inc_ok = 0;
+    dst->hint = 0;
+    dst->l1max = src->l1max;
     return 0;
 }
 
@@ -217,6 +235,8 @@ static int compact(fdt_cell *c)
     memcpy(c->f, c->tf, (size_t)c->ntf * sizeof *c->f);
     c->nring = c->ntring;
     c->nf = c->ntf;
+    c->inc_ok = 0;
+    c->hint = 0;
     return 0;
 }
 
@@ -244,18 +264,183 @@ int fdt_cell_compact(fdt_cell *c)
     return 0;
 }
 
-/* A cut's faces made the cell's (cut_tol, once it has them all in the
+/* ------------------------------------------------------------------ */
+/* Each vertex's faces, for the climb                                  */
+/* ------------------------------------------------------------------ */
+
+/* The vertices from which a cut climbs (climb()) rather than classing
+ * them all: a cell clipped by the box has a few dozen (most cut cells:
+ * the vertices' faces cost more than the classing there, a terrain
+ * scan's cells took 20 % longer), an outlier's thousands. */
+#define CLIMB_MIN_VERTICES 64
+
+/* Vertex v is entry pos of face f's ring. */
+static int inc_add(fdt_cell *c, int v, int f, int pos)
+{
+    if (grow(&c->inc, &c->capinc, 3 * (c->ninc + 1), sizeof(int)))
+        return -1;
+    c->inc[3 * c->ninc] = f;
+    c->inc[3 * c->ninc + 1] = pos;
+    c->inc[3 * c->ninc + 2] = c->inc_head[v];
+    c->inc_head[v] = c->ninc++;
+    return 0;
+}
+
+/* Vertex v is now entry pos of face f's rewritten ring. */
+static int inc_move(fdt_cell *c, int v, int f, int pos)
+{
+    for (int e = c->inc_head[v]; e >= 0; e = c->inc[3 * e + 2])
+        if (c->inc[3 * e] == f) {
+            c->inc[3 * e + 1] = pos;
+            return 0;
+        }
+    return inc_add(c, v, f, pos);
+}
+
+/* The faces of every vertex, from the rings; the stamps cleared. */
+static int inc_build(fdt_cell *c)
+{
+    if (grow(&c->inc_head, &c->capinchead, c->np, sizeof(int)) ||
+        grow(&c->stamp, &c->capstamp, c->np, sizeof *c->stamp) ||
+        grow(&c->fstamp, &c->capfstamp, c->nf + 1, sizeof *c->fstamp))
+        return -1;
+    c->ninc = 0;
+    for (int i = 0; i < c->np; i++) {
+        c->inc_head[i] = -1;
+        c->stamp[i] = 0;
+    }
+    for (int f = 0; f < c->nf; f++) {
+        c->fstamp[f] = 0;
+        for (int j = 0; j < c->f[f].count; j++)
+            if (inc_add(c, c->ring[c->f[f].start + j], f, j))
+                return -1;
+    }
+    c->cutno = 0;
+    c->inc_ok = 1;
+    return 0;
+}
+
+/* The plane of one cut and its classing of a vertex. Each vertex has
+ * its own tolerance, the size of the rounding in its s: a far vertex's
+ * is coarse, a near one's fine, so a small cell cut from a large box
+ * keeps its precision (one tolerance for all, scaled by the box, cost a
+ * cell 1e-6 of the box 1e-7 of its volume). */
+typedef struct plane {
+    double n[3], h, n1, tol;
+} plane;
+
+static inline int class_of(const plane *pl, const double *p, double *s)
+{
+    *s = pl->n[0] * p[0] + pl->n[1] * p[1] + pl->n[2] * p[2] - pl->h;
+    double eps = pl->tol * (pl->n1 * (fabs(p[0]) + fabs(p[1]) + fabs(p[2])) + fabs(pl->h));
+    return *s > eps ? OUT : *s < -eps ? IN : ON;
+}
+
+/* Vertex v classed for this cut (once: the stamp). */
+static inline void class_once(fdt_cell *c, const plane *pl, int v)
+{
+    if (c->stamp[v] == c->cutno)
+        return;
+    double s;
+    int side = class_of(pl, c->p[v], &s);
+    c->v[v] = (fdt_cell_scratch){s, side, -1, -1};
+    c->stamp[v] = c->cutno;
+}
+
+/* The neighbour before (k = 0) or after (k = 1) the vertex of incidence
+ * entry e in its face's ring. */
+static inline int ring_neighbour(const fdt_cell *c, int e, int k)
+{
+    const fdt_cell_ring *f = &c->f[c->inc[3 * e]];
+    int j = c->inc[3 * e + 1] + (k ? 1 : f->count - 1);
+    return c->ring[f->start + (j >= f->count ? j - f->count : j)];
+}
+
+/*
+ * The vertices outside the plane found without classing the others:
+ * from the hint, climb to a neighbour farther out while there is one (on
+ * a convex cell the last is the farthest vertex), then walk the outside
+ * region from it through neighbours. 1 with the region in queue[0 ..
+ * *nq), 0 when no vertex is outside, -1 out of memory, 2 when the climb
+ * cannot tell (the farthest vertex within the largest tolerance of the
+ * plane, or no vertex inside met): the caller classes every vertex.
+ */
+static int climb(fdt_cell *c, const plane *pl, int *nq)
+{
+    if (!c->inc_ok && inc_build(c))
+        return -1;
+    if (grow(&c->v, &c->capv, c->np, sizeof *c->v) ||
+        grow(&c->queue, &c->capqueue, c->np, sizeof(int)))
+        return -1;
+    if (++c->cutno == 0) { /* the stamps wrapped: start again */
+        if (inc_build(c))
+            return -1;
+        c->cutno = 1;
+    }
+    int cur = c->hint;
+    if (cur < 0 || cur >= c->np || c->inc_head[cur] < 0 || isnan(c->p[cur][0]))
+        cur = c->ring[c->f[0].start];
+    class_once(c, pl, cur);
+    for (int moved = 1; moved;) {
+        moved = 0;
+        for (int e = c->inc_head[cur]; e >= 0 && !moved; e = c->inc[3 * e + 2])
+            for (int k = 0; k < 2 && !moved; k++) {
+                int u = ring_neighbour(c, e, k);
+                class_once(c, pl, u);
+                if (c->v[u].s > c->v[cur].s) {
+                    cur = u;
+                    moved = 1;
+                }
+            }
+    }
+    double epsmax = pl->tol * (pl->n1 * c->l1max + fabs(pl->h));
+    if (c->v[cur].s < -epsmax)
+        return 0; /* every vertex farther in than any tolerance */
+    if (c->v[cur].side != OUT || c->v[cur].s <= epsmax)
+        return 2;
+    int n = 0, in = 0;
+    c->queue[n++] = cur;
+    c->v[cur].map = 1; /* queued (map is only compact's) */
+    for (int q = 0; q < n; q++) {
+        int v = c->queue[q];
+        for (int e = c->inc_head[v]; e >= 0; e = c->inc[3 * e + 2])
+            for (int k = 0; k < 2; k++) {
+                int u = ring_neighbour(c, e, k);
+                class_once(c, pl, u);
+                if (c->v[u].side == OUT && c->v[u].map != 1) {
+                    c->v[u].map = 1;
+                    c->queue[n++] = u;
+                }
+                in |= c->v[u].side == IN;
+            }
+    }
+    *nq = n;
+    return in ? 1 : 2;
+}
+
+/*
+ * A cut's faces made the cell's (cut_tol, once it has them all in the
  * scratch): each kept face reached by the cut gets its new ring at the
  * end of ring[] (its old one left there unused), a face cut away goes
  * (the others keep their order), the cap (if any: the scratch's last
- * face) comes last, and the vertices cut off become NaN. np0: the
- * vertices before the cut's crossings. 0, or -1 when out of memory (the
- * cell is then as before the cut but for unused room). */
-static int apply_cut(fdt_cell *c, int nt, int np0)
+ * face) comes last, and the vertices cut off (out[0 .. nout), or every
+ * one classed OUT when out is NULL) become NaN. The faces of each vertex
+ * follow. np0: the vertices before the cut's crossings. 0, or -1 when
+ * out of memory (the cell is then as before the cut but for unused
+ * room).
+ */
+static int apply_cut(fdt_cell *c, int nt, int np0, const int *out, int nout)
 {
     if (grow(&c->ring, &c->capring, c->nring + c->ntring, sizeof(int)) ||
-        grow(&c->f, &c->capf, c->nf + 1, sizeof *c->f))
+        grow(&c->f, &c->capf, c->nf + 1, sizeof *c->f) ||
+        (c->inc_ok && (grow(&c->inc_head, &c->capinchead, c->np, sizeof(int)) ||
+                       grow(&c->stamp, &c->capstamp, c->np, sizeof *c->stamp) ||
+                       grow(&c->fstamp, &c->capfstamp, c->nf + 1, sizeof *c->fstamp))))
         return -1;
+    for (int x = np0; c->inc_ok && x < c->np; x++) {
+        c->inc_head[x] = -1;
+        c->stamp[x] = 0;
+    }
     int t = 0, gone = 0;
     for (int i = 0; i < nt; i++) {
         int f = c->touched[i];
@@ -268,30 +453,49 @@ static int apply_cut(fdt_cell *c, int nt, int np0)
         }
         const fdt_cell_ring *src = &c->tf[t++];
         memcpy(c->ring + c->nring, c->tring + src->start, (size_t)src->count * sizeof(int));
+        for (int j = 0; c->inc_ok && j < src->count; j++) {
+            int v = c->tring[src->start + j];
+            if (v >= np0 ? inc_add(c, v, f, j) : inc_move(c, v, f, j))
+                c->inc_ok = 0; /* out of memory: rebuilt at the next cut */
+        }
         c->live_ring += src->count - c->f[f].count;
         c->f[f].start = c->nring;
         c->f[f].count = src->count;
         c->nring += src->count;
     }
-    if (gone) {
+    if (gone) { /* the faces' numbers move: their vertices' lists rebuilt */
         int m = 0;
         for (int f = 0; f < c->nf; f++)
             if (c->f[f].count > 0)
                 c->f[m++] = c->f[f];
         c->nf = m;
+        c->inc_ok = 0;
     }
     if (t < c->ntf) { /* the cap */
         const fdt_cell_ring *src = &c->tf[t];
         memcpy(c->ring + c->nring, c->tring + src->start, (size_t)src->count * sizeof(int));
+        for (int j = 0; c->inc_ok && j < src->count; j++)
+            if (inc_add(c, c->tring[src->start + j], c->nf, j))
+                c->inc_ok = 0;
+        if (c->inc_ok)
+            c->fstamp[c->nf] = 0;
+        c->hint = c->tring[src->start];
         c->f[c->nf++] = (fdt_cell_ring){c->nring, src->count, src->label};
         c->nring += src->count;
         c->live_ring += src->count;
     }
-    for (int i = 0; i < np0; i++)
-        if (c->v[i].side == OUT) {
-            c->p[i][0] = c->p[i][1] = c->p[i][2] = NAN;
+    if (out) {
+        for (int i = 0; i < nout; i++) {
+            c->p[out[i]][0] = c->p[out[i]][1] = c->p[out[i]][2] = NAN;
             c->ndead++;
         }
+    } else {
+        for (int i = 0; i < np0; i++)
+            if (c->v[i].side == OUT) {
+                c->p[i][0] = c->p[i][1] = c->p[i][2] = NAN;
+                c->ndead++;
+            }
+    }
     /* the space left unused, once it is as large as what is used (out
      * of memory there leaves it for later: the cell is whole either way) */
     if (c->nring > 2 * c->live_ring + 256 || 2 * c->ndead > c->np + 256)
@@ -299,63 +503,110 @@ static int apply_cut(fdt_cell *c, int nt, int np0)
     return 0;
 }
 
+/* Face f cut (cut_face) into the scratch, its fate in touched[*nt]:
+ * 1 with its entry (or -1), or -2 / -3 as cut_face. */
+static int cut_one(fdt_cell *c, int f, int *nt, int *first, int *edges)
+{
+    int tf0 = c->ntf;
+    int e = cut_face(c, &c->f[f]);
+    if (e == -2 || e == -3)
+        return e;
+    c->touched[(*nt)++] = c->ntf > tf0 ? f : -1 - f;
+    if (e >= 0) {
+        (*edges)++;
+        if (*first < 0)
+            *first = e;
+    }
+    return 1;
+}
+
+static int int_cmp(const void *x, const void *y)
+{
+    int a = *(const int *)x, b = *(const int *)y;
+    return (a > b) - (a < b);
+}
+
 /*
  * fdt_cell_cut with the ON tolerance tol (FDT_CELL_TOL, or coarser).
- * Every vertex is classed (one pass of a few operations each; a vertex
- * cut off earlier is NaN, which classes as ON and no face uses), but
- * only the faces that have a vertex outside are cut and rewritten: a
- * cell of k faces, each cut adding one (a point with thousands of
- * Delaunay neighbours: a scan's outlier above it), took k^2 / 2 ring
- * copies when every cut rebuilt every face (bench/NOTES.md entry 129).
+ * The vertices outside come from a climb and a walk (climb()), the
+ * faces they are on from each vertex's faces, and only those faces are
+ * cut and rewritten: a cut costs about what it changes. Where the climb
+ * cannot tell, every vertex is classed and every face looked at, as
+ * before. Rebuilding every face at every cut took k^2 / 2 ring copies
+ * for a cell of k faces (a scan's outlier above it, thousands of
+ * Delaunay neighbours: bench/NOTES.md entry 129).
  */
 static int cut_tol(fdt_cell *c, const double n[3], double h, long label, double tol)
 {
-    /* Each vertex classed once; a crossing point is ON by construction. */
-    if (grow(&c->v, &c->capv, c->np, sizeof *c->v))
+    plane pl = {{n[0], n[1], n[2]}, h, fabs(n[0]) + fabs(n[1]) + fabs(n[2]), tol};
+    int nq = 0;
+    /* a small cell is classed whole: quicker than its faces' lists */
+    int got = c->np >= CLIMB_MIN_VERTICES && !c->classify_all ? climb(c, &pl, &nq) : 2;
+    if (got < 0)
         return -1;
-    /* Each vertex's own tolerance, the size of the rounding in its s: a
-     * far vertex's is coarse, a near one's fine, so a small cell cut from
-     * a large box keeps its precision (one tolerance for all, scaled by
-     * the box, cost a cell 1e-6 of the box 1e-7 of its volume). */
-    double n1 = fabs(n[0]) + fabs(n[1]) + fabs(n[2]);
-    int nout = 0, nin = 0;
-    for (int i = 0; i < c->np; i++) {
-        const double *p = c->p[i];
-        double s = n[0] * p[0] + n[1] * p[1] + n[2] * p[2] - h;
-        double eps = tol * (n1 * (fabs(p[0]) + fabs(p[1]) + fabs(p[2])) + fabs(h));
-        int side = s > eps ? OUT : s < -eps ? IN : ON;
-        c->v[i] = (fdt_cell_scratch){s, side, -1, -1};
-        nout += side == OUT;
-        nin += side == IN;
-    }
-    if (nout == 0)
+    if (got == 0)
         return 0;
-    if (nin == 0)
-        return -2;
+    int full = got == 2;
+    if (full) {
+        /* Each vertex classed once; a crossing point is ON by construction. */
+        if (grow(&c->v, &c->capv, c->np, sizeof *c->v))
+            return -1;
+        int nout = 0, nin = 0;
+        for (int i = 0; i < c->np; i++) {
+            double s;
+            int side = class_of(&pl, c->p[i], &s);
+            c->v[i] = (fdt_cell_scratch){s, side, -1, -1};
+            nout += side == OUT;
+            nin += side == IN;
+        }
+        if (nout == 0)
+            return 0;
+        if (nin == 0)
+            return -2;
+    }
 
     int np0 = c->np, nt = 0;
     c->ne = c->ntring = c->ntf = 0;
     if (room_for_cut(c) || grow(&c->touched, &c->captouched, c->nf, sizeof(int)))
         return -1;
     int first = -1, edges = 0;
-    for (int f = 0; f < c->nf; f++) {
-        const int *r = c->ring + c->f[f].start;
-        int out = 0;
-        for (int j = 0; j < c->f[f].count; j++)
-            out |= c->v[r[j]].side == OUT;
-        if (!out)
-            continue; /* wholly kept: left as it is */
-        int tf0 = c->ntf;
-        int e = cut_face(c, &c->f[f]);
-        if (e == -2 || e == -3) {
-            c->np = np0; /* the crossings made so far unmade */
-            return e == -2 ? -1 : -3;
+    if (full) {
+        for (int f = 0; f < c->nf; f++) {
+            const int *r = c->ring + c->f[f].start;
+            int out = 0;
+            for (int j = 0; j < c->f[f].count; j++)
+                out |= c->v[r[j]].side == OUT;
+            if (!out)
+                continue; /* wholly kept: left as it is */
+            int e = cut_one(c, f, &nt, &first, &edges);
+            if (e < 0) {
+                c->np = np0; /* the crossings made so far unmade */
+                return e == -2 ? -1 : -3;
+            }
         }
-        c->touched[nt++] = c->ntf > tf0 ? f : -1 - f;
-        if (e >= 0) {
-            edges++;
-            if (first < 0)
-                first = e;
+    } else {
+        /* the faces of the vertices outside, in their order, every vertex
+         * of each classed */
+        int m = 0;
+        for (int q = 0; q < nq; q++)
+            for (int e = c->inc_head[c->queue[q]]; e >= 0; e = c->inc[3 * e + 2]) {
+                int f = c->inc[3 * e];
+                if (c->fstamp[f] != c->cutno) {
+                    c->fstamp[f] = c->cutno;
+                    c->touched[m++] = f;
+                }
+            }
+        qsort(c->touched, (size_t)m, sizeof(int), int_cmp);
+        for (int i = 0; i < m; i++)
+            for (int j = 0; j < c->f[c->touched[i]].count; j++)
+                class_once(c, &pl, c->ring[c->f[c->touched[i]].start + j]);
+        for (int i = 0; i < m; i++) {
+            /* touched[nt] is written as touched[i] is read: nt <= i */
+            int e = cut_one(c, c->touched[i], &nt, &first, &edges);
+            if (e < 0) {
+                c->np = np0;
+                return e == -2 ? -1 : -3;
+            }
         }
     }
     /* The cap: from an entry, round the next[] chain to it again. */
@@ -371,7 +622,7 @@ static int cut_tol(fdt_cell *c, const double n[3], double h, long label, double 
         } while (v != first);
         push_face(c, start, label);
     }
-    return apply_cut(c, nt, np0) ? -1 : 1;
+    return apply_cut(c, nt, np0, full ? NULL : c->queue, nq) ? -1 : 1;
 }
 
 /* A cut that finds the cell not convex has met vertices closer together

@@ -64,6 +64,24 @@ typedef struct fdt_cell {
     int ndead;          /* vertices cut off, still in p[] */
     int *touched;       /* this cut's faces: f kept, -1 - f gone */
     int captouched;
+    /* Each vertex's faces (inc_head[v]: the first of pairs (face, next)
+     * in inc[]), so that a cut finds the vertices outside its plane by
+     * climbing from one vertex to a neighbour farther out and walking
+     * the region it reaches, without classing every vertex; inc_ok 0:
+     * to be rebuilt (after a compaction, a face cut away, a copy). */
+    int *inc_head, capinchead;
+    int *inc, ninc, capinc;
+    int inc_ok;
+    unsigned *stamp;    /* the cut that classed each vertex */
+    int capstamp;
+    unsigned *fstamp;   /* the cut that reached each face */
+    int capfstamp;
+    unsigned cutno;
+    int *queue, capqueue; /* the vertices outside, as the walk finds them */
+    int hint;           /* where the next climb starts */
+    double l1max;       /* a bound on every vertex's |x| + |y| + |z| */
+    int classify_all;   /* 1: every cut classes every vertex, never
+                           climbs (tests/test_cell.c's second opinion) */
 } fdt_cell;
 
 /* One face of a measured cell. */
