@@ -672,6 +672,60 @@ static int cut_before(const double *a, double da, const double *b, double db)
     return da < db || (da == db && fdt_lex_compare(a, b) < 0);
 }
 
+/* Above this many neighbours cut_order merges sorted runs instead of
+ * inserting each (a scan's outlier has tens of thousands: the insertion
+ * took m^2 / 4 moves). cut_before is a strict order on distinct points,
+ * so both give the same order. */
+#define CUT_ORDER_MERGE 64
+
+/* cut_order for m neighbours (adj[b ..]) of the point at p: their
+ * distances, then a bottom-up merge sort of (order, dist) pairs. */
+static int cut_order_merge(vjob *j, const double *p, size_t b, size_t m)
+{
+    const vwork *w = j->w;
+    uint32_t *to = malloc(m * sizeof *to);
+    double *td = malloc(m * sizeof *td);
+    if (!to || !td) {
+        free(to);
+        free(td);
+        return FDT_ENOMEM;
+    }
+    for (size_t e = 0; e < m; e++) {
+        double d[3];
+        j->order[e] = j->adj[b + e];
+        sub3(w->xyz + 3 * (size_t)j->order[e], p, d);
+        j->dist[e] = dot3(d, d);
+    }
+    uint32_t *so = j->order, *dso = to;
+    double *sd = j->dist, *dsd = td;
+    for (size_t width = 1; width < m; width *= 2) {
+        for (size_t lo = 0; lo < m; lo += 2 * width) {
+            size_t mid = lo + width < m ? lo + width : m, hi = lo + 2 * width < m ? lo + 2 * width : m;
+            size_t x = lo, y = mid, o = lo;
+            while (x < mid || y < hi) {
+                int right = x == mid || (y < hi && cut_before(w->xyz + 3 * (size_t)so[y], sd[y],
+                                                              w->xyz + 3 * (size_t)so[x], sd[x]));
+                size_t k = right ? y++ : x++;
+                dso[o] = so[k];
+                dsd[o++] = sd[k];
+            }
+        }
+        uint32_t *t = so;
+        so = dso;
+        dso = t;
+        double *u = sd;
+        sd = dsd;
+        dsd = u;
+    }
+    if (so != j->order) {
+        memcpy(j->order, so, m * sizeof *so);
+        memcpy(j->dist, sd, m * sizeof *sd);
+    }
+    free(to);
+    free(td);
+    return FDT_OK;
+}
+
 /* Point l's neighbours in cutting order (cut_before). */
 static int cut_order(vjob *j, uint32_t l)
 {
@@ -689,6 +743,8 @@ static int cut_order(vjob *j, uint32_t l)
         j->cap_order = m;
     }
     const double *p = w->xyz + 3 * (size_t)l;
+    if (m > CUT_ORDER_MERGE)
+        return cut_order_merge(j, p, b, m);
     for (size_t e = 0; e < m; e++) {
         uint32_t nb = j->adj[b + e];
         const double *q = w->xyz + 3 * (size_t)nb;
