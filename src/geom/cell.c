@@ -423,9 +423,8 @@ static int climb(fdt_cell *c, const plane *pl, int *nq)
  * scratch): each kept face reached by the cut gets its new ring at the
  * end of ring[] (its old one left there unused), a face cut away goes
  * (the others keep their order), the cap (if any: the scratch's last
- * face) comes last, and the vertices cut off (out[0 .. nout), or every
- * one classed OUT when out is NULL) become NaN. The faces of each vertex
- * follow. np0: the vertices before the cut's crossings. 0, or -1 when
+ * face) comes last, and the vertices cut off, out[0 .. nout), become
+ * NaN. The faces of each vertex follow. np0: the vertices before the cut's crossings. 0, or -1 when
  * out of memory (the cell is then as before the cut but for unused
  * room).
  */
@@ -484,18 +483,9 @@ static int apply_cut(fdt_cell *c, int nt, int np0, const int *out, int nout)
         c->nring += src->count;
         c->live_ring += src->count;
     }
-    if (out) {
-        for (int i = 0; i < nout; i++) {
-            c->p[out[i]][0] = c->p[out[i]][1] = c->p[out[i]][2] = NAN;
-            c->ndead++;
-        }
-    } else {
-        for (int i = 0; i < np0; i++)
-            if (c->v[i].side == OUT) {
-                c->p[i][0] = c->p[i][1] = c->p[i][2] = NAN;
-                c->ndead++;
-            }
-    }
+    for (int i = 0; i < nout; i++)
+        c->p[out[i]][0] = c->p[out[i]][1] = c->p[out[i]][2] = NAN;
+    c->ndead += nout;
     /* the space left unused, once it is as large as what is used (out
      * of memory there leaves it for later: the cell is whole either way) */
     if (c->nring > 2 * c->live_ring + 256 || 2 * c->ndead > c->np + 256)
@@ -548,46 +538,44 @@ static int cut_tol(fdt_cell *c, const double n[3], double h, long label, double 
         return 0;
     int full = got == 2;
     if (full) {
-        /* Each vertex classed once; a crossing point is ON by construction. */
-        if (grow(&c->v, &c->capv, c->np, sizeof *c->v))
+        /* Each vertex classed once; a crossing point is ON by construction.
+         * The ones outside listed as the climb lists them. */
+        if (grow(&c->v, &c->capv, c->np, sizeof *c->v) ||
+            grow(&c->queue, &c->capqueue, c->np, sizeof(int)))
             return -1;
-        int nout = 0, nin = 0;
+        int nin = 0;
+        nq = 0; /* an undecided walk's list discarded */
         for (int i = 0; i < c->np; i++) {
             double s;
             int side = class_of(&pl, c->p[i], &s);
             c->v[i] = (fdt_cell_scratch){s, side, -1, -1};
-            nout += side == OUT;
+            if (side == OUT)
+                c->queue[nq++] = i;
             nin += side == IN;
         }
-        if (nout == 0)
+        if (nq == 0)
             return 0;
         if (nin == 0)
             return -2;
     }
 
-    int np0 = c->np, nt = 0;
+    int np0 = c->np, nt = 0, m = 0;
     c->ne = c->ntring = c->ntf = 0;
     if (room_for_cut(c) || grow(&c->touched, &c->captouched, c->nf, sizeof(int)))
         return -1;
-    int first = -1, edges = 0;
+    /* The faces with a vertex outside, in their order (the others are
+     * wholly kept: left as they are). */
     if (full) {
         for (int f = 0; f < c->nf; f++) {
             const int *r = c->ring + c->f[f].start;
             int out = 0;
             for (int j = 0; j < c->f[f].count; j++)
                 out |= c->v[r[j]].side == OUT;
-            if (!out)
-                continue; /* wholly kept: left as it is */
-            int e = cut_one(c, f, &nt, &first, &edges);
-            if (e < 0) {
-                c->np = np0; /* the crossings made so far unmade */
-                return e == -2 ? -1 : -3;
-            }
+            if (out)
+                c->touched[m++] = f;
         }
     } else {
-        /* the faces of the vertices outside, in their order, every vertex
-         * of each classed */
-        int m = 0;
+        /* the faces of the vertices outside, every vertex of each classed */
         for (int q = 0; q < nq; q++)
             for (int e = c->inc_head[c->queue[q]]; e >= 0; e = c->inc[3 * e + 2]) {
                 int f = c->inc[3 * e];
@@ -600,13 +588,14 @@ static int cut_tol(fdt_cell *c, const double n[3], double h, long label, double 
         for (int i = 0; i < m; i++)
             for (int j = 0; j < c->f[c->touched[i]].count; j++)
                 class_once(c, &pl, c->ring[c->f[c->touched[i]].start + j]);
-        for (int i = 0; i < m; i++) {
-            /* touched[nt] is written as touched[i] is read: nt <= i */
-            int e = cut_one(c, c->touched[i], &nt, &first, &edges);
-            if (e < 0) {
-                c->np = np0;
-                return e == -2 ? -1 : -3;
-            }
+    }
+    int first = -1, edges = 0;
+    for (int i = 0; i < m; i++) {
+        /* touched[nt] is written as touched[i] is read: nt <= i */
+        int e = cut_one(c, c->touched[i], &nt, &first, &edges);
+        if (e < 0) {
+            c->np = np0; /* the crossings made so far unmade */
+            return e == -2 ? -1 : -3;
         }
     }
     /* The cap: from an entry, round the next[] chain to it again. */
@@ -622,7 +611,7 @@ static int cut_tol(fdt_cell *c, const double n[3], double h, long label, double 
         } while (v != first);
         push_face(c, start, label);
     }
-    return apply_cut(c, nt, np0, full ? NULL : c->queue, nq) ? -1 : 1;
+    return apply_cut(c, nt, np0, c->queue, nq) ? -1 : 1;
 }
 
 /* A cut that finds the cell not convex has met vertices closer together

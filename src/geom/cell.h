@@ -64,8 +64,8 @@ typedef struct fdt_cell {
     int ndead;          /* vertices cut off, still in p[] */
     int *touched;       /* this cut's faces: f kept, -1 - f gone */
     int captouched;
-    /* Each vertex's faces (inc_head[v]: the first of pairs (face, next)
-     * in inc[]), so that a cut finds the vertices outside its plane by
+    /* Each vertex's faces (inc_head[v]: the first of triples (face, the
+     * vertex's place in its ring, next) in inc[]), so that a cut finds the vertices outside its plane by
      * climbing from one vertex to a neighbour farther out and walking
      * the region it reaches, without classing every vertex; inc_ok 0:
      * to be rebuilt (after a compaction, a face cut away, a copy). */
@@ -77,7 +77,7 @@ typedef struct fdt_cell {
     unsigned *fstamp;   /* the cut that reached each face */
     int capfstamp;
     unsigned cutno;
-    int *queue, capqueue; /* the vertices outside, as the walk finds them */
+    int *queue, capqueue; /* this cut's vertices outside */
     int hint;           /* where the next climb starts */
     double l1max;       /* a bound on every vertex's |x| + |y| + |z| */
     int classify_all;   /* 1: every cut classes every vertex, never

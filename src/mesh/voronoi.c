@@ -717,10 +717,8 @@ static int cut_order_merge(vjob *j, const double *p, size_t b, size_t m)
         sd = dsd;
         dsd = u;
     }
-    if (so != j->order) {
+    if (so != j->order) /* dist is scratch: only the order is read after */
         memcpy(j->order, so, m * sizeof *so);
-        memcpy(j->dist, sd, m * sizeof *sd);
-    }
     free(to);
     free(td);
     return FDT_OK;
