@@ -1986,6 +1986,36 @@ static void test_separators(tctx *t)
             "a delimiter or decimal comma applies to .xyz, .txt and .csv only");
 }
 
+/* Quoted fields (RFC 4180, as spreadsheets and PDAL write CSV): the
+ * text between the quotes is the field; a doubled quote and separators
+ * inside are text; the header may be quoted too. A quote that does not
+ * close, or text after the closing quote, is refused naming the line. */
+static void test_quoted(tctx *t)
+{
+    fdt_rd_opts o;
+    static const double sq[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const double half[] = {0.5, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    SEP_OK(t, "q.csv", "\"X\",\"Y\",\"Z\"\n\"0\",\"0\",\"0\"\n\"1\",\"0\",\"0\"\n"
+           "0,\"1\",0\n\"0\", \"0\" ,\"1\"\n", 0, 0, sq, 4);
+    /* no header: a first line of quoted numbers is data */
+    SEP_OK(t, "qn.csv", "\"0\",\"0\",\"0\"\n\"1\",\"0\",\"0\"\n\"0\",\"1\",\"0\"\n"
+           "\"0\",\"0\",\"1\"\n", 0, 0, sq, 4);
+    /* a skipped text column with commas and doubled quotes inside, and a
+     * header naming it "dist, m" (its ", m" is no number either) */
+    SEP_OK(t, "qt.csv", "\"x\",\"y\",\"z\",\"dist, 2\"\n0,0,0,\"a, b\"\n1,0,0,\"say \"\"hi\"\"\"\n"
+           "0,1,0,\"\"\n0,0,1,c\n", 0, 0, sq, 4);
+    /* quoted decimal commas with ';' between fields */
+    SEP_OK(t, "qd.csv", "\"0,5\";\"0\";\"0\"\n1;0;0\n0;1;0\n0;0;1\n", ';', 1, half, 4);
+    SEP_ERR(t, "qo.csv", "0,0,0\n\"1,0,0\n", 0, 0, "qo.csv:2: a quote that does not close: '\"1,0,0'");
+    SEP_ERR(t, "qa.csv", "0,0,0\n\"1\"x,0,0\n", 0, 0,
+            "qa.csv:2: text after the closing quote: '\"1\"x'");
+    SEP_ERR(t, "qx.csv", "0,0,0\n\"1x\",0,0\n", 0, 0, "qx.csv:2: not a number: '1x'");
+    SEP_ERR(t, "qc.csv", "0,0,0\n1,\"0,5\",0\n", 0, 0,
+            "qc.csv:2: a comma inside the quoted number '0,5': a decimal comma is read only");
+    /* a line of data that is quoted and short is still refused */
+    SEP_ERR(t, "qs.csv", "0,0,0\n\"1\",\"0\"\n", 0, 0, "qs.csv:2: expected 3 numbers, found 2");
+}
+
 static void test_columns(tctx *t)
 {
     static const double sq[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -2566,6 +2596,7 @@ int main(int argc, char **argv)
     test_parse_int(&t);
     test_columns(&t);
     test_separators(&t);
+    test_quoted(&t);
     test_stdin(&t);
     test_chunks(&t);
     replay_bad(&t, argv[1]);

@@ -49,6 +49,8 @@ def bad():
     put(BAD, 'subnormal.xyz', '0 0 0\n1 0 0\n0 1 0\n0 0 4.9e-324\n')
     put(BAD, 'hexfloat.xyz', '0 0 0\n0x1p3 0 0\n0 1 0\n0 0 1\n')
     put(BAD, 'stray_comma.xyz', '0,0,0\n1,,0,0\n0,1,0\n0,0,1\n')
+    put(BAD, 'quote_open.csv', '0,0,0\n1,0,0\n"0,1,0\n0,0,1\n')
+    put(BAD, 'quote_text.csv', '0,0,0\n1,0,0\n"0"1,1,0\n0,0,1\n')
     put(BAD, 'nul_byte.xyz', '0 0 0\n1 0 0\n0 1\x000\n0 0 1\n')
     put(BAD, 'crlf_four.txt', '0 0 0\r\n1 0 0\r\n0 1 0 1\r\n0 0 1\r\n')
     rnd = random.Random(20240601)
@@ -202,6 +204,15 @@ def good():
     put(GOOD, 'cube10_crlf_commas.TXT',
         '\xef\xbb\xbf' + ''.join('%r, %r,%r\r\n' % tuple(float(v) for v in p)
                                  for p in POINTS))
+    # CSV as spreadsheets and PDAL write it: a quoted header, quoted
+    # numbers, a quoted text column with a comma and doubled quotes, one
+    # line unquoted and one with blanks around its quotes
+    words = ['ground, bare', '2', '2', 'a ""quoted"" word', '', '2', '2', '2', '2', '2']
+    rows = ['"%r","%r","%r","%s"' % (tuple(float(v) for v in p) + (w,))
+            for p, w in zip(POINTS, words)]
+    rows[6] = '%r,%r,%r,2' % tuple(float(v) for v in POINTS[6])
+    rows[7] = '"%r", "%r" ,"%r",2' % tuple(float(v) for v in POINTS[7])
+    put(GOOD, 'cube10_quoted.csv', '"X","Y","Z","Classification"\n' + '\n'.join(rows) + '\n')
     put(GOOD, 'cube10.node',
         '# TetGen: 1-based, one attribute, markers\n%d 3 1 1\n' % len(POINTS)
         + ''.join('%d  %r %r %r  %g %d\n' % ((i + 1,) + p + (0.5 * i, i % 2))

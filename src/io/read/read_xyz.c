@@ -22,6 +22,64 @@
 /* .xyz / .txt                                                        */
 /* ------------------------------------------------------------------ */
 
+/* A field in double quotes, as spreadsheets and PDAL write CSV (RFC 4180:
+ * a quote inside is doubled, separators inside are text). f->p is at the
+ * opening quote; on success (1) the text between the quotes is ts[0, tl)
+ * and f->p is past the closing quote. 0: no closing quote on the line;
+ * -1: something other than a separator right after the closing quote
+ * (ts[0, tl): the field from its opening quote up to that point). */
+static int rd_quoted(rd_fields *f, const char **ts, size_t *tl)
+{
+    const char *q = f->p + 1;
+    for (;;) {
+        q = memchr(q, '"', (size_t)(f->e - q));
+        if (q == NULL)
+            return 0;
+        if (q + 1 < f->e && q[1] == '"') {
+            q += 2;
+            continue;
+        }
+        break;
+    }
+    *ts = f->p + 1;
+    *tl = (size_t)(q - *ts);
+    if (!fdt_rd_is_sep(f, q + 1)) {
+        *ts = f->p;
+        *tl = (size_t)(q + 2 - f->p);
+        return -1;
+    }
+    f->p = q + 1;
+    f->n++;
+    return 1;
+}
+
+/* fdt_rd_next_field with quoted fields (rd_quoted): 1 and the field (a
+ * quoted one without its quotes), 0 at the end of the line, -1 on an
+ * empty field, -2 on a quote that does not close or is followed by text
+ * (ts[0, tl): the field as written). */
+static int rd_next_field_q(rd_fields *f, const char **ts, size_t *tl)
+{
+    int r = fdt_rd_skip_sep(f);
+    if (r <= 0 || *f->p != '"')
+        return r <= 0 ? r : fdt_rd_next_field(f, ts, tl);
+    r = rd_quoted(f, ts, tl);
+    if (r == 0) {
+        *ts = f->p;
+        *tl = (size_t)(f->e - f->p);
+    }
+    return r > 0 ? 1 : -2;
+}
+
+/* The error of a quoted field that rd_quoted refused (r: its result). */
+static int rd_quote_fail(const rd_ctx *c, size_t line, int r, const char *ts, size_t tl)
+{
+    char q[RD_QUOTE_CAP];
+    fdt_rd_quote(q, ts, tl);
+    return r == 0 ? fdt_rd_fail(c, FDT_IO_EFORMAT, ":%zu: a quote that does not close: %s", line, q)
+                  : fdt_rd_fail(c, FDT_IO_EFORMAT, ":%zu: text after the closing quote: %s",
+                                line, q);
+}
+
 /* Whether the first content line s..e is a header: printable ASCII and
  * no field (between blanks and sep, and between ';' too: a line of
  * semicolon-separated numbers is data whose separator is refused, not a
@@ -39,9 +97,16 @@ static int rd_is_header(const char *s, const char *e, char sep, int decimal_comm
     while (p < e) {
         while (p < e && (rd_is_space(*p) || (sep && *p == sep) || *p == ';'))
             p++;
-        const char *t = p;
-        while (p < e && !rd_is_space(*p) && !(sep && *p == sep) && *p != ';')
-            p++;
+        const char *t = p, *u;
+        if (p < e && *p == '"' && (u = memchr(p + 1, '"', (size_t)(e - p - 1))) != NULL) {
+            /* a quoted field ("X", or "1.5" on a line of data) is judged
+             * by its text */
+            t = p + 1;
+            p = u;
+        } else {
+            while (p < e && !rd_is_space(*p) && !(sep && *p == sep) && *p != ';')
+                p++;
+        }
         if (p > t) {
             double v;
             /* a number, or a field that starts as one ("0,5" or "1.000,5"
@@ -54,6 +119,7 @@ static int rd_is_header(const char *s, const char *e, char sep, int decimal_comm
                 (!decimal_comma && fdt_rd_parse_real(t, tl, &v, 0) != NUM_SYNTAX))
                 return 0;
         }
+        p += p < e && *p == '"'; /* a quoted field's closing quote */
     }
     return 1;
 }
@@ -83,9 +149,11 @@ static size_t rd_count_fields(const char *s, const char *e, char sep)
     const char *ts;
     size_t tl;
     int r;
-    while ((r = fdt_rd_next_field(&f, &ts, &tl)) != 0)
+    while ((r = rd_next_field_q(&f, &ts, &tl)) != 0)
         if (r > 0)
             k++;
+        else if (r == -2)
+            return k + 1; /* the parse refuses the line */
         else
             f.p++;
     return k;
@@ -197,6 +265,32 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
                                    "--delimiter ',' if commas separate fields",
                                    L.lineno);
             int which = k == c0 ? 0 : k == c1 ? 1 : k == c2 ? 2 : -1;
+            if (*f.p == '"') {
+                /* quoted: the text between the quotes is the field */
+                if ((r = rd_quoted(&f, &ts, &tl)) <= 0) {
+                    if (r == 0)
+                        tl = (size_t)(f.e - (ts = f.p));
+                    return rd_quote_fail(c, L.lineno, r, ts, tl);
+                }
+                if (which >= 0) {
+                    int st = c->decimal_comma ? rd_parse_decimal_comma(ts, tl, &v[which])
+                                              : fdt_rd_parse_real(ts, tl, &v[which], 1);
+                    if (st == NUM_SYNTAX && c->sep == ',' && memchr(ts, ',', tl) != NULL) {
+                        char q[RD_QUOTE_CAP];
+                        return fdt_rd_fail(c, FDT_IO_EFORMAT,
+                                           ":%zu: a comma inside the quoted number %s: a decimal "
+                                           "comma is read only with another delimiter between "
+                                           "fields (--decimal-comma --delimiter ';' or ' ')",
+                                           L.lineno, fdt_rd_quote(q, ts, tl));
+                    }
+                    if (st != NUM_OK) {
+                        int rs = st == NUM_SYNTAX ? rd_sep_fail(c, L.lineno, ts, tl, s, e) : 0;
+                        return rs ? rs : fdt_rd_num_fail(c, L.lineno, "", st, ts, tl);
+                    }
+                }
+                k++;
+                continue;
+            }
             if (which < 0) {
                 /* not a coordinate: skipped, only counted */
                 fdt_rd_next_field(&f, &ts, &tl);
