@@ -22,7 +22,13 @@
 #include <stdio.h>
 #include <string.h>
 
-#if defined(__SIZEOF_INT128__)
+/* The fast path needs 128-bit integers and stores the digits as
+ * little-endian words. */
+#if defined(__SIZEOF_INT128__) && defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define DTOA_FAST 1
+#endif
+
+#if DTOA_FAST
 typedef unsigned __int128 u128;
 
 static const uint64_t pow5[28] = {
@@ -79,53 +85,58 @@ static uint64_t scaled(uint64_t m, int e, int k)
     return q >> 64 ? UINT64_MAX : (uint64_t)q;
 }
 
-/* "00" to "99". */
-static const char pairs[201] =
-    "0001020304050607080910111213141516171819"
-    "2021222324252627282930313233343536373839"
-    "4041424344454647484950515253545556575859"
-    "6061626364656667686970717273747576777879"
-    "8081828384858687888990919293949596979899";
-
-/* v < 10^8 as 8 digits at p: two digits a step from pairs, in two
- * independent halves (digit by digit, D's 17 divisions by ten were one
- * chain: 5 % of a --voronoi run's samples at 1M points, bench/NOTES.md
- * entry 112). */
-static inline void digits8(char *p, uint32_t v)
+/* v < 10^8 as 8 ASCII digits in one word, the first digit in its lowest
+ * byte (so that a little-endian store writes them in order), by SIMD
+ * within the word: v split into two halves of 4 digits (one a 32-bit
+ * lane), each into two of 2 digits (16-bit lanes), each into two digits
+ * (bytes). The quotients by 100 and 10 are multiplications: v 10486 / 2^20
+ * is floor(v / 100) for v < 10^4 (the error v 2.4e-7 stays under the
+ * fraction's gap 0.01), v 103 / 2^10 is floor(v / 10) for v < 100 (error
+ * under 0.06); each lane's product stays below the next lane, and the
+ * masks drop what the shifts bring down from it. Written digit by digit
+ * (two-byte stores read back by the layout's copies), the digits stalled
+ * store forwarding: a third of the function's cycles (bench/NOTES.md
+ * entry 130). */
+static inline uint64_t digits8(uint32_t v)
 {
-    uint32_t a = v / 10000, b = v % 10000;
-    memcpy(p, pairs + 2 * (a / 100), 2);
-    memcpy(p + 2, pairs + 2 * (a % 100), 2);
-    memcpy(p + 4, pairs + 2 * (b / 100), 2);
-    memcpy(p + 6, pairs + 2 * (b % 100), 2);
+    uint64_t x = (uint64_t)(v / 10000) | (uint64_t)(v % 10000) << 32;
+    uint64_t h = ((x * 10486) >> 20) & UINT64_C(0x0000007f0000007f);
+    x = h | (x - 100 * h) << 16;
+    uint64_t t = ((x * 103) >> 10) & UINT64_C(0x000f000f000f000f);
+    x = t | (x - 10 * t) << 8;
+    return x | UINT64_C(0x3030303030303030);
 }
 
-/* D's 17 digits at p (D < 10^17). */
-static inline void digits17(char *p, uint64_t d)
+static inline void put64(char *p, uint64_t w)
 {
-    uint64_t hi = d / 100000000;
-    uint32_t lo = (uint32_t)(d % 100000000);
-    p[0] = (char)('0' + hi / 100000000);
-    digits8(p + 1, (uint32_t)(hi % 100000000));
-    digits8(p + 9, lo);
+    memcpy(p, &w, sizeof w);
 }
 
-/* The digits of D = dig (17 of them) times 10^(X - 16), laid out by %g. */
-static size_t layout(char *p, int neg, const char *dig, int x)
+/* D = d (17 digits, d in [10^16, 10^17)) times 10^(X - 16) at p, laid out
+ * by %g: exponent form when X < -4 or X >= 17, trailing zeros of the
+ * fraction dropped, and the point with them when nothing follows it.
+ * The digits go from registers straight to their places: the first digit
+ * L, then ab, the other 16 as one 128-bit word (a the low 8). Stores may
+ * run past the text's end, never past p + FDT_DTOA17_MAX. */
+static size_t layout(char *p, int neg, uint64_t d, int x)
 {
-    char *o = p;
-    if (neg)
-        *o++ = '-';
-    int last = 16; /* the last digit kept: trailing zeros go */
-    while (last > 0 && dig[last] == '0')
-        last--;
+    char *o = p + neg;
+    p[0] = '-';
+    uint64_t rest = d % TEN16;
+    char lead = (char)('0' + d / TEN16);
+    uint64_t a = digits8((uint32_t)(rest / 100000000)), b = digits8((uint32_t)(rest % 100000000));
+    /* the trailing zeros: the top bytes of ab that are '0' */
+    const uint64_t zeros = UINT64_C(0x3030303030303030);
+    int tz = (b ^ zeros) ? __builtin_clzll(b ^ zeros) / 8
+             : (a ^ zeros) ? 8 + __builtin_clzll(a ^ zeros) / 8
+                           : 16;
+    int last = 16 - tz; /* the last digit kept, 0 the first */
     if (x < -4 || x >= 17) {
-        *o++ = dig[0];
-        if (last > 0) {
-            *o++ = '.';
-            memcpy(o, dig + 1, (size_t)last);
-            o += last;
-        }
+        o[0] = lead;
+        o[1] = '.';
+        put64(o + 2, a);
+        put64(o + 10, b);
+        o += last > 0 ? 2 + last : 1;
         int ax = x < 0 ? -x : x;
         *o++ = 'e';
         *o++ = x < 0 ? '-' : '+';
@@ -135,23 +146,30 @@ static size_t layout(char *p, int neg, const char *dig, int x)
         }
         *o++ = (char)('0' + ax / 10);
         *o++ = (char)('0' + ax % 10);
-    } else if (x >= 0) {
-        memcpy(o, dig, (size_t)x + 1);
-        o += x + 1;
-        if (last > x) {
-            *o++ = '.';
-            memcpy(o, dig + x + 1, (size_t)(last - x));
-            o += last - x;
-        }
-    } else {
-        *o++ = '0';
-        *o++ = '.';
-        for (int i = 0; i < -x - 1; i++)
-            *o++ = '0';
-        memcpy(o, dig, (size_t)last + 1);
-        o += last + 1;
+        return (size_t)(o - p);
     }
-    return (size_t)(o - p);
+    if (x < 0) { /* 0.000ddd: "0." and -x - 1 zeros (at most 3) */
+        put64(o, UINT64_C(0x3030303030302e30)); /* "0.000000" */
+        o += 1 - x;
+        o[0] = lead;
+        put64(o + 1, a);
+        put64(o + 9, b);
+        return (size_t)(o + 1 + last - p);
+    }
+    o[0] = lead;
+    if (last <= x) { /* an integer: x + 1 digits, no point */
+        put64(o + 1, a);
+        put64(o + 9, b);
+        return (size_t)(o + 1 + x - p);
+    }
+    /* the point after the first x + 1 digits, x <= 15: ab's bytes from x
+     * on move up one, the top one out to o[17] */
+    u128 ab = (u128)b << 64 | a, low = ((u128)1 << (8 * x)) - 1;
+    u128 r = (ab & low) | (u128)'.' << (8 * x) | (ab & ~low) << 8;
+    put64(o + 1, (uint64_t)r);
+    put64(o + 9, (uint64_t)(r >> 64));
+    o[17] = (char)(b >> 56);
+    return (size_t)(o + 2 + last - p);
 }
 
 static size_t fast(char *p, double x)
@@ -189,15 +207,13 @@ static size_t fast(char *p, double x)
         d = scaled(m, e, ++k);
     if (d < TEN16 || d >= TEN17)
         return 0;
-    char dig[17];
-    digits17(dig, d);
-    return layout(p, neg, dig, 16 - k);
+    return layout(p, neg, d, 16 - k);
 }
 #endif
 
 size_t fdt_dtoa17(char *p, double x)
 {
-#if defined(__SIZEOF_INT128__)
+#if DTOA_FAST
     size_t n = fast(p, x);
     if (n)
         return n;

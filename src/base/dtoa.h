@@ -17,9 +17,11 @@
 
 /* Writes x at p as snprintf(p, n, "%.17g", x) does in the C locale and
  * the default rounding mode, byte for byte, without the terminating NUL;
- * returns the number of bytes (at most FDT_DTOA17_MAX). Magnitudes from
- * 1e-11 to 1e43 take an exact integer path; the rest, and builds without
- * a 128-bit integer type, take snprintf itself. */
+ * returns the number of bytes (at most FDT_DTOA17_MAX). p must have room
+ * for FDT_DTOA17_MAX bytes: those past the text may be written too.
+ * Magnitudes from 1e-11 to 1e43 take an exact integer path; the rest, and
+ * builds without a 128-bit integer type or on big-endian machines, take
+ * snprintf itself. */
 size_t fdt_dtoa17(char *p, double x);
 
 /* Two decimal digits per lookup halves the divisions. */
