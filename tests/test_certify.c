@@ -111,9 +111,10 @@ static void test_against_check(int fam, size_t want, double delta, int trials)
 }
 
 /* Whether the certificate refuses m on one thread (*why: its failure)
- * and on two, three and eight: each face is checked from one end, chosen
- * differently inside a slot range and between two (src/mesh/certify.c), so
- * every corruption must be seen whichever range holds its slots. */
+ * and on two, three and eight: each face is checked from one end (its
+ * lower slot, src/mesh/certify.c), in whichever range of the space order
+ * holds that end, so every corruption must be seen however the ranges
+ * fall. */
 static int refused(const fdt_ins *m, fdt_certify_fail *why)
 {
     fdt_certify_fail w2;

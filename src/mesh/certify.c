@@ -8,6 +8,7 @@
 
 #include "base/bits.h"
 #include "geom/images.h"
+#include "base/mem.h"
 #include "base/spawn.h"
 
 #define INF FDT_NONE
@@ -188,27 +189,103 @@ static inline const char *check_pair_finite(const fdt_ins *m, const uint32_t *v,
 #define AHEAD 8
 
 /*
- * Whether slot t checks its face with slot nt (checks_here of one end and
- * not the other, for every face): the lower slot when both lie in the
- * range [lo, hi), which the sweep then reads again soon, still in cache
- * (the parity rule below for every face cost 25 % more on one thread);
- * between two ranges of fdt_certify_parallel, the lower slot when their
- * xor is odd and the higher when it is even: either end is as likely, so
- * the ranges get equal shares of those faces, which "always the lower
- * slot" did not (0.87 s against 0.53 s for the two halves of 1M uniform
- * points).
+ * The order the certificate visits the slots in (bench/NOTES.md entry
+ * 130): by the least vertex of their tet, a bucket of 2^BUCKET_SHIFT
+ * consecutive point ids at a time, slot order inside a bucket; freed
+ * slots left out. The point ids are in space order (the kd order, as
+ * insert.h asks), so a bucket's tets lie together, and the neighbours and
+ * points a tet reads were mostly read for the tets just before it. In
+ * slot order they were 2^20-2^23 slots apart: a slot is reused where its
+ * tet died, and each BRIO round lays its own sweep over the slots (the
+ * neighbours' rows were more than half of the certificate's time).
  */
-static inline unsigned checks_here(uint32_t t, uint32_t nt, uint32_t lo, uint32_t hi)
+#define BUCKET_SHIFT 9
+
+/* The bucket of live tet row v; a vertex id outside the mesh's (a broken
+ * mesh, which the checks then name) goes to bucket 0. */
+static inline uint32_t bucket_of(const fdt_ins *m, const uint32_t *v)
 {
-    /* t < nt, flipped for an even xor outside the range; in bit operations,
-     * as it decides at random (a branch on it mispredicted half the time) */
-    unsigned lower = t < nt, in = (nt >= lo) & (nt < hi), odd = (t ^ nt) & 1;
-    return lower ^ (~in & ~odd & 1u);
+    uint32_t a = v[0] < v[1] ? v[0] : v[1], b = v[2] < v[3] ? v[2] : v[3];
+    uint32_t x = (a < b ? a : b) - m->base; /* finite: one infinite vertex at most */
+    return x < m->n ? x >> BUCKET_SHIFT : 0;
+}
+
+/* A thread's part of the counting sort: the slots [lo, hi), counted into
+ * cnt (pass 0), then placed at cnt's places (pass 1). */
+typedef struct order_job {
+    const fdt_ins *m;
+    uint32_t lo, hi;
+    uint32_t *cnt;   /* a count, then the next place, a bucket */
+    uint32_t *order;
+    int pass;
+} order_job;
+
+static void *order_pass(void *arg)
+{
+    order_job *j = arg;
+    const fdt_ins *m = j->m;
+    for (uint32_t t = j->lo; t < j->hi; t++) {
+        const uint32_t *v = m->T + 8 * (size_t)t;
+        if (is_freed(v))
+            continue;
+        uint32_t b = bucket_of(m, v);
+        if (j->pass == 0)
+            j->cnt[b]++;
+        else
+            j->order[j->cnt[b]++] = t;
+    }
+    return NULL;
+}
+
+/* The live slots in the certificate's order into *order (*len of them),
+ * sorted on up to nthreads threads: each bucket's slots come from the
+ * threads' slot ranges in turn, so the order is the same for any thread
+ * count. FDT_OK or FDT_ENOMEM. */
+static int order_slots(const fdt_ins *m, int nthreads, uint32_t **order, uint32_t *len)
+{
+    uint32_t nb = (m->n >> BUCKET_SHIFT) + 1;
+    int nj = nthreads < 1 || m->nslots < 65536 ? 1 : nthreads > 64 ? 64 : nthreads;
+    order_job *j = calloc((size_t)nj, sizeof *j);
+    uint32_t *cnt = calloc((size_t)nj * nb, sizeof *cnt);
+    *order = NULL;
+    if (!j || !cnt) {
+        free(j);
+        free(cnt);
+        return FDT_ENOMEM;
+    }
+    for (int i = 0; i < nj; i++)
+        j[i] = (order_job){m, (uint32_t)((uint64_t)m->nslots * (uint64_t)i / (uint64_t)nj),
+                           (uint32_t)((uint64_t)m->nslots * (uint64_t)(i + 1) / (uint64_t)nj),
+                           cnt + (size_t)i * nb, NULL, 0};
+    /* the joins order each pass's writes before the next reads */
+    fdt_fork_join(j, sizeof *j, nj, order_pass);
+    uint32_t run = 0;
+    for (uint32_t b = 0; b < nb; b++)
+        for (int i = 0; i < nj; i++) {
+            uint32_t x = j[i].cnt[b];
+            j[i].cnt[b] = run;
+            run += x;
+        }
+    *order = fdt_mem_alloc_huge(run ? run : 1, sizeof **order, 0);
+    if (*order) {
+        for (int i = 0; i < nj; i++) {
+            j[i].order = *order;
+            j[i].pass = 1;
+        }
+        fdt_fork_join(j, sizeof *j, nj, order_pass);
+    }
+    *len = run;
+    free(j);
+    free(cnt);
+    return *order ? FDT_OK : FDT_ENOMEM;
 }
 
 /*
- * Checks 1-3 for the slots [lo, hi) of m. Each face is checked once, from
- * one of its two slots (checks_here). That end checks the geometry and
+ * Checks 1-3 for the slots order[lo, hi) of m. Each face is checked once,
+ * from its lower slot: both ends are visited close together in the order,
+ * so the other end's row is in cache whichever it is, and ranges of the
+ * order (space) get equal shares of their faces with other ranges (slot
+ * numbers are not in space order). That end checks the geometry and
  * the other end's reference back; the other end only counts its reference
  * (*skipped: four a tet in use, less the ones it checked) and the
  * checking end counts the pair (*pairs). Over the whole mesh every
@@ -218,22 +295,25 @@ static inline unsigned checks_here(uint32_t t, uint32_t nt, uint32_t lo, uint32_
  * someone else. Each neighbour slot is read once a face, where the
  * neighbour reads are most of the time.
  */
-static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, const fdt_certify_visit *vis,
-                         int job, fdt_pred_counts *cnt, fdt_certify_fail *why, size_t *skipped,
-                         size_t *pairs)
+static int certify_range(const fdt_ins *m, const uint32_t *order, uint32_t lo, uint32_t hi,
+                         const fdt_certify_visit *vis, int job, fdt_pred_counts *cnt,
+                         fdt_certify_fail *why, size_t *skipped, size_t *pairs)
 {
     size_t used = 0, npairs = 0; /* tets in use, pairs checked */
     const double dev = m->sf.img ? m->sf.img->err : 0;
-    for (uint32_t t = lo; t < hi; t++) {
-        if (t + 2 * AHEAD < hi) { /* the neighbours (a freed slot's are any value) */
-            const uint32_t *a = m->T + 8 * (size_t)(t + 2 * AHEAD);
+    for (uint32_t i = lo; i < hi; i++) {
+        const uint32_t t = order[i];
+        if (i + 3 * AHEAD < hi) /* the row: in the order, slots are far apart */
+            __builtin_prefetch(m->T + 8 * (size_t)order[i + 3 * AHEAD]);
+        if (i + 2 * AHEAD < hi) { /* its neighbours, mostly in cache already */
+            const uint32_t *a = m->T + 8 * (size_t)order[i + 2 * AHEAD];
             for (int k = 0; k < 4; k++) {
                 uint32_t nu = a[4 + k] >> 2;
                 __builtin_prefetch(m->T + 8 * (size_t)(nu < m->nslots ? nu : 0));
             }
         }
-        if (t + AHEAD < hi) { /* the points those tets will read, their rows now in cache */
-            const uint32_t *a = m->T + 8 * (size_t)(t + AHEAD);
+        if (i + AHEAD < hi) { /* the points those tets will read, their rows now in cache */
+            const uint32_t *a = m->T + 8 * (size_t)order[i + AHEAD];
             for (int k = 0; k < 4; k++) {
                 uint32_t nu = a[4 + k] >> 2, r = a[4 + k] & 3;
                 uint32_t q = m->T[8 * (size_t)(nu < m->nslots ? nu : 0) + r], x = a[k];
@@ -242,8 +322,6 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, const fdt_c
             }
         }
         const uint32_t *v = m->T + 8 * (size_t)t;
-        if (is_freed(v))
-            continue;
         int ninf = (v[0] == INF) + (v[1] == INF) + (v[2] == INF) + (v[3] == INF);
         if (ninf > 1)
             return fail(why, t, -1, "more than one infinite vertex");
@@ -268,7 +346,7 @@ static int certify_range(const fdt_ins *m, uint32_t lo, uint32_t hi, const fdt_c
         for (int k = 0; k < 4; k++) {
             uint32_t nt = v[4 + k] >> 2;
             bad |= (unsigned)((nt >= m->nslots) | (nt == t)) << k;
-            here |= checks_here(t, nt, lo, hi) << k;
+            here |= (unsigned)(t < nt) << k;
         }
         if (bad)
             return fail(why, t, fdt_ctz64(bad), "a neighbour reference past the slots, or to itself");
@@ -327,7 +405,11 @@ static int certify_serial(const fdt_ins *m, const fdt_certify_visit *vis, fdt_pr
                           fdt_certify_fail *why)
 {
     size_t skipped = 0, pairs = 0;
-    int err = certify_range(m, 0, m->nslots, vis, 0, cnt, why, &skipped, &pairs);
+    uint32_t *order, len;
+    int err = order_slots(m, 1, &order, &len);
+    if (!err)
+        err = certify_range(m, order, 0, len, vis, 0, cnt, why, &skipped, &pairs);
+    free(order);
     if (!err)
         err = certify_balance(m, skipped, pairs, why);
     return err ? err : fdt_certify_vertices(m, why);
@@ -340,6 +422,7 @@ int fdt_certify(const fdt_ins *m, fdt_pred_counts *cnt, fdt_certify_fail *why)
 
 typedef struct cert_job {
     const fdt_ins *m;
+    const uint32_t *order;
     const fdt_certify_visit *vis;
     int index;
     uint32_t lo, hi;
@@ -367,16 +450,16 @@ static void *cert_take(void *arg)
     int i;
     while ((i = atomic_fetch_add_explicit(&p->next, 1, memory_order_relaxed)) < p->njobs) {
         cert_job *j = &p->jobs[i];
-        j->rc = certify_range(j->m, j->lo, j->hi, j->vis, j->index, &j->pc, &j->why, &j->skipped,
-                              &j->pairs);
+        j->rc = certify_range(j->m, j->order, j->lo, j->hi, j->vis, j->index, &j->pc, &j->why,
+                              &j->skipped, &j->pairs);
     }
     return NULL;
 }
 
-/* Ranges a thread: the lower slots, reused through the whole build, cost
- * more a slot than the upper ones (their neighbours far apart), so halves
- * left one thread idle a third of the time (bench/NOTES.md entry 126);
- * threads take the next range as they finish one. */
+/* Ranges a thread: ranges can cost unequally (in slot order, before
+ * entry 130, the lower slots' neighbours lay far apart and halves left one
+ * thread idle a third of the time, bench/NOTES.md entry 126), so threads
+ * take the next range as they finish one. */
 #define RANGES_A_THREAD 4
 
 int fdt_certify_jobs(const fdt_ins *m, int nthreads)
@@ -403,17 +486,19 @@ int fdt_certify_parallel_visit(const fdt_ins *m, int nthreads, const fdt_certify
         nthreads = nj;
     cert_job *j = calloc((size_t)nj, sizeof *j);
     cert_pool **take = malloc((size_t)nthreads * sizeof *take);
-    if (!j || !take) {
+    uint32_t *order = NULL, len = 0;
+    if (!j || !take || order_slots(m, nthreads, &order, &len) != FDT_OK) {
         free(j);
         free(take);
         return FDT_ENOMEM;
     }
     for (int i = 0; i < nj; i++) {
         j[i].m = m;
+        j[i].order = order;
         j[i].vis = vis;
         j[i].index = i;
-        j[i].lo = (uint32_t)((uint64_t)m->nslots * (uint64_t)i / (uint64_t)nj);
-        j[i].hi = (uint32_t)((uint64_t)m->nslots * (uint64_t)(i + 1) / (uint64_t)nj);
+        j[i].lo = (uint32_t)((uint64_t)len * (uint64_t)i / (uint64_t)nj);
+        j[i].hi = (uint32_t)((uint64_t)len * (uint64_t)(i + 1) / (uint64_t)nj);
     }
     cert_pool pool = {.jobs = j, .njobs = nj};
     atomic_init(&pool.next, 0);
@@ -422,6 +507,7 @@ int fdt_certify_parallel_visit(const fdt_ins *m, int nthreads, const fdt_certify
     /* a thread that cannot start leaves its ranges to the others */
     fdt_fork_join(take, sizeof *take, nthreads, cert_take);
     free(take);
+    free(order);
     int err = FDT_OK;
     /* The joins publish each range's fields to this thread; the lowest
      * failing range is the one reported, whoever checked it. */

@@ -32,8 +32,10 @@
  * so a bug planted in the insertion's predicate cannot hide itself
  * (tests/test_certify.c, meson option plant).
  *
- * Cost: about one orient3d and two insphere filters a tet, read-only;
- * slot ranges may be certified on several threads at once.
+ * Cost: about one orient3d and two insphere filters a tet, read-only,
+ * the tets visited in space order (by their least vertex: their
+ * neighbours' rows and points then mostly in cache); ranges of that order
+ * may be certified on several threads at once.
  */
 #ifndef FDT_CERTIFY_H
 #define FDT_CERTIFY_H
@@ -61,7 +63,7 @@ int fdt_certify_vertices(const fdt_ins *m, fdt_certify_fail *why);
 int fdt_certify(const fdt_ins *m, fdt_pred_counts *cnt, fdt_certify_fail *why);
 
 /* The same on nthreads threads (the caller's one of them; fdt_certify_jobs
- * slot ranges of equal size, each taken by the next thread free, each face
+ * ranges of equal size of the space order, each taken by the next thread free, each face
  * checked in the range of one of its slots; a helper that cannot start
  * leaves its ranges to the others): FDT_OK, FDT_ECHECK (*why: the failure
  * of the lowest range that failed), or FDT_ENOMEM. cnt gets the sum of
@@ -75,9 +77,9 @@ int fdt_certify_parallel(const fdt_ins *m, int nthreads, fdt_pred_counts *cnt,
  * src/mesh/periodic.c): tet() for each tet in use, once its own checks
  * passed, with its lifted cofactors when it is finite (cof NULL and inf
  * the infinite vertex's index otherwise); job is the range's index, below
- * fdt_certify_jobs(m, nthreads), each range's calls on one thread in slot
- * order. A tet's call says nothing of the tets after it: the caller uses
- * its results only when the certificate passed.
+ * fdt_certify_jobs(m, nthreads), each range's calls on one thread in the
+ * certificate's order. A tet's call says nothing of the tets after it:
+ * the caller uses its results only when the certificate passed.
  */
 typedef struct fdt_certify_visit {
     void (*tet)(void *user, int job, uint32_t slot, const uint32_t v[4], int inf,
