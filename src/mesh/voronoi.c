@@ -96,8 +96,9 @@ typedef struct vwork {
     double *xyz;        /* 3m local coordinates (owned) */
     uint32_t *tets;     /* 4 local ids a tet, by lowest id (owned) */
     size_t ntets;
-    const fdt_vid *rtets; /* the result's tets, in input ids, that tets maps
-                             (NULL in a batch: tets are local already) */
+    const fdt_vid *rtets; /* the result's tets, in input ids, until
+                             bucket_tets maps them into tets (NULL in a
+                             batch: its tets are local already) */
     unsigned skip;      /* FDT_CELLS_NO_*: the moments, the DTFE sums left out */
     unsigned periodic;  /* a periodic set's batch: its periodic axes (add_tet) */
     size_t *bcnt;       /* bucket_tets's: each key's next entry */
@@ -331,14 +332,12 @@ static int number_points(vwork *w, const fdt_result *r, const double *xyz)
     return FDT_OK;
 }
 
-/* The result's tets in local ids: room for them and their source (the
- * jobs map and bucket them, bucket_tets). */
-static int local_tets(vwork *w, const fdt_result *r)
+/* The result's tets as the source of the local ones (bucket_tets maps
+ * them to local ids as it buckets them). */
+static void local_tets(vwork *w, const fdt_result *r)
 {
     w->ntets = r->ntets;
     w->rtets = r->tets;
-    w->tets = fdt_mem_alloc_huge(w->ntets ? 4 * w->ntets : 1, sizeof *w->tets, 0);
-    return w->tets ? FDT_OK : FDT_ENOMEM;
 }
 
 /* ---------------------------------------------------------------- tet pass */
@@ -1323,17 +1322,15 @@ static inline uint32_t tet_key(const uint32_t *x)
     return a < b ? a : b;
 }
 
-/* A job's slice of the result's tets, [t ntets / T, (t + 1) ntets / T),
- * in local ids. */
-static void *map_pass(void *arg)
+/* Tet t in local ids: the result's, mapped (the whole set), or w's own
+ * (a batch, numbered so already). */
+static inline void local_tet(const vwork *w, size_t t, uint32_t x[4])
 {
-    vjob *j = arg;
-    vwork *w = j->w;
-    size_t t = (size_t)(j - w->jobs), T = (size_t)w->njobs;
-    size_t end = 4 * (w->ntets * (t + 1) / T);
-    for (size_t c = 4 * (w->ntets * t / T); c < end; c++)
-        w->tets[c] = w->loc[w->rtets[c]];
-    return NULL;
+    if (w->rtets)
+        for (int k = 0; k < 4; k++)
+            x[k] = w->loc[w->rtets[4 * t + k]];
+    else
+        memcpy(x, w->tets + 4 * t, 4 * sizeof *x);
 }
 
 /* The job's keys counted, then each key's first entry relative to the
@@ -1344,7 +1341,9 @@ static void *count_pass(void *arg)
     vwork *w = j->w;
     size_t *cnt = w->bcnt, run = 0;
     for (size_t t = 0; t < w->ntets; t++) {
-        uint32_t k = tet_key(w->tets + 4 * t);
+        uint32_t x[4];
+        local_tet(w, t, x);
+        uint32_t k = tet_key(x);
         if (mine(j, k))
             cnt[k]++;
     }
@@ -1363,7 +1362,8 @@ static void *scatter_pass(void *arg)
     vjob *j = arg;
     vwork *w = j->w;
     for (size_t t = 0; t < w->ntets; t++) {
-        const uint32_t *x = w->tets + 4 * t;
+        uint32_t x[4];
+        local_tet(w, t, x);
         uint32_t k = tet_key(x);
         if (mine(j, k))
             memcpy(w->btets + 4 * (j->bbase + w->bcnt[k]++), x, 4 * sizeof *x);
@@ -1377,12 +1377,13 @@ static void *scatter_pass(void *arg)
  * run, bench/NOTES.md entry 105): a counting sort on the jobs' threads,
  * each job the keys of its own points (each reads all the tets, twice;
  * the buckets come out as one thread's sort would make them). The
- * result's tets are first mapped to local ids, a slice a job. Each pass
- * writes only its job's entries of tets, bcnt and btets; pthread_join
- * (fork_join) orders them before the next pass reads them. */
+ * result's tets are mapped to local ids as they are read (local_tet), not
+ * into a copy first: 16 bytes a tet of fresh memory less (bench/NOTES.md
+ * entry 130). Each pass writes only its job's entries of bcnt and btets;
+ * pthread_join (fork_join) orders them before the next pass reads them. */
 static int bucket_tets(vwork *w, vjob *jobs, int threads)
 {
-    int err = w->rtets ? fork_join(jobs, threads, map_pass) : FDT_OK;
+    int err = FDT_OK;
     w->bcnt = fdt_mem_alloc_huge(w->m + 1, sizeof *w->bcnt, 1);
     w->btets = fdt_mem_alloc_huge(w->ntets ? 4 * w->ntets : 1, sizeof *w->btets, 0);
     if (!err && (!w->bcnt || !w->btets))
@@ -1398,8 +1399,9 @@ static int bucket_tets(vwork *w, vjob *jobs, int threads)
     free(w->bcnt);
     w->bcnt = NULL;
     if (!err) {
-        free(w->tets);
+        free(w->tets); /* a batch's own; NULL for the whole set's */
         w->tets = w->btets;
+        w->rtets = NULL;
     } else {
         free(w->btets);
     }
@@ -1607,7 +1609,7 @@ int fdt_voronoi_build(const fdt_result *r, const double *xyz, size_t n, const fd
     if (!err) {
         w.nown = w.m;
         set_frame(&w);
-        err = local_tets(&w, r);
+        local_tets(&w, r);
     }
     if (!err)
         err = alloc_work(&w);
