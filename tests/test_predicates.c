@@ -630,6 +630,44 @@ static void fam_cospherical_fine(tctx *T, double (*p)[3])
     const double none[3] = {0, 0, 0};
     sphere_scaled(T, p, (double)(irand(T, 1L << 48, 1L << 49) | 1) * 0x1p-60, none, 0x1p-60);
 }
+/* A random m 2^s, m an integer up to 2^30 with a random sign. */
+static double stretched_value(tctx *T, int s)
+{
+    return ldexp((double)irand(T, -(1L << 30), 1L << 30), s);
+}
+/* Exact degeneracies whose coordinates span more than 2^63 units of their
+ * lowest bit (a boundary layer's wall distances beside the far field):
+ * each axis its own scale, 2^-100 to 2^20 (a span up to 2^150: the widest
+ * go on to stage C), so that the exact stages take stage X's wide limbs.
+ * p[0..3]: a rectangle (0, u, v, u + v), u = (a, 0, c) and v = (0, k, 0)
+ * on permuted axes, so u.v = 0: coplanar and cocircular, orient3d and
+ * insphere with any fifth point exactly 0, each sum exact (one scale an
+ * axis); p[4] anywhere. Half the cases nudge one coordinate by an ulp:
+ * signs decided in the lowest limbs. */
+static void fam_stretched(tctx *T, double (*p)[3])
+{
+    int sc[3], ax[3] = {0, 1, 2};
+    for (int k = 0; k < 3; k++)
+        sc[k] = (int)irand(T, -100, 20);
+    for (int k = 2; k > 0; k--) {
+        int j = (int)irand(T, 0, k), t = ax[k];
+        ax[k] = ax[j];
+        ax[j] = t;
+    }
+    const double u[3] = {stretched_value(T, sc[0]), 0, stretched_value(T, sc[2])};
+    const double v[3] = {0, stretched_value(T, sc[1]), 0};
+    for (int k = 0; k < 3; k++) {
+        p[0][ax[k]] = 0;
+        p[1][ax[k]] = u[k];
+        p[2][ax[k]] = v[k];
+        p[3][ax[k]] = u[k] + v[k]; /* one of them 0: exact */
+        p[4][ax[k]] = stretched_value(T, sc[k] + (int)irand(T, -20, 20));
+    }
+    if (irand(T, 0, 1)) {
+        const int i = (int)irand(T, 0, 3), k = (int)irand(T, 0, 2);
+        p[i][k] = nudge(p[i][k], irand(T, 0, 1) ? 1 : -1);
+    }
+}
 /* Magnitudes near 1e-150 and 1e150, rounded and exact scalings. */
 static void fam_near_coplanar_scaled(tctx *T, double (*p)[3])
 {
@@ -672,6 +710,7 @@ static const family families[] = {
     {"cospherical", fam_cospherical, 3000},
     {"cospherical-wide", fam_cospherical_wide, 3000},
     {"cospherical-fine", fam_cospherical_fine, 3000},
+    {"stretched", fam_stretched, 3000},
     {"near-coplanar-scaled", fam_near_coplanar_scaled, 2000},
     {"near-cospherical-scaled", fam_near_cospherical_scaled, 2000},
     {"lattice-scaled", fam_lattice_scaled, 2000},

@@ -629,17 +629,189 @@ static int insphere_stage_w(double (*r)[3], int k, double mx)
 }
 
 /*
+ * Wider integers for stage X (below): magnitudes as little-endian limbs,
+ * multiplied by schoolbook (at most 4 x 6 limbs), and sums accumulated in
+ * two's complement over as many limbs as their bound needs. Rows below
+ * M = 2^126: 2x2 minors below 2M^2 = 2^253 (4 limbs), 3x3 minors below
+ * 6M^3 < 2^382 (6), lifts below 3M^2 < 2^254 (4), insphere's det below
+ * 72M^5 < 2^637 (10) and orient3d's below 6M^3 (6): every sum fits its
+ * limbs with the sign bit to spare, so it is exact however the partial
+ * sums wrap. GMP on the same numbers (stage C) spent most of a stretched
+ * boundary layer's exact tests in its calls (bench/NOTES.md entry 130).
+ */
+#define XL 10
+
+/* r[0 .. na + nb) = a[0 .. na) b[0 .. nb), magnitudes. */
+static inline void mag_mul(const uint64_t *a, int na, const uint64_t *b, int nb, uint64_t *r)
+{
+    for (int i = 0; i < na + nb; i++)
+        r[i] = 0;
+    for (int i = 0; i < na; i++) {
+        u128w c = 0;
+        for (int j = 0; j < nb; j++) {
+            c += (u128w)a[i] * b[j] + r[i + j];
+            r[i + j] = (uint64_t)c;
+            c >>= 64;
+        }
+        r[i + nb] = (uint64_t)c;
+    }
+}
+
+/* |x| as two limbs; 1 when x < 0. */
+static inline int i128_mag(i128 x, uint64_t m[2])
+{
+    const u128w u = x < 0 ? (u128w)0 - (u128w)x : (u128w)x;
+    m[0] = (uint64_t)u;
+    m[1] = (uint64_t)(u >> 64);
+    return x < 0;
+}
+
+/* acc (n limbs, two's complement) += x or -x (neg), x a magnitude of nx
+ * <= n limbs: acc + ~x + 1 for the negative. */
+static inline void tc_add(uint64_t *acc, int n, const uint64_t *x, int nx, int neg)
+{
+    const uint64_t flip = neg ? ~UINT64_C(0) : 0;
+    u128w c = (u128w)neg;
+    for (int i = 0; i < n; i++) {
+        c += (u128w)acc[i] + ((i < nx ? x[i] : 0) ^ flip);
+        acc[i] = (uint64_t)c;
+        c >>= 64;
+    }
+}
+
+/* The magnitude of x (n limbs, two's complement, never -2^(64n-1)) into
+ * m; 1 when x < 0. */
+static inline int tc_mag(const uint64_t *x, int n, uint64_t *m)
+{
+    const int neg = (int)(x[n - 1] >> 63);
+    const uint64_t flip = neg ? ~UINT64_C(0) : 0;
+    u128w c = (u128w)neg;
+    for (int i = 0; i < n; i++) {
+        c += (u128w)(x[i] ^ flip);
+        m[i] = (uint64_t)c;
+        c >>= 64;
+    }
+    return neg;
+}
+
+static inline int tc_sign(const uint64_t *x, int n)
+{
+    if (x[n - 1] >> 63)
+        return -1;
+    for (int i = 0; i < n; i++)
+        if (x[i])
+            return 1;
+    return 0;
+}
+
+/* acc (n limbs) += s a b for a (na limbs) and b (nb limbs) magnitudes of
+ * signs sa, sb, s = +1 or -1 (sub). */
+static inline void tc_addmul(uint64_t *acc, int n, const uint64_t *a, int na, int sa,
+                             const uint64_t *b, int nb, int sb, int sub)
+{
+    uint64_t p[XL];
+    mag_mul(a, na, b, nb, p);
+    tc_add(acc, n, p, na + nb, sa ^ sb ^ sub);
+}
+
+/* The 2x2 minor p q' - p' q of rows below 2^126 (4 limbs). */
+static inline void minor2_x(i128 p, i128 q2, i128 p2, i128 q, uint64_t out[4])
+{
+    uint64_t a[2], b[2];
+    out[0] = out[1] = out[2] = out[3] = 0;
+    int sa = i128_mag(p, a), sb = i128_mag(q2, b);
+    tc_addmul(out, 4, a, 2, sa, b, 2, sb, 0);
+    sa = i128_mag(p2, a);
+    sb = i128_mag(q, b);
+    tc_addmul(out, 4, a, 2, sa, b, 2, sb, 1);
+}
+
+/* x2 yz - y2 xz + z2 xy (6 limbs), as minor3 (yz ... 4-limb minors). */
+static void minor3_x(i128 x2, const uint64_t yz[4], i128 y2, const uint64_t xz[4], i128 z2,
+                     const uint64_t xy[4], uint64_t out[6])
+{
+    const i128 c[3] = {x2, y2, z2};
+    const uint64_t *m[3] = {yz, xz, xy};
+    for (int i = 0; i < 6; i++)
+        out[i] = 0;
+    for (int t = 0; t < 3; t++) {
+        uint64_t a[2], b[4];
+        const int sa = i128_mag(c[t], a), sb = tc_mag(m[t], 4, b);
+        tc_addmul(out, 6, a, 2, sa, b, 4, sb, t == 1);
+    }
+}
+
+/* |P|^2 of a row below 2^126 (4 limbs, nonnegative). */
+static void lift_x(const i128 *r, uint64_t out[4])
+{
+    out[0] = out[1] = out[2] = out[3] = 0;
+    for (int k = 0; k < 3; k++) {
+        uint64_t a[2];
+        (void)i128_mag(r[k], a);
+        tc_addmul(out, 4, a, 2, 0, a, 2, 0, 0);
+    }
+}
+
+/* orient3d's sign from rows below 2^126. */
+static int orient_x_sign(i128 (*z)[3])
+{
+    const i128 *u = z[0], *v = z[1], *w = z[2];
+    uint64_t m[3][4], det[6] = {0};
+    minor2_x(v[1], w[2], v[2], w[1], m[0]);
+    minor2_x(v[2], w[0], v[0], w[2], m[1]);
+    minor2_x(v[0], w[1], v[1], w[0], m[2]);
+    for (int t = 0; t < 3; t++) {
+        uint64_t a[2], b[4];
+        const int sa = i128_mag(u[t], a), sb = tc_mag(m[t], 4, b);
+        tc_addmul(det, 6, a, 2, sa, b, 4, sb, 0);
+    }
+    return tc_sign(det, 6);
+}
+
+/* insphere's CGAL sign from rows below 2^126: insphere_w_sign's terms. */
+static int insphere_x_sign(i128 (*z)[3])
+{
+    const i128 *A = z[0], *B = z[1], *C = z[2], *D = z[3];
+    uint64_t ab[4], bc[4], cd[4], da[4], ac[4], bd[4];
+    minor2_x(A[0], B[1], B[0], A[1], ab);
+    minor2_x(B[0], C[1], C[0], B[1], bc);
+    minor2_x(C[0], D[1], D[0], C[1], cd);
+    minor2_x(D[0], A[1], A[0], D[1], da);
+    minor2_x(A[0], C[1], C[0], A[1], ac);
+    minor2_x(B[0], D[1], D[0], B[1], bd);
+    uint64_t m3[4][6], l[4][4], det[XL] = {0};
+    minor3_x(A[2], bc, B[2], ac, C[2], ab, m3[0]);  /* abc */
+    minor3_x(D[2], ab, -A[2], bd, B[2], da, m3[1]); /* dab */
+    minor3_x(C[2], da, -D[2], ac, A[2], cd, m3[2]); /* cda */
+    minor3_x(B[2], cd, C[2], bd, D[2], bc, m3[3]);  /* bcd */
+    lift_x(D, l[0]);
+    lift_x(C, l[1]);
+    lift_x(B, l[2]);
+    lift_x(A, l[3]);
+    /* (dl abc - cl dab) + (bl cda - al bcd) */
+    for (int t = 0; t < 4; t++) {
+        uint64_t b[6];
+        const int sb = tc_mag(m3[t], 6, b);
+        tc_addmul(det, XL, l[t], 4, 0, b, 6, sb, t & 1);
+    }
+    return -tc_sign(det, XL);
+}
+
+/*
  * Stage X: the coordinates themselves as integers, for differences that
  * are not exact doubles or span more than 2^52 units. With 2^k the lowest
- * set bit over the points' coordinates and every coordinate below 2^63
- * units (k at least ilogb(largest) - 62), x 2^-k is an integer that a
- * double and an int64 hold exactly; the differences to the last point,
- * in i128, are exact, and at most 2^62 of them take the limbs of stage W.
- * A stretched grid from 0 (cfdgrid: steps of 2^-62 beside coordinates
- * near 1) lands here instead of stage B's expansions (bench/NOTES.md
- * entry 116).
+ * set bit over the points' coordinates and every coordinate below 2^125
+ * units (k at least ilogb(largest) - 124), x 2^-k is an integer (its
+ * significand shifted); the differences to the last point, in i128, are
+ * exact. Up to 2^62 units they take the limbs of stage W; beyond, up to
+ * 2^126, the wider limbs above. A stretched grid from 0 (cfdgrid: steps
+ * of 2^-62 beside coordinates near 1) lands here instead of stage B's
+ * expansions (bench/NOTES.md entry 116), and a boundary layer's wall
+ * distances (blayer: 2^72 units and more) instead of stage C's GMP
+ * (entry 130). 0: beyond 2^126 units; 1: rows below 2^62 in z; 2: rows
+ * below 2^126 in zw.
  */
-static int coord_rows(const double *const *p, int n, int64_t (*z)[3])
+static int coord_rows(const double *const *p, int n, int64_t (*z)[3], i128 (*zw)[3])
 {
     double cm = 0;
     for (int i = 0; i < n; i++)
@@ -647,18 +819,33 @@ static int coord_rows(const double *const *p, int n, int64_t (*z)[3])
             cm = fabs(p[i][j]) > cm ? fabs(p[i][j]) : cm;
     if (!(cm > 0 && cm <= DBL_MAX))
         return 0;
-    const int k = grid_exponent(p, n, ilogb(cm) - 62);
-    if (k == INT_MIN || k == INT_MAX || k < -1022 || k > 1022)
+    const int k = grid_exponent(p, n, ilogb(cm) - 124);
+    if (k == INT_MIN || k == INT_MAX)
         return 0;
-    const double s = ldexp(1.0, -k);
-    const double *last = p[n - 1];
+    i128 q[5][3];
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < 3; j++) {
+            int e;
+            uint64_t m = int_mantissa(p[i][j], &e);
+            i128 v = 0;
+            if (m) { /* m 2^e, its lowest set bit at or above 2^k */
+                const int tz = fdt_ctz64(m);
+                v = (i128)((u128w)(m >> tz) << (e + tz - k)); /* below 2^125 */
+            }
+            q[i][j] = p[i][j] < 0 ? -v : v;
+        }
+    const i128 lim = (i128)1 << 62;
+    int narrow = 1;
     for (int i = 0; i + 1 < n; i++)
         for (int j = 0; j < 3; j++) {
-            const i128 d = (i128)(int64_t)(p[i][j] * s) - (i128)(int64_t)(last[j] * s);
-            if (d > ((i128)1 << 62) || d < -((i128)1 << 62))
-                return 0;
-            z[i][j] = (int64_t)d;
+            zw[i][j] = q[i][j] - q[n - 1][j];
+            narrow &= zw[i][j] <= lim && zw[i][j] >= -lim;
         }
+    if (!narrow)
+        return 2;
+    for (int i = 0; i + 1 < n; i++)
+        for (int j = 0; j < 3; j++)
+            z[i][j] = (int64_t)zw[i][j];
     return 1;
 }
 
@@ -666,7 +853,9 @@ static int orient_stage_x(const double *a, const double *b, const double *c, con
 {
     const double *const p[4] = {b, c, d, a}; /* rows b - a, c - a, d - a */
     int64_t z[3][3];
-    return coord_rows(p, 4, z) ? orient_w_sign(z) : FDT_PRED_UNSURE;
+    i128 zw[3][3];
+    const int r = coord_rows(p, 4, z, zw);
+    return r == 1 ? orient_w_sign(z) : r == 2 ? orient_x_sign(zw) : FDT_PRED_UNSURE;
 }
 
 static int insphere_stage_x(const double *a, const double *b, const double *c,
@@ -674,7 +863,9 @@ static int insphere_stage_x(const double *a, const double *b, const double *c,
 {
     const double *const p[5] = {a, b, c, d, e};
     int64_t z[4][3];
-    return coord_rows(p, 5, z) ? insphere_w_sign(z) : FDT_PRED_UNSURE;
+    i128 zw[4][3];
+    const int r = coord_rows(p, 5, z, zw);
+    return r == 1 ? insphere_w_sign(z) : r == 2 ? insphere_x_sign(zw) : FDT_PRED_UNSURE;
 }
 
 static int orient_stage_i(double (*r)[3], int k, double mx)
