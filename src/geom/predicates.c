@@ -11,9 +11,10 @@
  *            exact), 128-bit integers (I) or five 64-bit limbs (W). Tried
  *            before the adaptive stage where the point's coordinates have
  *            few significant bits, and first in the exact stages.
- *   stage X: the coordinates themselves as integers below 2^63 units,
- *            their differences exact in 128 bits, W's limbs: stretched
- *            grids from 0, differences that are not doubles.
+ *   stage X: the coordinates themselves as integers below 2^125 units,
+ *            their differences exact in 128 bits, W's limbs up to 2^62
+ *            and wider ones beyond: stretched grids from 0, boundary
+ *            layers' wall distances, differences that are not doubles.
  *   adaptive: coordinates in stage B's range, differences exact or not:
  *            the determinant of the rounded differences in double-word
  *            arithmetic plus the first-order terms of the differences'
@@ -30,8 +31,8 @@
  *            Fast-Expansion-Sum, Scale-Expansion and Compress, with zero
  *            elimination). Scanner data with big offsets lands here: by
  *            Sterbenz's lemma nearby coordinates subtract exactly.
- *   stage C: anything else (mixed magnitudes, subnormals, huge values,
- *            inexact differences): every double is m 2^k with an integer
+ *   stage C: anything else (magnitudes mixed beyond X's span,
+ *            subnormals beside normals, inexact differences of such): every double is m 2^k with an integer
  *            |m| < 2^53, so scaling all coordinates by 2^-kmin makes them
  *            integers, and the determinant is evaluated in GMP integers.
  *
