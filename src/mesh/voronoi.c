@@ -927,6 +927,13 @@ static int job_adjacency(vjob *j)
     return j->fsum ? FDT_OK : FDT_ENOMEM;
 }
 
+/* How many tets ahead tet_pass prefetches what add_tet reads of its
+ * points' lists: the face sums' entries (slot), a cache miss a share in
+ * a fifth of add_tet's samples (1M uniform), as the lists of a tet's
+ * other points lie anywhere in the 248 MB of sums; the list's place a
+ * step earlier (bench/NOTES.md entry 130; 8 measured the same as 4). */
+#define TET_AHEAD 4
+
 /* A thread's first pass: the tets' shares to its points. Threads write
  * disjoint entries only (their own points' accumulators and face sums);
  * pthread_join orders all of it before cell_pass reads it. */
@@ -937,6 +944,24 @@ static void *tet_pass(void *arg)
     if ((j->err = job_adjacency(j)) != FDT_OK)
         return NULL;
     for (size_t t = 0; t < w->ntets; t++) {
+        /* each own point's list place, then its neighbours and (4 lines:
+         * a dozen or so entries of 16 bytes) its face sums */
+        if (t + 2 * TET_AHEAD < w->ntets)
+            for (int m = 0; m < 4; m++) {
+                uint32_t v = w->tets[4 * (t + 2 * TET_AHEAD) + (size_t)m];
+                if (mine(j, v))
+                    __builtin_prefetch(&j->adj_start[v - j->lo]);
+            }
+        if (t + TET_AHEAD < w->ntets)
+            for (int m = 0; m < 4; m++) {
+                uint32_t v = w->tets[4 * (t + TET_AHEAD) + (size_t)m];
+                if (!mine(j, v))
+                    continue;
+                size_t b = j->adj_start[v - j->lo];
+                __builtin_prefetch(&j->adj[b]);
+                for (int l = 0; l < 4; l++)
+                    __builtin_prefetch(&j->fsum[b + 4 * (size_t)l]);
+            }
         const uint32_t *tv = w->tets + 4 * t;
         if (mine(j, tv[0]) || mine(j, tv[1]) || mine(j, tv[2]) || mine(j, tv[3]))
             add_tet(j, tv);
