@@ -213,20 +213,75 @@ static int morton(ext *e, uint32_t n, double blo[3], double bhi[3])
 
 /* ---- step 3: the kept tets and hull faces, normalised ------------------ */
 
-/* A tet (4 vertices) or hull face (3, then UINT64_MAX) as the periodic
- * mesh names it: packed vertices ascending, offsets relative to the
- * first. */
+/*
+ * A tet (4 vertices) or hull face (3) as the periodic mesh names it, in 20
+ * bytes: the vertices ascending (by input index, then offsets), offsets
+ * relative to the first, whose own are then 0 and not stored. w[0] is the
+ * first vertex's index; w[1..4] a 128-bit string, most significant word
+ * first, of each other vertex's index (32 bits) and offsets (3 bits an
+ * axis, the offset + 2: the images' offsets are -1..1, so relative ones
+ * -2..2), 41 bits a vertex, a hull face's missing fourth all ones. Word by
+ * word it compares as the vertices do. Keys of 4 x 8 bytes made the kept
+ * tets' sets 36 bytes a tet with their ranks (244 MB of fresh pages on
+ * 1M points, bench/NOTES.md entry 130).
+ */
 typedef struct key {
-    uint64_t v[4];
+    uint32_t w[5];
 } key;
+
+/* A vertex's offsets (each -2..2) as 9 bits, order kept. */
+#define OFF_CODE_NONE 0x1ffu
 
 static int key_cmp(const void *x, const void *y)
 {
     const key *a = x, *b = y;
-    for (int j = 0; j < 4; j++)
-        if (a->v[j] != b->v[j])
-            return a->v[j] < b->v[j] ? -1 : 1;
+    for (int j = 0; j < 5; j++)
+        if (a->w[j] != b->w[j])
+            return a->w[j] < b->w[j] ? -1 : 1;
     return 0;
+}
+
+/* k from the vertices a[0 .. 4) packed as vpack makes them, ascending,
+ * a[0]'s offsets zero (VZERO), the others' within -2..2; a missing
+ * fourth (a hull face's) is UINT64_MAX. */
+static void key_pack(const uint64_t a[4], key *k)
+{
+    uint64_t f[4]; /* f[1 .. 3]: a vertex's index and offsets, 41 bits */
+    for (int j = 1; j < 4; j++) {
+        uint64_t code = OFF_CODE_NONE;
+        if (a[j] != UINT64_MAX)
+            code = ((a[j] >> 16 & 255) - 126) << 6 | ((a[j] >> 8 & 255) - 126) << 3 |
+                   ((a[j] & 255) - 126);
+        f[j] = (uint64_t)(uint32_t)(a[j] >> 24) << 9 | code; /* all ones when missing */
+    }
+    /* the string's two 64-bit halves: f1 in bits 63..23 of hi, f2 across
+     * the halves (23 + 18 bits), f3 in bits 45..5 of lo */
+    const uint64_t hi = f[1] << 23 | f[2] >> 18;
+    const uint64_t lo = (f[2] & ((UINT64_C(1) << 18) - 1)) << 46 | f[3] << 5;
+    k->w[0] = (uint32_t)(a[0] >> 24);
+    k->w[1] = (uint32_t)(hi >> 32);
+    k->w[2] = (uint32_t)hi;
+    k->w[3] = (uint32_t)(lo >> 32);
+    k->w[4] = (uint32_t)lo;
+}
+
+/* Vertex j (0 .. 3) of k: its index and offsets. */
+static void key_vertex(const key *k, int j, uint32_t *id, int8_t o[3])
+{
+    if (j == 0) {
+        *id = k->w[0];
+        o[0] = o[1] = o[2] = 0;
+        return;
+    }
+    const uint64_t hi = (uint64_t)k->w[1] << 32 | k->w[2], lo = (uint64_t)k->w[3] << 32 | k->w[4];
+    const uint64_t m41 = (UINT64_C(1) << 41) - 1;
+    const uint64_t x = j == 1   ? hi >> 23
+                       : j == 2 ? ((hi & ((UINT64_C(1) << 23) - 1)) << 18 | lo >> 46)
+                                : (lo >> 5) & m41;
+    *id = (uint32_t)(x >> 9);
+    o[0] = (int8_t)((int)(x >> 6 & 7) - 2);
+    o[1] = (int8_t)((int)(x >> 3 & 7) - 2);
+    o[2] = (int8_t)((int)(x & 7) - 2);
 }
 
 /*
@@ -239,7 +294,7 @@ static int key_cmp(const void *x, const void *y)
  */
 static uint32_t make_key(const ext *e, const uint32_t *w, int nv, key *k, long *repeat)
 {
-    uint64_t *a = k->v;
+    uint64_t a[4];
     uint32_t least = w[0];
     for (int j = 0; j < nv; j++) {
         a[j] = e->vk[w[j]];
@@ -259,6 +314,7 @@ static uint32_t make_key(const ext *e, const uint32_t *w, int nv, key *k, long *
         if (j > 0 && a[j] >> 24 == a[j - 1] >> 24 && *repeat < 0)
             *repeat = (long)(a[j] >> 24); /* sorted: the first is the least */
     }
+    key_pack(a, k);
     return least;
 }
 
@@ -614,7 +670,7 @@ static void prove_tet(void *user, int job, uint32_t slot, const uint32_t v[4], i
     /* the least vertex's place among the owned points: its id when a
      * part owns them all (no load: that array's misses were an eighth of
      * this function's time on 1M points) */
-    uint32_t rank = r->own ? r->e.rank[least] : (uint32_t)(k.v[0] >> 24);
+    uint32_t rank = r->own ? r->e.rank[least] : k.w[0];
     j->err = keyset_add(inf < 0 ? &j->tets : &j->hull, &k, rank);
 }
 
@@ -793,14 +849,9 @@ static int one_round(run *r, const double m[3], int nthreads, fdt_periodic_mesh 
 static void unpack(const key *k, size_t count, int nv, uint32_t *ids, int8_t *off)
 {
     for (size_t i = 0; i < count; i++)
-        for (int j = 0; j < nv; j++) {
-            uint64_t x = k[i].v[j];
-            int8_t *o = off + 3 * ((size_t)nv * i + (size_t)j);
-            ids[(size_t)nv * i + (size_t)j] = (uint32_t)(x >> 24);
-            o[0] = (int8_t)((int)(x >> 16 & 255) - 128);
-            o[1] = (int8_t)((int)(x >> 8 & 255) - 128);
-            o[2] = (int8_t)((int)(x & 255) - 128);
-        }
+        for (int j = 0; j < nv; j++)
+            key_vertex(&k[i], j, &ids[(size_t)nv * i + (size_t)j],
+                       off + 3 * ((size_t)nv * i + (size_t)j));
 }
 
 /*
@@ -920,12 +971,17 @@ int fdt_periodic_sort_rows(uint32_t **ids, int8_t **off, size_t count, int nv, s
         return FDT_ENOMEM;
     }
     for (size_t i = 0; i < count; i++) {
-        for (int j = 0; j < 4; j++)
-            s.keys[i].v[j] = j < nv ? vpack((*ids)[(size_t)nv * i + (size_t)j],
-                                            *off + 3 * ((size_t)nv * i + (size_t)j))
-                                    : UINT64_MAX;
+        uint64_t a[4];
+        int ok = 1;
+        for (int j = 0; j < 4; j++) {
+            const int8_t *o = *off + 3 * ((size_t)nv * i + (size_t)j);
+            a[j] = j < nv ? vpack((*ids)[(size_t)nv * i + (size_t)j], o) : UINT64_MAX;
+            for (int d = 0; j < nv && d < 3; d++) /* canonical: key_pack's range */
+                ok &= j ? o[d] >= -2 && o[d] <= 2 : o[d] == 0;
+        }
+        key_pack(a, &s.keys[i]);
         s.rank[i] = (*ids)[(size_t)nv * i];
-        if (s.rank[i] >= n) {
+        if (s.rank[i] >= n || !ok) {
             keyset_free(&s);
             return FDT_EINVAL;
         }

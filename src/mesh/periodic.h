@@ -133,10 +133,11 @@ int fdt_periodic_build(const double *X, uint32_t n, const int32_t *names,
 void fdt_periodic_free(fdt_periodic_mesh *m);
 
 /* Sorts count canonical rows of nv vertices (*ids, 3 offsets a vertex in
- * *off, both malloc'ed; ids below n, the rows' least first) into the
- * mesh's order (fdt_periodic_build's), by the build's own buckets: the
- * parts' rows gathered (frontdt-mpi). The arrays are replaced. FDT_OK,
- * FDT_ENOMEM or FDT_EINVAL for an id of n or more (rows unchanged). */
+ * *off, both malloc'ed; ids below n, the rows' least first, its offsets
+ * 0 and the others' -2..2) into the mesh's order (fdt_periodic_build's),
+ * by the build's own buckets: the parts' rows gathered (frontdt-mpi). The
+ * arrays are replaced. FDT_OK, FDT_ENOMEM or FDT_EINVAL for an id of n or
+ * more or a row that is not canonical (rows unchanged). */
 int fdt_periodic_sort_rows(uint32_t **ids, int8_t **off, size_t count, int nv, size_t n);
 
 /*
