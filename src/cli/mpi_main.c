@@ -394,7 +394,8 @@ typedef struct rowbuf {
 static int setup_exit_code(int err);
 
 /* The rows sorted as .tets sorts them (tets, then hull faces), ids below
- * n: FDT_OK or FDT_ENOMEM. */
+ * n: FDT_OK, FDT_ENOMEM, or FDT_EINVAL for a row that is not canonical
+ * (a bug). */
 static int sort_rows(rowbuf rows[2], size_t n)
 {
     int err = FDT_OK;
@@ -450,12 +451,14 @@ static int periodic_pieces(const opts *o, int rank, fdt_result *res, rowbuf rows
 {
     char diag[1024] = "";
     int err = sort_rows(rows, n);
-    int bad = err != FDT_OK, worst;
+    int bad = err == FDT_OK ? 0 : err == FDT_ENOMEM ? 1 : 2, worst;
     MPI_Allreduce(&bad, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     if (worst) {
         if (rank == 0)
-            fprintf(stderr, "frontdt-mpi: out of memory sorting a piece's rows\n");
-        return CLI_RESOURCES;
+            fprintf(stderr, worst == 1 ? "frontdt-mpi: out of memory sorting a piece's rows\n"
+                                       : "frontdt-mpi: a piece's periodic rows are not canonical "
+                                         "(a bug: please report)\n");
+        return worst == 1 ? CLI_RESOURCES : CLI_INTERNAL;
     }
     fdt_sethash h = {0, 0};
     fdt_sethash_add_periodic(&h, (const uint32_t *)rows[0].ids, rows[0].off, rows[0].n);
@@ -754,8 +757,11 @@ static int periodic_run(const opts *o, int rank, int size)
         rc = err == FDT_ENOMEM ? CLI_RESOURCES : CLI_WRITE;
         goto out;
     }
-    if (rank == 0 && !err && !pieces)
-        err = sort_rows(rows, n);
+    if (rank == 0 && !err && !pieces && (err = sort_rows(rows, n)) == FDT_EINVAL) {
+        fprintf(stderr, "frontdt-mpi: the gathered periodic rows are not canonical (a bug: "
+                        "please report)\n");
+        err = FDT_EINTERNAL;
+    }
     rc = err ? fdt_cli_engine_exit(err) : CLI_OK;
     if (rank == 0 && !err && pieces && o->set_hash) /* the pieces are written */
         printf("set-hash: %016" PRIx64 "\n", piece_hash);
