@@ -11,6 +11,7 @@
 #include "base/hash.h"
 #include "base/mem.h"
 #include "base/sortu64.h"
+#include "base/spawn.h"
 #include "geom/images.h"
 #include "geom/morton.h"
 #include "mesh/certify.h"
@@ -854,20 +855,78 @@ static void unpack(const key *k, size_t count, int nv, uint32_t *ids, int8_t *of
                        off + 3 * ((size_t)nv * i + (size_t)j));
 }
 
+/* A thread's share of emit: the ranks [lo, hi), whose keys it counts
+ * (pass 0), places in their buckets (1), and sorts and unpacks (2). Each
+ * writes only its ranks' entries of start and its buckets' of tmp, ids
+ * and offs; fdt_fork_join's joins order each pass before the next. */
+typedef struct emit_job {
+    const keyset *s;
+    int ns, nv, pass;
+    uint32_t lo, hi;
+    size_t *start;
+    key *tmp;
+    uint32_t *ids;
+    int8_t *offs;
+} emit_job;
+
+static void *emit_pass(void *arg)
+{
+    emit_job *j = arg;
+    size_t *start = j->start;
+    if (j->pass < 2) {
+        /* the sets in order, each in its order: a bucket's keys come as
+         * one thread's pass would place them */
+        for (int i = 0; i < j->ns; i++)
+            for (size_t k = 0; k < j->s[i].n; k++) {
+                const uint32_t r = j->s[i].rank[k];
+                if (r < j->lo || r >= j->hi)
+                    continue;
+                if (j->pass == 0)
+                    start[r + 1]++;
+                else
+                    j->tmp[start[r]++] = j->s[i].keys[k];
+            }
+        return NULL;
+    }
+    for (size_t v = j->lo; v < j->hi; v++) {
+        key *a = j->tmp + start[v];
+        size_t c = start[v + 1] - start[v];
+        if (c > 32) {
+            qsort(a, c, sizeof *a, key_cmp);
+            continue;
+        }
+        for (size_t i = 1; i < c; i++) {
+            key x = a[i];
+            size_t y = i;
+            for (; y > 0 && key_cmp(&x, &a[y - 1]) < 0; y--)
+                a[y] = a[y - 1];
+            a[y] = x;
+        }
+    }
+    const size_t b = start[j->lo];
+    unpack(j->tmp + b, start[j->hi] - b, j->nv, j->ids + (size_t)j->nv * b,
+           j->offs + 3 * (size_t)j->nv * b);
+    return NULL;
+}
+
+/* The most threads emit takes: a range of ranks each. */
+#define EMIT_MAX_THREADS 64
+
 /*
- * The keys of the sets s[0 .. ns), sorted, into out's arrays; each set
- * freed once its keys are moved. Counted into buckets by their least
- * vertex's place among the n owned points (ascending ids, so the buckets'
- * order is the ids'), each bucket (the tets a point is the least vertex
- * of: a few) sorted by insertion, a large one by qsort (qsort of 6.8M
- * keys took a fifth of a 1M-point run). The buckets go in scratch
- * (scratch_bytes; NULL: a new array) and the rows' ids in the first set's
- * keys when they fit: memory every page of which is already mapped (a
- * fresh array's first touch, a page fault every 4 KB, was half of what
- * this took on 1M points; bench/NOTES.md entry 123).
+ * The keys of the sets s[0 .. ns), sorted, into out's arrays; the sets
+ * freed. Counted into buckets by their least vertex's place among the n
+ * owned points (ascending ids, so the buckets' order is the ids'), each
+ * bucket (the tets a point is the least vertex of: a few) sorted by
+ * insertion, a large one by qsort (qsort of 6.8M keys took a fifth of a
+ * 1M-point run); on up to nthreads threads, each a range of ranks (the
+ * same rows for any count). The buckets go in scratch (scratch_bytes;
+ * NULL: a new array) and the rows' ids in the first set's keys when they
+ * fit: memory every page of which is already mapped (a fresh array's
+ * first touch, a page fault every 4 KB, was half of what this took on 1M
+ * points; bench/NOTES.md entry 123).
  */
-static int emit(keyset *s, int ns, int nv, size_t n, void *scratch, size_t scratch_bytes,
-                uint32_t **ids, int8_t **offs, size_t *count)
+static int emit(keyset *s, int ns, int nv, size_t n, int nthreads, void *scratch,
+                size_t scratch_bytes, uint32_t **ids, int8_t **offs, size_t *count)
 {
     size_t total = 0;
     for (int i = 0; i < ns; i++)
@@ -877,21 +936,26 @@ static int emit(keyset *s, int ns, int nv, size_t n, void *scratch, size_t scrat
     key *tmp = scratch && total * sizeof *tmp <= scratch_bytes
                    ? scratch
                    : malloc((total ? total : 1) * sizeof *tmp);
+    int T = nthreads < 1 || total < 4096 ? 1 : nthreads > EMIT_MAX_THREADS ? EMIT_MAX_THREADS
+                                                                            : nthreads;
+    emit_job job[EMIT_MAX_THREADS];
     if (!start || !tmp) {
         free(start);
         if (tmp != scratch)
             free(tmp);
         return FDT_ENOMEM;
     }
-    for (int i = 0; i < ns; i++)
-        for (size_t k = 0; k < s[i].n; k++)
-            start[s[i].rank[k] + 1]++;
+    for (int t = 0; t < T; t++)
+        job[t] = (emit_job){s, ns, nv, 0, (uint32_t)(n * (size_t)t / (size_t)T),
+                            (uint32_t)(n * (size_t)(t + 1) / (size_t)T), start, tmp, NULL, NULL};
+    fdt_fork_join(job, sizeof *job, T, emit_pass);
     for (size_t v = 0; v < n; v++)
         start[v + 1] += start[v];
+    for (int t = 0; t < T; t++)
+        job[t].pass = 1;
+    fdt_fork_join(job, sizeof *job, T, emit_pass);
     void *reuse = NULL;
     for (int i = 0; i < ns; i++) {
-        for (size_t k = 0; k < s[i].n; k++)
-            tmp[start[s[i].rank[k]]++] = s[i].keys[k];
         if (!reuse && s[i].cap * sizeof *s[i].keys >= id_bytes) {
             reuse = s[i].keys;
             s[i].keys = NULL;
@@ -901,22 +965,6 @@ static int emit(keyset *s, int ns, int nv, size_t n, void *scratch, size_t scrat
     for (size_t v = n; v > 0; v--) /* start[v] was the end of bucket v */
         start[v] = start[v - 1];
     start[0] = 0;
-    for (size_t v = 0; v < n; v++) {
-        key *a = tmp + start[v];
-        size_t c = start[v + 1] - start[v];
-        if (c > 32) {
-            qsort(a, c, sizeof *a, key_cmp);
-            continue;
-        }
-        for (size_t i = 1; i < c; i++) {
-            key x = a[i];
-            size_t j = i;
-            for (; j > 0 && key_cmp(&x, &a[j - 1]) < 0; j--)
-                a[j] = a[j - 1];
-            a[j] = x;
-        }
-    }
-    free(start);
     if (reuse) { /* shrunk where it is */
         void *shrunk = realloc(reuse, id_bytes);
         *ids = shrunk ? shrunk : reuse;
@@ -926,8 +974,15 @@ static int emit(keyset *s, int ns, int nv, size_t n, void *scratch, size_t scrat
     *offs = malloc((total ? total : 1) * (size_t)nv * 3);
     fdt_mem_advise_huge(*offs, total * (size_t)nv * 3);
     int err = *ids && *offs ? FDT_OK : FDT_ENOMEM;
-    if (!err)
-        unpack(tmp, total, nv, *ids, *offs);
+    if (!err) {
+        for (int t = 0; t < T; t++) {
+            job[t].pass = 2;
+            job[t].ids = *ids;
+            job[t].offs = *offs;
+        }
+        fdt_fork_join(job, sizeof *job, T, emit_pass);
+    }
+    free(start);
     if (tmp != scratch)
         free(tmp);
     *count = total;
@@ -989,7 +1044,7 @@ int fdt_periodic_sort_rows(uint32_t **ids, int8_t **off, size_t count, int nv, s
     uint32_t *ni = NULL;
     int8_t *no = NULL;
     size_t got;
-    int err = emit(&s, 1, nv, n, NULL, 0, &ni, &no, &got);
+    int err = emit(&s, 1, nv, n, 1, NULL, 0, &ni, &no, &got);
     if (err) {
         keyset_free(&s);
         free(ni);
@@ -1248,9 +1303,9 @@ int fdt_periodic_build_part(const double *X, uint32_t n, const int32_t *names,
     ext_free(&r.e);
     free(r.near);
     if (err == FDT_OK &&
-        ((err = emit(r.tets, r.nsets, 4, r.nown, scratch, scratch_bytes, &out->tets,
+        ((err = emit(r.tets, r.nsets, 4, r.nown, nthreads, scratch, scratch_bytes, &out->tets,
                      &out->tet_off, &out->ntets)) ||
-         (err = emit(r.hull, r.nsets, 3, r.nown, scratch, scratch_bytes, &out->hull,
+         (err = emit(r.hull, r.nsets, 3, r.nown, nthreads, scratch, scratch_bytes, &out->hull,
                      &out->hull_off, &out->nhull)) ||
          (stars && ((err = gather(r.star, r.nsets, 4, &out->star_tets, &out->star_off,
                                   &out->star_pos, &out->nstar)) ||
