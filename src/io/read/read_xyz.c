@@ -202,6 +202,16 @@ static int rd_sep_fail(const rd_ctx *c, size_t line, const char *ts, size_t tl,
     return 0;
 }
 
+/* The refusal of field ts[0, tl) of line s..e, which did not read as a
+ * number (st: the parse's status): its separator's or decimal mark's
+ * when that is why (rd_sep_fail), else the number's. */
+static int rd_field_fail(const rd_ctx *c, size_t line, int st, const char *ts, size_t tl,
+                         const char *s, const char *e)
+{
+    int rs = st == NUM_SYNTAX ? rd_sep_fail(c, line, ts, tl, s, e) : 0;
+    return rs ? rs : fdt_rd_num_fail(c, line, "", st, ts, tl);
+}
+
 /* A decimal-comma field ts[0, tl) as a number: the one ',' read as '.'
  * (a '.' in it is refused: 1.000,5 has a thousands separator). */
 static int rd_parse_decimal_comma(const char *ts, size_t tl, double *v)
@@ -283,10 +293,8 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
                                            "fields (--decimal-comma --delimiter ';' or ' ')",
                                            L.lineno, fdt_rd_quote(q, ts, tl));
                     }
-                    if (st != NUM_OK) {
-                        int rs = st == NUM_SYNTAX ? rd_sep_fail(c, L.lineno, ts, tl, s, e) : 0;
-                        return rs ? rs : fdt_rd_num_fail(c, L.lineno, "", st, ts, tl);
-                    }
+                    if (st != NUM_OK)
+                        return rd_field_fail(c, L.lineno, st, ts, tl, s, e);
                 }
                 k++;
                 continue;
@@ -300,10 +308,8 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
             if (c->decimal_comma) {
                 fdt_rd_next_field(&f, &ts, &tl);
                 int st = rd_parse_decimal_comma(ts, tl, &v[which]);
-                if (st != NUM_OK) {
-                    int rs = st == NUM_SYNTAX ? rd_sep_fail(c, L.lineno, ts, tl, s, e) : 0;
-                    return rs ? rs : fdt_rd_num_fail(c, L.lineno, "", st, ts, tl);
-                }
+                if (st != NUM_OK)
+                    return rd_field_fail(c, L.lineno, st, ts, tl, s, e);
                 k++;
                 continue;
             }
@@ -317,8 +323,7 @@ static int rd_read_xyz_lines(const rd_ctx *c, const char *start, const char *end
                 st = fdt_rd_parse_real(ts, tl, &v[which], 1);
                 if (st == NUM_OK) /* cannot happen: the scan stopped early */
                     st = NUM_SYNTAX;
-                int rs = st == NUM_SYNTAX ? rd_sep_fail(c, L.lineno, ts, tl, s, e) : 0;
-                return rs ? rs : fdt_rd_num_fail(c, L.lineno, "", st, ts, tl);
+                return rd_field_fail(c, L.lineno, st, ts, tl, s, e);
             }
             if (st != NUM_OK)
                 return fdt_rd_num_fail(c, L.lineno, "", st, ts, used);
