@@ -144,6 +144,9 @@ typedef struct vjob {
      * memory as doubles (farea), half of it given back (owned) */
     size_t *adj_start;
     uint32_t *adj;
+    /* own point x's first entry above x that cell_pass has not yet copied
+     * to its upper neighbour, relative to its list's start (owned) */
+    uint32_t *up;
     union {
         fdt_fix *fsum;
         double *farea;
@@ -154,8 +157,8 @@ typedef struct vjob {
     uint32_t *order;     /* scratch: a cell's neighbours in cutting order */
     double *dist;        /* scratch: their squared distances */
     size_t cap_order;
-    uint32_t *nloc;      /* scratch: a row's neighbours' local points (neighbors_pass) */
-    size_t cap_nloc;
+    uint64_t *nkey;      /* scratch: a row's neighbours' keys (neighbors_pass) */
+    size_t cap_nkey;
     size_t *first;       /* cut cell lo + k: its faces from face[first[k]] */
     size_t nbucket, bbase; /* the tets whose key is in [lo, hi): how many; where
                               they start */
@@ -404,22 +407,24 @@ static int mine(const vjob *j, uint32_t x)
  * the tet came. Returns the orientation in that order (+1 or -1). */
 static inline int canon_tet(const double *X, const uint32_t *tv, uint32_t s[4], double q[4][3])
 {
-    int sigma = 1;
+    /* Each point's rank is the number of points before it, from the six
+     * comparisons, with no branch on their outcomes (an insertion sort's
+     * were a coin flip each: 5 % of the tet pass); the orientation's
+     * sign is the parity of the pairs out of order. */
+    const double *p[4];
     for (int m = 0; m < 4; m++)
-        s[m] = tv[m];
-    for (int x = 1; x < 4; x++)
-        for (int y = x; y > 0 && lex_after(X + 3 * (size_t)s[y - 1], X + 3 * (size_t)s[y]);
-             y--) {
-            uint32_t t = s[y];
-            s[y] = s[y - 1];
-            s[y - 1] = t;
-            sigma = -sigma;
-        }
+        p[m] = X + 3 * (size_t)tv[m];
+    int c01 = lex_after(p[0], p[1]), c02 = lex_after(p[0], p[2]), c03 = lex_after(p[0], p[3]);
+    int c12 = lex_after(p[1], p[2]), c13 = lex_after(p[1], p[3]), c23 = lex_after(p[2], p[3]);
+    s[c01 + c02 + c03] = tv[0];
+    s[1 - c01 + c12 + c13] = tv[1];
+    s[2 - c02 - c12 + c23] = tv[2];
+    s[3 - c03 - c13 - c23] = tv[3];
     const double *p0 = X + 3 * (size_t)s[0];
     q[0][0] = q[0][1] = q[0][2] = 0;
     for (int m = 1; m < 4; m++)
         sub3(X + 3 * (size_t)s[m], p0, q[m]);
-    return sigma;
+    return (c01 + c02 + c03 + c12 + c13 + c23) & 1 ? -1 : 1;
 }
 
 /* fdt_voronoi_resolution's refusal of points a and b (input ids, named
@@ -861,7 +866,8 @@ static int job_adjacency(vjob *j)
     size_t *ts = fdt_mem_alloc_huge(k + 1, sizeof *ts, 1);
     uint64_t *seen = calloc(w->m / 64 + 1, sizeof *seen);
     j->adj_start = fdt_mem_alloc_huge(k + 1, sizeof *j->adj_start, 0);
-    if (!ts || !seen || !j->adj_start) {
+    j->up = fdt_mem_alloc_huge(k ? k : 1, sizeof *j->up, 0);
+    if (!ts || !seen || !j->adj_start || !j->up) {
         free(ts);
         free(seen);
         return FDT_ENOMEM;
@@ -916,8 +922,12 @@ static int job_adjacency(vjob *j)
             }
         }
         seen[l / 64] = 0;
-        for (size_t e = b; e < o; e++)
+        size_t below = 0;
+        for (size_t e = b; e < o; e++) {
             seen[adj[e] / 64] = 0;
+            below += adj[e] < l;
+        }
+        j->up[x] = (uint32_t)below;
     }
     j->adj_start[k] = o;
     free(ts);
@@ -1024,13 +1034,20 @@ static void *cell_pass(void *arg)
     vwork *w = j->w;
     if (j->err)
         return NULL;
+    /* An own lower neighbour nb meets its upper neighbours l in
+     * ascending order, as they stand in its list: its entry for l is the
+     * next one above nb (j->up), no search. */
     for (uint32_t l = j->lo; l < j->hi; l++)
         for (size_t e = j->adj_start[l - j->lo]; e < j->adj_start[l - j->lo + 1]; e++) {
             uint32_t nb = j->adj[e];
             if (nb > l)
                 break; /* ascending */
-            const vjob *oj = owner(w, nb);
-            j->fsum[e] = oj->fsum[slot(oj, nb, l)];
+            if (mine(j, nb)) {
+                j->fsum[e] = j->fsum[j->adj_start[nb - j->lo] + j->up[nb - j->lo]++];
+            } else {
+                const vjob *oj = owner(w, nb);
+                j->fsum[e] = oj->fsum[slot(oj, nb, l)];
+            }
         }
     for (uint32_t l = j->lo; l < j->hi && !j->err; l++) {
         vcell *c = &w->cells[l];
@@ -1207,39 +1224,53 @@ static void *neighbors_pass(void *arg)
             continue;
         }
         double total = w->cells[l].area;
-        if (k > j->cap_nloc) {
-            uint32_t *q = realloc(j->nloc, k * sizeof *q);
+        if (k > j->cap_nkey) {
+            uint64_t *q = realloc(j->nkey, k * sizeof *q);
             if (!q) {
                 j->err = FDT_ENOMEM;
                 return NULL;
             }
-            j->nloc = q;
-            j->cap_nloc = k;
+            j->nkey = q;
+            j->cap_nkey = k;
         }
-        size_t m = 0;
-        for (size_t e = oj->adj_start[l - oj->lo]; e < oj->adj_start[l - oj->lo + 1]; e++) {
-            double ar = oj->farea[e];
-            if (!real_face(ar, total))
+        /* The real faces as keys, input id << 32 | entry, sorted: one
+         * 8-byte move an insertion step (a dozen entries, in local order,
+         * which is not the ids'), where moving the ids, areas and points
+         * apart took most of the pass. */
+        size_t e0 = oj->adj_start[l - oj->lo], e1 = oj->adj_start[l - oj->lo + 1], m = 0;
+        const uint32_t *nb = oj->adj + e0;
+        uint64_t *key = j->nkey;
+        for (size_t e = e0; e < e1; e++) {
+            if (!real_face(oj->farea[e], total))
                 continue;
-            uint32_t nb = oj->adj[e];
-            fdt_vid id = (fdt_vid)w->perm[nb];
-            ar *= f2;
-            /* ascending input ids (insertion, a dozen); two images of one
-             * point (a periodic set's) in their coordinates' order, not
-             * the numbering's, which differs from batch to batch */
+            uint64_t x = (uint64_t)w->perm[nb[e - e0]] << 32 | (e - e0);
             size_t y = m++;
-            for (; y > 0 && (v->nid[o + y - 1] > id ||
-                             (v->nid[o + y - 1] == id &&
-                              fdt_lex_compare(w->xyz + 3 * (size_t)j->nloc[y - 1],
-                                              w->xyz + 3 * (size_t)nb) > 0));
-                 y--) {
-                v->nid[o + y] = v->nid[o + y - 1];
-                v->narea[o + y] = v->narea[o + y - 1];
-                j->nloc[y] = j->nloc[y - 1];
+            for (; y > 0 && key[y - 1] > x; y--)
+                key[y] = key[y - 1];
+            key[y] = x;
+        }
+        /* Two images of one point (a periodic set's) in their
+         * coordinates' order, not the numbering's, which differs from
+         * batch to batch: runs of one id sorted again (rare). */
+        for (size_t a = 0, b; a < m; a = b) {
+            for (b = a + 1; b < m && key[b] >> 32 == key[a] >> 32; b++)
+                ;
+            for (size_t x = a + 1; x < b; x++) {
+                uint64_t kx = key[x];
+                const double *px = w->xyz + 3 * (size_t)nb[(uint32_t)kx];
+                size_t y = x;
+                for (; y > a; y--) {
+                    const double *py = w->xyz + 3 * (size_t)nb[(uint32_t)key[y - 1]];
+                    if (fdt_lex_compare(py, px) <= 0)
+                        break;
+                    key[y] = key[y - 1];
+                }
+                key[y] = kx;
             }
-            v->nid[o + y] = id;
-            v->narea[o + y] = ar;
-            j->nloc[y] = nb;
+        }
+        for (size_t f = 0; f < m; f++) {
+            v->nid[o + f] = (fdt_vid)(key[f] >> 32);
+            v->narea[o + f] = oj->farea[e0 + (uint32_t)key[f]] * f2;
         }
     }
     return NULL;
@@ -1573,9 +1604,10 @@ static int cells_run(vwork *w, fdt_voronoi *v, int threads, int neighbors, fdt_v
         free(jobs[t].face);
         free(jobs[t].order);
         free(jobs[t].dist);
-        free(jobs[t].nloc);
+        free(jobs[t].nkey);
         free(jobs[t].first);
         free(jobs[t].adj_start);
+        free(jobs[t].up);
         free(jobs[t].adj);
         free(jobs[t].fsum);
     }
