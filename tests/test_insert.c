@@ -696,6 +696,57 @@ static void test_set(pts p, int extra)
     free(p.xyz);
 }
 
+/* ---- the hull walk ---------------------------------------------------- */
+
+/*
+ * Points of a surface lie outside the hull of those before them, and on
+ * some the visibility walk between neighbours crosses hundreds of long
+ * tets: every integer point of one sphere (140 a point). The build then
+ * locates by the hull walk (src/mesh/insert.c, hull_walk). Each mesh is
+ * checked by fdt_check and by its structure, and the points shuffled
+ * (other walks, other starts) give the same tets; on the integer sphere
+ * the hull walk must have run, and the walks must stay short.
+ */
+static void test_hull_walk(const char *gen)
+{
+    static const char *fams[] = {"intsphere", "sphere", "cylscan", "cone"};
+    for (size_t f = 0; f < sizeof fams / sizeof fams[0]; f++) {
+        pts p = gen_family(gen, fams[f], 12000, 2);
+        prepped pp;
+        prep(&p, &pp);
+        fdt_ins m, m2;
+        CHECK_EQ(fdt_ins_build(&m, pp.pr.p, 0, pp.m, NULL), FDT_OK);
+        check_structure(&m, fams[f]);
+        check_independent(&m, fams[f]);
+        double walk = (double)m.stats.walk_steps / (double)pp.m;
+        printf("hull walk %-10s %6u points  %zu hull walks  walk %.1f\n", fams[f], pp.m,
+               m.stats.hull_walks, walk);
+        if (f == 0) {
+            CHECK(m.stats.hull_walks > pp.m / 2);
+            CHECK(walk < 40); /* 16 and a few; 140 without the hull walk */
+        }
+        /* reversed order: every walk another */
+        double *Q = malloc((size_t)pp.m * 3 * sizeof *Q);
+        uint32_t *perm = malloc((size_t)pp.m * sizeof *perm);
+        CHECK(Q && perm);
+        for (uint32_t i = 0; i < pp.m; i++) {
+            perm[i] = pp.m - 1 - i;
+            memcpy(Q + 3 * (size_t)i, pp.pr.p + 3 * (size_t)perm[i], 3 * sizeof *Q);
+        }
+        CHECK_EQ(fdt_ins_build(&m2, Q, 0, pp.m, NULL), FDT_OK);
+        meshset a = kernel_mesh(&m, NULL), b = kernel_mesh(&m2, perm);
+        same_mesh(&a, &b, fams[f]);
+        meshset_free(&a);
+        meshset_free(&b);
+        fdt_ins_free(&m);
+        fdt_ins_free(&m2);
+        free(Q);
+        free(perm);
+        prep_free(&pp);
+        free(p.xyz);
+    }
+}
+
 /* ---- the tets array's size ----------------------------------------------- */
 
 /*
@@ -1215,6 +1266,7 @@ int main(int argc, char **argv)
     test_star_edges();
     test_star_links();
     test_slot_sizing(gen);
+    test_hull_walk(gen);
 
     /* Every family of gen_points; sizes keep the reference (the front,
      * quadratic on cospherical sets) within a few seconds. */

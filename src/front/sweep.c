@@ -197,6 +197,7 @@ static void add_ins_stats(fdt_ins_stats *a, const fdt_ins_stats *b)
 {
     a->inserted += b->inserted;
     a->walk_steps += b->walk_steps;
+    a->hull_walks += b->hull_walks;
     a->cavity_tets += b->cavity_tets;
     a->created_tets += b->created_tets;
     if (b->max_cavity > a->max_cavity)

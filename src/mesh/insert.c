@@ -83,6 +83,11 @@ typedef struct build {
     ins_local local;               /* links small stars (ins_make_star) */
     ins_edges edges;               /* links the others */
     uint64_t rng;                  /* the walk's choices */
+    int outside;                   /* the last point lay outside the hull
+                                      (its cavity began at an infinite tet) */
+    int has_o;                     /* the hull walk's o: 0 not yet, 1 set,
+                                      -1 none (hull_origin) */
+    double o[3];
 } build;
 
 /* ------------------------------------------------------------------ */
@@ -160,13 +165,17 @@ static inline void free_slot(build *b, uint32_t t)
 /* ------------------------------------------------------------------ */
 /* Insertion. */
 
+/* walk's return when it stopped at its budget of steps (*out: where) */
+#define WALK_LONG 1
+
 /* The walk (see the top) from `start` to the tet holding p, or to the
- * infinite tet over a hull face p is strictly outside. rng: the walk's
+ * infinite tet over a hull face p is strictly outside, in at most budget
+ * steps (SIZE_MAX: no bound; else WALK_LONG at the bound). rng: the walk's
  * pseudo-random choices (the caller's); steps counts the tets crossed
  * (may be NULL). Reads m only, so other threads may walk a built mesh. */
 static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng,
-                const fdt_pred_static *sf, fdt_pred_counts *cnt, size_t *steps_out,
-                uint32_t *out)
+                const fdt_pred_static *sf, fdt_pred_counts *cnt, size_t budget,
+                size_t *steps_out, uint32_t *out)
 {
     const uint32_t *T = m->T;
     uint32_t t = start;
@@ -177,9 +186,14 @@ static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng
         }
     int from = -1;
     size_t steps = 0;
+    int err = FDT_OK;
     for (;; steps++) {
         if (steps > m->nslots)
             return FDT_EINTERNAL; /* a cycle: impossible in a regular triangulation */
+        if (steps == budget) {
+            err = WALK_LONG;
+            break;
+        }
         const uint32_t *v = T + 8 * (size_t)t;
         if (ins_is_infinite(v))
             break;
@@ -193,13 +207,14 @@ static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng
     if (steps_out)
         *steps_out += steps;
     *out = t;
-    return FDT_OK;
+    return err;
 }
 
 /* The tet where the build's walk for p from `start` ends. */
 static int locate(build *b, const double *p, uint32_t start, uint32_t *out)
 {
-    return walk(b->m, p, start, &b->rng, &b->m->sf, b->cnt, &b->m->stats.walk_steps, out);
+    return walk(b->m, p, start, &b->rng, &b->m->sf, b->cnt, SIZE_MAX, &b->m->stats.walk_steps,
+                out);
 }
 
 /* Whether tet t is in conflict with p (see the top for infinite tets). */
@@ -209,14 +224,141 @@ static inline int conflict(build *b, uint32_t t, const double *p)
     return ins_conflict(b->m, t, p, &b->m->sf, b->cnt);
 }
 
+/*
+ * The hull walk: where a point outside the hull starts its cavity when
+ * the last point lay outside too (every point of a sphere, a cylinder).
+ * The visibility walk from the last star to such a point crosses the long
+ * tets through the body: every integer point of one sphere (tests/
+ * gen_points intsphere) walked 140 tets a point. Seen from a point o
+ * strictly inside the hull (a finite tet's centroid: the hull only
+ * grows), the hull faces' cones partition space; this walk crosses from
+ * hull face to hull face (infinite tet to infinite tet, across the faces
+ * that hold the infinite vertex) by the planes through o and each hull
+ * edge, to the face whose cone holds p. If p is strictly outside that
+ * face, its infinite tet is in conflict, as a walk's end is; otherwise
+ * (p inside the hull there, or on a plane) the visibility walk starts
+ * from the finite tet under it, near p. A step bound ends a walk that
+ * meets a cycle of ties the same way. Builds with periodic images never
+ * take it (their predicates read only the images' own points).
+ */
+#define HULL_WALK_STEPS 4096
+/* The steps of the visibility walk before an outside point takes the
+ * hull walk. */
+#define HULL_AFTER 16
+
+/* o: the centroid of a finite tet t, checked strictly inside it (exact
+ * predicates); 0 if it is not (a flat tet). */
+static int hull_origin(build *b, uint32_t t)
+{
+    fdt_ins *m = b->m;
+    const uint32_t *v = m->T + 8 * (size_t)t;
+    for (int k = 0; k < 3; k++)
+        b->o[k] = 0.25 * (ins_pt(m, v[0])[k] + ins_pt(m, v[1])[k] + ins_pt(m, v[2])[k] +
+                          ins_pt(m, v[3])[k]);
+    for (int k = 0; k < 4; k++) {
+        const double *q[4] = {ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3])};
+        q[k] = b->o;
+        if (ins_orient(q[0], q[1], q[2], q[3], &m->sf, b->cnt) <= 0)
+            return 0;
+    }
+    return 1;
+}
+
+/* The hull walk from the last star's infinite tets to p: the tet the
+ * cavity or the visibility walk starts from (*t0), and whether it is
+ * the cavity's start (1) or the walk's (0). */
+__attribute__((noinline, cold)) static int hull_walk(build *b, const double *p, uint32_t *t0)
+{
+    fdt_ins *m = b->m;
+    const uint32_t *T = m->T;
+    /* the last star's hull faces first: in cache, and p, next to the
+     * last point, is often outside one of them */
+    uint32_t t = FDT_NONE;
+    int inf = -1;
+    for (size_t i = 0; i < b->nbnd; i++) {
+        const uint32_t *w = T + 8 * (size_t)b->newt[i];
+        if (!ins_is_infinite(w))
+            continue;
+        t = b->newt[i];
+        if (ins_conflict_local(m, w, p, &m->sf, b->cnt, &inf) == 1) {
+            *t0 = t;
+            return 1;
+        }
+    }
+    if (t == FDT_NONE)
+        return 0;
+    const uint32_t *v = T + 8 * (size_t)t;
+    inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : 3;
+    if (b->has_o == 0)
+        b->has_o = hull_origin(b, v[4 + inf] >> 2) ? 1 : -1;
+    if (b->has_o < 0) {
+        *t0 = t;
+        return 0;
+    }
+    int from = -1;
+    for (int steps = 0; steps < HULL_WALK_STEPS; steps++) {
+        v = T + 8 * (size_t)t;
+        inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : 3;
+        /* the tet's finite vertices with o for the infinite one: o is
+         * below the hull face, so the tuple is negative; p past the
+         * plane through o and the edge opposite k makes it positive */
+        const double *q[4];
+        for (int i = 0; i < 4; i++)
+            q[i] = i == inf ? b->o : ins_pt(m, v[i]);
+        b->rng = b->rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
+        uint32_t r = (uint32_t)(b->rng >> 61);
+        int exit = -1;
+        for (uint32_t j = 0; j < 4 && exit < 0; j++) {
+            int k = (int)((r + j) & 3);
+            if (k == inf || k == from)
+                continue;
+            const double *s4[4] = {q[0], q[1], q[2], q[3]};
+            s4[k] = p;
+            if (ins_orient(s4[0], s4[1], s4[2], s4[3], &m->sf, b->cnt) > 0)
+                exit = k;
+        }
+        if (exit < 0)
+            break;
+        uint32_t nb = v[4 + exit];
+        t = nb >> 2;
+        from = (int)(nb & 3);
+    }
+    v = T + 8 * (size_t)t;
+    int dummy = -1;
+    if (ins_conflict_local(m, v, p, &m->sf, b->cnt, &dummy) == 1) {
+        *t0 = t;
+        return 1;
+    }
+    inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : 3;
+    *t0 = v[4 + inf] >> 2;
+    return 0;
+}
+
+/* The tet where p's cavity starts: the walk from the last star, and
+ * where the last point lay outside the hull and this walk grows long,
+ * the hull walk (most of a surface's points never need it: a sphere's
+ * random points walk 8 tets, its integer points 140). */
+static int locate_from(build *b, const double *p, uint32_t start, uint32_t *t0)
+{
+    fdt_ins *m = b->m;
+    int surface = b->outside && !m->sf.img;
+    int err = walk(m, p, start, &b->rng, &m->sf, b->cnt, surface ? HULL_AFTER : SIZE_MAX,
+                   &m->stats.walk_steps, t0);
+    if (err != WALK_LONG)
+        return err;
+    m->stats.hull_walks++;
+    return hull_walk(b, p, t0) ? FDT_OK : locate(b, p, *t0, t0);
+}
+
 static int insert_point(build *b, uint32_t pid, uint32_t *last)
 {
     fdt_ins *m = b->m;
     const double *p = ins_pt(m, pid);
     uint32_t t0;
-    int err = locate(b, p, *last, &t0);
+    int err = locate_from(b, p, *last, &t0);
     if (err)
         return err;
+    b->outside = ins_is_infinite(m->T + 8 * (size_t)t0);
     const uint32_t *v0 = m->T + 8 * (size_t)t0;
     /* A point equal to a vertex lies in the closed tet of that vertex only,
      * so the walk ends in a tet that has it: refuse rather than break the
@@ -888,7 +1030,7 @@ int fdt_ins_conflict_vertices(const fdt_ins *m, const double *q, uint32_t *hint,
     }
     fdt_pred_static sf;
     fdt_pred_static_init(&sf, lo, hi);
-    int err = walk(m, q, t, &qs->rng, &sf, cnt, NULL, &t);
+    int err = walk(m, q, t, &qs->rng, &sf, cnt, SIZE_MAX, NULL, &t);
     if (err)
         return err;
     *hint = t;
