@@ -88,6 +88,7 @@ typedef struct build {
     int has_o;                     /* the hull walk's o: 0 not yet, 1 set,
                                       -1 none (hull_origin) */
     double o[3];
+    uint32_t hull_tries, hull_capped; /* hull walks, and those that gave up */
 } build;
 
 /* ------------------------------------------------------------------ */
@@ -237,14 +238,20 @@ static inline int conflict(build *b, uint32_t t, const double *p)
  * edge, to the face whose cone holds p. If p is strictly outside that
  * face, its infinite tet is in conflict, as a walk's end is; otherwise
  * (p inside the hull there, or on a plane) the visibility walk starts
- * from the finite tet under it, near p. A step bound ends a walk that
- * meets a cycle of ties the same way. Builds with periodic images never
+ * from the finite tet under it, near p. A hull walk past HULL_WALK_STEPS
+ * steps (a cycle of ties, or sliver faces) gives up, and the visibility
+ * walk goes on from where it stopped. Builds with periodic images never
  * take it (their predicates read only the images' own points).
  */
-#define HULL_WALK_STEPS 4096
+#define HULL_WALK_STEPS 64
 /* The steps of the visibility walk before an outside point takes the
  * hull walk. */
 #define HULL_AFTER 16
+/* The hull walks after which the build stops taking them when more than
+ * a quarter gave up (a pipe's scan: the hull faces are long slivers, a
+ * hull walk crossed 92 of them where the visibility walk crosses 35
+ * tets): a function of the input, the same on every run. */
+#define HULL_TRIAL 64
 
 /* o: the centroid of a finite tet t, checked strictly inside it (exact
  * predicates); 0 if it is not (a flat tet). */
@@ -264,9 +271,10 @@ static int hull_origin(build *b, uint32_t t)
     return 1;
 }
 
-/* The hull walk from the last star's infinite tets to p: the tet the
- * cavity or the visibility walk starts from (*t0), and whether it is
- * the cavity's start (1) or the walk's (0). */
+/* The hull walk from the last star's infinite tets to p: 1 with the
+ * cavity's start in *t0, 0 with a tet near p for the visibility walk to
+ * start from, or -1 (*t0 unchanged) when it gave up: no hull face in the
+ * last star, no o, or HULL_WALK_STEPS steps. */
 __attribute__((noinline, cold)) static int hull_walk(build *b, const double *p, uint32_t *t0)
 {
     fdt_ins *m = b->m;
@@ -286,17 +294,17 @@ __attribute__((noinline, cold)) static int hull_walk(build *b, const double *p, 
         }
     }
     if (t == FDT_NONE)
-        return 0;
+        return -1;
     const uint32_t *v = T + 8 * (size_t)t;
     inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : 3;
     if (b->has_o == 0)
         b->has_o = hull_origin(b, v[4 + inf] >> 2) ? 1 : -1;
-    if (b->has_o < 0) {
-        *t0 = t;
-        return 0;
-    }
-    int from = -1;
-    for (int steps = 0; steps < HULL_WALK_STEPS; steps++) {
+    if (b->has_o < 0)
+        return -1;
+    int from = -1, steps = 0;
+    for (;; steps++) {
+        if (steps == HULL_WALK_STEPS)
+            return -1;
         v = T + 8 * (size_t)t;
         inf = v[0] == INF ? 0 : v[1] == INF ? 1 : v[2] == INF ? 2 : 3;
         /* the tet's finite vertices with o for the infinite one: o is
@@ -341,13 +349,17 @@ __attribute__((noinline, cold)) static int hull_walk(build *b, const double *p, 
 static int locate_from(build *b, const double *p, uint32_t start, uint32_t *t0)
 {
     fdt_ins *m = b->m;
-    int surface = b->outside && !m->sf.img;
+    int surface = b->outside && !m->sf.img &&
+                  !(b->hull_tries >= HULL_TRIAL && 4 * b->hull_capped > b->hull_tries);
     int err = walk(m, p, start, &b->rng, &m->sf, b->cnt, surface ? HULL_AFTER : SIZE_MAX,
                    &m->stats.walk_steps, t0);
     if (err != WALK_LONG)
         return err;
     m->stats.hull_walks++;
-    return hull_walk(b, p, t0) ? FDT_OK : locate(b, p, *t0, t0);
+    int got = hull_walk(b, p, t0);
+    b->hull_tries++;
+    b->hull_capped += got < 0;
+    return got == 1 ? FDT_OK : locate(b, p, *t0, t0);
 }
 
 static int insert_point(build *b, uint32_t pid, uint32_t *last)
