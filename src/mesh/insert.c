@@ -254,14 +254,16 @@ static inline int conflict(build *b, uint32_t t, const double *p)
 #define HULL_TRIAL 64
 
 /* o: the centroid of a finite tet t, checked strictly inside it (exact
- * predicates); 0 if it is not (a flat tet). */
+ * predicates); 0 if it is not (a flat tet, or one so small that the
+ * quarters underflow). Each coordinate is quartered before the sum, which
+ * then stays finite for any finite points. */
 static int hull_origin(build *b, uint32_t t)
 {
     fdt_ins *m = b->m;
     const uint32_t *v = m->T + 8 * (size_t)t;
     for (int k = 0; k < 3; k++)
-        b->o[k] = 0.25 * (ins_pt(m, v[0])[k] + ins_pt(m, v[1])[k] + ins_pt(m, v[2])[k] +
-                          ins_pt(m, v[3])[k]);
+        b->o[k] = 0.25 * ins_pt(m, v[0])[k] + 0.25 * ins_pt(m, v[1])[k] +
+                  0.25 * ins_pt(m, v[2])[k] + 0.25 * ins_pt(m, v[3])[k];
     for (int k = 0; k < 4; k++) {
         const double *q[4] = {ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3])};
         q[k] = b->o;
