@@ -1095,6 +1095,11 @@ int fdt_periodic_renumber(fdt_periodic_mesh *m, const int32_t *orig, size_t n)
     for (size_t i = 1; i < n; i++)
         if (orig[i] <= orig[i - 1])
             return FDT_EINTERNAL;
+    /* n increasing ids from 0 that end at n - 1 are 0 .. n - 1: no
+     * duplicate was merged, and the rows are in input ids already (a
+     * pass of random reads over every tet's vertices less) */
+    if (n == 0 || (orig[0] == 0 && (size_t)orig[n - 1] == n - 1))
+        return FDT_OK;
     for (size_t i = 0; i < 4 * m->ntets; i++)
         m->tets[i] = (uint32_t)orig[m->tets[i]];
     for (size_t i = 0; i < 3 * m->nhull; i++)
