@@ -63,6 +63,31 @@ static int tables_fit(const char *fmt, int csv, int density, const fdt_voronoi *
     return !(missing & ~fdt_cells_table_skip(fmt, csv, density));
 }
 
+/* What a table's rows read, fetched from v once a range rather than a
+ * call a code of every row. */
+typedef struct cells_view {
+    const fdt_voronoi *v;
+    const fdt_vid *ids;  /* a streamed batch's rows' input ids, or NULL: row i is point i */
+    const double *pts;   /* the rows' points: the batch's, else xyz (NULL: no code reads them) */
+    const double *vol, *area, *cen, *dens; /* cen, dens NULL where skipped */
+    const int32_t *nfaces;
+    const uint8_t *flags;
+} cells_view;
+
+static cells_view view_of(const fdt_voronoi *v, const double *xyz)
+{
+    cells_view c = {v,
+                    fdt_voronoi_ids(v),
+                    fdt_voronoi_ids(v) ? fdt_voronoi_points(v) : xyz,
+                    fdt_voronoi_volumes(v),
+                    fdt_voronoi_areas(v),
+                    fdt_voronoi_centroids(v),
+                    fdt_voronoi_densities(v),
+                    fdt_voronoi_num_faces(v),
+                    fdt_voronoi_flags(v)};
+    return c;
+}
+
 /* Point i's neighbours (%n) or face areas (%f), separated by blanks. */
 static void list(out_file *o, const fdt_voronoi *v, size_t i, int areas)
 {
@@ -91,36 +116,30 @@ static void three(out_file *o, const double *x, char sep)
     }
 }
 
-static void code(out_file *o, char c, const fdt_voronoi *v, const double *xyz, size_t i,
-                 char sep)
+static void code(out_file *o, char c, const cells_view *cv, size_t i, char sep)
 {
-    /* a streamed batch's rows name their points and carry them */
-    const fdt_vid *ids = fdt_voronoi_ids(v);
-    const double *p = ids  ? fdt_voronoi_points(v) + 3 * i
-                      : xyz ? xyz + 3 * i
-                            : NULL; /* NULL: no code reads it */
-    const double *cen = fdt_voronoi_centroids(v); /* NULL: no code reads it */
-    int merged = (fdt_voronoi_flags(v)[i] & FDT_CELL_MERGED) != 0;
+    const double *p = cv->pts ? cv->pts + 3 * i : NULL; /* NULL: no code reads it */
+    int merged = (cv->flags[i] & FDT_CELL_MERGED) != 0;
     double rel[3];
     switch (c) {
-    case 'i': out_i64(o, ids ? (int64_t)ids[i] : (int64_t)i); break;
+    case 'i': out_i64(o, cv->ids ? (int64_t)cv->ids[i] : (int64_t)i); break;
     case 'x': out_double(o, p[0]); break;
     case 'y': out_double(o, p[1]); break;
     case 'z': out_double(o, p[2]); break;
     case 'q': three(o, p, sep); break;
-    case 'v': out_double(o, fdt_voronoi_volumes(v)[i]); break;
-    case 'F': out_double(o, fdt_voronoi_areas(v)[i]); break;
-    case 's': out_i64(o, fdt_voronoi_num_faces(v)[i]); break;
-    case 'n': list(o, v, i, 0); break;
-    case 'f': list(o, v, i, 1); break;
+    case 'v': out_double(o, cv->vol[i]); break;
+    case 'F': out_double(o, cv->area[i]); break;
+    case 's': out_i64(o, cv->nfaces[i]); break;
+    case 'n': list(o, cv->v, i, 0); break;
+    case 'f': list(o, cv->v, i, 1); break;
     case 'c':
         for (int k = 0; k < 3; k++)
-            rel[k] = merged ? 0 : cen[3 * i + k] - p[k];
+            rel[k] = merged ? 0 : cv->cen[3 * i + k] - p[k];
         three(o, rel, sep);
         break;
-    case 'C': three(o, merged ? p : cen + 3 * i, sep); break;
-    case 'd': out_double(o, fdt_voronoi_densities(v)[i]); break;
-    case 'h': out_i64(o, fdt_voronoi_flags(v)[i]); break;
+    case 'C': three(o, merged ? p : cv->cen + 3 * i, sep); break;
+    case 'd': out_double(o, cv->dens[i]); break;
+    case 'h': out_i64(o, cv->flags[i]); break;
     default: out_char(o, '%'); break;
     }
 }
@@ -148,16 +167,17 @@ static int close_out(out_file *o)
 static void put_range(out_file *o, const char *fmt, const fdt_voronoi *v, const double *xyz,
                       int csv, size_t lo, size_t hi)
 {
+    const cells_view cv = view_of(v, xyz);
     for (size_t i = lo; i < hi && !o->err; i++) {
         for (const char *p = fmt; *p; p++) {
             if (csv && p != fmt)
                 out_char(o, ',');
             if (csv)
-                code(o, *p, v, xyz, i, ',');
+                code(o, *p, &cv, i, ',');
             else if (*p != '%')
                 out_char(o, *p);
             else
-                code(o, *++p, v, xyz, i, ' ');
+                code(o, *++p, &cv, i, ' ');
         }
         out_char(o, '\n');
     }
