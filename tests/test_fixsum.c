@@ -147,9 +147,38 @@ static void test_sums(void)
     mpz_clear(v);
 }
 
+/* fdt_fix_value's low word, converted as two 32-bit halves, against the
+ * compiler's rounding of the whole unsigned word: the same double for
+ * every sum, of either sign, whatever its low word's top bits (the
+ * halves' sum rounds once, as the conversion does). */
+static void test_values(void)
+{
+    fdt_fix_grid grid = fdt_fix_grid_of(0);
+    for (int i = 0; i < 1000000; i++) {
+        fdt_fix a = {next(), (int64_t)(next() >> (2 + next() % 62))};
+        if (i % 3 == 0)
+            a.lo &= UINT64_C(0xffffffff) << (next() % 33); /* low halves of zeros */
+        if (next() & 1) { /* negative: two's complement */
+            a.lo = ~a.lo + 1;
+            a.hi = (int64_t)(~(uint64_t)a.hi + (a.lo == 0));
+        }
+        fdt_fix m = a;
+        int neg = m.hi < 0;
+        if (neg) {
+            m.lo = ~m.lo + 1;
+            m.hi = (int64_t)(~(uint64_t)m.hi + (m.lo == 0));
+        }
+        double want = (double)(uint64_t)m.hi * 0x1p64 + (double)m.lo;
+        want = neg ? -want : want;
+        double got = fdt_fix_value(a, grid);
+        EXPECTF(memcmp(&got, &want, sizeof got) == 0, "value %d: %.17g, not %.17g", i, got, want);
+    }
+}
+
 int main(void)
 {
     test_terms();
     test_sums();
+    test_values();
     return test_report("fixsum");
 }
