@@ -134,28 +134,41 @@ static inline uint64_t ins_slots_wanted(const fdt_ins *m, uint32_t done, uint32_
 }
 
 /*
+ * One step's choice of a walk in a tet of points q: the faces are tried
+ * from a pseudo-random one on (*rng, a 64-bit LCG, advances once), those
+ * whose bit is set in `skip` left out. Returns the first face k whose
+ * orientation, p put in place of q[k], has the sign `sign`, or -1 when
+ * none has.
+ */
+static inline int ins_walk_choose(const double *const q[4], const double *p, unsigned skip,
+                                  int sign, uint64_t *rng, const fdt_pred_static *sf,
+                                  fdt_pred_counts *cnt)
+{
+    *rng = *rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
+    uint32_t r = (uint32_t)(*rng >> 61);
+    for (uint32_t j = 0; j < 4; j++) {
+        int k = (int)((r + j) & 3);
+        if (skip >> k & 1)
+            continue;
+        const double *s[4] = {q[0], q[1], q[2], q[3]};
+        s[k] = p;
+        if (ins_orient(s[0], s[1], s[2], s[3], sf, cnt) * sign > 0)
+            return k;
+    }
+    return -1;
+}
+
+/*
  * One step of the visibility walk (src/mesh/insert.c's walk) in the finite
- * tet v (its four vertex ids): the faces are tried from a pseudo-random
- * one on (*rng, a 64-bit LCG, advances once), skipping `from`, the face
- * the walk came in by (-1: none). Returns the first face whose plane has p
- * strictly on its far side, or -1 when p is in the closed tet.
+ * tet v (its four vertex ids), skipping `from`, the face the walk came in
+ * by (-1: none): the first face (ins_walk_choose's order) whose plane has
+ * p strictly on its far side, or -1 when p is in the closed tet.
  */
 static inline int ins_walk_exit(const fdt_ins *m, const uint32_t *v, const double *p, int from,
                                 uint64_t *rng, const fdt_pred_static *sf, fdt_pred_counts *cnt)
 {
     const double *q[4] = {ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3])};
-    *rng = *rng * UINT64_C(6364136223846793005) + UINT64_C(1442695040888963407);
-    uint32_t r = (uint32_t)(*rng >> 61);
-    for (uint32_t j = 0; j < 4; j++) {
-        int k = (int)((r + j) & 3);
-        if (k == from)
-            continue;
-        const double *s[4] = {q[0], q[1], q[2], q[3]};
-        s[k] = p;
-        if (ins_orient(s[0], s[1], s[2], s[3], sf, cnt) < 0)
-            return k;
-    }
-    return -1;
+    return ins_walk_choose(q, p, from >= 0 ? 1u << from : 0, -1, rng, sf, cnt);
 }
 
 /* Whether p equals one of the finite vertices of tet v (the walk ends in

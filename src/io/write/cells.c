@@ -76,9 +76,10 @@ typedef struct cells_view {
 
 static cells_view view_of(const fdt_voronoi *v, const double *xyz)
 {
+    const fdt_vid *ids = fdt_voronoi_ids(v);
     cells_view c = {v,
-                    fdt_voronoi_ids(v),
-                    fdt_voronoi_ids(v) ? fdt_voronoi_points(v) : xyz,
+                    ids,
+                    ids ? fdt_voronoi_points(v) : xyz,
                     fdt_voronoi_volumes(v),
                     fdt_voronoi_areas(v),
                     fdt_voronoi_centroids(v),
