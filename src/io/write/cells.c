@@ -597,8 +597,8 @@ int fdt_wr_cells_vtu(FILE *f, fdt_voronoi *v, const double *xyz)
             "        <DataArray type=\"UInt8\" Name=\"types\"",
             "        <DataArray type=\"Int64\" Name=\"faces\"",
             "        <DataArray type=\"Int64\" Name=\"faceoffsets\"",
-            "</Cells>\n      <CellData Scalars=\"volume\">\n"
-            "        <DataArray type=\"Float64\" Name=\"volume\"",
+            ("</Cells>\n      <CellData Scalars=\"volume\">\n" /* one element, two lines */
+             "        <DataArray type=\"Float64\" Name=\"volume\""),
             "        <DataArray type=\"Int64\" Name=\"point\"",
         };
         uint16_t one = 1;
