@@ -368,7 +368,7 @@ static void refine(const double *pts, uint64_t *a, uint64_t *tmp, size_t n, layo
 static uint64_t *sorted_records(const double *pts, size_t n, const double box[6],
                                 const uint8_t *skip, layout l, size_t *m, uint64_t **block)
 {
-    uint64_t *r = malloc(2 * (n ? n : 1) * sizeof *r);
+    uint64_t *r = fdt_mem_alloc_huge(2 * (n ? n : 1), sizeof *r, 0);
     *block = r;
     if (!r)
         return NULL;

@@ -86,6 +86,13 @@ static int ext_grow(ext *e, size_t need)
         e->vk = vk;
     if (!P || !src || !off || !ex || !vk)
         return FDT_ENOMEM;
+    /* written at once, every page: huge pages (a 4 KB fault is a trap on
+     * some hosts, src/base/mem.h) */
+    fdt_mem_advise_huge(e->P, cap * 3 * sizeof *e->P);
+    fdt_mem_advise_huge(e->src, cap * sizeof *e->src);
+    fdt_mem_advise_huge(e->off, cap * 3 * sizeof *e->off);
+    fdt_mem_advise_huge(e->exact, cap);
+    fdt_mem_advise_huge(e->vk, cap * sizeof *e->vk);
     e->cap = (uint32_t)cap;
     return FDT_OK;
 }
@@ -185,10 +192,6 @@ static int morton(ext *e, uint32_t n, double blo[3], double bhi[3])
         ext_free(&s);
         return FDT_ENOMEM;
     }
-    /* the insertion and the proofs read them all over, as the plain
-     * engine's points (src/base/mem.h) */
-    fdt_mem_advise_huge(s.P, (size_t)e->n * 3 * sizeof *s.P);
-    fdt_mem_advise_huge(s.vk, (size_t)e->n * sizeof *s.vk);
     for (uint32_t i = 0; i < e->n; i++) {
         uint32_t j = i < n ? order[i] : n + order[i];
         memcpy(s.P + 3 * (size_t)i, e->P + 3 * (size_t)j, 3 * sizeof(double));
