@@ -1028,10 +1028,41 @@ static void test_parallel_many_threads(const char *gen)
     free(p.xyz);
 }
 
+/* The workers take the hull walk too (src/mesh/insert_par.c,
+ * hull_walk_locked): on the integer points of a sphere, where every point
+ * lies outside the hull before it, most points are located by it, and
+ * the tets are the serial build's. */
+static void test_parallel_hull_walk(const char *gen)
+{
+    pts p = gen_family(gen, "intsphere", 12000, 2);
+    prepped pp;
+    prep(&p, &pp);
+    meshset ref = serial_reference(&pp);
+    static const int threads[] = {2, 3, 5};
+    for (size_t ti = 0; ti < sizeof threads / sizeof threads[0]; ti++) {
+        fdt_ins m;
+        CHECK_EQ(fdt_ins_build_parallel(&m, pp.pr.p, 0, pp.m, threads[ti], NULL), FDT_OK);
+        char nm[64];
+        snprintf(nm, sizeof nm, "intsphere parallel hull walk t%d", threads[ti]);
+        meshset got = kernel_mesh(&m, NULL);
+        same_mesh(&got, &ref, nm);
+        check_structure(&m, nm);
+        printf("%s: %u points, %zu hull walks, %zu deferred\n", nm, pp.m, m.stats.hull_walks,
+               m.stats.deferred);
+        CHECK(m.stats.hull_walks > pp.m / 4); /* the serial start has 1/128 of them */
+        meshset_free(&got);
+        fdt_ins_free(&m);
+    }
+    meshset_free(&ref);
+    prep_free(&pp);
+    free(p.xyz);
+}
+
 static void run_parallel(const char *gen)
 {
     test_parallel_refusals(gen);
     test_parallel_many_threads(gen);
+    test_parallel_hull_walk(gen);
     static const struct {
         const char *fam;
         size_t n;

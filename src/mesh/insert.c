@@ -83,12 +83,7 @@ typedef struct build {
     ins_local local;               /* links small stars (ins_make_star) */
     ins_edges edges;               /* links the others */
     uint64_t rng;                  /* the walk's choices */
-    int outside;                   /* the last point lay outside the hull
-                                      (its cavity began at an infinite tet) */
-    int has_o;                     /* the hull walk's o: 0 not yet, 1 set,
-                                      -1 none (hull_origin) */
-    double o[3];
-    uint32_t hull_tries, hull_capped; /* hull walks, and those that gave up */
+    ins_hull hull;                 /* the hull walks (insert_impl.h) */
 } build;
 
 /* ------------------------------------------------------------------ */
@@ -191,13 +186,13 @@ static int walk(const fdt_ins *m, const double *p, uint32_t start, uint64_t *rng
     for (;; steps++) {
         if (steps > m->nslots)
             return FDT_EINTERNAL; /* a cycle: impossible in a regular triangulation */
+        const uint32_t *v = T + 8 * (size_t)t;
+        if (ins_is_infinite(v))
+            break; /* located: at any step, the budget's last too */
         if (steps == budget) {
             err = WALK_LONG;
             break;
         }
-        const uint32_t *v = T + 8 * (size_t)t;
-        if (ins_is_infinite(v))
-            break;
         int exit = ins_walk_exit(m, v, p, from, rng, sf, cnt);
         if (exit < 0)
             break;
@@ -225,63 +220,17 @@ static inline int conflict(build *b, uint32_t t, const double *p)
     return ins_conflict(b->m, t, p, &b->m->sf, b->cnt);
 }
 
-/*
- * The hull walk: where a point outside the hull starts its cavity when
- * the last point lay outside too (every point of a sphere, a cylinder).
- * The visibility walk from the last star to such a point crosses the long
- * tets through the body: every integer point of one sphere (tests/
- * gen_points intsphere) walked 140 tets a point. Seen from a point o
- * strictly inside the hull (a finite tet's centroid: the hull only
- * grows), the hull faces' cones partition space; this walk crosses from
- * hull face to hull face (infinite tet to infinite tet, across the faces
- * that hold the infinite vertex) by the planes through o and each hull
- * edge, to the face whose cone holds p. If p is strictly outside that
- * face, its infinite tet is in conflict, as a walk's end is; otherwise
- * (p inside the hull there, or on a plane) the visibility walk starts
- * from the finite tet under it, near p. A hull walk past HULL_WALK_STEPS
- * steps (a cycle of ties, or sliver faces) gives up, and the visibility
- * walk goes on from where it stopped. Builds with periodic images never
- * take it (their predicates read only the images' own points).
- */
-#define HULL_WALK_STEPS 64
-/* The steps of the visibility walk before an outside point takes the
- * hull walk. */
-#define HULL_AFTER 16
-/* The hull walks after which the build stops taking them when more than
- * a quarter gave up (a pipe's scan: the hull faces are long slivers, a
- * hull walk crossed 92 of them where the visibility walk crosses 35
- * tets): a function of the input, the same on every run. */
-#define HULL_TRIAL 64
-
-/* o: the centroid of a finite tet t, checked strictly inside it (exact
- * predicates); 0 if it is not (a flat tet, or one so small that the
- * quarters underflow). Each coordinate is quartered before the sum, which
- * then stays finite for any finite points. */
-static int hull_origin(build *b, uint32_t t)
-{
-    fdt_ins *m = b->m;
-    const uint32_t *v = m->T + 8 * (size_t)t;
-    for (int k = 0; k < 3; k++)
-        b->o[k] = 0.25 * ins_pt(m, v[0])[k] + 0.25 * ins_pt(m, v[1])[k] +
-                  0.25 * ins_pt(m, v[2])[k] + 0.25 * ins_pt(m, v[3])[k];
-    for (int k = 0; k < 4; k++) {
-        const double *q[4] = {ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3])};
-        q[k] = b->o;
-        if (ins_orient(q[0], q[1], q[2], q[3], &m->sf, b->cnt) <= 0)
-            return 0;
-    }
-    return 1;
-}
-
-/* The hull walk from the last star's infinite tets to p: 1 with the
- * cavity's start in *t0, 0 with a tet near p for the visibility walk to
- * start from, or -1 (*t0 unchanged) when it gave up: no hull face in the
- * last star, no o, or HULL_WALK_STEPS steps. Out of insert_point's code:
- * most inputs take it for a few points (1M uniform: 188). */
+/* The hull walk (insert_impl.h) from the last star's infinite tets to p:
+ * 1 with the cavity's start in *t0, 0 with a tet near p for the
+ * visibility walk to start from, or -1 (*t0 unchanged) when it gave up:
+ * no hull face in the last star, no o, or INS_HULL_WALK_STEPS steps. Out
+ * of insert_point's code: most inputs take it for a few points (1M
+ * uniform: 188). */
 __attribute__((noinline, cold)) static int hull_walk(build *b, const double *p, uint32_t *t0)
 {
     fdt_ins *m = b->m;
     const uint32_t *T = m->T;
+    ins_hull *h = &b->hull;
     /* the last star's hull faces first: in cache, and p, next to the
      * last point, is often outside one of them */
     uint32_t t = FDT_NONE;
@@ -299,24 +248,19 @@ __attribute__((noinline, cold)) static int hull_walk(build *b, const double *p, 
     if (t == FDT_NONE)
         return -1;
     const uint32_t *v = T + 8 * (size_t)t;
-    if (b->has_o == 0)
-        b->has_o = hull_origin(b, v[4 + fdt_ins_inf_index(v)] >> 2) ? 1 : -1;
-    if (b->has_o < 0)
+    if (h->has_o == 0)
+        h->has_o = ins_hull_origin(m, T + 8 * (size_t)(v[4 + fdt_ins_inf_index(v)] >> 2), h->o,
+                                   &m->sf, b->cnt)
+                       ? 1
+                       : -1;
+    if (h->has_o < 0)
         return -1;
     int from = -1, steps = 0;
     for (;; steps++) {
-        if (steps == HULL_WALK_STEPS)
+        if (steps == INS_HULL_WALK_STEPS)
             return -1;
         v = T + 8 * (size_t)t;
-        inf = fdt_ins_inf_index(v);
-        /* the tet's finite vertices with o for the infinite one: o is
-         * below the hull face, so the tuple is negative; p past the
-         * plane through o and the edge opposite k makes it positive */
-        const double *q[4];
-        for (int i = 0; i < 4; i++)
-            q[i] = i == inf ? b->o : ins_pt(m, v[i]);
-        unsigned skip = 1u << inf | (from >= 0 ? 1u << from : 0);
-        int exit = ins_walk_choose(q, p, skip, 1, &b->rng, &m->sf, b->cnt);
+        int exit = ins_hull_exit(m, v, h->o, p, from, &b->rng, &m->sf, b->cnt);
         if (exit < 0)
             break;
         uint32_t nb = v[4 + exit];
@@ -338,16 +282,14 @@ __attribute__((noinline, cold)) static int hull_walk(build *b, const double *p, 
 static int locate_from(build *b, const double *p, uint32_t start, uint32_t *t0)
 {
     fdt_ins *m = b->m;
-    int surface = b->outside && !m->sf.img &&
-                  !(b->hull_tries >= HULL_TRIAL && 4 * b->hull_capped > b->hull_tries);
-    int err = walk(m, p, start, &b->rng, &m->sf, b->cnt, surface ? HULL_AFTER : SIZE_MAX,
+    int err = walk(m, p, start, &b->rng, &m->sf, b->cnt, ins_hull_budget(&b->hull, m),
                    &m->stats.walk_steps, t0);
     if (err != WALK_LONG)
         return err;
     m->stats.hull_walks++;
     int got = hull_walk(b, p, t0);
-    b->hull_tries++;
-    b->hull_capped += got < 0;
+    b->hull.tries++;
+    b->hull.capped += got < 0;
     return got == 1 ? FDT_OK : locate(b, p, *t0, t0);
 }
 
@@ -359,7 +301,7 @@ static int insert_point(build *b, uint32_t pid, uint32_t *last)
     int err = locate_from(b, p, *last, &t0);
     if (err)
         return err;
-    b->outside = ins_is_infinite(m->T + 8 * (size_t)t0);
+    b->hull.outside = ins_is_infinite(m->T + 8 * (size_t)t0);
     const uint32_t *v0 = m->T + 8 * (size_t)t0;
     /* A point equal to a vertex lies in the closed tet of that vertex only,
      * so the walk ends in a tet that has it: refuse rather than break the

@@ -236,6 +236,89 @@ static inline int ins_is_infinite(const uint32_t *v)
 }
 
 /*
+ * The hull walk (src/mesh/insert.c's hull_walk, and the parallel
+ * workers'): where a point outside the hull starts its cavity when the
+ * last point lay outside too (every point of a sphere, a cylinder). The
+ * visibility walk from the last star to such a point crosses the long
+ * tets through the body: every integer point of one sphere (tests/
+ * gen_points intsphere) walked 140 tets a point. Seen from a point o
+ * strictly inside the hull (a finite tet's centroid: the hull only
+ * grows), the hull faces' cones partition space; the walk crosses from
+ * hull face to hull face (infinite tet to infinite tet, across the faces
+ * that hold the infinite vertex) by the planes through o and each hull
+ * edge, to the face whose cone holds p. If p is strictly outside that
+ * face, its infinite tet is in conflict, as a walk's end is; otherwise
+ * (p inside the hull there, or on a plane) the visibility walk starts
+ * from the finite tet under it, near p. A hull walk past
+ * INS_HULL_WALK_STEPS steps (a cycle of ties, or sliver faces) gives up,
+ * and the visibility walk goes on. Builds with periodic images never
+ * take it (their predicates read only the images' own points).
+ */
+#define INS_HULL_WALK_STEPS 64
+/* The steps of the visibility walk before an outside point takes the
+ * hull walk. */
+#define INS_HULL_AFTER 16
+/* The hull walks after which a build (a worker) stops taking them when
+ * more than a quarter gave up (a pipe's scan: the hull faces are long
+ * slivers, a hull walk crossed 92 of them where the visibility walk
+ * crosses 35 tets). */
+#define INS_HULL_TRIAL 64
+
+/* One build's (or worker's) hull walks. */
+typedef struct ins_hull {
+    int outside;       /* the last point lay outside the hull (its cavity
+                          began at an infinite tet) */
+    int has_o;         /* o: 0 not yet, 1 set, -1 none (ins_hull_origin) */
+    double o[3];
+    uint32_t tries, capped; /* hull walks, and those that gave up */
+} ins_hull;
+
+/* The visibility walk's budget before the hull walk: INS_HULL_AFTER when
+ * the last point lay outside and the hull walks still pay, else none. */
+static inline size_t ins_hull_budget(const ins_hull *h, const fdt_ins *m)
+{
+    int take = h->outside && !m->sf.img &&
+               !(h->tries >= INS_HULL_TRIAL && 4 * h->capped > h->tries);
+    return take ? INS_HULL_AFTER : SIZE_MAX;
+}
+
+/* o: the centroid of the finite tet v (its four ids), checked strictly
+ * inside it (exact predicates); 0 if it is not (a flat tet, or one so
+ * small that the quarters underflow). Each coordinate is quartered
+ * before the sum, which then stays finite for any finite points. */
+static inline int ins_hull_origin(const fdt_ins *m, const uint32_t *v, double o[3],
+                                  const fdt_pred_static *sf, fdt_pred_counts *cnt)
+{
+    const double *q[4] = {ins_pt(m, v[0]), ins_pt(m, v[1]), ins_pt(m, v[2]), ins_pt(m, v[3])};
+    for (int k = 0; k < 3; k++)
+        o[k] = 0.25 * q[0][k] + 0.25 * q[1][k] + 0.25 * q[2][k] + 0.25 * q[3][k];
+    for (int k = 0; k < 4; k++) {
+        const double *s[4] = {q[0], q[1], q[2], q[3]};
+        s[k] = o;
+        if (ins_orient(s[0], s[1], s[2], s[3], sf, cnt) <= 0)
+            return 0;
+    }
+    return 1;
+}
+
+/* One step of the hull walk in the infinite tet v (its ids), come in by
+ * face `from` (-1: none): the face to cross next, or -1 when p's cone is
+ * v's. v's finite vertices with o for the infinite one: o is below the
+ * hull face, so the tuple is negative; p past the plane through o and the
+ * edge opposite k makes it positive. */
+static inline int ins_hull_exit(const fdt_ins *m, const uint32_t *v, const double *o,
+                                const double *p, int from, uint64_t *rng,
+                                const fdt_pred_static *sf, fdt_pred_counts *cnt)
+{
+    int inf = fdt_ins_inf_index(v);
+    const double *q[4];
+    for (int i = 0; i < 4; i++)
+        q[i] = i == inf ? o : ins_pt(m, v[i]);
+    unsigned skip = 1u << inf | (from >= 0 ? 1u << from : 0);
+    return ins_walk_choose(q, p, skip, 1, rng, sf, cnt);
+}
+
+/*
  * The coplanar rule's second half: the tet u under a hull face decides
  * (ins_conflict_finite). u is finite in a valid mesh; one that is not
  * says the mesh is already broken (a wrong predicate, tests/test_plant.sh),

@@ -112,6 +112,10 @@ static uint32_t chunk_of(uint32_t n)
  * BUSY, another thread holds a tet it needs; FULL, the slots are spent
  * (phase 2). Either way nothing was written and nothing is held. */
 enum { BUSY = 1, FULL = 2 };
+/* walk_locked's answer at its budget (the hull walk's turn). */
+enum { WALK_LONG = 3 };
+/* The last star's infinite tets kept as the hull walk's starts. */
+enum { HULL_STARTS = 8 };
 
 /* lock_live's answers besides 0 (another worker holds the tet). */
 enum { MINE = 1, TAKEN = 2 };
@@ -181,6 +185,12 @@ typedef struct worker {
     uint32_t recent[RECENT];   /* more starts, when last is held elsewhere */
     unsigned nrecent;
     uint64_t rng;              /* the walk's choices */
+    ins_hull hull;             /* its hull walks (insert_impl.h) */
+    /* The last star's infinite tets, when its point lay outside the hull:
+     * slot and four vertex ids each, copied while the star was held, so
+     * that the next hull walk tests them without a lock. */
+    uint32_t hull_slot[HULL_STARTS], hull_ids[HULL_STARTS][4];
+    unsigned nhull_start;
     const uint32_t *pts;       /* its points in insertion order */
     size_t npts;
     size_t *round_end;         /* ends of its rounds in pts (borrowed) */
@@ -383,10 +393,11 @@ static inline uint32_t alloc_slot(worker *w)
 
 /*
  * Hand-over-hand visibility walk (src/mesh/insert.c's walk) from `start`,
- * which this worker has just locked. On 0 (located) *out is locked (the
+ * which this worker has just locked, in at most `budget` steps. On 0
+ * (located) and on WALK_LONG (the budget spent) *out is locked (the
  * caller's to let go); on BUSY nothing is held.
  */
-static int walk_locked(worker *w, const double *p, uint32_t start, uint32_t *out)
+static int walk_locked(worker *w, const double *p, uint32_t start, size_t budget, uint32_t *out)
 {
     shared *sh = w->sh;
     const fdt_ins *m = sh->m;
@@ -405,6 +416,7 @@ static int walk_locked(worker *w, const double *p, uint32_t start, uint32_t *out
         }
     int from = -1;
     size_t steps = 0;
+    int err = FDT_OK;
     for (;; steps++) {
         if (steps > m->cap) { /* a cycle: impossible in a regular triangulation */
             unlock_slot(sh, t);
@@ -412,7 +424,11 @@ static int walk_locked(worker *w, const double *p, uint32_t start, uint32_t *out
         }
         const uint32_t *v = T + 8 * (size_t)t;
         if (ins_is_infinite(v))
+            break; /* located: at any step, the budget's last too */
+        if (steps == budget) { /* held: WALK_LONG's tet is finite */
+            err = WALK_LONG;
             break;
+        }
         int exit = ins_walk_exit(m, v, p, from, &w->rng, &m->sf, &w->cnt);
         if (exit < 0)
             break;
@@ -429,7 +445,132 @@ static int walk_locked(worker *w, const double *p, uint32_t start, uint32_t *out
     }
     w->st.walk_steps += steps;
     *out = t;
-    return FDT_OK;
+    return err;
+}
+
+/* Whether this worker now holds slot t as the infinite tet with the ids
+ * v (a start copied from the last star): a lock taken on a slot handed
+ * out is on a live tet, which may since have become another one. */
+static int take_start(worker *w, uint32_t t, const uint32_t v[4])
+{
+    shared *sh = w->sh;
+    if (!lock_free_slot(sh, t, w->me))
+        return 0;
+    if (memcmp(sh->m->T + 8 * (size_t)t, v, 4 * sizeof *v) == 0)
+        return 1;
+    unlock_slot(sh, t);
+    return 0;
+}
+
+/*
+ * The hull walk (insert_impl.h) of a worker, hand over hand like
+ * walk_locked, while the visibility walk's tet `held` stays locked: the
+ * last star's infinite tets first, as the serial build tests them, here
+ * from their copies (without a lock: a lock and a test each cost the
+ * workers more than they saved, bench/NOTES.md entry 133), and only the
+ * one p is outside of taken; else from the first that can be taken,
+ * across hull faces. Returns 1 with the cavity's start in *out (locked;
+ * held let go), 0 with a tet near p for the visibility walk in *out
+ * (locked; held let go unless it is *out), or -1 when it gave up (a lock
+ * held elsewhere, no start, no o, or INS_HULL_WALK_STEPS steps): only
+ * held is held then.
+ */
+__attribute__((noinline, cold)) static int hull_walk_locked(worker *w, const double *p,
+                                                            uint32_t held, uint32_t *out)
+{
+    shared *sh = w->sh;
+    const fdt_ins *m = sh->m;
+    const uint32_t *T = m->T;
+    ins_hull *h = &w->hull;
+    int inf = -1;
+    for (unsigned i = 0; i < w->nhull_start; i++)
+        if (ins_conflict_local(m, w->hull_ids[i], p, &m->sf, &w->cnt, &inf) == 1 &&
+            take_start(w, w->hull_slot[i], w->hull_ids[i])) {
+            unlock_slot(sh, held);
+            *out = w->hull_slot[i];
+            return 1;
+        }
+    uint32_t t = FDT_NONE;
+    for (unsigned i = 0; i < w->nhull_start && t == FDT_NONE; i++)
+        if (take_start(w, w->hull_slot[i], w->hull_ids[i]))
+            t = w->hull_slot[i];
+    if (t == FDT_NONE)
+        return -1;
+    const uint32_t *v = T + 8 * (size_t)t;
+    if (h->has_o == 0) {
+        /* o from the finite tet under the start: it must be held to be
+         * read (held itself, or locked now) */
+        uint32_t u = v[4 + fdt_ins_inf_index(v)] >> 2;
+        int mine = u == held || lock_free_slot(sh, u, w->me);
+        if (mine) {
+            h->has_o = ins_hull_origin(m, T + 8 * (size_t)u, h->o, &m->sf, &w->cnt) ? 1 : -1;
+            if (u != held)
+                unlock_slot(sh, u);
+        }
+    }
+    if (h->has_o <= 0) {
+        unlock_slot(sh, t);
+        return -1;
+    }
+    int from = -1;
+    for (int steps = 0;; steps++) {
+        if (steps == INS_HULL_WALK_STEPS) {
+            unlock_slot(sh, t);
+            return -1;
+        }
+        v = T + 8 * (size_t)t;
+        int exit = ins_hull_exit(m, v, h->o, p, from, &w->rng, &m->sf, &w->cnt);
+        if (exit < 0)
+            break;
+        uint32_t nb = v[4 + exit];
+        /* t is held, so nb >> 2 is live until t is let go: take it first */
+        if (!lock_free_slot(sh, nb >> 2, w->me)) {
+            unlock_slot(sh, t);
+            return -1;
+        }
+        unlock_slot(sh, t);
+        t = nb >> 2;
+        from = (int)(nb & 3);
+    }
+    if (ins_conflict_local(m, v, p, &m->sf, &w->cnt, &inf) == 1) {
+        unlock_slot(sh, held);
+        *out = t;
+        return 1;
+    }
+    uint32_t u = v[4 + fdt_ins_inf_index(v)] >> 2;
+    if (u != held && !lock_free_slot(sh, u, w->me)) {
+        unlock_slot(sh, t);
+        return -1;
+    }
+    unlock_slot(sh, t);
+    if (u != held)
+        unlock_slot(sh, held);
+    *out = u;
+    return 0;
+}
+
+/* The walk from `start` (locked by this worker) to p: the visibility walk,
+ * and where the last point lay outside the hull and that walk grows long,
+ * the hull walk (src/mesh/insert.c's locate_from). On 0 *out is locked;
+ * on BUSY nothing is held. A worker's trial (ins_hull_budget) counts its
+ * own hull walks, whose points depend on the threads' shares: a choice of
+ * route, which cannot change the mesh (the perturbed DT is unique). */
+static int walk_from(worker *w, const double *p, uint32_t start, uint32_t *out)
+{
+    const fdt_ins *m = w->sh->m;
+    int err = walk_locked(w, p, start, ins_hull_budget(&w->hull, m), out);
+    if (err != WALK_LONG)
+        return err;
+    w->st.hull_walks++;
+    uint32_t t;
+    int got = hull_walk_locked(w, p, *out, &t);
+    w->hull.tries++;
+    w->hull.capped += got < 0;
+    if (got == 1) {
+        *out = t;
+        return FDT_OK;
+    }
+    return walk_locked(w, p, got == 0 ? t : *out, SIZE_MAX, out);
 }
 
 /* Takes a start for the walk to p (id pid) and walks: the last tet made,
@@ -443,11 +584,11 @@ static int locate(worker *w, uint32_t pid, const double *p, uint32_t *out)
      * each is live or freed (and then locked): a lock taken is on a live
      * tet. Slots never handed out are never named. */
     if (w->last != FDT_NONE && lock_free_slot(sh, w->last, w->me))
-        return walk_locked(w, p, w->last, out);
+        return walk_from(w, p, w->last, out);
     for (unsigned i = 0; i < RECENT && i < w->nrecent; i++) {
         uint32_t t = w->recent[(w->nrecent - 1 - i) % RECENT];
         if (lock_free_slot(sh, t, w->me))
-            return walk_locked(w, p, t, out);
+            return walk_from(w, p, t, out);
     }
     uint32_t i0 = pid - m->base;
     for (uint32_t d = 1; d <= HINT_REACH; d++) {
@@ -460,13 +601,13 @@ static int locate(worker *w, uint32_t pid, const double *p, uint32_t *out)
              * locked slot is always live (freed slots stay locked). */
             uint32_t t = atomic_load_explicit(&sh->hint[j], memory_order_relaxed);
             if (t != FDT_NONE && lock_free_slot(sh, t, w->me))
-                return walk_locked(w, p, t, out);
+                return walk_from(w, p, t, out);
         }
     }
     if (sh->single) { /* [0, nslots) was handed out before phase 3 */
         for (uint32_t t = 0; t < m->nslots; t++)
             if (lock_free_slot(sh, t, w->me))
-                return walk_locked(w, p, t, out);
+                return walk_from(w, p, t, out);
         return FDT_EINTERNAL;
     }
     return BUSY;
@@ -517,6 +658,7 @@ static int insert_point(worker *w, uint32_t pid)
     if (err)
         return err;
     const uint32_t *v0 = m->T + 8 * (size_t)t0;
+    const int outside = ins_is_infinite(v0);
     if (ins_is_vertex(m, v0, p)) { /* see src/mesh/insert.c: a duplicate */
         unlock_slot(sh, t0);
         return FDT_EINVAL;
@@ -597,6 +739,17 @@ static int insert_point(worker *w, uint32_t pid)
     for (size_t i = 0; i < w->ncav; i++)
         free_slot(w, w->cav[i]);
     ins_count_cavity(&w->st, w->ncav, w->nbnd);
+    /* p outside the hull: its star's infinite tets, read while held, are
+     * the next hull walk's starts */
+    w->hull.outside = outside;
+    w->nhull_start = 0;
+    for (size_t i = 0; outside && i < w->nbnd && w->nhull_start < HULL_STARTS; i++) {
+        const uint32_t *nv = m->T + 8 * (size_t)w->newt[i];
+        if (ins_is_infinite(nv)) {
+            w->hull_slot[w->nhull_start] = w->newt[i];
+            memcpy(w->hull_ids[w->nhull_start++], nv, 4 * sizeof *nv);
+        }
+    }
     /* Release: every write above happens before the next holder's
      * acquire. The coplanar rule's tets first: a freed cavity slot is
      * told from them by its tet (unlock_under). */
@@ -1092,6 +1245,7 @@ static void sum_worker_stats(fdt_ins *m, const worker *ws, int nw, fdt_pred_coun
         m->stats.conflict_tests += s->conflict_tests;
         m->stats.deferred += s->deferred;
         m->stats.stolen += s->stolen;
+        m->stats.hull_walks += s->hull_walks;
         if (s->max_cavity > m->stats.max_cavity)
             m->stats.max_cavity = s->max_cavity;
         if (cnt)

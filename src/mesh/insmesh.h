@@ -37,7 +37,7 @@
 typedef struct fdt_ins_stats {
     size_t inserted;      /* points inserted (n) */
     size_t walk_steps;    /* tets visited by point location */
-    size_t hull_walks;    /* locations by the hull walk (src/mesh/insert.c) */
+    size_t hull_walks;    /* locations by the hull walk (insert_impl.h), the workers' too */
     size_t cavity_tets;   /* tets destroyed (sum of the cavity sizes) */
     size_t created_tets;  /* tets created */
     size_t max_cavity;    /* largest cavity */
