@@ -1002,6 +1002,19 @@ static void test_parallel_refusals(const char *gen)
     free(u.xyz);
 }
 
+/* The parallel build of pp on `threads` threads into *m, checked: the
+ * serial build's tets (ref) and a sound structure; the caller reads its
+ * stats and frees it. */
+static void build_parallel_checked(const prepped *pp, const meshset *ref, int threads,
+                                   const char *nm, fdt_ins *m)
+{
+    CHECK_EQ(fdt_ins_build_parallel(m, pp->pr.p, 0, pp->m, threads, NULL), FDT_OK);
+    meshset got = kernel_mesh(m, NULL);
+    same_mesh(&got, ref, nm);
+    check_structure(m, nm);
+    meshset_free(&got);
+}
+
 /* More threads than a lock byte can name (63, src/mesh/insert_par.c): the
  * build runs on 63 workers and gives the same tets. */
 static void test_parallel_many_threads(const char *gen)
@@ -1013,13 +1026,9 @@ static void test_parallel_many_threads(const char *gen)
     meshset ref = serial_reference(&pp);
     static const int many[] = {63, 64, 100};
     for (size_t i = 0; i < sizeof many / sizeof many[0]; i++) {
-        CHECK_EQ(fdt_ins_build_parallel(&m, pp.pr.p, 0, pp.m, many[i], NULL), FDT_OK);
         char nm[64];
         snprintf(nm, sizeof nm, "clusters-3000 parallel t%d", many[i]);
-        meshset got = kernel_mesh(&m, NULL);
-        same_mesh(&got, &ref, nm);
-        check_structure(&m, nm);
-        meshset_free(&got);
+        build_parallel_checked(&pp, &ref, many[i], nm, &m);
         fdt_ins_free(&m);
     }
     printf("parallel clusters-3000: same as serial for 63, 64 and 100 threads\n");
@@ -1041,16 +1050,12 @@ static void test_parallel_hull_walk(const char *gen)
     static const int threads[] = {2, 3, 5};
     for (size_t ti = 0; ti < sizeof threads / sizeof threads[0]; ti++) {
         fdt_ins m;
-        CHECK_EQ(fdt_ins_build_parallel(&m, pp.pr.p, 0, pp.m, threads[ti], NULL), FDT_OK);
         char nm[64];
         snprintf(nm, sizeof nm, "intsphere parallel hull walk t%d", threads[ti]);
-        meshset got = kernel_mesh(&m, NULL);
-        same_mesh(&got, &ref, nm);
-        check_structure(&m, nm);
+        build_parallel_checked(&pp, &ref, threads[ti], nm, &m);
         printf("%s: %u points, %zu hull walks, %zu deferred\n", nm, pp.m, m.stats.hull_walks,
                m.stats.deferred);
         CHECK(m.stats.hull_walks > pp.m / 4); /* the serial start has 1/128 of them */
-        meshset_free(&got);
         fdt_ins_free(&m);
     }
     meshset_free(&ref);
