@@ -19,10 +19,11 @@
 void fdt_mem_advise_huge(void *p, size_t bytes);
 
 /* n elements of `size` bytes (zeroed when `zero`: calloc), huge pages
- * asked for before the first write (fdt_mem_advise_huge): for large
- * arrays written at once, where each 4 KB fault costs (a trap on a host
- * that hands pages over late, bench/NOTES.md entry 128) and random reads
- * and adds miss the TLB. NULL when out of memory or n * size overflows. */
+ * asked for before the first write (fdt_mem_advise_huge), or under 4 MB
+ * every page mapped at once: for arrays written at once (every page of
+ * them), where each 4 KB fault costs (a trap on a host that hands pages
+ * over late, bench/NOTES.md entries 128, 134) and random reads and adds
+ * miss the TLB. NULL when out of memory or n * size overflows. */
 void *fdt_mem_alloc_huge(size_t n, size_t size, int zero);
 
 /* Grows the array *pp of elements of `size` bytes, holding *cap, to hold
