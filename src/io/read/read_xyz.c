@@ -11,6 +11,7 @@
 
 #include "io/read/read_common.h"
 #include "io/read/reader.h"
+#include "base/mem.h"
 #include "base/spawn.h"
 
 #include <pthread.h>
@@ -573,7 +574,7 @@ static int rd_xyz_stream_from(rd_ctx *c, rd_points *pb, int whole, size_t ncols0
     size_t cap = fdt_rd_first_cap(c, chunk, c->size < chunk ? c->size + 1 : chunk);
     if (cap < 4)
         cap = 4;
-    char *buf = malloc(cap + 1);
+    char *buf = fdt_mem_alloc_huge(cap + 1, 1, 0); /* each read fills it */
     if (buf == NULL)
         return fdt_rd_fail(c, FDT_IO_ENOMEM, ": out of memory");
     /* Lines before the first content line are blank or comments; the
