@@ -286,10 +286,8 @@ static int locate_from(build *b, const double *p, uint32_t start, uint32_t *t0)
                    &m->stats.walk_steps, t0);
     if (err != WALK_LONG)
         return err;
-    m->stats.hull_walks++;
     int got = hull_walk(b, p, t0);
-    b->hull.tries++;
-    b->hull.capped += got < 0;
+    ins_hull_count(&b->hull, &m->stats.hull_walks, got);
     return got == 1 ? FDT_OK : locate(b, p, *t0, t0);
 }
 

@@ -282,6 +282,15 @@ static inline size_t ins_hull_budget(const ins_hull *h, const fdt_ins *m)
     return take ? INS_HULL_AFTER : SIZE_MAX;
 }
 
+/* One hull walk taken (ins_hull_budget's trial reads the counts): its
+ * answer got, -1 when it gave up; *walks the build's stats. */
+static inline void ins_hull_count(ins_hull *h, size_t *walks, int got)
+{
+    (*walks)++;
+    h->tries++;
+    h->capped += got < 0;
+}
+
 /* o: the centroid of the finite tet v (its four ids), checked strictly
  * inside it (exact predicates); 0 if it is not (a flat tet, or one so
  * small that the quarters underflow). Each coordinate is quartered

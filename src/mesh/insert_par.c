@@ -561,11 +561,9 @@ static int walk_from(worker *w, const double *p, uint32_t start, uint32_t *out)
     int err = walk_locked(w, p, start, ins_hull_budget(&w->hull, m), out);
     if (err != WALK_LONG)
         return err;
-    w->st.hull_walks++;
     uint32_t t;
     int got = hull_walk_locked(w, p, *out, &t);
-    w->hull.tries++;
-    w->hull.capped += got < 0;
+    ins_hull_count(&w->hull, &w->st.hull_walks, got);
     if (got == 1) {
         *out = t;
         return FDT_OK;
