@@ -8,6 +8,9 @@
  * only that the hint leaves the memory usable, and says so. Odd
  * alignments and sizes below the threshold must be harmless.
  *
+ * fdt_mem_alloc_huge's arrays, small and large, and fdt_mem_realloc_huge's
+ * kept bytes (test_alloc_realloc).
+ *
  * fdt_mem_available reads MemAvailable from a meminfo file of the test's
  * own (fdt_mem_available_at): the value in bytes; a count too big for
  * size_t as SIZE_MAX; a file without the line, or no file, falls back to
@@ -122,9 +125,46 @@ static void test_available(void)
     rmdir(mdir);
 }
 
+/* fdt_mem_alloc_huge under 4 MB (its pages mapped at once) and over,
+ * zeroed when asked; fdt_mem_realloc_huge keeps the old block's bytes
+ * (all of them when growing, the first new_bytes when shrinking), starts
+ * from NULL, and the result is freed with free(). */
+static void test_alloc_realloc(void)
+{
+    static const size_t sizes[] = {1, 4095, 4096, 100000, (size_t)3 << 20, (size_t)5 << 20};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        size_t n = sizes[k];
+        unsigned char *z = fdt_mem_alloc_huge(n, 1, 1);
+        EXPECTF(z != NULL, "alloc %zu", n);
+        size_t nz = 0;
+        for (size_t i = 0; z && i < n; i++)
+            nz += z[i] != 0;
+        EXPECTF(nz == 0, "%zu of %zu zeroed bytes not zero", nz, n);
+        free(z);
+        unsigned char *a = fdt_mem_realloc_huge(NULL, 0, n);
+        EXPECTF(a != NULL, "realloc from NULL, %zu", n);
+        if (!a)
+            continue;
+        for (size_t i = 0; i < n; i++)
+            a[i] = (unsigned char)(i * 13 + 1);
+        unsigned char *b = fdt_mem_realloc_huge(a, n, 2 * n + 7); /* grown */
+        EXPECTF(b != NULL, "grow %zu", n);
+        size_t bad = 0;
+        for (size_t i = 0; b && i < n; i++)
+            bad += b[i] != (unsigned char)(i * 13 + 1);
+        EXPECTF(bad == 0, "grow %zu: %zu bytes lost", n, bad);
+        unsigned char *c = b ? fdt_mem_realloc_huge(b, 2 * n + 7, n / 2 + 1) : NULL; /* shrunk */
+        for (size_t i = 0; c && i < n / 2 + 1; i++)
+            bad += c[i] != (unsigned char)(i * 13 + 1);
+        EXPECTF(c && bad == 0, "shrink %zu: %zu bytes lost", n, bad);
+        free(c);
+    }
+}
+
 int main(void)
 {
     test_available();
+    test_alloc_realloc();
 
     /* Harmless anywhere: NULL, tiny, unaligned. */
     fdt_mem_advise_huge(NULL, 1 << 30);

@@ -3,6 +3,7 @@
 #include "base/mem.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 #include "frontdt.h"
 
@@ -60,6 +61,17 @@ void *fdt_mem_alloc_huge(size_t n, size_t size, int zero)
     else
         fdt_mem_advise_huge(p, n * size);
     return p;
+}
+
+void *fdt_mem_realloc_huge(void *p, size_t old_bytes, size_t new_bytes)
+{
+    void *q = fdt_mem_alloc_huge(new_bytes ? new_bytes : 1, 1, 0);
+    if (!q)
+        return NULL;
+    if (p && old_bytes)
+        memcpy(q, p, old_bytes < new_bytes ? old_bytes : new_bytes);
+    free(p);
+    return q;
 }
 
 size_t fdt_mem_available(void)

@@ -26,6 +26,14 @@ void fdt_mem_advise_huge(void *p, size_t bytes);
  * miss the TLB. NULL when out of memory or n * size overflows. */
 void *fdt_mem_alloc_huge(size_t n, size_t size, int zero);
 
+/* realloc for such arrays: the block p (NULL: none), whose first
+ * old_bytes are kept, moved into a new block of new_bytes from
+ * fdt_mem_alloc_huge, so that its pages are asked for before the copy
+ * writes them (realloc's copy of a grown block faulted it in 4 KB at a
+ * time, before any advice could apply: bench/NOTES.md entry 134). NULL,
+ * p untouched, when out of memory. */
+void *fdt_mem_realloc_huge(void *p, size_t old_bytes, size_t new_bytes);
+
 /* Grows the array *pp of elements of `size` bytes, holding *cap, to hold
  * at least need (doubling from 64): 0, or FDT_ENOMEM (*pp and *cap
  * unchanged). */

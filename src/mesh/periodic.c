@@ -69,30 +69,26 @@ static int ext_grow(ext *e, size_t need)
         cap *= 2;
     if (cap > UINT32_MAX - 1)
         cap = UINT32_MAX - 1;
-    double *P = realloc(e->P, cap * 3 * sizeof *P);
+    /* written at once, every page: huge pages (a 4 KB fault is a trap on
+     * some hosts, src/base/mem.h) */
+    const size_t old = e->cap;
+    double *P = fdt_mem_realloc_huge(e->P, old * 3 * sizeof *P, cap * 3 * sizeof *P);
     if (P)
         e->P = P;
-    uint32_t *src = realloc(e->src, cap * sizeof *src);
+    uint32_t *src = fdt_mem_realloc_huge(e->src, old * sizeof *src, cap * sizeof *src);
     if (src)
         e->src = src;
-    int8_t *off = realloc(e->off, cap * 3 * sizeof *off);
+    int8_t *off = fdt_mem_realloc_huge(e->off, old * 3 * sizeof *off, cap * 3 * sizeof *off);
     if (off)
         e->off = off;
-    uint8_t *ex = realloc(e->exact, cap);
+    uint8_t *ex = fdt_mem_realloc_huge(e->exact, old, cap);
     if (ex)
         e->exact = ex;
-    uint64_t *vk = realloc(e->vk, cap * sizeof *vk);
+    uint64_t *vk = fdt_mem_realloc_huge(e->vk, old * sizeof *vk, cap * sizeof *vk);
     if (vk)
         e->vk = vk;
     if (!P || !src || !off || !ex || !vk)
         return FDT_ENOMEM;
-    /* written at once, every page: huge pages (a 4 KB fault is a trap on
-     * some hosts, src/base/mem.h) */
-    fdt_mem_advise_huge(e->P, cap * 3 * sizeof *e->P);
-    fdt_mem_advise_huge(e->src, cap * sizeof *e->src);
-    fdt_mem_advise_huge(e->off, cap * 3 * sizeof *e->off);
-    fdt_mem_advise_huge(e->exact, cap);
-    fdt_mem_advise_huge(e->vk, cap * sizeof *e->vk);
     e->cap = (uint32_t)cap;
     return FDT_OK;
 }

@@ -72,17 +72,14 @@ int fdt_rd_points_reserve(rd_points *pb, size_t cap)
         return -1;
     if (cap > SIZE_MAX / (3 * sizeof(double)))
         return -1;
-    /* Written at once, every page up to the count: huge pages, asked for
-     * before the first write, which for a grown array is the copy (a 4 KB
-     * fault is a trap on some hosts: 5,900 of them, about 0.1 s, filled a
-     * binary PLY's 1M points, and realloc's copy of the text reader's
-     * array took 6,800; bench/NOTES.md entry 134). */
-    double *x = fdt_mem_alloc_huge(cap * 3, sizeof(double), 0);
+    /* Written at once, every page up to the count (5,900 4 KB faults, about
+     * 0.1 s, filled a binary PLY's 1M points; realloc's copy of the text
+     * reader's array took 6,800: bench/NOTES.md entry 134). All of the old
+     * block is kept, as realloc keeps it: a binary PLY's bytes run past n. */
+    double *x = fdt_mem_realloc_huge(pb->xyz, pb->cap * 3 * sizeof(double),
+                                     cap * 3 * sizeof(double));
     if (x == NULL)
         return -1;
-    if (pb->cap) /* all of it, as realloc would: a binary PLY's bytes run past n */
-        memcpy(x, pb->xyz, pb->cap * 3 * sizeof(double));
-    free(pb->xyz);
     pb->xyz = x;
     pb->cap = cap;
     return 0;
