@@ -11,10 +11,13 @@
  * fdt_mem_alloc_huge's arrays, small and large, and fdt_mem_realloc_huge's
  * kept bytes (test_alloc_realloc).
  *
- * fdt_mem_available reads MemAvailable from a meminfo file of the test's
- * own (fdt_mem_available_at): the value in bytes; a count too big for
- * size_t as SIZE_MAX; a file without the line, or no file, falls back to
- * the free pages (sysconf), the value the test computes itself.
+ * fdt_mem_available reads MemAvailable from a fake system root of the
+ * test's own (fdt_mem_available_in): the value in bytes; a count too big
+ * for size_t as SIZE_MAX; a file without the line, or no file, falls back
+ * to the free pages (sysconf), the value the test computes itself; then
+ * the room under cgroup limits (v2, v1, nested, namespaced, "max"), and
+ * fdt_mem_fits refusing, through fdt_mem_alloc_huge and fdt_grow, a
+ * block past the real memory available.
  */
 #define _DEFAULT_SOURCE
 #include <stdint.h>
@@ -23,9 +26,11 @@
 #include <string.h>
 
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "base/mem.h"
+#include "frontdt.h"
 #include "testutil.h"
 
 /* The kernel's setting: 1 if it grants huge pages on request. */
@@ -65,18 +70,39 @@ static long huge_kb(const void *p, size_t bytes)
     return kb;
 }
 
-/* A meminfo file holding text, in a directory of its own. */
+/* A file of a fake system root (its directories made as needed)
+ * holding text; clear_root removes them. */
 static char mdir[] = "/tmp/fdt_test_mem_XXXXXX";
+static char made[32][160];
+static int nmade;
 
-static const char *meminfo(const char *text)
+static void put(const char *rel, const char *text)
 {
-    static char path[64];
-    snprintf(path, sizeof path, "%s/meminfo", mdir);
+    char path[160];
+    snprintf(path, sizeof path, "%s/%s", mdir, rel);
+    for (char *s = path + strlen(mdir) + 1; (s = strchr(s, '/')); s++) {
+        *s = '\0';
+        if (mkdir(path, 0700) == 0) {
+            CHECK(nmade < 32);
+            snprintf(made[nmade++], sizeof made[0], "%s", path);
+        }
+        *s = '/';
+    }
+    int is_new = access(path, F_OK) != 0; /* a file put again is listed once */
     FILE *f = fopen(path, "w");
     CHECK(f);
     CHECK(fputs(text, f) >= 0);
     CHECK(fclose(f) == 0);
-    return path;
+    CHECK(nmade < 32);
+    if (is_new)
+        snprintf(made[nmade++], sizeof made[0], "%s", path);
+}
+
+/* Every file and directory put made, the last first. */
+static void clear_root(void)
+{
+    while (nmade > 0)
+        CHECK(remove(made[--nmade]) == 0);
 }
 
 /* sysconf's free pages in bytes: the fallback, as mem.c computes it. */
@@ -99,30 +125,92 @@ static int near_free_pages(size_t got)
 static void test_available(void)
 {
     CHECK(mkdtemp(mdir));
-    EXPECT(fdt_mem_available_at(meminfo("MemTotal:       16000000 kB\n"
-                                        "MemFree:         1000000 kB\n"
-                                        "MemAvailable:    1234567 kB\n"
-                                        "Buffers:           10000 kB\n")) ==
-           (size_t)1234567 * 1024);
+    put("proc/meminfo", "MemTotal:       16000000 kB\n"
+                        "MemFree:         1000000 kB\n"
+                        "MemAvailable:    1234567 kB\n"
+                        "Buffers:           10000 kB\n");
+    EXPECT(fdt_mem_available_in(mdir) == (size_t)1234567 * 1024);
+    clear_root();
     /* the first line already */
-    EXPECT(fdt_mem_available_at(meminfo("MemAvailable: 7 kB\n")) == 7 * 1024);
+    put("proc/meminfo", "MemAvailable: 7 kB\n");
+    EXPECT(fdt_mem_available_in(mdir) == 7 * 1024);
+    clear_root();
     /* 2^64 - 1 kB: more than size_t holds in bytes */
-    EXPECT(fdt_mem_available_at(meminfo("MemAvailable: 18446744073709551615 kB\n")) ==
-           SIZE_MAX);
+    put("proc/meminfo", "MemAvailable: 18446744073709551615 kB\n");
+    EXPECT(fdt_mem_available_in(mdir) == SIZE_MAX);
+    clear_root();
     /* no MemAvailable line (kernels before 3.14): the free pages */
-    size_t got = fdt_mem_available_at(meminfo("MemTotal: 16000000 kB\nMemFree: 5 kB\n"));
+    put("proc/meminfo", "MemTotal: 16000000 kB\nMemFree: 5 kB\n");
+    size_t got = fdt_mem_available_in(mdir);
     EXPECTF(got != 5 * 1024 && near_free_pages(got), "%zu bytes", got);
-    char missing[96];
-    snprintf(missing, sizeof missing, "%s/none", mdir);
-    got = fdt_mem_available_at(missing);
+    clear_root();
+    /* no file at all */
+    got = fdt_mem_available_in(mdir);
     EXPECTF(near_free_pages(got), "%zu bytes", got);
+
+    /* cgroup v2: the room under the process's cgroup's limit, its usage
+     * less the file pages it can drop: 1,000,000 - 400,000 + 50,000 */
+    put("proc/meminfo", "MemAvailable: 1000000 kB\n");
+    put("proc/self/cgroup", "0::/a/b\n");
+    put("sys/fs/cgroup/a/b/memory.max", "1000000\n");
+    put("sys/fs/cgroup/a/b/memory.current", "400000\n");
+    put("sys/fs/cgroup/a/b/memory.stat", "anon 350000\ninactive_file 50000\nfile 60000\n");
+    EXPECT(fdt_mem_available_in(mdir) == 650000);
+    /* a parent's limit with less room left decides */
+    put("sys/fs/cgroup/a/memory.max", "500000\n");
+    put("sys/fs/cgroup/a/memory.current", "480000\n");
+    EXPECT(fdt_mem_available_in(mdir) == 20000);
+    clear_root();
+    /* no limit ("max"): MemAvailable */
+    put("proc/meminfo", "MemAvailable: 1000 kB\n");
+    put("proc/self/cgroup", "0::/a\n");
+    put("sys/fs/cgroup/a/memory.max", "max\n");
+    put("sys/fs/cgroup/a/memory.current", "400000\n");
+    EXPECT(fdt_mem_available_in(mdir) == 1000 * 1024);
+    clear_root();
+    /* inside a cgroup namespace ("0::/"): the mount's top files */
+    put("proc/meminfo", "MemAvailable: 1000 kB\n");
+    put("proc/self/cgroup", "0::/\n");
+    put("sys/fs/cgroup/memory.max", "123456\n");
+    put("sys/fs/cgroup/memory.current", "23456\n");
+    EXPECT(fdt_mem_available_in(mdir) == 100000);
+    /* usage past the limit: only the file pages are left */
+    put("sys/fs/cgroup/memory.stat", "inactive_file 99\n");
+    put("sys/fs/cgroup/memory.current", "200000\n");
+    EXPECT(fdt_mem_available_in(mdir) == 99);
+    clear_root();
+    /* cgroup v1 (a hybrid system lists both): the memory controller's
+     * files, its total_inactive_file (inactive_file is the cgroup's own) */
+    put("proc/meminfo", "MemAvailable: 1000000 kB\n");
+    put("proc/self/cgroup", "5:cpu,cpuacct:/q\n4:memory:/x\n0::/\n");
+    put("sys/fs/cgroup/memory/x/memory.limit_in_bytes", "3000000\n");
+    put("sys/fs/cgroup/memory/x/memory.usage_in_bytes", "1000000\n");
+    put("sys/fs/cgroup/memory/x/memory.stat", "inactive_file 99999\ntotal_inactive_file 7\n");
+    put("sys/fs/cgroup/memory.max", "1\n"); /* the v2 files are not the memory's */
+    put("sys/fs/cgroup/memory.current", "0\n");
+    EXPECT(fdt_mem_available_in(mdir) == 2000007);
+    clear_root();
+    CHECK(rmdir(mdir) == 0);
+
     /* the real one: some memory, and what fdt_mem_available says */
     size_t real = fdt_mem_available();
     EXPECT(real > 0 && real != SIZE_MAX);
-    char path[96];
-    snprintf(path, sizeof path, "%s/meminfo", mdir);
-    unlink(path);
-    rmdir(mdir);
+
+    /* fdt_mem_fits: small blocks always; a block past the memory
+     * available is refused by fdt_mem_alloc_huge and fdt_grow, though
+     * malloc would hand it out (Linux overcommits up to about the RAM,
+     * and kills the process when the pages run out) */
+    EXPECT(fdt_mem_fits(FDT_MEM_CHECKED - 1));
+    size_t past = real + real / 16 + FDT_MEM_CHECKED;
+    EXPECT(!fdt_mem_fits(past));
+    void *p = fdt_mem_alloc_huge(past, 1, 0);
+    EXPECT(p == NULL);
+    free(p);
+    char *g = NULL;
+    size_t cap = 0;
+    EXPECT(fdt_grow(&g, &cap, past, 1) == FDT_ENOMEM && g == NULL && cap == 0);
+    EXPECT(fdt_grow(&g, &cap, 1000, 1) == 0 && g && cap >= 1000);
+    free(g);
 }
 
 /* fdt_mem_alloc_huge under 4 MB (its pages mapped at once) and over,

@@ -436,10 +436,19 @@ static int run_single(fdt_context *ctx, const fdt_sink *user, fdt_engine eng, in
         err = fdt_emit_flush(&rs->em);
     rs->mem_mesh = fdt_meshbuf_bytes(&rs->mb);
     rs->mem_sink = fdt_emit_bytes(&rs->em);
-    if (err == FDT_ENOMEM)
-        snprintf(ctx->diag, sizeof ctx->diag, "out of memory after %lld tetrahedra",
-                 (long long)rs->em.ntets);
-    else if (err == FDT_ECHECK && !ctx->diag[0])
+    if (err == FDT_ENOMEM) {
+        /* The points' memory is known before the run, the tets' is not:
+         * a mesh can be quadratic in its points (src/base/mem.h,
+         * fdt_mem_fits). The one-part engine hands no tet out before its
+         * mesh is whole. */
+        char out[64] = "";
+        if (rs->em.ntets)
+            snprintf(out, sizeof out, " after %lld tetrahedra out", (long long)rs->em.ntets);
+        snprintf(ctx->diag, sizeof ctx->diag,
+                 "out of memory: the mesh of %zu points outgrew the memory available%s (points "
+                 "on lines or circles can have a mesh of up to n^2/4 tetrahedra)",
+                 pr->m, out);
+    } else if (err == FDT_ECHECK && !ctx->diag[0])
         snprintf(ctx->diag, sizeof ctx->diag, "mesh certificate failed: %s",
                  rs->fst.cert_what ? rs->fst.cert_what : "?");
     else if (err == FDT_EINTERNAL && !ctx->diag[0])

@@ -23,7 +23,8 @@ void fdt_mem_advise_huge(void *p, size_t bytes);
  * every page mapped at once: for arrays written at once (every page of
  * them), where each 4 KB fault costs (a trap on a host that hands pages
  * over late, bench/NOTES.md entries 128, 134) and random reads and adds
- * miss the TLB. NULL when out of memory or n * size overflows. */
+ * miss the TLB. NULL when out of memory, past fdt_mem_fits or when n *
+ * size overflows. */
 void *fdt_mem_alloc_huge(size_t n, size_t size, int zero);
 
 /* realloc for such arrays: the block p (NULL: none), whose first
@@ -36,18 +37,34 @@ void *fdt_mem_realloc_huge(void *p, size_t old_bytes, size_t new_bytes);
 
 /* Grows the array *pp of elements of `size` bytes, holding *cap, to hold
  * at least need (doubling from 64): 0, or FDT_ENOMEM (*pp and *cap
- * unchanged). */
+ * unchanged; also when the added bytes fail fdt_mem_fits). */
 int fdt_grow(void *pp, size_t *cap, size_t need, size_t size);
 
 /* The memory the system can still give without swapping, in bytes: the
  * kernel's MemAvailable (free memory plus the page cache it can drop),
- * else the free pages, else SIZE_MAX (unknown: no limit). For choices
- * that may trade memory for speed (the mesh of every point of an explicit
- * --mode, src/par/parallel.c; an MPI rank's replica) only, never for
- * correctness. */
+ * else the free pages, else SIZE_MAX (unknown: no limit), and no more
+ * than the room under the memory limits of the process's cgroup and the
+ * cgroups above it (v1 or v2; a container's limit, which MemAvailable
+ * does not show). */
 size_t fdt_mem_available(void);
-/* The same with the kernel's file at meminfo (fdt_mem_available passes
- * "/proc/meminfo"): lets tests/test_mem.c feed it a file of its own. */
-size_t fdt_mem_available_at(const char *meminfo);
+/* The same with the kernel's files under the directory root ("" for the
+ * system's own: root/proc/meminfo, root/proc/self/cgroup,
+ * root/sys/fs/cgroup/...): lets tests/test_mem.c give it files of its own. */
+size_t fdt_mem_available_in(const char *root);
+
+/*
+ * Whether a block of `bytes` may be taken: a block under FDT_MEM_CHECKED
+ * always, a larger one only within fdt_mem_available(). Past what the
+ * system (or the cgroup) can give, the pages would be taken from other
+ * programs by swapping, or the kernel would kill the run (a Delaunay
+ * mesh can be quadratic in the points: 50,000 on a line and 50,000 on a
+ * circle around it have 2.5e9 tets); refusing the block makes the run
+ * fail with FDT_ENOMEM and a message instead. fdt_mem_alloc_huge,
+ * fdt_mem_realloc_huge and fdt_grow ask it; so does any other growth of
+ * an array that scales with the tets. A failure never changes a result:
+ * the run stops.
+ */
+#define FDT_MEM_CHECKED ((size_t)64 << 20)
+int fdt_mem_fits(size_t bytes);
 
 #endif

@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/mem.h"
+
 int fdt_meshbuf_init(fdt_meshbuf *mb, size_t expected_tets, int want_nbrs)
 {
     memset(mb, 0, sizeof *mb);
@@ -42,6 +44,9 @@ int64_t fdt_meshbuf_add_tet(fdt_meshbuf *mb, const uint32_t v[4])
 {
     if (mb->ntets == mb->tcap) {
         size_t ncap = mb->tcap + mb->tcap / 2;
+        if (!fdt_mem_fits((ncap - mb->tcap) * 4 *
+                          (sizeof *mb->tets + (mb->nbrs ? sizeof *mb->nbrs : 0))))
+            return -1;
         uint32_t *nt = realloc(mb->tets, ncap * 4 * sizeof *nt);
         if (!nt)
             return -1;

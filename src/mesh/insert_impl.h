@@ -74,7 +74,8 @@ static inline int ins_insphere(const double *a, const double *b, const double *c
 
 /*
  * The tets array moved to a new block of nc slots, huge pages asked for
- * before its first write, its first `used` rows copied (used <= nc: the
+ * before its first write and the block refused past the memory available
+ * (fdt_mem_alloc_huge, fdt_mem_fits), its first `used` rows copied (used <= nc: the
  * slots below nslots, or, where other slots were handed out, the whole
  * capacity); the caller grows its own per-slot arrays and then sets
  * m->cap. FDT_ENOMEM (m->T unchanged). Not realloc: the huge-page advice covers a
@@ -85,10 +86,9 @@ static inline int ins_insphere(const double *a, const double *b, const double *c
  */
 static inline int ins_move_tets(fdt_ins *m, uint64_t nc, uint64_t used)
 {
-    uint32_t *t = malloc((size_t)nc * 8 * sizeof *t);
+    uint32_t *t = fdt_mem_alloc_huge((size_t)nc * 8, sizeof *t, 0);
     if (!t)
         return FDT_ENOMEM;
-    fdt_mem_advise_huge(t, (size_t)nc * 8 * sizeof *t);
     memcpy(t, m->T, (size_t)used * 8 * sizeof *t);
     free(m->T);
     m->T = t;
