@@ -18,9 +18,11 @@
 #define INF FDT_NONE
 
 /* Per-slot marks of a part's mesh: bits 0-3 a face of B (the tet across
- * it was emitted by an earlier part), then membership of U and
- * finality. */
-enum { IN_U = 16, FINAL = 32 };
+ * it was emitted by an earlier part), then membership of U, finality,
+ * and what the certificate's pass found of a finite tet's ball (BALL: it
+ * ends before the next slabs; BALL_UNSURE: the cofactors could not tell,
+ * ball_slow decides). */
+enum { IN_U = 16, FINAL = 32, BALL = 64, BALL_UNSURE = 128 };
 
 uint32_t fdt_sweep_slab(size_t m)
 {
@@ -133,9 +135,10 @@ static uint32_t map_find(const sweep *sw, uint32_t gid)
  * Whether the circumsphere of the positive finite tet v (local ids of
  * Q) ends strictly before `next` along the sweep (coordinates times dir):
  * then no point at or past `next` lies in or on it. Saying no is always
- * safe (the tet waits for a later part); yes must be certain.
+ * safe (the tet waits for a later part); yes must be certain. 1 yes, 0
+ * no, -1 where only ball_slow can tell.
  *
- * First from the lifted cofactors (src/geom/predicates.h, fdt_sphere_cof:
+ * First from the lifted cofactors c (src/geom/predicates.h, fdt_sphere_cof:
  * with a = v[0] as the origin, det and N; the centre is a + N / (2 det),
  * the radius |N| / (2 det)). Their errors: |det - det~| <= Bd =
  * FDT_O3D_COF_BOUND m^3 (proved there); each component of N is 18
@@ -153,9 +156,11 @@ static uint32_t map_find(const sweep *sw, uint32_t gid)
  * outside [2^-100, 2^100]), the apex search's conservative ball decides
  * (src/geom/kdtree.c: it holds the true sphere, widened by its rounding
  * bound, infinite where the tet is too flat to bound; the cofactors'
- * bound cost 5 % of a streamed run less).
+ * bound cost 5 % of a streamed run less): ball_by_cof returns -1 for
+ * ball_slow. The cofactors are the certificate's, which computes them
+ * for each finite tet (ball_visit, bench/NOTES.md entry 136).
  */
-static int ball_before(const sweep *sw, const uint32_t *v, double next, fdt_kdq *kq)
+static int ball_by_cof(const sweep *sw, const uint32_t *v, const fdt_sphere_cof *c, double next)
 {
     const double *Q = sw->Q;
     const double dir = sw->dir;
@@ -163,34 +168,65 @@ static int ball_before(const sweep *sw, const uint32_t *v, double next, fdt_kdq 
     for (int i = 0; i < 4; i++)
         if (!(dir * Q[3 * (size_t)v[i] + ax] < next))
             return 0; /* the tet itself reaches next: so does its sphere */
-    const double *a = Q + 3 * (size_t)v[0];
-    fdt_sphere_cof c;
-    fdt_sphere_cof_init(&c, a, Q + 3 * (size_t)v[1], Q + 3 * (size_t)v[2], Q + 3 * (size_t)v[3]);
-    if (fdt_pred_in_range(c.m)) {
-        const double m3 = c.m * c.m * c.m, bd = FDT_O3D_COF_BOUND * m3, bn = 0x1p-45 * (m3 * c.m);
-        if (c.det > 4.0 * bd) {
-            double nmax = fabs(c.n[0]);
-            nmax = fabs(c.n[1]) > nmax ? fabs(c.n[1]) : nmax;
-            nmax = fabs(c.n[2]) > nmax ? fabs(c.n[2]) : nmax;
-            const double delta = (bn + nmax * (bd / c.det)) / (2.0 * (c.det - bd));
-            const double h = 0.5 / c.det;
-            const double o[3] = {c.n[0] * h, c.n[1] * h, c.n[2] * h};
+    if (fdt_pred_in_range(c->m)) {
+        const double m3 = c->m * c->m * c->m, bd = FDT_O3D_COF_BOUND * m3,
+                     bn = 0x1p-45 * (m3 * c->m);
+        if (c->det > 4.0 * bd) {
+            double nmax = fabs(c->n[0]);
+            nmax = fabs(c->n[1]) > nmax ? fabs(c->n[1]) : nmax;
+            nmax = fabs(c->n[2]) > nmax ? fabs(c->n[2]) : nmax;
+            const double delta = (bn + nmax * (bd / c->det)) / (2.0 * (c->det - bd));
+            const double h = 0.5 / c->det;
+            const double o[3] = {c->n[0] * h, c->n[1] * h, c->n[2] * h};
             const double r = sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
-            const double ca = dir * a[ax], co = dir * o[ax];
+            const double ca = dir * Q[3 * (size_t)v[0] + ax], co = dir * o[ax];
             const double end =
                 ca + co + r + 3.0 * delta + 0x1p-50 * (fabs(ca) + fabs(co) + r);
             return end < next;
         }
     }
+    return -1;
+}
+
+/* The apex search's ball, where ball_by_cof could not tell. */
+static int ball_slow(const sweep *sw, const uint32_t *v, double next, fdt_kdq *kq)
+{
+    const double *Q = sw->Q;
     fdt_apex ap;
-    fdt_apex_init(&ap, a, Q + 3 * (size_t)v[1], Q + 3 * (size_t)v[2], v[0], v[1], v[2]);
+    fdt_apex_init(&ap, Q + 3 * (size_t)v[0], Q + 3 * (size_t)v[1], Q + 3 * (size_t)v[2], v[0],
+                  v[1], v[2]);
     fdt_apex_offer(&ap, v[3], Q + 3 * (size_t)v[3], kq);
     if (ap.best != v[3] || !(ap.rad < INFINITY))
         return 0;
-    double cc = dir * ap.center[ax], rr = ap.rad;
+    double cc = sw->dir * ap.center[sw->axis], rr = ap.rad;
     double end = cc + rr;
     end += (fabs(cc) + rr) * 0x1p-50;
     return end < next;
+}
+
+/* The certificate's pass over a part's mesh (fdt_certify_visit), with
+ * the cofactors it computed anyway: each slot in use into U, each finite
+ * tet's ball tested against the next slabs (not in the last part). Each
+ * slot is visited once, by one thread, and writes its own byte only;
+ * fdt_fork_join's joins publish the bytes to the caller. */
+typedef struct ball_pass {
+    const sweep *sw;
+    uint8_t *mark;
+    double next;
+    int last;
+} ball_pass;
+
+static void ball_visit(void *user, int job, uint32_t slot, const uint32_t v[4], int inf,
+                       const fdt_sphere_cof *cof)
+{
+    (void)job;
+    const ball_pass *b = user;
+    uint8_t m = IN_U;
+    if (inf < 0 && !b->last) {
+        int r = ball_by_cof(b->sw, v, cof, b->next);
+        m |= r > 0 ? BALL : r < 0 ? BALL_UNSURE : 0;
+    }
+    b->mark[slot] = m;
 }
 
 static void add_ins_stats(fdt_ins_stats *a, const fdt_ins_stats *b)
@@ -230,9 +266,13 @@ static int gather(sweep *sw, uint32_t begin, uint32_t end, size_t *nq_out)
     return FDT_OK;
 }
 
-/* The part's mesh, built and certified on the sweep's threads. */
-static int build(sweep *sw, fdt_ins *mesh, size_t nq)
+/* The part's mesh, built and certified on the sweep's threads; *mark
+ * (nslots bytes, the caller's to free) from the certificate's pass:
+ * IN_U on every slot in use, the finite tets' balls against `next`
+ * (ball_visit). */
+static int build(sweep *sw, fdt_ins *mesh, size_t nq, int last, double next, uint8_t **mark)
 {
+    *mark = NULL;
     fdt_sweep_stats *st = sw->st;
     double t0 = fdt_now_s();
     int err = sw->nthreads > 1
@@ -242,10 +282,13 @@ static int build(sweep *sw, fdt_ins *mesh, size_t nq)
     if (err)
         return err;
     add_ins_stats(&st->ins, &mesh->stats);
+    if (!(*mark = calloc(mesh->nslots ? mesh->nslots : 1, 1)))
+        return FDT_ENOMEM;
+    ball_pass bp = {sw, *mark, next, last};
+    const fdt_certify_visit vis = {ball_visit, &bp};
     fdt_certify_fail why;
     double t1 = fdt_now_s();
-    err = sw->nthreads > 1 ? fdt_certify_parallel(mesh, sw->nthreads, &st->pc, &why)
-                           : fdt_certify(mesh, &st->pc, &why);
+    err = fdt_certify_parallel_visit(mesh, sw->nthreads, &vis, &st->pc, &why);
     st->t_certify += fdt_now_s() - t1;
     st->certified_tets += mesh->nfinite;
     if (err == FDT_ECHECK)
@@ -277,15 +320,12 @@ static int take_out(uint8_t *mark, uint32_t t, uint32_t **queue, size_t *n, size
  * faces and the hull, so a flood fill from the far side of each face of B
  * (found in the mesh and marked) that never crosses one reaches all of it;
  * it holds only tets whose vertices are all old live ones, far fewer than
- * U's (filling U itself from B cost 3.5 % of a 1M run). mark[] zeroed,
- * nslots bytes.
+ * U's (filling U itself from B cost 3.5 % of a 1M run). mark[]: build's,
+ * IN_U on every slot in use.
  */
 static int region(sweep *sw, const fdt_ins *mesh, uint8_t *mark, uint32_t begin, uint32_t end,
                   size_t nq)
 {
-    for (uint32_t s = 0; s < mesh->nslots; s++)
-        if (!fdt_ins_is_free(mesh, s))
-            mark[s] = IN_U;
     if (sw->nwall == 0)
         return FDT_OK;
     if (map_build(sw, nq, begin, end))
@@ -347,7 +387,8 @@ static int emit(sweep *sw, const fdt_ins *mesh, uint8_t *mark, int last, double 
         const uint32_t *v = fdt_ins_tet(mesh, s);
         int inf = fdt_ins_inf_index(v);
         if (inf < 0) {
-            if (!last && !ball_before(sw, v, next, &kq))
+            if (!last && !(mark[s] & BALL) &&
+                !((mark[s] & BALL_UNSURE) && ball_slow(sw, v, next, &kq)))
                 continue;
             uint32_t t[4];
             fdt_vid in[4];
@@ -454,7 +495,8 @@ static int part(sweep *sw, uint32_t begin, uint32_t end, int last, double next)
     if (nq > st->max_part)
         st->max_part = nq;
     fdt_ins mesh;
-    err = build(sw, &mesh, nq);
+    uint8_t *mark;
+    err = build(sw, &mesh, nq, last, next, &mark);
     if (err == FDT_EDEGENERATE && !last && sw->nwall == 0) {
         /* The points so far are flat (a first slab on one plane): nothing
          * can be emitted yet, so all of them are live. */
@@ -464,7 +506,7 @@ static int part(sweep *sw, uint32_t begin, uint32_t end, int last, double next)
             sw->live[i] = (uint32_t)sw->g[i];
         sw->nlive = nq;
         sw->closing = 1; /* no sign of spheres that stay open yet */
-        return FDT_OK;
+        return FDT_OK; /* the build failed: no mark, no mesh */
     }
     if (err == FDT_EDEGENERATE || err == FDT_EINVAL || err == FDT_EINTERNAL) {
         /* the caller merged duplicates and checked the dimension: the
@@ -478,9 +520,6 @@ static int part(sweep *sw, uint32_t begin, uint32_t end, int last, double next)
                    (size_t)mesh.cap * (8 * sizeof *mesh.T + 1);
     if (!err && bytes > st->mem_part)
         st->mem_part = bytes;
-    uint8_t *mark = err ? NULL : calloc(mesh.nslots ? mesh.nslots : 1, 1);
-    if (!err && !mark)
-        err = FDT_ENOMEM;
     if (!err)
         err = region(sw, &mesh, mark, begin, end, nq);
     size_t before = st->final_tets;
